@@ -1,0 +1,57 @@
+"""Euler angles (z-x-z: precession ψ, nutation θ, proper rotation φ) and direction cosines.
+
+Convention of the papers (Leimanis; seeds 000–002): the unit vector of the fixed
+vertical Z in body axes is γ = (sin θ sin φ, sin θ cos φ, cos θ). With α and
+β the body components of the fixed X and Y axes (β = γ × α), ψ is read from
+α_z = sin ψ sin θ and β_z = −cos ψ sin θ.
+
+All angles come from atan2 of well-conditioned combinations, never from
+arccos: near θ = 0 the combination ψ + φ = atan2(β_x − α_y, α_x + β_y) keeps
+full relative accuracy (both arguments carry the factor 1 + cos θ), near θ = π
+ψ − φ = atan2(β_x + α_y, α_x − β_y) does. At θ exactly 0 or π only that sum
+or difference is defined; φ is then taken from γ (zero) and ψ carries it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pipeline.vectors import cross
+
+
+def gamma_from_angles(theta: float, phi: float) -> np.ndarray:
+    """Body components of the fixed vertical: γ = (sin θ sin φ, sin θ cos φ, cos θ)."""
+    return np.array([np.sin(theta) * np.sin(phi), np.sin(theta) * np.cos(phi), np.cos(theta)])
+
+
+def frame_from_angles(psi: float, theta: float, phi: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Body components (α, β, γ) of the fixed axes X, Y, Z for Euler angles (ψ, θ, φ)."""
+    sp, cp = np.sin(psi), np.cos(psi)
+    st, ct = np.sin(theta), np.cos(theta)
+    sf, cf = np.sin(phi), np.cos(phi)
+    alpha = np.array([cp * cf - sp * ct * sf, -cp * sf - sp * ct * cf, sp * st])
+    beta = np.array([sp * cf + cp * ct * sf, -sp * sf + cp * ct * cf, -cp * st])
+    gamma = np.array([st * sf, st * cf, ct])
+    return alpha, beta, gamma
+
+
+def nutation_and_spin(gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """θ and φ (wrapped to (−π, π]) from γ alone, for arrays of shape (..., 3)."""
+    horizontal = np.hypot(gamma[..., 0], gamma[..., 1])
+    theta = np.arctan2(horizontal, gamma[..., 2])
+    phi = np.arctan2(gamma[..., 0], gamma[..., 1])
+    return theta, phi
+
+
+def euler_angles(alpha: np.ndarray, gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Unwrapped (ψ, θ, φ) along a trajectory from α and γ of shape (n, 3)."""
+    alpha = np.atleast_2d(alpha)
+    gamma = np.atleast_2d(gamma)
+    beta = cross(gamma, alpha)
+    theta, phi = nutation_and_spin(gamma)
+    upper = gamma[:, 2] >= 0.0  # θ ≤ π/2: use ψ + φ; otherwise ψ − φ
+    psi_plus_phi = np.arctan2(beta[:, 0] - alpha[:, 1], alpha[:, 0] + beta[:, 1])
+    psi_minus_phi = np.arctan2(beta[:, 0] + alpha[:, 1], alpha[:, 0] - beta[:, 1])
+    psi = np.where(upper, psi_plus_phi - phi, psi_minus_phi + phi)
+    psi = np.angle(np.exp(1j * psi))  # wrap to (−π, π] before unwrapping
+    return np.unwrap(psi), theta, np.unwrap(phi)

@@ -1,0 +1,69 @@
+"""Contract of an integrator plugin: advance y' = f(t, y) and sample it at output times."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+RightHandSide = Callable[[float, np.ndarray], np.ndarray]
+
+
+@dataclass
+class IntegratorStats:
+    """Work done by one integration; ``n_rejected`` is None where the method does not report it."""
+
+    nfev: int
+    n_steps: int
+    n_rejected: int | None
+    wall_time: float
+    njev: int = 0
+    nlu: int = 0
+
+    def attributes(self) -> dict[str, Any]:
+        """netCDF-safe attributes (unknown counts are left out, not stored as a fake number)."""
+        return {f"integrator_{k}": v for k, v in asdict(self).items() if v is not None}
+
+
+@dataclass
+class Solution:
+    """Samples of the state at the requested output times."""
+
+    t: np.ndarray  # (n,)
+    y: np.ndarray  # (n, state size)
+    stats: IntegratorStats
+
+
+class Integrator(ABC):
+    """A method that integrates an initial-value problem.
+
+    Rules for implementers:
+
+    1. ``__init__(self, **params)`` takes the plugin's config parameters as
+       keyword arguments with defaults (``rtol``/``atol`` for adaptive
+       methods, ``step`` for fixed-step ones), validates them and raises
+       ``pipeline.errors.ConfigError`` on bad values.
+    2. ``integrate(fun, t_out, y0)`` returns the state at every time in
+       ``t_out`` (increasing, ``t_out[0]`` is the initial time), computed by
+       dense output or by landing on those times, never by storing every
+       internal step.
+    3. It counts its work (``IntegratorStats``: right-hand-side evaluations,
+       accepted and rejected steps where known, wall time).
+    4. It never returns non-finite values: a failure (step size underflow,
+       NaN or inf in the state) raises ``pipeline.errors.IntegrationError``
+       with one sentence saying when and why.
+    5. ``attributes()`` gives its settings for the dataset.
+    """
+
+    name: ClassVar[str]
+    adaptive: ClassVar[bool]
+
+    @abstractmethod
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray) -> Solution:
+        """Integrate from t_out[0] and sample the state at t_out."""
+
+    def attributes(self) -> dict[str, Any]:
+        return {}

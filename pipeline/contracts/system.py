@@ -1,0 +1,70 @@
+"""Contract of a mechanical system plugin: its state, equations of motion and outputs."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+from typing import Any, ClassVar
+
+import numpy as np
+import xarray as xr
+
+from pipeline.contracts.force import Force
+
+
+class System(ABC):
+    """The equations of motion of one kind of body, with their outputs and invariants.
+
+    Rules for implementers:
+
+    1. ``body_type`` is the class that reads the ``body`` config section
+       (``body_type.from_config(cfg)``); forces are built with that body.
+    2. ``__init__(self, body, forces, initial, output, **params)`` receives
+       the body, the built forces, the ``initial`` and ``output`` config
+       sections and the system's own parameters; it validates the initial
+       state (one-sentence ``ConfigError``) and decides the state layout.
+       It carries only the state its forces and requested outputs need.
+    3. ``initial_state()`` returns y0; ``rhs(t, y)`` returns dy/dt (model
+       units) for one state; it is the integrators' inner loop.
+    4. ``variables(t, y)`` turns a trajectory (n, size) into xarray
+       variables on dims ``time`` and ``axis``, each with CF ``units`` and
+       ``long_name``; it includes the monitored first integrals
+       (``invariants``), which are exactly those every force preserves.
+    5. ``attributes()`` describes the system's parameters and initial state
+       for the dataset; ``title()`` names the scene in a few words for figures.
+    """
+
+    name: ClassVar[str]
+    body_type: ClassVar[type]
+
+    def __init__(self, body: Any, forces: Sequence[Force], initial: Any, output: Any) -> None:
+        self.body = body
+        self.forces = list(forces)
+
+    @property
+    @abstractmethod
+    def state_size(self) -> int:
+        """Length of the state vector."""
+
+    @abstractmethod
+    def initial_state(self) -> np.ndarray:
+        """y0."""
+
+    @abstractmethod
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        """dy/dt for one state."""
+
+    @property
+    @abstractmethod
+    def invariants(self) -> tuple[str, ...]:
+        """Names of the first integrals this scene conserves (dataset variable names)."""
+
+    @abstractmethod
+    def variables(self, t: np.ndarray, y: np.ndarray) -> dict[str, xr.Variable]:
+        """Dataset variables of a trajectory."""
+
+    def attributes(self) -> dict[str, Any]:
+        return {}
+
+    def title(self) -> str:
+        return self.name

@@ -1,0 +1,71 @@
+"""The run dataset: trajectory, invariants and Euler angles with CF metadata and provenance.
+
+Attributes hold only netCDF-safe values (str, numbers, numeric arrays): the
+resolved config is stored as one YAML string, so a run can be rebuilt from
+its own dataset (``Scene.from_config(OmegaConf.create(ds.attrs["config"]))``).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import xarray as xr
+from omegaconf import OmegaConf
+
+from pipeline.contracts.integrator import Solution
+from pipeline.errors import ConfigError
+from pipeline.provenance import provenance
+
+if TYPE_CHECKING:
+    from pipeline.scene import Scene
+
+
+def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
+    system, integrator = scene.system, scene.integrator
+    body = system.body
+    variables = system.variables(solution.t, solution.y)
+    for name in system.invariants:
+        values = variables[name].values
+        variables[name].attrs["max_abs_drift"] = float(np.max(np.abs(values - values[0])))
+    coords = {
+        "time": ("time", solution.t, {"units": body.time_unit, "long_name": f"time [{body.time_label}]",
+                                      "standard_name": "time"}),
+        "axis": ("axis", np.array(["x", "y", "z"]), {"units": "1", "long_name": "principal body axis"}),
+    }
+    ds = xr.Dataset(variables, coords=coords)
+    attrs: dict[str, Any] = {
+        "title": system.title(),
+        "Conventions": "CF-1.8",
+        "config": OmegaConf.to_yaml(scene.config, resolve=True),
+        "monitored_invariants": " ".join(system.invariants),
+        "integrator": integrator.name,
+    }
+    attrs.update(provenance())
+    attrs.update(system.attributes())
+    attrs.update(integrator.attributes())
+    attrs.update(solution.stats.attributes())
+    ds.attrs.update(attrs)
+    return ds
+
+
+def write_dataset(ds: xr.Dataset, path: Path) -> Path:
+    """Write ``ds`` to ``path`` atomically: a temporary file in the same directory, then a rename."""
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        os.close(fd)
+    except OSError as error:
+        raise ConfigError(f"output directory {str(path.parent)!r} is not writable ({error.strerror}); "
+                          "choose a writable hydra.run.dir") from None
+    try:
+        ds.to_netcdf(tmp, engine="netcdf4")
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path

@@ -1,0 +1,83 @@
+"""Errors gyrolab reports to its users.
+
+Every message is one sentence naming the bad value and what would be valid;
+the command-line app prints it as ``gyrolab: error: <message>`` and exits
+non-zero before any ``run.nc`` is written.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+
+class GyrolabError(Exception):
+    """Base class of the errors the app turns into a one-line message."""
+
+    exit_code = 1
+
+
+class ConfigError(GyrolabError, ValueError):
+    """The scene's configuration is invalid (bad input from the user)."""
+
+    exit_code = 2
+
+
+class IntegrationError(GyrolabError, RuntimeError):
+    """An integrator could not produce a trustworthy trajectory."""
+
+    exit_code = 3
+
+
+def choices(names: Iterable[str]) -> str:
+    """Format valid choices for an error message."""
+    names = sorted(names)
+    return ", ".join(names) if names else "(none registered)"
+
+
+def require_finite(value: Any, where: str) -> None:
+    """Raise ConfigError if a number (or any number nested in lists/dicts) is NaN or inf."""
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return
+    if isinstance(value, Mapping):
+        for key, item in value.items():
+            require_finite(item, f"{where}.{key}" if where else str(key))
+        return
+    if isinstance(value, (list, tuple)):
+        for i, item in enumerate(value):
+            require_finite(item, f"{where}[{i}]")
+        return
+    if isinstance(value, (int, float)) and not math.isfinite(value):
+        raise ConfigError(f"{where}={value} is not a finite number; every numeric setting must be finite")
+
+
+def as_vector3(value: Any, where: str) -> tuple[float, float, float]:
+    """Read a 3-vector from a config value, with a one-sentence error otherwise."""
+    try:
+        items = [float(v) for v in value]
+    except (TypeError, ValueError):
+        raise ConfigError(f"{where}={value!r} must be a list of three numbers") from None
+    if len(items) != 3:
+        raise ConfigError(f"{where}={list(value)!r} must have exactly three components")
+    for item in items:
+        if not math.isfinite(item):
+            raise ConfigError(f"{where}={list(value)!r} contains a non-finite number; all three must be finite")
+    return items[0], items[1], items[2]
+
+
+def as_number(value: Any, where: str, *, positive: bool = False, nonnegative: bool = False) -> float:
+    """Read a finite float from a config value, optionally requiring a sign."""
+    if isinstance(value, bool):
+        raise ConfigError(f"{where}={value!r} must be a number, not a boolean")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ConfigError(f"{where}={value!r} must be a number") from None
+    if not math.isfinite(number):
+        raise ConfigError(f"{where}={value} is not a finite number; it must be finite")
+    if positive and number <= 0:
+        raise ConfigError(f"{where}={value} must be positive")
+    if nonnegative and number < 0:
+        raise ConfigError(f"{where}={value} must be zero or positive")
+    return number

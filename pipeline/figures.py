@@ -1,0 +1,116 @@
+"""Figures of one run, for people: state, invariant drift, Euler angles, body axis on the sphere."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import xarray as xr  # noqa: E402
+
+COMPONENTS = ("x", "y", "z")
+
+
+def _subtitle(ds: xr.Dataset) -> str:
+    name = ds.attrs.get("integrator", "?")
+    if "integrator_step" in ds.attrs:
+        setting = f"step={ds.attrs['integrator_step']:g}"
+    else:
+        setting = f"rtol={ds.attrs.get('integrator_rtol', float('nan')):g}, atol={ds.attrs.get('integrator_atol', float('nan')):g}"
+    return f"{ds.attrs.get('title', '')}\nfull equations of motion, {name} ({setting})"
+
+
+def _time_label(ds: xr.Dataset) -> str:
+    return ds.time.attrs.get("long_name", "time")
+
+
+def plot_state(ds: xr.Dataset) -> plt.Figure:
+    fig, (ax_w, ax_g) = plt.subplots(2, 1, sharex=True, figsize=(9, 6), constrained_layout=True)
+    labels = {"omega": ("p", "q", "r"), "gamma": ("γ", "γ′", "γ″")}
+    for ax, name in ((ax_w, "omega"), (ax_g, "gamma")):
+        for i, label in enumerate(labels[name]):
+            ax.plot(ds.time, ds[name].isel(axis=i), lw=0.8, label=label)
+        ax.set_ylabel(f"{ds[name].attrs['long_name']}\n[{ds[name].attrs['units']}]", fontsize=8)
+        ax.legend(loc="upper right", fontsize=8, ncol=3)
+        ax.grid(alpha=0.3)
+    ax_g.set_xlabel(_time_label(ds))
+    fig.suptitle(_subtitle(ds), fontsize=9)
+    return fig
+
+
+def plot_invariants(ds: xr.Dataset) -> plt.Figure:
+    fig, ax = plt.subplots(figsize=(9, 4.5), constrained_layout=True)
+    for name in ds.attrs.get("monitored_invariants", "").split():
+        values = ds[name].values
+        drift = np.abs(values - values[0])
+        drift[drift == 0] = np.nan  # log scale: exact conservation shows as a gap, not a spike
+        ax.semilogy(ds.time, drift, lw=0.8, label=f"{name} [{ds[name].attrs['units']}]")
+    ax.set_xlabel(_time_label(ds))
+    ax.set_ylabel("|I(t) − I(0)|  (absolute drift)")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    ax.set_title("drift of the monitored first integrals\n" + _subtitle(ds), fontsize=9)
+    return fig
+
+
+def plot_euler_angles(ds: xr.Dataset) -> plt.Figure:
+    names = [n for n in ("psi", "theta", "phi") if n in ds]
+    fig, axes = plt.subplots(len(names), 1, sharex=True, figsize=(9, 2.2 * len(names) + 1), constrained_layout=True)
+    for ax, name in zip(np.atleast_1d(axes), names):
+        ax.plot(ds.time, ds[name], lw=0.8)
+        ax.set_ylabel(f"{ds[name].attrs['long_name']}\n[{ds[name].attrs['units']}]", fontsize=8)
+        ax.grid(alpha=0.3)
+    np.atleast_1d(axes)[-1].set_xlabel(_time_label(ds))
+    fig.suptitle("Euler angles (z-x-z)\n" + _subtitle(ds), fontsize=9)
+    return fig
+
+
+def plot_body_axis(ds: xr.Dataset) -> plt.Figure:
+    """Trace of the body z axis on the unit sphere of the fixed frame (apex of the body)."""
+    fig = plt.figure(figsize=(6.5, 6.5), constrained_layout=True)
+    ax = fig.add_subplot(projection="3d")
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 37), np.linspace(0, np.pi, 19))
+    ax.plot_wireframe(np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v), color="0.85", lw=0.4)
+    gamma = ds["gamma"].values
+    if "alpha" in ds:
+        alpha = ds["alpha"].values
+        beta = np.cross(gamma, alpha)
+        trace = np.stack([alpha[:, 2], beta[:, 2], gamma[:, 2]], axis=1)  # body z in fixed X, Y, Z
+        frame, label = ("X", "Y", "Z (vertical)"), "body z axis in the fixed frame"
+    else:  # without the full attitude: the vertical seen from the body
+        trace = gamma
+        frame, label = ("body x", "body y", "body z"), "fixed vertical in body axes (γ)"
+    ax.plot(*trace.T, lw=0.8, label=label)
+    ax.scatter(*trace[0], color="green", s=25, label="start")
+    ax.scatter(*trace[-1], color="red", s=25, label="end")
+    ax.set_xlabel(frame[0])
+    ax.set_ylabel(frame[1])
+    ax.set_zlabel(frame[2])
+    ax.set_box_aspect((1, 1, 1))
+    ax.legend(fontsize=8, loc="upper left")
+    ax.set_title("trace on the unit sphere (direction cosines, dimensionless)\n" + _subtitle(ds), fontsize=8)
+    return fig
+
+
+PLOTS = {
+    "state": plot_state,
+    "invariant_drift": plot_invariants,
+    "euler_angles": plot_euler_angles,
+    "body_axis_sphere": plot_body_axis,
+}
+
+
+def save_figures(ds: xr.Dataset, directory: Path) -> list[Path]:
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, plot in PLOTS.items():
+        fig = plot(ds)
+        path = directory / f"{name}.png"
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        written.append(path)
+    return written

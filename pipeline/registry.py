@@ -1,0 +1,128 @@
+"""One registry of plugins: gyrolab's built-ins plus ``gyrolab.*`` entry points.
+
+Names are listed without importing anything; a plugin's module is imported
+the first time a scene asks for it. A config's ``_target_`` may only name a
+registered class of the group's contract, so a YAML file cannot make gyrolab
+call arbitrary code.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import warnings
+from functools import cache
+from importlib.metadata import entry_points
+from typing import Any
+
+from pipeline.contracts import Force, Integrator, Regime, System
+from pipeline.errors import ConfigError, choices
+
+#: config group -> (entry-point group, contract class)
+GROUPS: dict[str, tuple[str, type]] = {
+    "system": ("gyrolab.systems", System),
+    "force": ("gyrolab.forces", Force),
+    "integrator": ("gyrolab.integrators", Integrator),
+    "regime": ("gyrolab.regimes", Regime),
+}
+
+BUILTINS: dict[str, dict[str, str]] = {
+    "system": {
+        "fixed_point": "plugins.systems.fixed_point:FixedPoint",
+    },
+    "force": {
+        "uniform_gravity": "plugins.forces.uniform_gravity:UniformGravity",
+        "newtonian": "plugins.forces.newtonian:Newtonian",
+        "magnetic": "plugins.forces.magnetic:Magnetic",
+    },
+    "integrator": {
+        "rk4": "plugins.integrators.rk4:RK4",
+        "rk45": "plugins.integrators.scipy_solvers:RK45",
+        "dop853": "plugins.integrators.scipy_solvers:DOP853",
+        "lsoda": "plugins.integrators.scipy_solvers:LSODA",
+        "radau": "plugins.integrators.scipy_solvers:Radau",
+        "bdf": "plugins.integrators.scipy_solvers:BDF",
+    },
+    "regime": {},
+}
+
+
+def _normalise(target: str) -> str:
+    """'pkg.mod:Cls' and 'pkg.mod.Cls' name the same class."""
+    return target.replace(":", ".")
+
+
+@cache
+def external(group: str) -> dict[str, str]:
+    """Entry-point plugins of a group: name -> 'module:Class' (nothing imported)."""
+    ep_group, _ = GROUPS[group]
+    found: dict[str, str] = {}
+    for ep in entry_points(group=ep_group):
+        if ep.name in BUILTINS[group] or ep.name in found:
+            warnings.warn(
+                f"ignoring {ep_group} entry point {ep.name!r} ({ep.value}): the name is already registered",
+                stacklevel=2,
+            )
+            continue
+        found[ep.name] = ep.value
+    return found
+
+
+def targets(group: str) -> dict[str, str]:
+    """All registered plugins of a group: name -> 'module:Class'."""
+    _check_group(group)
+    return {**BUILTINS[group], **external(group)}
+
+
+def names(group: str) -> list[str]:
+    return sorted(targets(group))
+
+
+@cache
+def _import(target: str) -> type:
+    module_name, _, attr = target.partition(":")
+    if not attr:
+        module_name, _, attr = target.rpartition(".")
+    module = importlib.import_module(module_name)
+    return getattr(module, attr)
+
+
+def load(group: str, name: str) -> type:
+    """The plugin class registered under ``name``; ConfigError listing the valid names otherwise."""
+    registered = targets(group)
+    if name not in registered:
+        raise ConfigError(f"unknown {group} {name!r}; valid choices: {choices(registered)}")
+    cls = _import(registered[name])
+    _, contract = GROUPS[group]
+    if not (inspect.isclass(cls) and issubclass(cls, contract)):
+        raise ConfigError(
+            f"{group} plugin {name!r} ({registered[name]}) is not a {contract.__name__} subclass; "
+            "fix the plugin package's entry point"
+        )
+    return cls
+
+
+def resolve_target(group: str, target: Any, where: str) -> tuple[str, type]:
+    """(name, class) for a config's ``_target_``, which must be a registered plugin of the group."""
+    by_target = {_normalise(t): n for n, t in targets(group).items()}
+    name = by_target.get(_normalise(str(target)))
+    if name is None:
+        raise ConfigError(
+            f"{where}._target_={target!r} is not a registered {group} plugin; "
+            f"registered {group} plugins: {choices(targets(group).values())}"
+        )
+    return name, load(group, name)
+
+
+def default_params(cls: type) -> dict[str, Any]:
+    """A plugin's config parameters and defaults, read from its ``__init__`` keywords."""
+    params: dict[str, Any] = {}
+    for p in inspect.signature(cls.__init__).parameters.values():
+        if p.kind is p.KEYWORD_ONLY or (p.kind is p.POSITIONAL_OR_KEYWORD and p.default is not p.empty):
+            params[p.name] = None if p.default is p.empty else p.default
+    return params
+
+
+def _check_group(group: str) -> None:
+    if group not in GROUPS:
+        raise ConfigError(f"unknown plugin group {group!r}; valid choices: {choices(GROUPS)}")

@@ -1,0 +1,98 @@
+"""A scene: one run's validated config turned into a system, its forces and an integrator."""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from omegaconf import DictConfig, OmegaConf
+
+from pipeline import registry
+from pipeline.config import compose_config
+from pipeline.contracts import Force, Integrator, System
+from pipeline.dataset import build_dataset
+from pipeline.errors import ConfigError, as_number, require_finite
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class Scene:
+    """Everything one run needs, built and validated once; ``run()`` integrates and writes nothing."""
+
+    config: DictConfig
+    system: System
+    integrator: Integrator
+    times: np.ndarray
+
+    @classmethod
+    def from_config(cls, cfg: DictConfig) -> Scene:
+        plain = OmegaConf.to_container(cfg, resolve=True)
+        require_finite(plain, "")
+        system_cls = _plugin_class("system", cfg.system, "system")
+        body = system_cls.body_type.from_config(plain["body"])
+        forces = [
+            _build(_plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
+            for name, node in (cfg.get("force") or {}).items()
+        ]
+        system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
+        integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
+        times = _output_times(plain["time"])
+        return cls(config=cfg, system=system, integrator=integrator, times=times)
+
+    def run(self) -> xr.Dataset:
+        """Integrate the full equations of motion and return the self-describing dataset."""
+        log.info("integrating %s with %s over t=[%g, %g] (%d output times)", self.system.title(),
+                 self.integrator.name, self.times[0], self.times[-1], len(self.times))
+        solution = self.integrator.integrate(self.system.rhs, self.times, self.system.initial_state())
+        stats = solution.stats
+        log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
+                 "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)
+        return build_dataset(self, solution)
+
+
+def compose_scene(overrides: Sequence[str] = ()) -> Scene:
+    """Compose gyrolab's config with Hydra overrides, validate it and build the scene (once)."""
+    return Scene.from_config(compose_config(overrides))
+
+
+def run(overrides: Sequence[str] = ()) -> xr.Dataset:
+    """``compose_scene(overrides).run()``."""
+    return compose_scene(overrides).run()
+
+
+def _plugin_class(group: str, node: Any, where: str) -> type:
+    if not isinstance(node, DictConfig) or "_target_" not in node:
+        raise ConfigError(f"{where} must be a plugin config with a _target_; valid choices: "
+                          f"{', '.join(registry.names(group))}")
+    _, cls = registry.resolve_target(group, node._target_, where)
+    return cls
+
+
+def _build(cls: type, node: DictConfig, where: str, *args: Any) -> Any:
+    """Instantiate a registered plugin class with its config parameters (no nested instantiation)."""
+    params = {k: v for k, v in OmegaConf.to_container(node, resolve=True).items() if k != "_target_"}
+    for key, value in params.items():
+        if isinstance(value, dict) and "_target_" in value:
+            raise ConfigError(f"{where}.{key} has a nested _target_, which gyrolab does not instantiate")
+    accepted = registry.default_params(cls)
+    unknown = sorted(set(params) - set(accepted))
+    if unknown:
+        raise ConfigError(f"{where}.{unknown[0]} is not a parameter of {cls.__name__}; valid parameters: "
+                          f"{', '.join(sorted(accepted)) or '(none)'}")
+    return cls(*args, **params)
+
+
+def _output_times(time_cfg: dict[str, Any]) -> np.ndarray:
+    start = as_number(time_cfg.get("start", 0.0), "time.start")
+    end = as_number(time_cfg.get("end"), "time.end")
+    if end <= start:
+        raise ConfigError(f"time.end={end:g} must be after time.start={start:g}")
+    n = time_cfg.get("n_output")
+    if isinstance(n, bool) or not isinstance(n, int) or n < 2:
+        raise ConfigError(f"time.n_output={n!r} must be an integer ≥ 2 (number of stored samples, both ends included)")
+    return np.linspace(start, end, n)

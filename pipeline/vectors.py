@@ -1,0 +1,28 @@
+"""Small 3-vector helpers that work on one vector (shape (3,)) or a stack (shape (n, 3)).
+
+numpy's ``cross`` is general and slow for single 3-vectors; the right-hand
+sides call these helpers thousands of times per run.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """u × v along the last axis."""
+    if u.ndim == 1 and v.ndim == 1:
+        u0, u1, u2 = u
+        v0, v1, v2 = v
+        return np.array((u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0))
+    return np.cross(u, v)
+
+
+def dot(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """u · v along the last axis (a float for single vectors)."""
+    return np.sum(u * v, axis=-1)
+
+
+def norm(u: np.ndarray) -> np.ndarray:
+    """Euclidean norm along the last axis."""
+    return np.sqrt(dot(u, u))

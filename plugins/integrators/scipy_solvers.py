@@ -1,0 +1,95 @@
+"""scipy's ODE solvers (``scipy.integrate``) behind gyrolab's integrator contract.
+
+The solver is stepped directly (as ``solve_ivp`` does) so that gyrolab can
+count accepted and rejected steps, sample the dense output only at the
+requested times, and stop with a clear error on a non-finite state.
+Rejected steps are known for the explicit Runge–Kutta pairs: each attempt
+costs exactly ``n_stages`` evaluations, so the evaluations spent inside one
+``step()`` call count its attempts. Radau, BDF and LSODA do not expose them.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, ClassVar
+
+import numpy as np
+from scipy import integrate
+
+from pipeline.contracts.integrator import Integrator, IntegratorStats, RightHandSide, Solution
+from pipeline.errors import IntegrationError, as_number
+
+
+class ScipySolver(Integrator):
+    """Adaptive scipy solver; subclasses name the scipy class."""
+
+    adaptive = True
+    solver_class: ClassVar[type]
+
+    def __init__(self, *, rtol: float = 1e-10, atol: float = 1e-10, max_step: float | None = None) -> None:
+        self.rtol = as_number(rtol, "integrator.rtol", positive=True)
+        self.atol = as_number(atol, "integrator.atol", positive=True)
+        self.max_step = np.inf if max_step is None else as_number(max_step, "integrator.max_step", positive=True)
+
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray) -> Solution:
+        start = time.perf_counter()
+        t_out = np.asarray(t_out, dtype=float)
+        out = np.empty((len(t_out), len(y0)))
+        out[0] = y0
+        solver = self.solver_class(fun, t_out[0], np.array(y0, dtype=float), t_out[-1],
+                                   rtol=self.rtol, atol=self.atol, max_step=self.max_step)
+        stages = getattr(self.solver_class, "n_stages", None)
+        n_steps, n_rejected, filled = 0, 0, 1
+        while solver.status == "running" and filled < len(t_out):
+            nfev_before = solver.nfev
+            message = solver.step()
+            if solver.status == "failed":
+                raise IntegrationError(f"{self.name} failed near t={solver.t:.6g}: {message}")
+            if not np.all(np.isfinite(solver.y)):
+                raise IntegrationError(f"{self.name} produced a non-finite state at t={solver.t:.6g}")
+            n_steps += 1
+            if stages:
+                n_rejected += (solver.nfev - nfev_before) // stages - 1
+            reached = int(np.searchsorted(t_out, solver.t, side="right"))
+            if reached > filled:
+                dense = solver.dense_output()
+                out[filled:reached] = dense(t_out[filled:reached]).T
+                filled = reached
+        if solver.t == t_out[-1]:
+            out[-1] = solver.y  # the solver lands on t_bound exactly: no interpolation error at the end
+        stats = IntegratorStats(
+            nfev=solver.nfev, n_steps=n_steps, n_rejected=n_rejected if stages else None,
+            wall_time=time.perf_counter() - start, njev=solver.njev, nlu=solver.nlu,
+        )
+        return Solution(t=t_out, y=out, stats=stats)
+
+    def attributes(self) -> dict[str, Any]:
+        attrs: dict[str, Any] = {"integrator_rtol": self.rtol, "integrator_atol": self.atol}
+        if np.isfinite(self.max_step):
+            attrs["integrator_max_step"] = self.max_step
+        return attrs
+
+
+class RK45(ScipySolver):
+    name = "rk45"
+    solver_class = integrate.RK45
+
+
+class DOP853(ScipySolver):
+    name = "dop853"
+    solver_class = integrate.DOP853
+
+
+class LSODA(ScipySolver):
+    name = "lsoda"
+    solver_class = integrate.LSODA
+
+
+class Radau(ScipySolver):
+    name = "radau"
+    solver_class = integrate.Radau
+
+
+class BDF(ScipySolver):
+    name = "bdf"
+    solver_class = integrate.BDF

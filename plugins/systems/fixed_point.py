@@ -1,0 +1,142 @@
+"""Heavy rigid body about a fixed point: the Euler–Poisson equations in vector form.
+
+In principal body axes (seed 000 eq. 1, seed 001 eq. 1, any textbook):
+
+    I ω̇ = (I ω) × ω + Σ torques,        γ̇ = γ × ω,
+
+with γ the body components of the fixed vertical Z. The state is (ω, γ),
+plus α — the body components of the fixed X axis, α̇ = α × ω — only when
+the scene needs the full attitude: Euler-angle output (ψ needs it) or a
+force acting along a non-vertical direction. β = γ × α is never stored.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from pipeline.attitude import euler_angles, nutation_and_spin
+from pipeline.body import Body
+from pipeline.contracts.force import Force
+from pipeline.contracts.system import System
+from pipeline.initial import InitialAttitude
+from pipeline.vectors import cross, dot, norm
+
+
+class FixedPoint(System):
+    name = "fixed_point"
+    body_type = Body
+
+    def __init__(self, body: Body, forces: Sequence[Force], initial: Any, output: Any) -> None:
+        super().__init__(body, forces, initial, output)
+        self.initial = InitialAttitude.from_config(initial)
+        needed = set().union(*(f.required_axes for f in self.forces))
+        self.euler_angles = bool(output.get("euler_angles", True))
+        self.carries_alpha = self.euler_angles or bool(needed & {0, 1})
+        self.needs_beta = 1 in needed
+        self.inertia = body.inertia
+
+    # -- state ---------------------------------------------------------------
+    @property
+    def state_size(self) -> int:
+        return 9 if self.carries_alpha else 6
+
+    def initial_state(self) -> np.ndarray:
+        parts = [self.initial.omega, self.initial.gamma]
+        if self.carries_alpha:
+            parts.append(self.initial.alpha)
+        return np.concatenate(parts)
+
+    def _axes(self, y: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray]:
+        gamma = y[..., 3:6]
+        alpha = y[..., 6:9] if self.carries_alpha else None
+        beta = cross(gamma, alpha) if self.needs_beta else None
+        return alpha, beta, gamma
+
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        omega = y[0:3]
+        axes = self._axes(y)
+        torque = cross(self.inertia * omega, omega)
+        for force in self.forces:
+            torque = torque + force.torque(omega, axes)
+        parts = [torque / self.inertia, cross(axes[2], omega)]
+        if self.carries_alpha:
+            parts.append(cross(axes[0], omega))
+        return np.concatenate(parts)
+
+    # -- invariants ------------------------------------------------------------
+    @property
+    def invariants(self) -> tuple[str, ...]:
+        names = []
+        if all(f.conservative for f in self.forces):
+            names.append("energy")
+        if all(f.preserves_area_integral for f in self.forces):
+            names.append("area_integral")
+        names.append("gamma_norm")
+        if self.carries_alpha:
+            names.append("frame_error")
+        return tuple(names)
+
+    def energy(self, y: np.ndarray) -> np.ndarray:
+        omega = y[..., 0:3]
+        axes = self._axes(y)
+        energy = 0.5 * dot(omega, self.inertia * omega)
+        for force in self.forces:
+            energy = energy + force.potential(axes)
+        return energy
+
+    # -- outputs ---------------------------------------------------------------
+    def variables(self, t: np.ndarray, y: np.ndarray) -> dict[str, xr.Variable]:
+        body = self.body
+        omega, gamma = y[:, 0:3], y[:, 3:6]
+        out: dict[str, xr.Variable] = {
+            "omega": _var(("time", "axis"), omega, body.rate_unit,
+                          f"angular velocity (p, q, r) in body axes [{body.rate_label}]"),
+            "gamma": _var(("time", "axis"), gamma, "1", "direction cosines of the fixed vertical Z in body axes"),
+        }
+        invariants = self.invariants
+        if "energy" in invariants:
+            out["energy"] = _var("time", self.energy(y), body.energy_unit,
+                                 "total energy: kinetic ½ω·Iω plus the forces' potentials")
+        if "area_integral" in invariants:
+            out["area_integral"] = _var("time", dot(self.inertia * omega, gamma), body.momentum_unit,
+                                        "area integral: angular momentum about the vertical, Iω·γ")
+        out["gamma_norm"] = _var("time", norm(gamma), "1", "norm of the direction-cosine vector |γ| (exactly 1)")
+        if self.carries_alpha:
+            alpha = y[:, 6:9]
+            out["alpha"] = _var(("time", "axis"), alpha, "1", "direction cosines of the fixed X axis in body axes")
+            out["frame_error"] = _var("time", np.maximum(np.abs(norm(alpha) - 1.0), np.abs(dot(alpha, gamma))),
+                                      "1", "orthonormality error of (α, γ): max(| |α| − 1 |, |α·γ|)")
+        if self.euler_angles:
+            psi, theta, phi = euler_angles(y[:, 6:9], gamma)
+            out["psi"] = _var("time", psi, "rad", "precession angle ψ (unwrapped)")
+        else:
+            theta, phi = nutation_and_spin(gamma)
+            phi = np.unwrap(phi)
+        out["theta"] = _var("time", theta, "rad", "nutation angle θ")
+        out["phi"] = _var("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
+        return out
+
+    def attributes(self) -> dict[str, Any]:
+        attrs: dict[str, Any] = {"system": self.name, "state_size": self.state_size}
+        attrs.update(self.body.attributes())
+        attrs["initial_omega"] = self.initial.omega
+        attrs["initial_gamma"] = self.initial.gamma
+        for force in self.forces:
+            for key, value in force.attributes().items():
+                attrs[f"force_{force.name}_{key}"] = np.asarray(value, dtype=float) if isinstance(value, list) else value
+        return attrs
+
+    def title(self) -> str:
+        nd = self.body.nondimensional()
+        forces = " + ".join(f.name for f in self.forces) or "no force (Euler–Poinsot)"
+        p, q, r = self.initial.omega
+        return (f"body about a fixed point, a={nd['a']:.4g}, b={nd['b']:.4g}; {forces}; "
+                f"ω0=({p:.3g}, {q:.3g}, {r:.3g}) {self.body.rate_label}")
+
+
+def _var(dims: str | tuple[str, ...], data: np.ndarray, units: str, long_name: str) -> xr.Variable:
+    return xr.Variable(dims, np.asarray(data, dtype=float), attrs={"units": units, "long_name": long_name})
