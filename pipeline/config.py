@@ -66,5 +66,7 @@ def friendly_missing(error: MissingConfigException) -> ConfigError:
 
 
 def _first_line(error: Exception) -> str:
+    """The first line of a Hydra/OmegaConf message, without its pointer to the online docs."""
     lines = [line.strip() for line in str(error).strip().splitlines() if line.strip()]
-    return " ".join(lines[:2]) if lines else type(error).__name__
+    line = lines[0] if lines else type(error).__name__
+    return line.split(" See https://")[0]

@@ -23,24 +23,23 @@ class Newtonian(Force):
     required_axes = frozenset({2})
     preserves_area_integral = True
 
-    def __init__(self, body: Body, *, R: float | None = None, k: float | None = None) -> None:
-        if body.units == "si":
-            if k is not None or R is None:
-                raise ConfigError(
-                    f"force.newtonian needs the distance R (m) of the attracting centre for an SI body, got R={R}, k={k}"
-                )
-            R = as_number(R, "force.newtonian.R", positive=True)
-            if not body.g:
-                raise ConfigError("force.newtonian needs body.g > 0 to set N = 3g/R")
-            self.N = 3.0 * body.g / R
-        else:
-            if R is not None or k is None:
-                raise ConfigError(
-                    f"force.newtonian needs k = N/c² for a nondimensional body, got k={k}, R={R}"
-                )
-            self.N = as_number(k, "force.newtonian.k", nonnegative=True)
-        self.inertia = body.inertia
+    def __init__(self, body: Body, *, k: float | None = None, R: float | None = None) -> None:
+        if (k is None) == (R is None):
+            raise ConfigError(f"force.newtonian needs exactly one of k = N/c² or R (m), got k={k}, R={R}")
         self._nondim = body.nondimensional()
+        c2 = self._nondim.get("c2", 1.0)  # model units of a nondimensional body have c² = 1
+        if k is not None:
+            k = as_number(k, "force.newtonian.k", nonnegative=True)
+            if body.units == "si" and not c2 > 0:
+                raise ConfigError("force.newtonian.k = N/c² needs c² = Mgl/C > 0; give R (m) for a body without weight")
+            self.N = k * c2
+        else:
+            R = as_number(R, "force.newtonian.R", positive=True)
+            if body.units != "si" or not body.g:
+                raise ConfigError(f"force.newtonian.R={R:g} needs an SI body with g > 0 (N = 3g/R); "
+                                  "a nondimensional body takes k = N/c²")
+            self.N = 3.0 * body.g / R
+        self.inertia = body.inertia
 
     def torque(self, omega: np.ndarray, axes: Axes) -> np.ndarray:
         gamma = axes[2]
