@@ -17,12 +17,21 @@ from pathlib import Path
 import hydra
 from hydra._internal.utils import get_args_parser
 from hydra.core.hydra_config import HydraConfig
+from hydra import initialize_config_module
 from hydra.core.override_parser.overrides_parser import OverridesParser
+from hydra.core.override_parser.types import Override
 from hydra.errors import OverrideParseException
-from omegaconf import DictConfig
+from omegaconf import DictConfig, open_dict
 
-from pipeline.config import SELECTABLE_GROUPS, compose_config, register_plugin_configs
+from pipeline.config import (
+    CONFIG_MODULE,
+    SELECTABLE_GROUPS,
+    compose_config,
+    group_options,
+    register_plugin_configs,
+)
 from pipeline.errors import ConfigError, GyrolabError, choices
+from pipeline.scene import Scene
 
 log = logging.getLogger("gyrolab")
 
@@ -37,40 +46,45 @@ def preflight(argv: Sequence[str]) -> None:
     args, _ = get_args_parser().parse_known_args(list(argv))
     if args.help or args.hydra_help or args.info or args.shell_completion or args.cfg:
         return  # Hydra's own informational commands
-    try:
-        overrides = OverridesParser.create().parse_overrides(args.overrides)
-    except OverrideParseException as error:
-        raise ConfigError(f"malformed override: {str(error).strip().splitlines()[0]}") from None
-    sweeping = any(o.is_sweep_override() for o in overrides)
-    if args.multirun or sweeping:
-        # Check every swept plugin name, then one job composed from the first values.
-        from pipeline.config import group_options, CONFIG_MODULE
-        from hydra import initialize_config_module
-
-        with initialize_config_module(config_module=CONFIG_MODULE, version_base="1.3"):
-            for o in overrides:
-                if o.key_or_group in SELECTABLE_GROUPS and o.is_sweep_override():
-                    valid = group_options(o.key_or_group)
-                    for value in o.sweep_string_iterator():
-                        for name in value.strip("[]").split(","):
-                            if name.strip() and name.strip() not in valid:
-                                raise ConfigError(f"unknown {o.key_or_group} {name.strip()!r}; "
-                                                  f"valid choices: {choices(valid)}")
-        first = [f"{o.get_key_element()}={next(iter(o.sweep_string_iterator()))}" if o.is_sweep_override()
-                 else o.input_line for o in overrides]
-    else:
-        first = list(args.overrides)
+    parser = OverridesParser.create()
+    overrides = []
+    for text in args.overrides:
+        try:
+            overrides.extend(parser.parse_overrides([text]))
+        except OverrideParseException as error:
+            reason = str(error).strip().splitlines()[0].split(" See https://")[0]
+            raise ConfigError(f"malformed override {text!r}: {reason}") from None
+    sweeping = args.multirun or any(o.is_sweep_override() for o in overrides)
+    check_plugin_names(overrides)
+    # One job composed and validated: the first value of every sweep.
+    first = [f"{o.get_key_element()}={next(iter(o.sweep_string_iterator()))}" if o.is_sweep_override()
+             else o.input_line for o in overrides]
     cfg = compose_config(first, return_hydra_config=True)
-    from pipeline.scene import Scene
-
     Scene.from_config(_without_hydra(cfg))
-    run_dir = cfg.hydra.sweep.dir if (args.multirun or sweeping) else cfg.hydra.run.dir
+    run_dir = cfg.hydra.sweep.dir if sweeping else cfg.hydra.run.dir
     check_writable(Path(str(run_dir)))
+
+
+def check_plugin_names(overrides: Sequence[Override]) -> None:
+    """Every option named for a config group (swept or not, in lists too) must exist."""
+    selected = [o for o in overrides if o.key_or_group in SELECTABLE_GROUPS and o.package is None
+                and not o.is_delete()]
+    if not selected:
+        return
+    with initialize_config_module(config_module=CONFIG_MODULE, version_base="1.3"):
+        for o in selected:
+            valid = group_options(o.key_or_group)
+            values = list(o.sweep_string_iterator()) if o.is_sweep_override() else [o.value()]
+            for value in values:
+                items = value if isinstance(value, list) else str(value).strip("[]").split(",")
+                for name in (str(item).strip() for item in items):
+                    if name and name != "null" and name not in valid:
+                        raise ConfigError(f"unknown {o.key_or_group} {name!r}; valid choices: {choices(valid)}")
 
 
 def _without_hydra(cfg: DictConfig) -> DictConfig:
     cfg = cfg.copy()
-    with __import__("omegaconf").open_dict(cfg):
+    with open_dict(cfg):
         cfg.pop("hydra", None)
     return cfg
 
@@ -93,8 +107,7 @@ def check_writable(directory: Path) -> None:
 @hydra.main(config_path="pkg://conf", config_name="config", version_base="1.3")
 def _task(cfg: DictConfig) -> None:
     from pipeline.dataset import write_dataset
-    from pipeline.figures import save_figures
-    from pipeline.scene import Scene
+    from pipeline.figures import save_figures  # matplotlib only when figures are drawn
 
     try:
         out_dir = Path(HydraConfig.get().runtime.output_dir)

@@ -109,7 +109,7 @@ def resolve_target(group: str, target: Any, where: str) -> tuple[str, type]:
     if name is None:
         raise ConfigError(
             f"{where}._target_={target!r} is not a registered {group} plugin; "
-            f"registered {group} plugins: {choices(targets(group).values())}"
+            f"choose one by name ({group}=NAME), valid names: {choices(targets(group))}"
         )
     return name, load(group, name)
 

@@ -1,0 +1,58 @@
+"""Every option of every config group composes and builds; the registry refuses foreign targets."""
+
+from pathlib import Path
+
+import pytest
+
+from pipeline import compose_scene
+from pipeline.errors import ConfigError
+from pipeline.registry import BUILTINS, names
+
+CONF = Path(__file__).resolve().parent.parent / "conf"
+
+
+def _options(group):
+    return sorted(p.stem for p in (CONF / group).glob("*.yaml"))
+
+
+@pytest.mark.parametrize("group", ["system", "body", "initial", "integrator"])
+def test_every_option_composes_and_builds(group):
+    for option in _options(group):
+        scene = compose_scene([f"{group}={option}"])
+        assert scene.system.state_size in (6, 9)
+        assert len(scene.times) >= 2
+
+
+@pytest.mark.parametrize("option", _options("force"))
+def test_every_force_builds_alone_and_with_the_others(option):
+    scene = compose_scene([f"force=[{option}]"])
+    assert [f.name for f in scene.system.forces] == [option]
+    everything = compose_scene([f"force=[{','.join(_options('force'))}]"])
+    assert len(everything.system.forces) == len(_options("force"))
+
+
+def test_every_builtin_plugin_has_a_config_file():
+    for group, plugins in BUILTINS.items():
+        assert set(plugins) == set(_options(group)), group
+
+
+def test_no_force_gives_euler_poinsot():
+    scene = compose_scene(["force=[]"])
+    assert scene.system.forces == []
+
+
+def test_target_outside_the_registry_is_refused():
+    with pytest.raises(ConfigError, match="not a registered integrator plugin"):
+        compose_scene(["integrator._target_=os.system"])
+    with pytest.raises(ConfigError, match="not a registered force plugin"):
+        compose_scene(["force.newtonian._target_=subprocess.call"])
+
+
+def test_unknown_plugin_parameter_is_refused():
+    with pytest.raises(ConfigError, match="not a parameter of DOP853"):
+        compose_scene(["+integrator.order=5"])
+
+
+def test_registry_lists_builtins():
+    assert names("integrator") == ["bdf", "dop853", "lsoda", "radau", "rk4", "rk45"]
+    assert {"uniform_gravity", "newtonian", "magnetic"} <= set(names("force"))

@@ -1,0 +1,74 @@
+"""Integrator plugins: accuracy, convergence order, work statistics, agreement with scipy."""
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from pipeline import compose_scene, run
+from pipeline.errors import IntegrationError
+from pipeline.registry import load, names
+
+SHORT = ["time.end=5", "time.n_output=11"]
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return run(["integrator.rtol=1e-13", "integrator.atol=1e-13", *SHORT])
+
+
+@pytest.mark.parametrize("name", ["rk45", "dop853", "lsoda", "radau", "bdf"])
+def test_adaptive_methods_reach_their_tolerance(name, reference):
+    ds = run([f"integrator={name}", "integrator.rtol=1e-9", "integrator.atol=1e-9", *SHORT])
+    error = np.max(np.abs(ds.omega.values - reference.omega.values))
+    # The global error of a tolerance-controlled method grows with time; 1e-9 → below ~1e-5 at t = 5.
+    assert error < 1e-5, (name, error)
+    assert ds.attrs["integrator_nfev"] > 0 and ds.attrs["integrator_n_steps"] > 0
+    assert np.all(np.isfinite(ds.omega.values))
+
+
+def test_rk4_is_fourth_order(reference):
+    errors = []
+    steps = [0.02, 0.01, 0.005]
+    for h in steps:
+        ds = run(["integrator=rk4", f"integrator.step={h}", *SHORT])
+        errors.append(np.max(np.abs(ds.omega.values[-1] - reference.omega.values[-1])))
+        assert ds.attrs["integrator_nfev"] == 4 * ds.attrs["integrator_n_steps"]
+        assert ds.attrs["integrator_n_steps"] == round(5 / h)
+    slope = np.polyfit(np.log(steps), np.log(errors), 1)[0]
+    assert slope == pytest.approx(4.0, abs=0.2)
+
+
+def test_gyrolab_dop853_takes_scipys_steps():
+    scene = compose_scene(["integrator.rtol=1e-8", "integrator.atol=1e-8", *SHORT])
+    ds = scene.run()
+    y0 = scene.system.initial_state()
+    ref = solve_ivp(scene.system.rhs, (0, 5), y0, method="DOP853", rtol=1e-8, atol=1e-8, t_eval=scene.times)
+    np.testing.assert_allclose(ds.omega.values, ref.y[0:3].T, rtol=0, atol=1e-13)
+    # Same steps, same dense output; solve_ivp also interpolates t0 itself (3 more evaluations in DOP853's
+    # dense output), gyrolab stores y0 as given.
+    assert ds.attrs["integrator_nfev"] == ref.nfev - 3
+
+
+def test_rejected_steps_are_counted():
+    # A huge first step is rejected: scipy's own count of evaluations must split into attempts.
+    ds = run(["integrator=rk45", "integrator.rtol=1e-10", "integrator.atol=1e-10", *SHORT])
+    steps, rejected, nfev = (ds.attrs[f"integrator_{k}"] for k in ("n_steps", "n_rejected", "nfev"))
+    # each RK45 attempt costs 6 evaluations; 2 evaluations for the initial step guess; 0 for dense output
+    assert nfev == 2 + 6 * (steps + rejected)
+
+
+def test_unknown_rejections_are_not_invented():
+    ds = run(["integrator=radau", *SHORT])
+    assert "integrator_n_rejected" not in ds.attrs
+
+
+def test_failure_is_an_error_not_garbage():
+    scene = compose_scene(["integrator=rk4", "integrator.step=5", "initial.r0=1e3", *SHORT])
+    with pytest.raises(IntegrationError, match="non-finite state"):
+        scene.run()
+
+
+def test_every_registered_integrator_loads():
+    for name in names("integrator"):
+        cls = load("integrator", name)
+        assert cls.name == name
