@@ -16,6 +16,7 @@ from pipeline.config import compose_config
 from pipeline.contracts import Force, Integrator, System
 from pipeline.dataset import build_dataset
 from pipeline.errors import ConfigError, as_number, require_finite
+from pipeline.progress import Progress
 
 log = logging.getLogger(__name__)
 
@@ -48,7 +49,8 @@ class Scene:
         """Integrate the full equations of motion and return the self-describing dataset."""
         log.info("integrating %s with %s over t=[%g, %g] (%d output times)", self.system.title(),
                  self.integrator.name, self.times[0], self.times[-1], len(self.times))
-        solution = self.integrator.integrate(self.system.rhs, self.times, self.system.initial_state())
+        progress = Progress(self.integrator.name, self.times[0], self.times[-1])
+        solution = self.integrator.integrate(self.system.rhs, self.times, self.system.initial_state(), progress)
         stats = solution.stats
         log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
                  "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)

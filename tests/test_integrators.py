@@ -72,3 +72,11 @@ def test_every_registered_integrator_loads():
     for name in names("integrator"):
         cls = load("integrator", name)
         assert cls.name == name
+
+
+@pytest.mark.parametrize("name", ["rk4", "dop853"])
+def test_progress_reaches_the_end(name):
+    scene = compose_scene([f"integrator={name}", *SHORT])
+    seen = []
+    scene.integrator.integrate(scene.system.rhs, scene.times, scene.system.initial_state(), seen.append)
+    assert seen and seen[-1] == pytest.approx(5.0) and seen == sorted(seen)

@@ -10,6 +10,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 RightHandSide = Callable[[float, np.ndarray], np.ndarray]
+ProgressCallback = Callable[[float], None]
 
 
 @dataclass
@@ -55,14 +56,17 @@ class Integrator(ABC):
     4. It never returns non-finite values: a failure (step size underflow,
        NaN or inf in the state) raises ``pipeline.errors.IntegrationError``
        with one sentence saying when and why.
-    5. ``attributes()`` gives its settings for the dataset.
+    5. It calls ``progress(t)``, when given, every few steps (cheap; the
+       callback decides whether to report).
+    6. ``attributes()`` gives its settings for the dataset.
     """
 
     name: ClassVar[str]
     adaptive: ClassVar[bool]
 
     @abstractmethod
-    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray) -> Solution:
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+                  progress: ProgressCallback | None = None) -> Solution:
         """Integrate from t_out[0] and sample the state at t_out."""
 
     def attributes(self) -> dict[str, Any]:

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.contracts.integrator import Integrator, IntegratorStats, RightHandSide, Solution
+from pipeline.contracts.integrator import Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
 from pipeline.errors import IntegrationError, as_number
 
 
@@ -24,17 +24,19 @@ class RK4(Integrator):
     def __init__(self, *, step: float = 0.01) -> None:
         self.step = as_number(step, "integrator.step", positive=True)
 
-    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray) -> Solution:
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+                  progress: ProgressCallback | None = None) -> Solution:
         start = time.perf_counter()
         y = np.array(y0, dtype=float)
         out = np.empty((len(t_out), len(y)))
         out[0] = y
         with np.errstate(over="ignore", invalid="ignore"):  # a blow-up is reported below, in one sentence
-            n_steps = self._march(fun, t_out, y, out)
+            n_steps = self._march(fun, t_out, y, out, progress)
         stats = IntegratorStats(nfev=4 * n_steps, n_steps=n_steps, n_rejected=0, wall_time=time.perf_counter() - start)
         return Solution(t=np.asarray(t_out, dtype=float), y=out, stats=stats)
 
-    def _march(self, fun: RightHandSide, t_out: np.ndarray, y: np.ndarray, out: np.ndarray) -> int:
+    def _march(self, fun: RightHandSide, t_out: np.ndarray, y: np.ndarray, out: np.ndarray,
+               progress: ProgressCallback | None) -> int:
         """Fill ``out[1:]``; return the number of steps taken."""
         n_steps = 0
         for i in range(1, len(t_out)):
@@ -54,6 +56,8 @@ class RK4(Integrator):
                     f"rk4 produced a non-finite state before t={t_out[i]:.6g} with step {h:.3g}; reduce integrator.step"
                 )
             out[i] = y
+            if progress is not None:
+                progress(t_out[i])
         return n_steps
 
     def attributes(self) -> dict[str, Any]:

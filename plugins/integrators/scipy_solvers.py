@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import integrate
 
-from pipeline.contracts.integrator import Integrator, IntegratorStats, RightHandSide, Solution
+from pipeline.contracts.integrator import Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
 from pipeline.errors import IntegrationError, as_number
 
 
@@ -31,7 +31,8 @@ class ScipySolver(Integrator):
         self.atol = as_number(atol, "integrator.atol", positive=True)
         self.max_step = np.inf if max_step is None else as_number(max_step, "integrator.max_step", positive=True)
 
-    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray) -> Solution:
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+                  progress: ProgressCallback | None = None) -> Solution:
         start = time.perf_counter()
         t_out = np.asarray(t_out, dtype=float)
         out = np.empty((len(t_out), len(y0)))
@@ -50,6 +51,8 @@ class ScipySolver(Integrator):
             n_steps += 1
             if stages:
                 n_rejected += (solver.nfev - nfev_before) // stages - 1
+            if progress is not None:
+                progress(solver.t)
             reached = int(np.searchsorted(t_out, solver.t, side="right"))
             if reached > filled:
                 dense = solver.dense_output()
