@@ -42,6 +42,9 @@ BUILTINS: dict[str, dict[str, str]] = {
         "lsoda": "plugins.integrators.scipy_solvers:LSODA",
         "radau": "plugins.integrators.scipy_solvers:Radau",
         "bdf": "plugins.integrators.scipy_solvers:BDF",
+        "dop853_numba": "plugins.integrators.compiled_solvers:DOP853Numba",
+        "rk4_numba": "plugins.integrators.compiled_solvers:RK4Numba",
+        "taylor": "plugins.integrators.compiled_solvers:Taylor",
     },
     "regime": {},
 }

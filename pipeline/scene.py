@@ -43,6 +43,12 @@ class Scene:
         system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
         times = _output_times(plain["time"])
+        if integrator.needs_compiled_model and system.compiled_model() is None:
+            plain_forces = [f.name for f in system.forces if f.compiled_terms() is None]
+            raise ConfigError(
+                f"integrator {integrator.name!r} runs compiled models only, and force {plain_forces[0]!r} has no "
+                f"compiled form; choose a Python integrator (dop853, rk45, rk4, lsoda, radau, bdf)"
+            )
         return cls(config=cfg, system=system, integrator=integrator, times=times)
 
     def run(self) -> xr.Dataset:
@@ -50,7 +56,9 @@ class Scene:
         log.info("integrating %s with %s over t=[%g, %g] (%d output times)", self.system.title(),
                  self.integrator.name, self.times[0], self.times[-1], len(self.times))
         progress = Progress(self.integrator.name, self.times[0], self.times[-1])
-        solution = self.integrator.integrate(self.system.rhs, self.times, self.system.initial_state(), progress)
+        compiled = self.system.compiled_model() if self.integrator.needs_compiled_model else None
+        solution = self.integrator.integrate(self.system.rhs, self.times, self.system.initial_state(), progress,
+                                             compiled)
         stats = solution.stats
         log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
                  "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)

@@ -54,5 +54,6 @@ def test_unknown_plugin_parameter_is_refused():
 
 
 def test_registry_lists_builtins():
-    assert names("integrator") == ["bdf", "dop853", "lsoda", "radau", "rk4", "rk45"]
+    assert names("integrator") == ["bdf", "dop853", "dop853_numba", "lsoda", "radau", "rk4", "rk45", "rk4_numba",
+                                   "taylor"]
     assert {"uniform_gravity", "newtonian", "magnetic"} <= set(names("force"))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -11,6 +12,19 @@ import numpy as np
 #: For ``fixed_point`` the frame is the fixed space frame (X, Y, Z = vertical);
 #: an entry is ``None`` when the scene does not carry that axis.
 Axes = tuple[np.ndarray | None, np.ndarray | None, np.ndarray | None]
+
+
+@dataclass
+class CompiledTerms:
+    """A torque written in the two forms compiled kernels evaluate (model units).
+
+    ``linear[i]`` = u adds u × e_i; ``gradient[i]`` = N adds N e_i × I e_i, where e_i
+    is the body-frame image of reference axis i. Uniform gravity, the Newtonian
+    centre and a uniform magnetic field are all of this form.
+    """
+
+    linear: dict[int, np.ndarray] = field(default_factory=dict)
+    gradient: dict[int, float] = field(default_factory=dict)
 
 
 class Force(ABC):
@@ -40,6 +54,9 @@ class Force(ABC):
     6. ``attributes()`` describes the parameters for the dataset, in both the
        SI and the nondimensional form where the body allows it (netCDF-safe
        values: str, numbers, lists of numbers).
+    7. Optionally, ``compiled_terms()`` returns the torque as ``CompiledTerms``
+       so that compiled integrators can run it; a force without that form
+       runs with the Python integrators only.
     """
 
     name: ClassVar[str]
@@ -62,3 +79,7 @@ class Force(ABC):
     def attributes(self) -> dict[str, Any]:
         """Parameters for the dataset's attributes."""
         return {}
+
+    def compiled_terms(self) -> CompiledTerms | None:
+        """The torque in the compiled kernels' form, or None if it has none."""
+        return None

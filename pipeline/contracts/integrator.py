@@ -13,6 +13,14 @@ RightHandSide = Callable[[float, np.ndarray], np.ndarray]
 ProgressCallback = Callable[[float], None]
 
 
+@dataclass(frozen=True)
+class CompiledModel:
+    """A system in the compiled kernels' form: a model id (``plugins.compiled.models``) and its parameters."""
+
+    model: int
+    params: np.ndarray
+
+
 @dataclass
 class IntegratorStats:
     """Work done by one integration; ``n_rejected`` is None where the method does not report it."""
@@ -58,15 +66,20 @@ class Integrator(ABC):
        with one sentence saying when and why.
     5. It calls ``progress(t)``, when given, every few steps (cheap; the
        callback decides whether to report).
-    6. ``attributes()`` gives its settings for the dataset.
+    6. A compiled integrator sets ``needs_compiled_model`` and integrates the
+       ``compiled`` model it is given (the system's ``compiled_model()``)
+       instead of calling ``fun``; the scene refuses it, before integrating,
+       for a system or force that has no compiled form.
+    7. ``attributes()`` gives its settings for the dataset.
     """
 
     name: ClassVar[str]
     adaptive: ClassVar[bool]
+    needs_compiled_model: ClassVar[bool] = False
 
     @abstractmethod
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
-                  progress: ProgressCallback | None = None) -> Solution:
+                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         """Integrate from t_out[0] and sample the state at t_out."""
 
     def attributes(self) -> dict[str, Any]:

@@ -10,6 +10,7 @@ import numpy as np
 import xarray as xr
 
 from pipeline.contracts.force import Force
+from pipeline.contracts.integrator import CompiledModel
 
 
 class System(ABC):
@@ -32,6 +33,9 @@ class System(ABC):
        (``invariants``), which are exactly those every force preserves.
     5. ``attributes()`` describes the system's parameters and initial state
        for the dataset; ``title()`` names the scene in a few words for figures.
+    6. Optionally, ``compiled_model()`` returns the system (with its forces)
+       in the compiled kernels' form, or None when some part has none; the
+       compiled integrators need it.
     """
 
     name: ClassVar[str]
@@ -65,6 +69,10 @@ class System(ABC):
 
     def attributes(self) -> dict[str, Any]:
         return {}
+
+    def compiled_model(self) -> CompiledModel | None:
+        """The system in compiled form, or None (then only Python integrators run it)."""
+        return None
 
     def title(self) -> str:
         return self.name

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from pipeline.body import Body
-from pipeline.contracts.force import Axes, Force
+from pipeline.contracts.force import Axes, CompiledTerms, Force
 from pipeline.errors import ConfigError, as_number, as_vector3
 from pipeline.vectors import cross, dot
 
@@ -60,3 +60,6 @@ class Magnetic(Force):
 
     def attributes(self) -> dict[str, Any]:
         return {"moment": self.moment.tolist(), "field": self.field, "direction": self.direction.tolist()}
+
+    def compiled_terms(self) -> CompiledTerms:
+        return CompiledTerms(linear={i: self.field * self.direction[i] * self.moment for i in self.required_axes})

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from pipeline.body import Body
-from pipeline.contracts.force import Axes, Force
+from pipeline.contracts.force import Axes, CompiledTerms, Force
 from pipeline.errors import ConfigError, as_number
 from pipeline.vectors import cross, dot
 
@@ -55,3 +55,6 @@ class Newtonian(Force):
         if c2:
             attrs["k"] = self.N / c2
         return attrs
+
+    def compiled_terms(self) -> CompiledTerms:
+        return CompiledTerms(gradient={2: self.N})

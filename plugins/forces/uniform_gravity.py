@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from pipeline.body import Body
-from pipeline.contracts.force import Axes, Force
+from pipeline.contracts.force import Axes, CompiledTerms, Force
 from pipeline.vectors import cross, dot
 
 
@@ -33,3 +33,6 @@ class UniformGravity(Force):
 
     def attributes(self) -> dict[str, Any]:
         return {"weight_moment": self.weight_moment.tolist()}
+
+    def compiled_terms(self) -> CompiledTerms:
+        return CompiledTerms(linear={2: self.weight_moment})

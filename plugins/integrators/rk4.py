@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.contracts.integrator import Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
+from pipeline.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
 from pipeline.errors import IntegrationError, as_number
 
 
@@ -25,7 +25,7 @@ class RK4(Integrator):
         self.step = as_number(step, "integrator.step", positive=True)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
-                  progress: ProgressCallback | None = None) -> Solution:
+                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         start = time.perf_counter()
         y = np.array(y0, dtype=float)
         out = np.empty((len(t_out), len(y)))

@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import integrate
 
-from pipeline.contracts.integrator import Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
+from pipeline.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
 from pipeline.errors import IntegrationError, as_number
 
 
@@ -32,7 +32,7 @@ class ScipySolver(Integrator):
         self.max_step = np.inf if max_step is None else as_number(max_step, "integrator.max_step", positive=True)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
-                  progress: ProgressCallback | None = None) -> Solution:
+                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         start = time.perf_counter()
         t_out = np.asarray(t_out, dtype=float)
         out = np.empty((len(t_out), len(y0)))

@@ -21,6 +21,7 @@ import xarray as xr
 from pipeline.attitude import euler_angles, nutation_and_spin
 from pipeline.body import Body
 from pipeline.contracts.force import Force
+from pipeline.contracts.integrator import CompiledModel
 from pipeline.contracts.system import System
 from pipeline.initial import InitialAttitude
 from pipeline.vectors import cross, dot, norm
@@ -129,6 +130,14 @@ class FixedPoint(System):
             for key, value in force.attributes().items():
                 attrs[f"force_{force.name}_{key}"] = np.asarray(value, dtype=float) if isinstance(value, list) else value
         return attrs
+
+    def compiled_model(self) -> CompiledModel | None:
+        terms = [force.compiled_terms() for force in self.forces]
+        if any(term is None for term in terms):
+            return None
+        from plugins.compiled import fixed_point, models  # numba only when a compiled integrator runs
+
+        return CompiledModel(models.FIXED_POINT, fixed_point.pack(self.inertia, terms, self.carries_alpha))
 
     def title(self) -> str:
         nd = self.body.nondimensional()

@@ -1,0 +1,175 @@
+"""DOP853 (Hairer, Nørsett & Wanner, Solving ODEs I, §II.10) compiled, with scipy's exact controller.
+
+The step-size control, initial step, error norm and 7th-order dense output
+replicate ``scipy.integrate.DOP853`` (same coefficients, same formulas, same
+order of operations where it matters), so at equal settings both take the
+same steps and agree to rounding. The run is resumable: the integrator
+state (t, y, f, |h|) lives in arrays the caller keeps between chunks.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+from scipy.integrate._ivp import dop853_coefficients as _c
+
+from plugins.compiled.models import rhs
+
+N_STAGES = _c.N_STAGES  # 12
+N_EXTENDED = _c.N_STAGES_EXTENDED  # 16
+A = np.ascontiguousarray(_c.A[:N_EXTENDED, :N_EXTENDED])
+B = np.ascontiguousarray(_c.B)
+C = np.ascontiguousarray(_c.C[:N_EXTENDED])
+E3 = np.ascontiguousarray(_c.E3)
+E5 = np.ascontiguousarray(_c.E5)
+D = np.ascontiguousarray(_c.D)
+SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
+ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
+
+OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2
+
+
+@numba.njit(cache=True)
+def _rms(x):
+    return np.sqrt(np.sum(x * x) / x.size)
+
+
+@numba.njit(cache=True)
+def initial_step(model, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats):
+    """scipy.integrate._ivp.common.select_initial_step for order 7."""
+    interval = abs(t_bound - t0)
+    scale = atol + np.abs(y0) * rtol
+    d0 = _rms(y0 / scale)
+    d1 = _rms(f0 / scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, interval)
+    f1 = np.empty_like(y0)
+    rhs(model, t0 + h0, y0 + h0 * f0, p, f1)
+    stats[0] += 1
+    d2 = _rms((f1 - f0) / scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100 * h0, h1, interval, max_step)
+
+
+@numba.njit(cache=True)
+def _stage_sum(K, s, a_row, n, out):
+    for i in range(n):
+        acc = 0.0
+        for j in range(s):
+            acc += K[j, i] * a_row[j]
+        out[i] = acc
+
+
+@numba.njit(cache=True)
+def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, max_step, stats):
+    """Advance until t_out[i_stop − 1] is filled. state = [t, h_abs]; stats = [nfev, steps, rejected].
+
+    Returns (status, next output index). y and f are updated in place.
+    """
+    n = y.size
+    K = np.empty((N_EXTENDED, n))
+    dy = np.empty(n)
+    ytmp = np.empty(n)
+    y_new = np.empty(n)
+    err5 = np.empty(n)
+    err3 = np.empty(n)
+    F = np.empty((7, n))
+    t, h_abs = state[0], state[1]
+    i = i_next
+    while i < i_stop:
+        min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+        if h_abs > max_step:
+            h_abs = max_step
+        elif h_abs < min_step:
+            h_abs = min_step
+        rejected = False
+        while True:
+            if h_abs < min_step:
+                state[0], state[1] = t, h_abs
+                return TOO_SMALL_STEP, i
+            t_new = t + h_abs
+            if t_new - t_bound > 0:
+                t_new = t_bound
+            h = t_new - t
+            h_abs = abs(h)
+            K[0] = f
+            for s in range(1, N_STAGES):
+                _stage_sum(K, s, A[s], n, dy)
+                for m in range(n):
+                    ytmp[m] = y[m] + dy[m] * h
+                rhs(model, t + C[s] * h, ytmp, p, K[s])
+            _stage_sum(K, N_STAGES, B, n, dy)
+            for m in range(n):
+                y_new[m] = y[m] + h * dy[m]
+            rhs(model, t + h, y_new, p, K[N_STAGES])
+            stats[0] += N_STAGES
+            e5 = 0.0
+            e3 = 0.0
+            for m in range(n):
+                scale = atol + max(abs(y[m]), abs(y_new[m])) * rtol
+                a5 = 0.0
+                a3 = 0.0
+                for j in range(N_STAGES + 1):
+                    a5 += K[j, m] * E5[j]
+                    a3 += K[j, m] * E3[j]
+                err5[m] = a5 / scale
+                err3[m] = a3 / scale
+                e5 += err5[m] * err5[m]
+                e3 += err3[m] * err3[m]
+            if e5 == 0.0 and e3 == 0.0:
+                error_norm = 0.0
+            else:
+                error_norm = h_abs * e5 / np.sqrt((e5 + 0.01 * e3) * n)
+            if error_norm < 1.0:
+                factor = MAX_FACTOR if error_norm == 0.0 else min(MAX_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
+                if rejected:
+                    factor = min(1.0, factor)
+                h_abs *= factor
+                break
+            h_abs *= max(MIN_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
+            rejected = True
+            stats[2] += 1
+        stats[1] += 1
+        for m in range(n):
+            if not np.isfinite(y_new[m]):
+                state[0], state[1] = t, h_abs
+                return NOT_FINITE, i
+        # dense output for the outputs inside (t, t_new]
+        if i < i_stop and t_out[i] <= t_new:
+            t_old = t
+            for s in range(N_STAGES + 1, N_EXTENDED):
+                _stage_sum(K, s, A[s], n, dy)
+                for m in range(n):
+                    ytmp[m] = y[m] + dy[m] * h
+                rhs(model, t_old + C[s] * h, ytmp, p, K[s])
+            stats[0] += N_EXTENDED - N_STAGES - 1
+            for m in range(n):
+                delta = y_new[m] - y[m]
+                F[0, m] = delta
+                F[1, m] = h * f[m] - delta
+                F[2, m] = 2.0 * delta - h * (K[N_STAGES, m] + f[m])
+                for r in range(4):
+                    acc = 0.0
+                    for j in range(N_EXTENDED):
+                        acc += D[r, j] * K[j, m]
+                    F[3 + r, m] = h * acc
+            while i < i_stop and t_out[i] <= t_new:
+                if t_out[i] == t_new:
+                    Y[i] = y_new
+                else:
+                    x = (t_out[i] - t_old) / h
+                    for m in range(n):
+                        v = 0.0
+                        for r in range(7):
+                            v += F[6 - r, m]
+                            v *= x if r % 2 == 0 else 1.0 - x
+                        Y[i, m] = v + y[m]
+                i += 1
+        t = t_new
+        y[:] = y_new
+        f[:] = K[N_STAGES]
+    state[0], state[1] = t, h_abs
+    return OK, i

@@ -1,0 +1,148 @@
+"""Compiled (numba) kernels of the fixed-point system: right-hand side and Taylor coefficients.
+
+Parameters are one float array ``p`` (see ``pack``): inertia I (3), the
+linear-torque vectors U_i (torque U_i × e_i, 3×3), the gradient coefficients
+N_i (torque N_i e_i × I e_i, 3) and a flag saying whether the state carries α.
+e_0 = α (fixed X), e_1 = β = γ × α (fixed Y), e_2 = γ (vertical).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from pipeline.contracts.force import CompiledTerms
+
+N_PARAMS = 16
+
+
+def pack(inertia: np.ndarray, terms: list[CompiledTerms], carries_alpha: bool) -> np.ndarray:
+    p = np.zeros(N_PARAMS)
+    p[0:3] = inertia
+    for term in terms:
+        for axis, u in term.linear.items():
+            p[3 + 3 * axis: 6 + 3 * axis] += u
+        for axis, n in term.gradient.items():
+            p[12 + axis] += n
+    p[15] = 1.0 if carries_alpha else 0.0
+    return p
+
+
+@numba.njit(cache=True, inline="always")
+def _cross_add(u0, u1, u2, v0, v1, v2, s):
+    """s · (u × v) as three floats."""
+    return s * (u1 * v2 - u2 * v1), s * (u2 * v0 - u0 * v2), s * (u0 * v1 - u1 * v0)
+
+
+@numba.njit(cache=True)
+def rhs(t, y, p, out):
+    I0, I1, I2 = p[0], p[1], p[2]
+    w0, w1, w2 = y[0], y[1], y[2]
+    g0, g1, g2 = y[3], y[4], y[5]
+    # gyroscopic torque (Iω) × ω
+    t0 = (I1 - I2) * w1 * w2
+    t1 = (I2 - I0) * w2 * w0
+    t2 = (I0 - I1) * w0 * w1
+    # U_2 × γ  and  N_2 γ × Iγ
+    a0, a1, a2 = _cross_add(p[9], p[10], p[11], g0, g1, g2, 1.0)
+    n = p[14]
+    t0 += a0 + n * (I2 - I1) * g1 * g2
+    t1 += a1 + n * (I0 - I2) * g2 * g0
+    t2 += a2 + n * (I1 - I0) * g0 * g1
+    out[3] = g1 * w2 - g2 * w1
+    out[4] = g2 * w0 - g0 * w2
+    out[5] = g0 * w1 - g1 * w0
+    if p[15] != 0.0:
+        x0, x1, x2 = y[6], y[7], y[8]
+        b0, b1, b2 = g1 * x2 - g2 * x1, g2 * x0 - g0 * x2, g0 * x1 - g1 * x0
+        c0, c1, c2 = _cross_add(p[3], p[4], p[5], x0, x1, x2, 1.0)
+        d0, d1, d2 = _cross_add(p[6], p[7], p[8], b0, b1, b2, 1.0)
+        nx, ny = p[12], p[13]
+        t0 += c0 + d0 + nx * (I2 - I1) * x1 * x2 + ny * (I2 - I1) * b1 * b2
+        t1 += c1 + d1 + nx * (I0 - I2) * x2 * x0 + ny * (I0 - I2) * b2 * b0
+        t2 += c2 + d2 + nx * (I1 - I0) * x0 * x1 + ny * (I1 - I0) * b0 * b1
+        out[6] = x1 * w2 - x2 * w1
+        out[7] = x2 * w0 - x0 * w2
+        out[8] = x0 * w1 - x1 * w0
+    out[0] = t0 / I0
+    out[1] = t1 / I1
+    out[2] = t2 / I2
+
+
+@numba.njit(cache=True)
+def _cauchy_cross(A, ia, B, ib, k, s0, s1, s2, out):
+    """out += Σ_j s ⊙ (A[j, ia:ia+3]) × B[k−j, ib:ib+3] with a per-component scale s of A."""
+    r0 = 0.0
+    r1 = 0.0
+    r2 = 0.0
+    for j in range(k + 1):
+        u0, u1, u2 = s0 * A[j, ia], s1 * A[j, ia + 1], s2 * A[j, ia + 2]
+        v0, v1, v2 = B[k - j, ib], B[k - j, ib + 1], B[k - j, ib + 2]
+        r0 += u1 * v2 - u2 * v1
+        r1 += u2 * v0 - u0 * v2
+        r2 += u0 * v1 - u1 * v0
+    out[0] += r0
+    out[1] += r1
+    out[2] += r2
+
+
+@numba.njit(cache=True)
+def taylor_coefficients(p, Y, order, work):
+    """Fill Y[1..order] (rows: Taylor coefficients of the state) from Y[0].
+
+    The right-hand side is quadratic in the state, so the k-th coefficient of
+    every product is a Cauchy sum (Jorba & Zou 2005): Y[k+1] = F_k / (k + 1).
+    ``work`` (order+1, 3) holds the coefficients of β = γ × α when α is carried.
+    """
+    I0, I1, I2 = p[0], p[1], p[2]
+    has_alpha = p[15] != 0.0
+    acc = np.empty(3)
+    tmp = np.empty(3)
+    for k in range(order):
+        if has_alpha:  # β_k
+            acc[:] = 0.0
+            _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, acc)
+            work[k, 0], work[k, 1], work[k, 2] = acc[0], acc[1], acc[2]
+        # torque coefficient
+        acc[:] = 0.0
+        _cauchy_cross(Y, 0, Y, 0, k, I0, I1, I2, acc)  # (Iω) × ω
+        g0, g1, g2 = Y[k, 3], Y[k, 4], Y[k, 5]
+        acc[0] += p[10] * g2 - p[11] * g1
+        acc[1] += p[11] * g0 - p[9] * g2
+        acc[2] += p[9] * g1 - p[10] * g0
+        if p[14] != 0.0:  # N_2 γ × Iγ = −N_2 (Iγ) × γ
+            tmp[:] = 0.0
+            _cauchy_cross(Y, 3, Y, 3, k, I0, I1, I2, tmp)
+            acc[0] -= p[14] * tmp[0]
+            acc[1] -= p[14] * tmp[1]
+            acc[2] -= p[14] * tmp[2]
+        if has_alpha:
+            x0, x1, x2 = Y[k, 6], Y[k, 7], Y[k, 8]
+            b0, b1, b2 = work[k, 0], work[k, 1], work[k, 2]
+            acc[0] += p[4] * x2 - p[5] * x1 + p[7] * b2 - p[8] * b1
+            acc[1] += p[5] * x0 - p[3] * x2 + p[8] * b0 - p[6] * b2
+            acc[2] += p[3] * x1 - p[4] * x0 + p[6] * b1 - p[7] * b0
+            if p[12] != 0.0:
+                tmp[:] = 0.0
+                _cauchy_cross(Y, 6, Y, 6, k, I0, I1, I2, tmp)
+                acc[0] -= p[12] * tmp[0]
+                acc[1] -= p[12] * tmp[1]
+                acc[2] -= p[12] * tmp[2]
+            if p[13] != 0.0:
+                tmp[:] = 0.0
+                _cauchy_cross(work, 0, work, 0, k, I0, I1, I2, tmp)
+                acc[0] -= p[13] * tmp[0]
+                acc[1] -= p[13] * tmp[1]
+                acc[2] -= p[13] * tmp[2]
+        inv = 1.0 / (k + 1)
+        Y[k + 1, 0] = acc[0] / I0 * inv
+        Y[k + 1, 1] = acc[1] / I1 * inv
+        Y[k + 1, 2] = acc[2] / I2 * inv
+        # γ̇ = γ × ω, α̇ = α × ω
+        acc[:] = 0.0
+        _cauchy_cross(Y, 3, Y, 0, k, 1.0, 1.0, 1.0, acc)
+        Y[k + 1, 3], Y[k + 1, 4], Y[k + 1, 5] = acc[0] * inv, acc[1] * inv, acc[2] * inv
+        if has_alpha:
+            acc[:] = 0.0
+            _cauchy_cross(Y, 6, Y, 0, k, 1.0, 1.0, 1.0, acc)
+            Y[k + 1, 6], Y[k + 1, 7], Y[k + 1, 8] = acc[0] * inv, acc[1] * inv, acc[2] * inv

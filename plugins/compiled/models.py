@@ -1,0 +1,26 @@
+"""The compiled models integrator kernels can call, selected by an integer id.
+
+numba caches a kernel only if the functions it calls are module globals
+(a function passed as an argument or closed over is recompiled in every
+process), hence one dispatch on ``model`` instead of a callback.
+"""
+
+from __future__ import annotations
+
+import numba
+
+from plugins.compiled import fixed_point
+
+FIXED_POINT = 0
+
+
+@numba.njit(cache=True)
+def rhs(model, t, y, p, out):
+    if model == FIXED_POINT:
+        fixed_point.rhs(t, y, p, out)
+
+
+@numba.njit(cache=True)
+def taylor_coefficients(model, p, Y, order, work):
+    if model == FIXED_POINT:
+        fixed_point.taylor_coefficients(p, Y, order, work)

@@ -1,0 +1,152 @@
+"""Compiled integrators (numba): DOP853, RK4 and a high-order Taylor method.
+
+They run the system's compiled model (``System.compiled_model()``) entirely in
+machine code; Python only slices the output times into chunks, to report
+progress between them. Same contract and statistics as the Python plugins.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from pipeline.contracts.integrator import (
+    CompiledModel,
+    Integrator,
+    IntegratorStats,
+    ProgressCallback,
+    RightHandSide,
+    Solution,
+)
+from pipeline.errors import ConfigError, IntegrationError, as_number
+
+CHUNKS = 50  # progress reports per run at most
+
+
+def _chunks(n_out: int) -> list[tuple[int, int]]:
+    size = max(1, math.ceil((n_out - 1) / CHUNKS))
+    return [(i, min(i + size, n_out)) for i in range(1, n_out, size)]
+
+
+def steps_per_interval(t_out: np.ndarray, step: float) -> np.ndarray:
+    """Fewest equal steps no longer than ``step`` in each output interval (lands on every output time)."""
+    return np.maximum(1, np.ceil(np.diff(t_out) / step * (1.0 - 1e-12))).astype(np.int64)
+
+
+class DOP853Numba(Integrator):
+    name = "dop853_numba"
+    adaptive = True
+    needs_compiled_model = True
+
+    def __init__(self, *, rtol: float = 1e-10, atol: float = 1e-10, max_step: float | None = None) -> None:
+        self.rtol = as_number(rtol, "integrator.rtol", positive=True)
+        self.atol = as_number(atol, "integrator.atol", positive=True)
+        self.max_step = np.inf if max_step is None else as_number(max_step, "integrator.max_step", positive=True)
+
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+        from plugins.compiled import dop853, models
+
+        start = time.perf_counter()
+        t_out = np.asarray(t_out, dtype=float)
+        y = np.array(y0, dtype=float)
+        out = np.empty((len(t_out), len(y)))
+        out[0] = y
+        f = np.empty_like(y)
+        models.rhs(compiled.model, t_out[0], y, compiled.params, f)
+        stats = np.zeros(3, dtype=np.int64)
+        stats[0] = 1
+        h0 = dop853.initial_step(compiled.model, compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
+                                 self.rtol, self.atol, stats)
+        state = np.array([t_out[0], h0])
+        for first, stop in _chunks(len(t_out)):
+            status, _ = dop853.run(compiled.model, compiled.params, t_out, out, first, stop, state, y, f,
+                                   t_out[-1], self.rtol, self.atol, self.max_step, stats)
+            if status != dop853.OK:
+                reason = "the step size fell below the spacing of floating-point numbers" \
+                    if status == dop853.TOO_SMALL_STEP else "the state became non-finite"
+                raise IntegrationError(f"{self.name} failed near t={state[0]:.6g}: {reason}")
+            if progress is not None:
+                progress(state[0])
+        wall = time.perf_counter() - start
+        return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]),
+                                                    n_rejected=int(stats[2]), wall_time=wall))
+
+    def attributes(self) -> dict[str, Any]:
+        attrs: dict[str, Any] = {"integrator_rtol": self.rtol, "integrator_atol": self.atol}
+        if np.isfinite(self.max_step):
+            attrs["integrator_max_step"] = self.max_step
+        return attrs
+
+
+class RK4Numba(Integrator):
+    name = "rk4_numba"
+    adaptive = False
+    needs_compiled_model = True
+
+    def __init__(self, *, step: float = 0.01) -> None:
+        self.step = as_number(step, "integrator.step", positive=True)
+
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+        from plugins.compiled import rk4
+
+        start = time.perf_counter()
+        t_out = np.asarray(t_out, dtype=float)
+        steps = steps_per_interval(t_out, self.step)
+        y = np.array(y0, dtype=float)
+        out = np.empty((len(t_out), len(y)))
+        out[0] = y
+        for first, stop in _chunks(len(t_out)):
+            reached = rk4.run(compiled.model, compiled.params, t_out, steps, y, out, first, stop)
+            if reached != stop:
+                raise IntegrationError(f"rk4_numba produced a non-finite state before t={t_out[reached]:.6g} "
+                                       f"with step {self.step:.3g}; reduce integrator.step")
+            if progress is not None:
+                progress(t_out[stop - 1])
+        n_steps = int(steps.sum())
+        return Solution(t_out, out, IntegratorStats(nfev=4 * n_steps, n_steps=n_steps, n_rejected=0,
+                                                    wall_time=time.perf_counter() - start))
+
+    def attributes(self) -> dict[str, Any]:
+        return {"integrator_step": self.step}
+
+
+class Taylor(Integrator):
+    name = "taylor"
+    adaptive = True
+    needs_compiled_model = True
+
+    def __init__(self, *, order: int = 20, tol: float = 1e-16) -> None:
+        if isinstance(order, bool) or not isinstance(order, int) or not 4 <= order <= 60:
+            raise ConfigError(f"integrator.order={order!r} must be an integer from 4 to 60")
+        self.order = order
+        self.tol = as_number(tol, "integrator.tol", positive=True)
+
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+        from plugins.compiled import taylor
+
+        start = time.perf_counter()
+        t_out = np.asarray(t_out, dtype=float)
+        y = np.array(y0, dtype=float)
+        out = np.empty((len(t_out), len(y)))
+        out[0] = y
+        state = np.array([t_out[0]])
+        stats = np.zeros(2, dtype=np.int64)
+        for first, stop in _chunks(len(t_out)):
+            status, _ = taylor.run(compiled.model, compiled.params, self.order, self.tol, t_out, out, first, stop,
+                                   state, y, stats)
+            if status != taylor.OK:
+                raise IntegrationError(f"taylor produced a non-finite state near t={state[0]:.6g}")
+            if progress is not None:
+                progress(state[0])
+        # one Taylor step costs about as much as `order` right-hand-side evaluations; report the series count
+        return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
+                                                    wall_time=time.perf_counter() - start))
+
+    def attributes(self) -> dict[str, Any]:
+        return {"integrator_order": self.order, "integrator_tol": self.tol}
