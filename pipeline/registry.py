@@ -45,6 +45,7 @@ BUILTINS: dict[str, dict[str, str]] = {
         "dop853_numba": "plugins.integrators.compiled_solvers:DOP853Numba",
         "rk4_numba": "plugins.integrators.compiled_solvers:RK4Numba",
         "taylor": "plugins.integrators.compiled_solvers:Taylor",
+        "auto": "plugins.integrators.auto:Auto",
     },
     "regime": {},
 }

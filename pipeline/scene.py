@@ -56,7 +56,9 @@ class Scene:
         log.info("integrating %s with %s over t=[%g, %g] (%d output times)", self.system.title(),
                  self.integrator.name, self.times[0], self.times[-1], len(self.times))
         progress = Progress(self.integrator.name, self.times[0], self.times[-1])
-        compiled = self.system.compiled_model() if self.integrator.needs_compiled_model else None
+        integrator = self.integrator
+        wants = integrator.needs_compiled_model or integrator.prefers_compiled_model
+        compiled = self.system.compiled_model() if wants else None
         solution = self.integrator.integrate(self.system.rhs, self.times, self.system.initial_state(), progress,
                                              compiled)
         stats = solution.stats

@@ -76,6 +76,7 @@ class Integrator(ABC):
     name: ClassVar[str]
     adaptive: ClassVar[bool]
     needs_compiled_model: ClassVar[bool] = False
+    prefers_compiled_model: ClassVar[bool] = False  # use the compiled model when the system has one
 
     @abstractmethod
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
