@@ -14,7 +14,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
-from omegaconf import OmegaConf
 
 from pipeline.contracts.integrator import Solution
 from pipeline.errors import ConfigError
@@ -40,7 +39,7 @@ def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
     attrs: dict[str, Any] = {
         "title": system.title(),
         "Conventions": "CF-1.8",
-        "config": OmegaConf.to_yaml(scene.config, resolve=True),
+        "config": scene.config_yaml,
         "monitored_invariants": " ".join(system.invariants),
         "integrator": integrator.name,
     }

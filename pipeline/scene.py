@@ -5,6 +5,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -50,6 +51,11 @@ class Scene:
                 f"compiled form; choose a Python integrator (dop853, rk45, rk4, lsoda, radau, bdf)"
             )
         return cls(config=cfg, system=system, integrator=integrator, times=times)
+
+    @cached_property
+    def config_yaml(self) -> str:
+        """The resolved config as YAML (stored in every dataset; computed once per scene)."""
+        return OmegaConf.to_yaml(self.config, resolve=True)
 
     def run(self) -> xr.Dataset:
         """Integrate the full equations of motion and return the self-describing dataset."""

@@ -23,7 +23,13 @@ def _cache_dir() -> str:
     return str(root / "gyrolab" / f"numba-{digest.hexdigest()[:16]}")
 
 
-if "NUMBA_CACHE_DIR" not in os.environ:
-    import numba
+import numba  # noqa: E402
 
+if "NUMBA_CACHE_DIR" not in os.environ:
     numba.config.CACHE_DIR = _cache_dir()
+
+#: Decorator of every kernel: cached on disk; numpy's error model (no zero-division checks
+#: inside the arithmetic, which cost more than the arithmetic; a zero divisor gives inf/NaN,
+#: which the integrators detect and report).
+kernel = numba.njit(cache=True, error_model="numpy")
+inline_kernel = numba.njit(cache=True, error_model="numpy", inline="always")

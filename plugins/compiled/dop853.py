@@ -9,10 +9,10 @@ state (t, y, f, |h|) lives in arrays the caller keeps between chunks.
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 from scipy.integrate._ivp import dop853_coefficients as _c
 
+from plugins.compiled import kernel
 from plugins.compiled.models import rhs
 
 N_STAGES = _c.N_STAGES  # 12
@@ -29,12 +29,12 @@ ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
 OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2
 
 
-@numba.njit(cache=True)
+@kernel
 def _rms(x):
     return np.sqrt(np.sum(x * x) / x.size)
 
 
-@numba.njit(cache=True)
+@kernel
 def initial_step(model, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats):
     """scipy.integrate._ivp.common.select_initial_step for order 7."""
     interval = abs(t_bound - t0)
@@ -54,7 +54,7 @@ def initial_step(model, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats):
     return min(100 * h0, h1, interval, max_step)
 
 
-@numba.njit(cache=True)
+@kernel
 def _stage_sum(K, s, a_row, n, out):
     for i in range(n):
         acc = 0.0
@@ -63,7 +63,7 @@ def _stage_sum(K, s, a_row, n, out):
         out[i] = acc
 
 
-@numba.njit(cache=True)
+@kernel
 def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, max_step, stats):
     """Advance until t_out[i_stop − 1] is filled. state = [t, h_abs]; stats = [nfev, steps, rejected].
 

@@ -2,18 +2,18 @@
 
 Parameters are one float array ``p`` (see ``pack``): inertia I (3), the
 linear-torque vectors U_i (torque U_i × e_i, 3×3), the gradient coefficients
-N_i (torque N_i e_i × I e_i, 3) and a flag saying whether the state carries α.
+N_i (torque N_i e_i × I e_i, 3) a flag saying whether the state carries α, and 1/I (3).
 e_0 = α (fixed X), e_1 = β = γ × α (fixed Y), e_2 = γ (vertical).
 """
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from pipeline.contracts.force import CompiledTerms
+from plugins.compiled import inline_kernel, kernel
 
-N_PARAMS = 16
+N_PARAMS = 19
 
 
 def pack(inertia: np.ndarray, terms: list[CompiledTerms], carries_alpha: bool) -> np.ndarray:
@@ -25,16 +25,17 @@ def pack(inertia: np.ndarray, terms: list[CompiledTerms], carries_alpha: bool) -
         for axis, n in term.gradient.items():
             p[12 + axis] += n
     p[15] = 1.0 if carries_alpha else 0.0
+    p[16:19] = 1.0 / inertia  # multiplications in the inner loop, not divisions
     return p
 
 
-@numba.njit(cache=True, inline="always")
+@inline_kernel
 def _cross_add(u0, u1, u2, v0, v1, v2, s):
     """s · (u × v) as three floats."""
     return s * (u1 * v2 - u2 * v1), s * (u2 * v0 - u0 * v2), s * (u0 * v1 - u1 * v0)
 
 
-@numba.njit(cache=True)
+@inline_kernel
 def rhs(t, y, p, out):
     I0, I1, I2 = p[0], p[1], p[2]
     w0, w1, w2 = y[0], y[1], y[2]
@@ -64,12 +65,12 @@ def rhs(t, y, p, out):
         out[6] = x1 * w2 - x2 * w1
         out[7] = x2 * w0 - x0 * w2
         out[8] = x0 * w1 - x1 * w0
-    out[0] = t0 / I0
-    out[1] = t1 / I1
-    out[2] = t2 / I2
+    out[0] = t0 * p[16]
+    out[1] = t1 * p[17]
+    out[2] = t2 * p[18]
 
 
-@numba.njit(cache=True)
+@kernel
 def _cauchy_cross(A, ia, B, ib, k, s0, s1, s2, out):
     """out += Σ_j s ⊙ (A[j, ia:ia+3]) × B[k−j, ib:ib+3] with a per-component scale s of A."""
     r0 = 0.0
@@ -86,7 +87,7 @@ def _cauchy_cross(A, ia, B, ib, k, s0, s1, s2, out):
     out[2] += r2
 
 
-@numba.njit(cache=True)
+@kernel
 def taylor_coefficients(p, Y, order, work):
     """Fill Y[1..order] (rows: Taylor coefficients of the state) from Y[0].
 

@@ -7,20 +7,19 @@ process), hence one dispatch on ``model`` instead of a callback.
 
 from __future__ import annotations
 
-import numba
 
-from plugins.compiled import fixed_point
+from plugins.compiled import fixed_point, inline_kernel
 
 FIXED_POINT = 0
 
 
-@numba.njit(cache=True)
+@inline_kernel
 def rhs(model, t, y, p, out):
     if model == FIXED_POINT:
         fixed_point.rhs(t, y, p, out)
 
 
-@numba.njit(cache=True)
+@inline_kernel
 def taylor_coefficients(model, p, Y, order, work):
     if model == FIXED_POINT:
         fixed_point.taylor_coefficients(p, Y, order, work)

@@ -5,10 +5,11 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from plugins.compiled import kernel
 from plugins.compiled.models import rhs
 
 
-@numba.njit(cache=True)
+@kernel
 def _advance(model, p, t0, y, interval, steps, k1, k2, k3, k4, tmp):
     h = interval / steps
     n = y.size
@@ -28,7 +29,7 @@ def _advance(model, p, t0, y, interval, steps, k1, k2, k3, k4, tmp):
             y[m] += (h / 6.0) * (k1[m] + 2.0 * k2[m] + 2.0 * k3[m] + k4[m])
 
 
-@numba.njit(cache=True)
+@kernel
 def run(model, p, t_out, steps_per_interval, y, Y, i_next, i_stop):
     """Fill Y[i_next:i_stop]; y is advanced in place. Returns the first index left non-finite, or i_stop."""
     n = y.size
@@ -42,7 +43,7 @@ def run(model, p, t_out, steps_per_interval, y, Y, i_next, i_stop):
     return i_stop
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, error_model="numpy")
 def run_batch(model, P, t_out, steps_per_interval, Y0, Y):
     """Many trajectories at once: P[j] parameters and Y0[j] initial state of trajectory j; Y[j, i] the outputs."""
     count, n = Y0.shape

@@ -8,15 +8,15 @@ relative to the state; the series itself is the dense output.
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
+from plugins.compiled import kernel
 from plugins.compiled.models import taylor_coefficients
 
 OK, NOT_FINITE = 0, 2
 
 
-@numba.njit(cache=True)
+@kernel
 def _norm_inf(row):
     v = 0.0
     for x in row:
@@ -24,7 +24,7 @@ def _norm_inf(row):
     return v
 
 
-@numba.njit(cache=True)
+@kernel
 def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, stats):
     """Advance until t_out[i_stop − 1] is filled. state = [t]; stats = [coefficient evaluations, steps]."""
     n = y.size
