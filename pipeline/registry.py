@@ -46,6 +46,7 @@ BUILTINS: dict[str, dict[str, str]] = {
         "rk4_numba": "plugins.integrators.compiled_solvers:RK4Numba",
         "taylor": "plugins.integrators.compiled_solvers:Taylor",
         "auto": "plugins.integrators.auto:Auto",
+        "lie_poisson": "plugins.integrators.compiled_solvers:LiePoisson",
     },
     "regime": {},
 }

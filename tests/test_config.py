@@ -55,6 +55,6 @@ def test_unknown_plugin_parameter_is_refused():
 
 
 def test_registry_lists_builtins():
-    assert names("integrator") == ["auto", "bdf", "dop853", "dop853_numba", "lsoda", "radau", "rk4", "rk45",
-                                   "rk4_numba", "taylor"]
+    assert names("integrator") == ["auto", "bdf", "dop853", "dop853_numba", "lie_poisson", "lsoda", "radau", "rk4",
+                                   "rk45", "rk4_numba", "taylor"]
     assert {"uniform_gravity", "newtonian", "magnetic"} <= set(names("force"))

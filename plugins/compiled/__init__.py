@@ -4,7 +4,7 @@ Kernels take plain float arrays; systems pack their parameters (``pack``), the
 integrator kernels call ``models.rhs(model, ...)``. Compiled code is cached on
 disk between processes. numba only checks the timestamp of the file that
 defines a kernel, not of the kernels it calls, so the cache lives in a
-directory named after a hash of this package's sources: editing any kernel
+directory named after a hash of this package's sources and numba's version: editing any kernel
 starts a fresh cache instead of reusing stale machine code.
 """
 
@@ -12,11 +12,14 @@ from __future__ import annotations
 
 import hashlib
 import os
+import platform
 from pathlib import Path
 
 
 def _cache_dir() -> str:
-    digest = hashlib.sha256()
+    from importlib.metadata import version
+
+    digest = hashlib.sha256(f"numba {version('numba')} {platform.machine()}".encode())
     for source in sorted(Path(__file__).parent.glob("*.py")):
         digest.update(source.read_bytes())
     root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")

@@ -15,6 +15,7 @@ import numpy as np
 
 from pipeline.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
 from pipeline.errors import IntegrationError, as_number
+from plugins.integrators.step_guard import check_step
 
 
 class RK4(Integrator):
@@ -43,6 +44,7 @@ class RK4(Integrator):
             t0, interval = t_out[i - 1], t_out[i] - t_out[i - 1]
             m = max(1, math.ceil(interval / self.step * (1.0 - 1e-12)))
             h = interval / m
+            check_step(self.name, fun, t0, y, h)
             for j in range(m):
                 t = t0 + j * h
                 k1 = fun(t, y)

@@ -43,7 +43,10 @@ class ScipySolver(Integrator):
         n_steps, n_rejected, filled = 0, 0, 1
         while solver.status == "running" and filled < len(t_out):
             nfev_before = solver.nfev
-            message = solver.step()
+            try:
+                message = solver.step()
+            except (ValueError, ArithmeticError, np.linalg.LinAlgError) as error:  # e.g. LU of a NaN Jacobian
+                raise IntegrationError(f"{self.name} failed near t={solver.t:.6g}: {error}") from None
             if solver.status == "failed":
                 raise IntegrationError(f"{self.name} failed near t={solver.t:.6g}: {message}")
             if not np.all(np.isfinite(solver.y)):

@@ -1,0 +1,100 @@
+"""Compiled integrators: same steps as scipy, orders, accuracy against the extended-precision reference."""
+
+import numpy as np
+import pytest
+
+from pipeline import compose_scene, run
+from pipeline.errors import ConfigError
+from pipeline.reference import fixed_point_reference
+
+INERTIA, R_C, K = [2.0, 1.5, 1.0], [0.3, 0.2, 0.9327379053088815], 0.5
+Y0 = [0.1, -0.05, 5.0, np.sin(1.0), 0.0, np.cos(1.0)]
+REF_BASE = ["experiment=perf_reference", "time.n_output=11"]
+
+
+@pytest.fixture(scope="module")
+def reference20():
+    """The perf reference problem on [0, 20] in extended precision (independent of the kernels)."""
+    return fixed_point_reference(INERTIA, R_C, K, Y0, np.linspace(0, 20, 11)).astype(float)
+
+
+def _state(ds):
+    return np.concatenate([ds.omega.values, ds.gamma.values], axis=1)
+
+
+def test_compiled_dop853_takes_scipys_steps():
+    common = ["integrator.rtol=1e-9", "integrator.atol=1e-9", "time.end=20", "time.n_output=41"]
+    py, nb = run(["integrator=dop853", *common]), run(["integrator=dop853_numba", *common])
+    for key in ("integrator_nfev", "integrator_n_steps", "integrator_n_rejected"):
+        assert py.attrs[key] == nb.attrs[key], key
+    np.testing.assert_allclose(_state(nb), _state(py), rtol=0, atol=1e-12)
+
+
+def test_compiled_rk4_takes_the_python_rk4_steps():
+    common = ["integrator.step=0.01", "time.end=5", "time.n_output=11"]
+    py, nb = run(["integrator=rk4", *common]), run(["integrator=rk4_numba", *common])
+    assert py.attrs["integrator_n_steps"] == nb.attrs["integrator_n_steps"]
+    np.testing.assert_allclose(_state(nb), _state(py), rtol=0, atol=1e-12)
+
+
+def test_taylor_against_extended_precision(reference20):
+    ds = run([*REF_BASE, "integrator=taylor", "integrator.tol=1e-16", "time.end=20"])
+    assert np.max(np.abs(_state(ds) - reference20)) < 1e-13
+
+
+@pytest.mark.parametrize("order", [2, 4, 6])
+def test_lie_poisson_order(order, reference20):
+    errors, steps = [], [0.02, 0.01]
+    for h in steps:
+        ds = run([*REF_BASE, "integrator=lie_poisson", f"integrator.order={order}", f"integrator.step={h}",
+                  "time.end=20"])
+        errors.append(np.max(np.abs(_state(ds) - reference20)))
+    assert np.log2(errors[0] / errors[1]) == pytest.approx(order, abs=0.2)
+
+
+def test_lie_poisson_keeps_the_casimirs_and_bounds_energy_over_ten_thousand_spins():
+    # 10^4 spin periods of the reference body (r0 = 5: period 2π/5).
+    end = 1e4 * 2 * np.pi / 5
+    common = [*REF_BASE, f"time.end={end}", "time.n_output=2001"]
+    lp = run([*common, "integrator=lie_poisson", "integrator.step=0.02", "integrator.order=4"])
+    assert lp.gamma_norm.attrs["max_abs_drift"] < 1e-12
+    assert lp.area_integral.attrs["max_abs_drift"] < 1e-11
+    energy_error = np.abs(lp.energy.values - lp.energy.values[0])
+    early, late = energy_error[:200].max(), energy_error[-200:].max()
+    assert late < 3 * early  # bounded oscillation, no secular drift
+    rk = run([*common, "integrator=dop853_numba", "integrator.rtol=1e-8", "integrator.atol=1e-8"])
+    rk_error = np.abs(rk.energy.values - rk.energy.values[0])
+    assert rk_error[-200:].max() > 10 * rk_error[:200].max()  # the non-symplectic method drifts
+
+
+@pytest.mark.parametrize("accuracy", [1e-6, 1e-9, 1e-11])
+def test_auto_meets_its_accuracy(accuracy):
+    end = 60.0
+    reference = fixed_point_reference(INERTIA, R_C, K, Y0, [0.0, end])[-1].astype(float)
+    ds = run(["experiment=perf_reference", "time.n_output=2", f"time.end={end}", "integrator=auto",
+              f"accuracy={accuracy}"])
+    error = np.max(np.abs(_state(ds)[-1] - reference))
+    assert error <= accuracy
+    assert ds.attrs["auto_method"] == "taylor" and ds.attrs["accuracy"] == accuracy
+    assert ds.attrs["auto_predicted_error"] <= accuracy
+
+
+def test_auto_falls_back_to_scipy_without_compiled_forms(monkeypatch):
+    from plugins.forces.newtonian import Newtonian
+
+    monkeypatch.setattr(Newtonian, "compiled_terms", lambda self: None)
+    ds = run(["integrator=auto", "accuracy=1e-7", "time.end=5", "time.n_output=11"])
+    assert ds.attrs["auto_method"] == "dop853"
+
+
+def test_compiled_integrator_refuses_a_force_without_compiled_form(monkeypatch):
+    from plugins.forces.newtonian import Newtonian
+
+    monkeypatch.setattr(Newtonian, "compiled_terms", lambda self: None)
+    with pytest.raises(ConfigError, match="'newtonian' has no compiled form"):
+        compose_scene(["integrator=taylor"])
+
+
+def test_auto_refuses_an_accuracy_beyond_double_precision():
+    with pytest.raises(ConfigError, match="accuracy=1e-15 is below"):
+        run(["integrator=auto", "accuracy=1e-15", "time.end=1", "time.n_output=3"])
