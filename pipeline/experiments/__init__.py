@@ -1,0 +1,24 @@
+"""Experiments: tasks built from many scenes (``task: NAME`` in an experiment config).
+
+A plain run has ``task: scene``; an experiment file sets another task and
+its own section, and the app hands the composed config to the task's
+``run(cfg, out_dir)``, which writes its dataset and figures in ``out_dir``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+
+from omegaconf import DictConfig
+
+from pipeline.errors import ConfigError, choices
+
+TASKS = {"work_precision": "pipeline.experiments.work_precision"}
+
+
+def run_task(name: str, cfg: DictConfig, out_dir: Path) -> list[Path]:
+    """Run experiment task ``name``; returns the files it wrote."""
+    if name not in TASKS:
+        raise ConfigError(f"unknown task {name!r}; valid choices: {choices(['scene', *TASKS])}")
+    return importlib.import_module(TASKS[name]).run(cfg, out_dir)
