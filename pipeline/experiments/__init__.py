@@ -14,7 +14,16 @@ from omegaconf import DictConfig
 
 from pipeline.errors import ConfigError, choices
 
-TASKS = {"work_precision": "pipeline.experiments.work_precision"}
+TASKS = {
+    "work_precision": "pipeline.experiments.work_precision",
+    # expansion regimes (seeds 000, 001)
+    "regime": "pipeline.experiments.regime_run",
+    "regime_validity": "pipeline.experiments.regime_validity",
+    "ismail2021_tables": "pipeline.experiments.ismail2021_tables",
+    "shaker_omega3": "pipeline.experiments.shaker_omega3",
+    # satellite-gyrostat (seed 002)
+    "yehia2021_precessions": "pipeline.experiments.yehia2021_precessions",
+}
 
 
 def run_task(name: str, cfg: DictConfig, out_dir: Path) -> list[Path]:
