@@ -11,8 +11,9 @@ SHORT = ["time.end=2", "time.n_output=11", "integrator.step=0.01"]
 
 
 @pytest.mark.parametrize("integrator", ["rk4_numba", "rk4"])
-def test_batch_equals_single_runs(integrator):
-    scene = compose_scene([f"integrator={integrator}", *SHORT])
+@pytest.mark.parametrize("euler_angles", [False, True])  # (ω, γ) by blocks; (ω, γ, α) one per thread
+def test_batch_equals_single_runs(integrator, euler_angles):
+    scene = compose_scene([f"integrator={integrator}", f"output.euler_angles={str(euler_angles).lower()}", *SHORT])
     rng = np.random.default_rng(0)
     y0s = np.tile(scene.system.initial_state(), (5, 1))
     y0s[:, 0:3] += rng.normal(scale=0.1, size=(5, 3))

@@ -147,3 +147,24 @@ def taylor_coefficients(p, Y, order, work):
             acc[:] = 0.0
             _cauchy_cross(Y, 6, Y, 0, k, 1.0, 1.0, 1.0, acc)
             Y[k + 1, 6], Y[k + 1, 7], Y[k + 1, 8] = acc[0] * inv, acc[1] * inv, acc[2] * inv
+
+
+@kernel
+def rhs_block(Y, P, out, count):
+    """The right-hand side for a block of trajectories stored by columns: Y[:, j] is trajectory j.
+
+    Same arithmetic as ``rhs`` (without the α terms: blocks carry (ω, γ) only), written
+    as loops over the block so that they vectorise across trajectories.
+    """
+    for j in range(count):
+        w0, w1, w2 = Y[0, j], Y[1, j], Y[2, j]
+        g0, g1, g2 = Y[3, j], Y[4, j], Y[5, j]
+        I0, I1, I2 = P[0, j], P[1, j], P[2, j]
+        n = P[14, j]
+        u0, u1, u2 = P[9, j], P[10, j], P[11, j]
+        out[0, j] = ((I1 - I2) * w1 * w2 + u1 * g2 - u2 * g1 + n * (I2 - I1) * g1 * g2) * P[16, j]
+        out[1, j] = ((I2 - I0) * w2 * w0 + u2 * g0 - u0 * g2 + n * (I0 - I2) * g2 * g0) * P[17, j]
+        out[2, j] = ((I0 - I1) * w0 * w1 + u0 * g1 - u1 * g0 + n * (I1 - I0) * g0 * g1) * P[18, j]
+        out[3, j] = g1 * w2 - g2 * w1
+        out[4, j] = g2 * w0 - g0 * w2
+        out[5, j] = g0 * w1 - g1 * w0
