@@ -48,7 +48,11 @@ BUILTINS: dict[str, dict[str, str]] = {
         "auto": "plugins.integrators.auto:Auto",
         "lie_poisson": "plugins.integrators.compiled_solvers:LiePoisson",
     },
-    "regime": {},
+    "regime": {
+        "small_parameter": "plugins.regimes.small_parameter:SmallParameter",
+        "large_parameter": "plugins.regimes.large_parameter:LargeParameter",
+        "resonant_omega3": "plugins.regimes.resonant_omega3:ResonantOmega3",
+    },
 }
 
 

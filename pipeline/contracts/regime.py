@@ -1,4 +1,4 @@
-"""Contract of an expansion-regime plugin: an analytic approximation valid in a stated domain."""
+"""Contract of an expansion-regime plugin: an analytic periodic solution valid in a stated domain."""
 
 from __future__ import annotations
 
@@ -8,6 +8,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from pipeline.contracts.system import System
+from pipeline.errors import ConfigError, choices
+
+FORMULAS = ("corrected", "printed")
 
 
 class Regime(ABC):
@@ -15,25 +18,64 @@ class Regime(ABC):
 
     Rules for implementers:
 
-    1. ``systems`` lists the system names the expansion is derived for; a
+    1. ``__init__(self, *, formula="corrected", **params)`` takes the plugin's
+       config; ``formula`` selects the corrected formulas or the paper's
+       printed ones (``FORMULAS``); bad values raise ``ConfigError``.
+    2. ``systems`` lists the system names the expansion is derived for; a
        scene pairing it with another system is refused before integrating.
-    2. ``check_domain(system)`` returns a list of one-sentence warnings
-       (recorded in the dataset) or raises ``ConfigError`` when the scene is
-       outside the domain the expansion assumes.
-    3. ``solution(system, t)`` returns the analytic approximation of the
-       system's state at times ``t`` (shape (n, state size)), in model units.
+    3. ``parameter``/``parameter_long_name`` name the expansion's small or
+       large parameter; ``parameter_value(system)`` computes it from the scene,
+       and ``order`` gives the theory's error order in it, per variable.
+    4. ``check_domain(system)`` returns a list of one-sentence warnings
+       (recorded in the dataset) or raises ``ConfigError`` (one sentence,
+       naming the bad value and what is valid) when the scene is outside the
+       domain the expansion assumes (parameter range, resonances, physical
+       admissibility, forces).
+    5. The expansion describes one periodic orbit through the scene's spin r0
+       and nutation θ0 (other initial values are the orbit's own):
+       ``initial_state(system)`` is its state (ω, γ) at t = 0 (shape (6,)),
+       ``period(system)`` its period and ``solution(system, t)`` its state at
+       times t (shape (n, 6)), all in the scene's model units.
+    6. ``euler_angles(system, t)`` returns ``{"psi", "theta", "phi"}`` of the
+       analytic solution (ψ(0) = scene's ψ0).
+    7. ``attributes()`` describes the regime for the dataset (netCDF-safe values).
     """
 
     name: ClassVar[str]
-    systems: ClassVar[tuple[str, ...]]
+    systems: ClassVar[tuple[str, ...]] = ("fixed_point",)
+    parameter: ClassVar[str]
+    parameter_long_name: ClassVar[str]
+    #: the theory's error order of each variable in the parameter (error ∝ parameter**order)
+    order: ClassVar[dict[str, float]] = {}
+
+    def __init__(self, *, formula: str = "corrected") -> None:
+        if formula not in FORMULAS:
+            raise ConfigError(f"regime.formula={formula!r} is not valid; valid choices: {choices(FORMULAS)}")
+        self.formula = formula
+
+    @abstractmethod
+    def parameter_value(self, system: System) -> float:
+        """The expansion parameter of the scene."""
 
     @abstractmethod
     def check_domain(self, system: System) -> list[str]:
         """Warnings for a scene inside but near the edge of the domain; ConfigError outside it."""
 
     @abstractmethod
+    def initial_state(self, system: System) -> np.ndarray:
+        """(ω, γ) of the analytic periodic orbit at t = 0."""
+
+    @abstractmethod
+    def period(self, system: System) -> float:
+        """Period of the body-frame motion of the analytic orbit (model time units)."""
+
+    @abstractmethod
     def solution(self, system: System, t: np.ndarray) -> np.ndarray:
-        """The analytic approximation of the state at times t."""
+        """The analytic approximation of (ω, γ) at times t, shape (n, 6)."""
+
+    @abstractmethod
+    def euler_angles(self, system: System, t: np.ndarray) -> dict[str, np.ndarray]:
+        """ψ, θ, φ of the analytic solution at times t."""
 
     def attributes(self) -> dict[str, Any]:
-        return {}
+        return {"regime": self.name, "regime_formula": self.formula, "regime_parameter": self.parameter}

@@ -1,0 +1,224 @@
+"""A regime run (``gyrolab regime=NAME ...``): the analytic periodic solution against the full model and the exact orbit.
+
+For the scene's body, forces, spin r0 and tilt θ0, the regime's analytic
+periodic orbit (``Regime.solution``) is compared over ``regime.periods``
+periods with
+
+* the full model integrated from the analytic orbit's own t = 0 state with
+  the scene's integrator ("full"), and
+* the exact periodic orbit of the full model through the same r0, θ0, γ'(0) = 0
+  (Newton shooting from the analytic one, ``pipeline.periodic``), sampled with
+  the compiled Taylor method ("orbit").
+
+Writes ``regime.nc`` (every variable with CF units and long_name; domain
+warnings in the attribute ``regime_warnings``) and ``figures/regime_comparison.png``.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from omegaconf import DictConfig, OmegaConf
+
+from pipeline import registry
+from pipeline.contracts.regime import Regime
+from pipeline.dataset import write_dataset
+from pipeline.errors import ConfigError
+from pipeline.periodic import FixedPointModel, PeriodicOrbit, shoot
+from pipeline.provenance import provenance
+from pipeline.scene import Scene
+
+log = logging.getLogger(__name__)
+SOURCES = ("analytic", "full", "orbit")
+SOURCE_NAMES = {"analytic": "analytic solution", "full": "full model from the analytic t = 0 state",
+                "orbit": "exact periodic orbit (Newton shooting)"}
+
+
+def build_regime(cfg: DictConfig) -> Regime:
+    """The regime plugin selected by ``cfg.regime`` (a registered class only)."""
+    node = cfg.get("regime")
+    if not isinstance(node, DictConfig) or "_target_" not in node:
+        raise ConfigError(f"regime must be selected by name (regime=NAME); valid choices: "
+                          f"{', '.join(registry.names('regime'))}")
+    _, cls = registry.resolve_target("regime", node._target_, "regime")
+    params = {k: v for k, v in OmegaConf.to_container(node, resolve=True).items() if k != "_target_"}
+    accepted = registry.default_params(cls)
+    unknown = sorted(set(params) - set(accepted))
+    if unknown:
+        raise ConfigError(f"regime.{unknown[0]} is not a parameter of {cls.__name__}; valid parameters: "
+                          f"{', '.join(sorted(accepted))}")
+    return cls(**params)
+
+
+def prepare(cfg: DictConfig) -> tuple[Scene, Regime, list[str]]:
+    """Scene, regime and the domain warnings; ConfigError (before any integration) outside the domain."""
+    scene = Scene.from_config(cfg)
+    regime = build_regime(cfg)
+    if scene.system.name not in regime.systems:
+        raise ConfigError(f"regime {regime.name} is derived for system {', '.join(regime.systems)}, "
+                          f"not {scene.system.name}")
+    warnings = regime.check_domain(scene.system)
+    for warning in warnings:
+        log.warning("%s: %s", regime.name, warning)
+    return scene, regime, warnings
+
+
+def exact_orbit(scene: Scene, regime: Regime) -> PeriodicOrbit:
+    """The full model's periodic orbit, by Newton shooting from the analytic one."""
+    system = scene.system
+    y0 = regime.initial_state(system)
+    y0[3] = np.sqrt(max(0.0, 1.0 - y0[5] ** 2))
+    y0[4] = 0.0
+    return shoot(FixedPointModel.from_system(system), y0, regime.period(system))
+
+
+def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = False) -> np.ndarray:
+    """The full model from y0 (the system's layout) at times t: the scene's integrator or compiled Taylor."""
+    system = scene.system
+    if taylor:
+        from plugins.integrators.compiled_solvers import Taylor
+
+        return Taylor(order=24, tol=1e-16).integrate(system.rhs, t, y0, None, system.compiled_model()).y
+    integrator = scene.integrator
+    wants = integrator.needs_compiled_model or integrator.prefers_compiled_model
+    return integrator.integrate(system.rhs, t, y0, None, system.compiled_model() if wants else None).y
+
+
+def with_alpha(scene: Scene, regime: Regime, y6: np.ndarray) -> np.ndarray:
+    """A 6-state in the system's layout (α from ψ0 and the state's θ, φ)."""
+    from pipeline.attitude import frame_from_angles
+
+    if scene.system.state_size == 6:
+        return y6
+    psi0 = float(regime.euler_angles(scene.system, np.array([0.0]))["psi"][0])
+    alpha, _, _ = frame_from_angles(psi0, float(np.arccos(np.clip(y6[5], -1, 1))), float(np.arctan2(y6[3], y6[4])))
+    return np.concatenate([y6, alpha])
+
+
+def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True) -> dict[str, Any]:
+    """States (n, 6) and Euler angles of the three sources, the exact orbit and its analytic period."""
+    system = scene.system
+    out: dict[str, Any] = {"orbit": exact_orbit(scene, regime), "period_analytic": regime.period(system)}
+    states = {"analytic": regime.solution(system, t)}
+    angles = {"analytic": regime.euler_angles(system, t)}
+    runs = {"orbit": out["orbit"].y0}
+    if full:
+        runs["full"] = regime.full_initial_state(system)[:6]
+    for source, y0 in runs.items():
+        y = integrate(scene, with_alpha(scene, regime, y0), t, taylor=source == "orbit")
+        states[source] = y[:, :6]
+        variables = system.variables(t, y)
+        angles[source] = {k: variables[k].values for k in ("psi", "theta", "phi") if k in variables}
+    out["states"], out["angles"] = states, angles
+    return out
+
+
+def errors(result: dict[str, Any], against: str = "orbit") -> dict[str, float]:
+    """Max errors of the analytic solution over the window, per group of variables (model units)."""
+    a, b = result["states"]["analytic"], result["states"][against]
+    d = np.abs(a - b)
+    out = {"pq": float(d[:, :2].max()), "r": float(d[:, 2].max()), "gamma": float(d[:, 3:5].max()),
+           "gamma3": float(d[:, 5].max())}
+    if against == "orbit":
+        out["period"] = abs(result["period_analytic"] - result["orbit"].period)
+    return out
+
+
+def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
+    scene, regime, warnings = prepare(cfg)
+    system = scene.system
+    T = regime.period(system)
+    t = np.linspace(0.0, regime.periods * T, regime.periods * regime.samples_per_period + 1)
+    result = compute(scene, regime, t)
+    orbit = result["orbit"]
+    log.info("%s (%s): %s = %.4g, analytic period %.10g, exact %.10g, Newton residuals %s", regime.name,
+             regime.formula, regime.parameter, regime.parameter_value(system), T, orbit.period,
+             ", ".join(f"{r:.1e}" for r in orbit.residuals))
+    ds = dataset(scene, regime, t, result, warnings)
+    written = [write_dataset(ds, Path(out_dir) / "regime.nc")]
+    written.append(plot(ds, Path(out_dir) / "figures" / "regime_comparison.png"))
+    return written
+
+
+def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any], warnings: list[str]) -> xr.Dataset:
+    system, body = scene.system, scene.system.body
+    orbit = result["orbit"]
+    data: dict[str, Any] = {}
+    for source, y in result["states"].items():
+        label = SOURCE_NAMES[source]
+        data[f"omega_{source}"] = (("time", "axis"), y[:, :3],
+                                   {"units": body.rate_unit, "long_name": f"angular velocity (p, q, r), {label}"})
+        data[f"gamma_{source}"] = (("time", "axis"), y[:, 3:6],
+                                   {"units": "1", "long_name": f"direction cosines of the vertical (γ, γ', γ''), {label}"})
+        for name, values in result["angles"][source].items():
+            data[f"{name}_{source}"] = ("time", values, {"units": "rad", "long_name": f"Euler angle {name}, {label}"})
+    for against in ("full", "orbit"):
+        d = np.max(np.abs(result["states"]["analytic"] - result["states"][against]), axis=0)
+        data[f"max_error_vs_{against}"] = ("component", d, {
+            "units": "1", "long_name": f"max |analytic − {SOURCE_NAMES[against]}| over the window, per component "
+                                       f"(model units of ω, γ)"})
+    n = len(orbit.residuals)
+    data["newton_residual"] = ("iteration", np.array(orbit.residuals), {
+        "units": "1", "long_name": "max-norm of the shooting return residual y(T) − y(0), relative to max(1, |y0|)"})
+    data["floquet_multiplier_real"] = ("multiplier", orbit.multipliers.real, {
+        "units": "1", "long_name": "Floquet multipliers (eigenvalues of the monodromy matrix), real part"})
+    data["floquet_multiplier_imag"] = ("multiplier", orbit.multipliers.imag, {
+        "units": "1", "long_name": "Floquet multipliers, imaginary part"})
+    data["orbit_initial_state"] = ("component", orbit.y0, {
+        "units": "1", "long_name": "exact orbit initial state (p, q, r, γ, γ', γ'') in model units"})
+    data["period_analytic"] = ((), result["period_analytic"], {"units": body.time_unit,
+                                                                "long_name": "period of the analytic orbit"})
+    data["period_orbit"] = ((), orbit.period, {"units": body.time_unit, "long_name": "period of the exact orbit"})
+    coords = {
+        "time": ("time", t, {"units": body.time_unit, "long_name": f"time [{body.time_label}]", "standard_name": "time"}),
+        "axis": ("axis", np.array(["x", "y", "z"]), {"units": "1", "long_name": "principal body axis"}),
+        "component": ("component", np.array(["p", "q", "r", "gamma_x", "gamma_y", "gamma_z"]),
+                      {"units": "1", "long_name": "state component"}),
+        "iteration": ("iteration", np.arange(n), {"units": "1", "long_name": "Newton iteration"}),
+        "multiplier": ("multiplier", np.arange(6), {"units": "1", "long_name": "Floquet multiplier index"}),
+    }
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update({
+        "title": f"regime {regime.name} ({regime.formula}): {system.title()}",
+        "Conventions": "CF-1.8",
+        "config": scene.config_yaml,
+        "regime_parameter_value": float(regime.parameter_value(system)),
+        "regime_warnings": " | ".join(warnings) if warnings else "none",
+        "scene": system.title(),
+        "rate_label": body.rate_label,
+        **regime.attributes(), **provenance(), **system.attributes(),
+    })
+    return ds
+
+
+def plot(ds: xr.Dataset, path: Path) -> Path:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    t = ds.time.values
+    styles = {"analytic": dict(ls="--", lw=1.6), "full": dict(ls="-", lw=1.0), "orbit": dict(ls=":", lw=2.0)}
+    rate_unit = ds.attrs["rate_label"]
+    panels = [("omega", 0, f"p [{rate_unit}]"), ("omega", 1, f"q [{rate_unit}]"), ("omega", 2, f"r [{rate_unit}]"),
+              ("gamma", 2, "γ'' = cos θ [1]")]
+    fig, axes = plt.subplots(2, 2, figsize=(10, 7), sharex=True)
+    for ax, (var, i, label) in zip(axes.flat, panels):
+        for source in SOURCES:
+            ax.plot(t, ds[f"{var}_{source}"].values[:, i], label=SOURCE_NAMES[source], **styles[source])
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    for ax in axes[1]:
+        ax.set_xlabel(f"time t [{ds.time.attrs['long_name'].split('[')[-1].rstrip(']')}]")
+    axes[0, 0].legend(fontsize=7)
+    fig.suptitle(f"{ds.attrs['title']}\n{ds.attrs['regime_parameter']} = {ds.attrs['regime_parameter_value']:.4g}",
+                 fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

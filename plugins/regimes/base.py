@@ -1,0 +1,143 @@
+"""What the fixed-point regimes share: the scene in the papers' nondimensional form, and the unit mapping.
+
+The papers work with time in 1/c and rates in c (c² = Mgℓ/C), a = A/C, b = B/C,
+the unit centre-of-mass direction (x0', y0', z0') and k = N/c². A scene in SI
+units is mapped there and back: t' = c t, ω' = ω/c.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from pipeline.attitude import frame_from_angles
+from pipeline.contracts.regime import Regime
+from pipeline.contracts.system import System
+from pipeline.errors import ConfigError
+
+SUPPORTED_FORCES = ("uniform_gravity", "newtonian")
+
+
+@dataclass(frozen=True)
+class NondimensionalScene:
+    a: float
+    b: float
+    x0: float
+    y0: float
+    z0: float
+    k: float  # N/c²
+    c: float  # √(Mgℓ/C) in model rate units (1 for a nondimensional body)
+    r0: float  # initial spin in units of c
+    theta0: float
+    psi0: float
+    nonphysical: bool
+
+    @property
+    def omega2(self) -> float:
+        """ω² = −A1B1 = (C−A)(C−B)/(AB) (seed 000 eq. 5, seed 001 §2)."""
+        return (1 - self.a) * (1 - self.b) / (self.a * self.b)
+
+    @property
+    def gamma0pp(self) -> float:
+        return float(np.cos(self.theta0))
+
+
+def nondimensional_scene(system: System, regime: str) -> NondimensionalScene:
+    """The scene's body, forces and initial spin/tilt in the papers' form; ConfigError for other forces."""
+    names = [f.name for f in system.forces]
+    foreign = [n for n in names if n not in SUPPORTED_FORCES]
+    if foreign or "uniform_gravity" not in names:
+        raise ConfigError(f"regime {regime} is derived for force=[uniform_gravity] or [uniform_gravity,newtonian], "
+                          f"got force={names}")
+    body = system.body
+    nd = body.nondimensional()
+    c2 = nd.get("c2", 1.0)
+    if c2 <= 0:
+        raise ConfigError(f"regime {regime} needs a heavy body (c² = Mgℓ/C > 0), got c²={c2:g}")
+    c = float(np.sqrt(c2))
+    k = 0.0
+    for force in system.forces:
+        if force.name == "newtonian":
+            k = float(force.N) / c2
+    omega0, gamma0 = system.initial.omega, system.initial.gamma
+    theta0 = float(np.arctan2(np.hypot(gamma0[0], gamma0[1]), gamma0[2]))
+    alpha0 = system.initial.alpha
+    psi0 = float(np.arctan2(alpha0[2], -np.cross(gamma0, alpha0)[2])) if np.sin(theta0) > 1e-12 else 0.0
+    x0, y0, z0 = nd["com_direction"]
+    return NondimensionalScene(a=nd["a"], b=nd["b"], x0=x0, y0=y0, z0=z0, k=k, c=c, r0=float(omega0[2]) / c,
+                               theta0=theta0, psi0=psi0, nonphysical=bool(body.nonphysical))
+
+
+class FixedPointRegime(Regime):
+    """Base of the built-in regimes: nondimensional formulas, mapped to the scene's model units.
+
+    ``periods`` and ``samples_per_period`` set the window of a regime run (t from 0 to
+    ``periods`` periods of the analytic orbit).
+    """
+
+    def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200) -> None:
+        super().__init__(formula=formula)
+        for key, value in (("periods", periods), ("samples_per_period", samples_per_period)):
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ConfigError(f"regime.{key}={value!r} must be a positive integer")
+        self.periods = periods
+        self.samples_per_period = samples_per_period
+
+    # Subclasses implement the nondimensional solution (time in 1/c, rates in c).
+    def _state(self, s: NondimensionalScene, t: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def _period(self, s: NondimensionalScene) -> float:
+        raise NotImplementedError
+
+    def _euler(self, s: NondimensionalScene, t: np.ndarray) -> dict[str, np.ndarray]:
+        raise NotImplementedError
+
+    def scene(self, system: System) -> NondimensionalScene:
+        return nondimensional_scene(system, self.name)
+
+    def initial_state(self, system: System) -> np.ndarray:
+        return self.solution(system, np.array([0.0]))[0]
+
+    def period(self, system: System) -> float:
+        s = self.scene(system)
+        return self._period(s) / s.c
+
+    def solution(self, system: System, t: np.ndarray) -> np.ndarray:
+        s = self.scene(system)
+        y = self._state(s, s.c * np.asarray(t, dtype=float))
+        y[:, :3] *= s.c
+        return y
+
+    def euler_angles(self, system: System, t: np.ndarray) -> dict[str, np.ndarray]:
+        s = self.scene(system)
+        angles = self._euler(s, s.c * np.asarray(t, dtype=float))
+        angles["psi"] = angles["psi"] + s.psi0
+        return angles
+
+    def full_initial_state(self, system: System) -> np.ndarray:
+        """The orbit's t = 0 state in the system's layout (α appended from ψ0, θ(0), φ(0) when carried)."""
+        y = self.initial_state(system)
+        y[3:6] /= np.linalg.norm(y[3:6])  # the series satisfies |γ| = 1 to its order only
+        if system.state_size == 6:
+            return y
+        angles = self.euler_angles(system, np.array([0.0]))
+        alpha, _, _ = frame_from_angles(float(angles["psi"][0]), float(np.arccos(np.clip(y[5], -1, 1))),
+                                        float(np.arctan2(y[3], y[4])))
+        return np.concatenate([y, alpha])
+
+    def reseat_warnings(self, system: System) -> list[str]:
+        """Warnings naming the scene's initial values the orbit replaces (p0, q0, φ0)."""
+        y = self.initial_state(system)
+        given = np.concatenate([system.initial.omega, system.initial.gamma])
+        out = []
+        if np.max(np.abs(given[:2] - y[:2])) > 1e-12 or abs(given[4]) > 1e-12:
+            out.append(f"the analytic orbit starts from its own p0={y[0]:.6g}, q0={y[1]:.6g}, φ0=π/2 "
+                       f"(the scene gave p0={given[0]:.6g}, q0={given[1]:.6g}, γ'0={given[4]:.3g}); "
+                       "r0 and θ0 are the scene's")
+        return out
+
+    def attributes(self) -> dict[str, Any]:
+        return {**super().attributes(), "regime_parameter_long_name": self.parameter_long_name}

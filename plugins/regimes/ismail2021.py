@@ -1,0 +1,188 @@
+"""Seed 000: the fast-spin periodic solution of Ismail (2021), printed and corrected.
+
+A. I. Ismail, "The periodic rotary motions of a rigid body in a new domain of
+angular velocity", J. Egypt. Math. Soc. 29:2 (2021). Verification report:
+``docs/derivations/seed000_large_parameter.md`` (cited below as "report §n").
+
+Scaling (the only one consistent with the paper's eqs. (1)-(2), report §3;
+the paper's eq. (4) prints μ = c/r0, which contradicts them):
+
+    μ = r0/c (≫ 1: FAST spin),  ε = 1/μ = c/r0,  τ = r0 t,
+    p1 = p/c, q1 = q/c, r1 = r/r0,  γ0'' = Γ/μ (eq. 28),  k = N/c².
+
+Notation: a = A/C, b = B/C, A1 = (1−b)/a, B1 = (a−1)/b, C1 = b−a,
+ω² = −A1B1 (eq. 5); (x0', y0', z0') = unit centre-of-mass direction.
+All functions are plain numpy on floats; times in units of 1/c, rates in c
+(multiply by c, divide by c for another unit system).
+
+Validity (report §5, §9): generic ω away from 1, 2, 3 (denominators 1−ω²,
+4−ω², 9−ω²), M1 = M2 = 0, μ ≫ 1 and Γ = μγ0'' = O(1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Params:
+    """Body and orbit in the paper's nondimensional form (time unit 1/c)."""
+
+    a: float
+    b: float
+    x0: float
+    y0: float
+    z0: float
+    k: float  # N/c²
+    mu: float  # r0/c
+    g0: float  # γ0'' = cos θ0
+
+    @property
+    def A1(self) -> float:
+        return (1 - self.b) / self.a
+
+    @property
+    def B1(self) -> float:
+        return (self.a - 1) / self.b
+
+    @property
+    def C1(self) -> float:
+        return self.b - self.a
+
+    @property
+    def omega2(self) -> float:
+        """ω² = −A1B1 = (C−A)(C−B)/(AB) (eq. 5)."""
+        return -self.A1 * self.B1
+
+    @property
+    def chi1(self) -> float:
+        """χ1 = (1−ω²)⁻¹[−z0'(a⁻¹ − A1b⁻¹) + kγ0''(A1 − ω²)] (eq. 10)."""
+        return (-self.z0 * (1 / self.a - self.A1 / self.b) + self.k * self.g0 * (self.A1 - self.omega2)) / (1 - self.omega2)
+
+    @property
+    def chi2(self) -> float:
+        """χ2 = χ1 + z0'a⁻¹ − kA1γ0'' (eq. 10)."""
+        return self.chi1 + self.z0 / self.a - self.k * self.A1 * self.g0
+
+
+# -- corrected (report §5.1, derived independently by Lindstedt–Poincaré) -----------------------------
+def frequency(P: Params) -> float:
+    """Ω = 2π/T_τ = 1 − μ⁻²(x0' + kC1/4 − z0'γ0'') + O(μ⁻⁴) (corrected (36), report §5.2)."""
+    return 1 - (P.x0 + 0.25 * P.k * P.C1 - P.z0 * P.g0) / P.mu**2
+
+
+def period_correction(P: Params, n: int = 1) -> float:
+    """α = T_τ − 2πn (corrected (36)): 2πnμ⁻²(x0' − z0'γ0'' + kC1/4) + O(μ⁻⁴)."""
+    return 2 * np.pi * n * (P.x0 - P.z0 * P.g0 + 0.25 * P.k * P.C1) / P.mu**2
+
+
+def scaled(tau: np.ndarray, P: Params) -> dict[str, np.ndarray]:
+    """Corrected (35) in strained time s = Ωτ: p1, q1 O(μ⁻³), r1, γ's O(μ⁻⁴) (report §5.3)."""
+    e, g0, C1, x, y, z, a, b = 1 / P.mu, P.g0, P.C1, P.x0, P.y0, P.z0, P.a, P.b
+    kc = P.k * C1
+    s = frequency(P) * np.asarray(tau, dtype=float)
+    cs, ss, c2, s2, c3, s3 = np.cos(s), np.sin(s), np.cos(2 * s), np.sin(2 * s), np.cos(3 * s), np.sin(3 * s)
+    p1 = e * (x * g0 / (1 - a) + P.chi1 * cs)
+    q1 = e * (y * g0 / (1 - b) + P.chi2 / P.A1 * ss)
+    r1 = 1 - e**2 * (x * (1 - cs) + y * ss + 0.25 * kc * (1 - c2))
+    g1 = (1 - 0.5 * g0**2) * cs + e**2 * (kc / 16 * (c3 - cs) - 0.5 * x * (1 - c2) + y * (ss - 0.5 * s2))
+    g2 = -(1 - 0.5 * g0**2) * ss + e**2 * (-kc / 16 * (ss + s3) - 0.5 * x * s2 + y * (cs - 0.5 - 0.5 * c2)
+                                           - g0 * z * C1 / (a + b - 1) * ss)
+    g3 = g0 + e**2 * (-z * C1 / (a + b - 1) * ss**2
+                      + g0 * (x / (1 - a) * (1 - cs) + y / (1 - b) * ss - 0.25 * kc * (1 - c2)))
+    return dict(p1=p1, q1=q1, r1=r1, g1=g1, g2=g2, g3=g3, s=s)
+
+
+def euler(t: np.ndarray, P: Params) -> dict[str, np.ndarray]:
+    """Corrected (38)-(39), t in 1/c, ψ(0) = 0, φ(0) = π/2 (report §6): θ, ψ O(μ⁻⁴), φ O(μ⁻³·⁵)."""
+    e, g0, C1, A1, x, y, z, a, b, k = 1 / P.mu, P.g0, P.C1, P.A1, P.x0, P.y0, P.z0, P.a, P.b, P.k
+    r0 = P.mu
+    t = np.asarray(t, dtype=float)
+    s = frequency(P) * r0 * t
+    th0 = np.arccos(g0)
+
+    def th2(u):
+        return (y * g0 / (1 - b) * np.sin(u) - x * g0 / (1 - a) * np.cos(u)
+                + 0.5 * C1 * (z / (a + b - 1) + 0.5 * k * g0) * np.cos(2 * u))
+
+    def ps1(u):
+        return (0.25 * (P.chi1 + P.chi2 / A1) * np.sin(2 * u) + y * g0 / (1 - b) * np.cos(u)
+                + x * g0 / (1 - a) * np.sin(u))
+
+    theta = th0 - e**2 / np.sin(th0) * (th2(s) - th2(0.0))
+    psi = 0.5 / r0 * (P.chi1 - P.chi2 / A1) * t + e**2 * (ps1(s) - ps1(0.0))
+    phi = np.pi / 2 + s + e**2 * (x * np.sin(s) + y * (np.cos(s) - 1) + k * C1 / 8 * np.sin(2 * s))
+    return dict(theta=theta, psi=psi, phi=phi)
+
+
+# -- as printed (all three extractions agree unless noted; report §5.2, §6) --------------------------
+def printed_period_correction(P: Params, n: int = 1) -> float:
+    """α of (36) as printed (003/004; M3 = 1): C1 coefficient 1/16 and a spurious B1γ0''(1−γ0'') term."""
+    return 2 * np.pi * n / P.mu**2 * (P.x0 - P.z0 * P.g0 - 0.5 * P.k * (
+        P.g0**2 * (P.b * P.B1 - P.a * P.A1) + P.B1 * P.g0 * (1 - P.g0) - 0.125 * P.C1))
+
+
+def printed_frequency(P: Params) -> float:
+    """Ω = 2π/(2π + α) with the printed α (used for the printed period only)."""
+    return 2 * np.pi / (2 * np.pi + printed_period_correction(P))
+
+
+def printed_scaled(tau: np.ndarray, P: Params) -> dict[str, np.ndarray]:
+    """(35) as printed (M3 = 1), evaluated at the unstrained τ as the paper does."""
+    e, g0, C1, x, y, z, a, b, k = 1 / P.mu, P.g0, P.C1, P.x0, P.y0, P.z0, P.a, P.b, P.k
+    tau = np.asarray(tau, dtype=float)
+    ct, st = np.cos(tau), np.sin(tau)
+    Gam = g0 * P.mu
+    p1 = e * (x * g0 / (1 - a) + P.chi1 * ct)
+    q1 = e * (y * g0 / (1 - b) + P.chi2 / P.A1 * st)
+    r1 = 1 - 0.25 * e**2 * (k * C1 + 4 * x * (1 - ct) + y * st - k * C1 * np.cos(2 * tau))
+    g1 = ct - 0.5 * e**2 * Gam**2 * ct
+    g2 = -st + 0.5 * e**2 * Gam**2 * st
+    g3 = g0 + e**2 * (x * g0 / (1 - a) - 0.5 * C1 * (z / (a + b - 1) + 0.5 * k * g0)
+                      - x * g0 / (1 - a) * ct + y * g0 / (1 - b) * st
+                      + 0.25 * C1 * (2 * z / (a + b - 1) + k * g0) * np.cos(2 * tau))
+    return dict(p1=p1, q1=q1, r1=r1, g1=g1, g2=g2, g3=g3, s=tau)
+
+
+def printed_euler(t: np.ndarray, P: Params) -> dict[str, np.ndarray]:
+    """(38)-(39) exactly as printed (r0⁻¹t arguments, '+ sin 2r0⁻¹t', prefactor μ⁻¹c, θ sign +, −0.667k)."""
+    e, g0, C1, A1, x, y, z, a, b, k = 1 / P.mu, P.g0, P.C1, P.A1, P.x0, P.y0, P.z0, P.a, P.b, P.k
+    r0 = P.mu
+    w = 1 / r0
+    th0 = np.arccos(g0)
+    t = np.asarray(t, dtype=float)
+
+    def th2(u):
+        return (y * g0 / (1 - b) * np.sin(w * u) - x * g0 / (1 - a) * np.cos(w * u)
+                + 0.5 * C1 * (z / (a + b - 1) - 0.667 * k * g0) * np.cos(2 * w * u))
+
+    def ps1(u):
+        return (0.25 * (P.chi1 + P.chi2 / A1) + np.sin(2 * w * u) + y * g0 / (1 - b) * np.cos(w * u)
+                + x * g0 / (1 - a) * np.sin(w * u))
+
+    theta = th0 + e**2 / np.sin(th0) * (th2(t) - th2(0.0))
+    psi = 0.5 / r0 * (P.chi1 - P.chi2 / A1) * t + e * (ps1(t) - ps1(0.0))
+    phi = np.pi / 2 + (w - 0.5 / r0 * g0 * (P.chi1 - P.chi2 / A1)) * t
+    return dict(theta=theta, psi=psi, phi=phi)
+
+
+def scaled_to_model(S: dict[str, np.ndarray], P: Params) -> np.ndarray:
+    """(p, q, r, γ, γ', γ'') in units of c from the scaled solution: p = c p1, r = r0 r1 (report §3)."""
+    return np.stack([S["p1"], S["q1"], P.mu * S["r1"], S["g1"], S["g2"], S["g3"]], axis=-1)
+
+
+# -- reduced quasilinear system (000 eq. 1: the scaled equations integrated in τ) ---------------------
+def scaled_rhs(tau: float, Y: np.ndarray, P: Params) -> np.ndarray:
+    """The paper's eq. (1) in τ = r0 t, Y = (p1, q1, r1, γ, γ', γ''); exact (it is the full model rescaled)."""
+    a, b, x, y, z, k, A1, B1, C1 = P.a, P.b, P.x0, P.y0, P.z0, P.k, P.A1, P.B1, P.C1
+    p, q, r, g1, g2, g3 = Y
+    e = 1 / P.mu
+    return np.array([
+        -A1 * q * r + e / a * (g3 * y - g2 * z + k * a * A1 * g2 * g3),
+        -B1 * p * r + e / b * (g1 * z - g3 * x + k * b * B1 * g3 * g1),
+        e**2 * (-C1 * p * q + g2 * x - g1 * y + k * C1 * g1 * g2),
+        r * g2 - e * q * g3,
+        e * p * g3 - r * g1,
+        e * (q * g1 - p * g2)])

@@ -1,0 +1,73 @@
+"""The resonant case ω = 3 (seed 001, Shaker, El-Barki, Ismail), case (i) M1 = M2 = 0, corrected or printed.
+
+Fast spin with the small parameter μ = c√(cos θ0)/r0 and the 3:1 resonance
+of the generating system, ω² = (C−A)(C−B)/(AB) = 9. Since ω² − 1 =
+C(C−A−B)/(AB), ω = 3 requires A + B < C: no real rigid body has it
+(``docs/derivations/seed001_resonant_omega3.md`` §3). The scene must say so
+explicitly with ``body.allow_nonphysical=true``.
+
+Theory error orders in μ (report §6): p, q 3; r, γ's 4; period 4 (corrected);
+printed: p, q 1 (wrong ℓ1), γ'' 2, γ, γ' 2 (their O(μ²) terms are not printed), period 2.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pipeline.errors import ConfigError
+from plugins.regimes import shaker_omega3 as paper
+from plugins.regimes.base import FixedPointRegime, NondimensionalScene
+
+OMEGA_TOLERANCE = 1e-6
+
+
+class ResonantOmega3(FixedPointRegime):
+    name = "resonant_omega3"
+    parameter = "mu"
+    parameter_long_name = "seed 001's small parameter μ = c√(cos θ0)/r0"
+    order = {"pq": 3.0, "r": 4.0, "gamma": 4.0, "gamma3": 4.0, "period": 4.0}
+    printed_order = {"pq": 1.0, "r": 4.0, "gamma": 2.0, "gamma3": 2.0, "period": 2.0}
+
+    def constants(self, s: NondimensionalScene) -> paper.Constants:
+        C = paper.Constants(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k_gt=s.k, theta0=s.theta0)
+        return C.as_printed() if self.formula == "printed" else C
+
+    def parameter_value(self, system) -> float:
+        s = self.scene(system)
+        return paper.mu_of(s.r0, s.theta0) if s.gamma0pp > 0 and s.r0 > 0 else np.inf
+
+    def check_domain(self, system) -> list[str]:
+        s = self.scene(system)
+        w = np.sqrt(max(s.omega2, 0.0))
+        if abs(w - 3.0) > OMEGA_TOLERANCE:
+            raise ConfigError(f"regime resonant_omega3 needs ω = 3 but the body has ω = {w:.6g} "
+                              f"(ω² = (C−A)(C−B)/(AB)); choose b = (1−a)/(1+8a) = {paper.omega3_b(s.a):.10g} "
+                              "for a = A/C, which is non-physical (A + B < C)")
+        if not system.body.source.get("allow_nonphysical", False):
+            raise ConfigError("regime resonant_omega3 describes a non-physical body (ω = 3 requires A + B < C); "
+                              "set body.allow_nonphysical=true to study it anyway")
+        if not 0 < s.theta0 < np.pi / 2:
+            raise ConfigError(f"regime resonant_omega3 needs 0 < θ0 < π/2 (μ = c√cos θ0/r0 and M3 = tan θ0), "
+                              f"got θ0={s.theta0:.4g}")
+        mu = paper.mu_of(s.r0, s.theta0) if s.r0 > 0 else np.inf
+        if not mu < 1:
+            raise ConfigError(f"regime resonant_omega3 needs fast spin, μ = c√(cos θ0)/r0 < 1, but the scene "
+                              f"gives μ={mu:.4g}; increase initial.r0")
+        C = self.constants(s)
+        warnings = [f"non-physical body (A + B < C, ω = 3): admitted by body.allow_nonphysical=true"]
+        if mu > 0.2:
+            warnings.append(f"μ = {mu:.3g} > 0.2: near the edge of the fast-spin domain, expect errors of order "
+                            f"μ² ≈ {mu**2:.2g}")
+        if abs(C.a2) < 0.05 or abs(C.l1) * mu > 0.5:
+            warnings.append(f"a2 = {C.a2:.3g} is near 0 (ℓ1 = M3³L310/a2 = {C.l1:.3g}): secondary resonance, "
+                            "the case (i) series degrades")
+        return warnings + self.reseat_warnings(system)
+
+    def _state(self, s, t):
+        return paper.state(t, s.r0, self.constants(s))
+
+    def _period(self, s):
+        return paper.period(s.r0, self.constants(s))
+
+    def _euler(self, s, t):
+        return paper.euler(t, s.r0, self.constants(s))

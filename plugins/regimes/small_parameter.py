@@ -1,0 +1,89 @@
+"""Fast spin about a fixed point: Poincaré's small-parameter periodic solution, ε = c/r0 ≪ 1 (seed 000, corrected).
+
+Seed 000 (Ismail 2021) calls this a "large-parameter" method for small r0,
+but its equations (1)-(2) are consistent only with μ = r0/c (report §3 of
+``docs/derivations/seed000_large_parameter.md``): it is the classical fast-top
+expansion in ε = 1/μ = c/r0 = √(Mgℓ/C)/r0. This plugin is that expansion,
+with the corrected (35), (36), (38)-(39) (``plugins.regimes.ismail2021``);
+``formula=printed`` evaluates the paper's printed formulas in the same
+consistent scaling.
+
+Domain: ε < 1 (warning above 0.2), ω away from the resonances 1, 2, 3 of
+the generating system, and γ0'' = cos θ0 = O(ε) (the derivation sets
+γ0'' = Γ/μ; warning when Γ = γ0''/ε > 3). Theory error orders in ε:
+p, q 3; r, γ, γ', γ'' 4; period 4 (corrected) — the printed r, γ, γ' are 2.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pipeline.errors import ConfigError
+from plugins.regimes import ismail2021 as paper
+from plugins.regimes.base import FixedPointRegime, NondimensionalScene
+
+RESONANCES = (1.0, 2.0, 3.0)
+REFUSE_DISTANCE = 0.02  # |ω − n| below this: refused (the 1/(n² − ω²) terms blow up)
+WARN_DISTANCE = 0.1
+
+
+class SmallParameter(FixedPointRegime):
+    name = "small_parameter"
+    parameter = "c/r0"
+    parameter_long_name = "Poincaré's small parameter ε = c/r0 = √(Mgℓ/C)/r0 (seed 000's 1/μ)"
+    order = {"pq": 3.0, "r": 4.0, "gamma": 4.0, "gamma3": 4.0, "period": 4.0}
+    printed_order = {"pq": 3.0, "r": 2.0, "gamma": 2.0, "gamma3": 4.0, "period": 2.0}
+
+    def params(self, s: NondimensionalScene) -> paper.Params:
+        return paper.Params(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k, mu=s.r0, g0=s.gamma0pp)
+
+    def parameter_value(self, system) -> float:
+        s = self.scene(system)
+        return 1.0 / s.r0 if s.r0 != 0 else np.inf
+
+    def check_domain(self, system) -> list[str]:
+        s = self.scene(system)
+        eps = 1.0 / s.r0 if s.r0 > 0 else np.inf
+        if not 0 < eps < 1:
+            raise ConfigError(f"regime small_parameter needs fast spin, 0 < c/r0 < 1, but initial.r0 gives "
+                              f"c/r0={eps:.4g}; choose r0 > c (r0 ≥ 5c for errors below ~1e-3)")
+        w2 = s.omega2
+        w = np.sqrt(w2) if w2 > 0 else 0.0
+        for n in RESONANCES:
+            if w2 > 0 and abs(w - n) < REFUSE_DISTANCE:
+                raise ConfigError(f"regime small_parameter excludes the resonance ω = {n:g}: the body has "
+                                  f"ω = {w:.5g} (ω² = (C−A)(C−B)/(AB)); choose a, b with |ω − {n:g}| ≥ "
+                                  f"{REFUSE_DISTANCE:g}" + (" (or regime=resonant_omega3)" if n == 3 else ""))
+        warnings = []
+        for n in RESONANCES:
+            if w2 > 0 and abs(w - n) < WARN_DISTANCE:
+                warnings.append(f"ω = {w:.4g} is within {WARN_DISTANCE:g} of the excluded resonance ω = {n:g}: "
+                                f"terms ∝ 1/({n:g}² − ω²) = {1 / (n * n - w2):.3g} amplify the error")
+        if w2 <= 0:
+            warnings.append(f"ω² = {w2:.4g} ≤ 0 (A, B on both sides of C): the generating p-mode is not an "
+                            "oscillation; the expansion is untested there")
+        if eps > 0.2:
+            warnings.append(f"c/r0 = {eps:.3g} > 0.2: near the edge of the fast-spin domain, expect errors of "
+                            f"order (c/r0)² ≈ {eps**2:.2g}")
+        gamma = s.gamma0pp / eps
+        if abs(gamma) > 3:
+            warnings.append(f"Γ = cos θ0 · r0/c = {gamma:.3g}: the expansion assumes cos θ0 = O(c/r0) "
+                            "(a nearly horizontal axis, seed 000 eq. 28); expect larger errors")
+        if abs(s.a + s.b - 1) < 0.05:
+            warnings.append(f"a + b − 1 = {s.a + s.b - 1:.3g}: the z0'/(a + b − 1) terms of (35) are large")
+        return warnings + self.reseat_warnings(system)
+
+    def _state(self, s, t):
+        P = self.params(s)
+        tau = s.r0 * t
+        S = paper.printed_scaled(tau, P) if self.formula == "printed" else paper.scaled(tau, P)
+        return paper.scaled_to_model(S, P)
+
+    def _period(self, s):
+        P = self.params(s)
+        omega = paper.printed_frequency(P) if self.formula == "printed" else paper.frequency(P)
+        return 2 * np.pi / (omega * s.r0)
+
+    def _euler(self, s, t):
+        P = self.params(s)
+        return paper.printed_euler(t, P) if self.formula == "printed" else paper.euler(t, P)
