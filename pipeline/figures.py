@@ -93,7 +93,14 @@ def plot_body_axis(ds: xr.Dataset) -> plt.Figure:
     u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 37), np.linspace(0, np.pi, 19))
     ax.plot_wireframe(np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v), color="0.85", lw=0.4)
     gamma = ds["gamma"].values
-    if "alpha" in ds:
+    if "body_axis_inertial" in ds:  # a system that reports the body axis in its own frames (orbiting gyrostat)
+        for name, style in (("body_axis_orbital", "-"), ("body_axis_inertial", "--")):
+            trace = ds[name].values
+            ax.plot(*trace.T, style, lw=0.8, label=ds[name].attrs.get("long_name", name))
+            ax.scatter(*trace[0], color="green", s=25)
+        frame = ("axis 1", "axis 2", "axis 3 (orbit normal)")
+        trace, label = None, None
+    elif "alpha" in ds:
         alpha = ds["alpha"].values
         beta = np.cross(gamma, alpha)
         trace = np.stack([alpha[:, 2], beta[:, 2], gamma[:, 2]], axis=1)  # body z in fixed X, Y, Z
@@ -101,9 +108,10 @@ def plot_body_axis(ds: xr.Dataset) -> plt.Figure:
     else:  # without the full attitude: the vertical seen from the body
         trace = gamma
         frame, label = ("body x", "body y", "body z"), "fixed vertical in body axes (γ)"
-    ax.plot(*trace.T, lw=0.8, label=label)
-    ax.scatter(*trace[0], color="green", s=25, label="start")
-    ax.scatter(*trace[-1], color="red", s=25, label="end")
+    if trace is not None:
+        ax.plot(*trace.T, lw=0.8, label=label)
+        ax.scatter(*trace[0], color="green", s=25, label="start")
+        ax.scatter(*trace[-1], color="red", s=25, label="end")
     ax.set_xlabel(frame[0])
     ax.set_ylabel(frame[1])
     ax.set_zlabel(frame[2])

@@ -29,6 +29,7 @@ GROUPS: dict[str, tuple[str, type]] = {
 BUILTINS: dict[str, dict[str, str]] = {
     "system": {
         "fixed_point": "plugins.systems.fixed_point:FixedPoint",
+        "orbiting_gyrostat": "plugins.systems.orbiting_gyrostat:OrbitingGyrostat",
     },
     "force": {
         "uniform_gravity": "plugins.forces.uniform_gravity:UniformGravity",

@@ -46,8 +46,9 @@ class Scene:
         times = _output_times(plain["time"])
         if integrator.needs_compiled_model and system.compiled_model() is None:
             plain_forces = [f.name for f in system.forces if f.compiled_terms() is None]
+            culprit = f"force {plain_forces[0]!r}" if plain_forces else f"system {system.name!r}"
             raise ConfigError(
-                f"integrator {integrator.name!r} runs compiled models only, and force {plain_forces[0]!r} has no "
+                f"integrator {integrator.name!r} runs compiled models only, and {culprit} has no "
                 f"compiled form; choose a Python integrator (dop853, rk45, rk4, lsoda, radau, bdf)"
             )
         return cls(config=cfg, system=system, integrator=integrator, times=times)

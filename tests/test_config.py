@@ -19,6 +19,8 @@ def _options(group):
 def test_every_option_composes_and_builds(group):
     for option in _options(group):
         needs = ["accuracy=1e-8"] if (group, option) == ("integrator", "auto") else []
+        if "gyrostat" in option:  # the satellite's options come with its preset (forces of an orbit)
+            needs.append("experiment=gyrostat")
         scene = compose_scene([f"{group}={option}", *needs])
         assert scene.system.state_size in (6, 9)
         assert len(scene.times) >= 2
@@ -35,6 +37,22 @@ def test_every_force_builds_alone_and_with_the_others(option):
 def test_every_builtin_plugin_has_a_config_file():
     for group, plugins in BUILTINS.items():
         assert set(plugins) == set(_options(group)), group
+
+
+def test_every_scene_preset_builds():
+    scene = compose_scene(["experiment=gyrostat"])
+    assert scene.system.name == "orbiting_gyrostat"
+    assert [f.name for f in scene.system.forces] == ["newtonian", "magnetic"]
+
+
+def test_a_satellite_refuses_a_weight():
+    with pytest.raises(ConfigError, match="uniform_gravity acts on a body about a fixed point"):
+        compose_scene(["experiment=gyrostat", "force=[uniform_gravity,newtonian]"])
+
+
+def test_compiled_integrator_refuses_a_system_without_compiled_form():
+    with pytest.raises(ConfigError, match="system 'orbiting_gyrostat' has no compiled form"):
+        compose_scene(["experiment=gyrostat", "integrator=taylor"])
 
 
 def test_no_force_gives_euler_poinsot():

@@ -1,0 +1,86 @@
+"""Linear stability of a regular precession: Floquet multipliers of the full vector equations.
+
+In body axes the state y = (ω, α, γ) of a precession is periodic when n/m is rational
+(T = 2π q/|m| for n/m = p/q; n = 0: 2π/|m|) and, at θ0 = 0 or π, depends only on ψ ± φ
+(T = 2π/|n ± m|); a rate of zero makes it an equilibrium of the body-frame equations.
+The monodromy matrix Φ(T) comes from the variational equations Φ̇ = Df(y(t)) Φ along the
+exact motion, Df by complex-step differentiation of the system's own right-hand side
+(exact to rounding, whatever force plugins it carries). For an equilibrium the multipliers
+over one orbit are exp(λ·2π/Ω), λ the eigenvalues of Df.
+
+Trivial multipliers equal to 1 come from the constraints |α| = |γ| = 1, α·γ = 0, the flow
+direction and the Jacobi integral (and from symmetries); being in Jordan blocks they are
+computed only to about the square root of the integration error. The motion is called
+linearly (spectrally) stable when every |ρ| ≤ 1 + ``tolerance`` (1e-3): an unstable motion
+has a reciprocal pair |ρ|, 1/|ρ| with |ρ| > 1 (the flow is Hamiltonian on the constraint set).
+Spectral stability is necessary, not sufficient, for stability.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from pipeline.precession.motion import Precession, states
+from plugins.systems.orbiting_gyrostat import OrbitingGyrostat
+
+TOLERANCE = 1e-3
+STEP = 1e-30
+
+
+@dataclass(frozen=True)
+class Floquet:
+    kind: str  # "periodic", "equilibrium" or "quasi-periodic" (not analysed)
+    period: float
+    multipliers: np.ndarray
+
+    @property
+    def max_modulus(self) -> float:
+        return float(np.max(np.abs(self.multipliers))) if self.multipliers.size else float("nan")
+
+    @property
+    def stable(self) -> bool | None:
+        return None if not self.multipliers.size else bool(self.max_modulus <= 1.0 + TOLERANCE)
+
+
+def jacobian(system: OrbitingGyrostat, y: np.ndarray) -> np.ndarray:
+    """Df(y) (9 × 9) by complex steps of the system's right-hand side."""
+    size = len(y)
+    probes = np.tile(y.astype(complex), (size, 1)) + 1j * STEP * np.eye(size)
+    return (system.derivative(probes).imag / STEP).T
+
+
+def body_frame_period(motion: Precession, Omega: float, max_denominator: int = 12) -> tuple[str, float]:
+    n, m = motion.n, motion.m
+    if abs(np.sin(motion.theta0)) < 1e-12:
+        rate = n + m if np.cos(motion.theta0) > 0 else m - n
+        return ("equilibrium", 2 * np.pi / Omega) if abs(rate) < 1e-12 else ("periodic", 2 * np.pi / abs(rate))
+    if abs(n) < 1e-12 and abs(m) < 1e-12:
+        return "equilibrium", 2 * np.pi / Omega
+    if abs(n) < 1e-12 or abs(m) < 1e-12:
+        return "periodic", 2 * np.pi / abs(m if abs(n) < 1e-12 else n)
+    ratio = Fraction(n / m).limit_denominator(max_denominator)
+    if abs(float(ratio) - n / m) > 1e-12:
+        return "quasi-periodic", float("nan")
+    return "periodic", 2 * np.pi * ratio.denominator / abs(m)
+
+
+def floquet(system: OrbitingGyrostat, motion: Precession, rtol: float = 1e-11) -> Floquet:
+    kind, period = body_frame_period(motion, system.Omega)
+    if kind == "quasi-periodic":
+        return Floquet(kind, period, np.array([]))
+    if kind == "equilibrium":
+        y = states(system, motion, np.zeros(1))[0][0]
+        return Floquet(kind, period, np.exp(np.linalg.eigvals(jacobian(system, y)) * period))
+    size = system.state_size
+
+    def variational(t: float, z: np.ndarray) -> np.ndarray:
+        y = states(system, motion, np.array([t]))[0][0]  # the exact motion (its residual is checked separately)
+        return (jacobian(system, y) @ z.reshape(size, size)).ravel()
+
+    solution = solve_ivp(variational, (0.0, period), np.eye(size).ravel(), method="DOP853", rtol=rtol, atol=rtol)
+    monodromy = solution.y[:, -1].reshape(size, size)
+    return Floquet(kind, period, np.linalg.eigvals(monodromy))

@@ -1,0 +1,24 @@
+"""``experiment=yehia2021_precessions`` end to end: the table, its verdicts against the vector evidence, files."""
+
+import csv
+
+import pipeline.experiments as experiments
+from pipeline.config import compose_config
+
+
+def test_experiment_writes_the_case_table(tmp_path):
+    cfg = compose_config(["experiment=yehia2021_precessions", "yehia2021.orbits=2"])
+    written = experiments.run_task("yehia2021_precessions", cfg, tmp_path)
+    names = {p.name for p in written}
+    assert {"precession_cases.csv", "precession_cases.nc"} <= names
+    assert sum(n.startswith("body_axis_") for n in names) == 3  # cylindrical, conical, hyperboloidal
+    with (tmp_path / "precession_cases.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert list(rows[0]) == ["case", "formula", "residual_vector", "residual_euler_angles", "max_theta_deviation",
+                             "stable", "verdict", "condition"]
+    for row in rows:
+        holds = float(row["residual_vector"]) < 1e-10
+        assert row["verdict"] == ("holds" if holds else "fails"), row
+    verdict = {(r["case"], r["formula"]): r["verdict"] for r in rows}
+    assert verdict[("14.1", "printed")] == "fails" and verdict[("14.1", "corrected")] == "holds"
+    assert verdict[("29.1", "printed")] == "fails" and verdict[("29.1", "corrected")] == "holds"
