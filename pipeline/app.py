@@ -4,6 +4,11 @@ Before Hydra starts, a preflight turns the usual mistakes — an unknown plugin
 name, a malformed override, an invalid scene, an unwritable output
 directory — into one sentence and a non-zero exit, so that no run directory
 with a partial ``run.nc`` is left behind.
+
+In a multirun each job is resumable and a failing job is recorded, not fatal
+(``pipeline.sweep.job``); the sweep callback then writes ``sweep.nc``. Two
+more commands work on results: ``gyrolab --reproduce PATH/run.nc`` and
+``gyrolab --aggregate SWEEP_DIR``.
 """
 
 from __future__ import annotations
@@ -13,6 +18,7 @@ import sys
 import tempfile
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import hydra
 from hydra._internal.utils import get_args_parser
@@ -21,6 +27,7 @@ from hydra import initialize_config_module
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override
 from hydra.errors import OverrideParseException
+from hydra.types import RunMode
 from omegaconf import DictConfig, open_dict
 
 from pipeline.config import (
@@ -31,7 +38,14 @@ from pipeline.config import (
     register_plugin_configs,
 )
 from pipeline.errors import ConfigError, GyrolabError, choices
+from pipeline.progress import allow_bars, on_terminal
 from pipeline.scene import Scene
+from pipeline.sweep.grid import Grid
+from pipeline.sweep.identity import job_identity
+from pipeline.sweep.job import run_sweep_job
+
+if TYPE_CHECKING:
+    from pipeline.sweep.aggregate import SweepSummary
 
 log = logging.getLogger("gyrolab")
 
@@ -56,6 +70,8 @@ def preflight(argv: Sequence[str]) -> None:
             raise ConfigError(f"malformed override {text!r}: {reason}") from None
     sweeping = args.multirun or any(o.is_sweep_override() for o in overrides)
     check_plugin_names(overrides)
+    if sweeping:
+        Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
     # One job composed and validated: the first value of every sweep.
     first = [f"{o.get_key_element()}={next(iter(o.sweep_string_iterator()))}" if o.is_sweep_override()
              else o.input_line for o in overrides]
@@ -106,28 +122,97 @@ def check_writable(directory: Path) -> None:
 
 @hydra.main(config_path="pkg://conf", config_name="config", version_base="1.3")
 def _task(cfg: DictConfig) -> None:
+    hydra_cfg = HydraConfig.get()
+    out_dir = Path(hydra_cfg.runtime.output_dir)
+    if hydra_cfg.mode == RunMode.MULTIRUN:
+        allow_bars(False)  # the sweep shows one bar for all its jobs
+        _quiet_console()
+        run_sweep_job(cfg, out_dir, list(hydra_cfg.overrides.task), hydra_cfg.job.num,
+                      lambda job_id: _run_one(cfg, out_dir, job_id))
+        return
+    try:
+        _run_one(cfg, out_dir)
+    except GyrolabError as error:
+        fail(error)
+
+
+def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
+    """Run the scene, write ``run.nc`` (and figures) in ``out_dir``; GyrolabError on bad input or a failed run."""
     from pipeline.dataset import write_dataset
     from pipeline.figures import save_figures  # matplotlib only when figures are drawn
 
-    try:
-        out_dir = Path(HydraConfig.get().runtime.output_dir)
-        scene = Scene.from_config(cfg)
-        ds = scene.run()
-        ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
-        path = write_dataset(ds, out_dir / "run.nc")
-        log.info("wrote %s", path)
-        if cfg.output.get("figures", True):
-            for figure in save_figures(ds, out_dir / "figures"):
-                log.info("wrote %s", figure)
-    except GyrolabError as error:
-        fail(error)
+    scene = Scene.from_config(cfg)
+    ds = scene.run()
+    ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
+    ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
+    path = write_dataset(ds, out_dir / "run.nc")
+    log.info("wrote %s", path)
+    if cfg.output.get("figures", True):
+        for figure in save_figures(ds, out_dir / "figures"):
+            log.info("wrote %s", figure)
+    return path
+
+
+def _quiet_console() -> None:
+    """On a terminal, a sweep job logs warnings only to the console (all of it goes to its log file)."""
+    if not on_terminal(sys.stderr):
+        return
+    for handler in logging.getLogger().handlers:
+        if isinstance(handler, logging.StreamHandler) and not isinstance(handler, logging.FileHandler):
+            handler.setLevel(logging.WARNING)
+
+
+def run_command(argv: Sequence[str]) -> int | None:
+    """``--reproduce PATH`` and ``--aggregate SWEEP_DIR``: their exit status, or None for a Hydra run."""
+    if not argv or argv[0].split("=", 1)[0] not in ("--reproduce", "--aggregate"):
+        return None
+    option, _, value = argv[0].partition("=")
+    rest = ([value] if value else []) + list(argv[1:])
+    if len(rest) != 1:
+        raise ConfigError(f"{option} takes exactly one path (got {len(rest)}: {' '.join(rest) or 'none'}); "
+                          f"usage: gyrolab {option} {'PATH/run.nc' if option == '--reproduce' else 'SWEEP_DIR'}")
+    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
+    if option == "--reproduce":
+        from pipeline.sweep.reproduce import report, reproduce
+
+        comparison, stored = reproduce(Path(rest[0]))
+        print("\n".join(report(Path(rest[0]), comparison, stored)))
+        return 0 if comparison.identical else 1
+    from pipeline.sweep.aggregate import aggregate_sweep, log_summary
+
+    summary = aggregate_sweep(Path(rest[0]))
+    log_summary(summary)
+    return _sweep_status(summary)
+
+
+def _sweep_status(summary: SweepSummary | None = None) -> int:
+    """0 if every job of the last sweep finished, else 1 (with one line saying where the errors are)."""
+    from pipeline.sweep import callbacks
+
+    if callbacks.last_error:
+        print(f"gyrolab: error: {callbacks.last_error}", file=sys.stderr)
+        return 1
+    summary = summary or callbacks.last_summary
+    if summary is None or not (summary.failed or summary.missing):
+        return 0
+    missing = f" and {summary.missing} did not run" if summary.missing else ""
+    print(f"gyrolab: {summary.failed} of {summary.n_jobs} jobs failed{missing}; see failed_job_error and "
+          f"job_status in {summary.path}", file=sys.stderr)
+    return 1
 
 
 def main() -> None:
     """Console entry point ``gyrolab`` (also ``python -m pipeline``)."""
+    argv = sys.argv[1:]
     try:
+        status = run_command(argv)
+        if status is not None:
+            sys.exit(status)
         register_plugin_configs()
-        preflight(sys.argv[1:])
+        preflight(argv)
     except GyrolabError as error:
         fail(error)
     _task()
+    status = _sweep_status()
+    if status:
+        sys.exit(status)

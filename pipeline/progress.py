@@ -1,23 +1,64 @@
-"""Progress of a long integration, reported on the log: silent for runs that finish quickly."""
+"""Progress of long integrations and sweeps: a tqdm bar on a terminal, the log otherwise.
+
+On a terminal (stderr is a TTY) a run shows a bar once it has lasted
+``BAR_DELAY`` seconds (quick runs stay silent) and removes it when done.
+Elsewhere (files, pipes, notebooks, cluster logs) nothing is drawn and a line
+is logged every ``every`` seconds instead. Sweep jobs turn integration bars
+off (``allow_bars(False)``): the sweep shows one bar for all its jobs.
+"""
 
 from __future__ import annotations
 
 import logging
+import sys
+import threading
 import time
+from typing import Any, TextIO
 
 log = logging.getLogger("gyrolab.progress")
 
+BAR_DELAY = 2.0
+_bars_allowed = True
+
+
+def allow_bars(allowed: bool) -> None:
+    """Whether ``Progress`` may draw bars in this process (sweep jobs say no)."""
+    global _bars_allowed
+    _bars_allowed = allowed
+
+
+def on_terminal(stream: Any) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError):  # closed or not a real stream
+        return False
+
 
 class Progress:
-    """Callable ``progress(t)`` that logs how far model time has got, at most every ``every`` seconds."""
+    """Callable ``progress(t)`` that integrators call every few steps with the model time reached."""
 
-    def __init__(self, label: str, t_start: float, t_end: float, every: float = 5.0) -> None:
+    def __init__(self, label: str, t_start: float, t_end: float, every: float = 5.0,
+                 stream: TextIO | None = None) -> None:
         self.label = label
         self.t_start, self.t_end = t_start, t_end
         self.every = every
         self._began = self._last = time.perf_counter()
+        stream = sys.stderr if stream is None else stream
+        self._bar = self._make_bar(stream) if _bars_allowed and on_terminal(stream) else None
+
+    def _make_bar(self, stream: TextIO) -> Any:
+        from tqdm import tqdm
+
+        return tqdm(total=self.t_end - self.t_start, desc=self.label, file=stream, delay=BAR_DELAY, leave=False,
+                    mininterval=0.25, bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.4g} of {total:.4g} "
+                                                 "[{elapsed}<{remaining}]")
 
     def __call__(self, t: float) -> None:
+        if self._bar is not None:
+            self._bar.update(min(t, self.t_end) - self.t_start - self._bar.n)
+            if t >= self.t_end:
+                self.close()
+            return
         now = time.perf_counter()
         if now - self._last < self.every:
             return
@@ -27,3 +68,42 @@ class Progress:
         remaining = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
         log.info("%s: %3.0f%% (t=%.6g of %.6g), %.0f s elapsed, ~%.0f s to go",
                  self.label, 100 * fraction, t, self.t_end, elapsed, remaining)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+    def __del__(self) -> None:
+        self.close()
+
+
+class LinesAboveBar:
+    """A stream wrapper that prints whole lines above a tqdm bar (clears it, writes, redraws).
+
+    Installed as ``sys.stdout``/``sys.stderr`` while a sweep bar is shown, so
+    that log lines written in the same process do not run into the bar.
+    """
+
+    def __init__(self, stream: TextIO, bar: Any) -> None:
+        self._stream, self._bar = stream, bar
+        self._pending = ""
+        self._lock = threading.RLock()
+
+    def write(self, text: str) -> int:
+        with self._lock:
+            self._pending += text
+            if "\n" in self._pending:
+                lines, _, self._pending = self._pending.rpartition("\n")
+                with self._bar.get_lock():
+                    self._bar.clear(nolock=True)
+                    self._stream.write(lines + "\n")
+                    self._stream.flush()
+                    self._bar.refresh(nolock=True)
+        return len(text)
+
+    def flush(self) -> None:
+        self._stream.flush()  # a partial line waits for its end, so that it never lands inside the bar
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import hashlib
 import platform
+import re
 import subprocess
 from functools import cache
 from importlib import metadata
@@ -10,7 +12,12 @@ from pathlib import Path
 from typing import Any
 
 SOURCE_ROOT = Path(__file__).resolve().parent.parent
+#: always recorded (when installed), on top of gyrolab's declared dependencies
 LIBRARIES = ("numpy", "scipy", "xarray", "netCDF4", "hydra-core", "omegaconf", "matplotlib")
+#: entry-point groups whose providers (third-party plugin packages) are part of the code that ran
+#: what can change a result (docs, tests and the README cannot)
+CODE_PATHS = ("pipeline", "plugins", "conf", "pyproject.toml")
+PLUGIN_GROUPS = ("gyrolab.systems", "gyrolab.forces", "gyrolab.integrators", "gyrolab.regimes")
 
 
 def gyrolab_version() -> str:
@@ -28,19 +35,87 @@ def _git(*args: str) -> str | None:
     return done.stdout.strip() if done.returncode == 0 else None
 
 
+def _in_own_checkout() -> bool:
+    """True when the source is a git checkout of gyrolab itself (not a package inside some other repo)."""
+    top = _git("rev-parse", "--show-toplevel")
+    return top is not None and Path(top).resolve() == SOURCE_ROOT
+
+
+def _untracked_code() -> list[str]:
+    """New files under CODE_PATHS that git does not track yet (they may be imported all the same)."""
+    listed = _git("ls-files", "--others", "--exclude-standard", "--", *CODE_PATHS)
+    return sorted(line for line in (listed or "").splitlines() if line)
+
+
+def _diff_digest(untracked: list[str]) -> str:
+    """sha256 of the uncommitted changes to the code (CODE_PATHS), untracked files included."""
+    try:
+        done = subprocess.run(["git", "diff", "HEAD", "--binary", "--", *CODE_PATHS], cwd=SOURCE_ROOT,
+                              capture_output=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired):
+        return ""
+    if done.returncode != 0:
+        return ""
+    digest = hashlib.sha256(done.stdout)
+    for name in untracked:
+        try:
+            digest.update(f"\0{name}\0".encode() + (SOURCE_ROOT / name).read_bytes())
+        except OSError:
+            digest.update(f"\0{name}\0(unreadable)".encode())
+    return digest.hexdigest()
+
+
+def _libraries() -> list[str]:
+    """LIBRARIES plus every runtime dependency gyrolab declares (so a new dependency is recorded too)."""
+    names = list(LIBRARIES)
+    try:
+        requirements = metadata.requires("gyrolab") or []
+    except metadata.PackageNotFoundError:
+        requirements = []
+    for requirement in requirements:
+        if "extra ==" in requirement:
+            continue
+        match = re.match(r"[A-Za-z0-9][A-Za-z0-9._-]*", requirement)
+        if match and match.group(0).lower() not in {n.lower() for n in names}:
+            names.append(match.group(0))
+    return names
+
+
+def plugin_packages() -> str:
+    """'name==version' of every installed distribution that registers gyrolab plugins, sorted."""
+    found = set()
+    for group in PLUGIN_GROUPS:
+        for ep in metadata.entry_points(group=group):
+            dist = getattr(ep, "dist", None)
+            if dist is not None and dist.metadata["Name"] and dist.metadata["Name"].lower() != "gyrolab":
+                found.add(f"{dist.metadata['Name']}=={dist.version}")
+    return " ".join(sorted(found))
+
+
 @cache
 def provenance() -> dict[str, Any]:
-    """Attributes every dataset carries (netCDF-safe)."""
-    commit = _git("rev-parse", "HEAD")
+    """Attributes every dataset carries (netCDF-safe).
+
+    ``git_dirty`` is 1 when tracked files differ from ``git_commit`` or new
+    code files (under ``CODE_PATHS``) are not committed yet, 0 when clean, -1
+    when unknown (not a git checkout of gyrolab, or git unavailable);
+    ``git_diff_sha256`` is the sha256 of the uncommitted code changes, new
+    files included, so that two dirty trees can be told apart.
+    """
+    commit = _git("rev-parse", "HEAD") if _in_own_checkout() else None
     status = _git("status", "--porcelain", "--untracked-files=no") if commit else None
+    untracked = _untracked_code() if commit else []
+    dirty = -1 if status is None else int(bool(status or untracked))
     attrs: dict[str, Any] = {
         "gyrolab_version": gyrolab_version(),
         "git_commit": commit or "unknown",
-        "git_dirty": -1 if status is None else int(bool(status)),
+        "git_dirty": dirty,
+        "git_diff_sha256": _diff_digest(untracked) if dirty == 1 else "",
         "python_version": platform.python_version(),
         "platform": platform.platform(),
+        "plugin_packages": plugin_packages(),
     }
-    for lib in LIBRARIES:
+    for lib in _libraries():
         try:
             attrs[f"version_{lib.replace('-', '_')}"] = metadata.version(lib)
         except metadata.PackageNotFoundError:

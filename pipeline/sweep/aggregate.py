@@ -1,0 +1,384 @@
+"""One dataset per sweep: every job's ``run.nc`` on the sweep's grid, plus a table of failed jobs.
+
+Layout of ``sweep.nc`` (``assemble``):
+
+* one dimension per swept parameter, named after the override key's last
+  part (``body.a`` -> ``a``; the full key, dots as underscores, when that is
+  ambiguous), its coordinate holding the swept values (numbers stay numbers)
+  and the key in ``override_key``;
+* every data variable of the runs over (swept dims..., time, ...), NaN where
+  a job failed or is missing. If the jobs' output times differ (a swept
+  ``time.end``), ``time`` becomes a variable over (swept dims..., sample);
+* per-job quantities as variables over the swept dims: the integrator's
+  statistics (``integrator_nfev``, ``integrator_wall_time``, ...), each
+  invariant's ``<name>_max_abs_drift``, ``config`` (each job's resolved YAML),
+  ``hydra_overrides``, ``job_id``, ``job_dir`` and ``job_status`` (0 missing,
+  1 finished, 2 failed); run attributes that differ between jobs become such
+  variables too (``run_<name>`` if ``<name>`` is taken), equal ones stay
+  global attributes;
+* a table of failed jobs along dimension ``failed_job``: ``failed_job_dir``,
+  ``failed_job_overrides``, ``failed_job_error``, ``failed_job_error_type``,
+  ``failed_job_exit_code``.
+
+``assemble`` only needs each grid point's dataset (or its failure), so a batch
+integrator that computes a whole grid in one process can produce the same
+layout without writing per-job files.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass, field, fields
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from omegaconf import OmegaConf
+
+from pipeline.contracts.integrator import IntegratorStats
+from pipeline.dataset import write_dataset
+from pipeline.errors import ConfigError
+from pipeline.sweep.grid import Grid
+from pipeline.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
+
+log = logging.getLogger("gyrolab.sweep")
+
+SWEEP_NAME = "sweep.nc"
+MISSING = "missing"
+STATUS_FLAGS = {MISSING: 0, FINISHED: 1, FAILED: 2}
+#: run attributes that are per-job quantities, always variables over the swept dims
+PER_JOB_ATTRS = ("config", "hydra_overrides") + tuple(f"integrator_{f.name}" for f in fields(IntegratorStats))
+#: variable attributes that are per-job quantities
+PER_JOB_VARIABLE_ATTRS = ("max_abs_drift",)
+#: attributes of sweep.nc that legitimately differ between two aggregations of the same sweep
+VOLATILE_ATTRS = ("date_created", "sweep_launcher")
+#: variables of sweep.nc that legitimately differ between two runs of the same sweep
+VOLATILE_VARIABLES = ("integrator_wall_time",)
+
+
+@dataclass
+class JobResult:
+    """How one grid point ended: its dataset if finished, its error if failed, nothing if missing."""
+
+    status: str = MISSING
+    dataset: xr.Dataset | None = None
+    job_id: str = ""
+    job_dir: str = ""
+    error: str = ""
+    error_type: str = ""
+    exit_code: int = 0
+    skipped: bool = False
+
+
+@dataclass
+class SweepSummary:
+    path: Path
+    n_jobs: int
+    finished: int
+    failed: int
+    missing: int
+    skipped: int
+    failures: list[tuple[str, str]] = field(default_factory=list)   # (overrides, error)
+    figures: list[Path] = field(default_factory=list)
+
+
+# ----------------------------------------------------------------------------- assembling
+
+
+def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
+    """The sweep dataset of ``grid`` from ``results[n]``, the outcome of job ``n``."""
+    if len(results) != len(grid.jobs):
+        raise ValueError(f"{len(results)} results for a grid of {len(grid.jobs)} jobs")
+    done = [(grid.index[n], r.dataset) for n, r in enumerate(results) if r.status == FINISHED]
+    names = _dim_names(grid, [ds for _, ds in done])
+    grid_dims = tuple(names)
+    shape = grid.shape
+    coords: dict[str, Any] = {
+        name: (name, dim.coordinate(), {"long_name": f"swept parameter {dim.key}", "override_key": dim.key})
+        for name, dim in zip(names, grid.dims)
+    }
+    data_vars: dict[str, Any] = {}
+
+    sample = _sample_dim([ds for _, ds in done])
+    if done:
+        first = done[0][1]
+        for name, coord in first.coords.items():
+            if name == "time" and sample == "sample":
+                continue
+            for _, ds in done[1:]:
+                if name not in ds.coords or not np.array_equal(ds[name].values, coord.values):
+                    raise ConfigError(f"jobs of this sweep disagree on coordinate {name!r}; they cannot share "
+                                      "one sweep.nc")
+            coords[name] = (coord.dims, coord.values, _common_attrs([ds[name] for _, ds in done]))
+            for attr, variable in _per_job_attrs(done, name, shape, grid_dims).items():
+                data_vars[f"{name}_{attr}"] = variable
+        if sample == "sample":
+            data_vars["time"] = _stack(done, "time", shape, grid_dims, sample)
+        for name in _union([list(ds.data_vars) for _, ds in done]):
+            data_vars[name] = _stack(done, name, shape, grid_dims, sample)
+            for attr, variable in _per_job_attrs(done, name, shape, grid_dims).items():
+                data_vars[f"{name}_{attr}"] = variable
+
+    taken = set(coords) | set(data_vars) | set(grid_dims) | {"sample", "failed_job", "job_status", "job_dir",
+                                                              "job_id", "title", "Conventions"}
+    common: dict[str, Any] = {}
+    for key in _union([list(ds.attrs) for _, ds in done]):
+        if key == "job_id":
+            continue
+        values = {index: ds.attrs[key] for index, ds in done if key in ds.attrs}
+        if key not in PER_JOB_ATTRS and len(values) == len(done) and _all_same(list(values.values())):
+            common[key] = next(iter(values.values()))
+            continue
+        name = key if key not in taken else f"run_{key}"
+        data_vars[name] = _cell_variable(values, shape, grid_dims, name)
+        taken.add(name)
+
+    statuses = np.zeros(shape, dtype=np.int8)
+    job_ids = np.full(shape, "", dtype=object)
+    job_dirs = np.full(shape, "", dtype=object)
+    for n, result in enumerate(results):
+        statuses[grid.index[n]] = STATUS_FLAGS[result.status]
+        job_ids[grid.index[n]] = result.job_id
+        job_dirs[grid.index[n]] = result.job_dir
+    data_vars["job_status"] = (grid_dims, statuses, {
+        "long_name": "how the job ended", "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8),
+        "flag_meanings": " ".join(STATUS_FLAGS)})
+    data_vars["job_id"] = (grid_dims, job_ids, {"long_name": "hash of the job's resolved config and code version"})
+    data_vars["job_dir"] = (grid_dims, job_dirs, {"long_name": "job directory, relative to the sweep directory"})
+    data_vars.update(_failure_table(grid, results))
+
+    ds = xr.Dataset(data_vars, coords=coords)
+    counts = {status: sum(r.status == status for r in results) for status in STATUS_FLAGS}
+    ds.attrs.update(common)
+    ds.attrs.update({
+        "title": f"gyrolab sweep over {' × '.join(grid_dims) or 'no parameter'} ({len(results)} jobs)",
+        "Conventions": "CF-1.8",
+        "sweep_dims": " ".join(grid_dims),
+        "sweep_keys": " ".join(d.key for d in grid.dims),
+        "n_jobs": len(results),
+        "n_finished": counts[FINISHED],
+        "n_failed": counts[FAILED],
+        "n_missing": counts[MISSING],
+    })
+    return ds
+
+
+def _dim_names(grid: Grid, datasets: Sequence[xr.Dataset]) -> list[str]:
+    reserved = {"time", "sample", "axis", "failed_job"}
+    for ds in datasets:
+        reserved |= set(ds.variables) | set(ds.dims)
+    shorts = [d.short_name for d in grid.dims]
+    names = []
+    for dim, short in zip(grid.dims, shorts):
+        name = short if shorts.count(short) == 1 and short not in reserved else dim.key.lstrip("+~").replace(".", "_")
+        while name in reserved or name in names:
+            name = f"sweep_{name}"
+        names.append(name)
+    return names
+
+
+def _sample_dim(datasets: Sequence[xr.Dataset]) -> str:
+    """'time' if every job has the same output times (the usual case), else 'sample'."""
+    times = [ds["time"].values for ds in datasets]
+    return "time" if all(np.array_equal(t, times[0]) for t in times[1:]) else "sample"
+
+
+def _union(lists: Sequence[Sequence[str]]) -> list[str]:
+    seen: dict[str, None] = {}
+    for items in lists:
+        seen.update(dict.fromkeys(items))
+    return list(seen)
+
+
+def _blank(shape: tuple[int, ...], dtype: np.dtype) -> np.ndarray:
+    if dtype.kind in "fc":
+        return np.full(shape, np.nan, dtype=dtype)
+    if dtype.kind in "iub":
+        return np.full(shape, np.nan, dtype=np.float64)   # NaN marks failed jobs: integers become floats
+    return np.full(shape, "", dtype=object)
+
+
+def _stack(done: Sequence[tuple[tuple[int, ...], xr.Dataset]], name: str, shape: tuple[int, ...],
+           grid_dims: tuple[str, ...], sample: str) -> tuple:
+    having = [(index, ds[name]) for index, ds in done if name in ds.variables]
+    template = having[0][1]
+    dims = tuple(sample if d == "time" else d for d in template.dims)
+    for _, da in having:
+        if da.dims != template.dims:
+            raise ConfigError(f"variable {name!r} has dimensions {da.dims} in one job and {template.dims} in "
+                              "another; they cannot share one sweep.nc")
+    sizes = [max(da.shape[i] for _, da in having) for i in range(template.ndim)]
+    out = _blank(shape + tuple(sizes), template.dtype)
+    for index, da in having:
+        out[index + tuple(slice(0, n) for n in da.shape)] = da.values
+    return grid_dims + dims, out, _common_attrs([da for _, da in having])
+
+
+def _common_attrs(arrays: Sequence[xr.DataArray]) -> dict[str, Any]:
+    """Attributes equal in every job (the others become per-job variables, see ``_per_job_attrs``)."""
+    return {k: v for k, v in arrays[0].attrs.items() if k not in PER_JOB_VARIABLE_ATTRS
+            and all(k in da.attrs and _same(v, da.attrs[k]) for da in arrays)}
+
+
+def _per_job_attrs(done: Sequence[tuple[tuple[int, ...], xr.Dataset]], name: str, shape: tuple[int, ...],
+                   grid_dims: tuple[str, ...]) -> dict[str, tuple]:
+    having = [(index, ds[name]) for index, ds in done if name in ds.variables]
+    out = {}
+    for attr in _union([list(da.attrs) for _, da in having]):
+        values = {index: da.attrs[attr] for index, da in having if attr in da.attrs}
+        if attr in PER_JOB_VARIABLE_ATTRS or len(values) < len(having) or not _all_same(list(values.values())):
+            out[attr] = _cell_variable(values, shape, grid_dims, f"{name}_{attr}")
+            if attr == "max_abs_drift":
+                out[attr][2].update({"long_name": f"max |{name}(t) − {name}(0)|",
+                                     "units": having[0][1].attrs.get("units", "1")})
+    return out
+
+
+def _cell_variable(values: dict[tuple[int, ...], Any], shape: tuple[int, ...], grid_dims: tuple[str, ...],
+                   name: str) -> tuple:
+    """A variable over the swept dims from one value per grid point (missing points: NaN or '')."""
+    items = list(values.values())
+    if items and all(_is_number(v) for v in items):
+        out = np.full(shape, np.nan)
+        for index, value in values.items():
+            out[index] = value
+        return grid_dims, out, {}
+    arrays = [np.asarray(v) for v in items]
+    if items and all(a.ndim == 1 and a.dtype.kind in "iuf" and a.shape == arrays[0].shape for a in arrays):
+        out = np.full(shape + arrays[0].shape, np.nan)
+        for index, value in values.items():
+            out[index] = value
+        return grid_dims + (f"{name}_index",), out, {}
+    out = np.full(shape, "", dtype=object)
+    for index, value in values.items():
+        out[index] = value if isinstance(value, str) else np.array2string(np.asarray(value), separator=", ")
+    return grid_dims, out, {}
+
+
+def _failure_table(grid: Grid, results: Sequence[JobResult]) -> dict[str, tuple]:
+    failed = [(n, r) for n, r in enumerate(results) if r.status == FAILED]
+    dim = ("failed_job",)
+    return {
+        "failed_job_dir": (dim, np.array([r.job_dir for _, r in failed], dtype=object),
+                           {"long_name": "failed job's directory, relative to the sweep directory"}),
+        "failed_job_overrides": (dim, np.array([" ".join(grid.jobs[n]) for n, _ in failed], dtype=object),
+                                 {"long_name": "failed job's overrides"}),
+        "failed_job_error": (dim, np.array([r.error for _, r in failed], dtype=object),
+                             {"long_name": "error message"}),
+        "failed_job_error_type": (dim, np.array([r.error_type for _, r in failed], dtype=object),
+                                  {"long_name": "error class"}),
+        "failed_job_exit_code": (dim, np.array([r.exit_code for _, r in failed], dtype=np.int32),
+                                 {"long_name": "exit code the single-run command would give"}),
+    }
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Equal attribute values (arrays element by element; NaN equals NaN)."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        a, b = np.asarray(a), np.asarray(b)
+        return (a.shape == b.shape and a.dtype.kind == b.dtype.kind
+                and bool(np.array_equal(a, b, equal_nan=a.dtype.kind == "f")))
+    if _is_number(a) and _is_number(b):
+        return bool(a == b or (np.isnan(a) and np.isnan(b)))
+    return type(a) is type(b) and a == b
+
+
+def _all_same(values: Sequence[Any]) -> bool:
+    return all(_same(v, values[0]) for v in values[1:])
+
+
+# ----------------------------------------------------------------------------- from a sweep directory
+
+
+def collect(sweep_dir: Path, grid: Grid) -> list[JobResult]:
+    """Each grid job's outcome, from the job records under ``sweep_dir`` (matched by their overrides)."""
+    sweep_dir = Path(sweep_dir)
+    found: dict[tuple[str, ...], tuple[float, Path, JobRecord]] = {}
+    for path in record_paths(sweep_dir):
+        record = read_record(path.parent)
+        if record is None:
+            continue
+        key, mtime = tuple(record.overrides), path.stat().st_mtime
+        if key not in found or found[key][0] < mtime:  # a stale copy elsewhere: the newest record wins
+            found[key] = (mtime, path.parent, record)
+    results = []
+    for job in grid.jobs:
+        if job not in found:
+            results.append(JobResult())
+            continue
+        _, job_dir, record = found[job]
+        where = job_dir.relative_to(sweep_dir).as_posix()
+        common = {"job_id": record.job_id, "job_dir": where, "skipped": record.skipped}
+        if record.status == FAILED:
+            results.append(JobResult(FAILED, error=record.error, error_type=record.error_type,
+                                     exit_code=record.exit_code, **common))
+            continue
+        try:
+            ds = xr.load_dataset(job_dir / str(record.run), decode_times=False, decode_timedelta=False)
+        except (OSError, ValueError) as error:
+            log.warning("job %s: cannot read its dataset (%s); counted as missing", where, error)
+            results.append(JobResult())
+            continue
+        if ds.attrs.get("job_id") != record.job_id:
+            log.warning("job %s: its dataset belongs to another job (id %s, record %s); counted as missing",
+                        where, ds.attrs.get("job_id"), record.job_id)
+            results.append(JobResult())
+            continue
+        results.append(JobResult(FINISHED, dataset=ds, **common))
+    return results
+
+
+def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: bool | None = None,
+                    launcher: str = "") -> SweepSummary:
+    """Write ``sweep_dir/sweep.nc`` (and summary figures) from the sweep's job directories.
+
+    ``hydra_cfg`` is the multirun's ``hydra`` config node; without it, it is
+    read from ``sweep_dir/multirun.yaml`` (which Hydra writes at the start of
+    every sweep). ``figures=None``: as the sweep's callback was configured.
+    """
+    sweep_dir = Path(sweep_dir)
+    if hydra_cfg is None:
+        saved = sweep_dir / "multirun.yaml"
+        if not saved.is_file():
+            raise ConfigError(f"{str(sweep_dir)!r} is not a sweep directory (no multirun.yaml); give the "
+                              "directory a 'gyrolab -m ...' run wrote (its hydra.sweep.dir)")
+        hydra_cfg = OmegaConf.load(saved).hydra
+        launcher = launcher or _short_target(hydra_cfg.get("launcher", {}).get("_target_", ""))
+    if figures is None:
+        figures = bool(OmegaConf.select(hydra_cfg, "callbacks.sweep.figures", default=True))
+    grid = Grid.from_hydra(hydra_cfg)
+    results = collect(sweep_dir, grid)
+    ds = assemble(grid, results)
+    ds.attrs["sweep_launcher"] = launcher
+    ds.attrs["date_created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    path = write_dataset(ds, sweep_dir / SWEEP_NAME)
+    summary = SweepSummary(
+        path=path, n_jobs=len(results), finished=int(ds.attrs["n_finished"]), failed=int(ds.attrs["n_failed"]),
+        missing=int(ds.attrs["n_missing"]), skipped=sum(r.skipped for r in results),
+        failures=[(" ".join(grid.jobs[n]), r.error) for n, r in enumerate(results) if r.status == FAILED])
+    if figures and grid.dims and summary.finished:
+        from pipeline.sweep.figures import save_sweep_figures  # matplotlib only when figures are drawn
+
+        summary.figures = save_sweep_figures(ds, sweep_dir / "figures")
+    return summary
+
+
+def _short_target(target: str) -> str:
+    return str(target).rsplit(".", 1)[-1]
+
+
+def log_summary(summary: SweepSummary) -> None:
+    log.info("sweep: %d jobs: %d finished, %d failed, %d missing; skipped %d finished jobs (done earlier)",
+             summary.n_jobs, summary.finished, summary.failed, summary.missing, summary.skipped)
+    for overrides, error in summary.failures:
+        log.warning("failed job (%s): %s", overrides, error)
+    log.info("wrote %s", summary.path)
+    for figure in summary.figures:
+        log.info("wrote %s", figure)

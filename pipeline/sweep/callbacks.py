@@ -1,0 +1,77 @@
+"""The Hydra callback that turns a multirun into one ``sweep.nc`` (configured in ``conf/config.yaml``).
+
+``on_multirun_start`` starts the sweep's progress display; ``on_multirun_end``
+(run by Hydra on the launching machine once every job has returned, whatever
+the launcher) aggregates the job directories into ``sweep.nc`` and the
+summary figures. The jobs themselves record their outcome (``job.json``) in
+``pipeline.app``; nothing here runs in the jobs.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+from typing import Any
+
+from hydra.experimental.callback import Callback
+from omegaconf import DictConfig
+
+from pipeline.errors import GyrolabError
+from pipeline.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
+from pipeline.sweep.grid import Grid
+from pipeline.sweep.watch import SweepWatcher
+
+log = logging.getLogger("gyrolab.sweep")
+
+#: outcome of the last sweep aggregated in this process (read by the command's exit status)
+last_summary: SweepSummary | None = None
+last_error: str | None = None
+
+
+class SweepCallback(Callback):
+    """Aggregate a multirun into ``<sweep dir>/sweep.nc``; ``figures``: also draw the summary figures."""
+
+    def __init__(self, figures: bool = True, progress: bool = True) -> None:
+        self.figures = bool(figures)
+        self.progress = bool(progress)
+        self._watcher: SweepWatcher | None = None
+
+    def __getstate__(self) -> dict[str, Any]:  # launchers pickle callbacks to send them to the jobs
+        return {"figures": self.figures, "progress": self.progress, "_watcher": None}
+
+    def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
+        global last_summary, last_error
+        last_summary, last_error = None, None
+        if not self.progress or not _basic_sweeper(config):
+            return
+        try:
+            total = len(Grid.from_hydra(config.hydra).jobs)
+        except GyrolabError:
+            return  # the sweeper will report the problem
+        self._watcher = SweepWatcher(Path(config.hydra.sweep.dir), total)
+        self._watcher.start()
+
+    def on_multirun_end(self, config: DictConfig, **kwargs: Any) -> None:
+        global last_summary, last_error
+        if self._watcher is not None:
+            self._watcher.stop()
+            self._watcher = None
+        if not _basic_sweeper(config):
+            log.warning("sweep.nc is written for Hydra's basic sweeper only (this sweep used %s)",
+                        config.hydra.sweeper.get("_target_"))
+            return
+        sweep_dir = Path(config.hydra.sweep.dir)
+        try:
+            summary = aggregate_sweep(sweep_dir, hydra_cfg=config.hydra, figures=self.figures,
+                                      launcher=str(config.hydra.launcher.get("_target_", "")).rsplit(".", 1)[-1])
+        except Exception as error:  # noqa: BLE001 - the jobs' results are safe; say how to aggregate them later
+            last_error = f"could not aggregate the sweep ({type(error).__name__}: {error}); the job results are " \
+                         f"intact: run 'gyrolab --aggregate {sweep_dir}' once the cause is fixed"
+            log.exception("aggregation failed")
+            return
+        last_summary = summary
+        log_summary(summary)
+
+
+def _basic_sweeper(config: DictConfig) -> bool:
+    return str(config.hydra.sweeper.get("_target_", "")).endswith("BasicSweeper")

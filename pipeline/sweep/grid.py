@@ -1,0 +1,102 @@
+"""The grid of a multirun: one dimension per swept parameter, one job per grid point.
+
+Built from the sweep's overrides exactly as Hydra's basic sweeper builds its
+jobs (the Cartesian product, in command-line order, the last parameter
+varying fastest), so job ``n`` of a sweep is ``Grid.jobs[n]`` whichever
+launcher ran it. A batch integrator that computes a whole grid at once can
+use the same grid to fill the same ``sweep.nc`` layout.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from hydra.core.override_parser.overrides_parser import OverridesParser
+from hydra.errors import OverrideParseException
+
+from pipeline.errors import ConfigError
+
+
+@dataclass(frozen=True)
+class Dim:
+    """A swept parameter: its override key, the values as typed on the command line, and parsed."""
+
+    key: str
+    labels: tuple[str, ...]
+    values: tuple[Any, ...]
+
+    @property
+    def short_name(self) -> str:
+        return self.key.rsplit(".", 1)[-1].lstrip("+~")
+
+    def coordinate(self) -> np.ndarray:
+        """Numbers stay numbers (float64, or int64 if all are integers); anything else is its label."""
+        numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in self.values)
+        if numbers:
+            as_int = all(isinstance(v, int) for v in self.values)
+            return np.array(self.values, dtype=np.int64 if as_int else np.float64)
+        return np.array(self.labels, dtype=object)
+
+
+@dataclass(frozen=True)
+class Grid:
+    dims: tuple[Dim, ...]
+    jobs: tuple[tuple[str, ...], ...]       # overrides of job n, exactly as the job sees them
+    index: tuple[tuple[int, ...], ...]      # grid position of job n
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(d.labels) for d in self.dims)
+
+    @classmethod
+    def from_overrides(cls, overrides: Sequence[str]) -> Grid:
+        """ConfigError for a malformed override, a non-discrete sweep or a value given twice."""
+        parser = OverridesParser.create()
+        try:
+            parsed = parser.parse_overrides(list(overrides))
+        except OverrideParseException as error:
+            raise ConfigError(f"malformed sweep override: {str(error).strip().splitlines()[0]}") from None
+        choices: dict[str, list[str]] = {}      # key -> job overrides, in first-seen order (as Hydra does)
+        typed: dict[str, list[Any]] = {}
+        for o in parsed:
+            key = o.get_key_element()
+            if o.is_sweep_override():
+                if not o.is_discrete_sweep():
+                    raise ConfigError(f"{o.input_line!r} is not a list of values; the basic sweeper runs "
+                                      "discrete sweeps only (a,b,c or range(...) or choice(...))")
+                labels = list(o.sweep_string_iterator())
+                choices[key] = [f"{key}={label}" for label in labels]
+                typed[key] = list(o.sweep_iterator())
+                _refuse_repeats(key, labels, typed[key])
+            else:
+                choices[key] = [f"{key}={o.get_value_element_as_str()}"]
+                typed.pop(key, None)
+        dims = tuple(Dim(key, tuple(c.split("=", 1)[1] for c in choices[key]), tuple(typed[key]))
+                     for key in choices if key in typed)
+        lists = list(choices.values())
+        jobs = tuple(tuple(job) for job in itertools.product(*lists))
+        swept = [i for i, key in enumerate(choices) if key in typed]
+        index = tuple(tuple(position[i] for i in swept)
+                      for position in itertools.product(*(range(len(values)) for values in lists)))
+        return cls(dims=dims, jobs=jobs, index=index)
+
+    @classmethod
+    def from_hydra(cls, hydra_cfg: Mapping[str, Any]) -> Grid:
+        """The grid of a multirun config's ``hydra`` node (sweeper params first, as the basic sweeper does)."""
+        params = hydra_cfg.get("sweeper", {}).get("params") or {}
+        overrides = [f"{k}={v}" for k, v in params.items()] + list(hydra_cfg["overrides"]["task"])
+        return cls.from_overrides(overrides)
+
+
+def _refuse_repeats(key: str, labels: list[str], values: list[Any]) -> None:
+    seen: dict[str, str] = {}
+    for label, value in zip(labels, values):
+        marker = repr(float(value)) if isinstance(value, (int, float)) and not isinstance(value, bool) else label
+        if marker in seen:
+            raise ConfigError(f"{key} sweeps the value {label} twice (as {seen[marker]} and {label}); "
+                              "give each value once")
+        seen[marker] = label

@@ -1,0 +1,77 @@
+"""A job's record, ``job.json`` next to its ``run.nc``: what ran, with which identity, and how it ended.
+
+The record is written (atomically) after ``run.nc``, so a job killed at any
+point leaves either a complete record or none; a job without a complete
+record is recomputed when the sweep is run again.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+
+RECORD_NAME = "job.json"
+FINISHED, FAILED = "finished", "failed"
+
+
+@dataclass
+class JobRecord:
+    job_id: str
+    status: str                          # FINISHED or FAILED
+    overrides: list[str]                 # the job's Hydra overrides, as the sweeper built them
+    code_version: str
+    job_num: int | None = None
+    run: str | None = None               # dataset file name in the job directory (finished jobs)
+    error: str = ""                      # one sentence (failed jobs)
+    error_type: str = ""
+    exit_code: int = 0                   # what the single-run command would have exited with
+    deterministic: bool = True           # False: an unexpected error, retried when the sweep is run again
+    skipped: bool = False                # True: this session found the job finished and did not rerun it
+
+    def reusable_for(self, job_id: str, job_dir: Path) -> bool:
+        """Whether this record settles a job of identity ``job_id``: same identity, and its result is still there."""
+        if self.job_id != job_id:
+            return False
+        if self.status == FINISHED:
+            return self.run is not None and (job_dir / self.run).is_file()
+        return self.status == FAILED and self.deterministic
+
+
+def write_record(job_dir: Path, record: JobRecord) -> Path:
+    path = Path(job_dir) / RECORD_NAME
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{RECORD_NAME}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as stream:
+            json.dump(asdict(record), stream, indent=1)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def read_record(job_dir: Path) -> JobRecord | None:
+    """The record in ``job_dir``, or None when there is none (or it is unreadable: treated as unfinished)."""
+    try:
+        data = json.loads((Path(job_dir) / RECORD_NAME).read_text())
+        known = {f.name for f in fields(JobRecord)}
+        return JobRecord(**{k: v for k, v in data.items() if k in known})
+    except (OSError, ValueError, TypeError):
+        return None
+
+
+def remove_record(job_dir: Path) -> None:
+    (Path(job_dir) / RECORD_NAME).unlink(missing_ok=True)
+
+
+def record_paths(sweep_dir: Path) -> Iterator[Path]:
+    """Every job record under ``sweep_dir``, skipping hidden folders (.hydra, .submitit)."""
+    for root, dirs, files in os.walk(sweep_dir):
+        dirs[:] = sorted(d for d in dirs if not d.startswith("."))
+        if RECORD_NAME in files:
+            yield Path(root) / RECORD_NAME

@@ -1,0 +1,126 @@
+"""``gyrolab --reproduce PATH/run.nc``: rerun a dataset's stored config and say whether the result is identical.
+
+Identical means every data variable and coordinate is equal bit for bit.
+Otherwise the report names each differing variable with its largest
+absolute difference. Provenance that differs (commit, library versions,
+platform) is listed as a hint to why.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from omegaconf import OmegaConf
+
+from pipeline.errors import ConfigError
+from pipeline.provenance import provenance
+from pipeline.scene import Scene
+
+#: provenance attributes worth comparing (the wall time differs by nature)
+PROVENANCE_KEYS = ("gyrolab_version", "git_commit", "git_dirty", "git_diff_sha256", "python_version", "platform",
+                   "plugin_packages")
+
+
+@dataclass
+class Comparison:
+    same: list[str] = field(default_factory=list)
+    differ: list[str] = field(default_factory=list)          # one sentence per differing variable
+    provenance: list[str] = field(default_factory=list)      # stored vs now, where they differ
+
+    @property
+    def identical(self) -> bool:
+        return not self.differ
+
+
+def load_run(path: Path) -> xr.Dataset:
+    path = Path(path)
+    try:
+        ds = xr.load_dataset(path, decode_times=False, decode_timedelta=False)
+    except (OSError, ValueError) as error:
+        raise ConfigError(f"cannot read {str(path)!r} as a netCDF dataset ({error}); give a run.nc that "
+                          "gyrolab wrote") from None
+    if "config" not in ds.attrs and "job_status" in ds:
+        raise ConfigError(f"{str(path)!r} is a sweep dataset, not a run; give one job's run.nc (sweep.nc's "
+                          "job_dir variable names each job's directory)")
+    if "config" not in ds.attrs:
+        raise ConfigError(f"{str(path)!r} has no 'config' attribute; give a run.nc that gyrolab wrote")
+    return ds
+
+
+def rerun(stored: xr.Dataset) -> xr.Dataset:
+    cfg = OmegaConf.create(stored.attrs["config"])
+    return Scene.from_config(cfg).run()
+
+
+def compare(stored: xr.Dataset, new: xr.Dataset) -> Comparison:
+    result = Comparison()
+    for kind, names_old, names_new in (("coordinate", stored.coords, new.coords),
+                                       ("variable", stored.data_vars, new.data_vars)):
+        for name in sorted(set(names_old) | set(names_new)):
+            if name not in names_new:
+                result.differ.append(f"{kind} {name}: in the dataset, not in the rerun")
+            elif name not in names_old:
+                result.differ.append(f"{kind} {name}: in the rerun, not in the dataset")
+            else:
+                message = _difference(stored[name], new[name])
+                (result.differ.append(f"{kind} {name}: {message}") if message else result.same.append(name))
+    now = provenance()
+    for key in PROVENANCE_KEYS:
+        then = stored.attrs.get(key)
+        if then is not None and str(then) != str(now.get(key)):
+            result.provenance.append(f"{key}: {then} then, {now.get(key)} now")
+    for key, then in stored.attrs.items():
+        if key.startswith("version_") and str(then) != str(now.get(key)):
+            result.provenance.append(f"{key[len('version_'):]}: {then} then, {now.get(key, 'not installed')} now")
+    return result
+
+
+def _difference(old: xr.DataArray, new: xr.DataArray) -> str:
+    """'' if bit-for-bit equal, else one phrase saying how they differ."""
+    a, b = np.asarray(old.values), np.asarray(new.values)
+    if old.dims != new.dims or a.shape != b.shape:
+        return f"shape {dict(zip(old.dims, a.shape))} in the dataset, {dict(zip(new.dims, b.shape))} in the rerun"
+    if a.dtype.kind in "fc" and b.dtype.kind in "fc":
+        a, b = a.astype(np.float64), b.astype(np.float64)
+        if a.view(np.uint8).tobytes() == b.view(np.uint8).tobytes():
+            return ""
+        nan_a, nan_b = np.isnan(a), np.isnan(b)
+        if (nan_a != nan_b).any():
+            return f"NaN at {int((nan_a != nan_b).sum())} places where the other has a number"
+        delta = np.abs(a - b)
+        delta[nan_a] = 0.0
+        scale = float(np.max(np.abs(a))) or 1.0
+        worst = np.unravel_index(int(np.argmax(delta)), delta.shape)
+        where = ", ".join(f"{d}={old[d].values[i]}" if d in old.coords else f"{d}[{i}]"
+                          for d, i in zip(old.dims, worst))
+        return (f"max |Δ| = {float(delta[worst]):.3g} (relative to max |value| {float(delta[worst]) / scale:.3g}) "
+                f"at {where or 'the only value'}; {int((delta > 0).sum())} of {delta.size} values differ")
+    if a.dtype == b.dtype and np.array_equal(a, b):
+        return ""
+    if a.dtype.kind in "iub" and b.dtype.kind in "iub":
+        return f"max |Δ| = {int(np.max(np.abs(a.astype(np.int64) - b.astype(np.int64))))}"
+    equal = np.asarray(a.astype(str) == b.astype(str))
+    return "" if equal.all() else f"{int((~equal).sum())} of {equal.size} values differ"
+
+
+def reproduce(path: Path) -> tuple[Comparison, xr.Dataset]:
+    stored = load_run(path)
+    return compare(stored, rerun(stored)), stored
+
+
+def report(path: Path, comparison: Comparison, stored: xr.Dataset) -> list[str]:
+    head = (f"reproducing {path} ({stored.attrs.get('title', '?')}; {stored.attrs.get('integrator', '?')}, "
+            f"{stored.sizes.get('time', '?')} output times)")
+    lines = [head]
+    lines += [f"  provenance differs: {p}" for p in comparison.provenance]
+    if comparison.identical:
+        lines.append(f"identical: {len(comparison.same)} variables and coordinates equal bit for bit "
+                     f"({', '.join(comparison.same)})")
+    else:
+        lines += [f"  {d}" for d in comparison.differ]
+        lines.append(f"NOT identical: {len(comparison.differ)} of {len(comparison.differ) + len(comparison.same)} "
+                     "variables and coordinates differ")
+    return lines
