@@ -141,6 +141,14 @@ def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
     from pipeline.dataset import write_dataset
     from pipeline.figures import save_figures  # matplotlib only when figures are drawn
 
+    task = task_of(cfg)
+    if task != "scene":
+        from pipeline.experiments import run_task
+
+        written = run_task(task, cfg, out_dir)
+        for path in written:
+            log.info("wrote %s", path)
+        return written[0]
     scene = Scene.from_config(cfg)
     ds = scene.run()
     ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
@@ -151,6 +159,12 @@ def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
         for figure in save_figures(ds, out_dir / "figures"):
             log.info("wrote %s", figure)
     return path
+
+
+def task_of(cfg: DictConfig) -> str:
+    """What a run does: an experiment's task, a regime comparison when a regime is chosen, else the scene."""
+    task = cfg.get("task") or "scene"
+    return "regime" if task == "scene" and cfg.get("regime") else task
 
 
 def _quiet_console() -> None:

@@ -44,17 +44,27 @@ def group_options(group: str) -> list[str]:
 
 
 def compose_config(overrides: Sequence[str], *, return_hydra_config: bool = False) -> DictConfig:
-    """Compose gyrolab's config with command-line style overrides; ConfigError on any problem."""
+    """Compose gyrolab's config with command-line style overrides; ConfigError on any problem.
+
+    Inside a running gyrolab app (an experiment composing its scenes) Hydra is already
+    initialised on the same config module, and is reused.
+    """
     register_plugin_configs()
+    if GlobalHydra.instance().is_initialized():
+        return _compose(overrides, return_hydra_config)
     with initialize_config_module(config_module=CONFIG_MODULE, version_base="1.3"):
-        try:
-            return compose(config_name=CONFIG_NAME, overrides=list(overrides), return_hydra_config=return_hydra_config)
-        except MissingConfigException as error:
-            raise friendly_missing(error) from None
-        except OverrideParseException as error:
-            raise ConfigError(f"malformed override: {_first_line(error)}") from None
-        except (HydraException, OmegaConfBaseException) as error:
-            raise ConfigError(_first_line(error)) from None
+        return _compose(overrides, return_hydra_config)
+
+
+def _compose(overrides: Sequence[str], return_hydra_config: bool) -> DictConfig:
+    try:
+        return compose(config_name=CONFIG_NAME, overrides=list(overrides), return_hydra_config=return_hydra_config)
+    except MissingConfigException as error:
+        raise friendly_missing(error) from None
+    except OverrideParseException as error:
+        raise ConfigError(f"malformed override: {_first_line(error)}") from None
+    except (HydraException, OmegaConfBaseException) as error:
+        raise ConfigError(_first_line(error)) from None
 
 
 def friendly_missing(error: MissingConfigException) -> ConfigError:

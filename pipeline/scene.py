@@ -14,7 +14,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from pipeline import registry
 from pipeline.config import compose_config
-from pipeline.contracts import Force, Integrator, System
+from pipeline.contracts import CompiledModel, Integrator, System
 from pipeline.dataset import build_dataset
 from pipeline.errors import ConfigError, as_number, require_finite
 from pipeline.progress import Progress
@@ -58,16 +58,21 @@ class Scene:
         """The resolved config as YAML (stored in every dataset; computed once per scene)."""
         return OmegaConf.to_yaml(self.config, resolve=True)
 
-    def run(self) -> xr.Dataset:
-        """Integrate the full equations of motion and return the self-describing dataset."""
-        log.info("integrating %s with %s over t=[%g, %g] (%d output times)", self.system.title(),
-                 self.integrator.name, self.times[0], self.times[-1], len(self.times))
-        progress = Progress(self.integrator.name, self.times[0], self.times[-1])
+    @cached_property
+    def compiled(self) -> CompiledModel | None:
+        """The system's compiled model, when the integrator uses one (packed once per scene)."""
         integrator = self.integrator
         wants = integrator.needs_compiled_model or integrator.prefers_compiled_model
-        compiled = self.system.compiled_model() if wants else None
+        return self.system.compiled_model() if wants else None
+
+    def run(self) -> xr.Dataset:
+        """Integrate the full equations of motion and return the self-describing dataset."""
+        if log.isEnabledFor(logging.INFO):  # the title is worth building only when someone reads it
+            log.info("integrating %s with %s over t=[%g, %g] (%d output times)", self.system.title(),
+                     self.integrator.name, self.times[0], self.times[-1], len(self.times))
+        progress = Progress(self.integrator.name, self.times[0], self.times[-1])
         solution = self.integrator.integrate(self.system.rhs, self.times, self.system.initial_state(), progress,
-                                             compiled)
+                                             self.compiled)
         stats = solution.stats
         log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
                  "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)

@@ -22,3 +22,30 @@ def test_multirun_writes_one_dataset_per_job(cli, tmp_path):
         with xr.open_dataset(tmp_path / "sweep" / job / "run.nc") as ds:
             names.append(ds.attrs["integrator"])
     assert names == ["rk4", "dop853"]
+
+
+import pytest  # noqa: E402
+
+EXPERIMENTS = {
+    # experiment (or regime) -> (extra overrides keeping it small, files it must write)
+    "regime=small_parameter": ([], ["regime.nc", "figures/regime_comparison.png"]),
+    "experiment=ismail2021_tables": ([], ["table1.csv", "table2.csv"]),
+    "experiment=shaker_omega3": ([], []),
+    "experiment=regime_validity": ([], []),
+    "experiment=yehia2021_precessions": ([], ["precession_cases.csv"]),
+    "experiment=work_precision": (["time.end=5", "work_precision.repeats=1", "~work_precision.methods",
+                                   "+work_precision.methods={taylor: {tol: [1e-10]}, rk4_numba: {step: [0.01]}}"],
+                                  ["work_precision.nc", "figures/error_vs_wall_time.png"]),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("selector", EXPERIMENTS)
+def test_every_experiment_runs_from_the_command_line(selector, cli, tmp_path):
+    extra, expected = EXPERIMENTS[selector]
+    done = cli(selector, *extra, "hydra.run.dir=out")
+    assert done.returncode == 0, done.stderr[-2000:]
+    written = [p for p in (tmp_path / "out").rglob("*") if p.is_file() and ".hydra" not in p.parts]
+    assert any(p.suffix in (".nc", ".csv") for p in written), written
+    for name in expected:
+        assert (tmp_path / "out" / name).exists(), name

@@ -88,14 +88,34 @@ def _cauchy_cross(A, ia, B, ib, k, s0, s1, s2, out):
 
 
 @kernel
+def _cauchy_pairs(A, ia, k, out):
+    """k-th coefficients of (e_y e_z, e_z e_x, e_x e_y) for e = A[:, ia:ia+3]: the products behind e × I e."""
+    r0 = 0.0
+    r1 = 0.0
+    r2 = 0.0
+    for j in range(k + 1):
+        x0, x1, x2 = A[j, ia], A[j, ia + 1], A[j, ia + 2]
+        z0, z1, z2 = A[k - j, ia], A[k - j, ia + 1], A[k - j, ia + 2]
+        r0 += x1 * z2
+        r1 += x2 * z0
+        r2 += x0 * z1
+    out[0] = r0
+    out[1] = r1
+    out[2] = r2
+
+
+@kernel
 def taylor_coefficients(p, Y, order, work):
     """Fill Y[1..order] (rows: Taylor coefficients of the state) from Y[0].
 
     The right-hand side is quadratic in the state, so the k-th coefficient of
     every product is a Cauchy sum (Jorba & Zou 2005): Y[k+1] = F_k / (k + 1).
+    The gyroscopic and gradient torques use their component form,
+    ((Iω) × ω)_x = (I_y − I_z) ω_y ω_z, one product per term instead of two.
     ``work`` (order+1, 3) holds the coefficients of β = γ × α when α is carried.
     """
     I0, I1, I2 = p[0], p[1], p[2]
+    d0, d1, d2 = I1 - I2, I2 - I0, I0 - I1  # ((Iω) × ω) = (d0 ω_y ω_z, d1 ω_z ω_x, d2 ω_x ω_y)
     has_alpha = p[15] != 0.0
     acc = np.empty(3)
     tmp = np.empty(3)
@@ -104,19 +124,17 @@ def taylor_coefficients(p, Y, order, work):
             acc[:] = 0.0
             _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, acc)
             work[k, 0], work[k, 1], work[k, 2] = acc[0], acc[1], acc[2]
-        # torque coefficient
-        acc[:] = 0.0
-        _cauchy_cross(Y, 0, Y, 0, k, I0, I1, I2, acc)  # (Iω) × ω
+        _cauchy_pairs(Y, 0, k, tmp)  # (Iω) × ω
+        acc[0], acc[1], acc[2] = d0 * tmp[0], d1 * tmp[1], d2 * tmp[2]
         g0, g1, g2 = Y[k, 3], Y[k, 4], Y[k, 5]
         acc[0] += p[10] * g2 - p[11] * g1
         acc[1] += p[11] * g0 - p[9] * g2
         acc[2] += p[9] * g1 - p[10] * g0
-        if p[14] != 0.0:  # N_2 γ × Iγ = −N_2 (Iγ) × γ
-            tmp[:] = 0.0
-            _cauchy_cross(Y, 3, Y, 3, k, I0, I1, I2, tmp)
-            acc[0] -= p[14] * tmp[0]
-            acc[1] -= p[14] * tmp[1]
-            acc[2] -= p[14] * tmp[2]
+        if p[14] != 0.0:  # N_2 γ × Iγ = −N_2 (d ⊙ pairs of γ)
+            _cauchy_pairs(Y, 3, k, tmp)
+            acc[0] -= p[14] * d0 * tmp[0]
+            acc[1] -= p[14] * d1 * tmp[1]
+            acc[2] -= p[14] * d2 * tmp[2]
         if has_alpha:
             x0, x1, x2 = Y[k, 6], Y[k, 7], Y[k, 8]
             b0, b1, b2 = work[k, 0], work[k, 1], work[k, 2]
@@ -124,21 +142,19 @@ def taylor_coefficients(p, Y, order, work):
             acc[1] += p[5] * x0 - p[3] * x2 + p[8] * b0 - p[6] * b2
             acc[2] += p[3] * x1 - p[4] * x0 + p[6] * b1 - p[7] * b0
             if p[12] != 0.0:
-                tmp[:] = 0.0
-                _cauchy_cross(Y, 6, Y, 6, k, I0, I1, I2, tmp)
-                acc[0] -= p[12] * tmp[0]
-                acc[1] -= p[12] * tmp[1]
-                acc[2] -= p[12] * tmp[2]
+                _cauchy_pairs(Y, 6, k, tmp)
+                acc[0] -= p[12] * d0 * tmp[0]
+                acc[1] -= p[12] * d1 * tmp[1]
+                acc[2] -= p[12] * d2 * tmp[2]
             if p[13] != 0.0:
-                tmp[:] = 0.0
-                _cauchy_cross(work, 0, work, 0, k, I0, I1, I2, tmp)
-                acc[0] -= p[13] * tmp[0]
-                acc[1] -= p[13] * tmp[1]
-                acc[2] -= p[13] * tmp[2]
+                _cauchy_pairs(work, 0, k, tmp)
+                acc[0] -= p[13] * d0 * tmp[0]
+                acc[1] -= p[13] * d1 * tmp[1]
+                acc[2] -= p[13] * d2 * tmp[2]
         inv = 1.0 / (k + 1)
-        Y[k + 1, 0] = acc[0] / I0 * inv
-        Y[k + 1, 1] = acc[1] / I1 * inv
-        Y[k + 1, 2] = acc[2] / I2 * inv
+        Y[k + 1, 0] = acc[0] * p[16] * inv
+        Y[k + 1, 1] = acc[1] * p[17] * inv
+        Y[k + 1, 2] = acc[2] * p[18] * inv
         # γ̇ = γ × ω, α̇ = α × ω
         acc[:] = 0.0
         _cauchy_cross(Y, 3, Y, 0, k, 1.0, 1.0, 1.0, acc)
