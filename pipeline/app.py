@@ -139,7 +139,6 @@ def _task(cfg: DictConfig) -> None:
 def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
     """Run the scene, write ``run.nc`` (and figures) in ``out_dir``; GyrolabError on bad input or a failed run."""
     from pipeline.dataset import write_dataset
-    from pipeline.figures import save_figures  # matplotlib only when figures are drawn
 
     task = task_of(cfg)
     if task != "scene":
@@ -156,6 +155,8 @@ def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
     path = write_dataset(ds, out_dir / "run.nc")
     log.info("wrote %s", path)
     if cfg.output.get("figures", True):
+        from pipeline.figures import save_figures  # matplotlib only when figures are drawn
+
         for figure in save_figures(ds, out_dir / "figures"):
             log.info("wrote %s", figure)
     return path
