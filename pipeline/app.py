@@ -178,7 +178,9 @@ def _quiet_console() -> None:
 
 
 def run_command(argv: Sequence[str]) -> int | None:
-    """``--reproduce PATH`` and ``--aggregate SWEEP_DIR``: their exit status, or None for a Hydra run."""
+    """``--reproduce PATH``, ``--aggregate SWEEP_DIR``, ``--batch OVERRIDES``: exit status, or None for a Hydra run."""
+    if argv and argv[0] == "--batch":
+        return _batch(argv[1:])
     if not argv or argv[0].split("=", 1)[0] not in ("--reproduce", "--aggregate"):
         return None
     option, _, value = argv[0].partition("=")
@@ -198,6 +200,29 @@ def run_command(argv: Sequence[str]) -> int | None:
     summary = aggregate_sweep(Path(rest[0]))
     log_summary(summary)
     return _sweep_status(summary)
+
+
+def _batch(overrides: Sequence[str]) -> int:
+    """``gyrolab --batch KEY=V1,V2 ... [hydra.sweep.dir=DIR]``: the grid in one batch, one sweep.nc."""
+    from datetime import datetime
+
+    from pipeline.sweep.batch import run_batch_sweep
+
+    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
+    out_dir = Path(f"outputs/batch/{datetime.now():%Y-%m-%d}/{datetime.now():%H-%M-%S}")
+    scene_overrides = []
+    for override in overrides:
+        if override.startswith("hydra.sweep.dir="):
+            out_dir = Path(override.split("=", 1)[1])
+        elif override.startswith("hydra."):
+            raise ConfigError(f"{override!r}: a batch sweep runs in one process; of Hydra's settings it takes "
+                              "hydra.sweep.dir only")
+        else:
+            scene_overrides.append(override)
+    check_writable(out_dir)
+    path = run_batch_sweep(scene_overrides, out_dir)
+    log.info("wrote %s", path)
+    return 0
 
 
 def _sweep_status(summary: SweepSummary | None = None) -> int:
