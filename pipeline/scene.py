@@ -44,6 +44,7 @@ class Scene:
         system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
         times = _output_times(plain["time"])
+        integrator.prepare(system)
         if integrator.needs_compiled_model and system.compiled_model() is None:
             plain_forces = [f.name for f in system.forces if f.compiled_terms() is None]
             culprit = f"force {plain_forces[0]!r}" if plain_forces else f"system {system.name!r}"

@@ -98,3 +98,6 @@ def test_compiled_integrator_refuses_a_force_without_compiled_form(monkeypatch):
 def test_auto_refuses_an_accuracy_beyond_double_precision():
     with pytest.raises(ConfigError, match="accuracy=1e-15 is below"):
         run(["integrator=auto", "accuracy=1e-15", "time.end=1", "time.n_output=3"])
+    # 300 time units at spin 5: ~2000 steps, round-off ~2e-12 (the Taylor method's measured floor there)
+    with pytest.raises(ConfigError, match="below the round-off"):
+        run(["experiment=perf_reference", "time.n_output=2", "accuracy=1e-12"])

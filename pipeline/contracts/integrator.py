@@ -83,5 +83,9 @@ class Integrator(ABC):
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         """Integrate from t_out[0] and sample the state at t_out."""
 
+    def prepare(self, system: Any) -> None:
+        """Called once by the scene with its system, for integrators that need more than the right-hand
+        side (``auto`` consults the system's analytic regimes). The default needs nothing."""
+
     def attributes(self) -> dict[str, Any]:
         return {}

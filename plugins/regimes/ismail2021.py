@@ -186,3 +186,134 @@ def scaled_rhs(tau: float, Y: np.ndarray, P: Params) -> np.ndarray:
         r * g2 - e * q * g3,
         e * p * g3 - r * g1,
         e * (q * g1 - p * g2)])
+
+
+# -- the reduction (7), (9)-(14) term by term (errata 000-2, 000-3; report §4) ------------------------
+# Every function below is plain numpy and accepts a complex μ (so that tests can take Taylor coefficients
+# in ε = 1/μ by Cauchy integrals). The right-hand side ``scaled_rhs`` is quadratic in the state, so
+# its Jacobian applied to v is exactly (f(Y + v) − f(Y − v))/2.
+def flow_derivative(Y: np.ndarray, P: Params) -> tuple[np.ndarray, np.ndarray]:
+    """(Ẏ, Ÿ) of the paper's eq. (1) at Y (d/dτ): Ÿ = J(Y)Ẏ, exact because (1) is quadratic."""
+    f = scaled_rhs(0.0, Y, P)
+    return f, 0.5 * (scaled_rhs(0.0, Y + f, P) - scaled_rhs(0.0, Y - f, P))
+
+
+def state_from_integrals(p1, q1, g1, g2, s2, s3, P: Params, iterations: int = 60) -> np.ndarray:
+    """Y = (p1, q1, r1, γ, γ', γ'') with r1, γ'' from the integrals (2)-(3) for given s2, s3 (eq. 6).
+
+    r1² = 1 + μ⁻²s1, s1 = s3 − 2z0'(γ0'' − γ'') + k(γ0''² − γ''²); r1γ'' = γ0'' + μ⁻¹s2 (fixed point).
+    """
+    e, g0, z, k = 1 / P.mu, P.g0, P.z0, P.k
+    r1, g3 = 1.0 + 0j * e, g0 + 0j * e
+    for _ in range(iterations):
+        s1 = s3 - 2 * z * (g0 - g3) + k * (g0**2 - g3**2)
+        r1 = np.sqrt(1 + e**2 * s1)
+        g3 = (g0 + e * s2) / r1
+    return np.array([p1, q1, r1, g1, g2, g3])
+
+
+def eq7_gamma_mu2(p1, q1, g1, g2, s2, s3, P: Params, printed: bool = False):
+    """μ⁻² coefficient of γ̈ + γ in eq. (7) (the γ-equation), at the state of ``state_from_integrals``.
+
+    −γ[s3 + y0'γ' + z0'b⁻¹γ0'' + q1² ∓ k(C1γ'² − B1γ0''²)] + p1[(1+B1)s2 + (1−C1)q1γ'] + x0'(b⁻¹γ0''² + γ'²).
+    Printed: "+k(C1γ'² − B1γ0''²)" inside the bracket; corrected "−k(…)" (erratum 000-2).
+    """
+    g0, x, y, z, k, b, B1, C1 = P.g0, P.x0, P.y0, P.z0, P.k, P.b, P.B1, P.C1
+    sign = 1.0 if printed else -1.0
+    return (p1 * ((1 + B1) * s2 + (1 - C1) * q1 * g2)
+            - g1 * (s3 + y * g2 + z * g0 / b + q1**2 + sign * k * (C1 * g2**2 - B1 * g0**2))
+            + x * (g0**2 / b + g2**2))
+
+
+def eq12_s11_s21(Z: np.ndarray, Z0: np.ndarray, P: Params) -> tuple:
+    """s11, s21 of eq. (12) for Z = (p2, ṗ2, γ2, γ̇2) and the initial Z0 (the leading parts of s1, s2)."""
+    a, b, x, y, k, A1 = P.a, P.b, P.x0, P.y0, P.k, P.A1
+    Pn, Pd, G, Gd = Z[0], Z[1], Z[2], Z[3]
+    P0, Pd0, G0, Gd0 = Z0[0], Z0[1], Z0[2], Z0[3]
+    s11 = (a * (P0**2 - Pn**2) + b * (Pd0**2 - Pd**2) / A1**2 - 2 * (x * (G0 - G) + y * (Gd0 - Gd))
+           + k * (a * (G0**2 - G**2) + b * (Gd0**2 - Gd**2)))
+    s21 = a * (P0 * G0 - Pn * G) - b / A1 * (Pd0 * Gd0 - Pd * Gd)
+    return s11, s21
+
+
+def eq14_F2_Phi2(Z: np.ndarray, Z0: np.ndarray, P: Params, printed: bool = False) -> tuple:
+    """F2, Φ2 of eq. (14): p̈2 + ω²p2 = μ⁻²F2 + O(μ⁻³), γ̈2 + γ2 = μ⁻²Φ2 + O(μ⁻³).
+
+    F2 is correct as printed. Φ2 printed has x0'(γ̇2² + b⁻¹γ0''); corrected x0'(γ̇2² + b⁻¹γ0''²) (erratum 000-3).
+    """
+    a, b, x, y, z, k, g0, A1, B1, C1, w2, chi1 = (P.a, P.b, P.x0, P.y0, P.z0, P.k, P.g0, P.A1, P.B1, P.C1,
+                                                  P.omega2, P.chi1)
+    Pn, Pd, G, Gd = Z[0], Z[1], Z[2], Z[3]
+    s11, s21 = eq12_s11_s21(Z, Z0, P)
+    f2 = (x * (A1 / b * s21 + Pd * Gd) + Pd / A1 * (C1 * Pn * Pd - y * (2 * A1 + b / a) * G)
+          - Pn * (w2 * s11 + y / a * Gd + z / a * g0)
+          - k * (G * ((1 - C1) * Pd * Gd + A1 * (1 + B1) * s21) - A1 * Pn * (g0**2 - Gd**2)))
+    phi2 = ((1 + B1) * Pn * s21 + x * (Gd**2 + (g0 if printed else g0**2) / b)
+            - Pd / A1 * (G * Pd / A1 + (1 - C1) * Pn * Gd)
+            - G * (s11 + z / b * g0 + y * Gd - k * (C1 * Gd**2 - B1 * g0**2)))
+    F2 = f2 - a * g0 * chi1 * (1 - w2) * Pn
+    Phi2 = phi2 + a * g0 * (1 - w2) * (chi1 * G + g0 * x / (1 - a))
+    return F2, Phi2
+
+
+def reduced_from_scaled(Y: np.ndarray, P: Params) -> np.ndarray:
+    """Z = (p2, ṗ2, γ2, γ̇2) from the scaled state Y by the exact change of variables (9).
+
+    p1 = p2 + μ⁻¹(χ1γ2 + x0'γ0''/(1−a)), γ = γ2 + μ⁻¹aγ0''p2; the dots are d/dτ along eq. (1).
+    """
+    e, a, g0, chi1, xa = 1 / P.mu, P.a, P.g0, P.chi1, P.x0 / (1 - P.a)
+    f = scaled_rhs(0.0, Y, P)
+    det = 1 - e**2 * chi1 * a * g0
+    p2 = (Y[0] - e * xa * g0 - e * chi1 * Y[3]) / det
+    p2d = (f[0] - e * chi1 * f[3]) / det
+    return np.array([p2, p2d, Y[3] - e * a * g0 * p2, f[3] - e * a * g0 * p2d])
+
+
+def scaled_from_reduced(Z: np.ndarray, P: Params, Y0: np.ndarray | None = None, iterations: int = 60) -> np.ndarray:
+    """Inverse of ``reduced_from_scaled``: Y = (p1, q1, r1, γ, γ', γ'') (eqs. 9, 10, 13, without truncation).
+
+    q1, γ' from eq. (1) (p- and γ-rows), r1, γ'' from the integrals (2) relative to the orbit's initial state
+    Y0 (r1 = 1, γ'' = γ0'' there; ``Y0=None`` means Z is that initial state). Fixed-point iteration in μ⁻¹.
+    """
+    e, a, y, z, k, g0, A1, chi1 = 1 / P.mu, P.a, P.y0, P.z0, P.k, P.g0, P.A1, P.chi1
+    Pn, Pd, G, Gd = Z
+    p1 = Pn + e * (chi1 * G + P.x0 * g0 / (1 - a))
+    g1 = G + e * a * g0 * Pn
+    p1d = Pd + e * chi1 * Gd
+    g1d = Gd + e * a * g0 * Pd
+    q1, g2, r1, g3 = -p1d / A1, g1d, 1.0 + 0 * e, g0 + 0 * e
+    for _ in range(iterations):
+        q1_new = (-p1d + e * ((y * g3 - z * g2) / a + k * A1 * g2 * g3)) / (A1 * r1)
+        g2_new = (g1d + e * q1 * g3) / r1
+        if Y0 is not None:
+            s1, s2 = _s1_s2([p1, q1, r1, g1, g2, g3], Y0, P)
+            r1 = np.sqrt(1 + e**2 * s1)
+            g3 = (g0 + e * s2) / r1
+        q1, g2 = q1_new, g2_new
+    return np.array([p1, q1, r1, g1, g2, g3])
+
+
+def _s1_s2(Y, Y0, P: Params):
+    """s1, s2 of eq. (3) from the energy and area integrals of (1), relative to the initial state Y0."""
+    a, b, x, y, z, k = P.a, P.b, P.x0, P.y0, P.z0, P.k
+    p, q, _, g1, g2, g3 = Y
+    p0, q0, _, g10, g20, g30 = Y0
+    s3 = (a * (p0**2 - p**2) + b * (q0**2 - q**2) - 2 * (x * (g10 - g1) + y * (g20 - g2))
+          + k * (a * (g10**2 - g1**2) + b * (g20**2 - g2**2)))
+    s1 = s3 - 2 * z * (g30 - g3) + k * (g30**2 - g3**2)
+    s2 = a * (p0 * g10 - p * g1) + b * (q0 * g20 - q * g2)
+    return s1, s2
+
+
+def reduced_rhs(tau: float, Z: np.ndarray, P: Params, Z0: np.ndarray, printed: bool = False) -> np.ndarray:
+    """The reduced quasilinear system (14) truncated after μ⁻²: d/dτ (p2, ṗ2, γ2, γ̇2).
+
+        p̈2 + ω²p2 = μ⁻²F2,   γ̈2 + γ2 = μ⁻²Φ2      (F3, Φ3 are wrong as printed: erratum 000-4)
+
+    Z0 is the initial state (it enters through s11, s21 of (12)). Its solution differs from the full model
+    by the dropped μ⁻³ terms: O(μ⁻³) over a period (measured in tests/test_regime_small_parameter.py).
+    ``printed`` uses the printed Φ2 (erratum 000-3).
+    """
+    F2, Phi2 = eq14_F2_Phi2(Z, Z0, P, printed=printed)
+    e2 = 1 / P.mu**2
+    return np.array([Z[1], -P.omega2 * Z[0] + e2 * F2, Z[3], -Z[2] + e2 * Phi2])

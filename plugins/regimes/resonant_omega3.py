@@ -63,6 +63,30 @@ class ResonantOmega3(FixedPointRegime):
                             "the case (i) series degrades")
         return warnings + self.reseat_warnings(system)
 
+    def reduced_rhs(self, system):
+        """Seed 001's scaled system (eq. 1 in the variables of eq. 5) for this scene: ``(rhs, Y0, to_model)``.
+
+        ``rhs(τ, Y)`` is d/dτ of Y = (p1, q1, r1, γ1, γ1', γ1''), τ = r0 t (exact rescaling of the full model,
+        ``shaker_omega3.scaled_rhs``); Y0 is the analytic orbit's τ = 0 state; ``to_model(Y)`` maps (6, n)
+        back to (n, 6) model-unit states at t = τ/(c r0).
+        """
+        s = self.scene(system)
+        C = self.constants(s)
+        mu, g0 = paper.mu_of(s.r0, s.theta0), s.gamma0pp
+        y0 = paper.state(np.array([0.0]), s.r0, C)[0]
+        Y0 = np.concatenate([y0[:2] / np.sqrt(g0), [y0[2] / s.r0], y0[3:] / g0])
+
+        def rhs(tau, Y):
+            return paper.scaled_rhs(tau, Y, mu, C)
+
+        def to_model(Y):
+            Y = np.asarray(Y, dtype=float).reshape(6, -1)
+            out = np.stack([np.sqrt(g0) * Y[0], np.sqrt(g0) * Y[1], s.r0 * Y[2], g0 * Y[3], g0 * Y[4], g0 * Y[5]], -1)
+            out[:, :3] *= s.c
+            return out
+
+        return rhs, Y0, to_model
+
     def _state(self, s, t):
         return paper.state(t, s.r0, self.constants(s))
 

@@ -125,6 +125,27 @@ def mu_of(r0: float, theta0: float) -> float:
     return float(np.sqrt(np.cos(theta0)) / r0)
 
 
+def scaled_rhs(tau: float, Y: np.ndarray, mu: float, C: Constants) -> np.ndarray:
+    """The paper's scaled system (eq. 1 with the variables of eq. 5; report §1), d/dτ of
+    Y = (p1, q1, r1, γ1, γ1', γ1'') with τ = r0 t, p = c√γ0'' p1, r = r0 r1, γ = γ0'' γ1 and k = k_gt γ0'':
+
+        ṗ1 + A1q1r1 = μa⁻¹(y0'γ1'' − z0'γ1' + kaA1γ1'γ1''),  q̇1 + B1p1r1 = μb⁻¹(z0'γ1 − x0'γ1'' + kbB1γ1''γ1),
+        ṙ1 = μ²(−C1p1q1 + x0'γ1' − y0'γ1 + kC1γ1γ1'),
+        γ̇1 = r1γ1' − μq1γ1'',  γ̇1' = μp1γ1'' − r1γ1,  γ̇1'' = μ(q1γ1 − p1γ1').
+
+    Exact: it is the full model rescaled (tests/test_regime_resonant_omega3.py).
+    """
+    a, b, x, y, z, k, A1, B1, C1 = C.a, C.b, C.x0, C.y0, C.z0, C.k, C.A1, C.B1, C.C1
+    p, q, r, g1, g2, g3 = Y
+    return np.array([
+        -A1 * q * r + mu / a * (y * g3 - z * g2 + k * a * A1 * g2 * g3),
+        -B1 * p * r + mu / b * (z * g1 - x * g3 + k * b * B1 * g3 * g1),
+        mu**2 * (-C1 * p * q + x * g2 - y * g1 + k * C1 * g1 * g2),
+        r * g2 - mu * q * g3,
+        mu * p * g3 - r * g1,
+        mu * (q * g1 - p * g2)])
+
+
 def period(r0: float, C: Constants) -> float:
     """T = (2π + α)/r0 in units of 1/c (28)."""
     return (2.0 * np.pi + C.alpha2 * mu_of(r0, C.theta0) ** 2) / r0

@@ -73,6 +73,35 @@ class SmallParameter(FixedPointRegime):
             warnings.append(f"a + b − 1 = {s.a + s.b - 1:.3g}: the z0'/(a + b − 1) terms of (35) are large")
         return warnings + self.reseat_warnings(system)
 
+    def reduced_rhs(self, system):
+        """The reduced quasilinear system (000 eq. 14, truncated after μ⁻²) for this scene.
+
+        Returns ``(rhs, Z0, to_model)``: ``rhs(τ, Z)`` gives d/dτ of Z = (p2, ṗ2, γ2, γ̇2) (τ = r0 t, any
+        integrator); Z0 is the orbit's τ = 0 state (that of ``initial_state`` with r = r0, γ'' = γ0'');
+        ``to_model(Z, Z0)`` maps a (4, n) solution back to (n, 6) model-unit states (p, q, r, γ, γ', γ'')
+        at t = τ/(c r0). ``formula=printed`` uses the printed Φ2 (erratum 000-3). Error against the full model
+        over a period: p, q O(μ⁻³), γ's O(μ⁻⁴) (tests/test_regime_small_parameter.py).
+        """
+        s = self.scene(system)
+        P = self.params(s)
+        S = paper.scaled(np.array([0.0]), P)
+        Y0 = np.array([S[k][0] for k in ("p1", "q1", "r1", "g1", "g2", "g3")])
+        Y0[3] = np.sqrt(1 - Y0[4] ** 2 - Y0[5] ** 2)
+        Z0 = paper.reduced_from_scaled(Y0, P)
+        printed = self.formula == "printed"
+
+        def rhs(tau, Z):
+            return paper.reduced_rhs(tau, Z, P, Z0, printed)
+
+        def to_model(Z):
+            Z = np.asarray(Z, dtype=float).reshape(4, -1)
+            Y = np.array([paper.scaled_from_reduced(Z[:, i], P, Y0) for i in range(Z.shape[1])])
+            y = paper.scaled_to_model({k: Y[:, i] for i, k in enumerate(("p1", "q1", "r1", "g1", "g2", "g3"))}, P)
+            y[:, :3] *= s.c
+            return y
+
+        return rhs, Z0, to_model
+
     def _state(self, s, t):
         P = self.params(s)
         tau = s.r0 * t
