@@ -22,6 +22,7 @@ from pipeline.contracts.integrator import (
     Solution,
 )
 from pipeline.errors import ConfigError, IntegrationError, as_number
+from plugins.integrators.tolerances import Tolerances
 from plugins.integrators.step_guard import check_step, compiled_rhs
 
 CHUNKS = 50  # progress reports per run at most
@@ -32,30 +33,30 @@ def _chunks(n_out: int) -> list[tuple[int, int]]:
     return [(i, min(i + size, n_out)) for i in range(1, n_out, size)]
 
 
+def _outputs(t_out: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(output times as floats, a working copy of y0, the output array with y0 in its first row)."""
+    y = np.array(y0, dtype=float)
+    out = np.empty((len(t_out), len(y)))
+    out[0] = y
+    return np.asarray(t_out, dtype=float), y, out
+
+
 def steps_per_interval(t_out: np.ndarray, step: float) -> np.ndarray:
     """Fewest equal steps no longer than ``step`` in each output interval (lands on every output time)."""
     return np.maximum(1, np.ceil(np.diff(t_out) / step * (1.0 - 1e-12))).astype(np.int64)
 
 
-class DOP853Numba(Integrator):
+class DOP853Numba(Tolerances, Integrator):
     name = "dop853_numba"
     adaptive = True
     needs_compiled_model = True
-
-    def __init__(self, *, rtol: float = 1e-10, atol: float = 1e-10, max_step: float | None = None) -> None:
-        self.rtol = as_number(rtol, "integrator.rtol", positive=True)
-        self.atol = as_number(atol, "integrator.atol", positive=True)
-        self.max_step = np.inf if max_step is None else as_number(max_step, "integrator.max_step", positive=True)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         from plugins.compiled import dop853, models
 
         start = time.perf_counter()
-        t_out = np.asarray(t_out, dtype=float)
-        y = np.array(y0, dtype=float)
-        out = np.empty((len(t_out), len(y)))
-        out[0] = y
+        t_out, y, out = _outputs(t_out, y0)
         f = np.empty_like(y)
         models.rhs(compiled.model, t_out[0], y, compiled.params, f)
         stats = np.zeros(3, dtype=np.int64)
@@ -76,12 +77,6 @@ class DOP853Numba(Integrator):
         return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]),
                                                     n_rejected=int(stats[2]), wall_time=wall))
 
-    def attributes(self) -> dict[str, Any]:
-        attrs: dict[str, Any] = {"integrator_rtol": self.rtol, "integrator_atol": self.atol}
-        if np.isfinite(self.max_step):
-            attrs["integrator_max_step"] = self.max_step
-        return attrs
-
 
 class RK4Numba(Integrator):
     name = "rk4_numba"
@@ -96,11 +91,8 @@ class RK4Numba(Integrator):
         from plugins.compiled import rk4
 
         start = time.perf_counter()
-        t_out = np.asarray(t_out, dtype=float)
+        t_out, y, out = _outputs(t_out, y0)
         steps = steps_per_interval(t_out, self.step)
-        y = np.array(y0, dtype=float)
-        out = np.empty((len(t_out), len(y)))
-        out[0] = y
         fun = compiled_rhs(compiled)
         for first, stop in _chunks(len(t_out)):
             check_step(self.name, fun, t_out[first - 1], y, float(np.diff(t_out)[first - 1] / steps[first - 1]))
@@ -134,10 +126,7 @@ class Taylor(Integrator):
         from plugins.compiled import taylor
 
         start = time.perf_counter()
-        t_out = np.asarray(t_out, dtype=float)
-        y = np.array(y0, dtype=float)
-        out = np.empty((len(t_out), len(y)))
-        out[0] = y
+        t_out, y, out = _outputs(t_out, y0)
         state = np.array([t_out[0]])
         stats = np.zeros(2, dtype=np.int64)
         for first, stop in _chunks(len(t_out)):
@@ -176,12 +165,9 @@ class LiePoisson(Integrator):
         if compiled.model != models.FIXED_POINT:
             raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian only; valid systems: fixed_point")
         start = time.perf_counter()
-        t_out = np.asarray(t_out, dtype=float)
+        t_out, y, out = _outputs(t_out, y0)
         steps = steps_per_interval(t_out, self.step)
         w = lie_poisson.weights(self.order)
-        y = np.array(y0, dtype=float)
-        out = np.empty((len(t_out), len(y)))
-        out[0] = y
         fun = compiled_rhs(compiled)
         for first, stop in _chunks(len(t_out)):
             check_step(self.name, fun, t_out[first - 1], y, float(np.diff(t_out)[first - 1] / steps[first - 1]))

@@ -11,25 +11,21 @@ costs exactly ``n_stages`` evaluations, so the evaluations spent inside one
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 from scipy import integrate
 
 from pipeline.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
-from pipeline.errors import IntegrationError, as_number
+from pipeline.errors import IntegrationError
+from plugins.integrators.tolerances import Tolerances
 
 
-class ScipySolver(Integrator):
+class ScipySolver(Tolerances, Integrator):
     """Adaptive scipy solver; subclasses name the scipy class."""
 
     adaptive = True
     solver_class: ClassVar[type]
-
-    def __init__(self, *, rtol: float = 1e-10, atol: float = 1e-10, max_step: float | None = None) -> None:
-        self.rtol = as_number(rtol, "integrator.rtol", positive=True)
-        self.atol = as_number(atol, "integrator.atol", positive=True)
-        self.max_step = np.inf if max_step is None else as_number(max_step, "integrator.max_step", positive=True)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
@@ -68,12 +64,6 @@ class ScipySolver(Integrator):
             wall_time=time.perf_counter() - start, njev=solver.njev, nlu=solver.nlu,
         )
         return Solution(t=t_out, y=out, stats=stats)
-
-    def attributes(self) -> dict[str, Any]:
-        attrs: dict[str, Any] = {"integrator_rtol": self.rtol, "integrator_atol": self.atol}
-        if np.isfinite(self.max_step):
-            attrs["integrator_max_step"] = self.max_step
-        return attrs
 
 
 class RK45(ScipySolver):

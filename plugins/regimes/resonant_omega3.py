@@ -54,7 +54,7 @@ class ResonantOmega3(FixedPointRegime):
             raise ConfigError(f"regime resonant_omega3 needs fast spin, μ = c√(cos θ0)/r0 < 1, but the scene "
                               f"gives μ={mu:.4g}; increase initial.r0")
         C = self.constants(s)
-        warnings = [f"non-physical body (A + B < C, ω = 3): admitted by body.allow_nonphysical=true"]
+        warnings = ["non-physical body (A + B < C, ω = 3): admitted by body.allow_nonphysical=true"]
         if mu > 0.2:
             warnings.append(f"μ = {mu:.3g} > 0.2: near the edge of the fast-spin domain, expect errors of order "
                             f"μ² ≈ {mu**2:.2g}")

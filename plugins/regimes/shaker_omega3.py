@@ -199,7 +199,7 @@ def euler(t: np.ndarray, r0: float, C: Constants, *, printed_phi2: bool | None =
     mu = mu_of(r0, C.theta0)
     t = np.asarray(t, dtype=float)
     th0, M, e, e1, e2, l1, A1, C1, k = C.theta0, C.M, C.e, C.e1, C.e2, C.l1, C.A1, C.C1, C.k
-    x, y, a, b = C.x0, C.y0, C.a, C.b
+    x, y, a = C.x0, C.y0, C.a
     s = r0 * t if C.printed else (1.0 - C.alpha2 * mu**2 / (2 * np.pi)) * r0 * t
     yA = y / (a * A1)
     tn, ct = np.tan(th0), 1.0 / np.tan(th0)
