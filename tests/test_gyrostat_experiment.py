@@ -22,3 +22,7 @@ def test_experiment_writes_the_case_table(tmp_path):
     verdict = {(r["case"], r["formula"]): r["verdict"] for r in rows}
     assert verdict[("14.1", "printed")] == "fails" and verdict[("14.1", "corrected")] == "holds"
     assert verdict[("29.1", "printed")] == "fails" and verdict[("29.1", "corrected")] == "holds"
+    import xarray as xr
+    with xr.open_dataset(tmp_path / "precession_cases.nc") as ds:
+        assert float(ds.floquet_tolerance.max()) < 1e-4  # tied to the integration accuracy, not a fixed 1e-3
+        assert float(ds.floquet_uncertainty.max()) < 1e-5

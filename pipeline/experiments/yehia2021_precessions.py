@@ -75,7 +75,8 @@ def evaluate(cfg: DictConfig, case: Case, orbits: float, tol: float) -> tuple[di
     row = {"case": case.case, "label": case.label, "formula": case.formula, "residual_vector": res_v,
            "residual_euler_angles": res_e, "max_theta_deviation": float(deviation.max()),
            "max_theta_deviation_orbit1": float(deviation[first].max()), "stable": stability.stable,
-           "max_floquet_modulus": stability.max_modulus, "floquet_kind": stability.kind, "verdict": verdict,
+           "max_floquet_modulus": stability.max_modulus, "floquet_tolerance": stability.tolerance,
+           "floquet_uncertainty": stability.uncertainty, "floquet_kind": stability.kind, "verdict": verdict,
            "condition": case.condition, "orbital_frame": kind.orbital, "inertial_frame": kind.inertial,
            "geometric": kind.geometric,
            "jacobi_drift": float(ds.jacobi_integral.attrs["max_abs_drift"]) if "jacobi_integral" in ds else np.nan}
@@ -124,6 +125,8 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
                "max_theta_deviation": "max |θ − θ0| of the integrated full equations",
                "max_theta_deviation_orbit1": "max |θ − θ0| over the first orbit",
                "max_floquet_modulus": "largest modulus of the Floquet multipliers",
+               "floquet_tolerance": "stable if max |rho| <= 1 + this (10 max(sqrt(rtol), delta))",
+               "floquet_uncertainty": "delta: change of the sorted |rho| between rtol and 100 rtol",
                "jacobi_drift": "max |H − H0| of the integration"}
     for name, long_name in numeric.items():
         data[name] = ("case", np.array([r[name] for r in rows], dtype=float), {"units": "1", "long_name": long_name})
