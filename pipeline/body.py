@@ -33,33 +33,21 @@ _NONDIM_KEYS = ("a", "b", "com_direction")
 UNIT_TOLERANCE = 1e-9
 
 
-@dataclass(frozen=True)
-class Body:
-    """A rigid body in model units (see module docstring)."""
+class ModelUnits:
+    """CF units of a body's model quantities: SI, or dimensionless ("1") in a nondimensional form.
+
+    Subclasses say in ``time_label``/``rate_label`` what the nondimensional unit is (1/c, 1/Ω, ...).
+    """
 
     units: str
-    inertia: np.ndarray  # (A, B, C) in model units
-    weight_moment: np.ndarray  # M g r_c in model units (torque units)
-    g: float | None  # gravity in model units (SI only; None when scale-free)
-    nonphysical: bool  # inertia violates the triangle inequality (allowed explicitly)
-    source: dict[str, Any]  # the config values as given, for the dataset
 
     @property
     def time_unit(self) -> str:
-        """CF units string of model time."""
         return "s" if self.units == "si" else "1"
-
-    @property
-    def time_label(self) -> str:
-        return "s" if self.units == "si" else "1/c"
 
     @property
     def rate_unit(self) -> str:
         return "rad s-1" if self.units == "si" else "1"
-
-    @property
-    def rate_label(self) -> str:
-        return "rad/s" if self.units == "si" else "c"
 
     @property
     def torque_unit(self) -> str:
@@ -72,6 +60,26 @@ class Body:
     @property
     def momentum_unit(self) -> str:
         return "kg m2 s-1" if self.units == "si" else "1"
+
+
+@dataclass(frozen=True)
+class Body(ModelUnits):
+    """A rigid body in model units (see module docstring)."""
+
+    units: str
+    inertia: np.ndarray  # (A, B, C) in model units
+    weight_moment: np.ndarray  # M g r_c in model units (torque units)
+    g: float | None  # gravity in model units (SI only; None when scale-free)
+    nonphysical: bool  # inertia violates the triangle inequality (allowed explicitly)
+    source: dict[str, Any]  # the config values as given, for the dataset
+
+    @property
+    def time_label(self) -> str:
+        return "s" if self.units == "si" else "1/c"
+
+    @property
+    def rate_label(self) -> str:
+        return "rad/s" if self.units == "si" else "c"
 
     @classmethod
     def from_config(cls, cfg: Any) -> Body:

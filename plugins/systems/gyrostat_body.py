@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.body import _check_inertia, _netcdf_safe, _satisfies_triangle
+from pipeline.body import ModelUnits, _check_inertia, _netcdf_safe, _satisfies_triangle
 from pipeline.errors import ConfigError, as_number, as_vector3, choices
 
 UNITS = ("si", "nondimensional")
@@ -30,7 +30,7 @@ KEYS = ("units", "inertia", "gyrostatic_momentum", "orbit_rate", "allow_nonphysi
 
 
 @dataclass(frozen=True)
-class GyrostatBody:
+class GyrostatBody(ModelUnits):
     """A satellite-gyrostat on a circular orbit, in model units (see module docstring)."""
 
     units: str
@@ -56,34 +56,14 @@ class GyrostatBody:
 
     g = None  # no uniform gravity
 
-    # units, for the dataset (same names as pipeline.body.Body)
-    @property
-    def time_unit(self) -> str:
-        return "s" if self.units == "si" else "1"
-
+    # units: pipeline.body.ModelUnits, with the orbit's rate as the nondimensional unit
     @property
     def time_label(self) -> str:
         return "s" if self.units == "si" else "1/Ω" if self.orbit_rate == 1.0 else "model time"
 
     @property
-    def rate_unit(self) -> str:
-        return "rad s-1" if self.units == "si" else "1"
-
-    @property
     def rate_label(self) -> str:
         return "rad/s" if self.units == "si" else "Ω" if self.orbit_rate == 1.0 else "model rate"
-
-    @property
-    def torque_unit(self) -> str:
-        return "N m" if self.units == "si" else "1"
-
-    @property
-    def energy_unit(self) -> str:
-        return "J" if self.units == "si" else "1"
-
-    @property
-    def momentum_unit(self) -> str:
-        return "kg m2 s-1" if self.units == "si" else "1"
 
     @classmethod
     def from_config(cls, cfg: Any) -> GyrostatBody:
