@@ -22,8 +22,15 @@ def _cache_dir() -> str:
     digest = hashlib.sha256(f"numba {version('numba')} {platform.machine()}".encode())
     for source in sorted(Path(__file__).parent.glob("*.py")):
         digest.update(source.read_bytes())
-    root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return str(root / "gyrolab" / f"numba-{digest.hexdigest()[:16]}")
+    name = f"numba-{digest.hexdigest()[:16]}"
+    root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "gyrolab"
+    try:
+        (root / name).mkdir(parents=True, exist_ok=True)
+    except OSError:  # a read-only home (some cluster nodes): cache per machine in the temporary directory
+        import tempfile
+
+        root = Path(tempfile.gettempdir()) / "gyrolab"
+    return str(root / name)
 
 
 import numba  # noqa: E402
