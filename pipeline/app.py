@@ -76,7 +76,13 @@ def preflight(argv: Sequence[str]) -> None:
     first = [f"{o.get_key_element()}={next(iter(o.sweep_string_iterator()))}" if o.is_sweep_override()
              else o.input_line for o in overrides]
     cfg = compose_config(first, return_hydra_config=True)
-    Scene.from_config(_without_hydra(cfg))
+    scene_cfg = _without_hydra(cfg)
+    if task_of(scene_cfg) == "regime":  # the regime's domain is checked before anything is written
+        from pipeline.experiments.regime_run import prepare
+
+        prepare(scene_cfg)
+    else:
+        Scene.from_config(scene_cfg)
     run_dir = cfg.hydra.sweep.dir if sweeping else cfg.hydra.run.dir
     check_writable(Path(str(run_dir)))
 

@@ -76,3 +76,14 @@ def test_command_line_exit_code_and_no_partial_output(cli, tmp_path):
     assert done.stderr.strip().splitlines() == ["gyrolab: error: initial.r0=nan is not a finite number; "
                                                 "every numeric setting must be finite"]
     assert not (tmp_path / "out").exists()
+
+
+def test_regime_outside_its_domain_writes_nothing(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", ["gyrolab", "regime=large_parameter", "hydra.run.dir=out"])
+    with pytest.raises(SystemExit) as stop:
+        app.main()
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "large_parameter" in err and "small_parameter" in err
+    assert not (tmp_path / "out").exists()
