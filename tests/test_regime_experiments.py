@@ -20,6 +20,14 @@ def test_regime_run_writes_a_self_describing_dataset_and_figure(tmp_path):
     assert ds.newton_residual.values[-1] < 1e-13
     # ε = 0.05: analytic vs exact orbit errors of order ε³..ε⁴ (relative to c and r0)
     assert ds.max_error_vs_orbit.values[:2].max() < 1e-3
+    # the reduced system (000 eq. 14 truncated after μ⁻², integrated numerically) against the exact orbit over two
+    # periods: p, q O(μ⁻³), γ's O(μ⁻⁴) at μ = r0/c = 20 (measured 2.1e-4 and 9.2e-6)
+    assert ds.omega_reduced.shape == ds.omega_orbit.shape
+    assert np.allclose(ds.omega_reduced.values[0], ds.omega_analytic.values[0], atol=1e-12)  # same τ = 0 state
+    err = ds.max_error_reduced_vs_orbit.values
+    assert 1e-5 < err[:2].max() < 4 * 20.0**-3
+    assert err[3:].max() < 4 * 20.0**-4
+    assert "regime_comparison.png" in {p.name for p in written}
 
 
 def test_bad_regime_input_writes_nothing(tmp_path):
@@ -57,7 +65,8 @@ def test_regime_validity_verdict(tmp_path):
     cfg = compose_config(["experiment=regime_validity",
                           "regime_validity.small_parameter.values=[2.0,0.0625,0.03125,0.015625]",
                           "regime_validity.resonant_omega3.values=[0.05,0.035,0.025]",
-                          "regime_validity.large_parameter.values=[16.0]"])
+                          "regime_validity.large_parameter.values=[16.0]",
+                          "regime_validity.resonance_sweep.distances=[0.1,0.05,0.02,0.01]"])
     run_task("regime_validity", cfg, tmp_path)
     ds = xr.open_dataset(tmp_path / "regime_validity.nc")
     verdict = ds.attrs["verdict"]
@@ -66,3 +75,12 @@ def test_regime_validity_verdict(tmp_path):
     assert ds.small_parameter_order_pq.values == pytest.approx(3, abs=0.2)
     assert ds.large_parameter_error_gamma3_vs_orbit.values[0] > 0.5  # report §3: 0.97 at μ = 16
     assert (tmp_path / "figures" / "regime_validity.png").exists()
+    # ω swept across the resonances 1, 2: |ω − n| = 0.01 refused (not crashed), the rest computed, error growing
+    assert "near the resonance ω = 1" in verdict and "near the resonance ω = 2" in verdict
+    status = ds.resonance_status.values
+    assert all(s.startswith("refused") for s in status[:, :, 3].ravel())
+    assert all(s == "ok" for s in status[:, :, :3].ravel())
+    e = ds.resonance_error_max_vs_orbit.values[:, :, :3]
+    assert np.all(np.diff(e, axis=-1) > 0)
+    assert ds.resonance_exponent_max.sel(resonance=2.0).item() == pytest.approx(1.0, abs=0.15)
+    assert ds.resonance_omega.attrs["units"] == "1"

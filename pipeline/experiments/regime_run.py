@@ -8,7 +8,10 @@ periods with
   the scene's integrator ("full"), and
 * the exact periodic orbit of the full model through the same r0, θ0, γ'(0) = 0
   (Newton shooting from the analytic one, ``pipeline.periodic``), sampled with
-  the compiled Taylor method ("orbit").
+  the compiled Taylor method ("orbit"), and
+* the regime's reduced system (``regime.reduced_rhs``: seed 000 eq. 14, seed 001 eq. 1) integrated in
+  τ = r0 t with DOP853 (rtol 1e-12, atol 1e-14) from its own τ = 0 state and mapped back ("reduced"),
+  for regimes that have one.
 
 Writes ``regime.nc`` (every variable with CF units and long_name; domain
 warnings in the attribute ``regime_warnings``) and ``figures/regime_comparison.png``.
@@ -35,7 +38,8 @@ from pipeline.scene import Scene
 log = logging.getLogger(__name__)
 SOURCES = ("analytic", "full", "orbit")
 SOURCE_NAMES = {"analytic": "analytic solution", "full": "full model from the analytic t = 0 state",
-                "orbit": "exact periodic orbit (Newton shooting)"}
+                "orbit": "exact periodic orbit (Newton shooting)",
+                "reduced": "reduced quasilinear system integrated numerically (DOP853)"}
 
 
 def build_regime(cfg: DictConfig) -> Regime:
@@ -117,6 +121,23 @@ def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True) -
     return out
 
 
+def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> np.ndarray | None:
+    """The regime's reduced system integrated over t (model units, (n, 6)); None if the regime has none."""
+    if not hasattr(regime, "reduced_rhs"):
+        return None
+    from scipy.integrate import solve_ivp
+
+    from pipeline.errors import IntegrationError
+
+    rhs, Z0, to_model = regime.reduced_rhs(scene.system)
+    s = regime.scene(scene.system)
+    tau = s.r0 * s.c * np.asarray(t, dtype=float)
+    sol = solve_ivp(rhs, (tau[0], tau[-1]), Z0, method="DOP853", rtol=1e-12, atol=1e-14, t_eval=tau)
+    if not sol.success or sol.y.shape[1] != len(tau) or not np.all(np.isfinite(sol.y)):
+        raise IntegrationError(f"the reduced system of {regime.name} failed to integrate: {sol.message}")
+    return to_model(sol.y)
+
+
 def errors(result: dict[str, Any], against: str = "orbit") -> dict[str, float]:
     """Max errors of the analytic solution over the window, per group of variables (model units)."""
     a, b = result["states"]["analytic"], result["states"][against]
@@ -134,6 +155,9 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     T = regime.period(system)
     t = np.linspace(0.0, regime.periods * T, regime.periods * regime.samples_per_period + 1)
     result = compute(scene, regime, t)
+    reduced = reduced_solution(scene, regime, t)
+    if reduced is not None:
+        result["states"]["reduced"] = reduced
     orbit = result["orbit"]
     log.info("%s (%s): %s = %.4g, analytic period %.10g, exact %.10g, Newton residuals %s", regime.name,
              regime.formula, regime.parameter, regime.parameter_value(system), T, orbit.period,
@@ -154,13 +178,18 @@ def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any],
                                    {"units": body.rate_unit, "long_name": f"angular velocity (p, q, r), {label}"})
         data[f"gamma_{source}"] = (("time", "axis"), y[:, 3:6],
                                    {"units": "1", "long_name": f"direction cosines of the vertical (γ, γ', γ''), {label}"})
-        for name, values in result["angles"][source].items():
+        for name, values in result["angles"].get(source, {}).items():
             data[f"{name}_{source}"] = ("time", values, {"units": "rad", "long_name": f"Euler angle {name}, {label}"})
     for against in ("full", "orbit"):
         d = np.max(np.abs(result["states"]["analytic"] - result["states"][against]), axis=0)
         data[f"max_error_vs_{against}"] = ("component", d, {
             "units": "1", "long_name": f"max |analytic − {SOURCE_NAMES[against]}| over the window, per component "
                                        f"(model units of ω, γ)"})
+    if "reduced" in result["states"]:
+        d = np.max(np.abs(result["states"]["reduced"] - result["states"]["orbit"]), axis=0)
+        data["max_error_reduced_vs_orbit"] = ("component", d, {
+            "units": "1", "long_name": f"max |{SOURCE_NAMES['reduced']} − {SOURCE_NAMES['orbit']}| over the window, "
+                                       "per component (model units of ω, γ)"})
     n = len(orbit.residuals)
     data["newton_residual"] = ("iteration", np.array(orbit.residuals), {
         "units": "1", "long_name": "max-norm of the shooting return residual y(T) − y(0), relative to max(1, |y0|)"})
@@ -203,13 +232,16 @@ def plot(ds: xr.Dataset, path: Path) -> Path:
 
     path.parent.mkdir(parents=True, exist_ok=True)
     t = ds.time.values
-    styles = {"analytic": dict(ls="--", lw=1.6), "full": dict(ls="-", lw=1.0), "orbit": dict(ls=":", lw=2.0)}
+    styles = {"analytic": dict(ls="--", lw=1.6), "full": dict(ls="-", lw=1.0), "orbit": dict(ls=":", lw=2.0),
+              "reduced": dict(ls="-.", lw=1.2)}
     rate_unit = ds.attrs["rate_label"]
     panels = [("omega", 0, f"p [{rate_unit}]"), ("omega", 1, f"q [{rate_unit}]"), ("omega", 2, f"r [{rate_unit}]"),
               ("gamma", 2, "γ'' = cos θ [1]")]
     fig, axes = plt.subplots(2, 2, figsize=(10, 7), sharex=True)
     for ax, (var, i, label) in zip(axes.flat, panels):
-        for source in SOURCES:
+        for source in [*SOURCES, "reduced"]:
+            if f"{var}_{source}" not in ds:
+                continue
             ax.plot(t, ds[f"{var}_{source}"].values[:, i], label=SOURCE_NAMES[source], **styles[source])
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)

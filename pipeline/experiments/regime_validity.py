@@ -6,6 +6,12 @@ outside the domain are recorded as refused (NaN, with the reason). Error orders 
 ``fit_below`` and compared with the theory's; a verdict is written to the dataset attrs and the log.
 ``large_parameter`` is refused by design: its row evaluates the evidence instead (the printed
 formulas under the paper's reading μ = c/r0 against the full model, γ'' error over one τ period).
+
+``regime_validity.resonance_sweep`` sweeps the body's natural frequency ω (ω² = (a−1)(b−1)/(ab), set
+through a = (1−b)/(1−b+ω²b) at fixed b) across the resonances ω → n excluded by ``small_parameter``
+(its series has small divisors n² − ω²), at one fixed c/r0 inside the domain: the error against the exact
+orbit as a function of |ω − n| on both sides, the fitted growth e ∝ |n² − ω²|^−s, the distance from
+which the error stays below ``tolerance``, and the points refused (check_domain) or where shooting fails.
 """
 
 from __future__ import annotations
@@ -18,7 +24,7 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from pipeline.dataset import write_dataset
-from pipeline.errors import ConfigError
+from pipeline.errors import ConfigError, IntegrationError
 from pipeline.experiments.regime_run import compute, errors, prepare
 from pipeline.provenance import provenance
 
@@ -103,10 +109,144 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         rows.append((regime_name, values, errs, orders, status))
     if "large_parameter" in spec.get("evidence", []):
         verdicts.append(_large_parameter_evidence(cfg, rows))
+    sweep = None
+    if spec.get("resonance_sweep") is not None:
+        sweep = resonance_sweep(cfg)
+        verdicts.extend(sweep["verdicts"])
     ds = _dataset(rows, verdicts, cfg)
+    if sweep is not None:
+        ds = ds.merge(_resonance_dataset(sweep))
     written = [write_dataset(ds, Path(out_dir) / "regime_validity.nc")]
-    written.append(_plot(rows, Path(out_dir) / "figures" / "regime_validity.png"))
+    written.append(_plot(rows, Path(out_dir) / "figures" / "regime_validity.png", sweep))
     return written
+
+
+def a_for_omega(omega: float, b: float) -> float:
+    """The body's a = A/C that gives natural frequency ω at fixed b: (1−a)(1−b) = ω² a b."""
+    return (1.0 - b) / ((1.0 - b) + omega * omega * b)
+
+
+def resonance_cfg(cfg: DictConfig, omega: float) -> DictConfig:
+    """The small_parameter scene of the resonance sweep with the body's ω set through a (b fixed)."""
+    spec = cfg.regime_validity.resonance_sweep
+    b = float(spec.b)
+    sub = _cfg_for(cfg, spec.regime, float(spec.r0))
+    with open_dict(sub):
+        sub.body.a = a_for_omega(float(omega), b)
+        sub.body.b = b
+        sub.body.allow_nonphysical = True  # ω > 1 needs A + B < C (ω² − 1 = (1 − a − b)/(ab))
+    return sub
+
+
+def resonance_point(cfg: DictConfig, omega: float, *, check: bool = True) -> tuple[str, dict[str, float]]:
+    """(status, relative errors against the exact orbit over one period) at natural frequency ω.
+
+    ``check=False`` skips the regime's domain check (to measure the error inside the refused band).
+    """
+    sub = resonance_cfg(cfg, omega)
+    nan = {k: np.nan for k in KEYS}
+    try:
+        if check:
+            scene, regime, _ = prepare(sub)
+        else:
+            from pipeline.experiments.regime_run import build_regime
+            from pipeline.scene import Scene
+
+            scene, regime = Scene.from_config(sub), build_regime(sub)
+    except ConfigError as error:
+        return f"refused: {error}", nan
+    T = regime.period(scene.system)
+    try:
+        result = compute(scene, regime, np.linspace(0, T, 241), full=False)
+    except IntegrationError as error:
+        return f"failed: {error}", nan
+    sc = _scales(regime, scene.system)
+    e = errors(result, "orbit")
+    return "ok", {k: e[k] / sc[k] for k in KEYS}
+
+
+def resonance_sweep(cfg: DictConfig) -> dict:
+    """Errors of small_parameter against exact orbits across the resonances ω → n (both sides)."""
+    spec = cfg.regime_validity.resonance_sweep
+    resonances = [float(n) for n in spec.resonances]
+    distances = np.array([float(d) for d in spec.distances])
+    fit_within, tol = float(spec.fit_within), float(spec.tolerance)
+    sides = np.array([-1.0, 1.0])
+    shape = (len(resonances), 2, len(distances))
+    err = {k: np.full(shape, np.nan) for k in (*KEYS, "max")}
+    status = np.empty(shape, dtype=object)
+    omega = np.empty(shape)
+    exponents = {k: np.full(len(resonances), np.nan) for k in (*KEYS, "max")}
+    holds = np.full(len(resonances), np.nan)
+    verdicts = []
+    for i, n in enumerate(resonances):
+        for j, side in enumerate(sides):
+            for m, d in enumerate(distances):
+                w = n + side * d
+                omega[i, j, m] = w
+                status[i, j, m], e = resonance_point(cfg, w)
+                for k in KEYS:
+                    err[k][i, j, m] = e[k]
+                err["max"][i, j, m] = max(e.values()) if status[i, j, m] == "ok" else np.nan
+        small = np.abs(n * n - omega[i] ** 2)
+        for k in exponents:
+            y = err[k][i]
+            ok = (distances[None, :] <= fit_within) & np.isfinite(y) & (y > 0)
+            if ok.sum() >= 3:
+                exponents[k][i] = -float(np.polyfit(np.log(small[ok]), np.log(y[ok]), 1)[0])
+        # per distance, the worst point over both sides: +inf where shooting failed, NaN where refused
+        failed_at = np.vectorize(lambda x: str(x).startswith("failed"))(status[i])
+        refused_at = np.vectorize(lambda x: str(x).startswith("refused"))(status[i])
+        worst = np.where(failed_at, np.inf, err["max"][i])
+        computed = ~np.all(refused_at, axis=0)
+        worst = np.array([np.nanmax(worst[:, m]) if computed[m] else np.nan for m in range(len(distances))])
+        # holds: the smallest swept distance from which every computed point on both sides has error ≤ tol
+        for m in np.argsort(distances)[::-1]:
+            if not computed[m]:
+                continue
+            if not worst[m] <= tol:
+                break
+            holds[i] = distances[m]
+        refused = [f"{d:g}" for d in sorted(distances[np.any(refused_at, axis=0)])]
+        failed = [f"{w:.4g}" for w in omega[i][failed_at]]
+        ref = distances.max()
+        far = worst[np.argmax(distances)]
+        edge = worst[computed][np.argmin(distances[computed])] if computed.any() else np.nan
+        verdicts.append(
+            f"{spec.regime} near the resonance ω = {n:g} (c/r0 = {1 / float(spec.r0):g}, b = {float(spec.b):g}, ω set "
+            f"through a): max relative error against the exact orbit grows as |{n:g}² − ω²|^−s with s = "
+            f"{exponents['max'][i]:.2f} (p, q {exponents['pq'][i]:.2f}, γ, γ' {exponents['gamma'][i]:.2f}, "
+            f"γ'' {exponents['gamma3'][i]:.2f}; fitted for |ω − {n:g}| ≤ {fit_within:g}); {far:.2g} at |ω − {n:g}| = "
+            f"{ref:g}, {edge:.2g} at the closest accepted point; the regime holds (error ≤ {tol:g}) for |ω − {n:g}| ≥ "
+            f"{holds[i]:g}; " + (f"refused at |ω − {n:g}| = {', '.join(refused)}" if refused else "no refused point")
+            + (f"; shooting failed at ω = {', '.join(failed)}" if failed else ""))
+        log.info("%s", verdicts[-1])
+    return {"resonances": resonances, "distances": distances, "sides": sides, "omega": omega, "errors": err,
+            "status": status, "exponents": exponents, "holds": holds, "verdicts": verdicts,
+            "fit_within": fit_within, "tolerance": tol, "epsilon": 1 / float(spec.r0)}
+
+
+def _resonance_dataset(sweep: dict) -> xr.Dataset:
+    dims = ("resonance", "side", "resonance_distance")
+    names = dict(LONG, max="all variables (max)")
+    data = {"resonance_omega": (dims, sweep["omega"], {"units": "1", "long_name": "natural frequency ω of the body "
+                                                       "(ω² = (C−A)(C−B)/(AB)), in units of the spin r0"}),
+            "resonance_status": (dims, sweep["status"].astype(str), {"units": "1", "long_name": "ok, refused (reason) "
+                                                                     "or failed (shooting did not converge)"}),
+            "resonance_holds_from": ("resonance", sweep["holds"], {
+                "units": "1", "long_name": f"smallest |ω − n| from which the max relative error is ≤ "
+                                           f"{sweep['tolerance']:g} on both sides"})}
+    for k, e in sweep["errors"].items():
+        data[f"resonance_error_{k}_vs_orbit"] = (dims, e, {
+            "units": "1", "long_name": f"max relative error of {names[k]} of small_parameter against the exact orbit "
+                                       f"at c/r0 = {sweep['epsilon']:g}"})
+        data[f"resonance_exponent_{k}"] = ("resonance", sweep["exponents"][k], {
+            "units": "1", "long_name": f"fitted s in error of {names[k]} ∝ |n² − ω²|^−s "
+                                       f"(|ω − n| ≤ {sweep['fit_within']:g})"})
+    coords = {"resonance": ("resonance", np.array(sweep["resonances"]), {"units": "1", "long_name": "excluded resonance n (ω = n)"}),
+              "side": ("side", sweep["sides"], {"units": "1", "long_name": "side of the resonance: sign of ω − n"}),
+              "resonance_distance": ("resonance_distance", sweep["distances"], {"units": "1", "long_name": "|ω − n|"})}
+    return xr.Dataset(data, coords=coords)
 
 
 def _regime_class(name: str):
@@ -167,14 +307,17 @@ def _dataset(rows, verdicts, cfg) -> xr.Dataset:
     return ds
 
 
-def _plot(rows, path: Path) -> Path:
+def _plot(rows, path: Path, sweep: dict | None = None) -> Path:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig, axes = plt.subplots(1, len(rows), figsize=(5.5 * len(rows), 4.8), squeeze=False)
+    ncol = len(rows) + (sweep is not None)
+    fig, axes = plt.subplots(1, ncol, figsize=(5.5 * ncol, 4.8), squeeze=False)
+    if sweep is not None:
+        _plot_resonance(axes[0, -1], sweep)
     for ax, (name, values, errs, orders, _) in zip(axes[0], rows):
         for k, e in errs["orbit"].items():
             e = np.array(e, dtype=float)
@@ -190,3 +333,22 @@ def _plot(rows, path: Path) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def _plot_resonance(ax, sweep: dict) -> None:
+    d = sweep["distances"]
+    for i, n in enumerate(sweep["resonances"]):
+        for j, side in enumerate(sweep["sides"]):
+            e = sweep["errors"]["max"][i, j]
+            s = sweep["exponents"]["max"][i]
+            label = f"ω → {n:g}{'+' if side > 0 else '−'}" + (f" (s = {s:.2f})" if j == 0 and np.isfinite(s) else "")
+            ax.loglog(d, np.where(e > 0, e, np.nan), "o-" if side > 0 else "s--", label=label)
+        refused = [dd for dd, row in zip(d, sweep["status"][i].T) if any(str(x).startswith("refused") for x in row)]
+        if refused:
+            ax.axvspan(min(d) * 0.8, max(refused) * 1.1, color="grey", alpha=0.15)
+    ax.axhline(sweep["tolerance"], color="k", lw=0.8, ls=":", label=f"tolerance {sweep['tolerance']:g}")
+    ax.set_xlabel("distance to the resonance |ω − n| [1] (grey: refused)")
+    ax.set_ylabel("max relative error against the exact orbit [1]")
+    ax.set_title(f"small_parameter across ω = n, c/r0 = {sweep['epsilon']:g}", fontsize=9)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
