@@ -45,14 +45,15 @@ class Scene:
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
         times = _output_times(plain["time"])
         integrator.prepare(system)
-        if integrator.needs_compiled_model and system.compiled_model() is None:
+        scene = cls(config=cfg, system=system, integrator=integrator, times=times)
+        if integrator.needs_compiled_model and scene.compiled is None:
             plain_forces = [f.name for f in system.forces if f.compiled_terms() is None]
             culprit = f"force {plain_forces[0]!r}" if plain_forces else f"system {system.name!r}"
             raise ConfigError(
                 f"integrator {integrator.name!r} runs compiled models only, and {culprit} has no "
                 f"compiled form; choose a Python integrator (dop853, rk45, rk4, lsoda, radau, bdf)"
             )
-        return cls(config=cfg, system=system, integrator=integrator, times=times)
+        return scene
 
     @cached_property
     def config_yaml(self) -> str:
