@@ -1,4 +1,4 @@
-"""The resonant case ω = 3 (seed 001, Shaker, El-Barki, Ismail), case (i) M1 = M2 = 0, corrected or printed.
+"""The resonant case ω = 3 (seed 001, Shaker, El-Barki, Ismail), branches (i)-(iv) of eq. (23), corrected or printed.
 
 Fast spin with the small parameter μ = c√(cos θ0)/r0 and the 3:1 resonance
 of the generating system, ω² = (C−A)(C−B)/(AB) = 9. Since ω² − 1 =
@@ -8,6 +8,14 @@ explicitly with ``body.allow_nonphysical=true``.
 
 Theory error orders in μ (report §6): p, q 3; r, γ's 4; period 4 (corrected);
 printed: p, q 1 (wrong ℓ1), γ'' 2, γ, γ' 2 (their O(μ²) terms are not printed), period 2.
+
+``branch`` selects the solution of (23): ``i`` (M1 = M2 = 0, the default and the
+paper's worked case), ``iii`` (M1 = ``sign``·√(a2/a1), M2 = 0), and, in the printed
+reading only, ``ii`` (M2 = ``sign``·√(a2/a1)) and ``iv`` (phase ``phase_deg`` on the
+amplitude circle). Corrected, (ii) and (iv) are refused: the resonant forcing
+M3³L310 ≠ 0 locks the p-mode phase to branch (iii) (erratum 001-6). Branch (iii)
+orders: p, q 1 (the O(μ) amplitude correction is not derived), r, γ's, period 2
+(``shaker_omega3`` module docstring; tests/test_regime_branches.py).
 """
 
 from __future__ import annotations
@@ -19,6 +27,9 @@ from plugins.regimes import shaker_omega3 as paper
 from plugins.regimes.base import FixedPointRegime, NondimensionalScene
 
 OMEGA_TOLERANCE = 1e-6
+BRANCHES = ("i", "ii", "iii", "iv")
+BRANCH_ORDER = {"pq": 1.0, "r": 2.0, "gamma": 2.0, "gamma3": 2.0, "period": 2.0}
+PRINTED_BRANCH_ORDER = {"pq": 0.0, "r": 2.0, "gamma": 1.0, "gamma3": 1.0, "period": 2.0}
 
 
 class ResonantOmega3(FixedPointRegime):
@@ -28,9 +39,32 @@ class ResonantOmega3(FixedPointRegime):
     order = {"pq": 3.0, "r": 4.0, "gamma": 4.0, "gamma3": 4.0, "period": 4.0}
     printed_order = {"pq": 1.0, "r": 4.0, "gamma": 2.0, "gamma3": 2.0, "period": 2.0}
 
+    def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200,
+                 branch: str = "i", sign: int = 1, phase_deg: float = 45.0) -> None:
+        super().__init__(formula=formula, periods=periods, samples_per_period=samples_per_period)
+        branch = str(branch)
+        if branch not in BRANCHES:
+            raise ConfigError(f"regime.branch={branch!r} is not a branch of seed 001's eq. (23); valid choices: "
+                              f"{', '.join(BRANCHES)}")
+        if formula == "corrected" and branch in ("ii", "iv"):
+            raise ConfigError(f"regime.branch={branch} is not a periodic solution: the resonant forcing M3³L310 locks "
+                              "the p-mode phase to branch iii (erratum 001-6, docs/errata.md); valid choices: i, iii "
+                              "(or regime.formula=printed to reproduce the paper's claim)")
+        if sign not in (1, -1) or isinstance(sign, bool):
+            raise ConfigError(f"regime.sign={sign!r} must be 1 or -1 (the ± of eq. 23)")
+        phase = float(phase_deg)
+        if branch == "iv" and not (0.0 < phase % 90.0):
+            raise ConfigError(f"regime.phase_deg={phase_deg!r} puts branch iv on branch ii or iii; choose a phase that "
+                              "is not a multiple of 90 degrees")
+        self.branch, self.sign, self.phase_deg = branch, int(sign), phase
+        if branch != "i":
+            self.order = BRANCH_ORDER
+            self.printed_order = PRINTED_BRANCH_ORDER
+
     def constants(self, s: NondimensionalScene) -> paper.Constants:
         C = paper.Constants(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k_gt=s.k, theta0=s.theta0)
-        return C.as_printed() if self.formula == "printed" else C
+        C = C.as_printed() if self.formula == "printed" else C
+        return C.on_branch(self.branch, self.sign, np.radians(self.phase_deg))
 
     def parameter_value(self, system) -> float:
         s = self.scene(system)
@@ -54,14 +88,28 @@ class ResonantOmega3(FixedPointRegime):
             raise ConfigError(f"regime resonant_omega3 needs fast spin, μ = c√(cos θ0)/r0 < 1, but the scene "
                               f"gives μ={mu:.4g}; increase initial.r0")
         C = self.constants(s)
+        if self.branch != "i" and not C.a2 / C.a1 > 0:
+            raise ConfigError(f"regime.branch={self.branch} needs a2/a1 > 0 (eq. 24: the amplitude is √(a2/a1)), but "
+                              f"this body has a2 = {C.a2:.4g}, a1 = {C.a1:.4g}; valid choices for it: branch i")
         warnings = ["non-physical body (A + B < C, ω = 3): admitted by body.allow_nonphysical=true"]
+        if self.branch in ("ii", "iv"):
+            warnings.append(f"branch {self.branch} as printed: not a periodic solution (L310 = {C.L310:.3g} ≠ 0 "
+                            "locks the p-mode phase to branch iii, erratum 001-6); expect no exact orbit near it")
         if mu > 0.2:
             warnings.append(f"μ = {mu:.3g} > 0.2: near the edge of the fast-spin domain, expect errors of order "
                             f"μ² ≈ {mu**2:.2g}")
-        if abs(C.a2) < 0.05 or abs(C.l1) * mu > 0.5:
+        if self.branch == "i" and (abs(C.a2) < 0.05 or abs(C.l1) * mu > 0.5):
             warnings.append(f"a2 = {C.a2:.3g} is near 0 (ℓ1 = M3³L310/a2 = {C.l1:.3g}): secondary resonance, "
                             "the case (i) series degrades")
         return warnings + self.reseat_warnings(system)
+
+    def attributes(self) -> dict:
+        out = {**super().attributes(), "regime_branch": self.branch}
+        if self.branch != "i":
+            out["regime_branch_sign"] = self.sign
+        if self.branch == "iv":
+            out["regime_branch_phase_deg"] = self.phase_deg
+        return out
 
     def reduced_rhs(self, system):
         """Seed 001's scaled system (eq. 1 in the variables of eq. 5) for this scene: ``(rhs, Y0, to_model)``.

@@ -1,4 +1,4 @@
-"""Seed 001: the resonant case ω = 3 (Shaker, El-Barki, Ismail), case (i) M1 = M2 = 0, printed and corrected.
+"""Seed 001: the resonant case ω = 3 (Shaker, El-Barki, Ismail): the branches (i)-(iv) of eq. (23), printed and corrected.
 
 M. O. Shaker, F. A. El-Barki, A. I. Ismail, "Singular value of the natural
 frequency for the motion of rigid body". Verification report:
@@ -15,6 +15,16 @@ A + B < C: no real body has ω = 3 (ω² − 1 = C(C−A−B)/(AB), report §3).
 Normalisation: r(0) = r0, γ''(0) = γ0'', γ'(0) = 0 (φ(0) = π/2), ψ(0) = 0.
 Measured accuracy of the corrected series (report §6): p, q O(μ³) relative to
 c√γ0''; r/r0, γ/γ0'' O(μ⁴); period O(μ⁴); Euler angles O(μ⁴).
+
+Branches of (23) (the generating p-mode p2 = M1 cos 3τ + M2 sin 3τ, E² = M1² + M2²):
+(i) M1 = M2 = 0 is the full series above. (iii) M1 = ±√(a2/a1), M2 = 0: the paper gives
+only the amplitude; the solution here is the case-(i) series with the p-mode amplitude
+μℓ1 replaced by M1 (exact in every term linear in the p-mode, i.e. to O(μ) in γ, γ', γ'';
+the O(μ) amplitude correction β1 and the M1² terms of r and the period are not derived),
+so p, q are O(μ) and the rest O(μ²) (measured: tests/test_regime_branches.py).
+(ii) M1 = 0 and (iv) 0 < |M2| < E are not periodic solutions unless L310 = 0 (erratum
+001-6): the resonant forcing M3³L310 locks the p-mode phase to ε = 0, π. They exist
+only as the printed reading, as the generating solution (16).
 """
 
 from __future__ import annotations
@@ -41,6 +51,8 @@ class Constants:
     k_gt: float
     theta0: float
     printed: bool = False
+    M1: float = 0.0  # generating p-mode amplitudes of (16)/(23): zero for branch (i)
+    M2: float = 0.0
 
     @property
     def A1(self) -> float:
@@ -116,8 +128,40 @@ class Constants:
         return np.pi * (2.0 * self.M * self.x0 - 8.0 * self.nu * self.e1 - self.z0 / self.b
                         + self.k * (half * self.M**2 * (self.b - self.a) - self.B1))
 
+    @property
+    def E(self) -> float:
+        """Amplitude of the p-mode on branches (ii)-(iv): E² = M1² + M2² = a2/a1 (23); NaN if a2/a1 < 0."""
+        ratio = self.a2 / self.a1
+        return float(np.sqrt(ratio)) if ratio > 0 else float("nan")
+
     def as_printed(self) -> Constants:
         return replace(self, printed=True)
+
+    def on_branch(self, branch: str, sign: float = 1.0, phase: float = np.pi / 4) -> Constants:
+        """These constants on branch (i)-(iv) of (23): M1 = M2 = 0; M2 = ±E; M1 = ±E; (M1, M2) = ±E(cos ε, sin ε)."""
+        E = self.E
+        M1, M2 = {"i": (0.0, 0.0), "ii": (0.0, sign * E), "iii": (sign * E, 0.0),
+                  "iv": (sign * E * np.cos(phase), sign * E * np.sin(phase))}[branch]
+        return replace(self, M1=float(M1), M2=float(M2))
+
+    @property
+    def branch_i(self) -> bool:
+        return self.M1 == 0.0 and self.M2 == 0.0
+
+    def pmode(self, mu: float) -> tuple[float, float]:
+        """Coefficients (L, K) of μ cos 3τ and μ sin 3τ in p1: (ℓ1, 0) on branch (i), (M1/μ, M2/μ) otherwise."""
+        return (self.l1, 0.0) if self.branch_i else (self.M1 / mu, self.M2 / mu)
+
+    def gamma_l1(self, mu: float) -> float:
+        """The p-mode coefficient in the γ and Euler-angle terms (linear in it): ℓ1 on branch (i); M1/μ on the
+        corrected branch (iii); 0 for the printed branches, which are the generating solution (16) there."""
+        if self.branch_i:
+            return self.l1
+        if self.printed:
+            return 0.0
+        if self.M2 != 0.0:
+            raise ValueError("branches (ii), (iv) are not periodic solutions (erratum 001-6); printed reading only")
+        return self.M1 / mu
 
 
 def mu_of(r0: float, theta0: float) -> float:
@@ -159,13 +203,15 @@ def state(t: np.ndarray, r0: float, C: Constants) -> np.ndarray:
     and its γ'' bracket (27) with the printed ℓ1.
     """
     mu = mu_of(r0, C.theta0)
-    M, e, e1, e2, l1, A1, C1, k = C.M, C.e, C.e1, C.e2, C.l1, C.A1, C.C1, C.k
+    M, e, e1, e2, A1, C1, k = C.M, C.e, C.e1, C.e2, C.A1, C.C1, C.k
     a, b, x, y = C.a, C.b, C.x0, C.y0
+    L, K = C.pmode(mu)
+    l1 = C.gamma_l1(mu)
     t = np.asarray(t, dtype=float)
     th = r0 * t if C.printed else (1.0 - C.alpha2 * mu**2 / (2 * np.pi)) * r0 * t
     cs, sn = np.cos, np.sin
-    p1 = mu * (e + e1 * M * cs(th) + l1 * cs(3 * th))
-    q1 = mu / A1 * (y / a + e2 * M * sn(th) + 3.0 * l1 * sn(3 * th))
+    p1 = mu * (e + e1 * M * cs(th) + L * cs(3 * th) + K * sn(3 * th))
+    q1 = mu / A1 * (y / a + e2 * M * sn(th) + 3.0 * (L * sn(3 * th) - K * cs(3 * th)))
     r1 = 1.0 - mu**2 * M * (x * (1 - cs(th)) + y * sn(th) + 0.25 * k * C1 * M * (1 - cs(2 * th)))
     if C.printed:
         g1, g1p = M * cs(th), -M * sn(th)
@@ -198,8 +244,9 @@ def euler(t: np.ndarray, r0: float, C: Constants, *, printed_phi2: bool | None =
     printed_phi2 = C.printed if printed_phi2 is None else printed_phi2
     mu = mu_of(r0, C.theta0)
     t = np.asarray(t, dtype=float)
-    th0, M, e, e1, e2, l1, A1, C1, k = C.theta0, C.M, C.e, C.e1, C.e2, C.l1, C.A1, C.C1, C.k
+    th0, M, e, e1, e2, A1, C1, k = C.theta0, C.M, C.e, C.e1, C.e2, C.A1, C.C1, C.k
     x, y, a = C.x0, C.y0, C.a
+    l1 = C.gamma_l1(mu)
     s = r0 * t if C.printed else (1.0 - C.alpha2 * mu**2 / (2 * np.pi)) * r0 * t
     yA = y / (a * A1)
     tn, ct = np.tan(th0), 1.0 / np.tan(th0)
