@@ -7,7 +7,7 @@ import xarray as xr
 from pipeline.config import compose_config
 from pipeline.errors import ConfigError
 from pipeline.experiments import run_task
-from tests.test_regime_helpers import overrides_000
+from tests.test_regime_helpers import B1, overrides_000, overrides_001
 
 
 def test_regime_run_writes_a_self_describing_dataset_and_figure(tmp_path):
@@ -28,6 +28,37 @@ def test_regime_run_writes_a_self_describing_dataset_and_figure(tmp_path):
     assert 1e-5 < err[:2].max() < 4 * 20.0**-3
     assert err[3:].max() < 4 * 20.0**-4
     assert "regime_comparison.png" in {p.name for p in written}
+
+
+def test_reduced_system_is_integrated_by_the_scenes_integrator(tmp_path):
+    # seed 001's eq. (1) is an exact linear rescaling of the full model and RK4 is invariant under linear changes
+    # of variables: integrated by the scene's rk4 with the same step, reduced and full agree to round-off
+    # (measured 1e-15); a different method differs from the full model's RK4 by RK4's truncation error (2e-9)
+    rk4 = run_task("regime", compose_config([*overrides_001(B1, 0.05), "integrator=rk4", "integrator.step=0.002"]),
+                   tmp_path / "rk4")
+    ds = xr.open_dataset(rk4[0])
+    assert ds.attrs["reduced_system_integrator"] == "rk4"
+    scale = np.abs(ds.omega_full.values).max()
+    assert np.abs(ds.omega_reduced.values - ds.omega_full.values).max() < 1e-11 * scale
+    compiled = run_task("regime", compose_config([*overrides_001(B1, 0.05), "integrator=rk4_numba",
+                                                  "integrator.step=0.002"]), tmp_path / "numba")
+    ds = xr.open_dataset(compiled[0])
+    assert ds.attrs["reduced_system_integrator"].startswith("dop853")  # compiled-only: DOP853 stands in, recorded
+    assert "rk4_numba" in ds.attrs["reduced_system_integrator"]
+    assert np.abs(ds.omega_reduced.values - ds.omega_full.values).max() > 1e-10 * scale
+
+
+def test_printed_branch_ii_run_records_what_the_orbit_search_found(tmp_path):
+    B3 = dict(a=0.4, b=1 / 7, rc=(0.48, 0.36, -0.8), k=2.0, theta0=np.pi / 3)
+    cfg = compose_config([*overrides_001(B3, 0.02, "printed"), "regime.branch=ii", "force.newtonian.R=null"])
+    ds = xr.open_dataset(run_task("regime", cfg, tmp_path)[0])
+    assert "branch ii as printed: not a periodic solution" in ds.attrs["regime_warnings"]
+    assert ds.attrs["regime_branch"] == "ii"
+    if ds.attrs["exact_orbit"] == "found":  # it is a branch (iii) orbit: O(1) away from (ii) in p, q
+        assert ds.max_error_vs_orbit.values[:2].max() > 1.0
+    else:
+        assert ds.attrs["exact_orbit"].startswith("not found: Newton shooting did not converge")
+        assert "omega_orbit" not in ds
 
 
 def test_bad_regime_input_writes_nothing(tmp_path):
