@@ -97,7 +97,7 @@ def test_regime_validity_verdict(tmp_path):
                           "regime_validity.small_parameter.values=[2.0,0.0625,0.03125,0.015625]",
                           "regime_validity.resonant_omega3.values=[0.05,0.035,0.025]",
                           "regime_validity.large_parameter.values=[16.0]",
-                          "regime_validity.resonance_sweep.distances=[0.1,0.05,0.02,0.01]"])
+                          "regime_validity.resonance_sweep.distances=[0.1,0.05,0.025,0.01]"])
     run_task("regime_validity", cfg, tmp_path)
     ds = xr.open_dataset(tmp_path / "regime_validity.nc")
     verdict = ds.attrs["verdict"]

@@ -9,7 +9,8 @@ with the corrected (35), (36), (38)-(39) (``plugins.regimes.ismail2021``);
 consistent scaling.
 
 Domain: ε < 1 (warning above 0.2), ω away from the resonances 1, 2, 3 of
-the generating system, and γ0'' = cos θ0 = O(ε) (the derivation sets
+the generating system (refused where |n² − ω²| < ``divisor_threshold(n, ε)``, a band that
+narrows as the spin grows: ε^(4/3) at ω = 1, ε³ at ω = 2, 3), and γ0'' = cos θ0 = O(ε) (the derivation sets
 γ0'' = Γ/μ; warning when Γ = γ0''/ε > 3). Theory error orders in ε:
 p, q 3; r, γ, γ', γ'' 4; period 4 (corrected) — the printed r, γ, γ' are 2.
 """
@@ -23,8 +24,24 @@ from plugins.regimes import ismail2021 as paper
 from plugins.regimes.base import FixedPointRegime, NondimensionalScene
 
 RESONANCES = (1.0, 2.0, 3.0)
-REFUSE_DISTANCE = 0.02  # |ω − n| below this: refused (the 1/(n² − ω²) terms blow up)
 WARN_DISTANCE = 0.1
+# Refusal band around a resonance, |n² − ω²| < divisor_threshold(n, ε), where the error against the exact orbit
+# reaches ~1e-2 (measured by regime_validity's resonance sweep, body I, c/r0 = 0.1, 0.05, 0.025; docs/regimes.md):
+# near ω = 2 the error is 5.7 ε^2.96 / |4 − ω²|^0.95 (the ε³ terms carry one small divisor), hence ε³/|n² − ω²|
+# ≤ 1/580; near ω = 1 (1:1 with the γ-mode) it blows up at |1 − ω²| ≈ 0.11, 0.042, 0.017: ∝ ε^(4/3), the fold
+# of a weakly nonlinear forced oscillator (detuning ~ ε^(2/3) of the forcing ε and the ε² frequency shift).
+REFUSE_CUBIC = 580.0
+REFUSE_ONE_TO_ONE = 2.28
+
+
+def divisor_threshold(n: float, eps: float) -> float:
+    """|n² − ω²| below which small_parameter refuses the scene (ε = c/r0)."""
+    return REFUSE_ONE_TO_ONE * eps ** (4 / 3) if n == 1.0 else REFUSE_CUBIC * eps**3
+
+
+def refusal_distance(n: float, eps: float) -> float:
+    """The widest |ω − n| that is refused at ε (the side below the resonance)."""
+    return float(n - np.sqrt(max(n * n - divisor_threshold(n, eps), 0.0)))
 
 
 class SmallParameter(FixedPointRegime):
@@ -50,10 +67,12 @@ class SmallParameter(FixedPointRegime):
         w2 = s.omega2
         w = np.sqrt(w2) if w2 > 0 else 0.0
         for n in RESONANCES:
-            if w2 > 0 and abs(w - n) < REFUSE_DISTANCE:
+            if w2 > 0 and abs(n * n - w2) < divisor_threshold(n, eps):
                 raise ConfigError(f"regime small_parameter excludes the resonance ω = {n:g}: the body has "
-                                  f"ω = {w:.5g} (ω² = (C−A)(C−B)/(AB)); choose a, b with |ω − {n:g}| ≥ "
-                                  f"{REFUSE_DISTANCE:g}" + (" (or regime=resonant_omega3)" if n == 3 else ""))
+                                  f"ω = {w:.5g} (ω² = (C−A)(C−B)/(AB)), |{n:g}² − ω²| = {abs(n * n - w2):.3g} < "
+                                  f"{divisor_threshold(n, eps):.3g} at c/r0 = {eps:.3g}; choose a, b with |ω − {n:g}| ≥ "
+                                  f"{refusal_distance(n, eps):.3g} or spin faster"
+                                  + (" (or regime=resonant_omega3)" if n == 3 else ""))
         warnings = []
         for n in RESONANCES:
             if w2 > 0 and abs(w - n) < WARN_DISTANCE:
