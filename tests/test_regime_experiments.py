@@ -96,12 +96,18 @@ def test_regime_validity_verdict(tmp_path):
     cfg = compose_config(["experiment=regime_validity",
                           "regime_validity.small_parameter.values=[2.0,0.0625,0.03125,0.015625]",
                           "regime_validity.resonant_omega3.values=[0.05,0.035,0.025]",
+                          "regime_validity.resonant_omega3_iii.values=[0.4,0.01,0.005,0.0025]",
                           "regime_validity.large_parameter.values=[16.0]",
                           "regime_validity.resonance_sweep.distances=[0.1,0.05,0.025,0.01]"])
     run_task("regime_validity", cfg, tmp_path)
     ds = xr.open_dataset(tmp_path / "regime_validity.nc")
     verdict = ds.attrs["verdict"]
     assert "small_parameter" in verdict and "NOT consistent" not in verdict
+    # seed 001's branch (iii): orders 1 (p, q) and 2 against exact orbits; far out (μ = 0.4) no orbit near the series
+    assert "resonant_omega3_iii" in verdict
+    assert ds.resonant_omega3_iii_status.values[0].startswith("failed: Newton shooting did not converge")
+    assert ds.resonant_omega3_iii_order_pq.item() == pytest.approx(1.0, abs=0.2)
+    assert ds.resonant_omega3_iii_order_gamma.item() == pytest.approx(2.0, abs=0.2)
     assert ds.small_parameter_status.values[0].startswith("refused")
     assert ds.small_parameter_order_pq.values == pytest.approx(3, abs=0.2)
     assert ds.large_parameter_error_gamma3_vs_orbit.values[0] > 0.5  # report §3: 0.97 at μ = 16
