@@ -7,7 +7,8 @@ import xarray as xr
 from pipeline.config import compose_config
 from pipeline.errors import ConfigError
 from pipeline.experiments import run_task
-from tests.test_regime_helpers import B1, overrides_000, overrides_001
+from pipeline.experiments.regime_run import angles_from_states
+from tests.test_regime_helpers import B1, overrides_000, overrides_001, run_case
 
 
 def test_regime_run_writes_a_self_describing_dataset_and_figure(tmp_path):
@@ -28,6 +29,18 @@ def test_regime_run_writes_a_self_describing_dataset_and_figure(tmp_path):
     assert 1e-5 < err[:2].max() < 4 * 20.0**-3
     assert err[3:].max() < 4 * 20.0**-4
     assert "regime_comparison.png" in {p.name for p in written}
+    # the reduced system's Euler angles (ψ by quadrature of eq. 29): O(μ⁻²)-close to the exact orbit's
+    for name in ("psi", "theta", "phi"):
+        assert np.abs(ds[f"{name}_reduced"].values - ds[f"{name}_orbit"].values).max() < 1e-3
+
+
+def test_euler_angles_by_quadrature_match_the_fixed_axis():
+    # ψ from ψ̇ = (pγ + qγ')/(1 − γ''²) on the samples against ψ from the integrated fixed axis α (full model)
+    scene, regime, t, result = run_case(overrides_001(B1, 0.05), samples=200, full=True)
+    for source in ("orbit", "full"):
+        angles = angles_from_states(t, result["states"][source], float(result["angles"][source]["psi"][0]))
+        for name, values in angles.items():
+            assert np.abs(values - result["angles"][source][name]).max() < 1e-9, (source, name)
 
 
 def test_reduced_system_is_integrated_by_the_scenes_integrator(tmp_path):
