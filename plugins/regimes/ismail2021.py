@@ -236,13 +236,25 @@ def eq12_s11_s21(Z: np.ndarray, Z0: np.ndarray, P: Params) -> tuple:
     return s11, s21
 
 
-def eq14_F2_Phi2(Z: np.ndarray, Z0: np.ndarray, P: Params, printed: bool = False) -> tuple:
-    """F2, Φ2 of eq. (14): p̈2 + ω²p2 = μ⁻²F2 + O(μ⁻³), γ̈2 + γ2 = μ⁻²Φ2 + O(μ⁻³).
+def eq12_s12_s22(Z: np.ndarray, Z0: np.ndarray, P: Params) -> tuple:
+    """s12, s22 of eq. (12): s1 = s11 + 2μ⁻¹s12 + …, s2 = s21 + μ⁻¹s22 + … (correct as printed, y0' reading)."""
+    a, b, x, y, z, k, g0, A1, chi1, chi2 = P.a, P.b, P.x0, P.y0, P.z0, P.k, P.g0, P.A1, P.chi1, P.chi2
+    Pn, Pd, G, Gd = Z[0], Z[1], Z[2], Z[3]
+    P0, Pd0, G0, Gd0 = Z0[0], Z0[1], Z0[2], Z0[3]
+    _, s21 = eq12_s11_s21(Z, Z0, P)
+    xa = x / (1 - a)
+    dPG, dPdGd = P0 * G0 - Pn * G, Pd0 * Gd0 - Pd * Gd
+    s12 = (a * (xa * g0 * (P0 - Pn) + chi1 * dPG) - b / A1**2 * (y / a * g0 * (Pd0 - Pd) - chi2 * dPdGd)
+           - a * x * g0 * (P0 - Pn) + y * b / A1 * g0 * (Pd0 - Pd) + (z - k * g0) * s21
+           + k * g0 * (a**2 * dPG - b**2 / A1 * dPdGd))
+    s22 = (a * (a * g0 * (P0**2 - Pn**2) + xa * g0 * (G0 - G) + chi1 * (G0**2 - G**2))
+           + b / A1 * (b / A1 * g0 * (Pd0**2 - Pd**2) + y / a * g0 * (Gd0 - Gd) - chi2 * (Gd0**2 - Gd**2)))
+    return s12, s22
 
-    F2 is correct as printed. Φ2 printed has x0'(γ̇2² + b⁻¹γ0''); corrected x0'(γ̇2² + b⁻¹γ0''²) (erratum 000-3).
-    """
-    a, b, x, y, z, k, g0, A1, B1, C1, w2, chi1 = (P.a, P.b, P.x0, P.y0, P.z0, P.k, P.g0, P.A1, P.B1, P.C1,
-                                                  P.omega2, P.chi1)
+
+def _eq14_f2_phi2(Z: np.ndarray, Z0: np.ndarray, P: Params, printed: bool = False) -> tuple:
+    """f2, φ2 of eq. (14) (F2, Φ2 before the χ1, γ0'' terms of the change of variables (9))."""
+    a, b, x, y, z, k, g0, A1, B1, C1, w2 = P.a, P.b, P.x0, P.y0, P.z0, P.k, P.g0, P.A1, P.B1, P.C1, P.omega2
     Pn, Pd, G, Gd = Z[0], Z[1], Z[2], Z[3]
     s11, s21 = eq12_s11_s21(Z, Z0, P)
     f2 = (x * (A1 / b * s21 + Pd * Gd) + Pd / A1 * (C1 * Pn * Pd - y * (2 * A1 + b / a) * G)
@@ -251,9 +263,83 @@ def eq14_F2_Phi2(Z: np.ndarray, Z0: np.ndarray, P: Params, printed: bool = False
     phi2 = ((1 + B1) * Pn * s21 + x * (Gd**2 + (g0 if printed else g0**2) / b)
             - Pd / A1 * (G * Pd / A1 + (1 - C1) * Pn * Gd)
             - G * (s11 + z / b * g0 + y * Gd - k * (C1 * Gd**2 - B1 * g0**2)))
+    return f2, phi2
+
+
+def eq14_F2_Phi2(Z: np.ndarray, Z0: np.ndarray, P: Params, printed: bool = False) -> tuple:
+    """F2, Φ2 of eq. (14): p̈2 + ω²p2 = μ⁻²F2 + O(μ⁻³), γ̈2 + γ2 = μ⁻²Φ2 + O(μ⁻³).
+
+    F2 is correct as printed. Φ2 printed has x0'(γ̇2² + b⁻¹γ0''); corrected x0'(γ̇2² + b⁻¹γ0''²) (erratum 000-3).
+    """
+    a, g0, w2, chi1 = P.a, P.g0, P.omega2, P.chi1
+    Pn, G = Z[0], Z[2]
+    f2, phi2 = _eq14_f2_phi2(Z, Z0, P, printed)
     F2 = f2 - a * g0 * chi1 * (1 - w2) * Pn
-    Phi2 = phi2 + a * g0 * (1 - w2) * (chi1 * G + g0 * x / (1 - a))
+    Phi2 = phi2 + a * g0 * (1 - w2) * (chi1 * G + g0 * P.x0 / (1 - a))
     return F2, Phi2
+
+
+def eq14_F3_Phi3(Z: np.ndarray, Z0: np.ndarray, P: Params, printed: bool = False) -> tuple:
+    """F3, Φ3 of eq. (14): p̈2 + ω²p2 = μ⁻²F2 + μ⁻³F3 + O(μ⁻⁴), γ̈2 + γ2 = μ⁻²Φ2 + μ⁻³Φ3 + O(μ⁻⁴).
+
+    F3 = f3 − χ1Φ2, Φ3 = φ3 + aγ0''[aγ0''χ1(1−ω²)p2 − f2] as printed; f3, φ3 in the 000/004 reading
+    (003 is corrupted there). Corrected = the ε³ Taylor coefficient of the full model in the variables (9),
+    derived exactly in docs/derivations/scripts/seed000/derive_f3_phi3.py (erratum 000-4). With
+    u = χ1γ2 + γ0''x0'/(1−a) (the μ⁻¹ shift of p1 in (9)), the printed → corrected terms are:
+
+    F3 (f3 and the Φ2 it contains):
+      (F-a) Φ2 inside F3: the erratum 000-3 typo b⁻¹γ0'' → b⁻¹γ0''², propagated by −χ1Φ2;
+      (F-b) C1A1⁻¹ṗ2[ṗ2u + 2p2ṗ2(χ2γ̇2 − y0'a⁻¹γ0'')] → […+ 2p2(χ2γ̇2 − y0'a⁻¹γ0'')] (spurious ṗ2);
+      (F-c) x0'-line −γ0''γ̇2(y0'a⁻¹ − χ2γ̇2) → −γ̇2(y0'a⁻¹γ0'' − χ2γ̇2) (γ0'' belongs to y0'a⁻¹ only);
+      (F-d) y0'-line −y0'a⁻¹γ0''[γ̇2(χ1γ2 + x0'/(1−a)) − bA1⁻¹p2ṗ2]
+            → −y0'a⁻¹[γ̇2 u − bA1⁻¹γ0''p2ṗ2] (no γ0'' on χ1γ2γ̇2; this is the y0'γ2γ̇2 term and, through
+            the kγ0'' part of χ1, the only k-term that was wrong);
+      (F-e) z0'-line −γ0''(χ1γ2 + x0'/(1−a)) → −γ0''u (x0'/(1−a) lost its γ0'').
+    Φ3 (φ3):
+      (Φ-a) (1−C1)A1⁻¹[… + p2γ̇2(y0'a⁻¹ − χ2γ̇2)] → p2γ̇2(y0'a⁻¹γ0'' − χ2γ̇2) (the slip of F-c);
+      (Φ-b) the constant b⁻¹γ0''²x0' inside (1−C1)A1⁻¹[…] is spurious (removed).
+    Everything else, including all other k-terms, s12, s22 and f2, is correct as printed.
+    """
+    a, b, x, y, z, k, g0, A1, B1, C1, w2, chi1, chi2 = (P.a, P.b, P.x0, P.y0, P.z0, P.k, P.g0, P.A1, P.B1,
+                                                        P.C1, P.omega2, P.chi1, P.chi2)
+    Pn, Pd, G, Gd = Z[0], Z[1], Z[2], Z[3]
+    s11, s21 = eq12_s11_s21(Z, Z0, P)
+    s12, s22 = eq12_s12_s22(Z, Z0, P)
+    f2, _ = _eq14_f2_phi2(Z, Z0, P, printed)
+    _, Phi2 = eq14_F2_Phi2(Z, Z0, P, printed)
+    xa = x / (1 - a)
+    u = chi1 * G + xa * g0
+    ya = y / a
+    if printed:
+        c_line = 2 * Pn * Pd * (chi2 * Gd - ya * g0)
+        x_line = g0 * Gd * (ya - chi2 * Gd)
+        y_line = ya * g0 * (Gd * (chi1 * G + xa) - b / A1 * Pn * Pd)
+        z_line = g0 * (chi1 * G + xa)
+        p_line = Pn * Gd * (ya - chi2 * Gd) + x * g0**2 / b
+    else:
+        c_line = 2 * Pn * (chi2 * Gd - ya * g0)
+        x_line = Gd * (ya * g0 - chi2 * Gd)
+        y_line = ya * (Gd * u - b / A1 * g0 * Pn * Pd)
+        z_line = g0 * u
+        p_line = Pn * Gd * (ya * g0 - chi2 * Gd)
+    f3 = (-w2 * (s11 * u + 2 * Pn * s12)
+          + C1 / A1 * Pd * (Pd * u + c_line)
+          + x * (A1 / b * s22 - b / A1 * g0 * Pd**2 - x_line)
+          - y_line
+          + z / a * (0.5 / b * (2 * b - 1) * s11 * G - z_line - Pn * s21)
+          + y * (2 - b) / (1 - b) * (G * (ya * g0 - chi2 * Gd) - a * g0 * Pn * Pd)
+          + k * ((1 - C1) * ((ya * g0 - chi2 * Gd) * G * Gd - a * g0 * Pn * Pd * Gd + b / A1 * g0 * G * Pd**2)
+                 + Pn * g0 * (2 * b * Pd * Gd - a * A1 * (1 + B1) * s21 + 2 * A1 * s21)
+                 + A1 * (u * (g0**2 - Gd**2) - (1 + B1) * G * s22)))
+    phi3 = (-2 * s12 * G - a * g0 * Pn * s11 + (1 + B1) * (Pn * s22 + u * s21)
+            + 2 * x * g0 * (s21 / b - b / A1 * Pd * Gd) - z / b * (a * g0**2 * Pn + s21 * G)
+            + (1 - C1) / A1 * (b / A1 * g0 * Pn * Pd**2 - u * Pd * Gd + p_line)
+            - y * g0 * (a * Pn * Gd - b / A1 * G * Pd)
+            + (2 * Pd * (ya * g0 - chi2 * Gd) * G - a * g0 * Pn * Pd**2) / A1**2
+            + k * g0 * (a * Pn * (C1 * Gd**2 - B1 * g0**2) - 2 * G * (b / A1 * C1 * Pd * Gd + B1 * s21)))
+    F3 = f3 - chi1 * Phi2
+    Phi3 = phi3 + a * g0 * (a * g0 * chi1 * (1 - w2) * Pn - f2)
+    return F3, Phi3
 
 
 def reduced_from_scaled(Y: np.ndarray, P: Params) -> np.ndarray:
@@ -305,15 +391,23 @@ def _s1_s2(Y, Y0, P: Params):
     return s1, s2
 
 
-def reduced_rhs(tau: float, Z: np.ndarray, P: Params, Z0: np.ndarray, printed: bool = False) -> np.ndarray:
-    """The reduced quasilinear system (14) truncated after μ⁻²: d/dτ (p2, ṗ2, γ2, γ̇2).
+def reduced_rhs(tau: float, Z: np.ndarray, P: Params, Z0: np.ndarray, printed: bool = False,
+                order: int = 3) -> np.ndarray:
+    """The reduced quasilinear system (14) through the μ⁻³ terms: d/dτ (p2, ṗ2, γ2, γ̇2).
 
-        p̈2 + ω²p2 = μ⁻²F2,   γ̈2 + γ2 = μ⁻²Φ2      (F3, Φ3 are wrong as printed: erratum 000-4)
+        p̈2 + ω²p2 = μ⁻²F2 + μ⁻³F3,   γ̈2 + γ2 = μ⁻²Φ2 + μ⁻³Φ3      (``order=2`` drops the μ⁻³ terms)
 
-    Z0 is the initial state (it enters through s11, s21 of (12)). Its solution differs from the full model
-    by the dropped μ⁻³ terms: O(μ⁻³) over a period (measured in tests/test_regime_small_parameter.py).
-    ``printed`` uses the printed Φ2 (erratum 000-3).
+    Z0 is the initial state (it enters through s11, s12, s21, s22 of (12)). Error against the full model over a
+    period (tests/test_erratum_000_4.py): O(μ⁻⁴) from a generic state (``order=2``: O(μ⁻³)); on the periodic
+    orbit of (35) p, q O(μ⁻⁵), γ's O(μ⁻⁴) (``order=2``: p, q O(μ⁻³)). ``printed`` uses the printed Φ2, F3, Φ3
+    (errata 000-3, 000-4): p, q error O(μ⁻³), γ's O(μ⁻²) (O(μ⁻³) when γ0'' = O(μ⁻¹): the Φ2 typo ∝ γ0''(1 − γ0'')).
     """
+    if order not in (2, 3):
+        raise ValueError(f"order={order!r}: the reduced system (14) is available through μ⁻² or μ⁻³ (order 2 or 3)")
     F2, Phi2 = eq14_F2_Phi2(Z, Z0, P, printed=printed)
-    e2 = 1 / P.mu**2
-    return np.array([Z[1], -P.omega2 * Z[0] + e2 * F2, Z[3], -Z[2] + e2 * Phi2])
+    e = 1 / P.mu
+    F, Phi = e**2 * F2, e**2 * Phi2
+    if order >= 3:
+        F3, Phi3 = eq14_F3_Phi3(Z, Z0, P, printed=printed)
+        F, Phi = F + e**3 * F3, Phi + e**3 * Phi3
+    return np.array([Z[1], -P.omega2 * Z[0] + F, Z[3], -Z[2] + Phi])
