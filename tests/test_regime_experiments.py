@@ -21,8 +21,8 @@ def test_regime_run_writes_a_self_describing_dataset_and_figure(tmp_path):
     assert ds.newton_residual.values[-1] < 1e-13
     # ε = 0.05: analytic vs exact orbit errors of order ε³..ε⁴ (relative to c and r0)
     assert ds.max_error_vs_orbit.values[:2].max() < 1e-3
-    # the reduced system (000 eq. 14 truncated after μ⁻², integrated numerically) against the exact orbit over two
-    # periods: p, q O(μ⁻³), γ's O(μ⁻⁴) at μ = r0/c = 20 (measured 2.1e-4 and 9.2e-6)
+    # the reduced system (000 eq. 14 through μ⁻³, integrated numerically) against the exact orbit over two
+    # periods at μ = r0/c = 20, started at the analytic τ = 0 state, not on the orbit (measured 9.2e-5 and 1.2e-5)
     assert ds.omega_reduced.shape == ds.omega_orbit.shape
     assert np.allclose(ds.omega_reduced.values[0], ds.omega_analytic.values[0], atol=1e-12)  # same τ = 0 state
     err = ds.max_error_reduced_vs_orbit.values
