@@ -120,6 +120,9 @@ def test_branch_refusals():
         ResonantOmega3(branch="iii", sign=2)
     with pytest.raises(ConfigError, match="phase_deg"):
         ResonantOmega3(branch="iv", formula="printed", phase_deg=90)
+    for bad in ("abc", float("nan")):
+        with pytest.raises(ConfigError, match="regime.phase_deg"):
+            ResonantOmega3(branch="iv", formula="printed", phase_deg=bad)
     ResonantOmega3(branch="iv", formula="printed", phase_deg=30)  # the paper's reading stays available
 
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.errors import ConfigError
+from pipeline.errors import ConfigError, as_number
 from plugins.regimes import shaker_omega3 as paper
 from plugins.regimes.base import FixedPointRegime, NondimensionalScene
 
@@ -52,7 +52,7 @@ class ResonantOmega3(FixedPointRegime):
                               "(or regime.formula=printed to reproduce the paper's claim)")
         if sign not in (1, -1) or isinstance(sign, bool):
             raise ConfigError(f"regime.sign={sign!r} must be 1 or -1 (the ± of eq. 23)")
-        phase = float(phase_deg)
+        phase = as_number(phase_deg, "regime.phase_deg")
         if branch == "iv" and not (0.0 < phase % 90.0):
             raise ConfigError(f"regime.phase_deg={phase_deg!r} puts branch iv on branch ii or iii; choose a phase that "
                               "is not a multiple of 90 degrees")
