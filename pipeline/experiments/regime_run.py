@@ -138,7 +138,8 @@ def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[np.nd
 
     The reduced system is written in τ = c r0 t; it is integrated in t (d/dt = c r0 d/dτ) so that the plugin's
     settings (a fixed step, tolerances) mean what they mean for the full model. A compiled-only integrator cannot
-    take it (it has no compiled form): scipy's DOP853 with the same tolerances stands in, and the dataset says so.
+    take it (it has no compiled form), nor can ``auto`` (its choice is made for the full model): scipy's DOP853
+    with the same tolerances (1e-12 where there are none) stands in, and the dataset says so.
     """
     if not hasattr(regime, "reduced_rhs"):
         return None
@@ -231,7 +232,6 @@ def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any],
         data["max_error_reduced_vs_orbit"] = ("component", d, {
             "units": "1", "long_name": f"max |{SOURCE_NAMES['reduced']} − {SOURCE_NAMES['orbit']}| over the window, "
                                        "per component (model units of ω, γ)"})
-    n = len(orbit.residuals) if orbit is not None else 0
     if orbit is not None:
         data.update(orbit_variables(orbit, body))
     data["period_analytic"] = ((), result["period_analytic"], {"units": body.time_unit,
@@ -241,11 +241,10 @@ def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any],
         "axis": ("axis", np.array(["x", "y", "z"]), {"units": "1", "long_name": "principal body axis"}),
         "component": ("component", np.array(["p", "q", "r", "gamma_x", "gamma_y", "gamma_z"]),
                       {"units": "1", "long_name": "state component"}),
-        "iteration": ("iteration", np.arange(n), {"units": "1", "long_name": "Newton iteration"}),
-        "multiplier": ("multiplier", np.arange(6), {"units": "1", "long_name": "Floquet multiplier index"}),
     }
-    if orbit is None:
-        coords = {k: v for k, v in coords.items() if k not in ("iteration", "multiplier")}
+    if orbit is not None:
+        coords["iteration"] = ("iteration", np.arange(len(orbit.residuals)), {"units": "1", "long_name": "Newton iteration"})
+        coords["multiplier"] = ("multiplier", np.arange(6), {"units": "1", "long_name": "Floquet multiplier index"})
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update({
         "title": f"regime {regime.name} ({regime.formula}): {system.title()}",

@@ -62,6 +62,13 @@ def _scales(regime, system) -> dict[str, float]:
             "gamma": g, "gamma3": g, "period": 1 / (s.r0 * s.c)}
 
 
+def _append_missing(errs: dict) -> None:
+    """NaN for every error of a point that was refused or has no orbit."""
+    for table in errs.values():
+        for k in KEYS:
+            table[k].append(np.nan)
+
+
 def _r0_for(regime: str, value: float, cfg: DictConfig) -> float:
     if _group(cfg, regime) == "resonant_omega3":
         theta0 = float(cfg.regime_validity[regime].scene["initial.theta0"])
@@ -84,9 +91,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                 scene, regime, _ = prepare(sub)
             except ConfigError as error:
                 status.append(f"refused: {error}")
-                for against in errs:
-                    for k in KEYS:
-                        errs[against][k].append(np.nan)
+                _append_missing(errs)
                 continue
             theory = regime.order  # the instance's: a branch may have other orders than the class default
             T = regime.period(scene.system)
@@ -95,9 +100,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                 result = compute(scene, regime, t)
             except IntegrationError as error:  # no exact orbit near the series (far outside its domain)
                 status.append(f"failed: {error}")
-                for against in errs:
-                    for k in KEYS:
-                        errs[against][k].append(np.nan)
+                _append_missing(errs)
                 continue
             status.append("ok")
             sc = _scales(regime, scene.system)

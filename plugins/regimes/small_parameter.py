@@ -28,8 +28,8 @@ WARN_DISTANCE = 0.1
 # Refusal band around a resonance, |n² − ω²| < divisor_threshold(n, ε), where the error against the exact orbit
 # reaches ~1e-2 (measured by regime_validity's resonance sweep, body I, c/r0 = 0.1, 0.05, 0.025; docs/regimes.md):
 # near ω = 2 the error is 5.7 ε^2.96 / |4 − ω²|^0.95 (the ε³ terms carry one small divisor), hence ε³/|n² − ω²|
-# ≤ 1/580; near ω = 1 (1:1 with the γ-mode) it blows up at |1 − ω²| ≈ 0.11, 0.042, 0.017: ∝ ε^(4/3), the fold
-# of a weakly nonlinear forced oscillator (detuning ~ ε^(2/3) of the forcing ε and the ε² frequency shift).
+# ≤ 1/580; near ω = 1 (1:1 with the γ-mode) it blows up at |1 − ω²| ≈ 0.11, 0.042, 0.017, i.e. ∝ ε^(4/3): the
+# detuning at which a weakly nonlinear oscillator with forcing ε and frequency shift ε²A² folds.
 REFUSE_CUBIC = 580.0
 REFUSE_ONE_TO_ONE = 2.28
 
