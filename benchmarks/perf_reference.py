@@ -7,7 +7,7 @@ Reference problem (issue 5, ``experiment=perf_reference``): nondimensional
 Euler–Poisson, A, B, C = 2, 1.5, 1, r_c = (0.3, 0.2, 0.9327…), k = 0.5,
 ω0 = (0.1, −0.05, 5), γ0 = (sin 1, 0, cos 1), t ∈ [0, 300]. Error = max-norm
 of the final state's error against an extended-precision Taylor reference
-(``pipeline.reference``; two settings of it agree to ~1e-14).
+(``gyrolab.physics.reference``; two settings of it agree to ~1e-14).
 
 The scipy baseline is what a researcher would write: ``solve_ivp`` with a
 plain numpy right-hand side. For each target error, a method's time is that
@@ -28,9 +28,9 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from pipeline import compose_scene
-from pipeline.batch import integrate_batch
-from pipeline.reference import fixed_point_reference
+from gyrolab import compose_scene
+from gyrolab.engine.batch import integrate_batch
+from gyrolab.physics.reference import fixed_point_reference
 
 INERTIA = np.array([2.0, 1.5, 1.0])
 R_C = np.array([0.3, 0.2, 0.9327379053088815])
@@ -99,7 +99,7 @@ def cold_default_run():
         times = []
         for i in range(2):  # the first may fill the kernel cache; the second is a cold process with a warm cache
             start = time.perf_counter()
-            subprocess.run([sys.executable, "-m", "pipeline", f"hydra.run.dir={tmp}/run{i}"], check=True,
+            subprocess.run([sys.executable, "-m", "gyrolab", f"hydra.run.dir={tmp}/run{i}"], check=True,
                            capture_output=True, cwd=tmp)
             times.append(time.perf_counter() - start)
     return times

@@ -1,3 +1,3 @@
-from pipeline.app import main
+from gyrolab.app import main
 
 main()

@@ -6,7 +6,7 @@ directory — into one sentence and a non-zero exit, so that no run directory
 with a partial ``run.nc`` is left behind.
 
 In a multirun each job is resumable and a failing job is recorded, not fatal
-(``pipeline.sweep.job``); the sweep callback then writes ``sweep.nc``. Two
+(``gyrolab.sweep.job``); the sweep callback then writes ``sweep.nc``. Two
 more commands work on results: ``gyrolab --reproduce PATH/run.nc`` and
 ``gyrolab --aggregate SWEEP_DIR``.
 """
@@ -30,22 +30,22 @@ from hydra.errors import OverrideParseException
 from hydra.types import RunMode
 from omegaconf import DictConfig, open_dict
 
-from pipeline.config import (
+from gyrolab.engine.config import (
     CONFIG_MODULE,
     SELECTABLE_GROUPS,
     compose_config,
     group_options,
     register_plugin_configs,
 )
-from pipeline.errors import ConfigError, GyrolabError, choices
-from pipeline.progress import allow_bars, on_terminal
-from pipeline.scene import Scene
-from pipeline.sweep.grid import Grid
-from pipeline.sweep.identity import job_identity
-from pipeline.sweep.job import run_sweep_job
+from gyrolab.errors import ConfigError, GyrolabError, choices
+from gyrolab.engine.progress import allow_bars, on_terminal
+from gyrolab.engine.scene import Scene
+from gyrolab.sweep.grid import Grid
+from gyrolab.sweep.identity import job_identity
+from gyrolab.sweep.job import run_sweep_job
 
 if TYPE_CHECKING:
-    from pipeline.sweep.aggregate import SweepSummary
+    from gyrolab.sweep.aggregate import SweepSummary
 
 log = logging.getLogger("gyrolab")
 
@@ -69,6 +69,7 @@ def preflight(argv: Sequence[str]) -> None:
             reason = str(error).strip().splitlines()[0].split(" See https://")[0]
             raise ConfigError(f"malformed override {text!r}: {reason}") from None
     sweeping = args.multirun or any(o.is_sweep_override() for o in overrides)
+    check_launcher_installed(overrides)
     check_plugin_names(overrides)
     if sweeping:
         Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
@@ -78,7 +79,7 @@ def preflight(argv: Sequence[str]) -> None:
     cfg = compose_config(first, return_hydra_config=True)
     scene_cfg = _without_hydra(cfg)
     if task_of(scene_cfg) == "regime":  # the regime's domain is checked before anything is written
-        from pipeline.experiments.regime_run import prepare
+        from gyrolab.experiments.regime_run import prepare
 
         prepare(scene_cfg)
     else:
@@ -104,6 +105,29 @@ def check_plugin_names(overrides: Sequence[Override]) -> None:
                         raise ConfigError(f"unknown {o.key_or_group} {name!r}; valid choices: {choices(valid)}")
 
 
+#: launcher option -> the module that provides it (installed by the ``cluster`` extra)
+EXTRA_LAUNCHERS = {
+    "joblib": "hydra_plugins.hydra_joblib_launcher",
+    "submitit_local": "hydra_plugins.hydra_submitit_launcher",
+    "submitit_slurm": "hydra_plugins.hydra_submitit_launcher",
+    "slurm": "hydra_plugins.hydra_submitit_launcher",
+}
+
+
+def check_launcher_installed(overrides: Sequence[Override]) -> None:
+    """A launcher of the ``cluster`` extra, chosen without the extra installed, is one sentence."""
+    from importlib.util import find_spec
+
+    for o in overrides:
+        if o.key_or_group != "hydra/launcher" or o.is_delete():
+            continue
+        name = str(o.value())
+        module = EXTRA_LAUNCHERS.get(name)
+        if module is not None and find_spec(module) is None:
+            raise ConfigError(f"hydra/launcher={name} needs the sweep launchers, which are not installed; "
+                              'install them with: pip install "gyrolab[cluster]"')
+
+
 def _without_hydra(cfg: DictConfig) -> DictConfig:
     cfg = cfg.copy()
     with open_dict(cfg):
@@ -126,7 +150,7 @@ def check_writable(directory: Path) -> None:
                           "choose a writable hydra.run.dir (or hydra.sweep.dir)") from None
 
 
-@hydra.main(config_path="pkg://conf", config_name="config", version_base="1.3")
+@hydra.main(config_path="pkg://gyrolab.conf", config_name="config", version_base="1.3")
 def _task(cfg: DictConfig) -> None:
     hydra_cfg = HydraConfig.get()
     out_dir = Path(hydra_cfg.runtime.output_dir)
@@ -144,11 +168,11 @@ def _task(cfg: DictConfig) -> None:
 
 def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
     """Run the scene, write ``run.nc`` (and figures) in ``out_dir``; GyrolabError on bad input or a failed run."""
-    from pipeline.dataset import write_dataset
+    from gyrolab.output.dataset import write_dataset
 
     task = task_of(cfg)
     if task != "scene":
-        from pipeline.experiments import run_task
+        from gyrolab.experiments import run_task
 
         written = run_task(task, cfg, out_dir)
         for path in written:
@@ -161,7 +185,7 @@ def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
     path = write_dataset(ds, out_dir / "run.nc")
     log.info("wrote %s", path)
     if cfg.output.get("figures", True):
-        from pipeline.figures import save_figures  # matplotlib only when figures are drawn
+        from gyrolab.output.figures import save_figures  # matplotlib only when figures are drawn
 
         for figure in save_figures(ds, out_dir / "figures"):
             log.info("wrote %s", figure)
@@ -196,12 +220,12 @@ def run_command(argv: Sequence[str]) -> int | None:
                           f"usage: gyrolab {option} {'PATH/run.nc' if option == '--reproduce' else 'SWEEP_DIR'}")
     logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
     if option == "--reproduce":
-        from pipeline.sweep.reproduce import report, reproduce
+        from gyrolab.sweep.reproduce import report, reproduce
 
         comparison, stored = reproduce(Path(rest[0]))
         print("\n".join(report(Path(rest[0]), comparison, stored)))
         return 0 if comparison.identical else 1
-    from pipeline.sweep.aggregate import aggregate_sweep, log_summary
+    from gyrolab.sweep.aggregate import aggregate_sweep, log_summary
 
     summary = aggregate_sweep(Path(rest[0]))
     log_summary(summary)
@@ -212,7 +236,7 @@ def _batch(overrides: Sequence[str]) -> int:
     """``gyrolab --batch KEY=V1,V2 ... [hydra.sweep.dir=DIR]``: the grid in one batch, one sweep.nc."""
     from datetime import datetime
 
-    from pipeline.sweep.batch import run_batch_sweep
+    from gyrolab.sweep.batch import run_batch_sweep
 
     logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
     out_dir = Path(f"outputs/batch/{datetime.now():%Y-%m-%d}/{datetime.now():%H-%M-%S}")
@@ -233,7 +257,7 @@ def _batch(overrides: Sequence[str]) -> int:
 
 def _sweep_status(summary: SweepSummary | None = None) -> int:
     """0 if every job of the last sweep finished, else 1 (with one line saying where the errors are)."""
-    from pipeline.sweep import callbacks
+    from gyrolab.sweep import callbacks
 
     if callbacks.last_error:
         print(f"gyrolab: error: {callbacks.last_error}", file=sys.stderr)
@@ -248,8 +272,13 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
 
 
 def main() -> None:
-    """Console entry point ``gyrolab`` (also ``python -m pipeline``)."""
+    """Console entry point ``gyrolab`` (also ``python -m gyrolab``)."""
     argv = sys.argv[1:]
+    if argv[:1] in (["--version"], ["-V"]):
+        from gyrolab.output.provenance import gyrolab_version
+
+        print(f"gyrolab {gyrolab_version()}")
+        sys.exit(0)
     try:
         status = run_command(argv)
         if status is not None:

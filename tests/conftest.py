@@ -15,7 +15,7 @@ def cli(tmp_path):
     def _run(*args, env_extra=None):
         env = dict(os.environ)
         env.update(env_extra or {})
-        return subprocess.run([sys.executable, "-m", "pipeline", *args], cwd=tmp_path, env=env,
+        return subprocess.run([sys.executable, "-m", "gyrolab", *args], cwd=tmp_path, env=env,
                               capture_output=True, text=True, timeout=300)
 
     return _run

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from pipeline.attitude import euler_angles, frame_from_angles, gamma_from_angles
+from gyrolab.physics.attitude import euler_angles, frame_from_angles, gamma_from_angles
 
 
 def _angles_of(psi, theta, phi):

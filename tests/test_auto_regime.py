@@ -7,9 +7,9 @@ body I of the verification report); errors are judged against the extended-preci
 import numpy as np
 import pytest
 
-from pipeline import compose_scene
-from pipeline.reference import fixed_point_reference
-from plugins.regimes.small_parameter import SmallParameter
+from gyrolab import compose_scene
+from gyrolab.physics.reference import fixed_point_reference
+from gyrolab.plugins.regimes.small_parameter import SmallParameter
 
 MU, GAMMA = 32.0, 0.5
 RC = [0.5, 0.3, float(np.sqrt(1 - 0.34))]

@@ -4,7 +4,7 @@ import sys
 
 import pytest
 
-from pipeline import app
+from gyrolab import app
 
 CASES = {
     "unknown integrator": (["integrator=foo"], ["'foo'", "dop853", "rk4"]),
@@ -64,7 +64,7 @@ def test_unwritable_output_directory(tmp_path, monkeypatch, capsys):
 
 
 def test_nonphysical_body_runs_when_allowed_and_says_so():
-    from pipeline import run
+    from gyrolab import run
 
     ds = run(["body.a=3", "body.b=1.5", "body.allow_nonphysical=true", "time.end=1", "time.n_output=3"])
     assert ds.attrs["body_nonphysical"] == 1

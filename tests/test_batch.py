@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from pipeline import compose_scene
-from pipeline.batch import integrate_batch
-from pipeline.errors import ConfigError
+from gyrolab import compose_scene
+from gyrolab.engine.batch import integrate_batch
+from gyrolab.errors import ConfigError
 
 SHORT = ["time.end=2", "time.n_output=11", "integrator.step=0.01"]
 

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from pipeline import compose_scene, run
-from pipeline.errors import ConfigError
-from pipeline.reference import fixed_point_reference
+from gyrolab import compose_scene, run
+from gyrolab.errors import ConfigError
+from gyrolab.physics.reference import fixed_point_reference
 
 INERTIA, R_C, K = [2.0, 1.5, 1.0], [0.3, 0.2, 0.9327379053088815], 0.5
 Y0 = [0.1, -0.05, 5.0, np.sin(1.0), 0.0, np.cos(1.0)]
@@ -80,7 +80,7 @@ def test_auto_meets_its_accuracy(accuracy):
 
 
 def test_auto_falls_back_to_scipy_without_compiled_forms(monkeypatch):
-    from plugins.forces.newtonian import Newtonian
+    from gyrolab.plugins.forces.newtonian import Newtonian
 
     monkeypatch.setattr(Newtonian, "compiled_terms", lambda self: None)
     ds = run(["integrator=auto", "accuracy=1e-7", "time.end=5", "time.n_output=11"])
@@ -88,7 +88,7 @@ def test_auto_falls_back_to_scipy_without_compiled_forms(monkeypatch):
 
 
 def test_compiled_integrator_refuses_a_force_without_compiled_form(monkeypatch):
-    from plugins.forces.newtonian import Newtonian
+    from gyrolab.plugins.forces.newtonian import Newtonian
 
     monkeypatch.setattr(Newtonian, "compiled_terms", lambda self: None)
     with pytest.raises(ConfigError, match="'newtonian' has no compiled form"):

@@ -4,9 +4,9 @@ from pathlib import Path
 
 import pytest
 
-from pipeline import compose_scene
-from pipeline.errors import ConfigError
-from pipeline.registry import BUILTINS, names
+from gyrolab import compose_scene
+from gyrolab.errors import ConfigError
+from gyrolab.engine.registry import BUILTINS, names
 
 CONF = Path(__file__).resolve().parent.parent / "conf"
 

@@ -5,9 +5,9 @@ import pytest
 import xarray as xr
 from omegaconf import OmegaConf
 
-from pipeline import run
-from pipeline.dataset import write_dataset
-from pipeline.scene import Scene
+from gyrolab import run
+from gyrolab.output.dataset import write_dataset
+from gyrolab.engine.scene import Scene
 
 SHORT = ["time.end=2", "time.n_output=21"]
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from plugins.regimes import ismail2021 as paper
+from gyrolab.plugins.regimes import ismail2021 as paper
 from tests.test_regime_helpers import GAMMA_000, slope
 
 BODY_I = paper.Params(a=2.0, b=1.5, x0=0.5, y0=0.3, z0=0.8124, k=0.3, mu=1.0, g0=0.37)  # A > B > C

@@ -5,12 +5,12 @@ import textwrap
 import numpy as np
 import pytest
 
-from pipeline import config, registry
-from pipeline import run
+from gyrolab.engine import config, registry
+from gyrolab import run
 
 PLUGIN = textwrap.dedent('''
     """Linear viscous drag on the body: torque −c ω (a third-party plugin)."""
-    from pipeline.contracts import Force
+    from gyrolab.contracts import Force
 
 
     class ViscousDrag(Force):

@@ -9,8 +9,8 @@ Each run must be finite with its monitored invariants within a bound set by its 
 import numpy as np
 import pytest
 
-from pipeline import run
-from pipeline.errors import IntegrationError
+from gyrolab import run
+from gyrolab.errors import IntegrationError
 
 SCENES = {
     "slow spin r0=1e-3": ["initial.r0=1e-3", "initial.p0=0", "initial.q0=0", "time.end=20"],

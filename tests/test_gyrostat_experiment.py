@@ -2,8 +2,8 @@
 
 import csv
 
-import pipeline.experiments as experiments
-from pipeline.config import compose_config
+import gyrolab.experiments as experiments
+from gyrolab.engine.config import compose_config
 
 
 def test_experiment_writes_the_case_table(tmp_path):

@@ -4,15 +4,15 @@ integral, precession verdicts from residuals and integration (never copied from 
 import numpy as np
 import pytest
 
-from pipeline import compose_scene
-from pipeline.errors import ConfigError
-from pipeline.precession.cases import BY_LABEL, CASES
-from pipeline.precession.finder import find_precessions
-from pipeline.precession.classify import classify
-from pipeline.precession.motion import Precession, build_system, states, theta_deviation, vector_residual, window
-from pipeline.precession.stability import body_frame_period, floquet, monodromy_multipliers
-from plugins.integrators.scipy_solvers import DOP853
-from plugins.systems.gyrostat_euler import GyrostatParameters, kinematic_matrix, lagrange_equations
+from gyrolab import compose_scene
+from gyrolab.errors import ConfigError
+from gyrolab.physics.precession.cases import BY_LABEL, CASES
+from gyrolab.physics.precession.finder import find_precessions
+from gyrolab.physics.precession.classify import classify
+from gyrolab.physics.precession.motion import Precession, build_system, states, theta_deviation, vector_residual, window
+from gyrolab.physics.precession.stability import body_frame_period, floquet, monodromy_multipliers
+from gyrolab.plugins.integrators.scipy_solvers import DOP853
+from gyrolab.plugins.systems.gyrostat_euler import GyrostatParameters, kinematic_matrix, lagrange_equations
 
 GYROSTAT = ["body=gyrostat_asymmetric", "initial=gyrostat_precession", "force=[newtonian,magnetic]",
             "force.newtonian.k=null"]
@@ -32,7 +32,7 @@ def test_euler_angle_equations_are_the_projected_vector_equations():
         J = kinematic_matrix(th, ph)
         J_dot = np.array([[ct * sf * qd[1] + st * cf * qd[2], -sf * qd[2], 0.0],
                           [ct * cf * qd[1] - st * sf * qd[2], -cf * qd[2], 0.0], [-st * qd[1], 0.0, 0.0]])
-        from pipeline.attitude import frame_from_angles
+        from gyrolab.physics.attitude import frame_from_angles
         alpha, _, gamma = frame_from_angles(*q)
         relative = J @ qd
         omega = relative + p.Omega * gamma
@@ -143,7 +143,7 @@ def test_finder_recovers_the_catalogue_case(label):
 
 
 def _orbital_frame_in_body(psi, theta, phi):
-    """Rows α, β, γ of Rz(ψ) Rx(θ) Rz(φ) (eq. 1), written out here independently of pipeline.attitude."""
+    """Rows α, β, γ of Rz(ψ) Rx(θ) Rz(φ) (eq. 1), written out here independently of gyrolab.physics.attitude."""
     def rz(a):
         return np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
     rx = np.array([[1.0, 0.0, 0.0], [0.0, np.cos(theta), -np.sin(theta)], [0.0, np.sin(theta), np.cos(theta)]])
@@ -233,7 +233,7 @@ def test_state_figure_reads_right_for_the_gyrostat():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from pipeline.figures import plot_state
+    from gyrolab.output.figures import plot_state
     ds = compose_scene([*GYROSTAT, "time.end=3", "time.n_output=11", "output.figures=false"]).run()
     fig = plot_state(ds)
     labels = [ax.get_ylabel() for ax in fig.axes]

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pipeline import compose_scene, run
-from pipeline.errors import IntegrationError
-from pipeline.registry import load, names
+from gyrolab import compose_scene, run
+from gyrolab.errors import IntegrationError
+from gyrolab.engine.registry import load, names
 
 SHORT = ["time.end=5", "time.n_output=11"]
 
@@ -66,7 +66,7 @@ def test_unknown_rejections_are_not_invented():
 def test_failure_is_an_error_not_garbage(name, monkeypatch):
     # A torque growing like |ω|ω (a broken plugin): ω̇3 ≈ 10 ω3² blows up at t ≈ 1/(10 r0) = 0.02.
     # The run must stop and say when, not return NaN or inf.
-    from plugins.forces.uniform_gravity import UniformGravity
+    from gyrolab.plugins.forces.uniform_gravity import UniformGravity
 
     monkeypatch.setattr(UniformGravity, "torque", lambda self, omega, axes: 10.0 * np.linalg.norm(omega) * omega)
     monkeypatch.setattr(UniformGravity, "compiled_terms", lambda self: None)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.special import ellipj
 
-from pipeline import run
+from gyrolab import run
 
 TIGHT = ["integrator=dop853", "integrator.rtol=1e-12", "integrator.atol=1e-12"]
 

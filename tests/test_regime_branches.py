@@ -10,11 +10,11 @@ r_c = (0.48, 0.36, −0.8), k = 2, θ0 = 60°), where a2/a1 > 0.
 import numpy as np
 import pytest
 
-from pipeline.errors import ConfigError
-from pipeline.experiments.regime_run import errors
-from pipeline.periodic import FixedPointModel, shoot
-from plugins.regimes import shaker_omega3 as paper
-from plugins.regimes.resonant_omega3 import ResonantOmega3
+from gyrolab.errors import ConfigError
+from gyrolab.experiments.regime_run import errors
+from gyrolab.physics.periodic import FixedPointModel, shoot
+from gyrolab.plugins.regimes import shaker_omega3 as paper
+from gyrolab.plugins.regimes.resonant_omega3 import ResonantOmega3
 from tests.test_regime_helpers import B1, overrides_001, run_case, slope
 
 B3 = dict(a=0.4, b=1 / 7, rc=(0.48, 0.36, -0.8), k=2.0, theta0=np.pi / 3)

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline.config import compose_config
-from pipeline.errors import ConfigError
-from pipeline.experiments import run_task
-from pipeline.experiments.regime_run import angles_from_states
+from gyrolab.engine.config import compose_config
+from gyrolab.errors import ConfigError
+from gyrolab.experiments import run_task
+from gyrolab.experiments.regime_run import angles_from_states
 from tests.test_regime_helpers import B1, overrides_000, overrides_001, run_case
 
 

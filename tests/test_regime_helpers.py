@@ -7,8 +7,8 @@ docs/derivations/, never from the regime code under test.
 
 import numpy as np
 
-from pipeline.config import compose_config
-from pipeline.experiments.regime_run import compute, prepare
+from gyrolab.engine.config import compose_config
+from gyrolab.experiments.regime_run import compute, prepare
 
 # Seed 000 report, body I: a = 2, b = 1.5, r_c = (0.5, 0.3, 0.8124), k = 0.3, Γ = μγ0'' = 0.5.
 BODY_000 = ["body.a=2.0", "body.b=1.5", f"body.com_direction=[0.5,0.3,{float(np.sqrt(1 - 0.34))!r}]",

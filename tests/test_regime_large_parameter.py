@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from pipeline.config import compose_config
-from pipeline.errors import ConfigError
-from pipeline.experiments.regime_run import prepare
-from pipeline.scene import Scene
-from plugins.regimes import ismail2021 as paper
-from plugins.regimes.base import nondimensional_scene
-from plugins.regimes.large_parameter import printed_reading_state
+from gyrolab.engine.config import compose_config
+from gyrolab.errors import ConfigError
+from gyrolab.experiments.regime_run import prepare
+from gyrolab.engine.scene import Scene
+from gyrolab.plugins.regimes import ismail2021 as paper
+from gyrolab.plugins.regimes.base import nondimensional_scene
+from gyrolab.plugins.regimes.large_parameter import printed_reading_state
 from tests.test_regime_helpers import BODY_000, GAMMA_000
 
 

@@ -1,16 +1,16 @@
 """small_parameter across its excluded resonances ω → 1, 2: the error grows toward them, the refusal band is where it is large.
 
 Every error is the analytic solution's distance to the exact periodic orbit of the full model (Newton
-shooting, pipeline/periodic.py) over one period, relative to c (p, q), r0 (r) and the period; ω is set through
+shooting, pipeline/physics/periodic.py) over one period, relative to c (p, q), r0 (r) and the period; ω is set through
 the body's a at fixed b = 0.6, c/r0 = 0.05, Γ = 0.5 (conf/experiment/regime_validity.yaml).
 """
 
 import numpy as np
 import pytest
 
-from pipeline.config import compose_config
-from pipeline.experiments.regime_validity import a_for_omega, resonance_point
-from plugins.regimes.small_parameter import WARN_DISTANCE, divisor_threshold, refusal_distance
+from gyrolab.engine.config import compose_config
+from gyrolab.experiments.regime_validity import a_for_omega, resonance_point
+from gyrolab.plugins.regimes.small_parameter import WARN_DISTANCE, divisor_threshold, refusal_distance
 
 TOL = 1e-2  # a relative error the regime should not exceed where it accepts a scene
 EPS = 0.05  # c/r0 of the experiment's sweep

@@ -8,10 +8,10 @@ numerical ℓ1 are the report's independent measurements.
 import numpy as np
 import pytest
 
-from pipeline.config import compose_config
-from pipeline.errors import ConfigError
-from pipeline.experiments.regime_run import errors, prepare
-from plugins.regimes import shaker_omega3 as paper
+from gyrolab.engine.config import compose_config
+from gyrolab.errors import ConfigError
+from gyrolab.experiments.regime_run import errors, prepare
+from gyrolab.plugins.regimes import shaker_omega3 as paper
 from tests.test_regime_helpers import B1, B2, overrides_001, run_case, slope
 
 MUS = (0.05, 0.035, 0.025)
@@ -92,8 +92,8 @@ def test_regime_refuses_a_body_without_omega3():
 
 def test_nonphysical_flag_is_required_by_the_regime():
     # ω = 3 body given explicitly; allow_nonphysical is what the regime checks
-    from plugins.regimes.resonant_omega3 import ResonantOmega3
-    from pipeline.scene import Scene
+    from gyrolab.plugins.regimes.resonant_omega3 import ResonantOmega3
+    from gyrolab.engine.scene import Scene
 
     scene = Scene.from_config(compose_config(overrides_001(B1, 0.05)))
     scene.system.body.source["allow_nonphysical"] = False
@@ -112,7 +112,7 @@ def test_constants_match_the_report():
 def test_reduced_rhs_001_eq1_is_the_full_model_rescaled():
     # seed 001 eq. (1)/(5): d/dτ of the scaled variables equals the Euler–Poisson right-hand side rescaled
     # (p = c√γ0'' p1, r = r0 r1, γ = γ0'' γ1, τ = r0 t, k = k_gt γ0''); c = 1 here
-    from pipeline.periodic import FixedPointModel
+    from gyrolab.physics.periodic import FixedPointModel
 
     C = paper.Constants(B1["a"], B1["b"], *B1["rc"], B1["k"], B1["theta0"])
     model = FixedPointModel(np.array([C.a, C.b, 1.0]), np.array([C.x0, C.y0, C.z0]), C.k_gt)

@@ -8,10 +8,10 @@ measured with an independent DOP853 shooting (§5.3, §6).
 import numpy as np
 import pytest
 
-from pipeline.config import compose_config
-from pipeline.errors import ConfigError
-from pipeline.experiments.regime_run import errors, prepare
-from plugins.regimes import ismail2021 as paper
+from gyrolab.engine.config import compose_config
+from gyrolab.errors import ConfigError
+from gyrolab.experiments.regime_run import errors, prepare
+from gyrolab.plugins.regimes import ismail2021 as paper
 from tests.test_regime_helpers import GAMMA_000, overrides_000, run_case, slope
 
 MUS = (16.0, 32.0, 64.0)

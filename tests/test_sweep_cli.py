@@ -32,7 +32,7 @@ CODE_DEPENDENT_VARIABLES = ("job_id",)
 
 
 def gyrolab(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "pipeline", *args], cwd=cwd, capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "gyrolab", *args], cwd=cwd, capture_output=True, text=True,
                           timeout=300)
 
 
@@ -115,8 +115,8 @@ def test_every_finished_job_is_in_sweep_nc_bit_for_bit(basic):
 
 
 def test_failing_jobs_are_recorded_not_fatal(basic):
-    from pipeline import compose_scene
-    from pipeline.errors import ConfigError
+    from gyrolab import compose_scene
+    from gyrolab.errors import ConfigError
 
     sweep_dir, done = basic
     # The sweep ran to its end and says that some jobs failed.
@@ -176,7 +176,7 @@ def test_resume_skips_finished_jobs_and_recomputes_the_rest(basic, tmp_path):
 
 @pytest.mark.slow
 def test_resume_after_kill_9(basic, tmp_path):
-    args = [sys.executable, "-m", "pipeline", "-m", *SWEEP, "hydra.sweep.dir=sweep"]
+    args = [sys.executable, "-m", "gyrolab", "-m", *SWEEP, "hydra.sweep.dir=sweep"]
     process = subprocess.Popen(args, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                start_new_session=True)
     deadline = time.monotonic() + 120
@@ -196,7 +196,7 @@ def test_resume_after_kill_9(basic, tmp_path):
 
 
 def test_reproduce_round_trip(basic, tmp_path, monkeypatch, capsys):
-    from pipeline import app
+    from gyrolab import app
 
     run_nc = next(d for o, d in jobs_by_overrides(basic[0]).items() if "integrator=dop853" in o
                   and "body.a=1.5" in o) / "run.nc"
@@ -223,7 +223,7 @@ def test_reproduce_round_trip(basic, tmp_path, monkeypatch, capsys):
 
 
 def test_reproduce_refuses_what_is_not_a_run(basic, monkeypatch, capsys):
-    from pipeline import app
+    from gyrolab import app
 
     monkeypatch.setattr(sys, "argv", ["gyrolab", "--reproduce", str(basic[0] / "sweep.nc")])
     with pytest.raises(SystemExit) as stop:

@@ -9,15 +9,16 @@ import pytest
 from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
 from hydra.core.override_parser.overrides_parser import OverridesParser
 
-from pipeline import app, progress, run
-from pipeline.config import compose_config
-from pipeline.errors import IntegrationError
-from pipeline.sweep.aggregate import FINISHED, JobResult, assemble
-from pipeline.sweep.grid import Grid
-from pipeline.sweep.identity import job_identity
-from pipeline.sweep.job import run_sweep_job
-from pipeline.sweep.record import FAILED, read_record
-from pipeline.sweep.watch import SweepWatcher
+from gyrolab import app, run
+from gyrolab.engine import progress
+from gyrolab.engine.config import compose_config
+from gyrolab.errors import IntegrationError
+from gyrolab.sweep.aggregate import FINISHED, JobResult, assemble
+from gyrolab.sweep.grid import Grid
+from gyrolab.sweep.identity import job_identity
+from gyrolab.sweep.job import run_sweep_job
+from gyrolab.sweep.record import FAILED, read_record
+from gyrolab.sweep.watch import SweepWatcher
 
 TINY = ["time.end=1", "time.n_output=11", "output.figures=false"]
 
@@ -123,7 +124,7 @@ def test_jobs_of_different_lengths_share_a_sample_dimension(uneven):
 
 
 def test_summary_figures_show_final_values(uneven, tmp_path):
-    from pipeline.sweep.figures import final_values, save_sweep_figures
+    from gyrolab.sweep.figures import final_values, save_sweep_figures
 
     ds, runs = uneven
     final = final_values(ds.omega)
@@ -137,7 +138,7 @@ def test_summary_figures_show_final_values(uneven, tmp_path):
 def test_sweep_round_trips_through_netcdf(uneven, tmp_path):
     import xarray as xr
 
-    from pipeline.dataset import write_dataset
+    from gyrolab.output.dataset import write_dataset
 
     ds, _ = uneven
     back = xr.load_dataset(write_dataset(ds, tmp_path / "sweep.nc"), decode_times=False)
@@ -149,11 +150,11 @@ def test_slurm_launcher_config_composes():
     launcher = cfg.hydra.launcher
     assert launcher._target_ == "hydra_plugins.hydra_submitit_launcher.submitit_launcher.SlurmLauncher"
     assert launcher.partition == "compute" and launcher.cpus_per_task == 1 and launcher.max_num_timeout == 0
-    assert cfg.hydra.callbacks.sweep._target_ == "pipeline.sweep.callbacks.SweepCallback"
+    assert cfg.hydra.callbacks.sweep._target_ == "gyrolab.sweep.callbacks.SweepCallback"
 
 
 def test_watcher_counts_jobs_that_ended_since_it_started(tmp_path):
-    from pipeline.sweep.record import JobRecord, write_record
+    from gyrolab.sweep.record import JobRecord, write_record
 
     old = JobRecord("a", FINISHED, ["x=1"], "code", run="run.nc")
     write_record(tmp_path / "0", old)
@@ -213,7 +214,7 @@ def test_provenance_names_every_declared_dependency_and_the_code_state():
     import re
     from importlib import metadata
 
-    from pipeline.provenance import provenance
+    from gyrolab.output.provenance import provenance
 
     attrs = provenance()
     for requirement in metadata.requires("gyrolab") or []:

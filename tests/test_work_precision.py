@@ -3,8 +3,8 @@
 import numpy as np
 import xarray as xr
 
-from pipeline.config import compose_config
-from pipeline.experiments import run_task
+from gyrolab.engine.config import compose_config
+from gyrolab.experiments import run_task
 
 
 def test_work_precision_task(tmp_path):

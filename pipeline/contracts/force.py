@@ -33,9 +33,9 @@ class Force(ABC):
     Rules for implementers:
 
     1. ``__init__(self, body, **params)`` takes the system's body (in model
-       units, see ``pipeline.body``) and the plugin's config parameters as
+       units, see ``gyrolab.physics.body``) and the plugin's config parameters as
        keyword arguments with defaults; it validates them and raises
-       ``pipeline.errors.ConfigError`` (one sentence, naming the bad value) on
+       ``gyrolab.errors.ConfigError`` (one sentence, naming the bad value) on
        bad input. The keyword defaults are the plugin's default config.
     2. ``required_axes`` names the reference-frame axes (0, 1, 2) whose body
        components ``torque`` and ``potential`` read. A system carries an axis

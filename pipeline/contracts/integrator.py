@@ -15,7 +15,7 @@ ProgressCallback = Callable[[float], None]
 
 @dataclass(frozen=True)
 class CompiledModel:
-    """A system in the compiled kernels' form: a model id (``plugins.compiled.models``) and its parameters."""
+    """A system in the compiled kernels' form: a model id (``gyrolab.plugins.compiled.models``) and its parameters."""
 
     model: int
     params: np.ndarray
@@ -54,7 +54,7 @@ class Integrator(ABC):
     1. ``__init__(self, **params)`` takes the plugin's config parameters as
        keyword arguments with defaults (``rtol``/``atol`` for adaptive
        methods, ``step`` for fixed-step ones), validates them and raises
-       ``pipeline.errors.ConfigError`` on bad values.
+       ``gyrolab.errors.ConfigError`` on bad values.
     2. ``integrate(fun, t_out, y0)`` returns the state at every time in
        ``t_out`` (increasing, ``t_out[0]`` is the initial time), computed by
        dense output or by landing on those times, never by storing every
@@ -62,7 +62,7 @@ class Integrator(ABC):
     3. It counts its work (``IntegratorStats``: right-hand-side evaluations,
        accepted and rejected steps where known, wall time).
     4. It never returns non-finite values: a failure (step size underflow,
-       NaN or inf in the state) raises ``pipeline.errors.IntegrationError``
+       NaN or inf in the state) raises ``gyrolab.errors.IntegrationError``
        with one sentence saying when and why.
     5. It calls ``progress(t)``, when given, every few steps (cheap; the
        callback decides whether to report).

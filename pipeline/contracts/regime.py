@@ -7,8 +7,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from pipeline.contracts.system import System
-from pipeline.errors import ConfigError, choices
+from gyrolab.contracts.system import System
+from gyrolab.errors import ConfigError, choices
 
 FORMULAS = ("corrected", "printed")
 

@@ -9,8 +9,8 @@ from typing import Any, ClassVar
 import numpy as np
 import xarray as xr
 
-from pipeline.contracts.force import Force
-from pipeline.contracts.integrator import CompiledModel
+from gyrolab.contracts.force import Force
+from gyrolab.contracts.integrator import CompiledModel
 
 
 class System(ABC):

@@ -12,17 +12,17 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from pipeline.errors import ConfigError, choices
+from gyrolab.errors import ConfigError, choices
 
 TASKS = {
-    "work_precision": "pipeline.experiments.work_precision",
+    "work_precision": "gyrolab.experiments.work_precision",
     # expansion regimes (seeds 000, 001)
-    "regime": "pipeline.experiments.regime_run",
-    "regime_validity": "pipeline.experiments.regime_validity",
-    "ismail2021_tables": "pipeline.experiments.ismail2021_tables",
-    "shaker_omega3": "pipeline.experiments.shaker_omega3",
+    "regime": "gyrolab.experiments.regime_run",
+    "regime_validity": "gyrolab.experiments.regime_validity",
+    "ismail2021_tables": "gyrolab.experiments.ismail2021_tables",
+    "shaker_omega3": "gyrolab.experiments.shaker_omega3",
     # satellite-gyrostat (seed 002)
-    "yehia2021_precessions": "pipeline.experiments.yehia2021_precessions",
+    "yehia2021_precessions": "gyrolab.experiments.yehia2021_precessions",
 }
 
 

@@ -25,8 +25,8 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline.dataset import write_dataset
-from pipeline.provenance import provenance
+from gyrolab.output.dataset import write_dataset
+from gyrolab.output.provenance import provenance
 
 log = logging.getLogger(__name__)
 COLUMNS = ("p2", "gamma2", "dp2", "dgamma2")

@@ -7,7 +7,7 @@ periods with
 * the full model integrated from the analytic orbit's own t = 0 state with
   the scene's integrator ("full"), and
 * the exact periodic orbit of the full model through the same r0, θ0, γ'(0) = 0
-  (Newton shooting from the analytic one, ``pipeline.periodic``), sampled with
+  (Newton shooting from the analytic one, ``gyrolab.physics.periodic``), sampled with
   the compiled Taylor method ("orbit"), and
 * the regime's reduced system (``regime.reduced_rhs``: seed 000 eq. 14, seed 001 eq. 1) integrated
   with the scene's integrator plugin from its own τ = 0 state and mapped back ("reduced"), for regimes
@@ -27,13 +27,13 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline import registry
-from pipeline.contracts.regime import Regime
-from pipeline.dataset import write_dataset
-from pipeline.errors import ConfigError, IntegrationError
-from pipeline.periodic import FixedPointModel, PeriodicOrbit, shoot
-from pipeline.provenance import provenance
-from pipeline.scene import Scene
+from gyrolab.engine import registry
+from gyrolab.contracts.regime import Regime
+from gyrolab.output.dataset import write_dataset
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.physics.periodic import FixedPointModel, PeriodicOrbit, shoot
+from gyrolab.output.provenance import provenance
+from gyrolab.engine.scene import Scene
 
 log = logging.getLogger(__name__)
 SOURCES = ("analytic", "full", "orbit")
@@ -84,7 +84,7 @@ def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = Fal
     """The full model from y0 (the system's layout) at times t: the scene's integrator or compiled Taylor."""
     system = scene.system
     if taylor:
-        from plugins.integrators.compiled_solvers import Taylor
+        from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
         return Taylor(order=24, tol=1e-16).integrate(system.rhs, t, y0, None, system.compiled_model()).y
     integrator = scene.integrator
@@ -94,7 +94,7 @@ def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = Fal
 
 def with_alpha(scene: Scene, regime: Regime, y6: np.ndarray) -> np.ndarray:
     """A 6-state in the system's layout (α from ψ0 and the state's θ, φ)."""
-    from pipeline.attitude import frame_from_angles
+    from gyrolab.physics.attitude import frame_from_angles
 
     if scene.system.state_size == 6:
         return y6
@@ -153,7 +153,7 @@ def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[np.nd
     integrator = scene.integrator
     label = integrator.name
     if integrator.needs_compiled_model or integrator.name == "auto":  # auto's choices are made for the full model
-        from plugins.integrators.scipy_solvers import DOP853
+        from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
         settings = {k: getattr(integrator, k, 1e-12) for k in ("rtol", "atol")}
         integrator = DOP853(**settings)
@@ -169,7 +169,7 @@ def angles_from_states(t: np.ndarray, y: np.ndarray, psi0: float) -> dict[str, n
     period against ψ from α, tests/test_regime_experiments.py) — for states that come without the fixed axis α."""
     from scipy.interpolate import CubicSpline
 
-    from pipeline.attitude import nutation_and_spin
+    from gyrolab.physics.attitude import nutation_and_spin
 
     theta, phi = nutation_and_spin(y[:, 3:6])
     rate = (y[:, 0] * y[:, 3] + y[:, 1] * y[:, 4]) / (1.0 - y[:, 5] ** 2)

@@ -23,10 +23,10 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from pipeline.dataset import write_dataset
-from pipeline.errors import ConfigError, IntegrationError
-from pipeline.experiments.regime_run import compute, errors, prepare
-from pipeline.provenance import provenance
+from gyrolab.output.dataset import write_dataset
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.experiments.regime_run import compute, errors, prepare
+from gyrolab.output.provenance import provenance
 
 log = logging.getLogger(__name__)
 KEYS = ("pq", "r", "gamma", "gamma3", "period")
@@ -39,7 +39,7 @@ def _group(cfg: DictConfig, entry: str) -> str:
 
 
 def _cfg_for(cfg: DictConfig, regime: str, r0: float) -> DictConfig:
-    from pipeline.config import compose_config
+    from gyrolab.engine.config import compose_config
 
     base = OmegaConf.to_container(cfg, resolve=True)
     new = compose_config([f"regime={_group(cfg, regime)}", "regime.periods=1"])
@@ -173,8 +173,8 @@ def resonance_point(cfg: DictConfig, omega: float, *, check: bool = True) -> tup
         if check:
             scene, regime, _ = prepare(sub)
         else:
-            from pipeline.experiments.regime_run import build_regime
-            from pipeline.scene import Scene
+            from gyrolab.experiments.regime_run import build_regime
+            from gyrolab.engine.scene import Scene
 
             scene, regime = Scene.from_config(sub), build_regime(sub)
     except ConfigError as error:
@@ -274,16 +274,16 @@ def _resonance_dataset(sweep: dict) -> xr.Dataset:
 
 
 def _regime_class(name: str):
-    from pipeline import registry
+    from gyrolab.engine import registry
 
     return registry.load("regime", name)
 
 
 def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:
     """Printed (35) under μ = c/r0 against the full model: γ'' error over one τ period (seed 000 report §3)."""
-    from pipeline.scene import Scene
-    from plugins.regimes.base import nondimensional_scene
-    from plugins.regimes.large_parameter import printed_reading_state
+    from gyrolab.engine.scene import Scene
+    from gyrolab.plugins.regimes.base import nondimensional_scene
+    from gyrolab.plugins.regimes.large_parameter import printed_reading_state
 
     errs = []
     mus = [float(v) for v in cfg.regime_validity.large_parameter["values"]]
@@ -297,7 +297,7 @@ def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:
         approx = printed_reading_state(t, s)
         y0 = approx[0].copy()
         y0[3:6] /= np.linalg.norm(y0[3:6])
-        from plugins.integrators.compiled_solvers import Taylor
+        from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
         model = scene.system.compiled_model()
         y0 = np.concatenate([y0, scene.system.initial_state()[6:]])[: scene.system.state_size]

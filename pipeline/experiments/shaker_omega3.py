@@ -15,9 +15,9 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline.dataset import write_dataset
-from pipeline.experiments.regime_run import compute, prepare
-from pipeline.provenance import provenance
+from gyrolab.output.dataset import write_dataset
+from gyrolab.experiments.regime_run import compute, prepare
+from gyrolab.output.provenance import provenance
 
 log = logging.getLogger(__name__)
 

@@ -2,7 +2,7 @@
 
 For each method and setting (``work_precision.methods``), the scene is run
 ``repeats`` times (best wall time kept); the final state's (ω, γ) is compared
-with a reference: the extended-precision Taylor method (``pipeline.reference``)
+with a reference: the extended-precision Taylor method (``gyrolab.physics.reference``)
 when the scene is uniform gravity + Newtonian field, otherwise the compiled
 Taylor method at tol 1e-18 (recorded in the dataset, with its lower trust).
 Writes ``work_precision.nc`` (dims: run) and figures error vs wall time and
@@ -20,18 +20,18 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from pipeline.dataset import write_dataset
-from pipeline.errors import ConfigError
-from pipeline.provenance import provenance
-from pipeline.reference import fixed_point_reference
-from pipeline.scene import Scene
+from gyrolab.output.dataset import write_dataset
+from gyrolab.errors import ConfigError
+from gyrolab.output.provenance import provenance
+from gyrolab.physics.reference import fixed_point_reference
+from gyrolab.engine.scene import Scene
 
 log = logging.getLogger(__name__)
 SETTING_KEYS = {"rtol": ("rtol", "atol"), "tol": ("tol",), "step": ("step",), "accuracy": ("accuracy",)}
 
 
 def _scene_for(cfg: DictConfig, method: str, key: str, value: float) -> Scene:
-    from pipeline.config import compose_config
+    from gyrolab.engine.config import compose_config
 
     overrides = [f"integrator={method}"]
     overrides += [f"accuracy={value!r}"] if key == "accuracy" else [f"integrator.{k}={value!r}" for k in SETTING_KEYS[key]]
@@ -59,8 +59,8 @@ def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
     y0 = scene.system.initial_state()[:6]
     if not extra:
         ref = fixed_point_reference(p[0:3], p[9:12], p[14], y0, scene.times[[0, -1]])
-        return ref[-1].astype(float), "extended-precision Taylor (pipeline.reference)"
-    from plugins.integrators.compiled_solvers import Taylor
+        return ref[-1].astype(float), "extended-precision Taylor (gyrolab.physics.reference)"
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
     sol = Taylor(order=24, tol=1e-18).integrate(scene.system.rhs, scene.times, scene.system.initial_state(), None,
                                                 compiled)

@@ -1,6 +1,6 @@
 """Every regular-precession case of Yehia & El-kenani (2021), sections 4.1.1, 4.1.2, 4.2, checked on the full model.
 
-For each case of ``pipeline.precession.cases`` (concrete parameters satisfying the printed — or, in an
+For each case of ``gyrolab.physics.precession.cases`` (concrete parameters satisfying the printed — or, in an
 extra row, the corrected — conditions): (a) the residual along ψ = nt + ψ0, θ = θ0, φ = mt of the vector
 equations (the ``orbiting_gyrostat`` system with its force plugins) and of the Euler-angle equations;
 (b) a scene of the configured integrator from the precession's initial state, max |θ − θ0| over
@@ -21,15 +21,15 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from pipeline.dataset import write_dataset
-from pipeline.errors import ConfigError, as_number
-from pipeline.precession.cases import CASES, Case
-from pipeline.precession.classify import classify
-from pipeline.precession.closed_forms import check_closed_forms
-from pipeline.precession.motion import body_config, euler_residual, magnetic_config, vector_residual, window
-from pipeline.precession.stability import floquet
-from pipeline.provenance import provenance
-from pipeline.scene import Scene
+from gyrolab.output.dataset import write_dataset
+from gyrolab.errors import ConfigError, as_number
+from gyrolab.physics.precession.cases import CASES, Case
+from gyrolab.physics.precession.classify import classify
+from gyrolab.physics.precession.closed_forms import check_closed_forms
+from gyrolab.physics.precession.motion import body_config, euler_residual, magnetic_config, vector_residual, window
+from gyrolab.physics.precession.stability import floquet
+from gyrolab.output.provenance import provenance
+from gyrolab.engine.scene import Scene
 
 log = logging.getLogger(__name__)
 COLUMNS = ("case", "formula", "residual_vector", "residual_euler_angles", "max_theta_deviation", "stable", "verdict",
@@ -47,8 +47,8 @@ def _scene(cfg: DictConfig, case: Case, orbits: float) -> Scene:
     scene_cfg = OmegaConf.create(OmegaConf.to_container(cfg, resolve=True))
     with open_dict(scene_cfg):
         scene_cfg.body = body_config(case.params)
-        scene_cfg.force = {"newtonian": {"_target_": "plugins.forces.newtonian.Newtonian", "k": None, "R": None},
-                           "magnetic": {"_target_": "plugins.forces.magnetic.Magnetic", **magnetic_config(case.params)}}
+        scene_cfg.force = {"newtonian": {"_target_": "gyrolab.plugins.forces.newtonian.Newtonian", "k": None, "R": None},
+                           "magnetic": {"_target_": "gyrolab.plugins.forces.magnetic.Magnetic", **magnetic_config(case.params)}}
         scene_cfg.initial = case.motion.initial_config()
         scene_cfg.time = {"start": 0.0, "end": orbits * 2 * np.pi / case.params.Omega, "n_output": 2001}
         scene_cfg.output.figures = False

@@ -38,11 +38,11 @@ import numpy as np
 import xarray as xr
 from omegaconf import OmegaConf
 
-from pipeline.contracts.integrator import IntegratorStats
-from pipeline.dataset import write_dataset
-from pipeline.errors import ConfigError
-from pipeline.sweep.grid import Grid
-from pipeline.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
+from gyrolab.contracts.integrator import IntegratorStats
+from gyrolab.output.dataset import write_dataset
+from gyrolab.errors import ConfigError
+from gyrolab.sweep.grid import Grid
+from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
 
 log = logging.getLogger("gyrolab.sweep")
 
@@ -364,7 +364,7 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
         missing=int(ds.attrs["n_missing"]), skipped=sum(r.skipped for r in results),
         failures=[(" ".join(grid.jobs[n]), r.error) for n, r in enumerate(results) if r.status == FAILED])
     if figures and grid.dims and summary.finished:
-        from pipeline.sweep.figures import save_sweep_figures  # matplotlib only when figures are drawn
+        from gyrolab.sweep.figures import save_sweep_figures  # matplotlib only when figures are drawn
 
         summary.figures = save_sweep_figures(ds, sweep_dir / "figures")
     return summary

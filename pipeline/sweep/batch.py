@@ -4,8 +4,8 @@
 applies each grid point's overrides to the resolved config (no per-point Hydra composition,
 which dominates small jobs), builds and validates each point's scene (an invalid point is a
 failed job, as in a multirun), integrates all valid points together
-(``pipeline.batch.integrate_batch``: the compiled, vectorised RK4 path for fixed-step RK4, one
-run per point otherwise) and assembles ``sweep.nc`` with ``pipeline.sweep.aggregate.assemble``.
+(``gyrolab.engine.batch.integrate_batch``: the compiled, vectorised RK4 path for fixed-step RK4, one
+run per point otherwise) and assembles ``sweep.nc`` with ``gyrolab.sweep.aggregate.assemble``.
 Only parameters of the body, the initial state and the forces may vary: the system, the forces'
 list, the integrator and the output times are one for the whole batch.
 """
@@ -20,15 +20,15 @@ from pathlib import Path
 import numpy as np
 from omegaconf import OmegaConf
 
-from pipeline.batch import integrate_batch
-from pipeline.config import compose_config
-from pipeline.contracts.integrator import IntegratorStats, Solution
-from pipeline.dataset import build_dataset, write_dataset
-from pipeline.errors import ConfigError, GyrolabError
-from pipeline.scene import Scene
-from pipeline.sweep.aggregate import FAILED, FINISHED, JobResult, assemble
-from pipeline.sweep.grid import Grid
-from pipeline.sweep.identity import job_identity
+from gyrolab.engine.batch import integrate_batch
+from gyrolab.engine.config import compose_config
+from gyrolab.contracts.integrator import IntegratorStats, Solution
+from gyrolab.output.dataset import build_dataset, write_dataset
+from gyrolab.errors import ConfigError, GyrolabError
+from gyrolab.engine.scene import Scene
+from gyrolab.sweep.aggregate import FAILED, FINISHED, JobResult, assemble
+from gyrolab.sweep.grid import Grid
+from gyrolab.sweep.identity import job_identity
 
 log = logging.getLogger(__name__)
 VARIABLE_SECTIONS = ("body.", "initial.", "force.")

@@ -4,7 +4,7 @@
 (run by Hydra on the launching machine once every job has returned, whatever
 the launcher) aggregates the job directories into ``sweep.nc`` and the
 summary figures. The jobs themselves record their outcome (``job.json``) in
-``pipeline.app``; nothing here runs in the jobs.
+``gyrolab.app``; nothing here runs in the jobs.
 """
 
 from __future__ import annotations
@@ -16,10 +16,10 @@ from typing import Any
 from hydra.experimental.callback import Callback
 from omegaconf import DictConfig
 
-from pipeline.errors import GyrolabError
-from pipeline.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
-from pipeline.sweep.grid import Grid
-from pipeline.sweep.watch import SweepWatcher
+from gyrolab.errors import GyrolabError
+from gyrolab.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
+from gyrolab.sweep.grid import Grid
+from gyrolab.sweep.watch import SweepWatcher
 
 log = logging.getLogger("gyrolab.sweep")
 

@@ -18,7 +18,7 @@ import numpy as np
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import OverrideParseException
 
-from pipeline.errors import ConfigError
+from gyrolab.errors import ConfigError
 
 
 @dataclass(frozen=True)

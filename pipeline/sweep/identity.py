@@ -13,7 +13,7 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline.provenance import provenance
+from gyrolab.output.provenance import provenance
 
 #: bump when the meaning of an identity changes (invalidates every stored result)
 SCHEME = "gyrolab-job-1"

@@ -13,9 +13,9 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from pipeline.errors import GyrolabError
-from pipeline.sweep.identity import code_version, job_identity
-from pipeline.sweep.record import FAILED, FINISHED, JobRecord, read_record, remove_record, write_record
+from gyrolab.errors import GyrolabError
+from gyrolab.sweep.identity import code_version, job_identity
+from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, remove_record, write_record
 
 log = logging.getLogger("gyrolab.sweep")
 

@@ -15,9 +15,9 @@ import numpy as np
 import xarray as xr
 from omegaconf import OmegaConf
 
-from pipeline.errors import ConfigError
-from pipeline.provenance import provenance
-from pipeline.scene import Scene
+from gyrolab.errors import ConfigError
+from gyrolab.output.provenance import provenance
+from gyrolab.engine.scene import Scene
 
 #: provenance attributes worth comparing (the wall time differs by nature)
 PROVENANCE_KEYS = ("gyrolab_version", "git_commit", "git_dirty", "git_diff_sha256", "python_version", "platform",

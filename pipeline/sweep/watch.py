@@ -16,8 +16,8 @@ import time
 from pathlib import Path
 from typing import Any
 
-from pipeline.progress import LinesAboveBar, on_terminal
-from pipeline.sweep.record import record_paths
+from gyrolab.engine.progress import LinesAboveBar, on_terminal
+from gyrolab.sweep.record import record_paths
 
 log = logging.getLogger("gyrolab.sweep")
 

@@ -10,10 +10,10 @@ state (t, y, f, |h|) lives in arrays the caller keeps between chunks.
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate._ivp import dop853_coefficients as _c
 
-from plugins.compiled import kernel
-from plugins.compiled.models import rhs
+from gyrolab.plugins.compiled import dop853_tableau as _c
+from gyrolab.plugins.compiled import kernel
+from gyrolab.plugins.compiled.models import rhs
 
 N_STAGES = _c.N_STAGES  # 12
 N_EXTENDED = _c.N_STAGES_EXTENDED  # 16

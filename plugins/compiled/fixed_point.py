@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.contracts.force import CompiledTerms
-from plugins.compiled import inline_kernel, kernel
+from gyrolab.contracts.force import CompiledTerms
+from gyrolab.plugins.compiled import inline_kernel, kernel
 
 N_PARAMS = 19
 

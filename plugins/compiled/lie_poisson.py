@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from plugins.compiled import inline_kernel, kernel
+from gyrolab.plugins.compiled import inline_kernel, kernel
 
 # Yoshida (1990) triple-jump weights: order 2 -> 4 -> 6
 _W4 = (1.0 / (2.0 - 2.0 ** (1.0 / 3.0)), -(2.0 ** (1.0 / 3.0)) / (2.0 - 2.0 ** (1.0 / 3.0)))

@@ -8,7 +8,7 @@ process), hence one dispatch on ``model`` instead of a callback.
 from __future__ import annotations
 
 
-from plugins.compiled import fixed_point, inline_kernel
+from gyrolab.plugins.compiled import fixed_point, inline_kernel
 
 FIXED_POINT = 0
 

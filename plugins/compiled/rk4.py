@@ -5,9 +5,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from plugins.compiled import kernel
-from plugins.compiled.fixed_point import rhs_block
-from plugins.compiled.models import rhs
+from gyrolab.plugins.compiled import kernel
+from gyrolab.plugins.compiled.fixed_point import rhs_block
+from gyrolab.plugins.compiled.models import rhs
 
 
 @kernel

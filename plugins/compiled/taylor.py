@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from plugins.compiled import kernel
-from plugins.compiled.models import taylor_coefficients
+from gyrolab.plugins.compiled import kernel
+from gyrolab.plugins.compiled.models import taylor_coefficients
 
 OK, NOT_FINITE = 0, 2
 

@@ -16,10 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.body import Body
-from pipeline.contracts.force import Axes, CompiledTerms, Force
-from pipeline.errors import ConfigError, as_number, as_vector3
-from pipeline.vectors import cross, dot
+from gyrolab.physics.body import Body
+from gyrolab.contracts.force import Axes, CompiledTerms, Force
+from gyrolab.errors import ConfigError, as_number, as_vector3
+from gyrolab.physics.vectors import cross, dot
 
 UNIT_TOLERANCE = 1e-9
 

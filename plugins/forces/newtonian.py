@@ -20,10 +20,10 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.body import Body
-from pipeline.contracts.force import Axes, CompiledTerms, Force
-from pipeline.errors import ConfigError, as_number
-from pipeline.vectors import cross, dot
+from gyrolab.physics.body import Body
+from gyrolab.contracts.force import Axes, CompiledTerms, Force
+from gyrolab.errors import ConfigError, as_number
+from gyrolab.physics.vectors import cross, dot
 
 log = logging.getLogger(__name__)
 

@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.body import Body
-from pipeline.contracts.force import Axes, CompiledTerms, Force
-from pipeline.vectors import cross, dot
+from gyrolab.physics.body import Body
+from gyrolab.contracts.force import Axes, CompiledTerms, Force
+from gyrolab.physics.vectors import cross, dot
 
 
 class UniformGravity(Force):

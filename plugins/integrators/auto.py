@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.contracts.integrator import (
+from gyrolab.contracts.integrator import (
     CompiledModel,
     Integrator,
     IntegratorStats,
@@ -37,7 +37,7 @@ from pipeline.contracts.integrator import (
     RightHandSide,
     Solution,
 )
-from pipeline.errors import ConfigError, GyrolabError, as_number
+from gyrolab.errors import ConfigError, GyrolabError, as_number
 
 PILOT_POINTS = 65
 MIN_GROWTH = 2.0
@@ -66,10 +66,10 @@ class Auto(Integrator):
 
     def _method(self, compiled: CompiledModel | None, tol: float) -> Integrator:
         if compiled is not None:
-            from plugins.integrators.compiled_solvers import Taylor
+            from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
             return Taylor(order=20, tol=tol)
-        from plugins.integrators.scipy_solvers import DOP853
+        from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
         return DOP853(rtol=tol, atol=tol)
 
@@ -124,8 +124,8 @@ class Auto(Integrator):
         """The first regime whose analytic series is predicted to meet the accuracy on this scene, or None."""
         if self.system is None or compiled is None or t_out[0] != 0.0:
             return None
-        from pipeline import registry
-        from plugins.integrators.compiled_solvers import Taylor
+        from gyrolab.engine import registry
+        from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
         span = t_out[-1] - t_out[0]
         for name in registry.names("regime"):
@@ -147,7 +147,7 @@ class Auto(Integrator):
                 continue
             y = regime.solution(self.system, t_out)
             if len(y0) > 6:  # the scene carries the fixed X axis: from the series' Euler angles
-                from pipeline.attitude import frame_from_angles
+                from gyrolab.physics.attitude import frame_from_angles
 
                 angles = regime.euler_angles(self.system, t_out)
                 alpha = np.stack([frame_from_angles(a, b, c)[0] for a, b, c in

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.contracts.integrator import (
+from gyrolab.contracts.integrator import (
     CompiledModel,
     Integrator,
     IntegratorStats,
@@ -21,9 +21,9 @@ from pipeline.contracts.integrator import (
     RightHandSide,
     Solution,
 )
-from pipeline.errors import ConfigError, IntegrationError, as_number
-from plugins.integrators.tolerances import Tolerances
-from plugins.integrators.step_guard import check_step, compiled_rhs
+from gyrolab.errors import ConfigError, IntegrationError, as_number
+from gyrolab.plugins.integrators.tolerances import Tolerances
+from gyrolab.plugins.integrators.step_guard import check_step, compiled_rhs
 
 CHUNKS = 50  # progress reports per run at most
 
@@ -53,7 +53,7 @@ class DOP853Numba(Tolerances, Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from plugins.compiled import dop853, models
+        from gyrolab.plugins.compiled import dop853, models
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
@@ -88,7 +88,7 @@ class RK4Numba(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from plugins.compiled import rk4
+        from gyrolab.plugins.compiled import rk4
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
@@ -123,7 +123,7 @@ class Taylor(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from plugins.compiled import taylor
+        from gyrolab.plugins.compiled import taylor
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
@@ -145,7 +145,7 @@ class Taylor(Integrator):
 
 
 class LiePoisson(Integrator):
-    """Structure-preserving splitting of the fixed-point system (see ``plugins.compiled.lie_poisson``)."""
+    """Structure-preserving splitting of the fixed-point system (see ``gyrolab.plugins.compiled.lie_poisson``)."""
 
     name = "lie_poisson"
     adaptive = False
@@ -160,7 +160,7 @@ class LiePoisson(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from plugins.compiled import lie_poisson, models
+        from gyrolab.plugins.compiled import lie_poisson, models
 
         if compiled.model != models.FIXED_POINT:
             raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian only; valid systems: fixed_point")

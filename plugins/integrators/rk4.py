@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
-from pipeline.errors import IntegrationError, as_number
-from plugins.integrators.step_guard import check_step
+from gyrolab.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
+from gyrolab.errors import IntegrationError, as_number
+from gyrolab.plugins.integrators.step_guard import check_step
 
 GUARD_CHECKS = 50  # as often as the compiled methods check (once per output chunk)
 

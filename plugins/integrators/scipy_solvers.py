@@ -16,9 +16,9 @@ from typing import ClassVar
 import numpy as np
 from scipy import integrate
 
-from pipeline.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
-from pipeline.errors import IntegrationError
-from plugins.integrators.tolerances import Tolerances
+from gyrolab.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
+from gyrolab.errors import IntegrationError
+from gyrolab.plugins.integrators.tolerances import Tolerances
 
 
 class ScipySolver(Tolerances, Integrator):

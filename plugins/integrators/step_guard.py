@@ -12,7 +12,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from pipeline.errors import IntegrationError
+from gyrolab.errors import IntegrationError
 
 MAX_ANGLE_PER_STEP = 0.5
 
@@ -47,7 +47,7 @@ def jacobian_norm(fun: Callable[[float, np.ndarray], np.ndarray], t: float, y: n
 
 def compiled_rhs(compiled) -> Callable[[float, np.ndarray], np.ndarray]:
     """The compiled model's right-hand side as a Python callable (for occasional checks only)."""
-    from plugins.compiled import models
+    from gyrolab.plugins.compiled import models
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
         out = np.empty_like(y)

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.errors import as_number
+from gyrolab.errors import as_number
 
 
 class Tolerances:

@@ -12,10 +12,10 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.attitude import frame_from_angles
-from pipeline.contracts.regime import Regime
-from pipeline.contracts.system import System
-from pipeline.errors import ConfigError
+from gyrolab.physics.attitude import frame_from_angles
+from gyrolab.contracts.regime import Regime
+from gyrolab.contracts.system import System
+from gyrolab.errors import ConfigError
 
 SUPPORTED_FORCES = ("uniform_gravity", "newtonian")
 

@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.errors import ConfigError
-from plugins.regimes import ismail2021 as paper
-from plugins.regimes.base import FixedPointRegime
+from gyrolab.errors import ConfigError
+from gyrolab.plugins.regimes import ismail2021 as paper
+from gyrolab.plugins.regimes.base import FixedPointRegime
 
 REFUSAL = ("regime large_parameter (seed 000's μ = c/r0 ≫ 1, slow spin) has no consistent expansion: the "
            "paper's eq. (4) contradicts its eqs. (1)-(2), whose only consistent scaling is μ = r0/c, and read "

@@ -22,9 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.errors import ConfigError, as_number
-from plugins.regimes import shaker_omega3 as paper
-from plugins.regimes.base import FixedPointRegime, NondimensionalScene
+from gyrolab.errors import ConfigError, as_number
+from gyrolab.plugins.regimes import shaker_omega3 as paper
+from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
 
 OMEGA_TOLERANCE = 1e-6
 BRANCHES = ("i", "ii", "iii", "iv")

@@ -4,7 +4,7 @@ Seed 000 (Ismail 2021) calls this a "large-parameter" method for small r0,
 but its equations (1)-(2) are consistent only with μ = r0/c (report §3 of
 ``docs/derivations/seed000_large_parameter.md``): it is the classical fast-top
 expansion in ε = 1/μ = c/r0 = √(Mgℓ/C)/r0. This plugin is that expansion,
-with the corrected (35), (36), (38)-(39) (``plugins.regimes.ismail2021``);
+with the corrected (35), (36), (38)-(39) (``gyrolab.plugins.regimes.ismail2021``);
 ``formula=printed`` evaluates the paper's printed formulas in the same
 consistent scaling.
 
@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.errors import ConfigError
-from plugins.regimes import ismail2021 as paper
-from plugins.regimes.base import FixedPointRegime, NondimensionalScene
+from gyrolab.errors import ConfigError
+from gyrolab.plugins.regimes import ismail2021 as paper
+from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
 
 RESONANCES = (1.0, 2.0, 3.0)
 WARN_DISTANCE = 0.1

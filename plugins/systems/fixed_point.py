@@ -18,13 +18,13 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from pipeline.attitude import euler_angles, nutation_and_spin
-from pipeline.body import Body
-from pipeline.contracts.force import Force
-from pipeline.contracts.integrator import CompiledModel
-from pipeline.contracts.system import System
-from pipeline.initial import InitialAttitude
-from pipeline.vectors import cross, dot, norm
+from gyrolab.physics.attitude import euler_angles, nutation_and_spin
+from gyrolab.physics.body import Body
+from gyrolab.contracts.force import Force
+from gyrolab.contracts.integrator import CompiledModel
+from gyrolab.contracts.system import System
+from gyrolab.physics.initial import InitialAttitude
+from gyrolab.physics.vectors import cross, dot, norm
 
 
 class FixedPoint(System):
@@ -135,7 +135,7 @@ class FixedPoint(System):
         terms = [force.compiled_terms() for force in self.forces]
         if any(term is None for term in terms):
             return None
-        from plugins.compiled import fixed_point, models  # numba only when a compiled integrator runs
+        from gyrolab.plugins.compiled import fixed_point, models  # numba only when a compiled integrator runs
 
         return CompiledModel(models.FIXED_POINT, fixed_point.pack(self.inertia, terms, self.carries_alpha))
 

@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.body import ModelUnits, _check_inertia, _netcdf_safe, _satisfies_triangle
-from pipeline.errors import ConfigError, as_number, as_vector3, choices
+from gyrolab.physics.body import ModelUnits, _check_inertia, _netcdf_safe, _satisfies_triangle
+from gyrolab.errors import ConfigError, as_number, as_vector3, choices
 
 UNITS = ("si", "nondimensional")
 KEYS = ("units", "inertia", "gyrostatic_momentum", "orbit_rate", "allow_nonphysical")
@@ -56,7 +56,7 @@ class GyrostatBody(ModelUnits):
 
     g = None  # no uniform gravity
 
-    # units: pipeline.body.ModelUnits, with the orbit's rate as the nondimensional unit
+    # units: gyrolab.physics.body.ModelUnits, with the orbit's rate as the nondimensional unit
     @property
     def time_label(self) -> str:
         return "s" if self.units == "si" else "1/Ω" if self.orbit_rate == 1.0 else "model time"

@@ -2,7 +2,7 @@
 
 Euler angles (ψ, θ, φ), z-x-z, of the body relative to the orbital frame (α radial,
 β along-track, γ orbit normal): α, β, γ in body axes are eq. (1) of Yehia & El-kenani
-(2021) = ``pipeline.attitude.frame_from_angles``; ω′ = J(θ, φ) q̇ and ω = ω′ + Ωγ.
+(2021) = ``gyrolab.physics.attitude.frame_from_angles``; ω′ = J(θ, φ) q̇ and ω = ω′ + Ωγ.
 From L = ½ω·Iω + ω·k − V with V = ½N α·Iα + μ·(h1 α + h2 β + h3 γ) (N = 3Ω², the
 paper has h2 = 0 and the sign +μ·H), E_q = d/dt ∂L/∂q̇ − ∂L/∂q is
 
@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pipeline.attitude import frame_from_angles
+from gyrolab.physics.attitude import frame_from_angles
 
 
 @dataclass(frozen=True)

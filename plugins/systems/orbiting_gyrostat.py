@@ -24,14 +24,14 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from pipeline.attitude import euler_angles
-from pipeline.contracts.force import Force
-from pipeline.contracts.system import System
-from pipeline.errors import ConfigError, as_vector3
-from pipeline.initial import InitialAttitude
-from pipeline.vectors import cross, dot, norm
-from plugins.systems.gyrostat_body import GyrostatBody
-from plugins.systems.gyrostat_euler import GyrostatParameters, kinematic_matrix
+from gyrolab.physics.attitude import euler_angles
+from gyrolab.contracts.force import Force
+from gyrolab.contracts.system import System
+from gyrolab.errors import ConfigError, as_vector3
+from gyrolab.physics.initial import InitialAttitude
+from gyrolab.physics.vectors import cross, dot, norm
+from gyrolab.plugins.systems.gyrostat_body import GyrostatBody
+from gyrolab.plugins.systems.gyrostat_euler import GyrostatParameters, kinematic_matrix
 
 INITIAL_KEYS = ("p0", "q0", "r0", "psi0", "theta0", "phi0", "gamma0", "euler_rates0")
 

@@ -10,8 +10,8 @@ import logging
 
 import numpy as np
 
-from pipeline.config import compose_config
-from pipeline.experiments.regime_validity import resonance_point
+from gyrolab.engine.config import compose_config
+from gyrolab.experiments.regime_validity import resonance_point
 
 logging.disable(logging.WARNING)
 

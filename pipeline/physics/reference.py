@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.errors import ConfigError
+from gyrolab.errors import ConfigError
 
 EXTENDED = np.longdouble
 

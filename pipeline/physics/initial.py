@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.attitude import frame_from_angles, nutation_and_spin
-from pipeline.errors import ConfigError, as_number, as_vector3
+from gyrolab.physics.attitude import frame_from_angles, nutation_and_spin
+from gyrolab.errors import ConfigError, as_number, as_vector3
 
 UNIT_TOLERANCE = 1e-9
 

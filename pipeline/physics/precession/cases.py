@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pipeline.precession.motion import Precession
-from plugins.systems.gyrostat_euler import GyrostatParameters
+from gyrolab.physics.precession.motion import Precession
+from gyrolab.plugins.systems.gyrostat_euler import GyrostatParameters
 
 
 @dataclass(frozen=True)

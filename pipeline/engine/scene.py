@@ -12,12 +12,12 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline import registry
-from pipeline.config import compose_config
-from pipeline.contracts import CompiledModel, Integrator, System
-from pipeline.dataset import build_dataset
-from pipeline.errors import ConfigError, as_number, require_finite
-from pipeline.progress import Progress
+from gyrolab.engine import registry
+from gyrolab.engine.config import compose_config
+from gyrolab.contracts import CompiledModel, Integrator, System
+from gyrolab.output.dataset import build_dataset
+from gyrolab.errors import ConfigError, as_number, require_finite
+from gyrolab.engine.progress import Progress
 
 log = logging.getLogger(__name__)
 

@@ -28,8 +28,8 @@ from fractions import Fraction
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from pipeline.precession.motion import Precession, states
-from plugins.systems.orbiting_gyrostat import OrbitingGyrostat
+from gyrolab.physics.precession.motion import Precession, states
+from gyrolab.plugins.systems.orbiting_gyrostat import OrbitingGyrostat
 
 TOLERANCE_FACTOR = 10.0  # tolerance = TOLERANCE_FACTOR · max(√rtol, δ)
 STEP = 1e-30

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.vectors import cross
+from gyrolab.physics.vectors import cross
 
 
 def gamma_from_angles(theta: float, phi: float) -> np.ndarray:

@@ -11,7 +11,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-SOURCE_ROOT = Path(__file__).resolve().parent.parent
+SOURCE_ROOT = Path(__file__).resolve().parents[2]
 #: always recorded (when installed), on top of gyrolab's declared dependencies
 LIBRARIES = ("numpy", "scipy", "xarray", "netCDF4", "hydra-core", "omegaconf", "matplotlib")
 #: entry-point groups whose providers (third-party plugin packages) are part of the code that ran

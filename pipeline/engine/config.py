@@ -12,10 +12,10 @@ from hydra.errors import HydraException, MissingConfigException, OverrideParseEx
 from omegaconf import DictConfig
 from omegaconf.errors import OmegaConfBaseException
 
-from pipeline import registry
-from pipeline.errors import ConfigError, choices
+from gyrolab.engine import registry
+from gyrolab.errors import ConfigError, choices
 
-CONFIG_MODULE = "conf"
+CONFIG_MODULE = "gyrolab.conf"
 CONFIG_NAME = "config"
 #: groups whose options are chosen by name on the command line
 SELECTABLE_GROUPS = ("system", "body", "initial", "force", "integrator", "regime", "experiment")

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from pipeline.errors import ConfigError, as_number, as_vector3, choices
+from gyrolab.errors import ConfigError, as_number, as_vector3, choices
 
 UNITS = ("si", "nondimensional")
 _SI_KEYS = ("inertia", "mass", "com", "g")

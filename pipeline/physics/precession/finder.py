@@ -18,9 +18,9 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.stats import qmc
 
-from pipeline.errors import ConfigError
-from pipeline.precession.motion import Precession, build_system, states, vector_residual
-from plugins.systems.gyrostat_euler import GyrostatParameters
+from gyrolab.errors import ConfigError
+from gyrolab.physics.precession.motion import Precession, build_system, states, vector_residual
+from gyrolab.plugins.systems.gyrostat_euler import GyrostatParameters
 
 MOTION = ("n", "m", "theta0", "psi0")
 

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pipeline.errors import ConfigError, IntegrationError
-from pipeline.scene import Scene
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.engine.scene import Scene
 
 FAST_PATH = ("rk4", "rk4_numba")
 
@@ -37,7 +37,7 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
     """Integrate ``scene`` from each row of ``initial_states``.
 
     ``params`` (trajectories × n) optionally replaces the compiled model's
-    parameters per trajectory (see ``plugins.compiled.fixed_point.pack``).
+    parameters per trajectory (see ``gyrolab.plugins.compiled.fixed_point.pack``).
     """
     y0s = np.ascontiguousarray(initial_states, dtype=float)
     size = scene.system.state_size
@@ -48,8 +48,8 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
     compiled = scene.system.compiled_model()
     start = time.perf_counter()
     if scene.integrator.name in FAST_PATH and compiled is not None:
-        from plugins.compiled import rk4
-        from plugins.integrators.compiled_solvers import steps_per_interval
+        from gyrolab.plugins.compiled import rk4
+        from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
 
         steps = steps_per_interval(scene.times, scene.integrator.step)
         P = np.tile(compiled.params, (len(y0s), 1)) if params is None else np.ascontiguousarray(params, dtype=float)
@@ -75,6 +75,6 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
 
 def _blockable(compiled, size: int) -> bool:
     """The block kernel covers the fixed-point model with state (ω, γ)."""
-    from plugins.compiled import models
+    from gyrolab.plugins.compiled import models
 
     return compiled.model == models.FIXED_POINT and size == 6

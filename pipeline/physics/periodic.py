@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pipeline.errors import ConfigError, IntegrationError
-from plugins.compiled import kernel
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.plugins.compiled import kernel
 
 ORDER = 24
 TOL = 1e-17

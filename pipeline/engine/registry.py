@@ -15,8 +15,8 @@ from functools import cache
 from importlib.metadata import entry_points
 from typing import Any
 
-from pipeline.contracts import Force, Integrator, Regime, System
-from pipeline.errors import ConfigError, choices
+from gyrolab.contracts import Force, Integrator, Regime, System
+from gyrolab.errors import ConfigError, choices
 
 #: config group -> (entry-point group, contract class)
 GROUPS: dict[str, tuple[str, type]] = {
@@ -28,38 +28,46 @@ GROUPS: dict[str, tuple[str, type]] = {
 
 BUILTINS: dict[str, dict[str, str]] = {
     "system": {
-        "fixed_point": "plugins.systems.fixed_point:FixedPoint",
-        "orbiting_gyrostat": "plugins.systems.orbiting_gyrostat:OrbitingGyrostat",
+        "fixed_point": "gyrolab.plugins.systems.fixed_point:FixedPoint",
+        "orbiting_gyrostat": "gyrolab.plugins.systems.orbiting_gyrostat:OrbitingGyrostat",
     },
     "force": {
-        "uniform_gravity": "plugins.forces.uniform_gravity:UniformGravity",
-        "newtonian": "plugins.forces.newtonian:Newtonian",
-        "magnetic": "plugins.forces.magnetic:Magnetic",
+        "uniform_gravity": "gyrolab.plugins.forces.uniform_gravity:UniformGravity",
+        "newtonian": "gyrolab.plugins.forces.newtonian:Newtonian",
+        "magnetic": "gyrolab.plugins.forces.magnetic:Magnetic",
     },
     "integrator": {
-        "rk4": "plugins.integrators.rk4:RK4",
-        "rk45": "plugins.integrators.scipy_solvers:RK45",
-        "dop853": "plugins.integrators.scipy_solvers:DOP853",
-        "lsoda": "plugins.integrators.scipy_solvers:LSODA",
-        "radau": "plugins.integrators.scipy_solvers:Radau",
-        "bdf": "plugins.integrators.scipy_solvers:BDF",
-        "dop853_numba": "plugins.integrators.compiled_solvers:DOP853Numba",
-        "rk4_numba": "plugins.integrators.compiled_solvers:RK4Numba",
-        "taylor": "plugins.integrators.compiled_solvers:Taylor",
-        "auto": "plugins.integrators.auto:Auto",
-        "lie_poisson": "plugins.integrators.compiled_solvers:LiePoisson",
+        "rk4": "gyrolab.plugins.integrators.rk4:RK4",
+        "rk45": "gyrolab.plugins.integrators.scipy_solvers:RK45",
+        "dop853": "gyrolab.plugins.integrators.scipy_solvers:DOP853",
+        "lsoda": "gyrolab.plugins.integrators.scipy_solvers:LSODA",
+        "radau": "gyrolab.plugins.integrators.scipy_solvers:Radau",
+        "bdf": "gyrolab.plugins.integrators.scipy_solvers:BDF",
+        "dop853_numba": "gyrolab.plugins.integrators.compiled_solvers:DOP853Numba",
+        "rk4_numba": "gyrolab.plugins.integrators.compiled_solvers:RK4Numba",
+        "taylor": "gyrolab.plugins.integrators.compiled_solvers:Taylor",
+        "auto": "gyrolab.plugins.integrators.auto:Auto",
+        "lie_poisson": "gyrolab.plugins.integrators.compiled_solvers:LiePoisson",
     },
     "regime": {
-        "small_parameter": "plugins.regimes.small_parameter:SmallParameter",
-        "large_parameter": "plugins.regimes.large_parameter:LargeParameter",
-        "resonant_omega3": "plugins.regimes.resonant_omega3:ResonantOmega3",
+        "small_parameter": "gyrolab.plugins.regimes.small_parameter:SmallParameter",
+        "large_parameter": "gyrolab.plugins.regimes.large_parameter:LargeParameter",
+        "resonant_omega3": "gyrolab.plugins.regimes.resonant_omega3:ResonantOmega3",
     },
 }
 
 
+#: import paths of gyrolab 0.1 (top-level ``plugins``), still found in configs stored in older datasets
+_LEGACY_PREFIXES = {"plugins.": "gyrolab.plugins."}
+
+
 def _normalise(target: str) -> str:
-    """'pkg.mod:Cls' and 'pkg.mod.Cls' name the same class."""
-    return target.replace(":", ".")
+    """'pkg.mod:Cls' and 'pkg.mod.Cls' name the same class; a 0.1 path names its class of today."""
+    target = target.replace(":", ".")
+    for old, new in _LEGACY_PREFIXES.items():
+        if target.startswith(old):
+            return new + target[len(old):]
+    return target
 
 
 @cache

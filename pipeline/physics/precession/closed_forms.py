@@ -1,13 +1,13 @@
 """The paper's printed closed-form solutions (15), (16), (18), (20), (21), (25), (28), (30), after (31), (45)
-checked numerically against eq. (1) (``pipeline.attitude.frame_from_angles`` and ω′ = J q̇) at random
+checked numerically against eq. (1) (``gyrolab.physics.attitude.frame_from_angles`` and ω′ = J q̇) at random
 parameters and times: max difference of α, β, γ, ω′, and whether the printed triad is right-handed."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from pipeline.attitude import frame_from_angles
-from plugins.systems.gyrostat_euler import kinematic_matrix
+from gyrolab.physics.attitude import frame_from_angles
+from gyrolab.plugins.systems.gyrostat_euler import kinematic_matrix
 
 c, s = np.cos, np.sin
 R3 = np.sqrt(3.0)

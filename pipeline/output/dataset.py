@@ -15,12 +15,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
-from pipeline.contracts.integrator import Solution
-from pipeline.errors import ConfigError
-from pipeline.provenance import provenance
+from gyrolab.contracts.integrator import Solution
+from gyrolab.errors import ConfigError
+from gyrolab.output.provenance import provenance
 
 if TYPE_CHECKING:
-    from pipeline.scene import Scene
+    from gyrolab.engine.scene import Scene
 
 
 def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:

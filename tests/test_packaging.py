@@ -1,0 +1,74 @@
+"""The package installs under the one import name ``gyrolab`` and says its own version."""
+
+import shutil
+import subprocess
+import sys
+import tomllib
+import zipfile
+from importlib import metadata
+from pathlib import Path
+
+import pytest
+
+from gyrolab.engine import registry
+from gyrolab.errors import ConfigError
+
+REPO = Path(__file__).resolve().parent.parent
+PYPROJECT = tomllib.loads((REPO / "pyproject.toml").read_text())
+SETUPTOOLS = PYPROJECT["tool"]["setuptools"]
+
+
+def _import_name(folder: Path) -> str:
+    """The import name a source folder installs under, from pyproject's package-dir."""
+    relative = folder.relative_to(REPO).as_posix()
+    best = max((src for src in SETUPTOOLS["package-dir"].values() if relative == src or relative.startswith(src + "/")),
+               key=len)
+    name = next(k for k, v in SETUPTOOLS["package-dir"].items() if v == best)
+    rest = relative[len(best):].strip("/")
+    return ".".join([name, *rest.split("/")]) if rest else name
+
+
+def test_every_source_package_is_installed_under_gyrolab():
+    folders = [init.parent for top in ("pipeline", "plugins", "conf") for init in (REPO / top).rglob("__init__.py")
+               if "__pycache__" not in init.parts]
+    expected = sorted(_import_name(folder) for folder in folders)
+    assert sorted(SETUPTOOLS["packages"]) == expected
+    assert all(name == "gyrolab" or name.startswith("gyrolab.") for name in expected)
+
+
+def test_version_flag_prints_gyrolab_version():
+    done = subprocess.run([sys.executable, "-m", "gyrolab", "--version"], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0
+    assert done.stdout.strip() == f"gyrolab {metadata.version('gyrolab')}"
+
+
+def test_targets_of_version_0_1_still_name_their_plugins():
+    # configs stored in datasets written before the package was named gyrolab
+    name, cls = registry.resolve_target("force", "plugins.forces.newtonian.Newtonian", "force.newtonian")
+    assert name == "newtonian" and cls.__module__ == "gyrolab.plugins.forces.newtonian"
+
+
+def test_a_launcher_of_the_cluster_extra_missing_is_one_sentence(monkeypatch):
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
+    from gyrolab import app
+
+    monkeypatch.setitem(app.EXTRA_LAUNCHERS, "joblib", "hydra_plugins.not_installed_launcher")
+    overrides = OverridesParser.create().parse_overrides(["hydra/launcher=joblib"])
+    with pytest.raises(ConfigError, match=r'pip install "gyrolab\[cluster\]"'):
+        app.check_launcher_installed(overrides)
+
+
+@pytest.mark.slow
+def test_wheel_installs_only_gyrolab(tmp_path):
+    source = tmp_path / "source"  # a copy, so that the build leaves nothing in the checkout
+    shutil.copytree(REPO, source, ignore=shutil.ignore_patterns(".git", "outputs", "build", "__pycache__", "*.egg-info"))
+    done = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(tmp_path), str(source)],
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    (wheel,) = tmp_path.glob("gyrolab-*.whl")
+    with zipfile.ZipFile(wheel) as archive:
+        tops = {name.split("/")[0] for name in archive.namelist()}
+        names = archive.namelist()
+    assert {top for top in tops if not top.endswith(".dist-info")} == {"gyrolab"}
+    assert "gyrolab/conf/config.yaml" in names and "gyrolab/plugins/forces/newtonian.py" in names
