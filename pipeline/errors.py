@@ -30,6 +30,12 @@ class IntegrationError(GyrolabError, RuntimeError):
     exit_code = 3
 
 
+class OutputError(GyrolabError, OSError):
+    """A result could not be written (no space, file too large, read-only, permission denied)."""
+
+    exit_code = 3
+
+
 def choices(names: Iterable[str]) -> str:
     """Format valid choices for an error message."""
     names = sorted(names)

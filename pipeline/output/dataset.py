@@ -7,8 +7,6 @@ its own dataset (``Scene.from_config(OmegaConf.create(ds.attrs["config"]))``).
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -17,6 +15,7 @@ import xarray as xr
 
 from gyrolab.contracts.integrator import Solution
 from gyrolab.errors import ConfigError
+from gyrolab.output.atomic import atomic_path
 from gyrolab.output.provenance import provenance
 
 if TYPE_CHECKING:
@@ -52,26 +51,8 @@ def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
 
 
 def write_dataset(ds: xr.Dataset, path: Path) -> Path:
-    """Write ``ds`` to ``path`` atomically: a temporary file in the same directory, then a rename."""
+    """Write ``ds`` to ``path`` atomically (``gyrolab.output.atomic``)."""
     path = Path(path)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-        os.close(fd)
-    except OSError as error:
-        raise ConfigError(f"output directory {str(path.parent)!r} is not writable ({error.strerror}); "
-                          "choose a writable hydra.run.dir") from None
-    try:
+    with atomic_path(path) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4")
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes the file private; results are ordinary files
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return path
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
