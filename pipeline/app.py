@@ -38,6 +38,7 @@ from gyrolab.engine.config import (
     register_plugin_configs,
 )
 from gyrolab.errors import ConfigError, GyrolabError, choices
+from gyrolab.figures.options import figure_options
 from gyrolab.engine.progress import allow_bars, on_terminal
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
@@ -78,6 +79,7 @@ def preflight(argv: Sequence[str]) -> None:
              else o.input_line for o in overrides]
     cfg = compose_config(first, return_hydra_config=True)
     scene_cfg = _without_hydra(cfg)
+    figure_options(scene_cfg.get("output"))  # figure formats and dpi, before anything runs
     if task_of(scene_cfg) == "regime":  # the regime's domain is checked before anything is written
         from gyrolab.experiments.regime_run import prepare
 
@@ -184,11 +186,10 @@ def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
     ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
     path = write_dataset(ds, out_dir / "run.nc")
     log.info("wrote %s", path)
-    if cfg.output.get("figures", True):
-        from gyrolab.output.figures import save_figures  # matplotlib only when figures are drawn
+    from gyrolab.figures.redraw import draw_figures  # matplotlib only when figures are drawn
 
-        for figure in save_figures(ds, out_dir / "figures"):
-            log.info("wrote %s", figure)
+    for figure in draw_figures("run.nc", ds, out_dir, cfg.output):
+        log.info("wrote %s", figure)
     return path
 
 
@@ -208,9 +209,12 @@ def _quiet_console() -> None:
 
 
 def run_command(argv: Sequence[str]) -> int | None:
-    """``--reproduce PATH``, ``--aggregate SWEEP_DIR``, ``--batch OVERRIDES``: exit status, or None for a Hydra run."""
+    """``--reproduce PATH``, ``--aggregate SWEEP_DIR``, ``--batch OVERRIDES``, ``--plot PATH``: exit status, or None
+    for a Hydra run."""
     if argv and argv[0] == "--batch":
         return _batch(argv[1:])
+    if argv and argv[0].split("=", 1)[0] == "--plot":
+        return _plot(argv)
     if not argv or argv[0].split("=", 1)[0] not in ("--reproduce", "--aggregate"):
         return None
     option, _, value = argv[0].partition("=")
@@ -230,6 +234,28 @@ def run_command(argv: Sequence[str]) -> int | None:
     summary = aggregate_sweep(Path(rest[0]))
     log_summary(summary)
     return _sweep_status(summary)
+
+
+def _plot(argv: Sequence[str]) -> int:
+    """``gyrolab --plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]``: redraw every figure of the
+    datasets under PATH (``gyrolab.figures.redraw``) with the current style, formats and dpi; nothing is integrated."""
+    _, _, value = argv[0].partition("=")
+    rest = ([value] if value else []) + list(argv[1:])
+    paths = [a for a in rest if "=" not in a]
+    overrides = [a for a in rest if "=" in a]
+    if len(paths) != 1:
+        raise ConfigError(f"--plot takes exactly one path (got {len(paths)}: {' '.join(paths) or 'none'}); "
+                          "usage: gyrolab --plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]")
+    foreign = [o for o in overrides if not o.startswith("output.")]
+    if foreign:
+        raise ConfigError(f"--plot {foreign[0]!r}: a redraw takes output.* settings only (figure_formats, dpi)")
+    from gyrolab.figures.redraw import redraw
+
+    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
+    formats, dpi = figure_options(compose_config(overrides).output)
+    for path in redraw(Path(paths[0]), formats, dpi):
+        log.info("wrote %s", path)
+    return 0
 
 
 def _batch(overrides: Sequence[str]) -> int:

@@ -26,6 +26,7 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.output.dataset import write_dataset
+from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 
 log = logging.getLogger(__name__)
@@ -137,34 +138,5 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         "inferred_parameters": f"A = {A:g} (published), W = {W_P2} (fitted by the research), τ = 2πt/100",
         "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
     written.append(write_dataset(ds, out_dir / "ismail2021_tables.nc"))
-    written.append(_plot(ds, out_dir / "figures" / "ismail2021_tables.png"))
+    written += draw_figures("ismail2021_tables.nc", ds, out_dir, cfg.get("output"))
     return written
-
-
-def _plot(ds: xr.Dataset, path: Path) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
-    t = ds.t.values
-    for n, marker in ((1, "o"), (2, "s")):
-        axes[0].plot(t, ds[f"published{n}"].values[:, 1], marker, mfc="none", label=f"published Table {n}")
-        axes[0].plot(t, ds[f"table{n}"].values[:, 1], "-" if n == 1 else "--", label=f"regenerated Table {n}")
-        axes[1].semilogy(t, np.maximum(np.abs(ds[f"table{n}"].values[:, 1] - ds[f"published{n}"].values[:, 1]),
-                                       1e-12), marker + "-", label=f"|regenerated − published|, Table {n}")
-    axes[1].semilogy(t, np.maximum(np.abs(ds.published1.values[:, 1] - ds.published2.values[:, 1]), 1e-12), "k^-",
-                     label="|Table 1 − Table 2| (RK4 truncation)")
-    axes[0].set(xlabel="t (tables' time, τ = 2πt/100) [1]", ylabel="γ2 [1]")
-    axes[1].set(xlabel="t (tables' time, τ = 2πt/100) [1]", ylabel="absolute difference of γ2 [1]")
-    for ax in axes:
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.suptitle("Ismail (2021) Tables 1-2: generating solution and RK4 (Δτ = π/10) on uncoupled oscillators",
-                 fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path

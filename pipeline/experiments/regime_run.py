@@ -32,6 +32,7 @@ from gyrolab.contracts.regime import Regime
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.physics.periodic import FixedPointModel, PeriodicOrbit, shoot
+from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 
@@ -206,7 +207,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                  ", ".join(f"{r:.1e}" for r in orbit.residuals))
     ds = dataset(scene, regime, t, result, warnings)
     written = [write_dataset(ds, Path(out_dir) / "regime.nc")]
-    written.append(plot(ds, Path(out_dir) / "figures" / "regime_comparison.png"))
+    written += draw_figures("regime.nc", ds, out_dir, cfg.get("output"))
     return written
 
 
@@ -274,35 +275,3 @@ def orbit_variables(orbit: PeriodicOrbit, body) -> dict[str, Any]:
             "units": "1", "long_name": "exact orbit initial state (p, q, r, γ, γ', γ'') in model units"}),
         "period_orbit": ((), orbit.period, {"units": body.time_unit, "long_name": "period of the exact orbit"}),
     }
-
-
-def plot(ds: xr.Dataset, path: Path) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    t = ds.time.values
-    styles = {"analytic": dict(ls="--", lw=1.6), "full": dict(ls="-", lw=1.0), "orbit": dict(ls=":", lw=2.0),
-              "reduced": dict(ls="-.", lw=1.2)}
-    rate_unit = ds.attrs["rate_label"]
-    panels = [("omega", 0, f"p [{rate_unit}]"), ("omega", 1, f"q [{rate_unit}]"), ("omega", 2, f"r [{rate_unit}]"),
-              ("gamma", 2, "γ'' = cos θ [1]")]
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7), sharex=True)
-    for ax, (var, i, label) in zip(axes.flat, panels):
-        for source in [*SOURCES, "reduced"]:
-            if f"{var}_{source}" not in ds:
-                continue
-            ax.plot(t, ds[f"{var}_{source}"].values[:, i], label=SOURCE_NAMES[source], **styles[source])
-        ax.set_ylabel(label)
-        ax.grid(alpha=0.3)
-    for ax in axes[1]:
-        ax.set_xlabel(f"time t [{ds.time.attrs['long_name'].split('[')[-1].rstrip(']')}]")
-    axes[0, 0].legend(fontsize=7)
-    fig.suptitle(f"{ds.attrs['title']}\n{ds.attrs['regime_parameter']} = {ds.attrs['regime_parameter_value']:.4g}",
-                 fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path

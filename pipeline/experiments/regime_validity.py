@@ -26,6 +26,7 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.experiments.regime_run import compute, errors, prepare
+from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 
 log = logging.getLogger(__name__)
@@ -141,7 +142,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     if sweep is not None:
         ds = ds.merge(_resonance_dataset(sweep))
     written = [write_dataset(ds, Path(out_dir) / "regime_validity.nc")]
-    written.append(_plot(rows, Path(out_dir) / "figures" / "regime_validity.png", sweep))
+    written += draw_figures("regime_validity.nc", ds, out_dir, cfg.get("output"))
     return written
 
 
@@ -329,50 +330,3 @@ def _dataset(rows, verdicts, cfg) -> xr.Dataset:
     ds.attrs.update({"title": "validity of the expansion regimes", "Conventions": "CF-1.8",
                      "verdict": "\n".join(verdicts), "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
     return ds
-
-
-def _plot(rows, path: Path, sweep: dict | None = None) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    ncol = len(rows) + (sweep is not None)
-    fig, axes = plt.subplots(1, ncol, figsize=(5.5 * ncol, 4.8), squeeze=False)
-    if sweep is not None:
-        _plot_resonance(axes[0, -1], sweep)
-    for ax, (name, values, errs, orders, _) in zip(axes[0], rows):
-        for k, e in errs["orbit"].items():
-            e = np.array(e, dtype=float)
-            label = f"{LONG[k]}" + (f" (slope {orders[k]:.2f})" if k in orders and np.isfinite(orders[k]) else "")
-            ax.loglog(values, np.where(e > 0, e, np.nan), "o-", label=label)
-        ax.set_xlabel(f"expansion parameter of {name} [1]")
-        ax.set_ylabel("max relative error against the exact orbit / full model [1]")
-        ax.set_title(name, fontsize=9)
-        ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7)
-    fig.suptitle("validity of the expansion regimes (errors of the analytic solutions)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
-
-
-def _plot_resonance(ax, sweep: dict) -> None:
-    d = sweep["distances"]
-    for i, n in enumerate(sweep["resonances"]):
-        for j, side in enumerate(sweep["sides"]):
-            e = sweep["errors"]["max"][i, j]
-            s = sweep["exponents"]["max"][i]
-            label = f"ω → {n:g}{'+' if side > 0 else '−'}" + (f" (s = {s:.2f})" if j == 0 and np.isfinite(s) else "")
-            ax.loglog(d, np.where(e > 0, e, np.nan), "o-" if side > 0 else "s--", label=label)
-        refused = [dd for dd, row in zip(d, sweep["status"][i].T) if any(str(x).startswith("refused") for x in row)]
-        if refused:
-            ax.axvspan(min(d) * 0.8, max(refused) * 1.1, color="grey", alpha=0.15)
-    ax.axhline(sweep["tolerance"], color="k", lw=0.8, ls=":", label=f"tolerance {sweep['tolerance']:g}")
-    ax.set_xlabel("distance to the resonance |ω − n| [1] (grey: refused)")
-    ax.set_ylabel("max relative error against the exact orbit [1]")
-    ax.set_title(f"small_parameter across ω = n, c/r0 = {sweep['epsilon']:g}", fontsize=9)
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)

@@ -17,6 +17,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.output.dataset import write_dataset
 from gyrolab.experiments.regime_run import compute, prepare
+from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 
 log = logging.getLogger(__name__)
@@ -43,32 +44,5 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                      **{f"max_error_{k}": v for k, v in errors.items()},
                      "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
     written = [write_dataset(ds, out_dir / "shaker_omega3.nc")]
-    written.append(_plot(ds, out_dir / "figures" / "shaker_omega3_euler.png", body.time_label))
+    written += draw_figures("shaker_omega3.nc", ds, out_dir, cfg.get("output"))
     return written
-
-
-def _plot(ds: xr.Dataset, path: Path, time_label: str) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
-    t = ds.time.values
-    for ax, (name, label) in zip(axes, (("theta", "θ [rad]"), ("psi", "ψ [rad]"), ("phi", "φ − r0 t [rad]"))):
-        shift = t * float(ds.attrs.get("spin", 0.0)) if name == "phi" else 0.0
-        full, series = ds[f"{name}_full"].values, ds[f"{name}_series"].values
-        if name == "phi":
-            shift = (full[-1] - full[0]) / (t[-1] - t[0]) * t  # remove the mean spin to show the O(μ²) part
-        ax.plot(t, full - shift, "-", lw=1.2, label="full model (exact periodic orbit)")
-        ax.plot(t, series - shift, "--", lw=1.2, label="ω = 3 series (corrected)")
-        ax.set_ylabel(label if name != "phi" else "φ − (mean rate) t [rad]")
-        ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=8)
-    axes[-1].set_xlabel(f"time t [{time_label}]")
-    fig.suptitle(ds.attrs["title"], fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path

@@ -25,6 +25,7 @@ from gyrolab.errors import ConfigError
 from gyrolab.output.provenance import provenance
 from gyrolab.physics.reference import fixed_point_reference
 from gyrolab.engine.scene import Scene
+from gyrolab.figures.redraw import draw_figures
 
 log = logging.getLogger(__name__)
 SETTING_KEYS = {"rtol": ("rtol", "atol"), "tol": ("tol",), "step": ("step",), "accuracy": ("accuracy",)}
@@ -97,7 +98,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     result = _dataset(rows, cfg, reference_name)
     result.attrs["scene"] = scene_title
     written = [write_dataset(result, out_dir / "work_precision.nc")]
-    written += plot(result, out_dir / "figures")
+    written += draw_figures("work_precision.nc", result, out_dir, cfg.get("output"))
     return written
 
 
@@ -114,32 +115,3 @@ def _dataset(rows: list[dict[str, Any]], cfg: DictConfig, reference_name: str) -
     ds.attrs.update({"title": "work against precision", "Conventions": "CF-1.8", "reference": reference_name,
                      "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
     return ds
-
-
-def plot(ds: xr.Dataset, directory: Path) -> list[Path]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    directory.mkdir(parents=True, exist_ok=True)
-    written = []
-    for x, label, name in (("wall_time", "wall time of one run [s]", "error_vs_wall_time"),
-                           ("nfev", "right-hand-side evaluations", "error_vs_nfev")):
-        fig, ax = plt.subplots(figsize=(8, 5.5))
-        for method in dict.fromkeys(ds.method.values):
-            sel = ds.where(ds.method == method, drop=True)
-            order = np.argsort(sel[x].values)
-            ax.loglog(sel[x].values[order], np.maximum(sel.error.values[order], 1e-16), "o-", label=method)
-        ax.set_xlabel(label)
-        ax.set_ylabel("max-norm error of the final state (ω, γ)")
-        ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=8)
-        ax.set_title(f"work against precision: {ds.attrs['scene']}\nerror against {ds.attrs['reference']}",
-                     fontsize=8)
-        fig.tight_layout()
-        path = directory / f"{name}.png"
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-        written.append(path)
-    return written

@@ -111,11 +111,31 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
             writer.writerow([row["case"], row["formula"], f"{row['residual_vector']:.3e}",
                              f"{row['residual_euler_angles']:.3e}", f"{row['max_theta_deviation']:.3e}",
                              {True: "true", False: "false", None: ""}[row["stable"]], row["verdict"], row["condition"]])
-    written = [write_dataset(_dataset(rows, closed, cfg), out_dir / "precession_cases.nc")]
+    ds = _dataset(rows, closed, cfg).merge(trace_variables(rows, traces), combine_attrs="override")
+    written = [write_dataset(ds, out_dir / "precession_cases.nc")]
     tmp.replace(csv_path)
     written.insert(0, csv_path)
-    written += plot_classes(rows, traces, out_dir / "figures")
+    if cfg.output.get("figures", True):
+        from gyrolab.figures.options import figure_options
+        from gyrolab.figures.precessions import save_figures
+
+        written += save_figures(ds, out_dir / "figures", *figure_options(cfg.output))
     return written
+
+
+def trace_variables(rows: list[dict[str, Any]], traces: dict[str, xr.Dataset]) -> xr.Dataset:
+    """The body z axis of every case's integration, in the orbital and inertial frames (what the figures draw)."""
+    data = {}
+    for name in ("body_axis_orbital", "body_axis_inertial"):
+        first = traces[rows[0]["label"]][name]
+        n = max(traces[r["label"]].sizes["time"] for r in rows)
+        values = np.full((len(rows), n, 3), np.nan)
+        for i, row in enumerate(rows):
+            trace = traces[row["label"]][name].values
+            values[i, : len(trace)] = trace
+        data[name] = (("case", "sample", "frame_axis"), values, {
+            "units": "1", "long_name": first.attrs.get("long_name", name) + ", over the integration of each case"})
+    return xr.Dataset(data, coords={"case": ("case", np.array([r["label"] for r in rows]), {"long_name": "case label"})})
 
 
 def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) -> xr.Dataset:
@@ -145,39 +165,3 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
     ds.attrs.update({"title": "regular precessions of a satellite-gyrostat (Yehia & El-kenani 2021)",
                      "Conventions": "CF-1.8", "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
     return ds
-
-
-def plot_classes(rows: list[dict[str, Any]], traces: dict[str, xr.Dataset], directory: Path) -> list[Path]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    directory.mkdir(parents=True, exist_ok=True)
-    written = []
-    holding = [r for r in rows if r["verdict"] == "holds"]
-    for geometric in sorted({r["geometric"] for r in holding}):
-        fig = plt.figure(figsize=(11, 5.5))
-        for i, (frame, variable) in enumerate((("orbital", "body_axis_orbital"), ("inertial", "body_axis_inertial"))):
-            ax = fig.add_subplot(1, 2, i + 1, projection="3d")
-            u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 25), np.linspace(0, np.pi, 13))
-            ax.plot_wireframe(np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v), color="0.88", lw=0.4)
-            for row in holding:
-                if row["geometric"] == geometric:
-                    trace = traces[row["label"]][variable].values
-                    ax.plot(*trace.T, lw=1.0, label=row["label"])
-                    ax.scatter(*trace[0], s=12)
-            labels = ("α (radial)", "β (along-track)", "γ (normal)") if frame == "orbital" else ("X", "Y", "Z (normal)")
-            ax.set_xlabel(labels[0], fontsize=8)
-            ax.set_ylabel(labels[1], fontsize=8)
-            ax.set_zlabel(labels[2], fontsize=8)
-            ax.set_box_aspect((1, 1, 1))
-            ax.set_title(f"body z axis, {frame} frame", fontsize=9)
-            ax.legend(fontsize=7, loc="upper left")
-        fig.suptitle(f"{geometric} cases (verdict holds): trace of the body z axis on the unit sphere\n"
-                     "integrated full equations, Yehia & El-kenani (2021)", fontsize=10)
-        path = directory / f"body_axis_{geometric.replace(' ', '_')}.png"
-        fig.savefig(path, dpi=100)
-        plt.close(fig)
-        written.append(path)
-    return written

@@ -1,0 +1,98 @@
+"""``gyrolab --plot PATH``: redraw every figure from the datasets under PATH, without integrating anything.
+
+PATH is a run directory (``run.nc``), a regime run, an experiment or sweep directory, or one ``.nc``
+file. Each dataset's figures are written to ``figures/`` beside it, with the current style, formats
+and dpi. Datasets directly in PATH are always drawn; in a sweep directory the jobs' ``run.nc`` are
+redrawn only where the job drew figures in the first place (``output.figures`` in its stored config).
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Iterable
+from pathlib import Path
+
+import xarray as xr
+from omegaconf import OmegaConf
+
+from gyrolab.errors import ConfigError, OutputError
+from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
+
+#: dataset file name -> the gyrolab.figures module that draws its figures
+KINDS = {
+    "run.nc": "run",
+    "sweep.nc": "sweep",
+    "regime.nc": "regime",
+    "regime_validity.nc": "regime_validity",
+    "work_precision.nc": "work_precision",
+    "ismail2021_tables.nc": "tables",
+    "precession_cases.nc": "precessions",
+    "shaker_omega3.nc": "shaker",
+}
+
+
+def draw_dataset(path: Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int = DEFAULT_DPI) -> list[Path]:
+    """Redraw the figures of one dataset file into ``figures/`` beside it."""
+    path = Path(path)
+    if path.name not in KINDS:
+        raise ConfigError(f"{str(path)!r} is not a dataset gyrolab draws figures from; known: {', '.join(KINDS)}")
+    try:
+        ds = xr.load_dataset(path)
+    except (OSError, ValueError) as error:
+        raise OutputError(f"cannot read {str(path)!r}: {error}") from None
+    module = importlib.import_module(f"gyrolab.figures.{KINDS[path.name]}")
+    directory = path.parent / "figures"
+    if KINDS[path.name] == "sweep":
+        return module.save_sweep_figures(ds, directory, tuple(formats), dpi)
+    return module.save_figures(ds, directory, tuple(formats), dpi)
+
+
+def _drew_figures(path: Path) -> bool:
+    """Whether the run stored at ``path`` drew figures (its stored config's ``output.figures``)."""
+    try:
+        with xr.open_dataset(path) as ds:
+            config = ds.attrs.get("config", "")
+        return bool(OmegaConf.select(OmegaConf.create(config), "output.figures", default=True))
+    except Exception:  # noqa: BLE001 -- unreadable: leave it alone
+        return False
+
+
+def datasets(path: Path) -> list[Path]:
+    """The datasets ``gyrolab --plot PATH`` redraws."""
+    path = Path(path)
+    if path.is_file():
+        return [path]
+    if not path.is_dir():
+        raise ConfigError(f"--plot: {str(path)!r} is neither a directory nor a dataset file")
+    found = [path / name for name in KINDS if (path / name).is_file()]
+    for nested in sorted(path.glob("*/run.nc")):  # a sweep's jobs
+        if _drew_figures(nested):
+            found.append(nested)
+    if not found:
+        raise ConfigError(f"--plot: no gyrolab dataset in {str(path)!r} (looked for {', '.join(KINDS)}, "
+                          "and */run.nc in a sweep directory)")
+    return found
+
+
+def redraw(path: str | Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int = DEFAULT_DPI) -> list[Path]:
+    """Redraw every figure of the datasets under ``path``; returns the files written."""
+    written = []
+    for dataset in datasets(Path(path)):
+        written += draw_dataset(dataset, formats, dpi)
+    return written
+
+
+def draw_figures(name: str, ds: xr.Dataset, out_dir: str | Path, output: object | None) -> list[Path]:
+    """The figures of dataset ``name`` (a key of ``KINDS``) drawn from ``ds`` into ``out_dir/figures``, in the
+    formats and dpi of the ``output`` config section; none when ``output.figures`` is false."""
+    from gyrolab.figures.options import figure_options
+
+    output = output if output is not None else {}
+    if not output.get("figures", True):
+        return []
+    formats, dpi = figure_options(output)
+    module = importlib.import_module(f"gyrolab.figures.{KINDS[name]}")
+    directory = Path(out_dir) / "figures"
+    if KINDS[name] == "sweep":
+        return module.save_sweep_figures(ds, directory, formats, dpi)
+    return module.save_figures(ds, directory, formats, dpi)

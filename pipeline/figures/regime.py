@@ -1,0 +1,52 @@
+"""Figure of a regime run (``regime.nc``): the analytic periodic solution against the full model, the
+exact periodic orbit and (where the regime has one) the reduced system, for p, q, r and γ₃ = cos θ."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import xarray as xr
+
+from gyrolab.figures.labels import label, time_label, unit
+from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
+from gyrolab.figures.save import save_all
+from gyrolab.figures.style import DOUBLE, legend_outside, panel_note, styled, subplots
+
+#: source suffix -> (legend, line style); drawn in this order
+SOURCES = {"orbit": ("exact periodic orbit (Newton shooting)", dict(ls="-", lw=2.2, color="0.75")),
+           "full": ("full model from the analytic t = 0 state", dict(ls="-", lw=0.9, color="C0")),
+           "analytic": ("analytic solution", dict(ls="--", lw=1.2, color="C1")),
+           "reduced": ("reduced system, integrated", dict(ls=":", lw=1.4, color="C2"))}
+
+
+@styled
+def draw_regime_comparison(ds: xr.Dataset) -> plt.Figure:
+    rate = unit(ds, ds["omega_analytic"].attrs.get("units"), "rate")
+    panels = [("omega", 0, label("p", rate)), ("omega", 1, label("q", rate)), ("omega", 2, label("r", rate)),
+              ("gamma", 2, "γ₃ = cos θ")]
+    fig, axes = subplots(2, 2, width=DOUBLE, height=4.6, sharex=True)
+    t = ds["time"].values
+    for ax, (var, i, ylabel) in zip(axes.flat, panels):
+        for source, (name, style) in SOURCES.items():
+            if f"{var}_{source}" in ds:
+                ax.plot(t, ds[f"{var}_{source}"].values[:, i], label=name, **style)
+        ax.set_ylabel(ylabel)
+    for ax in axes[1]:
+        ax.set_xlabel(time_label(ds))
+    regime = ds.attrs.get("regime", ds.attrs.get("title", "regime").split(":")[0])
+    value = ds.attrs.get("regime_parameter_value")
+    if value is not None:
+        panel_note(axes[0, 0], f"{ds.attrs.get('regime_parameter', 'parameter')} = {float(value):.4g}")
+    legend_outside(fig, ncols=2)
+    fig.suptitle(f"Regime {regime}: analytic solution against the full model")
+    return fig
+
+
+FIGURES = {"regime_comparison": draw_regime_comparison}
+
+
+def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
+                 dpi: int = DEFAULT_DPI) -> list[Path]:
+    return save_all({name: draw(ds) for name, draw in FIGURES.items()}, directory, ds, formats, dpi)

@@ -1,0 +1,142 @@
+"""gyrolab's figure style, applied in one place, and the drawing helpers every figure module shares.
+
+``STYLE`` (``gyrolab.mplstyle``) is applied by ``styled`` around every ``draw_*`` function and by
+``gyrolab.figures.save.save`` around writing, so a figure looks the same whatever the caller's
+matplotlib settings, and the caller's settings are left as they were.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, TypeVar
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+STYLE = Path(__file__).with_name("gyrolab.mplstyle")
+#: journal column widths in inches (single column, double column / full page width)
+SINGLE = 3.5
+DOUBLE = 7.1
+#: more visible oscillations than this across a panel and a line becomes a solid band: draw the envelope
+MAX_OSCILLATIONS = 40
+#: at most this many bins of the min–max envelope
+ENVELOPE_BINS = 400
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def styled(draw: F) -> F:
+    """Run a drawing function inside gyrolab's style context; its log axes get readable ticks."""
+    @functools.wraps(draw)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with plt.style.context(STYLE):
+            fig = draw(*args, **kwargs)
+            for ax in fig.axes:
+                if ax.name == "rectilinear":
+                    tidy_log(ax)
+            return fig
+    return wrapper  # type: ignore[return-value]
+
+
+def tidy_log(ax: plt.Axes) -> None:
+    """Log axes: no labels on minor ticks (they collide on narrow panels); an axis spanning less than
+    about two decades gets majors at 1, 2, 5 × 10ⁿ instead, so it is never left without a label."""
+    for axis, limits in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+        if axis.get_scale() != "log":
+            continue
+        low, high = sorted(abs(v) for v in limits)
+        if low > 0 and np.log10(high / low) < 1.8:
+            axis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+            axis.set_major_formatter(matplotlib.ticker.LogFormatterSciNotation(labelOnlyBase=False))
+        axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+
+
+def subplots(nrows: int = 1, ncols: int = 1, *, width: float = SINGLE, height: float | None = None,
+             **kwargs: Any) -> tuple[plt.Figure, np.ndarray]:
+    """A grid of panels at a journal column width (``SINGLE`` or ``DOUBLE``); axes always 2-D."""
+    height = height if height is not None else 1.0 + 1.7 * nrows
+    fig, axes = plt.subplots(nrows, ncols, figsize=(width, height), squeeze=False, **kwargs)
+    return fig, axes
+
+
+def legend_outside(fig: plt.Figure, axes: Sequence[plt.Axes] | None = None, *, ncols: int | None = None,
+                   where: str = "lower center") -> None:
+    """One legend for the figure, outside every panel (it never covers data); duplicates merged."""
+    handles, labels = {}, []
+    for ax in (axes if axes is not None else fig.axes):
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            if label not in handles and not label.startswith("_"):
+                handles[label] = handle
+                labels.append(label)
+    if labels:  # without a layout engine (3-D figures, margins set by hand) the caller leaves room for it
+        loc = f"outside {where}" if fig.get_layout_engine() is not None else where
+        fig.legend([handles[label] for label in labels], labels, loc=loc, ncols=ncols or min(len(labels), 4))
+
+
+def panel_note(ax: plt.Axes, text: str) -> None:
+    """A short note in the panel's upper left corner, in the axes' own margin above the data."""
+    ax.set_title(text, loc="left", fontsize=6.5, color="0.3")
+
+
+def oscillations(y: np.ndarray) -> int:
+    """How many times a series crosses its mean: a measure of how dense its line is on a panel."""
+    y = np.asarray(y, dtype=float)
+    y = y[np.isfinite(y)]
+    if y.size < 3:
+        return 0
+    sign = np.sign(y - y.mean())
+    return int(np.count_nonzero(sign[1:] * sign[:-1] < 0) // 2)
+
+
+def trace(ax: plt.Axes, t: np.ndarray, y: np.ndarray, *, label: str | None = None, **style: Any) -> bool:
+    """A line, or the min–max envelope of the series over ``ENVELOPE_BINS`` bins when the line would
+    be a solid band (more than ``MAX_OSCILLATIONS`` oscillations); True when the envelope was drawn.
+    Each bin spans about two oscillations, so the band is the envelope, not the oscillation itself."""
+    t, y = np.asarray(t, dtype=float), np.asarray(y, dtype=float)
+    n = oscillations(y)
+    bins = min(ENVELOPE_BINS, n // 2)
+    if n <= MAX_OSCILLATIONS or len(t) < 4 * bins:
+        ax.plot(t, y, label=label, **style)
+        return False
+    edges = np.linspace(0, len(t), bins + 1).astype(int)
+    with np.errstate(all="ignore"):
+        low = np.array([np.nanmin(y[a:b]) for a, b in zip(edges[:-1], edges[1:])])
+        high = np.array([np.nanmax(y[a:b]) for a, b in zip(edges[:-1], edges[1:])])
+    centres = np.array([t[a:b].mean() for a, b in zip(edges[:-1], edges[1:])])
+    color = style.get("color")
+    band = ax.fill_between(centres, low, high, alpha=0.45, lw=0, color=color, label=label)
+    ax.plot(centres, low, lw=0.4, color=band.get_facecolor()[0][:3])
+    ax.plot(centres, high, lw=0.4, color=band.get_facecolor()[0][:3])
+    return True
+
+
+def fast_window(t: np.ndarray, series: Sequence[np.ndarray], periods: float = 6.0) -> slice:
+    """The leading part of the time span that shows about ``periods`` oscillations of the fastest series."""
+    n = max((oscillations(y) for y in series), default=0)
+    if n <= periods:
+        return slice(None)
+    end = t[0] + (t[-1] - t[0]) * periods / n
+    stop = int(np.searchsorted(t, end, side="right"))
+    return slice(0, max(stop, 3))
+
+
+def unit_sphere(ax: Any, n: int = 25) -> None:
+    """A light wireframe of the unit sphere on a 3-D axes."""
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, n), np.linspace(0, np.pi, (n + 1) // 2))
+    ax.plot_wireframe(np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v), color="0.85", lw=0.3)
+    ax.set_box_aspect((1, 1, 1))
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(matplotlib.ticker.FixedLocator([-1, 0, 1]))
+        axis.label.set_size(7)
+    ax.tick_params(labelsize=6, pad=0)
+
+
+def log_positive(values: np.ndarray) -> np.ndarray:
+    """Values for a log axis: zeros and negatives become NaN (gaps, never a fake floor)."""
+    values = np.asarray(values, dtype=float)
+    return np.where(values > 0, values, np.nan)

@@ -1,0 +1,100 @@
+"""Figures of ``work_precision.nc``: error of the final state against what each method costs.
+
+* ``error_vs_wall_time`` -- every method; the wall time is the best of the repeats of a whole run
+  (``Scene.run``), so ``auto`` includes its pilot runs and its choice.
+* ``error_vs_nfev`` -- only the methods whose evaluations are right-hand-side calls. Taylor's are
+  evaluations of an order-N series (each costs far more than one right-hand side), ``lie_poisson``'s
+  are exact sub-flows and ``auto`` mixes its pilot runs with the method it chose: they are compared in
+  wall time only, and the figure says so.
+
+Every method keeps one marker in both figures; methods whose points coincide (dop853 and
+dop853_numba take the same steps) are drawn with open and filled markers of different sizes and the
+legend says which coincide, so no series hides another.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+import xarray as xr
+
+from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
+from gyrolab.figures.save import save_all
+from gyrolab.figures.style import SINGLE, legend_outside, log_positive, panel_note, styled, subplots
+from gyrolab.figures.sweep import NOT_RHS_CALLS
+
+MARKERS = "osD^v<>ph*"
+
+
+def _methods(ds: xr.Dataset) -> list[str]:
+    return list(dict.fromkeys(str(m) for m in ds["method"].values))
+
+
+def _points(ds: xr.Dataset, method: str, x: str) -> tuple[np.ndarray, np.ndarray]:
+    pick = np.array([str(m) == method for m in ds["method"].values])
+    xs, errs = ds[x].values[pick].astype(float), ds["error"].values[pick].astype(float)
+    order = np.argsort(xs)
+    return xs[order], errs[order]
+
+
+def _draw(ds: xr.Dataset, x: str, methods: list[str], xlabel: str) -> plt.Figure:
+    fig, axes = subplots(1, 1, width=SINGLE, height=3.4)
+    ax = axes[0, 0]
+    everyone = _methods(ds)
+    drawn: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    zeros = []
+    for method in methods:
+        k = everyone.index(method)
+        xs, errs = _points(ds, method, x)
+        same = [other for other, (ox, oe) in drawn.items() if len(ox) == len(xs) and np.allclose(ox, xs, rtol=1e-12)
+                and np.allclose(oe, errs, rtol=1e-12)]
+        label = method + (f" (same points as {', '.join(same)})" if same else "")
+        size = 3.0 if same else 5.0
+        ax.plot(xs, log_positive(errs), marker=MARKERS[k % len(MARKERS)], ms=size, lw=0.8, color=f"C{k % 8}",
+                mfc=f"C{k % 8}" if same else "none", label=label)
+        drawn[method] = (xs, errs)
+        if np.any(errs <= 0):
+            zeros.append(method)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.grid(True, which="both", alpha=0.2)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("max-norm error of the final (ω, γ)")
+    if zeros:
+        panel_note(ax, f"error exactly 0 (not drawn): {', '.join(zeros)}")
+    legend_outside(fig, [ax], ncols=2)
+    return fig
+
+
+@styled
+def draw_error_vs_wall_time(ds: xr.Dataset) -> plt.Figure:
+    """Error against the best wall time of a whole run, every method (auto: pilot runs included)."""
+    fig = _draw(ds, "wall_time", _methods(ds), "wall time of one run (s), best of the repeats")
+    fig.suptitle("Work against precision: wall time")
+    return fig
+
+
+@styled
+def draw_error_vs_nfev(ds: xr.Dataset) -> plt.Figure:
+    """Error against right-hand-side calls, for the methods whose evaluations are right-hand-side calls."""
+    methods = _methods(ds)
+    counted = [m for m in methods if m not in NOT_RHS_CALLS]
+    fig = _draw(ds, "nfev", counted, "right-hand-side evaluations")
+    left_out = [m for m in methods if m in NOT_RHS_CALLS]
+    if left_out:
+        fig.text(0.5, 0.005, f"Not shown (their evaluations are not right-hand-side calls; compare them in wall "
+                 f"time): {', '.join(left_out)}.", ha="center", va="bottom", fontsize=6, color="0.3", wrap=True)
+        fig.get_layout_engine().set(rect=(0, 0.05, 1, 0.95))
+    fig.suptitle("Work against precision: right-hand-side calls")
+    return fig
+
+
+FIGURES = {"error_vs_wall_time": draw_error_vs_wall_time, "error_vs_nfev": draw_error_vs_nfev}
+
+
+def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
+                 dpi: int = DEFAULT_DPI) -> list[Path]:
+    return save_all({name: draw(ds) for name, draw in FIGURES.items()}, directory, ds, formats, dpi)
