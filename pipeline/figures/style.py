@@ -51,8 +51,9 @@ def tidy_log(ax: plt.Axes) -> None:
             continue
         low, high = sorted(abs(v) for v in limits)
         if low > 0 and np.log10(high / low) < 1.8:
-            axis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
-            axis.set_major_formatter(matplotlib.ticker.LogFormatterSciNotation(labelOnlyBase=False))
+            axis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0), numticks=15))
+            axis.set_major_formatter(matplotlib.ticker.LogFormatterSciNotation(
+                labelOnlyBase=False, minor_thresholds=(np.inf, np.inf)))
         axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
@@ -79,8 +80,9 @@ def legend_outside(fig: plt.Figure, axes: Sequence[plt.Axes] | None = None, *, n
 
 
 def panel_note(ax: plt.Axes, text: str) -> None:
-    """A short note in the panel's upper left corner, in the axes' own margin above the data."""
-    ax.set_title(text, loc="left", fontsize=6.5, color="0.3")
+    """A short note above the panel's upper left corner (outside the data); notes accumulate, one per line."""
+    before = ax.get_title(loc="left")
+    ax.set_title(f"{before}\n{text}" if before else text, loc="left", fontsize=6.5, color="0.3")
 
 
 def oscillations(y: np.ndarray) -> int:

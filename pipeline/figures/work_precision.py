@@ -34,14 +34,19 @@ def _methods(ds: xr.Dataset) -> list[str]:
 
 
 def _points(ds: xr.Dataset, method: str, x: str) -> tuple[np.ndarray, np.ndarray]:
+    """A method's (cost, error) in the order of its settings (so the line follows the tolerance, not the cost)."""
     pick = np.array([str(m) == method for m in ds["method"].values])
-    xs, errs = ds[x].values[pick].astype(float), ds["error"].values[pick].astype(float)
-    order = np.argsort(xs)
-    return xs[order], errs[order]
+    return ds[x].values[pick].astype(float), ds["error"].values[pick].astype(float)
+
+
+def _coincide(xs: np.ndarray, errs: np.ndarray, other: tuple[np.ndarray, np.ndarray]) -> bool:
+    """Whether any point of a method lies on a point of another (same cost and error to 1e-9)."""
+    ox, oe = other
+    return bool(np.any(np.isclose(xs[:, None], ox[None, :], rtol=1e-9) & np.isclose(errs[:, None], oe[None, :], rtol=1e-9)))
 
 
 def _draw(ds: xr.Dataset, x: str, methods: list[str], xlabel: str) -> plt.Figure:
-    fig, axes = subplots(1, 1, width=SINGLE, height=3.4)
+    fig, axes = subplots(1, 1, width=SINGLE, height=3.6)
     ax = axes[0, 0]
     everyone = _methods(ds)
     drawn: dict[str, tuple[np.ndarray, np.ndarray]] = {}
@@ -49,12 +54,10 @@ def _draw(ds: xr.Dataset, x: str, methods: list[str], xlabel: str) -> plt.Figure
     for method in methods:
         k = everyone.index(method)
         xs, errs = _points(ds, method, x)
-        same = [other for other, (ox, oe) in drawn.items() if len(ox) == len(xs) and np.allclose(ox, xs, rtol=1e-12)
-                and np.allclose(oe, errs, rtol=1e-12)]
-        label = method + (f" (same points as {', '.join(same)})" if same else "")
-        size = 3.0 if same else 5.0
-        ax.plot(xs, log_positive(errs), marker=MARKERS[k % len(MARKERS)], ms=size, lw=0.8, color=f"C{k % 8}",
-                mfc=f"C{k % 8}" if same else "none", label=label)
+        same = [other for other, points in drawn.items() if _coincide(xs, errs, points)]
+        label = method + (f" (points coincide with {', '.join(same)})" if same else "")
+        ax.plot(xs, log_positive(errs), marker=MARKERS[k % len(MARKERS)], ms=2.5 if same else 5.5, lw=0.8,
+                color=f"C{k % 8}", mfc=f"C{k % 8}" if same else "none", zorder=3 if same else 2, label=label)
         drawn[method] = (xs, errs)
         if np.any(errs <= 0):
             zeros.append(method)
@@ -73,6 +76,8 @@ def _draw(ds: xr.Dataset, x: str, methods: list[str], xlabel: str) -> plt.Figure
 def draw_error_vs_wall_time(ds: xr.Dataset) -> plt.Figure:
     """Error against the best wall time of a whole run, every method (auto: pilot runs included)."""
     fig = _draw(ds, "wall_time", _methods(ds), "wall time of one run (s), best of the repeats")
+    if "auto" in _methods(ds):
+        panel_note(fig.axes[0], "auto: its pilot runs included")
     fig.suptitle("Work against precision: wall time")
     return fig
 
@@ -85,9 +90,8 @@ def draw_error_vs_nfev(ds: xr.Dataset) -> plt.Figure:
     fig = _draw(ds, "nfev", counted, "right-hand-side evaluations")
     left_out = [m for m in methods if m in NOT_RHS_CALLS]
     if left_out:
-        fig.text(0.5, 0.005, f"Not shown (their evaluations are not right-hand-side calls; compare them in wall "
-                 f"time): {', '.join(left_out)}.", ha="center", va="bottom", fontsize=6, color="0.3", wrap=True)
-        fig.get_layout_engine().set(rect=(0, 0.05, 1, 0.95))
+        panel_note(fig.axes[0], f"not shown: {', '.join(left_out)} (their evaluations are not\n"
+                                "right-hand-side calls; compare them in wall time)")
     fig.suptitle("Work against precision: right-hand-side calls")
     return fig
 

@@ -1,0 +1,157 @@
+"""Figures are functions of datasets: `gyrolab --plot` redraws them, in the configured formats and dpi,
+with the dataset's provenance in the file metadata; the defects of the old figures stay fixed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+from PIL import Image
+
+from gyrolab.app import preflight, run_command
+from gyrolab.engine.config import compose_config
+from gyrolab.engine.scene import Scene
+from gyrolab.errors import ConfigError
+from gyrolab.figures.options import figure_options
+from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.style import SINGLE
+from gyrolab.output.dataset import write_dataset
+
+TINY = ["time.end=2", "time.n_output=41"]
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory):
+    """A run directory as `gyrolab` leaves it: run.nc and figures/ drawn at the run."""
+    directory = tmp_path_factory.mktemp("run")
+    cfg = compose_config(TINY)
+    ds = Scene.from_config(cfg).run()
+    write_dataset(ds, directory / "run.nc")
+    draw_figures("run.nc", ds, directory, cfg.output)
+    return directory
+
+
+def _names(directory):
+    return sorted(p.name for p in (directory / "figures").iterdir())
+
+
+def test_plot_redraws_the_same_figures_in_the_formats_and_dpi_asked_with_provenance(run_dir):
+    drawn = _names(run_dir)
+    assert drawn == ["body_axis_sphere.png", "euler_angles.png", "invariant_drift.png", "state.png"]
+    for path in (run_dir / "figures").iterdir():
+        path.unlink()
+    assert run_command(["--plot", str(run_dir), "output.figure_formats=[png,pdf,svg]", "output.dpi=50"]) == 0
+    figures = run_dir / "figures"
+    stems = {p.removesuffix(".png") for p in drawn}
+    for fmt in ("png", "pdf", "svg"):
+        assert {p.stem for p in figures.glob(f"*.{fmt}")} == stems
+    assert len(list(figures.iterdir())) == 3 * len(stems)
+    ds = xr.load_dataset(run_dir / "run.nc")
+    with Image.open(figures / "invariant_drift.png") as png:
+        # a single-column figure: 3.5 in wide at 50 dpi (the style's width, not matplotlib's default)
+        assert png.size[0] == round(SINGLE * 50)
+        assert png.text["gyrolab:git_commit"] == ds.attrs["git_commit"]
+        assert png.text["gyrolab:config"] == ds.attrs["config"]
+    pdf = (figures / "state.pdf").read_bytes()
+    assert f"git_commit={ds.attrs['git_commit']}".encode() in pdf
+    svg = (figures / "state.svg").read_text()
+    assert ds.attrs["git_commit"] in svg and "<dc:description>" in svg
+
+
+@pytest.mark.parametrize("output, words", [
+    ({"figure_formats": ["png", "jpg"]}, "'jpg'"),
+    ({"figure_formats": []}, "empty"),
+    ({"dpi": 0}, "output.dpi=0"),
+    ({"dpi": "high"}, "output.dpi='high'"),
+])
+def test_bad_figure_settings_are_one_sentence(output, words):
+    with pytest.raises(ConfigError, match=words) as error:
+        figure_options(output)
+    assert "\n" not in str(error.value)
+
+
+def test_bad_format_is_refused_before_anything_runs(tmp_path):
+    with pytest.raises(ConfigError, match="valid: pdf, png, svg"):
+        preflight(["output.figure_formats=[png,eps]", f"hydra.run.dir={tmp_path / 'out'}"])
+    assert not (tmp_path / "out").exists()
+
+
+def test_plot_of_a_path_without_datasets_is_one_sentence(tmp_path):
+    with pytest.raises(ConfigError, match="no gyrolab dataset"):
+        run_command(["--plot", str(tmp_path)])
+
+
+def test_body_axis_sphere_draws_z_along_the_weight(run_dir):
+    from gyrolab.figures.run import draw_body_axis
+
+    fig = draw_body_axis(xr.load_dataset(run_dir / "run.nc"))
+    ax = fig.axes[0]
+    assert ax.zaxis_inverted() and "weight" in ax.get_zlabel()
+
+
+def test_initial_upright_stands_and_hanging_hangs():
+    # Z points along the weight: with the centre of mass on +z, θ0 = π is the sleeping (upright) top,
+    # an equilibrium that a Lagrange top keeps exactly (r0² = 25 > 4a = 3.2: stable); θ0 = 0 hangs.
+    for initial, theta in (("upright", np.pi), ("hanging", 0.0)):
+        ds = Scene.from_config(compose_config(["body=lagrange_top", f"initial={initial}", "time.end=2",
+                                               "time.n_output=21"])).run()
+        np.testing.assert_allclose(ds.theta.values, theta, atol=1e-12)
+        np.testing.assert_allclose(ds.gamma.values[:, 2], np.cos(theta), atol=1e-12)
+
+
+def _sweep(values):
+    return xr.Dataset({"integrator_nfev": (("integrator", "r0"), values, {"units": "1"})},
+                      coords={"integrator": ["rk4", "taylor"], "r0": ("r0", [2.0, 5.0, 10.0])},
+                      attrs={"sweep_dims": "integrator r0", "n_finished": 6, "n_failed": 0})
+
+
+def test_sweep_points_are_markers_and_evaluation_kinds_are_named():
+    from gyrolab.figures.sweep import draw_cost
+
+    fig = draw_cost(_sweep(np.array([[100.0, 200, 400], [10, 20, 40]])))
+    lines = [line for ax in fig.axes for line in ax.get_lines() if len(line.get_xdata()) == 3]
+    assert lines and all(line.get_linestyle() == "None" for line in lines)  # discrete values: never joined
+    assert all(ax.get_ylabel() for ax in fig.axes)
+    assert "taylor: Taylor series evaluations" in fig.axes[0].get_title(loc="left")
+
+
+def _work_precision():
+    # dop853 and dop853_numba take the same steps at equal tolerances (identical points)
+    methods = ["dop853"] * 2 + ["dop853_numba"] * 3 + ["taylor"] * 2 + ["auto"]
+    nfev = [1e4, 2e4, 1e4, 2e4, 4e4, 500, 800, 900]
+    error = [1e-6, 1e-8, 1e-6, 1e-8, 1e-10, 1e-9, 0.0, 1e-9]
+    return xr.Dataset({"method": ("run", methods), "nfev": ("run", nfev), "error": ("run", error),
+                       "wall_time": ("run", np.linspace(0.1, 0.8, 8))})
+
+
+def test_work_precision_counts_only_right_hand_side_calls_and_hides_no_method():
+    from gyrolab.figures.work_precision import draw_error_vs_nfev, draw_error_vs_wall_time
+
+    ds = _work_precision()
+    fig = draw_error_vs_nfev(ds)
+    labels = fig.legends[0].get_texts()
+    assert [t.get_text() for t in labels] == ["dop853", "dop853_numba (points coincide with dop853)"]
+    assert "not shown: taylor, auto" in fig.axes[0].get_title(loc="left")
+    fig = draw_error_vs_wall_time(ds)
+    assert {t.get_text().split(" ")[0] for t in fig.legends[0].get_texts()} == {"dop853", "dop853_numba", "taylor",
+                                                                              "auto"}
+    note = fig.axes[0].get_title(loc="left")
+    assert "pilot runs included" in note and "exactly 0 (not drawn): taylor" in note
+
+
+def test_exact_zeros_are_gaps_not_a_floor(tmp_path):
+    """Ismail's Tables 1 and 2 agree exactly at t = 0: that zero is marked on the axis edge, never drawn at a
+    made-up floor value."""
+    from omegaconf import OmegaConf
+
+    from gyrolab.experiments import ismail2021_tables
+    from gyrolab.figures.tables import draw_tables
+
+    ismail2021_tables.run(OmegaConf.create({"output": {"figures": False}}), tmp_path)
+    fig = draw_tables(xr.load_dataset(tmp_path / "ismail2021_tables.nc"))
+    right = fig.axes[1]
+    drawn = np.concatenate([np.asarray(line.get_ydata(), dtype=float) for line in right.get_lines()
+                            if line.get_transform() == right.transData])
+    finite = drawn[np.isfinite(drawn)]
+    assert finite.min() > 1e-12 and np.isnan(drawn).any()
+    assert any("exactly 0" in t.get_text() for t in fig.legends[0].get_texts())
