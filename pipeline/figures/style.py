@@ -118,9 +118,10 @@ def trace(ax: plt.Axes, t: np.ndarray, y: np.ndarray, *, label: str | None = Non
 
 
 def fast_window(t: np.ndarray, series: Sequence[np.ndarray], periods: float = 6.0) -> slice:
-    """The leading part of the time span that shows about ``periods`` oscillations of the fastest series."""
+    """The leading part of the time span that shows about ``periods`` oscillations of the fastest series;
+    the whole span (``slice(None)``) when no series is dense (at most ``MAX_OSCILLATIONS / 2`` oscillations)."""
     n = max((oscillations(y) for y in series), default=0)
-    if n <= periods:
+    if n <= MAX_OSCILLATIONS / 2:
         return slice(None)
     end = t[0] + (t[-1] - t[0]) * periods / n
     stop = int(np.searchsorted(t, end, side="right"))
