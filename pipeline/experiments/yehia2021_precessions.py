@@ -28,6 +28,7 @@ from gyrolab.physics.precession.classify import classify
 from gyrolab.physics.precession.closed_forms import check_closed_forms
 from gyrolab.physics.precession.motion import body_config, euler_residual, magnetic_config, vector_residual, window
 from gyrolab.physics.precession.stability import floquet
+from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 
@@ -115,11 +116,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     written = [write_dataset(ds, out_dir / "precession_cases.nc")]
     tmp.replace(csv_path)
     written.insert(0, csv_path)
-    if cfg.output.get("figures", True):
-        from gyrolab.figures.options import figure_options
-        from gyrolab.figures.precessions import save_figures
-
-        written += save_figures(ds, out_dir / "figures", *figure_options(cfg.output))
+    written += draw_figures("precession_cases.nc", ds, out_dir, cfg.get("output"))
     return written
 
 

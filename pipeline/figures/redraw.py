@@ -40,11 +40,18 @@ def draw_dataset(path: Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int 
         ds = xr.load_dataset(path)
     except (OSError, ValueError) as error:
         raise OutputError(f"cannot read {str(path)!r}: {error}") from None
-    module = importlib.import_module(f"gyrolab.figures.{KINDS[path.name]}")
-    directory = path.parent / "figures"
-    if KINDS[path.name] == "sweep":
-        return module.save_sweep_figures(ds, directory, tuple(formats), dpi)
-    return module.save_figures(ds, directory, tuple(formats), dpi)
+    return save_kind(path.name, ds, path.parent / "figures", tuple(formats), dpi)
+
+
+def save_kind(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ...], dpi: int) -> list[Path]:
+    """Every figure of dataset kind ``name`` drawn from ``ds``: the module's own ``save_figures`` when it
+    has one (figures that depend on the data, parallel drawing), else each of its ``FIGURES``."""
+    module = importlib.import_module(f"gyrolab.figures.{KINDS[name]}")
+    if hasattr(module, "save_figures"):
+        return module.save_figures(ds, directory, formats, dpi)
+    from gyrolab.figures.save import save_all
+
+    return save_all({stem: draw(ds) for stem, draw in module.FIGURES.items()}, directory, ds, formats, dpi)
 
 
 def _drew_figures(path: Path) -> bool:
@@ -91,8 +98,4 @@ def draw_figures(name: str, ds: xr.Dataset, out_dir: str | Path, output: object 
     if not output.get("figures", True):
         return []
     formats, dpi = figure_options(output)
-    module = importlib.import_module(f"gyrolab.figures.{KINDS[name]}")
-    directory = Path(out_dir) / "figures"
-    if KINDS[name] == "sweep":
-        return module.save_sweep_figures(ds, directory, formats, dpi)
-    return module.save_figures(ds, directory, formats, dpi)
+    return save_kind(name, ds, Path(out_dir) / "figures", formats, dpi)

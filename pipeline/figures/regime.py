@@ -3,15 +3,10 @@ exact periodic orbit and (where the regime has one) the reduced system, for p, q
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from pathlib import Path
-
 import matplotlib.pyplot as plt
 import xarray as xr
 
 from gyrolab.figures.labels import label, time_label, unit
-from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
-from gyrolab.figures.save import save_all
 from gyrolab.figures.style import DOUBLE, legend_outside, panel_note, styled, subplots
 
 #: source suffix -> (legend, line style); drawn in this order
@@ -45,8 +40,3 @@ def draw_regime_comparison(ds: xr.Dataset) -> plt.Figure:
 
 
 FIGURES = {"regime_comparison": draw_regime_comparison}
-
-
-def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
-                 dpi: int = DEFAULT_DPI) -> list[Path]:
-    return save_all({name: draw(ds) for name, draw in FIGURES.items()}, directory, ds, formats, dpi)

@@ -7,8 +7,6 @@ on a log axis: they are left out and a panel that has any says so.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from pathlib import Path
 from typing import Any
 
 import matplotlib.pyplot as plt
@@ -16,8 +14,6 @@ import numpy as np
 import xarray as xr
 from omegaconf import OmegaConf
 
-from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
-from gyrolab.figures.save import save_all
 from gyrolab.figures.style import DOUBLE, log_positive, styled, subplots
 
 #: error key -> (legend, marker); one color per key in every panel
@@ -117,8 +113,3 @@ def draw_regime_validity(ds: xr.Dataset) -> plt.Figure:
 
 
 FIGURES = {"regime_validity": draw_regime_validity}
-
-
-def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
-                 dpi: int = DEFAULT_DPI) -> list[Path]:
-    return save_all({name: draw(ds) for name, draw in FIGURES.items()}, directory, ds, formats, dpi)

@@ -3,15 +3,10 @@ full model on the exact periodic orbit (the mean spin is removed from φ to show
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from pathlib import Path
-
 import matplotlib.pyplot as plt
 import xarray as xr
 
 from gyrolab.figures.labels import time_label
-from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
-from gyrolab.figures.save import save_all
 from gyrolab.figures.style import SINGLE, legend_outside, styled, subplots
 
 
@@ -33,8 +28,3 @@ def draw_shaker(ds: xr.Dataset) -> plt.Figure:
 
 
 FIGURES = {"shaker_omega3_euler": draw_shaker}
-
-
-def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
-                 dpi: int = DEFAULT_DPI) -> list[Path]:
-    return save_all({name: draw(ds) for name, draw in FIGURES.items()}, directory, ds, formats, dpi)

@@ -163,8 +163,8 @@ FIGURES = {"sweep_final_state": (draw_final_state, _final_state), "sweep_invaria
            "sweep_cost": (draw_cost, _cost)}
 
 
-def save_sweep_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
-                       dpi: int = DEFAULT_DPI) -> list[Path]:
+def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
+                 dpi: int = DEFAULT_DPI) -> list[Path]:
     """Every sweep figure that has something to show, into ``directory``."""
     figures = {name: draw(ds) for name, (draw, panels) in FIGURES.items() if panels(ds)}
     return save_all(figures, directory, ds, formats, dpi)

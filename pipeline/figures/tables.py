@@ -4,15 +4,10 @@ drawn on it: they are marked ▼ on the bottom edge of the panel and the legend 
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from pathlib import Path
-
 import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
-from gyrolab.figures.save import save_all
 from gyrolab.figures.style import DOUBLE, legend_outside, log_positive, styled, subplots
 
 COLUMN = "gamma2"
@@ -53,8 +48,3 @@ def draw_tables(ds: xr.Dataset) -> plt.Figure:
 
 
 FIGURES = {"ismail2021_tables": draw_tables}
-
-
-def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
-                 dpi: int = DEFAULT_DPI) -> list[Path]:
-    return save_all({name: draw(ds) for name, draw in FIGURES.items()}, directory, ds, formats, dpi)

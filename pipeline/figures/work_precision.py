@@ -14,15 +14,10 @@ legend says which coincide, so no series hides another.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from pathlib import Path
-
 import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
-from gyrolab.figures.save import save_all
 from gyrolab.figures.style import SINGLE, legend_outside, log_positive, panel_note, styled, subplots
 from gyrolab.figures.sweep import NOT_RHS_CALLS
 
@@ -97,8 +92,3 @@ def draw_error_vs_nfev(ds: xr.Dataset) -> plt.Figure:
 
 
 FIGURES = {"error_vs_wall_time": draw_error_vs_wall_time, "error_vs_nfev": draw_error_vs_nfev}
-
-
-def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
-                 dpi: int = DEFAULT_DPI) -> list[Path]:
-    return save_all({name: draw(ds) for name, draw in FIGURES.items()}, directory, ds, formats, dpi)

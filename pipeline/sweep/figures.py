@@ -21,7 +21,7 @@ __all__ = ["choose_x", "final_values", "save_sweep_figures"]
 def save_sweep_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] | None = None,
                        dpi: int | None = None) -> list[Path]:
     """Draw the sweep's summary figures into ``directory`` (``<sweep dir>/figures``)."""
-    from gyrolab.figures.sweep import save_sweep_figures as draw
+    from gyrolab.figures.sweep import save_figures as draw
 
     directory = Path(directory)
     saved = directory.parent / "multirun.yaml"
