@@ -6,6 +6,7 @@ the file: PNG text chunks, the PDF info dictionary (Subject, Keywords), SVG's de
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -16,6 +17,8 @@ import xarray as xr
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.style import STYLE
 from gyrolab.output.atomic import atomic_path
+
+logging.getLogger("fontTools").setLevel(logging.WARNING)  # PDF font subsetting logs every table at INFO
 
 #: dataset attributes copied into every figure's metadata
 PROVENANCE_KEYS = ("gyrolab_version", "git_commit", "git_dirty", "git_diff_sha256", "job_id", "hydra_overrides")
