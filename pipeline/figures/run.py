@@ -64,7 +64,7 @@ def draw_state(ds: xr.Dataset) -> plt.Figure:
     if ncols == 2:
         panel_note(axes[0, 0], "whole run" + (f" ({', '.join(enveloped)}: min–max envelope, too dense for lines)"
                                               if enveloped else ""))
-        panel_note(axes[0, 1], f"first {t[window][-1] - t[0]:.3g} time units")
+        panel_note(axes[0, 1], f"leading window, t ≤ {t[window][-1]:.3g}")
     fig.suptitle("Angular velocity and direction cosines in body axes")
     return fig
 
