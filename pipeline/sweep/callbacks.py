@@ -16,9 +16,10 @@ from typing import Any
 from hydra.experimental.callback import Callback
 from omegaconf import DictConfig
 
-from gyrolab.errors import GyrolabError
+from gyrolab.errors import GyrolabError, OutputError
 from gyrolab.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
 from gyrolab.sweep.grid import Grid
+from gyrolab.sweep.orphans import announce_launcher, forget_launcher
 from gyrolab.sweep.watch import SweepWatcher
 
 log = logging.getLogger("gyrolab.sweep")
@@ -26,6 +27,8 @@ log = logging.getLogger("gyrolab.sweep")
 #: outcome of the last sweep aggregated in this process (read by the command's exit status)
 last_summary: SweepSummary | None = None
 last_error: str | None = None
+#: exit status of the command when ``last_error`` is set (3: sweep.nc could not be written)
+last_exit_code: int = 1
 
 
 class SweepCallback(Callback):
@@ -40,8 +43,9 @@ class SweepCallback(Callback):
         return {"figures": self.figures, "progress": self.progress, "_watcher": None}
 
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
-        global last_summary, last_error
-        last_summary, last_error = None, None
+        global last_summary, last_error, last_exit_code
+        last_summary, last_error, last_exit_code = None, None, 1
+        self._announced = announce_launcher()  # worker processes of this sweep die with this process
         if not self.progress or not _basic_sweeper(config):
             return
         try:
@@ -52,10 +56,11 @@ class SweepCallback(Callback):
         self._watcher.start()
 
     def on_multirun_end(self, config: DictConfig, **kwargs: Any) -> None:
-        global last_summary, last_error
+        global last_summary, last_error, last_exit_code
         if self._watcher is not None:
             self._watcher.stop()
             self._watcher = None
+        forget_launcher(self.__dict__.pop("_announced", None))
         if not _basic_sweeper(config):
             log.warning("sweep.nc is written for Hydra's basic sweeper only (this sweep used %s)",
                         config.hydra.sweeper.get("_target_"))
@@ -64,6 +69,11 @@ class SweepCallback(Callback):
         try:
             summary = aggregate_sweep(sweep_dir, hydra_cfg=config.hydra, figures=self.figures,
                                       launcher=str(config.hydra.launcher.get("_target_", "")).rsplit(".", 1)[-1])
+        except OutputError as error:  # a full disk: one sentence, exit 3, the jobs' results intact
+            last_error = f"{error}; the job results are intact: run 'gyrolab --aggregate {sweep_dir}' once " \
+                         "the cause is fixed"
+            last_exit_code = error.exit_code
+            return
         except Exception as error:  # noqa: BLE001 - the jobs' results are safe; say how to aggregate them later
             last_error = f"could not aggregate the sweep ({type(error).__name__}: {error}); the job results are " \
                          f"intact: run 'gyrolab --aggregate {sweep_dir}' once the cause is fixed"
