@@ -10,6 +10,7 @@ off (``allow_bars(False)``): the sweep shows one bar for all its jobs.
 from __future__ import annotations
 
 import logging
+import math
 import sys
 import threading
 import time
@@ -32,6 +33,18 @@ def on_terminal(stream: Any) -> bool:
         return bool(stream.isatty())
     except (AttributeError, ValueError):  # closed or not a real stream
         return False
+
+
+def duration(seconds: float) -> str:
+    """A wall-clock duration for people: '42 s', '7.5 min', '3.1 h', '12 days', '290 years', '9.5e+06 years'."""
+    if not math.isfinite(seconds):
+        return "? s"
+    for unit, size, limit in (("s", 1, 120), ("min", 60, 120), ("h", 3600, 48), ("days", 86400, 730),
+                              ("years", 365.25 * 86400, 1e4)):
+        value = seconds / size
+        if value < limit:
+            return f"{value:.0f} {unit}" if value >= 10 or unit == "s" else f"{value:.1f} {unit}"
+    return f"{seconds / (365.25 * 86400):.2g} years"
 
 
 class Progress:
@@ -66,8 +79,8 @@ class Progress:
         fraction = (t - self.t_start) / (self.t_end - self.t_start)
         elapsed = now - self._began
         remaining = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
-        log.info("%s: %3.0f%% (t=%.6g of %.6g), %.0f s elapsed, ~%.0f s to go",
-                 self.label, 100 * fraction, t, self.t_end, elapsed, remaining)
+        log.info("%s: %3.0f%% (t=%.6g of %.6g), %s elapsed, ~%s to go",
+                 self.label, 100 * fraction, t, self.t_end, duration(elapsed), duration(remaining))
 
     def close(self) -> None:
         if self._bar is not None:

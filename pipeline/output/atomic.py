@@ -115,7 +115,7 @@ def diagnose(error: BaseException, tmp: Path, expected_bytes: int | None = None)
         written = 0
     limit, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
     if limit != resource.RLIM_INFINITY and max(written + PROBE_BYTES, expected_bytes or 0) >= limit:
-        return f"{_REASONS[errno.EFBIG]} ({_size(limit)})"
+        return f"file too large for the process's file-size limit of {_size(limit)} (ulimit -f)"
     try:  # a full disk or quota fails this small write too, with the errno the library did not report
         with open(tmp, "ab") as handle:
             handle.write(bytes(PROBE_BYTES))

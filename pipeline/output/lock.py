@@ -90,14 +90,20 @@ def unlock(directory: str | os.PathLike[str]) -> None:
     os.close(entry[0])  # releases the flock
 
 
-@contextmanager
-def directory_lock(directory: str | os.PathLike[str], what: str = "run directory") -> Iterator[Path]:
-    """Hold ``directory``'s lock for the block; ``Busy`` (a ConfigError, exit 2) if another process holds it."""
-    directory = Path(directory)
+def lock(directory: str | os.PathLike[str], what: str = "run directory") -> None:
+    """Take ``directory``'s lock (release it with ``unlock``); ``Busy`` (a ConfigError, exit 2) if another
+    process holds it, ``OutputError`` if no lock file can be made there."""
     if not try_lock(directory):
-        owner = owner_of(directory)
+        owner = owner_of(Path(directory))
         raise Busy(f"{what} {str(directory)!r} is in use by another gyrolab run"
                    f"{f' ({owner})' if owner else ''}; wait for it to end or choose another directory", owner)
+
+
+@contextmanager
+def directory_lock(directory: str | os.PathLike[str], what: str = "run directory") -> Iterator[Path]:
+    """Hold ``directory``'s lock for the block (see ``lock``)."""
+    directory = Path(directory)
+    lock(directory, what)
     try:
         yield directory
     finally:

@@ -10,6 +10,7 @@ summary figures. The jobs themselves record their outcome (``job.json``) in
 from __future__ import annotations
 
 import logging
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -17,6 +18,7 @@ from hydra.experimental.callback import Callback
 from omegaconf import DictConfig
 
 from gyrolab.errors import GyrolabError, OutputError
+from gyrolab.output.lock import lock, unlock
 from gyrolab.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.orphans import announce_launcher, forget_launcher
@@ -32,7 +34,12 @@ last_exit_code: int = 1
 
 
 class SweepCallback(Callback):
-    """Aggregate a multirun into ``<sweep dir>/sweep.nc``; ``figures``: also draw the summary figures."""
+    """Aggregate a multirun into ``<sweep dir>/sweep.nc``; ``figures``: also draw the summary figures.
+
+    For a single run it also locks the run directory before Hydra writes anything there
+    (``on_run_start``), so that a second run into a directory in use is refused in one sentence
+    (exit 2) without touching the first run's files.
+    """
 
     def __init__(self, figures: bool = True, progress: bool = True) -> None:
         self.figures = bool(figures)
@@ -40,7 +47,21 @@ class SweepCallback(Callback):
         self._watcher: SweepWatcher | None = None
 
     def __getstate__(self) -> dict[str, Any]:  # launchers pickle callbacks to send them to the jobs
-        return {"figures": self.figures, "progress": self.progress, "_watcher": None}
+        return {"figures": self.figures, "progress": self.progress, "_watcher": None}  # no lock, no announcement
+
+    def on_run_start(self, config: DictConfig, **kwargs: Any) -> None:
+        run_dir = Path(str(config.hydra.run.dir))  # the directory Hydra is about to create (same resolution)
+        try:
+            lock(run_dir)
+        except GyrolabError as error:
+            print(f"gyrolab: error: {error}", file=sys.stderr)
+            sys.exit(error.exit_code)
+        self._locked = run_dir
+
+    def on_run_end(self, config: DictConfig, **kwargs: Any) -> None:
+        locked = self.__dict__.pop("_locked", None)
+        if locked is not None:
+            unlock(locked)
 
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
         global last_summary, last_error, last_exit_code
