@@ -361,3 +361,20 @@ def test_remaining_time_is_in_units_people_read(seconds, shown):
     from gyrolab.engine.progress import duration
 
     assert duration(seconds) == shown
+
+
+@pytest.mark.parametrize("name", ["rk4_numba"])
+def test_compiled_fixed_step_reports_inside_a_long_output_interval(name, monkeypatch):
+    from gyrolab.engine.scene import compose_scene
+    from gyrolab.plugins.integrators import compiled_solvers
+
+    scene = compose_scene([f"integrator={name}", "integrator.step=1e-4", "time.end=1", "time.n_output=2"])
+    args = (scene.system.rhs, scene.times, scene.system.initial_state())
+    whole = scene.integrator.integrate(*args, None, scene.compiled)          # 10^4 steps in one call
+    monkeypatch.setattr(compiled_solvers._Chunks, "step_budget", 1000)       # pieces of 1000 steps
+    seen = []
+    pieces = scene.integrator.integrate(*args, seen.append, scene.compiled)
+    assert np.allclose([t for t in seen if t < 1.0], np.arange(1, 10) / 10) and seen[-1] == 1.0
+    assert pieces.stats.n_steps == whole.stats.n_steps == 10_000
+    # the same steps, the piece boundaries rounded: equal to rounding error
+    np.testing.assert_allclose(pieces.y, whole.y, rtol=1e-12, atol=1e-12)

@@ -56,6 +56,7 @@ class Progress:
         self.t_start, self.t_end = t_start, t_end
         self.every = every
         self._began = self._last = time.perf_counter()
+        self._t_last: float | None = None
         stream = sys.stderr if stream is None else stream
         self._bar = self._make_bar(stream) if _bars_allowed and on_terminal(stream) else None
 
@@ -75,10 +76,14 @@ class Progress:
         now = time.perf_counter()
         if now - self._last < self.every:
             return
-        self._last = now
         fraction = (t - self.t_start) / (self.t_end - self.t_start)
         elapsed = now - self._began
-        remaining = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
+        # the remaining time at the pace since the last report (a compiled method's first report includes
+        # its compilation), or since the start at the first report
+        since, t_since = (self._last, self._t_last) if self._t_last is not None else (self._began, self.t_start)
+        self._last, self._t_last = now, t
+        pace = (t - t_since) / (now - since) if now > since else 0.0
+        remaining = (self.t_end - t) / pace if pace > 0 else float("nan")
         log.info("%s: %3.0f%% (t=%.6g of %.6g), %s elapsed, ~%s to go",
                  self.label, 100 * fraction, t, self.t_end, duration(elapsed), duration(remaining))
 
