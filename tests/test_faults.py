@@ -363,7 +363,7 @@ def test_remaining_time_is_in_units_people_read(seconds, shown):
     assert duration(seconds) == shown
 
 
-@pytest.mark.parametrize("name", ["rk4_numba"])
+@pytest.mark.parametrize("name", ["rk4_numba", "lie_poisson"])
 def test_compiled_fixed_step_reports_inside_a_long_output_interval(name, monkeypatch):
     from gyrolab.engine.scene import compose_scene
     from gyrolab.plugins.integrators import compiled_solvers

@@ -95,6 +95,33 @@ def steps_per_interval(t_out: np.ndarray, step: float) -> np.ndarray:
     return np.maximum(1, np.ceil(np.diff(t_out) / step * (1.0 - 1e-12))).astype(np.int64)
 
 
+def _fixed_step(kernel: Any, name: str, fun: RightHandSide, t_out: np.ndarray, steps: np.ndarray, y: np.ndarray,
+                out: np.ndarray, progress: ProgressCallback | None) -> int:
+    """Fill ``out[1:]`` with a compiled fixed-step ``kernel(grid, steps, rows, first, stop) -> reached``.
+
+    Returns the index of the first output left non-finite, or ``len(t_out)``. Progress is reported
+    after each chunk, and after each piece of an output interval too long for one chunk.
+    """
+    gaps = np.diff(t_out)
+    chunks = _Chunks(len(t_out), steps)
+    for first, stop in chunks:
+        check_step(name, fun, t_out[first - 1], y, float(gaps[first - 1] / steps[first - 1]))
+        budget = chunks.step_budget
+        if stop - first == 1 and steps[first - 1] > budget:  # one long interval: in pieces
+            rows = np.empty((math.ceil(steps[first - 1] / budget) + 1, len(y)))
+            finite = _interval_in_pieces(lambda tau, sub, j: kernel(tau, sub, rows, j, j + 1) == j + 1,
+                                         t_out[first - 1], t_out[first], int(steps[first - 1]), budget, progress)
+            out[first] = y
+            reached = stop if finite else first
+        else:
+            reached = kernel(t_out, steps, out, first, stop)
+        if reached != stop:
+            return reached
+        if progress is not None:
+            progress(t_out[stop - 1])
+    return len(t_out)
+
+
 class DOP853Numba(Tolerances, Integrator):
     name = "dop853_numba"
     adaptive = True
@@ -143,25 +170,12 @@ class RK4Numba(Integrator):
         t_out, y, out = _outputs(t_out, y0)
         steps = steps_per_interval(t_out, self.step)
         fun = compiled_rhs(compiled)
-        gaps = np.diff(t_out)
-        chunks = _Chunks(len(t_out), steps)
-        for first, stop in chunks:
-            check_step(self.name, fun, t_out[first - 1], y, float(gaps[first - 1] / steps[first - 1]))
-            if stop - first == 1 and steps[first - 1] > chunks.step_budget:  # one long interval: in pieces
-                buffer = np.empty((math.ceil(steps[first - 1] / chunks.step_budget) + 1, len(y)))
-                finite = _interval_in_pieces(
-                    lambda tau, sub, j: rk4.run(compiled.model, compiled.params, tau, sub, y, buffer, j,
-                                                j + 1) == j + 1,
-                    t_out[first - 1], t_out[first], int(steps[first - 1]), chunks.step_budget, progress)
-                out[first] = y
-                reached = stop if finite else first
-            else:
-                reached = rk4.run(compiled.model, compiled.params, t_out, steps, y, out, first, stop)
-            if reached != stop:
-                raise IntegrationError(f"rk4_numba produced a non-finite state before t={t_out[reached]:.6g} "
-                                       f"with step {self.step:.3g}; reduce integrator.step")
-            if progress is not None:
-                progress(t_out[stop - 1])
+        reached = _fixed_step(lambda grid, n, rows, first, stop: rk4.run(compiled.model, compiled.params, grid, n,
+                                                                         y, rows, first, stop),
+                              self.name, fun, t_out, steps, y, out, progress)
+        if reached != len(t_out):
+            raise IntegrationError(f"rk4_numba produced a non-finite state before t={t_out[reached]:.6g} "
+                                   f"with step {self.step:.3g}; reduce integrator.step")
         n_steps = int(steps.sum())
         return Solution(t_out, out, IntegratorStats(nfev=4 * n_steps, n_steps=n_steps, n_rejected=0,
                                                     wall_time=time.perf_counter() - start))
@@ -229,25 +243,12 @@ class LiePoisson(Integrator):
         steps = steps_per_interval(t_out, self.step)
         w = lie_poisson.weights(self.order)
         fun = compiled_rhs(compiled)
-        gaps = np.diff(t_out)
-        chunks = _Chunks(len(t_out), steps)
-        for first, stop in chunks:
-            check_step(self.name, fun, t_out[first - 1], y, float(gaps[first - 1] / steps[first - 1]))
-            if stop - first == 1 and steps[first - 1] > chunks.step_budget:  # one long interval: in pieces
-                buffer = np.empty((math.ceil(steps[first - 1] / chunks.step_budget) + 1, len(y)))
-                finite = _interval_in_pieces(
-                    lambda tau, sub, j: lie_poisson.run(compiled.params, tau, sub, w, y, buffer, j,
-                                                        j + 1) == j + 1,
-                    t_out[first - 1], t_out[first], int(steps[first - 1]), chunks.step_budget, progress)
-                out[first] = y
-                reached = stop if finite else first
-            else:
-                reached = lie_poisson.run(compiled.params, t_out, steps, w, y, out, first, stop)
-            if reached != stop:
-                raise IntegrationError(f"lie_poisson produced a non-finite state before t={t_out[reached]:.6g}; "
-                                       "reduce integrator.step")
-            if progress is not None:
-                progress(t_out[stop - 1])
+        reached = _fixed_step(lambda grid, n, rows, first, stop: lie_poisson.run(compiled.params, grid, n, w, y,
+                                                                                 rows, first, stop),
+                              self.name, fun, t_out, steps, y, out, progress)
+        if reached != len(t_out):
+            raise IntegrationError(f"lie_poisson produced a non-finite state before t={t_out[reached]:.6g}; "
+                                   "reduce integrator.step")
         n_steps = int(steps.sum())
         # per step: len(w) Strang stages, each with 2 kicks (one torque evaluation each)
         return Solution(t_out, out, IntegratorStats(nfev=2 * len(w) * n_steps, n_steps=n_steps, n_rejected=0,
