@@ -24,7 +24,7 @@ import xarray as xr
 
 from gyrolab.errors import OutputError
 from gyrolab.output import atomic
-from gyrolab.output.atomic import atomic_open, atomic_path, remove_stale_temporaries
+from gyrolab.output.atomic import atomic_open, atomic_path
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.lock import LOCK_NAME, Busy, directory_lock, writing_in
 from gyrolab.sweep.aggregate import wait_for_jobs
@@ -378,3 +378,13 @@ def test_compiled_fixed_step_reports_inside_a_long_output_interval(name, monkeyp
     assert pieces.stats.n_steps == whole.stats.n_steps == 10_000
     # the same steps, the piece boundaries rounded: equal to rounding error
     np.testing.assert_allclose(pieces.y, whole.y, rtol=1e-12, atol=1e-12)
+
+
+def test_a_netcdf_error_about_content_is_not_called_a_write_failure(tmp_path, monkeypatch):
+    def bad_content(self, path, **kwargs):
+        raise RuntimeError("NetCDF: Not a valid data type or _FillValue type mismatch")
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", bad_content)
+    with pytest.raises(RuntimeError, match="Not a valid data type"):   # a bug to see, not a full disk
+        write_dataset(BIG, tmp_path / "run.nc")
+    assert leftovers(tmp_path) == []

@@ -54,10 +54,14 @@ def _umask() -> int:
     return mask
 
 
+#: what netCDF's RuntimeErrors say when the write itself failed (a full disk or a file-size limit is "HDF error")
+_LIBRARY_WRITE_FAILURES = ("HDF error", "Write to read only", "Permission denied", "No space", "Disk quota",
+                           "File too large", "Can't create file", "I/O failure")
+
+
 def _library_failure(error: BaseException) -> bool:
-    """An error of a writing library that stands for a failed write (netCDF/HDF5 say only "HDF error")."""
-    text = str(error)
-    return isinstance(error, RuntimeError) and ("NetCDF" in text or "HDF" in text)
+    """An error of a writing library that stands for a failed write, not for bad content (a bug)."""
+    return isinstance(error, RuntimeError) and any(text in str(error) for text in _LIBRARY_WRITE_FAILURES)
 
 
 @contextmanager
