@@ -50,7 +50,10 @@ class SweepCallback(Callback):
         return {"figures": self.figures, "progress": self.progress, "_watcher": None}  # no lock, no announcement
 
     def on_run_start(self, config: DictConfig, **kwargs: Any) -> None:
-        run_dir = Path(str(config.hydra.run.dir))  # the directory Hydra is about to create (same resolution)
+        try:  # the directory Hydra is about to create (the same config object: the same ${now:} values)
+            run_dir = Path(str(config.hydra.run.dir))
+        except Exception:  # noqa: BLE001 - not resolvable yet: the run locks it itself (gyrolab.app._run_one)
+            return
         try:
             lock(run_dir)
         except GyrolabError as error:
