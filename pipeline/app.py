@@ -167,7 +167,18 @@ def _task(cfg: DictConfig) -> None:
 
 
 def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
-    """Run the scene, write ``run.nc`` (and figures) in ``out_dir``; GyrolabError on bad input or a failed run."""
+    """Run the scene, write ``run.nc`` (and figures) in ``out_dir``; GyrolabError on bad input or a failed run.
+
+    ``out_dir`` is locked meanwhile (a second run into it is refused in one sentence) and cleared of
+    the temporary files that killed writes left there (``gyrolab.output.lock.writing_in``).
+    """
+    from gyrolab.output.lock import writing_in
+
+    with writing_in(out_dir):
+        return _run_locked(cfg, out_dir, job_id)
+
+
+def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None) -> Path:
     from gyrolab.output.dataset import write_dataset
 
     task = task_of(cfg)
@@ -261,7 +272,7 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
 
     if callbacks.last_error:
         print(f"gyrolab: error: {callbacks.last_error}", file=sys.stderr)
-        return 1
+        return callbacks.last_exit_code
     summary = summary or callbacks.last_summary
     if summary is None or not (summary.failed or summary.missing):
         return 0
