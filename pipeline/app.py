@@ -29,7 +29,7 @@ from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override
 from hydra.errors import OverrideParseException
 from hydra.types import RunMode
-from omegaconf import DictConfig, open_dict
+from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.engine.budget import check_budget, check_tolerances
 from gyrolab.engine.config import (
@@ -43,7 +43,7 @@ from gyrolab.engine.config import (
     use_source,
 )
 from gyrolab.engine.safety import check_config, check_output_dir
-from gyrolab.errors import ConfigError, GyrolabError, choices, shorten
+from gyrolab.errors import ConfigError, GyrolabError, choices, require_finite, shorten
 from gyrolab.engine.progress import allow_bars, on_terminal
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
@@ -75,7 +75,11 @@ def preflight(argv: Sequence[str]) -> None:
     if args.help or args.hydra_help or args.info or args.shell_completion or args.cfg:
         return  # Hydra's own informational commands
     overrides = parse_overrides(args.overrides)
-    sweeping = args.multirun or any(o.is_sweep_override() for o in overrides)
+    sweeps = [o for o in overrides if o.is_sweep_override()]
+    if sweeps and not args.multirun:
+        raise ConfigError(f"{shorten(sweeps[0].input_line)!r} is a sweep; run it with -m (gyrolab -m "
+                          f"{shorten(sweeps[0].input_line)} ...), or give one value")
+    sweeping = bool(args.multirun)
     check_launcher_installed(overrides)
     with hydra_for(source):
         check_plugin_names(overrides)
@@ -84,11 +88,14 @@ def preflight(argv: Sequence[str]) -> None:
             Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
         # One job composed and validated: the first value of every sweep (each group choice checked for safety).
         configs = [_compose_job(source, _job_overrides(overrides, {}), sweeping)]
-        for o in overrides:
+        swept = [*overrides, *(_sweeper_params(configs[0]) if sweeping else [])]
+        for o in swept:
             if o.is_sweep_override() and _is_group(o, configs[0]):
-                configs += [_compose_job(source, _job_overrides(overrides, {id(o): value}), sweeping)
-                            for value in list(o.sweep_string_iterator())[1:]]
+                configs += [_compose_job(source, _job_overrides(swept, {id(o): value}), sweeping)
+                            for value in list(o.sweep_string_iterator())]
     cfg = configs[0]
+    for composed in configs:
+        check_scene_config(_without_hydra(composed))
     run_text = str(cfg.hydra.sweep.dir if sweeping else cfg.hydra.run.dir)
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
@@ -114,6 +121,9 @@ def parse_overrides(texts: Sequence[str]) -> list[Override]:
                               f"{OVERRIDE_FORMS}") from None
     for o in overrides:
         key = o.key_or_group
+        if len(key) > MAX_KEY_CHARS:
+            raise ConfigError(f"override key {shorten(key)!r} is longer than {MAX_KEY_CHARS} characters; keys are "
+                              "short dotted names such as time.end")
         if not key.strip():
             raise ConfigError(f"override {shorten(o.input_line)!r} has no key; valid forms are {OVERRIDE_FORMS}")
         if o.is_delete() and key in REQUIRED_SECTIONS:
@@ -125,6 +135,7 @@ def parse_overrides(texts: Sequence[str]) -> list[Override]:
 #: what a valid override looks like (for the grammar errors)
 OVERRIDE_FORMS = "key=value (time.end=50), group=option (integrator=rk4), +key=value (add), ~key (delete)"
 MAX_OVERRIDE_CHARS = 10_000
+MAX_KEY_CHARS = 200
 #: sections every run needs, with a key to show in the message
 REQUIRED_SECTIONS = {"time": "end", "output": "figures", "body": "a", "initial": "r0", "system": "_target_",
                      "integrator": "rtol"}
@@ -134,6 +145,17 @@ def _job_overrides(overrides: Sequence[Override], chosen: dict[int, str]) -> lis
     """The overrides of one job: a sweep's first value, or the value chosen for it."""
     return [f"{o.get_key_element()}={chosen.get(id(o), next(iter(o.sweep_string_iterator())))}"
             if o.is_sweep_override() else o.input_line for o in overrides]
+
+
+def _sweeper_params(cfg: DictConfig) -> list[Override]:
+    """The sweep a config file declares in ``hydra.sweeper.params`` (Hydra adds it to the command line's)."""
+    params = OmegaConf.to_container(cfg.hydra.sweeper, resolve=False).get("params") or {}
+    overrides = parse_overrides([f"{key}={value}" for key, value in params.items()])
+    for o in overrides:
+        if o.key_or_group.startswith(("hydra.", "hydra/")):
+            raise ConfigError(f"hydra.sweeper.params.{shorten(o.key_or_group)} sweeps a Hydra setting; Hydra's "
+                              "settings are one per sweep, so a config may not sweep them")
+    return overrides
 
 
 def _is_group(o: Override, cfg: DictConfig) -> bool:
@@ -154,9 +176,17 @@ def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
 
 def validate_scene(scene_cfg: DictConfig) -> None:
     """The checks every run's scene config passes: schema, tolerances, budget, the scene's own validation."""
+    from gyrolab.experiments import TASKS
+
     plain = check_scene_config(scene_cfg)
+    require_finite(plain, "")
     check_tolerances(plain)
-    if task_of(scene_cfg) not in ("scene", "regime"):
+    task = task_of(scene_cfg)
+    if task not in ("scene", *TASKS):
+        close = difflib.get_close_matches(task, ["scene", *TASKS], n=1)
+        hint = f"did you mean task={close[0]}? " if close else ""
+        raise ConfigError(f"unknown task {shorten(repr(task))}; {hint}valid choices: {choices(['scene', *TASKS])}")
+    if task not in ("scene", "regime"):
         return  # an experiment validates the scenes it composes
     probe = scene_cfg.copy()
     with open_dict(probe):

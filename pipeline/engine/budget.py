@@ -48,7 +48,7 @@ def check_budget(plain: dict[str, Any], state_size: int) -> None:
         return
     time = plain["time"]
     n = int(time["n_output"])
-    size = n * state_size * 8
+    size = float(n) * state_size * 8
     if size > MAX_STATE_BYTES:
         raise ConfigError(f"time.n_output={n} needs at least {_bytes(size)} for the state alone ({n:.3g} samples × "
                           f"{state_size} values × 8 bytes), beyond the budget of {_bytes(MAX_STATE_BYTES)}; "
@@ -83,6 +83,8 @@ def estimated_steps(plain: dict[str, Any]) -> tuple[float, str]:
 
 
 def _bytes(n: float) -> str:
+    if not math.isfinite(n):
+        return "more bytes than a float can count"
     for unit, scale in (("TiB", 1024**4), ("GiB", 1024**3), ("MiB", 1024**2)):
         if n >= scale:
             return f"{n / scale:.3g} {unit}"

@@ -189,15 +189,21 @@ def friendly_composition_error(error: Exception, overrides: Sequence[str], confi
     """One sentence for Hydra's "Could not override 'KEY'" and friends, with the closest valid name."""
     text = _first_line(error)
     cause = error.__cause__ or error.__context__
-    key = None
-    if text.startswith("Could not override '") or text.startswith("Could not append to config. An item is already"):
-        key = text.split("'")[1] if "'" in text else None
-    if key is not None:
+    if text.startswith("Could not append to config. An item is already at '"):
+        key = text.split("'")[1]
+        return ConfigError(f"+{shorten(key)}=... adds a key, but `{shorten(key)}` exists already; change it with "
+                           f"{shorten(key)}=VALUE (or ++{shorten(key)}=VALUE to add or change)")
+    if text.startswith("Error merging override ") and cause is not None:
+        override = text[len("Error merging override "):]
+        reason = _first_line(cause).split(" full_key:")[0]
+        return ConfigError(f"override {shorten(override)!r} cannot be applied ({shorten(reason, 160)})")
+    if text.startswith("Could not override '"):
+        key = text.split("'")[1]
         override = next((o for o in overrides if o.lstrip("+~").split("=", 1)[0].split("@")[0] == key), key)
         return ConfigError(unknown_key_sentence(key, _known_names(overrides, key, config_name), override,
                                                 type(cause).__name__ if cause else ""))
     if "Could not delete from config" in text or "Could not find" in text:
-        return ConfigError(f"{text}; ~KEY deletes only a key or group the config has")
+        return ConfigError(f"{shorten(text, 200)}; ~KEY deletes only a key or group the config has")
     return ConfigError(shorten(text, 300))
 
 
@@ -253,8 +259,6 @@ def _first_line(error: Exception) -> str:
 _CLOSED_SECTIONS = ("time", "output")
 #: sections whose valid keys are the union over the packaged options of their group
 _OPTION_SECTIONS = ("body", "initial")
-#: top-level keys that are not in the packaged config.yaml but are read when present
-_EXTRA_TOP_LEVEL = ("allow_large",)
 
 
 @cache
@@ -275,7 +279,7 @@ def packaged_reference() -> dict[str, Any]:
             if option.name.endswith(".yaml"):
                 keys |= set(OmegaConf.load(str(option)))
         sections[group] = keys
-    return {"top": top | set(SELECTABLE_GROUPS) | set(_EXTRA_TOP_LEVEL), "defaults": main, "sections": sections}
+    return {"top": top | set(SELECTABLE_GROUPS), "defaults": main, "sections": sections}
 
 
 def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
@@ -321,6 +325,9 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
     for key in ("task",):
         if key in plain and not isinstance(plain[key], str):
             raise ConfigError(f"{key}={shorten(repr(plain[key]))} must be a task name (a string)")
+    accuracy = plain.get("accuracy")
+    if accuracy is not None:
+        check_type("accuracy", accuracy, 0.0)
     if "allow_large" in plain:
         check_type("allow_large", plain["allow_large"], False)
     return plain

@@ -91,8 +91,11 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
     allowed_plugins = plugin_targets()
     for path, value in _targets(scene):
         if registry._normalise(str(value)) not in allowed_plugins:
-            raise ConfigError(f"{path}={shorten(repr(value))} is not a registered gyrolab plugin; a config may name "
-                              "only registered plugins (gyrolab plugins lists them) and cannot call other code")
+            group = path.split(".", 1)[0]
+            valid = (f"choose one by name ({group}=NAME), valid names: {', '.join(registry.names(group))}"
+                     if group in registry.GROUPS else "a config may name only registered gyrolab plugins")
+            raise ConfigError(f"{path}={shorten(repr(value))} is not a registered gyrolab plugin and cannot be "
+                              f"called; {valid}")
     if not plain_hydra:
         return
     allowed = hydra_targets()
@@ -101,10 +104,10 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
             raise ConfigError(f"{path}={shorten(repr(value))} is not allowed; under hydra a config may name only "
                               f"gyrolab's sweep callback and the installed launchers and sweepers "
                               f"({', '.join(sorted(t.rsplit('.', 1)[1] for t in allowed))})")
+    _check_paths(plain_hydra, Path(run_dir))
     out = _output_dir(run_dir, plain_hydra, job_subdir)
     for name in ("job_logging", "hydra_logging"):
         _check_logging(plain_hydra.get(name), f"hydra.{name}", out)
-    _check_paths(plain_hydra, Path(run_dir))
     for key in (plain_hydra.get("job") or {}).get("env_set") or {}:
         if not ENV_ALLOWED.match(str(key)):
             raise ConfigError(f"hydra.job.env_set.{shorten(str(key))} is not allowed; a config may set thread counts "

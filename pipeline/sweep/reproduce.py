@@ -42,7 +42,8 @@ def load_run(path: Path) -> xr.Dataset:
     try:
         ds = xr.load_dataset(path, decode_times=False, decode_timedelta=False)
     except (OSError, ValueError, RuntimeError, KeyError, TypeError) as error:
-        reason = shorten(str(error).splitlines()[0] if str(error) else type(error).__name__, 120)
+        reason = (getattr(error, "strerror", None) or "it is not a netCDF file" if isinstance(error, (OSError, ValueError))
+                  else shorten(str(error).splitlines()[0] if str(error) else type(error).__name__, 120))
         raise ConfigError(f"cannot read {str(path)!r} as a netCDF dataset ({reason}); give a run.nc that "
                           "gyrolab wrote") from None
     if "config" not in ds.attrs and "job_status" in ds:
