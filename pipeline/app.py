@@ -61,7 +61,7 @@ def fail(error: GyrolabError) -> None:
     sys.exit(error.exit_code)
 
 
-def preflight(argv: Sequence[str]) -> None:
+def preflight(argv: Sequence[str]) -> list[str]:
     """Validate the command line before Hydra creates any output directory.
 
     The config is composed exactly as Hydra will compose it (the same search path,
@@ -73,7 +73,10 @@ def preflight(argv: Sequence[str]) -> None:
     source = ConfigSource.from_args(args.config_path, args.config_name, args.config_dir)
     use_source(source)
     if args.help or args.hydra_help or args.info or args.shell_completion or args.cfg:
-        return  # Hydra's own informational commands
+        return list(argv)  # Hydra's own informational commands
+    overrides = parse_overrides(args.overrides)
+    argv = _plus_group_as_override(source, list(argv), overrides)
+    args, _ = get_args_parser().parse_known_args(argv)
     overrides = parse_overrides(args.overrides)
     sweeps = [o for o in overrides if o.is_sweep_override()]
     if sweeps and not args.multirun:
@@ -103,6 +106,25 @@ def preflight(argv: Sequence[str]) -> None:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     validate_scene(_without_hydra(cfg))
     check_writable(run_dir)
+    return argv
+
+
+def _plus_group_as_override(source: ConfigSource, argv: list[str], overrides: Sequence[Override]) -> list[str]:
+    """``+experiment=mine`` as ``experiment=mine`` when the primary config already lists the group.
+
+    Hydra refuses to add a group its defaults list has (``experiment: null`` in gyrolab's
+    config.yaml); both spellings are common, so both select the option. The command line
+    Hydra runs is rewritten the same way.
+    """
+    adds = [o for o in overrides if o.is_add() and o.key_or_group in SELECTABLE_GROUPS and o.package is None]
+    if not adds:
+        return argv
+    with hydra_for(source):
+        listed = compose_config([], return_hydra_config=True, config_name=source.config_name).hydra.runtime.choices
+    for o in adds:
+        if o.key_or_group in listed and o.input_line in argv:
+            argv[argv.index(o.input_line)] = o.input_line[1:]
+    return argv
 
 
 def parse_overrides(texts: Sequence[str]) -> list[Override]:
@@ -446,7 +468,7 @@ def main() -> None:
         if status is not None:
             sys.exit(status)
         register_plugin_configs()
-        preflight(argv)
+        sys.argv[1:] = preflight(argv)
     except GyrolabError as error:
         fail(error)
     _task()

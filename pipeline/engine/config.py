@@ -310,14 +310,14 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
                 check_type(f"{section}.{key}", value, ref["defaults"][section][key])
     for group in ("integrator", "system", "regime"):
         node = plain.get(group)
-        if isinstance(node, dict) and "_target_" in node:
+        if isinstance(node, dict) and "_target_" in node and _plugin_keys(group, node["_target_"]):
             valid = _plugin_keys(group, node["_target_"]) | ref["sections"][group]
             for key in node:
                 if key not in valid:
                     raise ConfigError(unknown_key_sentence(f"{group}.{key}", [f"{group}.{k}" for k in valid]))
     for name, node in (plain.get("force") or {}).items():
-        if isinstance(node, dict) and "_target_" in node:
-            valid = _plugin_keys("force", node["_target_"])
+        valid = _plugin_keys("force", node["_target_"]) if isinstance(node, dict) and "_target_" in node else set()
+        if valid:
             for key in node:
                 if key not in valid:
                     raise ConfigError(unknown_key_sentence(f"force.{name}.{key}",
