@@ -61,7 +61,7 @@ def test_user_configs_in_a_multirun_a_batch_and_a_reproduction(myconf, tmp_path,
     with xr.open_dataset(tmp_path / "sweep" / "sweep.nc") as ds:
         assert list(ds["job_status"].values) == [STATUS_FLAGS[FINISHED]] * 2
     assert "a: 1.8" in stored(tmp_path / "sweep" / "1" / "run.nc")[0]
-    code, err = run_main(["--config-dir", "myconf", "--batch", "experiment=lopsided_top", "integrator=rk4",
+    code, err = run_main(["--config-dir", "myconf", "--batch", "body=lopsided", "integrator=rk4",
                           "initial.r0=1,2", *SMALL, "hydra.sweep.dir=batch"], monkeypatch, capsys)
     assert code == 0, err
     with xr.open_dataset(tmp_path / "batch" / "sweep.nc") as ds:
