@@ -65,7 +65,7 @@ def test_user_configs_in_a_multirun_a_batch_and_a_reproduction(myconf, tmp_path,
                           "initial.r0=1,2", *SMALL, "hydra.sweep.dir=batch"], monkeypatch, capsys)
     assert code == 0, err
     with xr.open_dataset(tmp_path / "batch" / "sweep.nc") as ds:
-        assert ds.attrs["sweep_launcher"] == "batch" and ds.sizes["job"] == 2
+        assert ds.attrs["sweep_launcher"] == "batch" and ds.sizes["r0"] == 2 and ds.attrs["body_a"] == 1.8
     code, err = run_main(["--reproduce", "sweep/1/run.nc"], monkeypatch, capsys)
     assert code == 0, err
 
