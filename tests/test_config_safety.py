@@ -5,7 +5,6 @@ written by someone else. Each attack must be refused in one sentence naming the 
 nothing run and no file left behind.
 """
 
-import sys
 import textwrap
 from pathlib import Path
 
@@ -13,7 +12,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from gyrolab.engine.config import ConfigSource, compose_config, use_source
+from gyrolab.engine.config import compose_config
 from gyrolab.engine.safety import check_config
 from gyrolab.errors import ConfigError
 from tests.test_bad_input import run_main
@@ -89,17 +88,43 @@ EVIL_EXPERIMENT = """\
     """
 
 
+@pytest.fixture(scope="module")
+def composed():
+    """gyrolab's default config with its hydra node, composed once; tests change copies of it."""
+    return compose_config([], return_hydra_config=True)
+
+
+def check_variant(composed, tmp_path, key, yaml_text):
+    """check_config on the default config with node ``key`` replaced by ``yaml_text``: the refusal sentence."""
+    from omegaconf import OmegaConf, open_dict
+
+    cfg = composed.copy()
+    with open_dict(cfg):
+        OmegaConf.update(cfg, key, OmegaConf.create(textwrap.dedent(yaml_text)), merge=False, force_add=True)
+    with pytest.raises(ConfigError) as refusal:
+        check_config(cfg, tmp_path / "out")
+    return str(refusal.value)
+
+
 @pytest.mark.parametrize("target, args", [
-    ("shutil.copyfile", "src: /etc/hostname\n          dst: COPIED"),
+    ("shutil.copyfile", "src: /etc/hostname\ndst: COPIED"),
     ("os.system", "_args_: ['touch PWNED']"),
     ("builtins.exec", "_args_: ['open(\"PWNED\", \"w\")']"),
     ("subprocess.run", "args: [touch, PWNED]"),
     ("hydra.experimental.callbacks.PickleJobInfoCallback", ""),
+    ("gyrolab.sweep.callbacks.SweepCallback\nfigures:\n  _target_: os.system", ""),  # nested in an allowed one
 ])
+def test_callback_targets_are_on_an_allowlist(target, args, composed, tmp_path):
+    sentence = check_variant(composed, tmp_path, "hydra.callbacks.x", f"_target_: {target}\n{args}")
+    assert sentence.startswith("hydra.callbacks.x.") and "is not allowed" in sentence
+
+
 @pytest.mark.parametrize("how", ["+experiment=evil", "experiment=evil"])
-def test_callback_from_a_user_experiment_is_refused(target, args, how, tmp_path, monkeypatch, capsys):
-    conf = user_dir(tmp_path, "experiment/evil.yaml", EVIL_EXPERIMENT.format(target=target, args=args))
+def test_callback_from_a_user_experiment_is_refused(how, tmp_path, monkeypatch, capsys):
+    conf = user_dir(tmp_path, "experiment/evil.yaml", EVIL_EXPERIMENT.format(target="os.system",
+                                                                             args="_args_: ['touch PWNED']"))
     refused(["--config-dir", str(conf), how], tmp_path, monkeypatch, capsys, "hydra.callbacks.x._target_")
+    assert not (tmp_path / "PWNED").exists()
 
 
 def test_callback_through_hydra_searchpath_is_refused(tmp_path, monkeypatch, capsys):
@@ -127,15 +152,21 @@ def test_a_sweep_declared_in_a_config_file_cannot_set_hydra(tmp_path, monkeypatc
             "hydra.sweeper.params.hydra.callbacks.x._target_ sweeps a Hydra setting")
 
 
+@pytest.mark.parametrize("key, text, named", [
+    ("hydra.launcher", "_target_: os.system", "hydra.launcher._target_='os.system'"),
+    ("hydra.sweeper", "_target_: builtins.exec", "hydra.sweeper._target_='builtins.exec'"),
+    ("hydra.job.env_set", "LD_PRELOAD: /tmp/evil.so", "hydra.job.env_set.LD_PRELOAD"),
+    ("hydra.job.env_set", "PYTHONSTARTUP: /tmp/evil.py", "hydra.job.env_set.PYTHONSTARTUP"),
+    ("force.newtonian", "_target_: os.system", "force.newtonian._target_='os.system'"),
+    ("extra", "_target_: shutil.rmtree\npath: /", "extra._target_='shutil.rmtree'"),
+])
+def test_targets_and_settings_anywhere_are_checked(key, text, named, composed, tmp_path):
+    assert named in check_variant(composed, tmp_path, key, text)
+
+
 @pytest.mark.parametrize("override, key", [
-    ("hydra.launcher._target_=os.system", "hydra.launcher._target_='os.system'"),
-    ("hydra.sweeper._target_=builtins.exec", "hydra.sweeper._target_='builtins.exec'"),
-    ("hydra.callbacks.sweep._target_=os.system", "hydra.callbacks.sweep._target_"),
     ("hydra.callbacks.sweep.figures={_target_:os.system,_args_:[touch PWNED]}", "hydra.callbacks.sweep.figures._target_"),
     ("+hydra.job.env_set.LD_PRELOAD=/tmp/evil.so", "hydra.job.env_set.LD_PRELOAD"),
-    ("+hydra.job.env_set.PYTHONSTARTUP=/tmp/evil.py", "hydra.job.env_set.PYTHONSTARTUP"),
-    ("+foo._target_=os.system", "foo"),
-    ("force.newtonian._target_=os.system", "force.newtonian._target_='os.system'"),
 ])
 def test_targets_and_settings_on_the_command_line_are_refused(override, key, tmp_path, monkeypatch, capsys):
     refused([override], tmp_path, monkeypatch, capsys, key)
@@ -166,14 +197,18 @@ LOGGING = {
 
 @pytest.mark.parametrize("name", LOGGING)
 @pytest.mark.parametrize("which", ["job_logging", "hydra_logging"])
-def test_logging_configs_cannot_run_code_or_write_outside(name, which, tmp_path, monkeypatch, capsys):
+def test_logging_configs_cannot_run_code_or_write_outside(name, which, composed, tmp_path):
     body, key = LOGGING[name]
-    outside = tmp_path / "elsewhere"
-    outside.mkdir()
-    text = "version: 1\n" + body.format(outside=outside) + "\nroot:\n  handlers: []\n"
-    conf = user_dir(tmp_path, f"hydra/{which}/evil.yaml", text)
-    refused(["--config-dir", str(conf), f"hydra/{which}=evil"], tmp_path, monkeypatch, capsys, f"hydra.{which}.{key}")
-    assert list(outside.iterdir()) == [] and not (tmp_path / "PWNED").exists()
+    text = "version: 1\n" + body.format(outside=tmp_path / "elsewhere") + "\nroot:\n  handlers: []\n"
+    assert f"hydra.{which}.{key}" in check_variant(composed, tmp_path, f"hydra.{which}", text)
+
+
+def test_a_logging_config_in_a_user_directory_is_refused(tmp_path, monkeypatch, capsys):
+    text = "version: 1\n" + LOGGING["handler factory"][0] + "\nroot:\n  handlers: []\n"
+    conf = user_dir(tmp_path, "hydra/job_logging/evil.yaml", text)
+    refused(["--config-dir", str(conf), "hydra/job_logging=evil"], tmp_path, monkeypatch, capsys,
+            "hydra.job_logging.handlers.h.()")
+    assert not (tmp_path / "PWNED").exists()
 
 
 def test_log_file_aimed_outside_on_the_command_line(tmp_path, monkeypatch, capsys):
@@ -182,12 +217,23 @@ def test_log_file_aimed_outside_on_the_command_line(tmp_path, monkeypatch, capsy
     assert not (tmp_path.parent / "evil.log").exists()
 
 
-@pytest.mark.parametrize("override, key", [
-    ("hydra.output_subdir=../../.hydra", "hydra.output_subdir"),
-    ("hydra.job.name=../../evil", "hydra.job.name"),
+@pytest.mark.parametrize("key, text, named", [
+    ("hydra.output_subdir", "../../.hydra", "hydra.output_subdir"),
+    ("hydra.job.name", "../../evil", "hydra.job.name"),
+    ("hydra.launcher", "submitit_folder: /tmp/elsewhere/%j", "hydra.launcher.submitit_folder"),
 ])
-def test_hydra_paths_stay_inside_the_run_directory(override, key, tmp_path, monkeypatch, capsys):
-    refused([override], tmp_path, monkeypatch, capsys, key)
+def test_hydra_paths_stay_inside_the_run_directory(key, text, named, composed, tmp_path):
+    from omegaconf import OmegaConf, open_dict
+
+    cfg = composed.copy()
+    with open_dict(cfg):
+        if key == "hydra.launcher":
+            cfg.hydra.launcher = OmegaConf.create({"_target_": "hydra._internal.core_plugins.basic_launcher."
+                                                   "BasicLauncher", "submitit_folder": text.split(": ", 1)[1]})
+        else:
+            OmegaConf.update(cfg, key, text, merge=False)
+    with pytest.raises(ConfigError, match=named.replace(".", r"\.")):
+        check_config(cfg, tmp_path / "out")
 
 
 def test_cluster_shell_lines_from_a_config_file_are_refused(tmp_path, monkeypatch, capsys):
@@ -206,9 +252,8 @@ def test_cluster_shell_lines_from_a_config_file_are_refused(tmp_path, monkeypatc
 def test_safe_configs_pass(tmp_path, monkeypatch):
     """The packaged settings, the launchers and shell lines typed by the user are accepted."""
     monkeypatch.chdir(tmp_path)
-    for overrides in ([], ["hydra/launcher=joblib"], ["hydra/job_logging=stdout"], ["hydra/hydra_logging=disabled"],
-                      ["hydra/launcher=slurm"], ["hydra/launcher=slurm", "hydra.launcher.setup=[module load x]"],
-                      ["+hydra.job.env_set.OMP_NUM_THREADS=1"]):
+    for overrides in ([], ["hydra/launcher=joblib", "hydra/job_logging=stdout", "+hydra.job.env_set.OMP_NUM_THREADS=1"],
+                      ["hydra/launcher=slurm", "hydra.launcher.setup=[module load x]"]):
         cfg = compose_config(overrides, return_hydra_config=True)
         check_config(cfg, Path(cfg.hydra.sweep.dir), command_line=overrides, job_subdir=True)
     assert list(tmp_path.iterdir()) == []
@@ -239,20 +284,12 @@ def test_reproduce_refuses_a_dangerous_stored_config(name, tmp_path, monkeypatch
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]
 
 
-def test_reproduce_refuses_a_stored_config_beyond_the_budget(tmp_path):
-    from gyrolab.sweep.reproduce import stored_config
-
-    text = compose_config(["time.end=1e12"]).__class__  # placeholder to keep imports used
-    del text
-    cfg = compose_config([])
+def test_reproduce_refuses_a_stored_config_beyond_the_budget(composed):
     from omegaconf import OmegaConf
 
+    from gyrolab.sweep.reproduce import stored_config
+
+    cfg = OmegaConf.masked_copy(composed, [k for k in composed if k != "hydra"])
     cfg.time.end = 1.0e12
-    stored = xr.Dataset(attrs={"config": OmegaConf.to_yaml(cfg, resolve=True)})
     with pytest.raises(ConfigError, match="integrator steps"):
-        stored_config(stored)
-
-
-def test_source_is_reset_between_in_process_runs():
-    use_source(ConfigSource())
-    assert sys.argv  # run_main resets the source; a leftover would change every later composition
+        stored_config(xr.Dataset(attrs={"config": OmegaConf.to_yaml(cfg, resolve=True)}))
