@@ -73,7 +73,11 @@ def preflight(argv: Sequence[str]) -> list[str]:
     source = ConfigSource.from_args(args.config_path, args.config_name, args.config_dir)
     use_source(source)
     if args.help or args.hydra_help or args.info or args.shell_completion or args.cfg:
-        return list(argv)  # Hydra's own informational commands
+        # Hydra's own informational commands: --help and --hydra-help configure logging from the config
+        with hydra_for(source):
+            cfg = _compose_job(source, list(args.overrides), False)
+        check_config(cfg, Path(str(cfg.hydra.run.dir)), command_line=args.overrides)
+        return list(argv)
     overrides = parse_overrides(args.overrides)
     argv = _plus_group_as_override(source, list(argv), overrides)
     args, _ = get_args_parser().parse_known_args(argv)

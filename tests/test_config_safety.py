@@ -293,3 +293,12 @@ def test_reproduce_refuses_a_stored_config_beyond_the_budget(composed):
     cfg.time.end = 1.0e12
     with pytest.raises(ConfigError, match="integrator steps"):
         stored_config(xr.Dataset(attrs={"config": OmegaConf.to_yaml(cfg, resolve=True)}))
+
+
+def test_help_commands_do_not_configure_a_dangerous_logging_config(tmp_path, monkeypatch, capsys):
+    """--help and --hydra-help configure Hydra's logging from the config: checked first as well."""
+    text = "version: 1\n" + LOGGING["formatter factory"][0] + "\nroot:\n  handlers: []\n"
+    conf = user_dir(tmp_path, "hydra/hydra_logging/evil.yaml", text)
+    refused(["--hydra-help", "--config-dir", str(conf), "hydra/hydra_logging=evil"], tmp_path, monkeypatch, capsys,
+            "hydra.hydra_logging.formatters.f.()")
+    assert not (tmp_path / "PWNED").exists()
