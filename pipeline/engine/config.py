@@ -277,7 +277,11 @@ def packaged_reference() -> dict[str, Any]:
         keys: set[str] = set()
         for option in (conf / group).iterdir():
             if option.name.endswith(".yaml"):
-                keys |= set(OmegaConf.load(str(option)))
+                text = option.read_text()
+                node = OmegaConf.create(text) if text.strip() else OmegaConf.create({})
+                if "@package _global_" in text.split("\n", 1)[0]:
+                    node = node.get(group) or {}
+                keys |= set(node) - {"defaults"}
         sections[group] = keys
     return {"top": top | set(SELECTABLE_GROUPS), "defaults": main, "sections": sections}
 
