@@ -13,6 +13,7 @@ more commands work on results: ``gyrolab --reproduce PATH/run.nc`` and
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import logging
 import os
@@ -88,13 +89,15 @@ def preflight(argv: Sequence[str]) -> list[str]:
                           f"{shorten(sweeps[0].input_line)} ...), or give one value")
     sweeping = bool(args.multirun)
     check_launcher_installed(overrides)
+    if sweeping:
+        _refuse_swept_hydra_settings(overrides)
+        Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
     with hydra_for(source):
-        check_plugin_names(overrides)
-        if sweeping:
-            _refuse_swept_hydra_settings(overrides)
-            Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
         # One job composed and validated: the first value of every sweep (each group choice checked for safety).
-        configs = [_compose_job(source, _job_overrides(overrides, {}), sweeping)]
+        first = _compose_job(source, _job_overrides(overrides, {}), sweeping)
+    with hydra_for(dataclasses.replace(source, searchpath=tuple(first.hydra.searchpath or ()))):
+        check_plugin_names(overrides)  # every value of every swept group
+        configs = [first]
         swept = [*overrides, *(_sweeper_params(configs[0]) if sweeping else [])]
         for o in swept:
             if o.is_sweep_override() and _is_group(o, configs[0]):
@@ -230,9 +233,6 @@ def check_plugin_names(overrides: Sequence[Override]) -> None:
     """Every option named for a config group (swept or not, in lists too) must exist (needs a Hydra)."""
     selected = [o for o in overrides if o.key_or_group in SELECTABLE_GROUPS and o.package is None
                 and not o.is_delete()]
-    searchpath = [o for o in overrides if o.key_or_group == "hydra.searchpath"]
-    if not selected or searchpath:
-        return  # with hydra.searchpath on the command line, composition itself finds the options
     for o in selected:
         valid = group_options(o.key_or_group)
         values = list(o.sweep_string_iterator()) if o.is_sweep_override() else [o.value()]

@@ -28,14 +28,9 @@ def stored(path):
         return ds.attrs["config"], ds.attrs["integrator"], ds.sizes["time"]
 
 
-@pytest.mark.parametrize("argv", [
-    ["--config-dir", "myconf", "experiment=lopsided_top"],
-    ["--config-dir=myconf", "+experiment=lopsided_top"],
-    ["hydra.searchpath=[file://{conf}]", "experiment=lopsided_top"],
-])
-def test_user_experiment_runs_as_written(argv, myconf, tmp_path, monkeypatch, capsys):
-    argv = [a.format(conf=myconf) for a in argv]
-    code, err = run_main([*argv, "time.end=1", "hydra.run.dir=out"], monkeypatch, capsys)
+def test_user_experiment_runs_as_written(myconf, tmp_path, monkeypatch, capsys):
+    code, err = run_main(["--config-dir=myconf", "+experiment=lopsided_top", "time.end=1", "hydra.run.dir=out"],
+                         monkeypatch, capsys)
     assert code == 0, err
     config, integrator, n = stored(tmp_path / "out" / "run.nc")
     # lopsided_top.yaml: its own body option (a = 1.8, b = 1.2), rk45, r0 = 2, 201 samples
@@ -43,17 +38,34 @@ def test_user_experiment_runs_as_written(argv, myconf, tmp_path, monkeypatch, ca
     assert "a: 1.8" in config and "b: 1.2" in config and "r0: 2.0" in config and "rtol: 1.0e-09" in config
 
 
-@pytest.mark.parametrize("argv", [
-    ["--config-dir", "myconf", "--config-name", "mine"],
-    ["-cp", "myconf", "-cn", "mine"],             # a relative --config-path is read from the working directory
-])
-def test_user_primary_config(argv, myconf, tmp_path, monkeypatch, capsys):
-    code, err = run_main([*argv, "hydra.run.dir=out"], monkeypatch, capsys)
+def test_user_primary_config_runs(myconf, tmp_path, monkeypatch, capsys):
+    # a relative --config-path is read from the working directory
+    code, err = run_main(["-cp", "myconf", "-cn", "mine", "hydra.run.dir=out"], monkeypatch, capsys)
     assert code == 0, err
     config, integrator, n = stored(tmp_path / "out" / "run.nc")
     assert (integrator, n) == ("dop853", 101) and "a: 1.8" in config and not (tmp_path / "out" / "figures").exists()
 
 
+@pytest.mark.parametrize("argv, expected", [
+    (["hydra.searchpath=[file://{conf}]", "experiment=lopsided_top"], ("RK45", 1.8, 201)),
+    (["--config-dir", "myconf", "--config-name", "mine"], ("DOP853", 1.8, 101)),
+    (["--config-path", "myconf", "--config-name", "mine", "body=asymmetric_top"], ("DOP853", 2.0, 101)),
+])
+def test_the_preflight_composes_the_users_config(argv, expected, myconf, monkeypatch):
+    """Each form passes the preflight, which composes from the user's folder (the runs above: Hydra agrees)."""
+    from hydra._internal.utils import get_args_parser
+
+    from gyrolab import app
+    from gyrolab.engine.config import ConfigSource, compose_config, current_source, use_source
+
+    argv = app.absolute_config_path([a.format(conf=myconf) for a in argv])
+    try:
+        app.preflight([*argv, "hydra.run.dir=out"])
+        overrides = get_args_parser().parse_known_args(argv)[0].overrides
+        cfg = compose_config(overrides, config_name=current_source().config_name)
+    finally:
+        use_source(ConfigSource())
+    assert (cfg.integrator._target_.rsplit(".", 1)[1], cfg.body.a, cfg.time.n_output) == expected
 def test_user_configs_in_a_multirun_a_batch_and_a_reproduction(myconf, tmp_path, monkeypatch, capsys):
     code, err = run_main(["-m", "--config-dir", "myconf", "experiment=lopsided_top", "initial.r0=1,2", *SMALL,
                           "hydra.sweep.dir=sweep"], monkeypatch, capsys)

@@ -46,6 +46,8 @@ class ConfigSource:
     config_path: str = PACKAGED_PATH
     config_name: str = CONFIG_NAME
     config_dir: str | None = None
+    #: ``hydra.searchpath`` of the composed config (Hydra appends it while composing; listing options needs it)
+    searchpath: tuple[str, ...] = ()
 
     @classmethod
     def from_args(cls, config_path: str | None, config_name: str | None, config_dir: str | None) -> ConfigSource:
@@ -73,6 +75,8 @@ class ConfigSource:
         if self.config_dir is not None:
             search_path.prepend(provider="command-line", path=f"file://{self.config_dir}",
                                 anchor=SearchPathQuery(provider="schema"))
+        for path in self.searchpath:
+            search_path.append(provider="main", path=path)
         return search_path
 
 
