@@ -63,7 +63,7 @@ def fail(error: GyrolabError) -> None:
 
 
 def preflight(argv: Sequence[str]) -> list[str]:
-    """Validate the command line before Hydra creates any output directory.
+    """Validate the command line before Hydra creates any output directory; the command line Hydra should run.
 
     The config is composed exactly as Hydra will compose it (the same search path,
     primary config and overrides, from a user's ``--config-dir`` too), checked by
@@ -80,9 +80,11 @@ def preflight(argv: Sequence[str]) -> list[str]:
         check_config(cfg, Path(str(cfg.hydra.run.dir)), command_line=args.overrides)
         return list(argv)
     overrides = parse_overrides(args.overrides)
-    argv = _plus_group_as_override(source, list(argv), overrides)
-    args, _ = get_args_parser().parse_known_args(argv)
-    overrides = parse_overrides(args.overrides)
+    rewritten = _plus_group_as_override(source, list(argv), overrides)
+    if rewritten != list(argv):
+        argv = rewritten
+        args, _ = get_args_parser().parse_known_args(argv)
+        overrides = parse_overrides(args.overrides)
     sweeps = [o for o in overrides if o.is_sweep_override()]
     if sweeps and not args.multirun:
         raise ConfigError(f"{shorten(sweeps[0].input_line)!r} is a sweep; run it with -m (gyrolab -m "
@@ -101,8 +103,8 @@ def preflight(argv: Sequence[str]) -> list[str]:
         swept = [*overrides, *(_sweeper_params(configs[0]) if sweeping else [])]
         for o in swept:
             if o.is_sweep_override() and _is_group(o, configs[0]):
-                configs += [_compose_job(source, _job_overrides(swept, {id(o): value}), sweeping)
-                            for value in list(o.sweep_string_iterator())]
+                values = list(o.sweep_string_iterator())[(1 if o in overrides else 0):]  # the first: composed
+                configs += [_compose_job(source, _job_overrides(swept, {id(o): value}), sweeping) for value in values]
     cfg = configs[0]
     for composed in configs:
         check_scene_config(_without_hydra(composed))
