@@ -163,7 +163,8 @@ class LiePoisson(Integrator):
         from gyrolab.plugins.compiled import lie_poisson, models
 
         if compiled.model != models.FIXED_POINT:
-            raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian only; valid systems: fixed_point")
+            raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian with the built-in torque "
+                              "forms only; valid systems: fixed_point with uniform_gravity, newtonian, magnetic")
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         steps = steps_per_interval(t_out, self.step)
