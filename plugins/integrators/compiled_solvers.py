@@ -64,9 +64,12 @@ class DOP853Numba(Tolerances, Integrator):
         h0 = dop853.initial_step(compiled.model, compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
                                  self.rtol, self.atol, stats)
         state = np.array([t_out[0], h0])
+        reached = 1
         for first, stop in _chunks(len(t_out)):
-            status, _ = dop853.run(compiled.model, compiled.params, t_out, out, first, stop, state, y, f,
-                                   t_out[-1], self.rtol, self.atol, self.max_step, stats)
+            if reached >= stop:
+                continue  # a long step already filled this chunk's outputs
+            status, reached = dop853.run(compiled.model, compiled.params, t_out, out, reached, stop, state, y, f,
+                                         t_out[-1], self.rtol, self.atol, self.max_step, stats)
             if status != dop853.OK:
                 reason = "the step size fell below the spacing of floating-point numbers" \
                     if status == dop853.TOO_SMALL_STEP else "the state became non-finite"
