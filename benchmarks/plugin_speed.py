@@ -1,6 +1,6 @@
 """A third-party force plugin against the built-ins: compiled speed of a traced torque (issue 12, item 1).
 
-    python benchmarks/plugin_speed.py            # tolerances 1e-8 .. 1e-12, 5 repeats
+    python benchmarks/plugin_speed.py            # tolerances 1e-8 .. 1e-12, 10 repeats
     python benchmarks/plugin_speed.py --quick    # two tolerances, 3 repeats
 
 The reference problem (``experiment=perf_reference``: uniform gravity + Newtonian centre, k = 0.5,
@@ -65,12 +65,41 @@ def _install(site: Path) -> None:
     sys.path.insert(0, str(site))
 
 
+def rhs_cost(base: list[str], plugin: list[str], compose_scene) -> None:
+    """One right-hand-side evaluation, built-in form against the traced plugin (ns; best of 20 loops of 10⁵)."""
+    import numba
+
+    from gyrolab.plugins.compiled import models
+
+    @numba.njit
+    def loop(model, p, y, out, n):
+        for i in range(n):
+            models.rhs(model, 1e-9 * i, y, p, out)
+            y[0] += 1e-300 * out[0]  # a dependency, so that no evaluation is optimised away
+        return out[0]
+
+    costs = []
+    for overrides in (base, plugin):
+        compiled = compose_scene(overrides).compiled
+        y = compose_scene(overrides).system.initial_state()
+        out = np.empty_like(y)
+        loop(compiled.model, compiled.params, y, out, 10)
+        best = np.inf
+        for _ in range(20):
+            start = time.perf_counter()
+            loop(compiled.model, compiled.params, y, out, 100_000)
+            best = min(best, time.perf_counter() - start)
+        costs.append(best / 100_000 * 1e9)
+    print(f"right-hand side: built-in {costs[0]:.1f} ns, plugin {costs[1]:.1f} ns per evaluation "
+          f"(ratio {costs[1] / costs[0]:.2f})\n")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
     tols = (1e-8, 1e-11) if args.quick else (1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
-    repeats = 3 if args.quick else 5
+    repeats = 3 if args.quick else 10
     _install(Path(tempfile.mkdtemp()))
 
     from gyrolab import compose_scene
@@ -98,6 +127,7 @@ def main() -> None:
 
     for overrides in ([*base, "integrator=dop853_numba"], [*plugin, "integrator=dop853_numba"]):
         timed(overrides, 1e-6, 1)  # compile (or load) the kernels outside the timing
+    rhs_cost([*base, "integrator=dop853_numba"], [*plugin, "integrator=dop853_numba"], compose_scene)
     print(f"{'tol':>7} {'built-in s':>11} {'error':>9} {'plugin s':>9} {'error':>9} {'ratio':>6}")
     rows = []
     for tol in tols:

@@ -42,6 +42,10 @@ class Scene:
             for name, node in (cfg.get("force") or {}).items()
         ]
         system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
+        timed = [f.name for f in forces if f.time_dependent]
+        if timed and system.name != "fixed_point":
+            raise ConfigError(f"force {timed[0]!r} is time-dependent, which system {system.name!r} does not support; "
+                              "valid systems: fixed_point")
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
         times = _output_times(plain["time"])
         integrator.prepare(system)
