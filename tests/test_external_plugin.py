@@ -13,10 +13,10 @@ from pathlib import Path
 
 import pytest
 
-from gyrolab.engine import config, registry
 from gyrolab.engine.scene import compose_scene
 from gyrolab.errors import ConfigError
 from gyrolab.scaffold import new_force_package, render
+from tests.conftest import installed_distribution
 
 REPO = Path(__file__).resolve().parent.parent
 EXAMPLE = REPO / "examples" / "gyrolab-viscous-drag"
@@ -25,22 +25,10 @@ EXAMPLE = REPO / "examples" / "gyrolab-viscous-drag"
 @pytest.fixture(scope="module")
 def installed_plugin(tmp_path_factory):
     """The example's package on the path, plus a .dist-info carrying its pyproject's entry points."""
-    site = tmp_path_factory.mktemp("site")
     project = tomllib.loads((EXAMPLE / "pyproject.toml").read_text())["project"]
-    info = site / f"{project['name'].replace('-', '_')}-{project['version']}.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {project['name']}\nVersion: {project['version']}\n")
-    points = project["entry-points"]["gyrolab.forces"]
-    (info / "entry_points.txt").write_text("[gyrolab.forces]\n" + "".join(f"{k} = {v}\n" for k, v in points.items()))
-    mp = pytest.MonkeyPatch()
-    mp.syspath_prepend(str(EXAMPLE))
-    mp.syspath_prepend(str(site))
-    registry.external.cache_clear()
-    config.register_plugin_configs.cache_clear()
-    yield site
-    mp.undo()
-    registry.external.cache_clear()
-    config.register_plugin_configs.cache_clear()
+    with installed_distribution(tmp_path_factory.mktemp("site"), project["name"], project["version"],
+                                project["entry-points"]["gyrolab.forces"], [EXAMPLE]) as site:
+        yield site
 
 
 def _example_tests():

@@ -12,13 +12,13 @@ import textwrap
 import numpy as np
 import pytest
 
-from gyrolab.engine import config, registry
 from gyrolab.engine.scene import compose_scene
 from gyrolab.errors import ConfigError
 from gyrolab.plugins.forces.magnetic import Magnetic
 from gyrolab.plugins.forces.newtonian import Newtonian
 from gyrolab.plugins.forces.uniform_gravity import UniformGravity
 from gyrolab.testing import check_force
+from tests.conftest import installed_distribution
 
 FORCES = textwrap.dedent('''
     import numpy as np
@@ -96,21 +96,11 @@ NAMES = ("tilted", "wrong_potential", "pulsed", "branchy", "undeclared")
 def kit_forces(tmp_path_factory):
     site = tmp_path_factory.mktemp("site")
     (site / "kit_forces.py").write_text(FORCES)
-    info = site / "kit_forces-0.1.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: kit-forces\nVersion: 0.1\n")
-    (info / "entry_points.txt").write_text("[gyrolab.forces]\n" + "".join(
-        f"{n} = kit_forces:{''.join(w.title() for w in n.split('_'))}\n" for n in NAMES))
-    mp = pytest.MonkeyPatch()
-    mp.syspath_prepend(str(site))
-    registry.external.cache_clear()
-    config.register_plugin_configs.cache_clear()
-    import kit_forces
+    classes = {n: f"kit_forces:{''.join(w.title() for w in n.split('_'))}" for n in NAMES}
+    with installed_distribution(site, "kit-forces", "0.1", classes):
+        import kit_forces
 
-    yield kit_forces
-    mp.undo()
-    registry.external.cache_clear()
-    config.register_plugin_configs.cache_clear()
+        yield kit_forces
 
 
 @pytest.mark.parametrize("cls, params", [(UniformGravity, {}), (Newtonian, {"k": 1.5}), (Magnetic, {"field": 0.7}),
