@@ -112,6 +112,7 @@ def check_force(cls: type, body: Any = None, *, n_states: int = 20, **params: An
     if not isinstance(name, str) or not _NAME.match(name):
         raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config key force.NAME)")
     where = f"force.{name}"
+    params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}  # as a config gives them
     try:
         force = build_force(cls, dict(params), where, body)
     except ConfigError as exc:
