@@ -215,3 +215,33 @@ def test_auto_batch_taylor_and_untraceable_torques(kit_forces):
     for row, start in enumerate(y0s):  # --batch's compiled path = one compiled trajectory at a time
         alone = scene.integrator.integrate(scene.system.rhs, scene.times, start, None, scene.compiled)
         np.testing.assert_allclose(batch.y[row], alone.y, rtol=0, atol=1e-13)
+
+
+def test_first_compile_of_a_form_is_logged_once_then_loaded_from_the_cache(tmp_path, monkeypatch, caplog):
+    import logging
+
+    from gyrolab.contracts import Force
+    from gyrolab.plugins import compiled
+    from gyrolab.plugins.compiled import plugin_torque
+
+    class Once(Force):
+        name = "once_only"
+        preserves_area_integral = False
+
+        def __init__(self, body):
+            pass
+
+        def torque(self, omega, axes):
+            return -0.25 * omega * omega[1] / 3.0  # a form no other test traces
+
+    monkeypatch.setattr(compiled, "kernel_cache_dir", lambda: str(tmp_path))
+    monkeypatch.setattr(plugin_torque, "_LOADED", {})
+    with caplog.at_level(logging.INFO, logger=plugin_torque.__name__):
+        first = plugin_torque.compile_trace(plugin_torque.trace([Once(None)]), ["once_only"])
+        assert "compiling force once_only, once" in caplog.text
+        caplog.clear()
+        monkeypatch.setattr(plugin_torque, "_LOADED", {})  # a new process: the module and numba's cache reload
+        again = plugin_torque.compile_trace(plugin_torque.trace([Once(None)]), ["once_only"])
+        assert "compiling" not in caplog.text
+    assert len(list((tmp_path / "forces").glob("gyrolab_force_*.py"))) == 1
+    np.testing.assert_array_equal(first.constants, again.constants)
