@@ -362,7 +362,8 @@ def _quiet_console() -> None:
 
 
 def run_command(argv: Sequence[str]) -> int | None:
-    """``--reproduce PATH``, ``--aggregate SWEEP_DIR``, ``--batch OVERRIDES``: exit status, or None for a Hydra run.
+    """``--reproduce PATH``, ``--aggregate SWEEP_DIR``, ``--batch OVERRIDES``, ``--new-force NAME``: exit status,
+    or None for a Hydra run.
 
     Hydra's config options (``--config-dir``, ``--config-path``, ``--config-name``) may come first.
     """
@@ -370,6 +371,15 @@ def run_command(argv: Sequence[str]) -> int | None:
     if argv and argv[0] == "--batch":
         use_source(source)
         return _batch(argv[1:])
+    if argv and argv[0].split("=", 1)[0] == "--new-force":
+        from gyrolab.scaffold import new_force_package
+
+        name = argv[0].partition("=")[2] or (argv[1] if len(argv) == 2 else "")
+        if len(argv) > (1 if "=" in argv[0] else 2):
+            raise ConfigError("--new-force takes one name; usage: gyrolab --new-force NAME")
+        root = new_force_package(name)
+        print(f"wrote {root}/: pip install -e {root} && python -m pytest {root}/tests")
+        return 0
     if not argv or argv[0].split("=", 1)[0] not in ("--reproduce", "--aggregate"):
         return None
     option, _, value = argv[0].partition("=")

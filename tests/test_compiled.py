@@ -79,19 +79,26 @@ def test_auto_meets_its_accuracy(accuracy):
     assert ds.attrs["auto_predicted_error"] <= accuracy
 
 
-def test_auto_falls_back_to_scipy_without_compiled_forms(monkeypatch):
+def _untraceable_newtonian(monkeypatch):
+    """Newtonian without its compiled form, its torque unchanged but computed through float(): not traceable."""
     from gyrolab.plugins.forces.newtonian import Newtonian
 
+    torque = Newtonian.torque
     monkeypatch.setattr(Newtonian, "compiled_terms", lambda self: None)
+    monkeypatch.setattr(Newtonian, "torque",
+                        lambda self, omega, axes: np.array([float(v) for v in torque(self, omega, axes)]))
+
+
+def test_auto_falls_back_to_scipy_without_compiled_forms(monkeypatch):
+    _untraceable_newtonian(monkeypatch)
     ds = run(["integrator=auto", "accuracy=1e-7", "time.end=5", "time.n_output=11"])
     assert ds.attrs["auto_method"] == "dop853"
 
 
 def test_compiled_integrator_refuses_a_force_without_compiled_form(monkeypatch):
-    from gyrolab.plugins.forces.newtonian import Newtonian
-
-    monkeypatch.setattr(Newtonian, "compiled_terms", lambda self: None)
-    with pytest.raises(ConfigError, match="'newtonian' has no compiled form"):
+    _untraceable_newtonian(monkeypatch)
+    with pytest.raises(ConfigError, match="the torque of force 'newtonian' cannot be compiled: it converts the state "
+                                          "to a Python float"):
         compose_scene(["integrator=taylor"])
 
 

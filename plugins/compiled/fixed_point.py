@@ -29,6 +29,30 @@ def pack(inertia: np.ndarray, terms: list[CompiledTerms], carries_alpha: bool) -
     return p
 
 
+def compiled_model(inertia: np.ndarray, forces: list, carries_alpha: bool):
+    """The fixed-point system's compiled model: built-in torque forms packed, any other torque traced and compiled.
+
+    Forces with ``compiled_terms()`` fill the packed forms; the others' torques are traced together into
+    one compiled kernel (``plugin_torque``), whose address and constants extend the parameter array.
+    Raises ``plugin_torque.NotCompilable`` naming the construct that prevents compilation.
+    """
+    from gyrolab.contracts.integrator import CompiledModel
+    from gyrolab.plugins.compiled import models, plugin_torque
+
+    terms, plugins = [], []
+    for force in forces:
+        term = force.compiled_terms()
+        if term is None:
+            plugins.append(force)
+        else:
+            terms.append(term)
+    p = pack(inertia, terms, carries_alpha)
+    if not plugins:
+        return CompiledModel(models.FIXED_POINT, p)
+    compiled = plugin_torque.compile_trace(plugin_torque.trace(plugins), [f.name for f in plugins])
+    return CompiledModel(models.FIXED_POINT_PLUGIN, np.concatenate([p, [float(compiled.address)], compiled.constants]))
+
+
 @inline_kernel
 def _cross_add(u0, u1, u2, v0, v1, v2, s):
     """s · (u × v) as three floats."""

@@ -66,9 +66,11 @@ class Auto(Integrator):
 
     def _method(self, compiled: CompiledModel | None, tol: float) -> Integrator:
         if compiled is not None:
-            from gyrolab.plugins.integrators.compiled_solvers import Taylor
+            from gyrolab.plugins.compiled.models import TAYLOR_MODELS
+            from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
 
-            return Taylor(order=20, tol=tol)
+            # a compiled plugin torque has no Taylor coefficients: compiled DOP853 instead
+            return Taylor(order=20, tol=tol) if compiled.model in TAYLOR_MODELS else DOP853Numba(rtol=tol, atol=tol)
         from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
         return DOP853(rtol=tol, atol=tol)
@@ -122,8 +124,10 @@ class Auto(Integrator):
     def _series(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                 start: float) -> Solution | None:
         """The first regime whose analytic series is predicted to meet the accuracy on this scene, or None."""
-        if self.system is None or compiled is None or t_out[0] != 0.0:
-            return None
+        from gyrolab.plugins.compiled.models import TAYLOR_MODELS
+
+        if self.system is None or compiled is None or t_out[0] != 0.0 or compiled.model not in TAYLOR_MODELS:
+            return None  # the truth check below integrates with Taylor
         from gyrolab.engine import registry
         from gyrolab.plugins.integrators.compiled_solvers import Taylor
 

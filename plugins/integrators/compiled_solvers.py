@@ -140,9 +140,12 @@ class DOP853Numba(Tolerances, Integrator):
         h0 = dop853.initial_step(compiled.model, compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
                                  self.rtol, self.atol, stats)
         state = np.array([t_out[0], h0])
+        reached = 1
         for first, stop in _Chunks(len(t_out)):
-            status, _ = dop853.run(compiled.model, compiled.params, t_out, out, first, stop, state, y, f,
-                                   t_out[-1], self.rtol, self.atol, self.max_step, stats)
+            if reached >= stop:
+                continue  # a long step already filled this chunk's outputs
+            status, reached = dop853.run(compiled.model, compiled.params, t_out, out, reached, stop, state, y, f,
+                                         t_out[-1], self.rtol, self.atol, self.max_step, stats)
             if status != dop853.OK:
                 reason = "the step size fell below the spacing of floating-point numbers" \
                     if status == dop853.TOO_SMALL_STEP else "the state became non-finite"
@@ -237,7 +240,8 @@ class LiePoisson(Integrator):
         from gyrolab.plugins.compiled import lie_poisson, models
 
         if compiled.model != models.FIXED_POINT:
-            raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian only; valid systems: fixed_point")
+            raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian with the built-in torque "
+                              "forms only; valid systems: fixed_point with uniform_gravity, newtonian, magnetic")
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         steps = steps_per_interval(t_out, self.step)
