@@ -111,15 +111,29 @@ class RK4Numba(Integrator):
 
 
 class Taylor(Integrator):
+    """Taylor series method (``gyrolab.plugins.compiled.taylor``): order and step from the tolerance.
+
+    ``order=None`` (the default) takes Jorba and Zou's optimal order for ``tol``; an explicit order
+    overrides it. Calls into the kernel are sized by wall time (about ``CHUNK_SECONDS`` each, after a
+    short first chunk that measures the speed): a run of a few milliseconds is one or two calls,
+    a long run still reports progress regularly.
+    """
+
     name = "taylor"
     adaptive = True
     needs_compiled_model = True
+    CHUNK_SECONDS = 0.25
 
-    def __init__(self, *, order: int = 20, tol: float = 1e-16) -> None:
-        if isinstance(order, bool) or not isinstance(order, int) or not 4 <= order <= 60:
-            raise ConfigError(f"integrator.order={order!r} must be an integer from 4 to 60")
-        self.order = order
+    def __init__(self, *, order: int | None = None, tol: float = 1e-16) -> None:
+        from gyrolab.plugins.compiled.taylor import MAX_ORDER, MIN_ORDER, order_for
+
         self.tol = as_number(tol, "integrator.tol", positive=True)
+        if order is None:
+            order = order_for(self.tol)
+        if isinstance(order, bool) or not isinstance(order, int) or not MIN_ORDER <= order <= MAX_ORDER:
+            raise ConfigError(f"integrator.order={order!r} must be an integer from {MIN_ORDER} to {MAX_ORDER} "
+                              "(or null: chosen from integrator.tol)")
+        self.order = order
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
@@ -128,14 +142,22 @@ class Taylor(Integrator):
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         state = np.array([t_out[0]])
+        carry = np.zeros_like(y)
         stats = np.zeros(2, dtype=np.int64)
-        for first, stop in _chunks(len(t_out)):
+        first, n_out = 1, len(t_out)
+        size = max(1, (n_out - 1) // CHUNKS)  # first chunk: 1/CHUNKS of the outputs, to measure the speed
+        while first < n_out:
+            stop = min(first + size, n_out)
+            began = time.perf_counter()
             status, _ = taylor.run(compiled.model, compiled.params, self.order, self.tol, t_out, out, first, stop,
-                                   state, y, stats)
+                                   state, y, carry, stats)
             if status != taylor.OK:
                 raise IntegrationError(f"taylor produced a non-finite state near t={state[0]:.6g}")
             if progress is not None:
                 progress(state[0])
+            per_output = (time.perf_counter() - began) / (stop - first)
+            size = max(1, int(self.CHUNK_SECONDS / per_output)) if per_output > 0 else n_out
+            first = stop
         # one Taylor step costs about as much as `order` right-hand-side evaluations; report the series count
         return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
                                                     wall_time=time.perf_counter() - start))
