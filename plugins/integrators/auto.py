@@ -120,7 +120,7 @@ class Auto(Integrator):
             per_tol, growth, nfev, measured, tight = self._pilot(fun, pilot_times, y0, compiled, tau)
             pilot_nfev += nfev
             # per_tol bounds the truncation error even when the pilot saw only round-off
-            chosen = min(self.accuracy / (self.safety * CALIBRATION * per_tol), MAX_TOLERANCE)
+            chosen = min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
             if not measured and tau < MAX_TOLERANCE / 100:  # only round-off seen: measure with a looser pilot
                 tau *= 100
             elif chosen > 10 * tau:  # re-centre: never extrapolate far towards looser tolerances
@@ -135,7 +135,7 @@ class Auto(Integrator):
             raise ConfigError(f"accuracy={self.accuracy:g} is below the round-off that double precision accumulates "
                               f"on this scene (about {roundoff:.1g} over ~{steps:.0f} steps); ask for at least that")
         if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
-            chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol)
+            chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         method = self._method(compiled, chosen)
         if pilot_tau * 1e-2 <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
             head = np.isin(pilot_times, t_out[t_out < t_pilot])
