@@ -138,7 +138,7 @@ class Auto(Integrator):
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         method = self._method(compiled, chosen)
         if pilot_tau * 1e-2 <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
-            head = np.isin(pilot_times, t_out[t_out < t_pilot])
+            head = np.searchsorted(pilot_times, t_out[t_out < t_pilot])  # the outputs inside the pilot
             rest = t_out[t_out >= t_pilot]
             tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest,
                                     tight.y[-1], progress, compiled)
