@@ -151,9 +151,8 @@ def taylor_coefficients(p, Y, order, work):
         acc[1] = d1 * (w1 - n2 * g1) + p[11] * e0 - p[9] * e2
         acc[2] = d2 * (w2 - n2 * g2) + p[9] * e1 - p[10] * e0
         if has_alpha:
-            acc_b = np.zeros(3)  # β_k = Σ γ_j × α_{k−j}
-            _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, acc_b)
-            work[k, 0], work[k, 1], work[k, 2] = acc_b[0], acc_b[1], acc_b[2]
+            work[k, 0] = work[k, 1] = work[k, 2] = 0.0  # β_k = Σ γ_j × α_{k−j}
+            _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, work[k])
             x0, x1, x2 = Y[k, 6], Y[k, 7], Y[k, 8]
             b0, b1, b2 = work[k, 0], work[k, 1], work[k, 2]
             acc[0] += p[4] * x2 - p[5] * x1 + p[7] * b2 - p[8] * b1
@@ -176,7 +175,7 @@ def taylor_coefficients(p, Y, order, work):
         # γ̇ = γ × ω, α̇ = α × ω
         Y[k + 1, 3], Y[k + 1, 4], Y[k + 1, 5] = c0 * inv, c1 * inv, c2 * inv
         if has_alpha:
-            acc[:] = 0.0
+            acc[0] = acc[1] = acc[2] = 0.0
             _cauchy_cross(Y, 6, Y, 0, k, 1.0, 1.0, 1.0, acc)
             Y[k + 1, 6], Y[k + 1, 7], Y[k + 1, 8] = acc[0] * inv, acc[1] * inv, acc[2] * inv
 

@@ -57,7 +57,8 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     i = i_next
     safety = math.exp(-0.7 / (order - 1))
     while i < i_stop:
-        T[0] = y
+        for m in range(n):
+            T[0, m] = y[m]
         taylor_coefficients(model, p, T, order, work)
         stats[0] += 1
         scale = max(1.0, _norm_inf(y))
@@ -91,7 +92,7 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
             s = y[m] + inc
             carry[m] = (s - y[m]) - inc
             y[m] = s
-            finite = finite and np.isfinite(s)
+            finite = finite and math.isfinite(s)
         if not finite:
             state[0] = t
             return NOT_FINITE, i
