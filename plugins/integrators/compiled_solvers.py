@@ -32,16 +32,20 @@ PACE = 1.0  # seconds of compiled work between two returns to Python (progress r
 class _Chunks:
     """Output-index ranges ``(first, stop)`` for the compiled kernels, each taking about ``PACE`` seconds.
 
-    Never more than 1/CHUNKS of the outputs at once; the size follows the measured speed, so a long
-    run reports progress every second or so. For fixed-step methods (``steps`` given) it also says
-    when one output interval alone is too long (``step_budget``): that interval is then advanced in
-    pieces (``_interval_in_pieces``).
+    The first range is 1/CHUNKS of the outputs (one output for fixed-step methods, ``steps`` given,
+    whose single output interval may already be long); later ones follow the measured speed, so a
+    long run reports progress about every ``PACE`` seconds and a short one costs only a few calls
+    into the kernel (each call has a fixed cost of some microseconds, which matters for millisecond
+    runs). Fixed-step methods never take more than 1/CHUNKS of the outputs at once and learn
+    when one output interval alone is too long (``step_budget``): that interval is then advanced
+    in pieces (``_interval_in_pieces``).
     """
 
     def __init__(self, n_out: int, steps: np.ndarray | None = None) -> None:
         self.n_out, self.steps = n_out, steps
-        self.cap = max(1, math.ceil((n_out - 1) / CHUNKS))
-        self.size = 1
+        share = max(1, math.ceil((n_out - 1) / CHUNKS))
+        self.cap = share if steps is not None else n_out
+        self.size = 1 if steps is not None else share
         self.step_rate = 1e5  # steps per second, until measured
 
     def __iter__(self):
@@ -188,15 +192,27 @@ class RK4Numba(Integrator):
 
 
 class Taylor(Integrator):
+    """Taylor series method (``gyrolab.plugins.compiled.taylor``): order and step from the tolerance.
+
+    ``order=None`` (the default) takes Jorba and Zou's optimal order for ``tol``; an explicit order
+    overrides it. Calls into the kernel are sized by wall time (``_Chunks``): a run of a few
+    milliseconds is one or two calls, a long run still reports progress regularly.
+    """
+
     name = "taylor"
     adaptive = True
     needs_compiled_model = True
 
-    def __init__(self, *, order: int = 20, tol: float = 1e-16) -> None:
-        if isinstance(order, bool) or not isinstance(order, int) or not 4 <= order <= 60:
-            raise ConfigError(f"integrator.order={order!r} must be an integer from 4 to 60")
-        self.order = order
+    def __init__(self, *, order: int | None = None, tol: float = 1e-16) -> None:
+        from gyrolab.plugins.compiled.taylor import MAX_ORDER, MIN_ORDER, order_for
+
         self.tol = as_number(tol, "integrator.tol", positive=True)
+        if order is None:
+            order = order_for(self.tol)
+        if isinstance(order, bool) or not isinstance(order, int) or not MIN_ORDER <= order <= MAX_ORDER:
+            raise ConfigError(f"integrator.order={order!r} must be an integer from {MIN_ORDER} to {MAX_ORDER} "
+                              "(or null: chosen from integrator.tol)")
+        self.order = order
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
@@ -205,10 +221,11 @@ class Taylor(Integrator):
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         state = np.array([t_out[0]])
+        carry = np.zeros_like(y)
         stats = np.zeros(2, dtype=np.int64)
         for first, stop in _Chunks(len(t_out)):
             status, _ = taylor.run(compiled.model, compiled.params, self.order, self.tol, t_out, out, first, stop,
-                                   state, y, stats)
+                                   state, y, carry, stats)
             if status != taylor.OK:
                 raise IntegrationError(f"taylor produced a non-finite state near t={state[0]:.6g}")
             if progress is not None:
