@@ -217,3 +217,79 @@ def test_reduced_rhs_is_exposed_on_the_plugin():
     # reduced system vs exact orbit: p, q O(μ⁻³) relative to c, γ's O(μ⁻⁴) (32⁻³ ≈ 3e-5, 32⁻⁴ ≈ 1e-6)
     assert np.max(np.abs(y[:, :2] - orbit[:, :2])) / s.c < 2e-4
     assert np.max(np.abs(y[:, 3:] - orbit[:, 3:])) < 2e-5
+
+
+# -- the finite-tilt period and the order-N series (issue 13, items 1, 4 and 5c) -------------------------------
+from gyrolab.experiments.regime_run import exact_orbit  # noqa: E402
+from tests.test_regime_helpers import BODY_000  # noqa: E402
+
+
+def _tilted(eps, g0, *extra):
+    overrides = ["regime=small_parameter", *BODY_000, f"initial.r0={1 / eps!r}",
+                 f"initial.theta0={float(np.arccos(g0))!r}", *extra]
+    scene, regime, _ = prepare(compose_config(overrides))
+    return scene, regime
+
+
+def test_period_keeps_the_finite_tilt():
+    # (36) keeps only the −z0'γ0'' tilt term; the truth is the exact orbit's period. Body I, ε = 0.01, γ0'' = 0.3:
+    # α/ε² = (T_τ − 2π)/ε² is 1.124 on the exact orbit, 1.375 by (36) (an O(γ0''²) error, not O(ε²)).
+    eps, g0 = 0.01, 0.3
+    scene, regime = _tilted(eps, g0)
+    exact = (exact_orbit(scene, regime).period / eps - 2 * np.pi) / eps**2
+    ours = (regime.period(scene.system) / eps - 2 * np.pi) / eps**2
+    P = regime.params(regime.scene(scene.system))
+    assert abs(paper.period_correction(P) / eps**2 - exact) > 0.2  # the formula this replaces
+    assert ours == pytest.approx(exact, abs=5e-3)
+    # and at a larger tilt, through ε³: the relative period error is O(ε⁴) (coefficient 1.1 on body I at
+    # γ0'' = 0.7), where (36)'s is O(ε²γ0''²)
+    eps, g0 = 0.05, 0.7
+    scene, regime = _tilted(eps, g0)
+    T = exact_orbit(scene, regime).period
+    assert abs(regime.period(scene.system) - T) / T < 2 * eps**4
+    P = regime.params(regime.scene(scene.system))
+    assert abs(eps * (2 * np.pi + paper.period_correction(P)) - T) / T > 20 * eps**4
+
+
+@pytest.fixture(scope="module")
+def order10():
+    return _tilted(0.05, 0.3, "regime.order=10")
+
+
+def test_order_10_shows_its_error_slope_and_radius(order10):
+    scene, regime = order10
+    data, coords, attrs = regime.diagnostics(scene.system)
+    assert attrs["series_order"] == 10
+    assert attrs["series_error_slope"] == pytest.approx(11, abs=0.3)
+    R = attrs["series_radius_of_convergence"]
+    # three estimates from the same coefficients agree within 10 %; the scene is well inside the radius
+    assert attrs["series_radius_root_test"] == pytest.approx(R, rel=0.1)
+    assert attrs["series_radius_pade"] == pytest.approx(R, rel=0.1)
+    assert attrs["series_min_r0_over_c"] == pytest.approx(1 / R)
+    assert np.all(data["series_ladder_error"][1] > 1e-13)
+    assert attrs["series_consistency_max"] < 1e-11
+    # at the scene's ε the order-10 series is the exact orbit to ~ε¹¹ (5e-15 relative): round-off level
+    orbit = exact_orbit(scene, regime)
+    t = np.linspace(0.0, orbit.period, 9)
+    from gyrolab.experiments.regime_run import integrate
+
+    y = integrate(scene, orbit.y0, t, taylor=True)[:, :6]
+    assert np.max(np.abs(regime.solution(scene.system, t) - y) / np.array([1, 1, 20, 1, 1, 1])) < 1e-12
+    assert regime.period(scene.system) == pytest.approx(orbit.period, rel=1e-13)
+
+
+def test_bad_order_is_refused():
+    from gyrolab.plugins.regimes.small_parameter import SmallParameter
+
+    for value in (0, True, 2.5, 61, "6"):
+        with pytest.raises(ConfigError, match="regime.order"):
+            SmallParameter(order=value)
+    with pytest.raises(ConfigError, match="no printed form"):
+        SmallParameter(order=6, formula="printed")
+    with pytest.raises(ConfigError, match="regime.order"):  # and through the configuration
+        prepare(compose_config([*overrides_000(20.0), "regime.order=0"]))
+
+
+def test_order_beyond_the_radius_of_convergence_is_refused():
+    with pytest.raises(ConfigError, match="radius of convergence"):
+        _tilted(0.8, 0.3, "regime.order=6")

@@ -62,6 +62,7 @@ def divisor_threshold(n: float, eps: float) -> float:
 # 0.5 % of the Lagrange top's exact branch point at order 32; on body I it moves by < 2 % from order 24 to 40).
 RADIUS_ORDER = 32
 MAX_ORDER = 60
+CANDIDATES = 3  # orders offered to integrator=auto (it measures each, lowest first, and takes the first that meets)
 
 
 @lru_cache(maxsize=32)
@@ -129,22 +130,28 @@ class SmallParameter(FixedPointRegime):
                               order=order)
 
     def series_candidates(self, system, accuracy: float) -> list[tuple[SmallParameter, float]]:
-        """(regime at order N, its predicted max error in model units) for N = 1, 2, …, lowest first.
+        """(regime at order N, its predicted max error in model units), the lowest ``CANDIDATES`` orders predicted
+        to meet ``accuracy``, lowest first, after the closed forms (no prediction: auto measures them) when the
+        regime has no order of its own.
 
         The prediction is the first omitted term (``LindstedtSeries.error_estimate``) in model units (p, q
         scale with c, r with c/ε); only orders predicted to meet ``accuracy`` are listed (none when the scene's ε
         is beyond half the radius of convergence, where the estimate is not trustworthy).
         """
         s = self.scene(system)
+        out = [(self, float("nan"))] if self.series_order is None else []  # the closed forms, measured by auto
+        if not s.r0 > 1 or not abs(s.gamma0pp) < 1:
+            return out
         eps = 1.0 / s.r0
         sol = self.series(system)
         if not eps < 0.5 * sol.radius_of_convergence():
-            return []
-        out = []
+            return out
         for n in range(1, sol.max_order):
             estimate = sol.error_estimate(eps, n) * s.c * max(1.0, 1 / eps)
             if estimate <= accuracy:
                 out.append((self.with_order(n), estimate))
+            if len(out) == CANDIDATES + (self.series_order is None):
+                break
         return out
 
     def attributes(self) -> dict[str, Any]:
@@ -204,8 +211,9 @@ class SmallParameter(FixedPointRegime):
             return warnings + self.reseat_warnings(system)
         gamma = s.gamma0pp / eps
         if abs(gamma) > 3:
-            warnings.append(f"Γ = cos θ0 · r0/c = {gamma:.3g}: the expansion assumes cos θ0 = O(c/r0) "
-                            "(a nearly horizontal axis, seed 000 eq. 28); expect larger errors")
+            warnings.append(f"Γ = cos θ0 · r0/c = {gamma:.3g}: the closed forms assume cos θ0 = O(c/r0) "
+                            "(a nearly horizontal axis, seed 000 eq. 28); expect errors of order cos⁴θ0 in the γ's "
+                            "(the period keeps the finite tilt); regime.order=N gives the finite-tilt series")
         if abs(s.a + s.b - 1) < 0.05:
             warnings.append(f"a + b − 1 = {s.a + s.b - 1:.3g}: the z0'/(a + b − 1) terms of (35) are large")
         return warnings + self.reseat_warnings(system)
