@@ -293,3 +293,36 @@ def test_bad_order_is_refused():
 def test_order_beyond_the_radius_of_convergence_is_refused():
     with pytest.raises(ConfigError, match="radius of convergence"):
         _tilted(0.8, 0.3, "regime.order=6")
+
+
+def test_auto_takes_the_lowest_series_order_that_meets_the_target():
+    # A scene on the exact orbit (shooting) at r0/c = 32: the closed forms (error ~1e-5) cannot meet 1e-9,
+    # the numeric series can; auto records the order it used, and the result meets the target against the
+    # extended-precision reference.
+    from gyrolab import compose_scene
+    from gyrolab.physics.periodic import FixedPointModel, shoot
+    from gyrolab.physics.reference import fixed_point_reference
+    from gyrolab.plugins.regimes.small_parameter import SmallParameter
+
+    base = [*BODY_000, "initial.r0=32.0", f"initial.theta0={float(np.arccos(0.5 / 32))!r}", "time.end=1.0",
+            "time.n_output=21", "integrator=auto"]
+    system = compose_scene([*base, "accuracy=1e-9"]).system
+    regime = SmallParameter()
+    orbit = shoot(FixedPointModel.from_system(system), regime.initial_state(system), regime.period(system))
+    on_orbit = [*base, f"initial.p0={float(orbit.y0[0])!r}", f"initial.q0={float(orbit.y0[1])!r}"]
+    ds = compose_scene([*on_orbit, "accuracy=1e-9"]).run()
+    assert ds.attrs["auto_method"] == "regime small_parameter"
+    order = int(ds.attrs["regime_order"])
+    y0 = np.concatenate([ds.omega.values[0], ds.gamma.values[0]])
+    rc = [0.5, 0.3, float(np.sqrt(1 - 0.34))]
+    ref = fixed_point_reference([2.0, 1.5, 1.0], rc, 0.3, y0, ds.time.values).astype(float)
+    assert np.max(np.abs(np.concatenate([ds.omega.values, ds.gamma.values], axis=1) - ref)) <= 1e-9
+    # the lowest: one order less is disqualified by auto's rules — its error over one period, extrapolated to the
+    # span with the safety factor 3, misses the target, or the scene does not start on its orbit (a warning: its
+    # p0, q0 differ by more than 1e-12)
+    scene = compose_scene([*on_orbit, "accuracy=1e-9"])
+    lower = SmallParameter(order=order - 1)
+    t = np.linspace(0.0, regime.period(system), 33)
+    truth = fixed_point_reference([2.0, 1.5, 1.0], rc, 0.3, orbit.y0, t).astype(float)
+    missed = np.max(np.abs(lower.solution(system, t) - truth)) * 1.0 / t[-1] * 3 > 1e-9
+    assert missed or lower.check_domain(scene.system)

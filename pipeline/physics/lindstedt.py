@@ -150,16 +150,21 @@ class LindstedtSeries:
         r = self.radius()
         return r["domb_sykes"] if np.isfinite(r["domb_sykes"]) else r["domb_sykes_norm"]
 
-    def error_estimate(self, eps: float, order: int) -> float:
-        """Predicted max error of the order-``order`` series in the scaled state: the first omitted term's size.
+    def error_estimate(self, eps: float, order: int, weights=(1.0, 1.0, 1.0, 1.0, 1.0, 1.0)) -> float:
+        """Predicted max error of the order-``order`` series over one period: the first omitted term's size.
 
-        Uses ε^(order+1)‖Y_(order+1)‖ plus the phase drift of one period, 2π ε^(order+1)|Ω_(order+1)| ·
-        max‖Y_0'‖; needs order < max_order.
+        max_i w_i ε^(N+1)‖Y_(N+1),i‖ plus the phase drift of one period, 2π ε^(N+1)|Ω_(N+1)| · max_i w_i‖Y_0,i'‖
+        (``weights`` scale the components to the units wanted, e.g. (c, c, c/ε, 1, 1, 1) for model units).
+        Needs order < max_order.
         """
         if order >= self.max_order:
             raise ConfigError(f"the error of order {order} needs the series through order {order + 1}")
         nxt = order + 1
-        return float(eps**nxt * (self.norms()[nxt] + 2 * np.pi * abs(self.omega[nxt])))
+        w = np.asarray(weights, dtype=float)
+        term = np.abs(self.fourier[nxt]).sum(axis=1)
+        harmonics = np.fft.fftfreq(self.fourier.shape[2], 1.0 / self.fourier.shape[2])
+        speed = np.abs(self.fourier[0] * harmonics).sum(axis=1)
+        return float(eps**nxt * (np.max(w * term) + 2 * np.pi * abs(self.omega[nxt]) * np.max(w * speed)))
 
 
 def _domb_sykes(c: np.ndarray) -> float:

@@ -135,7 +135,7 @@ class SmallParameter(FixedPointRegime):
         regime has no order of its own.
 
         The prediction is the first omitted term (``LindstedtSeries.error_estimate``) in model units (p, q
-        scale with c, r with c/ε); only orders predicted to meet ``accuracy`` are listed (none when the scene's ε
+        scale with c, r with c/ε = c r0); only orders predicted to meet ``accuracy`` are listed (none when the scene's ε
         is beyond half the radius of convergence, where the estimate is not trustworthy).
         """
         s = self.scene(system)
@@ -147,7 +147,7 @@ class SmallParameter(FixedPointRegime):
         if not eps < 0.5 * sol.radius_of_convergence():
             return out
         for n in range(1, sol.max_order):
-            estimate = sol.error_estimate(eps, n) * s.c * max(1.0, 1 / eps)
+            estimate = sol.error_estimate(eps, n, (s.c, s.c, s.c / eps, 1.0, 1.0, 1.0))
             if estimate <= accuracy:
                 out.append((self.with_order(n), estimate))
             if len(out) == CANDIDATES + (self.series_order is None):
