@@ -28,6 +28,7 @@ lists them. The solvability conditions left over (mean of R_r, mean of R_γ'', t
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -116,8 +117,8 @@ class LindstedtSeries:
         ``domb_sykes``: the ratios |Ω_k/Ω_{k−2}|^½ extrapolated linearly in 1/k to 1/k = 0 (``domb_sykes_norm``:
         the same with ‖Y_k‖); ``pade``: the smallest |pole| of the diagonal Padé approximant of Ω (in ε², when Ω is
         even in ε as at a fixed tilt). On the Lagrange top, whose Ω(ε) is known in closed form (steady precession,
-        branch point ε = 1/(2√(aγ0''))), ``domb_sykes`` is within 0.5 % at order 32 (tests/test_lindstedt.py);
-        it is the estimate ``radius_of_convergence`` reports.
+        branch point ε = 1/(2√(aγ0''))), ``domb_sykes`` is within 0.5 % at order 32, ``root`` within 3 % below
+        (tests/test_lindstedt.py).
         """
         n = self.norms()
         ks = np.arange(len(n))
@@ -137,7 +138,9 @@ class LindstedtSeries:
             from scipy.interpolate import pade as pade_fit
 
             try:
-                _, q = pade_fit(list(coeffs[: 2 * m + 1]), m)
+                with warnings.catch_warnings():  # an ill-conditioned Padé system is expected near resonances
+                    warnings.simplefilter("ignore")
+                    _, q = pade_fit(list(coeffs[: 2 * m + 1]), m)
                 poles = np.roots(q.coeffs)
                 poles = poles[np.isfinite(poles)]
                 pade = float(np.min(np.abs(poles)) ** (1 / power)) if poles.size else np.nan
@@ -146,9 +149,17 @@ class LindstedtSeries:
         return {"root": root, "domb_sykes": domb, "domb_sykes_norm": domb_norm, "pade": pade}
 
     def radius_of_convergence(self) -> float:
-        """The Domb–Sykes estimate from Ω (from the coefficient norms when Ω's ratios are not usable)."""
+        """The median of the root-test, Domb–Sykes (Ω) and Padé estimates: robust to one of them failing.
+
+        Far from resonances Domb–Sykes is the sharpest (the Lagrange top's branch point within 0.5 %) and the
+        root test is biased low (the k^(−3/2) of a square-root branch point: up to 20 % at order 32); near ω = n
+        several complex singularities crowd, the ratios oscillate and Domb–Sykes can be off by 5×, while the root
+        test and Padé agree within a few per cent; Padé alone sometimes returns a spurious pole (a Froissart
+        doublet).
+        """
         r = self.radius()
-        return r["domb_sykes"] if np.isfinite(r["domb_sykes"]) else r["domb_sykes_norm"]
+        finite = [v for v in (r["root"], r["domb_sykes"], r["pade"]) if np.isfinite(v)]
+        return float(np.median(finite)) if finite else float("nan")
 
     def error_estimate(self, eps: float, order: int, weights=(1.0, 1.0, 1.0, 1.0, 1.0, 1.0)) -> float:
         """Predicted max error of the order-``order`` series over one period: the first omitted term's size.
