@@ -101,3 +101,13 @@ def test_small_divisor_is_explicit_and_a_resonance_is_refused():
     sol = series(BODY_I, 4, tilt=0.3)
     w2 = (1 - 2.0) * (1 - 1.5) / (2.0 * 1.5)
     assert sol.small_divisors[2] == pytest.approx(4 - w2, abs=1e-15)
+
+
+@pytest.mark.parametrize("a,b,tilt", [(2.0, 1.5, 0.3), (3.0, 1.2, 0.5), (0.5, 0.7, -0.6), (1.2, 1.2, 0.8)])
+def test_finite_tilt_frequency_is_the_series_eps2_coefficient(a, b, tilt):
+    # small_parameter's closed finite-tilt Ω (fitted from the series' ε² coefficient) holds exactly in γ0''
+    from gyrolab.plugins.regimes.small_parameter import finite_tilt_frequency
+
+    body = Body(a=a, b=b, x0=0.48, y0=-0.36, z0=0.8, k=0.7)
+    P = paper.Params(a=a, b=b, x0=0.48, y0=-0.36, z0=0.8, k=0.7, mu=1.0, g0=tilt)
+    assert series(body, 3, tilt=tilt).omega[2] == pytest.approx(finite_tilt_frequency(P) - 1, abs=1e-13)
