@@ -326,3 +326,26 @@ def test_auto_takes_the_lowest_series_order_that_meets_the_target():
     truth = fixed_point_reference([2.0, 1.5, 1.0], rc, 0.3, orbit.y0, t).astype(float)
     missed = np.max(np.abs(lower.solution(system, t) - truth)) * 1.0 / t[-1] * 3 > 1e-9
     assert missed or lower.check_domain(scene.system)
+
+
+def test_vertical_magnetic_field_adds_to_the_weight():
+    # m × B with B = B e_Z has the form U × γ of the weight: U = Mg r_c + B m. The order-6 series of that U must
+    # match the exact orbit of the full model (which integrates the magnetic torque itself) to ~ε⁷.
+    eps = 0.05
+    overrides = ["regime=small_parameter", "regime.order=6", "body.a=2.0", "body.b=1.5",
+                 "force=[uniform_gravity,magnetic]", "force.magnetic.field=0.5", "force.magnetic.moment=[0.0,0.8,0.6]",
+                 f"initial.r0={1.3 / eps!r}", "initial.theta0=1.2"]
+    scene, regime, _ = prepare(compose_config(overrides))
+    s = regime.scene(scene.system)
+    U = np.array([0.3, 0.2, 0.9327379053088815]) + 0.5 * np.array([0.0, 0.8, 0.6])
+    assert s.c == pytest.approx(np.sqrt(np.linalg.norm(U)))
+    assert [s.x0, s.y0, s.z0] == pytest.approx(U / np.linalg.norm(U))
+    orbit = exact_orbit(scene, regime)
+    t = np.linspace(0.0, orbit.period, 9)
+    from gyrolab.experiments.regime_run import integrate
+
+    y = integrate(scene, orbit.y0, t, taylor=True)[:, :6]
+    error = np.abs(regime.solution(scene.system, t) - y) / np.array([s.c, s.c, s.c * s.r0, 1, 1, 1])
+    assert np.max(error) < 5 * (1 / s.r0) ** 7  # 6.6e-10 = 1.6 ε⁷ at ε = c/r0 = 0.0456; 2.4e-2 without the field
+    with pytest.raises(ConfigError, match="vertical magnetic field"):
+        prepare(compose_config([*overrides, "force.magnetic.direction=[1.0,0.0,0.0]"]))

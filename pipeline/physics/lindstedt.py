@@ -48,20 +48,9 @@ class Body:
     k: float
 
     @property
-    def A1(self) -> float:
-        return (1 - self.b) / self.a
-
-    @property
-    def B1(self) -> float:
-        return (self.a - 1) / self.b
-
-    @property
-    def C1(self) -> float:
-        return self.b - self.a
-
-    @property
-    def omega2(self) -> float:
-        return -self.A1 * self.B1
+    def coefficients(self) -> tuple[float, float, float]:
+        """(A1, B1, C1) = ((1 − b)/a, (a − 1)/b, b − a) of seed 000's eq. (1); ω² = −A1B1."""
+        return (1 - self.b) / self.a, (self.a - 1) / self.b, self.b - self.a
 
 
 def _cauchy(u: np.ndarray, v: np.ndarray, k: int) -> np.ndarray:
@@ -208,18 +197,18 @@ def series(body: Body, order: int, *, tilt: float = 0.0, tilt_slope: float = 0.0
         raise ConfigError(f"series order {order!r} must be a non-negative integer")
     if not -1 < tilt < 1:
         raise ConfigError(f"the fast-spin series needs a tilted axis, |γ0''| < 1, got γ0''={tilt:g}")
-    if abs(body.A1) < 1e-14:
+    A1, B1, C1 = body.coefficients
+    if abs(A1) < 1e-14:
         raise ConfigError(f"the fast-spin series needs B ≠ C (b = {body.b:g})")
     M = grid or max(32, 4 * (order + 4))
     harmonics = np.fft.fftfreq(M, 1.0 / M)
     s = 2 * np.pi * np.arange(M) / M
-    w2 = body.omega2
+    w2 = -A1 * B1
     divisors = harmonics**2 - w2
     needed = np.abs(harmonics) <= order + 2
     if np.any(np.abs(divisors[needed]) < divisor_floor):
         n = int(abs(harmonics[needed][np.argmin(np.abs(divisors[needed]))]))
         raise ConfigError(f"the fast-spin series is singular at the resonance ω = {n}: ω² = {w2:.12g}")
-    A1, B1, C1 = body.A1, body.B1, body.C1
     a, b, x, y, z, kk = body.a, body.b, body.x0, body.y0, body.z0, body.k
     rho = np.sqrt(1 - tilt**2)
     Y = np.zeros((order + 2, 6, M))  # one spare row so that every Cauchy product can read index k
