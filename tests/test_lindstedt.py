@@ -8,10 +8,16 @@ is known in closed form: aγ0''ψ̇² ∓ r0ψ̇ + 1 = 0 (c = 1), so Ω(ε) has 
 
 import numpy as np
 import pytest
-
 from gyrolab.errors import ConfigError
-from gyrolab.physics.lindstedt import Body, error_ladder, exact_orbit, series, series_error
+from gyrolab.physics.lindstedt import (
+    Body,
+    error_ladder,
+    exact_orbit,
+    series,
+    series_error,
+)
 from gyrolab.plugins.regimes import ismail2021 as paper
+
 from tests.test_regime_helpers import slope
 
 Z0 = float(np.sqrt(1 - 0.34))

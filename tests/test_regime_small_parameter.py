@@ -7,12 +7,18 @@ measured with an independent DOP853 shooting (§5.3, §6).
 
 import numpy as np
 import pytest
-
 from gyrolab.engine.config import compose_config
 from gyrolab.errors import ConfigError
-from gyrolab.experiments.regime_run import errors, prepare
+from gyrolab.experiments.regime_run import errors, exact_orbit, integrate, prepare
 from gyrolab.plugins.regimes import ismail2021 as paper
-from tests.test_regime_helpers import GAMMA_000, overrides_000, run_case, slope
+
+from tests.test_regime_helpers import (
+    BODY_000,
+    GAMMA_000,
+    overrides_000,
+    run_case,
+    slope,
+)
 
 MUS = (16.0, 32.0, 64.0)
 
@@ -220,8 +226,6 @@ def test_reduced_rhs_is_exposed_on_the_plugin():
 
 
 # -- the finite-tilt period and the order-N series (issue 13, items 1, 4 and 5c) -------------------------------
-from gyrolab.experiments.regime_run import exact_orbit  # noqa: E402
-from tests.test_regime_helpers import BODY_000  # noqa: E402
 
 
 def _tilted(eps, g0, *extra):
@@ -258,7 +262,7 @@ def order10():
 
 def test_order_10_shows_its_error_slope_and_radius(order10):
     scene, regime = order10
-    data, coords, attrs = regime.diagnostics(scene.system)
+    data, _, attrs = regime.diagnostics(scene.system)
     assert attrs["series_order"] == 10
     assert attrs["series_error_slope"] == pytest.approx(11, abs=0.3)
     R = attrs["series_radius_of_convergence"]
@@ -271,8 +275,6 @@ def test_order_10_shows_its_error_slope_and_radius(order10):
     # at the scene's ε the order-10 series is the exact orbit to ~ε¹¹ (5e-15 relative): round-off level
     orbit = exact_orbit(scene, regime)
     t = np.linspace(0.0, orbit.period, 9)
-    from gyrolab.experiments.regime_run import integrate
-
     y = integrate(scene, orbit.y0, t, taylor=True)[:, :6]
     assert np.max(np.abs(regime.solution(scene.system, t) - y) / np.array([1, 1, 20, 1, 1, 1])) < 1e-12
     assert regime.period(scene.system) == pytest.approx(orbit.period, rel=1e-13)
@@ -342,8 +344,6 @@ def test_vertical_magnetic_field_adds_to_the_weight():
     assert [s.x0, s.y0, s.z0] == pytest.approx(U / np.linalg.norm(U))
     orbit = exact_orbit(scene, regime)
     t = np.linspace(0.0, orbit.period, 9)
-    from gyrolab.experiments.regime_run import integrate
-
     y = integrate(scene, orbit.y0, t, taylor=True)[:, :6]
     error = np.abs(regime.solution(scene.system, t) - y) / np.array([s.c, s.c, s.c * s.r0, 1, 1, 1])
     assert np.max(error) < 5 * (1 / s.r0) ** 7  # 6.6e-10 = 1.6 ε⁷ at ε = c/r0 = 0.0456; 2.4e-2 without the field

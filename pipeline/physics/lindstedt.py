@@ -32,7 +32,6 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-
 from gyrolab.errors import ConfigError
 
 
@@ -81,12 +80,12 @@ class LindstedtSeries:
             raise ConfigError(f"series order {order} is not available; computed through {self.max_order}")
         return order
 
-    def frequency(self, eps: float | complex, order: int | None = None):
+    def frequency(self, eps: complex, order: int | None = None):
         """Ω(ε) = Σ_{k ≤ order} Ω_k ε^k (τ-frequency: the τ-period is 2π/Ω)."""
         order = self._check(order)
         return np.polyval(self.omega[: order + 1][::-1], eps)
 
-    def scaled(self, eps: float | complex, tau: np.ndarray, order: int | None = None) -> np.ndarray:
+    def scaled(self, eps: complex, tau: np.ndarray, order: int | None = None) -> np.ndarray:
         """(p1, q1, r1, γ, γ', γ'') at times τ = r0 t, series through ε^order, shape (n, 6) (complex ε: complex)."""
         order = self._check(order)
         s = self.frequency(eps, order) * np.asarray(tau, dtype=float)  # complex for a complex ε
@@ -271,7 +270,7 @@ def series(body: Body, order: int, *, tilt: float = 0.0, tilt_slope: float = 0.0
         Y[k, 3], Y[k, 4], D[k, 3], D[k, 4] = zt.real, zt.imag, dzt.real, dzt.imag
     fourier = np.fft.fft(Y[: order + 1], axis=2) / M
     fourier[np.abs(fourier) < 1e-300] = 0.0
-    shown = {n: float(n * n - w2) for n in range(0, min(order + 2, M // 2))}
+    shown = {n: float(n * n - w2) for n in range(min(order + 2, M // 2))}
     return LindstedtSeries(body=body, tilt=(float(tilt), float(tilt_slope)), fourier=fourier, omega=omega,
                            consistency=consistency, small_divisors=shown)
 

@@ -30,7 +30,6 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
-
 from gyrolab.errors import ConfigError
 from gyrolab.physics import lindstedt
 from gyrolab.plugins.regimes import ismail2021 as paper
@@ -296,7 +295,7 @@ class SmallParameter(FixedPointRegime):
             periodic += np.real(spec[m] / (1j * n[m]) * (np.exp(1j * n[m] * u) - 1))
         Y = sol.scaled(eps, s.r0 * np.asarray(t, dtype=float), self.series_order)
         phi = np.pi / 2 + u + np.angle((Y[:, 4] + 1j * Y[:, 3]) * np.exp(-1j * (np.pi / 2 + u)))
-        return dict(theta=np.arccos(np.clip(Y[:, 5], -1, 1)), psi=np.real(spec[0]) * u + periodic, phi=phi)
+        return {"theta": np.arccos(np.clip(Y[:, 5], -1, 1)), "psi": np.real(spec[0]) * u + periodic, "phi": phi}
 
 
 def series_diagnostics(regime: SmallParameter, system) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:

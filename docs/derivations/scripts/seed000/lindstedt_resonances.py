@@ -13,7 +13,6 @@ Run: python docs/derivations/scripts/seed000/lindstedt_resonances.py   (about 20
 """
 
 import numpy as np
-
 from gyrolab.errors import GyrolabError
 from gyrolab.physics.lindstedt import Body, exact_orbit, series, series_error
 from gyrolab.plugins.regimes.small_parameter import divisor_threshold
