@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from gyrolab.engine.config import compose_config
 from gyrolab.errors import ConfigError
-from gyrolab.experiments.regime_run import errors, exact_orbit, integrate, prepare
+from gyrolab.experiments.regime_run import errors, exact_orbit, integrate, prepare, with_alpha
 from gyrolab.plugins.regimes import ismail2021 as paper
 
 from tests.test_regime_helpers import (
@@ -275,9 +275,13 @@ def test_order_10_shows_its_error_slope_and_radius(order10):
     # at the scene's ε the order-10 series is the exact orbit to ~ε¹¹ (5e-15 relative): round-off level
     orbit = exact_orbit(scene, regime)
     t = np.linspace(0.0, orbit.period, 9)
-    y = integrate(scene, orbit.y0, t, taylor=True)[:, :6]
-    assert np.max(np.abs(regime.solution(scene.system, t) - y) / np.array([1, 1, 20, 1, 1, 1])) < 1e-12
+    y = integrate(scene, with_alpha(scene, regime, orbit.y0), t, taylor=True)
+    assert np.max(np.abs(regime.solution(scene.system, t) - y[:, :6]) / np.array([1, 1, 20, 1, 1, 1])) < 1e-12
     assert regime.period(scene.system) == pytest.approx(orbit.period, rel=1e-13)
+    # Euler angles of the series (ψ integrated spectrally) against those of the integrated orbit
+    angles, truth = regime.euler_angles(scene.system, t), scene.system.variables(t, y)
+    for name in ("psi", "theta", "phi"):
+        assert np.max(np.abs(angles[name] - truth[name].values)) < 1e-12, name
 
 
 def test_bad_order_is_refused():
