@@ -205,7 +205,8 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                  regime.formula, regime.parameter, regime.parameter_value(system), T, orbit.period,
                  ", ".join(f"{r:.1e}" for r in orbit.residuals))
     ds = dataset(scene, regime, t, result, warnings)
-    data, coords, attrs = regime.diagnostics(system)  # e.g. small_parameter's order-N series evidence
+    diagnostics = getattr(regime, "diagnostics", None)  # e.g. small_parameter's order-N series evidence
+    data, coords, attrs = diagnostics(system) if diagnostics is not None else ({}, {}, {})
     if data or attrs:
         ds = ds.assign_coords(coords).assign(data)
         ds.attrs.update(attrs)

@@ -133,7 +133,8 @@ class Auto(Integrator):
             try:
                 base = registry.load("regime", name)()
                 if self.system.name in base.systems:
-                    candidates += [(name, r) for r, _ in base.series_candidates(self.system, self.accuracy / self.safety)]
+                    ladder = getattr(base, "series_candidates", lambda system, accuracy: [(base, None)])
+                    candidates += [(name, r) for r, _ in ladder(self.system, self.accuracy / self.safety)]
             except GyrolabError:
                 continue
         for name, regime in candidates:

@@ -194,7 +194,7 @@ class SmallParameter(FixedPointRegime):
         if w2 <= 0:
             warnings.append(f"ω² = {w2:.4g} ≤ 0 (A, B on both sides of C): the generating p-mode is not an "
                             "oscillation; the expansion is untested there")
-        if eps > 0.2:
+        if eps > 0.2 and self.series_order is None:  # the order-N series warns at half its radius instead
             warnings.append(f"c/r0 = {eps:.3g} > 0.2: near the edge of the fast-spin domain, expect errors of "
                             f"order (c/r0)² ≈ {eps**2:.2g}")
         if self.series_order is not None:
