@@ -206,6 +206,12 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                  regime.formula, regime.parameter, regime.parameter_value(system), T, orbit.period,
                  ", ".join(f"{r:.1e}" for r in orbit.residuals))
     ds = dataset(scene, regime, t, result, warnings)
+    diagnostics = getattr(regime, "diagnostics", None)  # e.g. small_parameter's order-N series evidence
+    data, coords, attrs = diagnostics(system) if diagnostics is not None else ({}, {}, {})
+    if data or attrs:
+        ds = ds.assign_coords(coords).assign(data)
+        ds.attrs.update(attrs)
+        log.info("%s: %s", regime.name, ", ".join(f"{k} = {v}" for k, v in attrs.items() if not isinstance(v, list)))
     written = [write_dataset(ds, Path(out_dir) / "regime.nc")]
     written += draw_figures("regime.nc", ds, out_dir, cfg.get("output"))
     return written

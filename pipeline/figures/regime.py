@@ -34,6 +34,10 @@ def draw_regime_comparison(ds: xr.Dataset) -> plt.Figure:
     value = ds.attrs.get("regime_parameter_value")
     if value is not None:
         panel_note(axes[0, 0], f"{ds.attrs.get('regime_parameter', 'parameter')} = {float(value):.4g}")
+    if "series_order" in ds.attrs:  # a regime with a series of configurable order
+        panel_note(axes[0, 1], f"order-{ds.attrs['series_order']} series: error slope "
+                               f"{float(ds.attrs['series_error_slope']):.2f}, radius of convergence c/r₀ = "
+                               f"{float(ds.attrs['series_radius_of_convergence']):.3g}")
     legend_outside(fig, ncols=2)
     fig.suptitle(f"Regime {regime}: analytic solution against the full model")
     return fig
