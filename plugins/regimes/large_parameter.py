@@ -74,6 +74,7 @@ class SlowSpinSeries:
 
     @classmethod
     def build(cls, a: float, b: float, k: float, theta0: float) -> SlowSpinSeries:
+        """Five shootings; use ``series_for`` (cached per (a, b, k, θ0))."""
         model = FixedPointModel(np.array([a, b, 1.0]), np.array([0.0, 0.0, 1.0]), k)
         section = Section("turning", float(np.cos(theta0)))
         T0 = pendulum.period(b, pendulum.kappa(a, k), theta0)
@@ -130,6 +131,7 @@ class SlowSpinSeries:
 
 
 HARMONICS = 256
+_CACHE: dict[tuple, "SlowSpinSeries"] = {}  # (a, b, k, θ0) → series: building one takes 5 shootings
 POWERS = (2, 3, 4, 5, 6, 7)
 EVEN, ODD = [1, 3, 5], [0, 2, 4]  # q, γ, γ'' even in ε at fixed phase; p, r, γ' odd (time reversal + mirror)
 
@@ -150,6 +152,13 @@ def _sample(model: FixedPointModel, y0: np.ndarray, times: np.ndarray, tangent: 
     return states if tangent is None else (states, moved)
 
 
+def series_for(a: float, b: float, k: float, theta0: float) -> SlowSpinSeries:
+    key = (float(a), float(b), float(k), float(theta0))
+    if key not in _CACHE:
+        _CACHE[key] = SlowSpinSeries.build(*key)
+    return _CACHE[key]
+
+
 class LargeParameter(FixedPointRegime):
     name = "large_parameter"
     parameter = "r0/c"
@@ -158,16 +167,12 @@ class LargeParameter(FixedPointRegime):
 
     def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200) -> None:
         super().__init__(formula=formula, periods=periods, samples_per_period=samples_per_period)
-        self._cache: dict[tuple, SlowSpinSeries] = {}
 
     def parameter_value(self, system) -> float:
         return float(self.scene(system).r0)
 
     def series(self, s: NondimensionalScene) -> SlowSpinSeries:
-        key = (s.a, s.b, s.k, s.theta0)
-        if key not in self._cache:
-            self._cache[key] = SlowSpinSeries.build(s.a, s.b, s.k, s.theta0)
-        return self._cache[key]
+        return series_for(s.a, s.b, s.k, s.theta0)
 
     def tilt_axis_warnings(self, system) -> list[str]:
         given = np.concatenate([system.initial.omega, system.initial.gamma])
