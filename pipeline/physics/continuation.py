@@ -29,6 +29,7 @@ from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.physics.periodic import FixedPointModel
 
 SECTIONS = ("gamma_prime", "turning")
+MAX_LOG_STEP = 0.5
 STABILITY_TOL = 1e-6  # |s| ≤ 2 + this counts as stable (s is computed to ~1e-10 on these orbits)
 
 
@@ -124,6 +125,9 @@ def _newton(model, section, z, *, tangent=None, anchor=None, fixed_r0=None, tol=
         step = np.linalg.lstsq(J, -res, rcond=None)[0]
         if fixed:
             step = np.append(step, 0.0)
+        largest = float(np.max(np.abs(step[2:])))
+        if largest > MAX_LOG_STEP:  # a Newton step may not multiply T or r0 by more than e^MAX_LOG_STEP
+            step *= MAX_LOG_STEP / largest
         for damping in 0.5 ** np.arange(0, 12):
             try:
                 trial = system(z + damping * step)
@@ -161,12 +165,13 @@ def _tangent(model, section, z, previous=None):
 
 
 def continue_family(model: FixedPointModel, section: Section, start: FamilyPoint, r0_end: float, *,
-                    step: float = 0.1, max_step: float = 0.4, min_step: float = 1e-4, max_points: int = 400
-                    ) -> list[FamilyPoint]:
+                    step: float = 0.1, max_step: float = 0.4, min_step: float = 1e-4, max_points: int = 400,
+                    max_period: float = 200.0) -> list[FamilyPoint]:
     """Pseudo-arclength continuation from ``start`` (r0 > 0) until ln r0 passes ln ``r0_end``.
 
     Step control: grow by 1.3 after an easy correction (≤ 4 iterations), halve after a failure; stops (and
-    returns what it has) below ``min_step`` or after ``max_points`` points.
+    returns what it has) below ``min_step``, after ``max_points`` points or when the period exceeds ``max_period``
+    (an orbit approaching an equilibrium or a homoclinic loop: the period diverges).
     """
     if start.r0 <= 0 or r0_end <= 0:
         raise ConfigError("continuation in ln r0 needs r0 > 0 at both ends")
@@ -189,11 +194,13 @@ def continue_family(model: FixedPointModel, section: Section, start: FamilyPoint
                 break
             continue
         t_new = _tangent(model, section, z_new, t)
-        if np.arccos(np.clip(t_new @ t, -1, 1)) > 0.3:  # too sharp a turn: refine
+        if np.arccos(np.clip(t_new @ t, -1, 1)) > 0.3 or (z_new - z) @ t <= 0.2 * h:  # sharp turn or going back
             h *= 0.5
             if h < min_step:
                 break
             continue
+        if np.exp(z_new[2]) > max_period:
+            break
         z, t = z_new, t_new
         points.append(FamilyPoint(float(np.exp(z[3])), float(np.exp(z[2])), y0, phi, norm, t))
         h = min(max_step, 1.3 * h)
