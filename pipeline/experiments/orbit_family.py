@@ -39,7 +39,8 @@ BANDS = (1e-6, 1e-3)
 
 def _family_spec(name: str, spec: dict) -> dict[str, Any]:
     where = f"orbit_family.families.{name}"
-    out = {key: as_number(spec.get(key), f"{where}.{key}") for key in ("a", "b", "k", "theta0", "r0_start", "r0_end")}
+    out = {key: as_number(spec.get(key), f"{where}.{key}", positive=key != "k")
+           for key in ("a", "b", "k", "theta0", "r0_start", "r0_end")}
     com = spec.get("com_direction")
     if not isinstance(com, (list, tuple)) or len(com) != 3:
         raise ConfigError(f"{where}.com_direction must be a list of three numbers, got {com!r}")
