@@ -12,7 +12,6 @@ from __future__ import annotations
 import difflib
 import os
 import re
-import re
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
