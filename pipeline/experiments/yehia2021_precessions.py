@@ -21,6 +21,7 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
+from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError, as_number
 from gyrolab.physics.precession.cases import CASES, Case
@@ -132,7 +133,7 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
         data[name] = ("case", np.array([r[name] for r in rows], dtype=float), {"units": "1", "long_name": long_name})
     for name in ("formula", "verdict", "condition", "orbital_frame", "inertial_frame", "geometric", "floquet_kind"):
         data[name] = ("case", np.array([str(r[name]) for r in rows]), {"units": "1", "long_name": name.replace("_", " ")})
-    data["stable"] = ("case", np.array([-1 if r["stable"] is None else int(r["stable"]) for r in rows]),
+    data["stable"] = ("case", np.array([-1 if r["stable"] is None else int(r["stable"]) for r in rows], dtype=np.int32),
                       {"units": "1", "long_name": "linearly stable (1), unstable (0), not analysed (-1)"})
     for key in closed[0]:
         if key != "solution":
@@ -143,8 +144,8 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
                               {"long_name": "printed solution"})}
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update({"title": "regular precessions of a satellite-gyrostat (Yehia & El-kenani 2021)",
-                     "Conventions": "CF-1.8", "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    return ds
+                     "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
+    return conform(ds, source="yehia2021_precessions experiment")
 
 
 def plot_classes(rows: list[dict[str, Any]], traces: dict[str, xr.Dataset], directory: Path) -> list[Path]:

@@ -30,7 +30,6 @@ from __future__ import annotations
 import logging
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
-from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +38,7 @@ import xarray as xr
 from omegaconf import OmegaConf
 
 from gyrolab.contracts.integrator import IntegratorStats
+from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError
 from gyrolab.sweep.grid import Grid
@@ -54,7 +54,18 @@ PER_JOB_ATTRS = ("config", "hydra_overrides") + tuple(f"integrator_{f.name}" for
 #: variable attributes that are per-job quantities
 PER_JOB_VARIABLE_ATTRS = ("max_abs_drift",)
 #: attributes of sweep.nc that legitimately differ between two aggregations of the same sweep
-VOLATILE_ATTRS = ("date_created", "sweep_launcher")
+VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
+#: CF units and long_name of the per-job variables a run's attributes become (others: "run attribute NAME")
+PER_JOB_METADATA = {
+    "config": (None, "the job's resolved config (YAML)"),
+    "hydra_overrides": (None, "the job's command-line overrides"),
+    "integrator_nfev": ("1", "right-hand-side evaluations of the integrator"),
+    "integrator_n_steps": ("1", "integrator steps accepted"),
+    "integrator_n_rejected": ("1", "integrator steps rejected"),
+    "integrator_wall_time": ("s", "integrator wall time"),
+    "integrator_njev": ("1", "Jacobian evaluations of the integrator"),
+    "integrator_nlu": ("1", "LU decompositions of the integrator"),
+}
 #: variables of sweep.nc that legitimately differ between two runs of the same sweep
 VOLATILE_VARIABLES = ("integrator_wall_time",)
 
@@ -134,6 +145,9 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
             continue
         name = key if key not in taken else f"run_{key}"
         data_vars[name] = _cell_variable(values, shape, grid_dims, name)
+        units, long_name = PER_JOB_METADATA.get(key, (None, f"run attribute {key}, per job"))
+        data_vars[name][2].update({"long_name": long_name} if units is None or data_vars[name][1].dtype == object
+                                  else {"long_name": long_name, "units": units})
         taken.add(name)
 
     statuses = np.zeros(shape, dtype=np.int8)
@@ -155,7 +169,6 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
     ds.attrs.update(common)
     ds.attrs.update({
         "title": f"gyrolab sweep over {' × '.join(grid_dims) or 'no parameter'} ({len(results)} jobs)",
-        "Conventions": "CF-1.8",
         "sweep_dims": " ".join(grid_dims),
         "sweep_keys": " ".join(d.key for d in grid.dims),
         "n_jobs": len(results),
@@ -163,7 +176,7 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
         "n_failed": counts[FAILED],
         "n_missing": counts[MISSING],
     })
-    return ds
+    return conform(ds, source=f"sweep of {len(results)} jobs over {' × '.join(grid_dims) or 'no parameter'}")
 
 
 def _dim_names(grid: Grid, datasets: Sequence[xr.Dataset]) -> list[str]:
@@ -234,6 +247,8 @@ def _per_job_attrs(done: Sequence[tuple[tuple[int, ...], xr.Dataset]], name: str
             if attr == "max_abs_drift":
                 out[attr][2].update({"long_name": f"max |{name}(t) − {name}(0)|",
                                      "units": having[0][1].attrs.get("units", "1")})
+            else:
+                out[attr][2]["long_name"] = f"attribute {attr} of {name}, per job"
     return out
 
 
@@ -357,7 +372,6 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
     results = collect(sweep_dir, grid)
     ds = assemble(grid, results)
     ds.attrs["sweep_launcher"] = launcher
-    ds.attrs["date_created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
     path = write_dataset(ds, sweep_dir / SWEEP_NAME)
     summary = SweepSummary(
         path=path, n_jobs=len(results), finished=int(ds.attrs["n_finished"]), failed=int(ds.attrs["n_failed"]),
