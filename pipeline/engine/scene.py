@@ -89,9 +89,10 @@ class Scene:
 
     def sampling_warning(self) -> str:
         """One sentence when the output times undersample the fastest motion (fewer than
-        ``MIN_SAMPLES_PER_PERIOD`` samples per period 2π/ν), else ''."""
+        ``MIN_SAMPLES_PER_PERIOD`` samples per period 2π/ν), else ''. Two samples ask for the end states
+        only (as work_precision does), not for a series: no warning."""
         per_period = samples_per_period(self.times, self.fastest_rate)
-        if per_period >= MIN_SAMPLES_PER_PERIOD:
+        if per_period >= MIN_SAMPLES_PER_PERIOD or len(self.times) <= 2:
             return ""
         needed = _needed_samples(float(self.times[-1] - self.times[0]), self.fastest_rate, MIN_SAMPLES_PER_PERIOD)
         given = ("the cap of time.n_output=auto" if self.n_output_requested == AUTO

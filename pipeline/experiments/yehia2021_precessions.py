@@ -131,8 +131,15 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
                "jacobi_drift": "max |H − H0| of the integration"}
     for name, long_name in numeric.items():
         data[name] = ("case", np.array([r[name] for r in rows], dtype=float), {"units": "1", "long_name": long_name})
-    for name in ("formula", "verdict", "condition", "orbital_frame", "inertial_frame", "geometric", "floquet_kind"):
-        data[name] = ("case", np.array([str(r[name]) for r in rows]), {"units": "1", "long_name": name.replace("_", " ")})
+    text = {"formula": "which formula of the case: printed, corrected or new",
+            "verdict": "does the precession satisfy the full equations: holds, fails or unclear",
+            "condition": "the paper's condition for the case",
+            "orbital_frame": "kind of precession in the orbital frame",
+            "inertial_frame": "kind of precession in the inertial frame",
+            "geometric": "surface the body z axis sweeps in inertial space (cylindrical, conical, ...)",
+            "floquet_kind": "linear stability class from the Floquet multipliers"}
+    for name, long_name in text.items():
+        data[name] = ("case", np.array([str(r[name]) for r in rows]), {"units": "1", "long_name": long_name})
     data["stable"] = ("case", np.array([-1 if r["stable"] is None else int(r["stable"]) for r in rows], dtype=np.int32),
                       {"units": "1", "long_name": "linearly stable (1), unstable (0), not analysed (-1)"})
     for key in closed[0]:

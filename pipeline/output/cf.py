@@ -7,6 +7,10 @@ experiments). It makes the netCDF file a CF-1.8 file without changing what the d
   what made the file) and ``date_created`` (ISO 8601, UTC); a builder's own ``title`` is kept;
 * coordinates carry no ``_FillValue`` (CF §2.5.1: a coordinate has no missing values), set through
   the variable's netCDF encoding, so the in-memory dataset is unchanged;
+* string-valued coordinates (``axis`` = x, y, z; ``frame_axis``; a swept integrator's names; case
+  labels) are stored as character arrays (CF §2.2, the labels of §6.1): a CF coordinate variable is
+  numeric (§1.3), and compliance-checker's monotonicity check fails on a string one. xarray reads
+  them back as the same strings, so ``ds.omega.sel(axis="z")`` keeps working;
 * 64-bit integers become 32-bit (CF-1.8 §2.2 lists byte, short, int, float, double, char; int64
   arrives only with CF-1.9), or float64 (exact to 2**53) when a value is outside the int32 range;
 * ``standard_name: time`` is dropped wherever the units are not ``<unit> since <epoch>``: gyrolab's
@@ -65,6 +69,8 @@ def conform(ds: xr.Dataset, title: str | None = None, source: str = "") -> xr.Da
             attrs["long_name"] = str(name)
         if name in ds.coords:
             variable.encoding["_FillValue"] = None
+            if _is_text(variable):
+                variable.encoding["dtype"] = "S1"
     created = now_iso()
     what = f": {source}" if source else ""
     ds.attrs["Conventions"] = CONVENTIONS
@@ -72,6 +78,11 @@ def conform(ds: xr.Dataset, title: str | None = None, source: str = "") -> xr.Da
     ds.attrs["date_created"] = created
     ds.attrs["history"] = f"{created} written by gyrolab {gyrolab_version()}{what}"
     return ds
+
+
+def _is_text(variable: xr.Variable) -> bool:
+    kind = variable.dtype.kind
+    return kind == "U" or (kind == "O" and all(isinstance(v, str) for v in variable.values.ravel()))
 
 
 def unit_attributes(body: Any) -> dict[str, Any]:
