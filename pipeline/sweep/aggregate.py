@@ -53,6 +53,8 @@ STATUS_FLAGS = {MISSING: 0, FINISHED: 1, FAILED: 2}
 PER_JOB_ATTRS = ("config", "hydra_overrides") + tuple(f"integrator_{f.name}" for f in fields(IntegratorStats))
 #: variable attributes that are per-job quantities
 PER_JOB_VARIABLE_ATTRS = ("max_abs_drift",)
+#: run attributes left in the jobs' own run.nc: the sweep has its own (set by ``gyrolab.output.cf.conform``)
+JOB_ONLY_ATTRS = ("job_id", "date_created", "history", "Conventions")
 #: attributes of sweep.nc that legitimately differ between two aggregations of the same sweep
 VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
 #: CF units and long_name of the per-job variables a run's attributes become (others: "run attribute NAME")
@@ -65,6 +67,10 @@ PER_JOB_METADATA = {
     "integrator_wall_time": ("s", "integrator wall time"),
     "integrator_njev": ("1", "Jacobian evaluations of the integrator"),
     "integrator_nlu": ("1", "LU decompositions of the integrator"),
+    "sampling_fastest_rate": (None, "upper estimate of the fastest angular frequency (model rate units)"),
+    "sampling_samples_per_period": ("1", "stored samples per period of the fastest motion"),
+    "sampling_n_output_requested": (None, "time.n_output as the config gave it"),
+    "sampling_warning": (None, "warning when the output times undersample the motion"),
 }
 #: variables of sweep.nc that legitimately differ between two runs of the same sweep
 VOLATILE_VARIABLES = ("integrator_wall_time",)
@@ -137,7 +143,7 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
                                                               "job_id", "title", "Conventions"}
     common: dict[str, Any] = {}
     for key in _union([list(ds.attrs) for _, ds in done]):
-        if key == "job_id":
+        if key in JOB_ONLY_ATTRS:
             continue
         values = {index: ds.attrs[key] for index, ds in done if key in ds.attrs}
         if key not in PER_JOB_ATTRS and len(values) == len(done) and _all_same(list(values.values())):
