@@ -80,7 +80,7 @@ def test_auto_output_resolves_the_fast_spin_over_a_long_span():
     assert "sampling_warning" not in attrs and attrs["sampling_n_output_requested"] == "auto"
 
 
-def test_explicit_undersampling_is_warned_in_one_sentence_and_recorded(caplog, tmp_path):
+def test_explicit_undersampling_is_warned_in_one_sentence_and_recorded(ds, caplog, tmp_path):
     from gyrolab.engine.scene import compose_scene
 
     with caplog.at_level("WARNING", logger="gyrolab.engine.scene"):
@@ -90,13 +90,13 @@ def test_explicit_undersampling_is_warned_in_one_sentence_and_recorded(caplog, t
     assert [r.getMessage() for r in caplog.records if r.name == "gyrolab.engine.scene"] == [warning]
     assert warning.startswith("time.n_output=2001 ") and "alias" in warning and warning.count(". ") == 0
     # a short run that undersamples the same way (2 time units apart, 0.63 samples per spin period) records it
-    ds = run(["time.end=20", "time.n_output=11"])
-    assert ds.attrs["sampling_warning"].startswith("time.n_output=11 ")
-    per_spin_period = SPIN_PERIOD / 2.0                              # spin period / output spacing
-    assert ds.attrs["sampling_samples_per_period"] <= per_spin_period  # ν ≥ r0: fewer per fastest period
-    with xr.open_dataset(write_dataset(ds, tmp_path / "run.nc")) as loaded:
-        assert loaded.attrs["sampling_warning"] == ds.attrs["sampling_warning"]
-    assert "sampling_warning" not in run(SHORT).attrs                  # 0.1 apart: 12.6 samples per spin period
+    coarse = run(["time.end=20", "time.n_output=11"])
+    assert coarse.attrs["sampling_warning"].startswith("time.n_output=11 ")
+    per_spin_period = SPIN_PERIOD / 2.0                                  # spin period / output spacing
+    assert coarse.attrs["sampling_samples_per_period"] <= per_spin_period  # ν ≥ r0: fewer per fastest period
+    with xr.open_dataset(write_dataset(coarse, tmp_path / "run.nc")) as loaded:
+        assert loaded.attrs["sampling_warning"] == coarse.attrs["sampling_warning"]
+    assert "sampling_warning" not in ds.attrs                          # SHORT: 0.1 apart, 12.6 per spin period
 
 
 def test_fastest_rate_bounds_the_motion_it_must_resolve():
@@ -116,10 +116,13 @@ def test_fastest_rate_bounds_the_motion_it_must_resolve():
 
 
 def test_batch_points_share_the_densest_auto_grid():
-    from gyrolab.engine.scene import compose_scene
+    from gyrolab.engine.config import compose_config
     from gyrolab.sweep.batch import _share_output_times
 
-    slow, fast = compose_scene(["time.end=300", "initial.r0=1"]), compose_scene(["time.end=300", "initial.r0=20"])
+    cfg = compose_config(["time.end=300", "initial.r0=1"])
+    slow = Scene.from_config(cfg)
+    cfg.initial.r0 = 20.0
+    fast = Scene.from_config(cfg)
     assert len(fast.times) > len(slow.times)         # a spin 20 times faster needs more samples over the same span
     dense = fast.times
     _share_output_times([slow, fast])

@@ -83,16 +83,18 @@ class Scene:
         return self.system.compiled_model() if wants else None
 
     @cached_property
-    def fastest_rate(self) -> float:
-        """Upper estimate of the scene's fastest angular frequency (``fastest_rate``)."""
+    def fastest_rate(self) -> float | None:
+        """Upper estimate of the scene's fastest angular frequency (``fastest_rate``; None: not known)."""
         return fastest_rate(self.system)
 
     def sampling_warning(self) -> str:
         """One sentence when the output times undersample the fastest motion (fewer than
         ``MIN_SAMPLES_PER_PERIOD`` samples per period 2π/ν), else ''. Two samples ask for the end states
         only (as work_precision does), not for a series: no warning."""
+        if self.fastest_rate is None or len(self.times) <= 2:
+            return ""
         per_period = samples_per_period(self.times, self.fastest_rate)
-        if per_period >= MIN_SAMPLES_PER_PERIOD or len(self.times) <= 2:
+        if per_period >= MIN_SAMPLES_PER_PERIOD:
             return ""
         needed = _needed_samples(float(self.times[-1] - self.times[0]), self.fastest_rate, MIN_SAMPLES_PER_PERIOD)
         given = ("the cap of time.n_output=auto" if self.n_output_requested == AUTO
@@ -104,11 +106,10 @@ class Scene:
 
     def sampling_attributes(self) -> dict[str, Any]:
         """Dataset attributes saying how the output times were chosen and whether they resolve the motion."""
-        attrs: dict[str, Any] = {
-            "sampling_n_output_requested": str(self.n_output_requested),
-            "sampling_fastest_rate": self.fastest_rate,
-            "sampling_samples_per_period": samples_per_period(self.times, self.fastest_rate),
-        }
+        attrs: dict[str, Any] = {"sampling_n_output_requested": str(self.n_output_requested)}
+        if self.fastest_rate is not None:
+            attrs["sampling_fastest_rate"] = float(self.fastest_rate)
+            attrs["sampling_samples_per_period"] = float(samples_per_period(self.times, self.fastest_rate))
         warning = self.sampling_warning()
         if warning:
             attrs["sampling_warning"] = warning
@@ -160,7 +161,7 @@ def _build(cls: type, node: DictConfig, where: str, *args: Any) -> Any:
     return cls(*args, **params)
 
 
-def fastest_rate(system: System) -> float:
+def fastest_rate(system: System) -> float | None:
     """An upper estimate ν of the fastest angular frequency in the stored series (model units).
 
     A body turning at |ω| moves every body-frame vector (γ, α) at up to |ω|, and its
@@ -170,9 +171,12 @@ def fastest_rate(system: System) -> float:
     ΔV the range of the potentials (2|M g r_c| for the weight, ½N(I_max − I_min) for an attracting
     centre or a circular orbit's gradient N = 3Ω², 2|m||B| for a dipole). The orbiting gyrostat
     adds the orbit rate Ω (the frame turns) and the rotor |k|/I_min. ν is at least the slowest
-    torque's pendulum frequency √(ΔV/I_min), so a body at rest still has a time scale.
+    torque's pendulum frequency √(ΔV/I_min), so a body at rest still has a time scale. None for a
+    third-party system whose body has no principal ``inertia`` (then auto stores AUTO_MIN_SAMPLES).
     """
     body = system.body
+    if getattr(body, "inertia", None) is None or system.state_size < 3:
+        return None
     inertia = np.asarray(body.inertia, dtype=float)
     i_min, i_max = float(inertia.min()), float(inertia.max())
     omega0 = np.asarray(system.initial_state()[:3], dtype=float)
@@ -200,14 +204,15 @@ def _needed_samples(span: float, rate: float, per_period: float) -> int:
     return int(np.ceil(per_period * span * rate / (2.0 * np.pi))) + 1
 
 
-def _output_times(time_cfg: dict[str, Any], rate: float) -> np.ndarray:
+def _output_times(time_cfg: dict[str, Any], rate: float | None) -> np.ndarray:
     start = as_number(time_cfg.get("start", 0.0), "time.start")
     end = as_number(time_cfg.get("end"), "time.end")
     if end <= start:
         raise ConfigError(f"time.end={end:g} must be after time.start={start:g}")
     n = time_cfg.get("n_output", AUTO)
     if n == AUTO:
-        n = min(max(_needed_samples(end - start, rate, AUTO_SAMPLES_PER_PERIOD), AUTO_MIN_SAMPLES), AUTO_MAX_SAMPLES)
+        needed = AUTO_MIN_SAMPLES if rate is None else _needed_samples(end - start, rate, AUTO_SAMPLES_PER_PERIOD)
+        n = min(max(needed, AUTO_MIN_SAMPLES), AUTO_MAX_SAMPLES)
     elif isinstance(n, bool) or not isinstance(n, int) or n < 2:
         raise ConfigError(f"time.n_output={n!r} must be an integer ≥ 2 (number of stored samples, both ends "
                           "included) or auto")
