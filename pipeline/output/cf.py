@@ -14,7 +14,9 @@ experiments). It makes the netCDF file a CF-1.8 file without changing what the d
 * 64-bit integers become 32-bit (CF-1.8 §2.2 lists byte, short, int, float, double, char; int64
   arrives only with CF-1.9), or float64 (exact to 2**53) when a value is outside the int32 range;
 * ``standard_name: time`` is dropped wherever the units are not ``<unit> since <epoch>``: gyrolab's
-  time is elapsed model time (s, or a nondimensional unit), not a calendar date (CF §4.4);
+  time is elapsed model time (s, or a nondimensional unit), not a calendar date (CF §4.4). The
+  one message compliance-checker (6.x) still prints comes from its §5.1 heuristic that a dimension
+  named ``time`` must carry that standard name; claiming a calendar would be false, so it stays;
 * every variable and coordinate has a ``long_name`` (CF §3.3 wants one where there is no
   ``standard_name``): one a builder forgot (a third-party system's variable, say) becomes the
   variable's name, logged; gyrolab's own builders give real ones (tests/test_cf_compliance.py).
