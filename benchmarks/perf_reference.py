@@ -1,17 +1,25 @@
-"""Speed against accuracy on the reference problem: gyrolab against scipy, as ratios measured in one run.
+"""Speed against accuracy on the reference problem: gyrolab against heyoka and scipy, measured interleaved.
 
-    python benchmarks/perf_reference.py            # full table (about a minute)
-    python benchmarks/perf_reference.py --quick    # fewer tolerances, fewer repeats
+    pip install -e ".[bench]"                      # heyoka (optional: its rows are skipped when absent)
+    python benchmarks/perf_reference.py            # full tables (a few minutes)
+    python benchmarks/perf_reference.py --quick    # fewer tolerances, fewer rounds
 
 Reference problem (issue 5, ``experiment=perf_reference``): nondimensional
 Euler–Poisson, A, B, C = 2, 1.5, 1, r_c = (0.3, 0.2, 0.9327…), k = 0.5,
-ω0 = (0.1, −0.05, 5), γ0 = (sin 1, 0, cos 1), t ∈ [0, 300]. Error = max-norm
-of the final state's error against an extended-precision Taylor reference
-(``gyrolab.physics.reference``; two settings of it agree to ~1e-14).
+ω0 = (0.1, −0.05, 5), γ0 = (sin 1, 0, cos 1), t ∈ [0, 300], 3,001 output
+times. Error = max-norm of the final state's error against an
+extended-precision Taylor reference (``gyrolab.physics.reference``; two
+settings of it agree to ~1e-14).
 
-The scipy baseline is what a researcher would write: ``solve_ivp`` with a
-plain numpy right-hand side. For each target error, a method's time is that
-of its cheapest tolerance reaching the target (best of several runs).
+Peer: heyoka (LLVM Taylor integrator) with ``propagate_grid`` on the same 3,001
+times (dense output from its Taylor polynomials), against gyrolab's ``taylor``
+and ``auto`` integrating on that grid (``Integrator.integrate``) and the whole
+``Scene.run()`` (dataset included). For a target error ε each method's time is
+that of its cheapest setting whose final error is ≤ ε (``auto`` has one
+setting per ε: ε itself). Every contestant runs once per round, rounds
+interleave all of them (a shared machine slows all alike), and a contestant's
+time is its minimum over the rounds. The scipy baseline is what a researcher
+would write: ``solve_ivp`` with a plain numpy right-hand side.
 """
 
 from __future__ import annotations
@@ -37,8 +45,6 @@ R_C = np.array([0.3, 0.2, 0.9327379053088815])
 K = 0.5
 Y0 = np.array([0.1, -0.05, 5.0, np.sin(1.0), 0.0, np.cos(1.0)])
 T_END = 300.0
-TARGETS = (1e-8, 1e-11)
-BASE = ["experiment=perf_reference", "time.n_output=2"]
 
 
 def plain_numpy_rhs(t, y):
@@ -53,35 +59,108 @@ def plain_numpy_rhs(t, y):
                      g2 * r - g3 * q, g3 * p - g1 * r, g1 * q - g2 * p])
 
 
-def best_time(fn, repeats):
-    times, result = [], None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        result = fn()
-        times.append(time.perf_counter() - start)
-    return min(times), result
+GRID = np.linspace(0.0, T_END, 3001)
+EPSILONS = [10.0 ** -k for k in range(6, 14)]
 
 
-def scipy_row(method, tol, reference, repeats):
-    wall, sol = best_time(lambda: solve_ivp(plain_numpy_rhs, (0, T_END), Y0, method=method, rtol=tol, atol=tol),
-                          repeats)
-    return {"method": f"scipy {method}", "setting": f"tol={tol:.1e}", "error": np.max(np.abs(sol.y[:, -1] - reference)),
-            "time": wall, "integration": wall, "nfev": sol.nfev}
+def heyoka_contestants():
+    """{tolerance: propagate_grid callable returning the final state}, or {} when heyoka is not installed."""
+    try:
+        import heyoka as hy
+    except ImportError:
+        return {}
+    A, B, C = INERTIA
+    x0, y0, z0 = R_C
+    p, q, r, g1, g2, g3 = hy.make_vars("p", "q", "r", "g1", "g2", "g3")
+    system = [(p, ((B - C) * q * r + y0 * g3 - z0 * g2 + K * (C - B) * g2 * g3) / A),
+              (q, ((C - A) * r * p + z0 * g1 - x0 * g3 + K * (A - C) * g3 * g1) / B),
+              (r, ((A - B) * p * q + x0 * g2 - y0 * g1 + K * (B - A) * g1 * g2) / C),
+              (g1, g2 * r - g3 * q), (g2, g3 * p - g1 * r), (g3, g1 * q - g2 * p)]
+
+    def contestant(tol):
+        ta = hy.taylor_adaptive(system, Y0, tol=tol)
+
+        def call():
+            ta.time = 0.0
+            ta.state[:] = Y0
+            return ta.propagate_grid(GRID)[-1][-1]
+        return call, ta.order
+
+    return {tol: contestant(tol) for tol in [10.0 ** -k for k in range(6, 16)] + [np.finfo(float).eps]}
 
 
-def gyrolab_row(overrides, label, setting, reference, repeats):
-    scene = compose_scene(BASE + overrides)
-    scene.run()  # compile / load cached kernels once
-    wall, ds = best_time(scene.run, repeats)
-    final = np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
-    integration = min(scene.run().attrs["integrator_wall_time"] for _ in range(repeats))
-    return {"method": f"gyrolab {label}", "setting": setting, "error": np.max(np.abs(final - reference)),
-            "time": wall, "integration": integration, "nfev": int(ds.attrs["integrator_nfev"])}
+def interleaved(contestants, rounds):
+    """Minimum wall time and last result of each callable, running every one once per round."""
+    best = {key: (np.inf, None) for key in contestants}
+    for _ in range(rounds):
+        for key, fn in contestants.items():
+            start = time.perf_counter()
+            result = fn()
+            elapsed = time.perf_counter() - start
+            best[key] = (min(best[key][0], elapsed), result)
+    return best
 
 
-def cheapest(rows, prefix, target):
-    ok = [r for r in rows if r["method"] == prefix and r["error"] <= target]
-    return min(ok, key=lambda r: r["time"]) if ok else None
+def final_state(ds):
+    return np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
+
+
+def peer_table(reference, rounds, quick):
+    """Time to reach each ε: heyoka propagate_grid against gyrolab taylor/auto (integration and Scene.run)."""
+    from gyrolab.plugins.integrators.auto import Auto
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    scene = compose_scene(["experiment=perf_reference"])
+    compiled, y0 = scene.compiled, scene.system.initial_state()
+    epsilons = EPSILONS[::3] if quick else EPSILONS
+    contestants, settings = {}, {}
+    for tol, (call, order) in heyoka_contestants().items():
+        contestants[("heyoka", tol)] = call
+        settings[("heyoka", tol)] = f"tol={tol:.1e}, order {order}"
+    for tol in ([1e-9, 1e-12, 1e-16] if quick else [10.0 ** -k for k in range(7, 18)]):
+        taylor = Taylor(tol=tol)
+        contestants[("taylor", tol)] = lambda t=taylor: t.integrate(None, GRID, y0, None, compiled).y[-1]
+        settings[("taylor", tol)] = f"tol={tol:.0e}, order {taylor.order}"
+    scenes = {}
+    for eps in epsilons:
+        def auto_call(eps=eps):
+            auto = Auto(accuracy=eps)
+            auto.prepare(scene.system)
+            return auto.integrate(None, GRID, y0, None, compiled).y[-1]
+        contestants[("auto", eps)] = auto_call
+        settings[("auto", eps)] = f"accuracy={eps:.0e}"
+        scenes[eps] = compose_scene(["experiment=perf_reference", f"accuracy={eps}"])
+        contestants[("auto Scene.run()", eps)] = lambda s=scenes[eps]: final_state(s.run())
+        settings[("auto Scene.run()", eps)] = f"accuracy={eps:.0e}"
+    interleaved(contestants, 1)  # compile, load caches, build heyoka's kernels
+    best = interleaved(contestants, rounds)
+    errors = {key: float(np.max(np.abs(np.asarray(result)[:6] - reference))) for key, (_, result) in best.items()}
+
+    def cheapest(method, eps):
+        ok = [key for key in best if key[0] == method and errors[key] <= eps]
+        return min(ok, key=lambda key: best[key][0]) if ok else None
+
+    def cell(key):
+        return "not reached" if key is None else f"{best[key][0] * 1e3:.2f} ({errors[key]:.1e})"
+
+    has_peer = any(key[0] == "heyoka" for key in best)
+    print("\nTime to reach a final error ≤ ε on 3,001 output times, ms (error reached); minimum over "
+          f"{rounds} interleaved rounds.\n")
+    print("| ε | heyoka propagate_grid | gyrolab auto, integration | gyrolab auto, Scene.run() | "
+          "gyrolab taylor, integration | auto / heyoka | Scene.run() / heyoka | taylor / heyoka |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    for eps in epsilons:
+        peer, taylor = cheapest("heyoka", eps), cheapest("taylor", eps)
+        auto, run_ = ("auto", eps), ("auto Scene.run()", eps)
+        auto_key = auto if errors[auto] <= eps else None
+        run_key = run_ if errors[run_] <= eps else None
+        ratios = ["" if peer is None or key is None else f"{best[key][0] / best[peer][0]:.2f}"
+                  for key in (auto_key, run_key, taylor)]
+        print(f"| {eps:.0e} | {cell(peer) if has_peer else 'not installed'} | {cell(auto_key)} | {cell(run_key)} | "
+              f"{cell(taylor)} | {' | '.join(ratios)} |")
+    print("\nEvery setting measured:\n\n| method | setting | final error | time [ms] |\n| --- | --- | --- | --- |")
+    for key in sorted(best, key=lambda key: (key[0], -key[1])):
+        print(f"| {key[0]} | {settings[key]} | {errors[key]:.2e} | {best[key][0] * 1e3:.2f} |")
 
 
 def batch_throughput(repeats):
@@ -105,63 +184,46 @@ def cold_default_run():
     return times
 
 
+def scipy_and_dop853_rows(reference, repeats, quick):
+    """(method, setting, error, time) of scipy DOP853 / RK45 and gyrolab dop853_numba (Scene.run()), interleaved."""
+    tols = [1e-9, 1e-12] if quick else [1e-7, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14]
+    contestants = {}
+    for tol in tols:
+        contestants[("scipy DOP853", tol)] = lambda tol=tol: solve_ivp(
+            plain_numpy_rhs, (0, T_END), Y0, method="DOP853", rtol=tol, atol=tol, t_eval=GRID).y[:, -1]
+        scene = compose_scene(["experiment=perf_reference", "integrator=dop853_numba", f"integrator.rtol={tol}",
+                               f"integrator.atol={tol}"])
+        contestants[("gyrolab dop853_numba, Scene.run()", tol)] = lambda s=scene: final_state(s.run())
+    interleaved(contestants, 1)
+    best = interleaved(contestants, repeats)
+    return [(key[0], f"tol={key[1]:.0e}", float(np.max(np.abs(result - reference))), wall)
+            for key, (wall, result) in best.items()]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="fewer tolerances and repeats")
+    parser.add_argument("--quick", action="store_true", help="fewer tolerances and rounds")
     args = parser.parse_args()
-    repeats = 2 if args.quick else 5
+    rounds = 3 if args.quick else 15
     print(f"# gyrolab perf_reference benchmark, {datetime.date.today()}, {platform.machine()}, "
-          f"{os.cpu_count()} cores, {platform.processor() or platform.platform()}, Python {platform.python_version()}")
+          f"{os.cpu_count()} cores, {platform.processor() or platform.platform()}, Python {platform.python_version()}, "
+          f"load average {os.getloadavg()[0]:.1f} at start")
     start = time.perf_counter()
     reference = fixed_point_reference(INERTIA, R_C, K, Y0, [0.0, T_END])[-1].astype(float)
     print(f"# reference: extended-precision Taylor, {time.perf_counter() - start:.1f} s")
-    tols = [3.2e-11, 1e-14] if args.quick else [1e-9, 1e-10, 3.2e-11, 1e-11, 1e-12, 1e-13, 3.2e-14, 1e-14]
-    rows = [scipy_row("DOP853", tol, reference, repeats) for tol in tols]
-    rows += [scipy_row("RK45", tol, reference, max(1, repeats // 2)) for tol in (1e-9, 1e-11)]
-    rows += [gyrolab_row(["integrator=dop853_numba", f"integrator.rtol={tol}", f"integrator.atol={tol}"],
-                         "dop853_numba", f"tol={tol:.1e}", reference, repeats) for tol in tols]
-    for tol in ([1e-10, 1e-13] if args.quick else [1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14]):
-        rows.append(gyrolab_row(["integrator=taylor", f"integrator.tol={tol}"], "taylor", f"order 20, tol={tol:.0e}",
-                                reference, repeats))
-    for target in TARGETS:
-        rows.append(gyrolab_row(["integrator=auto", f"accuracy={target}"], "auto", f"accuracy={target:.0e}",
-                                reference, repeats))
+    peer_table(reference, rounds, args.quick)
 
-    print("\n`time` is the whole call (scipy: solve_ivp; gyrolab: Scene.run(), which also builds the dataset with"
-          " its invariants and metadata, ~1 ms); `integration` is gyrolab's integrator alone.\n")
-    print("| method | setting | final error | time [s] | integration [s] | nfev |\n| --- | --- | --- | --- | --- | --- |")
-    for r in rows:
-        print(f"| {r['method']} | {r['setting']} | {r['error']:.2e} | {r['time']:.4f} | {r['integration']:.4f} | "
-              f"{r['nfev']} |")
-
-    print("\n| target error | scipy DOP853 [s] | gyrolab auto, Scene.run() [s] | ratio | auto, integration [s] | ratio |"
-          " goal | best gyrolab run [s] | ratio |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    for target, goal in zip(TARGETS, (250, 300)):
-        base = cheapest(rows, "scipy DOP853", target)
-        auto = next(r for r in rows if r["setting"] == f"accuracy={target:.0e}")
-        best = min((r for r in rows if r["method"].startswith("gyrolab") and r["error"] <= target),
-                   key=lambda r: r["time"], default=None)
-        if base is None:
-            print(f"| {target:.0e} | not reached | | | | | |")
-            continue
-        auto_ok = auto["error"] <= target
-        print(f"| {target:.0e} | {base['time']:.4f} | {auto['time']:.4f}{'' if auto_ok else ' (missed)'} | "
-              f"{base['time'] / auto['time']:.0f}× | {auto['integration']:.4f} | "
-              f"{base['time'] / auto['integration']:.0f}× | {goal}× | {best['time']:.4f} ({best['method']}, "
-              f"{best['setting']}) | {base['time'] / best['time']:.0f}× |")
-    same = [(s, g) for s in rows for g in rows if s["method"] == "scipy DOP853" and g["method"] == "gyrolab dop853_numba"
-            and s["setting"] == g["setting"]]
-    ratios = [s["time"] / g["time"] for s, g in same]
-    # same steps ⇔ same evaluation counts (within the 3 of solve_ivp interpolating t0 itself)
-    same_steps = [s["setting"] for s, g in same if abs(s["nfev"] - g["nfev"]) <= 3]
-    print(f"\ncompiled DOP853 vs scipy DOP853 at equal tolerance: {min(ratios):.0f}×–{max(ratios):.0f}× faster; "
-          f"same steps at {', '.join(same_steps) or 'no tolerance'} (near round-off, rounding flips accept/reject)")
-    print(f"batch: 1000 trajectories, fixed-step RK4 (rk4_numba): {batch_throughput(repeats):.3g} trajectory-steps/s "
+    rows = scipy_and_dop853_rows(reference, 2, args.quick)
+    print("\nC-speed DOP853 and scipy (3,001 output times; gyrolab: Scene.run()):\n\n"
+          "| method | setting | final error | time [ms] |\n| --- | --- | --- | --- |")
+    for method, setting, error, wall in sorted(rows):
+        print(f"| {method} | {setting} | {error:.2e} | {wall * 1e3:.2f} |")
+    print(f"\nbatch: 1000 trajectories, fixed-step RK4 (rk4_numba): {batch_throughput(3):.3g} trajectory-steps/s "
           f"(goal 1.5e7)")
     cold = cold_default_run()
     print(f"cold `gyrolab` default run, end to end: {cold[1]:.2f} s with warm kernel cache "
           f"(first process {cold[0]:.2f} s; goal 3 s)")
+    print(f"\nload average {os.getloadavg()[0]:.1f} at the end (a loaded machine slows every contestant alike)")
 
 
 if __name__ == "__main__":

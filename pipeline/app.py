@@ -13,7 +13,10 @@ more commands work on results: ``gyrolab --reproduce PATH/run.nc`` and
 
 from __future__ import annotations
 
+import dataclasses
+import difflib
 import logging
+import os
 import sys
 import tempfile
 from collections.abc import Sequence
@@ -23,21 +26,25 @@ from typing import TYPE_CHECKING
 import hydra
 from hydra._internal.utils import get_args_parser
 from hydra.core.hydra_config import HydraConfig
-from hydra import initialize_config_module
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override
 from hydra.errors import OverrideParseException
 from hydra.types import RunMode
-from omegaconf import DictConfig, open_dict
+from omegaconf import DictConfig, OmegaConf, open_dict
 
+from gyrolab.engine.budget import check_budget, check_tolerances
 from gyrolab.engine.config import (
-    CONFIG_MODULE,
     SELECTABLE_GROUPS,
+    ConfigSource,
+    check_scene_config,
     compose_config,
     group_options,
+    hydra_for,
     register_plugin_configs,
+    use_source,
 )
-from gyrolab.errors import ConfigError, GyrolabError, choices
+from gyrolab.engine.safety import check_config, check_output_dir
+from gyrolab.errors import ConfigError, GyrolabError, choices, require_finite, shorten
 from gyrolab.engine.progress import allow_bars, on_terminal
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
@@ -55,54 +62,190 @@ def fail(error: GyrolabError) -> None:
     sys.exit(error.exit_code)
 
 
-def preflight(argv: Sequence[str]) -> None:
-    """Validate the command line before Hydra creates any output directory."""
+def preflight(argv: Sequence[str]) -> list[str]:
+    """Validate the command line before Hydra creates any output directory; the command line Hydra should run.
+
+    The config is composed exactly as Hydra will compose it (the same search path,
+    primary config and overrides, from a user's ``--config-dir`` too), checked by
+    ``gyrolab.engine.safety`` (no config can run code), against the schema (unknown
+    keys, types), the budget, and the scene's own validation.
+    """
     args, _ = get_args_parser().parse_known_args(list(argv))
+    source = ConfigSource.from_args(args.config_path, args.config_name, args.config_dir)
+    use_source(source)
     if args.help or args.hydra_help or args.info or args.shell_completion or args.cfg:
-        return  # Hydra's own informational commands
+        # Hydra's own informational commands: --help and --hydra-help configure logging from the config
+        with hydra_for(source):
+            cfg = _compose_job(source, list(args.overrides), False)
+        check_config(cfg, Path(str(cfg.hydra.run.dir)), command_line=args.overrides)
+        return list(argv)
+    overrides = parse_overrides(args.overrides)
+    rewritten = _plus_group_as_override(source, list(argv), overrides)
+    if rewritten != list(argv):
+        argv = rewritten
+        args, _ = get_args_parser().parse_known_args(argv)
+        overrides = parse_overrides(args.overrides)
+    sweeps = [o for o in overrides if o.is_sweep_override()]
+    if sweeps and not args.multirun:
+        raise ConfigError(f"{shorten(sweeps[0].input_line)!r} is a sweep; run it with -m (gyrolab -m "
+                          f"{shorten(sweeps[0].input_line)} ...), or give one value")
+    sweeping = bool(args.multirun)
+    check_launcher_installed(overrides)
+    if sweeping:
+        _refuse_swept_hydra_settings(overrides)
+        Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
+    with hydra_for(source):
+        # One job composed and validated: the first value of every sweep (each group choice checked for safety).
+        first = _compose_job(source, _job_overrides(overrides, {}), sweeping)
+    with hydra_for(dataclasses.replace(source, searchpath=tuple(first.hydra.searchpath or ()))):
+        check_plugin_names(overrides)  # every value of every swept group
+        configs = [first]
+        swept = [*overrides, *(_sweeper_params(configs[0]) if sweeping else [])]
+        for o in swept:
+            if o.is_sweep_override() and _is_group(o, configs[0]):
+                values = list(o.sweep_string_iterator())[(1 if o in overrides else 0):]  # the first: composed
+                configs += [_compose_job(source, _job_overrides(swept, {id(o): value}), sweeping) for value in values]
+    cfg = configs[0]
+    for composed in configs:
+        check_scene_config(_without_hydra(composed))
+    run_text = str(cfg.hydra.sweep.dir if sweeping else cfg.hydra.run.dir)
+    check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
+    run_dir = Path(run_text)
+    for composed in configs:
+        check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
+    validate_scene(_without_hydra(cfg))
+    check_writable(run_dir)
+    return argv
+
+
+def _plus_group_as_override(source: ConfigSource, argv: list[str], overrides: Sequence[Override]) -> list[str]:
+    """``+experiment=mine`` as ``experiment=mine`` when the primary config already lists the group.
+
+    Hydra refuses to add a group its defaults list has (``experiment: null`` in gyrolab's
+    config.yaml); both spellings are common, so both select the option. The command line
+    Hydra runs is rewritten the same way.
+    """
+    adds = [o for o in overrides if o.is_add() and o.key_or_group in SELECTABLE_GROUPS and o.package is None]
+    if not adds:
+        return argv
+    with hydra_for(source):
+        listed = compose_config([], return_hydra_config=True, config_name=source.config_name).hydra.runtime.choices
+    for o in adds:
+        if o.key_or_group in listed and o.input_line in argv:
+            argv[argv.index(o.input_line)] = o.input_line[1:]
+    return argv
+
+
+def parse_overrides(texts: Sequence[str]) -> list[Override]:
+    """Hydra's override grammar, with one sentence showing the override and the valid forms."""
     parser = OverridesParser.create()
     overrides = []
-    for text in args.overrides:
+    for text in texts:
+        if len(text) > MAX_OVERRIDE_CHARS:
+            raise ConfigError(f"override {shorten(text)} is longer than {MAX_OVERRIDE_CHARS} characters; "
+                              "keys are short dotted names such as time.end")
         try:
             overrides.extend(parser.parse_overrides([text]))
         except OverrideParseException as error:
             reason = str(error).strip().splitlines()[0].split(" See https://")[0]
-            raise ConfigError(f"malformed override {text!r}: {reason}") from None
-    sweeping = args.multirun or any(o.is_sweep_override() for o in overrides)
-    check_launcher_installed(overrides)
-    check_plugin_names(overrides)
-    if sweeping:
-        Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
-    # One job composed and validated: the first value of every sweep.
-    first = [f"{o.get_key_element()}={next(iter(o.sweep_string_iterator()))}" if o.is_sweep_override()
-             else o.input_line for o in overrides]
-    cfg = compose_config(first, return_hydra_config=True)
-    scene_cfg = _without_hydra(cfg)
+            raise ConfigError(f"malformed override {shorten(text)!r} ({shorten(reason, 120)}); valid forms are "
+                              f"{OVERRIDE_FORMS}") from None
+    for o in overrides:
+        key = o.key_or_group
+        if len(key) > MAX_KEY_CHARS:
+            raise ConfigError(f"override key {shorten(key)!r} is longer than {MAX_KEY_CHARS} characters; keys are "
+                              "short dotted names such as time.end")
+        if not key.strip():
+            raise ConfigError(f"override {shorten(o.input_line)!r} has no key; valid forms are {OVERRIDE_FORMS}")
+        if o.is_delete() and key in REQUIRED_SECTIONS:
+            raise ConfigError(f"{o.input_line!r} deletes the section {key}, which every run needs; set its keys "
+                              f"instead (e.g. {key}.{REQUIRED_SECTIONS[key]}=...)")
+    return overrides
+
+
+#: what a valid override looks like (for the grammar errors)
+OVERRIDE_FORMS = "key=value (time.end=50), group=option (integrator=rk4), +key=value (add), ~key (delete)"
+MAX_OVERRIDE_CHARS = 10_000
+MAX_KEY_CHARS = 200
+#: sections every run needs, with a key to show in the message
+REQUIRED_SECTIONS = {"time": "end", "output": "figures", "body": "a", "initial": "r0", "system": "_target_",
+                     "integrator": "rtol"}
+
+
+def _job_overrides(overrides: Sequence[Override], chosen: dict[int, str]) -> list[str]:
+    """The overrides of one job: a sweep's first value, or the value chosen for it."""
+    return [f"{o.get_key_element()}={chosen.get(id(o), next(iter(o.sweep_string_iterator())))}"
+            if o.is_sweep_override() else o.input_line for o in overrides]
+
+
+def _sweeper_params(cfg: DictConfig) -> list[Override]:
+    """The sweep a config file declares in ``hydra.sweeper.params`` (Hydra adds it to the command line's)."""
+    params = OmegaConf.to_container(cfg.hydra.sweeper, resolve=False).get("params") or {}
+    overrides = parse_overrides([f"{key}={value}" for key, value in params.items()])
+    for o in overrides:
+        if o.key_or_group.startswith(("hydra.", "hydra/")):
+            raise ConfigError(f"hydra.sweeper.params.{shorten(o.key_or_group)} sweeps a Hydra setting; Hydra's "
+                              "settings are one per sweep, so a config may not sweep them")
+    return overrides
+
+
+def _is_group(o: Override, cfg: DictConfig) -> bool:
+    return o.key_or_group in (cfg.hydra.runtime.choices or {}) or o.key_or_group.startswith("hydra/")
+
+
+def _compose_job(source: ConfigSource, overrides: list[str], sweeping: bool) -> DictConfig:
+    return compose_config(overrides, return_hydra_config=True, from_shell=True, config_name=source.config_name,
+                          run_mode=RunMode.MULTIRUN if sweeping else RunMode.RUN)
+
+
+def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
+    for o in overrides:
+        if o.is_sweep_override() and (o.key_or_group.startswith(("hydra.", "hydra/"))):
+            raise ConfigError(f"{shorten(o.input_line)!r} sweeps a Hydra setting; Hydra's settings are one per "
+                              "sweep, so give a single value")
+
+
+def validate_scene(scene_cfg: DictConfig) -> None:
+    """The checks every run's scene config passes: schema, tolerances, budget, the scene's own validation."""
+    from gyrolab.experiments import TASKS
+
+    plain = check_scene_config(scene_cfg)
+    require_finite(plain, "")
+    check_tolerances(plain)
+    task = task_of(scene_cfg)
+    if task not in ("scene", *TASKS):
+        close = difflib.get_close_matches(task, ["scene", *TASKS], n=1)
+        hint = f"did you mean task={close[0]}? " if close else ""
+        raise ConfigError(f"unknown task {shorten(repr(task))}; {hint}valid choices: {choices(['scene', *TASKS])}")
+    if task not in ("scene", "regime"):
+        return  # an experiment validates the scenes it composes
+    probe = scene_cfg.copy()
+    with open_dict(probe):
+        probe.time.n_output = 2  # the state's size, before allocating n_output samples
+    check_budget(plain, Scene.from_config(probe).system.initial_state().size)
     if task_of(scene_cfg) == "regime":  # the regime's domain is checked before anything is written
         from gyrolab.experiments.regime_run import prepare
 
         prepare(scene_cfg)
     else:
         Scene.from_config(scene_cfg)
-    run_dir = cfg.hydra.sweep.dir if sweeping else cfg.hydra.run.dir
-    check_writable(Path(str(run_dir)))
 
 
 def check_plugin_names(overrides: Sequence[Override]) -> None:
-    """Every option named for a config group (swept or not, in lists too) must exist."""
+    """Every option named for a config group (swept or not, in lists too) must exist (needs a Hydra)."""
     selected = [o for o in overrides if o.key_or_group in SELECTABLE_GROUPS and o.package is None
                 and not o.is_delete()]
-    if not selected:
-        return
-    with initialize_config_module(config_module=CONFIG_MODULE, version_base="1.3"):
-        for o in selected:
-            valid = group_options(o.key_or_group)
-            values = list(o.sweep_string_iterator()) if o.is_sweep_override() else [o.value()]
-            for value in values:
-                items = value if isinstance(value, list) else str(value).strip("[]").split(",")
-                for name in (str(item).strip() for item in items):
-                    if name and name != "null" and name not in valid:
-                        raise ConfigError(f"unknown {o.key_or_group} {name!r}; valid choices: {choices(valid)}")
+    for o in selected:
+        valid = group_options(o.key_or_group)
+        values = list(o.sweep_string_iterator()) if o.is_sweep_override() else [o.value()]
+        for value in values:
+            items = value if isinstance(value, list) else str(value).strip("[]").split(",")
+            for name in (str(item).strip() for item in items):
+                if name and name != "null" and name not in valid:
+                    close = difflib.get_close_matches(name, valid, n=1)
+                    hint = f"did you mean {o.key_or_group}={close[0]}? " if close else ""
+                    raise ConfigError(f"unknown {o.key_or_group} {shorten(repr(name))}; {hint}valid choices: "
+                                      f"{choices(valid)}")
 
 
 #: launcher option -> the module that provides it (installed by the ``cluster`` extra)
@@ -167,7 +310,18 @@ def _task(cfg: DictConfig) -> None:
 
 
 def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
-    """Run the scene, write ``run.nc`` (and figures) in ``out_dir``; GyrolabError on bad input or a failed run."""
+    """Run the scene, write ``run.nc`` (and figures) in ``out_dir``; GyrolabError on bad input or a failed run.
+
+    ``out_dir`` is locked meanwhile (a second run into it is refused in one sentence) and cleared of
+    the temporary files that killed writes left there (``gyrolab.output.lock.writing_in``).
+    """
+    from gyrolab.output.lock import writing_in
+
+    with writing_in(out_dir):
+        return _run_locked(cfg, out_dir, job_id)
+
+
+def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None) -> Path:
     from gyrolab.output.dataset import write_dataset
 
     task = task_of(cfg)
@@ -208,15 +362,30 @@ def _quiet_console() -> None:
 
 
 def run_command(argv: Sequence[str]) -> int | None:
-    """``--reproduce PATH``, ``--aggregate SWEEP_DIR``, ``--batch OVERRIDES``: exit status, or None for a Hydra run."""
+    """``--reproduce PATH``, ``--aggregate SWEEP_DIR``, ``--batch OVERRIDES``, ``--new-force NAME``: exit status,
+    or None for a Hydra run.
+
+    Hydra's config options (``--config-dir``, ``--config-path``, ``--config-name``) may come first.
+    """
+    source, argv = split_source_options(argv)
     if argv and argv[0] == "--batch":
+        use_source(source)
         return _batch(argv[1:])
+    if argv and argv[0].split("=", 1)[0] == "--new-force":
+        from gyrolab.scaffold import new_force_package
+
+        name = argv[0].partition("=")[2] or (argv[1] if len(argv) == 2 else "")
+        if len(argv) > (1 if "=" in argv[0] else 2):
+            raise ConfigError("--new-force takes one name; usage: gyrolab --new-force NAME")
+        root = new_force_package(name)
+        print(f"wrote {root}/: pip install -e {root} && python -m pytest {root}/tests")
+        return 0
     if not argv or argv[0].split("=", 1)[0] not in ("--reproduce", "--aggregate"):
         return None
     option, _, value = argv[0].partition("=")
     rest = ([value] if value else []) + list(argv[1:])
     if len(rest) != 1:
-        raise ConfigError(f"{option} takes exactly one path (got {len(rest)}: {' '.join(rest) or 'none'}); "
+        raise ConfigError(f"{option} takes exactly one path (got {len(rest)}: {shorten(' '.join(rest)) or 'none'}); "
                           f"usage: gyrolab {option} {'PATH/run.nc' if option == '--reproduce' else 'SWEEP_DIR'}")
     logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
     if option == "--reproduce":
@@ -232,24 +401,66 @@ def run_command(argv: Sequence[str]) -> int | None:
     return _sweep_status(summary)
 
 
+#: Hydra's options that choose where configs come from, long and short
+SOURCE_OPTIONS = {"--config-dir": "config_dir", "-cd": "config_dir", "--config-path": "config_path",
+                  "-cp": "config_path", "--config-name": "config_name", "-cn": "config_name"}
+
+
+def split_source_options(argv: Sequence[str]) -> tuple[ConfigSource, list[str]]:
+    """(the config source named by leading ``--config-dir``/``--config-path``/``--config-name``, the rest)."""
+    given: dict[str, str] = {}
+    rest = list(argv)
+    while rest and rest[0].split("=", 1)[0] in SOURCE_OPTIONS:
+        option, has_value, value = rest.pop(0).partition("=")
+        if not has_value:
+            if not rest:
+                raise ConfigError(f"{option} needs a value, e.g. {option} myconf")
+            value = rest.pop(0)
+        given[SOURCE_OPTIONS[option]] = value
+    source = ConfigSource.from_args(given.get("config_path"), given.get("config_name"), given.get("config_dir"))
+    return source, rest
+
+
+def absolute_config_path(argv: Sequence[str]) -> list[str]:
+    """``argv`` with a relative ``--config-path`` made absolute from the working directory.
+
+    Hydra reads a relative --config-path against the folder of the app's source file,
+    which is inside the installed package; a user means the working directory.
+    """
+    out = list(argv)
+    for i, arg in enumerate(out):
+        option, has_value, value = arg.partition("=")
+        if option in ("--config-path", "-cp"):
+            if has_value and value and not value.startswith("pkg://"):
+                out[i] = f"{option}={os.path.abspath(value)}"
+            elif not has_value and i + 1 < len(out) and not out[i + 1].startswith("pkg://"):
+                out[i + 1] = os.path.abspath(out[i + 1])
+    return out
+
+
 def _batch(overrides: Sequence[str]) -> int:
     """``gyrolab --batch KEY=V1,V2 ... [hydra.sweep.dir=DIR]``: the grid in one batch, one sweep.nc."""
     from datetime import datetime
 
     from gyrolab.sweep.batch import run_batch_sweep
 
-    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
     out_dir = Path(f"outputs/batch/{datetime.now():%Y-%m-%d}/{datetime.now():%H-%M-%S}")
     scene_overrides = []
     for override in overrides:
         if override.startswith("hydra.sweep.dir="):
             out_dir = Path(override.split("=", 1)[1])
         elif override.startswith("hydra."):
-            raise ConfigError(f"{override!r}: a batch sweep runs in one process; of Hydra's settings it takes "
-                              "hydra.sweep.dir only")
+            raise ConfigError(f"{shorten(override)!r}: a batch sweep runs in one process; of Hydra's settings it "
+                              "takes hydra.sweep.dir only")
         else:
             scene_overrides.append(override)
+    parsed = parse_overrides(scene_overrides)
+    check_output_dir(str(out_dir), "hydra.sweep.dir")
+    first = compose_config(_job_overrides(parsed, {}))
+    check_config(first)
+    validate_scene(first)
     check_writable(out_dir)
+    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
     path = run_batch_sweep(scene_overrides, out_dir)
     log.info("wrote %s", path)
     return 0
@@ -261,7 +472,7 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
 
     if callbacks.last_error:
         print(f"gyrolab: error: {callbacks.last_error}", file=sys.stderr)
-        return 1
+        return callbacks.last_exit_code
     summary = summary or callbacks.last_summary
     if summary is None or not (summary.failed or summary.missing):
         return 0
@@ -273,7 +484,7 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
 
 def main() -> None:
     """Console entry point ``gyrolab`` (also ``python -m gyrolab``)."""
-    argv = sys.argv[1:]
+    argv = sys.argv[1:] = absolute_config_path(sys.argv[1:])
     if argv[:1] in (["--version"], ["-V"]):
         from gyrolab.output.provenance import gyrolab_version
 
@@ -284,7 +495,7 @@ def main() -> None:
         if status is not None:
             sys.exit(status)
         register_plugin_configs()
-        preflight(argv)
+        sys.argv[1:] = preflight(argv)
     except GyrolabError as error:
         fail(error)
     _task()

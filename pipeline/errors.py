@@ -36,6 +36,16 @@ class OutputError(GyrolabError, OSError):
     exit_code = 3
 
 
+#: the largest integer a float64 can hold (a longer integer cannot be used as a number)
+MAX_FLOAT_INT = int(1.7976931348623157e308)
+
+
+def shorten(text: str, limit: int = 80) -> str:
+    """``text`` cut to ``limit`` characters (with its length) so that a one-sentence error stays readable."""
+    text = str(text).replace("\n", " ")
+    return text if len(text) <= limit else f"{text[:limit // 2]}…{text[-limit // 4:]} ({len(text)} characters)"
+
+
 def choices(names: Iterable[str]) -> str:
     """Format valid choices for an error message."""
     names = sorted(names)
@@ -54,7 +64,10 @@ def require_finite(value: Any, where: str) -> None:
         for i, item in enumerate(value):
             require_finite(item, f"{where}[{i}]")
         return
-    if isinstance(value, (int, float)) and not math.isfinite(value):
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_FLOAT_INT:
+        raise ConfigError(f"{where}={shorten(str(value))} is too large to be represented as a 64-bit float "
+                          f"({len(str(abs(value)))} digits); every numeric setting must be below 1.8e308")
+    if isinstance(value, float) and not math.isfinite(value):
         raise ConfigError(f"{where}={value} is not a finite number; every numeric setting must be finite")
 
 
@@ -62,7 +75,7 @@ def as_vector3(value: Any, where: str) -> tuple[float, float, float]:
     """Read a 3-vector from a config value, with a one-sentence error otherwise."""
     try:
         items = [float(v) for v in value]
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ConfigError(f"{where}={value!r} must be a list of three numbers") from None
     if len(items) != 3:
         raise ConfigError(f"{where}={list(value)!r} must have exactly three components")
@@ -78,6 +91,8 @@ def as_number(value: Any, where: str, *, positive: bool = False, nonnegative: bo
         raise ConfigError(f"{where}={value!r} must be a number, not a boolean")
     try:
         number = float(value)
+    except OverflowError:
+        raise ConfigError(f"{where}={shorten(str(value))} is too large to be represented as a 64-bit float") from None
     except (TypeError, ValueError):
         raise ConfigError(f"{where}={value!r} must be a number") from None
     if not math.isfinite(number):

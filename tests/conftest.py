@@ -1,3 +1,4 @@
+import contextlib
 import os
 import sys
 from pathlib import Path
@@ -19,3 +20,27 @@ def cli(tmp_path):
                               capture_output=True, text=True, timeout=300)
 
     return _run
+
+
+@contextlib.contextmanager
+def installed_distribution(site, name, version, forces, paths=()):
+    """A distribution laid out the way pip does it: ``site``/NAME-VERSION.dist-info with its
+    ``gyrolab.forces`` entry points (dict name -> "module:Class"), ``site`` and ``paths`` on sys.path,
+    gyrolab's plugin registry refreshed on entry and on exit."""
+    from gyrolab.engine import config, registry
+
+    info = site / f"{name.replace('-', '_')}-{version}.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: {version}\n")
+    (info / "entry_points.txt").write_text("[gyrolab.forces]\n" + "".join(f"{k} = {v}\n" for k, v in forces.items()))
+    mp = pytest.MonkeyPatch()
+    for path in (*paths, site):
+        mp.syspath_prepend(str(path))
+    registry.external.cache_clear()
+    config.register_plugin_configs.cache_clear()
+    try:
+        yield site
+    finally:
+        mp.undo()
+        registry.external.cache_clear()
+        config.register_plugin_configs.cache_clear()

@@ -87,3 +87,116 @@ def test_regime_outside_its_domain_writes_nothing(tmp_path, monkeypatch, capsys)
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "large_parameter" in err and "small_parameter" in err
     assert not (tmp_path / "out").exists()
+
+
+# ---- the corpus: every bad input is one sentence, a non-zero exit, nothing created -------------------------
+
+def run_main(argv, monkeypatch, capsys):
+    """``gyrolab ARGV`` in this process: (exit code, stderr)."""
+    from gyrolab.engine.config import ConfigSource, use_source
+
+    monkeypatch.setattr(sys, "argv", ["gyrolab", *argv])
+    try:
+        app.main()
+        code = 0
+    except SystemExit as stop:
+        code = stop.code
+    finally:
+        use_source(ConfigSource())
+    return code, capsys.readouterr().err
+
+
+LONG = "x" * 100_000
+DIGITS = "1" * 400
+SITE = __import__("sysconfig").get_paths()["purelib"]
+
+#: (command line, a phrase the sentence must contain); hydra.run.dir / hydra.sweep.dir are added unless given
+CORPUS = [
+    # Hydra's override grammar
+    (["=5"], "has no key"), (["="], "valid forms"), (["~"], "valid forms"),
+    (["+"], "malformed override"), (["time.end=[1"], "valid forms"), (["time.end={a"], "valid forms"),
+    (["time.end='5"], "valid forms"), (["time..end=5"], "valid forms"), ([".time=5"], "valid forms"),
+    (["time.end=${"], "valid forms"), (["time.end=1,2"], "run it with -m"),
+    (["-m", "time.end=interval(0,1)"], "not a list of values"), (["-m", "time.end=1,1"], "time.end"),
+    (["@=5"], "valid forms"),
+    # interpolations
+    (["initial.r0=${nope.key}"], "${nope.key}"), (["initial.r0=${time}"], "initial.r0"),
+    (["initial.r0=${oc.env:GYROLAB_SURELY_UNSET_VARIABLE}"], "initial.r0"),
+    # sections deleted or replaced by a value
+    (["~time"], "deletes the section time"),
+    (["~body"], "deletes the section body"),
+    (["~system"], "deletes the section system"),
+    (["time=5"], "`time` is a section"), (["output=5"], "`output` is a section"),
+    # unknown keys, with the closest valid one
+    (["+foo=1"], "`foo` is not a key of the config"), (["++foo=1"], "`foo` is not a key of the config"),
+    (["+time.ennd=5"], "did you mean `time.end`?"), (["time.ennd=5"], "did you mean `time.end`?"),
+    (["output.figure=false"], "did you mean `output.figures`?"), (["+body.mass_kg=3"], "body.mass_kg"),
+    (["+integrator.rtoll=1e-9"], "did you mean `integrator.rtol`?"),
+    (["+force.newtonian.kk=1"], "force.newtonian.kk"),
+    (["integrater=rk4"], "did you mean `integrator`?"),
+    (["+time.end=5"], "exists already"), (["+experiment=nope"], "unknown experiment 'nope'"),
+    (["experiment=perf_referenc"], "did you mean experiment=perf_reference?"),
+    (["force=[newtonian,magnet]"], "'magnet'"),
+    ([f"{LONG}=1"], "characters"),
+    ([f"time.end={LONG}"], "characters"), ([f"+time.{'e' * 5000}=1"], "longer than 200 characters"),
+    (["task=nope"], "unknown task 'nope'"),
+    # types
+    (["output.figures=maybe"], "output.figures='maybe' must be true or false"),
+    (["time.n_output=2.5"], "time.n_output=2.5 must be an integer"),
+    (["time.start=abc"], "time.start='abc' must be a number"),
+    (["time.end=true"], "must be a number"),
+    (["task=5"], "task=5"), (["allow_large=maybe"], "true or false"),
+    (["accuracy=abc"], "accuracy='abc' must be a number"),
+    (["body.com_direction=[1,0]"], "three"),
+    # numbers that are not representable
+    ([f"initial.r0={DIGITS}"], "too large"),
+    ([f"time.n_output={DIGITS}"], "too large"), (["time.end=1e400"], "finite"), (["initial.r0=-inf"], "finite"),
+    # output paths
+    (["hydra.run.dir="], "working directory"), (["hydra.run.dir=."], "working directory"),
+    (["hydra.run.dir=.."], "working directory or one of its parents"),
+    (["-m", "time.end=1,2", "hydra.sweep.dir="], "hydra.sweep.dir"),
+    (["hydra.output_subdir=../x"], "hydra.output_subdir"),
+    (["-m", "time.end=1,2", "hydra.sweep.subdir=../x"], "hydra.sweep.subdir"),
+    (["hydra.job.name=../x"], "hydra.job.name"), ([f"hydra.run.dir={SITE}/gyrolab_out"], "where Python loads code"),
+    # tolerances outside (0, 1)
+    (["integrator.rtol=2"], "integrator.rtol=2 is outside (0, 1)"),
+    (["integrator.rtol=0"], "outside (0, 1)"), (["integrator.atol=5"], "integrator.atol=5"),
+    (["integrator=taylor", "integrator.tol=1.5"], "integrator.tol=1.5"), (["integrator=auto", "accuracy=2"], "accuracy=2"),
+    # infeasible requests (the budget)
+    (["time.n_output=1000000000"], "67.1 GiB"),
+    (["time.end=1e12"], "integrator steps"), (["integrator=rk4", "integrator.step=1e-9"], "1e+11 integrator steps"),
+    (["integrator.max_step=1e-9"], "integrator.max_step"),
+    # Hydra settings swept, config sources
+    (["-m", "hydra.launcher.n_jobs=1,2"], "sweeps a Hydra setting"),
+    (["-m", "+hydra.callbacks.x._target_=a,b"], "sweeps a Hydra setting"),
+    (["--config-dir", "/nonexistent/gyrolab-conf"], "--config-dir"), (["--config-name", "nope"], "primary config 'nope'"),
+    (["--config-path", "/nonexistent/gyrolab-conf"], "--config-path"),
+    # the other commands
+    (["--reproduce"], "exactly one path"), (["--reproduce", "a.nc", "b.nc"], "exactly one path"),
+    (["--reproduce", "missing.nc"], "No such file"), (["--batch", "hydra.run.dir=x"], "hydra.sweep.dir only"),
+    (["--batch", "time.end=1,2"], "varies body, initial and force"), (["--batch", "=5"], "has no key"),
+    (["--batch", "+foo=1"], "`foo` is not a key"), (["--batch", "integrator.rtol=2"], "outside (0, 1)"),
+    (["--batch", "hydra.sweep.dir="], "working directory"),
+]
+
+
+@pytest.mark.parametrize("argv, phrase", CORPUS, ids=[" ".join(a)[:60] for a, _ in CORPUS])
+def test_corpus_of_bad_inputs(argv, phrase, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    given = " ".join(argv)
+    extra = [] if "hydra.run.dir" in given or argv[0].startswith("--") and argv[0] != "--config-name" else \
+        ["hydra.run.dir=out"]
+    if "-m" in argv and "hydra.sweep.dir" not in given:
+        extra.append("hydra.sweep.dir=sweep")
+    code, err = run_main([*argv, *extra], monkeypatch, capsys)
+    assert code not in (0, None)
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("gyrolab: error: "), err
+    assert phrase in lines[0], (phrase, lines[0])
+    assert len(lines[0]) < 1200
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_corpus_has_at_least_100_cases():
+    assert len(CORPUS) + len(CASES) >= 100

@@ -7,10 +7,12 @@ p1 = p/(c√γ0'') over one period (θ = 2πt/T). Body B3 of report 001 §6 (a =
 r_c = (0.48, 0.36, −0.8), k = 2, θ0 = 60°), where a2/a1 > 0.
 """
 
+import re
+
 import numpy as np
 import pytest
 
-from gyrolab.errors import ConfigError
+from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.experiments.regime_run import errors
 from gyrolab.physics.periodic import FixedPointModel, shoot
 from gyrolab.plugins.regimes import shaker_omega3 as paper
@@ -42,19 +44,26 @@ def _orbit_from(C, mu):
     return shoot(MODEL, y0, paper.period(r0, C))
 
 
-@pytest.mark.parametrize("mu", [0.02, 0.01])
-@pytest.mark.parametrize("branch,sign,phase_deg", [("ii", 1, 90.0), ("iv", 1, 45.0), ("iv", -1, 45.0)])
-def test_erratum_001_6_branches_ii_iv_are_not_periodic_solutions(mu, branch, sign, phase_deg):
+@pytest.mark.parametrize("mu, branch, sign, phase_deg, outcome", [
+    (0.02, "ii", 1, 90.0, "no orbit"), (0.02, "iv", 1, 45.0, "no orbit"), (0.02, "iv", -1, 45.0, "branch iii"),
+    (0.01, "ii", 1, 90.0, "no orbit"), (0.01, "iv", 1, 45.0, "branch iii"), (0.01, "iv", -1, 45.0, "no orbit"),
+])
+def test_erratum_001_6_branches_ii_iv_are_not_periodic_solutions(mu, branch, sign, phase_deg, outcome):
     # The paper claims an orbit with the p-mode phase ε of the branch; shooting from it lands on a
     # branch-(iii) orbit (phase 0 or π), or finds nothing: the orbits on the circle are isolated.
     C = CONSTANTS.as_printed().on_branch(branch, sign, np.radians(phase_deg))
-    try:
-        orbit = _orbit_from(C, mu)
-    except Exception:  # no orbit near the printed branch at all
+    if outcome == "no orbit":
+        # Newton stalls far above its acceptance (1e-11) and above the 1e-10 return residual that points
+        # near the amplitude circle can have without being on an orbit (gyrolab.physics.periodic.shoot)
+        with pytest.raises(IntegrationError, match="Newton shooting did not converge") as failed:
+            _orbit_from(C, mu)
+        stall = float(re.search(r"return residual ([0-9.e+-]+)", str(failed.value)).group(1))
+        assert stall > 1e-9
         return
-    c3, s3 = _p_mode(orbit)
+    c3, s3 = _p_mode(_orbit_from(C, mu))
     assert abs(s3 - C.M2) > 1.5  # the printed phase is not that of the orbit: M2 = E sin ε ≥ 1.8 claimed
     assert abs(s3) < 0.1 and abs(abs(c3) - CONSTANTS.E) < 0.1  # it is a branch (iii) orbit (corrected E)
+    assert np.sign(c3) == sign  # on the side of the circle the printed start was on
 
 
 @pytest.mark.parametrize("sign", [1, -1])

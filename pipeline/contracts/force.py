@@ -30,47 +30,65 @@ class CompiledTerms:
 class Force(ABC):
     """A torque acting on a rigid body, composable with others in a list.
 
-    Rules for implementers:
+    Rules for implementers (``gyrolab.testing.check_force`` checks them; run it in your tests):
 
     1. ``__init__(self, body, **params)`` takes the system's body (in model
        units, see ``gyrolab.physics.body``) and the plugin's config parameters as
        keyword arguments with defaults; it validates them and raises
        ``gyrolab.errors.ConfigError`` (one sentence, naming the bad value) on
-       bad input. The keyword defaults are the plugin's default config.
+       bad input. The keyword defaults are the plugin's default config. A
+       ``ValueError`` or ``TypeError`` escaping ``__init__`` (``float("abc")``)
+       is reported by gyrolab as one sentence naming the parameter.
     2. ``required_axes`` names the reference-frame axes (0, 1, 2) whose body
        components ``torque`` and ``potential`` read. A system carries an axis
-       only if some force (or the output) needs it, so ask for no more.
+       only if some force (or the output) needs it, so ask for no more; an axis
+       not declared is passed as ``None``.
     3. ``torque(omega, axes)`` returns the torque in body axes, model units,
-       for one state (vectors of shape (3,)). It is called in the integrator's
-       inner loop: no allocation beyond the result, no Python-level loops.
-    4. A conservative force overrides ``potential(axes)``, returning the
+       for one state (vectors of shape (3,)). Write it as arithmetic on the
+       vectors (numpy operations, ``gyrolab.physics.vectors`` helpers, np.sqrt,
+       np.exp, np.sin, ...): gyrolab traces it once into compiled code, so it runs
+       under the compiled integrators, ``--batch`` and ``auto`` at machine speed.
+       A torque that branches on the state (``if``, comparisons, ``max``) or
+       converts it to a float (``float()``, ``math.*``) runs with the Python
+       integrators only; the log and any compiled integrator say which construct.
+    4. ``time_dependent = True`` declares a torque that also depends on time:
+       it is then called as ``torque(omega, axes, t)``. Such a force has no
+       conserved energy (its ``potential`` is not used).
+    5. A conservative force overrides ``potential(axes)``, returning the
        potential energy for axes of shape (n, 3) (vectorised over a
        trajectory); a force that does not is non-conservative, and the system
        then stops monitoring the energy.
        The torque of a potential V(axes) is Σ_i e_i × ∂V/∂e_i.
-    5. ``preserves_area_integral`` is true when the torque has no component
-       along the reference Z axis for every state (a field symmetric about Z),
-       so that the area integral Iω·γ is conserved.
-    6. ``attributes()`` describes the parameters for the dataset, in both the
+    6. ``preserves_area_integral`` has no default: every force declares it (a
+       class attribute, or set in ``__init__`` when it depends on the
+       parameters). It is true exactly when the torque has no component along
+       the reference Z axis (axis 2, γ) for every state — a field symmetric
+       about Z — so that the area integral Iω·γ is conserved (d(Iω·γ)/dt =
+       torque·γ) and monitored as an invariant. Drag, or a field along X, is
+       False. A force without the declaration is refused (ConfigError).
+    7. ``attributes()`` describes the parameters for the dataset, in both the
        SI and the nondimensional form where the body allows it (netCDF-safe
-       values: str, numbers, lists of numbers).
-    7. Optionally, ``compiled_terms()`` returns the torque as ``CompiledTerms``
-       so that compiled integrators can run it; a force without that form
-       runs with the Python integrators only.
+       values: str, int, float, lists of numbers; names of letters, digits, _).
+    8. Optionally, ``compiled_terms()`` returns the torque as ``CompiledTerms``,
+       the built-in forms every compiled integrator (Taylor and Lie–Poisson too)
+       evaluates; a traced torque (rule 3) runs with ``dop853_numba``,
+       ``rk4_numba``, ``--batch`` and ``auto`` (through DOP853), not ``taylor``
+       or ``lie_poisson``.
     """
 
     name: ClassVar[str]
     required_axes: frozenset[int] = frozenset()
-    preserves_area_integral: bool = True
+    time_dependent: ClassVar[bool] = False
+    preserves_area_integral: bool  # no default: declare it (rule 6)
 
     @abstractmethod
     def torque(self, omega: np.ndarray, axes: Axes) -> np.ndarray:
-        """Torque (3,) in body axes for one state."""
+        """Torque (3,) in body axes for one state (``torque(omega, axes, t)`` when ``time_dependent``)."""
 
     @property
     def conservative(self) -> bool:
-        """True when the plugin defines a potential (it overrides ``potential``)."""
-        return type(self).potential is not Force.potential
+        """True when the plugin defines a potential (it overrides ``potential``) of a time-independent torque."""
+        return type(self).potential is not Force.potential and not self.time_dependent
 
     def potential(self, axes: Axes) -> np.ndarray | None:
         """Potential energy along a trajectory, or None for a non-conservative force."""
@@ -81,5 +99,17 @@ class Force(ABC):
         return {}
 
     def compiled_terms(self) -> CompiledTerms | None:
-        """The torque in the compiled kernels' form, or None if it has none."""
+        """The torque in the compiled kernels' built-in form, or None (the torque is then traced, rule 3)."""
         return None
+
+
+def check_declared(force: Force, where: str) -> None:
+    """ConfigError unless the force declares ``preserves_area_integral`` as a bool (rule 6)."""
+    from gyrolab.errors import ConfigError
+
+    flag = getattr(force, "preserves_area_integral", None)
+    if not isinstance(flag, (bool, np.bool_)):
+        raise ConfigError(
+            f"{where} ({type(force).__name__}) must declare preserves_area_integral = True or False: True only "
+            "when its torque has no component along the vertical Z (γ) for every state; see gyrolab.contracts.Force"
+        )

@@ -1,24 +1,109 @@
-"""Hydra composition for gyrolab: the config module, plugin config nodes, friendly errors."""
+"""Hydra composition for gyrolab: where configs come from, plugin config nodes, friendly errors.
+
+A :class:`ConfigSource` says where Hydra finds the primary config and the config
+groups: the packaged ``gyrolab.conf`` by default, or a user's directory given with
+``--config-dir`` / ``--config-path`` / ``--config-name`` (and ``hydra.searchpath``).
+The search path is built with Hydra's own functions, exactly as ``@hydra.main``
+builds it, so the config the preflight validates is the config that runs.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import difflib
+import os
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
 from functools import cache
+from pathlib import Path
+from typing import Any
 
-from hydra import compose, initialize_config_module
+from hydra._internal.utils import create_automatic_config_search_path
+from hydra.core.config_search_path import ConfigSearchPath, SearchPathQuery
 from hydra.core.config_store import ConfigStore
 from hydra.core.global_hydra import GlobalHydra
 from hydra.errors import HydraException, MissingConfigException, OverrideParseException
-from omegaconf import DictConfig
+from hydra.types import RunMode
+from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.engine import registry
-from gyrolab.errors import ConfigError, choices
+from gyrolab.errors import ConfigError, choices, shorten
 
 CONFIG_MODULE = "gyrolab.conf"
 CONFIG_NAME = "config"
+PACKAGED_PATH = f"pkg://{CONFIG_MODULE}"
 #: groups whose options are chosen by name on the command line
 SELECTABLE_GROUPS = ("system", "body", "initial", "force", "integrator", "regime", "experiment")
+#: the file of ``@hydra.main``: Hydra resolves a relative ``--config-path`` against its folder
+_APP_FILE = str(Path(__file__).resolve().parent.parent / "app.py")
+
+
+@dataclass(frozen=True)
+class ConfigSource:
+    """Where the primary config and the config groups come from (Hydra's ``-cp``, ``-cn``, ``-cd``)."""
+
+    config_path: str = PACKAGED_PATH
+    config_name: str = CONFIG_NAME
+    config_dir: str | None = None
+    #: ``hydra.searchpath`` of the composed config (Hydra appends it while composing; listing options needs it)
+    searchpath: tuple[str, ...] = ()
+
+    @classmethod
+    def from_args(cls, config_path: str | None, config_name: str | None, config_dir: str | None) -> ConfigSource:
+        """The source Hydra would use for these command-line options; ConfigError for a missing directory."""
+        if config_dir is not None:
+            config_dir = os.path.abspath(config_dir)
+            if not os.path.isdir(config_dir):
+                raise ConfigError(f"--config-dir {config_dir!r} is not a directory; give the folder that holds "
+                                  "your YAML files (e.g. --config-dir myconf)")
+        if config_path is not None and not config_path.startswith("pkg://"):
+            config_path = os.path.abspath(config_path)
+            if not os.path.isdir(config_path):
+                raise ConfigError(f"--config-path {config_path!r} is not a directory; give the folder that holds "
+                                  "your primary config (e.g. --config-path myconf --config-name mine)")
+        if config_name is not None:
+            config_name = config_name.removesuffix(".yaml")
+            if not config_name or "\0" in config_name:
+                raise ConfigError("--config-name is empty; give the name of your primary YAML file without "
+                                  ".yaml (e.g. --config-name mine)")
+        return cls(config_path or PACKAGED_PATH, config_name or CONFIG_NAME, config_dir)
+
+    def search_path(self) -> ConfigSearchPath:
+        """Hydra's search path for this source, built as ``hydra._internal.utils._run_hydra`` builds it."""
+        search_path = create_automatic_config_search_path(_APP_FILE, None, self.config_path)
+        if self.config_dir is not None:
+            search_path.prepend(provider="command-line", path=f"file://{self.config_dir}",
+                                anchor=SearchPathQuery(provider="schema"))
+        for path in self.searchpath:
+            search_path.append(provider="main", path=path)
+        return search_path
+
+
+_source = ConfigSource()
+
+
+def use_source(source: ConfigSource) -> None:
+    """Make ``source`` the one :func:`compose_config` composes from (the app sets it from its options)."""
+    global _source
+    _source = source
+
+
+def current_source() -> ConfigSource:
+    return _source
+
+
+@contextmanager
+def hydra_for(source: ConfigSource | None = None) -> Iterator[None]:
+    """A Hydra initialised on ``source`` (default: the current one) for the duration of the block."""
+    from hydra._internal.hydra import Hydra
+
+    GlobalHydra.instance().clear()
+    Hydra.create_main_hydra2(task_name="app", config_search_path=(source or _source).search_path())
+    try:
+        yield
+    finally:
+        GlobalHydra.instance().clear()
 
 
 @cache
@@ -43,36 +128,126 @@ def group_options(group: str) -> list[str]:
     return sorted(loader.get_group_options(group))
 
 
-def compose_config(overrides: Sequence[str], *, return_hydra_config: bool = False) -> DictConfig:
+def compose_config(overrides: Sequence[str], *, return_hydra_config: bool = False,
+                   run_mode: RunMode = RunMode.RUN, from_shell: bool = False,
+                   config_name: str | None = None) -> DictConfig:
     """Compose gyrolab's config with command-line style overrides; ConfigError on any problem.
 
     Inside a running gyrolab app (an experiment composing its scenes) Hydra is already
-    initialised on the same config module, and is reused.
+    initialised on the run's search path, and is reused with the run's primary config.
     """
     register_plugin_configs()
     if GlobalHydra.instance().is_initialized():
-        return _compose(overrides, return_hydra_config)
-    with initialize_config_module(config_module=CONFIG_MODULE, version_base="1.3"):
-        return _compose(overrides, return_hydra_config)
+        return _compose(overrides, config_name or _running_config_name(), return_hydra_config, run_mode,
+                        from_shell)
+    with hydra_for(_source):
+        return _compose(overrides, _source.config_name, return_hydra_config, run_mode, from_shell)
 
 
-def _compose(overrides: Sequence[str], return_hydra_config: bool) -> DictConfig:
+def _running_config_name() -> str:
+    from hydra.core.hydra_config import HydraConfig
+
+    if HydraConfig.initialized():
+        return HydraConfig.get().job.config_name or _source.config_name
+    return _source.config_name
+
+
+def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bool, run_mode: RunMode,
+             from_shell: bool) -> DictConfig:
+    hydra = GlobalHydra.instance().hydra
     try:
-        return compose(config_name=CONFIG_NAME, overrides=list(overrides), return_hydra_config=return_hydra_config)
+        cfg = hydra.compose_config(config_name=config_name, overrides=list(overrides), run_mode=run_mode,
+                                   from_shell=from_shell)
     except MissingConfigException as error:
-        raise friendly_missing(error) from None
+        raise friendly_missing(error, config_name) from None
     except OverrideParseException as error:
         raise ConfigError(f"malformed override: {_first_line(error)}") from None
     except (HydraException, OmegaConfBaseException) as error:
-        raise ConfigError(_first_line(error)) from None
+        raise friendly_composition_error(error, overrides, config_name) from None
+    except (ValueError, TypeError) as error:  # Hydra's defaults list on a malformed group override
+        raise ConfigError(f"cannot compose the config with {shorten(' '.join(overrides), 120)} "
+                          f"({shorten(_first_line(error), 120)})") from None
+    if not return_hydra_config and "hydra" in cfg:
+        from omegaconf import open_dict
+
+        with open_dict(cfg):
+            del cfg["hydra"]
+    return cfg
 
 
-def friendly_missing(error: MissingConfigException) -> ConfigError:
+def friendly_missing(error: MissingConfigException, config_name: str = CONFIG_NAME) -> ConfigError:
     missing = error.missing_cfg_file or ""
     group, _, option = missing.rpartition("/")
     if group and error.options is not None:
-        return ConfigError(f"unknown {group} {option!r}; valid choices: {choices(error.options)}")
+        close = difflib.get_close_matches(option, error.options, n=1)
+        hint = f"; did you mean {group}={close[0]}?" if close else ""
+        return ConfigError(f"unknown {group} {shorten(repr(option))}{hint} (valid choices: {choices(error.options)})")
+    if missing == config_name or "Primary config" in str(error):
+        return ConfigError(f"primary config {config_name!r} not found in {_source.config_path}"
+                           f"{' or ' + _source.config_dir if _source.config_dir else ''}; --config-name names a "
+                           "YAML file (without .yaml) in --config-path or --config-dir")
     return ConfigError(_first_line(error))
+
+
+def friendly_composition_error(error: Exception, overrides: Sequence[str], config_name: str) -> ConfigError:
+    """One sentence for Hydra's "Could not override 'KEY'" and friends, with the closest valid name."""
+    text = _first_line(error)
+    cause = error.__cause__ or error.__context__
+    if text.startswith("Could not append to config. An item is already at '"):
+        key = text.split("'")[1]
+        return ConfigError(f"+{shorten(key)}=... adds a key, but `{shorten(key)}` exists already; change it with "
+                           f"{shorten(key)}=VALUE (or ++{shorten(key)}=VALUE to add or change)")
+    if text.startswith("Error merging override ") and cause is not None:
+        override = text[len("Error merging override "):]
+        reason = _first_line(cause).split(" full_key:")[0]
+        return ConfigError(f"override {shorten(override)!r} cannot be applied ({shorten(reason, 160)})")
+    if text.startswith("Could not override '"):
+        key = text.split("'")[1]
+        override = next((o for o in overrides if o.lstrip("+~").split("=", 1)[0].split("@")[0] == key), key)
+        return ConfigError(unknown_key_sentence(key, _known_names(overrides, key, config_name), override,
+                                                type(cause).__name__ if cause else ""))
+    if "Could not delete from config" in text or "Could not find" in text:
+        return ConfigError(f"{shorten(text, 200)}; ~KEY deletes only a key or group the config has")
+    return ConfigError(shorten(text, 300))
+
+
+def unknown_key_sentence(key: str, known: Sequence[str], override: str = "", cause: str = "") -> str:
+    """"`time.ennd` is not a key of `time`; did you mean `time.end`?" (with the valid keys if none is close)."""
+    parent, _, leaf = key.rpartition(".")
+    where = f"`{parent}`" if parent else "the config"
+    close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
+    if "ValidationError" in cause or "ConfigTypeError" in cause:
+        return (f"{shorten(override or key)!s}: `{shorten(key)}` is a section, not a value; set one of its keys "
+                f"(e.g. {next((k for k in known if k.startswith(key + '.')), key + '.KEY')}=...)")
+    if close:
+        return f"`{shorten(key)}` is not a key of {where}; did you mean `{close[0]}`?"
+    siblings = sorted(k.rpartition(".")[2] for k in known if k.rpartition(".")[0] == parent)
+    return (f"`{shorten(key)}` is not a key of {where}; valid keys: "
+            f"{shorten(', '.join(siblings) or '(none)', 300)}")
+
+
+def _known_names(overrides: Sequence[str], key: str, config_name: str) -> list[str]:
+    """Every key path of the config composed without the override of ``key`` (and the config groups)."""
+    rest = [o for o in overrides if o.lstrip("+~").split("=", 1)[0].split("@")[0] != key]
+    try:
+        cfg = GlobalHydra.instance().hydra.compose_config(config_name=config_name, overrides=rest,
+                                                          run_mode=RunMode.RUN, from_shell=False)
+    except Exception:  # noqa: BLE001 - the hint is best effort; the sentence stands without it
+        return []
+    names = list(key_paths(cfg))
+    names += [group for group in SELECTABLE_GROUPS]
+    return names
+
+
+def key_paths(node: Any, prefix: str = "") -> Iterator[str]:
+    """Dotted paths of every key in a config (mappings only; list items are not keys)."""
+    if isinstance(node, DictConfig):
+        for key in node.keys():
+            path = f"{prefix}.{key}" if prefix else str(key)
+            yield path
+            child = node._get_node(key)
+            if isinstance(child, DictConfig) and not child._is_interpolation():
+                yield from key_paths(child, path)
 
 
 def _first_line(error: Exception) -> str:
@@ -80,3 +255,135 @@ def _first_line(error: Exception) -> str:
     lines = [line.strip() for line in str(error).strip().splitlines() if line.strip()]
     line = lines[0] if lines else type(error).__name__
     return line.split(" See https://")[0]
+
+
+# ---- the scene config's schema: closed sections, value types ------------------------------------------------
+
+#: sections whose keys are fixed: their valid keys and value types are read from the packaged config
+_CLOSED_SECTIONS = ("time", "output")
+#: sections whose valid keys are the union over the packaged options of their group
+_OPTION_SECTIONS = ("body", "initial")
+
+
+@cache
+def packaged_reference() -> dict[str, Any]:
+    """The packaged config's plain defaults and, per section, the keys any packaged option uses."""
+    from importlib.resources import files
+
+    conf = files(CONFIG_MODULE)
+    main = OmegaConf.to_container(OmegaConf.load(str(conf / "config.yaml")), resolve=False)
+    top = set(main) - {"defaults", "hydra"}
+    for option in (conf / "experiment").iterdir():
+        if option.name.endswith(".yaml"):
+            top |= set(OmegaConf.load(str(option))) - {"defaults", "hydra"}
+    sections: dict[str, set[str]] = {}
+    for group in (*_OPTION_SECTIONS, "integrator", "system", "regime"):
+        keys: set[str] = set()
+        for option in (conf / group).iterdir():
+            if option.name.endswith(".yaml"):
+                text = option.read_text()
+                node = OmegaConf.create(text) if text.strip() else OmegaConf.create({})
+                if "@package _global_" in text.split("\n", 1)[0]:
+                    node = node.get(group) or {}
+                keys |= set(node) - {"defaults"}
+        sections[group] = keys
+    return {"top": top | set(SELECTABLE_GROUPS), "defaults": main, "sections": sections}
+
+
+def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
+    """The scene config resolved to plain values; ConfigError for an unknown key, a wrong type, a bad reference.
+
+    Unknown keys are refused with the closest valid one (``+time.ennd=5``, a typo in
+    a user's experiment file); values of ``time`` and ``output`` must have the type of
+    the packaged default; an interpolation must point at a key that exists.
+    """
+    ref = packaged_reference()
+    for key in cfg.keys():
+        if key not in ref["top"]:
+            raise ConfigError(unknown_key_sentence(str(key), sorted(ref["top"])))
+    for section in ("time", "output", "body", "initial"):
+        if section not in cfg or cfg[section] is None:
+            raise ConfigError(f"the config has no `{section}` section (deleted with ~{section}?); every run needs "
+                              f"it: set its keys instead (e.g. {section}.{_example_key(section)}=...)")
+    plain = resolve_plain(cfg)
+    for section in ("time", "output", "body", "initial"):
+        if not isinstance(plain[section], dict):
+            raise ConfigError(f"{section}={shorten(repr(plain[section]))}: `{section}` is a section, not a value; "
+                              f"set one of its keys (e.g. {section}.{_example_key(section)}=...)")
+        valid = (ref["defaults"][section] if section in _CLOSED_SECTIONS else ref["sections"][section])
+        for key, value in plain[section].items():
+            if key not in valid:
+                raise ConfigError(unknown_key_sentence(f"{section}.{key}", [f"{section}.{k}" for k in valid]))
+            if section in _CLOSED_SECTIONS:
+                check_type(f"{section}.{key}", value, ref["defaults"][section][key])
+    for group in ("integrator", "system", "regime"):
+        node = plain.get(group)
+        if isinstance(node, dict) and "_target_" in node and _plugin_keys(group, node["_target_"]):
+            valid = _plugin_keys(group, node["_target_"]) | ref["sections"][group]
+            for key in node:
+                if key not in valid:
+                    raise ConfigError(unknown_key_sentence(f"{group}.{key}", [f"{group}.{k}" for k in valid]))
+    for name, node in (plain.get("force") or {}).items():
+        valid = _plugin_keys("force", node["_target_"]) if isinstance(node, dict) and "_target_" in node else set()
+        if valid:
+            for key in node:
+                if key not in valid:
+                    raise ConfigError(unknown_key_sentence(f"force.{name}.{key}",
+                                                           [f"force.{name}.{k}" for k in valid]))
+    for key in ("task",):
+        if key in plain and not isinstance(plain[key], str):
+            raise ConfigError(f"{key}={shorten(repr(plain[key]))} must be a task name (a string)")
+    accuracy = plain.get("accuracy")
+    if accuracy is not None:
+        check_type("accuracy", accuracy, 0.0)
+    if "allow_large" in plain:
+        check_type("allow_large", plain["allow_large"], False)
+    return plain
+
+
+def _plugin_keys(group: str, target: Any) -> set[str]:
+    try:
+        _, cls = registry.resolve_target(group, target, group)
+    except ConfigError:
+        return set()  # Scene.from_config says which targets are valid
+    return {"_target_", *registry.default_params(cls)}
+
+
+def _example_key(section: str) -> str:
+    return {"time": "end", "output": "figures", "body": "a", "initial": "r0"}[section]
+
+
+def check_type(where: str, value: Any, default: Any) -> None:
+    """ConfigError unless ``value`` has the type of the packaged default (an int is a valid float)."""
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise ConfigError(f"{where}={shorten(repr(value))} must be true or false")
+    elif isinstance(default, int):
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{where}={shorten(repr(value))} must be an integer")
+    elif isinstance(default, float):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"{where}={shorten(repr(value))} must be a number")
+
+
+def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
+    """``OmegaConf.to_container(cfg, resolve=True)`` with a one-sentence error for a broken interpolation."""
+    try:
+        return OmegaConf.to_container(cfg, resolve=True, throw_on_missing=True)
+    except OmegaConfBaseException as error:
+        key = getattr(error, "full_key", None) or "?"
+        raw = _raw_value(cfg, key)
+        reason = _first_line(error).split(" full_key:")[0]
+        return_hint = "refer to an existing key, e.g. ${time.end}, or give a plain value"
+        raise ConfigError(f"{shorten(key)}={shorten(str(raw))} cannot be resolved ({shorten(reason, 160)}); "
+                          f"{return_hint}") from None
+
+
+def _raw_value(cfg: DictConfig, key: str) -> Any:
+    node: Any = cfg
+    try:
+        for part in key.split("."):
+            node = node._get_node(part)
+        return node._value()
+    except Exception:  # noqa: BLE001 - only for the message
+        return "?"

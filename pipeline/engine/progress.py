@@ -10,6 +10,7 @@ off (``allow_bars(False)``): the sweep shows one bar for all its jobs.
 from __future__ import annotations
 
 import logging
+import math
 import sys
 import threading
 import time
@@ -34,6 +35,18 @@ def on_terminal(stream: Any) -> bool:
         return False
 
 
+def duration(seconds: float) -> str:
+    """A wall-clock duration for people: '42 s', '7.5 min', '3.1 h', '12 days', '290 years', '9.5e+06 years'."""
+    if not math.isfinite(seconds):
+        return "? s"
+    for unit, size, limit in (("s", 1, 120), ("min", 60, 120), ("h", 3600, 48), ("days", 86400, 730),
+                              ("years", 365.25 * 86400, 1e4)):
+        value = seconds / size
+        if value < limit:
+            return f"{value:.0f} {unit}" if value >= 10 or unit == "s" else f"{value:.1f} {unit}"
+    return f"{seconds / (365.25 * 86400):.2g} years"
+
+
 class Progress:
     """Callable ``progress(t)`` that integrators call every few steps with the model time reached."""
 
@@ -43,6 +56,7 @@ class Progress:
         self.t_start, self.t_end = t_start, t_end
         self.every = every
         self._began = self._last = time.perf_counter()
+        self._t_last: float | None = None
         stream = sys.stderr if stream is None else stream
         self._bar = self._make_bar(stream) if _bars_allowed and on_terminal(stream) else None
 
@@ -62,12 +76,16 @@ class Progress:
         now = time.perf_counter()
         if now - self._last < self.every:
             return
-        self._last = now
         fraction = (t - self.t_start) / (self.t_end - self.t_start)
         elapsed = now - self._began
-        remaining = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
-        log.info("%s: %3.0f%% (t=%.6g of %.6g), %.0f s elapsed, ~%.0f s to go",
-                 self.label, 100 * fraction, t, self.t_end, elapsed, remaining)
+        # the remaining time at the pace since the last report (a compiled method's first report includes
+        # its compilation), or since the start at the first report
+        since, t_since = (self._last, self._t_last) if self._t_last is not None else (self._began, self.t_start)
+        self._last, self._t_last = now, t
+        pace = (t - t_since) / (now - since) if now > since else 0.0
+        remaining = (self.t_end - t) / pace if pace > 0 else float("nan")
+        log.info("%s: %3.0f%% (t=%.6g of %.6g), %s elapsed, ~%s to go",
+                 self.label, 100 * fraction, t, self.t_end, duration(elapsed), duration(remaining))
 
     def close(self) -> None:
         if self._bar is not None:

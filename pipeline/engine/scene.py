@@ -49,10 +49,14 @@ class Scene:
         system_cls = _plugin_class("system", cfg.system, "system")
         body = system_cls.body_type.from_config(plain["body"])
         forces = [
-            _build(_plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
+            build_force(_plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
             for name, node in (cfg.get("force") or {}).items()
         ]
         system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
+        timed = [f.name for f in forces if f.time_dependent]
+        if timed and system.name != "fixed_point":
+            raise ConfigError(f"force {timed[0]!r} is time-dependent, which system {system.name!r} does not support; "
+                              "valid systems: fixed_point")
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
         requested = plain["time"].get("n_output", AUTO)
         times = _output_times(plain["time"], fastest_rate(system))
@@ -62,12 +66,24 @@ class Scene:
         if warning:
             log.warning("%s", warning)
         if integrator.needs_compiled_model and scene.compiled is None:
-            plain_forces = [f.name for f in system.forces if f.compiled_terms() is None]
-            culprit = f"force {plain_forces[0]!r}" if plain_forces else f"system {system.name!r}"
+            reason = getattr(system, "compile_error", None) or f"system {system.name!r} has no compiled form"
             raise ConfigError(
-                f"integrator {integrator.name!r} runs compiled models only, and {culprit} has no "
-                f"compiled form; choose a Python integrator (dop853, rk45, rk4, lsoda, radau, bdf)"
+                f"integrator {integrator.name!r} runs compiled models only, and {reason}; "
+                f"choose dop853 (or rk45, rk4, lsoda, radau, bdf) or integrator=auto"
             )
+        if scene.compiled is not None and integrator.name in ("taylor", "lie_poisson"):
+            from gyrolab.plugins.compiled import models
+
+            if scene.compiled.model not in models.TAYLOR_MODELS:
+                traced = ", ".join(f.name for f in system.forces if f.compiled_terms() is None)
+                raise ConfigError(
+                    f"integrator {integrator.name!r} evaluates the built-in torque forms only, and force {traced} "
+                    f"is a compiled plugin torque; choose dop853_numba, rk4_numba or integrator=auto"
+                )
+        elif scene.compiled is None and integrator.prefers_compiled_model:
+            reason = getattr(system, "compile_error", None)
+            if reason:
+                log.info("%s; %s runs scipy's integrators", reason, integrator.name)
         return scene
 
     @cached_property
@@ -120,9 +136,10 @@ class Scene:
         if log.isEnabledFor(logging.INFO):  # the title is worth building only when someone reads it
             log.info("integrating %s with %s over t=[%g, %g] (%d output times)", self.system.title(),
                      self.integrator.name, self.times[0], self.times[-1], len(self.times))
+        compiled = self.compiled  # a plugin's torque compiles here (once), before progress is timed
         progress = Progress(self.integrator.name, self.times[0], self.times[-1])
         solution = self.integrator.integrate(self.system.rhs, self.times, self.system.initial_state(), progress,
-                                             self.compiled)
+                                             compiled)
         stats = solution.stats
         log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
                  "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)
@@ -159,6 +176,38 @@ def _build(cls: type, node: DictConfig, where: str, *args: Any) -> Any:
         raise ConfigError(f"{where}.{unknown[0]} is not a parameter of {cls.__name__}; valid parameters: "
                           f"{', '.join(sorted(accepted)) or '(none)'}")
     return cls(*args, **params)
+
+
+def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
+    """Instantiate a force plugin; its ValueError/TypeError becomes one ConfigError naming the parameter.
+
+    ``node`` is the force's config (a DictConfig or a dict of parameters). The culprit is found by
+    building the force with each given parameter alone; the force must declare its area-integral flag.
+    """
+    from gyrolab.contracts.force import check_declared
+
+    if not isinstance(node, DictConfig):
+        node = OmegaConf.create(dict(node))
+    try:
+        force = _build(cls, node, where, body)
+    except (ValueError, TypeError) as exc:
+        if isinstance(exc, ConfigError):
+            raise
+        params = {k: v for k, v in OmegaConf.to_container(node, resolve=True).items() if k != "_target_"}
+        culprit = next((key for key in params if _fails(cls, body, {key: params[key]})), None)
+        named = f"{where}.{culprit}={params[culprit]!r}" if culprit else \
+            f"{where} ({', '.join(f'{k}={v!r}' for k, v in params.items()) or 'defaults'})"
+        raise ConfigError(f"{named} is not valid for {cls.__name__}: {type(exc).__name__}: {exc}") from None
+    check_declared(force, where)
+    return force
+
+
+def _fails(cls: type, body: Any, params: dict[str, Any]) -> bool:
+    try:
+        cls(body, **params)
+    except (ValueError, TypeError):
+        return True
+    return False
 
 
 def fastest_rate(system: System) -> float | None:

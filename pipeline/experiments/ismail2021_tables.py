@@ -25,6 +25,7 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
+from gyrolab.output.atomic import atomic_path
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
@@ -109,8 +110,9 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     data, written = {}, []
     for number, values in ((1, table1()), (2, table2())):
         path = out_dir / f"table{number}.csv"
-        np.savetxt(path, np.column_stack([T, values]), delimiter=",", header="t," + ",".join(COLUMNS),
-                   comments="", fmt="%.9g")
+        with atomic_path(path) as tmp:
+            np.savetxt(tmp, np.column_stack([T, values]), delimiter=",", header="t," + ",".join(COLUMNS),
+                       comments="", fmt="%.9g")
         written.append(path)
         deviation = np.abs(values - PUBLISHED[number])
         units = deviation / PRINT_UNIT[number]

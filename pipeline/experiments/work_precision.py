@@ -53,7 +53,7 @@ def _final(ds: xr.Dataset) -> np.ndarray:
 def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
     """Final (ω, γ) of the scene from the most accurate reference available, and its name."""
     compiled = scene.system.compiled_model()
-    if compiled is None:
+    if compiled is None or compiled.model != 0:  # 0: models.FIXED_POINT, the built-in torque forms only
         raise ConfigError("work_precision needs a scene whose forces have compiled forms (for its reference run)")
     p = compiled.params
     extra = np.any(p[3:9] != 0) or np.any(p[12:14] != 0)  # torques along non-vertical axes

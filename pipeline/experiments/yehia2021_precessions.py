@@ -21,6 +21,7 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
+from gyrolab.output.atomic import atomic_open
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError, as_number
@@ -102,8 +103,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                  item["right_handed_error"])
     out_dir.mkdir(parents=True, exist_ok=True)
     csv_path = out_dir / "precession_cases.csv"
-    tmp = csv_path.with_suffix(".csv.tmp")
-    with tmp.open("w", newline="") as handle:
+    with atomic_open(csv_path, "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(COLUMNS)
         for row in rows:
@@ -112,9 +112,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
             writer.writerow([row["case"], row["formula"], f"{row['residual_vector']:.3e}",
                              f"{row['residual_euler_angles']:.3e}", f"{row['max_theta_deviation']:.3e}",
                              {True: "true", False: "false", None: ""}[row["stable"]], row["verdict"], row["condition"]])
-    written = [write_dataset(_dataset(rows, closed, cfg), out_dir / "precession_cases.nc")]
-    tmp.replace(csv_path)
-    written.insert(0, csv_path)
+    written = [csv_path, write_dataset(_dataset(rows, closed, cfg), out_dir / "precession_cases.nc")]
     written += plot_classes(rows, traces, out_dir / "figures")
     return written
 

@@ -2,17 +2,25 @@
 
 A result is written to a temporary file beside its final path (same directory,
 so the rename cannot cross file systems), flushed to disk, then renamed over
-the final name. A killed process leaves at most a temporary file, named
-``.<final name>.<random>.tmp``, which the next run or resume in that directory
-removes (``remove_stale_temporaries``). A write that fails for want of space,
-quota or permission is one ``OutputError`` sentence naming the file and the
-reason, and leaves no partial file.
+the final name (and the directory entry flushed too). A killed process leaves
+at most a temporary file, named ``.<final name>.<random>.tmp``, which the next
+run or resume in that directory removes (``remove_stale_temporaries``, called
+while the directory is locked, see ``gyrolab.output.lock``). A write that
+fails for want of space, quota or permission is one ``OutputError`` sentence
+naming the file and the reason, and leaves no partial file.
+
+The netCDF library reports a full disk or a file-size limit as
+``RuntimeError("NetCDF: HDF error")``, without an errno; the reason is then
+found after the failure (``diagnose``): the process's file-size limit, a
+probe write beside the file (which fails with the real errno when the disk or
+quota is full), and the free space against the expected size of the file.
 """
 
 from __future__ import annotations
 
 import errno
 import os
+import resource
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -22,6 +30,8 @@ from gyrolab.errors import OutputError
 
 #: how a temporary file of ``atomic_path`` is named: prefix "." + final name + ".", suffix
 TEMP_SUFFIX = ".tmp"
+#: bytes written by the probe that looks for the reason of a write failure without an errno
+PROBE_BYTES = 1 << 20
 
 _REASONS = {
     errno.ENOSPC: "no space left on device",
@@ -44,12 +54,24 @@ def _umask() -> int:
     return mask
 
 
+#: what netCDF's RuntimeErrors say when the write itself failed (a full disk or a file-size limit is "HDF error")
+_LIBRARY_WRITE_FAILURES = ("HDF error", "Write to read only", "Permission denied", "No space", "Disk quota",
+                           "File too large", "Can't create file", "I/O failure")
+
+
+def _library_failure(error: BaseException) -> bool:
+    """An error of a writing library that stands for a failed write, not for bad content (a bug)."""
+    return isinstance(error, RuntimeError) and any(text in str(error) for text in _LIBRARY_WRITE_FAILURES)
+
+
 @contextmanager
-def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
+def atomic_path(path: str | os.PathLike[str], *, expected_bytes: int | None = None) -> Iterator[Path]:
     """Yield a temporary path to write; on success it is renamed to ``path``, on failure removed.
 
-    OSErrors raised while writing (or by the caller's writer, e.g. netCDF's "HDF error" for a full
-    disk surfaces as OSError/RuntimeError) become one ``OutputError`` naming ``path``.
+    OSErrors raised while writing, and the netCDF library's "HDF error" (a full disk or a file-size
+    limit), become one ``OutputError`` naming ``path`` and the reason. ``expected_bytes``, the
+    approximate size of the finished file, lets the reason of an errno-less failure be found from
+    the free space.
     """
     path = Path(path)
     try:
@@ -64,12 +86,68 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
         _fsync(tmp)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes the file private; results are ordinary files
         os.replace(tmp, path)
-    except OSError as error:
+        _fsync_directory(path.parent)
+    except OutputError:
         tmp.unlink(missing_ok=True)
-        raise OutputError(f"cannot write {str(path)!r}: {reason(error)}") from None
+        raise
+    except (OSError, RuntimeError) as error:
+        if not isinstance(error, OSError) and not _library_failure(error):
+            tmp.unlink(missing_ok=True)
+            raise
+        why = diagnose(error, tmp, expected_bytes)
+        tmp.unlink(missing_ok=True)
+        raise OutputError(f"cannot write {str(path)!r}: {why}") from None
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+@contextmanager
+def atomic_open(path: str | os.PathLike[str], mode: str = "w", **kwargs) -> Iterator:
+    """``open`` for writing, atomically: the file appears at ``path`` whole when the block ends."""
+    with atomic_path(path) as tmp, open(tmp, mode, **kwargs) as handle:
+        yield handle
+
+
+def diagnose(error: BaseException, tmp: Path, expected_bytes: int | None = None) -> str:
+    """Why writing ``tmp`` failed: the error's own errno, else what the file system says now."""
+    if isinstance(error, OSError) and error.errno in _REASONS:
+        return reason(error)
+    try:
+        written = tmp.stat().st_size
+    except OSError:
+        written = 0
+    limit, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
+    if limit != resource.RLIM_INFINITY and max(written + PROBE_BYTES, expected_bytes or 0) >= limit:
+        return f"file too large for the process's file-size limit of {_size(limit)} (ulimit -f)"
+    try:  # a full disk or quota fails this small write too, with the errno the library did not report
+        with open(tmp, "ab") as handle:
+            handle.write(bytes(PROBE_BYTES))
+            handle.flush()
+            os.fsync(handle.fileno())
+    except OSError as probe:
+        if probe.errno in _REASONS:
+            return reason(probe)
+    try:
+        stats = os.statvfs(tmp.parent)
+    except OSError:
+        stats = None
+    if stats is not None:
+        free = (stats.f_bfree if os.geteuid() == 0 else stats.f_bavail) * stats.f_frsize
+        free += written + PROBE_BYTES  # the temporary file is removed: its blocks count as free
+        if expected_bytes is not None and free < expected_bytes:
+            return f"{_REASONS[errno.ENOSPC]} ({_size(free)} free, about {_size(expected_bytes)} needed)"
+    if isinstance(error, OSError):
+        return reason(error)
+    return f"the netCDF library failed ({error})"
+
+
+def _size(n: int) -> str:
+    for unit in ("bytes", "KiB", "MiB", "GiB", "TiB"):
+        if n < 1024 or unit == "TiB":
+            return f"{n:.0f} {unit}" if unit == "bytes" else f"{n:.1f} {unit}"
+        n /= 1024
+    return f"{n} bytes"  # pragma: no cover - unreachable
 
 
 def _fsync(path: Path) -> None:
@@ -77,11 +155,37 @@ def _fsync(path: Path) -> None:
         os.fsync(handle.fileno())
 
 
+def _fsync_directory(directory: Path) -> None:
+    """Flush the rename itself (POSIX keeps it in the directory's metadata)."""
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass  # some file systems cannot fsync a directory; the rename has happened all the same
+    finally:
+        os.close(fd)
+
+
+def is_temporary(path: Path) -> bool:
+    """Whether ``path`` is named like a temporary file of ``atomic_path``."""
+    return path.name.startswith(".") and path.name.endswith(TEMP_SUFFIX)
+
+
 def remove_stale_temporaries(directory: str | os.PathLike[str]) -> list[Path]:
-    """Remove temporary files that killed writes left in ``directory`` (not recursive); returns them."""
+    """Remove temporary files that killed writes left in ``directory`` (not recursive).
+
+    Call it only while holding the directory's lock (``gyrolab.output.lock``): a temporary file of a
+    write in progress is indistinguishable from a stale one. Returns the files removed.
+    """
     removed = []
     for leftover in Path(directory).glob(f".*{TEMP_SUFFIX}"):
-        if leftover.is_file():
-            leftover.unlink(missing_ok=True)
-            removed.append(leftover)
+        try:
+            if leftover.is_file():
+                leftover.unlink()
+                removed.append(leftover)
+        except OSError:
+            pass  # gone already, or not ours to remove: nothing is lost by leaving it
     return removed

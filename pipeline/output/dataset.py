@@ -66,8 +66,12 @@ def time_attributes(body: ModelUnits) -> dict[str, str]:
 
 
 def write_dataset(ds: xr.Dataset, path: Path) -> Path:
-    """Write ``ds`` to ``path`` atomically (``gyrolab.output.atomic``)."""
+    """Write ``ds`` to ``path`` atomically (``gyrolab.output.atomic``).
+
+    A full disk, a quota or a file-size limit (which netCDF reports as "HDF error") is one
+    ``OutputError`` naming the file and the reason, and leaves no file at ``path``.
+    """
     path = Path(path)
-    with atomic_path(path) as tmp:
+    with atomic_path(path, expected_bytes=int(ds.nbytes)) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4")
     return path

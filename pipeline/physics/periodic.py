@@ -146,7 +146,7 @@ class FixedPointModel:
     @classmethod
     def from_system(cls, system) -> FixedPointModel:
         compiled = system.compiled_model()
-        if compiled is None:
+        if compiled is None or compiled.model != 0:  # 0: models.FIXED_POINT, the built-in torque forms only
             raise ConfigError("periodic orbits need forces with compiled forms; valid forces: uniform_gravity, newtonian")
         p = compiled.params
         if np.any(p[3:9] != 0) or np.any(p[12:14] != 0):

@@ -28,6 +28,7 @@ layout without writing per-job files.
 from __future__ import annotations
 
 import logging
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -40,6 +41,7 @@ from omegaconf import OmegaConf
 from gyrolab.contracts.integrator import IntegratorStats
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
+from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
 from gyrolab.errors import ConfigError
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
@@ -375,10 +377,17 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
     if figures is None:
         figures = bool(OmegaConf.select(hydra_cfg, "callbacks.sweep.figures", default=True))
     grid = Grid.from_hydra(hydra_cfg)
-    results = collect(sweep_dir, grid)
-    ds = assemble(grid, results)
-    ds.attrs["sweep_launcher"] = launcher
-    path = write_dataset(ds, sweep_dir / SWEEP_NAME)
+    wait_for_jobs(sweep_dir)
+    # Two processes resuming one sweep aggregate one after the other; the later one sees every job.
+    try_lock(sweep_dir, blocking=True)
+    try:
+        clear_temporaries(sweep_dir)
+        results = collect(sweep_dir, grid)
+        ds = assemble(grid, results)
+        ds.attrs["sweep_launcher"] = launcher
+        path = write_dataset(ds, sweep_dir / SWEEP_NAME)
+    finally:
+        unlock(sweep_dir)
     summary = SweepSummary(
         path=path, n_jobs=len(results), finished=int(ds.attrs["n_finished"]), failed=int(ds.attrs["n_failed"]),
         missing=int(ds.attrs["n_missing"]), skipped=sum(r.skipped for r in results),
@@ -388,6 +397,18 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
 
         summary.figures = save_sweep_figures(ds, sweep_dir / "figures")
     return summary
+
+
+def wait_for_jobs(sweep_dir: Path) -> None:
+    """Wait for the jobs of this sweep that another process is running (a concurrent resume)."""
+    for root, dirs, files in os.walk(sweep_dir):
+        dirs[:] = sorted(d for d in dirs if not d.startswith("."))
+        if LOCK_NAME in files and Path(root) != Path(sweep_dir):
+            owner = owner_of(Path(root))
+            if owner:
+                log.info("waiting for job %s, run by another gyrolab process (%s)",
+                         Path(root).relative_to(sweep_dir).as_posix(), owner)
+            wait_for(Path(root))
 
 
 def _short_target(target: str) -> str:

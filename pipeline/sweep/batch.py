@@ -18,12 +18,13 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-from omegaconf import OmegaConf
+from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.engine.batch import integrate_batch
 from gyrolab.engine.config import compose_config
 from gyrolab.contracts.integrator import IntegratorStats, Solution
 from gyrolab.output.dataset import build_dataset, write_dataset
+from gyrolab.output.lock import writing_in
 from gyrolab.errors import ConfigError, GyrolabError
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.aggregate import FAILED, FINISHED, JobResult, assemble
@@ -35,13 +36,22 @@ VARIABLE_SECTIONS = ("body.", "initial.", "force.")
 
 
 def run_batch_sweep(overrides: Sequence[str], out_dir: Path) -> Path:
-    """Run the grid of ``overrides`` as one batch; write and return ``out_dir/sweep.nc``."""
+    """Run the grid of ``overrides`` as one batch; write and return ``out_dir/sweep.nc``.
+
+    ``out_dir`` is locked meanwhile (a second batch into it is refused in one sentence) and cleared
+    of the temporary files that killed writes left there.
+    """
     grid = Grid.from_overrides(overrides)
     for dim in grid.dims:
         if not dim.key.lstrip("+~").startswith(VARIABLE_SECTIONS):
             raise ConfigError(f"a batch sweep varies body, initial and force parameters only, not {dim.key!r}; "
                               "sweep it with gyrolab -m instead")
     base = compose_config(list(grid.jobs[0]))
+    with writing_in(out_dir, "sweep directory"):  # after the cheap checks: a bad grid leaves no directory
+        return _integrate_and_write(grid, base, Path(out_dir))
+
+
+def _integrate_and_write(grid: Grid, base: DictConfig, out_dir: Path) -> Path:
     plain = OmegaConf.to_container(base, resolve=True)
     start = time.perf_counter()
     scenes: list[Scene | None] = []

@@ -10,15 +10,18 @@ summary figures. The jobs themselves record their outcome (``job.json``) in
 from __future__ import annotations
 
 import logging
+import sys
 from pathlib import Path
 from typing import Any
 
 from hydra.experimental.callback import Callback
 from omegaconf import DictConfig
 
-from gyrolab.errors import GyrolabError
+from gyrolab.errors import GyrolabError, OutputError
+from gyrolab.output.lock import lock, unlock
 from gyrolab.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
 from gyrolab.sweep.grid import Grid
+from gyrolab.sweep.orphans import announce_launcher, forget_launcher
 from gyrolab.sweep.watch import SweepWatcher
 
 log = logging.getLogger("gyrolab.sweep")
@@ -26,10 +29,17 @@ log = logging.getLogger("gyrolab.sweep")
 #: outcome of the last sweep aggregated in this process (read by the command's exit status)
 last_summary: SweepSummary | None = None
 last_error: str | None = None
+#: exit status of the command when ``last_error`` is set (3: sweep.nc could not be written)
+last_exit_code: int = 1
 
 
 class SweepCallback(Callback):
-    """Aggregate a multirun into ``<sweep dir>/sweep.nc``; ``figures``: also draw the summary figures."""
+    """Aggregate a multirun into ``<sweep dir>/sweep.nc``; ``figures``: also draw the summary figures.
+
+    For a single run it also locks the run directory before Hydra writes anything there
+    (``on_run_start``), so that a second run into a directory in use is refused in one sentence
+    (exit 2) without touching the first run's files.
+    """
 
     def __init__(self, figures: bool = True, progress: bool = True) -> None:
         self.figures = bool(figures)
@@ -37,11 +47,29 @@ class SweepCallback(Callback):
         self._watcher: SweepWatcher | None = None
 
     def __getstate__(self) -> dict[str, Any]:  # launchers pickle callbacks to send them to the jobs
-        return {"figures": self.figures, "progress": self.progress, "_watcher": None}
+        return {"figures": self.figures, "progress": self.progress, "_watcher": None}  # no lock, no announcement
+
+    def on_run_start(self, config: DictConfig, **kwargs: Any) -> None:
+        try:  # the directory Hydra is about to create (the same config object: the same ${now:} values)
+            run_dir = Path(str(config.hydra.run.dir))
+        except Exception:  # noqa: BLE001 - not resolvable yet: the run locks it itself (gyrolab.app._run_one)
+            return
+        try:
+            lock(run_dir)
+        except GyrolabError as error:
+            print(f"gyrolab: error: {error}", file=sys.stderr)
+            sys.exit(error.exit_code)
+        self._locked = run_dir
+
+    def on_run_end(self, config: DictConfig, **kwargs: Any) -> None:
+        locked = self.__dict__.pop("_locked", None)
+        if locked is not None:
+            unlock(locked)
 
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
-        global last_summary, last_error
-        last_summary, last_error = None, None
+        global last_summary, last_error, last_exit_code
+        last_summary, last_error, last_exit_code = None, None, 1
+        self._announced = announce_launcher()  # worker processes of this sweep die with this process
         if not self.progress or not _basic_sweeper(config):
             return
         try:
@@ -52,10 +80,11 @@ class SweepCallback(Callback):
         self._watcher.start()
 
     def on_multirun_end(self, config: DictConfig, **kwargs: Any) -> None:
-        global last_summary, last_error
+        global last_summary, last_error, last_exit_code
         if self._watcher is not None:
             self._watcher.stop()
             self._watcher = None
+        forget_launcher(self.__dict__.pop("_announced", None))
         if not _basic_sweeper(config):
             log.warning("sweep.nc is written for Hydra's basic sweeper only (this sweep used %s)",
                         config.hydra.sweeper.get("_target_"))
@@ -64,6 +93,11 @@ class SweepCallback(Callback):
         try:
             summary = aggregate_sweep(sweep_dir, hydra_cfg=config.hydra, figures=self.figures,
                                       launcher=str(config.hydra.launcher.get("_target_", "")).rsplit(".", 1)[-1])
+        except OutputError as error:  # a full disk: one sentence, exit 3, the jobs' results intact
+            last_error = f"{error}; the job results are intact: run 'gyrolab --aggregate {sweep_dir}' once " \
+                         "the cause is fixed"
+            last_exit_code = error.exit_code
+            return
         except Exception as error:  # noqa: BLE001 - the jobs' results are safe; say how to aggregate them later
             last_error = f"could not aggregate the sweep ({type(error).__name__}: {error}); the job results are " \
                          f"intact: run 'gyrolab --aggregate {sweep_dir}' once the cause is fixed"

@@ -2,7 +2,13 @@
 
 A failing job is recorded, not fatal: the error goes into the job's record
 (and, through the aggregator, into ``sweep.nc``'s table of failed jobs) and
-the sweep goes on.
+the sweep goes on. A write failure (no space, quota, permission) fails the
+job like any other error, but is retried when the sweep is run again.
+
+The job's directory is locked while the job runs (``gyrolab.output.lock``):
+when two processes resume one sweep, a job that one of them is running is
+skipped by the other, so no job runs twice. Temporary files that a killed
+job left in its directory are removed before it runs again.
 """
 
 from __future__ import annotations
@@ -13,9 +19,19 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from gyrolab.errors import GyrolabError
+from gyrolab.errors import GyrolabError, OutputError
+from gyrolab.output.lock import clear_temporaries, owner_of, try_lock, unlock
 from gyrolab.sweep.identity import code_version, job_identity
-from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, remove_record, write_record
+from gyrolab.sweep.orphans import guard_worker
+from gyrolab.sweep.record import (
+    ELSEWHERE,
+    FAILED,
+    FINISHED,
+    JobRecord,
+    read_record,
+    remove_record,
+    write_record,
+)
 
 log = logging.getLogger("gyrolab.sweep")
 
@@ -26,10 +42,34 @@ def run_sweep_job(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_
 
     Never raises for a failing scene: a GyrolabError is recorded as a
     deterministic failure (the same config and code fail the same way, so it
-    is not retried); any other exception is recorded too, with its traceback
-    in the job's log, and retried when the sweep is run again.
+    is not retried), except a write failure (``OutputError``: the disk may
+    have room next time); any other exception is recorded too, with its
+    traceback in the job's log, and retried when the sweep is run again. A
+    job that another live process is running is left to it (status
+    ``ELSEWHERE``, nothing written).
     """
     job_dir = Path(job_dir)
+    guard_worker()  # in a launcher's worker process: die with the launching process
+    try:
+        if not try_lock(job_dir):
+            owner = owner_of(job_dir)
+            log.warning("job %s is being run by another gyrolab process%s; left to it", job_num,
+                        f" ({owner})" if owner else "")
+            return JobRecord(job_id="", status=ELSEWHERE, overrides=list(overrides), code_version="",
+                             job_num=job_num, skipped=True)
+    except OutputError as error:  # the job directory cannot even hold a lock file: nothing can be written
+        log.error("job %s failed: %s", job_num, error)
+        return _failed(JobRecord("", FAILED, list(overrides), "", job_num), error, error.exit_code,
+                       deterministic=False)
+    try:
+        clear_temporaries(job_dir)
+        return _run_locked(cfg, job_dir, overrides, job_num, work)
+    finally:
+        unlock(job_dir)
+
+
+def _run_locked(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_num: int | None,
+                work: Callable[[str], Path]) -> JobRecord:
     code = code_version()
     try:
         job_id = job_identity(cfg, code)
@@ -37,20 +77,19 @@ def run_sweep_job(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_
         record = _failed(JobRecord(job_id="", status=FAILED, overrides=list(overrides), code_version=code,
                                    job_num=job_num), error, 2, deterministic=False)
         log.error("job %s failed: its config does not resolve: %s", job_num, record.error)
-        write_record(job_dir, record)
-        return record
+        return _recorded(job_dir, record)
     previous = read_record(job_dir)
     if previous is not None and previous.reusable_for(job_id, job_dir):
         log.info("job %s: %s earlier (job id %s); skipped", job_num, previous.status, job_id)
         previous.skipped, previous.job_num, previous.overrides = True, job_num, list(overrides)
-        write_record(job_dir, previous)
-        return previous
+        return _recorded(job_dir, previous)
     remove_record(job_dir)  # a stale record (other config or code) must not outlive this attempt
-    for leftover in job_dir.glob(".*.tmp"):  # temporary files of a job killed while writing
-        leftover.unlink(missing_ok=True)
     base = JobRecord(job_id=job_id, status=FAILED, overrides=list(overrides), code_version=code, job_num=job_num)
     try:
         path = work(job_id)
+    except OutputError as error:
+        log.error("job %s failed: %s", job_num, error)
+        record = _failed(base, error, error.exit_code, deterministic=False)
     except GyrolabError as error:
         log.error("job %s failed: %s", job_num, error)
         record = _failed(base, error, error.exit_code, deterministic=True)
@@ -62,7 +101,15 @@ def run_sweep_job(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_
         record = base
     if record.status == FAILED:
         (job_dir / "run.nc").unlink(missing_ok=True)  # no partial or stale output next to a failure
-    write_record(job_dir, record)
+    return _recorded(job_dir, record)
+
+
+def _recorded(job_dir: Path, record: JobRecord) -> JobRecord:
+    """Write the job's record; if even that fails (a full disk), say so: the job reruns next time."""
+    try:
+        write_record(job_dir, record)
+    except OutputError as error:
+        log.error("job %s: %s; it will run again when the sweep is resumed", record.job_num, error)
     return record
 
 

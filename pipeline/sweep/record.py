@@ -9,13 +9,16 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
+from gyrolab.output.atomic import atomic_open
+
 RECORD_NAME = "job.json"
 FINISHED, FAILED = "finished", "failed"
+#: status of a job that another live process is running (returned, never written)
+ELSEWHERE = "running elsewhere"
 
 
 @dataclass
@@ -42,16 +45,10 @@ class JobRecord:
 
 
 def write_record(job_dir: Path, record: JobRecord) -> Path:
+    """Write ``job_dir/job.json`` atomically (OutputError, one sentence, if it cannot be written)."""
     path = Path(job_dir) / RECORD_NAME
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{RECORD_NAME}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as stream:
-            json.dump(asdict(record), stream, indent=1)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_open(path, "w") as stream:
+        json.dump(asdict(record), stream, indent=1)
     return path
 
 

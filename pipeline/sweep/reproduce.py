@@ -13,9 +13,11 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from omegaconf import OmegaConf
+from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.errors import ConfigError
+from gyrolab.engine.budget import check_budget
+from gyrolab.engine.safety import check_stored_config
+from gyrolab.errors import ConfigError, shorten
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 
@@ -39,8 +41,10 @@ def load_run(path: Path) -> xr.Dataset:
     path = Path(path)
     try:
         ds = xr.load_dataset(path, decode_times=False, decode_timedelta=False)
-    except (OSError, ValueError) as error:
-        raise ConfigError(f"cannot read {str(path)!r} as a netCDF dataset ({error}); give a run.nc that "
+    except (OSError, ValueError, RuntimeError, KeyError, TypeError) as error:
+        reason = (getattr(error, "strerror", None) or "it is not a netCDF file" if isinstance(error, (OSError, ValueError))
+                  else shorten(str(error).splitlines()[0] if str(error) else type(error).__name__, 120))
+        raise ConfigError(f"cannot read {str(path)!r} as a netCDF dataset ({reason}); give a run.nc that "
                           "gyrolab wrote") from None
     if "config" not in ds.attrs and "job_status" in ds:
         raise ConfigError(f"{str(path)!r} is a sweep dataset, not a run; give one job's run.nc (sweep.nc's "
@@ -50,9 +54,25 @@ def load_run(path: Path) -> xr.Dataset:
     return ds
 
 
+def stored_config(stored: xr.Dataset, where: str = "the dataset's config attribute") -> DictConfig:
+    """The config a dataset stores, read with a safe YAML loader and checked as any config is.
+
+    A dataset may come from someone else: its config is parsed without YAML tags,
+    may not contain interpolations (gyrolab stores it resolved), may name only
+    registered plugins (``gyrolab.engine.safety``) and must be within the budget.
+    """
+    cfg = check_stored_config(stored.attrs["config"], where)
+    plain = OmegaConf.to_container(cfg)
+    time = plain.get("time")
+    if isinstance(time, dict) and {"start", "end", "n_output"} <= set(time) and isinstance(time["n_output"], int):
+        probe = cfg.copy()
+        probe.time.n_output = 2
+        check_budget(plain, Scene.from_config(probe).system.initial_state().size)
+    return cfg
+
+
 def rerun(stored: xr.Dataset) -> xr.Dataset:
-    cfg = OmegaConf.create(stored.attrs["config"])
-    return Scene.from_config(cfg).run()
+    return Scene.from_config(stored_config(stored)).run()
 
 
 def compare(stored: xr.Dataset, new: xr.Dataset) -> Comparison:

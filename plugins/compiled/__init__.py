@@ -38,6 +38,11 @@ import numba  # noqa: E402
 if "NUMBA_CACHE_DIR" not in os.environ:
     numba.config.CACHE_DIR = _cache_dir()
 
+
+def kernel_cache_dir() -> str:
+    """The directory of compiled kernels (also of the generated force modules, ``plugin_torque``)."""
+    return numba.config.CACHE_DIR or _cache_dir()
+
 #: Decorator of every kernel: cached on disk; numpy's error model (no zero-division checks
 #: inside the arithmetic, which cost more than the arithmetic; a zero divisor gives inf/NaN,
 #: which the integrators detect and report).

@@ -67,7 +67,8 @@ def _stage_sum(K, s, a_row, n, out):
 def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, max_step, stats):
     """Advance until t_out[i_stop − 1] is filled. state = [t, h_abs]; stats = [nfev, steps, rejected].
 
-    Returns (status, next output index). y and f are updated in place.
+    Returns (status, next output index). y and f are updated in place. The last step fills every
+    output it covers, also beyond i_stop (the next call cannot go back): the next index can pass i_stop.
     """
     n = y.size
     K = np.empty((N_EXTENDED, n))
@@ -138,7 +139,7 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
                 state[0], state[1] = t, h_abs
                 return NOT_FINITE, i
         # dense output for the outputs inside (t, t_new]
-        if i < i_stop and t_out[i] <= t_new:
+        if i < i_stop and t_out[i] <= t_new:  # (then on to every output inside the step, past i_stop too)
             t_old = t
             for s in range(N_STAGES + 1, N_EXTENDED):
                 _stage_sum(K, s, A[s], n, dy)
@@ -156,7 +157,7 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
                     for j in range(N_EXTENDED):
                         acc += D[r, j] * K[j, m]
                     F[3 + r, m] = h * acc
-            while i < i_stop and t_out[i] <= t_new:
+            while i < t_out.size and t_out[i] <= t_new:
                 if t_out[i] == t_new:
                     Y[i] = y_new
                 else:

@@ -8,6 +8,7 @@ e_0 = α (fixed X), e_1 = β = γ × α (fixed Y), e_2 = γ (vertical).
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from gyrolab.contracts.force import CompiledTerms
@@ -27,6 +28,30 @@ def pack(inertia: np.ndarray, terms: list[CompiledTerms], carries_alpha: bool) -
     p[15] = 1.0 if carries_alpha else 0.0
     p[16:19] = 1.0 / inertia  # multiplications in the inner loop, not divisions
     return p
+
+
+def compiled_model(inertia: np.ndarray, forces: list, carries_alpha: bool):
+    """The fixed-point system's compiled model: built-in torque forms packed, any other torque traced and compiled.
+
+    Forces with ``compiled_terms()`` fill the packed forms; the others' torques are traced together into
+    one compiled kernel (``plugin_torque``), whose address and constants extend the parameter array.
+    Raises ``plugin_torque.NotCompilable`` naming the construct that prevents compilation.
+    """
+    from gyrolab.contracts.integrator import CompiledModel
+    from gyrolab.plugins.compiled import models, plugin_torque
+
+    terms, plugins = [], []
+    for force in forces:
+        term = force.compiled_terms()
+        if term is None:
+            plugins.append(force)
+        else:
+            terms.append(term)
+    p = pack(inertia, terms, carries_alpha)
+    if not plugins:
+        return CompiledModel(models.FIXED_POINT, p)
+    compiled = plugin_torque.compile_trace(plugin_torque.trace(plugins), [f.name for f in plugins])
+    return CompiledModel(models.FIXED_POINT_PLUGIN, np.concatenate([p, [float(compiled.address)], compiled.constants]))
 
 
 @inline_kernel
@@ -104,7 +129,10 @@ def _cauchy_pairs(A, ia, k, out):
     out[2] = r2
 
 
-@kernel
+# The Cauchy sums may be reassociated and contracted (fused multiply-add): ~15 % faster, and a coefficient's
+# rounding enters the state multiplied by h^k. The state update itself (``taylor.run``) stays strict: its
+# Kahan summation would be optimised away under reassociation.
+@numba.njit(cache=True, error_model="numpy", fastmath={"reassoc", "contract", "nsz"})
 def taylor_coefficients(p, Y, order, work):
     """Fill Y[1..order] (rows: Taylor coefficients of the state) from Y[0].
 
@@ -112,30 +140,43 @@ def taylor_coefficients(p, Y, order, work):
     every product is a Cauchy sum (Jorba & Zou 2005): Y[k+1] = F_k / (k + 1).
     The gyroscopic and gradient torques use their component form,
     ((Iω) × ω)_x = (I_y − I_z) ω_y ω_z, one product per term instead of two.
-    ``work`` (order+1, 3) holds the coefficients of β = γ × α when α is carried.
+    The sums over ω and γ (the products of (Iω) × ω, γ × Iγ and γ × ω) share one
+    pass over the coefficient rows. ``work`` (order+1, 3) holds the coefficients
+    of β = γ × α when α is carried.
     """
     I0, I1, I2 = p[0], p[1], p[2]
     d0, d1, d2 = I1 - I2, I2 - I0, I0 - I1  # ((Iω) × ω) = (d0 ω_y ω_z, d1 ω_z ω_x, d2 ω_x ω_y)
     has_alpha = p[15] != 0.0
+    n2 = p[14]
     acc = np.empty(3)
     tmp = np.empty(3)
     for k in range(order):
-        if has_alpha:  # β_k
-            acc[:] = 0.0
-            _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, acc)
-            work[k, 0], work[k, 1], work[k, 2] = acc[0], acc[1], acc[2]
-        _cauchy_pairs(Y, 0, k, tmp)  # (Iω) × ω
-        acc[0], acc[1], acc[2] = d0 * tmp[0], d1 * tmp[1], d2 * tmp[2]
-        g0, g1, g2 = Y[k, 3], Y[k, 4], Y[k, 5]
-        acc[0] += p[10] * g2 - p[11] * g1
-        acc[1] += p[11] * g0 - p[9] * g2
-        acc[2] += p[9] * g1 - p[10] * g0
-        if p[14] != 0.0:  # N_2 γ × Iγ = −N_2 (d ⊙ pairs of γ)
-            _cauchy_pairs(Y, 3, k, tmp)
-            acc[0] -= p[14] * d0 * tmp[0]
-            acc[1] -= p[14] * d1 * tmp[1]
-            acc[2] -= p[14] * d2 * tmp[2]
+        # one pass: pairs of ω (w·), pairs of γ (g·), γ × ω (c·)
+        w0 = w1 = w2 = 0.0
+        g0 = g1 = g2 = 0.0
+        c0 = c1 = c2 = 0.0
+        for j in range(k + 1):
+            a0, a1, a2 = Y[j, 0], Y[j, 1], Y[j, 2]
+            b0, b1, b2 = Y[j, 3], Y[j, 4], Y[j, 5]
+            A0, A1, A2 = Y[k - j, 0], Y[k - j, 1], Y[k - j, 2]
+            B0, B1, B2 = Y[k - j, 3], Y[k - j, 4], Y[k - j, 5]
+            w0 += a1 * A2
+            w1 += a2 * A0
+            w2 += a0 * A1
+            g0 += b1 * B2
+            g1 += b2 * B0
+            g2 += b0 * B1
+            c0 += b1 * A2 - b2 * A1
+            c1 += b2 * A0 - b0 * A2
+            c2 += b0 * A1 - b1 * A0
+        e0, e1, e2 = Y[k, 3], Y[k, 4], Y[k, 5]
+        # (Iω) × ω + U_2 × γ − N_2 (d ⊙ pairs of γ)   (N_2 γ × Iγ = −N_2 d ⊙ pairs)
+        acc[0] = d0 * (w0 - n2 * g0) + p[10] * e2 - p[11] * e1
+        acc[1] = d1 * (w1 - n2 * g1) + p[11] * e0 - p[9] * e2
+        acc[2] = d2 * (w2 - n2 * g2) + p[9] * e1 - p[10] * e0
         if has_alpha:
+            work[k, 0] = work[k, 1] = work[k, 2] = 0.0  # β_k = Σ γ_j × α_{k−j}
+            _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, work[k])
             x0, x1, x2 = Y[k, 6], Y[k, 7], Y[k, 8]
             b0, b1, b2 = work[k, 0], work[k, 1], work[k, 2]
             acc[0] += p[4] * x2 - p[5] * x1 + p[7] * b2 - p[8] * b1
@@ -156,11 +197,9 @@ def taylor_coefficients(p, Y, order, work):
         Y[k + 1, 1] = acc[1] * p[17] * inv
         Y[k + 1, 2] = acc[2] * p[18] * inv
         # γ̇ = γ × ω, α̇ = α × ω
-        acc[:] = 0.0
-        _cauchy_cross(Y, 3, Y, 0, k, 1.0, 1.0, 1.0, acc)
-        Y[k + 1, 3], Y[k + 1, 4], Y[k + 1, 5] = acc[0] * inv, acc[1] * inv, acc[2] * inv
+        Y[k + 1, 3], Y[k + 1, 4], Y[k + 1, 5] = c0 * inv, c1 * inv, c2 * inv
         if has_alpha:
-            acc[:] = 0.0
+            acc[0] = acc[1] = acc[2] = 0.0
             _cauchy_cross(Y, 6, Y, 0, k, 1.0, 1.0, 1.0, acc)
             Y[k + 1, 6], Y[k + 1, 7], Y[k + 1, 8] = acc[0] * inv, acc[1] * inv, acc[2] * inv
 

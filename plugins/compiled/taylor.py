@@ -1,12 +1,24 @@
 """Taylor series method of high order with automatic step size (Jorba & Zou, Exp. Math. 14, 2005).
 
 The right-hand sides are quadratic, so the Taylor coefficients come from
-Cauchy products (``models.taylor_coefficients``). The step is chosen from
-the last two coefficients so that the first neglected term is about ``tol``
-relative to the state; the series itself is the dense output.
+Cauchy products (``models.taylor_coefficients``). The order follows from the
+tolerance (``order_for``: p = ⌈−ln(tol)/2 + 1⌉, which minimises the work per
+unit time when the coefficients decay geometrically) and the step from the last
+two coefficients, h = min_k (tol·max(1, ‖y‖)/‖y_k‖)^(1/k) for k = p−1, p,
+times Jorba and Zou's safety factor exp(−0.7/(p−1)). The series is the dense
+output: every output time inside a step is one Horner evaluation, no extra step.
+
+The state update y ← y + Σ_{k≥1} y_k h^k is a compensated (Kahan) sum: the low
+bits lost when a small increment is added to an O(1) state are carried to the
+next step, so round-off no longer grows as one ulp of the state per step (the
+floor of the uncompensated update was ~2e-12 over the 3,000 steps of the
+reference scene). Time needs no compensation: the step actually taken is
+h = fl(t + h) − t, exact in floating point, and the state advances by exactly it.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -14,6 +26,12 @@ from gyrolab.plugins.compiled import kernel
 from gyrolab.plugins.compiled.models import taylor_coefficients
 
 OK, NOT_FINITE = 0, 2
+MIN_ORDER, MAX_ORDER = 4, 60
+
+
+def order_for(tol: float) -> int:
+    """Jorba & Zou's optimal order for a tolerance: ⌈−ln(tol)/2 + 1⌉, within [MIN_ORDER, MAX_ORDER]."""
+    return int(min(MAX_ORDER, max(MIN_ORDER, math.ceil(-math.log(tol) / 2.0 + 1.0))))
 
 
 @kernel
@@ -25,16 +43,22 @@ def _norm_inf(row):
 
 
 @kernel
-def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, stats):
-    """Advance until t_out[i_stop − 1] is filled. state = [t]; stats = [coefficient evaluations, steps]."""
+def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+    """Advance until t_out[i_stop − 1] is filled.
+
+    state = [t]; carry = the Kahan compensation of y (zeros at the start); stats = [coefficient
+    evaluations, steps]. Returns (status, index of the next output time to fill).
+    """
     n = y.size
     T = np.empty((order + 1, n))
     work = np.zeros((order + 1, 3))
     t = state[0]
     t_end = t_out[i_stop - 1]
     i = i_next
+    safety = math.exp(-0.7 / (order - 1))
     while i < i_stop:
-        T[0] = y
+        for m in range(n):
+            T[0, m] = y[m]
         taylor_coefficients(model, p, T, order, work)
         stats[0] += 1
         scale = max(1.0, _norm_inf(y))
@@ -45,7 +69,7 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, stats):
             h = min(h, (tol * scale / n1) ** (1.0 / (order - 1)))
         if n2 > 0:
             h = min(h, (tol * scale / n2) ** (1.0 / order))
-        h *= 0.9
+        h *= safety
         if not h < np.inf:
             h = t_end - t
         t_new = min(t + h, t_end)
@@ -54,18 +78,24 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, stats):
             dt = t_out[i] - t
             for m in range(n):
                 v = T[order, m]
-                for k in range(order - 1, -1, -1):
+                for k in range(order - 1, 0, -1):
                     v = v * dt + T[k, m]
-                Y[i, m] = v
+                Y[i, m] = y[m] + (v * dt - carry[m])
             i += 1
+        finite = True
         for m in range(n):
             v = T[order, m]
-            for k in range(order - 1, -1, -1):
+            for k in range(order - 1, 0, -1):
                 v = v * h + T[k, m]
-            y[m] = v
-            if not np.isfinite(v):
-                state[0] = t
-                return NOT_FINITE, i
+            # Kahan: y + v·h with the bits lost in the previous additions carried in `carry`
+            inc = v * h - carry[m]
+            s = y[m] + inc
+            carry[m] = (s - y[m]) - inc
+            y[m] = s
+            finite = finite and math.isfinite(s)
+        if not finite:
+            state[0] = t
+            return NOT_FINITE, i
         t = t_new
         stats[1] += 1
     state[0] = t

@@ -1,17 +1,26 @@
 """Accuracy-targeted choice: the cheapest integrator and setting predicted to reach ``accuracy``.
 
 A tolerance is not an accuracy: how the final error depends on it varies
-with the scene. So ``auto`` measures that dependence on the scene itself
-with a short pilot: two runs over the first ``pilot_fraction`` of the time
-span, at tolerances τ and τ/100, give the error of the τ run at the pilot's
-end and at its middle (hence a growth exponent q, error ∝ t^q). The error is
-proportional to the tolerance for both candidates (checked in the tests), so
-the full span at tolerance τ' is predicted to end with error
-err(τ) · (τ'/τ) · (T/T_pilot)^q, with q ≥ 2: a non-symplectic method drifts
-in energy linearly on a near-integrable motion, so its phase error grows
-quadratically (measured on the reference problem: the error of Taylor at
-tol 1e-10 grows ×100 from t = 30 to t = 300). ``auto`` picks τ' to meet ``accuracy``
-with a safety factor, runs once, and records the choice and the prediction.
+with the scene (on the reference scene the final error of the Taylor method
+is 24 to 470 times its per-step tolerance depending on the order; on the
+extremes matrix the ratio spans four decades), and no per-step error control
+predicts how local errors grow into the global one. So ``auto`` measures
+that dependence on the scene itself with a short pilot: two runs over the
+first ``pilot_fraction`` of the time span, at tolerances τ and τ/100 and the
+same order, give the error of the τ run along the pilot (hence a growth
+exponent q, error ∝ t^q). At a fixed order the error is proportional to the
+tolerance (checked in the tests), so the full span at tolerance τ' is
+predicted to end with error err(τ) · (τ'/τ) · (T/T_pilot)^q, with q ≥ 2: a
+non-symplectic method drifts in energy linearly on a near-integrable motion,
+so its phase error grows quadratically (measured on the reference problem:
+the error of Taylor at tol 1e-10 grows ×100 from t = 30 to t = 300).
+``auto`` picks τ' to meet ``accuracy`` with a safety factor and records the
+prediction multiplied by ``CALIBRATION`` (the largest ratio of actual to
+raw predicted error measured on the extremes matrix and the reference
+scene, rounded up; ``tests/test_extremes.py`` checks that the recorded
+prediction bounds the actual error there). The pilot is not wasted: its τ/100
+run is at least as accurate as the final one, so it is the first
+``pilot_fraction`` of the trajectory and the final run continues from its end.
 
 Candidates, fastest first: an expansion regime's analytic series (no
 integration at all), when the scene lies in the regime's domain, starts on the
@@ -19,6 +28,11 @@ periodic orbit the series describes, and the series' error — measured over one
 period against a tight Taylor run and extrapolated linearly in time, as a
 phase drift — meets the target; then the compiled Taylor method when the
 scene has a compiled model; otherwise scipy's DOP853.
+
+Round-off: the Taylor state update is compensated (Kahan), so round-off no
+longer grows by an ulp per step but as a random walk, about eps·|y|·√steps
+(measured floor on the reference scene: 9e-15 over 2,700 steps, where this
+estimate gives 6e-14); targets below that estimate are refused.
 """
 
 from __future__ import annotations
@@ -41,7 +55,13 @@ from gyrolab.errors import ConfigError, GyrolabError, as_number
 
 PILOT_POINTS = 65
 MIN_GROWTH = 2.0
-FLOOR = 1e-13  # below this, double-precision round-off dominates on unit-scale states
+FLOOR = 1e-15  # relative to the state's size: nothing in double precision reaches below this
+MIN_TOLERANCE = 1e-13  # first pilot: tighter tolerances differ from τ/100 by round-off only on O(1) states
+MAX_TOLERANCE = 1e-5  # looser per-step tolerances take steps near the Taylor series' radius of convergence
+FIRST_RATIO = 1e-3  # first pilot tolerance relative to the accuracy (the typical error/tolerance ratio is 10–500)
+#: actual / raw predicted final error, largest measured on the extremes matrix and the reference scene
+#: (accuracies 1e-4 to 1e-12), rounded up; the recorded prediction is the raw one times this.
+CALIBRATION = 3.0
 
 
 class Auto(Integrator):
@@ -49,7 +69,7 @@ class Auto(Integrator):
     adaptive = True
     prefers_compiled_model = True
 
-    def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 3.0) -> None:
+    def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 1.0) -> None:
         if accuracy is None:
             raise ConfigError("integrator=auto needs a target: set accuracy=... (max-norm error of the final state)")
         self.accuracy = as_number(accuracy, "accuracy", positive=True)
@@ -60,21 +80,28 @@ class Auto(Integrator):
         self.choice: dict[str, Any] = {}
         self.system: Any = None
         self._pilot_steps = 0
+        self._order: int | None = None
 
     def prepare(self, system: Any) -> None:
         self.system = system
 
     def _method(self, compiled: CompiledModel | None, tol: float) -> Integrator:
         if compiled is not None:
-            from gyrolab.plugins.integrators.compiled_solvers import Taylor
+            from gyrolab.plugins.compiled.models import TAYLOR_MODELS
+            from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
 
-            return Taylor(order=20, tol=tol)
+            # a compiled plugin torque has no Taylor coefficients: compiled DOP853 instead
+            if compiled.model in TAYLOR_MODELS:
+                return Taylor(order=self._order, tol=tol)
+            return DOP853Numba(rtol=tol, atol=tol)
         from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
         return DOP853(rtol=tol, atol=tol)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+        from gyrolab.plugins.compiled.taylor import order_for
+
         start = time.perf_counter()
         t_out = np.asarray(t_out, dtype=float)
         scale = max(1.0, float(np.max(np.abs(y0))))
@@ -85,45 +112,65 @@ class Auto(Integrator):
         if series is not None:
             return series
         span = t_out[-1] - t_out[0]
-        pilot_times = t_out[0] + span * self.pilot_fraction * np.linspace(0.0, 1.0, PILOT_POINTS)
-        tau, pilot_nfev = min(1e-6, self.accuracy * 1e-2), 0
-        for _ in range(3):  # re-centre the pilot near the chosen tolerance: never extrapolate far in τ
-            per_tol, growth, nfev, measured = self._pilot(fun, pilot_times, y0, compiled, tau)
+        t_pilot = t_out[0] + span * self.pilot_fraction
+        # the pilot's grid holds the output times it covers: its tight run is the start of the trajectory
+        pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * np.linspace(0.0, 1.0, PILOT_POINTS),
+                                 t_out[t_out < t_pilot])
+        tau, pilot_nfev = float(np.clip(self.accuracy * FIRST_RATIO, MIN_TOLERANCE, MAX_TOLERANCE / 10)), 0
+        # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance
+        self._order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
+        for _ in range(3):
+            pilot_tau = tau
+            per_tol, growth, nfev, measured, tight = self._pilot(fun, pilot_times, y0, compiled, tau)
             pilot_nfev += nfev
-            if not measured:  # no difference above round-off in the pilot: no licence to loosen τ
-                chosen = tau
+            # per_tol bounds the truncation error even when the pilot saw only round-off
+            chosen = min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
+            if not measured and tau < MAX_TOLERANCE / 100:  # only round-off seen: measure with a looser pilot
+                tau *= 100
+            elif chosen > 10 * tau:  # re-centre: never extrapolate far towards looser tolerances
+                tau = chosen
+            else:  # at a fixed order, extrapolating to tighter tolerances is safe (the leading term dominates more)
                 break
-            chosen = min(self.accuracy / (self.safety * per_tol), 1e-6)
-            if abs(math.log10(chosen / tau)) <= 1.0:
-                break
-            tau = chosen
-        # Round-off grows with the number of steps (one rounding per step at most, at the state's scale):
+        # Round-off of the compensated update grows as a random walk over the steps (see the module's note):
         # a target below it cannot be met in double precision, whatever the tolerance.
-        steps = self._pilot_steps / self.pilot_fraction
-        roundoff = np.finfo(float).eps * scale * steps
+        steps = self._pilot_steps / self.pilot_fraction * max(1.0, (pilot_tau / 100 / chosen) ** (1.0 / self._order))
+        roundoff = np.finfo(float).eps * scale * math.sqrt(steps)
         if roundoff > self.accuracy:
             raise ConfigError(f"accuracy={self.accuracy:g} is below the round-off that double precision accumulates "
                               f"on this scene (about {roundoff:.1g} over ~{steps:.0f} steps); ask for at least that")
+        if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
+            chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         method = self._method(compiled, chosen)
-        solution = method.integrate(fun, t_out, y0, progress, compiled)
+        if pilot_tau * 1e-2 <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
+            head = np.searchsorted(pilot_times, t_out[t_out < t_pilot])  # the outputs inside the pilot
+            rest = t_out[t_out >= t_pilot]
+            tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest,
+                                    tight.y[-1], progress, compiled)
+            y = np.concatenate([tight.y[head], tail.y[-len(rest):]])
+            final_stats = tail.stats
+            n_steps = tail.stats.n_steps + tight.stats.n_steps
+        else:
+            solution = method.integrate(fun, t_out, y0, progress, compiled)
+            y, final_stats, n_steps = solution.y, solution.stats, solution.stats.n_steps
         self.choice = {
             "auto_method": method.name,
             "auto_tolerance": chosen,
-            "auto_predicted_error": max(per_tol * chosen, roundoff),
+            "auto_predicted_error": CALIBRATION * per_tol * chosen + roundoff,
             "auto_error_growth_exponent": growth,
             "auto_pilot_nfev": pilot_nfev,
             **{f"auto_{k.removeprefix('integrator_')}": v for k, v in method.attributes().items()},
         }
-        stats = solution.stats
-        return Solution(solution.t, solution.y, IntegratorStats(
-            nfev=stats.nfev + pilot_nfev, n_steps=stats.n_steps, n_rejected=stats.n_rejected,
-            wall_time=time.perf_counter() - start, njev=stats.njev, nlu=stats.nlu))
+        return Solution(t_out, y, IntegratorStats(
+            nfev=final_stats.nfev + pilot_nfev, n_steps=n_steps, n_rejected=final_stats.n_rejected,
+            wall_time=time.perf_counter() - start, njev=final_stats.njev, nlu=final_stats.nlu))
 
     def _series(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                 start: float) -> Solution | None:
         """The first regime whose analytic series is predicted to meet the accuracy on this scene, or None."""
-        if self.system is None or compiled is None or t_out[0] != 0.0:
-            return None
+        from gyrolab.plugins.compiled.models import TAYLOR_MODELS
+
+        if self.system is None or compiled is None or t_out[0] != 0.0 or compiled.model not in TAYLOR_MODELS:
+            return None  # the truth check below integrates with Taylor
         from gyrolab.engine import registry
         from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
@@ -161,25 +208,26 @@ class Auto(Integrator):
         return None
 
     def _pilot(self, fun: RightHandSide, times: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
-               tau: float) -> tuple[float, float, int, bool]:
-        """(predicted final error per unit tolerance, growth exponent q, evaluations, whether the pilot measured
-        an error above round-off) from runs at τ and τ/100."""
+               tau: float) -> tuple[float, float, int, bool, Solution]:
+        """(raw predicted final error per unit tolerance, growth exponent q, evaluations, whether the pilot
+        measured an error above round-off, the τ/100 run) from runs at τ and τ/100."""
         loose = self._method(compiled, tau).integrate(fun, times, y0, None, compiled)
         tight = self._method(compiled, tau * 1e-2).integrate(fun, times, y0, None, compiled)
         # Envelope of the error: pointwise errors of periodic motions dip through zero.
         envelope = np.maximum.accumulate(np.max(np.abs(loose.y - tight.y), axis=1))
         # differences within a few hundred ulps are round-off, not a measurement of the truncation error
         measured = bool(envelope[-1] > 100 * np.finfo(float).eps * max(1.0, float(np.max(np.abs(y0)))))
-        late = slice(PILOT_POINTS // 4, None)
+        elapsed = times - times[0]
+        late = elapsed >= elapsed[-1] / 4
         # A non-symplectic method on a (near-)integrable motion drifts in energy linearly, hence in phase
         # quadratically: assume q = 2 unless the pilot shows faster growth (its early error is a plateau).
         growth = MIN_GROWTH
         if np.all(envelope[late] > 0):
-            slope = np.polyfit(np.log(times[late] - times[0]), np.log(envelope[late]), 1)[0]
+            slope = np.polyfit(np.log(elapsed[late]), np.log(envelope[late]), 1)[0]
             growth = float(np.clip(slope, MIN_GROWTH, 4.0))
         per_tol = envelope[-1] / tau * (1.0 / self.pilot_fraction) ** growth
         self._pilot_steps = tight.stats.n_steps
-        return per_tol, growth, loose.stats.nfev + tight.stats.nfev, measured
+        return per_tol, growth, loose.stats.nfev + tight.stats.nfev, measured, tight
 
     def attributes(self) -> dict[str, Any]:
         return {"accuracy": self.accuracy, **self.choice}

@@ -25,12 +25,65 @@ from gyrolab.errors import ConfigError, IntegrationError, as_number
 from gyrolab.plugins.integrators.tolerances import Tolerances
 from gyrolab.plugins.integrators.step_guard import check_step, compiled_rhs
 
-CHUNKS = 50  # progress reports per run at most
+CHUNKS = 50  # progress reports per run at least (when the run has that many output intervals)
+PACE = 1.0  # seconds of compiled work between two returns to Python (progress reports), about
 
 
-def _chunks(n_out: int) -> list[tuple[int, int]]:
-    size = max(1, math.ceil((n_out - 1) / CHUNKS))
-    return [(i, min(i + size, n_out)) for i in range(1, n_out, size)]
+class _Chunks:
+    """Output-index ranges ``(first, stop)`` for the compiled kernels, each taking about ``PACE`` seconds.
+
+    The first range is 1/CHUNKS of the outputs (one output for fixed-step methods, ``steps`` given,
+    whose single output interval may already be long); later ones follow the measured speed, so a
+    long run reports progress about every ``PACE`` seconds and a short one costs only a few calls
+    into the kernel (each call has a fixed cost of some microseconds, which matters for millisecond
+    runs). Fixed-step methods never take more than 1/CHUNKS of the outputs at once and learn
+    when one output interval alone is too long (``step_budget``): that interval is then advanced
+    in pieces (``_interval_in_pieces``).
+    """
+
+    def __init__(self, n_out: int, steps: np.ndarray | None = None) -> None:
+        self.n_out, self.steps = n_out, steps
+        share = max(1, math.ceil((n_out - 1) / CHUNKS))
+        self.cap = share if steps is not None else n_out
+        self.size = 1 if steps is not None else share
+        self.step_rate = 1e5  # steps per second, until measured
+
+    def __iter__(self):
+        first = 1
+        while first < self.n_out:
+            stop = min(first + self.size, self.n_out)
+            tic = time.perf_counter()
+            yield first, stop
+            took = max(time.perf_counter() - tic, 1e-6)
+            if self.steps is not None:
+                self.step_rate = max(1e3, float(self.steps[first - 1:stop - 1].sum()) / took)
+            self.size = int(min(self.cap, max(1, (stop - first) * PACE / took)))
+            first = stop
+
+    @property
+    def step_budget(self) -> int:
+        return max(1000, int(self.step_rate * PACE))
+
+
+def _interval_in_pieces(advance: Any, t0: float, t1: float, m: int, budget: int,
+                        progress: ProgressCallback | None) -> bool:
+    """Advance one long output interval of ``m`` equal steps in pieces of at most ``budget`` steps.
+
+    ``advance(tau, sub_steps, j)`` runs the kernel over piece ``j`` of the grid ``tau`` and says
+    whether the state stayed finite. The pieces' steps equal the interval's (up to rounding of the
+    piece boundaries), so the result is the unsplit one to rounding error; progress is reported
+    after each piece.
+    """
+    marks = np.unique(np.linspace(0, m, math.ceil(m / budget) + 1).round().astype(np.int64))
+    tau = t0 + marks * ((t1 - t0) / m)
+    tau[-1] = t1
+    sub_steps = np.diff(marks)
+    for j in range(1, len(tau)):
+        if not advance(tau, sub_steps, j):
+            return False
+        if progress is not None and j < len(tau) - 1:
+            progress(tau[j])
+    return True
 
 
 def _outputs(t_out: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -44,6 +97,33 @@ def _outputs(t_out: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, np.ndarray,
 def steps_per_interval(t_out: np.ndarray, step: float) -> np.ndarray:
     """Fewest equal steps no longer than ``step`` in each output interval (lands on every output time)."""
     return np.maximum(1, np.ceil(np.diff(t_out) / step * (1.0 - 1e-12))).astype(np.int64)
+
+
+def _fixed_step(kernel: Any, name: str, fun: RightHandSide, t_out: np.ndarray, steps: np.ndarray, y: np.ndarray,
+                out: np.ndarray, progress: ProgressCallback | None) -> int:
+    """Fill ``out[1:]`` with a compiled fixed-step ``kernel(grid, steps, rows, first, stop) -> reached``.
+
+    Returns the index of the first output left non-finite, or ``len(t_out)``. Progress is reported
+    after each chunk, and after each piece of an output interval too long for one chunk.
+    """
+    gaps = np.diff(t_out)
+    chunks = _Chunks(len(t_out), steps)
+    for first, stop in chunks:
+        check_step(name, fun, t_out[first - 1], y, float(gaps[first - 1] / steps[first - 1]))
+        budget = chunks.step_budget
+        if stop - first == 1 and steps[first - 1] > budget:  # one long interval: in pieces
+            rows = np.empty((math.ceil(steps[first - 1] / budget) + 1, len(y)))
+            finite = _interval_in_pieces(lambda tau, sub, j: kernel(tau, sub, rows, j, j + 1) == j + 1,
+                                         t_out[first - 1], t_out[first], int(steps[first - 1]), budget, progress)
+            out[first] = y
+            reached = stop if finite else first
+        else:
+            reached = kernel(t_out, steps, out, first, stop)
+        if reached != stop:
+            return reached
+        if progress is not None:
+            progress(t_out[stop - 1])
+    return len(t_out)
 
 
 class DOP853Numba(Tolerances, Integrator):
@@ -64,9 +144,12 @@ class DOP853Numba(Tolerances, Integrator):
         h0 = dop853.initial_step(compiled.model, compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
                                  self.rtol, self.atol, stats)
         state = np.array([t_out[0], h0])
-        for first, stop in _chunks(len(t_out)):
-            status, _ = dop853.run(compiled.model, compiled.params, t_out, out, first, stop, state, y, f,
-                                   t_out[-1], self.rtol, self.atol, self.max_step, stats)
+        reached = 1
+        for first, stop in _Chunks(len(t_out)):
+            if reached >= stop:
+                continue  # a long step already filled this chunk's outputs
+            status, reached = dop853.run(compiled.model, compiled.params, t_out, out, reached, stop, state, y, f,
+                                         t_out[-1], self.rtol, self.atol, self.max_step, stats)
             if status != dop853.OK:
                 reason = "the step size fell below the spacing of floating-point numbers" \
                     if status == dop853.TOO_SMALL_STEP else "the state became non-finite"
@@ -94,14 +177,12 @@ class RK4Numba(Integrator):
         t_out, y, out = _outputs(t_out, y0)
         steps = steps_per_interval(t_out, self.step)
         fun = compiled_rhs(compiled)
-        for first, stop in _chunks(len(t_out)):
-            check_step(self.name, fun, t_out[first - 1], y, float(np.diff(t_out)[first - 1] / steps[first - 1]))
-            reached = rk4.run(compiled.model, compiled.params, t_out, steps, y, out, first, stop)
-            if reached != stop:
-                raise IntegrationError(f"rk4_numba produced a non-finite state before t={t_out[reached]:.6g} "
-                                       f"with step {self.step:.3g}; reduce integrator.step")
-            if progress is not None:
-                progress(t_out[stop - 1])
+        reached = _fixed_step(lambda grid, n, rows, first, stop: rk4.run(compiled.model, compiled.params, grid, n,
+                                                                         y, rows, first, stop),
+                              self.name, fun, t_out, steps, y, out, progress)
+        if reached != len(t_out):
+            raise IntegrationError(f"rk4_numba produced a non-finite state before t={t_out[reached]:.6g} "
+                                   f"with step {self.step:.3g}; reduce integrator.step")
         n_steps = int(steps.sum())
         return Solution(t_out, out, IntegratorStats(nfev=4 * n_steps, n_steps=n_steps, n_rejected=0,
                                                     wall_time=time.perf_counter() - start))
@@ -111,15 +192,27 @@ class RK4Numba(Integrator):
 
 
 class Taylor(Integrator):
+    """Taylor series method (``gyrolab.plugins.compiled.taylor``): order and step from the tolerance.
+
+    ``order=None`` (the default) takes Jorba and Zou's optimal order for ``tol``; an explicit order
+    overrides it. Calls into the kernel are sized by wall time (``_Chunks``): a run of a few
+    milliseconds is one or two calls, a long run still reports progress regularly.
+    """
+
     name = "taylor"
     adaptive = True
     needs_compiled_model = True
 
-    def __init__(self, *, order: int = 20, tol: float = 1e-16) -> None:
-        if isinstance(order, bool) or not isinstance(order, int) or not 4 <= order <= 60:
-            raise ConfigError(f"integrator.order={order!r} must be an integer from 4 to 60")
-        self.order = order
+    def __init__(self, *, order: int | None = None, tol: float = 1e-16) -> None:
+        from gyrolab.plugins.compiled.taylor import MAX_ORDER, MIN_ORDER, order_for
+
         self.tol = as_number(tol, "integrator.tol", positive=True)
+        if order is None:
+            order = order_for(self.tol)
+        if isinstance(order, bool) or not isinstance(order, int) or not MIN_ORDER <= order <= MAX_ORDER:
+            raise ConfigError(f"integrator.order={order!r} must be an integer from {MIN_ORDER} to {MAX_ORDER} "
+                              "(or null: chosen from integrator.tol)")
+        self.order = order
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
@@ -128,10 +221,11 @@ class Taylor(Integrator):
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         state = np.array([t_out[0]])
+        carry = np.zeros_like(y)
         stats = np.zeros(2, dtype=np.int64)
-        for first, stop in _chunks(len(t_out)):
+        for first, stop in _Chunks(len(t_out)):
             status, _ = taylor.run(compiled.model, compiled.params, self.order, self.tol, t_out, out, first, stop,
-                                   state, y, stats)
+                                   state, y, carry, stats)
             if status != taylor.OK:
                 raise IntegrationError(f"taylor produced a non-finite state near t={state[0]:.6g}")
             if progress is not None:
@@ -163,20 +257,19 @@ class LiePoisson(Integrator):
         from gyrolab.plugins.compiled import lie_poisson, models
 
         if compiled.model != models.FIXED_POINT:
-            raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian only; valid systems: fixed_point")
+            raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian with the built-in torque "
+                              "forms only; valid systems: fixed_point with uniform_gravity, newtonian, magnetic")
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         steps = steps_per_interval(t_out, self.step)
         w = lie_poisson.weights(self.order)
         fun = compiled_rhs(compiled)
-        for first, stop in _chunks(len(t_out)):
-            check_step(self.name, fun, t_out[first - 1], y, float(np.diff(t_out)[first - 1] / steps[first - 1]))
-            reached = lie_poisson.run(compiled.params, t_out, steps, w, y, out, first, stop)
-            if reached != stop:
-                raise IntegrationError(f"lie_poisson produced a non-finite state before t={t_out[reached]:.6g}; "
-                                       "reduce integrator.step")
-            if progress is not None:
-                progress(t_out[stop - 1])
+        reached = _fixed_step(lambda grid, n, rows, first, stop: lie_poisson.run(compiled.params, grid, n, w, y,
+                                                                                 rows, first, stop),
+                              self.name, fun, t_out, steps, y, out, progress)
+        if reached != len(t_out):
+            raise IntegrationError(f"lie_poisson produced a non-finite state before t={t_out[reached]:.6g}; "
+                                   "reduce integrator.step")
         n_steps = int(steps.sum())
         # per step: len(w) Strang stages, each with 2 kicks (one torque evaluation each)
         return Solution(t_out, out, IntegratorStats(nfev=2 * len(w) * n_steps, n_steps=n_steps, n_rejected=0,

@@ -18,6 +18,7 @@ from gyrolab.errors import IntegrationError, as_number
 from gyrolab.plugins.integrators.step_guard import check_step
 
 GUARD_CHECKS = 50  # as often as the compiled methods check (once per output chunk)
+PROGRESS_STEPS = 1000  # steps between calls of the progress callback within an output interval (~20 ms)
 
 
 class RK4(Integrator):
@@ -56,6 +57,8 @@ class RK4(Integrator):
                 k3 = fun(t + 0.5 * h, y + (0.5 * h) * k2)
                 k4 = fun(t + h, y + h * k3)
                 y = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+                if progress is not None and j % PROGRESS_STEPS == PROGRESS_STEPS - 1:
+                    progress(t + h)  # inside a long output interval too (Progress reports by elapsed time)
             n_steps += m
             if not np.all(np.isfinite(y)):
                 raise IntegrationError(

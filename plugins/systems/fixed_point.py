@@ -62,7 +62,7 @@ class FixedPoint(System):
         axes = self._axes(y)
         torque = cross(self.inertia * omega, omega)
         for force in self.forces:
-            torque = torque + force.torque(omega, axes)
+            torque = torque + (force.torque(omega, axes, t) if force.time_dependent else force.torque(omega, axes))
         parts = [torque / self.inertia, cross(axes[2], omega)]
         if self.carries_alpha:
             parts.append(cross(axes[0], omega))
@@ -132,12 +132,14 @@ class FixedPoint(System):
         return attrs
 
     def compiled_model(self) -> CompiledModel | None:
-        terms = [force.compiled_terms() for force in self.forces]
-        if any(term is None for term in terms):
-            return None
-        from gyrolab.plugins.compiled import fixed_point, models  # numba only when a compiled integrator runs
+        """The compiled model, or None when a torque cannot be compiled (``compile_error`` then says why)."""
+        from gyrolab.plugins.compiled import fixed_point, plugin_torque  # numba only when a compiled integrator runs
 
-        return CompiledModel(models.FIXED_POINT, fixed_point.pack(self.inertia, terms, self.carries_alpha))
+        try:
+            return fixed_point.compiled_model(self.inertia, self.forces, self.carries_alpha)
+        except plugin_torque.NotCompilable as exc:
+            self.compile_error = str(exc)
+            return None
 
     def title(self) -> str:
         nd = self.body.nondimensional()

@@ -1,0 +1,158 @@
+"""A third-party force plugin against the built-ins: compiled speed of a traced torque (issue 12, item 1).
+
+    python benchmarks/plugin_speed.py            # tolerances 1e-8 .. 1e-12, 10 repeats
+    python benchmarks/plugin_speed.py --quick    # two tolerances, 3 repeats
+
+The reference problem (``experiment=perf_reference``: uniform gravity + Newtonian centre, k = 0.5,
+t ∈ [0, 300], 3,001 output times) is run twice: with the built-in forces (their packed compiled
+form), and with the same two torques written as a third-party plugin in plain Python
+(``cross(r, γ)`` and ``N γ × Iγ``: the same arithmetic), which gyrolab traces and compiles. Both
+under ``dop853_numba``, interleaved, integration time only (best of the repeats); the plugin also
+under scipy's DOP853 (gyrolab's ``dop853``: the Python right-hand side), at equal error.
+Error = max-norm of the final state's error against the extended-precision reference.
+Targets (issue 12): plugin ≤ 1.3× the built-in's time; ≥ 150× faster than scipy DOP853.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+
+PLUGIN = textwrap.dedent('''
+    from gyrolab.contracts import Force
+    from gyrolab.physics.vectors import cross
+
+
+    class PlainGravity(Force):
+        name = "plain_gravity"
+        required_axes = frozenset({2})
+        preserves_area_integral = True
+
+        def __init__(self, body):
+            self.w = body.weight_moment
+
+        def torque(self, omega, axes):
+            return cross(self.w, axes[2])
+
+
+    class PlainNewtonian(Force):
+        name = "plain_newtonian"
+        required_axes = frozenset({2})
+        preserves_area_integral = True
+
+        def __init__(self, body, *, k=0.5):
+            self.N, self.inertia = float(k), body.inertia  # nondimensional body: c² = 1, N = k
+
+        def torque(self, omega, axes):
+            e = axes[2]
+            return self.N * cross(e, self.inertia * e)
+''')
+
+
+def _install(site: Path) -> None:
+    (site / "plain_forces.py").write_text(PLUGIN)
+    info = site / "plain_forces-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: plain-forces\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text("[gyrolab.forces]\nplain_gravity = plain_forces:PlainGravity\n"
+                                           "plain_newtonian = plain_forces:PlainNewtonian\n")
+    sys.path.insert(0, str(site))
+
+
+def rhs_cost(base: list[str], plugin: list[str], compose_scene) -> None:
+    """One right-hand-side evaluation, built-in form against the traced plugin (ns; best of 20 loops of 10⁵)."""
+    import numba
+
+    from gyrolab.plugins.compiled import models
+
+    @numba.njit
+    def loop(model, p, y, out, n):
+        for i in range(n):
+            models.rhs(model, 1e-9 * i, y, p, out)
+            y[0] += 1e-300 * out[0]  # a dependency, so that no evaluation is optimised away
+        return out[0]
+
+    costs = []
+    for overrides in (base, plugin):
+        compiled = compose_scene(overrides).compiled
+        y = compose_scene(overrides).system.initial_state()
+        out = np.empty_like(y)
+        loop(compiled.model, compiled.params, y, out, 10)
+        best = np.inf
+        for _ in range(20):
+            start = time.perf_counter()
+            loop(compiled.model, compiled.params, y, out, 100_000)
+            best = min(best, time.perf_counter() - start)
+        costs.append(best / 100_000 * 1e9)
+    print(f"right-hand side: built-in {costs[0]:.1f} ns, plugin {costs[1]:.1f} ns per evaluation "
+          f"(ratio {costs[1] / costs[0]:.2f})\n")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args()
+    tols = (1e-8, 1e-11) if args.quick else (1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
+    repeats = 3 if args.quick else 10
+    _install(Path(tempfile.mkdtemp()))
+
+    from gyrolab import compose_scene
+    from gyrolab.physics.reference import fixed_point_reference
+
+    scene = ["body=asymmetric_top", "initial=fast_spin", "initial.gamma0=[0.8414709848078965,0.0,0.5403023058681398]",
+             "initial.theta0=null", "initial.phi0=null", "time.end=300", "time.n_output=3001",
+             "output.euler_angles=false"]  # experiment=perf_reference, spelled out so that the forces can change
+    base = [*scene, "force=[uniform_gravity,newtonian]", "force.newtonian.k=0.5"]
+    plugin = [*scene, "force=[plain_gravity,plain_newtonian]", "force.plain_newtonian.k=0.5"]
+    first = compose_scene([*base, "integrator=dop853_numba"])
+    y0 = first.system.initial_state()
+    truth = fixed_point_reference(first.system.inertia, first.system.body.weight_moment, 0.5, y0,
+                                  [0.0, 300.0])[-1].astype(float)
+
+    def timed(overrides: list[str], tol: float, n: int) -> tuple[float, float]:
+        scene = compose_scene([*overrides, f"integrator.rtol={tol}", f"integrator.atol={tol}"])
+        compiled = scene.compiled
+        best, error = np.inf, np.nan
+        for _ in range(n):
+            solution = scene.integrator.integrate(scene.system.rhs, scene.times, y0, None, compiled)
+            best = min(best, solution.stats.wall_time)
+            error = float(np.max(np.abs(solution.y[-1] - truth)))
+        return best, error
+
+    for overrides in ([*base, "integrator=dop853_numba"], [*plugin, "integrator=dop853_numba"]):
+        timed(overrides, 1e-6, 1)  # compile (or load) the kernels outside the timing
+    rhs_cost([*base, "integrator=dop853_numba"], [*plugin, "integrator=dop853_numba"], compose_scene)
+    print(f"{'tol':>7} {'built-in s':>11} {'error':>9} {'plugin s':>9} {'error':>9} {'ratio':>6}")
+    rows = []
+    for tol in tols:
+        b_time = p_time = np.inf
+        for _ in range(repeats):  # interleaved: the machine's load hits both alike
+            bt, b_err = timed([*base, "integrator=dop853_numba"], tol, 1)
+            pt, p_err = timed([*plugin, "integrator=dop853_numba"], tol, 1)
+            b_time, p_time = min(b_time, bt), min(p_time, pt)
+        rows.append((tol, p_time, p_err))
+        print(f"{tol:7.0e} {b_time:11.5f} {b_err:9.2e} {p_time:9.5f} {p_err:9.2e} {p_time / b_time:6.2f}")
+
+    print("\nscipy DOP853 (gyrolab dop853, Python right-hand side) on the plugin scene, at equal error:")
+    print(f"{'tol':>7} {'scipy s':>9} {'error':>9}   {'compiled plugin s':>17} (its error) {'speed-up':>9}")
+    for tol in ((1e-8, 1e-10) if args.quick else (1e-8, 1e-9, 1e-10, 1e-11)):
+        s_time, s_err = timed([*plugin, "integrator=dop853"], tol, 1)
+        # the cheapest compiled run whose error is at most scipy's
+        candidates = [(t, e) for _, t, e in rows if e <= s_err]
+        if not candidates:
+            print(f"{tol:7.0e} {s_time:9.3f} {s_err:9.2e}   (no compiled run as accurate)")
+            continue
+        c_time, c_err = min(candidates)
+        print(f"{tol:7.0e} {s_time:9.3f} {s_err:9.2e}   {c_time:17.5f} ({c_err:8.2e}) {s_time / c_time:8.0f}×")
+
+
+if __name__ == "__main__":
+    start = time.perf_counter()
+    main()
+    print(f"\n(total {time.perf_counter() - start:.0f} s; timings are noisy on a shared machine)")

@@ -1,0 +1,20 @@
+"""Linear viscous drag on the body: torque −c ω (a gyrolab force plugin)."""
+
+from gyrolab.contracts import Force
+from gyrolab.errors import as_number
+
+
+class ViscousDrag(Force):
+    name = "viscous_drag"
+    required_axes = frozenset()           # reference axes the torque reads: none (2 would be the vertical γ)
+    preserves_area_integral = False       # −c ω has a component along γ: Iω·γ decays, it is no invariant
+
+    def __init__(self, body, *, coefficient=0.1):   # keyword defaults are the plugin's config
+        self.coefficient = as_number(coefficient, "force.viscous_drag.coefficient", nonnegative=True)
+
+    def torque(self, omega, axes):        # plain numpy on 3-vectors: gyrolab compiles it
+        return -self.coefficient * omega
+
+    def attributes(self):                 # stored in run.nc as force_viscous_drag_coefficient
+        return {"coefficient": self.coefficient}
+    # no potential(axes): drag is not conservative, so the energy is not monitored

@@ -1,0 +1,98 @@
+"""Requests gyrolab refuses before anything runs: tolerances outside (0, 1), and plainly infeasible work.
+
+The budget (README "Your own configs"): the state array of one run at most
+:data:`MAX_STATE_BYTES` (n_output × state size × 8 bytes), and at most
+:data:`MAX_STEPS` integrator steps, estimated from below:
+
+- a fixed-step integrator (``step``) or a step bound (``max_step``) takes at least
+  span / step steps;
+- any integrator takes at least one step per output interval, and at least one step
+  per :data:`RADIANS_PER_STEP` radians the body turns (|ω0| × span; an adaptive
+  method that resolves the rotation does far more).
+
+A top-level ``allow_large=true`` lifts the budget for people who mean it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from gyrolab.errors import ConfigError
+
+MAX_STATE_BYTES = 2 * 1024**3
+MAX_STEPS = 1_000_000_000
+#: an optimistic cost of one step (fast compiled kernels), used to say how long a request would take
+SECONDS_PER_STEP = 1e-6
+RADIANS_PER_STEP = 2.0
+#: tolerance-like parameters, relative to the state's scale: each must lie in (0, 1)
+TOLERANCES = ("rtol", "atol", "tol", "accuracy")
+ESCAPE = "set allow_large=true to run it anyway"
+
+
+def check_tolerances(plain: dict[str, Any]) -> None:
+    """ConfigError for a tolerance (integrator.rtol, atol, tol, accuracy; top-level accuracy) outside (0, 1)."""
+    items = [(f"integrator.{k}", v) for k, v in (plain.get("integrator") or {}).items() if k in TOLERANCES]
+    items.append(("accuracy", plain.get("accuracy")))
+    for where, value in items:
+        if value is None or isinstance(value, bool) or not isinstance(value, (int, float)):
+            continue
+        if not 0 < value < 1:
+            raise ConfigError(f"{where}={value!r} is outside (0, 1); a tolerance must be positive and below 1, "
+                              "e.g. 1e-10")
+
+
+def check_budget(plain: dict[str, Any], state_size: int) -> None:
+    """ConfigError when the output arrays or the step count of one run are beyond the budget."""
+    if plain.get("allow_large") is True:
+        return
+    time = plain["time"]
+    n = int(time["n_output"])
+    size = float(n) * state_size * 8
+    if size > MAX_STATE_BYTES:
+        raise ConfigError(f"time.n_output={n} needs at least {_bytes(size)} for the state alone ({n:.3g} samples × "
+                          f"{state_size} values × 8 bytes), beyond the budget of {_bytes(MAX_STATE_BYTES)}; "
+                          f"store fewer samples or {ESCAPE}")
+    steps, why = estimated_steps(plain)
+    if steps > MAX_STEPS:
+        raise ConfigError(f"{why} needs at least {steps:.2g} integrator steps, {_duration(steps * SECONDS_PER_STEP)} "
+                          f"even at {SECONDS_PER_STEP * 1e6:g} µs a step, beyond the budget of {MAX_STEPS:.0e} steps; "
+                          f"shorten the span, enlarge the step or {ESCAPE}")
+
+
+def estimated_steps(plain: dict[str, Any]) -> tuple[float, str]:
+    """A lower bound on the steps of one run, and the settings it comes from (for the message)."""
+    time = plain["time"]
+    span = float(time["end"]) - float(time["start"])
+    integrator = plain.get("integrator") or {}
+    candidates = [(float(time["n_output"]) - 1, f"time.n_output={time['n_output']}")]
+    for key in ("step", "max_step"):
+        step = integrator.get(key)
+        if isinstance(step, (int, float)) and not isinstance(step, bool) and step > 0:
+            candidates.append((span / step, f"integrator.{key}={step:g} over time.start={time['start']:g} to "
+                                            f"time.end={time['end']:g}"))
+    initial = plain.get("initial") or {}
+    rates = [initial.get(k) for k in ("p0", "q0", "r0")]
+    if all(isinstance(r, (int, float)) and not isinstance(r, bool) for r in rates):
+        turn = math.sqrt(sum(float(r) ** 2 for r in rates)) * span
+        candidates.append((turn / RADIANS_PER_STEP, f"time.end={time['end']:g} (|ω0| = "
+                                                    f"{math.sqrt(sum(float(r) ** 2 for r in rates)):.3g} rad per "
+                                                    f"time unit over a span of {span:.3g}, one step per "
+                                                    f"{RADIANS_PER_STEP:g} rad at most)"))
+    return max(candidates, key=lambda c: c[0])
+
+
+def _bytes(n: float) -> str:
+    if not math.isfinite(n):
+        return "more bytes than a float can count"
+    for unit, scale in (("TiB", 1024**4), ("GiB", 1024**3), ("MiB", 1024**2)):
+        if n >= scale:
+            return f"{n / scale:.3g} {unit}"
+    return f"{n:.0f} bytes"
+
+
+def _duration(seconds: float) -> str:
+    for unit, scale in (("years", 3.156e7), ("days", 86400.0), ("hours", 3600.0), ("minutes", 60.0)):
+        if seconds >= scale:
+            return f"{seconds / scale:.3g} {unit}"
+    return f"{seconds:.3g} s"

@@ -1,0 +1,315 @@
+"""No config and no dataset can run code: the one place where gyrolab decides what a config may name.
+
+Threat model: a YAML file (an experiment, a primary config, a whole ``--config-dir``)
+or a ``run.nc`` that someone else wrote. Reading it must not run code that is not
+gyrolab's or an installed, registered plugin's, and must not write outside the run
+directory. Installed packages are trusted (they could run code anyway); text is not.
+
+:func:`check_config` is applied by the preflight to every composed config (each group
+choice of a sweep too) before Hydra creates a directory, instantiates a callback or
+configures logging, and by ``--reproduce`` and ``--batch`` to the configs they build:
+
+- every ``_target_`` anywhere must be on an allowlist: under ``hydra`` gyrolab's sweep
+  callback and the installed Hydra launchers and sweepers; elsewhere a registered
+  gyrolab plugin (``gyrolab.engine.registry``);
+- Hydra's logging configs (``hydra.job_logging``, ``hydra.hydra_logging``) may name only
+  the standard logging handler, formatter and filter classes (``()`` and ``class`` keys),
+  no ``.`` attribute setters, no ``ext://`` object other than ``sys.stdout``/``sys.stderr``,
+  and log files only inside the run directory, ending in ``.log``;
+- Hydra's own paths (``output_subdir``, ``sweep.subdir``, the submitit folder) stay inside
+  the run directory, which may not be empty, the working directory or one of its parents,
+  or inside an installation of Python packages;
+- ``hydra.job.env_set`` may set thread counts only; the shell lines of a cluster launcher
+  (``setup``, ``srun_args``, ``additional_parameters``) must be the packaged ones or typed
+  on the command line.
+
+Each refusal is one ConfigError sentence naming the key.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import site
+import sysconfig
+from collections.abc import Iterator, Sequence
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+from omegaconf import DictConfig, ListConfig, OmegaConf, open_dict
+from omegaconf.errors import OmegaConfBaseException
+
+from gyrolab.engine import registry
+from gyrolab.errors import ConfigError, shorten
+
+#: ``_target_`` values allowed under ``hydra`` besides the installed launchers and sweepers
+HYDRA_TARGETS = frozenset({"gyrolab.sweep.callbacks.SweepCallback"})
+#: classes a logging config may name with ``class`` or ``()``
+LOGGING_CLASSES = frozenset({
+    "logging.StreamHandler", "logging.FileHandler", "logging.NullHandler",
+    "logging.handlers.RotatingFileHandler", "logging.handlers.WatchedFileHandler",
+    "logging.Formatter", "logging.Filter", "colorlog.ColoredFormatter",
+})
+#: ``ext://`` objects a logging config may name
+LOGGING_EXTERNALS = frozenset({"ext://sys.stdout", "ext://sys.stderr"})
+#: environment variables a config may set for its jobs
+ENV_ALLOWED = re.compile(r"^(OMP|MKL|OPENBLAS|NUMEXPR|NUMBA|VECLIB_MAXIMUM|BLIS)_NUM_THREADS$")
+#: launcher options that become shell lines or scheduler arguments
+LAUNCHER_SHELL_KEYS = ("setup", "srun_args", "additional_parameters")
+
+
+@cache
+def hydra_targets() -> frozenset[str]:
+    """gyrolab's callback and every installed Hydra launcher and sweeper class."""
+    from hydra.core.plugins import Plugins
+    from hydra.plugins.launcher import Launcher
+    from hydra.plugins.sweeper import Sweeper
+
+    found = {f"{cls.__module__}.{cls.__qualname__}" for kind in (Launcher, Sweeper)
+             for cls in Plugins.instance().discover(kind)}
+    return HYDRA_TARGETS | found
+
+
+def plugin_targets() -> frozenset[str]:
+    """Every registered gyrolab plugin class, as a dotted path."""
+    return frozenset(registry._normalise(t) for group in registry.GROUPS for t in registry.targets(group).values())
+
+
+def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: Sequence[str] = (),
+                 job_subdir: bool = False) -> None:
+    """ConfigError (one sentence naming the key) unless ``cfg`` is safe to hand to Hydra and gyrolab.
+
+    ``cfg`` is a composed config, with its ``hydra`` node when Hydra will run it;
+    ``run_dir`` is the directory the run (or sweep) writes in; ``job_subdir`` says a
+    sweep job writes in ``run_dir/<hydra.sweep.subdir>``; ``command_line`` holds the
+    overrides the user typed (shell lines of a launcher are accepted from there).
+    """
+    scene = _plain(cfg, skip="hydra")
+    hydra = cfg.get("hydra") if "hydra" in cfg else None
+    plain_hydra = _resolved_hydra(cfg, run_dir, job_subdir) if hydra is not None and run_dir is not None else {}
+    allowed_plugins = plugin_targets()
+    for path, value in _targets(scene):
+        if registry._normalise(str(value)) not in allowed_plugins:
+            group = path.split(".", 1)[0]
+            valid = (f"choose one by name ({group}=NAME), valid names: {', '.join(registry.names(group))}"
+                     if group in registry.GROUPS else "a config may name only registered gyrolab plugins")
+            raise ConfigError(f"{path}={shorten(repr(value))} is not a registered gyrolab plugin and cannot be "
+                              f"called; {valid}")
+    if not plain_hydra:
+        return
+    allowed = hydra_targets()
+    for path, value in _targets(plain_hydra, "hydra"):
+        if str(value) not in allowed:
+            raise ConfigError(f"{path}={shorten(repr(value))} is not allowed; under hydra a config may name only "
+                              f"gyrolab's sweep callback and the installed launchers and sweepers "
+                              f"({', '.join(sorted(t.rsplit('.', 1)[1] for t in allowed))})")
+    _check_paths(plain_hydra, Path(run_dir))
+    out = _output_dir(run_dir, plain_hydra, job_subdir)
+    for name in ("job_logging", "hydra_logging"):
+        _check_logging(plain_hydra.get(name), f"hydra.{name}", out)
+    for key in (plain_hydra.get("job") or {}).get("env_set") or {}:
+        if not ENV_ALLOWED.match(str(key)):
+            raise ConfigError(f"hydra.job.env_set.{shorten(str(key))} is not allowed; a config may set thread counts "
+                              "only (OMP_NUM_THREADS, MKL_NUM_THREADS, ...); set other variables in your shell")
+    _check_launcher_shell(plain_hydra.get("launcher") or {}, command_line)
+
+
+def check_stored_config(text: str, where: str) -> DictConfig:
+    """A config stored in a dataset, parsed with a safe YAML loader; ConfigError for tags or interpolations."""
+    import yaml
+
+    if not isinstance(text, str):
+        raise ConfigError(f"{where} is not text; give a run.nc that gyrolab wrote")
+    try:
+        plain = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        at = f" at line {mark.line + 1}" if mark is not None else ""
+        problem = getattr(error, "problem", None) or type(error).__name__
+        raise ConfigError(f"{where} is not plain YAML{at} ({shorten(str(problem), 120)}); gyrolab reads stored "
+                          "configs with a safe loader and refuses tags such as !!python/...") from None
+    if not isinstance(plain, dict):
+        raise ConfigError(f"{where} is not a YAML mapping of config sections; give a run.nc that gyrolab wrote")
+    for path, value in _leaves(plain):
+        if isinstance(value, str) and "${" in value:
+            raise ConfigError(f"{where}: {path}={shorten(repr(value))} is an interpolation, but a stored config is "
+                              "resolved; the dataset was edited, and gyrolab will not rerun it")
+    try:
+        cfg = OmegaConf.create(plain)
+    except OmegaConfBaseException as error:
+        raise ConfigError(f"{where} is not a valid config ({shorten(str(error).splitlines()[0], 120)})") from None
+    check_config(cfg)
+    return cfg
+
+
+def check_output_dir(text: str, key: str) -> None:
+    """ConfigError for an output directory that is empty, the working directory or a parent, or in site-packages."""
+    directory = Path(text)
+    if not text.strip() or text.strip() in (".", "./"):
+        raise ConfigError(f"{key}={text!r} would write into the working directory itself; give a directory "
+                          f"for the results, e.g. {key}=outputs/run1")
+    resolved = Path(os.path.abspath(directory))
+    cwd = Path(os.getcwd())
+    if resolved == cwd or resolved in cwd.parents:
+        raise ConfigError(f"{key}={shorten(text)} is the working directory or one of its parents; give a "
+                          f"directory of its own for the results, e.g. {key}=outputs/run1")
+    for protected in _protected_dirs():
+        if resolved == protected or protected in resolved.parents:
+            raise ConfigError(f"{key}={shorten(text)} is inside {protected}, where Python loads code from; give a "
+                              f"directory for results, e.g. {key}=outputs/run1")
+
+
+@cache
+def _protected_dirs() -> tuple[Path, ...]:
+    import gyrolab
+
+    dirs = set()
+    for path in [*site.getsitepackages(), site.getusersitepackages(),
+                 *(sysconfig.get_paths().get(k) for k in ("purelib", "platlib", "stdlib", "platstdlib")),
+                 os.path.dirname(gyrolab.__file__)]:
+        if path:
+            dirs.add(Path(os.path.abspath(path)))
+    return tuple(sorted(dirs))
+
+
+# ---- helpers ----------------------------------------------------------------------------------------------
+
+def _plain(cfg: DictConfig, skip: str) -> dict[str, Any]:
+    from gyrolab.engine.config import resolve_plain
+
+    keys = [k for k in cfg.keys() if k != skip]
+    return resolve_plain(OmegaConf.masked_copy(cfg, keys)) if keys else {}
+
+
+def _resolved_hydra(cfg: DictConfig, run_dir: Path, job_subdir: bool) -> dict[str, Any]:
+    """The ``hydra`` node resolved as a job would see it (output_dir set, job 0 of a sweep)."""
+    copy = cfg.copy()
+    with open_dict(copy):
+        copy.hydra.job.num = 0
+        copy.hydra.job.id = "0"
+        copy.hydra.runtime.output_dir = str(run_dir)
+        if job_subdir:
+            subdir = OmegaConf.select(copy, "hydra.sweep.subdir", throw_on_resolution_failure=False)
+            copy.hydra.runtime.output_dir = str(Path(run_dir) / str(subdir))
+    plain: dict[str, Any] = {}
+    try:
+        for key in copy.hydra.keys():
+            if key != "overrides":  # the command line as typed (checked as the config it composes)
+                node = copy.hydra._get_node(key)
+                plain[str(key)] = (OmegaConf.to_container(node, resolve=True, throw_on_missing=False)
+                                   if isinstance(node, (DictConfig, ListConfig)) else copy.hydra[key])
+    except OmegaConfBaseException as error:
+        key = getattr(error, "full_key", None) or "hydra"
+        raise ConfigError(f"{shorten(str(key))} cannot be resolved before the run "
+                          f"({shorten(str(error).splitlines()[0], 120)}); give a plain value") from None
+    return plain
+
+
+def _output_dir(run_dir: Path, hydra: dict[str, Any], job_subdir: bool) -> Path:
+    out = Path(os.path.abspath(run_dir))
+    return out / str((hydra.get("sweep") or {}).get("subdir", "")) if job_subdir else out
+
+
+def _leaves(node: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    if isinstance(node, dict):
+        for key, value in node.items():
+            yield from _leaves(value, f"{prefix}.{key}" if prefix else str(key))
+    elif isinstance(node, list):
+        for i, value in enumerate(node):
+            yield from _leaves(value, f"{prefix}[{i}]")
+    else:
+        yield prefix, node
+
+
+def _items(node: Any, prefix: str = "") -> Iterator[tuple[str, str, Any]]:
+    """(path, key, value) of every mapping entry, at any depth (lists too)."""
+    if isinstance(node, dict):
+        for key, value in node.items():
+            path = f"{prefix}.{key}" if prefix else str(key)
+            yield path, str(key), value
+            yield from _items(value, path)
+    elif isinstance(node, list):
+        for i, value in enumerate(node):
+            yield from _items(value, f"{prefix}[{i}]")
+
+
+def _targets(node: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    for path, key, value in _items(node, prefix):
+        if key == "_target_":
+            yield path, value
+
+
+def _check_logging(conf: Any, where: str, out_dir: Path) -> None:
+    if conf is None:
+        return
+    if not isinstance(conf, dict):
+        raise ConfigError(f"{where} must be a logging configuration (a mapping)")
+    for path, key, value in _items(conf, where):
+        if key in ("()", "class"):
+            if str(value) not in LOGGING_CLASSES:
+                raise ConfigError(f"{path}={shorten(repr(value))} is not allowed; a logging config may name only "
+                                  f"{', '.join(sorted(LOGGING_CLASSES))}")
+        elif key == ".":
+            raise ConfigError(f"{path} sets attributes of a logging object, which a config may not do")
+        elif key == "filename":
+            _check_log_file(path, value, out_dir)
+        if isinstance(value, str) and value.startswith("ext://") and value not in LOGGING_EXTERNALS:
+            raise ConfigError(f"{path}={shorten(repr(value))} is not allowed; a logging config may refer only to "
+                              "ext://sys.stdout and ext://sys.stderr")
+
+
+def _check_log_file(path: str, value: Any, out_dir: Path) -> None:
+    target = Path(os.path.abspath(os.path.join(out_dir, str(value))))
+    inside = target.parent == out_dir or out_dir in target.parents
+    if not inside or target.suffix != ".log" or os.path.islink(target):
+        raise ConfigError(f"{path}={shorten(str(value))} is not allowed; a log file must be a .log file inside the "
+                          f"run directory ({shorten(str(out_dir))})")
+
+
+def _check_paths(hydra: dict[str, Any], run_dir: Path) -> None:
+    for key, value in (("hydra.output_subdir", hydra.get("output_subdir")),
+                       ("hydra.sweep.subdir", (hydra.get("sweep") or {}).get("subdir"))):
+        if value is None:
+            continue
+        text = str(value)
+        parts = Path(text).parts
+        if not text.strip() or Path(text).is_absolute() or ".." in parts:
+            raise ConfigError(f"{key}={text!r} must be a relative path inside the run directory (no '..'), "
+                              "e.g. .hydra")
+    name = str((hydra.get("job") or {}).get("name", ""))
+    if not name or "/" in name or os.sep in name or name in (".", ".."):
+        raise ConfigError(f"hydra.job.name={shorten(repr(name))} must be a plain name (no '/'), e.g. gyrolab")
+    folder = (hydra.get("launcher") or {}).get("submitit_folder")
+    if folder is not None:
+        resolved = Path(os.path.abspath(str(folder).replace("%j", "job")))
+        base = Path(os.path.abspath(run_dir))
+        if base not in resolved.parents:
+            raise ConfigError(f"hydra.launcher.submitit_folder={shorten(str(folder))} must be inside the sweep "
+                              "directory, e.g. ${hydra.sweep.dir}/.submitit/%j")
+
+
+@cache
+def _packaged_launcher_shell() -> dict[str, Any]:
+    from importlib.resources import files
+
+    found: dict[str, Any] = {}
+    for option in (files("gyrolab.conf") / "hydra" / "launcher").iterdir():
+        if option.name.endswith(".yaml"):
+            node = OmegaConf.to_container(OmegaConf.load(str(option)))
+            for key in LAUNCHER_SHELL_KEYS:
+                if node.get(key) is not None:
+                    found.setdefault(key, []).append(node[key])
+    return found
+
+
+def _check_launcher_shell(launcher: dict[str, Any], command_line: Sequence[str]) -> None:
+    typed = {o.lstrip("+").split("=", 1)[0] for o in command_line}
+    for key in LAUNCHER_SHELL_KEYS:
+        value = launcher.get(key)
+        if value in (None, [], {}, "") or f"hydra.launcher.{key}" in typed:
+            continue
+        if value not in _packaged_launcher_shell().get(key, []):
+            raise ConfigError(f"hydra.launcher.{key}={shorten(repr(value))} comes from a config file; shell lines and "
+                              f"scheduler arguments run as you, so give them on the command line "
+                              f"(hydra.launcher.{key}=...)")

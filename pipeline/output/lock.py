@@ -1,0 +1,174 @@
+"""One writer per directory: a run directory, a sweep job's directory or a sweep's ``sweep.nc``.
+
+A lock is an exclusive ``flock`` on a hidden file in the directory
+(``.gyrolab.lock``, holding the owner's pid and host for the messages). The
+kernel drops flock locks when their process ends, however it ends, so a lock
+left by ``kill -9`` is stale by construction and the next run takes it. The
+lock file is removed on release (safely: a taker checks that the file it
+locked is still the one in the directory).
+
+flock works between processes on one machine and on most cluster file
+systems (NFSv4, Lustre and GPFS map it onto their own locks); on a file system
+without it the lock is taken without effect and a warning is logged.
+
+A process may take a lock it already holds (the hold is counted), so a sweep
+job that holds its directory can call code that locks the same directory.
+"""
+
+from __future__ import annotations
+
+import errno
+import fcntl
+import logging
+import os
+import socket
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from gyrolab.errors import ConfigError, OutputError
+from gyrolab.output.atomic import reason, remove_stale_temporaries
+
+log = logging.getLogger("gyrolab")
+
+LOCK_NAME = ".gyrolab.lock"
+
+
+class Busy(ConfigError):
+    """The directory is locked by another live process (``owner`` says which, when it wrote it)."""
+
+    def __init__(self, message: str, owner: str) -> None:
+        super().__init__(message)
+        self.owner = owner
+
+
+#: directory (resolved) -> [file descriptor, hold count] for the locks this process holds
+_held: dict[Path, list[int]] = {}
+
+
+def owner_of(directory: Path) -> str:
+    """Who holds (or last held) ``directory``'s lock, as its lock file says: 'pid N on HOST', or ''."""
+    try:
+        return (Path(directory) / LOCK_NAME).read_text().strip()
+    except OSError:
+        return ""
+
+
+def try_lock(directory: str | os.PathLike[str], *, blocking: bool = False) -> bool:
+    """Take ``directory``'s lock if free (True), or say it is held by another live process (False).
+
+    ``blocking``: wait for it instead. Release it with ``unlock``. The directory is created if needed.
+    """
+    key = Path(directory).resolve()
+    if key in _held:
+        _held[key][1] += 1
+        return True
+    try:
+        key.mkdir(parents=True, exist_ok=True)
+        fd = _acquire(key / LOCK_NAME, blocking=blocking)
+    except OSError as error:
+        raise OutputError(f"cannot lock {str(directory)!r}: {reason(error)}") from None
+    if fd is None:
+        return False
+    _held[key] = [fd, 1]
+    return True
+
+
+def unlock(directory: str | os.PathLike[str]) -> None:
+    key = Path(directory).resolve()
+    entry = _held.get(key)
+    if entry is None:
+        return
+    entry[1] -= 1
+    if entry[1] > 0:
+        return
+    del _held[key]
+    try:
+        (key / LOCK_NAME).unlink(missing_ok=True)  # still ours: nobody else can hold it while we do
+    except OSError:
+        pass
+    os.close(entry[0])  # releases the flock
+
+
+def lock(directory: str | os.PathLike[str], what: str = "run directory") -> None:
+    """Take ``directory``'s lock (release it with ``unlock``); ``Busy`` (a ConfigError, exit 2) if another
+    process holds it, ``OutputError`` if no lock file can be made there."""
+    if not try_lock(directory):
+        owner = owner_of(Path(directory))
+        raise Busy(f"{what} {str(directory)!r} is in use by another gyrolab run"
+                   f"{f' ({owner})' if owner else ''}; wait for it to end or choose another directory", owner)
+
+
+@contextmanager
+def directory_lock(directory: str | os.PathLike[str], what: str = "run directory") -> Iterator[Path]:
+    """Hold ``directory``'s lock for the block (see ``lock``)."""
+    directory = Path(directory)
+    lock(directory, what)
+    try:
+        yield directory
+    finally:
+        unlock(directory)
+
+
+@contextmanager
+def writing_in(directory: str | os.PathLike[str], what: str = "run directory") -> Iterator[Path]:
+    """Hold ``directory``'s lock and remove the temporary files killed writes left in it and its ``figures``."""
+    with directory_lock(directory, what) as held:
+        clear_temporaries(held)
+        yield held
+
+
+def clear_temporaries(directory: str | os.PathLike[str]) -> None:
+    """Remove what killed writes left in ``directory`` and its ``figures``; hold the directory's lock."""
+    directory = Path(directory)
+    for place in (directory, directory / "figures"):
+        for leftover in remove_stale_temporaries(place):
+            log.info("removed %s, left by an interrupted write", leftover)
+
+
+def wait_for(directory: str | os.PathLike[str]) -> None:
+    """Block until no other process holds ``directory``'s lock (returns at once when it is free)."""
+    path = Path(directory) / LOCK_NAME
+    if not path.exists() or Path(directory).resolve() in _held:
+        return
+    try:
+        fd = _acquire(path, blocking=True, create=False)
+    except OSError:
+        return
+    if fd is not None:
+        os.close(fd)  # taken and given back at once; the file stays for whoever else waits
+
+
+def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
+    """An fd holding an exclusive flock on ``path`` (the file now in the directory), or None when busy."""
+    while True:
+        try:
+            fd = os.open(path, os.O_RDWR | (os.O_CREAT if create else 0), 0o644)
+        except FileNotFoundError:
+            if not create:
+                return None
+            raise
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
+        except OSError as error:
+            os.close(fd)
+            if error.errno in (errno.EWOULDBLOCK, errno.EAGAIN):
+                return None
+            if error.errno in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS):
+                log.warning("the file system of %s has no file locks; two gyrolab runs in this directory "
+                            "would not be told apart", path.parent)
+                return os.open(path, os.O_RDWR)
+            raise
+        try:
+            same = os.fstat(fd).st_ino == os.stat(path).st_ino
+        except FileNotFoundError:
+            same = False
+        if not same:  # the holder released and removed the file between our open and our flock: again
+            os.close(fd)
+            if not create:
+                return None
+            continue
+        if create:
+            os.ftruncate(fd, 0)
+            os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}\n".encode())
+        return fd

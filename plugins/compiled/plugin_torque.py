@@ -1,0 +1,303 @@
+"""A force plugin's Python torque, traced into straight-line code and compiled (numba ``cfunc``).
+
+The plugin's own ``torque(omega, axes[, t])`` runs once on symbolic 3-vectors (numpy object
+arrays of ``Expr``): every arithmetic operation it performs is recorded, and the record is
+written out as scalar code, one local variable per operation, without allocation. Every number
+the torque uses (the plugin's parameters, and constants computed from them) becomes an entry of
+the parameter array instead of a literal, so the generated source — hence the compiled machine
+code, cached on disk under a hash of that source — depends only on the torque's *form*: a
+sweep over a plugin's parameters compiles once.
+
+The compiled kernel has the C signature ``void(double t, double* y, double* p, double* out)``
+and adds I⁻¹ T to out[0:3]; ``models.rhs`` calls it through its address (stored in ``p``),
+so the integrator kernels, cached once, need no recompilation for a new plugin.
+
+What traces: + − × / unary −, powers, sqrt, exp, log, sin, cos, tan, arctan, tanh, abs, on the
+state components, the reference axes the force declares, time, and numbers; numpy's elementwise
+operations, ``cross``, ``dot``, ``sum`` and ``linalg.norm`` on such vectors. What does not: a
+comparison or ``if`` on the state (the compiled code has no branches), converting the state to
+a float (``float()``, ``math.*``), and numpy functions without an object-array form.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import logging
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+#: Layout of the fixed-point parameter array that the generated code reads (see fixed_point.pack).
+INV_INERTIA = 16
+ADDRESS = 19
+FIRST_CONSTANT = 20
+
+_UNARY = {"neg": "-{0}", "sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
+          "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})", "arctan": "math.atan({0})",
+          "tanh": "math.tanh({0})", "abs": "abs({0})"}
+_BINARY = {"add": "{0} + {1}", "sub": "{0} - {1}", "mul": "{0} * {1}", "div": "{0} / {1}", "arctan2": "math.atan2({0}, {1})"}
+
+
+class NotCompilable(Exception):
+    """The torque uses a construct the tracer cannot record; the message names it (one sentence, no period)."""
+
+
+class Graph:
+    """The recorded operations: inputs (state components, time), constants and results."""
+
+    def __init__(self) -> None:
+        self.nodes: list[tuple[str, tuple[Any, ...]]] = []
+        self.constants: list[float] = []
+
+    def add(self, op: str, *args: Any) -> Expr:
+        self.nodes.append((op, args))
+        return Expr(self, len(self.nodes) - 1)
+
+    def lift(self, value: Any) -> Expr:
+        if isinstance(value, Expr):
+            if value.graph is not self:
+                raise NotCompilable("it mixes two traces")
+            return value
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise NotCompilable(f"it combines the state with a {type(value).__name__}, not a number")
+        if not math.isfinite(float(value)):
+            raise NotCompilable(f"it uses the non-finite number {float(value)!r}")
+        self.constants.append(float(value))
+        return self.add("const", len(self.constants) - 1)
+
+
+def _construct(name: str) -> NotCompilable:
+    return NotCompilable(name)
+
+
+class Expr:
+    """One recorded scalar; numpy object arrays of these stand for the state's vectors."""
+
+    __slots__ = ("graph", "index")
+    __array_priority__ = 1000.0
+
+    def __init__(self, graph: Graph, index: int) -> None:
+        self.graph = graph
+        self.index = index
+
+    def _bin(self, op: str, other: Any, reflected: bool = False) -> Expr:
+        if isinstance(other, np.ndarray):  # a scalar with a vector: elementwise, an object array
+            out = np.empty(other.shape, dtype=object)
+            for k, item in np.ndenumerate(other):
+                out[k] = self._bin(op, item, reflected)
+            return out
+        if not isinstance(other, Expr) and type(other) is int:  # exact integer identities fold away
+            if op == "add" and other == 0:
+                return self
+            if op == "mul" and other == 1:
+                return self
+        o = self.graph.lift(other)
+        return self.graph.add(op, o, self) if reflected else self.graph.add(op, self, o)
+
+    def __add__(self, o): return self._bin("add", o)  # noqa: E704
+    def __radd__(self, o): return self._bin("add", o, True)  # noqa: E704
+    def __sub__(self, o): return self._bin("sub", o)  # noqa: E704
+    def __rsub__(self, o): return self._bin("sub", o, True)  # noqa: E704
+    def __mul__(self, o): return self._bin("mul", o)  # noqa: E704
+    def __rmul__(self, o): return self._bin("mul", o, True)  # noqa: E704
+    def __truediv__(self, o): return self._bin("div", o)  # noqa: E704
+    def __rtruediv__(self, o): return self._bin("div", o, True)  # noqa: E704
+    def __neg__(self): return self.graph.add("neg", self)  # noqa: E704
+    def __pos__(self): return self  # noqa: E704
+    def __abs__(self): return self.graph.add("abs", self)  # noqa: E704
+
+    def __pow__(self, exponent: Any) -> Expr:
+        if isinstance(exponent, Expr):
+            return self.graph.add("powx", self, exponent)
+        if isinstance(exponent, (int, np.integer)) or (isinstance(exponent, (float, np.floating))
+                                                       and float(exponent).is_integer() and abs(exponent) <= 16):
+            return self.graph.add("ipow", self, int(exponent))
+        return self.graph.add("powx", self, self.graph.lift(exponent))
+
+    def __rpow__(self, base: Any) -> Expr:
+        return self.graph.add("powx", self.graph.lift(base), self)
+
+    # numpy's ufuncs on object arrays call the element's method of the same name
+    def sqrt(self): return self.graph.add("sqrt", self)  # noqa: E704
+    def exp(self): return self.graph.add("exp", self)  # noqa: E704
+    def log(self): return self.graph.add("log", self)  # noqa: E704
+    def sin(self): return self.graph.add("sin", self)  # noqa: E704
+    def cos(self): return self.graph.add("cos", self)  # noqa: E704
+    def tan(self): return self.graph.add("tan", self)  # noqa: E704
+    def arctan(self): return self.graph.add("arctan", self)  # noqa: E704
+    def tanh(self): return self.graph.add("tanh", self)  # noqa: E704
+    def square(self): return self.graph.add("ipow", self, 2)  # noqa: E704
+    def conjugate(self): return self  # noqa: E704  (np.dot / vdot on object arrays)
+
+    def arctan2(self, other: Any) -> Expr:
+        return self.graph.add("arctan2", self, self.graph.lift(other))
+
+    def __bool__(self) -> bool:
+        raise _construct("it branches on the state (an `if`, `and`/`or` or `max`/`min` on it), and compiled code "
+                         "cannot branch")
+
+    def _compare(self, other: Any) -> bool:
+        raise _construct("it compares the state (`<`, `>`, `==`, an `if` or `max`/`min` on it), and compiled code "
+                         "cannot branch")
+
+    __lt__ = __le__ = __gt__ = __ge__ = _compare
+
+    def __eq__(self, other: Any) -> bool:  # type: ignore[override]
+        return self._compare(other)
+
+    __hash__ = object.__hash__
+
+    def __float__(self) -> float:
+        raise _construct("it converts the state to a Python float (`float()` or a `math` function) instead of "
+                         "using numpy's functions (np.sqrt, np.exp, ...)")
+
+    __int__ = __index__ = __complex__ = __float__  # type: ignore[assignment]
+
+
+def _vector(graph: Graph, op: str, first: int) -> np.ndarray:
+    out = np.empty(3, dtype=object)
+    for k in range(3):
+        out[k] = graph.add(op, first + k)
+    return out
+
+
+@dataclass
+class Trace:
+    """A traced torque: the graph, the output expressions (three per force) and what it reads."""
+
+    graph: Graph
+    outputs: list[Any]
+    needs_beta: bool
+    uses_time: bool
+
+    def source(self) -> str:
+        """The cfunc's Python source, with constants read from p (so it depends on the form only)."""
+        lines = []
+        names: dict[int, str] = {}
+        for i, (op, args) in enumerate(self.graph.nodes):
+            names[i] = f"v{i}"
+            if op == "y":
+                expr = f"y[{args[0]}]"
+            elif op == "time":
+                expr = "t"
+            elif op == "const":
+                expr = f"p[{FIRST_CONSTANT + args[0]}]"
+            elif op == "ipow":
+                expr = f"{names[args[0].index]} ** {args[1]}"
+            elif op == "powx":
+                expr = f"{names[args[0].index]} ** {names[args[1].index]}"
+            elif op in _UNARY:
+                expr = _UNARY[op].format(names[args[0].index])
+            else:
+                expr = _BINARY[op].format(names[args[0].index], names[args[1].index])
+            lines.append(f"    v{i} = {expr}")
+        for k in range(3):
+            total = " + ".join(self._term(out[k], names) for out in self.outputs) or "0.0"
+            lines.append(f"    out[{k}] += ({total}) * p[{INV_INERTIA + k}]")
+        return _HEADER + "\n".join(lines) + "\n"
+
+    def _term(self, value: Any, names: dict[int, str]) -> str:
+        return names[value.index] if isinstance(value, Expr) else repr(float(value))
+
+
+_HEADER = '''"""Generated by gyrolab from a force plugin's torque (see gyrolab.plugins.compiled.plugin_torque)."""
+import math
+
+import numba
+from numba import types
+
+SIGNATURE = types.void(types.float64, types.CPointer(types.float64), types.CPointer(types.float64),
+                       types.CPointer(types.float64))
+
+
+@numba.cfunc(SIGNATURE, cache=True, error_model="numpy")
+def kernel(t, y, p, out):
+'''
+
+
+def trace(forces: list[Any]) -> Trace:
+    """Record the torques of ``forces`` (one trace for all); raises NotCompilable naming the construct."""
+    graph = Graph()
+    omega = _vector(graph, "y", 0)
+    gamma = _vector(graph, "y", 3)
+    needed = set().union(*(f.required_axes for f in forces))
+    alpha = _vector(graph, "y", 6) if needed & {0, 1} else None
+    beta = None
+    if 1 in needed:
+        g, a = gamma, alpha
+        beta = np.array([g[1] * a[2] - g[2] * a[1], g[2] * a[0] - g[0] * a[2], g[0] * a[1] - g[1] * a[0]], dtype=object)
+    uses_time = any(getattr(f, "time_dependent", False) for f in forces)
+    t = graph.add("time") if uses_time else None
+    outputs = []
+    for force in forces:
+        axes = tuple(v if i in force.required_axes else None for i, v in enumerate((alpha, beta, gamma)))
+        name = force.name
+        try:
+            with np.errstate(all="ignore"):
+                value = force.torque(omega, axes, t) if getattr(force, "time_dependent", False) \
+                    else force.torque(omega, axes)
+        except NotCompilable as exc:
+            raise NotCompilable(f"the torque of force {name!r} cannot be compiled: {exc}") from None
+        except Exception as exc:  # numpy functions without an object form, undeclared axes (None), ...
+            raise NotCompilable(f"the torque of force {name!r} cannot be compiled: tracing it raised "
+                                f"{type(exc).__name__}: {exc}") from None
+        value = np.asarray(value, dtype=object)
+        if value.shape != (3,):
+            raise NotCompilable(f"the torque of force {name!r} has shape {value.shape}, not (3,)")
+        # a component that does not depend on the state is a number: a parameter too, unless exactly 0
+        outputs.append([v if isinstance(v, Expr) or v == 0 else graph.lift(v) for v in value])
+    return Trace(graph, outputs, beta is not None, uses_time)
+
+
+@dataclass
+class CompiledTorque:
+    """A compiled trace: the cfunc (kept alive here), its address and the trace's constants."""
+
+    kernel: Any
+    address: int
+    constants: np.ndarray
+
+
+_LOADED: dict[str, Any] = {}
+
+
+def compile_trace(result: Trace, names: list[str]) -> CompiledTorque:
+    """The compiled kernel of a trace: generated once per form, compiled once per machine (cached on disk)."""
+    source = result.source()
+    digest = hashlib.sha256(source.encode()).hexdigest()[:16]
+    if digest not in _LOADED:
+        from gyrolab.plugins.compiled import kernel_cache_dir
+
+        folder = Path(kernel_cache_dir()) / "forces"
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError:  # a read-only cache (some cluster nodes): this machine's temporary directory
+            import tempfile
+
+            folder = Path(tempfile.gettempdir()) / "gyrolab" / "forces"
+            folder.mkdir(parents=True, exist_ok=True)
+        path = folder / f"gyrolab_force_{digest}.py"
+        marker = path.with_suffix(".compiled")
+        if not path.exists() or path.read_text() != source:
+            from gyrolab.output.atomic import atomic_path
+
+            with atomic_path(path) as tmp:
+                Path(tmp).write_text(source)
+        if not marker.exists():
+            log.info("compiling force %s, once (cached for later runs)", " + ".join(names))
+        module_name = f"gyrolab_force_{digest}"
+        spec = importlib.util.spec_from_file_location(module_name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[module_name] = module
+        spec.loader.exec_module(module)
+        _LOADED[digest] = module.kernel  # the cfunc compiled (or loaded its cache) on import
+        marker.touch()
+    kernel = _LOADED[digest]
+    return CompiledTorque(kernel, int(kernel.address), np.array(result.graph.constants, dtype=float))

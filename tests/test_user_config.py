@@ -1,0 +1,96 @@
+"""A user's own config directory works everywhere the packaged one does (README "Your own configs").
+
+Everything runs from a temporary directory outside the source tree, on a copy of
+examples/myconf (the README's example), in this process (a handful of steps keeps it fast).
+"""
+
+import shutil
+
+import pytest
+import xarray as xr
+
+from gyrolab.sweep.aggregate import FINISHED, STATUS_FLAGS
+from tests.conftest import REPO
+from tests.test_bad_input import run_main
+
+SMALL = ["time.end=1", "time.n_output=11"]
+
+
+@pytest.fixture
+def myconf(tmp_path, monkeypatch):
+    shutil.copytree(REPO / "examples" / "myconf", tmp_path / "myconf")
+    monkeypatch.chdir(tmp_path)
+    return tmp_path / "myconf"
+
+
+def stored(path):
+    with xr.open_dataset(path) as ds:
+        return ds.attrs["config"], ds.attrs["integrator"], ds.sizes["time"]
+
+
+def test_user_experiment_runs_as_written(myconf, tmp_path, monkeypatch, capsys):
+    code, err = run_main(["--config-dir=myconf", "+experiment=lopsided_top", "time.end=1", "hydra.run.dir=out"],
+                         monkeypatch, capsys)
+    assert code == 0, err
+    config, integrator, n = stored(tmp_path / "out" / "run.nc")
+    # lopsided_top.yaml: its own body option (a = 1.8, b = 1.2), rk45, r0 = 2, 201 samples
+    assert (integrator, n) == ("rk45", 201)
+    assert "a: 1.8" in config and "b: 1.2" in config and "r0: 2.0" in config and "rtol: 1.0e-09" in config
+
+
+def test_user_primary_config_runs(myconf, tmp_path, monkeypatch, capsys):
+    # a relative --config-path is read from the working directory
+    code, err = run_main(["-cp", "myconf", "-cn", "mine", "hydra.run.dir=out"], monkeypatch, capsys)
+    assert code == 0, err
+    config, integrator, n = stored(tmp_path / "out" / "run.nc")
+    assert (integrator, n) == ("dop853", 101) and "a: 1.8" in config and not (tmp_path / "out" / "figures").exists()
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (["hydra.searchpath=[file://{conf}]", "experiment=lopsided_top"], ("RK45", 1.8, 201)),
+    (["--config-dir", "myconf", "--config-name", "mine"], ("DOP853", 1.8, 101)),
+    (["--config-path", "myconf", "--config-name", "mine", "body=asymmetric_top"], ("DOP853", 2.0, 101)),
+])
+def test_the_preflight_composes_the_users_config(argv, expected, myconf, monkeypatch):
+    """Each form passes the preflight, which composes from the user's folder (the runs above: Hydra agrees)."""
+    from hydra._internal.utils import get_args_parser
+
+    from gyrolab import app
+    from gyrolab.engine.config import ConfigSource, compose_config, current_source, use_source
+
+    argv = app.absolute_config_path([a.format(conf=myconf) for a in argv])
+    try:
+        app.preflight([*argv, "hydra.run.dir=out"])
+        overrides = get_args_parser().parse_known_args(argv)[0].overrides
+        cfg = compose_config(overrides, config_name=current_source().config_name)
+    finally:
+        use_source(ConfigSource())
+    assert (cfg.integrator._target_.rsplit(".", 1)[1], cfg.body.a, cfg.time.n_output) == expected
+def test_user_configs_in_a_multirun_a_batch_and_a_reproduction(myconf, tmp_path, monkeypatch, capsys):
+    code, err = run_main(["-m", "--config-dir", "myconf", "experiment=lopsided_top", "initial.r0=1,2", *SMALL,
+                          "hydra.sweep.dir=sweep"], monkeypatch, capsys)
+    assert code == 0, err
+    with xr.open_dataset(tmp_path / "sweep" / "sweep.nc") as ds:
+        assert list(ds["job_status"].values) == [STATUS_FLAGS[FINISHED]] * 2
+    assert "a: 1.8" in stored(tmp_path / "sweep" / "1" / "run.nc")[0]
+    code, err = run_main(["--config-dir", "myconf", "--batch", "body=lopsided", "integrator=rk4",
+                          "initial.r0=1,2", *SMALL, "hydra.sweep.dir=batch"], monkeypatch, capsys)
+    assert code == 0, err
+    with xr.open_dataset(tmp_path / "batch" / "sweep.nc") as ds:
+        assert ds.attrs["sweep_launcher"] == "batch" and ds.sizes["r0"] == 2 and ds.attrs["body_a"] == 1.8
+    code, err = run_main(["--reproduce", "sweep/1/run.nc"], monkeypatch, capsys)
+    assert code == 0, err
+
+
+def test_the_preflight_validates_the_users_config(myconf, tmp_path, monkeypatch, capsys):
+    """A typo or a bad value in the user's own file is refused like one on the command line."""
+    (myconf / "experiment" / "typo.yaml").write_text("# @package _global_\ntime:\n  ennd: 5.0\n")
+    (myconf / "experiment" / "task.yaml").write_text("# @package _global_\ntask: work_precison\n")
+    (myconf / "experiment" / "large.yaml").write_text("# @package _global_\ntime:\n  n_output: 1000000000\n")
+    for name, phrase in (("typo", "`time.ennd` is not a key of `time`; did you mean `time.end`?"),
+                         ("task", "did you mean task=work_precision?"), ("large", "67.1 GiB"),
+                         ("lopsided_topp", "did you mean experiment=lopsided_top?")):
+        code, err = run_main(["--config-dir", "myconf", f"experiment={name}", "hydra.run.dir=out"],
+                             monkeypatch, capsys)
+        assert code == 2 and phrase in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "out").exists()
