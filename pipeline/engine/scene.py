@@ -62,9 +62,6 @@ class Scene:
         times = _output_times(plain["time"], fastest_rate(system))
         integrator.prepare(system)
         scene = cls(config=cfg, system=system, integrator=integrator, times=times, n_output_requested=requested)
-        warning = scene.sampling_warning()
-        if warning:
-            log.warning("%s", warning)
         if integrator.needs_compiled_model and scene.compiled is None:
             reason = getattr(system, "compile_error", None) or f"system {system.name!r} has no compiled form"
             raise ConfigError(
@@ -84,6 +81,9 @@ class Scene:
             reason = getattr(system, "compile_error", None)
             if reason:
                 log.info("%s; %s runs scipy's integrators", reason, integrator.name)
+        warning = scene.sampling_warning()
+        if warning:
+            log.warning("%s", warning)
         return scene
 
     @cached_property
