@@ -7,12 +7,18 @@ measured with an independent DOP853 shooting (§5.3, §6).
 
 import numpy as np
 import pytest
-
 from gyrolab.engine.config import compose_config
 from gyrolab.errors import ConfigError
-from gyrolab.experiments.regime_run import errors, prepare
+from gyrolab.experiments.regime_run import errors, exact_orbit, integrate, prepare, with_alpha
 from gyrolab.plugins.regimes import ismail2021 as paper
-from tests.test_regime_helpers import GAMMA_000, overrides_000, run_case, slope
+
+from tests.test_regime_helpers import (
+    BODY_000,
+    GAMMA_000,
+    overrides_000,
+    run_case,
+    slope,
+)
 
 MUS = (16.0, 32.0, 64.0)
 
@@ -217,3 +223,133 @@ def test_reduced_rhs_is_exposed_on_the_plugin():
     # reduced system vs exact orbit: p, q O(μ⁻³) relative to c, γ's O(μ⁻⁴) (32⁻³ ≈ 3e-5, 32⁻⁴ ≈ 1e-6)
     assert np.max(np.abs(y[:, :2] - orbit[:, :2])) / s.c < 2e-4
     assert np.max(np.abs(y[:, 3:] - orbit[:, 3:])) < 2e-5
+
+
+# -- the finite-tilt period and the order-N series (issue 13, items 1, 4 and 5c) -------------------------------
+
+
+def _tilted(eps, g0, *extra):
+    overrides = ["regime=small_parameter", *BODY_000, f"initial.r0={1 / eps!r}",
+                 f"initial.theta0={float(np.arccos(g0))!r}", *extra]
+    scene, regime, _ = prepare(compose_config(overrides))
+    return scene, regime
+
+
+def test_period_keeps_the_finite_tilt():
+    # (36) keeps only the −z0'γ0'' tilt term; the truth is the exact orbit's period. Body I, ε = 0.01, γ0'' = 0.3:
+    # α/ε² = (T_τ − 2π)/ε² is 1.124 on the exact orbit, 1.375 by (36) (an O(γ0''²) error, not O(ε²)).
+    eps, g0 = 0.01, 0.3
+    scene, regime = _tilted(eps, g0)
+    exact = (exact_orbit(scene, regime).period / eps - 2 * np.pi) / eps**2
+    ours = (regime.period(scene.system) / eps - 2 * np.pi) / eps**2
+    P = regime.params(regime.scene(scene.system))
+    assert abs(paper.period_correction(P) / eps**2 - exact) > 0.2  # the formula this replaces
+    assert ours == pytest.approx(exact, abs=5e-3)
+    # and at a larger tilt, through ε³: the relative period error is O(ε⁴) (coefficient 1.1 on body I at
+    # γ0'' = 0.7), where (36)'s is O(ε²γ0''²)
+    eps, g0 = 0.05, 0.7
+    scene, regime = _tilted(eps, g0)
+    T = exact_orbit(scene, regime).period
+    assert abs(regime.period(scene.system) - T) / T < 2 * eps**4
+    P = regime.params(regime.scene(scene.system))
+    assert abs(eps * (2 * np.pi + paper.period_correction(P)) - T) / T > 20 * eps**4
+
+
+@pytest.fixture(scope="module")
+def order10():
+    return _tilted(0.05, 0.3, "regime.order=10")
+
+
+def test_order_10_shows_its_error_slope_and_radius(order10):
+    scene, regime = order10
+    data, _, attrs = regime.diagnostics(scene.system)
+    assert attrs["series_order"] == 10
+    assert attrs["series_error_slope"] == pytest.approx(11, abs=0.3)
+    R = attrs["series_radius_of_convergence"]
+    # three estimates from the same coefficients agree within 10 %; the scene is well inside the radius
+    assert attrs["series_radius_root_test"] == pytest.approx(R, rel=0.1)
+    assert attrs["series_radius_pade"] == pytest.approx(R, rel=0.1)
+    assert attrs["series_min_r0_over_c"] == pytest.approx(1 / R)
+    assert np.all(data["series_ladder_error"][1] > 1e-13)
+    assert attrs["series_consistency_max"] < 1e-11
+    # at the scene's ε the order-10 series is the exact orbit to ~ε¹¹ (5e-15 relative): round-off level
+    orbit = exact_orbit(scene, regime)
+    t = np.linspace(0.0, orbit.period, 9)
+    y = integrate(scene, with_alpha(scene, regime, orbit.y0), t, taylor=True)
+    assert np.max(np.abs(regime.solution(scene.system, t) - y[:, :6]) / np.array([1, 1, 20, 1, 1, 1])) < 1e-12
+    assert regime.period(scene.system) == pytest.approx(orbit.period, rel=1e-13)
+    # Euler angles of the series (ψ integrated spectrally) against those of the integrated orbit
+    angles, truth = regime.euler_angles(scene.system, t), scene.system.variables(t, y)
+    for name in ("psi", "theta", "phi"):
+        assert np.max(np.abs(angles[name] - truth[name].values)) < 1e-12, name
+
+
+def test_bad_order_is_refused():
+    from gyrolab.plugins.regimes.small_parameter import SmallParameter
+
+    for value in (0, True, 2.5, 61, "6"):
+        with pytest.raises(ConfigError, match="regime.order"):
+            SmallParameter(order=value)
+    with pytest.raises(ConfigError, match="no printed form"):
+        SmallParameter(order=6, formula="printed")
+    with pytest.raises(ConfigError, match="regime.order"):  # and through the configuration
+        prepare(compose_config([*overrides_000(20.0), "regime.order=0"]))
+
+
+def test_order_beyond_the_radius_of_convergence_is_refused():
+    with pytest.raises(ConfigError, match="radius of convergence"):
+        _tilted(0.8, 0.3, "regime.order=6")
+
+
+def test_auto_takes_the_lowest_series_order_that_meets_the_target():
+    # A scene on the exact orbit (shooting) at r0/c = 32: the closed forms (error ~1e-5) cannot meet 1e-9,
+    # the numeric series can; auto records the order it used, and the result meets the target against the
+    # extended-precision reference.
+    from gyrolab import compose_scene
+    from gyrolab.physics.periodic import FixedPointModel, shoot
+    from gyrolab.physics.reference import fixed_point_reference
+    from gyrolab.plugins.regimes.small_parameter import SmallParameter
+
+    base = [*BODY_000, "initial.r0=32.0", f"initial.theta0={float(np.arccos(0.5 / 32))!r}", "time.end=1.0",
+            "time.n_output=21", "integrator=auto"]
+    system = compose_scene([*base, "accuracy=1e-9"]).system
+    regime = SmallParameter()
+    orbit = shoot(FixedPointModel.from_system(system), regime.initial_state(system), regime.period(system))
+    on_orbit = [*base, f"initial.p0={float(orbit.y0[0])!r}", f"initial.q0={float(orbit.y0[1])!r}"]
+    ds = compose_scene([*on_orbit, "accuracy=1e-9"]).run()
+    assert ds.attrs["auto_method"] == "regime small_parameter"
+    order = int(ds.attrs["regime_order"])
+    y0 = np.concatenate([ds.omega.values[0], ds.gamma.values[0]])
+    rc = [0.5, 0.3, float(np.sqrt(1 - 0.34))]
+    ref = fixed_point_reference([2.0, 1.5, 1.0], rc, 0.3, y0, ds.time.values).astype(float)
+    assert np.max(np.abs(np.concatenate([ds.omega.values, ds.gamma.values], axis=1) - ref)) <= 1e-9
+    # the lowest: one order less is disqualified by auto's rules — its error over one period, extrapolated to the
+    # span with the safety factor 3, misses the target, or the scene does not start on its orbit (a warning: its
+    # p0, q0 differ by more than 1e-12)
+    scene = compose_scene([*on_orbit, "accuracy=1e-9"])
+    lower = SmallParameter(order=order - 1)
+    t = np.linspace(0.0, regime.period(system), 33)
+    truth = fixed_point_reference([2.0, 1.5, 1.0], rc, 0.3, orbit.y0, t).astype(float)
+    missed = np.max(np.abs(lower.solution(system, t) - truth)) * 1.0 / t[-1] * 3 > 1e-9
+    assert missed or lower.check_domain(scene.system)
+
+
+def test_vertical_magnetic_field_adds_to_the_weight():
+    # m × B with B = B e_Z has the form U × γ of the weight: U = Mg r_c + B m. The order-6 series of that U must
+    # match the exact orbit of the full model (which integrates the magnetic torque itself) to ~ε⁷.
+    eps = 0.05
+    overrides = ["regime=small_parameter", "regime.order=6", "body.a=2.0", "body.b=1.5",
+                 "force=[uniform_gravity,magnetic]", "force.magnetic.field=0.5", "force.magnetic.moment=[0.0,0.8,0.6]",
+                 f"initial.r0={1.3 / eps!r}", "initial.theta0=1.2"]
+    scene, regime, _ = prepare(compose_config(overrides))
+    s = regime.scene(scene.system)
+    U = np.array([0.3, 0.2, 0.9327379053088815]) + 0.5 * np.array([0.0, 0.8, 0.6])
+    assert s.c == pytest.approx(np.sqrt(np.linalg.norm(U)))
+    assert [s.x0, s.y0, s.z0] == pytest.approx(U / np.linalg.norm(U))
+    orbit = exact_orbit(scene, regime)
+    t = np.linspace(0.0, orbit.period, 9)
+    y = integrate(scene, orbit.y0, t, taylor=True)[:, :6]
+    error = np.abs(regime.solution(scene.system, t) - y) / np.array([s.c, s.c, s.c * s.r0, 1, 1, 1])
+    assert np.max(error) < 5 * (1 / s.r0) ** 7  # 6.6e-10 = 1.6 ε⁷ at ε = c/r0 = 0.0456; 2.4e-2 without the field
+    with pytest.raises(ConfigError, match="vertical magnetic field"):
+        prepare(compose_config([*overrides, "force.magnetic.direction=[1.0,0.0,0.0]"]))

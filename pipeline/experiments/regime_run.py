@@ -206,6 +206,12 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                  regime.formula, regime.parameter, regime.parameter_value(system), T, orbit.period,
                  ", ".join(f"{r:.1e}" for r in orbit.residuals))
     ds = dataset(scene, regime, t, result, warnings)
+    diagnostics = getattr(regime, "diagnostics", None)  # e.g. small_parameter's order-N series evidence
+    data, coords, attrs = diagnostics(system) if diagnostics is not None else ({}, {}, {})
+    if data or attrs:
+        ds = ds.assign_coords(coords).assign(data)
+        ds.attrs.update(attrs)
+        log.info("%s: %s", regime.name, ", ".join(f"{k} = {v}" for k, v in attrs.items() if not isinstance(v, list)))
     written = [write_dataset(ds, Path(out_dir) / "regime.nc")]
     written.append(plot(ds, Path(out_dir) / "figures" / "regime_comparison.png"))
     return written
@@ -302,8 +308,10 @@ def plot(ds: xr.Dataset, path: Path) -> Path:
     for ax in axes[1]:
         ax.set_xlabel(f"time t [{ds.time.attrs['long_name'].split('[')[-1].rstrip(']')}]")
     axes[0, 0].legend(fontsize=7)
-    fig.suptitle(f"{ds.attrs['title']}\n{ds.attrs['regime_parameter']} = {ds.attrs['regime_parameter_value']:.4g}",
-                 fontsize=8)
+    series = (f"; order-{ds.attrs['series_order']} series: error slope {ds.attrs['series_error_slope']:.2f}, radius of "
+              f"convergence c/r0 = {ds.attrs['series_radius_of_convergence']:.3g}" if "series_order" in ds.attrs else "")
+    fig.suptitle(f"{ds.attrs['title']}\n{ds.attrs['regime_parameter']} = {ds.attrs['regime_parameter_value']:.4g}"
+                 f"{series}", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -175,10 +175,18 @@ class Auto(Integrator):
         from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
         span = t_out[-1] - t_out[0]
+        candidates = []  # each regime's variants predicted to meet the target, lowest series order first
         for name in registry.names("regime"):
             try:
-                regime = registry.load("regime", name)()
-                if self.system.name not in regime.systems or regime.check_domain(self.system):
+                base = registry.load("regime", name)()
+                if self.system.name in base.systems:
+                    ladder = getattr(base, "series_candidates", lambda system, accuracy: [(base, None)])
+                    candidates += [(name, r) for r, _ in ladder(self.system, self.accuracy / self.safety)]
+            except GyrolabError:
+                continue
+        for name, regime in candidates:
+            try:
+                if regime.check_domain(self.system):
                     continue  # outside the domain, or near its edge (warnings): no confidence in the series
                 orbit0 = regime.initial_state(self.system)
             except GyrolabError:

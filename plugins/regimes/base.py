@@ -17,7 +17,7 @@ from gyrolab.contracts.regime import Regime
 from gyrolab.contracts.system import System
 from gyrolab.errors import ConfigError
 
-SUPPORTED_FORCES = ("uniform_gravity", "newtonian")
+SUPPORTED_FORCES = ("uniform_gravity", "newtonian", "magnetic")
 
 
 @dataclass(frozen=True)
@@ -48,14 +48,26 @@ def nondimensional_scene(system: System, regime: str) -> NondimensionalScene:
     """The scene's body, forces and initial spin/tilt in the papers' form; ConfigError for other forces."""
     names = [f.name for f in system.forces]
     foreign = [n for n in names if n not in SUPPORTED_FORCES]
-    if foreign or "uniform_gravity" not in names:
-        raise ConfigError(f"regime {regime} is derived for force=[uniform_gravity] or [uniform_gravity,newtonian], "
-                          f"got force={names}")
+    if foreign or not {"uniform_gravity", "magnetic"} & set(names):
+        raise ConfigError(f"regime {regime} is derived for force=[uniform_gravity] or [uniform_gravity,newtonian] "
+                          f"(a vertical magnetic field may add to or replace gravity), got force={names}")
     body = system.body
     nd = body.nondimensional()
+    # The torque U × γ: the weight's moment plus m·B of a vertical uniform field (the same form, seed 000 eq. 1)
+    U = np.array(body.weight_moment, dtype=float) if "uniform_gravity" in names else np.zeros(3)
+    for force in system.forces:
+        if force.name == "magnetic":
+            if np.any(force.direction[:2] != 0):
+                raise ConfigError(f"regime {regime} needs a vertical magnetic field, force.magnetic.direction="
+                                  f"[0,0,±1], got {force.direction.tolist()}")
+            U = U + force.field * force.direction[2] * force.moment
+    if np.linalg.norm(U - np.asarray(body.weight_moment)) > 0:
+        moment = float(np.linalg.norm(U))
+        nd = {**nd, "c2": moment / float(body.inertia[2]),
+              "com_direction": (U / moment).tolist() if moment > 0 else [0.0, 0.0, 0.0]}
     c2 = nd.get("c2", 1.0)
     if c2 <= 0:
-        raise ConfigError(f"regime {regime} needs a heavy body (c² = Mgℓ/C > 0), got c²={c2:g}")
+        raise ConfigError(f"regime {regime} needs a heavy body (c² = |U|/C > 0 with U = Mg r_c [+ m·B]), got c²={c2:g}")
     c = float(np.sqrt(c2))
     k = 0.0
     for force in system.forces:
@@ -141,3 +153,15 @@ class FixedPointRegime(Regime):
 
     def attributes(self) -> dict[str, Any]:
         return {**super().attributes(), "regime_parameter_long_name": self.parameter_long_name}
+
+    def diagnostics(self, system: System) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
+        """Extra evidence for a regime run's dataset: (data variables, coordinates, attributes); none by default."""
+        return {}, {}, {}
+
+    def series_candidates(self, system: System, accuracy: float) -> list[tuple[Regime, float]]:
+        """Variants of this regime (lowest order first) with their predicted max error, for ``integrator=auto``.
+
+        The default is the regime itself with no prediction (auto measures it); a regime with a series of
+        selectable order lists the orders predicted to meet ``accuracy``.
+        """
+        return [(self, float("nan"))]

@@ -13,13 +13,25 @@ the generating system (refused where |n² − ω²| < ``divisor_threshold(n, ε)
 narrows as the spin grows: ε^(4/3) at ω = 1, ε³ at ω = 2, 3), and γ0'' = cos θ0 = O(ε) (the derivation sets
 γ0'' = Γ/μ; warning when Γ = γ0''/ε > 3). Theory error orders in ε:
 p, q 3; r, γ, γ', γ'' 4; period 4 (corrected) — the printed r, γ, γ' are 2.
+
+``order=N`` replaces the closed forms by the numeric Poincaré–Lindstedt series through ε^N at the scene's own
+(finite) tilt (``gyrolab.physics.lindstedt``): every variable's error is O(ε^(N+1)) — O(ε^(N+2)) for the
+variables whose next term vanishes by the (ε, p, q) → (−ε, −p, −q) symmetry — and the series' radius of
+convergence in ε, estimated from its coefficients, is the smallest c/r0 at which it can be used.
+
+The default (``order`` unset) keeps the paper's closed forms, with one fix: the frequency is the finite-tilt
+one, Ω = 1 − ε²[x0'√(1 − γ0''²) − z0'γ0'' + (k/4)(b − a − γ0''²(a + 3b − 4))] + O(ε⁴) (``finite_tilt_frequency``,
+exact in γ0'' at this order), where (36) keeps only the −z0'γ0'' tilt term (its error is O(ε²γ0''²)).
 """
 
 from __future__ import annotations
 
-import numpy as np
+from functools import lru_cache
+from typing import Any
 
+import numpy as np
 from gyrolab.errors import ConfigError
+from gyrolab.physics import lindstedt
 from gyrolab.plugins.regimes import ismail2021 as paper
 from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
 
@@ -44,6 +56,36 @@ def divisor_threshold(n: float, eps: float) -> float:
     return min(rule, n * n - (n - WARN_DISTANCE) ** 2)
 
 
+# The series is computed at least through this order: the order above the one used gives its error estimate,
+# and the radius of convergence is estimated from the upper half of the coefficients (Domb–Sykes on Ω: within
+# 0.5 % of the Lagrange top's exact branch point at order 32; on body I it moves by < 2 % from order 24 to 40).
+RADIUS_ORDER = 32
+MAX_ORDER = 60
+CANDIDATES = 3  # orders offered to integrator=auto (it measures each, lowest first, and takes the first that meets)
+
+
+@lru_cache(maxsize=32)
+def _series(body: lindstedt.Body, order: int, tilt: float) -> lindstedt.LindstedtSeries:
+    return lindstedt.series(body, order, tilt=tilt)
+
+
+def series_body(s: NondimensionalScene) -> lindstedt.Body:
+    return lindstedt.Body(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k)
+
+
+def finite_tilt_frequency(P: paper.Params) -> float:
+    """Ω = 2π/T_τ through ε³ at a fixed tilt γ0'' (the ε³ term vanishes by symmetry).
+
+    The ε² coefficient is −[x0'√(1 − γ0''²) − z0'γ0'' + (k/4)(b − a − γ0''²(a + 3b − 4))]: (36) with the finite
+    tilt kept — its O(γ0''²) terms are O(ε⁴) in seed 000's scaling γ0'' = Γε, so (36) agrees with it there.
+    Found from the numeric series' ε² coefficient (exact in γ0'') and checked against exact orbits'
+    periods (tests/test_regime_small_parameter.py).
+    """
+    g = P.g0
+    return 1 - (P.x0 * np.sqrt(1 - g * g) - P.z0 * g
+                + 0.25 * P.k * (P.b - P.a - g * g * (P.a + 3 * P.b - 4))) / P.mu**2
+
+
 def refusal_distance(n: float, eps: float) -> float:
     """The widest |ω − n| that is refused at ε (the side below the resonance)."""
     return float(n - np.sqrt(max(n * n - divisor_threshold(n, eps), 0.0)))
@@ -55,6 +97,72 @@ class SmallParameter(FixedPointRegime):
     parameter_long_name = "Poincaré's small parameter ε = c/r0 = √(Mgℓ/C)/r0 (seed 000's 1/μ)"
     order = {"pq": 3.0, "r": 4.0, "gamma": 4.0, "gamma3": 4.0, "period": 4.0}
     printed_order = {"pq": 3.0, "r": 2.0, "gamma": 2.0, "gamma3": 4.0, "period": 2.0}
+
+    def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200,
+                 order: int | None = None) -> None:
+        super().__init__(formula=formula, periods=periods, samples_per_period=samples_per_period)
+        if order is not None and (isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= MAX_ORDER):
+            raise ConfigError(f"regime.order={order!r} must be an integer from 1 to {MAX_ORDER} (or null: the "
+                              "paper's closed forms)")
+        if order is not None and formula == "printed":
+            raise ConfigError("regime.order selects the numeric series, which has no printed form; "
+                              "use regime.formula=corrected with regime.order, or drop regime.order")
+        self.series_order = order
+        if order is not None:
+            # fixed tilt: p, q carry the odd powers of ε, r and the γ's the even ones, Ω is even
+            odd, even = (order + 1 if (order + 1) % 2 else order + 2), (order + 1 if order % 2 else order + 2)
+            self.order = {"pq": float(odd), "r": float(even), "gamma": float(even), "gamma3": float(even),
+                          "period": float(even)}
+
+    def series(self, system) -> lindstedt.LindstedtSeries:
+        """The numeric Lindstedt series of the scene's orbit, through max(order + 1, RADIUS_ORDER)."""
+        s = self.scene(system)
+        self.check_series_domain(s)
+        return _series(series_body(s), max((self.series_order or 3) + 1, RADIUS_ORDER), float(s.gamma0pp))
+
+    def check_series_domain(self, s: NondimensionalScene) -> None:
+        if not abs(s.gamma0pp) < 1:
+            raise ConfigError(f"regime small_parameter needs a tilted axis, 0 < θ0 < π, got θ0={s.theta0:.4g}")
+
+    def with_order(self, order: int) -> SmallParameter:
+        return SmallParameter(formula=self.formula, periods=self.periods, samples_per_period=self.samples_per_period,
+                              order=order)
+
+    def series_candidates(self, system, accuracy: float) -> list[tuple[SmallParameter, float]]:
+        """(regime at order N, its predicted max error in model units), the lowest ``CANDIDATES`` orders predicted
+        to meet ``accuracy``, lowest first, after the closed forms (no prediction: auto measures them) when the
+        regime has no order of its own.
+
+        The prediction is the first omitted term (``LindstedtSeries.error_estimate``) in model units (p, q
+        scale with c, r with c/ε = c r0); only orders predicted to meet ``accuracy`` are listed (none when the scene's ε
+        is beyond half the radius of convergence, where the estimate is not trustworthy).
+        """
+        s = self.scene(system)
+        out = [(self, float("nan"))] if self.series_order is None else []  # the closed forms, measured by auto
+        if not s.r0 > 1 or not abs(s.gamma0pp) < 1:
+            return out
+        eps = 1.0 / s.r0
+        sol = self.series(system)
+        if not eps < 0.5 * sol.radius_of_convergence():
+            return out
+        for n in range(1, sol.max_order):
+            estimate = sol.error_estimate(eps, n, (s.c, s.c, s.c / eps, 1.0, 1.0, 1.0))
+            if estimate <= accuracy:
+                out.append((self.with_order(n), estimate))
+            if len(out) == CANDIDATES + (self.series_order is None):
+                break
+        return out
+
+    def attributes(self) -> dict[str, Any]:
+        out = super().attributes()
+        out["regime_order"] = "paper (closed forms)" if self.series_order is None else int(self.series_order)
+        return out
+
+    def diagnostics(self, system) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
+        """Series coefficients, radius of convergence, small divisors and the measured order-N error slope."""
+        if self.series_order is None:
+            return {}, {}, {}
+        return series_diagnostics(self, system)
 
     def params(self, s: NondimensionalScene) -> paper.Params:
         return paper.Params(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k, mu=s.r0, g0=s.gamma0pp)
@@ -86,13 +194,25 @@ class SmallParameter(FixedPointRegime):
         if w2 <= 0:
             warnings.append(f"ω² = {w2:.4g} ≤ 0 (A, B on both sides of C): the generating p-mode is not an "
                             "oscillation; the expansion is untested there")
-        if eps > 0.2:
+        if eps > 0.2 and self.series_order is None:  # the order-N series warns at half its radius instead
             warnings.append(f"c/r0 = {eps:.3g} > 0.2: near the edge of the fast-spin domain, expect errors of "
                             f"order (c/r0)² ≈ {eps**2:.2g}")
+        if self.series_order is not None:
+            self.check_series_domain(s)
+            R = self.series(system).radius_of_convergence()
+            if not eps < R:
+                raise ConfigError(f"regime small_parameter with order={self.series_order} needs c/r0 below the "
+                                  f"series' radius of convergence {R:.3g} (estimated from its coefficients), but "
+                                  f"c/r0={eps:.4g}; choose r0/c > {1 / R:.3g}")
+            if eps > 0.5 * R:
+                warnings.append(f"c/r0 = {eps:.3g} is beyond half the series' radius of convergence {R:.3g}: "
+                                f"the error falls only like ({eps / R:.2f})^(N+1) with the order N")
+            return warnings + self.reseat_warnings(system)
         gamma = s.gamma0pp / eps
         if abs(gamma) > 3:
-            warnings.append(f"Γ = cos θ0 · r0/c = {gamma:.3g}: the expansion assumes cos θ0 = O(c/r0) "
-                            "(a nearly horizontal axis, seed 000 eq. 28); expect larger errors")
+            warnings.append(f"Γ = cos θ0 · r0/c = {gamma:.3g}: the closed forms assume cos θ0 = O(c/r0) "
+                            "(a nearly horizontal axis, seed 000 eq. 28); expect errors of order cos⁴θ0 in the γ's "
+                            "(the period keeps the finite tilt); regime.order=N gives the finite-tilt series")
         if abs(s.a + s.b - 1) < 0.05:
             warnings.append(f"a + b − 1 = {s.a + s.b - 1:.3g}: the z0'/(a + b − 1) terms of (35) are large")
         return warnings + self.reseat_warnings(system)
@@ -130,14 +250,94 @@ class SmallParameter(FixedPointRegime):
     def _state(self, s, t):
         P = self.params(s)
         tau = s.r0 * t
-        S = paper.printed_scaled(tau, P) if self.formula == "printed" else paper.scaled(tau, P)
-        return paper.scaled_to_model(S, P)
+        if self.series_order is not None:
+            sol = _series(series_body(s), max(self.series_order + 1, RADIUS_ORDER), float(s.gamma0pp))
+            y = sol.scaled(1.0 / s.r0, tau, self.series_order)
+            y[:, 2] *= s.r0
+            return y
+        if self.formula == "printed":
+            return paper.scaled_to_model(paper.printed_scaled(tau, P), P)
+        # the closed forms in the finite-tilt strained time s = Ωτ (they evaluate s = frequency(P)·τ)
+        return paper.scaled_to_model(paper.scaled(tau * finite_tilt_frequency(P) / paper.frequency(P), P), P)
+
+    def _omega(self, s) -> float:
+        P = self.params(s)
+        if self.series_order is not None:
+            sol = _series(series_body(s), max(self.series_order + 1, RADIUS_ORDER), float(s.gamma0pp))
+            return float(sol.frequency(1.0 / s.r0, self.series_order))
+        return paper.printed_frequency(P) if self.formula == "printed" else finite_tilt_frequency(P)
 
     def _period(self, s):
-        P = self.params(s)
-        omega = paper.printed_frequency(P) if self.formula == "printed" else paper.frequency(P)
-        return 2 * np.pi / (omega * s.r0)
+        return 2 * np.pi / (self._omega(s) * s.r0)
 
     def _euler(self, s, t):
         P = self.params(s)
-        return paper.printed_euler(t, P) if self.formula == "printed" else paper.euler(t, P)
+        if self.series_order is not None:
+            return self._series_euler(s, t)
+        if self.formula == "printed":
+            return paper.printed_euler(t, P)
+        return paper.euler(t * finite_tilt_frequency(P) / paper.frequency(P), P)
+
+    def _series_euler(self, s, t):
+        """θ = arccos γ'', φ = π/2 + s + a periodic part, ψ from ψ̇ = (pγ + qγ')/(1 − γ''²) integrated exactly
+        (spectrally in s: its mean gives the precession rate, its harmonics the periodic part)."""
+        sol = _series(series_body(s), max(self.series_order + 1, RADIUS_ORDER), float(s.gamma0pp))
+        eps, omega = 1.0 / s.r0, self._omega(s)
+        M = sol.fourier.shape[2]
+        grid = 2 * np.pi * np.arange(M) / M
+        Yg = sol.scaled(eps, grid / omega, self.series_order)
+        dpsi_ds = (Yg[:, 0] * Yg[:, 3] + Yg[:, 1] * Yg[:, 4]) / (1 - Yg[:, 5] ** 2) / (omega * s.r0)
+        spec = np.fft.fft(dpsi_ds) / M
+        n = np.fft.fftfreq(M, 1.0 / M)
+        u = omega * s.r0 * np.asarray(t, dtype=float)
+        periodic = np.zeros_like(u)
+        for m in np.nonzero(n)[0]:
+            periodic += np.real(spec[m] / (1j * n[m]) * (np.exp(1j * n[m] * u) - 1))
+        Y = sol.scaled(eps, s.r0 * np.asarray(t, dtype=float), self.series_order)
+        phi = np.pi / 2 + u + np.angle((Y[:, 4] + 1j * Y[:, 3]) * np.exp(-1j * (np.pi / 2 + u)))
+        return {"theta": np.arccos(np.clip(Y[:, 5], -1, 1)), "psi": np.real(spec[0]) * u + periodic, "phi": phi}
+
+
+def series_diagnostics(regime: SmallParameter, system) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
+    """Dataset variables and attributes of an order-N run: coefficients' sizes, Ω_k, radius, small divisors,
+    and the order-N error against exact orbits at four ε (chosen where it is measurable) with its fitted slope."""
+    s = regime.scene(system)
+    sol = regime.series(system)
+    N = regime.series_order
+    radius = sol.radius()
+    R = sol.radius_of_convergence()
+    ladder = lindstedt.error_ladder(sol, N, float(s.gamma0pp))
+    k = np.arange(sol.max_order + 1)
+    data = {
+        "series_coefficient_norm": ("series_order", sol.norms(), {
+            "units": "1", "long_name": "max-norm of the ε^k coefficient Y_k of (p/c, q/c, r/r0, γ, γ', γ'') "
+                                       "(sum of |Fourier coefficients|)"}),
+        "series_frequency_coefficient": ("series_order", sol.omega, {
+            "units": "1", "long_name": "ε^k coefficient Ω_k of the τ-frequency Ω = 2π/T_τ (τ = r0 t)"}),
+        "series_consistency_residual": ("series_order", sol.consistency, {
+            "units": "1", "long_name": "residual of the solvability conditions the first integrals satisfy "
+                                       "(round-off when the series is right)"}),
+        "series_ladder_eps": ("ladder", ladder["eps"], {
+            "units": "1", "long_name": "c/r0 of the exact orbits the order-N series is checked against"}),
+        "series_ladder_error": ("ladder", ladder["state"], {
+            "units": "1", "long_name": "max error of the order-N series over one period against the exact orbit "
+                                       "(p/c, q/c, r/r0, γ's)"}),
+    }
+    coords = {"series_order": ("series_order", k, {"units": "1", "long_name": "power k of ε = c/r0"}),
+              "ladder": ("ladder", np.arange(len(ladder["eps"])), {"units": "1", "long_name": "ladder point"})}
+    divisors = sol.small_divisors
+    attrs = {
+        "series_order": int(N),
+        "series_expected_error_slope": float(regime.order["pq"] if N % 2 == 0 else regime.order["gamma"]),
+        "series_error_slope": float(ladder["slope"]),
+        "series_radius_of_convergence": float(R),
+        "series_radius_root_test": float(radius["root"]),
+        "series_radius_domb_sykes_norm": float(radius["domb_sykes_norm"]),
+        "series_radius_pade": float(radius["pade"]),
+        "series_min_r0_over_c": float(1 / R),
+        "series_scene_eps_over_radius": float((1 / s.r0) / R),
+        "series_small_divisors": [float(divisors[n]) for n in sorted(divisors)],
+        "series_small_divisors_long_name": "n² − ω² for n = 0, 1, …: the p-mode divisors of the coefficients",
+        "series_consistency_max": float(np.max(sol.consistency)),
+    }
+    return data, coords, attrs
