@@ -23,6 +23,7 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.errors import ConfigError, IntegrationError, as_number
+from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
 from gyrolab.physics import pendulum
@@ -192,9 +193,9 @@ def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
             parts.append(f"{key} series within " + ", ".join(f"{tol:g}: {bands(r0, np.array(errs), tol)}" for tol in BANDS))
         summary.append("; ".join(parts))
     ds.attrs.update({"title": "exact periodic-orbit families of the heavy body, fast to slow spin",
-                     "Conventions": "CF-1.8", "summary": " | ".join(summary),
+                     "summary": " | ".join(summary),
                      "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    return ds
+    return conform(ds, source="orbit_family experiment")
 
 
 def plot(traces: list[dict], path: Path) -> Path:

@@ -24,6 +24,7 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.output.atomic import atomic_open
+from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError, as_number
 from gyrolab.physics.precession.cases import CASES, Case
@@ -143,10 +144,17 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
                "jacobi_drift": "max |H − H0| of the integration"}
     for name, long_name in numeric.items():
         data[name] = ("case", np.array([r[name] for r in rows], dtype=float), {"units": "1", "long_name": long_name})
-    for name in ("formula", "verdict", "condition", "orbital_frame", "inertial_frame", "geometric", "floquet_kind",
-                 "stability_note"):
-        data[name] = ("case", np.array([str(r[name]) for r in rows]), {"units": "1", "long_name": name.replace("_", " ")})
-    data["stable"] = ("case", np.array([-1 if r["stable"] is None else int(r["stable"]) for r in rows]),
+    text = {"formula": "which formula of the case: printed, corrected or new",
+            "verdict": "does the precession satisfy the full equations: holds, fails or unclear",
+            "condition": "the paper's condition for the case",
+            "orbital_frame": "kind of precession in the orbital frame",
+            "inertial_frame": "kind of precession in the inertial frame",
+            "geometric": "surface the body z axis sweeps in inertial space (cylindrical, conical, ...)",
+            "floquet_kind": "linear stability class from the Floquet multipliers",
+            "stability_note": "why the stability was not analysed, if it was not"}
+    for name, long_name in text.items():
+        data[name] = ("case", np.array([str(r[name]) for r in rows]), {"units": "1", "long_name": long_name})
+    data["stable"] = ("case", np.array([-1 if r["stable"] is None else int(r["stable"]) for r in rows], dtype=np.int32),
                       {"units": "1", "long_name": "linearly stable (1), unstable (0), not analysed or not a solution (-1)"})
     for key in closed[0]:
         if key != "solution":
@@ -157,8 +165,8 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
                               {"long_name": "printed solution"})}
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update({"title": "regular precessions of a satellite-gyrostat (Yehia & El-kenani 2021)",
-                     "Conventions": "CF-1.8", "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    return ds
+                     "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
+    return conform(ds, source="yehia2021_precessions experiment")
 
 
 def plot_classes(rows: list[dict[str, Any]], traces: dict[str, xr.Dataset], directory: Path) -> list[Path]:
