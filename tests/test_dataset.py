@@ -59,3 +59,71 @@ def test_dataset_reproduces_its_own_run(ds):
 def test_only_requested_output_times_are_stored(ds):
     assert ds.sizes["time"] == 21
     assert ds.attrs["integrator_n_steps"] != 20  # the integrator's own steps are not the output grid
+
+
+# ----------------------------------------------------------------------------- output sampling (time.n_output)
+# The default initial state spins at r0 = 5 (conf/initial/fast_spin.yaml): in body axes the vertical γ turns
+# about ω at |ω| ≈ r0, so the fast-spin period is 2π/r0 ≈ 1.257 model time units (the γ panel's fastest motion).
+R0 = 5.0
+SPIN_PERIOD = 2 * np.pi / R0
+
+
+def test_auto_output_resolves_the_fast_spin_over_a_long_span():
+    """The README's long run (t = 0…12566 = 2000 × 2π): 2001 samples would be 6.28 apart, 0.2 per spin period."""
+    from gyrolab.engine.scene import AUTO_MAX_SAMPLES, compose_scene
+
+    scene = compose_scene(["time.end=12566"])
+    step = scene.times[1] - scene.times[0]
+    assert step <= SPIN_PERIOD / 8 and len(scene.times) <= AUTO_MAX_SAMPLES
+    assert np.allclose(np.diff(scene.times), step) and scene.times[-1] == 12566.0
+    attrs = scene.sampling_attributes()
+    assert "sampling_warning" not in attrs and attrs["sampling_n_output_requested"] == "auto"
+
+
+def test_explicit_undersampling_is_warned_in_one_sentence_and_recorded(ds, caplog, tmp_path):
+    from gyrolab.engine.scene import compose_scene
+
+    with caplog.at_level("WARNING", logger="gyrolab.engine.scene"):
+        scene = compose_scene(["time.end=12566", "time.n_output=2001"])
+    assert len(scene.times) == 2001                                  # the user's choice is respected
+    warning = scene.sampling_attributes()["sampling_warning"]
+    assert [r.getMessage() for r in caplog.records if r.name == "gyrolab.engine.scene"] == [warning]
+    assert warning.startswith("time.n_output=2001 ") and "alias" in warning and warning.count(". ") == 0
+    # a short run that undersamples the same way (2 time units apart, 0.63 samples per spin period) records it
+    coarse = run(["time.end=20", "time.n_output=11"])
+    assert coarse.attrs["sampling_warning"].startswith("time.n_output=11 ")
+    per_spin_period = SPIN_PERIOD / 2.0                                  # spin period / output spacing
+    assert coarse.attrs["sampling_samples_per_period"] <= per_spin_period  # ν ≥ r0: fewer per fastest period
+    with xr.open_dataset(write_dataset(coarse, tmp_path / "run.nc")) as loaded:
+        assert loaded.attrs["sampling_warning"] == coarse.attrs["sampling_warning"]
+    assert "sampling_warning" not in ds.attrs                          # SHORT: 0.1 apart, 12.6 per spin period
+
+
+def test_fastest_rate_bounds_the_motion_it_must_resolve():
+    """ν (sampling_fastest_rate) is an upper estimate: above the largest |ω(t)| of the integrated motion and
+    above the dominant frequency of γ_x in body axes, which is the spin |ω| ≈ r0 (found by FFT)."""
+    ds = run(["time.end=20", "time.n_output=2001"])
+    nu = ds.attrs["sampling_fastest_rate"]
+    speed = np.linalg.norm(ds.omega.values, axis=1)
+    assert speed.max() < nu
+    t, x = ds.time.values, ds.gamma.values[:, 0]
+    spectrum = np.abs(np.fft.rfft((x - x.mean()) * np.hanning(len(x))))
+    freqs = 2 * np.pi * np.fft.rfftfreq(len(x), t[1] - t[0])
+    peak = freqs[np.argmax(spectrum)]
+    resolution = 2 * np.pi / t[-1]
+    assert abs(peak - speed.mean()) < 2 * resolution and peak < nu
+    assert abs(peak - R0) < 0.1 * R0
+
+
+def test_batch_points_share_the_densest_auto_grid():
+    from gyrolab.engine.config import compose_config
+    from gyrolab.sweep.batch import _share_output_times
+
+    cfg = compose_config(["time.end=300", "initial.r0=1"])
+    slow = Scene.from_config(cfg)
+    cfg.initial.r0 = 20.0
+    fast = Scene.from_config(cfg)
+    assert len(fast.times) > len(slow.times)         # a spin 20 times faster needs more samples over the same span
+    dense = fast.times
+    _share_output_times([slow, fast])
+    assert slow.times is dense and fast.times is dense

@@ -138,6 +138,24 @@ def test_a_really_full_disk_is_one_sentence(tiny_tmpfs):
     small = BIG.isel(n=slice(0, 1000))               # 8 kB fits: the file system itself is fine
     write_dataset(small, tiny_tmpfs / "run.nc")
     assert leftovers(tiny_tmpfs) == ["run.nc"]
+    (tiny_tmpfs / "filler").write_bytes(bytes(_free_bytes(tiny_tmpfs)))   # now really full
+    with pytest.raises(OutputError, match="no space left on device"):   # netCDF says EACCES here: checked
+        write_dataset(small, tiny_tmpfs / "next.nc")
+    from hydra.core import utils as hydra_utils
+
+    import gyrolab.sweep.callbacks  # noqa: F401 - makes Hydra's .hydra/*.yaml copies tolerate a full disk
+
+    from omegaconf import OmegaConf
+
+    hydra_utils._save_config(OmegaConf.create({"a": "x" * 10_000}), "config.yaml", tiny_tmpfs)   # a warning, no file
+    with directory_lock(tiny_tmpfs / "job"):          # a lock needs no data block: a full disk does not stop it
+        pass
+    assert leftovers(tiny_tmpfs) == ["filler", "job", "run.nc"]
+
+
+def _free_bytes(directory):
+    stats = os.statvfs(directory)
+    return stats.f_bavail * stats.f_frsize
 
 
 def test_other_errors_of_the_writer_are_not_disguised(tmp_path):

@@ -15,13 +15,21 @@ def test_experiment_writes_the_case_table(tmp_path):
     with (tmp_path / "precession_cases.csv").open() as handle:
         rows = list(csv.DictReader(handle))
     assert list(rows[0]) == ["case", "formula", "residual_vector", "residual_euler_angles", "max_theta_deviation",
-                             "stable", "verdict", "condition"]
+                             "stable", "verdict", "condition", "stability_note"]
     for row in rows:
         holds = float(row["residual_vector"]) < 1e-10
         assert row["verdict"] == ("holds" if holds else "fails"), row
     verdict = {(r["case"], r["formula"]): r["verdict"] for r in rows}
     assert verdict[("14.1", "printed")] == "fails" and verdict[("14.1", "corrected")] == "holds"
     assert verdict[("29.1", "printed")] == "fails" and verdict[("29.1", "corrected")] == "holds"
+    # stability of a non-solution is meaningless: the printed failing sets get no `stable`, and a note says why
+    for row in rows:
+        if row["verdict"] == "fails":
+            assert row["stable"] == "" and row["stability_note"].startswith("not a solution"), row
+        else:
+            assert row["stable"] in ("true", "false") and row["stability_note"] == "", row
+    stable = {(r["case"], r["formula"]): r["stable"] for r in rows}
+    assert stable[("14.1", "printed")] == "" and stable[("29.1", "printed")] == ""
     import xarray as xr
     with xr.open_dataset(tmp_path / "precession_cases.nc") as ds:
         assert float(ds.floquet_tolerance.max()) < 1e-4  # tied to the integration accuracy, not a fixed 1e-3

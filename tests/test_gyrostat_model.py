@@ -7,7 +7,7 @@ import pytest
 from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
 from gyrolab.physics.precession.cases import BY_LABEL, CASES
-from gyrolab.physics.precession.finder import find_precessions
+from gyrolab.physics.precession.finder import find_normal_rests, find_precessions
 from gyrolab.physics.precession.classify import classify
 from gyrolab.physics.precession.motion import Precession, build_system, states, theta_deviation, vector_residual, window
 from gyrolab.physics.precession.stability import body_frame_period, floquet, monodromy_multipliers
@@ -100,13 +100,17 @@ FINDER_SEARCH = {
     "44.3": {"m": (-3.0, 0.0), "theta0": (-0.5, 0.5)},            # k != 0 force omega = 0: m = -(n + Omega)
     "N1": {"h1": (-3.0, 0.0), "k3": (-5.0, 2.0)},                 # h1 mu3 and k3 formulas
     "N2": {"n": (-1.5, 1.5), "m": (-1.5, 1.5), "theta0": (0.0, PI)},
+    "N3": {"m": (-1.5, -0.3), "h1": (-4.0, 4.0), "k1": (-3.0, 3.0)},  # A != B at rest forces m = -n, h1, k1
 }
 NOT_SEARCHABLE = {"14.1", "14.2", "19.1L", "29.1"}
+# The other rests on the orbit normal are recovered by the dedicated finder (test_normal_rest_finder_recovers_every_branch;
+# the general one finds them too — N4 in (m, h1), N5 in (m, k1) — at ~5 s each, not repeated here).
+NORMAL_REST_ONLY = {"N4", "N5"}
 
 
 def test_finder_table_covers_every_case_that_holds():
-    assert set(FINDER_SEARCH) | NOT_SEARCHABLE == {c.label for c in CASES}
-    assert not set(FINDER_SEARCH) & NOT_SEARCHABLE
+    assert set(FINDER_SEARCH) | NOT_SEARCHABLE | NORMAL_REST_ONLY == {c.label for c in CASES}
+    assert not set(FINDER_SEARCH) & (NOT_SEARCHABLE | NORMAL_REST_ONLY)
 
 
 def _case_value(case, name):
@@ -196,6 +200,44 @@ def test_finder_and_classifier_on_a_body_outside_the_paper(psi0, theta0, geometr
     assert label.orbital == "rest"
     assert label.inertial.startswith("permanent rotation") and f"{Omega:.4g})" in label.inertial
     assert label.geometric == geometric
+
+
+def test_paper_statement_26_is_contradicted_at_rest_on_the_orbit_normal():
+    """Seed 002, (26): with n ≠ 0 the θ0 = 0 precessions need A = B (θ0 = π otherwise). False when the body rests
+    in the orbital frame (n + m = 0): an asymmetric body (1.0, 1.4, 1.9), θ0 = 0, n = −m = 0.8, ψ0 = 0.6 with
+    h1 μ·β = −(3/2)Ω²(A − B) sin 2ψ0 (h1 ≈ −2.99) is exact. Evidence independent of cases.normal_rest: the
+    general relative-equilibrium condition (``relative_equilibrium`` above, from the torque balance) gives the
+    same h1 and k, the vector residual vanishes, and the integrated full equations stay on it."""
+    inertia, mu, h3, Omega, psi0 = (1.0, 1.4, 1.9), (0.4, -0.5, 0.6), 0.3, 1.0, 0.6
+    h1, k, _ = relative_equilibrium(inertia, mu, h3, Omega, 0.4, psi0, 0.0)
+    assert abs(h1) > 1 and inertia[0] != inertia[1]
+    catalogued = [c for c in CASES if c.motion.theta0 == 0.0 and c.motion.n != 0.0
+                  and c.params.inertia[0] != c.params.inertia[1] and abs(c.params.h[0] * c.params.mu[2]) > 0]
+    assert [c.label for c in catalogued] == ["N3"]
+    case = catalogued[0]
+    assert abs(case.params.h[0] - h1) < 1e-12 and np.max(np.abs(np.array(case.params.k) - k)) < 1e-12
+    motion = Precession(0.8, -0.8, psi0, 0.0)
+    system = build_system(GyrostatParameters(inertia, tuple(k), mu, (h1, 0.0, h3), Omega), motion)
+    assert vector_residual(system, motion, window(system, 3.0, 301)) < 1e-13
+    deviation = theta_deviation(system, motion, DOP853(rtol=1e-12, atol=1e-12), orbits=1, points=101)
+    assert deviation["max_theta_deviation"] < 1e-8
+
+
+@pytest.mark.parametrize("label", ["N3", "N4", "N5", "27"])
+def test_normal_rest_finder_recovers_every_branch(label):
+    """``find_normal_rests`` works from the system's right-hand side only (k1, k2 unknown, set to 9): it must return
+    the catalogue's orientation χ = ψ0 with its k1, k2 — generic h1 (N3, and 27 at θ0 = π), h1 = 0 with the
+    principal axes on the orbital axes (N4), μ·β = 0 with h1 free (N5) — every root with residual < 1e-12, and
+    A = B with h1 μ·β ≡ 0 (22's body at rest) as a one-parameter family in χ."""
+    case = BY_LABEL[label]
+    found = find_normal_rests(case.params.replace(k1=9.0, k2=9.0), case.motion.theta0, grid=360)
+    assert found and all(s.residual < 1e-12 and s.family_dimension == 0 for s in found)
+    hit = [s for s in found if abs(np.angle(np.exp(1j * (s.motion.psi0 - case.motion.psi0)))) < 1e-9]
+    assert len(hit) == 1
+    assert abs(hit[0].values["k1"] - case.params.k[0]) < 1e-10 and abs(hit[0].values["k2"] - case.params.k[1]) < 1e-10
+    if label == "27":
+        family = find_normal_rests(BY_LABEL["22"].params, 0.0, grid=360)
+        assert len(family) == 1 and family[0].family_dimension == 1
 
 
 def test_case_24_instability_is_robust():

@@ -23,7 +23,7 @@ import yaml
 SWEEP = ["integrator=rk4,dop853", "body.a=1.5,3", "time.end=1", "time.n_output=11", "output.figures=false"]
 # What legitimately differs between two runs of the same sweep: the time things took, when the file
 # was written and which launcher ran the jobs. Nothing else may differ.
-VOLATILE_ATTRS = ("date_created", "sweep_launcher")
+VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
 VOLATILE_VARIABLES = ("integrator_wall_time",)
 # ... unless someone edits the source tree between the two runs (other people work in this tree):
 # then the code version, and with it every job id, differs too, and correctly so.

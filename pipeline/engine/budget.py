@@ -47,7 +47,7 @@ def check_budget(plain: dict[str, Any], state_size: int) -> None:
     if plain.get("allow_large") is True:
         return
     time = plain["time"]
-    n = int(time["n_output"])
+    n = _n_output(time)
     size = float(n) * state_size * 8
     if size > MAX_STATE_BYTES:
         raise ConfigError(f"time.n_output={n} needs at least {_bytes(size)} for the state alone ({n:.3g} samples × "
@@ -65,7 +65,7 @@ def estimated_steps(plain: dict[str, Any]) -> tuple[float, str]:
     time = plain["time"]
     span = float(time["end"]) - float(time["start"])
     integrator = plain.get("integrator") or {}
-    candidates = [(float(time["n_output"]) - 1, f"time.n_output={time['n_output']}")]
+    candidates = [(float(_n_output(time)) - 1, f"time.n_output={time['n_output']}")]
     for key in ("step", "max_step"):
         step = integrator.get(key)
         if isinstance(step, (int, float)) and not isinstance(step, bool) and step > 0:
@@ -80,6 +80,13 @@ def estimated_steps(plain: dict[str, Any]) -> tuple[float, str]:
                                                     f"time unit over a span of {span:.3g}, one step per "
                                                     f"{RADIANS_PER_STEP:g} rad at most)"))
     return max(candidates, key=lambda c: c[0])
+
+
+def _n_output(time: dict[str, Any]) -> int:
+    """The stored samples, or for ``auto`` their cap (the count itself needs the built scene)."""
+    from gyrolab.engine.scene import AUTO, AUTO_MAX_SAMPLES
+
+    return AUTO_MAX_SAMPLES if time.get("n_output", AUTO) == AUTO else int(time["n_output"])
 
 
 def _bytes(n: float) -> str:

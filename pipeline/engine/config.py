@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import difflib
 import os
+import re
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -175,6 +176,21 @@ def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bo
     return cfg
 
 
+def _unknown_option(text: str) -> ConfigError | None:
+    """"Could not load 'force/magnet'" (an option of a list group) as an unknown option with the valid ones."""
+    loading = re.search(r"Could not load '(.+)/([^/']+)'", text)
+    if not loading:
+        return None
+    group, option = loading.groups()
+    try:
+        valid = group_options(group)
+    except Exception:  # noqa: BLE001 - the list is a hint
+        valid = []
+    close = difflib.get_close_matches(option, valid, n=1)
+    hint = f"; did you mean {group}={close[0]}?" if close else ""
+    return ConfigError(f"unknown {group} {shorten(repr(option))}{hint} (valid choices: {choices(valid)})")
+
+
 def friendly_missing(error: MissingConfigException, config_name: str = CONFIG_NAME) -> ConfigError:
     missing = error.missing_cfg_file or ""
     group, _, option = missing.rpartition("/")
@@ -186,7 +202,7 @@ def friendly_missing(error: MissingConfigException, config_name: str = CONFIG_NA
         return ConfigError(f"primary config {config_name!r} not found in {_source.config_path}"
                            f"{' or ' + _source.config_dir if _source.config_dir else ''}; --config-name names a "
                            "YAML file (without .yaml) in --config-path or --config-dir")
-    return ConfigError(_first_line(error))
+    return _unknown_option(_first_line(error)) or ConfigError(_first_line(error))
 
 
 def friendly_composition_error(error: Exception, overrides: Sequence[str], config_name: str) -> ConfigError:
@@ -201,6 +217,9 @@ def friendly_composition_error(error: Exception, overrides: Sequence[str], confi
         override = text[len("Error merging override "):]
         reason = _first_line(cause).split(" full_key:")[0]
         return ConfigError(f"override {shorten(override)!r} cannot be applied ({shorten(reason, 160)})")
+    unknown = _unknown_option(text)
+    if unknown is not None:
+        return unknown
     if text.startswith("Could not override '"):
         key = text.split("'")[1]
         override = next((o for o in overrides if o.lstrip("+~").split("=", 1)[0].split("@")[0] == key), key)

@@ -21,6 +21,15 @@ from gyrolab.engine.progress import Progress
 
 log = logging.getLogger(__name__)
 
+#: ``time.n_output: auto``: AUTO_SAMPLES_PER_PERIOD samples per period of the fastest motion
+#: (``fastest_rate``), at least AUTO_MIN_SAMPLES and at most AUTO_MAX_SAMPLES (then it warns)
+AUTO = "auto"
+AUTO_SAMPLES_PER_PERIOD = 8
+AUTO_MIN_SAMPLES = 2001
+AUTO_MAX_SAMPLES = 200_001
+#: fewer samples per fastest period than this (auto's cap or an explicit time.n_output) is warned about
+MIN_SAMPLES_PER_PERIOD = 2
+
 
 @dataclass
 class Scene:
@@ -30,6 +39,8 @@ class Scene:
     system: System
     integrator: Integrator
     times: np.ndarray
+    #: ``time.n_output`` as the config gave it: ``"auto"`` or a number of samples
+    n_output_requested: int | str = AUTO
 
     @classmethod
     def from_config(cls, cfg: DictConfig) -> Scene:
@@ -47,9 +58,10 @@ class Scene:
             raise ConfigError(f"force {timed[0]!r} is time-dependent, which system {system.name!r} does not support; "
                               "valid systems: fixed_point")
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
-        times = _output_times(plain["time"])
+        requested = plain["time"].get("n_output", AUTO)
+        times = _output_times(plain["time"], fastest_rate(system))
         integrator.prepare(system)
-        scene = cls(config=cfg, system=system, integrator=integrator, times=times)
+        scene = cls(config=cfg, system=system, integrator=integrator, times=times, n_output_requested=requested)
         if integrator.needs_compiled_model and scene.compiled is None:
             reason = getattr(system, "compile_error", None) or f"system {system.name!r} has no compiled form"
             raise ConfigError(
@@ -69,6 +81,9 @@ class Scene:
             reason = getattr(system, "compile_error", None)
             if reason:
                 log.info("%s; %s runs scipy's integrators", reason, integrator.name)
+        warning = scene.sampling_warning()
+        if warning:
+            log.warning("%s", warning)
         return scene
 
     @cached_property
@@ -82,6 +97,39 @@ class Scene:
         integrator = self.integrator
         wants = integrator.needs_compiled_model or integrator.prefers_compiled_model
         return self.system.compiled_model() if wants else None
+
+    @cached_property
+    def fastest_rate(self) -> float | None:
+        """Upper estimate of the scene's fastest angular frequency (``fastest_rate``; None: not known)."""
+        return fastest_rate(self.system)
+
+    def sampling_warning(self) -> str:
+        """One sentence when the output times undersample the fastest motion (fewer than
+        ``MIN_SAMPLES_PER_PERIOD`` samples per period 2π/ν), else ''. Two samples ask for the end states
+        only (as work_precision does), not for a series: no warning."""
+        if self.fastest_rate is None or len(self.times) <= 2:
+            return ""
+        per_period = samples_per_period(self.times, self.fastest_rate)
+        if per_period >= MIN_SAMPLES_PER_PERIOD:
+            return ""
+        needed = _needed_samples(float(self.times[-1] - self.times[0]), self.fastest_rate, MIN_SAMPLES_PER_PERIOD)
+        given = ("the cap of time.n_output=auto" if self.n_output_requested == AUTO
+                 else f"time.n_output={self.n_output_requested}")
+        return (f"{given} stores {per_period:.3g} samples per period of the fastest motion "
+                f"(2π/ν = {2 * np.pi / self.fastest_rate:.3g} time units, ν = {self.fastest_rate:.4g}), fewer than "
+                f"{MIN_SAMPLES_PER_PERIOD}: the stored series and figures may alias; time.n_output ≥ {needed} "
+                f"(or auto) resolves it")
+
+    def sampling_attributes(self) -> dict[str, Any]:
+        """Dataset attributes saying how the output times were chosen and whether they resolve the motion."""
+        attrs: dict[str, Any] = {"sampling_n_output_requested": str(self.n_output_requested)}
+        if self.fastest_rate is not None:
+            attrs["sampling_fastest_rate"] = float(self.fastest_rate)
+            attrs["sampling_samples_per_period"] = float(samples_per_period(self.times, self.fastest_rate))
+        warning = self.sampling_warning()
+        if warning:
+            attrs["sampling_warning"] = warning
+        return attrs
 
     def run(self) -> xr.Dataset:
         """Integrate the full equations of motion and return the self-describing dataset."""
@@ -162,12 +210,59 @@ def _fails(cls: type, body: Any, params: dict[str, Any]) -> bool:
     return False
 
 
-def _output_times(time_cfg: dict[str, Any]) -> np.ndarray:
+def fastest_rate(system: System) -> float | None:
+    """An upper estimate ν of the fastest angular frequency in the stored series (model units).
+
+    A body turning at |ω| moves every body-frame vector (γ, α) at up to |ω|, and its
+    nutation and the body-frame motion of ω run at up to (I_max/I_min) |ω| (a symmetric top
+    spinning at r nutates at C r/A; a free asymmetric one turns ω in the body at
+    r √((C−A)(C−B)/(AB))). |ω| itself is bounded by energy: ½ I_min |ω|² ≤ ½ ω0·Iω0 + ΔV, with
+    ΔV the range of the potentials (2|M g r_c| for the weight, ½N(I_max − I_min) for an attracting
+    centre or a circular orbit's gradient N = 3Ω², 2|m||B| for a dipole). The orbiting gyrostat
+    adds the orbit rate Ω (the frame turns) and the rotor |k|/I_min. ν is at least the slowest
+    torque's pendulum frequency √(ΔV/I_min), so a body at rest still has a time scale. None for a
+    third-party system whose body has no principal ``inertia`` (then auto stores AUTO_MIN_SAMPLES).
+    """
+    body = system.body
+    if getattr(body, "inertia", None) is None or system.state_size < 3:
+        return None
+    inertia = np.asarray(body.inertia, dtype=float)
+    i_min, i_max = float(inertia.min()), float(inertia.max())
+    omega0 = np.asarray(system.initial_state()[:3], dtype=float)
+    orbit = float(getattr(body, "orbit_rate", 0.0) or 0.0)
+    spread = 0.5 * (i_max - i_min)
+    dv = 2.0 * float(np.linalg.norm(getattr(body, "weight_moment", np.zeros(3))))
+    for force in system.forces:
+        dv += spread * float(getattr(force, "N", 0.0) or 0.0)
+        moment, field = getattr(force, "moment", None), getattr(force, "field", None)
+        if moment is not None and field is not None:
+            dv += 2.0 * float(np.linalg.norm(moment)) * abs(float(field))
+    rotor = float(np.linalg.norm(getattr(body, "gyrostatic_momentum", np.zeros(3)))) / i_min
+    omega_max = np.sqrt(float(omega0 @ (inertia * omega0)) / i_min + 2.0 * dv / i_min)
+    rate = (i_max / i_min) * (omega_max + rotor) + orbit
+    return max(rate, np.sqrt(dv / i_min), orbit, 1e-300)
+
+
+def samples_per_period(times: np.ndarray, rate: float) -> float:
+    """Stored samples per period 2π/rate of evenly spaced ``times``."""
+    step = float(times[1] - times[0])
+    return 2.0 * np.pi / (rate * step)
+
+
+def _needed_samples(span: float, rate: float, per_period: float) -> int:
+    return int(np.ceil(per_period * span * rate / (2.0 * np.pi))) + 1
+
+
+def _output_times(time_cfg: dict[str, Any], rate: float | None) -> np.ndarray:
     start = as_number(time_cfg.get("start", 0.0), "time.start")
     end = as_number(time_cfg.get("end"), "time.end")
     if end <= start:
         raise ConfigError(f"time.end={end:g} must be after time.start={start:g}")
-    n = time_cfg.get("n_output")
-    if isinstance(n, bool) or not isinstance(n, int) or n < 2:
-        raise ConfigError(f"time.n_output={n!r} must be an integer ≥ 2 (number of stored samples, both ends included)")
+    n = time_cfg.get("n_output", AUTO)
+    if n == AUTO:
+        needed = AUTO_MIN_SAMPLES if rate is None else _needed_samples(end - start, rate, AUTO_SAMPLES_PER_PERIOD)
+        n = min(max(needed, AUTO_MIN_SAMPLES), AUTO_MAX_SAMPLES)
+    elif isinstance(n, bool) or not isinstance(n, int) or n < 2:
+        raise ConfigError(f"time.n_output={n!r} must be an integer ≥ 2 (number of stored samples, both ends "
+                          "included) or auto")
     return np.linspace(start, end, n)

@@ -21,6 +21,7 @@ TASKS = {
     "regime_validity": "gyrolab.experiments.regime_validity",
     "ismail2021_tables": "gyrolab.experiments.ismail2021_tables",
     "shaker_omega3": "gyrolab.experiments.shaker_omega3",
+    "orbit_family": "gyrolab.experiments.orbit_family",
     # satellite-gyrostat (seed 002)
     "yehia2021_precessions": "gyrolab.experiments.yehia2021_precessions",
 }

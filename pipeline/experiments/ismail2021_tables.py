@@ -26,6 +26,7 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.output.atomic import atomic_path
+from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
@@ -131,7 +132,6 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         "column": ("column", np.array(COLUMNS), {"units": "1", "long_name": "p2, γ2, dp2/dτ, dγ2/dτ"})})
     ds.attrs.update({
         "title": "Ismail (2021) Tables 1 and 2 regenerated",
-        "Conventions": "CF-1.8",
         "what_the_tables_show": "Table 1 = generating solution γ2 = cos τ, p2 = A cos τ (A = 1.88117e-15, i.e. 0); "
                                 "Table 2 = RK4 with Δτ = π/10 on uncoupled oscillators (W = 0.99607889 for p2, 1 "
                                 "for γ2); their difference is RK4 truncation error",
@@ -139,6 +139,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                                        "they test nothing of the asymptotic solution",
         "inferred_parameters": f"A = {A:g} (published), W = {W_P2} (fitted by the research), τ = 2πt/100",
         "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
+    conform(ds, source="ismail2021_tables experiment")
     written.append(write_dataset(ds, out_dir / "ismail2021_tables.nc"))
     written += draw_figures("ismail2021_tables.nc", ds, out_dir, cfg.get("output"))
     return written

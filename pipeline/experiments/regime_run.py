@@ -29,7 +29,8 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.engine import registry
 from gyrolab.contracts.regime import Regime
-from gyrolab.output.dataset import write_dataset
+from gyrolab.output.cf import conform, unit_attributes
+from gyrolab.output.dataset import time_attributes, write_dataset
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.physics.periodic import FixedPointModel, PeriodicOrbit, shoot
 from gyrolab.figures.redraw import draw_figures
@@ -244,18 +245,19 @@ def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any],
     data["period_analytic"] = ((), result["period_analytic"], {"units": body.time_unit,
                                                                 "long_name": "period of the analytic orbit"})
     coords = {
-        "time": ("time", t, {"units": body.time_unit, "long_name": f"time [{body.time_label}]", "standard_name": "time"}),
+        "time": ("time", t, time_attributes(body)),
         "axis": ("axis", np.array(["x", "y", "z"]), {"units": "1", "long_name": "principal body axis"}),
         "component": ("component", np.array(["p", "q", "r", "gamma_x", "gamma_y", "gamma_z"]),
                       {"units": "1", "long_name": "state component"}),
     }
     if orbit is not None:
-        coords["iteration"] = ("iteration", np.arange(len(orbit.residuals)), {"units": "1", "long_name": "Newton iteration"})
-        coords["multiplier"] = ("multiplier", np.arange(6), {"units": "1", "long_name": "Floquet multiplier index"})
+        coords["iteration"] = ("iteration", np.arange(len(orbit.residuals), dtype=np.int32),
+                               {"units": "1", "long_name": "Newton iteration"})
+        coords["multiplier"] = ("multiplier", np.arange(6, dtype=np.int32),
+                                {"units": "1", "long_name": "Floquet multiplier index"})
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update({
         "title": f"regime {regime.name} ({regime.formula}): {system.title()}",
-        "Conventions": "CF-1.8",
         "config": scene.config_yaml,
         "regime_parameter_value": float(regime.parameter_value(system)),
         "regime_warnings": " | ".join(warnings) if warnings else "none",
@@ -263,9 +265,9 @@ def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any],
         "exact_orbit": "found" if orbit is not None else f"not found: {result['orbit_failure']}",
         "scene": system.title(),
         "rate_label": body.rate_label,
-        **regime.attributes(), **provenance(), **system.attributes(),
+        **regime.attributes(), **provenance(), **system.attributes(), **unit_attributes(body),
     })
-    return ds
+    return conform(ds, source=f"regime run ({regime.name}, {regime.formula})")
 
 
 def orbit_variables(orbit: PeriodicOrbit, body) -> dict[str, Any]:

@@ -23,6 +23,7 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
+from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.experiments.regime_run import compute, errors, prepare
@@ -141,6 +142,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     ds = _dataset(rows, verdicts, cfg)
     if sweep is not None:
         ds = ds.merge(_resonance_dataset(sweep))
+    conform(ds, source="regime_validity experiment")
     written = [write_dataset(ds, Path(out_dir) / "regime_validity.nc")]
     written += draw_figures("regime_validity.nc", ds, out_dir, cfg.get("output"))
     return written
@@ -327,6 +329,6 @@ def _dataset(rows, verdicts, cfg) -> xr.Dataset:
         for k, v in orders.items():
             data[f"{name}_order_{k}"] = ((), v, {"units": "1", "long_name": f"fitted error order of {LONG[k]}"})
     ds = xr.Dataset(data)
-    ds.attrs.update({"title": "validity of the expansion regimes", "Conventions": "CF-1.8",
+    ds.attrs.update({"title": "validity of the expansion regimes",
                      "verdict": "\n".join(verdicts), "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
     return ds

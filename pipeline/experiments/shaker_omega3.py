@@ -15,7 +15,8 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.output.dataset import write_dataset
+from gyrolab.output.cf import conform, unit_attributes
+from gyrolab.output.dataset import time_attributes, write_dataset
 from gyrolab.experiments.regime_run import compute, prepare
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
@@ -36,13 +37,13 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         errors[name] = float(np.abs(series - full).max())
         log.info("max |series − full| of %s over t ∈ [%g, %g]: %.2e rad", name, t[0], t[-1], errors[name])
     body = scene.system.body
-    ds = xr.Dataset(data, coords={"time": ("time", t, {"units": body.time_unit, "long_name": f"time [{body.time_label}]",
-                                                       "standard_name": "time"})})
-    ds.attrs.update({"title": f"ω = 3 Euler angles: {scene.system.title()}", "Conventions": "CF-1.8",
+    ds = xr.Dataset(data, coords={"time": ("time", t, time_attributes(body))})
+    ds.attrs.update({"title": f"ω = 3 Euler angles: {scene.system.title()}", **unit_attributes(body),
                      "regime_warnings": " | ".join(warnings) or "none",
                      "period_series": result["period_analytic"], "period_exact": result["orbit"].period,
                      **{f"max_error_{k}": v for k, v in errors.items()},
                      "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
+    conform(ds, source="shaker_omega3 experiment (ω = 3 Euler angles against the exact orbit)")
     written = [write_dataset(ds, out_dir / "shaker_omega3.nc")]
     written += draw_figures("shaker_omega3.nc", ds, out_dir, cfg.get("output"))
     return written

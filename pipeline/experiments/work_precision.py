@@ -20,6 +20,7 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
+from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError
 from gyrolab.output.provenance import provenance
@@ -111,7 +112,8 @@ def _dataset(rows: list[dict[str, Any]], cfg: DictConfig, reference_name: str) -
             for name, (u, ln) in units.items()}
     data["method"] = ("run", np.array([r["method"] for r in rows]), {"units": "1", "long_name": "integrator"})
     data["setting"] = ("run", np.array([r["setting"] for r in rows]), {"units": "1", "long_name": "its setting"})
-    ds = xr.Dataset(data, coords={"run": ("run", np.arange(len(rows)), {"units": "1", "long_name": "run index"})})
-    ds.attrs.update({"title": "work against precision", "Conventions": "CF-1.8", "reference": reference_name,
+    ds = xr.Dataset(data, coords={"run": ("run", np.arange(len(rows), dtype=np.int32),
+                                          {"units": "1", "long_name": "run index"})})
+    ds.attrs.update({"title": "work against precision", "reference": reference_name,
                      "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    return ds
+    return conform(ds, source="work_precision experiment")

@@ -4,9 +4,11 @@ For each case of ``gyrolab.physics.precession.cases`` (concrete parameters satis
 extra row, the corrected — conditions): (a) the residual along ψ = nt + ψ0, θ = θ0, φ = mt of the vector
 equations (the ``orbiting_gyrostat`` system with its force plugins) and of the Euler-angle equations;
 (b) a scene of the configured integrator from the precession's initial state, max |θ − θ0| over
-``yehia2021.orbits`` orbits; (c) Floquet multipliers. Verdict (vector evidence only): ``holds`` when the
-vector residual < ``residual_tolerance`` and the first orbit stays within 1e-6 of θ0, ``fails`` when the
-residual > 1e-6. Writes precession_cases.csv, precession_cases.nc (all rows, new families and the
+``yehia2021.orbits`` orbits; (c) Floquet multipliers, only for a motion that holds: the multipliers of the
+variational equations along a prescribed motion that does not satisfy the equations describe no motion, so
+``stable`` is left empty for a non-solution and ``stability_note`` says why. Verdict (vector evidence only):
+``holds`` when the vector residual < ``residual_tolerance`` and the first orbit stays within 1e-6 of θ0,
+``fails`` when the residual > 1e-6. Writes precession_cases.csv, precession_cases.nc (all rows, new families and the
 closed-form check) and one figure per geometric class.
 """
 
@@ -22,20 +24,21 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.output.atomic import atomic_open
+from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError, as_number
 from gyrolab.physics.precession.cases import CASES, Case
 from gyrolab.physics.precession.classify import classify
 from gyrolab.physics.precession.closed_forms import check_closed_forms
 from gyrolab.physics.precession.motion import body_config, euler_residual, magnetic_config, vector_residual, window
-from gyrolab.physics.precession.stability import floquet
+from gyrolab.physics.precession.stability import Floquet, floquet
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 
 log = logging.getLogger(__name__)
 COLUMNS = ("case", "formula", "residual_vector", "residual_euler_angles", "max_theta_deviation", "stable", "verdict",
-           "condition")
+           "condition", "stability_note")
 
 
 def _settings(cfg: DictConfig) -> dict[str, float]:
@@ -66,7 +69,6 @@ def evaluate(cfg: DictConfig, case: Case, orbits: float, tol: float) -> tuple[di
     ds = scene.run()
     deviation = np.abs(ds.theta.values - case.motion.theta0)
     first = ds.time.values <= 2 * np.pi / system.Omega * (1 + 1e-12)
-    stability = floquet(system, case.motion)
     kind = classify(case.motion, system.Omega)
     if res_v < tol and deviation[first].max() < 1e-6:
         verdict = "holds"
@@ -74,17 +76,30 @@ def evaluate(cfg: DictConfig, case: Case, orbits: float, tol: float) -> tuple[di
         verdict = "fails"
     else:
         verdict = "unclear"
+    stability, note = stability_of(system, case, verdict, res_v)
     row = {"case": case.case, "label": case.label, "formula": case.formula, "residual_vector": res_v,
            "residual_euler_angles": res_e, "max_theta_deviation": float(deviation.max()),
            "max_theta_deviation_orbit1": float(deviation[first].max()), "stable": stability.stable,
            "max_floquet_modulus": stability.max_modulus, "floquet_tolerance": stability.tolerance,
            "floquet_uncertainty": stability.uncertainty, "floquet_kind": stability.kind, "verdict": verdict,
+           "stability_note": note,
            "condition": case.condition, "orbital_frame": kind.orbital, "inertial_frame": kind.inertial,
            "geometric": kind.geometric,
            "jacobi_drift": float(ds.jacobi_integral.attrs["max_abs_drift"]) if "jacobi_integral" in ds else np.nan}
     log.info("%-6s %-9s res %.1e/%.1e  dθ %.1e  |ρ|max %.3g  %s  (%s)", case.label, case.formula, res_v, res_e,
              row["max_theta_deviation"], stability.max_modulus, verdict, kind)
     return row, ds
+
+
+def stability_of(system, case: Case, verdict: str, residual: float) -> tuple[Floquet, str]:
+    """Floquet analysis of a motion that holds; for anything else no multipliers and the reason."""
+    if verdict == "holds":
+        stability = floquet(system, case.motion)
+        note = "" if stability.stable is not None else "quasi-periodic in the body frame: not analysed"
+        return stability, note
+    why = (f"not a solution (vector residual {residual:.1e}): stability of a non-solution is undefined"
+           if verdict == "fails" else f"residual {residual:.1e} neither ~0 nor large: not analysed")
+    return Floquet("not a solution" if verdict == "fails" else "unclear", float("nan"), np.array([])), why
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
@@ -111,8 +126,10 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                 continue
             writer.writerow([row["case"], row["formula"], f"{row['residual_vector']:.3e}",
                              f"{row['residual_euler_angles']:.3e}", f"{row['max_theta_deviation']:.3e}",
-                             {True: "true", False: "false", None: ""}[row["stable"]], row["verdict"], row["condition"]])
-    ds = _dataset(rows, closed, cfg).merge(trace_variables(rows, traces), combine_attrs="override")
+                             {True: "true", False: "false", None: ""}[row["stable"]], row["verdict"], row["condition"],
+                             row["stability_note"]])
+    ds = conform(_dataset(rows, closed, cfg).merge(trace_variables(rows, traces), combine_attrs="override"),
+                 source="yehia2021_precessions experiment")
     written = [csv_path, write_dataset(ds, out_dir / "precession_cases.nc")]
     written += draw_figures("precession_cases.nc", ds, out_dir, cfg.get("output"))
     return written
@@ -145,10 +162,18 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
                "jacobi_drift": "max |H − H0| of the integration"}
     for name, long_name in numeric.items():
         data[name] = ("case", np.array([r[name] for r in rows], dtype=float), {"units": "1", "long_name": long_name})
-    for name in ("formula", "verdict", "condition", "orbital_frame", "inertial_frame", "geometric", "floquet_kind"):
-        data[name] = ("case", np.array([str(r[name]) for r in rows]), {"units": "1", "long_name": name.replace("_", " ")})
-    data["stable"] = ("case", np.array([-1 if r["stable"] is None else int(r["stable"]) for r in rows]),
-                      {"units": "1", "long_name": "linearly stable (1), unstable (0), not analysed (-1)"})
+    text = {"formula": "which formula of the case: printed, corrected or new",
+            "verdict": "does the precession satisfy the full equations: holds, fails or unclear",
+            "condition": "the paper's condition for the case",
+            "orbital_frame": "kind of precession in the orbital frame",
+            "inertial_frame": "kind of precession in the inertial frame",
+            "geometric": "surface the body z axis sweeps in inertial space (cylindrical, conical, ...)",
+            "floquet_kind": "linear stability class from the Floquet multipliers",
+            "stability_note": "why the stability was not analysed, if it was not"}
+    for name, long_name in text.items():
+        data[name] = ("case", np.array([str(r[name]) for r in rows]), {"units": "1", "long_name": long_name})
+    data["stable"] = ("case", np.array([-1 if r["stable"] is None else int(r["stable"]) for r in rows], dtype=np.int32),
+                      {"units": "1", "long_name": "linearly stable (1), unstable (0), not analysed or not a solution (-1)"})
     for key in closed[0]:
         if key != "solution":
             data[f"closed_form_{key}"] = ("closed_form", np.array([float(c[key]) for c in closed]),
@@ -158,5 +183,5 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
                               {"long_name": "printed solution"})}
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update({"title": "regular precessions of a satellite-gyrostat (Yehia & El-kenani 2021)",
-                     "Conventions": "CF-1.8", "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    return ds
+                     "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
+    return conform(ds, source="yehia2021_precessions experiment")

@@ -21,10 +21,9 @@ OMEGA = ("p", "q", "r")
 
 def scale_rate(ds: xr.Dataset) -> str:
     """The rate that makes the dataset's model units (c for a heavy body, Ω for the orbiting gyrostat)."""
-    for name in ("time_scale_label", "time_unit_label"):  # a machine-readable scale, when the dataset has one
-        value = ds.attrs.get(name) or (ds["time"].attrs.get(name) if "time" in ds.coords else None)
-        if value:
-            return str(value).removeprefix("1/")
+    rate = str(ds.attrs.get("rate_unit", ""))  # the machine-readable model unit (gyrolab.output.cf), when present
+    if rate and rate not in ("rad/s", "rad s-1"):
+        return rate
     if "time" in ds.coords:
         found = re.search(r"\[1/([^\]]+)\]", ds["time"].attrs.get("long_name", ""))
         if found:
@@ -37,6 +36,9 @@ def unit(ds: xr.Dataset, units: str | None, kind: str) -> str:
     if units in SI:
         return SI[units]
     if kind in KINDS and units in (None, "1", ""):
+        stored = str(ds.attrs.get("energy_unit", "")) if kind == "energy" else ""
+        if stored and stored != "J":  # e.g. "C c2", "I0 Ω2" (gyrolab.output.cf)
+            return "units of " + stored.replace("2", "²")
         return "units of " + KINDS[kind].format(s=scale_rate(ds))
     return "" if units in (None, "1", "") else units
 

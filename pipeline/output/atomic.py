@@ -109,9 +109,14 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w", **kwargs) -> Iter
         yield handle
 
 
+#: errnos that say what happened; others (netCDF reports a failed create on a full disk as EACCES) are checked
+_TRUSTED = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS)
+
+
 def diagnose(error: BaseException, tmp: Path, expected_bytes: int | None = None) -> str:
-    """Why writing ``tmp`` failed: the error's own errno, else what the file system says now."""
-    if isinstance(error, OSError) and error.errno in _REASONS:
+    """Why writing ``tmp`` failed: the error's own errno when it is unambiguous, else what the file system
+    says now (file-size limit, a probe write, the free space), else the error's own reason."""
+    if isinstance(error, OSError) and error.errno in _TRUSTED:
         return reason(error)
     try:
         written = tmp.stat().st_size
@@ -126,7 +131,7 @@ def diagnose(error: BaseException, tmp: Path, expected_bytes: int | None = None)
             handle.flush()
             os.fsync(handle.fileno())
     except OSError as probe:
-        if probe.errno in _REASONS:
+        if probe.errno in _TRUSTED:
             return reason(probe)
     try:
         stats = os.statvfs(tmp.parent)

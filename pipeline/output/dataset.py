@@ -16,10 +16,15 @@ import xarray as xr
 from gyrolab.contracts.integrator import Solution
 from gyrolab.errors import ConfigError
 from gyrolab.output.atomic import atomic_path
+from gyrolab.output.cf import conform, unit_attributes
 from gyrolab.output.provenance import provenance
 
 if TYPE_CHECKING:
     from gyrolab.engine.scene import Scene
+    from gyrolab.physics.body import ModelUnits
+
+#: labels of the ``frame_axis`` dimension (the orbiting gyrostat's orbital and inertial frames)
+FRAME_AXES = ("x_radial", "y_along_track", "z_normal")
 
 
 def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
@@ -30,14 +35,16 @@ def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
         values = variables[name].values
         variables[name].attrs["max_abs_drift"] = float(np.max(np.abs(values - values[0])))
     coords = {
-        "time": ("time", solution.t, {"units": body.time_unit, "long_name": f"time [{body.time_label}]",
-                                      "standard_name": "time"}),
+        "time": ("time", solution.t, time_attributes(body)),
         "axis": ("axis", np.array(["x", "y", "z"]), {"units": "1", "long_name": "principal body axis"}),
     }
+    if any("frame_axis" in v.dims for v in variables.values()):
+        coords["frame_axis"] = ("frame_axis", np.array(FRAME_AXES), {
+            "units": "1", "long_name": "frame axis: orbital (radial, along-track, orbit normal) or inertial (X, Y, Z: "
+                                       "the orbital axes at t = 0)"})
     ds = xr.Dataset(variables, coords=coords)
     attrs: dict[str, Any] = {
         "title": system.title(),
-        "Conventions": "CF-1.8",
         "config": scene.config_yaml,
         "monitored_invariants": " ".join(system.invariants),
         "integrator": integrator.name,
@@ -46,8 +53,16 @@ def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
     attrs.update(system.attributes())
     attrs.update(integrator.attributes())
     attrs.update(solution.stats.attributes())
+    attrs.update(unit_attributes(body))
+    attrs.update(scene.sampling_attributes())
     ds.attrs.update(attrs)
-    return ds
+    return conform(ds, source=f"run of system {system.name} with integrator {integrator.name}")
+
+
+def time_attributes(body: ModelUnits) -> dict[str, str]:
+    """CF attributes of a time coordinate in ``body``'s model units: elapsed time, not a calendar date
+    (so no ``standard_name: time``, which CF reserves for ``<unit> since <epoch>``)."""
+    return {"units": body.time_unit, "long_name": f"time [{body.time_label}]"}
 
 
 def write_dataset(ds: xr.Dataset, path: Path) -> Path:

@@ -161,7 +161,7 @@ def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
             raise
         try:
             same = os.fstat(fd).st_ino == os.stat(path).st_ino
-        except FileNotFoundError:
+        except OSError:
             same = False
         if not same:  # the holder released and removed the file between our open and our flock: again
             os.close(fd)
@@ -169,6 +169,9 @@ def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
                 return None
             continue
         if create:
-            os.ftruncate(fd, 0)
-            os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}\n".encode())
+            try:  # who holds it, for the messages of others; a full disk may refuse this, the lock holds anyway
+                os.ftruncate(fd, 0)
+                os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}\n".encode())
+            except OSError:
+                pass
         return fd

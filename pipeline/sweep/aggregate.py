@@ -31,7 +31,6 @@ import logging
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
-from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
@@ -40,6 +39,7 @@ import xarray as xr
 from omegaconf import OmegaConf
 
 from gyrolab.contracts.integrator import IntegratorStats
+from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
 from gyrolab.errors import ConfigError
@@ -55,8 +55,25 @@ STATUS_FLAGS = {MISSING: 0, FINISHED: 1, FAILED: 2}
 PER_JOB_ATTRS = ("config", "hydra_overrides") + tuple(f"integrator_{f.name}" for f in fields(IntegratorStats))
 #: variable attributes that are per-job quantities
 PER_JOB_VARIABLE_ATTRS = ("max_abs_drift",)
+#: run attributes left in the jobs' own run.nc: the sweep has its own (set by ``gyrolab.output.cf.conform``)
+JOB_ONLY_ATTRS = ("job_id", "date_created", "history", "Conventions")
 #: attributes of sweep.nc that legitimately differ between two aggregations of the same sweep
-VOLATILE_ATTRS = ("date_created", "sweep_launcher")
+VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
+#: CF units and long_name of the per-job variables a run's attributes become (others: "run attribute NAME")
+PER_JOB_METADATA = {
+    "config": (None, "the job's resolved config (YAML)"),
+    "hydra_overrides": (None, "the job's command-line overrides"),
+    "integrator_nfev": ("1", "right-hand-side evaluations of the integrator"),
+    "integrator_n_steps": ("1", "integrator steps accepted"),
+    "integrator_n_rejected": ("1", "integrator steps rejected"),
+    "integrator_wall_time": ("s", "integrator wall time"),
+    "integrator_njev": ("1", "Jacobian evaluations of the integrator"),
+    "integrator_nlu": ("1", "LU decompositions of the integrator"),
+    "sampling_fastest_rate": (None, "upper estimate of the fastest angular frequency (model rate units)"),
+    "sampling_samples_per_period": ("1", "stored samples per period of the fastest motion"),
+    "sampling_n_output_requested": (None, "time.n_output as the config gave it"),
+    "sampling_warning": (None, "warning when the output times undersample the motion"),
+}
 #: variables of sweep.nc that legitimately differ between two runs of the same sweep
 VOLATILE_VARIABLES = ("integrator_wall_time",)
 
@@ -128,7 +145,7 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
                                                               "job_id", "title", "Conventions"}
     common: dict[str, Any] = {}
     for key in _union([list(ds.attrs) for _, ds in done]):
-        if key == "job_id":
+        if key in JOB_ONLY_ATTRS:
             continue
         values = {index: ds.attrs[key] for index, ds in done if key in ds.attrs}
         if key not in PER_JOB_ATTRS and len(values) == len(done) and _all_same(list(values.values())):
@@ -136,6 +153,9 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
             continue
         name = key if key not in taken else f"run_{key}"
         data_vars[name] = _cell_variable(values, shape, grid_dims, name)
+        units, long_name = PER_JOB_METADATA.get(key, (None, f"run attribute {key}, per job"))
+        data_vars[name][2].update({"long_name": long_name} if units is None or data_vars[name][1].dtype == object
+                                  else {"long_name": long_name, "units": units})
         taken.add(name)
 
     statuses = np.zeros(shape, dtype=np.int8)
@@ -157,7 +177,6 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
     ds.attrs.update(common)
     ds.attrs.update({
         "title": f"gyrolab sweep over {' × '.join(grid_dims) or 'no parameter'} ({len(results)} jobs)",
-        "Conventions": "CF-1.8",
         "sweep_dims": " ".join(grid_dims),
         "sweep_keys": " ".join(d.key for d in grid.dims),
         "n_jobs": len(results),
@@ -165,7 +184,7 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
         "n_failed": counts[FAILED],
         "n_missing": counts[MISSING],
     })
-    return ds
+    return conform(ds, source=f"sweep of {len(results)} jobs over {' × '.join(grid_dims) or 'no parameter'}")
 
 
 def _dim_names(grid: Grid, datasets: Sequence[xr.Dataset]) -> list[str]:
@@ -236,6 +255,8 @@ def _per_job_attrs(done: Sequence[tuple[tuple[int, ...], xr.Dataset]], name: str
             if attr == "max_abs_drift":
                 out[attr][2].update({"long_name": f"max |{name}(t) − {name}(0)|",
                                      "units": having[0][1].attrs.get("units", "1")})
+            else:
+                out[attr][2]["long_name"] = f"attribute {attr} of {name}, per job"
     return out
 
 
@@ -364,7 +385,6 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
         results = collect(sweep_dir, grid)
         ds = assemble(grid, results)
         ds.attrs["sweep_launcher"] = launcher
-        ds.attrs["date_created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
         path = write_dataset(ds, sweep_dir / SWEEP_NAME)
     finally:
         unlock(sweep_dir)

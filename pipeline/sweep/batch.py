@@ -74,6 +74,7 @@ def _integrate_and_write(grid: Grid, base: DictConfig, out_dir: Path) -> Path:
     log.info("batch sweep: %d points, %d valid, scenes built in %.1f s", len(scenes), len(valid),
              time.perf_counter() - start)
     if valid:
+        _share_output_times([scenes[n] for n in valid])
         first = scenes[valid[0]]
         params = None
         if first.system.compiled_model() is not None:
@@ -93,3 +94,12 @@ def _integrate_and_write(grid: Grid, base: DictConfig, out_dir: Path) -> Path:
     sweep = assemble(grid, results)
     sweep.attrs["sweep_launcher"] = "batch"
     return write_dataset(sweep, Path(out_dir) / "sweep.nc")
+
+
+def _share_output_times(scenes: Sequence[Scene]) -> None:
+    """One output grid for the batch: with ``time.n_output: auto`` the points' own grids may differ (a faster
+    spin needs more samples), so every point gets the densest of them (the same span, so no point undersamples)."""
+    densest = max(scenes, key=lambda scene: len(scene.times)).times
+    for scene in scenes:
+        scene.times = densest
+

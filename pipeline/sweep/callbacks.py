@@ -18,6 +18,7 @@ from hydra.experimental.callback import Callback
 from omegaconf import DictConfig
 
 from gyrolab.errors import GyrolabError, OutputError
+from gyrolab.output.atomic import reason
 from gyrolab.output.lock import lock, unlock
 from gyrolab.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
 from gyrolab.sweep.grid import Grid
@@ -105,6 +106,39 @@ class SweepCallback(Callback):
             return
         last_summary = summary
         log_summary(summary)
+
+
+def _tolerate_hydra_record_failures() -> None:
+    """A full disk while Hydra saves a job's ``.hydra/*.yaml`` is a warning, not the end of the sweep.
+
+    Hydra writes those copies of the config (non-atomically) before the job starts; an OSError there
+    would abort the whole multirun with a traceback. The config is also in the job's ``job.json``
+    and ``run.nc``, so the copy is dropped (no partial file is left) and the job goes on: a job
+    that then cannot write its results fails alone, in one sentence, like any other write failure.
+    """
+    import functools
+
+    from hydra.core import utils as hydra_utils
+
+    save = hydra_utils._save_config
+    if getattr(save, "_gyrolab_tolerant", False):
+        return
+
+    @functools.wraps(save)
+    def save_or_warn(cfg: Any, filename: str, output_dir: Path) -> None:
+        try:
+            save(cfg, filename, output_dir)
+        except OSError as error:
+            target = Path(output_dir) / filename
+            target.unlink(missing_ok=True)
+            log.warning("cannot write %s (%s); the job's config is also stored in its job.json and run.nc",
+                        target, reason(error))
+
+    save_or_warn._gyrolab_tolerant = True  # type: ignore[attr-defined]
+    hydra_utils._save_config = save_or_warn
+
+
+_tolerate_hydra_record_failures()
 
 
 def _basic_sweeper(config: DictConfig) -> bool:

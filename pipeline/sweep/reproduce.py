@@ -64,7 +64,8 @@ def stored_config(stored: xr.Dataset, where: str = "the dataset's config attribu
     cfg = check_stored_config(stored.attrs["config"], where)
     plain = OmegaConf.to_container(cfg)
     time = plain.get("time")
-    if isinstance(time, dict) and {"start", "end", "n_output"} <= set(time) and isinstance(time["n_output"], int):
+    if isinstance(time, dict) and {"start", "end", "n_output"} <= set(time) and (
+            isinstance(time["n_output"], int) or time["n_output"] == "auto"):
         probe = cfg.copy()
         probe.time.n_output = 2
         check_budget(plain, Scene.from_config(probe).system.initial_state().size)

@@ -56,3 +56,5 @@ def rhs(model, t, y, p, out):
 def taylor_coefficients(model, p, Y, order, work):
     if model == FIXED_POINT:
         fixed_point.taylor_coefficients(p, Y, order, work)
+    else:  # a traced plugin torque has no Taylor coefficients (scenes refuse taylor for it; docs/plugins.md)
+        raise ValueError("this compiled model has no Taylor coefficients")

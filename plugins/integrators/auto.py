@@ -131,10 +131,12 @@ class Auto(Integrator):
                 tau = chosen
             else:  # at a fixed order, extrapolating to tighter tolerances is safe (the leading term dominates more)
                 break
-        # Round-off of the compensated update grows as a random walk over the steps (see the module's note):
-        # a target below it cannot be met in double precision, whatever the tolerance.
+        # Round-off of the compensated Taylor update grows as a random walk over the steps (see the module's
+        # note), that of scipy's plain update by up to an ulp per step: a target below it cannot be met in
+        # double precision, whatever the tolerance.
         steps = self._pilot_steps / self.pilot_fraction * max(1.0, (pilot_tau / 100 / chosen) ** (1.0 / self._order))
-        roundoff = np.finfo(float).eps * scale * math.sqrt(steps)
+        compensated = self._method(compiled, chosen).name == "taylor"
+        roundoff = np.finfo(float).eps * scale * (math.sqrt(steps) if compensated else steps)
         if roundoff > self.accuracy:
             raise ConfigError(f"accuracy={self.accuracy:g} is below the round-off that double precision accumulates "
                               f"on this scene (about {roundoff:.1g} over ~{steps:.0f} steps); ask for at least that")

@@ -5,7 +5,8 @@ asymmetric body (A, B, C) = (1.0, 1.4, 1.9), symmetric A = B = 1.2, C = 2.0; μ 
 h1 = 0.5, h3 = 0.3, k3 = 0.4 where free; spin m = 1.3 (n = 0), n = 0.8, ψ0 = 0.6 (n ≠ 0).
 Labels: the paper's equation and set number; ``c`` = corrected set (the printed one fails),
 ``19.1L`` = the literal reading of the garbled k3 of (19.1) (printed), ``19.1`` = its bracket reading,
-``31.2a``/``31.2b`` = the two alternatives of (31.2), ``N1``/``N2`` = families not in the paper.
+``31.2a``/``31.2b`` = the two alternatives of (31.2), ``N1``…``N5`` = families not in the paper
+(``N3``…``N5``: the body at rest in the orbital frame with its z axis on the orbit normal, ``normal_rest``).
 """
 
 from __future__ import annotations
@@ -52,6 +53,33 @@ def _case(label, section, printed, motion, params, note=""):
 
 
 _S3 = np.sqrt(3.0)
+
+
+def normal_rest(inertia, mu, h3, Omega, theta0: float, chi: float, k3: float = 0.0, h1: float | None = None,
+                N: float | None = None) -> GyrostatParameters:
+    """Parameters that make θ0 ∈ {0, π}, n ± m = 0 (rest in the orbital frame, ω = Ωγ) a solution.
+
+    σ = cos θ0 = ±1, χ = ψ0 − σφ0 (only ψ ± φ matters): α = (cos χ, −σ sin χ, 0), β = (sin χ, σ cos χ, 0),
+    γ = (0, 0, σ). The residual is constant; its γ-component does not contain k and gives
+        h1 (μ1 sin χ + σ μ2 cos χ) = −(3/2) N/3 (A − B) sin 2χ          (μ·β h1 = −(N/2)(A − B) sin 2χ),
+    its components ⊥ γ give k1 = (μ1 h3 − σ μ3 h1 cos χ)/Ω, k2 = (μ2 h3 + μ3 h1 sin χ)/Ω; C, k3, μ3, h3 free.
+    Branches: μ·β ≠ 0 → h1 from the first equation (any A, B); μ·β = 0 → needs (A − B) sin 2χ = 0, h1 free
+    (``h1`` must then be given). Derivation in docs/gyrostat.md; verified by the vector residual (tests)."""
+    A, B, C = map(float, inertia)
+    sigma = float(np.sign(np.cos(theta0)))
+    s, c = np.sin(chi), np.cos(chi)
+    gradient = 3.0 * Omega ** 2 if N is None else float(N)
+    mu_beta = mu[0] * s + sigma * mu[1] * c
+    rhs = -0.5 * gradient * (A - B) * np.sin(2 * chi)
+    if h1 is None:
+        if abs(mu_beta) < 1e-14:
+            raise ValueError("normal_rest: μ·β = 0 at this χ, so h1 is free: give it")
+        h1 = rhs / mu_beta
+    elif abs(h1 * mu_beta - rhs) > 1e-12 * max(1.0, abs(rhs)):
+        raise ValueError(f"normal_rest: h1 = {h1:g} violates h1 μ·β = −(N/2)(A − B) sin 2χ")
+    k = ((mu[0] * h3 - sigma * mu[2] * h1 * c) / Omega, (mu[1] * h3 + mu[2] * h1 * s) / Omega, k3)
+    params = _params(A, B, C, k, mu, h1, h3, Omega)
+    return params if N is None else GyrostatParameters(params.inertia, params.k, params.mu, params.h, params.Omega, N)
 
 
 def build_cases():
@@ -182,6 +210,23 @@ def build_cases():
                        _params(Aa, Ba, Ca, (2 * mu[0] * h3 / W, 2 * mu[1] * h3 / W,
                                                 -W * (Aa + Ba - Ca) + 2 * mu[2] * h3 / W),
                                    mu, _S3 * h3, h3, W)))
+    # body at rest in the orbital frame with e3 on the orbit normal (n ± m = 0): A != B allowed, against (26)
+    mo = dict(n=n_pr, m=-n_pr, psi0=psi0, theta0=0.0)
+    cases.append(_case('N3', 'new, theta0=0 rest',
+                       'theta0=0, m=-n, A!=B: h1 (mu1 sin psi0 + mu2 cos psi0) = -3/2 Omega^2 (A-B) sin 2psi0, '
+                       'k1 = (mu1 h3 - mu3 h1 cos psi0)/Omega, k2 = (mu2 h3 + mu3 h1 sin psi0)/Omega',
+                       mo, normal_rest((Aa, Ba, Ca), mu, h3, W, 0.0, psi0, k3)))
+    mo = dict(n=n_pr, m=-n_pr, psi0=0.0, theta0=0.0)
+    cases.append(_case('N4', 'new, theta0=0 rest',
+                       'theta0=0, m=-n, A!=B, principal axes on the orbital axes (sin 2psi0 = 0): h1 = 0, '
+                       'k1 = mu1 h3/Omega, k2 = mu2 h3/Omega',
+                       mo, normal_rest((Aa, Ba, Ca), mu, h3, W, 0.0, 0.0, k3)))
+    mu5 = (0.0, -0.5, 0.6)
+    mo = dict(n=n_pr, m=n_pr, psi0=np.pi / 2, theta0=np.pi)
+    cases.append(_case('N5', 'new, theta0=pi rest',
+                       'theta0=pi, m=n, A!=B, psi0=pi/2, mu1=0 (mu.beta = 0, where (27) is 0/0): h1 free, '
+                       'k1 = (mu1 h3 + mu3 h1 cos psi0)/Omega, k2 = (mu2 h3 + mu3 h1 sin psi0)/Omega',
+                       mo, normal_rest((Aa, Ba, Ca), mu5, h3, W, np.pi, np.pi / 2, k3, h1=h1)))
     return cases
 
 

@@ -89,3 +89,62 @@ def find_precessions(params: GyrostatParameters, window: dict[str, tuple[float, 
         signatures.append(signature)
         found.append(Solution(motion, p, values, vector_residual(system, motion, t), dimension))
     return found
+
+
+def _rest_torque(params: GyrostatParameters, theta0: float, chi: float) -> np.ndarray:
+    """I(ω̇ − f_ω) of the system's own right-hand side for the body at rest in the orbital frame at (χ, θ0)."""
+    motion = Precession(0.0, 0.0, chi, theta0)
+    system = build_system(params, motion)
+    y, y_dot = states(system, motion, np.zeros(1))
+    return ((y_dot - system.derivative(y))[0, 0:3] * system.inertia).astype(float)
+
+
+def find_normal_rests(params: GyrostatParameters, theta0: float, *, grid: int = 720,
+                      accept: float = 1e-12) -> list[Solution]:
+    """Every rest in the orbital frame with the body z axis on the orbit normal (θ0 = 0 or π, n ± m = 0).
+
+    Only ψ0 ∓ φ0 = χ matters. The γ-component of the (constant) residual does not contain k (k × Ωγ ⊥ γ):
+    its zeros in χ ∈ [0, 2π) are found on a grid (sign changes, then Brent; grazing minima polished) from the
+    system's right-hand side; at each zero the two components ⊥ γ, linear in (k1, k2), fix k1, k2 (k3 as given).
+    A γ-component that vanishes for every χ (A = B with h1 μ·β ≡ 0) is a one-parameter family: one
+    representative χ = 0 with ``family_dimension`` 1. Each solution is re-checked by the vector residual.
+    """
+    from scipy.optimize import brentq, minimize_scalar
+
+    sigma = 1.0 if np.cos(theta0) > 0 else -1.0
+    theta0 = 0.0 if sigma > 0 else np.pi
+    chis = np.linspace(0.0, 2 * np.pi, grid + 1)
+    g = np.array([sigma * _rest_torque(params, theta0, x)[2] for x in chis])
+    scale = max(float(np.max(np.abs(params.I))) * params.Omega ** 2, 1e-300)
+    if np.max(np.abs(g)) < accept * scale:
+        roots, dimension = [0.0], 1
+    else:
+        dimension, roots = 0, []
+        gamma_torque = lambda x: sigma * _rest_torque(params, theta0, x)[2]  # noqa: E731
+        for i in range(grid):
+            a, b = chis[i], chis[i + 1]
+            if g[i] == 0.0:
+                roots.append(a)
+            elif g[i] * g[i + 1] < 0:
+                roots.append(brentq(gamma_torque, a, b, xtol=1e-15, rtol=1e-15))
+            elif 0 < i and abs(g[i]) < abs(g[i - 1]) and abs(g[i]) < abs(g[i + 1]):
+                polish = minimize_scalar(lambda x: abs(gamma_torque(x)), bounds=(chis[i - 1], b), method="bounded",
+                                         options={"xatol": 1e-14})
+                if abs(polish.fun) < accept * scale:
+                    roots.append(float(polish.x))
+        roots = [r % (2 * np.pi) for r in roots]
+        roots = [r for j, r in enumerate(roots) if all(abs(np.angle(np.exp(1j * (r - q)))) > 1e-9 for q in roots[:j])]
+    found = []
+    for chi in roots:
+        base = _rest_torque(params.replace(k1=0.0, k2=0.0), theta0, chi)
+        columns = [_rest_torque(params.replace(k1=float(e1), k2=float(e2)), theta0, chi) - base
+                   for e1, e2 in ((1.0, 0.0), (0.0, 1.0))]
+        k12 = np.linalg.solve(np.array(columns).T[0:2], -base[0:2])
+        p = params.replace(k1=float(k12[0]), k2=float(k12[1]))
+        motion = Precession(0.0, 0.0, float(chi), theta0)
+        system = build_system(p, motion)
+        residual = vector_residual(system, motion, np.linspace(0.0, 4 * np.pi / params.Omega, 64))
+        if residual < 1e-9:
+            found.append(Solution(motion, p, {"n": 0.0, "m": 0.0, "psi0": float(chi), "theta0": theta0,
+                                              "k1": float(k12[0]), "k2": float(k12[1])}, residual, dimension))
+    return found

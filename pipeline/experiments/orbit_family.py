@@ -1,0 +1,245 @@
+"""``experiment=orbit_family``: the exact periodic orbit of the heavy body followed from fast to slow spin.
+
+For each family of ``orbit_family.families`` (a body, a tilt θ0 = arccos γ''(0), a section and a start): the orbit is
+found by shooting at the start spin (from the fast-spin series of ``small_parameter`` at r0/c = 100, or from the
+pendulum swing at r0/c = 0.01) and continued by pseudo-arclength in ln r0 (``gyrolab.physics.continuation``) toward
+the other end. Per point: r0/c, period, initial state, Floquet multipliers, stability index s = ρ + 1/ρ, stable,
+the nutation amplitude (max θ − min θ), the bifurcations met (fold, branch point, period doubling), and the
+relative error of the series against the point (max of |Δy(0)|/max(1, |y(0)|) and |ΔT|/T): the fast-spin series
+(``small_parameter``; each ``regime.order`` it accepts, else the paper's order) for r0/c ≥ 1 and the slow-spin series
+(``large_parameter``) inside its domain. Writes ``orbit_family.nc`` (dimension ``point``) and
+``figures/orbit_family.png``. Numbers and verdict: docs/regimes.md.
+"""
+
+from __future__ import annotations
+
+import inspect
+import logging
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from omegaconf import DictConfig, OmegaConf
+
+from gyrolab.errors import ConfigError, IntegrationError, as_number
+from gyrolab.output.cf import conform
+from gyrolab.output.dataset import write_dataset
+from gyrolab.output.provenance import provenance
+from gyrolab.physics import pendulum
+from gyrolab.physics.continuation import FamilyPoint, Section, bifurcations, continue_family, shoot_section
+from gyrolab.physics.periodic import FixedPointModel
+from gyrolab.plugins.regimes import large_parameter as slow
+from gyrolab.plugins.regimes.base import NondimensionalScene
+from gyrolab.plugins.regimes.small_parameter import SmallParameter
+
+log = logging.getLogger(__name__)
+COMPONENTS = ("p", "q", "r", "gamma_x", "gamma_y", "gamma_z")
+BANDS = (1e-6, 1e-3)
+
+
+def _family_spec(name: str, spec: dict) -> dict[str, Any]:
+    where = f"orbit_family.families.{name}"
+    out = {key: as_number(spec.get(key), f"{where}.{key}", positive=key != "k")
+           for key in ("a", "b", "k", "theta0", "r0_start", "r0_end")}
+    com = spec.get("com_direction")
+    if not isinstance(com, (list, tuple)) or len(com) != 3:
+        raise ConfigError(f"{where}.com_direction must be a list of three numbers, got {com!r}")
+    out["com"] = np.array([as_number(c, f"{where}.com_direction") for c in com], dtype=float)
+    out["com"] /= np.linalg.norm(out["com"])
+    out["section"] = str(spec.get("section", "gamma_prime"))
+    out["max_points"] = int(as_number(spec.get("max_points", 120), f"{where}.max_points", positive=True))
+    out["max_period"] = as_number(spec.get("max_period", 40.0), f"{where}.max_period", positive=True)
+    out["label"] = str(spec.get("label", name))
+    return out
+
+
+def _scene(f: dict, r0: float) -> NondimensionalScene:
+    return NondimensionalScene(f["a"], f["b"], *map(float, f["com"]), f["k"], 1.0, float(r0), f["theta0"], 0.0, False)
+
+
+def fast_spin_orders() -> list[int | None]:
+    """The orders ``small_parameter`` accepts (3, 6, 10 when it has ``order``; else only the paper's: None)."""
+    return [3, 6, 10] if "order" in inspect.signature(SmallParameter.__init__).parameters else [None]
+
+
+def fast_spin_error(f: dict, point: FamilyPoint, order: int | None) -> float:
+    regime = SmallParameter() if order is None else SmallParameter(order=order)  # type: ignore[call-arg]
+    s = _scene(f, point.r0)
+    y = regime._state(s, np.array([0.0]))[0]
+    return _error(y, regime._period(s), point)
+
+
+def slow_spin_error(f: dict, point: FamilyPoint) -> float:
+    on_axis = abs(f["com"][0]) < 1e-12 and abs(f["com"][1]) < 1e-12 and f["com"][2] > 0
+    if not (on_axis and 0 < point.r0 <= slow.MAX_SPIN and slow.MIN_TILT <= f["theta0"] <= slow.MAX_TILT):
+        return float("nan")
+    series = slow.series_for(f["a"], f["b"], f["k"], f["theta0"])
+    return _error(series.initial_state(point.r0), series.period(point.r0), point)
+
+
+def _error(y0: np.ndarray, period: float, point: FamilyPoint) -> float:
+    state = float(np.max(np.abs(y0 - point.y0))) / max(1.0, float(np.max(np.abs(point.y0))))
+    return max(state, abs(period - point.period) / point.period)
+
+
+def start_point(f: dict, model: FixedPointModel, section: Section) -> FamilyPoint:
+    r0 = f["r0_start"]
+    if section.kind == "turning":  # from the pendulum swing (slow-spin series when in its domain)
+        T0 = pendulum.period(f["b"], pendulum.kappa(f["a"], f["k"]), f["theta0"])
+        return shoot_section(model, section, np.zeros(2), T0, r0)
+    s = _scene(f, r0)
+    regime = SmallParameter()
+    y = regime._state(s, np.array([0.0]))[0]
+    return shoot_section(model, section, y[:2], regime._period(s), r0)
+
+
+def amplitude(model: FixedPointModel, point: FamilyPoint, samples: int = 48) -> float:
+    """Nutation amplitude max θ − min θ over one period (θ = arccos γ'')."""
+    theta, y, now = [np.arccos(np.clip(point.y0[5], -1, 1))], point.y0, 0.0
+    for t in np.linspace(0, point.period, samples + 1)[1:]:
+        y, _ = model.flow(y, t - now, np.zeros((6, 0)))
+        now = t
+        theta.append(np.arccos(np.clip(y[5], -1, 1)))
+    return float(np.max(theta) - np.min(theta))
+
+
+def trace(name: str, f: dict) -> dict[str, Any]:
+    model = FixedPointModel(np.array([f["a"], f["b"], 1.0]), f["com"], f["k"])
+    section = Section(f["section"], float(np.cos(f["theta0"])))
+    try:
+        start = start_point(f, model, section)
+    except IntegrationError as error:
+        raise IntegrationError(f"family {name}: no periodic orbit at its start r0/c={f['r0_start']:g} ({error})")
+    points = continue_family(model, section, start, f["r0_end"], max_points=f["max_points"],
+                             max_period=f["max_period"])
+    events = bifurcations(points)
+    reached = points[-1].r0
+    ended = ("reached r0/c = {:.4g}".format(reached) if (np.log(f["r0_end"]) - np.log(reached))
+             * np.sign(np.log(f["r0_end"]) - np.log(f["r0_start"])) <= 0 else
+             f"stopped at r0/c = {reached:.4g} with period {points[-1].period:.4g} (period limit {f['max_period']:g} "
+             f"or {f['max_points']} points)")
+    errors = {f"order_{o or 'paper'}": [fast_spin_error(f, p, o) if p.r0 >= 1 else np.nan for p in points]
+              for o in fast_spin_orders()}
+    errors["slow"] = [slow_spin_error(f, p) for p in points]
+    log.info("family %s: %d points, %s; bifurcations: %s", name, len(points), ended,
+             ", ".join(f"{label} at r0/c = {points[i].r0:.5g}" for i, label in events) or "none")
+    return {"name": name, "label": f["label"], "points": points, "events": events, "ended": ended,
+            "amplitude": [amplitude(model, p) for p in points], "errors": errors}
+
+
+def bands(r0: np.ndarray, error: np.ndarray, tol: float) -> str:
+    ok = np.isfinite(error) & (error <= tol)
+    if not ok.any():
+        return "nowhere"
+    return f"r0/c {r0[ok].min():.3g}–{r0[ok].max():.3g}"
+
+
+def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
+    spec = OmegaConf.to_container(cfg.get("orbit_family") or {}, resolve=True)
+    families = spec.get("families") or {}
+    if not isinstance(families, dict) or not families:
+        raise ConfigError("orbit_family.families must name at least one family (body, theta0, section, r0_start, r0_end)")
+    traces = [trace(name, _family_spec(name, f)) for name, f in families.items()]
+    ds = dataset(traces, cfg)
+    out_dir = Path(out_dir)
+    written = [write_dataset(ds, out_dir / "orbit_family.nc"), plot(traces, out_dir / "figures" / "orbit_family.png")]
+    return written
+
+
+def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
+    points = [p for tr in traces for p in tr["points"]]
+    family = np.array([tr["name"] for tr in traces for _ in tr["points"]])
+    labels = {i: "" for i in range(len(points))}
+    offset = 0
+    for tr in traces:
+        for i, label in tr["events"]:
+            labels[offset + i] = (labels[offset + i] + ", " if labels[offset + i] else "") + label
+        offset += len(tr["points"])
+    multipliers = np.array([p.multipliers for p in points])
+    data: dict[str, Any] = {
+        "r0_over_c": ("point", np.array([p.r0 for p in points]), {"units": "1", "long_name": "spin r0 in units of c = √(Mgℓ/C)"}),
+        "period": ("point", np.array([p.period for p in points]), {"units": "1", "long_name": "period of the body-frame motion (units of 1/c)"}),
+        "initial_state": (("point", "component"), np.array([p.y0 for p in points]),
+                          {"units": "1", "long_name": "state (p, q, r, γ, γ', γ'') at t = 0 (rates in units of c)"}),
+        "floquet_multiplier_real": (("point", "multiplier"), multipliers.real, {"units": "1", "long_name": "Floquet multiplier, real part"}),
+        "floquet_multiplier_imag": (("point", "multiplier"), multipliers.imag, {"units": "1", "long_name": "Floquet multiplier, imaginary part"}),
+        "stability_index": ("point", np.array([p.stability_index for p in points]),
+                            {"units": "1", "long_name": "s = tr(monodromy) − 4 = ρ + 1/ρ of the non-trivial pair"}),
+        "stable": ("point", np.array([int(p.stable) for p in points]), {"units": "1", "long_name": "linearly stable (|s| ≤ 2): 1, else 0"}),
+        "amplitude": ("point", np.concatenate([tr["amplitude"] for tr in traces]), {"units": "rad", "long_name": "nutation amplitude max θ − min θ"}),
+        "return_residual": ("point", np.array([p.residual for p in points]), {"units": "1", "long_name": "relative return residual of the shooting"}),
+        "family": ("point", family, {"units": "1", "long_name": "family name (orbit_family.families)"}),
+        "bifurcation": ("point", np.array([labels[i] for i in range(len(points))]),
+                        {"units": "1", "long_name": "bifurcation detected between the previous point and this one"}),
+    }
+    for key in traces[0]["errors"]:
+        name = "fast_spin" if key.startswith("order") else "slow_spin"
+        what = (f"fast-spin series (small_parameter, {key.replace('_', ' ')})" if name == "fast_spin"
+                else "slow-spin series (large_parameter)")
+        data[f"error_{name}_{key}" if name == "fast_spin" else "error_slow_spin_series"] = (
+            "point", np.concatenate([tr["errors"][key] for tr in traces]),
+            {"units": "1", "long_name": f"relative error of the {what} against the exact orbit (NaN: outside its domain)"})
+    coords = {"point": ("point", np.arange(len(points)), {"units": "1", "long_name": "point along the families"}),
+              "component": ("component", np.array(COMPONENTS), {"units": "1", "long_name": "state component"}),
+              "multiplier": ("multiplier", np.arange(6), {"units": "1", "long_name": "Floquet multiplier index"})}
+    ds = xr.Dataset(data, coords=coords)
+    summary = []
+    for tr in traces:
+        r0 = np.array([p.r0 for p in tr["points"]])
+        parts = [f"{tr['name']}: {tr['ended']}"]
+        parts += [f"{label} at r0/c = {tr['points'][i].r0:.5g}" for i, label in tr["events"][:6]]
+        for key, errs in tr["errors"].items():
+            parts.append(f"{key} series within " + ", ".join(f"{tol:g}: {bands(r0, np.array(errs), tol)}" for tol in BANDS))
+        summary.append("; ".join(parts))
+    ds.attrs.update({"title": "exact periodic-orbit families of the heavy body, fast to slow spin",
+                     "summary": " | ".join(summary),
+                     "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
+    return conform(ds, source="orbit_family experiment")
+
+
+def plot(traces: list[dict], path: Path) -> Path:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from gyrolab.output.atomic import atomic_path
+
+    fig, axes = plt.subplots(3, 1, figsize=(8, 10), sharex=True)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for n, tr in enumerate(traces):
+        r0 = np.array([p.r0 for p in tr["points"]])
+        period = np.array([p.period for p in tr["points"]])
+        stable = np.array([p.stable for p in tr["points"]])
+        amp = np.array(tr["amplitude"])
+        c = colours[n % len(colours)]
+        for ax, values in ((axes[0], period), (axes[1], amp)):
+            ax.plot(r0, values, "-", color=c, lw=0.8, label=tr["label"])
+            ax.scatter(r0[stable], values[stable], s=10, color=c, marker="o")
+            ax.scatter(r0[~stable], values[~stable], s=10, facecolors="none", edgecolors=c, marker="o")
+            for i, label in tr["events"]:
+                ax.annotate({"fold": "F", "branch point": "BP", "period doubling": "PD"}[label], (r0[i], values[i]),
+                            fontsize=6, color=c)
+        for key, errs in tr["errors"].items():
+            errs = np.array(errs)
+            if np.isfinite(errs).any():
+                axes[2].plot(r0, errs, ".-", color=c, lw=0.6, ms=3, label=f"{tr['name']}: {key} series")
+    for tol in BANDS:
+        axes[2].axhline(tol, color="0.5", lw=0.6, ls="--")
+    axes[0].set_yscale("log")
+    axes[0].set_ylabel("period (1/c)")
+    axes[1].set_ylabel("nutation amplitude (rad)")
+    axes[2].set_yscale("log")
+    axes[2].set_ylabel("series error vs exact orbit")
+    axes[2].set_xlabel("r0/c")
+    axes[2].set_xscale("log")
+    axes[0].legend(fontsize=7, title="filled: stable, open: unstable; F fold, BP branch point, PD period doubling",
+                   title_fontsize=6)
+    axes[2].legend(fontsize=6)
+    fig.suptitle("exact periodic-orbit families: fast spin (right) to slow spin (left)", fontsize=10)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
+    plt.close(fig)
+    return path

@@ -1,0 +1,126 @@
+"""CF-1.8 conventions for every dataset gyrolab writes (checked by compliance-checker's ``cf:1.8`` suite).
+
+``conform(ds, title, source)`` is the last step of every dataset builder (run, regime run, sweep,
+experiments). It makes the netCDF file a CF-1.8 file without changing what the dataset holds:
+
+* global attributes ``Conventions: CF-1.8``, ``title``, ``history`` (one line: when, which gyrolab,
+  what made the file) and ``date_created`` (ISO 8601, UTC); a builder's own ``title`` is kept;
+* coordinates carry no ``_FillValue`` (CF §2.5.1: a coordinate has no missing values), set through
+  the variable's netCDF encoding, so the in-memory dataset is unchanged;
+* string-valued coordinates (``axis`` = x, y, z; ``frame_axis``; a swept integrator's names; case
+  labels) are stored as character arrays (CF §2.2, the labels of §6.1): a CF coordinate variable is
+  numeric (§1.3), and compliance-checker's monotonicity check fails on a string one. xarray reads
+  them back as the same strings, so ``ds.omega.sel(axis="z")`` keeps working;
+* 64-bit integers become 32-bit (CF-1.8 §2.2 lists byte, short, int, float, double, char; int64
+  arrives only with CF-1.9), or float64 (exact to 2**53) when a value is outside the int32 range;
+* ``standard_name: time`` is dropped wherever the units are not ``<unit> since <epoch>``: gyrolab's
+  time is elapsed model time (s, or a nondimensional unit), not a calendar date (CF §4.4). The
+  one message compliance-checker (6.x) still prints comes from its §5.1 heuristic that a dimension
+  named ``time`` must carry that standard name; claiming a calendar would be false, so it stays;
+* every variable and coordinate has a ``long_name`` (CF §3.3 wants one where there is no
+  ``standard_name``): one a builder forgot (a third-party system's variable, say) becomes the
+  variable's name, logged; gyrolab's own builders give real ones (tests/test_cf_compliance.py).
+
+``unit_attributes(body)`` gives the machine-readable scales of a body's model units (global
+attributes ``time_unit``, ``energy_unit``, ``rate_unit`` and, for an SI fixed-point body, the
+papers' nondimensional scales ``time_scale_s`` = 1/c and ``energy_scale_J`` = C c²).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import re
+from datetime import datetime, timezone
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from gyrolab.output.provenance import gyrolab_version
+
+log = logging.getLogger(__name__)
+
+CONVENTIONS = "CF-1.8"
+_SINCE = re.compile(r"^\s*\S+\s+since\s+\S")
+_INT32 = np.iinfo(np.int32)
+
+
+def now_iso() -> str:
+    """The current UTC time in ISO 8601, to the second (``date_created``)."""
+    return datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+def conform(ds: xr.Dataset, title: str | None = None, source: str = "") -> xr.Dataset:
+    """Make ``ds`` a CF-1.8 dataset in place (see the module docstring) and return it.
+
+    ``title`` is used only when ``ds`` has none; ``source`` says what made the file (``history``).
+    """
+    for name in list(ds.variables):
+        variable = ds.variables[name]
+        if variable.dtype.kind in "iu" and variable.dtype.itemsize > 4:
+            values = variable.values
+            fits = not values.size or (values.min() >= _INT32.min and values.max() <= _INT32.max)
+            ds[name] = variable.astype(np.int32 if fits else np.float64)
+            variable = ds.variables[name]
+        attrs = variable.attrs
+        if attrs.get("standard_name") == "time" and not _SINCE.match(str(attrs.get("units", ""))):
+            del attrs["standard_name"]
+        if not attrs.get("long_name") and not attrs.get("standard_name"):
+            log.info("dataset variable %r has no long_name; its name stands in", name)
+            attrs["long_name"] = str(name)
+        if name in ds.coords:
+            variable.encoding["_FillValue"] = None
+            if _is_text(variable):
+                variable.encoding["dtype"] = "S1"
+    created = now_iso()
+    what = f": {source}" if source else ""
+    ds.attrs["Conventions"] = CONVENTIONS
+    ds.attrs["title"] = ds.attrs.get("title") or title or "gyrolab dataset"
+    ds.attrs["date_created"] = created
+    ds.attrs["history"] = f"{created} written by gyrolab {gyrolab_version()}{what}"
+    return ds
+
+
+def _is_text(variable: xr.Variable) -> bool:
+    kind = variable.dtype.kind
+    return kind == "U" or (kind == "O" and all(isinstance(v, str) for v in variable.values.ravel()))
+
+
+def unit_attributes(body: Any) -> dict[str, Any]:
+    """Machine-readable model units of ``body`` (netCDF-safe global attributes).
+
+    ``time_unit``/``rate_unit``/``energy_unit``: what one model unit of time, angular rate and
+    energy is (``s``, ``rad/s``, ``J`` for an SI body; ``1/c``, ``c``, ``C c2`` in the papers'
+    nondimensional form, c² = M g ℓ / C). An SI fixed-point body also gives the papers' scales in
+    SI: ``time_scale_s`` = 1/c and ``energy_scale_J`` = C c², so t/time_scale_s and
+    E/energy_scale_J are the papers' nondimensional time and energy. A nondimensional body is
+    scale-free: it has no SI scale, and says so in ``time_unit_description``.
+    """
+    time_label, rate_label = body.time_label, body.rate_label
+    si = body.units == "si"
+    attrs: dict[str, Any] = {"time_unit": time_label, "rate_unit": rate_label}
+    nondim = body.nondimensional() if hasattr(body, "nondimensional") else {}
+    c2 = nondim.get("c2")
+    if si:
+        attrs["energy_unit"] = "J"
+        if c2 is not None and c2 > 0:
+            attrs["time_scale_s"] = 1.0 / math.sqrt(c2)
+            attrs["energy_scale_J"] = float(body.inertia[2]) * c2
+            attrs["time_unit_description"] = ("model time in s; the papers' nondimensional time is t c with "
+                                              "c = sqrt(M g l / C) = 1/time_scale_s, their energy E/(C c2) "
+                                              "= E/energy_scale_J")
+        else:
+            attrs["time_unit_description"] = "model time in s"
+    elif time_label == "1/c":
+        attrs["energy_unit"] = "C c2"
+        attrs["time_unit_description"] = ("nondimensional: time in units of 1/c, c = sqrt(M g l / C), energy in "
+                                          "units of C c2 (scale-free: no SI scale)")
+    else:  # the orbiting gyrostat: the orbit's rate is the unit of rate when it is 1
+        rate = "Ω" if rate_label == "Ω" else "W"
+        attrs["energy_unit"] = f"I0 {rate}2"
+        attrs["time_unit_description"] = (f"nondimensional: time in units of {time_label}, energy in units of "
+                                          f"I0 {rate}2 with I0 the unit of body.inertia"
+                                          + ("" if rate == "Ω" else " and W the unit of body.orbit_rate")
+                                          + " (scale-free: no SI scale)")
+    return attrs

@@ -1,0 +1,223 @@
+"""Families of exact periodic orbits of the heavy body about a fixed point: shooting on a section and
+pseudo-arclength continuation in the spin r0, with Floquet stability and bifurcation labels.
+
+A section fixes γ''(0) = cos θ0 and r(0) = r0 and one more coordinate, leaving two state unknowns and the period:
+
+* ``"gamma_prime"`` — γ'(0) = 0, unknowns (p0, q0): the seeds' section (``gyrolab.physics.periodic.shoot``);
+* ``"turning"`` — q(0) = 0, unknowns (p0, γ'0): the turning point of a swing about the body y axis, the section
+  that stays transversal at r0 = 0, where the seeds' one contains the whole planar pendulum orbit (γ' ≡ 0).
+
+The return residual y(T) − y(0) has rank 3 (three first integrals); Newton's step is the least-squares one with the
+exact Jacobian [Φ(T)D − D, f(y(T)), (Φ(T) − 1) e_r r0] (Φ the monodromy matrix from the compiled Taylor flow).
+Continuation unknowns z = (p0, x0, ln T, ln r0); the tangent is the null vector of that 6 × 4 Jacobian, and the
+corrector adds the arclength condition t·(z − z_pred) = 0.
+
+Stability: the monodromy matrix has four trivial multipliers 1 (|γ| = 1, energy, area integral, flow) and one
+reciprocal pair ρ, 1/ρ, so s = tr Φ(T) − 4 = ρ + 1/ρ without identifying eigenvalues: |s| < 2 elliptic (linearly
+stable, ρ on the unit circle), |s| > 2 hyperbolic (unstable). Along a family: s crossing +2 is a multiplier through
+1 (a branch point, or a fold when d ln r0/ds changes sign there too), s crossing −2 a period doubling; a sign
+change of d ln r0/ds is a fold in r0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.physics.periodic import FixedPointModel
+
+SECTIONS = ("gamma_prime", "turning")
+MAX_LOG_STEP = 0.5
+STABILITY_TOL = 1e-6  # |s| ≤ 2 + this counts as stable (s is computed to ~1e-10 on these orbits)
+
+
+@dataclass(frozen=True)
+class Section:
+    kind: str
+    gpp: float  # γ''(0) = cos θ0
+
+    def __post_init__(self) -> None:
+        if self.kind not in SECTIONS:
+            raise ConfigError(f"section {self.kind!r} is not valid; valid choices: {', '.join(SECTIONS)}")
+
+    def state(self, u: np.ndarray, r0: float) -> np.ndarray:
+        """y0 from the two unknowns u = (p0, q0) or (p0, γ'0)."""
+        p0, x = float(u[0]), float(u[1])
+        if self.kind == "gamma_prime":
+            return np.array([p0, x, r0, np.sqrt(max(0.0, 1 - self.gpp ** 2)), 0.0, self.gpp])
+        return np.array([p0, 0.0, r0, np.sqrt(max(0.0, 1 - x ** 2 - self.gpp ** 2)), x, self.gpp])
+
+    def derivative(self, u: np.ndarray) -> np.ndarray:
+        """∂y0/∂u (6 × 2)."""
+        D = np.zeros((6, 2))
+        D[0, 0] = 1.0
+        if self.kind == "gamma_prime":
+            D[1, 1] = 1.0
+        else:
+            g = np.sqrt(max(1e-300, 1 - u[1] ** 2 - self.gpp ** 2))
+            D[4, 1], D[3, 1] = 1.0, -u[1] / g
+        return D
+
+
+@dataclass
+class FamilyPoint:
+    r0: float
+    period: float
+    y0: np.ndarray
+    monodromy: np.ndarray
+    residual: float
+    tangent: np.ndarray = field(default_factory=lambda: np.full(4, np.nan))
+    multipliers: np.ndarray = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.multipliers = np.linalg.eigvals(self.monodromy)
+
+    @property
+    def stability_index(self) -> float:
+        """s = tr Φ(T) − 4 = ρ + 1/ρ of the non-trivial pair."""
+        return float(np.trace(self.monodromy) - 4.0)
+
+    @property
+    def stable(self) -> bool:
+        return bool(abs(self.stability_index) <= 2.0 + STABILITY_TOL)
+
+
+def _evaluate(model: FixedPointModel, section: Section, z: np.ndarray, r0: float | None = None):
+    """Residual (relative), raw residual, Jacobian in z = (p0, x, ln T, ln r0), start state, monodromy.
+
+    With ``r0`` given, the spin is that value (r0 = 0 allowed) and z[3] is ignored."""
+    u, T = z[:2], float(np.exp(z[2]))
+    r0 = float(np.exp(z[3])) if r0 is None else float(r0)
+    y0 = section.state(u, r0)
+    yT, phi = model.flow(y0, T)
+    scale = max(1.0, float(np.max(np.abs(y0))))
+    D = section.derivative(u)
+    e_r = np.zeros(6)
+    e_r[2] = 1.0
+    J = np.column_stack([phi @ D - D, model.rhs(yT) * T, (phi @ e_r - e_r) * r0]) / scale
+    res = (yT - y0) / scale
+    return float(np.max(np.abs(res))), res, J, y0, phi
+
+
+def _newton(model, section, z, *, tangent=None, anchor=None, fixed_r0=None, tol=1e-13, accept=1e-11,
+            max_iter=25):
+    """Gauss–Newton on the return residual (+ the arclength condition), damped when the residual grows.
+
+    ``fixed_r0``: the spin held at that value (plain shooting in (p0, x, ln T))."""
+    fixed = fixed_r0 is not None
+
+    def system(zz):
+        norm, res, J, y0, phi = _evaluate(model, section, zz, fixed_r0)
+        if fixed:
+            J = J[:, :3]
+        elif tangent is not None:
+            res = np.append(res, tangent @ (zz - anchor))
+            J = np.vstack([J, tangent])
+        return norm, res, J, y0, phi
+
+    norm, res, J, y0, phi = system(z)
+    history = [norm]
+    for _ in range(max_iter):
+        if norm < tol:
+            break
+        step = np.linalg.lstsq(J, -res, rcond=None)[0]
+        if fixed:
+            step = np.append(step, 0.0)
+        largest = float(np.max(np.abs(step[2:])))
+        if largest > MAX_LOG_STEP:  # a Newton step may not multiply T or r0 by more than e^MAX_LOG_STEP
+            step *= MAX_LOG_STEP / largest
+        for damping in 0.5 ** np.arange(0, 12):
+            try:
+                trial = system(z + damping * step)
+            except IntegrationError:
+                continue
+            if trial[0] < max(history[-4:]) or damping == 1.0 and trial[0] < 10 * norm:
+                break
+        else:
+            break
+        z = z + damping * step
+        norm, res, J, y0, phi = trial
+        history.append(norm)
+        if len(history) > 3 and norm > 0.5 * history[-2] and norm < accept:
+            break  # at the rounding floor
+    if not norm < accept:
+        raise IntegrationError(f"shooting did not converge: return residual {norm:.2e} (needs < {accept:.0e}) "
+                               f"after {len(history) - 1} iterations")
+    return z, norm, y0, phi
+
+
+def shoot_section(model: FixedPointModel, section: Section, u: np.ndarray, period: float, r0: float,
+                  **kwargs) -> FamilyPoint:
+    """The periodic orbit through the section at spin r0 (fixed), Newton from (u, period)."""
+    z = np.array([u[0], u[1], np.log(period), 0.0])
+    z, norm, y0, phi = _newton(model, section, z, fixed_r0=float(r0), **kwargs)
+    return FamilyPoint(float(r0), float(np.exp(z[2])), y0, phi, norm)
+
+
+def _tangent(model, section, z, previous=None):
+    _, _, J, _, _ = _evaluate(model, section, z)
+    t = np.linalg.svd(J)[2][-1]
+    if previous is not None and t @ previous < 0:
+        t = -t
+    return t
+
+
+def continue_family(model: FixedPointModel, section: Section, start: FamilyPoint, r0_end: float, *,
+                    step: float = 0.1, max_step: float = 0.4, min_step: float = 1e-4, max_points: int = 400,
+                    max_period: float = 200.0) -> list[FamilyPoint]:
+    """Pseudo-arclength continuation from ``start`` (r0 > 0) until ln r0 passes ln ``r0_end``.
+
+    Step control: grow by 1.3 after an easy correction (≤ 4 iterations), halve after a failure; stops (and
+    returns what it has) below ``min_step``, after ``max_points`` points or when the period exceeds ``max_period``
+    (an orbit approaching an equilibrium or a homoclinic loop: the period diverges).
+    """
+    if start.r0 <= 0 or r0_end <= 0:
+        raise ConfigError("continuation in ln r0 needs r0 > 0 at both ends")
+    x = start.y0[1] if section.kind == "gamma_prime" else start.y0[4]
+    z = np.array([start.y0[0], x, np.log(start.period), np.log(start.r0)])
+    direction = np.sign(np.log(r0_end) - z[3])
+    t = _tangent(model, section, z)
+    if t[3] * direction < 0:
+        t = -t
+    start.tangent = t
+    points = [start]
+    h = step
+    while len(points) < max_points and (np.log(r0_end) - z[3]) * direction > 0:
+        anchor = z + h * t
+        try:
+            z_new, norm, y0, phi = _newton(model, section, anchor.copy(), tangent=t, anchor=anchor, max_iter=12)
+        except IntegrationError:
+            h *= 0.5
+            if h < min_step:
+                break
+            continue
+        t_new = _tangent(model, section, z_new, t)
+        if np.arccos(np.clip(t_new @ t, -1, 1)) > 0.3 or (z_new - z) @ t <= 0.2 * h:  # sharp turn or going back
+            h *= 0.5
+            if h < min_step:
+                break
+            continue
+        if np.exp(z_new[2]) > max_period:
+            break
+        z, t = z_new, t_new
+        points.append(FamilyPoint(float(np.exp(z[3])), float(np.exp(z[2])), y0, phi, norm, t))
+        h = min(max_step, 1.3 * h)
+    return points
+
+
+def bifurcations(points: list[FamilyPoint]) -> list[tuple[int, str]]:
+    """(index of the point after the event, label): "fold" (d ln r0/ds changes sign), "branch point" (s through
+    +2 without a fold), "period doubling" (s through −2)."""
+    events = []
+    for i in range(1, len(points)):
+        a, b = points[i - 1], points[i]
+        fold = np.sign(a.tangent[3]) != np.sign(b.tangent[3]) and np.all(np.isfinite([a.tangent[3], b.tangent[3]]))
+        if fold:
+            events.append((i, "fold"))
+        if (a.stability_index - 2) * (b.stability_index - 2) < 0 and not fold:
+            events.append((i, "branch point"))
+        if (a.stability_index + 2) * (b.stability_index + 2) < 0:
+            events.append((i, "period doubling"))
+    return events

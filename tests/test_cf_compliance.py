@@ -1,0 +1,216 @@
+"""Every dataset kind gyrolab writes passes compliance-checker's CF-1.8 suite without errors.
+
+One small dataset of each kind (run.nc of both systems, a multirun sweep.nc, a --batch sweep.nc,
+regime.nc, work_precision.nc, regime_validity.nc, ismail2021_tables.nc, shaker_omega3.nc,
+precession_cases.nc, orbit_family.nc) is built in-process, written with ``write_dataset`` and checked with
+``compliance_checker``'s ``cf:1.8`` suite. The experiments run their real code up to the dataset
+write; their figures are not drawn (another test's job, and the costly part).
+
+One error is expected and allowed, by message: the checker's §5.1 heuristic wants a dimension named
+``time`` to carry ``standard_name: time``, which CF reserves for ``<unit> since <epoch>`` (§4.4),
+while gyrolab's time is elapsed model time (s, or 1/c: no epoch, no calendar). Claiming a calendar
+would be false, so gyrolab drops the standard name (as the issue asks) and the test allows exactly
+that message for exactly the ``time`` coordinate, nothing else.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import importlib
+import re
+from datetime import datetime
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+pytest.importorskip("compliance_checker", reason="compliance-checker is not installed (pip install -e '.[test]')")
+
+from compliance_checker.base import BaseCheck  # noqa: E402
+from compliance_checker.cf import util as cfutil  # noqa: E402
+from compliance_checker.runner import CheckSuite  # noqa: E402
+
+from gyrolab import run  # noqa: E402
+from gyrolab.engine.config import compose_config  # noqa: E402
+from gyrolab.experiments import TASKS, run_task  # noqa: E402
+from gyrolab.output.dataset import write_dataset  # noqa: E402
+from gyrolab.sweep.aggregate import FINISHED, JobResult, assemble  # noqa: E402
+from gyrolab.sweep.batch import run_batch_sweep  # noqa: E402
+from gyrolab.sweep.grid import Grid  # noqa: E402
+from tests.test_regime_helpers import overrides_000  # noqa: E402
+
+#: the one error allowed (see the module docstring)
+ELAPSED_TIME = re.compile(r"^Coordinate variable 'time' should have standard_name='time', found: 'None'$")
+TINY = ["time.end=1", "time.n_output=11", "output.figures=false"]
+#: pure queries of an open netCDF file that the checker repeats for every variable (quadratic in the
+#: number of variables); cached per file while it is checked, the results are the same (checked once
+#: by hand on every kind: identical results, 5-8 times faster)
+CACHED_QUERIES = ("get_auxiliary_coordinate_variables", "get_axis_map", "get_axis_variables", "get_climatology_variable",
+                  "get_coordinate_variables", "get_geophysical_variables", "get_time_variable", "get_time_variables",
+                  "get_z_variables")
+
+
+@contextlib.contextmanager
+def _cached_queries():
+    originals = {name: getattr(cfutil, name) for name in CACHED_QUERIES if hasattr(cfutil, name)}
+    try:
+        for name, function in originals.items():
+            setattr(cfutil, name, functools.lru_cache(maxsize=None)(function))
+        yield
+    finally:
+        for name, function in originals.items():
+            setattr(cfutil, name, function)
+
+
+def cf_failures(path: Path) -> tuple[list[str], list[str], list[str]]:
+    """(errors, allowed errors, warnings) of the cf:1.8 suite on ``path``, one 'section: message' each."""
+    suite = CheckSuite()
+    suite.load_all_available_checkers()
+    nc = suite.load_dataset(str(path))
+    try:
+        with _cached_queries():
+            groups, crashed = suite.run_all(nc, ["cf:1.8"], skip_checks=[])["cf:1.8"]
+    finally:
+        nc.close()
+    assert not crashed, f"checks that crashed: {crashed}"
+    errors, allowed, warnings = [], [], []
+
+    def walk(results):
+        for result in results:
+            value = result.value
+            passed, total = value if isinstance(value, tuple) else (int(bool(value)), 1)
+            if passed < total:
+                for message in result.msgs or ["(no message)"]:
+                    if result.weight == BaseCheck.HIGH:
+                        (allowed if ELAPSED_TIME.match(message) else errors).append(f"{result.name}: {message}")
+                    elif result.weight == BaseCheck.MEDIUM:
+                        warnings.append(f"{result.name}: {message}")
+            walk(result.children)
+
+    walk(groups)
+    return errors, allowed, warnings
+
+
+class _Written(Exception):
+    """Raised after an experiment's dataset is written, so that its figures are not drawn."""
+
+
+def _experiment(task: str, overrides: list[str], out_dir: Path, monkeypatch) -> tuple[xr.Dataset, Path]:
+    module = importlib.import_module(TASKS[task])
+    captured = []
+
+    def write_and_stop(ds, path):
+        captured.append((ds, write_dataset(ds, path)))
+        raise _Written
+
+    monkeypatch.setattr(module, "write_dataset", write_and_stop)
+    with pytest.raises(_Written):
+        run_task(task, compose_config(overrides), out_dir)
+    return captured[0]
+
+
+def _sweep(tmp_path, monkeypatch):
+    grid = Grid.from_overrides(["body.a=1.5,2", "output.euler_angles=false", *TINY])
+    results = []
+    for n, job in enumerate(grid.jobs):
+        ds = run(list(job))
+        ds.attrs.update(hydra_overrides=" ".join(job), job_id=f"job{n}")
+        results.append(JobResult(FINISHED, ds, job_id=f"job{n}", job_dir=str(n)))
+    ds = assemble(grid, results)
+    return ds, write_dataset(ds, tmp_path / "sweep.nc")
+
+
+def _batch(tmp_path, monkeypatch):
+    path = run_batch_sweep(["integrator=rk4", "integrator.step=0.01", "body.a=1.5,2", "output.euler_angles=false",
+                            *TINY], tmp_path)
+    return xr.load_dataset(path, decode_times=False), path
+
+
+def _yehia(tmp_path, monkeypatch):
+    """One case of the Yehia table (the full table integrates every case for several orbits)."""
+    from gyrolab.experiments import yehia2021_precessions as yehia
+    from gyrolab.physics.precession.cases import CASES
+    from gyrolab.physics.precession.closed_forms import check_closed_forms
+
+    cfg = compose_config(["experiment=yehia2021_precessions", "yehia2021.orbits=0.1"])
+    row, _ = yehia.evaluate(cfg, CASES[0], 0.1, 1e-10)
+    ds = yehia._dataset([row], check_closed_forms(), cfg)
+    return ds, write_dataset(ds, tmp_path / "precession_cases.nc")
+
+
+def _run(overrides):
+    def build(tmp_path, monkeypatch):
+        ds = run([*overrides, *TINY])
+        return ds, write_dataset(ds, tmp_path / "run.nc")
+    return build
+
+
+def _task(task, overrides):
+    return lambda tmp_path, monkeypatch: _experiment(task, overrides, tmp_path, monkeypatch)
+
+
+KINDS = {
+    "run_fixed_point": _run([]),
+    "run_orbiting_gyrostat": _run(["body=gyrostat_symmetric", "force=[newtonian]", "force.newtonian.k=null"]),
+    "sweep_multirun": _sweep,
+    "sweep_batch": _batch,
+    "regime": _task("regime", [*overrides_000(20.0), "regime.periods=1", "regime.samples_per_period=50"]),
+    "work_precision": _task("work_precision", [
+        "experiment=work_precision", "time.end=1", "work_precision.repeats=1", "~work_precision.methods",
+        "+work_precision.methods={dop853: {rtol: [1e-6]}}"]),
+    "regime_validity": _task("regime_validity", [
+        "experiment=regime_validity", "regime_validity.regimes=[small_parameter]", "regime_validity.evidence=[]",
+        "regime_validity.small_parameter.values=[0.0625,0.03125]", "regime_validity.resonance_sweep=null"]),
+    "ismail2021_tables": _task("ismail2021_tables", ["experiment=ismail2021_tables"]),
+    "shaker_omega3": _task("shaker_omega3", ["experiment=shaker_omega3", "time.n_output=201"]),
+    "yehia2021_precessions": _yehia,
+    "orbit_family": _task("orbit_family", [
+        "experiment=orbit_family", "~orbit_family.families",
+        "+orbit_family.families={one: {label: default body, a: 2.0, b: 1.5, com_direction: [0.3, 0.2, "
+        "0.9327379053088815], k: 0.5, theta0: 1.5, section: gamma_prime, r0_start: 100.0, r0_end: 60.0, "
+        "max_points: 3, max_period: 40.0}}"]),
+}
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_dataset_kind_is_cf_1_8(kind, tmp_path, monkeypatch):
+    ds, path = KINDS[kind](tmp_path, monkeypatch)
+    errors, allowed, warnings = cf_failures(path)
+    assert not errors, f"{kind}: compliance-checker cf:1.8 errors:\n" + "\n".join(errors)
+    if warnings:  # reported, not failed: the checker's recommendations (none at the time of writing)
+        print(f"{kind}: compliance-checker cf:1.8 warnings:\n" + "\n".join(warnings))
+    assert all("'time'" in a for a in allowed)
+    assert (len(allowed) > 0) == ("time" in ds.dims)   # the allowance is used only where there is a time axis
+
+    attrs = ds.attrs
+    assert attrs["Conventions"] == "CF-1.8" and attrs["title"]
+    assert datetime.fromisoformat(attrs["date_created"]).tzinfo is not None      # ISO 8601, UTC
+    assert attrs["history"].startswith(attrs["date_created"]) and "gyrolab" in attrs["history"]
+    assert "config" in attrs or "config" in ds                                    # the resolved config stays
+    for name, variable in ds.variables.items():
+        assert variable.attrs.get("long_name") not in (None, "", name), f"{kind}: {name} has no real long_name"
+        assert variable.dtype != np.int64, f"{kind}: {name} is int64"
+        assert variable.attrs.get("standard_name") != "time", f"{kind}: {name} claims a calendar time"
+
+    with xr.open_dataset(path, decode_times=False) as back:                     # still round-trips identically
+        xr.testing.assert_identical(back.load(), ds)
+    if "frame_axis" in ds.dims:   # the gyrostat's frames are labelled; the orbital z component is γ'' (orbit normal)
+        assert list(ds.frame_axis.values) == ["x_radial", "y_along_track", "z_normal"]
+        np.testing.assert_array_equal(ds.body_axis_orbital.sel(frame_axis="z_normal").values, ds.gamma.values[:, 2])
+
+
+def test_model_units_are_machine_readable():
+    """The nondimensional scales are attributes, not only long_name text; an SI top gives them in SI."""
+    ds = run(TINY)
+    assert ds.attrs["time_unit"] == "1/c" and ds.attrs["energy_unit"] == "C c2" and ds.attrs["rate_unit"] == "c"
+    assert "time_scale_s" not in ds.attrs        # a nondimensional body is scale-free
+    # SI top: C = 0.02 kg m², M g ℓ = 0.5 kg × 9.81 m/s² × 0.1 m: c² = M g ℓ / C = 24.525 s⁻², 1/c and C c² in SI
+    si = run(["body.units=si", "body.a=null", "body.b=null", "body.com_direction=null", "body.inertia=[0.03,0.025,0.02]",
+              "body.mass=0.5", "body.com=[0,0,0.1]", "body.g=9.81", "force=[uniform_gravity]", *TINY])
+    c2 = 0.5 * 9.81 * 0.1 / 0.02
+    assert si.attrs["time_unit"] == "s" and si.attrs["energy_unit"] == "J"
+    assert si.attrs["time_scale_s"] == pytest.approx(1 / np.sqrt(c2), rel=1e-12)
+    assert si.attrs["energy_scale_J"] == pytest.approx(0.02 * c2, rel=1e-12)
+
