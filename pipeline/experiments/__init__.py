@@ -16,13 +16,13 @@ from gyrolab.errors import ConfigError, choices
 
 TASKS = {
     "work_precision": "gyrolab.experiments.work_precision",
-    # expansion regimes (seeds 000, 001)
+    # expansion regimes (Ismail (2021), Shaker et al.)
     "regime": "gyrolab.experiments.regime_run",
     "regime_validity": "gyrolab.experiments.regime_validity",
     "ismail2021_tables": "gyrolab.experiments.ismail2021_tables",
     "shaker_omega3": "gyrolab.experiments.shaker_omega3",
     "orbit_family": "gyrolab.experiments.orbit_family",
-    # satellite-gyrostat (seed 002)
+    # satellite-gyrostat (Yehia & El-kenani (2021))
     "yehia2021_precessions": "gyrolab.experiments.yehia2021_precessions",
 }
 

@@ -1,4 +1,4 @@
-"""Tables 1 and 2 of seed 000 (Ismail 2021) regenerated, with their deviation from the published values.
+"""Tables 1 and 2 of Ismail (2021) regenerated, with their deviation from the published values.
 
 What the tables are (docs/derivations/seed000_large_parameter.md §7, reverse-engineered there):
 the table's t is not τ: τ = 2πt/100, and the derivative columns are d/dτ.

@@ -9,7 +9,7 @@ periods with
 * the exact periodic orbit of the full model through the same r0, θ0, γ'(0) = 0
   (Newton shooting from the analytic one, ``gyrolab.physics.periodic``), sampled with
   the compiled Taylor method ("orbit"), and
-* the regime's reduced system (``regime.reduced_rhs``: seed 000 eq. 14, seed 001 eq. 1) integrated
+* the regime's reduced system (``regime.reduced_rhs``: Ismail (2021) eq. 14, Shaker et al. eq. 1) integrated
   with the scene's integrator plugin from its own τ = 0 state and mapped back ("reduced"), for regimes
   that have one.
 
@@ -115,7 +115,7 @@ def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True,
     out: dict[str, Any] = {"period_analytic": regime.period(system)}
     try:
         out["orbit"] = exact_orbit(scene, regime)
-    except IntegrationError as err:  # e.g. seed 001's printed branches (ii), (iv): no orbit exists near them
+    except IntegrationError as err:  # e.g. Shaker et al.'s printed branches (ii), (iv): no orbit exists near them
         if not allow_no_orbit:
             raise
         out["orbit"], out["orbit_failure"] = None, str(err)
@@ -167,7 +167,7 @@ def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[np.nd
 
 def angles_from_states(t: np.ndarray, y: np.ndarray, psi0: float) -> dict[str, np.ndarray]:
     """Euler angles of sampled (ω, γ) states: θ and φ from γ, ψ by quadrature of ψ̇ = (pγ + qγ')/(1 − γ''²)
-    (seed 001 eq. 29) with a cubic spline through the samples (error ~ h⁴: 7e-11 rad at 200 samples per
+    (Shaker et al. eq. 29) with a cubic spline through the samples (error ~ h⁴: 7e-11 rad at 200 samples per
     period against ψ from α, tests/test_regime_experiments.py) — for states that come without the fixed axis α."""
     from scipy.interpolate import CubicSpline
 

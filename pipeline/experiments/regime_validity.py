@@ -52,7 +52,7 @@ def _cfg_for(cfg: DictConfig, regime: str, r0: float) -> DictConfig:
             OmegaConf.update(new, key, value, force_add=True)
         new.initial.r0 = float(r0)
         gamma = base["regime_validity"].get(regime, {}).get("Gamma")
-        if gamma is not None:  # seed 000's γ0'' = Γ c/r0 (eq. 28): the tilt follows the spin
+        if gamma is not None:  # Ismail's (2021) γ0'' = Γ c/r0 (eq. 28): the tilt follows the spin
             new.initial.theta0 = float(np.arccos(min(1.0, gamma / r0)))
     return new
 
@@ -283,7 +283,7 @@ def _regime_class(name: str):
 
 
 def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:
-    """Printed (35) under μ = c/r0 against the full model: γ'' error over one τ period (seed 000 report §3)."""
+    """Printed (35) under μ = c/r0 against the full model: γ'' error over one τ period (Ismail (2021) report §3)."""
     from gyrolab.engine.scene import Scene
     from gyrolab.plugins.regimes.base import nondimensional_scene
     from gyrolab.plugins.regimes.large_parameter import printed_reading_state

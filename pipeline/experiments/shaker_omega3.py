@@ -1,4 +1,4 @@
-"""Seed 001's Euler angles θ, ψ, φ against t: the ω = 3 series against the full model (report §9 body).
+"""Shaker et al.'s Euler angles θ, ψ, φ against t: the ω = 3 series against the full model (report §9 body).
 
 The body is the research's suggestion (docs/derivations/seed001_resonant_omega3.md §9): a = 0.4,
 b = 1/7 (A:B:C = 14:5:35, non-physical, ω = 3), r_c = (0.48, 0.36, 0.8), k = N/c² = 1, θ0 = arctan 0.75,

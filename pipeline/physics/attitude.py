@@ -1,6 +1,6 @@
 """Euler angles (z-x-z: precession ψ, nutation θ, proper rotation φ) and direction cosines.
 
-Convention of the papers (Leimanis; seeds 000–002): the unit vector of the fixed
+Convention of the papers (Leimanis, and the three papers): the unit vector of the fixed
 vertical Z in body axes is γ = (sin θ sin φ, sin θ cos φ, cos θ). With α and
 β the body components of the fixed X and Y axes (β = γ × α), ψ is read from
 α_z = sin ψ sin θ and β_z = −cos ψ sin θ.

@@ -5,7 +5,7 @@ Two equivalent ways to give a body (``body.units``):
 * ``si``: principal moments of inertia ``inertia = [A, B, C]`` (kg m²),
   ``mass`` M (kg), centre of mass ``com = [x0, y0, z0]`` (m, body axes) and
   gravity ``g`` (m/s²). The model runs in SI: time in s, ω in rad/s.
-* ``nondimensional`` (the papers' form, seeds 000/001): ``a = A/C``,
+* ``nondimensional`` (the papers' form, Ismail (2021) and Shaker et al.): ``a = A/C``,
   ``b = B/C``, unit centre-of-mass direction ``com_direction = [x0', y0', z0']``.
   Inertia is measured in units of C, time in units of 1/c with
   c² = M g ℓ / C (ℓ = |r_c|), angular velocity in units of c, torques in

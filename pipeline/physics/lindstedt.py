@@ -2,7 +2,7 @@
 
 The heavy body about a fixed point, with a torque U × γ + N γ × Iγ (uniform gravity, a vertical uniform magnetic
 field, the Newtonian centre: every force with a compiled form that is symmetric about the vertical), in the
-scaled variables of seed 000 (``gyrolab.plugins.regimes.ismail2021``; p = c p1, q = c q1, r = r0 r1, τ = r0 t,
+scaled variables of Ismail (2021) (``gyrolab.plugins.regimes.ismail2021``; p = c p1, q = c q1, r = r0 r1, τ = r0 t,
 c² = |U|/C, a = A/C, b = B/C, (x0', y0', z0') = U/|U|, k = N/c²):
 
     ṗ1 = −A1 q1 r1 + ε[(γ''y0' − γ'z0')/a + kA1γ'γ''],    q̇1 = −B1 p1 r1 + ε[(γz0' − γ''x0')/b + kB1γ''γ],
@@ -48,7 +48,7 @@ class Body:
 
     @property
     def coefficients(self) -> tuple[float, float, float]:
-        """(A1, B1, C1) = ((1 − b)/a, (a − 1)/b, b − a) of seed 000's eq. (1); ω² = −A1B1."""
+        """(A1, B1, C1) = ((1 − b)/a, (a − 1)/b, b − a) of Ismail's (2021) eq. (1); ω² = −A1B1."""
         return (1 - self.b) / self.a, (self.a - 1) / self.b, self.b - self.a
 
 

@@ -10,7 +10,7 @@ parameters) is integrated together with its variational equations
 method of high order compiled with numba: the right-hand sides are quadratic,
 so every Taylor coefficient is a Cauchy product (Jorba & Zou, Exp. Math. 14, 2005).
 
-Shooting (the setting of seeds 000 and 001): the orbit passes through a
+Shooting (the setting of Ismail (2021) and Shaker et al.): the orbit passes through a
 point with r = r0, γ' = 0, γ'' = γ0'' fixed (γ = +√(1 − γ''²)); the unknowns
 are p(0), q(0) and the period T. The residual is the 6-component return map
 y(T) − y(0); the three first integrals make it rank 3, so Newton's step is the
@@ -207,7 +207,7 @@ def shoot(model: FixedPointModel, y0: np.ndarray, period: float, *, tol: float =
     ``tol`` or no step along the Newton direction decreases it (the rounding floor). The result is an
     orbit only if the residual is below ``accept``: a stall above it means there is no orbit near the
     guess, or Newton cannot reach it (IntegrationError). The default ``accept`` is tight on purpose:
-    near a family of almost-periodic motions (seed 001's amplitude circle, report §6) the return residual
+    near a family of almost-periodic motions (Shaker et al.'s amplitude circle, report §6) the return residual
     of a point that is *not* on an orbit can be as small as 1e-10.
     """
     y0 = np.asarray(y0, dtype=float)

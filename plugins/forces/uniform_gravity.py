@@ -1,4 +1,4 @@
-"""Uniform gravity on a heavy body: torque M g r_c × γ (seed 000 eq. 1, seed 001 eq. 1).
+"""Uniform gravity on a heavy body: torque M g r_c × γ (Ismail (2021) eq. 1, Shaker et al. eq. 1).
 
 γ is the unit vector of the fixed vertical Z, which in the papers points
 along the weight (towards the attracting centre); the potential is

@@ -1,4 +1,4 @@
-"""Classical fourth-order Runge–Kutta with a fixed step: the method of seeds 000 and 001.
+"""Classical fourth-order Runge–Kutta with a fixed step: the method of Ismail (2021) and Shaker et al.
 
 The step ``step`` is an upper bound: each interval between output times is
 split into the fewest equal steps not longer than ``step``, so the method

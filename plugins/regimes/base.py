@@ -36,7 +36,7 @@ class NondimensionalScene:
 
     @property
     def omega2(self) -> float:
-        """ω² = −A1B1 = (C−A)(C−B)/(AB) (seed 000 eq. 5, seed 001 §2)."""
+        """ω² = −A1B1 = (C−A)(C−B)/(AB) (Ismail (2021) eq. 5, Shaker et al. §2)."""
         return (1 - self.a) * (1 - self.b) / (self.a * self.b)
 
     @property
@@ -53,7 +53,7 @@ def nondimensional_scene(system: System, regime: str) -> NondimensionalScene:
                           f"(a vertical magnetic field may add to or replace gravity), got force={names}")
     body = system.body
     nd = body.nondimensional()
-    # The torque U × γ: the weight's moment plus m·B of a vertical uniform field (the same form, seed 000 eq. 1)
+    # The torque U × γ: the weight's moment plus m·B of a vertical uniform field (the same form, Ismail (2021) eq. 1)
     U = np.array(body.weight_moment, dtype=float) if "uniform_gravity" in names else np.zeros(3)
     for force in system.forces:
         if force.name == "magnetic":

@@ -1,4 +1,4 @@
-"""Seed 000: the fast-spin periodic solution of Ismail (2021), printed and corrected.
+"""The fast-spin periodic solution of Ismail (2021), printed and corrected.
 
 A. I. Ismail, "The periodic rotary motions of a rigid body in a new domain of
 angular velocity", J. Egypt. Math. Soc. 29:2 (2021). Verification report:

@@ -1,6 +1,6 @@
-"""Slow spin about a fixed point (small r0/c): the perturbed physical pendulum — seed 000's "new domain", done right.
+"""Slow spin about a fixed point (small r0/c): the perturbed physical pendulum — Ismail's (2021) "new domain", done right.
 
-Seed 000 (Ismail 2021) claims a "large-parameter" solution for small r0 with μ = c/r0, but its equations (1)-(2)
+Ismail (2021) claims a "large-parameter" solution for small r0 with μ = c/r0, but its equations (1)-(2)
 hold only for μ = r0/c (``docs/derivations/seed000_large_parameter.md`` §3): read as printed its formulas miss
 the motion by O(1). This plugin is the slow-spin regime built from the right generating motion instead:
 
@@ -41,7 +41,7 @@ WARN_SPIN = 0.1
 MIN_TILT, MAX_TILT = 0.05, 3.0
 MIN_INDEX_GAP = 0.05  # |s0 − 2| below this: the swing is (nearly) degenerate out of plane
 FIT_SPINS = (0.01, 0.02, 0.03, 0.04)
-PRINTED_WARNING = ("regime.formula=printed evaluates seed 000's printed (35) under its own reading μ = c/r0: it is "
+PRINTED_WARNING = ("regime.formula=printed evaluates Ismail's (2021) printed (35) under its own reading μ = c/r0: it is "
                    "not a solution of the equations of motion and misses the full model by O(1) (γ'' error 0.87-0.99 "
                    "at c/r0 = 4-64); the measured error is max_error_vs_full")
 

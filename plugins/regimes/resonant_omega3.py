@@ -1,4 +1,4 @@
-"""The resonant case ω = 3 (seed 001, Shaker, El-Barki, Ismail), branches (i)-(iv) of eq. (23), corrected or printed.
+"""The resonant case ω = 3 (Shaker, El-Barki & Ismail), branches (i)-(iv) of eq. (23), corrected or printed.
 
 Fast spin with the small parameter μ = c√(cos θ0)/r0 and the 3:1 resonance
 of the generating system, ω² = (C−A)(C−B)/(AB) = 9. Since ω² − 1 =
@@ -35,7 +35,7 @@ PRINTED_BRANCH_ORDER = {"pq": 0.0, "r": 2.0, "gamma": 1.0, "gamma3": 1.0, "perio
 class ResonantOmega3(FixedPointRegime):
     name = "resonant_omega3"
     parameter = "mu"
-    parameter_long_name = "seed 001's small parameter μ = c√(cos θ0)/r0"
+    parameter_long_name = "Shaker et al.'s small parameter μ = c√(cos θ0)/r0"
     order = {"pq": 3.0, "r": 4.0, "gamma": 4.0, "gamma3": 4.0, "period": 4.0}
     printed_order = {"pq": 1.0, "r": 4.0, "gamma": 2.0, "gamma3": 2.0, "period": 2.0}
 
@@ -44,7 +44,7 @@ class ResonantOmega3(FixedPointRegime):
         super().__init__(formula=formula, periods=periods, samples_per_period=samples_per_period)
         branch = str(branch)
         if branch not in BRANCHES:
-            raise ConfigError(f"regime.branch={branch!r} is not a branch of seed 001's eq. (23); valid choices: "
+            raise ConfigError(f"regime.branch={branch!r} is not a branch of Shaker et al.'s eq. (23); valid choices: "
                               f"{', '.join(BRANCHES)}")
         if formula == "corrected" and branch in ("ii", "iv"):
             raise ConfigError(f"regime.branch={branch} is not a periodic solution: the resonant forcing M3³L310 locks "
@@ -112,7 +112,7 @@ class ResonantOmega3(FixedPointRegime):
         return out
 
     def reduced_rhs(self, system):
-        """Seed 001's scaled system (eq. 1 in the variables of eq. 5) for this scene: ``(rhs, Y0, to_model)``.
+        """Shaker et al.'s scaled system (eq. 1 in the variables of eq. 5) for this scene: ``(rhs, Y0, to_model)``.
 
         ``rhs(τ, Y)`` is d/dτ of Y = (p1, q1, r1, γ1, γ1', γ1''), τ = r0 t (exact rescaling of the full model,
         ``shaker_omega3.scaled_rhs``); Y0 is the analytic orbit's τ = 0 state; ``to_model(Y)`` maps (6, n)

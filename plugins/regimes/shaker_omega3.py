@@ -1,4 +1,4 @@
-"""Seed 001: the resonant case ω = 3 (Shaker, El-Barki, Ismail): the branches (i)-(iv) of eq. (23), printed and corrected.
+"""The resonant case ω = 3 of Shaker, El-Barki & Ismail: the branches (i)-(iv) of eq. (23), printed and corrected.
 
 M. O. Shaker, F. A. El-Barki, A. I. Ismail, "Singular value of the natural
 frequency for the motion of rigid body". Verification report:

@@ -1,6 +1,6 @@
-"""Fast spin about a fixed point: Poincaré's small-parameter periodic solution, ε = c/r0 ≪ 1 (seed 000, corrected).
+"""Fast spin about a fixed point: Poincaré's small-parameter periodic solution, ε = c/r0 ≪ 1 (Ismail (2021), corrected).
 
-Seed 000 (Ismail 2021) calls this a "large-parameter" method for small r0,
+Ismail (2021) calls this a "large-parameter" method for small r0,
 but its equations (1)-(2) are consistent only with μ = r0/c (report §3 of
 ``docs/derivations/seed000_large_parameter.md``): it is the classical fast-top
 expansion in ε = 1/μ = c/r0 = √(Mgℓ/C)/r0. This plugin is that expansion,
@@ -77,7 +77,7 @@ def finite_tilt_frequency(P: paper.Params) -> float:
     """Ω = 2π/T_τ through ε³ at a fixed tilt γ0'' (the ε³ term vanishes by symmetry).
 
     The ε² coefficient is −[x0'√(1 − γ0''²) − z0'γ0'' + (k/4)(b − a − γ0''²(a + 3b − 4))]: (36) with the finite
-    tilt kept — its O(γ0''²) terms are O(ε⁴) in seed 000's scaling γ0'' = Γε, so (36) agrees with it there.
+    tilt kept — its O(γ0''²) terms are O(ε⁴) in Ismail's (2021) scaling γ0'' = Γε, so (36) agrees with it there.
     Found from the numeric series' ε² coefficient (exact in γ0'') and checked against exact orbits'
     periods (tests/test_regime_small_parameter.py).
     """
@@ -94,7 +94,7 @@ def refusal_distance(n: float, eps: float) -> float:
 class SmallParameter(FixedPointRegime):
     name = "small_parameter"
     parameter = "c/r0"
-    parameter_long_name = "Poincaré's small parameter ε = c/r0 = √(Mgℓ/C)/r0 (seed 000's 1/μ)"
+    parameter_long_name = "Poincaré's small parameter ε = c/r0 = √(Mgℓ/C)/r0 (Ismail's (2021) 1/μ)"
     order = {"pq": 3.0, "r": 4.0, "gamma": 4.0, "gamma3": 4.0, "period": 4.0}
     printed_order = {"pq": 3.0, "r": 2.0, "gamma": 2.0, "gamma3": 4.0, "period": 2.0}
 
@@ -211,7 +211,7 @@ class SmallParameter(FixedPointRegime):
         gamma = s.gamma0pp / eps
         if abs(gamma) > 3:
             warnings.append(f"Γ = cos θ0 · r0/c = {gamma:.3g}: the closed forms assume cos θ0 = O(c/r0) "
-                            "(a nearly horizontal axis, seed 000 eq. 28); expect errors of order cos⁴θ0 in the γ's "
+                            "(a nearly horizontal axis, Ismail (2021) eq. 28); expect errors of order cos⁴θ0 in the γ's "
                             "(the period keeps the finite tilt); regime.order=N gives the finite-tilt series")
         if abs(s.a + s.b - 1) < 0.05:
             warnings.append(f"a + b − 1 = {s.a + s.b - 1:.3g}: the z0'/(a + b − 1) terms of (35) are large")

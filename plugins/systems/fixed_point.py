@@ -1,6 +1,6 @@
 """Heavy rigid body about a fixed point: the Euler–Poisson equations in vector form.
 
-In principal body axes (seed 000 eq. 1, seed 001 eq. 1, any textbook):
+In principal body axes (Ismail (2021) eq. 1, Shaker et al. eq. 1, any textbook):
 
     I ω̇ = (I ω) × ω + Σ torques,        γ̇ = γ × ω,
 

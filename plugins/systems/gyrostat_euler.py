@@ -1,4 +1,4 @@
-"""Lagrange equations of the orbiting satellite-gyrostat in Euler angles (seed 002, eqs. 5–7 re-derived).
+"""Lagrange equations of the orbiting satellite-gyrostat in Euler angles (Yehia & El-kenani (2021), eqs. 5–7 re-derived).
 
 Euler angles (ψ, θ, φ), z-x-z, of the body relative to the orbital frame (α radial,
 β along-track, γ orbit normal): α, β, γ in body axes are eq. (1) of Yehia & El-kenani

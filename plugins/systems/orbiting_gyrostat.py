@@ -1,4 +1,4 @@
-"""Satellite-gyrostat on a circular orbit: gravity-gradient and magnetic torques (seed 002).
+"""Satellite-gyrostat on a circular orbit: gravity-gradient and magnetic torques (Yehia & El-kenani (2021)).
 
 Yehia & El-kenani, J. Appl. Comput. Mech. 7(4) (2021) 2120–2128, eqs. (1)–(3), in vector
 form (docs/gyrostat.md). Body axes are principal, I = diag(A, B, C); k is the rotors'

@@ -1,4 +1,4 @@
-"""Regular precessions of the orbiting satellite-gyrostat (seed 002): motion and residuals, stability,
+"""Regular precessions of the orbiting satellite-gyrostat (Yehia & El-kenani (2021)): motion and residuals, stability,
 classification, numerical finder, the paper's case catalogue and printed closed forms."""
 
 from gyrolab.physics.precession.classify import Classification, classify

@@ -1,4 +1,4 @@
-"""The catalogue of seed 002's regular precessions: one concrete parameter set per printed condition set.
+"""The catalogue of Yehia & El-kenani's (2021) regular precessions: one concrete parameter set per printed condition set.
 
 Lifted from docs/derivations/scripts/seed002/model.py (``build_cases``). Ω = 1; common numbers:
 asymmetric body (A, B, C) = (1.0, 1.4, 1.9), symmetric A = B = 1.2, C = 2.0; μ = (0.4, −0.5, 0.6),
