@@ -13,6 +13,7 @@ more commands work on results: ``gyrolab --reproduce PATH/run.nc`` and
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import difflib
 import logging
@@ -109,7 +110,7 @@ def preflight(argv: Sequence[str]) -> list[str]:
     cfg = configs[0]
     for composed in configs:
         check_scene_config(_without_hydra(composed))
-    run_text = str(cfg.hydra.sweep.dir if sweeping else cfg.hydra.run.dir)
+    run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
     for composed in configs:
@@ -117,6 +118,25 @@ def preflight(argv: Sequence[str]) -> list[str]:
     validate_scene(_without_hydra(cfg))
     check_writable(run_dir)
     return argv
+
+
+def _output_dir_text(cfg: DictConfig, mode: str) -> str:
+    """``hydra.run.dir`` (or ``hydra.sweep.dir``) resolved as Hydra will resolve it, or one sentence why not.
+
+    ``${hydra:...}`` needs the Hydra config registered, as it is inside the run; a key that only
+    exists once the job runs (``hydra.runtime.*``) cannot name the directory before it exists.
+    """
+    from omegaconf.errors import OmegaConfBaseException
+
+    key = f"hydra.{mode}.dir"
+    try:
+        HydraConfig.instance().set_config(copy.deepcopy(cfg))  # set_config marks its argument read-only
+        return str(OmegaConf.select(cfg, key, throw_on_missing=True))
+    except (OmegaConfBaseException, ValueError, TypeError) as error:
+        raw = OmegaConf.to_container(cfg.hydra[mode], resolve=False).get("dir")
+        reason = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+        raise ConfigError(f"{key}={raw!r} cannot be resolved before the run starts ({reason}); give a path, "
+                          "optionally with ${now:...} or ${hydra:job.name}") from None
 
 
 def _plus_group_as_override(source: ConfigSource, argv: list[str], overrides: Sequence[Override]) -> list[str]:

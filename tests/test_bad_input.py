@@ -122,6 +122,7 @@ CORPUS = [
     # interpolations
     (["initial.r0=${nope.key}"], "${nope.key}"), (["initial.r0=${time}"], "initial.r0"),
     (["initial.r0=${oc.env:GYROLAB_SURELY_UNSET_VARIABLE}"], "initial.r0"),
+    (["hydra.run.dir=${nope.key}/x"], "cannot be resolved before the run starts"),
     # sections deleted or replaced by a value
     (["~time"], "deletes the section time"),
     (["~body"], "deletes the section body"),

@@ -94,3 +94,12 @@ def test_the_preflight_validates_the_users_config(myconf, tmp_path, monkeypatch,
                              monkeypatch, capsys)
         assert code == 2 and phrase in err and len(err.strip().splitlines()) == 1, err
     assert not (tmp_path / "out").exists()
+
+
+def test_run_dir_may_use_hydra_resolvers(tmp_path, monkeypatch):
+    # ${hydra:...} in the run directory is Hydra's own idiom: the preflight resolves it as the run will
+    from gyrolab import app
+
+    monkeypatch.chdir(tmp_path)
+    argv = app.preflight(["hydra.run.dir=${hydra:runtime.cwd}/by_cwd", "time.end=1"])
+    assert "hydra.run.dir=${hydra:runtime.cwd}/by_cwd" in argv
