@@ -143,8 +143,9 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     traces = [trace(name, _family_spec(name, f)) for name, f in families.items()]
     ds = dataset(traces, cfg)
     out_dir = Path(out_dir)
-    written = [write_dataset(ds, out_dir / "orbit_family.nc"), plot(traces, out_dir / "figures" / "orbit_family.png")]
-    return written
+    from gyrolab.figures.redraw import draw_figures
+
+    return [write_dataset(ds, out_dir / "orbit_family.nc"), *draw_figures("orbit_family.nc", ds, out_dir, cfg.get("output"))]
 
 
 def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
@@ -170,6 +171,8 @@ def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
         "amplitude": ("point", np.concatenate([tr["amplitude"] for tr in traces]), {"units": "rad", "long_name": "nutation amplitude max θ − min θ"}),
         "return_residual": ("point", np.array([p.residual for p in points]), {"units": "1", "long_name": "relative return residual of the shooting"}),
         "family": ("point", family, {"units": "1", "long_name": "family name (orbit_family.families)"}),
+        "family_label": ("point", np.array([tr["label"] for tr in traces for _ in tr["points"]]),
+                         {"units": "1", "long_name": "family description (body, tilt, where it starts)"}),
         "bifurcation": ("point", np.array([labels[i] for i in range(len(points))]),
                         {"units": "1", "long_name": "bifurcation detected between the previous point and this one"}),
     }
@@ -196,50 +199,3 @@ def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
                      "summary": " | ".join(summary),
                      "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
     return conform(ds, source="orbit_family experiment")
-
-
-def plot(traces: list[dict], path: Path) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from gyrolab.output.atomic import atomic_path
-
-    fig, axes = plt.subplots(3, 1, figsize=(8, 10), sharex=True)
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for n, tr in enumerate(traces):
-        r0 = np.array([p.r0 for p in tr["points"]])
-        period = np.array([p.period for p in tr["points"]])
-        stable = np.array([p.stable for p in tr["points"]])
-        amp = np.array(tr["amplitude"])
-        c = colours[n % len(colours)]
-        for ax, values in ((axes[0], period), (axes[1], amp)):
-            ax.plot(r0, values, "-", color=c, lw=0.8, label=tr["label"])
-            ax.scatter(r0[stable], values[stable], s=10, color=c, marker="o")
-            ax.scatter(r0[~stable], values[~stable], s=10, facecolors="none", edgecolors=c, marker="o")
-            for i, label in tr["events"]:
-                ax.annotate({"fold": "F", "branch point": "BP", "period doubling": "PD"}[label], (r0[i], values[i]),
-                            fontsize=6, color=c)
-        for key, errs in tr["errors"].items():
-            errs = np.array(errs)
-            if np.isfinite(errs).any():
-                axes[2].plot(r0, errs, ".-", color=c, lw=0.6, ms=3, label=f"{tr['name']}: {key} series")
-    for tol in BANDS:
-        axes[2].axhline(tol, color="0.5", lw=0.6, ls="--")
-    axes[0].set_yscale("log")
-    axes[0].set_ylabel("period (1/c)")
-    axes[1].set_ylabel("nutation amplitude (rad)")
-    axes[2].set_yscale("log")
-    axes[2].set_ylabel("series error vs exact orbit")
-    axes[2].set_xlabel("r0/c")
-    axes[2].set_xscale("log")
-    axes[0].legend(fontsize=7, title="filled: stable, open: unstable; F fold, BP branch point, PD period doubling",
-                   title_fontsize=6)
-    axes[2].legend(fontsize=6)
-    fig.suptitle("exact periodic-orbit families: fast spin (right) to slow spin (left)", fontsize=10)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=100, format="png")
-    plt.close(fig)
-    return path

@@ -28,6 +28,7 @@ KINDS = {
     "ismail2021_tables.nc": "tables",
     "precession_cases.nc": "precessions",
     "shaker_omega3.nc": "shaker",
+    "orbit_family.nc": "orbit_family",
 }
 
 
