@@ -544,6 +544,13 @@ def main() -> None:
         sys.argv[1:] = preflight(argv)
     except GyrolabError as error:
         fail(error)
+    from gyrolab.sweep import callbacks
+
+    # each command starts clean (tests and notebooks run several in one process): no outcome of an earlier
+    # sweep (a sweep without gyrolab's callback, from a user's primary config, would not clear it) and bars
+    # allowed again (a multirun job turns them off)
+    callbacks.reset()
+    allow_bars(True)
     _task()
     status = _sweep_status()
     if status:

@@ -34,6 +34,12 @@ last_error: str | None = None
 last_exit_code: int = 1
 
 
+def reset() -> None:
+    """Forget the last sweep's outcome: each command starts clean (the app may run several in one process)."""
+    global last_summary, last_error, last_exit_code
+    last_summary, last_error, last_exit_code = None, None, 1
+
+
 class SweepCallback(Callback):
     """Aggregate a multirun into ``<sweep dir>/sweep.nc``; ``figures``: also draw the summary figures.
 
@@ -68,8 +74,7 @@ class SweepCallback(Callback):
             unlock(locked)
 
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
-        global last_summary, last_error, last_exit_code
-        last_summary, last_error, last_exit_code = None, None, 1
+        reset()
         self._announced = announce_launcher()  # worker processes of this sweep die with this process
         if not self.progress or not _basic_sweeper(config):
             return
