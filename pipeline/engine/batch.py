@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.contracts import CompiledModel, Integrator
 from gyrolab.engine.scene import Scene
 
 FAST_PATH = ("rk4", "rk4_numba")
@@ -34,43 +35,70 @@ class BatchSolution:
 
 
 def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray | None = None) -> BatchSolution:
-    """Integrate ``scene`` from each row of ``initial_states``.
+    """Integrate ``scene`` from each row of ``initial_states`` over ``scene.times``.
 
     ``params`` (trajectories × n) optionally replaces the compiled model's
     parameters per trajectory (see ``gyrolab.plugins.compiled.fixed_point.pack``).
     """
-    y0s = np.ascontiguousarray(initial_states, dtype=float)
     size = scene.system.state_size
+    y0s = np.ascontiguousarray(initial_states, dtype=float)
     if y0s.ndim != 2 or y0s.shape[1] != size:
         raise ConfigError(f"initial_states has shape {y0s.shape}; it must be (trajectories, {size})")
-    if not np.all(np.isfinite(y0s)):
-        raise ConfigError("initial_states contains NaN or inf; every initial state must be finite")
     compiled = scene.system.compiled_model()
-    start = time.perf_counter()
-    if scene.integrator.name in FAST_PATH and compiled is not None:
-        from gyrolab.plugins.compiled import rk4
-        from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
-
-        steps = steps_per_interval(scene.times, scene.integrator.step)
-        P = np.tile(compiled.params, (len(y0s), 1)) if params is None else np.ascontiguousarray(params, dtype=float)
-        if P.shape != (len(y0s), compiled.params.size):
-            raise ConfigError(f"params has shape {P.shape}; it must be ({len(y0s)}, {compiled.params.size})")
-        out = np.empty((len(y0s), len(scene.times), size))
-        if _blockable(compiled, size):
-            rk4.run_batch_blocks(P, scene.times, steps, y0s, out)
-        else:
-            rk4.run_batch(compiled.model, P, scene.times, steps, y0s, out)
-        n_steps = int(steps.sum())
-    else:
+    if scene.integrator.name not in FAST_PATH or compiled is None:
         if params is not None:
             raise ConfigError(f"per-trajectory params need integrator rk4 or rk4_numba, not {scene.integrator.name}")
+        _require_finite(y0s)
+        start = time.perf_counter()
         runs = [scene.integrator.integrate(scene.system.rhs, scene.times, y0, None, compiled) for y0 in y0s]
         out = np.stack([r.y for r in runs])
-        n_steps = max(r.stats.n_steps for r in runs)
+        _require_finite_out(out)
+        return BatchSolution(scene.times, out, max(r.stats.n_steps for r in runs), time.perf_counter() - start)
+    return integrate_arrays(compiled, scene.integrator, scene.times, y0s, params)
+
+
+def integrate_arrays(compiled: CompiledModel, integrator: Integrator, times: np.ndarray, initial_states: np.ndarray,
+                     params: np.ndarray | None = None) -> BatchSolution:
+    """The batch kernel entry point: no scene, only arrays.
+
+    ``compiled`` is a system's compiled model (its ``params`` are used for every trajectory unless
+    ``params``, trajectories × ``compiled.params.size``, gives them per trajectory), ``integrator``
+    the integrator plugin (its name and settings choose the kernel), ``times`` the output times and
+    ``initial_states`` (trajectories × state size) one row per trajectory.
+    """
+    y0s = np.ascontiguousarray(initial_states, dtype=float)
+    if y0s.ndim != 2:
+        raise ConfigError(f"initial_states has shape {y0s.shape}; it must be (trajectories, state size)")
+    _require_finite(y0s)
+    if integrator.name not in FAST_PATH:
+        raise ConfigError(f"batch kernels run integrator rk4 or rk4_numba, not {integrator.name}")
+    from gyrolab.plugins.compiled import rk4
+    from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
+
+    P = np.tile(compiled.params, (len(y0s), 1)) if params is None else np.ascontiguousarray(params, dtype=float)
+    if P.shape != (len(y0s), compiled.params.size):
+        raise ConfigError(f"params has shape {P.shape}; it must be ({len(y0s)}, {compiled.params.size})")
+    start = time.perf_counter()
+    steps = steps_per_interval(times, integrator.step)
+    size = y0s.shape[1]
+    out = np.empty((len(y0s), len(times), size))
+    if _blockable(compiled, size):
+        rk4.run_batch_blocks(P, times, steps, y0s, out)
+    else:
+        rk4.run_batch(compiled.model, P, times, steps, y0s, out)
+    _require_finite_out(out)
+    return BatchSolution(np.asarray(times), out, int(steps.sum()), time.perf_counter() - start)
+
+
+def _require_finite(y0s: np.ndarray) -> None:
+    if not np.all(np.isfinite(y0s)):
+        raise ConfigError("initial_states contains NaN or inf; every initial state must be finite")
+
+
+def _require_finite_out(out: np.ndarray) -> None:
     if not np.all(np.isfinite(out)):
         bad = int(np.argmax(~np.all(np.isfinite(out), axis=(1, 2))))
         raise IntegrationError(f"trajectory {bad} of the batch became non-finite; reduce integrator.step")
-    return BatchSolution(scene.times, out, n_steps, time.perf_counter() - start)
 
 
 def _blockable(compiled, size: int) -> bool:
