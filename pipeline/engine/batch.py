@@ -28,6 +28,9 @@ class BatchSolution:
     y: np.ndarray  # (trajectories, n_out, state size)
     n_steps: int  # per trajectory
     wall_time: float
+    #: (trajectories,) True where the trajectory became non-finite (its rows from then on are NaN);
+    #: only with ``failures="mark"``, else all False (a failure raised instead)
+    failed: np.ndarray | None = None
 
     @property
     def trajectory_steps_per_second(self) -> float:
@@ -58,13 +61,15 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
 
 
 def integrate_arrays(compiled: CompiledModel, integrator: Integrator, times: np.ndarray, initial_states: np.ndarray,
-                     params: np.ndarray | None = None) -> BatchSolution:
+                     params: np.ndarray | None = None, failures: str = "raise") -> BatchSolution:
     """The batch kernel entry point: no scene, only arrays.
 
     ``compiled`` is a system's compiled model (its ``params`` are used for every trajectory unless
     ``params``, trajectories × ``compiled.params.size``, gives them per trajectory), ``integrator``
     the integrator plugin (its name and settings choose the kernel), ``times`` the output times and
-    ``initial_states`` (trajectories × state size) one row per trajectory.
+    ``initial_states`` (trajectories × state size) one row per trajectory. A trajectory that becomes
+    non-finite raises IntegrationError (``failures="raise"``) or is marked in ``BatchSolution.failed``
+    (``failures="mark"``: a batch keeps its other trajectories).
     """
     y0s = np.ascontiguousarray(initial_states, dtype=float)
     if y0s.ndim != 2:
@@ -86,8 +91,10 @@ def integrate_arrays(compiled: CompiledModel, integrator: Integrator, times: np.
         rk4.run_batch_blocks(P, times, steps, y0s, out)
     else:
         rk4.run_batch(compiled.model, P, times, steps, y0s, out)
-    _require_finite_out(out)
-    return BatchSolution(np.asarray(times), out, int(steps.sum()), time.perf_counter() - start)
+    failed = ~np.all(np.isfinite(out), axis=(1, 2))
+    if failures == "raise":
+        _require_finite_out(out)
+    return BatchSolution(np.asarray(times), out, int(steps.sum()), time.perf_counter() - start, failed)
 
 
 def _require_finite(y0s: np.ndarray) -> None:
