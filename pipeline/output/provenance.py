@@ -20,7 +20,9 @@ CODE_PATHS = ("pipeline", "plugins", "conf", "pyproject.toml")
 PLUGIN_GROUPS = ("gyrolab.systems", "gyrolab.forces", "gyrolab.integrators", "gyrolab.regimes")
 
 
+@cache
 def gyrolab_version() -> str:
+    """The installed gyrolab's version (read once per process: every dataset's history line asks for it)."""
     try:
         return metadata.version("gyrolab")
     except metadata.PackageNotFoundError:
