@@ -62,6 +62,9 @@ FIRST_RATIO = 1e-3  # first pilot tolerance relative to the accuracy (the typica
 #: actual / raw predicted final error, largest measured on the extremes matrix and the reference scene
 #: (accuracies 1e-4 to 1e-12), rounded up; the recorded prediction is the raw one times this.
 CALIBRATION = 3.0
+#: a series' predicted error (its first omitted term) is an estimate: trusted to within this factor when ruling
+#: out the other orders of a regime whose orbit the scene misses
+MISS_MARGIN = 1000.0
 
 
 class Auto(Integrator):
@@ -183,18 +186,35 @@ class Auto(Integrator):
                 base = registry.load("regime", name)()
                 if self.system.name in base.systems:
                     ladder = getattr(base, "series_candidates", lambda system, accuracy: [(base, None)])
-                    candidates += [(name, r) for r, _ in ladder(self.system, self.accuracy / self.safety)]
+                    candidates += [(name, r, float("nan") if e is None else float(e))
+                                   for r, e in ladder(self.system, self.accuracy / self.safety)]
             except GyrolabError:
                 continue
-        for name, regime in candidates:
+        tolerance = self.accuracy / (10 * self.safety)  # how far from the orbit's start the scene may begin
+        far: set[str] = set()  # regimes whose orbit the scene is known to miss by far more than any variant's error
+        for name, regime, estimate in candidates:
+            if name in far and np.isfinite(estimate):
+                continue
             try:
-                if regime.check_domain(self.system):
+                # A variant with a predicted error (a series order) comes from a regime whose series is built and
+                # whose domain admits the scene: its start is cheap, so it goes first (most scenes miss the orbit,
+                # and the domain check evaluates it again). Otherwise the domain check goes first: a refusal is
+                # cheap where the orbit may not be (a shooting method).
+                if not np.isfinite(estimate) and regime.check_domain(self.system):
                     continue  # outside the domain, or near its edge (warnings): no confidence in the series
-                orbit0 = regime.initial_state(self.system)
+                with np.errstate(all="ignore"):  # an orbit may evaluate to inf/nan: a miss
+                    distance = float(np.max(np.abs(regime.initial_state(self.system)[:6] - y0[:6])))
+                if not distance <= tolerance:
+                    # Variants of one regime (series orders) approximate the same orbit, each predicted within
+                    # accuracy/safety of it (series_candidates lists only those): the scene misses every one by
+                    # at least distance − 2·accuracy/safety; MISS_MARGIN covers the prediction being an estimate.
+                    if np.isfinite(estimate) and distance > tolerance + 2 * MISS_MARGIN * self.accuracy / self.safety:
+                        far.add(name)
+                    continue  # the scene does not start on the orbit the series describes
+                if np.isfinite(estimate) and regime.check_domain(self.system):
+                    continue
             except GyrolabError:
                 continue
-            if np.max(np.abs(orbit0[:6] - y0[:6])) > self.accuracy / (10 * self.safety):
-                continue  # the scene does not start on the orbit the series describes
             window = min(span, regime.period(self.system))
             check = np.linspace(0.0, window, 33)
             truth = Taylor(order=20, tol=1e-15).integrate(fun, check, y0, None, compiled)
