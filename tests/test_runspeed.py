@@ -1,0 +1,126 @@
+"""The lean paths of a run (issue 12, item 4) give the same results as the plain ones.
+
+* ``gyrolab.output.dataset.assemble`` puts the run dataset together without xarray's merge: the dataset must
+  be the one ``xr.Dataset(variables, coords=coords)`` builds (same variables in the same order, values,
+  attributes, indexes, netCDF encodings), and its values those of an independent recomputation from the
+  integrated states (the formulas written out here, not the system's code).
+* ``integrator=auto`` skips the other series orders of a regime whose orbit the scene misses by far: it
+  must evaluate only one order's start there, and still take the series on the orbit
+  (``tests/test_auto_regime.py``, ``tests/test_regime_small_parameter.py``).
+"""
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from gyrolab import compose_scene
+from gyrolab.output import dataset
+
+FIXED_POINT = ["time.end=2", "time.n_output=21"]  # the default scene: gravity + Newtonian centre, Euler angles
+GYROSTAT = ["experiment=gyrostat", "time.end=1", "time.n_output=11"]  # frame_axis variables
+
+
+def _without_clock(ds):
+    ds = ds.copy()
+    for key in ("date_created", "history"):  # the time of writing differs between two builds
+        ds.attrs.pop(key)
+    return ds
+
+
+def _both(overrides, monkeypatch):
+    """(lean dataset, xarray's public construction) of one integration of the scene."""
+    scene = compose_scene(overrides)
+    solution = scene.integrator.integrate(scene.system.rhs, scene.times, scene.system.initial_state(), None,
+                                          scene.compiled)
+    lean = dataset.build_dataset(scene, solution)
+    with monkeypatch.context() as m:
+        m.setattr(dataset, "assemble", lambda variables, coords: xr.Dataset(variables, coords=coords))
+        public = dataset.build_dataset(scene, solution)
+    return scene, solution, lean, public
+
+
+@pytest.mark.parametrize("overrides", [FIXED_POINT, GYROSTAT], ids=["fixed_point", "orbiting_gyrostat"])
+def test_lean_assembly_builds_the_dataset_xarray_builds(overrides, monkeypatch):
+    _, _, lean, public = _both(overrides, monkeypatch)
+    assert _without_clock(lean).identical(_without_clock(public))
+    assert list(lean.variables) == list(public.variables)
+    assert dict(lean.sizes) == dict(public.sizes)
+    assert set(lean.xindexes) == set(public.xindexes) == set(public.dims)
+    for name in lean.variables:
+        assert lean[name].encoding == public[name].encoding, name
+        assert lean[name].dtype == public[name].dtype, name
+    assert lean.sel(axis="z", time=1.0).omega.item() == public.sel(axis="z", time=1.0).omega.item()
+
+
+def test_dataset_values_match_an_independent_recomputation(monkeypatch):
+    scene, solution, ds, _ = _both(FIXED_POINT, monkeypatch)
+    y = solution.y
+    omega, gamma, alpha = y[:, 0:3], y[:, 3:6], y[:, 6:9]
+    inertia = np.array([2.0, 1.5, 1.0])  # body.a, body.b of the default config, C = 1
+    weight = np.array([0.3, 0.2, np.sqrt(1 - 0.3**2 - 0.2**2)])  # body.com_direction, |U| = 1 (c² = 1)
+    n = 0.5  # force.newtonian.k · c²
+    np.testing.assert_array_equal(ds.time.values, scene.times)
+    np.testing.assert_array_equal(ds.omega.values, omega)
+    np.testing.assert_array_equal(ds.gamma.values, gamma)
+    np.testing.assert_array_equal(ds.alpha.values, alpha)
+    # Euler–Poisson energy ½ω·Iω − U·γ + ½N γ·Iγ, area integral Iω·γ, |γ|, (α, γ) orthonormality
+    energy = 0.5 * (inertia * omega**2).sum(1) - gamma @ weight + 0.5 * n * (inertia * gamma**2).sum(1)
+    tight = dict(rtol=0, atol=1e-14)
+    np.testing.assert_allclose(ds.energy.values, energy, **tight)
+    np.testing.assert_allclose(ds.area_integral.values, (inertia * omega * gamma).sum(1), **tight)
+    np.testing.assert_allclose(ds.gamma_norm.values, np.sqrt((gamma**2).sum(1)), **tight)
+    frame = np.maximum(np.abs(np.sqrt((alpha**2).sum(1)) - 1), np.abs((alpha * gamma).sum(1)))
+    np.testing.assert_allclose(ds.frame_error.values, frame, **tight)
+    drift = np.max(np.abs(energy - energy[0]))
+    assert ds.energy.attrs["max_abs_drift"] == pytest.approx(drift, abs=1e-14)
+    # γ/|γ| = (sin θ sin φ, sin θ cos φ, cos θ); α_z = sin ψ sin θ, β_z = −cos ψ sin θ (β = γ × α), to within
+    # the integrated frame's departure from orthonormality (DOP853 keeps |γ| = 1 to ~1e-10 here)
+    theta, phi, psi = ds.theta.values, ds.phi.values, ds.psi.values
+    unit = gamma / np.sqrt((gamma**2).sum(1))[:, None]
+    np.testing.assert_allclose(np.cos(theta), unit[:, 2], **tight)
+    np.testing.assert_allclose(np.sin(theta) * np.sin(phi), unit[:, 0], **tight)
+    np.testing.assert_allclose(np.sin(theta) * np.cos(phi), unit[:, 1], **tight)
+    beta_z = gamma[:, 0] * alpha[:, 1] - gamma[:, 1] * alpha[:, 0]
+    loose = dict(rtol=0, atol=1e-14 + 10 * max(frame.max(), np.abs(ds.gamma_norm.values - 1).max()))
+    np.testing.assert_allclose(np.sin(psi) * np.sin(theta), alpha[:, 2], **loose)
+    np.testing.assert_allclose(-np.cos(psi) * np.sin(theta), beta_z, **loose)
+    assert np.all(np.abs(np.diff(phi)) < np.pi) and np.all(np.abs(np.diff(psi)) < np.pi)  # unwrapped
+    for name, variable in {**ds.data_vars, **ds.coords}.items():
+        assert variable.attrs.get("units") and variable.attrs.get("long_name"), name
+
+
+def test_inconsistent_variables_get_xarrays_own_error():
+    coords = {"time": ("time", np.arange(3.0), {"units": "1", "long_name": "t"})}
+    short = {"x": xr.Variable("time", np.zeros(2), {"units": "1", "long_name": "x"})}
+    with pytest.raises(ValueError) as lean:
+        dataset.assemble(short, coords)
+    with pytest.raises(ValueError) as public:
+        xr.Dataset(short, coords=coords)
+    assert str(lean.value) == str(public.value)
+    # a coordinate that is not a dimension's own (name ≠ dimension) goes the public way too
+    aux = {"label": ("time", np.array(["a", "b", "c"]), {"units": "1", "long_name": "label"}), **coords}
+    ok = {"x": xr.Variable("time", np.ones(3), {"units": "1", "long_name": "x"})}
+    assert dataset.assemble(ok, aux).identical(xr.Dataset(ok, coords=aux))
+
+
+def test_auto_evaluates_one_series_order_off_the_orbit(monkeypatch):
+    """Off the orbit by ~0.1 with accuracy 1e-9: the first order's start rules out the others."""
+    from gyrolab.plugins.regimes.small_parameter import SmallParameter
+
+    theta0 = float(np.arccos(0.5 / 32.0))
+    scene = compose_scene(["body.a=2.0", "body.b=1.5", "force.newtonian.k=0.3", "initial.r0=32.0",
+                           f"initial.theta0={theta0!r}", "initial.p0=0.3", "initial.q0=0.0", "time.end=0.5",
+                           "time.n_output=6", "integrator=auto", "accuracy=1e-9", "output.euler_angles=false"])
+    ladder = SmallParameter().series_candidates(scene.system, 1e-9)
+    assert sum(np.isfinite(e) for _, e in ladder) >= 2  # the check below means something
+    starts = []
+    original = SmallParameter.initial_state
+
+    def counted(self, system):
+        starts.append(self.series_order)
+        return original(self, system)
+
+    monkeypatch.setattr(SmallParameter, "initial_state", counted)
+    ds = scene.run()
+    assert ds.attrs["auto_method"] == "taylor"
+    assert len([order for order in starts if order is not None]) == 1
