@@ -253,11 +253,17 @@ class Auto(Integrator):
         # quadratically: assume q = 2 unless the pilot shows faster growth (its early error is a plateau).
         growth = MIN_GROWTH
         if np.all(envelope[late] > 0):
-            slope = np.polyfit(np.log(elapsed[late]), np.log(envelope[late]), 1)[0]
-            growth = float(np.clip(slope, MIN_GROWTH, 4.0))
+            growth = float(np.clip(_slope(np.log(elapsed[late]), np.log(envelope[late])), MIN_GROWTH, 4.0))
         per_tol = envelope[-1] / tau * (1.0 / self.pilot_fraction) ** growth
         self._pilot_steps = tight.stats.n_steps
         return per_tol, growth, loose.stats.nfev + tight.stats.nfev, measured, tight
 
     def attributes(self) -> dict[str, Any]:
         return {"accuracy": self.accuracy, **self.choice}
+
+
+def _slope(x: np.ndarray, y: np.ndarray) -> float:
+    """Least-squares slope of y against x, in closed form: ``np.polyfit(x, y, 1)[0]`` to rounding, without
+    LAPACK (whose BLAS worker threads keep spinning after the call and bill the run for a second core)."""
+    dx = x - x.mean()
+    return float(np.sum(dx * (y - y.mean())) / np.sum(dx * dx))
