@@ -170,6 +170,39 @@ def peer_table(reference, rounds, quick):
         print(f"| {key[0]} | {settings[key]} | {errors[key]:.2e} | {best[key][0] * 1e3:.2f} |")
 
 
+def run_breakdown(rounds, quick):
+    """Where ``Scene.run()`` with ``integrator=auto`` spends its time: the regimes' series check, the pilot and
+    final Taylor runs (auto without the series check), the dataset, interleaved like the peer table."""
+    from gyrolab.output.dataset import build_dataset
+    from gyrolab.plugins.integrators.auto import Auto
+
+    contestants = {}
+    for eps in EPSILONS[::3] if quick else EPSILONS[::2]:
+        scene = compose_scene(["experiment=perf_reference", f"accuracy={eps}"])
+        compiled, y0 = scene.compiled, scene.system.initial_state()
+
+        def series(scene=scene, eps=eps, compiled=compiled, y0=y0):
+            auto = Auto(accuracy=eps)
+            auto.prepare(scene.system)
+            return auto._series(None, GRID, y0, compiled, 0.0)
+
+        def integration(eps=eps, compiled=compiled, y0=y0):  # no system: auto skips the series check
+            return Auto(accuracy=eps).integrate(None, GRID, y0, None, compiled)
+
+        solution = integration()
+        contestants[("series check", eps)] = series
+        contestants[("pilot + Taylor", eps)] = integration
+        contestants[("dataset", eps)] = lambda scene=scene, solution=solution: build_dataset(scene, solution)
+        contestants[("Scene.run()", eps)] = scene.run
+    interleaved(contestants, 1)
+    best = interleaved(contestants, rounds)
+    parts = list(dict.fromkeys(key[0] for key in best))
+    print(f"\nWhere `auto`'s Scene.run() spends its time, {'wall' if WALL else 'CPU'} ms (minimum over {rounds} "
+          f"interleaved rounds):\n\n| ε | {' | '.join(parts)} |\n| --- |{' --- |' * len(parts)}")
+    for eps in dict.fromkeys(key[1] for key in best):
+        print(f"| {eps:.0e} | {' | '.join(f'{best[(part, eps)][0] * 1e3:.2f}' for part in parts)} |")
+
+
 def batch_throughput(repeats):
     scene = compose_scene(["experiment=perf_reference", "integrator=rk4_numba", "integrator.step=0.01",
                            "time.end=10", "time.n_output=11"])
@@ -217,11 +250,13 @@ def main() -> None:
     rounds = 3 if args.quick else 15
     print(f"# gyrolab perf_reference benchmark, {datetime.date.today()}, {platform.machine()}, "
           f"{os.cpu_count()} cores, {platform.processor() or platform.platform()}, Python {platform.python_version()}, "
-          f"load average {os.getloadavg()[0]:.1f} at start")
+          f"load average {os.getloadavg()[0]:.1f} at start, OPENBLAS_NUM_THREADS="
+          f"{os.environ.get('OPENBLAS_NUM_THREADS', 'unset')} (BLAS threads spinning on small arrays bill CPU time)")
     start = time.perf_counter()
     reference = fixed_point_reference(INERTIA, R_C, K, Y0, [0.0, T_END])[-1].astype(float)
     print(f"# reference: extended-precision Taylor, {time.perf_counter() - start:.1f} s")
     peer_table(reference, rounds, args.quick)
+    run_breakdown(rounds, args.quick)
 
     rows = scipy_and_dop853_rows(reference, 2, args.quick)
     print("\nC-speed DOP853 and scipy (3,001 output times; gyrolab: Scene.run()):\n\n"
