@@ -65,7 +65,7 @@ def test_dataset_values_match_an_independent_recomputation(monkeypatch):
     np.testing.assert_array_equal(ds.alpha.values, alpha)
     # Euler–Poisson energy ½ω·Iω − U·γ + ½N γ·Iγ, area integral Iω·γ, |γ|, (α, γ) orthonormality
     energy = 0.5 * (inertia * omega**2).sum(1) - gamma @ weight + 0.5 * n * (inertia * gamma**2).sum(1)
-    tight = dict(rtol=0, atol=1e-14)
+    tight = {"rtol": 0, "atol": 1e-14}
     np.testing.assert_allclose(ds.energy.values, energy, **tight)
     np.testing.assert_allclose(ds.area_integral.values, (inertia * omega * gamma).sum(1), **tight)
     np.testing.assert_allclose(ds.gamma_norm.values, np.sqrt((gamma**2).sum(1)), **tight)
@@ -81,7 +81,7 @@ def test_dataset_values_match_an_independent_recomputation(monkeypatch):
     np.testing.assert_allclose(np.sin(theta) * np.sin(phi), unit[:, 0], **tight)
     np.testing.assert_allclose(np.sin(theta) * np.cos(phi), unit[:, 1], **tight)
     beta_z = gamma[:, 0] * alpha[:, 1] - gamma[:, 1] * alpha[:, 0]
-    loose = dict(rtol=0, atol=1e-14 + 10 * max(frame.max(), np.abs(ds.gamma_norm.values - 1).max()))
+    loose = {"rtol": 0, "atol": 1e-14 + 10 * max(frame.max(), np.abs(ds.gamma_norm.values - 1).max())}
     np.testing.assert_allclose(np.sin(psi) * np.sin(theta), alpha[:, 2], **loose)
     np.testing.assert_allclose(-np.cos(psi) * np.sin(theta), beta_z, **loose)
     assert np.all(np.abs(np.diff(phi)) < np.pi) and np.all(np.abs(np.diff(psi)) < np.pi)  # unwrapped
