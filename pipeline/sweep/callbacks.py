@@ -147,4 +147,4 @@ _tolerate_hydra_record_failures()
 
 
 def _basic_sweeper(config: DictConfig) -> bool:
-    return str(config.hydra.sweeper.get("_target_", "")).endswith("BasicSweeper")
+    return str(config.hydra.sweeper.get("_target_", "")).endswith(("BasicSweeper", "GyrolabSweeper"))
