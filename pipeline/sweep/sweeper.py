@@ -187,6 +187,7 @@ def register_plugin() -> None:
     (``pip install -e .``) hides from it; registering the class explicitly works for every install.
     """
     from hydra.core.plugins import Plugins
+
     from hydra_plugins.gyrolab_sweeper.gyrolab_sweeper import GyrolabSweeper
 
     Plugins.instance().register(GyrolabSweeper)
