@@ -28,9 +28,11 @@ from pathlib import Path
 from typing import Any
 
 from hydra._internal.config_loader_impl import ConfigLoaderImpl
-from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override, OverrideType
+from hydra.plugins.launcher import Launcher
+from hydra.plugins.sweeper import Sweeper
+from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.sweep.identity import code_version, job_identity
@@ -46,17 +48,38 @@ MERGE_GAP = 8
 _RESOLVER = re.compile(r"\$\{\s*[\w.]+\s*:")
 
 
-class ResumingSweeper(BasicSweeper):
+class ResumingSweeper(Sweeper):
     """Hydra's basic sweeper (same jobs, same numbers, same ``max_batch_size`` and ``params``) that does
-    not launch the jobs a previous run of the same sweep already settled."""
+    not launch the jobs a previous run of the same sweep already settled.
+
+    It derives from Hydra's ``Sweeper`` and calls the basic sweeper's functions rather than subclassing
+    it: Hydra re-imports its own plugin modules when it scans them, which would leave a subclass with
+    a stale base class.
+    """
+
+    def __init__(self, max_batch_size: int | None = None, params: dict[str, str] | None = None) -> None:
+        super().__init__()
+        self.max_batch_size = max_batch_size
+        self.params = dict(params or {})
+        self.hydra_context: HydraContext | None = None
+        self.config: DictConfig | None = None
+        self.launcher: Launcher | None = None
+
+    def setup(self, *, hydra_context: HydraContext, task_function: TaskFunction, config: DictConfig) -> None:
+        from hydra.core.plugins import Plugins
+
+        self.hydra_context, self.config = hydra_context, config
+        self.launcher = Plugins.instance().instantiate_launcher(hydra_context=hydra_context,
+                                                                task_function=task_function, config=config)
 
     def sweep(self, arguments: list[str]) -> Any:
         assert self.config is not None and self.launcher is not None and self.hydra_context is not None
+        from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
+
         parser = OverridesParser.create(config_loader=self.hydra_context.config_loader)
-        overrides = parser.parse_overrides([*self._parse_config(), *arguments])
-        jobs = [job for batch in self.split_arguments(overrides, None) for job in batch]
-        self.overrides = [jobs]  # Hydra's bookkeeping (is_done/get_job_batch are not used here)
-        self.batch_index = 1
+        params = [f"{key}={value}" for key, value in self.params.items()]  # as the basic sweeper: params first
+        overrides = parser.parse_overrides([*params, *arguments])
+        jobs = [job for batch in BasicSweeper.split_arguments(overrides, None) for job in batch]
         sweep_dir = Path(self.config.hydra.sweep.dir)
         sweep_dir.mkdir(parents=True, exist_ok=True)
         OmegaConf.save(self.config, sweep_dir / "multirun.yaml")
