@@ -1,1 +1,0 @@
-"""gyrolab's Hydra sweeper plugin (Hydra instantiates sweepers only from the ``hydra_plugins`` package)."""
