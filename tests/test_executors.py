@@ -14,12 +14,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("distributed")
+from gyrolab.batch import executors
+from gyrolab.batch.executors import IntegrationChunk, integrate_chunk, map_chunks
+from gyrolab.engine.config import compose_config
+from gyrolab.errors import ConfigError
 
-from gyrolab.batch import executors  # noqa: E402
-from gyrolab.batch.executors import IntegrationChunk, integrate_chunk, map_chunks  # noqa: E402
-from gyrolab.engine.config import compose_config  # noqa: E402
-from gyrolab.errors import ConfigError  # noqa: E402
+pytest.importorskip("distributed")
 
 DASK = str(Path(sys.executable).with_name("dask"))
 # A tiny fixed-point scene (heavy top, default body), rk4_numba: the (ω, γ) block kernel.

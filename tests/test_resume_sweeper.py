@@ -10,7 +10,6 @@ import shutil
 import sys
 from pathlib import Path
 
-import pytest
 import xarray as xr
 
 from gyrolab.sweep.sweeper import launch_runs

@@ -33,7 +33,7 @@ from hydra.core.override_parser.types import Override, OverrideType
 from hydra.plugins.launcher import Launcher
 from hydra.plugins.sweeper import Sweeper
 from hydra.types import HydraContext, TaskFunction
-from omegaconf import DictConfig, OmegaConf, open_dict
+from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.sweep.identity import code_version, job_identity
 from gyrolab.sweep.job import mark_skipped
@@ -133,6 +133,8 @@ def settled_jobs(master: DictConfig, loader: ConfigLoaderImpl,
     records = {}
     for num in range(len(jobs)):
         job_dir = _job_dir(master, num, sweep_dir)
+        if job_dir is None:  # the jobs find their own directories (and records)
+            return {}
         record = read_record(job_dir)
         if record is not None:
             records[num] = (job_dir, record)
@@ -149,14 +151,15 @@ def settled_jobs(master: DictConfig, loader: ConfigLoaderImpl,
     return settled
 
 
-def _job_dir(master: DictConfig, num: int, sweep_dir: Path) -> Path:
+def _job_dir(master: DictConfig, num: int, sweep_dir: Path) -> Path | None:
+    """Job ``num``'s directory; None when ``hydra.sweep.subdir`` depends on more than the job number
+    (e.g. ``${hydra.job.override_dirname}``: only Hydra knows it before the job runs)."""
     subdir = OmegaConf.to_container(master.hydra.sweep, resolve=False).get("subdir")
-    if subdir == "${hydra.job.num}":  # gyrolab's default: no need to resolve anything
+    if subdir == "${hydra.job.num}":  # gyrolab's default
         return sweep_dir / str(num)
-    node = copy.deepcopy(master.hydra)
-    with open_dict(node):
-        node.job.num = num
-    return sweep_dir / str(node.sweep.subdir)
+    if "${" in str(subdir):
+        return None
+    return sweep_dir / str(subdir)
 
 
 class IdentityPredictor:
@@ -203,14 +206,25 @@ def _predictable(cfg: DictConfig) -> bool:
     return not _RESOLVER.search(repr(plain))
 
 
-def register_plugin() -> None:
-    """Make gyrolab's sweeper known to Hydra in this process.
+class GyrolabSweeper(ResumingSweeper):
+    """The sweeper gyrolab's config selects (``hydra/sweeper: gyrolab``)."""
 
-    Hydra finds plugins by listing the ``hydra_plugins`` namespace package, which an editable install
-    (``pip install -e .``) hides from it; registering the class explicitly works for every install.
-    """
+
+#: Hydra instantiates a sweeper only from the ``hydra_plugins`` namespace (it checks the name and imports
+#: it): the class goes by that name there (``register_plugin``) instead of shipping a second top-level package
+GyrolabSweeper.__module__ = "hydra_plugins.gyrolab_sweeper"
+PLUGIN_TARGET = f"{GyrolabSweeper.__module__}.{GyrolabSweeper.__qualname__}"
+
+
+def register_plugin() -> None:
+    """Make gyrolab's sweeper known to Hydra in this process (before Hydra instantiates the sweeper)."""
+    import sys
+    import types
+
     from hydra.core.plugins import Plugins
 
-    from hydra_plugins.gyrolab_sweeper.gyrolab_sweeper import GyrolabSweeper
-
+    if GyrolabSweeper.__module__ not in sys.modules:
+        module = types.ModuleType(GyrolabSweeper.__module__, "gyrolab's sweeper (gyrolab.sweep.sweeper) for Hydra")
+        module.GyrolabSweeper = GyrolabSweeper  # type: ignore[attr-defined]
+        sys.modules[GyrolabSweeper.__module__] = module
     Plugins.instance().register(GyrolabSweeper)
