@@ -18,12 +18,12 @@ itself, exactly as before.
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import logging
 import re
 import time
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -127,8 +127,8 @@ def launch_runs(remaining: Sequence[int], jobs: Sequence[Sequence[str]], max_bat
 
 def settled_jobs(master: DictConfig, loader: ConfigLoaderImpl,
                  jobs: Sequence[Sequence[str]]) -> dict[int, tuple[Path, JobRecord]]:
-    """The jobs whose directory holds a record that settles their identity, by job number (none when the
-    identities cannot be predicted outside the jobs: then every job is launched and checks itself)."""
+    """The jobs whose directory holds a record that settles their identity, by job number (a job whose
+    identity cannot be predicted outside it is not among them: it is launched and checks itself)."""
     sweep_dir = Path(master.hydra.sweep.dir)
     records = {}
     for num in range(len(jobs)):
@@ -143,10 +143,8 @@ def settled_jobs(master: DictConfig, loader: ConfigLoaderImpl,
     predictor = IdentityPredictor(master, loader)
     settled = {}
     for num, (job_dir, record) in records.items():
-        job_id = predictor.identity(jobs[num])
-        if job_id is None:
-            return {}
-        if record.reusable_for(job_id, job_dir):
+        job_id = predictor.identity(jobs[num])  # None: not predictable here, the job checks itself
+        if job_id is not None and record.reusable_for(job_id, job_dir):
             settled[num] = (job_dir, record)
     return settled
 
@@ -162,48 +160,75 @@ def _job_dir(master: DictConfig, num: int, sweep_dir: Path) -> Path | None:
     return sweep_dir / str(subdir)
 
 
+@dataclass
+class _Base:
+    """The config (without ``hydra``) of one composed job, and its value overrides by key."""
+
+    scene: DictConfig
+    applied: dict[str, Override]
+
+
 class IdentityPredictor:
-    """Job identities of a sweep's jobs as the jobs themselves will compute them (None: not predictable)."""
+    """Job identities of a sweep's jobs as the jobs themselves will compute them (None: not predictable).
+
+    Per job it costs a few override applications and one resolution of the config, not a composition:
+    the job's value overrides that differ from the composed job's are applied to that job's config, the
+    identity computed, and the composed job's values put back.
+    """
 
     def __init__(self, master: DictConfig, loader: ConfigLoaderImpl) -> None:
         self.master, self.loader = master, loader
         self.groups = set((master.hydra.runtime.get("choices") or {}).keys())
         self.parser = OverridesParser.create(config_loader=loader)
         self.code = code_version()
-        #: group choices -> (composed config of one job with those choices, its value overrides by key)
-        self._bases: dict[tuple[str, ...], tuple[DictConfig, dict[str, str]] | None] = {}
+        self._parsed: dict[str, Override] = {}
+        #: group choices -> the composed job with those choices (None: its config calls a resolver)
+        self._bases: dict[tuple[str, ...], _Base | None] = {}
 
     def identity(self, overrides: Sequence[str]) -> str | None:
-        parsed = self.parser.parse_overrides(list(overrides))
+        parsed = [self._parse(text) for text in overrides]
         choices = tuple(o.input_line for o in parsed if self._is_group(o))
-        values = [o for o in parsed if not self._is_group(o)]
+        # Hydra's own settings are the same for every job of a sweep and are not part of an identity
+        values = [o for o in parsed if not self._is_group(o) and not o.key_or_group.startswith("hydra.")]
         if choices not in self._bases:
             composed = self.loader.load_sweep_config(self.master, list(overrides))
-            self._bases[choices] = (composed, {o.key_or_group: o.input_line for o in values}) \
-                if _predictable(composed) else None
-            return job_identity(composed, self.code) if self._bases[choices] is not None else None
+            scene = OmegaConf.masked_copy(composed, [k for k in composed if k != "hydra"])
+            self._bases[choices] = _Base(scene, {o.key_or_group: o for o in values}) if _predictable(scene) else None
         base = self._bases[choices]
         if base is None:
             return None
-        composed, applied = base
-        changed = [o for o in values if applied.get(o.key_or_group) != o.input_line]
-        if any(o.is_delete() for o in changed):
+        changed = [o for o in values if base.applied[o.key_or_group].input_line != o.input_line] \
+            if all(o.key_or_group in base.applied for o in values) else None
+        if changed is None or any(o.is_delete() for o in changed):
             return None
-        cfg = copy.deepcopy(composed)
-        for o in changed:
-            if o.is_add():  # the key is there already (added by the composed job): a plain assignment
-                o = dataclasses.replace(o, type=OverrideType.CHANGE)
-            ConfigLoaderImpl._apply_overrides_to_config([o], cfg)
-        return job_identity(cfg, self.code)
+        try:
+            for o in changed:
+                ConfigLoaderImpl._apply_overrides_to_config([_as_change(o)], base.scene)
+            plain = OmegaConf.to_container(base.scene, resolve=True)
+        except Exception:  # noqa: BLE001 - the job itself will say what is wrong with its config
+            return None
+        finally:
+            for o in changed:  # back to the composed job's values
+                ConfigLoaderImpl._apply_overrides_to_config([_as_change(base.applied[o.key_or_group])], base.scene)
+        return job_identity(plain, self.code)
+
+    def _parse(self, text: str) -> Override:
+        if text not in self._parsed:
+            self._parsed[text] = self.parser.parse_override(text)
+        return self._parsed[text]
 
     def _is_group(self, o: Override) -> bool:
         return o.key_or_group in self.groups or o.key_or_group.startswith("hydra/")
 
 
-def _predictable(cfg: DictConfig) -> bool:
-    """No value outside ``hydra`` interpolates through a resolver (the job could resolve it differently)."""
-    plain = OmegaConf.to_container(OmegaConf.masked_copy(cfg, [k for k in cfg if k != "hydra"]), resolve=False)
-    return not _RESOLVER.search(repr(plain))
+def _as_change(o: Override) -> Override:
+    """``+key=value`` as ``key=value``: the key is there already (the composed job added it)."""
+    return dataclasses.replace(o, type=OverrideType.CHANGE) if o.is_add() else o
+
+
+def _predictable(scene: DictConfig) -> bool:
+    """No value interpolates through a resolver (the job could resolve it differently)."""
+    return not _RESOLVER.search(repr(OmegaConf.to_container(scene, resolve=False)))
 
 
 class GyrolabSweeper(ResumingSweeper):
