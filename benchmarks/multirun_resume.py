@@ -4,6 +4,7 @@
     python benchmarks/multirun_resume.py                       # 1,000 jobs, 600 finished (~6 min: it runs them)
     python benchmarks/multirun_resume.py --jobs 100 --finished 60
     python benchmarks/multirun_resume.py --baseline            # also Hydra's basic sweeper (minutes more)
+    python benchmarks/multirun_resume.py --sweep-dir DIR       # reuse DIR's finished jobs (kept from a run)
 
 The sweep is a cheap scene on a 2-D grid with a config-group dimension (``integrator=rk4,dop853``, and
 ``initial.r0`` over jobs/2 values; t ∈ [0, 0.01], 2 output times, no figures). It is run for real with
@@ -79,12 +80,17 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=1000)
     parser.add_argument("--finished", type=int, default=600)
     parser.add_argument("--baseline", action="store_true", help="also time Hydra's basic sweeper")
+    parser.add_argument("--sweep-dir", type=Path, help="keep the sweep here; its finished jobs are reused")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="gyrolab-resume-") as tmp:
-        sweep_dir = Path(tmp) / "sweep"
+        sweep_dir = (args.sweep_dir or Path(tmp) / "sweep").resolve()
         tic = time.perf_counter()
-        records = run_until_finished(args.jobs, args.finished, sweep_dir)
-        print(f"{args.jobs}-job sweep killed after {records} job records ({time.perf_counter() - tic:.0f} s)")
+        records = len(list(sweep_dir.glob("*/job.json")))
+        if records < args.finished:
+            records = run_until_finished(args.jobs, args.finished, sweep_dir)
+            print(f"{args.jobs}-job sweep killed after {records} job records ({time.perf_counter() - tic:.0f} s)")
+        else:
+            print(f"{args.jobs}-job sweep in {sweep_dir} with {records} job records")
         seconds, first, checked = time_to_first_launch(args.jobs, sweep_dir)
         print(f"gyrolab's sweeper: first remaining job (#{first}) launched after {seconds:.2f} s  [{checked}]")
         if args.baseline:

@@ -27,7 +27,9 @@ OVERRIDES = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=2", "time
              "output.euler_angles=false", "output.figures=false"]
 
 
-def plain_config():
+@pytest.fixture(scope="module")
+def config():
+    """The scene's config as plain data, as a chunk task carries it."""
     from omegaconf import OmegaConf
 
     return OmegaConf.to_container(compose_config(OVERRIDES), resolve=True)
@@ -93,8 +95,7 @@ def in_process(tasks):
     return results
 
 
-def test_chunks_on_separately_started_workers_equal_in_process_bit_for_bit(scheduler):
-    config = plain_config()
+def test_chunks_on_separately_started_workers_equal_in_process_bit_for_bit(scheduler, config):
     tasks = chunks(config)
     expected = in_process(tasks)
     results = {}
@@ -112,9 +113,8 @@ def test_chunks_on_separately_started_workers_equal_in_process_bit_for_bit(sched
     assert sum(kept.values()) >= 1 and set(kept.values()) <= {0, 1}
 
 
-def test_in_flight_chunks_stay_bounded(scheduler):
+def test_in_flight_chunks_stay_bounded(scheduler, config):
     """Memory is bounded by a few chunks per worker: tasks are pulled only as results come back."""
-    config = plain_config()
     base = chunks(config, n_chunks=1, per_chunk=2)[0]
     pulled, ahead = [0], []
 
@@ -136,8 +136,7 @@ def test_in_flight_chunks_stay_bounded(scheduler):
 
 
 @pytest.mark.parametrize("where", ["process", "cluster"])
-def test_a_failing_chunk_is_one_sentence_naming_it(scheduler, where):
-    config = plain_config()
+def test_a_failing_chunk_is_one_sentence_naming_it(scheduler, where, config):
     tasks = chunks(config, n_chunks=2, per_chunk=2)
     tasks[1].initial_states[0, 0] = np.nan
     with pytest.raises(ConfigError) as caught:

@@ -248,8 +248,7 @@ def register_plugin() -> None:
 
     from hydra.core.plugins import Plugins
 
-    if GyrolabSweeper.__module__ not in sys.modules:
-        module = types.ModuleType(GyrolabSweeper.__module__, "gyrolab's sweeper (gyrolab.sweep.sweeper) for Hydra")
-        module.GyrolabSweeper = GyrolabSweeper  # type: ignore[attr-defined]
-        sys.modules[GyrolabSweeper.__module__] = module
+    name = GyrolabSweeper.__module__
+    module = sys.modules.setdefault(name, types.ModuleType(name, "gyrolab's sweeper (gyrolab.sweep.sweeper) for Hydra"))
+    module.GyrolabSweeper = GyrolabSweeper  # type: ignore[attr-defined]  # (also on a stale installed module)
     Plugins.instance().register(GyrolabSweeper)
