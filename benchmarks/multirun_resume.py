@@ -11,7 +11,8 @@ The sweep is a cheap scene on a 2-D grid with a config-group dimension (``integr
 Hydra's basic launcher and killed (SIGKILL, the whole process group) once ``--finished`` jobs have their
 record, as a crash would leave it. Then the same command is run again, and the time from its start to
 Hydra's "#K : ..." line for the first job it launches (K = the first unfinished job) is measured; the
-resumed sweep is then stopped. ``--baseline`` measures the same with ``hydra/sweeper=basic`` (Hydra's own
+resumed sweep is then stopped. For reference, the same time is measured for the sweep started afresh
+(its job #0): what any sweep pays before its first job, whatever the sweeper. ``--baseline`` measures the same with ``hydra/sweeper=basic`` (Hydra's own
 sweeper: it composes every job to validate the batch, then launches every job, which skips itself).
 Times are wall-clock on whatever else the machine is doing: run it on an idle machine for the README.
 """
@@ -93,6 +94,9 @@ def main() -> None:
             print(f"{args.jobs}-job sweep in {sweep_dir} with {records} job records")
         seconds, first, checked = time_to_first_launch(args.jobs, sweep_dir)
         print(f"gyrolab's sweeper: first remaining job (#{first}) launched after {seconds:.2f} s  [{checked}]")
+        fresh, _, _ = time_to_first_launch(args.jobs, Path(tmp) / "fresh")
+        print(f"for reference, the same sweep started afresh launches its job #0 after {fresh:.2f} s "
+              "(the command's start-up and Hydra's first composition)")
         if args.baseline:
             seconds, first, _ = time_to_first_launch(args.jobs, sweep_dir, "hydra/sweeper=basic")
             print(f"Hydra's basic sweeper: first job launched (#{first}) after {seconds:.2f} s; its jobs "

@@ -166,6 +166,8 @@ class _Base:
 
     scene: DictConfig
     applied: dict[str, Override]
+    #: the scene as plain data, when it has no interpolation (a job's differs only where its overrides say)
+    plain: dict[str, Any] | None = None
 
 
 class IdentityPredictor:
@@ -193,7 +195,9 @@ class IdentityPredictor:
         if choices not in self._bases:
             composed = self.loader.load_sweep_config(self.master, list(overrides))
             scene = OmegaConf.masked_copy(composed, [k for k in composed if k != "hydra"])
-            self._bases[choices] = _Base(scene, {o.key_or_group: o for o in values}) if _predictable(scene) else None
+            unresolved = OmegaConf.to_container(scene, resolve=False)
+            self._bases[choices] = None if _RESOLVER.search(repr(unresolved)) else _Base(
+                scene, {o.key_or_group: o for o in values}, None if "${" in repr(unresolved) else unresolved)
         base = self._bases[choices]
         if base is None:
             return None
@@ -204,7 +208,9 @@ class IdentityPredictor:
         try:
             for o in changed:
                 ConfigLoaderImpl._apply_overrides_to_config([_as_change(o)], base.scene)
-            plain = OmegaConf.to_container(base.scene, resolve=True)
+            plain = _patched(base, changed)
+            if plain is None:
+                plain = OmegaConf.to_container(base.scene, resolve=True)
         except Exception:  # noqa: BLE001 - the job itself will say what is wrong with its config
             return None
         finally:
@@ -226,9 +232,24 @@ def _as_change(o: Override) -> Override:
     return dataclasses.replace(o, type=OverrideType.CHANGE) if o.is_add() else o
 
 
-def _predictable(scene: DictConfig) -> bool:
-    """No value interpolates through a resolver (the job could resolve it differently)."""
-    return not _RESOLVER.search(repr(OmegaConf.to_container(scene, resolve=False)))
+def _patched(base: _Base, changed: Sequence[Override]) -> dict[str, Any] | None:
+    """The job's config as plain data: the composed job's, with the changed values read back from the config
+    they were applied to (so typed as Hydra types them); None when that is not the whole story (the config
+    or a new value interpolates, or a key goes through a list)."""
+    if base.plain is None or any("${" in o.input_line for o in changed):
+        return None
+    plain = dict(base.plain)
+    for o in changed:
+        *parents, leaf = o.key_or_group.split(".")
+        node, where = plain, base.scene
+        for key in parents:  # copy the dictionaries on the way: the composed job's stay as they are
+            if not isinstance(node.get(key), dict):
+                return None
+            node[key] = dict(node[key])
+            node, where = node[key], where[key]
+        value = where[leaf]
+        node[leaf] = OmegaConf.to_container(value, resolve=True) if OmegaConf.is_config(value) else value
+    return plain
 
 
 class GyrolabSweeper(ResumingSweeper):
