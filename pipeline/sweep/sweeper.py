@@ -85,16 +85,18 @@ class ResumingSweeper(Sweeper):
         OmegaConf.save(self.config, sweep_dir / "multirun.yaml")
 
         tic = time.perf_counter()
-        settled = settled_jobs(self.config, self.hydra_context.config_loader, jobs)
+        settled, unsure = check_jobs(self.config, self.hydra_context.config_loader, jobs)
         remaining = [num for num in range(len(jobs)) if num not in settled]
         if settled:
             log.info("sweep resumed: %d of %d jobs already settled, not launched (checked in %.1f s)",
                      len(settled), len(jobs), time.perf_counter() - tic)
+        # As the basic sweeper, refuse a sweep with a job Hydra cannot compose before launching any job: every
+        # job's overrides were applied above; the jobs where that failed are composed in full (Hydra's error).
+        self.validate_batch_is_legal([jobs[num] for num in unsure if num not in settled])
         # A sequential launcher gains nothing from launching settled jobs between remaining ones.
         gap = 0 if type(self.launcher).__name__ == "BasicLauncher" else MERGE_GAP
         returns, launched = [], set()
         for start, batch in launch_runs(remaining, jobs, self.max_batch_size, gap):
-            self.validate_batch_is_legal(batch[:1])  # one composition: the launcher composes every job anyway
             launched.update(range(start, start + len(batch)))
             results = self.launcher.launch(batch, initial_job_idx=start)
             for r in results:
@@ -125,28 +127,29 @@ def launch_runs(remaining: Sequence[int], jobs: Sequence[Sequence[str]], max_bat
     return out
 
 
-def settled_jobs(master: DictConfig, loader: ConfigLoaderImpl,
-                 jobs: Sequence[Sequence[str]]) -> dict[int, tuple[Path, JobRecord]]:
-    """The jobs whose directory holds a record that settles their identity, by job number (a job whose
-    identity cannot be predicted outside it is not among them: it is launched and checks itself)."""
+class OverridesDoNotApply(Exception):
+    """A job's value overrides could not be applied to the config of its group choices."""
+
+
+def check_jobs(master: DictConfig, loader: ConfigLoaderImpl,
+               jobs: Sequence[Sequence[str]]) -> tuple[dict[int, tuple[Path, JobRecord]], list[int]]:
+    """(the jobs whose directory holds a record that settles their identity, by job number; the jobs whose
+    overrides did not apply). A job whose identity cannot be predicted outside it is not settled here: it
+    is launched and checks itself."""
     sweep_dir = Path(master.hydra.sweep.dir)
-    records = {}
-    for num in range(len(jobs)):
-        job_dir = _job_dir(master, num, sweep_dir)
-        if job_dir is None:  # the jobs find their own directories (and records)
-            return {}
-        record = read_record(job_dir)
-        if record is not None:
-            records[num] = (job_dir, record)
-    if not records:
-        return {}
     predictor = IdentityPredictor(master, loader)
-    settled = {}
-    for num, (job_dir, record) in records.items():
-        job_id = predictor.identity(jobs[num])  # None: not predictable here, the job checks itself
-        if job_id is not None and record.reusable_for(job_id, job_dir):
+    settled, unsure = {}, []
+    for num, overrides in enumerate(jobs):
+        try:
+            job_id = predictor.identity(overrides)  # None: not predictable here
+        except OverridesDoNotApply:
+            unsure.append(num)
+            continue
+        job_dir = _job_dir(master, num, sweep_dir)  # None: the jobs find their own directories
+        record = read_record(job_dir) if job_id is not None and job_dir is not None else None
+        if record is not None and record.reusable_for(job_id, job_dir):
             settled[num] = (job_dir, record)
-    return settled
+    return settled, unsure
 
 
 def _job_dir(master: DictConfig, num: int, sweep_dir: Path) -> Path | None:
@@ -206,13 +209,17 @@ class IdentityPredictor:
         if changed is None or any(o.is_delete() for o in changed):
             return None
         try:
-            for o in changed:
-                ConfigLoaderImpl._apply_overrides_to_config([_as_change(o)], base.scene)
-            plain = _patched(base, changed)
-            if plain is None:
-                plain = OmegaConf.to_container(base.scene, resolve=True)
-        except Exception:  # noqa: BLE001 - the job itself will say what is wrong with its config
-            return None
+            try:
+                for o in changed:
+                    ConfigLoaderImpl._apply_overrides_to_config([_as_change(o)], base.scene)
+            except Exception as error:  # noqa: BLE001 - Hydra's composition will say what is wrong
+                raise OverridesDoNotApply(str(error)) from error
+            try:
+                plain = _patched(base, changed)
+                if plain is None:
+                    plain = OmegaConf.to_container(base.scene, resolve=True)
+            except Exception:  # noqa: BLE001 - e.g. an interpolation that does not resolve: the job records it
+                return None
         finally:
             for o in changed:  # back to the composed job's values
                 ConfigLoaderImpl._apply_overrides_to_config([_as_change(base.applied[o.key_or_group])], base.scene)
