@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import resource
 import signal
 import subprocess
 import sys
@@ -57,8 +58,15 @@ def run_until_finished(jobs: int, finished: int, sweep_dir: Path) -> int:
     return len(list(sweep_dir.glob("*/job.json")))
 
 
+def children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def time_to_first_launch(jobs: int, sweep_dir: Path, *extra: str) -> tuple[float, int, str]:
     """Seconds from the command's start to Hydra's line for the first job it launches (and that job's number)."""
+    global last_cpu
+    cpu = children_cpu()
     start = time.perf_counter()
     process = subprocess.Popen(command(jobs, sweep_dir, *extra), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                text=True, start_new_session=True)
@@ -74,6 +82,12 @@ def time_to_first_launch(jobs: int, sweep_dir: Path, *extra: str) -> tuple[float
         raise SystemExit(f"the resumed sweep launched no job (exit {process.wait()})")
     finally:
         stop(process)
+        last_cpu = children_cpu() - cpu
+
+
+#: CPU seconds (user + system) the last timed command used until it was stopped: on a busy machine, a
+#: better guide than the wall time to what the command costs on an idle one (it runs on one core)
+last_cpu = 0.0
 
 
 def main() -> None:
@@ -93,13 +107,14 @@ def main() -> None:
         else:
             print(f"{args.jobs}-job sweep in {sweep_dir} with {records} job records")
         seconds, first, checked = time_to_first_launch(args.jobs, sweep_dir)
-        print(f"gyrolab's sweeper: first remaining job (#{first}) launched after {seconds:.2f} s  [{checked}]")
+        print(f"gyrolab's sweeper: first remaining job (#{first}) launched after {seconds:.2f} s "
+              f"({last_cpu:.2f} CPU s)  [{checked}]")
         fresh, _, _ = time_to_first_launch(args.jobs, Path(tmp) / "fresh")
         print(f"for reference, the same sweep started afresh launches its job #0 after {fresh:.2f} s "
-              "(the command's start-up and Hydra's first composition)")
+              f"({last_cpu:.2f} CPU s; the command's start-up and Hydra's first composition)")
         if args.baseline:
             seconds, first, _ = time_to_first_launch(args.jobs, sweep_dir, "hydra/sweeper=basic")
-            print(f"Hydra's basic sweeper: first job launched (#{first}) after {seconds:.2f} s; its jobs "
+            print(f"Hydra's basic sweeper: first job launched (#{first}) after {seconds:.2f} s ({last_cpu:.0f} CPU s); its jobs "
                   "then skip themselves one by one")
             base_seconds = _time_basic_to_job(args.jobs, sweep_dir, records)
             print(f"Hydra's basic sweeper: first remaining job (#{records}) launched after {base_seconds:.2f} s")
