@@ -9,11 +9,14 @@ identity (``JobRecord.reusable_for``). Job numbers, and so job directories and `
 those of an unfiltered sweep: the remaining jobs are launched in runs of consecutive numbers.
 
 The identities are computed without composing every job: the config of one job per combination
-of config-group choices is composed as Hydra composes it, and the other jobs' value overrides are
-applied to a copy of it with Hydra's own override code. A config whose values interpolate something
-outside the config (``${hydra:...}``, ``${now:...}``, ``${oc.env:...}``, any resolver) could resolve
-differently inside the job, so then nothing is left out here: every job is launched and skips
-itself, exactly as before.
+of config-group choices is composed as Hydra composes it, and each other job's value overrides are
+applied to it with Hydra's own override code (and its values put back afterwards). Applying every
+job's overrides also stands in for the basic sweeper's validation of the whole batch; a job whose
+overrides do not apply is composed in full, so that Hydra reports it before any job starts. A config
+whose values call a resolver (``${hydra:...}``, ``${now:...}``, ``${oc.env:...}``, any other) could
+resolve differently inside the job, so then no job is left out here: every job is launched and skips
+itself, exactly as before. A wrong prediction can only cost a launch, never skip a job: a job is left
+out only when the predicted identity equals the one its finished record holds.
 """
 
 from __future__ import annotations
