@@ -74,6 +74,9 @@ class SweepCallback(Callback):
             unlock(locked)
 
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
+        from gyrolab.sweep.sweeper import register_plugin
+
+        register_plugin()  # Hydra instantiates the sweeper next (already done by the preflight; kept idempotent)
         reset()
         self._announced = announce_launcher()  # worker processes of this sweep die with this process
         if not self.progress or not _basic_sweeper(config):
