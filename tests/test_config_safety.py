@@ -74,7 +74,7 @@ def test_pth_dropped_by_a_primary_config_is_refused_in_a_real_process(cli, tmp_p
     assert done.stderr.strip().splitlines() == [
         "gyrolab: error: hydra.callbacks.drop._target_='shutil.copyfile' is not allowed; under hydra a config may "
         "name only gyrolab's sweep callback and the installed launchers and sweepers (BaseSubmititLauncher, "
-        "BasicLauncher, BasicSweeper, JoblibLauncher, LocalLauncher, SlurmLauncher, SweepCallback)"]
+        "BasicLauncher, BasicSweeper, GyrolabSweeper, JoblibLauncher, LocalLauncher, SlurmLauncher, SweepCallback)"]
     assert list(site.iterdir()) == [] and not (tmp_path / "PWNED").exists() and not (tmp_path / "out").exists()
 
 

@@ -1,28 +1,212 @@
-"""Where a batch's chunks run.
+"""Where a batch's chunks run: this process, a local Dask cluster, or an existing Dask scheduler.
 
-``map_chunks(function, tasks, on_result)`` calls ``function(task)`` for every task and hands each result
-to ``on_result(index, result)`` in the calling process as it arrives (so one process writes the output).
-``function`` must be a module-level function and the tasks picklable, so that the same call can run
-its chunks elsewhere (another process, a Dask cluster).
+``map_chunks(function, tasks, on_result, scheduler)`` calls ``function(task)`` for every task and hands
+each result to ``on_result(index, result)`` in the calling process as it arrives (so one process writes
+the output). ``function`` must be a module-level function and the tasks picklable, so that the same call
+runs its chunks in other processes or on other machines:
+
+- ``scheduler`` None or ``"process"``: here, one chunk after another (the compiled kernels use every core
+  through numba's threads);
+- ``"local"``: a Dask ``LocalCluster`` on this machine, one single-threaded worker process per core
+  (numba limited to one thread per worker, so the workers do not oversubscribe the cores);
+- ``"tcp://HOST:PORT"`` (or ``tls://``): an existing Dask scheduler and its workers (``dask scheduler``,
+  ``dask worker``, a dask-jobqueue ``SLURMCluster``: docs/cluster.md).
+
+At most a few chunks per worker are submitted at a time, so memory is bounded by a few chunks, not by
+the batch. A chunk that fails stops the batch with one sentence naming the chunk.
+
+A task carries what a worker needs to rebuild the compiled model (``IntegrationChunk.config``, a plain
+resolved config): a plugin torque's compiled function is a machine address that does not pickle. Each
+worker process rebuilds it once per config (``chunk_model``) and reuses it for the next chunks.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import itertools
+import json
+import os
+import uuid
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from importlib.util import find_spec
 from typing import Any, TypeVar
+
+import numpy as np
+
+from gyrolab.errors import ConfigError, GyrolabError, shorten
 
 Task = TypeVar("Task")
 Result = TypeVar("Result")
 
+IN_PROCESS = ("process", "")
+LOCAL = "local"
+#: seconds to wait for a scheduler to answer before saying it cannot be reached
+CONNECT_TIMEOUT = 10
+#: chunks submitted per worker thread at a time: one running, one queued (memory: a few chunks per worker)
+CHUNKS_PER_THREAD = 2
+#: environment of local-cluster workers: one thread each for numba and the BLAS libraries
+WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
-def map_chunks(function: Callable[[Task], Result], tasks: Sequence[Task],
+
+def map_chunks(function: Callable[[Task], Result], tasks: Iterable[Task],
                on_result: Callable[[int, Result], None], scheduler: str | None = None) -> None:
-    """Run ``function`` on every task; ``scheduler`` None runs them here, one after another
-    (the compiled kernels already use every core through numba's threads)."""
-    if scheduler not in (None, "", "process"):
-        raise ValueError(f"scheduler {scheduler!r} is not available here; valid: process")
-    for index, task in enumerate(tasks):
-        on_result(index, function(task))
+    """Run ``function`` on every task where ``scheduler`` says; ``on_result(index, result)`` for each result,
+    in this process, in the order they complete (in task order when they run here)."""
+    kind = scheduler_kind(scheduler)
+    if kind == "process":
+        for index, task in enumerate(tasks):
+            try:
+                result = function(task)
+            except Exception as error:  # noqa: BLE001 - one sentence naming the chunk, whatever went wrong
+                raise chunk_error(index, error, "in this process") from error
+            on_result(index, result)
+        return
+    with _client(kind, str(scheduler)) as client:
+        _map_on(client, function, tasks, on_result, where=_where(kind, str(scheduler)))
 
 
-__all__: Sequence[Any] = ["map_chunks"]
+def scheduler_kind(scheduler: str | None) -> str:
+    """``"process"``, ``"local"`` or ``"address"``; ConfigError for anything else, or when Dask is missing."""
+    if scheduler is None or str(scheduler).strip() in IN_PROCESS:
+        return "process"
+    text = str(scheduler).strip()
+    if text == LOCAL:
+        kind = "local"
+    elif text.startswith(("tcp://", "tls://")) and len(text) > len("tcp://"):
+        kind = "address"
+    else:
+        raise ConfigError(f"batch.scheduler={shorten(text)!r} is not a scheduler; valid: process (this process), "
+                          "local (a Dask cluster on this machine) or the address of a running Dask scheduler "
+                          "(tcp://HOST:PORT)")
+    if find_spec("distributed") is None:
+        raise ConfigError(f"batch.scheduler={text} runs chunks on Dask, which is not installed; install it with: "
+                          'pip install "gyrolab[cluster]"')
+    return kind
+
+
+def chunk_error(index: int, error: BaseException, where: str) -> GyrolabError:
+    """One sentence naming the chunk; a gyrolab error keeps its class (and so its exit status)."""
+    message = " ".join(str(error).split()) or type(error).__name__
+    if isinstance(error, GyrolabError):
+        return type(error)(f"chunk {index} of the batch failed {where}: {message}")
+    return GyrolabError(f"chunk {index} of the batch failed {where} ({type(error).__name__}: {message})")
+
+
+def _where(kind: str, scheduler: str) -> str:
+    return "on the local Dask cluster" if kind == "local" else f"on the Dask cluster at {scheduler}"
+
+
+def _client(kind: str, scheduler: str) -> Any:
+    """A connected ``distributed.Client`` (closing it also closes a local cluster it started)."""
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    if kind == "local":
+        cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR, env=dict(WORKER_ENV))
+        return Client(cluster, set_as_default=False)
+    try:
+        return Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
+    except (OSError, TimeoutError) as error:
+        reason = " ".join(str(error).split()).rstrip(".") or type(error).__name__
+        raise ConfigError(f"no Dask scheduler answers at batch.scheduler={scheduler} within {CONNECT_TIMEOUT} s "
+                          f"({shorten(reason, 120)}); start one (dask scheduler) or give its address") from None
+
+
+def _map_on(client: Any, function: Callable[[Task], Result], tasks: Iterable[Task],
+            on_result: Callable[[int, Result], None], *, where: str) -> None:
+    """Submit at most ``CHUNKS_PER_THREAD`` chunks per worker thread; hand results over as they complete."""
+    from distributed import as_completed
+
+    threads = sum(client.nthreads().values()) or 1
+    limit = max(2, CHUNKS_PER_THREAD * threads)
+    numbered = enumerate(tasks)
+    run = uuid.uuid4().hex[:12]
+    index_of: dict[str, int] = {}
+    pending = as_completed(loop=client.loop)
+
+    def submit(count: int) -> None:
+        for index, task in itertools.islice(numbered, count):
+            future = client.submit(function, task, key=f"gyrolab-chunk-{run}-{index}", pure=False, retries=0)
+            index_of[future.key] = index
+            pending.add(future)
+
+    submit(limit)
+    try:
+        for future in pending:
+            index = index_of.pop(future.key)
+            if future.status == "error":
+                raise chunk_error(index, future.exception(), where)
+            result = future.result()
+            future.release()  # the cluster forgets the result: memory stays bounded
+            on_result(index, result)
+            submit(1)
+    finally:
+        pending.clear()
+
+
+# ----------------------------------------------------------------------------- a chunk of trajectories
+
+
+@dataclass
+class ChunkModel:
+    """What integrating a chunk needs, rebuilt from a config once per process."""
+
+    compiled: Any          # gyrolab.contracts.CompiledModel
+    integrator: Any        # the integrator plugin instance
+    times: np.ndarray
+
+
+_models: dict[str, ChunkModel] = {}
+#: configs whose compiled model a process keeps (a batch uses one)
+MODELS_KEPT = 4
+
+
+def chunk_model(config: Mapping[str, Any]) -> ChunkModel:
+    """The compiled model, integrator and output times of a plain (resolved) config, built once per process
+    and config (the same config, as canonical JSON, reuses the first build)."""
+    from gyrolab.sweep.identity import canonical_config
+
+    key = canonical_config(dict(config))
+    model = _models.get(key)
+    if model is None:
+        from omegaconf import OmegaConf
+
+        from gyrolab.engine.scene import Scene
+
+        scene = Scene.from_config(OmegaConf.create(json.loads(key)))
+        compiled = scene.system.compiled_model()
+        if compiled is None:
+            raise ConfigError(f"system {scene.system.name!r} has no compiled form, which batch chunks need; "
+                              "choose a scene whose forces all have compiled forms")
+        if len(_models) >= MODELS_KEPT:
+            _models.pop(next(iter(_models)))
+        model = _models[key] = ChunkModel(compiled, scene.integrator, np.asarray(scene.times))
+    return model
+
+
+@dataclass
+class IntegrationChunk:
+    """Trajectories of one scene config from ``initial_states`` (rows), optionally with their own ``params``."""
+
+    config: dict[str, Any]
+    initial_states: np.ndarray
+    params: np.ndarray | None = None
+    failures: str = "mark"
+    #: free for the caller (e.g. where the chunk's points sit in the grid); returned with the solution
+    tag: Any = field(default=None)
+
+
+def integrate_chunk(chunk: IntegrationChunk) -> Any:
+    """``gyrolab.engine.batch.integrate_arrays`` for one chunk, with the compiled model rebuilt in this process;
+    returns its ``BatchSolution``."""
+    from gyrolab.engine.batch import integrate_arrays
+
+    model = chunk_model(chunk.config)
+    return integrate_arrays(model.compiled, model.integrator, model.times, chunk.initial_states, chunk.params,
+                            failures=chunk.failures)
+
+
+__all__ = ["ChunkModel", "IntegrationChunk", "chunk_error", "chunk_model", "integrate_chunk", "map_chunks",
+           "scheduler_kind"]

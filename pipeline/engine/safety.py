@@ -66,6 +66,9 @@ def hydra_targets() -> frozenset[str]:
     from hydra.plugins.launcher import Launcher
     from hydra.plugins.sweeper import Sweeper
 
+    from gyrolab.sweep.sweeper import register_plugin
+
+    register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), whatever the install
     found = {f"{cls.__module__}.{cls.__qualname__}" for kind in (Launcher, Sweeper)
              for cls in Plugins.instance().discover(kind)}
     return HYDRA_TARGETS | found

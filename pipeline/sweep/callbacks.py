@@ -74,6 +74,9 @@ class SweepCallback(Callback):
             unlock(locked)
 
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
+        from gyrolab.sweep.sweeper import register_plugin
+
+        register_plugin()  # Hydra instantiates the sweeper next (already done by the preflight; kept idempotent)
         reset()
         self._announced = announce_launcher()  # worker processes of this sweep die with this process
         if not self.progress or not _basic_sweeper(config):
@@ -147,4 +150,4 @@ _tolerate_hydra_record_failures()
 
 
 def _basic_sweeper(config: DictConfig) -> bool:
-    return str(config.hydra.sweeper.get("_target_", "")).endswith("BasicSweeper")
+    return str(config.hydra.sweeper.get("_target_", "")).endswith(("BasicSweeper", "GyrolabSweeper"))

@@ -81,8 +81,7 @@ def _run_locked(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_nu
     previous = read_record(job_dir)
     if previous is not None and previous.reusable_for(job_id, job_dir):
         log.info("job %s: %s earlier (job id %s); skipped", job_num, previous.status, job_id)
-        previous.skipped, previous.job_num, previous.overrides = True, job_num, list(overrides)
-        return _recorded(job_dir, previous)
+        return mark_skipped(job_dir, previous, job_num, overrides)
     remove_record(job_dir)  # a stale record (other config or code) must not outlive this attempt
     base = JobRecord(job_id=job_id, status=FAILED, overrides=list(overrides), code_version=code, job_num=job_num)
     try:
@@ -101,6 +100,14 @@ def _run_locked(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_nu
         record = base
     if record.status == FAILED:
         (job_dir / "run.nc").unlink(missing_ok=True)  # no partial or stale output next to a failure
+    return _recorded(job_dir, record)
+
+
+def mark_skipped(job_dir: Path, record: JobRecord, job_num: int | None, overrides: Sequence[str]) -> JobRecord:
+    """Record that this session found the job settled (``record``) and did not run it again."""
+    if record.skipped and record.job_num == job_num and record.overrides == list(overrides):
+        return record  # already says so: nothing to write
+    record.skipped, record.job_num, record.overrides = True, job_num, list(overrides)
     return _recorded(job_dir, record)
 
 

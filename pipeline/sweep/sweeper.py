@@ -1,0 +1,285 @@
+"""gyrolab's sweeper: Hydra's basic sweeper that leaves finished jobs out before launching anything.
+
+Resuming a sweep with Hydra's basic sweeper composes every job's config twice (once to validate the
+batch, once to launch it) and starts every job, finished ones included, which then skips itself
+(``gyrolab.sweep.job``): a 1,000-job sweep with 600 jobs done paid ~0.7 s per finished job. This
+sweeper computes each job's identity first (``gyrolab.sweep.identity.job_identity``, the same rule
+the jobs apply) and launches only the jobs whose directory holds no record that settles that
+identity (``JobRecord.reusable_for``). Job numbers, and so job directories and ``sweep.nc``, are
+those of an unfiltered sweep: the remaining jobs are launched in runs of consecutive numbers.
+
+The identities are computed without composing every job: the config of one job per combination
+of config-group choices is composed as Hydra composes it, and each other job's value overrides are
+applied to it with Hydra's own override code (and its values put back afterwards). Applying every
+job's overrides also stands in for the basic sweeper's validation of the whole batch; a job whose
+overrides do not apply is composed in full, so that Hydra reports it before any job starts. A config
+whose values call a resolver (``${hydra:...}``, ``${now:...}``, ``${oc.env:...}``, any other) could
+resolve differently inside the job, so then no job is left out here: every job is launched and skips
+itself, exactly as before. A wrong prediction can only cost a launch, never skip a job: a job is left
+out only when the predicted identity equals the one its finished record holds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import re
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from hydra._internal.config_loader_impl import ConfigLoaderImpl
+from hydra.core.override_parser.overrides_parser import OverridesParser
+from hydra.core.override_parser.types import Override, OverrideType
+from hydra.plugins.launcher import Launcher
+from hydra.plugins.sweeper import Sweeper
+from hydra.types import HydraContext, TaskFunction
+from omegaconf import DictConfig, OmegaConf
+
+from gyrolab.sweep.identity import code_version, job_identity
+from gyrolab.sweep.job import mark_skipped
+from gyrolab.sweep.record import JobRecord, read_record
+
+log = logging.getLogger("gyrolab.sweep")
+
+#: finished jobs between two runs of remaining jobs that are launched anyway (they skip themselves) rather
+#: than splitting the launch: a launcher with parallel workers keeps them busy across small gaps
+MERGE_GAP = 8
+#: an interpolation that calls a resolver (``${name:...}``): its value may differ inside the job
+_RESOLVER = re.compile(r"\$\{\s*[\w.]+\s*:")
+
+
+class ResumingSweeper(Sweeper):
+    """Hydra's basic sweeper (same jobs, same numbers, same ``max_batch_size`` and ``params``) that does
+    not launch the jobs a previous run of the same sweep already settled.
+
+    It derives from Hydra's ``Sweeper`` and calls the basic sweeper's functions rather than subclassing
+    it: Hydra re-imports its own plugin modules when it scans them, which would leave a subclass with
+    a stale base class.
+    """
+
+    def __init__(self, max_batch_size: int | None = None, params: dict[str, str] | None = None) -> None:
+        super().__init__()
+        self.max_batch_size = max_batch_size
+        self.params = dict(params or {})
+        self.hydra_context: HydraContext | None = None
+        self.config: DictConfig | None = None
+        self.launcher: Launcher | None = None
+
+    def setup(self, *, hydra_context: HydraContext, task_function: TaskFunction, config: DictConfig) -> None:
+        from hydra.core.plugins import Plugins
+
+        self.hydra_context, self.config = hydra_context, config
+        self.launcher = Plugins.instance().instantiate_launcher(hydra_context=hydra_context,
+                                                                task_function=task_function, config=config)
+
+    def sweep(self, arguments: list[str]) -> Any:
+        assert self.config is not None and self.launcher is not None and self.hydra_context is not None
+        from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
+
+        parser = OverridesParser.create(config_loader=self.hydra_context.config_loader)
+        params = [f"{key}={value}" for key, value in self.params.items()]  # as the basic sweeper: params first
+        overrides = parser.parse_overrides([*params, *arguments])
+        jobs = [job for batch in BasicSweeper.split_arguments(overrides, None) for job in batch]
+        sweep_dir = Path(self.config.hydra.sweep.dir)
+        sweep_dir.mkdir(parents=True, exist_ok=True)
+        OmegaConf.save(self.config, sweep_dir / "multirun.yaml")
+
+        tic = time.perf_counter()
+        settled, unsure = check_jobs(self.config, self.hydra_context.config_loader, jobs)
+        remaining = [num for num in range(len(jobs)) if num not in settled]
+        if settled:
+            log.info("sweep resumed: %d of %d jobs already settled, not launched (checked in %.1f s)",
+                     len(settled), len(jobs), time.perf_counter() - tic)
+        # As the basic sweeper, refuse a sweep with a job Hydra cannot compose before launching any job: every
+        # job's overrides were applied above; the jobs where that failed are composed in full (Hydra's error).
+        self.validate_batch_is_legal([jobs[num] for num in unsure if num not in settled])
+        # A sequential launcher gains nothing from launching settled jobs between remaining ones.
+        gap = 0 if type(self.launcher).__name__ == "BasicLauncher" else MERGE_GAP
+        returns, launched = [], set()
+        for start, batch in launch_runs(remaining, jobs, self.max_batch_size, gap):
+            launched.update(range(start, start + len(batch)))
+            results = self.launcher.launch(batch, initial_job_idx=start)
+            for r in results:
+                _ = r.return_value  # re-raises a job's exception, as the basic sweeper does
+            returns.append(results)
+        for num, (job_dir, record) in settled.items():  # as a job that skips itself records it
+            if num not in launched:
+                mark_skipped(job_dir, record, num, jobs[num])
+        return returns
+
+
+def launch_runs(remaining: Sequence[int], jobs: Sequence[Sequence[str]], max_batch_size: int | None,
+                merge_gap: int = MERGE_GAP) -> list[tuple[int, list[list[str]]]]:
+    """(first job number, overrides of consecutive jobs) to launch: runs of remaining jobs joined across gaps
+    of at most ``merge_gap`` settled jobs, each cut into batches of at most ``max_batch_size`` jobs."""
+    runs: list[list[int]] = []
+    for num in remaining:
+        if runs and num - runs[-1][-1] - 1 <= merge_gap:
+            runs[-1].extend(range(runs[-1][-1] + 1, num + 1))
+        else:
+            runs.append([num])
+    size = max_batch_size if max_batch_size and max_batch_size > 0 else None
+    out = []
+    for run in runs:
+        step = size or len(run)
+        for i in range(0, len(run), step):
+            out.append((run[i], [list(jobs[n]) for n in run[i:i + step]]))
+    return out
+
+
+class OverridesDoNotApply(Exception):
+    """A job's value overrides could not be applied to the config of its group choices."""
+
+
+def check_jobs(master: DictConfig, loader: ConfigLoaderImpl,
+               jobs: Sequence[Sequence[str]]) -> tuple[dict[int, tuple[Path, JobRecord]], list[int]]:
+    """(the jobs whose directory holds a record that settles their identity, by job number; the jobs whose
+    overrides did not apply). A job whose identity cannot be predicted outside it is not settled here: it
+    is launched and checks itself."""
+    sweep_dir = Path(master.hydra.sweep.dir)
+    predictor = IdentityPredictor(master, loader)
+    settled, unsure = {}, []
+    for num, overrides in enumerate(jobs):
+        try:
+            job_id = predictor.identity(overrides)  # None: not predictable here
+        except OverridesDoNotApply:
+            unsure.append(num)
+            continue
+        job_dir = _job_dir(master, num, sweep_dir)  # None: the jobs find their own directories
+        record = read_record(job_dir) if job_id is not None and job_dir is not None else None
+        if record is not None and record.reusable_for(job_id, job_dir):
+            settled[num] = (job_dir, record)
+    return settled, unsure
+
+
+def _job_dir(master: DictConfig, num: int, sweep_dir: Path) -> Path | None:
+    """Job ``num``'s directory; None when ``hydra.sweep.subdir`` depends on more than the job number
+    (e.g. ``${hydra.job.override_dirname}``: only Hydra knows it before the job runs)."""
+    subdir = OmegaConf.to_container(master.hydra.sweep, resolve=False).get("subdir")
+    if subdir == "${hydra.job.num}":  # gyrolab's default
+        return sweep_dir / str(num)
+    if "${" in str(subdir):
+        return None
+    return sweep_dir / str(subdir)
+
+
+@dataclass
+class _Base:
+    """The config (without ``hydra``) of one composed job, and its value overrides by key."""
+
+    scene: DictConfig
+    applied: dict[str, Override]
+    #: the scene as plain data, when it has no interpolation (a job's differs only where its overrides say)
+    plain: dict[str, Any] | None = None
+
+
+class IdentityPredictor:
+    """Job identities of a sweep's jobs as the jobs themselves will compute them (None: not predictable).
+
+    Per job it costs a few override applications and one resolution of the config, not a composition:
+    the job's value overrides that differ from the composed job's are applied to that job's config, the
+    identity computed, and the composed job's values put back.
+    """
+
+    def __init__(self, master: DictConfig, loader: ConfigLoaderImpl) -> None:
+        self.master, self.loader = master, loader
+        self.groups = set((master.hydra.runtime.get("choices") or {}).keys())
+        self.parser = OverridesParser.create(config_loader=loader)
+        self.code = code_version()
+        self._parsed: dict[str, Override] = {}
+        #: group choices -> the composed job with those choices (None: its config calls a resolver)
+        self._bases: dict[tuple[str, ...], _Base | None] = {}
+
+    def identity(self, overrides: Sequence[str]) -> str | None:
+        parsed = [self._parse(text) for text in overrides]
+        choices = tuple(o.input_line for o in parsed if self._is_group(o))
+        # Hydra's own settings are the same for every job of a sweep and are not part of an identity
+        values = [o for o in parsed if not self._is_group(o) and not o.key_or_group.startswith("hydra.")]
+        if choices not in self._bases:
+            composed = self.loader.load_sweep_config(self.master, list(overrides))
+            scene = OmegaConf.masked_copy(composed, [k for k in composed if k != "hydra"])
+            unresolved = OmegaConf.to_container(scene, resolve=False)
+            self._bases[choices] = None if _RESOLVER.search(repr(unresolved)) else _Base(
+                scene, {o.key_or_group: o for o in values}, None if "${" in repr(unresolved) else unresolved)
+        base = self._bases[choices]
+        if base is None:
+            return None
+        changed = [o for o in values if base.applied[o.key_or_group].input_line != o.input_line] \
+            if all(o.key_or_group in base.applied for o in values) else None
+        if changed is None or any(o.is_delete() for o in changed):
+            return None
+        try:
+            try:
+                for o in changed:
+                    ConfigLoaderImpl._apply_overrides_to_config([_as_change(o)], base.scene)
+            except Exception as error:  # noqa: BLE001 - Hydra's composition will say what is wrong
+                raise OverridesDoNotApply(str(error)) from error
+            try:
+                plain = _patched(base, changed)
+                if plain is None:
+                    plain = OmegaConf.to_container(base.scene, resolve=True)
+            except Exception:  # noqa: BLE001 - e.g. an interpolation that does not resolve: the job records it
+                return None
+        finally:
+            for o in changed:  # back to the composed job's values
+                ConfigLoaderImpl._apply_overrides_to_config([_as_change(base.applied[o.key_or_group])], base.scene)
+        return job_identity(plain, self.code)
+
+    def _parse(self, text: str) -> Override:
+        if text not in self._parsed:
+            self._parsed[text] = self.parser.parse_override(text)
+        return self._parsed[text]
+
+    def _is_group(self, o: Override) -> bool:
+        return o.key_or_group in self.groups or o.key_or_group.startswith("hydra/")
+
+
+def _as_change(o: Override) -> Override:
+    """``+key=value`` as ``key=value``: the key is there already (the composed job added it)."""
+    return dataclasses.replace(o, type=OverrideType.CHANGE) if o.is_add() else o
+
+
+def _patched(base: _Base, changed: Sequence[Override]) -> dict[str, Any] | None:
+    """The job's config as plain data: the composed job's, with the changed values read back from the config
+    they were applied to (so typed as Hydra types them); None when that is not the whole story (the config
+    or a new value interpolates, or a key goes through a list)."""
+    if base.plain is None or any("${" in o.input_line for o in changed):
+        return None
+    plain = dict(base.plain)
+    for o in changed:
+        *parents, leaf = o.key_or_group.split(".")
+        node, where = plain, base.scene
+        for key in parents:  # copy the dictionaries on the way: the composed job's stay as they are
+            if not isinstance(node.get(key), dict):
+                return None
+            node[key] = dict(node[key])
+            node, where = node[key], where[key]
+        value = where[leaf]
+        node[leaf] = OmegaConf.to_container(value, resolve=True) if OmegaConf.is_config(value) else value
+    return plain
+
+
+class GyrolabSweeper(ResumingSweeper):
+    """The sweeper gyrolab's config selects (``hydra/sweeper: gyrolab``)."""
+
+
+#: Hydra instantiates a sweeper only from the ``hydra_plugins`` namespace (it checks the name and imports
+#: it): the class goes by that name there (``register_plugin``) instead of shipping a second top-level package
+GyrolabSweeper.__module__ = "hydra_plugins.gyrolab_sweeper"
+PLUGIN_TARGET = f"{GyrolabSweeper.__module__}.{GyrolabSweeper.__qualname__}"
+
+
+def register_plugin() -> None:
+    """Make gyrolab's sweeper known to Hydra in this process (before Hydra instantiates the sweeper)."""
+    import sys
+    import types
+
+    from hydra.core.plugins import Plugins
+
+    name = GyrolabSweeper.__module__
+    module = sys.modules.setdefault(name, types.ModuleType(name, "gyrolab's sweeper (gyrolab.sweep.sweeper) for Hydra"))
+    module.GyrolabSweeper = GyrolabSweeper  # type: ignore[attr-defined]  # (also on a stale installed module)
+    Plugins.instance().register(GyrolabSweeper)

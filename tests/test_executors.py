@@ -1,0 +1,171 @@
+"""Chunks on Dask: a scheduler and two workers started from the ``dask`` command line, as on a cluster.
+
+The expectation for every chunk is the same chunk integrated in this process (the kernels are
+deterministic and each trajectory is independent, so where a chunk runs must not change a bit).
+"""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gyrolab.batch import executors
+from gyrolab.batch.executors import IntegrationChunk, integrate_chunk, map_chunks
+from gyrolab.engine.config import compose_config
+from gyrolab.errors import ConfigError
+
+pytest.importorskip("distributed")
+
+DASK = str(Path(sys.executable).with_name("dask"))
+# A tiny fixed-point scene (heavy top, default body), rk4_numba: the (ω, γ) block kernel.
+OVERRIDES = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=2", "time.n_output=2",
+             "output.euler_angles=false", "output.figures=false"]
+
+
+@pytest.fixture(scope="module")
+def config():
+    """The scene's config as plain data, as a chunk task carries it."""
+    from omegaconf import OmegaConf
+
+    return OmegaConf.to_container(compose_config(OVERRIDES), resolve=True)
+
+
+def chunks(config, n_chunks=3, per_chunk=8):
+    """Default initial state with ω0 perturbed differently for every trajectory."""
+    from omegaconf import OmegaConf
+
+    from gyrolab.engine.scene import Scene
+
+    y0 = Scene.from_config(OmegaConf.create(config)).system.initial_state()
+    rng = np.random.default_rng(14)
+    out = []
+    for _ in range(n_chunks):
+        states = np.tile(y0, (per_chunk, 1))
+        states[:, :3] += rng.normal(scale=0.05, size=(per_chunk, 3))
+        out.append(IntegrationChunk(config=config, initial_states=states))
+    return out
+
+
+def _stop(process):
+    if process.poll() is None:
+        os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+
+
+@pytest.fixture(scope="module")
+def scheduler(tmp_path_factory):
+    """``dask scheduler`` and two ``dask worker ADDRESS --nthreads 1``, each its own process; its address."""
+    tmp = tmp_path_factory.mktemp("dask")
+    scheduler_file = tmp / "scheduler.json"
+    processes = []
+    env = {**os.environ, "NUMBA_NUM_THREADS": "1"}
+
+    def start(*args):
+        processes.append(subprocess.Popen([DASK, *args], cwd=tmp, env=env, stdout=subprocess.DEVNULL,
+                                          stderr=subprocess.DEVNULL, start_new_session=True))
+
+    try:
+        start("scheduler", "--port", "0", "--no-dashboard", "--scheduler-file", str(scheduler_file))
+        deadline = time.monotonic() + 60
+        while not scheduler_file.is_file() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        import json
+
+        address = json.loads(scheduler_file.read_text())["address"]
+        for _ in range(2):
+            start("worker", address, "--nthreads", "1", "--no-dashboard", "--local-directory", str(tmp))
+        from distributed import Client
+
+        with Client(address, timeout=30, set_as_default=False) as client:
+            client.wait_for_workers(2, timeout=60)
+        yield address
+    finally:
+        for process in processes:
+            _stop(process)
+
+
+def in_process(tasks):
+    results = {}
+    map_chunks(integrate_chunk, tasks, lambda i, r: results.__setitem__(i, r))
+    return results
+
+
+def test_chunks_on_separately_started_workers_equal_in_process_bit_for_bit(scheduler, config):
+    tasks = chunks(config)
+    expected = in_process(tasks)
+    results = {}
+    map_chunks(integrate_chunk, tasks, lambda i, r: results.__setitem__(i, r), scheduler=scheduler)
+    assert sorted(results) == list(range(len(tasks)))
+    for i in range(len(tasks)):
+        assert np.array_equal(results[i].y, expected[i].y)   # bit for bit, every output time
+        assert np.array_equal(results[i].failed, expected[i].failed) and not results[i].failed.any()
+        assert results[i].n_steps == expected[i].n_steps == 200
+    # The chunks ran on the workers: they rebuilt the compiled model there (once per worker process).
+    from distributed import Client
+
+    with Client(scheduler, timeout=30, set_as_default=False) as client:
+        kept = client.run(lambda: len(__import__("gyrolab.batch.executors").batch.executors._models))
+    assert sum(kept.values()) >= 1 and set(kept.values()) <= {0, 1}
+
+
+def test_in_flight_chunks_stay_bounded(scheduler, config):
+    """Memory is bounded by a few chunks per worker: tasks are pulled only as results come back."""
+    base = chunks(config, n_chunks=1, per_chunk=2)[0]
+    pulled, ahead = [0], []
+
+    def tasks():
+        for _ in range(12):
+            pulled[0] += 1
+            yield base
+
+    done = []
+
+    def on_result(index, result):
+        done.append(index)
+        ahead.append(pulled[0] - len(done))
+
+    map_chunks(integrate_chunk, tasks(), on_result, scheduler=scheduler)
+    assert sorted(done) == list(range(12))
+    # two workers of one thread: at most 2 chunks per thread in flight, so at most 4 pulled and unfinished
+    assert max(ahead) <= executors.CHUNKS_PER_THREAD * 2 - 1
+
+
+@pytest.mark.parametrize("where", ["process", "cluster"])
+def test_a_failing_chunk_is_one_sentence_naming_it(scheduler, where, config):
+    tasks = chunks(config, n_chunks=2, per_chunk=2)
+    tasks[1].initial_states[0, 0] = np.nan
+    with pytest.raises(ConfigError) as caught:
+        map_chunks(integrate_chunk, tasks, lambda i, r: None, scheduler=scheduler if where == "cluster" else None)
+    message = str(caught.value)
+    assert message.startswith("chunk 1 of the batch failed") and "NaN" in message
+    assert (scheduler in message) == (where == "cluster") and "\n" not in message
+    assert caught.value.exit_code == 2
+
+
+def test_unreachable_scheduler_is_one_sentence_with_its_address(monkeypatch):
+    import socket
+
+    with socket.socket() as probe:  # a port nobody listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    monkeypatch.setattr(executors, "CONNECT_TIMEOUT", 1)
+    address = f"tcp://127.0.0.1:{port}"
+    with pytest.raises(ConfigError) as caught:
+        map_chunks(integrate_chunk, [], lambda i, r: None, scheduler=address)
+    assert address in str(caught.value) and "\n" not in str(caught.value) and caught.value.exit_code == 2
+
+
+def test_scheduler_values_and_missing_dask(monkeypatch):
+    with pytest.raises(ConfigError, match="valid: process.*local.*tcp://HOST:PORT"):
+        map_chunks(integrate_chunk, [], lambda i, r: None, scheduler="localhost:8786")
+    monkeypatch.setattr(executors, "find_spec", lambda name: None)
+    with pytest.raises(ConfigError, match=r'pip install "gyrolab\[cluster\]"'):
+        map_chunks(integrate_chunk, [], lambda i, r: None, scheduler="local")
+    ran = []
+    map_chunks(len, ["ab", "c"], lambda i, r: ran.append((i, r)))  # in this process, Dask not needed
+    assert ran == [(0, 2), (1, 1)]
