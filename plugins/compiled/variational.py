@@ -1,0 +1,242 @@
+"""Variational equations of the fixed-point system, and the chaos indicators they give (compiled, batched).
+
+State x = (ω, γ) of the Euler–Poisson equations with the built-in torques acting on the vertical
+(``fixed_point.pack``: uniform gravity U × γ with U = p[9:12], Newtonian N γ × Iγ with N = p[14]):
+
+    I ω̇ = (Iω) × ω + U × γ + N γ × Iγ,        γ̇ = γ × ω.
+
+The tangent vector δ = (δω, δγ) obeys δ̇ = J(x) δ with the analytic 6×6 Jacobian J (``jacobian``).
+Along it two indicators are integrated in the same RK4 steps as the state (14 unknowns per trajectory):
+
+* MEGNO (Cincotta & Simó 2000): Y(t) = (2/t) ∫₀ᵗ s ρ(s) ds with ρ = δ̇·δ / δ·δ = d ln‖δ‖/dt, and its
+  time mean ⟨Y⟩(t) = (1/t) ∫₀ᵗ Y(s) ds, as two quadratures a' = s ρ, b' = 2a/s (Y = 2a/t, ⟨Y⟩ = b/t).
+  ρ is invariant under a rescaling of δ, so δ is renormalised to unit length after every step without
+  touching the indicator; the logarithms of the norms are summed instead.
+* FLI (Froeschlé, Lega & Gonczi 1997): max over the steps of ln‖δ(t)‖ with ‖δ(0)‖ = 1, from that sum.
+
+The constraint |γ| = 1 is an invariant of the flow, and the linearised flow keeps γ·δγ constant
+(d/dt(γ·δγ) = (γ×ω)·δγ + γ·(δγ×ω) = 0), so a tangent vector whose δγ starts tangent to the sphere
+stays tangent: δ lives on the constraint manifold. The initial δ is chosen so (``initial_tangent``).
+
+Only 6-D (ω, γ) states: torques on the fixed horizontal axes (which need α) are refused by the caller.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from gyrolab.plugins.compiled import inline_kernel, kernel
+
+#: unknowns of the augmented system: x (6), δ (6), the MEGNO quadratures a and b
+AUGMENTED = 14
+#: an arbitrary fixed direction (no symmetry of the problem singles it out) for the initial tangent vector
+_DIRECTION = np.array([0.31, -0.47, 0.59, 0.23, -0.71, 0.37])
+
+
+def initial_tangent(y0s: np.ndarray) -> np.ndarray:
+    """Unit tangent vectors (one row per trajectory) with δγ ⟂ γ0: on the constraint manifold |γ| = 1."""
+    y0s = np.asarray(y0s, dtype=float)
+    d = np.tile(_DIRECTION, (len(y0s), 1))
+    g = y0s[:, 3:6] / np.linalg.norm(y0s[:, 3:6], axis=1, keepdims=True)
+    d[:, 3:6] -= np.sum(d[:, 3:6] * g, axis=1, keepdims=True) * g
+    return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+
+@kernel
+def rhs6(y, p, out):
+    """Euler–Poisson right-hand side of a 6-D (ω, γ) state: the arithmetic of ``fixed_point.rhs`` without α."""
+    I0, I1, I2 = p[0], p[1], p[2]
+    w0, w1, w2 = y[0], y[1], y[2]
+    g0, g1, g2 = y[3], y[4], y[5]
+    u0, u1, u2 = p[9], p[10], p[11]
+    n = p[14]
+    out[0] = ((I1 - I2) * w1 * w2 + u1 * g2 - u2 * g1 + n * (I2 - I1) * g1 * g2) * p[16]
+    out[1] = ((I2 - I0) * w2 * w0 + u2 * g0 - u0 * g2 + n * (I0 - I2) * g2 * g0) * p[17]
+    out[2] = ((I0 - I1) * w0 * w1 + u0 * g1 - u1 * g0 + n * (I1 - I0) * g0 * g1) * p[18]
+    out[3] = g1 * w2 - g2 * w1
+    out[4] = g2 * w0 - g0 * w2
+    out[5] = g0 * w1 - g1 * w0
+
+
+@kernel
+def tangent(y, d, p, out):
+    """out = J(y) d: the linearised right-hand side (``jacobian`` applied to d, without forming J)."""
+    I0, I1, I2 = p[0], p[1], p[2]
+    w0, w1, w2 = y[0], y[1], y[2]
+    g0, g1, g2 = y[3], y[4], y[5]
+    a0, a1, a2 = d[0], d[1], d[2]
+    c0, c1, c2 = d[3], d[4], d[5]
+    u0, u1, u2 = p[9], p[10], p[11]
+    n = p[14]
+    out[0] = ((I1 - I2) * (a1 * w2 + w1 * a2) + u1 * c2 - u2 * c1 + n * (I2 - I1) * (c1 * g2 + g1 * c2)) * p[16]
+    out[1] = ((I2 - I0) * (a2 * w0 + w2 * a0) + u2 * c0 - u0 * c2 + n * (I0 - I2) * (c2 * g0 + g2 * c0)) * p[17]
+    out[2] = ((I0 - I1) * (a0 * w1 + w0 * a1) + u0 * c1 - u1 * c0 + n * (I1 - I0) * (c0 * g1 + g0 * c1)) * p[18]
+    out[3] = c1 * w2 + g1 * a2 - c2 * w1 - g2 * a1
+    out[4] = c2 * w0 + g2 * a0 - c0 * w2 - g0 * a2
+    out[5] = c0 * w1 + g0 * a1 - c1 * w0 - g1 * a0
+
+
+def jacobian(y: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The 6×6 Jacobian ∂f/∂(ω, γ) at state y, written out entry by entry (rows: ω̇, γ̇)."""
+    I0, I1, I2 = p[0:3]
+    w0, w1, w2, g0, g1, g2 = y[:6]
+    u0, u1, u2 = p[9:12]
+    n = p[14]
+    J = np.zeros((6, 6))
+    J[0, 1:3] = (I1 - I2) * w2, (I1 - I2) * w1
+    J[1, 0], J[1, 2] = (I2 - I0) * w2, (I2 - I0) * w0
+    J[2, 0:2] = (I0 - I1) * w1, (I0 - I1) * w0
+    J[0, 4:6] = -u2 + n * (I2 - I1) * g2, u1 + n * (I2 - I1) * g1
+    J[1, 3], J[1, 5] = u2 + n * (I0 - I2) * g2, -u0 + n * (I0 - I2) * g0
+    J[2, 3:5] = -u1 + n * (I1 - I0) * g1, u0 + n * (I1 - I0) * g0
+    J[0:3] /= np.array([I0, I1, I2])[:, None]
+    # γ̇ = γ × ω: ∂/∂ω = [γ]×, ∂/∂γ = −[ω]×
+    J[3:6, 0:3] = [[0, -g2, g1], [g2, 0, -g0], [-g1, g0, 0]]
+    J[3:6, 3:6] = [[0, w2, -w1], [-w2, 0, w0], [w1, -w0, 0]]
+    return J
+
+
+@kernel
+def _augmented(s, z, p, out):
+    """Right-hand side of (x, δ, a, b) at time s since the start: ẋ = f, δ̇ = Jδ, ȧ = s ρ, ḃ = 2a/s."""
+    rhs6(z[0:6], p, out[0:6])
+    tangent(z[0:6], z[6:12], p, out[6:12])
+    dd = 0.0
+    dj = 0.0
+    for m in range(6):
+        dd += z[6 + m] * z[6 + m]
+        dj += z[6 + m] * out[6 + m]
+    out[12] = s * dj / dd
+    out[13] = 2.0 * z[12] / s if s > 0.0 else 0.0  # a = O(s²), so 2a/s → 0 at s = 0
+
+
+@kernel
+def _rk4_step(s, h, z, p, k1, k2, k3, k4, tmp):
+    _augmented(s, z, p, k1)
+    for m in range(AUGMENTED):
+        tmp[m] = z[m] + 0.5 * h * k1[m]
+    _augmented(s + 0.5 * h, tmp, p, k2)
+    for m in range(AUGMENTED):
+        tmp[m] = z[m] + 0.5 * h * k2[m]
+    _augmented(s + 0.5 * h, tmp, p, k3)
+    for m in range(AUGMENTED):
+        tmp[m] = z[m] + h * k3[m]
+    _augmented(s + h, tmp, p, k4)
+    for m in range(AUGMENTED):
+        z[m] += (h / 6.0) * (k1[m] + 2.0 * k2[m] + 2.0 * k3[m] + k4[m])
+
+
+@inline_kernel
+def _nutation(g2):
+    return np.arccos(min(1.0, max(-1.0, g2)))
+
+
+@numba.njit(cache=True, parallel=True, error_model="numpy")
+def run_indicators(P, t_out, steps_per_interval, Y0, D0, megno, fli, deviation, final):
+    """Integrate state and tangent vector of every trajectory (in parallel) with fixed-step RK4.
+
+    P[j], Y0[j], D0[j]: parameters, initial (ω, γ) and unit initial tangent vector of trajectory j.
+    Fills megno[j, i] = ⟨Y⟩ at t_out[i] (0 at the start), fli[j] = max ln‖δ‖ over the steps,
+    deviation[j] = max |θ − θ0| over the steps (θ = arccos γ3) and final[j] = the state at t_out[-1].
+    A trajectory that becomes non-finite is left NaN from there on.
+    """
+    for j in numba.prange(Y0.shape[0]):
+        _trajectory(P[j], t_out, steps_per_interval, Y0[j], D0[j], megno[j], fli, deviation, final[j], j)
+
+
+@kernel
+def _trajectory(p, t_out, steps_per_interval, y0, d0, megno, fli, deviation, final, j):
+    """One trajectory of ``run_indicators`` (a separate kernel: the parallel loop stays small to compile)."""
+    z = np.zeros(AUGMENTED)
+    k1, k2, k3 = np.empty(AUGMENTED), np.empty(AUGMENTED), np.empty(AUGMENTED)
+    k4, tmp = np.empty(AUGMENTED), np.empty(AUGMENTED)
+    z[0:6] = y0
+    z[6:12] = d0
+    theta0 = _nutation(z[5])
+    log_norm = 0.0
+    best = 0.0
+    worst = 0.0
+    megno[0] = 0.0
+    for i in range(1, t_out.size):
+        steps = steps_per_interval[i - 1]
+        h = (t_out[i] - t_out[i - 1]) / steps
+        for k in range(steps):
+            s = (t_out[i - 1] - t_out[0]) + k * h
+            _rk4_step(s, h, z, p, k1, k2, k3, k4, tmp)
+            norm = 0.0
+            for m in range(6, 12):
+                norm += z[m] * z[m]
+            norm = np.sqrt(norm)
+            for m in range(6, 12):
+                z[m] /= norm
+            log_norm += np.log(norm)
+            best = max(best, log_norm)
+            worst = max(worst, abs(_nutation(z[5]) - theta0))
+        if not np.isfinite(log_norm + z[12] + z[13] + z[0] + z[1] + z[2]):
+            megno[i:] = np.nan
+            fli[j] = deviation[j] = np.nan
+            final[:] = np.nan
+            return
+        megno[i] = z[13] / (t_out[i] - t_out[0])
+    fli[j] = best
+    deviation[j] = worst
+    final[:] = z[0:6]
+
+
+@kernel
+def section_crossings(p, y0, h, n_steps, level, out):
+    """Upward crossings of γ3 = level by one trajectory (RK4, step h, n_steps steps), at most len(out).
+
+    Each crossing is located by the cubic Hermite interpolant of the step (values and derivatives at
+    both ends: error O(h⁴), the order of RK4) and refined by bisection on it; out[k] = (t, ω, γ) there.
+    Returns the number of crossings recorded.
+    """
+    y = y0.copy()
+    k1, k2, k3, k4, tmp = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
+    f0, f1, prev = np.empty(6), np.empty(6), np.empty(6)
+    found = 0
+    rhs6(y, p, f0)
+    for step in range(n_steps):
+        prev[:] = y
+        rhs6(y, p, k1)
+        for m in range(6):
+            tmp[m] = y[m] + 0.5 * h * k1[m]
+        rhs6(tmp, p, k2)
+        for m in range(6):
+            tmp[m] = y[m] + 0.5 * h * k2[m]
+        rhs6(tmp, p, k3)
+        for m in range(6):
+            tmp[m] = y[m] + h * k3[m]
+        rhs6(tmp, p, k4)
+        for m in range(6):
+            y[m] += (h / 6.0) * (k1[m] + 2.0 * k2[m] + 2.0 * k3[m] + k4[m])
+        rhs6(y, p, f1)
+        if prev[5] < level <= y[5]:
+            lo, hi = 0.0, 1.0
+            for _ in range(60):
+                mid = 0.5 * (lo + hi)
+                if _hermite(prev[5], y[5], f0[5], f1[5], h, mid) < level:
+                    lo = mid
+                else:
+                    hi = mid
+            u = 0.5 * (lo + hi)
+            out[found, 0] = (step + u) * h
+            for m in range(6):
+                out[found, 1 + m] = _hermite(prev[m], y[m], f0[m], f1[m], h, u)
+            found += 1
+            if found == out.shape[0]:
+                return found
+        if not np.isfinite(y[5]):
+            return found
+        f0[:] = f1
+    return found
+
+
+@inline_kernel
+def _hermite(y0, y1, f0, f1, h, u):
+    """Cubic Hermite interpolant on a step of length h at fraction u."""
+    u2 = u * u
+    u3 = u2 * u
+    return ((2 * u3 - 3 * u2 + 1) * y0 + (u3 - 2 * u2 + u) * h * f0 + (-2 * u3 + 3 * u2) * y1
+            + (u3 - u2) * h * f1)
