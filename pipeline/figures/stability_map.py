@@ -127,9 +127,9 @@ def draw_stability_map(ds: xr.Dataset) -> plt.Figure:
     indicator = _values(ds, "indicator")
     is_megno = str(ds["indicator"].attrs.get("indicator_name", "MEGNO")) == "MEGNO"
     norm = Normalize(0.0, CLIP) if is_megno else Normalize(*np.nanpercentile(indicator, [1, 99]))
-    mesh = map_ax.pcolormesh(r_edges, t_edges, np.ma.masked_invalid(indicator), cmap="magma", norm=norm,
+    cmap = plt.get_cmap("magma").with_extremes(bad="0.75")
+    mesh = map_ax.pcolormesh(r_edges, t_edges, np.ma.masked_invalid(indicator), cmap=cmap, norm=norm,
                              shading="flat", rasterized=True)
-    mesh.cmap.set_bad("0.75")
     bar = fig.colorbar(mesh, ax=map_ax, extend="max" if is_megno else "neither", pad=0.02)
     bar.set_label(_indicator_label(ds), fontsize=7)
     if is_megno and indicator.size > 3 and np.isfinite(indicator).any() and r0.size > 1 and theta0.size > 1:
