@@ -72,6 +72,11 @@ def test_jacobian_matches_finite_differences_of_the_compiled_rhs():
             f = np.empty(6)
             fixed_point.rhs(0.0, y, p, f)
             assert abs(f[3:6] @ d[3:6] + y[3:6] @ out[3:6]) < 1e-13
+            # the batch kernel's right-hand side, column by column: f, J δ and the MEGNO integrands s ρ, 2a/s
+            Z = np.concatenate([y, d, [0.3, 0.0]])[:, None]
+            aug = np.empty((variational.AUGMENTED, 1))
+            variational._augmented_block(2.0, Z, p[:, None], aug, 1)
+            np.testing.assert_allclose(aug[:, 0], [*f, *(J @ d), 2.0 * (d @ J @ d) / (d @ d), 0.3], rtol=1e-13, atol=1e-14)
 
 
 def test_initial_tangent_is_unit_and_tangent_to_the_sphere():
@@ -146,6 +151,21 @@ def test_indicator_outputs_interface_and_nutation_deviation_against_the_batch_ke
     theta = np.arccos(np.clip(states[:, :, 5], -1, 1))
     np.testing.assert_allclose(out["max_nutation_deviation"][0], np.max(np.abs(theta - theta[:, :1]), axis=1),
                                rtol=0, atol=1e-12)
+
+
+def test_trajectories_are_independent_across_blocks_and_a_failure_stays_local():
+    scene = _scene(*CHAOTIC)
+    n = variational.BLOCK + 5  # two blocks, the second partial
+    y0 = _states(scene, np.linspace(0.2, 2.8, n), np.linspace(0.2, 4.0, n))
+    y0[3, 2] = 1e6  # ω h = 1e4: RK4 blows up
+    compiled, times = scene.system.compiled_model(), np.array([0.0, 2.0, 4.0])
+    batch = megno_run(compiled, scene.integrator, times, y0)
+    assert batch["failed"].tolist() == [j == 3 for j in range(n)]
+    assert np.isnan(batch["fli"][3]) and np.isnan(batch["final_state"][3]).all()
+    for j in (0, 4, n - 1):  # alone = in the batch, bit for bit
+        alone = megno_run(compiled, scene.integrator, times, y0[j:j + 1])
+        for key in ("megno", "fli", "max_nutation_deviation", "final_state"):
+            np.testing.assert_array_equal(alone[key][0], batch[key][j])
 
 
 def test_a_state_carrying_alpha_gives_the_same_indicators():

@@ -97,91 +97,115 @@ def jacobian(y: np.ndarray, p: np.ndarray) -> np.ndarray:
     return J
 
 
-@kernel
-def _augmented(s, z, p, out):
-    """Right-hand side of (x, δ, a, b) at time s since the start: ẋ = f, δ̇ = Jδ, ȧ = s ρ, ḃ = 2a/s."""
-    rhs6(z[0:6], p, out[0:6])
-    tangent(z[0:6], z[6:12], p, out[6:12])
-    dd = 0.0
-    dj = 0.0
-    for m in range(6):
-        dd += z[6 + m] * z[6 + m]
-        dj += z[6 + m] * out[6 + m]
-    out[12] = s * dj / dd
-    out[13] = 2.0 * z[12] / s if s > 0.0 else 0.0  # a = O(s²), so 2a/s → 0 at s = 0
-
-
-@kernel
-def _rk4_step(s, h, z, p, k1, k2, k3, k4, tmp):
-    _augmented(s, z, p, k1)
-    for m in range(AUGMENTED):
-        tmp[m] = z[m] + 0.5 * h * k1[m]
-    _augmented(s + 0.5 * h, tmp, p, k2)
-    for m in range(AUGMENTED):
-        tmp[m] = z[m] + 0.5 * h * k2[m]
-    _augmented(s + 0.5 * h, tmp, p, k3)
-    for m in range(AUGMENTED):
-        tmp[m] = z[m] + h * k3[m]
-    _augmented(s + h, tmp, p, k4)
-    for m in range(AUGMENTED):
-        z[m] += (h / 6.0) * (k1[m] + 2.0 * k2[m] + 2.0 * k3[m] + k4[m])
-
-
 @inline_kernel
 def _nutation(g2):
     return np.arccos(min(1.0, max(-1.0, g2)))
 
 
+#: trajectories advanced in lock step by one thread: 2.6× faster than one trajectory per thread (measured on a loaded
+#: machine; 16 and 64 were not faster)
+BLOCK = 32
+
+
+@kernel
+def _augmented_block(s, Z, P, out, count):
+    """Right-hand side of (x, δ, a, b) at time s since the start — ẋ = f, δ̇ = Jδ (``tangent``), ȧ = s ρ, ḃ = 2a/s —
+    for a block of trajectories stored by columns (Z[:, j] is trajectory j): the loop runs across trajectories,
+    so the arithmetic vectorises. Same arithmetic as ``rhs6`` and ``tangent``."""
+    for j in range(count):
+        I0, I1, I2 = P[0, j], P[1, j], P[2, j]
+        u0, u1, u2 = P[9, j], P[10, j], P[11, j]
+        n = P[14, j]
+        w0, w1, w2, g0, g1, g2 = Z[0, j], Z[1, j], Z[2, j], Z[3, j], Z[4, j], Z[5, j]
+        a0, a1, a2, c0, c1, c2 = Z[6, j], Z[7, j], Z[8, j], Z[9, j], Z[10, j], Z[11, j]
+        out[0, j] = ((I1 - I2) * w1 * w2 + u1 * g2 - u2 * g1 + n * (I2 - I1) * g1 * g2) * P[16, j]
+        out[1, j] = ((I2 - I0) * w2 * w0 + u2 * g0 - u0 * g2 + n * (I0 - I2) * g2 * g0) * P[17, j]
+        out[2, j] = ((I0 - I1) * w0 * w1 + u0 * g1 - u1 * g0 + n * (I1 - I0) * g0 * g1) * P[18, j]
+        out[3, j] = g1 * w2 - g2 * w1
+        out[4, j] = g2 * w0 - g0 * w2
+        out[5, j] = g0 * w1 - g1 * w0
+        d0 = ((I1 - I2) * (a1 * w2 + w1 * a2) + u1 * c2 - u2 * c1 + n * (I2 - I1) * (c1 * g2 + g1 * c2)) * P[16, j]
+        d1 = ((I2 - I0) * (a2 * w0 + w2 * a0) + u2 * c0 - u0 * c2 + n * (I0 - I2) * (c2 * g0 + g2 * c0)) * P[17, j]
+        d2 = ((I0 - I1) * (a0 * w1 + w0 * a1) + u0 * c1 - u1 * c0 + n * (I1 - I0) * (c0 * g1 + g0 * c1)) * P[18, j]
+        e0 = c1 * w2 + g1 * a2 - c2 * w1 - g2 * a1
+        e1 = c2 * w0 + g2 * a0 - c0 * w2 - g0 * a2
+        e2 = c0 * w1 + g0 * a1 - c1 * w0 - g1 * a0
+        out[6, j], out[7, j], out[8, j], out[9, j], out[10, j], out[11, j] = d0, d1, d2, e0, e1, e2
+        dd = a0 * a0 + a1 * a1 + a2 * a2 + c0 * c0 + c1 * c1 + c2 * c2
+        dj = a0 * d0 + a1 * d1 + a2 * d2 + c0 * e0 + c1 * e1 + c2 * e2
+        out[12, j] = s * dj / dd
+        out[13, j] = 2.0 * Z[12, j] / s if s > 0.0 else 0.0  # a = O(s²), so 2a/s → 0 at s = 0
+
+
 @numba.njit(cache=True, parallel=True, error_model="numpy")
 def run_indicators(P, t_out, steps_per_interval, Y0, D0, megno, fli, deviation, final):
-    """Integrate state and tangent vector of every trajectory (in parallel) with fixed-step RK4.
+    """Integrate state and tangent vector of every trajectory with fixed-step RK4, in parallel.
 
     P[j], Y0[j], D0[j]: parameters, initial (ω, γ) and unit initial tangent vector of trajectory j.
     Fills megno[j, i] = ⟨Y⟩ at t_out[i] (0 at the start), fli[j] = max ln‖δ‖ over the steps,
     deviation[j] = max |θ − θ0| over the steps (θ = arccos γ3) and final[j] = the state at t_out[-1].
-    A trajectory that becomes non-finite is left NaN from there on.
+    A trajectory that becomes non-finite is NaN from there on. Blocks of BLOCK trajectories advance in
+    lock step, stored by columns so that every loop runs across trajectories; blocks run in parallel.
     """
-    for j in numba.prange(Y0.shape[0]):
-        _trajectory(P[j], t_out, steps_per_interval, Y0[j], D0[j], megno[j], fli, deviation, final[j], j)
-
-
-@kernel
-def _trajectory(p, t_out, steps_per_interval, y0, d0, megno, fli, deviation, final, j):
-    """One trajectory of ``run_indicators`` (a separate kernel: the parallel loop stays small to compile)."""
-    z = np.zeros(AUGMENTED)
-    k1, k2, k3 = np.empty(AUGMENTED), np.empty(AUGMENTED), np.empty(AUGMENTED)
-    k4, tmp = np.empty(AUGMENTED), np.empty(AUGMENTED)
-    z[0:6] = y0
-    z[6:12] = d0
-    theta0 = _nutation(z[5])
-    log_norm = 0.0
-    best = 0.0
-    worst = 0.0
-    megno[0] = 0.0
-    for i in range(1, t_out.size):
-        steps = steps_per_interval[i - 1]
-        h = (t_out[i] - t_out[i - 1]) / steps
-        for k in range(steps):
-            s = (t_out[i - 1] - t_out[0]) + k * h
-            _rk4_step(s, h, z, p, k1, k2, k3, k4, tmp)
-            norm = 0.0
-            for m in range(6, 12):
-                norm += z[m] * z[m]
-            norm = np.sqrt(norm)
-            for m in range(6, 12):
-                z[m] /= norm
-            log_norm += np.log(norm)
-            best = max(best, log_norm)
-            worst = max(worst, abs(_nutation(z[5]) - theta0))
-        if not np.isfinite(log_norm + z[12] + z[13] + z[0] + z[1] + z[2]):
-            megno[i:] = np.nan
-            fli[j] = deviation[j] = np.nan
-            final[:] = np.nan
-            return
-        megno[i] = z[13] / (t_out[i] - t_out[0])
-    fli[j] = best
-    deviation[j] = worst
-    final[:] = z[0:6]
+    count = Y0.shape[0]
+    n = AUGMENTED
+    for b in numba.prange((count + BLOCK - 1) // BLOCK):
+        j0 = b * BLOCK
+        m = min(BLOCK, count - j0)
+        z = np.zeros((n, BLOCK))
+        p = np.zeros((P.shape[1], BLOCK))
+        theta0, log_norm = np.zeros(BLOCK), np.zeros(BLOCK)
+        best, worst = np.zeros(BLOCK), np.zeros(BLOCK)
+        for j in range(m):
+            z[0:6, j] = Y0[j0 + j]
+            z[6:12, j] = D0[j0 + j]
+            p[:, j] = P[j0 + j]
+            theta0[j] = _nutation(z[5, j])
+            megno[j0 + j, 0] = 0.0
+        k1, k2, k3 = np.empty((n, BLOCK)), np.empty((n, BLOCK)), np.empty((n, BLOCK))
+        k4, tmp = np.empty((n, BLOCK)), np.empty((n, BLOCK))
+        for i in range(1, t_out.size):
+            steps = steps_per_interval[i - 1]
+            h = (t_out[i] - t_out[i - 1]) / steps
+            for k in range(steps):
+                s = (t_out[i - 1] - t_out[0]) + k * h
+                _augmented_block(s, z, p, k1, m)
+                for c in range(n):
+                    for j in range(m):
+                        tmp[c, j] = z[c, j] + 0.5 * h * k1[c, j]
+                _augmented_block(s + 0.5 * h, tmp, p, k2, m)
+                for c in range(n):
+                    for j in range(m):
+                        tmp[c, j] = z[c, j] + 0.5 * h * k2[c, j]
+                _augmented_block(s + 0.5 * h, tmp, p, k3, m)
+                for c in range(n):
+                    for j in range(m):
+                        tmp[c, j] = z[c, j] + h * k3[c, j]
+                _augmented_block(s + h, tmp, p, k4, m)
+                for c in range(n):
+                    for j in range(m):
+                        z[c, j] += (h / 6.0) * (k1[c, j] + 2.0 * k2[c, j] + 2.0 * k3[c, j] + k4[c, j])
+                for j in range(m):
+                    norm = np.sqrt(z[6, j] * z[6, j] + z[7, j] * z[7, j] + z[8, j] * z[8, j]
+                                   + z[9, j] * z[9, j] + z[10, j] * z[10, j] + z[11, j] * z[11, j])
+                    for c in range(6, 12):
+                        z[c, j] /= norm
+                    log_norm[j] += np.log(norm)
+                    best[j] = max(best[j], log_norm[j])
+                    worst[j] = max(worst[j], abs(_nutation(z[5, j]) - theta0[j]))
+            for j in range(m):
+                megno[j0 + j, i] = z[13, j] / (t_out[i] - t_out[0])
+        for j in range(m):
+            ok = np.isfinite(log_norm[j] + z[0, j] + z[1, j] + z[2, j] + z[12, j] + z[13, j])
+            for i in range(1, t_out.size):
+                if not np.isfinite(megno[j0 + j, i]):
+                    ok = False
+                if not ok:
+                    megno[j0 + j, i] = np.nan
+            fli[j0 + j] = best[j] if ok else np.nan
+            deviation[j0 + j] = worst[j] if ok else np.nan
+            for c in range(6):
+                final[j0 + j, c] = z[c, j] if ok else np.nan
 
 
 @kernel
