@@ -53,6 +53,8 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
     if np.any(P[:, 3:9] != 0.0) or np.any(P[:, 12:14] != 0.0):
         raise ConfigError("chaos indicators need torques about the vertical only (uniform gravity, Newtonian "
                           "attraction along Z); a torque on the fixed horizontal axes is not supported")
+    P = P.copy()
+    P[:, 15] = 0.0  # α is not carried into the kernels (nothing depends on it: checked above)
     gamma = np.linalg.norm(y0s[:, 3:6], axis=1)
     if np.any(np.abs(gamma - 1.0) > 1e-9):
         raise ConfigError(f"an initial γ has norm {gamma[np.argmax(np.abs(gamma - 1.0))]:.12g}; |γ| must be 1 within 1e-9")

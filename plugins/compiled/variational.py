@@ -5,7 +5,7 @@ State x = (ω, γ) of the Euler–Poisson equations with the built-in torques ac
 
     I ω̇ = (Iω) × ω + U × γ + N γ × Iγ,        γ̇ = γ × ω.
 
-The tangent vector δ = (δω, δγ) obeys δ̇ = J(x) δ with the analytic 6×6 Jacobian J (``jacobian``).
+The tangent vector δ = (δω, δγ) obeys δ̇ = J(x) δ with the analytic 6×6 Jacobian J (``jacobian``; the kernel applies it without forming it).
 Along it two indicators are integrated in the same RK4 steps as the state (14 unknowns per trajectory):
 
 * MEGNO (Cincotta & Simó 2000): Y(t) = (2/t) ∫₀ᵗ s ρ(s) ds with ρ = δ̇·δ / δ·δ = d ln‖δ‖/dt, and its
@@ -18,7 +18,8 @@ The constraint |γ| = 1 is an invariant of the flow, and the linearised flow kee
 (d/dt(γ·δγ) = (γ×ω)·δγ + γ·(δγ×ω) = 0), so a tangent vector whose δγ starts tangent to the sphere
 stays tangent: δ lives on the constraint manifold. The initial δ is chosen so (``initial_tangent``).
 
-Only 6-D (ω, γ) states: torques on the fixed horizontal axes (which need α) are refused by the caller.
+Only 6-D (ω, γ) states with p[15] = 0 (α not carried): torques on the fixed horizontal axes (which need α) are
+refused by the caller.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import numba
 import numpy as np
 
 from gyrolab.plugins.compiled import inline_kernel, kernel
+from gyrolab.plugins.compiled.fixed_point import rhs, rhs_block
 
 #: unknowns of the augmented system: x (6), δ (6), the MEGNO quadratures a and b
 AUGMENTED = 14
@@ -41,40 +43,6 @@ def initial_tangent(y0s: np.ndarray) -> np.ndarray:
     g = y0s[:, 3:6] / np.linalg.norm(y0s[:, 3:6], axis=1, keepdims=True)
     d[:, 3:6] -= np.sum(d[:, 3:6] * g, axis=1, keepdims=True) * g
     return d / np.linalg.norm(d, axis=1, keepdims=True)
-
-
-@kernel
-def rhs6(y, p, out):
-    """Euler–Poisson right-hand side of a 6-D (ω, γ) state: the arithmetic of ``fixed_point.rhs`` without α."""
-    I0, I1, I2 = p[0], p[1], p[2]
-    w0, w1, w2 = y[0], y[1], y[2]
-    g0, g1, g2 = y[3], y[4], y[5]
-    u0, u1, u2 = p[9], p[10], p[11]
-    n = p[14]
-    out[0] = ((I1 - I2) * w1 * w2 + u1 * g2 - u2 * g1 + n * (I2 - I1) * g1 * g2) * p[16]
-    out[1] = ((I2 - I0) * w2 * w0 + u2 * g0 - u0 * g2 + n * (I0 - I2) * g2 * g0) * p[17]
-    out[2] = ((I0 - I1) * w0 * w1 + u0 * g1 - u1 * g0 + n * (I1 - I0) * g0 * g1) * p[18]
-    out[3] = g1 * w2 - g2 * w1
-    out[4] = g2 * w0 - g0 * w2
-    out[5] = g0 * w1 - g1 * w0
-
-
-@kernel
-def tangent(y, d, p, out):
-    """out = J(y) d: the linearised right-hand side (``jacobian`` applied to d, without forming J)."""
-    I0, I1, I2 = p[0], p[1], p[2]
-    w0, w1, w2 = y[0], y[1], y[2]
-    g0, g1, g2 = y[3], y[4], y[5]
-    a0, a1, a2 = d[0], d[1], d[2]
-    c0, c1, c2 = d[3], d[4], d[5]
-    u0, u1, u2 = p[9], p[10], p[11]
-    n = p[14]
-    out[0] = ((I1 - I2) * (a1 * w2 + w1 * a2) + u1 * c2 - u2 * c1 + n * (I2 - I1) * (c1 * g2 + g1 * c2)) * p[16]
-    out[1] = ((I2 - I0) * (a2 * w0 + w2 * a0) + u2 * c0 - u0 * c2 + n * (I0 - I2) * (c2 * g0 + g2 * c0)) * p[17]
-    out[2] = ((I0 - I1) * (a0 * w1 + w0 * a1) + u0 * c1 - u1 * c0 + n * (I1 - I0) * (c0 * g1 + g0 * c1)) * p[18]
-    out[3] = c1 * w2 + g1 * a2 - c2 * w1 - g2 * a1
-    out[4] = c2 * w0 + g2 * a0 - c0 * w2 - g0 * a2
-    out[5] = c0 * w1 + g0 * a1 - c1 * w0 - g1 * a0
 
 
 def jacobian(y: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -109,21 +77,16 @@ BLOCK = 32
 
 @kernel
 def _augmented_block(s, Z, P, out, count):
-    """Right-hand side of (x, δ, a, b) at time s since the start — ẋ = f, δ̇ = Jδ (``tangent``), ȧ = s ρ, ḃ = 2a/s —
+    """Right-hand side of (x, δ, a, b) at time s since the start — ẋ = f, δ̇ = Jδ (``jacobian`` applied to δ without forming J), ȧ = s ρ, ḃ = 2a/s —
     for a block of trajectories stored by columns (Z[:, j] is trajectory j): the loop runs across trajectories,
-    so the arithmetic vectorises. Same arithmetic as ``rhs6`` and ``tangent``."""
+    so the arithmetic vectorises. ẋ is ``fixed_point.rhs_block``."""
+    rhs_block(Z, P, out, count)  # rows 0-5: the state's right-hand side
     for j in range(count):
         I0, I1, I2 = P[0, j], P[1, j], P[2, j]
         u0, u1, u2 = P[9, j], P[10, j], P[11, j]
         n = P[14, j]
         w0, w1, w2, g0, g1, g2 = Z[0, j], Z[1, j], Z[2, j], Z[3, j], Z[4, j], Z[5, j]
         a0, a1, a2, c0, c1, c2 = Z[6, j], Z[7, j], Z[8, j], Z[9, j], Z[10, j], Z[11, j]
-        out[0, j] = ((I1 - I2) * w1 * w2 + u1 * g2 - u2 * g1 + n * (I2 - I1) * g1 * g2) * P[16, j]
-        out[1, j] = ((I2 - I0) * w2 * w0 + u2 * g0 - u0 * g2 + n * (I0 - I2) * g2 * g0) * P[17, j]
-        out[2, j] = ((I0 - I1) * w0 * w1 + u0 * g1 - u1 * g0 + n * (I1 - I0) * g0 * g1) * P[18, j]
-        out[3, j] = g1 * w2 - g2 * w1
-        out[4, j] = g2 * w0 - g0 * w2
-        out[5, j] = g0 * w1 - g1 * w0
         d0 = ((I1 - I2) * (a1 * w2 + w1 * a2) + u1 * c2 - u2 * c1 + n * (I2 - I1) * (c1 * g2 + g1 * c2)) * P[16, j]
         d1 = ((I2 - I0) * (a2 * w0 + w2 * a0) + u2 * c0 - u0 * c2 + n * (I0 - I2) * (c2 * g0 + g2 * c0)) * P[17, j]
         d2 = ((I0 - I1) * (a0 * w1 + w0 * a1) + u0 * c1 - u1 * c0 + n * (I1 - I0) * (c0 * g1 + g0 * c1)) * P[18, j]
@@ -220,22 +183,22 @@ def section_crossings(p, y0, h, n_steps, level, out):
     k1, k2, k3, k4, tmp = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
     f0, f1, prev = np.empty(6), np.empty(6), np.empty(6)
     found = 0
-    rhs6(y, p, f0)
+    rhs(0.0, y, p, f0)
     for step in range(n_steps):
         prev[:] = y
-        rhs6(y, p, k1)
+        rhs(0.0, y, p, k1)
         for m in range(6):
             tmp[m] = y[m] + 0.5 * h * k1[m]
-        rhs6(tmp, p, k2)
+        rhs(0.0, tmp, p, k2)
         for m in range(6):
             tmp[m] = y[m] + 0.5 * h * k2[m]
-        rhs6(tmp, p, k3)
+        rhs(0.0, tmp, p, k3)
         for m in range(6):
             tmp[m] = y[m] + h * k3[m]
-        rhs6(tmp, p, k4)
+        rhs(0.0, tmp, p, k4)
         for m in range(6):
             y[m] += (h / 6.0) * (k1[m] + 2.0 * k2[m] + 2.0 * k3[m] + k4[m])
-        rhs6(y, p, f1)
+        rhs(0.0, y, p, f1)
         if prev[5] < level <= y[5]:
             lo, hi = 0.0, 1.0
             for _ in range(60):
