@@ -69,10 +69,12 @@ def _fixed_step(integrator: Any) -> float:
 
 
 def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray,
-              params: np.ndarray | None = None) -> dict[str, np.ndarray]:
+              params: np.ndarray | None = None, every_time: bool = True) -> dict[str, np.ndarray]:
     """MEGNO ⟨Y⟩ at every output time, FLI, max |θ − θ0| and the final state of each trajectory.
 
-    Returns arrays ``megno`` (trajectories, times), ``fli``, ``max_nutation_deviation`` (trajectories,),
+    The RK4 steps are the batch kernels' (``integrate_arrays``): the fewest equal steps no longer than
+    ``integrator.step`` in each output interval. Returns arrays ``megno`` (trajectories, times; with
+    ``every_time=False`` (trajectories, 1): ⟨Y⟩ at the last time only), ``fli``, ``max_nutation_deviation`` (trajectories,),
     ``final_state`` (trajectories, 6) and ``failed`` (trajectories,) True where the trajectory became
     non-finite (its values are then NaN).
     """
@@ -85,7 +87,7 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
         raise ConfigError("times must be at least two increasing output times")
     steps = steps_per_interval(times, _fixed_step(integrator))
     n = len(y0)
-    megno = np.empty((n, times.size))
+    megno = np.empty((n, times.size if every_time else 1))
     fli, deviation, final = np.empty(n), np.empty(n), np.empty((n, 6))
     variational.run_indicators(P, times, steps, y0, variational.initial_tangent(y0), megno, fli, deviation, final)
     return {"megno": megno, "fli": fli, "max_nutation_deviation": deviation, "final_state": final,
@@ -100,7 +102,7 @@ def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np
     max |θ − θ0| over the integration steps (rad, θ from γ3 = cos θ). A trajectory that becomes non-finite
     gets NaN in all three (the caller marks it failed).
     """
-    run = megno_run(compiled, integrator, times, y0s, params)
+    run = megno_run(compiled, integrator, times, y0s, params, every_time=False)
     return {
         "indicator": (run["megno"][:, -1], {
             "units": "1", "long_name": "MEGNO chaos indicator <Y> at the end of the integration",
@@ -139,12 +141,13 @@ def poincare_section(compiled: Any, y0: np.ndarray, t_end: float, step: float, l
 
 
 def section_dataset(compiled: Any, y0s: np.ndarray, theta0: np.ndarray, r0: np.ndarray, t_end: float, step: float,
-                    params: np.ndarray | None = None, max_points: int = 2000) -> xr.Dataset:
+                    params: np.ndarray | None = None, max_points: int = 2000, rate_units: str = "1") -> xr.Dataset:
     """Poincaré sections (γ3 = its initial value, upward) of a few chosen points, as dataset variables.
 
     ``theta0``/``r0`` label the points (their coordinates on the map). Variables ``section_phi`` and
     ``section_r`` (section_point, crossing; NaN past a point's last crossing), ``section_theta0``,
-    ``section_r0`` and ``section_level`` (section_point); the stability-map figure draws them.
+    ``section_r0`` and ``section_level`` (section_point); the stability-map figure draws them. ``rate_units``:
+    the CF units of ω3 and r0 (the body's ``rate_unit``: "1" nondimensional, "rad s-1" SI).
     """
     y0s = np.atleast_2d(np.asarray(y0s, dtype=float))
     runs = [poincare_section(compiled, y0, t_end, step, None, None if params is None else np.atleast_2d(params)[j],
@@ -159,12 +162,12 @@ def section_dataset(compiled: Any, y0s: np.ndarray, theta0: np.ndarray, r0: np.n
     return xr.Dataset({
         "section_phi": (dims, phi, {"units": "rad", "long_name": "proper-rotation angle phi at upward crossings of "
                                     "the section gamma3 = const (Poincare section)"}),
-        "section_r": (dims, r, {"units": "1", "long_name": "spin omega3 at upward crossings of the section gamma3 = "
+        "section_r": (dims, r, {"units": rate_units, "long_name": "spin omega3 at upward crossings of the section gamma3 = "
                                 "const (Poincare section)"}),
         "section_theta0": ("section_point", np.asarray(theta0, dtype=float),
                            {"units": "rad", "long_name": "initial nutation angle of the section's trajectory"}),
         "section_r0": ("section_point", np.asarray(r0, dtype=float),
-                       {"units": "1", "long_name": "initial spin r0 of the section's trajectory"}),
+                       {"units": rate_units, "long_name": "initial spin r0 of the section's trajectory"}),
         "section_level": ("section_point", y0s[:, 5],
                           {"units": "1", "long_name": "section level gamma3 = cos(theta0)"}),
     }, attrs={"section_t_end": float(t_end), "section_step": float(step)})

@@ -5,7 +5,8 @@ State x = (ω, γ) of the Euler–Poisson equations with the built-in torques ac
 
     I ω̇ = (Iω) × ω + U × γ + N γ × Iγ,        γ̇ = γ × ω.
 
-The tangent vector δ = (δω, δγ) obeys δ̇ = J(x) δ with the analytic 6×6 Jacobian J (``jacobian``; the kernel applies it without forming it).
+The tangent vector δ = (δω, δγ) obeys δ̇ = J(x) δ with the analytic 6×6 Jacobian J (``jacobian``; the kernel
+applies it without forming it).
 Along it two indicators are integrated in the same RK4 steps as the state (14 unknowns per trajectory):
 
 * MEGNO (Cincotta & Simó 2000): Y(t) = (2/t) ∫₀ᵗ s ρ(s) ds with ρ = δ̇·δ / δ·δ = d ln‖δ‖/dt, and its
@@ -77,8 +78,8 @@ BLOCK = 32
 
 @kernel
 def _augmented_block(s, Z, P, out, count):
-    """Right-hand side of (x, δ, a, b) at time s since the start — ẋ = f, δ̇ = Jδ (``jacobian`` applied to δ without forming J), ȧ = s ρ, ḃ = 2a/s —
-    for a block of trajectories stored by columns (Z[:, j] is trajectory j): the loop runs across trajectories,
+    """Right-hand side of (x, δ, a, b) at time s since the start — ẋ = f, δ̇ = Jδ (``jacobian`` applied to δ
+    without forming J), ȧ = s ρ, ḃ = 2a/s — for a block of trajectories stored by columns (Z[:, j] is trajectory j): the loop runs across trajectories,
     so the arithmetic vectorises. ẋ is ``fixed_point.rhs_block``."""
     rhs_block(Z, P, out, count)  # rows 0-5: the state's right-hand side
     for j in range(count):
@@ -105,7 +106,8 @@ def run_indicators(P, t_out, steps_per_interval, Y0, D0, megno, fli, deviation, 
     """Integrate state and tangent vector of every trajectory with fixed-step RK4, in parallel.
 
     P[j], Y0[j], D0[j]: parameters, initial (ω, γ) and unit initial tangent vector of trajectory j.
-    Fills megno[j, i] = ⟨Y⟩ at t_out[i] (0 at the start), fli[j] = max ln‖δ‖ over the steps,
+    Fills megno[j, i] = ⟨Y⟩ at t_out[i] (0 at the start; megno with one column: ⟨Y⟩ at t_out[-1] only, so a
+    chunk's memory does not grow with the output times), fli[j] = max ln‖δ‖ over the steps,
     deviation[j] = max |θ − θ0| over the steps (θ = arccos γ3) and final[j] = the state at t_out[-1].
     A trajectory that becomes non-finite is NaN from there on. Blocks of BLOCK trajectories advance in
     lock step, stored by columns so that every loop runs across trajectories; blocks run in parallel.
@@ -125,6 +127,7 @@ def run_indicators(P, t_out, steps_per_interval, Y0, D0, megno, fli, deviation, 
             p[:, j] = P[j0 + j]
             theta0[j] = _nutation(z[5, j])
             megno[j0 + j, 0] = 0.0
+        every = megno.shape[1] > 1
         k1, k2, k3 = np.empty((n, BLOCK)), np.empty((n, BLOCK)), np.empty((n, BLOCK))
         k4, tmp = np.empty((n, BLOCK)), np.empty((n, BLOCK))
         for i in range(1, t_out.size):
@@ -156,11 +159,12 @@ def run_indicators(P, t_out, steps_per_interval, Y0, D0, megno, fli, deviation, 
                     log_norm[j] += np.log(norm)
                     best[j] = max(best[j], log_norm[j])
                     worst[j] = max(worst[j], abs(_nutation(z[5, j]) - theta0[j]))
-            for j in range(m):
-                megno[j0 + j, i] = z[13, j] / (t_out[i] - t_out[0])
+            if every or i == t_out.size - 1:
+                for j in range(m):
+                    megno[j0 + j, i if every else 0] = z[13, j] / (t_out[i] - t_out[0])
         for j in range(m):
             ok = np.isfinite(log_norm[j] + z[0, j] + z[1, j] + z[2, j] + z[12, j] + z[13, j])
-            for i in range(1, t_out.size):
+            for i in range(megno.shape[1]):  # NaN from the first non-finite output on
                 if not np.isfinite(megno[j0 + j, i]):
                     ok = False
                 if not ok:
