@@ -79,8 +79,8 @@ BLOCK = 32
 @kernel
 def _augmented_block(s, Z, P, out, count):
     """Right-hand side of (x, δ, a, b) at time s since the start — ẋ = f, δ̇ = Jδ (``jacobian`` applied to δ
-    without forming J), ȧ = s ρ, ḃ = 2a/s — for a block of trajectories stored by columns (Z[:, j] is trajectory j): the loop runs across trajectories,
-    so the arithmetic vectorises. ẋ is ``fixed_point.rhs_block``."""
+    without forming J), ȧ = s ρ, ḃ = 2a/s — for a block of trajectories stored by columns (Z[:, j] is
+    trajectory j): the loop runs across trajectories, so the arithmetic vectorises. ẋ is ``fixed_point.rhs_block``."""
     rhs_block(Z, P, out, count)  # rows 0-5: the state's right-hand side
     for j in range(count):
         I0, I1, I2 = P[0, j], P[1, j], P[2, j]
