@@ -23,6 +23,7 @@ import xarray as xr
 from gyrolab.errors import ConfigError, IntegrationError
 
 FIXED_STEP = ("rk4", "rk4_numba")
+ADAPTIVE = ("dop853", "dop853_numba")
 INDICATOR_NAME = "MEGNO"
 INDICATOR_DEFINITION = ("MEGNO <Y>(t_end) (Cincotta & Simo 2000): time mean of Y(t) = (2/t) int_0^t s d'.d/d.d ds "
                         "along the tangent vector d of the variational equations; regular quasi-periodic -> 2, "
@@ -61,19 +62,14 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
     return np.ascontiguousarray(y0s[:, :6]), P
 
 
-def _fixed_step(integrator: Any) -> float:
-    if getattr(integrator, "name", None) not in FIXED_STEP:
-        raise ConfigError(f"chaos indicators run with integrator rk4 or rk4_numba (fixed step integrator.step), "
-                          f"not {getattr(integrator, 'name', integrator)}")
-    return float(integrator.step)
-
-
 def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray,
               params: np.ndarray | None = None, every_time: bool = True) -> dict[str, np.ndarray]:
     """MEGNO ⟨Y⟩ at every output time, FLI, max |θ − θ0| and the final state of each trajectory.
 
-    The RK4 steps are the batch kernels' (``integrate_arrays``): the fewest equal steps no longer than
-    ``integrator.step`` in each output interval. Returns arrays ``megno`` (trajectories, times; with
+    ``integrator`` rk4/rk4_numba: fixed-step RK4 with the batch kernels' steps (``integrate_arrays``: the fewest
+    equal steps no longer than ``integrator.step`` in each output interval), by blocks of trajectories;
+    dop853/dop853_numba: adaptive DOP853 with its rtol, atol and max_step, steps landing on every output time,
+    one trajectory per thread (``steps``: accepted steps per trajectory). Returns arrays ``megno`` (trajectories, times; with
     ``every_time=False`` (trajectories, 1): ⟨Y⟩ at the last time only), ``fli``, ``max_nutation_deviation`` (trajectories,),
     ``final_state`` (trajectories, 6) and ``failed`` (trajectories,) True where the trajectory became
     non-finite (its values are then NaN).
@@ -85,13 +81,24 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
     times = np.ascontiguousarray(times, dtype=float)
     if times.ndim != 1 or times.size < 2 or not np.all(np.diff(times) > 0):
         raise ConfigError("times must be at least two increasing output times")
-    steps = steps_per_interval(times, _fixed_step(integrator))
+    name = getattr(integrator, "name", None)
     n = len(y0)
     megno = np.empty((n, times.size if every_time else 1))
     fli, deviation, final = np.empty(n), np.empty(n), np.empty((n, 6))
-    variational.run_indicators(P, times, steps, y0, variational.initial_tangent(y0), megno, fli, deviation, final)
+    tangent = variational.initial_tangent(y0)
+    if name in FIXED_STEP:
+        grid = steps_per_interval(times, float(integrator.step))
+        variational.run_indicators(P, times, grid, y0, tangent, megno, fli, deviation, final)
+        steps = np.full(n, int(grid.sum()))
+    elif name in ADAPTIVE:
+        steps = np.zeros(n, dtype=np.int64)
+        variational.run_indicators_dop853(P, times, y0, tangent, float(integrator.rtol), float(integrator.atol),
+                                          float(integrator.max_step), megno, fli, deviation, final, steps)
+    else:
+        raise ConfigError(f"chaos indicators run with integrator rk4, rk4_numba (fixed step) or dop853, dop853_numba "
+                          f"(adaptive), not {name or integrator}")
     return {"megno": megno, "fli": fli, "max_nutation_deviation": deviation, "final_state": final,
-            "failed": ~np.isfinite(megno[:, -1])}
+            "failed": ~np.isfinite(megno[:, -1]), "steps": steps}
 
 
 def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray,

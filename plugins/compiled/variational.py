@@ -28,7 +28,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from gyrolab.plugins.compiled import inline_kernel, kernel
+from gyrolab.plugins.compiled import dop853, inline_kernel, kernel
 from gyrolab.plugins.compiled.fixed_point import rhs, rhs_block
 
 #: unknowns of the augmented system: x (6), δ (6), the MEGNO quadratures a and b
@@ -173,6 +173,124 @@ def run_indicators(P, t_out, steps_per_interval, Y0, D0, megno, fli, deviation, 
             deviation[j0 + j] = worst[j] if ok else np.nan
             for c in range(6):
                 final[j0 + j, c] = z[c, j] if ok else np.nan
+
+
+@numba.njit(cache=True, parallel=True, error_model="numpy")
+def run_indicators_dop853(P, t_out, Y0, D0, rtol, atol, max_step, megno, fli, deviation, final, steps):
+    """``run_indicators`` with DOP853 (Hairer, Nørsett & Wanner §II.10; scipy's controller and error norm, as in
+    ``dop853.run``), one trajectory per thread: each has its own steps. The error is controlled on x and δ
+    (δ renormalised after every step), not on the MEGNO quadratures; steps land on every output time.
+    steps[j] counts the accepted steps; 0 with NaN results if the step fell below rounding or went non-finite.
+    """
+    for j in numba.prange(Y0.shape[0]):
+        _dop853_trajectory(P[j], t_out, Y0[j], D0[j], rtol, atol, max_step, megno[j], fli, deviation, final[j],
+                           steps, j)
+
+
+@kernel
+def _dop853_trajectory(p, t_out, y0, d0, rtol, atol, max_step, megno, fli, deviation, final, steps, j):
+    n = AUGMENTED
+    controlled = 12  # x and δ
+    P = np.empty((p.size, 1))
+    P[:, 0] = p
+    y = np.zeros((n, 1))
+    y[0:6, 0] = y0
+    y[6:12, 0] = d0
+    K = np.empty((dop853.N_STAGES + 1, n, 1))
+    f = np.empty((n, 1))
+    ytmp, y_new = np.empty((n, 1)), np.empty((n, 1))
+    theta0 = _nutation(y[5, 0])
+    log_norm = best = worst = 0.0
+    megno[0] = 0.0
+    every = megno.size > 1
+    _augmented_block(0.0, y, P, f, 1)
+    scale0 = 0.0
+    scale1 = 0.0
+    for m in range(controlled):
+        sc = atol + abs(y[m, 0]) * rtol
+        scale0 += (y[m, 0] / sc) ** 2
+        scale1 += (f[m, 0] / sc) ** 2
+    h_abs = 1e-6 if (scale0 < 1e-10 * controlled or scale1 < 1e-10 * controlled) else 0.01 * np.sqrt(scale0 / scale1)
+    h_abs = min(h_abs, max_step, t_out[-1] - t_out[0])
+    t = t_out[0]
+    accepted = 0
+    for i in range(1, t_out.size):
+        t_bound = t_out[i]
+        while t < t_bound:
+            min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+            h_abs = min(max(h_abs, min_step), max_step)
+            rejected = False
+            while True:
+                if h_abs < min_step or not np.isfinite(h_abs):
+                    return _dop853_failed(megno, fli, deviation, final, steps, j)
+                t_new = min(t + h_abs, t_bound)
+                h = t_new - t
+                K[0] = f
+                for s in range(1, dop853.N_STAGES):
+                    for m in range(n):
+                        acc = 0.0
+                        for q in range(s):
+                            acc += K[q, m, 0] * dop853.A[s, q]
+                        ytmp[m, 0] = y[m, 0] + acc * h
+                    _augmented_block(t + dop853.C[s] * h - t_out[0], ytmp, P, K[s], 1)
+                for m in range(n):
+                    acc = 0.0
+                    for q in range(dop853.N_STAGES):
+                        acc += K[q, m, 0] * dop853.B[q]
+                    y_new[m, 0] = y[m, 0] + h * acc
+                _augmented_block(t_new - t_out[0], y_new, P, K[dop853.N_STAGES], 1)
+                e5 = 0.0
+                e3 = 0.0
+                for m in range(controlled):
+                    sc = atol + max(abs(y[m, 0]), abs(y_new[m, 0])) * rtol
+                    a5 = 0.0
+                    a3 = 0.0
+                    for q in range(dop853.N_STAGES + 1):
+                        a5 += K[q, m, 0] * dop853.E5[q]
+                        a3 += K[q, m, 0] * dop853.E3[q]
+                    e5 += (a5 / sc) ** 2
+                    e3 += (a3 / sc) ** 2
+                error = 0.0 if e5 == 0.0 and e3 == 0.0 else abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * controlled)
+                if not np.isfinite(error):
+                    return _dop853_failed(megno, fli, deviation, final, steps, j)
+                if error < 1.0:
+                    factor = dop853.MAX_FACTOR if error == 0.0 else min(
+                        dop853.MAX_FACTOR, dop853.SAFETY * error ** dop853.ERROR_EXPONENT)
+                    h_abs *= min(1.0, factor) if rejected else factor
+                    break
+                h_abs *= max(dop853.MIN_FACTOR, dop853.SAFETY * error ** dop853.ERROR_EXPONENT)
+                rejected = True
+            accepted += 1
+            t = t_new
+            norm = 0.0
+            for m in range(6, 12):
+                norm += y_new[m, 0] * y_new[m, 0]
+            norm = np.sqrt(norm)
+            for m in range(n):
+                y[m, 0] = y_new[m, 0] / norm if 6 <= m < 12 else y_new[m, 0]
+            log_norm += np.log(norm)
+            best = max(best, log_norm)
+            worst = max(worst, abs(_nutation(y[5, 0]) - theta0))
+            _augmented_block(t - t_out[0], y, P, f, 1)  # δ rescaled: its derivative too
+        if every or i == t_out.size - 1:
+            megno[i if every else 0] = y[13, 0] / (t - t_out[0])
+    if not np.isfinite(log_norm + y[0, 0] + y[1, 0] + y[2, 0] + y[12, 0] + y[13, 0]):
+        return _dop853_failed(megno, fli, deviation, final, steps, j)
+    fli[j] = best
+    deviation[j] = worst
+    final[:] = y[0:6, 0]
+    steps[j] = accepted
+    return 0
+
+
+@kernel
+def _dop853_failed(megno, fli, deviation, final, steps, j):
+    megno[1:] = np.nan
+    megno[-1] = np.nan
+    fli[j] = deviation[j] = np.nan
+    final[:] = np.nan
+    steps[j] = 0
+    return 1
 
 
 @kernel
