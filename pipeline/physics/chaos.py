@@ -1,7 +1,8 @@
 """Chaos indicators of the heavy body about a fixed point: MEGNO, FLI, nutation deviation, Poincaré sections.
 
 The indicators come from the variational equations integrated with the state in a compiled batch kernel
-(``gyrolab.plugins.compiled.variational``: analytic Jacobian, fixed-step RK4, parallel over trajectories):
+(``gyrolab.plugins.compiled.variational``: analytic Jacobian; fixed-step RK4 by blocks of trajectories, or adaptive
+DOP853 one trajectory per thread; parallel over trajectories):
 
 * MEGNO ⟨Y⟩ (Cincotta & Simó 2000, A&AS 147, 205): the time mean of Y(t) = (2/t) ∫₀ᵗ s δ̇·δ/δ·δ ds.
   Regular quasi-periodic motion → 2, a stable periodic orbit without shear → 0, chaos → grows like λt/2
@@ -105,6 +106,7 @@ def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np
                       params: np.ndarray | None = None) -> dict[str, tuple[np.ndarray, dict[str, Any]]]:
     """Per-trajectory chaos indicators with their CF attributes (first axis = trajectory).
 
+    ``integrator``: rk4/rk4_numba (fixed step) or dop853/dop853_numba (adaptive), see ``megno_run``.
     ``indicator``: MEGNO ⟨Y⟩ at ``times[-1]``; ``fli``: the fast Lyapunov indicator; ``max_nutation_deviation``:
     max |θ − θ0| over the integration steps (rad, θ from γ3 = cos θ). A trajectory that becomes non-finite
     gets NaN in all three (the caller marks it failed).
