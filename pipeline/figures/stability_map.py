@@ -30,11 +30,11 @@ REGULAR_EDGE = 4.0
 #: the regimes' domains in r0/c (docs/regimes.md): small parameter ε = c/r0 ≤ 0.2, large parameter r0/c ≤ 0.2
 SMALL_PARAMETER_MIN = 5.0
 LARGE_PARAMETER_MAX = 0.2
-#: the seeds' example scenes, (label, θ0 in rad, r0 in units of c, note): conf/initial and conf/experiment
+#: the seeds' example scenes, (label, θ0 in rad, r0 in units of c): conf/initial and conf/experiment
 EXAMPLES = (
-    ("fast_spin (reference scene)", 1.0, 5.0, ""),
-    ("slow_spin (Ismail 2021's setting)", 1.5, 0.1, ""),
-    ("shaker_omega3 (Shaker et al., own body)", 0.6435011087932844, 8.94427190999916, ""),
+    ("fast_spin (reference scene)", 1.0, 5.0),
+    ("slow_spin (Ismail 2021's setting)", 1.5, 0.1),
+    ("shaker_omega3 (Shaker et al., own body)", 0.6435011087932844, 8.94427190999916),
 )
 
 
@@ -103,7 +103,7 @@ def _mark_examples(ax: plt.Axes, ds: xr.Dataset, t_lo: float, t_hi: float, r_lo:
     if c is None:
         return
     markers = ("*", "P", "X")
-    for (label, theta0, r0, _), marker in zip(EXAMPLES, markers):
+    for (label, theta0, r0), marker in zip(EXAMPLES, markers):
         if t_lo <= theta0 <= t_hi and r_lo <= r0 * c <= r_hi:
             ax.plot(r0 * c, theta0, marker, ms=8, mfc="white", mec="black", mew=0.7, ls="none", label=label)
 
