@@ -29,6 +29,7 @@ KINDS = {
     "precession_cases.nc": "precessions",
     "shaker_omega3.nc": "shaker",
     "orbit_family.nc": "orbit_family",
+    "stability_map.nc": "stability_map",
 }
 
 
