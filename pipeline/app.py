@@ -485,7 +485,7 @@ def _plot(argv: Sequence[str]) -> int:
 
 
 def _batch(overrides: Sequence[str]) -> int:
-    """``gyrolab --batch KEY=V1,V2 ... [hydra.sweep.dir=DIR]``: the grid in one batch, one sweep.nc."""
+    """``gyrolab --batch KEY=V1,V2 ... [hydra.sweep.dir=DIR]``: the grid in one batch, one sweep.nc (resumable)."""
     from datetime import datetime
 
     from gyrolab.sweep.batch import run_batch_sweep
