@@ -30,7 +30,7 @@ from gyrolab.errors import ConfigError
 log = logging.getLogger("gyrolab.batch")
 
 #: a chunk's trajectories (points × output times × state, float64) stay under ``batch.memory`` MiB
-DEFAULT_MEMORY_MIB = 256
+DEFAULT_MEMORY_MIB = 64
 MAX_CHUNK = 200_000
 INTEGRATION_FAILED = "the trajectory became non-finite (NaN or inf); reduce integrator.step or choose an adaptive " \
                      "integrator"
@@ -63,6 +63,16 @@ class Settings:
             raise ConfigError(f"batch.memory={memory!r} must be a positive number of MiB")
         return cls(output=output, decimate=decimate, chunk=chunk, memory=float(memory),
                    scheduler=node.get("scheduler") or None)
+
+
+@dataclass
+class RunStats:
+    """What ``run_plan`` did: the file, chunks run now, seconds in the kernels and in all."""
+
+    path: Path
+    chunks: int = 0
+    kernel_time: float = 0.0
+    wall_time: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -126,16 +136,16 @@ def chunks(shape: tuple[int, ...], size: int) -> list[Chunk]:
     return out
 
 
-def run_plan(plan: Plan, path: Path, settings: Settings) -> Path:
+def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     """Integrate every valid point of ``plan``, streaming to ``path`` (resuming a killed run of the same
-    command); returns ``path``."""
+    command)."""
     size = chunk_size(plan, settings)
     blocks = chunks(plan.shape, size)
     identity = plan.identity(size)
     store = Store(path, plan, identity, settings, messages=[*plan.messages, INTEGRATION_FAILED])
     done = store.open()
     if done is None:   # already complete
-        return path
+        return RunStats(path)
     pending = [i for i in range(len(blocks)) if i not in done]
     tasks, empty = [], []
     key = json.dumps(plan.base, sort_keys=True, default=str) if plan.base is not None else ""
@@ -154,8 +164,7 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> Path:
 
     executors.map_chunks(run_chunk, tasks, on_result, scheduler=settings.scheduler)
     store.finish()
-    progress.summary()
-    return path
+    return progress.summary(path)
 
 
 def _task(plan: Plan, chunk: Chunk, index: int, key: str, settings: Settings) -> ChunkTask | None:
@@ -224,7 +233,7 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
         failed = np.asarray(solution.failed, dtype=bool)
         good = np.flatnonzero(~failed)
         outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, good,
-                                lambda row: _system(context, task.config, task.combos[row]))
+                                lambda row: _system(context, task.config, task.combos[row]), compiled, task.params)
     all_failed = np.zeros(task.n_rows, dtype=bool)
     all_failed[task.rows] = failed
     return ChunkResult(index=task.index, outputs=merge_rows(outputs, task.rows, task.n_rows), failed=all_failed,
@@ -239,22 +248,21 @@ class _Progress:
 
     def __init__(self, n_chunks: int, n_points: int) -> None:
         self.n_chunks, self.n_points = n_chunks, n_points
-        self.chunks = self.points = 0
+        self.chunks = 0
         self.kernel = 0.0
         self.start = time.perf_counter()
 
     def update(self, result: ChunkResult) -> None:
         self.chunks += 1
-        self.points += int(np.count_nonzero(~np.isnan(next(iter(result.outputs.values())).data.reshape(
-            len(result.failed), -1)[:, 0]))) if result.outputs else 0
         self.kernel += result.kernel_time
         elapsed = time.perf_counter() - self.start
         eta = elapsed / self.chunks * (self.n_chunks - self.chunks)
         log.info("batch: chunk %d/%d done (%.0f%%), %s elapsed, ETA %s", self.chunks, self.n_chunks,
                  100.0 * self.chunks / max(self.n_chunks, 1), duration(elapsed), duration(eta))
 
-    def summary(self) -> None:
+    def summary(self, path: Path) -> RunStats:
         elapsed = time.perf_counter() - self.start
         if self.chunks:
             log.info("batch: %d chunks in %s, %.0f%% of it in the integration kernels", self.chunks,
                      duration(elapsed), 100.0 * self.kernel / max(elapsed, 1e-9))
+        return RunStats(path, self.chunks, self.kernel, elapsed)

@@ -17,7 +17,7 @@ from typing import Any
 from omegaconf import OmegaConf
 
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
-from gyrolab.batch.runner import Settings, run_plan
+from gyrolab.batch.runner import RunStats, Settings, run_plan
 from gyrolab.engine import batch as engine_batch
 from gyrolab.engine import scene as scene_module
 from gyrolab.errors import ConfigError
@@ -32,10 +32,11 @@ def run_batch_sweep(overrides: Sequence[str], out_dir: Path) -> Path:
     ``out_dir`` is locked meanwhile (a second batch into it is refused in one sentence).
     """
     fixed, dims = split_overrides(overrides)
-    return run_batch(fixed, dims, Path(out_dir) / SWEEP_NAME)
+    return run_batch(fixed, dims, Path(out_dir) / SWEEP_NAME).path
 
 
-def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *, plain: dict[str, Any] | None = None) -> Path:
+def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
+              plain: dict[str, Any] | None = None) -> RunStats:
     """The batch of grid ``dims`` over the config of ``fixed`` (or ``plain``), stored at ``path``."""
     plan = make_plan(fixed, dims, plain=plain)
     settings = Settings.from_config(plan.plain.get("batch"))
