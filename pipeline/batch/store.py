@@ -58,7 +58,7 @@ class Store:
                 log.info("batch: %s holds this batch complete already; nothing to run", self.path)
                 return None
             raise ConfigError(f"{self.path} holds another batch (identity {found}, this one is {self.identity}); "
-                              "give another hydra.sweep.dir or remove it")
+                              "choose another output directory (hydra.sweep.dir, or hydra.run.dir for an experiment) or remove it")
         if not self.part.exists():
             self.journal.unlink(missing_ok=True)
             return set()

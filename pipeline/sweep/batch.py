@@ -36,11 +36,14 @@ def run_batch_sweep(overrides: Sequence[str], out_dir: Path) -> Path:
 
 
 def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
-              plain: dict[str, Any] | None = None) -> RunStats:
-    """The batch of grid ``dims`` over the config of ``fixed`` (or ``plain``), stored at ``path``."""
+              plain: dict[str, Any] | None = None, lock: bool = True) -> RunStats:
+    """The batch of grid ``dims`` over the config of ``fixed`` (or ``plain``), stored at ``path``; its
+    directory is locked meanwhile unless ``lock`` is False (the caller holds the lock)."""
     plan = make_plan(fixed, dims, plain=plain)
     settings = Settings.from_config(plan.plain.get("batch"))
     check_integrator(plan)
+    if not lock:
+        return run_plan(plan, path, settings)
     with writing_in(path.parent, "sweep directory"):  # after the cheap checks: a bad grid leaves no directory
         return run_plan(plan, path, settings)
 
