@@ -157,7 +157,8 @@ def _reduce_fixed_point(y, p, out):
         for i in range(n_times):
             w0, w1, w2 = y[j, i, 0], y[j, i, 1], y[j, i, 2]
             g0, g1, g2 = y[j, i, 3], y[j, i, 4], y[j, i, 5]
-            energy = 0.5 * (I0 * w0 * w0 + I1 * w1 * w1 + I2 * w2 * w2) - (p[j, 9] * g0 + p[j, 10] * g1 + p[j, 11] * g2) \
+            energy = 0.5 * (I0 * w0 * w0 + I1 * w1 * w1 + I2 * w2 * w2) \
+                - (p[j, 9] * g0 + p[j, 10] * g1 + p[j, 11] * g2) \
                 + 0.5 * p[j, 14] * (I0 * g0 * g0 + I1 * g1 * g1 + I2 * g2 * g2)
             frame = 0.0
             if size == 9:

@@ -27,7 +27,7 @@ from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import OmegaConf
 
 from gyrolab.engine import scene as scene_module
 from gyrolab.engine.config import compose_config
@@ -157,8 +157,6 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
                 suspect |= in_combo
         else:
             systems[c] = built
-    if not systems and not errors.any_valid(suspect):
-        log.info("batch plan: no combination of body and force values is valid")
     reference = next(iter(systems.values()), None)
     if reference is not None:
         _same_structure(systems)
@@ -176,6 +174,8 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
             columns = {_key(dims[i])[len("initial."):]: _column(dims[i], i, shape, todo) for i in initial_axes}
             states, ok = hook(initial, columns)
             rows = np.flatnonzero(todo)
+            if not columns:   # no initial key swept: one state for every point
+                states, ok = np.broadcast_to(states, (rows.size, states.shape[1])), np.broadcast_to(ok, rows.shape)
             y0[rows[ok]] = states[ok]
             suspect[rows[~ok]] = True
         else:
@@ -233,9 +233,6 @@ class _Errors:
     @property
     def failed(self) -> np.ndarray:
         return self.index >= 0
-
-    def any_valid(self, suspect: np.ndarray) -> bool:
-        return bool(np.any(~self.failed | suspect))
 
 
 def _key(dim: Dim) -> str:
@@ -303,11 +300,11 @@ def _build_combo(plain: dict[str, Any], values: Mapping[str, Any]) -> _Built | _
                   for name, node in (cfg.get("force") or {}).items()]
     except GyrolabError as error:
         return _Failure(str(error), exact=True)
+    del body, forces   # built for their errors only; the scene builds its own
     try:
         scene = Scene.from_config(cfg)   # the rest of the single run's checks, on the base initial state
     except GyrolabError as error:
         return _Failure(str(error), exact=False)
-    del forces
     return _Built(scene.system, _compiled(scene))
 
 
@@ -370,7 +367,3 @@ def _batch_times(plain: dict[str, Any], systems: Mapping[int, _Built], y0: np.nd
 def plan_from_overrides(overrides: Sequence[str]) -> Plan:
     fixed, dims = split_overrides(overrides)
     return make_plan(fixed, dims)
-
-
-def config_of(plan: Plan) -> DictConfig:
-    return OmegaConf.create(plan.plain)

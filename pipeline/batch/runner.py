@@ -156,7 +156,7 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
              len(blocks), size, settings.output, len(done), len(tasks), path)
     for i in empty:   # no valid point: only the points' errors, which the store wrote when it was created
         store.chunk_done(i, blocks[i], None)
-    progress = _Progress(len(tasks), sum(len(t.rows) for t in tasks))
+    progress = _Progress(len(tasks))
 
     def on_result(_: int, result: ChunkResult) -> None:
         store.chunk_done(result.index, blocks[result.index], result)
@@ -246,8 +246,8 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
 class _Progress:
     """A log line per chunk (points done, rate, ETA) and a summary (share of the time in the kernels)."""
 
-    def __init__(self, n_chunks: int, n_points: int) -> None:
-        self.n_chunks, self.n_points = n_chunks, n_points
+    def __init__(self, n_chunks: int) -> None:
+        self.n_chunks = n_chunks
         self.chunks = 0
         self.kernel = 0.0
         self.start = time.perf_counter()

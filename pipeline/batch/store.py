@@ -24,15 +24,17 @@ import netCDF4
 import numpy as np
 from omegaconf import OmegaConf
 
-from gyrolab.batch.outputs import SERIES_MODES, output_times
+from gyrolab.batch.outputs import output_times
 from gyrolab.errors import ConfigError, OutputError
 from gyrolab.output.atomic import _fsync, _fsync_directory, reason
 from gyrolab.output.cf import CONVENTIONS, now_iso
 from gyrolab.output.provenance import gyrolab_version, provenance
+from gyrolab.sweep import record
+from gyrolab.sweep.aggregate import STATUS_FLAGS
 
 log = logging.getLogger("gyrolab.batch")
 
-FINISHED, FAILED = 1, 2
+FINISHED, FAILED = STATUS_FLAGS[record.FINISHED], STATUS_FLAGS[record.FAILED]
 STATUS_ATTRS = {"long_name": "how the point ended: 0 not run, 1 finished, 2 failed", "units": "1",
                 "flag_values": np.array([0, 1, 2], dtype=np.int8), "flag_meanings": "missing finished failed"}
 ERROR_ATTRS = {"long_name": "the point's error: index into error_message, -1 for none", "units": "1"}
@@ -58,7 +60,8 @@ class Store:
                 log.info("batch: %s holds this batch complete already; nothing to run", self.path)
                 return None
             raise ConfigError(f"{self.path} holds another batch (identity {found}, this one is {self.identity}); "
-                              "choose another output directory (hydra.sweep.dir, or hydra.run.dir for an experiment) or remove it")
+                              "choose another output directory (hydra.sweep.dir, or hydra.run.dir for an experiment) "
+                              "or remove it")
         if not self.part.exists():
             self.journal.unlink(missing_ok=True)
             return set()
@@ -137,14 +140,16 @@ class Store:
             values = dim.coordinate()
             if values.dtype.kind in "iu":
                 values = values.astype(np.int32) if np.abs(values).max() < 2**31 else values.astype(np.float64)
-            var = nc.createVariable(name, values.dtype if values.dtype.kind != "O" else str, (name,))
-            var[:] = values
-            var.setncatts({"long_name": f"swept parameter {dim.key}", "override_key": dim.key,
-                           **_key_units(dim.key, system)})
+            attrs = {"long_name": f"swept parameter {dim.key}", "override_key": dim.key, **_key_units(dim.key, system)}
+            if values.dtype.kind == "O":
+                _text_variable(nc, name, name, values, attrs)
+            else:
+                var = nc.createVariable(name, values.dtype, (name,))
+                var[:] = values
+                var.setncatts(attrs)
         nc.createDimension("error_kind", len(self.messages))
-        messages = nc.createVariable("error_message", str, ("error_kind",))
-        messages[:] = np.array(self.messages, dtype=object)
-        messages.setncatts({"long_name": "the one-sentence errors of the failed points (job_error indexes them)"})
+        _text_variable(nc, "error_message", "error_kind", self.messages,
+                       {"long_name": "the one-sentence errors of the failed points (job_error indexes them)"})
         grid = tuple(plan.names)
         # no fill value: every point's code is written below (a fill value would make readers mask the codes)
         status = nc.createVariable("job_status", "i1", grid, contiguous=True, fill_value=False)
@@ -184,9 +189,7 @@ class Store:
             var[:] = times
             var.setncatts(time_attributes(system.body) if system is not None else {"long_name": "time"})
         elif dim == "axis" and size == 3:
-            var = self.nc.createVariable("axis", str, ("axis",))
-            var[:] = np.array(["x", "y", "z"], dtype=object)
-            var.setncatts({"units": "1", "long_name": "principal body axis"})
+            _text_variable(self.nc, "axis", "axis", ["x", "y", "z"], {"units": "1", "long_name": "principal body axis"})
 
     def _attributes(self, system: Any) -> dict[str, Any]:
         plan, settings = self.plan, self.settings
@@ -210,6 +213,17 @@ class Store:
         for key, value in provenance().items():
             attrs[key] = value
         return attrs
+
+
+def _text_variable(nc: netCDF4.Dataset, name: str, dim: str, values: Any, attrs: dict[str, Any]) -> None:
+    """Text along ``dim`` as a UTF-8 char array (as xarray writes text, so CF checkers read it)."""
+    texts = [str(v) for v in values]
+    width = max([len(t.encode("utf-8")) for t in texts] + [1])
+    nc.createDimension(f"{name}_strlen", width)
+    var = nc.createVariable(name, "S1", (dim, f"{name}_strlen"))
+    var._Encoding = "utf-8"
+    var[:] = np.array(texts, dtype=f"U{width}")
+    var.setncatts(attrs)
 
 
 def _open(path: Path, mode: str) -> netCDF4.Dataset:

@@ -51,7 +51,8 @@ class FixedPoint(System):
             parts.append(self.initial.alpha)
         return np.concatenate(parts)
 
-    def initial_states(self, initial: Mapping[str, Any], columns: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    def initial_states(self, initial: Mapping[str, Any],
+                       columns: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """``initial_state()`` for many points at once (a batch's plan, ``gyrolab.batch.plan``).
 
         ``initial`` is the config's initial node (valid: this system was built from it) and ``columns``
@@ -150,7 +151,8 @@ class FixedPoint(System):
         if "area_integral" in values:
             out["area_integral"] = _var("time", values["area_integral"], body.momentum_unit,
                                         "area integral: angular momentum about the vertical, Iω·γ")
-        out["gamma_norm"] = _var("time", values["gamma_norm"], "1", "norm of the direction-cosine vector |γ| (exactly 1)")
+        out["gamma_norm"] = _var("time", values["gamma_norm"], "1",
+                                 "norm of the direction-cosine vector |γ| (exactly 1)")
         if self.carries_alpha:
             out["alpha"] = _var(("time", "axis"), y[:, 6:9], "1", "direction cosines of the fixed X axis in body axes")
             out["frame_error"] = _var("time", values["frame_error"], "1",
