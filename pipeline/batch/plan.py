@@ -60,6 +60,8 @@ class Plan:
     combo_params: np.ndarray          # (combos, n params): the compiled model's parameters, NaN rows if invalid
     error: np.ndarray                 # (N,) int32: index into ``messages``, -1 where the point is valid
     messages: list[str] = field(default_factory=list)
+    #: the system's dataset attributes (``System.attributes``, unit attributes) equal for every point
+    attributes: dict[str, Any] = field(default_factory=dict)
 
     @property
     def size(self) -> int:
@@ -195,7 +197,8 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
              " × ".join(f"{name} {n}" for name, n in zip(dim_names(dims), shape)), int(valid.sum()), n_combos,
              time.perf_counter() - start)
     return Plan(dims=dims, names=dim_names(dims), plain=plain, base=base, times=times, y0=y0, combo=combo,
-                combo_values=combo_values, combo_params=combo_params, error=errors.index, messages=errors.messages)
+                combo_values=combo_values, combo_params=combo_params, error=errors.index, messages=errors.messages,
+                attributes=_common_attributes(systems, swept_initial=bool(initial_axes)))
 
 
 # ----------------------------------------------------------------------------- pieces
@@ -338,6 +341,20 @@ def _same_structure(systems: Mapping[int, _Built]) -> None:
     if len(models) > 1:
         raise ConfigError("the swept values change the compiled model's form (its torques or state), which one batch "
                           "cannot integrate together; sweep them with gyrolab -m")
+
+
+def _common_attributes(systems: Mapping[int, _Built], swept_initial: bool) -> dict[str, Any]:
+    """The attributes a single run's dataset gets from its system and body that are the same for every point
+    (those of the initial state only when no initial key is swept)."""
+    from gyrolab.output.cf import unit_attributes
+
+    if not systems:
+        return {}
+    per = [{**b.system.attributes(), **unit_attributes(b.system.body)} for b in systems.values()]
+    first = per[0]
+    return {k: v for k, v in first.items()
+            if not (swept_initial and k.startswith("initial_"))
+            and all(k in other and np.array_equal(np.asarray(other[k]), np.asarray(v)) for other in per[1:])}
 
 
 def _batch_times(plain: dict[str, Any], systems: Mapping[int, _Built], y0: np.ndarray, combo: np.ndarray,

@@ -210,8 +210,9 @@ class Store:
         }
         if settings.output == "decimated":
             attrs["batch_decimate"] = settings.decimate
-        for key, value in provenance().items():
-            attrs[key] = value
+        for key, value in {**plan.attributes, **provenance()}.items():
+            if value is not None:
+                attrs[key] = int(value) if isinstance(value, (bool, np.bool_)) else value
         return attrs
 
 
