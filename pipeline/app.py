@@ -504,7 +504,11 @@ def _batch(overrides: Sequence[str]) -> int:
     check_output_dir(str(out_dir), "hydra.sweep.dir")
     first = compose_config(_job_overrides(parsed, {}))
     check_config(first)
-    validate_scene(first)
+    # the checks of the whole batch; each point's scene is validated by the batch's plan (an invalid point,
+    # the first included, is a failed entry, not a refused batch)
+    plain = check_scene_config(first)
+    figure_options(plain.get("output"))
+    check_tolerances(plain)
     check_writable(out_dir)
     logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
     path = run_batch_sweep(scene_overrides, out_dir)

@@ -108,8 +108,12 @@ class Store:
             self._create(None)
         status = self.nc["job_status"][:]
         status = np.asarray(status.filled(0) if np.ma.isMaskedArray(status) else status)
-        for name, code in (("n_missing", 0), ("n_finished", FINISHED), ("n_failed", FAILED)):
-            self.nc.setncattr(name, int(np.count_nonzero(status == code)))
+        counts = {name: int(np.count_nonzero(status == code))
+                  for name, code in (("n_missing", 0), ("n_finished", FINISHED), ("n_failed", FAILED))}
+        self.nc.setncatts(counts)
+        if counts["n_failed"]:
+            log.info("batch: %d of %d points failed; their errors are error_message[job_error] where job_status is 2",
+                     counts["n_failed"], status.size)
         self.nc.close()
         self.nc = None
         try:
