@@ -231,9 +231,12 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
         solution = integrate_arrays(compiled, integrator, task.times, task.y0, task.params, failures="mark")
         kernel_time = solution.wall_time
         failed = np.asarray(solution.failed, dtype=bool)
-        good = np.flatnonzero(~failed)
-        outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, good,
-                                lambda row: _system(context, task.config, task.combos[row]), compiled, task.params)
+        with np.errstate(invalid="ignore"):   # every row, so that a chunk whose points all failed still has its
+            outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, np.arange(len(failed)),
+                                    lambda row: _system(context, task.config, task.combos[row]), compiled,
+                                    task.params)   # variables (the store is created from the first chunk's)
+        for out in outputs.values():
+            out.data[failed] = np.nan
     all_failed = np.zeros(task.n_rows, dtype=bool)
     all_failed[task.rows] = failed
     return ChunkResult(index=task.index, outputs=merge_rows(outputs, task.rows, task.n_rows), failed=all_failed,

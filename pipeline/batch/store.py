@@ -67,8 +67,9 @@ class Store:
             return set()
         found = _identity_of(self.part)
         if found != self.identity:
-            raise ConfigError(f"{self.part} is an unfinished batch of another command (identity {found}, this one is "
-                              f"{self.identity}); rerun that command to finish it, or give another directory")
+            raise ConfigError(f"{self.part} is an unfinished batch of another command or gyrolab version (identity "
+                              f"{found}, this one is {self.identity}); rerun that command to finish it, or give "
+                              "another directory")
         done = _read_journal(self.journal, self.identity)
         if not done:   # killed before its first chunk was journaled: the journal starts again
             _start_journal(self.journal, self.identity)
