@@ -181,11 +181,22 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
             y0[rows[ok]] = states[ok]
             suspect[rows[~ok]] = True
         else:
-            for n in np.flatnonzero(todo):
-                _scalar_point(plain, dims, n, shape, y0, combo_params, combo[n], errors)
+            suspect |= todo   # a system without the vectorised hook: one system per point
     # everything the fast checks could not vouch for: the single run's own code
     for n in np.flatnonzero(suspect & ~errors.failed):
-        _scalar_point(plain, dims, n, shape, y0, combo_params, combo[n], errors)
+        built = _scalar_point(plain, dims, n, shape, errors)
+        if built is None:
+            continue
+        state, params = built
+        if not y0.shape[1]:   # no combo was valid with the base initial state: the first valid point says
+            y0 = np.full((n_points, state.size), np.nan)
+            combo_params = np.full((n_combos, params.size), np.nan)
+        if (state.size, params.size) != (y0.shape[1], combo_params.shape[1]):
+            raise ConfigError(f"the batch's points have states of different sizes ({y0.shape[1]} and {state.size}) "
+                              "or models of different forms; sweep them with gyrolab -m")
+        y0[n] = state
+        if np.isnan(combo_params[combo[n]]).all():
+            combo_params[combo[n]] = params
 
     valid = ~errors.failed
     base = None
@@ -319,21 +330,16 @@ def _compiled(scene: Scene) -> Any:
     return compiled
 
 
-def _scalar_point(plain: dict[str, Any], dims: Sequence[Dim], n: int, shape: tuple[int, ...], y0: np.ndarray,
-                  combo_params: np.ndarray, c: int, errors: _Errors) -> None:
-    """One point checked and built by the single run's code (its error, or its initial state)."""
+def _scalar_point(plain: dict[str, Any], dims: Sequence[Dim], n: int, shape: tuple[int, ...],
+                  errors: _Errors) -> tuple[np.ndarray, np.ndarray] | None:
+    """One point checked and built by the single run's code: (its initial state, compiled parameters), or
+    None with its error recorded."""
     try:
         scene = Scene.from_config(OmegaConf.create(_point_config(plain, dims, n, shape)))
     except GyrolabError as error:
         errors.set(n, str(error))
-        return
-    state = scene.system.initial_state()
-    if y0.shape[1] != state.size:
-        raise ConfigError(f"the batch's points have states of different sizes ({y0.shape[1]} and {state.size}); "
-                          "sweep them with gyrolab -m")
-    y0[n] = state
-    if np.isnan(combo_params[c]).all():
-        combo_params[c] = _compiled(scene).params
+        return None
+    return scene.system.initial_state(), _compiled(scene).params
 
 
 def _same_structure(systems: Mapping[int, _Built]) -> None:
