@@ -485,7 +485,7 @@ def _plot(argv: Sequence[str]) -> int:
 
 
 def _batch(overrides: Sequence[str]) -> int:
-    """``gyrolab --batch KEY=V1,V2 ... [hydra.sweep.dir=DIR]``: the grid in one batch, one sweep.nc."""
+    """``gyrolab --batch KEY=V1,V2 ... [hydra.sweep.dir=DIR]``: the grid in one batch, one sweep.nc (resumable)."""
     from datetime import datetime
 
     from gyrolab.sweep.batch import run_batch_sweep
@@ -504,7 +504,11 @@ def _batch(overrides: Sequence[str]) -> int:
     check_output_dir(str(out_dir), "hydra.sweep.dir")
     first = compose_config(_job_overrides(parsed, {}))
     check_config(first)
-    validate_scene(first)
+    # the checks of the whole batch; each point's scene is validated by the batch's plan (an invalid point,
+    # the first included, is a failed entry, not a refused batch)
+    plain = check_scene_config(first)
+    figure_options(plain.get("output"))
+    check_tolerances(plain)
     check_writable(out_dir)
     logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
     path = run_batch_sweep(scene_overrides, out_dir)

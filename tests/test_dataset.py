@@ -116,14 +116,11 @@ def test_fastest_rate_bounds_the_motion_it_must_resolve():
 
 
 def test_batch_points_share_the_densest_auto_grid():
+    from gyrolab.batch.plan import plan_from_overrides
     from gyrolab.engine.config import compose_config
-    from gyrolab.sweep.batch import _share_output_times
 
-    cfg = compose_config(["time.end=300", "initial.r0=1"])
-    slow = Scene.from_config(cfg)
-    cfg.initial.r0 = 20.0
-    fast = Scene.from_config(cfg)
+    slow = Scene.from_config(compose_config(["time.end=300", "initial.r0=1"]))
+    fast = Scene.from_config(compose_config(["time.end=300", "initial.r0=20"]))
     assert len(fast.times) > len(slow.times)         # a spin 20 times faster needs more samples over the same span
-    dense = fast.times
-    _share_output_times([slow, fast])
-    assert slow.times is dense and fast.times is dense
+    plan = plan_from_overrides(["time.end=300", "initial.r0=1,20"])
+    np.testing.assert_array_equal(plan.times, fast.times)

@@ -22,6 +22,8 @@ TASKS = {
     "ismail2021_tables": "gyrolab.experiments.ismail2021_tables",
     "shaker_omega3": "gyrolab.experiments.shaker_omega3",
     "orbit_family": "gyrolab.experiments.orbit_family",
+    # issue 14: a chaos indicator over a grid of initial conditions, as one resumable batch
+    "stability_map": "gyrolab.experiments.stability_map",
     # satellite-gyrostat (Yehia & El-kenani (2021))
     "yehia2021_precessions": "gyrolab.experiments.yehia2021_precessions",
 }

@@ -12,13 +12,13 @@ force acting along a non-vertical direction. β = γ × α is never stored.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from gyrolab.physics.attitude import euler_angles, nutation_and_spin
+from gyrolab.physics.attitude import euler_angles, frame_from_angles, nutation_and_spin
 from gyrolab.physics.body import Body
 from gyrolab.contracts.force import Force
 from gyrolab.contracts.integrator import CompiledModel
@@ -50,6 +50,37 @@ class FixedPoint(System):
         if self.carries_alpha:
             parts.append(self.initial.alpha)
         return np.concatenate(parts)
+
+    def initial_states(self, initial: Mapping[str, Any],
+                       columns: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """``initial_state()`` for many points at once (a batch's plan, ``gyrolab.batch.plan``).
+
+        ``initial`` is the config's initial node (valid: this system was built from it) and ``columns``
+        maps initial keys to arrays, one value per point (NaN where a value is not a number). Returns the
+        states (points × state size) and which rows are valid; an invalid row's error is the single
+        run's, found by building that point (``InitialAttitude.from_config``), not here.
+        """
+        n = len(next(iter(columns.values()))) if columns else 1
+        ok = np.ones(n, dtype=bool)
+        if "gamma0" in columns or (initial.get("gamma0") is not None and {"theta0", "phi0"} & set(columns)):
+            return np.full((n, self.state_size), np.nan), np.zeros(n, dtype=bool)
+        value = {}
+        for key in ("p0", "q0", "r0", "psi0", "theta0", "phi0"):
+            if key in columns:
+                value[key] = np.asarray(columns[key], dtype=float)
+                ok &= np.isfinite(value[key])
+            else:
+                value[key] = np.full(n, float(initial.get(key) or 0.0))  # valid numbers (or an unused null θ0, φ0)
+        omega = np.stack([value["p0"], value["q0"], value["r0"]], axis=1)
+        if initial.get("gamma0") is not None:   # γ0 kept bit for bit; α from its angles (as from_config does)
+            theta0, phi0 = (np.full(n, float(x)) for x in nutation_and_spin(self.initial.gamma))
+        else:
+            theta0, phi0 = value["theta0"], value["phi0"]
+        alpha, _, gamma = (np.asarray(v).T for v in frame_from_angles(value["psi0"], theta0, phi0))
+        if initial.get("gamma0") is not None:
+            gamma = np.broadcast_to(self.initial.gamma, (n, 3))
+        parts = [omega, gamma, alpha] if self.carries_alpha else [omega, gamma]
+        return np.concatenate(parts, axis=1), ok
 
     def _axes(self, y: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray]:
         gamma = y[..., 3:6]
@@ -89,6 +120,21 @@ class FixedPoint(System):
             energy = energy + force.potential(axes)
         return energy
 
+    def invariant_values(self, y: np.ndarray) -> dict[str, np.ndarray]:
+        """Each monitored invariant (``invariants``) along states ``y`` of shape (..., state size)."""
+        omega, gamma = y[..., 0:3], y[..., 3:6]
+        invariants = self.invariants
+        values = {}
+        if "energy" in invariants:
+            values["energy"] = self.energy(y)
+        if "area_integral" in invariants:
+            values["area_integral"] = dot(self.inertia * omega, gamma)
+        values["gamma_norm"] = norm(gamma)
+        if self.carries_alpha:
+            alpha = y[..., 6:9]
+            values["frame_error"] = np.maximum(np.abs(norm(alpha) - 1.0), np.abs(dot(alpha, gamma)))
+        return values
+
     # -- outputs ---------------------------------------------------------------
     def variables(self, t: np.ndarray, y: np.ndarray) -> dict[str, xr.Variable]:
         body = self.body
@@ -98,19 +144,19 @@ class FixedPoint(System):
                           f"angular velocity (p, q, r) in body axes [{body.rate_label}]"),
             "gamma": _var(("time", "axis"), gamma, "1", "direction cosines of the fixed vertical Z in body axes"),
         }
-        invariants = self.invariants
-        if "energy" in invariants:
-            out["energy"] = _var("time", self.energy(y), body.energy_unit,
+        values = self.invariant_values(y)
+        if "energy" in values:
+            out["energy"] = _var("time", values["energy"], body.energy_unit,
                                  "total energy: kinetic ½ω·Iω plus the forces' potentials")
-        if "area_integral" in invariants:
-            out["area_integral"] = _var("time", dot(self.inertia * omega, gamma), body.momentum_unit,
+        if "area_integral" in values:
+            out["area_integral"] = _var("time", values["area_integral"], body.momentum_unit,
                                         "area integral: angular momentum about the vertical, Iω·γ")
-        out["gamma_norm"] = _var("time", norm(gamma), "1", "norm of the direction-cosine vector |γ| (exactly 1)")
+        out["gamma_norm"] = _var("time", values["gamma_norm"], "1",
+                                 "norm of the direction-cosine vector |γ| (exactly 1)")
         if self.carries_alpha:
-            alpha = y[:, 6:9]
-            out["alpha"] = _var(("time", "axis"), alpha, "1", "direction cosines of the fixed X axis in body axes")
-            out["frame_error"] = _var("time", np.maximum(np.abs(norm(alpha) - 1.0), np.abs(dot(alpha, gamma))),
-                                      "1", "orthonormality error of (α, γ): max(| |α| − 1 |, |α·γ|)")
+            out["alpha"] = _var(("time", "axis"), y[:, 6:9], "1", "direction cosines of the fixed X axis in body axes")
+            out["frame_error"] = _var("time", values["frame_error"], "1",
+                                      "orthonormality error of (α, γ): max(| |α| − 1 |, |α·γ|)")
         if self.euler_angles:
             psi, theta, phi = euler_angles(y[:, 6:9], gamma)
             out["psi"] = _var("time", psi, "rad", "precession angle ψ (unwrapped)")

@@ -1,0 +1,230 @@
+"""What a batch stores per point (``batch.output``), computed from a chunk's trajectories.
+
+* ``trajectory``: every output variable of the system (as a single run's ``run.nc``) over the output times;
+* ``decimated``: the same at every ``batch.decimate``-th output time (the first and the k-th, 2k-th, ...);
+* ``final``: the final state's variables (angles wrapped to (−π, π]);
+* ``reductions``: ``final`` plus each monitored invariant's ``<name>_max_abs_drift`` (max over the stored
+  samples of |I(t) − I(0)|) and ``max_nutation_deviation`` (max |θ(t) − θ(0)|);
+* ``indicator``: the chaos indicator and the max nutation deviation of ``gyrolab.physics.chaos``, from the
+  variational equations (``indicator_outputs``).
+
+Each output is ``Output(dims, data, attrs)``: ``dims`` the trailing dimensions after the point's (grid)
+dimensions, ``data`` one row per point of the chunk.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numba
+import numpy as np
+
+from gyrolab.physics.attitude import nutation_and_spin
+
+MODES = ("trajectory", "decimated", "final", "reductions", "indicator")
+#: modes whose outputs carry a time dimension
+SERIES_MODES = ("trajectory", "decimated")
+DRIFT_SUFFIX = "_max_abs_drift"
+NUTATION = "max_nutation_deviation"
+NUTATION_ATTRS = {"units": "rad", "long_name": "max |θ(t) − θ(0)| over the stored samples (nutation deviation)"}
+#: points per block of the reductions' array arithmetic
+REDUCTION_BLOCK = 256
+#: angles a single run unwraps along its trajectory; a final value alone is wrapped to (−π, π]
+WRAPPED = ("phi", "psi")
+
+
+@dataclass
+class Output:
+    dims: tuple[str, ...]
+    data: np.ndarray
+    attrs: dict[str, Any]
+
+
+def output_times(times: np.ndarray, mode: str, decimate: int) -> np.ndarray:
+    """The output times a mode stores (only the series modes store any)."""
+    return times[::decimate] if mode == "decimated" else times
+
+
+def state_outputs(mode: str, decimate: int, times: np.ndarray, y: np.ndarray, rows: np.ndarray,
+                  system_of: Callable[[int], Any], compiled: Any = None, params: np.ndarray | None = None
+                  ) -> dict[str, Output]:
+    """The outputs of ``mode`` (not ``indicator``) for trajectories ``y`` (points × times × state).
+
+    ``rows`` are the points (row indices of ``y``) to compute, grouped by ``system_of(row)`` — the system
+    built with that point's body and forces (energy and units depend on them); the other rows stay NaN.
+    With the fixed-point system's compiled model (``compiled``, ``params`` per row of ``y``) the reductions
+    run compiled, in one pass over the trajectories.
+    """
+    outputs: dict[str, Output] = {}
+    groups: dict[int, list[int]] = {}
+    for row in rows:
+        groups.setdefault(id(system_of(int(row))), []).append(int(row))
+    for members in groups.values():
+        system = system_of(members[0])
+        index = np.asarray(members)
+        if mode in SERIES_MODES:
+            t = output_times(times, mode, decimate)
+            part = {}
+            for row in index:
+                variables = system.variables(t, y[row, ::decimate] if mode == "decimated" else y[row])
+                for name, var in variables.items():
+                    part.setdefault(name, (tuple(var.dims), [], dict(var.attrs)))[1].append(var.values)
+                for name, values in _drifts(system, y[row][None]).items():
+                    part.setdefault(name, ((), [], values[1]))[1].append(values[0][0])
+            _place(outputs, {k: (d, np.stack(v), a) for k, (d, v, a) in part.items()}, index, len(y))
+            continue
+        finals = _final_variables(system, times, y[index, -1])
+        _place(outputs, finals, index, len(y))
+        if mode == "reductions" and compiled is not None and _compiled_reductions(compiled, system, y.shape[2]):
+            _place(outputs, _fixed_point_reductions(system, y[index], params[index]), index, len(y))
+        elif mode == "reductions":   # by blocks of points that fit in the cache (numpy streams each operation)
+            for lo in range(0, len(index), REDUCTION_BLOCK):
+                rows = index[lo:lo + REDUCTION_BLOCK]
+                block = y[rows]
+                part = {k: ((), v, a) for k, (v, a) in _drifts(system, block).items()}
+                theta = nutation_and_spin(block[:, :, 3:6])[0]
+                part[NUTATION] = ((), np.max(np.abs(theta - theta[:, :1]), axis=1), dict(NUTATION_ATTRS))
+                _place(outputs, part, rows, len(y))
+    return outputs
+
+
+def _final_variables(system: Any, times: np.ndarray, final: np.ndarray) -> dict[str, tuple]:
+    """The system's variables at the final states, the points standing in for the time axis (every variable
+    is pointwise in time except the unwrapped angles, which are wrapped back)."""
+    t = np.full(len(final), times[-1])
+    out = {}
+    for name, var in system.variables(t, final).items():
+        values = np.asarray(var.values, dtype=float)
+        attrs = dict(var.attrs)
+        if name in WRAPPED:
+            values = np.angle(np.exp(1j * values))
+            attrs["long_name"] = str(attrs.get("long_name", name)).replace("(unwrapped)", "(wrapped to (−π, π])")
+        out[name] = (tuple(var.dims[1:]), values, attrs)
+    return out
+
+
+def _drifts(system: Any, y: np.ndarray) -> dict[str, tuple[np.ndarray, dict[str, Any]]]:
+    """Each monitored invariant's max |I(t) − I(0)| per trajectory of ``y`` (points × times × state)."""
+    hook = getattr(system, "invariant_values", None)
+    if hook is not None:
+        values = hook(y)
+    else:   # a system without the vectorised hook: its variables, one trajectory at a time
+        t = np.arange(y.shape[1], dtype=float)
+        per = [system.variables(t, row) for row in y]
+        values = {name: np.stack([v[name].values for v in per]) for name in system.invariants}
+    units = _units(system)
+    out = {}
+    for name in system.invariants:
+        series = np.asarray(values[name], dtype=float)
+        drift = np.max(np.abs(series - series[:, :1]), axis=1)
+        out[name + DRIFT_SUFFIX] = (drift, _drift_attrs(name, units))
+    return out
+
+
+def _compiled_reductions(compiled: Any, system: Any, size: int) -> bool:
+    """The compiled reductions cover the fixed-point model with the packed torque forms only."""
+    from gyrolab.plugins.compiled import fixed_point, models
+
+    return compiled.model == models.FIXED_POINT and compiled.params.size == fixed_point.N_PARAMS \
+        and size in (6, 9) and hasattr(system, "invariant_values")
+
+
+def _fixed_point_reductions(system: Any, y: np.ndarray, params: np.ndarray) -> dict[str, tuple]:
+    out = np.empty((len(y), 5))
+    _reduce_fixed_point(np.ascontiguousarray(y), np.ascontiguousarray(params), out)
+    units = _units(system)
+    part = {}
+    for k, name in enumerate(("energy", "area_integral", "gamma_norm", "frame_error")):
+        if name in system.invariants:
+            part[name + DRIFT_SUFFIX] = ((), out[:, k], _drift_attrs(name, units))
+    part[NUTATION] = ((), out[:, 4], dict(NUTATION_ATTRS))
+    return part
+
+
+@numba.njit(cache=True, parallel=True, error_model="numpy")
+def _reduce_fixed_point(y, p, out):
+    """Per trajectory of y (points × times × state (ω, γ[, α])) with packed parameters p (``fixed_point.pack``):
+    max |I(t) − I(0)| of the energy ½ω·Iω − Σ U_i·e_i + Σ ½ N_i e_i·I e_i (the potentials of the packed
+    torques U_i × e_i and N_i e_i × I e_i), of the area integral Iω·γ, of |γ| and of the frame error
+    max(| |α| − 1 |, |α·γ|); and max |θ(t) − θ(0)|, θ = atan2(|γ_xy|, γ_z)."""
+    n_points, n_times, size = y.shape
+    for j in numba.prange(n_points):
+        I0, I1, I2 = p[j, 0], p[j, 1], p[j, 2]
+        e0 = a0 = n0 = f0 = th0 = 0.0
+        de = da = dn = fmax = dth = 0.0
+        for i in range(n_times):
+            w0, w1, w2 = y[j, i, 0], y[j, i, 1], y[j, i, 2]
+            g0, g1, g2 = y[j, i, 3], y[j, i, 4], y[j, i, 5]
+            energy = 0.5 * (I0 * w0 * w0 + I1 * w1 * w1 + I2 * w2 * w2) \
+                - (p[j, 9] * g0 + p[j, 10] * g1 + p[j, 11] * g2) \
+                + 0.5 * p[j, 14] * (I0 * g0 * g0 + I1 * g1 * g1 + I2 * g2 * g2)
+            frame = 0.0
+            if size == 9:
+                x0, x1, x2 = y[j, i, 6], y[j, i, 7], y[j, i, 8]
+                b0, b1, b2 = g1 * x2 - g2 * x1, g2 * x0 - g0 * x2, g0 * x1 - g1 * x0
+                energy += -(p[j, 3] * x0 + p[j, 4] * x1 + p[j, 5] * x2) - (p[j, 6] * b0 + p[j, 7] * b1 + p[j, 8] * b2) \
+                    + 0.5 * p[j, 12] * (I0 * x0 * x0 + I1 * x1 * x1 + I2 * x2 * x2) \
+                    + 0.5 * p[j, 13] * (I0 * b0 * b0 + I1 * b1 * b1 + I2 * b2 * b2)
+                frame = max(abs(np.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - 1.0), abs(x0 * g0 + x1 * g1 + x2 * g2))
+            area = I0 * w0 * g0 + I1 * w1 * g1 + I2 * w2 * g2
+            gnorm = np.sqrt(g0 * g0 + g1 * g1 + g2 * g2)
+            theta = np.arctan2(np.hypot(g0, g1), g2)
+            if i == 0:
+                e0, a0, n0, f0, th0 = energy, area, gnorm, frame, theta
+            de = max(de, abs(energy - e0))
+            da = max(da, abs(area - a0))
+            dn = max(dn, abs(gnorm - n0))
+            dth = max(dth, abs(theta - th0))
+            fmax = max(fmax, abs(frame - f0))
+        out[j, 0], out[j, 1], out[j, 2], out[j, 3], out[j, 4] = de, da, dn, fmax, dth
+
+
+def _drift_attrs(name: str, units: Mapping[str, str]) -> dict[str, str]:
+    return {"units": units.get(name, "1"), "long_name": f"max |{name}(t) − {name}(0)| over the stored samples"}
+
+
+def _units(system: Any) -> dict[str, str]:
+    """The units of the system's variables (from a two-sample evaluation at a valid state)."""
+    cached = getattr(system, "_batch_units", None)
+    if cached is None:
+        y = np.tile(system.initial_state(), (2, 1))
+        cached = {name: str(var.attrs.get("units", "1")) for name, var in system.variables(np.zeros(2), y).items()}
+        system._batch_units = cached
+    return cached
+
+
+def _place(outputs: dict[str, Output], part: Mapping[str, tuple], index: np.ndarray, n_rows: int) -> None:
+    """Put one group's rows into the chunk's outputs (NaN rows elsewhere)."""
+    for name, (dims, values, attrs) in part.items():
+        values = np.asarray(values)
+        if name not in outputs:
+            data = np.full((n_rows,) + values.shape[1:], np.nan)
+            outputs[name] = Output(tuple(dims), data, attrs)
+        outputs[name].data[index] = values
+
+
+def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray,
+                      params: np.ndarray) -> dict[str, Output]:
+    """The chaos indicator's outputs (``gyrolab.physics.chaos.indicator_outputs``, imported here only)."""
+    from gyrolab.physics.chaos import indicator_outputs as compute
+
+    out = {}
+    for name, (data, attrs) in compute(compiled, integrator, times, y0s, params).items():
+        data = np.asarray(data)
+        out[name] = Output(tuple(f"{name}_{k}" for k in range(1, data.ndim)), data, dict(attrs))
+    return out
+
+
+def merge_rows(outputs: Mapping[str, Output], rows: np.ndarray, n_rows: int) -> dict[str, Output]:
+    """Outputs computed for ``rows`` only, spread over ``n_rows`` (NaN in the others)."""
+    merged = {}
+    for name, out in outputs.items():
+        data = np.full((n_rows,) + out.data.shape[1:], np.nan)
+        data[rows] = out.data
+        merged[name] = Output(out.dims, data, out.attrs)
+    return merged
+
+
+__all__: Sequence[str] = ["MODES", "Output", "state_outputs", "indicator_outputs", "merge_rows", "output_times"]

@@ -1,0 +1,392 @@
+"""A batch's plan: the grid of points as arrays (initial states, compiled-model parameters), validated.
+
+The config is composed once (the fixed overrides and each swept key's first value); the swept keys are
+split by what they feed: ``body.*`` and ``force.*`` build the body, the forces and the compiled model's
+parameters, once per combination of their values (a "combo": usually few), and ``initial.*`` the
+initial states, computed for the whole grid at once by the system's vectorised hook
+``initial_states(initial, columns)`` (the fixed-point system has one; other systems fall back to one
+system per distinct point). No OmegaConf config, scene or dataset is built per point.
+
+Validation stays exact: a point the fast checks cannot vouch for (a value that is not a finite number,
+a combo whose system refuses the base initial state, a row the vectorised hook marks invalid) is checked
+by the single run's own code (``Scene.from_config`` on that point's config), so a failed point carries
+the same one-sentence error a single run of it gives.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import logging
+import math
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+from omegaconf import OmegaConf
+
+from gyrolab.engine import scene as scene_module
+from gyrolab.engine.config import compose_config
+from gyrolab.engine.scene import Scene, build_force, fastest_rate
+from gyrolab.errors import ConfigError, GyrolabError, require_finite
+from gyrolab.sweep.grid import Dim, Grid
+from gyrolab.sweep.identity import canonical_config, code_version
+
+log = logging.getLogger("gyrolab.batch")
+
+VARIABLE_SECTIONS = ("body.", "initial.", "force.")
+PARAM_SECTIONS = ("body.", "force.")
+#: the batch's settings that do not change its result (left out of its identity)
+NOT_IN_IDENTITY = ("scheduler", "progress")
+SCHEME = "gyrolab-batch-1"
+
+
+@dataclass
+class Plan:
+    """Every point of the grid as arrays; point ``n`` is grid position ``np.unravel_index(n, shape)``."""
+
+    dims: tuple[Dim, ...]
+    names: tuple[str, ...]            # dimension names in the stored dataset
+    plain: dict[str, Any]             # the composed config (resolved, plain), swept keys at their first values
+    base: dict[str, Any] | None       # the config of the first valid point (what a worker rebuilds), None: none
+    times: np.ndarray
+    y0: np.ndarray                    # (N, state size), NaN rows where a point failed
+    combo: np.ndarray                 # (N,) int32: the point's combination of body/force values
+    combo_values: list[dict[str, Any]]  # per combo: swept key -> value
+    combo_params: np.ndarray          # (combos, n params): the compiled model's parameters, NaN rows if invalid
+    error: np.ndarray                 # (N,) int32: index into ``messages``, -1 where the point is valid
+    messages: list[str] = field(default_factory=list)
+    #: the system's dataset attributes (``System.attributes``, unit attributes) equal for every point
+    attributes: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def size(self) -> int:
+        return int(self.y0.shape[0])
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(d.values) for d in self.dims)
+
+    @property
+    def valid(self) -> np.ndarray:
+        return self.error < 0
+
+    def params(self, start: int, stop: int) -> np.ndarray:
+        return self.combo_params[self.combo[start:stop]]
+
+    def identity(self, chunk: int) -> str:
+        """20 hex digits over the code version, the composed config (without the settings that do not change
+        the result), the grid and the chunk size: the same command gives the same identity."""
+        plain = copy.deepcopy(self.plain)
+        for key in NOT_IN_IDENTITY:
+            (plain.get("batch") or {}).pop(key, None)
+        grid = [[d.key, list(d.labels)] for d in self.dims]
+        text = "\n".join((SCHEME, code_version(), canonical_config(plain), json.dumps(grid), str(chunk)))
+        return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+def split_overrides(overrides: Sequence[str]) -> tuple[list[str], list[Dim]]:
+    """(the fixed overrides, the swept dimensions) of a command line, each override parsed as the
+    multirun's grid parses it (``Grid.from_overrides``: its errors, its typed values)."""
+    fixed, dims = [], []
+    for override in overrides:
+        grid = Grid.from_overrides([override])
+        if grid.dims:
+            dims.extend(grid.dims)
+        else:
+            fixed.append(override)
+    keys = [d.key for d in dims]
+    repeated = next((k for k in keys if keys.count(k) > 1), None)
+    if repeated:
+        raise ConfigError(f"{repeated} is swept twice; give each swept key once")
+    for dim in dims:
+        if not dim.key.lstrip("+~").startswith(VARIABLE_SECTIONS):
+            raise ConfigError(f"a batch sweep varies body, initial and force parameters only, not {dim.key!r}; "
+                              "sweep it with gyrolab -m instead")
+    return fixed, dims
+
+
+def dim_names(dims: Sequence[Dim]) -> tuple[str, ...]:
+    """Each dimension named by its key's last part (``initial.theta0`` -> ``theta0``), the whole key with
+    dots as underscores where two would share a name."""
+    short = [d.short_name for d in dims]
+    return tuple(s if short.count(s) == 1 else d.key.lstrip("+~").replace(".", "_") for s, d in zip(short, dims))
+
+
+def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any] | None = None) -> Plan:
+    """The plan of the grid ``dims`` over the config composed from ``fixed`` (or given as ``plain``)."""
+    start = time.perf_counter()
+    dims = tuple(dims)
+    if not dims:
+        raise ConfigError("a batch needs at least one swept key, e.g. initial.r0=1,2,5")
+    if plain is None:
+        first = [f"{d.key}={d.labels[0]}" for d in dims]
+        plain = OmegaConf.to_container(compose_config(list(fixed) + first), resolve=True)
+        plain.pop("hydra", None)
+    shape = tuple(len(d.values) for d in dims)
+    n_points = math.prod(shape)
+    param_axes = [i for i, d in enumerate(dims) if _key(d).startswith(PARAM_SECTIONS)]
+    initial_axes = [i for i, d in enumerate(dims) if not _key(d).startswith(PARAM_SECTIONS)]
+    errors = _Errors(n_points)
+
+    # points with a value that is not a finite number: the single run's checks decide (rare)
+    suspect = np.zeros(n_points, dtype=bool)
+    for axis, dim in enumerate(dims):
+        odd = np.array([not _finite_number(v) for v in dim.values])
+        if odd.any():
+            suspect |= _along(odd, axis, shape)
+
+    # body and forces once per combination of their swept values
+    combo_shape = tuple(shape[i] for i in param_axes)
+    n_combos = math.prod(combo_shape)
+    combo_values = []
+    for flat in range(n_combos):
+        position = np.unravel_index(flat, combo_shape) if combo_shape else ()
+        combo_values.append({dims[i].key: dims[i].values[int(p)] for i, p in zip(param_axes, position)})
+    combo = _combo_index(shape, param_axes)
+    builds = [_build_combo(plain, values) for values in combo_values]
+    systems = {}
+    for c, built in enumerate(builds):
+        in_combo = combo == c
+        if isinstance(built, _Failure):
+            if built.exact:     # body or forces refused: the single run says the same, unless a NaN comes first
+                errors.set(in_combo & ~suspect, built.message)
+            else:
+                suspect |= in_combo
+        else:
+            systems[c] = built
+    reference = next(iter(systems.values()), None)
+    if reference is not None:
+        _same_structure(systems)
+
+    # initial states: vectorised over the grid, or one system per distinct point
+    y0 = np.full((n_points, reference.system.state_size if reference else 0), np.nan)
+    combo_params = np.full((n_combos, reference.compiled.params.size if reference else 0), np.nan)
+    for c, built in systems.items():
+        combo_params[c] = built.compiled.params
+    todo = ~suspect & ~errors.failed & np.isin(combo, list(systems))
+    if reference is not None and todo.any():
+        hook = getattr(reference.system, "initial_states", None)
+        initial = plain.get("initial") or {}
+        if hook is not None:
+            columns = {_key(dims[i])[len("initial."):]: _column(dims[i], i, shape, todo) for i in initial_axes}
+            states, ok = hook(initial, columns)
+            rows = np.flatnonzero(todo)
+            if not columns:   # no initial key swept: one state for every point
+                states, ok = np.broadcast_to(states, (rows.size, states.shape[1])), np.broadcast_to(ok, rows.shape)
+            y0[rows[ok]] = states[ok]
+            suspect[rows[~ok]] = True
+        else:
+            suspect |= todo   # a system without the vectorised hook: one system per point
+    # everything the fast checks could not vouch for: the single run's own code
+    for n in np.flatnonzero(suspect & ~errors.failed):
+        built = _scalar_point(plain, dims, n, shape, errors)
+        if built is None:
+            continue
+        state, params = built
+        if not y0.shape[1]:   # no combo was valid with the base initial state: the first valid point says
+            y0 = np.full((n_points, state.size), np.nan)
+            combo_params = np.full((n_combos, params.size), np.nan)
+        if (state.size, params.size) != (y0.shape[1], combo_params.shape[1]):
+            raise ConfigError(f"the batch's points have states of different sizes ({y0.shape[1]} and {state.size}) "
+                              "or models of different forms; sweep them with gyrolab -m")
+        y0[n] = state
+        if np.isnan(combo_params[combo[n]]).all():
+            combo_params[combo[n]] = params
+
+    valid = ~errors.failed
+    base = None
+    if valid.any():
+        n0 = int(np.argmax(valid))
+        base = _point_config(plain, dims, n0, shape)
+    times = _batch_times(plain, systems, y0, combo, valid)
+    log.info("batch plan: %d points (%s), %d valid, %d combinations of body/force values, %.2f s", n_points,
+             " × ".join(f"{name} {n}" for name, n in zip(dim_names(dims), shape)), int(valid.sum()), n_combos,
+             time.perf_counter() - start)
+    return Plan(dims=dims, names=dim_names(dims), plain=plain, base=base, times=times, y0=y0, combo=combo,
+                combo_values=combo_values, combo_params=combo_params, error=errors.index, messages=errors.messages,
+                attributes=_common_attributes(systems, swept_initial=bool(initial_axes)))
+
+
+# ----------------------------------------------------------------------------- pieces
+
+
+@dataclass
+class _Built:
+    system: Any
+    compiled: Any
+
+
+@dataclass
+class _Failure:
+    message: str
+    exact: bool   # the same message for every point of the combo
+
+
+class _Errors:
+    """Per-point error indices into a list of distinct messages."""
+
+    def __init__(self, n: int) -> None:
+        self.index = np.full(n, -1, dtype=np.int32)
+        self.messages: list[str] = []
+        self._known: dict[str, int] = {}
+
+    def code(self, message: str) -> int:
+        if message not in self._known:
+            self._known[message] = len(self.messages)
+            self.messages.append(message)
+        return self._known[message]
+
+    def set(self, where: np.ndarray | int, message: str) -> None:
+        self.index[where] = self.code(message)
+
+    @property
+    def failed(self) -> np.ndarray:
+        return self.index >= 0
+
+
+def _key(dim: Dim) -> str:
+    return dim.key.lstrip("+~")
+
+
+def _finite_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) \
+        and abs(value) < 1.7e308
+
+
+def _along(mask: np.ndarray, axis: int, shape: tuple[int, ...]) -> np.ndarray:
+    """A per-value mask of dimension ``axis`` spread over the whole grid (flat, C order)."""
+    view = [1] * len(shape)
+    view[axis] = shape[axis]
+    return np.broadcast_to(mask.reshape(view), shape).ravel()
+
+
+def _column(dim: Dim, axis: int, shape: tuple[int, ...], rows: np.ndarray) -> np.ndarray:
+    values = np.array([float(v) if _finite_number(v) else np.nan for v in dim.values])
+    return _along(values, axis, shape)[rows]
+
+
+def _combo_index(shape: tuple[int, ...], param_axes: list[int]) -> np.ndarray:
+    """(N,) the combo of each point: its position over the body/force dims, flattened."""
+    combo = np.zeros(shape, dtype=np.int32)
+    stride = 1
+    for axis in reversed(param_axes):
+        view = [1] * len(shape)
+        view[axis] = shape[axis]
+        combo = combo + (np.arange(shape[axis], dtype=np.int32) * stride).reshape(view)
+        stride *= shape[axis]
+    return np.ascontiguousarray(np.broadcast_to(combo, shape)).ravel()
+
+
+def _with_values(plain: dict[str, Any], values: Mapping[str, Any]) -> dict[str, Any]:
+    out = copy.deepcopy(plain)
+    for key, value in values.items():
+        node, parts = out, key.lstrip("+~").split(".")
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+        node[parts[-1]] = value
+    return out
+
+
+def _point_values(dims: Sequence[Dim], n: int, shape: tuple[int, ...]) -> dict[str, Any]:
+    position = np.unravel_index(n, shape)
+    return {d.key: d.values[int(p)] for d, p in zip(dims, position)}
+
+
+def _point_config(plain: dict[str, Any], dims: Sequence[Dim], n: int, shape: tuple[int, ...]) -> dict[str, Any]:
+    return _with_values(plain, _point_values(dims, n, shape))
+
+
+def _build_combo(plain: dict[str, Any], values: Mapping[str, Any]) -> _Built | _Failure:
+    """The system of one combination of body/force values with the base initial state (Scene.from_config's
+    order: body, forces, then the system; only the first two stages' errors hold for every point)."""
+    point = _with_values(plain, values)
+    try:
+        require_finite({k: v for k, v in point.items() if k != "initial"}, "")
+        cfg = OmegaConf.create(point)
+        system_cls = scene_module._plugin_class("system", cfg.system, "system")
+        body = system_cls.body_type.from_config(point["body"])
+        forces = [build_force(scene_module._plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
+                  for name, node in (cfg.get("force") or {}).items()]
+    except GyrolabError as error:
+        return _Failure(str(error), exact=True)
+    del body, forces   # built for their errors only; the scene builds its own
+    try:
+        scene = Scene.from_config(cfg)   # the rest of the single run's checks, on the base initial state
+    except GyrolabError as error:
+        return _Failure(str(error), exact=False)
+    return _Built(scene.system, _compiled(scene))
+
+
+def _compiled(scene: Scene) -> Any:
+    compiled = scene.system.compiled_model()
+    if compiled is None:
+        reason = getattr(scene.system, "compile_error", None) or f"system {scene.system.name!r} has no compiled form"
+        raise ConfigError(f"a batch runs the compiled batch kernels, and {reason}; sweep this scene with gyrolab -m")
+    return compiled
+
+
+def _scalar_point(plain: dict[str, Any], dims: Sequence[Dim], n: int, shape: tuple[int, ...],
+                  errors: _Errors) -> tuple[np.ndarray, np.ndarray] | None:
+    """One point checked and built by the single run's code: (its initial state, compiled parameters), or
+    None with its error recorded."""
+    try:
+        scene = Scene.from_config(OmegaConf.create(_point_config(plain, dims, n, shape)))
+    except GyrolabError as error:
+        errors.set(n, str(error))
+        return None
+    return scene.system.initial_state(), _compiled(scene).params
+
+
+def _same_structure(systems: Mapping[int, _Built]) -> None:
+    models = {(b.compiled.model, b.system.state_size, b.compiled.params.size) for b in systems.values()}
+    if len(models) > 1:
+        raise ConfigError("the swept values change the compiled model's form (its torques or state), which one batch "
+                          "cannot integrate together; sweep them with gyrolab -m")
+
+
+def _common_attributes(systems: Mapping[int, _Built], swept_initial: bool) -> dict[str, Any]:
+    """The attributes a single run's dataset gets from its system and body that are the same for every point
+    (those of the initial state only when no initial key is swept)."""
+    from gyrolab.output.cf import unit_attributes
+
+    if not systems:
+        return {}
+    per = [{**b.system.attributes(), **unit_attributes(b.system.body)} for b in systems.values()]
+    first = per[0]
+    return {k: v for k, v in first.items()
+            if not (swept_initial and k.startswith("initial_"))
+            and all(k in other and np.array_equal(np.asarray(other[k]), np.asarray(v)) for other in per[1:])}
+
+
+def _batch_times(plain: dict[str, Any], systems: Mapping[int, _Built], y0: np.ndarray, combo: np.ndarray,
+                 valid: np.ndarray) -> np.ndarray:
+    """One output grid for the batch: ``time.n_output: auto`` takes the densest any point needs (the fastest
+    rate over the combos, each with its most energetic initial ω)."""
+    time_cfg = plain["time"]
+    rate = None
+    if time_cfg.get("n_output", "auto") == "auto":
+        rates = []
+        for c, built in systems.items():
+            rows = np.flatnonzero(valid & (combo == c))
+            if not rows.size:
+                continue
+            inertia = np.asarray(getattr(built.system.body, "inertia", np.ones(3)), dtype=float)
+            omega = y0[rows, :3]
+            fastest = y0[rows[int(np.argmax(np.einsum("ij,j,ij->i", omega, inertia, omega)))]]
+            shim = SimpleNamespace(body=built.system.body, forces=built.system.forces,
+                                   state_size=built.system.state_size, initial_state=lambda s=fastest: s)
+            value = fastest_rate(shim)
+            if value is not None:
+                rates.append(value)
+        rate = max(rates) if rates else None
+    return scene_module._output_times(time_cfg, rate)
+
+
+def plan_from_overrides(overrides: Sequence[str]) -> Plan:
+    fixed, dims = split_overrides(overrides)
+    return make_plan(fixed, dims)

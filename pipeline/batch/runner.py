@@ -1,0 +1,271 @@
+"""Running a plan: chunks of points, each a picklable task integrated by the compiled batch kernels.
+
+``run_plan(plan, path, settings)`` cuts the grid into chunks (each a block of the grid, so that it is one
+hyperslab of the stored dataset), skips the chunks a killed run of the same command already stored,
+hands the others to ``gyrolab.batch.executors.map_chunks(run_chunk, ...)`` and streams each result to
+the store as it arrives. ``run_chunk`` is a module-level function: a worker rebuilds the compiled model
+and the integrator from the task's plain config (once per process and config, see ``_context``).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from omegaconf import OmegaConf
+
+from gyrolab.batch import executors
+from gyrolab.batch.outputs import MODES, Output, indicator_outputs, merge_rows, state_outputs
+from gyrolab.batch.plan import Plan, _with_values
+from gyrolab.batch.store import Store
+from gyrolab.engine.progress import duration
+from gyrolab.errors import ConfigError
+
+log = logging.getLogger("gyrolab.batch")
+
+#: a chunk's trajectories (points × output times × state, float64) stay under ``batch.memory`` MiB
+DEFAULT_MEMORY_MIB = 64
+MAX_CHUNK = 200_000
+INTEGRATION_FAILED = "the trajectory became non-finite (NaN or inf); reduce integrator.step or choose an adaptive " \
+                     "integrator"
+
+
+@dataclass(frozen=True)
+class Settings:
+    output: str = "reductions"
+    decimate: int = 10
+    chunk: int | None = None        # None: from ``memory``
+    memory: float = DEFAULT_MEMORY_MIB
+    scheduler: str | None = None
+
+    @classmethod
+    def from_config(cls, node: Any) -> Settings:
+        node = dict(node or {})
+        output = node.get("output", cls.output)
+        if output not in MODES:
+            raise ConfigError(f"batch.output={output!r} is not a batch output; valid choices: {', '.join(MODES)}")
+        decimate = node.get("decimate", cls.decimate)
+        if isinstance(decimate, bool) or not isinstance(decimate, int) or decimate < 1:
+            raise ConfigError(f"batch.decimate={decimate!r} must be a positive integer (store every k-th output time)")
+        chunk = node.get("chunk", "auto")
+        if chunk in (None, "auto"):
+            chunk = None
+        elif isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
+            raise ConfigError(f"batch.chunk={chunk!r} must be a positive number of points or auto")
+        memory = node.get("memory", cls.memory)
+        if isinstance(memory, bool) or not isinstance(memory, (int, float)) or not memory > 0:
+            raise ConfigError(f"batch.memory={memory!r} must be a positive number of MiB")
+        return cls(output=output, decimate=decimate, chunk=chunk, memory=float(memory),
+                   scheduler=node.get("scheduler") or None)
+
+
+@dataclass
+class RunStats:
+    """What ``run_plan`` did: the file, chunks run now, seconds in the kernels and in all."""
+
+    path: Path
+    chunks: int = 0
+    kernel_time: float = 0.0
+    wall_time: float = 0.0
+
+
+@dataclass(frozen=True)
+class Chunk:
+    """Points ``start:stop`` (flat, C order): one block of the grid, stored at ``slab``."""
+
+    start: int
+    stop: int
+    slab: tuple            # an int or a slice per grid dimension
+    shape: tuple[int, ...]  # the block's shape over the grid dimensions
+
+
+@dataclass
+class ChunkTask:
+    index: int
+    config: dict[str, Any]          # the first valid point's plain config: what a worker rebuilds
+    config_key: str
+    output: str
+    decimate: int
+    times: np.ndarray
+    rows: np.ndarray                # rows of the chunk with a valid point
+    y0: np.ndarray                  # their initial states
+    params: np.ndarray              # their compiled-model parameters
+    combos: list[dict[str, Any]]    # per row: the body/force values that differ from ``config``
+    n_rows: int
+
+
+@dataclass
+class ChunkResult:
+    index: int
+    outputs: dict[str, Output]
+    failed: np.ndarray              # (n_rows,) the integration failed (non-finite)
+    kernel_time: float
+    wall_time: float
+
+
+def chunk_size(plan: Plan, settings: Settings) -> int:
+    """Points per chunk: ``batch.chunk``, else as many as keep the chunk's trajectories under ``batch.memory``."""
+    if settings.chunk is not None:
+        return settings.chunk
+    state = max(plan.y0.shape[1], 1)
+    per_point = len(plan.times) * state * 8 * (2 if settings.output in ("trajectory", "decimated") else 1)
+    return int(min(MAX_CHUNK, max(1, settings.memory * 2**20 // per_point)))
+
+
+def chunks(shape: tuple[int, ...], size: int) -> list[Chunk]:
+    """Blocks of at most ``size`` points (at least one row of the last dimension), each a hyperslab."""
+    inner = [math.prod(shape[k:]) for k in range(len(shape) + 1)]
+    k = next(k for k in range(len(shape) + 1) if inner[k] <= size)
+    if k == 0:
+        return [Chunk(0, inner[0], tuple(slice(None) for _ in shape), shape)]
+    d = k - 1
+    block = max(1, size // inner[k])
+    out = []
+    for prefix in np.ndindex(*shape[:d]):
+        base = (np.ravel_multi_index(prefix, shape[:d]) if d else 0) * inner[d]
+        for lo in range(0, shape[d], block):
+            hi = min(lo + block, shape[d])
+            slab = tuple(int(p) for p in prefix) + (slice(lo, hi),) + tuple(slice(None) for _ in shape[k:])
+            out.append(Chunk(base + lo * inner[k], base + hi * inner[k], slab, (hi - lo,) + shape[k:]))
+    return out
+
+
+def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
+    """Integrate every valid point of ``plan``, streaming to ``path`` (resuming a killed run of the same
+    command)."""
+    size = chunk_size(plan, settings)
+    blocks = chunks(plan.shape, size)
+    identity = plan.identity(size)
+    store = Store(path, plan, identity, settings, messages=[*plan.messages, INTEGRATION_FAILED])
+    done = store.open()
+    if done is None:   # already complete
+        return RunStats(path)
+    pending = [i for i in range(len(blocks)) if i not in done]
+    tasks, empty = [], []
+    key = json.dumps(plan.base, sort_keys=True, default=str) if plan.base is not None else ""
+    for i in pending:
+        task = _task(plan, blocks[i], i, key, settings)
+        (tasks if task is not None else empty).append(task if task is not None else i)
+    log.info("batch: %d points in %d chunks of ≤ %d (%s), %d stored already, %d to run; output %s", plan.size,
+             len(blocks), size, settings.output, len(done), len(tasks), path)
+    for i in empty:   # no valid point: only the points' errors, which the store wrote when it was created
+        store.chunk_done(i, blocks[i], None)
+    progress = _Progress(len(tasks))
+
+    def on_result(_: int, result: ChunkResult) -> None:
+        store.chunk_done(result.index, blocks[result.index], result)
+        progress.update(result)
+
+    executors.map_chunks(run_chunk, tasks, on_result, scheduler=settings.scheduler)
+    store.finish()
+    return progress.summary(path)
+
+
+def _task(plan: Plan, chunk: Chunk, index: int, key: str, settings: Settings) -> ChunkTask | None:
+    valid = plan.valid[chunk.start:chunk.stop]
+    rows = np.flatnonzero(valid)
+    if not rows.size:
+        return None
+    points = chunk.start + rows
+    base_combo = plan.combo[int(np.argmax(plan.valid))]
+    combos = [plan.combo_values[c] if c != base_combo else {} for c in plan.combo[points]]
+    return ChunkTask(index=index, config=plan.base, config_key=key, output=settings.output,
+                     decimate=settings.decimate, times=plan.times, rows=rows, y0=plan.y0[points],
+                     params=plan.params(chunk.start, chunk.stop)[rows], combos=combos,
+                     n_rows=chunk.stop - chunk.start)
+
+
+# ----------------------------------------------------------------------------- in a worker
+
+_CONTEXTS: dict[str, Any] = {}
+
+
+def _context(task: ChunkTask) -> dict[str, Any]:
+    """The scene of the task's config (its compiled model, integrator), built once per process."""
+    context = _CONTEXTS.get(task.config_key)
+    if context is None:
+        from gyrolab.engine.scene import Scene
+
+        scene = Scene.from_config(OmegaConf.create(task.config))
+        context = {"scene": scene, "compiled": scene.system.compiled_model(), "systems": {}}
+        _CONTEXTS.clear()   # one batch at a time per process
+        _CONTEXTS[task.config_key] = context
+    return context
+
+
+def _system(context: dict[str, Any], config: dict[str, Any], values: dict[str, Any]) -> Any:
+    """The system with a point's body and force values (built once per process and combination)."""
+    if not values:
+        return context["scene"].system
+    key = json.dumps(values, sort_keys=True, default=str)
+    system = context["systems"].get(key)
+    if system is None:
+        from gyrolab.engine.scene import Scene
+
+        system = Scene.from_config(OmegaConf.create(_with_values(config, values))).system
+        context["systems"][key] = system
+    return system
+
+
+def run_chunk(task: ChunkTask) -> ChunkResult:
+    """Integrate one chunk's valid points and compute what ``task.output`` stores."""
+    from gyrolab.engine.batch import integrate_arrays
+
+    start = time.perf_counter()
+    context = _context(task)
+    compiled, integrator = context["compiled"], context["scene"].integrator
+    if task.output == "indicator":
+        kernel = time.perf_counter()
+        outputs = indicator_outputs(compiled, integrator, task.times, task.y0, task.params)
+        kernel_time = time.perf_counter() - kernel
+        failed = np.zeros(len(task.rows), dtype=bool)
+        for out in outputs.values():
+            failed |= ~np.isfinite(out.data.reshape(len(task.rows), -1)).all(axis=1)
+    else:
+        solution = integrate_arrays(compiled, integrator, task.times, task.y0, task.params, failures="mark")
+        kernel_time = solution.wall_time
+        failed = np.asarray(solution.failed, dtype=bool)
+        with np.errstate(invalid="ignore"):   # every row, so that a chunk whose points all failed still has its
+            outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, np.arange(len(failed)),
+                                    lambda row: _system(context, task.config, task.combos[row]), compiled,
+                                    task.params)   # variables (the store is created from the first chunk's)
+        for out in outputs.values():
+            out.data[failed] = np.nan
+    all_failed = np.zeros(task.n_rows, dtype=bool)
+    all_failed[task.rows] = failed
+    return ChunkResult(index=task.index, outputs=merge_rows(outputs, task.rows, task.n_rows), failed=all_failed,
+                       kernel_time=kernel_time, wall_time=time.perf_counter() - start)
+
+
+# ----------------------------------------------------------------------------- progress
+
+
+class _Progress:
+    """A log line per chunk (points done, rate, ETA) and a summary (share of the time in the kernels)."""
+
+    def __init__(self, n_chunks: int) -> None:
+        self.n_chunks = n_chunks
+        self.chunks = 0
+        self.kernel = 0.0
+        self.start = time.perf_counter()
+
+    def update(self, result: ChunkResult) -> None:
+        self.chunks += 1
+        self.kernel += result.kernel_time
+        elapsed = time.perf_counter() - self.start
+        eta = elapsed / self.chunks * (self.n_chunks - self.chunks)
+        log.info("batch: chunk %d/%d done (%.0f%%), %s elapsed, ETA %s", self.chunks, self.n_chunks,
+                 100.0 * self.chunks / max(self.n_chunks, 1), duration(elapsed), duration(eta))
+
+    def summary(self, path: Path) -> RunStats:
+        elapsed = time.perf_counter() - self.start
+        if self.chunks:
+            log.info("batch: %d chunks in %s, %.0f%% of it in the integration kernels", self.chunks,
+                     duration(elapsed), 100.0 * self.kernel / max(elapsed, 1e-9))
+        return RunStats(path, self.chunks, self.kernel, elapsed)

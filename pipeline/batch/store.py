@@ -1,0 +1,287 @@
+"""A batch's dataset on disk, written chunk by chunk, resumable after a kill.
+
+Layout: one dimension per swept parameter (named by ``gyrolab.batch.plan.dim_names``, the swept values as
+its coordinate), the per-point variables of ``batch.output`` over (grid dims..., their own dims), and per
+point ``job_status`` (0 not run, 1 finished, 2 failed: the codes of a multirun's ``sweep.nc``) and
+``job_error`` (an index into ``error_message``, -1 for none).
+
+Writes go to ``NAME.part`` beside the final name; each variable's storage is contiguous and allocated when
+the file is created, so a chunk's write changes data, never the file's structure, and a killed process
+leaves a file that opens. After a chunk's data is synced to disk its index is appended to ``NAME.chunks``
+(the journal, fsynced); a rerun with the same identity continues after the journaled chunks. When every
+chunk is stored the file is closed, synced and renamed to ``NAME``, and the journal removed.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+from pathlib import Path
+from typing import Any
+
+import netCDF4
+import numpy as np
+from omegaconf import OmegaConf
+
+from gyrolab.batch.outputs import output_times
+from gyrolab.errors import ConfigError, OutputError
+from gyrolab.output.atomic import _fsync, _fsync_directory, reason
+from gyrolab.output.cf import CONVENTIONS, now_iso
+from gyrolab.output.provenance import gyrolab_version, provenance
+from gyrolab.sweep import record
+from gyrolab.sweep.aggregate import STATUS_FLAGS
+
+log = logging.getLogger("gyrolab.batch")
+
+FINISHED, FAILED = STATUS_FLAGS[record.FINISHED], STATUS_FLAGS[record.FAILED]
+STATUS_ATTRS = {"long_name": "how the point ended: 0 not run, 1 finished, 2 failed", "units": "1",
+                "flag_values": np.array([0, 1, 2], dtype=np.int8), "flag_meanings": "missing finished failed"}
+ERROR_ATTRS = {"long_name": "the point's error: index into error_message, -1 for none", "units": "1"}
+#: units of swept initial-state keys (the body's rate unit for the angular velocity)
+ANGLE_KEYS = ("theta0", "phi0", "psi0")
+RATE_KEYS = ("p0", "q0", "r0")
+
+
+class Store:
+    def __init__(self, path: Path, plan: Any, identity: str, settings: Any, messages: list[str]) -> None:
+        self.path = Path(path)
+        self.part = self.path.with_name(self.path.name + ".part")
+        self.journal = self.path.with_name(self.path.name + ".chunks")
+        self.plan, self.identity, self.settings, self.messages = plan, identity, settings, messages
+        self.nc: netCDF4.Dataset | None = None
+
+    # -- opening: new, resumed or already complete ---------------------------------------------------
+    def open(self) -> set[int] | None:
+        """The chunks already stored (a resumed run), or None when ``path`` holds this batch complete."""
+        if self.path.exists():
+            found = _identity_of(self.path)
+            if found == self.identity:
+                log.info("batch: %s holds this batch complete already; nothing to run", self.path)
+                return None
+            raise ConfigError(f"{self.path} holds another batch (identity {found}, this one is {self.identity}); "
+                              "choose another output directory (hydra.sweep.dir, or hydra.run.dir for an experiment) "
+                              "or remove it")
+        if not self.part.exists():
+            self.journal.unlink(missing_ok=True)
+            return set()
+        found = _identity_of(self.part)
+        if found != self.identity:
+            raise ConfigError(f"{self.part} is an unfinished batch of another command or gyrolab version (identity "
+                              f"{found}, this one is {self.identity}); rerun that command to finish it, or give "
+                              "another directory")
+        done = _read_journal(self.journal, self.identity)
+        if not done:   # killed before its first chunk was journaled: the journal starts again
+            _start_journal(self.journal, self.identity)
+        self.nc = _open(self.part, "a")
+        log.info("batch: resuming %s (%d chunks stored)", self.part, len(done))
+        return done
+
+    # -- writing ----------------------------------------------------------------------------------------
+    def chunk_done(self, index: int, chunk: Any, result: Any) -> None:
+        """Store a chunk's result (None: a chunk without a valid point) and journal it."""
+        if self.nc is None:
+            self._create(result)
+        if result is not None:
+            valid = self.plan.valid[chunk.start:chunk.stop]
+            status = np.where(valid, FINISHED, FAILED).astype(np.int8)
+            error = self.plan.error[chunk.start:chunk.stop].copy()
+            status[result.failed] = FAILED
+            error[result.failed] = len(self.messages) - 1   # the integration failure's sentence
+            self._write("job_status", chunk, status)
+            self._write("job_error", chunk, error)
+            for name, out in result.outputs.items():
+                if name in self.nc.variables:
+                    self._write(name, chunk, out.data)
+        try:
+            self.nc.sync()
+            _fsync(self.part)
+            with open(self.journal, "a", encoding="utf-8") as journal:
+                journal.write(f"{index}\n")
+                journal.flush()
+                os.fsync(journal.fileno())
+        except OSError as error:
+            raise OutputError(f"could not write {self.part}: {reason(error)}") from None
+
+    def finish(self) -> None:
+        """Close the complete file and give it its final name."""
+        if self.nc is None:
+            self._create(None)
+        status = self.nc["job_status"][:]
+        status = np.asarray(status.filled(0) if np.ma.isMaskedArray(status) else status)
+        counts = {name: int(np.count_nonzero(status == code))
+                  for name, code in (("n_missing", 0), ("n_finished", FINISHED), ("n_failed", FAILED))}
+        self.nc.setncatts(counts)
+        if counts["n_failed"]:
+            log.info("batch: %d of %d points failed; their errors are error_message[job_error] where job_status is 2",
+                     counts["n_failed"], status.size)
+        self.nc.close()
+        self.nc = None
+        try:
+            _fsync(self.part)
+            os.replace(self.part, self.path)
+            _fsync_directory(self.path.parent)
+        except OSError as error:
+            raise OutputError(f"could not write {self.path}: {reason(error)}") from None
+        self.journal.unlink(missing_ok=True)
+
+    def _write(self, name: str, chunk: Any, data: np.ndarray) -> None:
+        data = np.asarray(data)
+        self.nc[name][chunk.slab] = data.reshape(chunk.shape + data.shape[1:])
+
+    # -- creating ------------------------------------------------------------------------------------------
+    def _create(self, result: Any) -> None:
+        plan = self.plan
+        try:
+            self.part.parent.mkdir(parents=True, exist_ok=True)
+            nc = netCDF4.Dataset(self.part, "w", format="NETCDF4")
+        except OSError as error:
+            raise OutputError(f"could not write {self.part}: {reason(error)}") from None
+        self.nc = nc
+        nc.set_auto_mask(False)
+        system = _reference_system(plan)
+        for name, dim in zip(plan.names, plan.dims):
+            nc.createDimension(name, len(dim.values))
+            values = dim.coordinate()
+            if values.dtype.kind in "iu":
+                values = values.astype(np.int32) if np.abs(values).max() < 2**31 else values.astype(np.float64)
+            attrs = {"long_name": f"swept parameter {dim.key}", "override_key": dim.key, **_key_units(dim.key, system)}
+            if values.dtype.kind == "O":
+                _text_variable(nc, name, name, values, attrs)
+            else:
+                var = nc.createVariable(name, values.dtype, (name,))
+                var[:] = values
+                var.setncatts(attrs)
+        nc.createDimension("error_kind", len(self.messages))
+        _text_variable(nc, "error_message", "error_kind", self.messages,
+                       {"long_name": "the one-sentence errors of the failed points (job_error indexes them)"})
+        grid = tuple(plan.names)
+        # no fill value: every point's code is written below (a fill value would make readers mask the codes)
+        status = nc.createVariable("job_status", "i1", grid, contiguous=True, fill_value=False)
+        status.setncatts(STATUS_ATTRS)
+        error = nc.createVariable("job_error", "i4", grid, contiguous=True, fill_value=False)
+        error.setncatts(ERROR_ATTRS)
+        shape = plan.shape
+        # every point's validation outcome now (so a failed point's error is there whatever happens next)
+        status[:] = np.where(plan.valid, 0, FAILED).astype(np.int8).reshape(shape)
+        error[:] = plan.error.reshape(shape)
+        if result is not None:
+            self._create_variables(result, system)
+        nc.setncatts(self._attributes(system))
+        nc.sync()
+        _fsync(self.part)
+        _start_journal(self.journal, self.identity)
+
+    def _create_variables(self, result: Any, system: Any) -> None:
+        nc, plan = self.nc, self.plan
+        for name, out in result.outputs.items():
+            for dim, size in zip(out.dims, out.data.shape[1:]):
+                if dim not in nc.dimensions:
+                    nc.createDimension(dim, size)
+                    self._coordinate(dim, size, system)
+            var = nc.createVariable(name, "f8", tuple(plan.names) + tuple(out.dims), contiguous=True,
+                                    fill_value=np.nan)
+            var.setncatts({k: (v if not isinstance(v, (list, tuple)) else np.asarray(v)) for k, v in out.attrs.items()
+                           if k != "_FillValue"})
+            var[(0,) * var.ndim] = np.nan   # allocates the variable's storage now, not at a later chunk's write
+
+    def _coordinate(self, dim: str, size: int, system: Any) -> None:
+        from gyrolab.output.dataset import time_attributes
+
+        if dim == "time":
+            times = output_times(self.plan.times, self.settings.output, self.settings.decimate)
+            var = self.nc.createVariable("time", "f8", ("time",))
+            var[:] = times
+            var.setncatts(time_attributes(system.body) if system is not None else {"long_name": "time"})
+        elif dim == "axis" and size == 3:
+            _text_variable(self.nc, "axis", "axis", ["x", "y", "z"], {"units": "1", "long_name": "principal body axis"})
+
+    def _attributes(self, system: Any) -> dict[str, Any]:
+        plan, settings = self.plan, self.settings
+        created = now_iso()
+        attrs: dict[str, Any] = {
+            "Conventions": CONVENTIONS,
+            "title": f"gyrolab batch of {plan.size} points over {' × '.join(plan.names)}"
+                     + (f": {system.title()}" if system is not None else ""),
+            "date_created": created,
+            "history": f"{created} written by gyrolab {gyrolab_version()}: batch ({settings.output})",
+            "config": OmegaConf.to_yaml(OmegaConf.create(plan.plain)),
+            "batch_grid": json.dumps([[d.key, list(d.labels)] for d in plan.dims]),
+            "batch_identity": self.identity,
+            "batch_output": settings.output,
+            "n_points": plan.size,
+            "sweep_launcher": "batch",
+            "integrator": str((plan.plain.get("integrator") or {}).get("_target_", "")).rsplit(".", 1)[-1],
+        }
+        if settings.output == "decimated":
+            attrs["batch_decimate"] = settings.decimate
+        for key, value in {**plan.attributes, **provenance()}.items():
+            if value is not None:
+                attrs[key] = int(value) if isinstance(value, (bool, np.bool_)) else value
+        return attrs
+
+
+def _text_variable(nc: netCDF4.Dataset, name: str, dim: str, values: Any, attrs: dict[str, Any]) -> None:
+    """Text along ``dim`` as a UTF-8 char array (as xarray writes text, so CF checkers read it)."""
+    texts = [str(v) for v in values]
+    width = max([len(t.encode("utf-8")) for t in texts] + [1])
+    nc.createDimension(f"{name}_strlen", width)
+    var = nc.createVariable(name, "S1", (dim, f"{name}_strlen"))
+    var._Encoding = "utf-8"
+    var[:] = np.array(texts, dtype=f"U{width}")
+    var.setncatts(attrs)
+
+
+def _open(path: Path, mode: str) -> netCDF4.Dataset:
+    try:
+        nc = netCDF4.Dataset(path, mode)
+    except OSError as error:
+        raise OutputError(f"could not open {path}: {reason(error)}; remove it to start the batch again") from None
+    nc.set_auto_mask(False)
+    return nc
+
+
+def _identity_of(path: Path) -> str:
+    nc = _open(path, "r")
+    try:
+        return str(getattr(nc, "batch_identity", "none (not a gyrolab batch)"))
+    finally:
+        nc.close()
+
+
+def _start_journal(path: Path, identity: str) -> None:
+    with open(path, "w", encoding="utf-8") as journal:
+        journal.write(f"identity {identity}\n")
+        journal.flush()
+        os.fsync(journal.fileno())
+
+
+def _read_journal(path: Path, identity: str) -> set[int]:
+    """The chunks a journal records (none if it is missing or belongs to another identity)."""
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except FileNotFoundError:
+        return set()
+    if not lines or lines[0] != f"identity {identity}":
+        return set()
+    return {int(line) for line in lines[1:] if line.strip().isdigit()}
+
+
+def _reference_system(plan: Any) -> Any:
+    if plan.base is None:
+        return None
+    from gyrolab.engine.scene import Scene
+
+    return Scene.from_config(OmegaConf.create(plan.base)).system
+
+
+def _key_units(key: str, system: Any) -> dict[str, str]:
+    """CF units of a swept key where gyrolab knows them (angles, the angular velocity, nondimensional ratios)."""
+    section, _, name = key.lstrip("+~").rpartition(".")
+    if section == "initial" and name in ANGLE_KEYS:
+        return {"units": "rad"}
+    if section == "initial" and name in RATE_KEYS and system is not None:
+        return {"units": system.body.rate_unit}
+    if section == "body" and name in ("a", "b"):
+        return {"units": "1"}
+    return {}

@@ -1,0 +1,189 @@
+"""gyrolab.batch: the grid as arrays (validated like single runs), chunks streamed to one file, resumable."""
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+import xarray as xr
+from omegaconf import OmegaConf
+
+from gyrolab import compose_scene
+from gyrolab.batch import outputs
+from gyrolab.batch.plan import plan_from_overrides, split_overrides
+from gyrolab.batch.runner import chunks
+from gyrolab.engine.batch import integrate_arrays
+from gyrolab.engine.config import compose_config
+from gyrolab.engine.scene import Scene
+from gyrolab.errors import ConfigError, GyrolabError
+from gyrolab.sweep.batch import run_batch, run_batch_sweep
+
+FIXED = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=1", "time.n_output=11", "output.figures=false"]
+
+
+def _single(overrides):
+    """What a single run of these overrides builds (its scene), or its error sentence."""
+    try:
+        return Scene.from_config(compose_config(list(overrides)))
+    except GyrolabError as error:
+        return str(error)
+
+
+def test_plan_equals_single_runs_state_params_and_errors():
+    """Every point's initial state and compiled parameters are the single run's bit for bit, and every
+    invalid point carries the single run's error sentence (non-physical body, a value that is no number,
+    NaN, a non-unit γ0 given with the angles unset)."""
+    swept = ["body.a=1.5,3", "initial.theta0=0.3,nan", "initial.r0=abc,5"]
+    plan = plan_from_overrides([*FIXED, "output.euler_angles=true", "initial.psi0=0.7", *swept])
+    assert plan.shape == (2, 2, 2)
+    for n in range(plan.size):
+        position = np.unravel_index(n, plan.shape)
+        point = [f"{d.key}={d.labels[p]}" for d, p in zip(plan.dims, position)]
+        single = _single([*FIXED, "output.euler_angles=true", "initial.psi0=0.7", *point])
+        if isinstance(single, str):
+            assert plan.error[n] >= 0 and plan.messages[plan.error[n]] == single, point
+        else:
+            assert plan.error[n] < 0, point
+            np.testing.assert_array_equal(plan.y0[n], single.system.initial_state())
+            np.testing.assert_array_equal(plan.params(n, n + 1)[0], single.system.compiled_model().params)
+    assert plan.valid.sum() == 1   # a = 1.5, θ0 = 0.3, r0 = 5
+    gamma = plan_from_overrides([*FIXED, "initial.theta0=null", "initial.phi0=null",
+                                 "initial.gamma0=[0,0,1],[0,0.6,0.8],[0,0,2]"])
+    assert gamma.valid.tolist() == [True, True, False]
+    assert gamma.messages[gamma.error[2]] == _single([*FIXED, "initial.theta0=null", "initial.phi0=null",
+                                                      "initial.gamma0=[0,0,2]"])
+
+
+def test_chunks_are_hyperslabs_covering_the_grid_once():
+    for shape, size in [((7, 5, 3), 10), ((7, 5, 3), 4), ((4, 6), 100), ((9,), 2), ((3, 50), 7)]:
+        flat = np.arange(int(np.prod(shape))).reshape(shape)
+        seen = []
+        for chunk in chunks(shape, size):
+            assert chunk.stop - chunk.start <= max(size, shape[-1])
+            np.testing.assert_array_equal(flat[chunk.slab].ravel(), np.arange(chunk.start, chunk.stop))
+            seen.extend(range(chunk.start, chunk.stop))
+        assert sorted(seen) == list(range(flat.size))
+
+
+@pytest.mark.parametrize("euler_angles", [False, True])
+def test_compiled_reductions_equal_the_systems_invariants(euler_angles):
+    """The compiled one-pass reductions against the system's own (numpy) invariants, on trajectories with
+    gravity, the Newtonian gradient and a magnetic dipole (torques along α and β when the frame is carried)."""
+    forces = "force=[uniform_gravity,newtonian,magnetic]" if euler_angles else "force=[uniform_gravity,newtonian]"
+    scene = compose_scene([*FIXED, forces, f"output.euler_angles={str(euler_angles).lower()}", "time.end=3"])
+    compiled = scene.system.compiled_model()
+    y0s = np.tile(scene.system.initial_state(), (4, 1))
+    y0s[:, 0:3] += np.random.default_rng(1).normal(scale=0.5, size=(4, 3))
+    y = integrate_arrays(compiled, scene.integrator, scene.times, y0s).y
+    params = np.tile(compiled.params, (4, 1))
+    rows = np.arange(4)
+    fast = outputs.state_outputs("reductions", 1, scene.times, y, rows, lambda _: scene.system, compiled, params)
+    slow = outputs.state_outputs("reductions", 1, scene.times, y, rows, lambda _: scene.system)
+    assert set(fast) == set(slow)
+    invariants = scene.system.invariant_values(y)
+    for name in scene.system.invariants:  # independently: max |I(t) − I(0)| from the system's formulas
+        expected = np.max(np.abs(invariants[name] - invariants[name][:, :1]), axis=1)
+        np.testing.assert_allclose(fast[name + "_max_abs_drift"].data, expected, rtol=1e-9, atol=1e-13)
+    theta = np.arccos(np.clip(y[:, :, 5] / np.linalg.norm(y[:, :, 3:6], axis=2), -1, 1))
+    np.testing.assert_allclose(fast["max_nutation_deviation"].data, np.max(np.abs(theta - theta[:, :1]), axis=1),
+                               atol=1e-9)
+    for name in fast:
+        np.testing.assert_allclose(fast[name].data, slow[name].data, rtol=1e-9, atol=1e-13)
+
+
+def test_final_mode_equals_single_runs_and_reads_lazily(tmp_path):
+    fixed, dims = split_overrides([*FIXED, "output.euler_angles=false", "batch.output=final", "batch.chunk=2",
+                                   "initial.r0=1,6", "body.b=1.2,1.5"])
+    stats = run_batch(fixed, dims, tmp_path / "sweep.nc")
+    assert stats.chunks == 2 and not (tmp_path / "sweep.nc.part").exists()
+    with xr.open_dataset(tmp_path / "sweep.nc", chunks={}) as ds:
+        assert ds.omega.dims == ("r0", "b", "axis") and ds.omega.chunks is not None   # dask: read lazily
+        assert ds.r0.attrs["units"] == "1" and ds.attrs["n_finished"] == 4
+        for variable in ds.data_vars.values():
+            assert variable.attrs.get("long_name"), variable.name
+        for i, r0 in enumerate([1, 6]):
+            for j, b in enumerate([1.2, 1.5]):
+                single = compose_scene([*FIXED, "output.euler_angles=false", f"initial.r0={r0}", f"body.b={b}"]).run()
+                np.testing.assert_allclose(ds.omega[i, j].values, single.omega[-1].values, rtol=0, atol=1e-12)
+                np.testing.assert_allclose(ds.energy[i, j].values, single.energy[-1].values, rtol=0, atol=1e-12)
+
+
+def test_a_chunk_whose_trajectories_all_fail_is_stored_as_failed_points(tmp_path):
+    """RK4 with a step far too long for a fast spin overflows: those points fail, the slow one is stored."""
+    fixed, dims = split_overrides(["integrator=rk4_numba", "integrator.step=0.9", "time.end=200", "time.n_output=3",
+                                   "output.euler_angles=false", "batch.chunk=1", "initial.r0=500,400,0.1"])
+    run_batch(fixed, dims, tmp_path / "sweep.nc")
+    with xr.open_dataset(tmp_path / "sweep.nc") as ds:
+        assert ds.job_status.values.tolist() == [2, 2, 1]
+        assert "became non-finite" in str(ds.error_message.values[ds.job_error.values[0]])
+        assert np.isnan(ds.omega.values[:2]).all() and np.isfinite(ds.omega.values[2]).all()
+
+
+def test_batch_refuses_scipy_integrators_and_another_command_in_its_directory(tmp_path):
+    with pytest.raises(ConfigError, match=r"integrator 'dop853' has no batch kernel; a batch runs integrator=rk4"):
+        run_batch_sweep(["integrator=dop853", "initial.r0=1,2"], tmp_path / "a")
+    run_batch_sweep([*FIXED, "initial.r0=1,2"], tmp_path / "b")
+    with pytest.raises(ConfigError, match="holds another batch"):
+        run_batch_sweep([*FIXED, "initial.r0=1,3"], tmp_path / "b")
+
+
+KILLED = textwrap.dedent("""
+    import os, signal, sys
+    from gyrolab.batch import store
+    from gyrolab.sweep.batch import run_batch_sweep
+
+    written = store.Store._write
+    calls = []
+
+    def write_then_die(self, name, chunk, data):   # kill -9 in the middle of the third chunk's writes
+        written(self, name, chunk, data)
+        calls.append(chunk.start)
+        if len(set(calls)) == 3 and name == "omega":
+            os.kill(os.getpid(), signal.SIGKILL)
+
+    store.Store._write = write_then_die
+    run_batch_sweep(sys.argv[2:], sys.argv[1])
+""")
+
+
+def test_kill_minus_9_then_the_same_command_resumes(tmp_path, caplog):
+    grid = [*FIXED, "output.euler_angles=false", "batch.output=reductions", "batch.chunk=2", "initial.r0=1,2,3",
+            "initial.theta0=0.5,1.0"]
+    script = tmp_path / "killed.py"
+    script.write_text(KILLED)
+    killed = subprocess.run([sys.executable, str(script), str(tmp_path / "run"), *grid], capture_output=True,
+                            text=True, timeout=300)
+    assert killed.returncode == -9, killed.stderr[-2000:]
+    assert not (tmp_path / "run" / "sweep.nc").exists() and (tmp_path / "run" / "sweep.nc.part").exists()
+    journal = (tmp_path / "run" / "sweep.nc.chunks").read_text().splitlines()
+    assert journal[1:] == ["0", "1"]   # two chunks stored; the third was being written
+    with caplog.at_level("INFO", logger="gyrolab.batch"):
+        run_batch_sweep(grid, tmp_path / "run")
+    assert "2 stored already, 1 to run" in caplog.text
+    run_batch_sweep(grid, tmp_path / "whole")
+    with xr.open_dataset(tmp_path / "run" / "sweep.nc") as resumed, \
+            xr.open_dataset(tmp_path / "whole" / "sweep.nc") as whole:
+        assert int(resumed.job_status.min()) == 1
+        for name in ("omega", "gamma", "energy_max_abs_drift", "max_nutation_deviation"):
+            np.testing.assert_array_equal(resumed[name].values, whole[name].values)
+    assert OmegaConf.create(resumed.attrs["config"]).batch.output == "reductions"
+
+
+def test_stability_map_is_a_theta0_r0_batch_that_a_rerun_finds_complete(tmp_path, caplog):
+    """The experiment's grid (batch.points as a square grid) runs as one batch into stability_map.nc with dims
+    (theta0, r0); the indicator itself is gyrolab.physics.chaos's (tested there), so this runs reductions."""
+    from gyrolab.experiments import stability_map
+
+    cfg = compose_config(["experiment=stability_map", "batch.points=9", "batch.output=reductions", "time.end=1",
+                          "time.n_output=11", "output.figures=false"])
+    np.testing.assert_allclose([d.values for d in stability_map.grid(cfg)], [[0.05, 1.57, 3.09], [0.1, 5.05, 10.0]],
+                               rtol=1e-15)
+    written = stability_map.run(cfg, tmp_path)
+    assert written == [tmp_path / "stability_map.nc"]
+    with xr.open_dataset(written[0]) as ds:
+        assert ds.max_nutation_deviation.dims == ("theta0", "r0") and ds.theta0.attrs["units"] == "rad"
+        assert int(ds.job_status.min()) == 1
+    with caplog.at_level("INFO", logger="gyrolab.batch"):
+        stability_map.run(cfg, tmp_path)
+    assert "holds this batch complete already" in caplog.text
