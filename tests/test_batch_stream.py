@@ -171,19 +171,24 @@ def test_kill_minus_9_then_the_same_command_resumes(tmp_path, caplog):
 
 
 def test_stability_map_is_a_theta0_r0_batch_that_a_rerun_finds_complete(tmp_path, caplog):
-    """The experiment's grid (batch.points as a square grid) runs as one batch into stability_map.nc with dims
-    (theta0, r0); the indicator itself is gyrolab.physics.chaos's (tested there), so this runs reductions."""
+    """The experiment's grid (batch.points as a square grid, r0 geometric) runs as one batch into stability_map.nc
+    with dims (theta0, r0) and the chosen points' Poincaré sections; the indicator's values are
+    gyrolab.physics.chaos's (tested there)."""
     from gyrolab.experiments import stability_map
 
-    cfg = compose_config(["experiment=stability_map", "batch.points=9", "batch.output=reductions", "time.end=1",
-                          "time.n_output=11", "output.figures=false"])
-    np.testing.assert_allclose([d.values for d in stability_map.grid(cfg)], [[0.05, 1.57, 3.09], [0.1, 5.05, 10.0]],
-                               rtol=1e-15)
+    cfg = compose_config(["experiment=stability_map", "batch.points=9", "time.end=1", "stability_map.section_time=20",
+                          "stability_map.sections=[[0.6,3.0],[1.0,1.5]]", "output.figures=false"])
+    # θ0 evenly spaced, r0 geometric: the middle value is the geometric mean of 0.05 and 10
+    np.testing.assert_allclose([d.values for d in stability_map.grid(cfg)],
+                               [[0.05, 1.57, 3.09], [0.05, np.sqrt(0.5), 10.0]], rtol=1e-15)
     written = stability_map.run(cfg, tmp_path)
     assert written == [tmp_path / "stability_map.nc"]
     with xr.open_dataset(written[0]) as ds:
-        assert ds.max_nutation_deviation.dims == ("theta0", "r0") and ds.theta0.attrs["units"] == "rad"
+        assert ds.indicator.dims == ds.max_nutation_deviation.dims == ("theta0", "r0")
+        assert ds.theta0.attrs["units"] == "rad" and "MEGNO" in ds.indicator.attrs["indicator_name"]
         assert int(ds.job_status.min()) == 1
+        np.testing.assert_array_equal(ds.section_theta0.values, [0.6, 1.0])
+        assert ds.section_phi.dims == ("section_point", "crossing")
     with caplog.at_level("INFO", logger="gyrolab.batch"):
         stability_map.run(cfg, tmp_path)
     assert "holds this batch complete already" in caplog.text

@@ -11,12 +11,17 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
+from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError, as_number
+from gyrolab.figures.redraw import draw_figures
+from gyrolab.output.dataset import write_dataset
 from gyrolab.sweep.grid import Dim
 
 log = logging.getLogger(__name__)
@@ -39,7 +44,11 @@ def grid(cfg: DictConfig) -> list[Dim]:
         if len(span) != 2:
             raise ConfigError(f"stability_map.{key}={list(span)!r} must be [first, last]")
         first, last = (as_number(v, f"stability_map.{key}") for v in span)
-        values = np.linspace(first, last, n) if n > 1 else np.array([first])
+        spacing = settings.get(f"{key}_spacing", "linear")
+        if spacing not in ("linear", "log") or (spacing == "log" and not 0 < first < last):
+            raise ConfigError(f"stability_map.{key}_spacing={spacing!r} must be linear or log (log: 0 < first < last)")
+        spaced = np.geomspace if spacing == "log" else np.linspace
+        values = spaced(first, last, n) if n > 1 else np.array([first])
         dims.append(Dim(f"initial.{key}", tuple(repr(float(v)) for v in values), tuple(float(v) for v in values)))
     return dims
 
@@ -51,23 +60,33 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     plain.pop("hydra", None)
     path = Path(out_dir) / cfg.stability_map.file
     run_batch([], grid(cfg), path, plain=plain, lock=False)   # the app holds the run directory's lock
-    written = [path]
-    if cfg.output.get("figures", True):
-        written += _figure(path, out_dir, cfg)
-    return written
-
-
-def _figure(path: Path, out_dir: Path, cfg: DictConfig) -> list[Path]:
-    # TODO(lead): gyrolab.figures.stability_map is H4's (branch chaos); this runs once it is merged.
-    try:
-        from gyrolab.figures import stability_map as figure
-    except ImportError:
-        log.warning("the stability-map figure needs gyrolab.figures.stability_map, which this install lacks; "
-                    "%s is written", path)
-        return []
-    import xarray as xr
-
-    target = Path(out_dir) / "figures" / "stability_map.png"
+    sections = cfg.stability_map.get("sections") or []
+    if sections:
+        _add_sections(path, plain, sections, as_number(cfg.stability_map.section_time, "stability_map.section_time"))
     with xr.open_dataset(path) as ds:
-        figure.draw(ds, target)
-    return [target]
+        return [path, *draw_figures("stability_map.nc", ds.load(), out_dir, cfg.get("output"))]
+
+
+def _add_sections(path: Path, plain: dict, points: Sequence[Sequence[float]], t_end: float) -> None:
+    """Poincaré sections of the chosen (θ0, r0) points, integrated by the chaos kernel with the map's step, added to
+    the map's file (rewritten atomically; a rerun replaces them)."""
+    from gyrolab.physics.chaos import section_dataset
+
+    if not t_end > 0:
+        raise ConfigError(f"stability_map.section_time={t_end!r} must be a positive time")
+    scenes = []
+    for n, point in enumerate(points):
+        if len(point) != 2:
+            raise ConfigError(f"stability_map.sections[{n}]={list(point)!r} must be [theta0, r0]")
+        cfg = OmegaConf.create(plain)
+        cfg.initial.theta0, cfg.initial.r0 = (as_number(v, f"stability_map.sections[{n}]") for v in point)
+        scenes.append(Scene.from_config(cfg))
+    compiled = scenes[0].system.compiled_model()
+    step = as_number(plain["integrator"].get("step") or 0.01, "integrator.step")
+    theta0, r0 = (np.array([float(p[k]) for p in points]) for k in (0, 1))
+    with xr.open_dataset(path) as stored:
+        ds = stored.drop_vars([v for v in stored.variables if str(v).startswith("section_")]).load()
+    sections = section_dataset(compiled, np.stack([s.system.initial_state()[:6] for s in scenes]), theta0, r0, t_end,
+                               step, np.stack([s.system.compiled_model().params for s in scenes]),
+                               rate_units=ds.r0.attrs.get("units", "1"))
+    write_dataset(ds.merge(sections, combine_attrs="drop_conflicts"), path)

@@ -42,12 +42,6 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
     plan = make_plan(fixed, dims, plain=plain)
     settings = Settings.from_config(plan.plain.get("batch"))
     check_integrator(plan)
-    if settings.output == "indicator":
-        try:
-            import gyrolab.physics.chaos  # noqa: F401
-        except ImportError:
-            raise ConfigError("batch.output=indicator needs gyrolab.physics.chaos, which this install lacks; "
-                              "choose batch.output=reductions, final, decimated or trajectory") from None
     if not lock:
         return run_plan(plan, path, settings)
     with writing_in(path.parent, "sweep directory"):  # after the cheap checks: a bad grid leaves no directory
