@@ -138,3 +138,33 @@ def test_auto_refuses_an_accuracy_beyond_double_precision():
     # 300 time units at spin 5: ~3000 steps; compensated round-off ~eps·|y|·√steps = 6e-14 (measured: 2e-14)
     with pytest.raises(ConfigError, match="below the round-off"):
         run(["experiment=perf_reference", "time.n_output=2", "accuracy=1e-14"])
+
+
+def test_taylor_steps_do_not_depend_on_how_the_run_is_cut_into_kernel_calls():
+    """The integrator cuts a run into kernel calls by measured wall time (for progress), so where a call stops
+    must not change a single step: one call over all outputs and calls stopping at arbitrary outputs give the
+    same bits."""
+    from gyrolab.plugins.compiled import taylor
+
+    scene = compose_scene(["experiment=perf_reference", "integrator=taylor", "integrator.tol=1e-9", "time.end=20",
+                           "time.n_output=201"])
+    compiled, order, tol = scene.system.compiled_model(), scene.integrator.order, scene.integrator.tol
+    t_out = scene.times
+
+    def cut_at(stops):
+        out = np.empty((t_out.size, scene.system.state_size))
+        y = scene.system.initial_state().copy()
+        out[0] = y
+        state, carry, stats, reached = np.array([t_out[0]]), np.zeros_like(y), np.zeros(2, dtype=np.int64), 1
+        for stop in stops:
+            if reached < stop:
+                status, reached = taylor.run(compiled.model, compiled.params, order, tol, t_out, out, reached, stop,
+                                             state, y, carry, stats)
+                assert status == taylor.OK
+        return out, int(stats[1])
+
+    whole, steps = cut_at([t_out.size])
+    for stops in ([2, 3, 50, 51, 137, t_out.size], list(range(2, t_out.size + 1))):
+        pieces, pieces_steps = cut_at(stops)
+        assert pieces_steps == steps
+        np.testing.assert_array_equal(pieces, whole)

@@ -46,14 +46,18 @@ def _norm_inf(row):
 def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     """Advance until t_out[i_stop − 1] is filled.
 
-    state = [t]; carry = the Kahan compensation of y (zeros at the start); stats = [coefficient
-    evaluations, steps]. Returns (status, index of the next output time to fill).
+    Steps are clipped at the run's last output time only, never at i_stop: where a call stops must not
+    change the steps (the caller sizes calls by wall time, for progress), so every output the last
+    step passes is filled, also beyond i_stop. state = [t]; carry = the Kahan compensation of y (zeros
+    at the start); stats = [coefficient evaluations, steps]. Returns (status, index of the next output
+    time to fill).
     """
     n = y.size
     T = np.empty((order + 1, n))
     work = np.zeros((order + 1, 3))
     t = state[0]
-    t_end = t_out[i_stop - 1]
+    n_out = t_out.size
+    t_end = t_out[n_out - 1]
     i = i_next
     safety = math.exp(-0.7 / (order - 1))
     while i < i_stop:
@@ -74,7 +78,7 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
             h = t_end - t
         t_new = min(t + h, t_end)
         h = t_new - t
-        while i < i_stop and t_out[i] <= t_new:
+        while i < n_out and t_out[i] <= t_new:
             dt = t_out[i] - t
             for m in range(n):
                 v = T[order, m]

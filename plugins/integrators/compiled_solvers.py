@@ -223,9 +223,12 @@ class Taylor(Integrator):
         state = np.array([t_out[0]])
         carry = np.zeros_like(y)
         stats = np.zeros(2, dtype=np.int64)
+        reached = 1
         for first, stop in _Chunks(len(t_out)):
-            status, _ = taylor.run(compiled.model, compiled.params, self.order, self.tol, t_out, out, first, stop,
-                                   state, y, carry, stats)
+            if reached >= stop:
+                continue  # a long step already filled this chunk's outputs
+            status, reached = taylor.run(compiled.model, compiled.params, self.order, self.tol, t_out, out, reached,
+                                         stop, state, y, carry, stats)
             if status != taylor.OK:
                 raise IntegrationError(f"taylor produced a non-finite state near t={state[0]:.6g}")
             if progress is not None:
