@@ -19,7 +19,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from gyrolab.plugins.compiled import taylor
+from gyrolab.plugins.compiled import kernel, taylor
 
 OK, NOT_FINITE = taylor.OK, taylor.NOT_FINITE
 
@@ -31,16 +31,20 @@ def run_each(model, Params, order, tol, t_out, Y0, Y, steps, status):
     steps[j] receives its number of steps, status[j] OK or NOT_FINITE (its outputs from the
     failed step on are NaN). t_out has at least two times.
     """
-    count, n = Y0.shape
-    for j in numba.prange(count):
-        y = Y0[j].copy()
-        Y[j, 0] = y
-        state = np.array([t_out[0]])
-        carry = np.zeros(n)
-        stats = np.zeros(2, dtype=np.int64)
-        code, reached = taylor.run(model, Params[j], order, tol, t_out, Y[j], 1, t_out.size, state, y, carry, stats)
-        steps[j] = stats[1]
-        status[j] = code
-        if code != OK:
-            for r in range(reached, t_out.size):
-                Y[j, r] = np.nan
+    for j in numba.prange(Y0.shape[0]):  # the loop stays small: numba's parallel pass compiles slowly on big bodies
+        _one(model, Params, order, tol, t_out, Y0, Y, steps, status, j)
+
+
+@kernel
+def _one(model, Params, order, tol, t_out, Y0, Y, steps, status, j):
+    y = Y0[j].copy()
+    Y[j, 0] = y
+    state = np.array([t_out[0]])
+    carry = np.zeros(y.size)
+    stats = np.zeros(2, dtype=np.int64)
+    code, reached = taylor.run(model, Params[j], order, tol, t_out, Y[j], 1, t_out.size, state, y, carry, stats)
+    steps[j] = stats[1]
+    status[j] = code
+    if code != OK:
+        for r in range(reached, t_out.size):
+            Y[j, r] = np.nan
