@@ -10,8 +10,8 @@ The compiled kernels run in parallel over trajectories (``numba.prange``):
 - ``taylor``: adaptive, one trajectory per thread (``plugins/compiled/batch_taylor.py`` says why).
 - ``auto accuracy=ε``: chooses method and tolerance on a few trajectories of the batch with the
   single run's pilot (``auto.py``), the tightest tolerance for all, then runs that method's kernel.
-``integrate_batch`` falls back to one run per trajectory with the scene's own integrator for any
-other integrator (correct, not fast).
+``integrate_batch`` (a scene's batch, ``--batch``) falls back to one run per trajectory with the
+scene's own integrator for ``auto`` and any other integrator (correct, not fast).
 """
 
 from __future__ import annotations
@@ -63,7 +63,9 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
     if y0s.ndim != 2 or y0s.shape[1] != size:
         raise ConfigError(f"initial_states has shape {y0s.shape}; it must be (trajectories, {size})")
     compiled = scene.system.compiled_model()
-    if scene.integrator.name not in FAST_PATH + ADAPTIVE or compiled is None:
+    # auto stays one run per trajectory here: each point of a ``--batch`` sweep records its own choice (and
+    # may take a regime's analytic series); integrate_arrays runs auto's batch choice for array batches
+    if scene.integrator.name not in FAST_PATH + ADAPTIVE or scene.integrator.name == "auto" or compiled is None:
         if params is not None:
             raise ConfigError(f"per-trajectory params need a compiled batch kernel ({_KERNELS}), "
                               f"not {scene.integrator.name}")
