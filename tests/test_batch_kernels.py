@@ -111,6 +111,8 @@ def test_bad_requests_are_one_sentence_config_errors():
     with pytest.raises(ConfigError, match="integrator taylor needs Taylor coefficients, which a compiled plugin torque "
                                           "does not have; valid choices for this model: rk4_numba, dop853_numba, auto$"):
         integrate_arrays(plugin_model, scene.integrator, scene.times, y0s)
+    with pytest.raises(ConfigError, match="^times must be a non-empty 1-D array of finite, strictly increasing"):
+        integrate_arrays(scene.compiled, scene.integrator, np.array([0.0, 1.0, 1.0]), y0s)
     with pytest.raises(ConfigError, match="^failures='skip' must be 'raise' or 'mark'$"):
         integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s, failures="skip")
     scipy_scene = compose_scene([*SHORT, "integrator=dop853"])

@@ -102,6 +102,8 @@ def integrate_arrays(compiled: CompiledModel, integrator: Integrator, times: np.
     if P.shape != (len(y0s), compiled.params.size):
         raise ConfigError(f"params has shape {P.shape}; it must be ({len(y0s)}, {compiled.params.size})")
     times = np.asarray(times, dtype=float)
+    if times.ndim != 1 or times.size == 0 or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+        raise ConfigError("times must be a non-empty 1-D array of finite, strictly increasing output times")
     if integrator.name in ADAPTIVE:
         return _adaptive(compiled, integrator, times, y0s, P, failures)
     from gyrolab.plugins.compiled import rk4
