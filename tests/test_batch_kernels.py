@@ -45,15 +45,19 @@ def test_batch_equals_the_single_trajectory_kernel(integrator, euler_angles):
 def test_a_lane_does_not_depend_on_its_neighbours():
     """One trajectory alone, among easy ones and among hard ones (fast spins, many more steps), in the first lane
     and in a lane refilled after another trajectory finished: bit for bit the same result and steps."""
+    import numba
+
     scene = _scene("dop853_numba")
+    count = 8 * batch_dop853.LANES * numba.get_num_threads()  # tasks of more trajectories than lanes: refills
+    refilled = batch_dop853.LANES + 1
+    assert batch_dop853.task_size(count) > refilled
     probe = _starts(scene, 1, seed=1)
-    easy = _starts(scene, 40, seed=2, scale=0.01)
-    hard = _starts(scene, 40, seed=3)
+    easy = _starts(scene, count - 1, seed=2, scale=0.01)
+    hard = _starts(scene, count - 1, seed=3)
     hard[:, 0:3] *= 4.0
     alone = integrate_arrays(scene.compiled, scene.integrator, scene.times, probe)
-    assert batch_dop853.LANES < 40  # the probe at row 40 enters a lane a finished trajectory left
     for neighbours in (easy, hard):
-        for row in (0, 40):
+        for row in (0, refilled):
             y0s = np.insert(neighbours, row, probe[0], axis=0)
             mixed = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s)
             np.testing.assert_array_equal(mixed.y[row], alone.y[0])

@@ -150,7 +150,7 @@ def _adaptive(compiled: CompiledModel, integrator: Integrator, times: np.ndarray
         rejected, nfev = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
         args = (times, y0s, out, integrator.rtol, integrator.atol, integrator.max_step, steps, rejected, nfev, status)
         if _blockable(compiled, size):
-            batch_dop853.run_blocks(P, *args)
+            batch_dop853.run_blocks(P, *args, batch_dop853.task_size(count))
         else:
             batch_dop853.run_each(compiled.model, P, *args)
     failed = status != 0

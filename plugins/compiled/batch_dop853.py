@@ -29,7 +29,7 @@ from gyrolab.plugins.compiled.dop853 import (A, B, C, D, E3, E5, ERROR_EXPONENT,
 from gyrolab.plugins.compiled.fixed_point import rhs_block
 
 LANES = 32  # trajectories advanced in lock step
-TASK = 256  # trajectories per parallel task
+TASK = 256  # trajectories per parallel task, at most
 RUNNING = -1  # status of a trajectory not finished yet
 
 
@@ -71,17 +71,24 @@ def _load(lane, traj, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t,
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def run_blocks(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status):
+def run_blocks(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status, task_size):
     """Every trajectory j (initial state Y0[j], parameters Params[j]) over t_out into Y[j].
 
     steps/rejected_steps/nfev[j] receive its counts, status[j] OK, TOO_SMALL_STEP or NOT_FINITE
-    (its outputs from the failed step on are NaN). t_out has at least two times.
+    (its outputs from the failed step on are NaN). t_out has at least two times. Tasks of
+    ``task_size`` trajectories (``task_size(count)``) run in parallel.
     """
     count = Y0.shape[0]
-    n_tasks = (count + TASK - 1) // TASK
+    n_tasks = (count + task_size - 1) // task_size
     for task in numba.prange(n_tasks):  # the loop stays small: numba's parallel pass compiles slowly on big bodies
         _task(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status,
-              task * TASK, min(task * TASK + TASK, count))
+              task * task_size, min(task * task_size + task_size, count))
+
+
+def task_size(count: int) -> int:
+    """Trajectories per parallel task: TASK, or fewer so that a small batch still gives every thread
+    a few tasks (never fewer than LANES: a task fills its lanes)."""
+    return int(max(LANES, min(TASK, -(-count // (4 * numba.get_num_threads())))))
 
 
 @numba.njit(cache=True, error_model="numpy")
