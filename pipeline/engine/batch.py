@@ -27,6 +27,8 @@ from gyrolab.engine.scene import Scene
 
 FAST_PATH = ("rk4", "rk4_numba")
 ADAPTIVE = ("dop853_numba", "taylor", "auto")
+#: every integrator ``integrate_arrays`` runs (``gyrolab --batch`` accepts these)
+BATCH_INTEGRATORS = FAST_PATH + ADAPTIVE
 #: trajectories of a batch on which ``auto`` runs its pilot (the first, the largest state, the most unusual parameters)
 AUTO_SAMPLE = 3
 
@@ -65,7 +67,7 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
     compiled = scene.system.compiled_model()
     # auto stays one run per trajectory here: each point of a ``--batch`` sweep records its own choice (and
     # may take a regime's analytic series); integrate_arrays runs auto's batch choice for array batches
-    if scene.integrator.name not in FAST_PATH + ADAPTIVE or scene.integrator.name == "auto" or compiled is None:
+    if scene.integrator.name not in BATCH_INTEGRATORS or scene.integrator.name == "auto" or compiled is None:
         if params is not None:
             raise ConfigError(f"per-trajectory params need a compiled batch kernel ({_KERNELS}), "
                               f"not {scene.integrator.name}")
@@ -94,7 +96,7 @@ def integrate_arrays(compiled: CompiledModel, integrator: Integrator, times: np.
     if y0s.ndim != 2:
         raise ConfigError(f"initial_states has shape {y0s.shape}; it must be (trajectories, state size)")
     _require_finite(y0s)
-    if integrator.name not in FAST_PATH + ADAPTIVE:
+    if integrator.name not in BATCH_INTEGRATORS:
         raise ConfigError(f"batch kernels run integrator {_KERNELS}, not {integrator.name}")
     if failures not in ("raise", "mark"):
         raise ConfigError(f"failures={failures!r} must be 'raise' or 'mark'")
