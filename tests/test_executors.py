@@ -169,3 +169,26 @@ def test_scheduler_values_and_missing_dask(monkeypatch):
     ran = []
     map_chunks(len, ["ab", "c"], lambda i, r: ran.append((i, r)))  # in this process, Dask not needed
     assert ran == [(0, 2), (1, 1)]
+
+
+def test_a_batch_on_separately_started_workers_writes_the_same_dataset(scheduler, tmp_path):
+    """The whole --batch path (plan, chunk tasks, workers rebuilding the scene, the streamed store) on the
+    CLI-started scheduler and workers gives the dataset of the same batch run in this process."""
+    import xarray as xr
+
+    from gyrolab.sweep.batch import run_batch_sweep
+
+    grid = [*OVERRIDES, "batch.output=final", "batch.chunk=4", "initial.r0=2,3,5", "initial.theta0=0.3,0.6,0.9"]
+    here = run_batch_sweep(grid, tmp_path / "here")
+    there = run_batch_sweep([*grid, f"batch.scheduler={scheduler}"], tmp_path / "there")
+    with xr.open_dataset(here) as a, xr.open_dataset(there) as b:
+        assert int(a.job_status.min()) == 1 and a.sizes["theta0"] == 3
+        states = [name for name in a.data_vars if "job_" not in name and name != "error_message"]
+        assert states
+        for name in states:
+            np.testing.assert_array_equal(b[name].values, a[name].values)   # bit for bit
+    from distributed import Client
+
+    with Client(scheduler, timeout=30, set_as_default=False) as client:  # the chunks ran there: scenes rebuilt
+        built = client.run(lambda: len(__import__("gyrolab.batch.runner").batch.runner._CONTEXTS))
+    assert sum(built.values()) >= 1
