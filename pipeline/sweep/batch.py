@@ -18,7 +18,7 @@ from omegaconf import OmegaConf
 
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
 from gyrolab.batch.runner import RunStats, Settings, run_plan
-from gyrolab.engine import batch as engine_batch
+from gyrolab.engine.batch import BATCH_INTEGRATORS
 from gyrolab.engine import scene as scene_module
 from gyrolab.errors import ConfigError
 from gyrolab.output.lock import writing_in
@@ -48,17 +48,12 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
         return run_plan(plan, path, settings)
 
 
-def batch_integrators() -> tuple[str, ...]:
-    """The integrators with a compiled batch kernel (``gyrolab.engine.batch``)."""
-    return tuple(getattr(engine_batch, "BATCH_INTEGRATORS", engine_batch.FAST_PATH))
-
-
 def check_integrator(plan: Plan) -> None:
     """A batch integrates with the compiled batch kernels only: scipy's integrators run one trajectory at a
     time in Python (a batch of them would be a slow multirun without its resume), so they are refused."""
     node = OmegaConf.create(plan.plain).integrator
     name = scene_module._plugin_class("integrator", node, "integrator").name
-    valid = batch_integrators()
+    valid = BATCH_INTEGRATORS
     if name not in valid:
         raise ConfigError(f"integrator {name!r} has no batch kernel; a batch runs integrator={' | '.join(valid)} "
                           "(or sweep with gyrolab -m, which runs any integrator)")
