@@ -2,7 +2,7 @@
 
 One small dataset of each kind (run.nc of both systems, a multirun sweep.nc, a --batch sweep.nc,
 regime.nc, work_precision.nc, regime_validity.nc, ismail2021_tables.nc, shaker_omega3.nc,
-precession_cases.nc, orbit_family.nc) is built in-process, written with ``write_dataset`` and checked with
+precession_cases.nc, orbit_family.nc, stability_map.nc) is built in-process, written with ``write_dataset`` and checked with
 ``compliance_checker``'s ``cf:1.8`` suite. The experiments run their real code up to the dataset
 write; their figures are not drawn (another test's job, and the costly part).
 
@@ -171,6 +171,9 @@ KINDS = {
         "+orbit_family.families={one: {label: default body, a: 2.0, b: 1.5, com_direction: [0.3, 0.2, "
         "0.9327379053088815], k: 0.5, theta0: 1.5, section: gamma_prime, r0_start: 100.0, r0_end: 60.0, "
         "max_points: 3, max_period: 40.0}}"]),
+    "stability_map": _task("stability_map", [
+        "experiment=stability_map", "batch.points=4", "time.end=0.5", "stability_map.sections=[[0.6,3.0]]",
+        "stability_map.section_time=20", "output.figures=false"]),
 }
 
 

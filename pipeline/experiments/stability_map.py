@@ -21,6 +21,7 @@ from omegaconf import DictConfig, OmegaConf
 from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError, as_number
 from gyrolab.figures.redraw import draw_figures
+from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.sweep.grid import Dim
 
@@ -89,4 +90,5 @@ def _add_sections(path: Path, plain: dict, points: Sequence[Sequence[float]], t_
     sections = section_dataset(compiled, np.stack([s.system.initial_state()[:6] for s in scenes]), theta0, r0, t_end,
                                step, np.stack([s.system.compiled_model().params for s in scenes]),
                                rate_units=ds.r0.attrs.get("units", "1"))
-    write_dataset(ds.merge(sections, combine_attrs="drop_conflicts"), path)
+    # conform: the rewrite must stay CF-1.8 like the store's file (no _FillValue on the coordinates, history)
+    write_dataset(conform(ds.merge(sections, combine_attrs="drop_conflicts"), source="Poincaré sections added"), path)
