@@ -243,3 +243,25 @@ def test_adaptive_dop853_indicators_agree_with_fine_step_rk4():
     assert np.all(adaptive["steps"] < 0.05 * fine["steps"])  # adaptive: far fewer steps
     np.testing.assert_allclose(adaptive["megno"], fine["megno"], rtol=0, atol=1e-8)
     np.testing.assert_allclose(adaptive["final_state"], fine["final_state"], rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize("com, hatched", [([0.0, 0.0, 1.0], True), ([0.3, 0.2, 0.9327379053088815], False)])
+def test_stability_map_marks_the_slow_spin_regime_only_for_a_body_it_applies_to(com, hatched):
+    """The large-parameter regime is derived for a centre of mass on the body z axis (its refusal says so): the
+    map hatches r0/c ≤ 0.2 for such a body only, and notes why it does not for the others."""
+    import matplotlib.pyplot as plt
+
+    from gyrolab.figures.stability_map import draw_stability_map
+
+    theta0, r0 = np.array([0.5, 1.0]), np.array([0.05, 1.0, 8.0])
+    ds = xr.Dataset({"indicator": (("theta0", "r0"), np.full((2, 3), 2.0), {"indicator_name": "MEGNO", "units": "1"})},
+                    coords={"theta0": ("theta0", theta0, {"units": "rad"}), "r0": ("r0", r0, {"units": "1"})},
+                    attrs={"body_nondim_a": 2.0, "body_nondim_b": 1.5, "body_nondim_com_direction": np.array(com)})
+    fig = draw_stability_map(ds)
+    try:
+        texts = [label for ax in fig.axes for label in ax.get_legend_handles_labels()[1]]
+        titles = " ".join(ax.get_title(loc="left") for ax in fig.axes)
+        assert any(label.startswith("large parameter") for label in texts) == hatched
+        assert ("centre of mass is off the z axis" in titles) != hatched
+    finally:
+        plt.close(fig)
