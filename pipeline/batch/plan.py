@@ -23,6 +23,7 @@ import math
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from types import SimpleNamespace
 from typing import Any
 
@@ -74,6 +75,17 @@ class Plan:
     @property
     def valid(self) -> np.ndarray:
         return self.error < 0
+
+    @cached_property
+    def base_key(self) -> str:
+        """The base config as canonical JSON (a worker's cache key for the scene it rebuilds)."""
+        return json.dumps(self.base, sort_keys=True, default=str) if self.base is not None else ""
+
+    @property
+    def integrator_name(self) -> str:
+        """The integrator plugin's name (``rk4_numba``, ``auto``, ...)."""
+        node = OmegaConf.create(self.plain).integrator
+        return scene_module._plugin_class("integrator", node, "integrator").name
 
     def params(self, start: int, stop: int) -> np.ndarray:
         return self.combo_params[self.combo[start:stop]]

@@ -96,8 +96,11 @@ class ChunkTask:
     rows: np.ndarray                # rows of the chunk with a valid point
     y0: np.ndarray                  # their initial states
     params: np.ndarray              # their compiled-model parameters
-    combos: list[dict[str, Any]]    # per row: the body/force values that differ from ``config``
+    combo: np.ndarray               # per row: its combination of body/force values (a key of ``combos``)
+    combos: dict[int, dict[str, Any]]  # per combination in the chunk: the body/force values that differ from ``config``
     n_rows: int
+    #: the integrator to run (``auto``: the method and tolerance chosen once for the batch); None: the config's
+    integrator: Any = None
 
 
 @dataclass
@@ -107,6 +110,8 @@ class ChunkResult:
     failed: np.ndarray              # (n_rows,) the integration failed (non-finite)
     kernel_time: float
     wall_time: float
+    #: the integrator settings the chunk ran with (adaptive kernels; None for fixed steps and the indicator)
+    settings: dict | None = None
 
 
 def chunk_size(plan: Plan, settings: Settings) -> int:
@@ -146,11 +151,11 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     done = store.open()
     if done is None:   # already complete
         return RunStats(path)
+    integrator, store.integrator_attributes = batch_integrator(plan)
     pending = [i for i in range(len(blocks)) if i not in done]
     tasks, empty = [], []
-    key = json.dumps(plan.base, sort_keys=True, default=str) if plan.base is not None else ""
     for i in pending:
-        task = _task(plan, blocks[i], i, key, settings)
+        task = chunk_task(plan, blocks[i], i, settings, integrator)
         (tasks if task is not None else empty).append(task if task is not None else i)
     log.info("batch: %d points in %d chunks of ≤ %d (%s), %d stored already, %d to run; output %s", plan.size,
              len(blocks), size, settings.output, len(done), len(tasks), path)
@@ -167,18 +172,50 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     return progress.summary(path)
 
 
-def _task(plan: Plan, chunk: Chunk, index: int, key: str, settings: Settings) -> ChunkTask | None:
+def batch_integrator(plan: Plan) -> tuple[Any, dict[str, Any]]:
+    """(the integrator every chunk runs, its dataset attributes); None: the config's own (a fixed choice).
+
+    ``auto`` chooses here, once for the batch, on the batch's valid points (``gyrolab.engine.batch``'s
+    choice for array batches: its pilot on the first point, the largest state and the most unusual
+    parameters, the tightest tolerance): every chunk then runs the same method at the same tolerance.
+    """
+    if plan.base is None or plan.integrator_name != "auto":
+        return None, {}
+    from gyrolab.engine.batch import _auto_choice
+    from gyrolab.engine.scene import Scene
+
+    scene = Scene.from_config(OmegaConf.create(plan.base))
+    valid = np.flatnonzero(plan.valid)
+    start = time.perf_counter()
+    method, settings = _auto_choice(scene.system.compiled_model(), scene.integrator, plan.times, plan.y0[valid],
+                                    plan.combo_params[plan.combo[valid]])
+    log.info("batch: auto chose %s at tolerance %.3g for every chunk (pilot on %d points, %.1f s)", method.name,
+             settings["auto_tolerance"], settings.get("auto_sampled_trajectories", 0), time.perf_counter() - start)
+    return method, {k: v for k, v in settings.items() if v is not None}
+
+
+def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integrator: Any = None) -> ChunkTask | None:
+    """The picklable task of one chunk (None: the chunk has no valid point)."""
     valid = plan.valid[chunk.start:chunk.stop]
     rows = np.flatnonzero(valid)
     if not rows.size:
         return None
     points = chunk.start + rows
-    base_combo = plan.combo[int(np.argmax(plan.valid))]
-    combos = [plan.combo_values[c] if c != base_combo else {} for c in plan.combo[points]]
-    return ChunkTask(index=index, config=plan.base, config_key=key, output=settings.output,
+    base_combo = int(plan.combo[int(np.argmax(plan.valid))])
+    combo = plan.combo[points]
+    combos = {int(c): (plan.combo_values[c] if c != base_combo else {}) for c in np.unique(combo)}
+    return ChunkTask(index=index, config=plan.base, config_key=plan.base_key, output=settings.output,
                      decimate=settings.decimate, times=plan.times, rows=rows, y0=plan.y0[points],
-                     params=plan.params(chunk.start, chunk.stop)[rows], combos=combos,
-                     n_rows=chunk.stop - chunk.start)
+                     params=plan.params(chunk.start, chunk.stop)[rows], combo=combo, combos=combos,
+                     n_rows=chunk.stop - chunk.start, integrator=integrator)
+
+
+def plan_tasks(plan: Plan, settings: Settings) -> list[ChunkTask]:
+    """Every chunk of ``plan`` with a valid point as its task (what ``run_plan`` hands the executor)."""
+    integrator = batch_integrator(plan)[0]
+    blocks = chunks(plan.shape, chunk_size(plan, settings))
+    tasks = (chunk_task(plan, block, i, settings, integrator) for i, block in enumerate(blocks))
+    return [task for task in tasks if task is not None]
 
 
 # ----------------------------------------------------------------------------- in a worker
@@ -219,7 +256,8 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
 
     start = time.perf_counter()
     context = _context(task)
-    compiled, integrator = context["compiled"], context["scene"].integrator
+    compiled = context["compiled"]
+    integrator = task.integrator if task.integrator is not None else context["scene"].integrator
     if task.output == "indicator":
         kernel = time.perf_counter()
         outputs = indicator_outputs(compiled, integrator, task.times, task.y0, task.params)
@@ -227,20 +265,23 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
         failed = np.zeros(len(task.rows), dtype=bool)
         for out in outputs.values():
             failed |= ~np.isfinite(out.data.reshape(len(task.rows), -1)).all(axis=1)
+        settings = None
     else:
         solution = integrate_arrays(compiled, integrator, task.times, task.y0, task.params, failures="mark")
         kernel_time = solution.wall_time
         failed = np.asarray(solution.failed, dtype=bool)
+        settings = solution.settings
+        groups = [(_system(context, task.config, task.combos[int(c)]), np.flatnonzero(task.combo == c))
+                  for c in np.unique(task.combo)]
         with np.errstate(invalid="ignore"):   # every row, so that a chunk whose points all failed still has its
-            outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, np.arange(len(failed)),
-                                    lambda row: _system(context, task.config, task.combos[row]), compiled,
+            outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, groups, compiled,
                                     task.params)   # variables (the store is created from the first chunk's)
         for out in outputs.values():
             out.data[failed] = np.nan
     all_failed = np.zeros(task.n_rows, dtype=bool)
     all_failed[task.rows] = failed
     return ChunkResult(index=task.index, outputs=merge_rows(outputs, task.rows, task.n_rows), failed=all_failed,
-                       kernel_time=kernel_time, wall_time=time.perf_counter() - start)
+                       kernel_time=kernel_time, wall_time=time.perf_counter() - start, settings=settings)
 
 
 # ----------------------------------------------------------------------------- progress

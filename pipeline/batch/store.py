@@ -50,6 +50,8 @@ class Store:
         self.journal = self.path.with_name(self.path.name + ".chunks")
         self.plan, self.identity, self.settings, self.messages = plan, identity, settings, messages
         self.nc: netCDF4.Dataset | None = None
+        #: the integrator's settings every chunk ran with (``auto``: its choice for the batch), as attributes
+        self.integrator_attributes: dict[str, Any] = {}
 
     # -- opening: new, resumed or already complete ---------------------------------------------------
     def open(self) -> set[int] | None:
@@ -215,7 +217,7 @@ class Store:
         }
         if settings.output == "decimated":
             attrs["batch_decimate"] = settings.decimate
-        for key, value in {**plan.attributes, **provenance()}.items():
+        for key, value in {**plan.attributes, **self.integrator_attributes, **provenance()}.items():
             if value is not None:
                 attrs[key] = int(value) if isinstance(value, (bool, np.bool_)) else value
         return attrs

@@ -14,12 +14,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from omegaconf import OmegaConf
-
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
 from gyrolab.batch.runner import RunStats, Settings, run_plan
 from gyrolab.engine.batch import BATCH_INTEGRATORS
-from gyrolab.engine import scene as scene_module
 from gyrolab.errors import ConfigError
 from gyrolab.output.lock import writing_in
 
@@ -51,8 +48,7 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
 def check_integrator(plan: Plan) -> None:
     """A batch integrates with the compiled batch kernels only: scipy's integrators run one trajectory at a
     time in Python (a batch of them would be a slow multirun without its resume), so they are refused."""
-    node = OmegaConf.create(plan.plain).integrator
-    name = scene_module._plugin_class("integrator", node, "integrator").name
+    name = plan.integrator_name
     valid = BATCH_INTEGRATORS
     if name not in valid:
         raise ConfigError(f"integrator {name!r} has no batch kernel; a batch runs integrator={' | '.join(valid)} "
