@@ -71,8 +71,10 @@ class RunStats:
 
     path: Path
     chunks: int = 0
-    kernel_time: float = 0.0
-    wall_time: float = 0.0
+    kernel_time: float = 0.0    # inside the integration kernels (``integrate_arrays``; its first call loads them)
+    wall_time: float = 0.0      # the chunks' phase: from the first task handed over to the file renamed
+    chunk_time: float = 0.0     # the chunks' own wall time (kernels plus their outputs), summed
+    plan_time: float = 0.0      # the plan (``gyrolab.sweep.batch.run_batch`` sets it)
 
 
 @dataclass(frozen=True)
@@ -294,11 +296,13 @@ class _Progress:
         self.n_chunks = n_chunks
         self.chunks = 0
         self.kernel = 0.0
+        self.in_chunks = 0.0
         self.start = time.perf_counter()
 
     def update(self, result: ChunkResult) -> None:
         self.chunks += 1
         self.kernel += result.kernel_time
+        self.in_chunks += result.wall_time
         elapsed = time.perf_counter() - self.start
         eta = elapsed / self.chunks * (self.n_chunks - self.chunks)
         log.info("batch: chunk %d/%d done (%.0f%%), %s elapsed, ETA %s", self.chunks, self.n_chunks,
@@ -309,4 +313,4 @@ class _Progress:
         if self.chunks:
             log.info("batch: %d chunks in %s, %.0f%% of it in the integration kernels", self.chunks,
                      duration(elapsed), 100.0 * self.kernel / max(elapsed, 1e-9))
-        return RunStats(path, self.chunks, self.kernel, elapsed)
+        return RunStats(path, self.chunks, self.kernel, elapsed, self.in_chunks)

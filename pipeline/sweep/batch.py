@@ -10,6 +10,7 @@ system, the forces' list, the integrator and the output times are one for the wh
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -36,13 +37,18 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
               plain: dict[str, Any] | None = None, lock: bool = True) -> RunStats:
     """The batch of grid ``dims`` over the config of ``fixed`` (or ``plain``), stored at ``path``; its
     directory is locked meanwhile unless ``lock`` is False (the caller holds the lock)."""
+    start = time.perf_counter()
     plan = make_plan(fixed, dims, plain=plain)
     settings = Settings.from_config(plan.plain.get("batch"))
     check_integrator(plan)
+    plan_time = time.perf_counter() - start
     if not lock:
-        return run_plan(plan, path, settings)
-    with writing_in(path.parent, "sweep directory"):  # after the cheap checks: a bad grid leaves no directory
-        return run_plan(plan, path, settings)
+        stats = run_plan(plan, path, settings)
+    else:
+        with writing_in(path.parent, "sweep directory"):  # after the cheap checks: a bad grid leaves no directory
+            stats = run_plan(plan, path, settings)
+    stats.plan_time = plan_time
+    return stats
 
 
 def check_integrator(plan: Plan) -> None:
