@@ -77,8 +77,8 @@ def state_outputs(mode: str, decimate: int, times: np.ndarray, y: np.ndarray,
         _place(outputs, finals, index, len(y))
         if mode == "reductions" and compiled is not None and _compiled_reductions(compiled, system, y.shape[2]):
             every = index.size == len(y)   # one group (the usual batch): no copy of the chunk's trajectories
-            _place(outputs, _fixed_point_reductions(system, y if every else y[index], params if every else params[index]),
-                   index, len(y))
+            part = _fixed_point_reductions(system, y if every else y[index], params if every else params[index])
+            _place(outputs, part, index, len(y))
         elif mode == "reductions":   # by blocks of points that fit in the cache (numpy streams each operation)
             for lo in range(0, len(index), REDUCTION_BLOCK):
                 rows = index[lo:lo + REDUCTION_BLOCK]
