@@ -153,7 +153,7 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     done = store.open()
     if done is None:   # already complete
         return RunStats(path)
-    integrator, store.integrator_attributes = batch_integrator(plan)
+    integrator, store.integrator_attributes = batch_integrator(plan, settings)
     pending = [i for i in range(len(blocks)) if i not in done]
     tasks, empty = [], []
     for i in pending:
@@ -174,14 +174,15 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     return progress.summary(path)
 
 
-def batch_integrator(plan: Plan) -> tuple[Any, dict[str, Any]]:
+def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any]]:
     """(the integrator every chunk runs, its dataset attributes); None: the config's own (a fixed choice).
 
     ``auto`` chooses here, once for the batch, on the batch's valid points (``gyrolab.engine.batch``'s
     choice for array batches: its pilot on the first point, the largest state and the most unusual
     parameters, the tightest tolerance): every chunk then runs the same method at the same tolerance.
+    (The chaos indicator takes no ``auto``: its kernels refuse it, in their own sentence.)
     """
-    if plan.base is None or plan.integrator_name != "auto":
+    if plan.base is None or plan.integrator_name != "auto" or settings.output == "indicator":
         return None, {}
     from gyrolab.engine.batch import _auto_choice
     from gyrolab.engine.scene import Scene
@@ -189,11 +190,11 @@ def batch_integrator(plan: Plan) -> tuple[Any, dict[str, Any]]:
     scene = Scene.from_config(OmegaConf.create(plan.base))
     valid = np.flatnonzero(plan.valid)
     start = time.perf_counter()
-    method, settings = _auto_choice(scene.system.compiled_model(), scene.integrator, plan.times, plan.y0[valid],
-                                    plan.combo_params[plan.combo[valid]])
+    method, choice = _auto_choice(scene.system.compiled_model(), scene.integrator, plan.times, plan.y0[valid],
+                                  plan.combo_params[plan.combo[valid]])
     log.info("batch: auto chose %s at tolerance %.3g for every chunk (pilot on %d points, %.1f s)", method.name,
-             settings["auto_tolerance"], settings.get("auto_sampled_trajectories", 0), time.perf_counter() - start)
-    return method, {k: v for k, v in settings.items() if v is not None}
+             choice["auto_tolerance"], choice.get("auto_sampled_trajectories", 0), time.perf_counter() - start)
+    return method, {k: v for k, v in choice.items() if v is not None}
 
 
 def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integrator: Any = None) -> ChunkTask | None:
@@ -214,7 +215,7 @@ def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integra
 
 def plan_tasks(plan: Plan, settings: Settings) -> list[ChunkTask]:
     """Every chunk of ``plan`` with a valid point as its task (what ``run_plan`` hands the executor)."""
-    integrator = batch_integrator(plan)[0]
+    integrator = batch_integrator(plan, settings)[0]
     blocks = chunks(plan.shape, chunk_size(plan, settings))
     tasks = (chunk_task(plan, block, i, settings, integrator) for i, block in enumerate(blocks))
     return [task for task in tasks if task is not None]
