@@ -11,12 +11,14 @@ run of N = 100 first, as a user's second run would find them.
 
 What the columns measure (printed under the table too):
   process wall   the whole child process, as a user's command: Python start-up, imports, plan, chunks, file;
-  start-up       the process wall before ``run_batch`` is called (interpreter, imports of gyrolab, numba, xarray);
+  start-up       the process wall before ``run_batch`` is called (interpreter, imports of gyrolab, numba, xarray,
+                 parsing the swept values);
   plan           ``make_plan`` (one Hydra composition, parsing the swept values, initial states, checks);
   in kernels     inside ``integrate_arrays`` (the compiled RK4 kernel; its first call loads it from numba's cache,
                  which is included), summed over chunks;
   outputs        the chunks' other work: final-state variables, the compiled reductions;
-  store + rest   writing, syncing and journaling the chunks, creating and closing the file, choosing chunks;
+  store + rest   writing, syncing and journaling the chunks, creating and closing the file, choosing chunks,
+                 the interpreter's exit (its final garbage collection: 0.5 s or more);
   kernel share   in kernels / process wall (the issue's target: ≥ 50 % at N = 10⁵);
   peak memory    the child's ``ru_maxrss``.
 """
@@ -91,11 +93,11 @@ def main() -> None:
         print(f"| {r['n']:,} | {r['wall_s']:.1f} | {r['startup_s']:.1f} | {r['plan_s']:.1f} | {r['kernel_s']:.1f} | "
               f"{r['outputs_s']:.1f} | {rest:.1f} | {100 * r['kernel_s'] / r['wall_s']:.0f} % | "
               f"{1e6 * r['wall_s'] / r['n']:.0f} | {r['peak_mib']:.0f} |", flush=True)
-    print("\nprocess wall: the whole child process (Python start-up, imports, plan, chunks, file), as a user's "
-          "command;\nstart-up: the process wall before run_batch is called; in kernels: inside integrate_arrays "
-          "(its first call loads\nthe cached kernel, included); outputs: the chunks' final variables and reductions; "
-          "store + rest: the rest\n(writing, syncing, journaling, the file's creation and closing); kernel share = "
-          "in kernels / process wall.")
+    print("\nprocess wall: the whole child process (Python start-up, imports, plan, chunks, file, exit), as a "
+          "user's command;\nstart-up: the process wall before run_batch is called (imports, parsing the swept values); "
+          "in kernels: inside\nintegrate_arrays (its first call loads the cached kernel, included); outputs: the "
+          "chunks' final variables and\nreductions; store + rest: the rest (writing, syncing, journaling, the file's "
+          "creation and closing, the\ninterpreter's exit); kernel share = in kernels / process wall.")
 
 
 if __name__ == "__main__":
