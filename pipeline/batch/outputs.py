@@ -58,6 +58,11 @@ def state_outputs(mode: str, decimate: int, times: np.ndarray, y: np.ndarray,
     compiled, in one pass over the trajectories.
     """
     outputs: dict[str, Output] = {}
+    reduced = None   # the compiled reductions of every row at once (one kernel call for all groups)
+    if mode == "reductions" and compiled is not None and y.size \
+            and all(_compiled_reductions(compiled, system, y.shape[2]) for system, _ in groups):
+        reduced = np.empty((len(y), 5))
+        _reduce_fixed_point(np.ascontiguousarray(y), np.ascontiguousarray(params), reduced)
     for system, index in groups:
         index = np.asarray(index)
         if not index.size:
@@ -75,10 +80,8 @@ def state_outputs(mode: str, decimate: int, times: np.ndarray, y: np.ndarray,
             continue
         finals = _final_variables(system, times, y[index, -1])
         _place(outputs, finals, index, len(y))
-        if mode == "reductions" and compiled is not None and _compiled_reductions(compiled, system, y.shape[2]):
-            every = index.size == len(y)   # one group (the usual batch): no copy of the chunk's trajectories
-            part = _fixed_point_reductions(system, y if every else y[index], params if every else params[index])
-            _place(outputs, part, index, len(y))
+        if reduced is not None:
+            _place(outputs, _fixed_point_reductions(system, reduced[index]), index, len(y))
         elif mode == "reductions":   # by blocks of points that fit in the cache (numpy streams each operation)
             for lo in range(0, len(index), REDUCTION_BLOCK):
                 rows = index[lo:lo + REDUCTION_BLOCK]
@@ -131,9 +134,8 @@ def _compiled_reductions(compiled: Any, system: Any, size: int) -> bool:
         and size in (6, 9) and hasattr(system, "invariant_values")
 
 
-def _fixed_point_reductions(system: Any, y: np.ndarray, params: np.ndarray) -> dict[str, tuple]:
-    out = np.empty((len(y), 5))
-    _reduce_fixed_point(np.ascontiguousarray(y), np.ascontiguousarray(params), out)
+def _fixed_point_reductions(system: Any, out: np.ndarray) -> dict[str, tuple]:
+    """The outputs of ``_reduce_fixed_point``'s rows ``out`` for points of ``system`` (its invariants, units)."""
     units = _units(system)
     part = {}
     for k, name in enumerate(("energy", "area_integral", "gamma_norm", "frame_error")):

@@ -69,6 +69,8 @@ class Plan:
     #: None: a grid (the outer product of the swept values); else how the explicit list of points was given
     #: (``zip``, or ``points_file`` with the file's path and SHA-256): the stored dimension is then ``point``
     points: dict[str, str] | None = None
+    #: per combination: the system the plan built for it (this process only; chunks run here reuse them)
+    systems: dict[int, Any] = field(default_factory=dict, repr=False)
 
     @property
     def size(self) -> int:
@@ -241,7 +243,8 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
              layout, int(valid.sum()), len(combo_values), time.perf_counter() - start)
     return Plan(dims=dims, names=dim_names(dims), plain=plain, base=base, times=times, y0=y0, combo=combo,
                 combo_values=combo_values, combo_params=combo_params, error=errors.index, messages=errors.messages,
-                attributes=_common_attributes(systems, swept_initial=bool(initial_axes)), points=points)
+                attributes=_common_attributes(systems, swept_initial=bool(initial_axes)), points=points,
+                systems={c: built.system for c, built in systems.items()})
 
 
 def _points(dims: tuple[Dim, ...], plain: dict[str, Any]) -> tuple[tuple[Dim, ...], dict[str, str] | None]:

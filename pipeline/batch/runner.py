@@ -164,6 +164,8 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     for i in empty:   # no valid point: only the points' errors, which the store wrote when it was created
         store.chunk_done(i, blocks[i], None)
     progress = _Progress(len(tasks))
+    if tasks and executors.scheduler_kind(settings.scheduler) == "process":
+        _share_systems(plan)
 
     def on_result(_: int, result: ChunkResult) -> None:
         store.chunk_done(result.index, blocks[result.index], result)
@@ -226,24 +228,40 @@ def plan_tasks(plan: Plan, settings: Settings) -> list[ChunkTask]:
 _CONTEXTS: dict[str, Any] = {}
 
 
-def _context(task: ChunkTask) -> dict[str, Any]:
-    """The scene of the task's config (its compiled model, integrator), built once per process."""
-    context = _CONTEXTS.get(task.config_key)
+def _context(key: str, config: dict[str, Any]) -> dict[str, Any]:
+    """The scene of a batch's config (its compiled model, integrator), built once per process."""
+    context = _CONTEXTS.get(key)
     if context is None:
         from gyrolab.engine.scene import Scene
 
-        scene = Scene.from_config(OmegaConf.create(task.config))
+        scene = Scene.from_config(OmegaConf.create(config))
         context = {"scene": scene, "compiled": scene.system.compiled_model(), "systems": {}}
         _CONTEXTS.clear()   # one batch at a time per process
-        _CONTEXTS[task.config_key] = context
+        _CONTEXTS[key] = context
     return context
+
+
+def _share_systems(plan: Plan) -> None:
+    """Chunks run in this process reuse the systems the plan built, one per combination of body/force values
+    (a Monte Carlo over bodies builds each body once, not again per chunk); workers elsewhere build their own."""
+    if plan.base is None:
+        return
+    systems = _context(plan.base_key, plan.base)["systems"]
+    base_combo = int(plan.combo[int(np.argmax(plan.valid))])
+    for c, system in plan.systems.items():
+        if c != base_combo:
+            systems.setdefault(_combo_key(plan.combo_values[c]), system)
+
+
+def _combo_key(values: dict[str, Any]) -> str:
+    return json.dumps(values, sort_keys=True, default=str)
 
 
 def _system(context: dict[str, Any], config: dict[str, Any], values: dict[str, Any]) -> Any:
     """The system with a point's body and force values (built once per process and combination)."""
     if not values:
         return context["scene"].system
-    key = json.dumps(values, sort_keys=True, default=str)
+    key = _combo_key(values)
     system = context["systems"].get(key)
     if system is None:
         from gyrolab.engine.scene import Scene
@@ -258,7 +276,7 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
     from gyrolab.engine.batch import integrate_arrays
 
     start = time.perf_counter()
-    context = _context(task)
+    context = _context(task.config_key, task.config)
     compiled = context["compiled"]
     integrator = task.integrator if task.integrator is not None else context["scene"].integrator
     if task.output == "indicator":
