@@ -4,43 +4,44 @@ a local Dask cluster (one single-threaded worker process per core)?
     python benchmarks/executors_local.py                 # 40,000 trajectories in 16 chunks
     python benchmarks/executors_local.py --points 200000 --chunks 40
 
-The chunk function is ``gyrolab.batch.executors.integrate_chunk``: the default heavy top (fixed point,
-uniform gravity), rk4_numba with step 0.01 over t ∈ [0, 10] (1,000 steps per trajectory), final state
-only, ω0 perturbed per trajectory. Each executor runs the same chunks; the results are checked equal
-bit for bit. The local cluster's time includes starting it (that is what a user waits for); its start
-alone is printed too. Times are wall-clock on whatever else the machine is doing.
+The chunks are the batch runner's own (``gyrolab.batch.runner.plan_tasks``, run by ``run_chunk``): the
+default heavy top (fixed point, uniform gravity), a grid initial.theta0 × initial.r0, rk4_numba with step
+0.01 over t ∈ [0, 10] (1,000 steps per trajectory), final state stored. Each executor runs the same
+chunks; the results are checked equal bit for bit. The local cluster's time includes starting it (that
+is what a user waits for); its start alone is printed too. Times are wall-clock on whatever else the
+machine is doing.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import time
 
 import numpy as np
-from omegaconf import OmegaConf
 
-from gyrolab.batch.executors import IntegrationChunk, integrate_chunk, map_chunks
-from gyrolab.engine.config import compose_config
-from gyrolab.engine.scene import Scene
+from gyrolab.batch.executors import map_chunks
+from gyrolab.batch.plan import plan_from_overrides
+from gyrolab.batch.runner import ChunkTask, Settings, plan_tasks, run_chunk
 
 OVERRIDES = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=10", "time.n_output=2",
              "output.euler_angles=false", "output.figures=false"]
 
 
-def make_chunks(points: int, n_chunks: int) -> list[IntegrationChunk]:
-    config = OmegaConf.to_container(compose_config(OVERRIDES), resolve=True)
-    y0 = Scene.from_config(OmegaConf.create(config)).system.initial_state()
-    rng = np.random.default_rng(0)
-    states = np.tile(y0, (points, 1))
-    states[:, :3] += rng.normal(scale=0.05, size=(points, 3))
-    return [IntegrationChunk(config=config, initial_states=part) for part in np.array_split(states, n_chunks)]
+def make_chunks(points: int, n_chunks: int) -> list[ChunkTask]:
+    n_theta = max(1, round(math.sqrt(points)))
+    n_r = max(1, points // n_theta)
+    theta0 = ",".join(repr(0.05 + 3.0 * i / n_theta) for i in range(n_theta))
+    r0 = ",".join(repr(0.5 + 9.5 * j / n_r) for j in range(n_r))
+    plan = plan_from_overrides([*OVERRIDES, f"initial.theta0={theta0}", f"initial.r0={r0}"])
+    return plan_tasks(plan, Settings(output="final", chunk=max(1, plan.size // n_chunks)))
 
 
-def timed(chunks: list[IntegrationChunk], scheduler: str | None) -> tuple[float, np.ndarray]:
+def timed(chunks: list[ChunkTask], scheduler: str | None) -> tuple[float, np.ndarray]:
     out: dict[int, np.ndarray] = {}
     start = time.perf_counter()
-    map_chunks(integrate_chunk, chunks, lambda i, r: out.__setitem__(i, r.y[:, -1]), scheduler=scheduler)
+    map_chunks(run_chunk, chunks, lambda i, r: out.__setitem__(i, r.outputs["omega"].data), scheduler=scheduler)
     return time.perf_counter() - start, np.concatenate([out[i] for i in range(len(chunks))])
 
 
@@ -50,9 +51,10 @@ def main() -> None:
     parser.add_argument("--chunks", type=int, default=16)
     args = parser.parse_args()
     chunks = make_chunks(args.points, args.chunks)
-    integrate_chunk(IntegrationChunk(chunks[0].config, chunks[0].initial_states[:2]))  # compile/load kernels
+    run_chunk(chunks[0])  # compile/load the kernels
     here, expected = timed(chunks, None)
-    print(f"{args.points} trajectories, {args.chunks} chunks, {os.cpu_count()} cores")
+    points = sum(len(task.rows) for task in chunks)
+    print(f"{points} trajectories, {len(chunks)} chunks, {os.cpu_count()} cores")
     print(f"in this process (numba threads): {here:.2f} s")
 
     from distributed import Client, LocalCluster

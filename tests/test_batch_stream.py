@@ -77,9 +77,9 @@ def test_compiled_reductions_equal_the_systems_invariants(euler_angles):
     y0s[:, 0:3] += np.random.default_rng(1).normal(scale=0.5, size=(4, 3))
     y = integrate_arrays(compiled, scene.integrator, scene.times, y0s).y
     params = np.tile(compiled.params, (4, 1))
-    rows = np.arange(4)
-    fast = outputs.state_outputs("reductions", 1, scene.times, y, rows, lambda _: scene.system, compiled, params)
-    slow = outputs.state_outputs("reductions", 1, scene.times, y, rows, lambda _: scene.system)
+    groups = [(scene.system, np.array([0, 2])), (scene.system, np.array([1, 3]))]   # two combinations' rows
+    fast = outputs.state_outputs("reductions", 1, scene.times, y, groups, compiled, params)
+    slow = outputs.state_outputs("reductions", 1, scene.times, y, groups)
     assert set(fast) == set(slow)
     invariants = scene.system.invariant_values(y)
     for name in scene.system.invariants:  # independently: max |I(t) − I(0)| from the system's formulas
@@ -192,3 +192,101 @@ def test_stability_map_is_a_theta0_r0_batch_that_a_rerun_finds_complete(tmp_path
     with caplog.at_level("INFO", logger="gyrolab.batch"):
         stability_map.run(cfg, tmp_path)
     assert "holds this batch complete already" in caplog.text
+
+
+# ----------------------------------------------------------------------------- a list of points
+
+POINTS_CSV = "initial.r0,initial.theta0,body.a\n2,0.3,1.5\n5,0.6,3\n3,0.4,1.2\n"   # a = 3: non-physical body
+
+
+def test_points_file_and_zip_give_a_point_dimension_equal_to_single_runs(tmp_path):
+    """Each row of a hand-written points file is one point along ``point`` (the keys its coordinates, the file's
+    values), with the single run's final state or error; the same points zipped on the command line give the
+    same dataset; an edited file rerun into the same directory is another command, refused."""
+    points = tmp_path / "points.csv"
+    points.write_text(POINTS_CSV)
+    fixed = [*FIXED, "output.euler_angles=false", "batch.output=final", "batch.chunk=2"]
+    listed = run_batch_sweep([*fixed, f"batch.points_file={points}"], tmp_path / "file")
+    zipped = run_batch_sweep([*fixed, "batch.zip=true", "initial.r0=2,5,3", "initial.theta0=0.3,0.6,0.4",
+                              "body.a=1.5,3,1.2"], tmp_path / "zip")
+    rows = [(2, 0.3, 1.5), (5, 0.6, 3), (3, 0.4, 1.2)]
+    with xr.open_dataset(listed) as ds, xr.open_dataset(zipped) as z:
+        assert ds.omega.dims == ("point", "axis") and ds.job_status.dims == ("point",)
+        for name, column in zip(("r0", "theta0", "a"), zip(*rows)):
+            assert ds[name].dims == ("point",) and ds[name].values.tolist() == list(column)
+            assert ds[name].attrs["override_key"] in POINTS_CSV and "units" in ds[name].attrs
+        assert ds.r0.attrs["units"] == "1" and ds.theta0.attrs["units"] == "rad"
+        for n, (r0, theta0, a) in enumerate(rows):
+            single = _single([*FIXED, "output.euler_angles=false", f"initial.r0={r0}", f"initial.theta0={theta0}",
+                              f"body.a={a}"])
+            if isinstance(single, str):
+                assert int(ds.job_status[n]) == 2 and str(ds.error_message.values[int(ds.job_error[n])]) == single
+                continue
+            final = single.run()
+            assert int(ds.job_status[n]) == 1
+            np.testing.assert_allclose(ds.omega[n].values, final.omega[-1].values, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(ds.energy[n].values, final.energy[-1].values, rtol=0, atol=1e-12)
+        assert ds.job_status.values.tolist() == [1, 2, 1]
+        for name in ("omega", "gamma", "job_status", "r0", "a"):
+            np.testing.assert_array_equal(z[name].values, ds[name].values)
+        assert z.attrs["batch_points_kind"] == "zip" and ds.attrs["batch_points_kind"] == "points_file"
+    points.write_text(POINTS_CSV.replace("3,0.4,1.2", "3,0.4,1.25"))
+    with pytest.raises(ConfigError, match="holds another batch"):
+        run_batch_sweep([*fixed, f"batch.points_file={points}"], tmp_path / "file")
+
+
+@pytest.mark.parametrize("text, says", [
+    (None, "cannot be read"),
+    ("initial.r0,initial.nope\n1,2\n", "'initial.nope' is not a key of this config"),
+    ("initial.r0,body.a\n1,1.5\n2\n", "line 3: 1 value, but the header names 2 keys"),
+    ("initial.r0\n1\nabc\n", "line 3, initial.r0: 'abc' is not a number"),
+    ("integrator.step\n0.1\n", "not a body, initial or force parameter"),
+])
+def test_a_bad_points_file_is_one_sentence_and_writes_nothing(tmp_path, text, says):
+    points = tmp_path / "points.csv"
+    if text is not None:
+        points.write_text(text)
+    with pytest.raises(ConfigError) as caught:
+        run_batch_sweep([*FIXED, f"batch.points_file={points}"], tmp_path / "out")
+    assert says in str(caught.value) and "\n" not in str(caught.value) and caught.value.exit_code == 2
+    assert not (tmp_path / "out").exists()
+
+
+def test_zip_needs_equal_lengths_and_a_grid_refuses_repeated_values():
+    with pytest.raises(ConfigError, match="each needs as many values; got initial.r0 3, body.a 2"):
+        plan_from_overrides([*FIXED, "batch.zip=true", "initial.r0=1,2,3", "body.a=1.5,1.2"])
+    with pytest.raises(ConfigError, match="sweeps the value 2 twice"):
+        plan_from_overrides([*FIXED, "initial.r0=1,2,2"])
+    assert plan_from_overrides([*FIXED, "batch.zip=true", "initial.r0=1,2,2", "body.a=1.5,1.5,1.2"]).shape == (3,)
+
+
+def test_auto_chooses_once_for_the_whole_batch(tmp_path, monkeypatch):
+    """integrator=auto: one choice in the parent, the same method and tolerance in every chunk, recorded in the
+    attributes. The expectation is the single runs' own choices: the batch samples its first point (r0 = 0.5)
+    and its largest state (r0 = 12) and takes the tighter tolerance; each chunk alone would have sampled its
+    own points (r0 0.5 and 1, r0 8 and 12), which here choose differently."""
+    from gyrolab.batch import runner
+
+    scene = ["integrator=auto", "integrator.accuracy=1e-8", "time.end=1", "time.n_output=3", "output.figures=false",
+             "output.euler_angles=false"]
+    tolerance = {r0: compose_scene([*scene, f"initial.r0={r0}"]).run().attrs["auto_tolerance"]
+                 for r0 in (0.5, 1, 8, 12)}
+    assert min(tolerance[0.5], tolerance[1]) != min(tolerance[8], tolerance[12])   # chunks alone would differ
+    seen = []
+    chunk = runner.run_chunk
+
+    def recorded(task):
+        result = chunk(task)
+        seen.append((task.integrator.name, result.settings))
+        return result
+
+    monkeypatch.setattr(runner, "run_chunk", recorded)
+    fixed, dims = split_overrides([*scene, "batch.output=final", "batch.chunk=2", "initial.r0=0.5,1,8,12"])
+    run_batch(fixed, dims, tmp_path / "sweep.nc")
+    assert len(seen) == 2 and seen[0] == seen[1]
+    with xr.open_dataset(tmp_path / "sweep.nc") as ds:
+        assert ds.attrs["auto_tolerance"] == min(tolerance[0.5], tolerance[12])
+        assert ds.attrs["accuracy"] == 1e-8 and ds.attrs["auto_method"] == seen[0][0]
+        tol = "integrator_tol" if seen[0][0] == "taylor" else "integrator_rtol"
+        assert seen[0][1][tol] == ds.attrs["auto_tolerance"]
+        assert int(ds.job_status.min()) == 1

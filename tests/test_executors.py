@@ -1,6 +1,7 @@
 """Chunks on Dask: a scheduler and two workers started from the ``dask`` command line, as on a cluster.
 
-The expectation for every chunk is the same chunk integrated in this process (the kernels are
+The chunks are the batch runner's own tasks (``gyrolab.batch.runner.plan_tasks``/``run_chunk``); the
+expectation for every chunk is the same chunk integrated in this process (the kernels are
 deterministic and each trajectory is independent, so where a chunk runs must not change a bit).
 """
 
@@ -15,8 +16,9 @@ import numpy as np
 import pytest
 
 from gyrolab.batch import executors
-from gyrolab.batch.executors import IntegrationChunk, integrate_chunk, map_chunks
-from gyrolab.engine.config import compose_config
+from gyrolab.batch.executors import map_chunks
+from gyrolab.batch.plan import plan_from_overrides
+from gyrolab.batch.runner import Settings, plan_tasks, run_chunk
 from gyrolab.errors import ConfigError
 
 pytest.importorskip("distributed")
@@ -27,28 +29,16 @@ OVERRIDES = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=2", "time
              "output.euler_angles=false", "output.figures=false"]
 
 
-@pytest.fixture(scope="module")
-def config():
-    """The scene's config as plain data, as a chunk task carries it."""
-    from omegaconf import OmegaConf
-
-    return OmegaConf.to_container(compose_config(OVERRIDES), resolve=True)
-
-
-def chunks(config, n_chunks=3, per_chunk=8):
-    """Default initial state with ω0 perturbed differently for every trajectory."""
-    from omegaconf import OmegaConf
-
-    from gyrolab.engine.scene import Scene
-
-    y0 = Scene.from_config(OmegaConf.create(config)).system.initial_state()
-    rng = np.random.default_rng(14)
-    out = []
-    for _ in range(n_chunks):
-        states = np.tile(y0, (per_chunk, 1))
-        states[:, :3] += rng.normal(scale=0.05, size=(per_chunk, 3))
-        out.append(IntegrationChunk(config=config, initial_states=states))
-    return out
+def chunks(n_chunks=3, per_chunk=8):
+    """The chunk tasks of a batch (the runner's own, as ``--batch`` makes them): ``per_chunk`` values of r0
+    per chunk, one chunk per θ0, final state stored."""
+    r0 = ",".join(str(2 + 0.25 * k) for k in range(per_chunk))
+    theta0 = ",".join(str(0.3 + 0.2 * k) for k in range(n_chunks))
+    plan = plan_from_overrides([*OVERRIDES, f"batch.chunk={per_chunk}", f"initial.theta0={theta0}",
+                                f"initial.r0={r0}"])
+    tasks = plan_tasks(plan, Settings(output="final", chunk=per_chunk))
+    assert len(tasks) == n_chunks
+    return tasks
 
 
 def _stop(process):
@@ -91,31 +81,32 @@ def scheduler(tmp_path_factory):
 
 def in_process(tasks):
     results = {}
-    map_chunks(integrate_chunk, tasks, lambda i, r: results.__setitem__(i, r))
+    map_chunks(run_chunk, tasks, lambda i, r: results.__setitem__(i, r))
     return results
 
 
-def test_chunks_on_separately_started_workers_equal_in_process_bit_for_bit(scheduler, config):
-    tasks = chunks(config)
+def test_chunks_on_separately_started_workers_equal_in_process_bit_for_bit(scheduler):
+    tasks = chunks()
     expected = in_process(tasks)
     results = {}
-    map_chunks(integrate_chunk, tasks, lambda i, r: results.__setitem__(i, r), scheduler=scheduler)
+    map_chunks(run_chunk, tasks, lambda i, r: results.__setitem__(i, r), scheduler=scheduler)
     assert sorted(results) == list(range(len(tasks)))
     for i in range(len(tasks)):
-        assert np.array_equal(results[i].y, expected[i].y)   # bit for bit, every output time
+        assert set(results[i].outputs) == set(expected[i].outputs) >= {"omega", "gamma", "energy"}
+        for name, out in expected[i].outputs.items():
+            assert np.array_equal(results[i].outputs[name].data, out.data), name   # bit for bit
         assert np.array_equal(results[i].failed, expected[i].failed) and not results[i].failed.any()
-        assert results[i].n_steps == expected[i].n_steps == 200
-    # The chunks ran on the workers: they rebuilt the compiled model there (once per worker process).
+    # The chunks ran on the workers: they rebuilt the scene there (once per worker process and batch).
     from distributed import Client
 
     with Client(scheduler, timeout=30, set_as_default=False) as client:
-        kept = client.run(lambda: len(__import__("gyrolab.batch.executors").batch.executors._models))
+        kept = client.run(lambda: len(__import__("gyrolab.batch.runner").batch.runner._CONTEXTS))
     assert sum(kept.values()) >= 1 and set(kept.values()) <= {0, 1}
 
 
-def test_in_flight_chunks_stay_bounded(scheduler, config):
+def test_in_flight_chunks_stay_bounded(scheduler):
     """Memory is bounded by a few chunks per worker: tasks are pulled only as results come back."""
-    base = chunks(config, n_chunks=1, per_chunk=2)[0]
+    base = chunks(n_chunks=1, per_chunk=2)[0]
     pulled, ahead = [0], []
 
     def tasks():
@@ -129,18 +120,18 @@ def test_in_flight_chunks_stay_bounded(scheduler, config):
         done.append(index)
         ahead.append(pulled[0] - len(done))
 
-    map_chunks(integrate_chunk, tasks(), on_result, scheduler=scheduler)
+    map_chunks(run_chunk, tasks(), on_result, scheduler=scheduler)
     assert sorted(done) == list(range(12))
     # two workers of one thread: at most 2 chunks per thread in flight, so at most 4 pulled and unfinished
     assert max(ahead) <= executors.CHUNKS_PER_THREAD * 2 - 1
 
 
 @pytest.mark.parametrize("where", ["process", "cluster"])
-def test_a_failing_chunk_is_one_sentence_naming_it(scheduler, where, config):
-    tasks = chunks(config, n_chunks=2, per_chunk=2)
-    tasks[1].initial_states[0, 0] = np.nan
+def test_a_failing_chunk_is_one_sentence_naming_it(scheduler, where):
+    tasks = chunks(n_chunks=2, per_chunk=2)
+    tasks[1].y0[0, 0] = np.nan
     with pytest.raises(ConfigError) as caught:
-        map_chunks(integrate_chunk, tasks, lambda i, r: None, scheduler=scheduler if where == "cluster" else None)
+        map_chunks(run_chunk, tasks, lambda i, r: None, scheduler=scheduler if where == "cluster" else None)
     message = str(caught.value)
     assert message.startswith("chunk 1 of the batch failed") and "NaN" in message
     assert (scheduler in message) == (where == "cluster") and "\n" not in message
@@ -156,16 +147,16 @@ def test_unreachable_scheduler_is_one_sentence_with_its_address(monkeypatch):
     monkeypatch.setattr(executors, "CONNECT_TIMEOUT", 1)
     address = f"tcp://127.0.0.1:{port}"
     with pytest.raises(ConfigError) as caught:
-        map_chunks(integrate_chunk, [], lambda i, r: None, scheduler=address)
+        map_chunks(run_chunk, [], lambda i, r: None, scheduler=address)
     assert address in str(caught.value) and "\n" not in str(caught.value) and caught.value.exit_code == 2
 
 
 def test_scheduler_values_and_missing_dask(monkeypatch):
     with pytest.raises(ConfigError, match="valid: process.*local.*tcp://HOST:PORT"):
-        map_chunks(integrate_chunk, [], lambda i, r: None, scheduler="localhost:8786")
+        map_chunks(run_chunk, [], lambda i, r: None, scheduler="localhost:8786")
     monkeypatch.setattr(executors, "find_spec", lambda name: None)
     with pytest.raises(ConfigError, match=r'pip install "gyrolab\[cluster\]"'):
-        map_chunks(integrate_chunk, [], lambda i, r: None, scheduler="local")
+        map_chunks(run_chunk, [], lambda i, r: None, scheduler="local")
     ran = []
     map_chunks(len, ["ab", "c"], lambda i, r: ran.append((i, r)))  # in this process, Dask not needed
     assert ran == [(0, 2), (1, 1)]

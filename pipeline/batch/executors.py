@@ -15,23 +15,20 @@ runs its chunks in other processes or on other machines:
 At most a few chunks per worker are submitted at a time, so memory is bounded by a few chunks, not by
 the batch. A chunk that fails stops the batch with one sentence naming the chunk.
 
-A task carries what a worker needs to rebuild the compiled model (``IntegrationChunk.config``, a plain
-resolved config): a plugin torque's compiled function is a machine address that does not pickle. Each
-worker process rebuilds it once per config (``chunk_model``) and reuses it for the next chunks.
+A batch's chunk task (``gyrolab.batch.runner.ChunkTask``) carries what a worker needs to rebuild the
+compiled model (a plain resolved config): a plugin torque's compiled function is a machine address that
+does not pickle. Each worker process rebuilds it once per config (``gyrolab.batch.runner.run_chunk``) and
+reuses it for the next chunks.
 """
 
 from __future__ import annotations
 
 import itertools
-import json
 import os
 import uuid
-from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable
 from importlib.util import find_spec
 from typing import Any, TypeVar
-
-import numpy as np
 
 from gyrolab.errors import ConfigError, GyrolabError, shorten
 
@@ -146,67 +143,4 @@ def _map_on(client: Any, function: Callable[[Task], Result], tasks: Iterable[Tas
         pending.clear()
 
 
-# ----------------------------------------------------------------------------- a chunk of trajectories
-
-
-@dataclass
-class ChunkModel:
-    """What integrating a chunk needs, rebuilt from a config once per process."""
-
-    compiled: Any          # gyrolab.contracts.CompiledModel
-    integrator: Any        # the integrator plugin instance
-    times: np.ndarray
-
-
-_models: dict[str, ChunkModel] = {}
-#: configs whose compiled model a process keeps (a batch uses one)
-MODELS_KEPT = 4
-
-
-def chunk_model(config: Mapping[str, Any]) -> ChunkModel:
-    """The compiled model, integrator and output times of a plain (resolved) config, built once per process
-    and config (the same config, as canonical JSON, reuses the first build)."""
-    from gyrolab.sweep.identity import canonical_config
-
-    key = canonical_config(dict(config))
-    model = _models.get(key)
-    if model is None:
-        from omegaconf import OmegaConf
-
-        from gyrolab.engine.scene import Scene
-
-        scene = Scene.from_config(OmegaConf.create(json.loads(key)))
-        compiled = scene.system.compiled_model()
-        if compiled is None:
-            raise ConfigError(f"system {scene.system.name!r} has no compiled form, which batch chunks need; "
-                              "choose a scene whose forces all have compiled forms")
-        if len(_models) >= MODELS_KEPT:
-            _models.pop(next(iter(_models)))
-        model = _models[key] = ChunkModel(compiled, scene.integrator, np.asarray(scene.times))
-    return model
-
-
-@dataclass
-class IntegrationChunk:
-    """Trajectories of one scene config from ``initial_states`` (rows), optionally with their own ``params``."""
-
-    config: dict[str, Any]
-    initial_states: np.ndarray
-    params: np.ndarray | None = None
-    failures: str = "mark"
-    #: free for the caller (e.g. where the chunk's points sit in the grid); returned with the solution
-    tag: Any = field(default=None)
-
-
-def integrate_chunk(chunk: IntegrationChunk) -> Any:
-    """``gyrolab.engine.batch.integrate_arrays`` for one chunk, with the compiled model rebuilt in this process;
-    returns its ``BatchSolution``."""
-    from gyrolab.engine.batch import integrate_arrays
-
-    model = chunk_model(chunk.config)
-    return integrate_arrays(model.compiled, model.integrator, model.times, chunk.initial_states, chunk.params,
-                            failures=chunk.failures)
-
-
-__all__ = ["ChunkModel", "IntegrationChunk", "chunk_error", "chunk_model", "integrate_chunk", "map_chunks",
-           "scheduler_kind"]
+__all__ = ["chunk_error", "map_chunks", "scheduler_kind"]

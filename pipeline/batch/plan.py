@@ -23,6 +23,7 @@ import math
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from types import SimpleNamespace
 from typing import Any
 
@@ -33,7 +34,7 @@ from gyrolab.engine import scene as scene_module
 from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene, build_force, fastest_rate
 from gyrolab.errors import ConfigError, GyrolabError, require_finite
-from gyrolab.sweep.grid import Dim, Grid
+from gyrolab.sweep.grid import Dim, Grid, _refuse_repeats
 from gyrolab.sweep.identity import canonical_config, code_version
 
 log = logging.getLogger("gyrolab.batch")
@@ -41,16 +42,19 @@ log = logging.getLogger("gyrolab.batch")
 VARIABLE_SECTIONS = ("body.", "initial.", "force.")
 PARAM_SECTIONS = ("body.", "force.")
 #: the batch's settings that do not change its result (left out of its identity)
-NOT_IN_IDENTITY = ("scheduler", "progress")
+NOT_IN_IDENTITY = ("scheduler", "progress", "points_file")   # a points file by its contents, not its path
 SCHEME = "gyrolab-batch-1"
+#: the stored dimension of an explicit list of points (``batch.points_file``, ``batch.zip``)
+POINT = "point"
 
 
 @dataclass
 class Plan:
-    """Every point of the grid as arrays; point ``n`` is grid position ``np.unravel_index(n, shape)``."""
+    """Every point of the batch as arrays; point ``n`` is grid position ``np.unravel_index(n, shape)`` (a list of
+    points: its n-th point)."""
 
-    dims: tuple[Dim, ...]
-    names: tuple[str, ...]            # dimension names in the stored dataset
+    dims: tuple[Dim, ...]             # the swept keys (grid: its dimensions; a list: each key's value per point)
+    names: tuple[str, ...]            # the swept keys' coordinate names in the stored dataset
     plain: dict[str, Any]             # the composed config (resolved, plain), swept keys at their first values
     base: dict[str, Any] | None       # the config of the first valid point (what a worker rebuilds), None: none
     times: np.ndarray
@@ -62,6 +66,11 @@ class Plan:
     messages: list[str] = field(default_factory=list)
     #: the system's dataset attributes (``System.attributes``, unit attributes) equal for every point
     attributes: dict[str, Any] = field(default_factory=dict)
+    #: None: a grid (the outer product of the swept values); else how the explicit list of points was given
+    #: (``zip``, or ``points_file`` with the file's path and SHA-256): the stored dimension is then ``point``
+    points: dict[str, str] | None = None
+    #: per combination: the system the plan built for it (this process only; chunks run here reuse them)
+    systems: dict[int, Any] = field(default_factory=dict, repr=False)
 
     @property
     def size(self) -> int:
@@ -69,11 +78,30 @@ class Plan:
 
     @property
     def shape(self) -> tuple[int, ...]:
+        """The stored grid's shape: one dimension per swept key, or (points,) for a list of points."""
+        if self.points is not None:
+            return (len(self.dims[0].values),)
         return tuple(len(d.values) for d in self.dims)
+
+    @property
+    def grid_dims(self) -> tuple[str, ...]:
+        """The stored dataset's per-point dimensions: the swept keys' names, or ``point``."""
+        return (POINT,) if self.points is not None else self.names
 
     @property
     def valid(self) -> np.ndarray:
         return self.error < 0
+
+    @cached_property
+    def base_key(self) -> str:
+        """The base config as canonical JSON (a worker's cache key for the scene it rebuilds)."""
+        return json.dumps(self.base, sort_keys=True, default=str) if self.base is not None else ""
+
+    @property
+    def integrator_name(self) -> str:
+        """The integrator plugin's name (``rk4_numba``, ``auto``, ...)."""
+        node = OmegaConf.create(self.plain).integrator
+        return scene_module._plugin_class("integrator", node, "integrator").name
 
     def params(self, start: int, stop: int) -> np.ndarray:
         return self.combo_params[self.combo[start:stop]]
@@ -85,16 +113,19 @@ class Plan:
         for key in NOT_IN_IDENTITY:
             (plain.get("batch") or {}).pop(key, None)
         grid = [[d.key, list(d.labels)] for d in self.dims]
+        if self.points is not None:   # a list: its kind, and a points file's contents (SHA-256)
+            grid.append(sorted((k, v) for k, v in self.points.items() if k != "points_file"))
         text = "\n".join((SCHEME, code_version(), canonical_config(plain), json.dumps(grid), str(chunk)))
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
 def split_overrides(overrides: Sequence[str]) -> tuple[list[str], list[Dim]]:
     """(the fixed overrides, the swept dimensions) of a command line, each override parsed as the
-    multirun's grid parses it (``Grid.from_overrides``: its errors, its typed values)."""
+    multirun's grid parses it (``Grid.from_overrides``: its errors, its typed values; a value given twice
+    is refused by ``make_plan`` for a grid, allowed for zipped keys)."""
     fixed, dims = [], []
     for override in overrides:
-        grid = Grid.from_overrides([override])
+        grid = Grid.from_overrides([override], repeats=True)
         if grid.dims:
             dims.extend(grid.dims)
         else:
@@ -118,36 +149,39 @@ def dim_names(dims: Sequence[Dim]) -> tuple[str, ...]:
 
 
 def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any] | None = None) -> Plan:
-    """The plan of the grid ``dims`` over the config composed from ``fixed`` (or given as ``plain``)."""
+    """The plan of the swept keys ``dims`` over the config composed from ``fixed`` (or given as ``plain``): their
+    grid, or the explicit list of points of ``batch.zip``/``batch.points_file``."""
     start = time.perf_counter()
     dims = tuple(dims)
-    if not dims:
-        raise ConfigError("a batch needs at least one swept key, e.g. initial.r0=1,2,5")
     if plain is None:
         first = [f"{d.key}={d.labels[0]}" for d in dims]
         plain = OmegaConf.to_container(compose_config(list(fixed) + first), resolve=True)
         plain.pop("hydra", None)
-    shape = tuple(len(d.values) for d in dims)
+    dims, points = _points(dims, plain)
+    if points is None:
+        shape = tuple(len(d.values) for d in dims)
+        axes = [(list(d.values), _along(np.arange(len(d.values), dtype=np.int32), axis, shape))
+                for axis, d in enumerate(dims)]
+    else:
+        shape = (len(dims[0].values),)
+        axes = [_distinct(d) for d in dims]
     n_points = math.prod(shape)
     param_axes = [i for i, d in enumerate(dims) if _key(d).startswith(PARAM_SECTIONS)]
     initial_axes = [i for i, d in enumerate(dims) if not _key(d).startswith(PARAM_SECTIONS)]
     errors = _Errors(n_points)
 
+    def values_of(n: int) -> dict[str, Any]:
+        return {d.key: values[codes[n]] for d, (values, codes) in zip(dims, axes)}
+
     # points with a value that is not a finite number: the single run's checks decide (rare)
     suspect = np.zeros(n_points, dtype=bool)
-    for axis, dim in enumerate(dims):
-        odd = np.array([not _finite_number(v) for v in dim.values])
+    for values, codes in axes:
+        odd = np.array([not _finite_number(v) for v in values], dtype=bool)
         if odd.any():
-            suspect |= _along(odd, axis, shape)
+            suspect |= odd[codes]
 
     # body and forces once per combination of their swept values
-    combo_shape = tuple(shape[i] for i in param_axes)
-    n_combos = math.prod(combo_shape)
-    combo_values = []
-    for flat in range(n_combos):
-        position = np.unravel_index(flat, combo_shape) if combo_shape else ()
-        combo_values.append({dims[i].key: dims[i].values[int(p)] for i, p in zip(param_axes, position)})
-    combo = _combo_index(shape, param_axes)
+    combo, combo_values = _combos([dims[i] for i in param_axes], [axes[i] for i in param_axes], n_points)
     builds = [_build_combo(plain, values) for values in combo_values]
     systems = {}
     for c, built in enumerate(builds):
@@ -163,9 +197,9 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
     if reference is not None:
         _same_structure(systems)
 
-    # initial states: vectorised over the grid, or one system per distinct point
+    # initial states: vectorised over the points, or one system per distinct point
     y0 = np.full((n_points, reference.system.state_size if reference else 0), np.nan)
-    combo_params = np.full((n_combos, reference.compiled.params.size if reference else 0), np.nan)
+    combo_params = np.full((len(combo_values), reference.compiled.params.size if reference else 0), np.nan)
     for c, built in systems.items():
         combo_params[c] = built.compiled.params
     todo = ~suspect & ~errors.failed & np.isin(combo, list(systems))
@@ -173,7 +207,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
         hook = getattr(reference.system, "initial_states", None)
         initial = plain.get("initial") or {}
         if hook is not None:
-            columns = {_key(dims[i])[len("initial."):]: _column(dims[i], i, shape, todo) for i in initial_axes}
+            columns = {_key(dims[i])[len("initial."):]: _column(axes[i], todo) for i in initial_axes}
             states, ok = hook(initial, columns)
             rows = np.flatnonzero(todo)
             if not columns:   # no initial key swept: one state for every point
@@ -184,13 +218,13 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
             suspect |= todo   # a system without the vectorised hook: one system per point
     # everything the fast checks could not vouch for: the single run's own code
     for n in np.flatnonzero(suspect & ~errors.failed):
-        built = _scalar_point(plain, dims, n, shape, errors)
+        built = _scalar_point(plain, values_of(int(n)), int(n), errors)
         if built is None:
             continue
         state, params = built
         if not y0.shape[1]:   # no combo was valid with the base initial state: the first valid point says
             y0 = np.full((n_points, state.size), np.nan)
-            combo_params = np.full((n_combos, params.size), np.nan)
+            combo_params = np.full((len(combo_values), params.size), np.nan)
         if (state.size, params.size) != (y0.shape[1], combo_params.shape[1]):
             raise ConfigError(f"the batch's points have states of different sizes ({y0.shape[1]} and {state.size}) "
                               "or models of different forms; sweep them with gyrolab -m")
@@ -201,15 +235,81 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
     valid = ~errors.failed
     base = None
     if valid.any():
-        n0 = int(np.argmax(valid))
-        base = _point_config(plain, dims, n0, shape)
+        base = _with_values(plain, values_of(int(np.argmax(valid))))
     times = _batch_times(plain, systems, y0, combo, valid)
+    layout = " × ".join(f"{name} {n}" for name, n in zip(dim_names(dims), shape)) if points is None else \
+        f"a list ({points['kind']}) over {', '.join(d.key for d in dims)}"
     log.info("batch plan: %d points (%s), %d valid, %d combinations of body/force values, %.2f s", n_points,
-             " × ".join(f"{name} {n}" for name, n in zip(dim_names(dims), shape)), int(valid.sum()), n_combos,
-             time.perf_counter() - start)
+             layout, int(valid.sum()), len(combo_values), time.perf_counter() - start)
     return Plan(dims=dims, names=dim_names(dims), plain=plain, base=base, times=times, y0=y0, combo=combo,
                 combo_values=combo_values, combo_params=combo_params, error=errors.index, messages=errors.messages,
-                attributes=_common_attributes(systems, swept_initial=bool(initial_axes)))
+                attributes=_common_attributes(systems, swept_initial=bool(initial_axes)), points=points,
+                systems={c: built.system for c, built in systems.items()})
+
+
+def _points(dims: tuple[Dim, ...], plain: dict[str, Any]) -> tuple[tuple[Dim, ...], dict[str, str] | None]:
+    """(the swept keys, how they give a list of points or None for a grid): ``batch.points_file`` (a CSV file's
+    columns), ``batch.zip`` (the command line's swept keys point by point), else the grid of ``dims``."""
+    node = plain.get("batch") or {}
+    path, zipped = node.get("points_file"), node.get("zip", False)
+    if not isinstance(zipped, bool):
+        raise ConfigError(f"batch.zip={zipped!r} must be true or false")
+    if path is not None:
+        if dims:
+            raise ConfigError(f"batch.points_file gives the batch's points, so no key may be swept on the command line "
+                              f"too ({dims[0].key}); add it to the file as a column")
+        if zipped:
+            raise ConfigError("batch.zip=true zips command-line sweeps and batch.points_file is a list already; "
+                              "give one of them")
+        from gyrolab.batch.points import read_points_file
+
+        columns, digest = read_points_file(path, plain, VARIABLE_SECTIONS)
+        return columns, {"kind": "points_file", "points_file": str(path), "points_file_sha256": digest}
+    if not dims:
+        raise ConfigError("a batch needs at least one swept key, e.g. initial.r0=1,2,5 (or a list of points: "
+                          "batch.points_file=PATH)")
+    if zipped:
+        counts = {d.key: len(d.values) for d in dims}
+        if len(set(counts.values())) > 1:
+            raise ConfigError("batch.zip=true takes the swept keys' values point by point, so each needs as many "
+                              f"values; got {', '.join(f'{k} {n}' for k, n in counts.items())}")
+        return dims, {"kind": "zip"}
+    for dim in dims:
+        _refuse_repeats(dim.key, list(dim.labels), list(dim.values))
+    return dims, None
+
+
+def _distinct(dim: Dim) -> tuple[list[Any], np.ndarray]:
+    """(the distinct values of a list's column, each point's index into them)."""
+    if not dim.labels:   # a points file's column: floats
+        values, codes = np.unique(np.asarray(dim.values, dtype=float), return_inverse=True)
+        return values.tolist(), codes.astype(np.int32).ravel()
+    index: dict[str, int] = {}
+    values, codes = [], np.empty(len(dim.values), dtype=np.int32)
+    for n, (label, value) in enumerate(zip(dim.labels, dim.values)):
+        if label not in index:
+            index[label] = len(values)
+            values.append(value)
+        codes[n] = index[label]
+    return values, codes
+
+
+def _combos(dims: Sequence[Dim], axes: Sequence[tuple[list[Any], np.ndarray]], n_points: int
+            ) -> tuple[np.ndarray, list[dict[str, Any]]]:
+    """((N,) each point's combination of body/force values, the values of each combination); a grid's
+    combinations in C order over its body/force dimensions."""
+    if not dims:
+        return np.zeros(n_points, dtype=np.int32), [{}]
+    sizes = [len(values) for values, _ in axes]
+    if math.prod(sizes) < 2**62:
+        distinct, combo = np.unique(np.ravel_multi_index([codes for _, codes in axes], sizes), return_inverse=True)
+        positions = np.unravel_index(distinct, sizes)
+    else:   # too many distinct values to number their product
+        distinct, combo = np.unique(np.stack([codes for _, codes in axes], axis=1), axis=0, return_inverse=True)
+        positions = distinct.T
+    combo_values = [{d.key: values[int(position[c])] for d, (values, _), position in zip(dims, axes, positions)}
+                    for c in range(len(distinct))]
+    return combo.astype(np.int32).ravel(), combo_values
 
 
 # ----------------------------------------------------------------------------- pieces
@@ -265,21 +365,10 @@ def _along(mask: np.ndarray, axis: int, shape: tuple[int, ...]) -> np.ndarray:
     return np.broadcast_to(mask.reshape(view), shape).ravel()
 
 
-def _column(dim: Dim, axis: int, shape: tuple[int, ...], rows: np.ndarray) -> np.ndarray:
-    values = np.array([float(v) if _finite_number(v) else np.nan for v in dim.values])
-    return _along(values, axis, shape)[rows]
-
-
-def _combo_index(shape: tuple[int, ...], param_axes: list[int]) -> np.ndarray:
-    """(N,) the combo of each point: its position over the body/force dims, flattened."""
-    combo = np.zeros(shape, dtype=np.int32)
-    stride = 1
-    for axis in reversed(param_axes):
-        view = [1] * len(shape)
-        view[axis] = shape[axis]
-        combo = combo + (np.arange(shape[axis], dtype=np.int32) * stride).reshape(view)
-        stride *= shape[axis]
-    return np.ascontiguousarray(np.broadcast_to(combo, shape)).ravel()
+def _column(axis: tuple[list[Any], np.ndarray], rows: np.ndarray) -> np.ndarray:
+    """A swept key's values (floats, NaN for any other) at ``rows`` of the points."""
+    values, codes = axis
+    return np.array([float(v) if _finite_number(v) else np.nan for v in values])[codes[rows]]
 
 
 def _with_values(plain: dict[str, Any], values: Mapping[str, Any]) -> dict[str, Any]:
@@ -290,15 +379,6 @@ def _with_values(plain: dict[str, Any], values: Mapping[str, Any]) -> dict[str, 
             node = node.setdefault(part, {})
         node[parts[-1]] = value
     return out
-
-
-def _point_values(dims: Sequence[Dim], n: int, shape: tuple[int, ...]) -> dict[str, Any]:
-    position = np.unravel_index(n, shape)
-    return {d.key: d.values[int(p)] for d, p in zip(dims, position)}
-
-
-def _point_config(plain: dict[str, Any], dims: Sequence[Dim], n: int, shape: tuple[int, ...]) -> dict[str, Any]:
-    return _with_values(plain, _point_values(dims, n, shape))
 
 
 def _build_combo(plain: dict[str, Any], values: Mapping[str, Any]) -> _Built | _Failure:
@@ -330,12 +410,12 @@ def _compiled(scene: Scene) -> Any:
     return compiled
 
 
-def _scalar_point(plain: dict[str, Any], dims: Sequence[Dim], n: int, shape: tuple[int, ...],
+def _scalar_point(plain: dict[str, Any], values: Mapping[str, Any], n: int,
                   errors: _Errors) -> tuple[np.ndarray, np.ndarray] | None:
-    """One point checked and built by the single run's code: (its initial state, compiled parameters), or
-    None with its error recorded."""
+    """Point ``n`` (its swept ``values``) checked and built by the single run's code: (its initial state,
+    compiled parameters), or None with its error recorded."""
     try:
-        scene = Scene.from_config(OmegaConf.create(_point_config(plain, dims, n, shape)))
+        scene = Scene.from_config(OmegaConf.create(_with_values(plain, values)))
     except GyrolabError as error:
         errors.set(n, str(error))
         return None

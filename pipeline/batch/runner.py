@@ -71,8 +71,10 @@ class RunStats:
 
     path: Path
     chunks: int = 0
-    kernel_time: float = 0.0
-    wall_time: float = 0.0
+    kernel_time: float = 0.0    # inside the integration kernels (``integrate_arrays``; its first call loads them)
+    wall_time: float = 0.0      # the chunks' phase: from the first task handed over to the file renamed
+    chunk_time: float = 0.0     # the chunks' own wall time (kernels plus their outputs), summed
+    plan_time: float = 0.0      # the plan (``gyrolab.sweep.batch.run_batch`` sets it)
 
 
 @dataclass(frozen=True)
@@ -96,8 +98,11 @@ class ChunkTask:
     rows: np.ndarray                # rows of the chunk with a valid point
     y0: np.ndarray                  # their initial states
     params: np.ndarray              # their compiled-model parameters
-    combos: list[dict[str, Any]]    # per row: the body/force values that differ from ``config``
+    combo: np.ndarray               # per row: its combination of body/force values (a key of ``combos``)
+    combos: dict[int, dict[str, Any]]  # per combination in the chunk: the body/force values that differ from ``config``
     n_rows: int
+    #: the integrator to run (``auto``: the method and tolerance chosen once for the batch); None: the config's
+    integrator: Any = None
 
 
 @dataclass
@@ -107,6 +112,8 @@ class ChunkResult:
     failed: np.ndarray              # (n_rows,) the integration failed (non-finite)
     kernel_time: float
     wall_time: float
+    #: the integrator settings the chunk ran with (adaptive kernels; None for fixed steps and the indicator)
+    settings: dict | None = None
 
 
 def chunk_size(plan: Plan, settings: Settings) -> int:
@@ -146,17 +153,19 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     done = store.open()
     if done is None:   # already complete
         return RunStats(path)
+    integrator, store.integrator_attributes = batch_integrator(plan, settings)
     pending = [i for i in range(len(blocks)) if i not in done]
     tasks, empty = [], []
-    key = json.dumps(plan.base, sort_keys=True, default=str) if plan.base is not None else ""
     for i in pending:
-        task = _task(plan, blocks[i], i, key, settings)
+        task = chunk_task(plan, blocks[i], i, settings, integrator)
         (tasks if task is not None else empty).append(task if task is not None else i)
     log.info("batch: %d points in %d chunks of ≤ %d (%s), %d stored already, %d to run; output %s", plan.size,
              len(blocks), size, settings.output, len(done), len(tasks), path)
     for i in empty:   # no valid point: only the points' errors, which the store wrote when it was created
         store.chunk_done(i, blocks[i], None)
     progress = _Progress(len(tasks))
+    if tasks and executors.scheduler_kind(settings.scheduler) == "process":
+        _share_systems(plan)
 
     def on_result(_: int, result: ChunkResult) -> None:
         store.chunk_done(result.index, blocks[result.index], result)
@@ -167,18 +176,51 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     return progress.summary(path)
 
 
-def _task(plan: Plan, chunk: Chunk, index: int, key: str, settings: Settings) -> ChunkTask | None:
+def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any]]:
+    """(the integrator every chunk runs, its dataset attributes); None: the config's own (a fixed choice).
+
+    ``auto`` chooses here, once for the batch, on the batch's valid points (``gyrolab.engine.batch``'s
+    choice for array batches: its pilot on the first point, the largest state and the most unusual
+    parameters, the tightest tolerance): every chunk then runs the same method at the same tolerance.
+    (The chaos indicator takes no ``auto``: its kernels refuse it, in their own sentence.)
+    """
+    if plan.base is None or plan.integrator_name != "auto" or settings.output == "indicator":
+        return None, {}
+    from gyrolab.engine.batch import _auto_choice
+    from gyrolab.engine.scene import Scene
+
+    scene = Scene.from_config(OmegaConf.create(plan.base))
+    valid = np.flatnonzero(plan.valid)
+    start = time.perf_counter()
+    method, choice = _auto_choice(scene.system.compiled_model(), scene.integrator, plan.times, plan.y0[valid],
+                                  plan.combo_params[plan.combo[valid]])
+    log.info("batch: auto chose %s at tolerance %.3g for every chunk (pilot on %d points, %.1f s)", method.name,
+             choice["auto_tolerance"], choice.get("auto_sampled_trajectories", 0), time.perf_counter() - start)
+    return method, {k: v for k, v in choice.items() if v is not None}
+
+
+def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integrator: Any = None) -> ChunkTask | None:
+    """The picklable task of one chunk (None: the chunk has no valid point)."""
     valid = plan.valid[chunk.start:chunk.stop]
     rows = np.flatnonzero(valid)
     if not rows.size:
         return None
     points = chunk.start + rows
-    base_combo = plan.combo[int(np.argmax(plan.valid))]
-    combos = [plan.combo_values[c] if c != base_combo else {} for c in plan.combo[points]]
-    return ChunkTask(index=index, config=plan.base, config_key=key, output=settings.output,
+    base_combo = int(plan.combo[int(np.argmax(plan.valid))])
+    combo = plan.combo[points]
+    combos = {int(c): (plan.combo_values[c] if c != base_combo else {}) for c in np.unique(combo)}
+    return ChunkTask(index=index, config=plan.base, config_key=plan.base_key, output=settings.output,
                      decimate=settings.decimate, times=plan.times, rows=rows, y0=plan.y0[points],
-                     params=plan.params(chunk.start, chunk.stop)[rows], combos=combos,
-                     n_rows=chunk.stop - chunk.start)
+                     params=plan.params(chunk.start, chunk.stop)[rows], combo=combo, combos=combos,
+                     n_rows=chunk.stop - chunk.start, integrator=integrator)
+
+
+def plan_tasks(plan: Plan, settings: Settings) -> list[ChunkTask]:
+    """Every chunk of ``plan`` with a valid point as its task (what ``run_plan`` hands the executor)."""
+    integrator = batch_integrator(plan, settings)[0]
+    blocks = chunks(plan.shape, chunk_size(plan, settings))
+    tasks = (chunk_task(plan, block, i, settings, integrator) for i, block in enumerate(blocks))
+    return [task for task in tasks if task is not None]
 
 
 # ----------------------------------------------------------------------------- in a worker
@@ -186,24 +228,40 @@ def _task(plan: Plan, chunk: Chunk, index: int, key: str, settings: Settings) ->
 _CONTEXTS: dict[str, Any] = {}
 
 
-def _context(task: ChunkTask) -> dict[str, Any]:
-    """The scene of the task's config (its compiled model, integrator), built once per process."""
-    context = _CONTEXTS.get(task.config_key)
+def _context(key: str, config: dict[str, Any]) -> dict[str, Any]:
+    """The scene of a batch's config (its compiled model, integrator), built once per process."""
+    context = _CONTEXTS.get(key)
     if context is None:
         from gyrolab.engine.scene import Scene
 
-        scene = Scene.from_config(OmegaConf.create(task.config))
+        scene = Scene.from_config(OmegaConf.create(config))
         context = {"scene": scene, "compiled": scene.system.compiled_model(), "systems": {}}
         _CONTEXTS.clear()   # one batch at a time per process
-        _CONTEXTS[task.config_key] = context
+        _CONTEXTS[key] = context
     return context
+
+
+def _share_systems(plan: Plan) -> None:
+    """Chunks run in this process reuse the systems the plan built, one per combination of body/force values
+    (a Monte Carlo over bodies builds each body once, not again per chunk); workers elsewhere build their own."""
+    if plan.base is None:
+        return
+    systems = _context(plan.base_key, plan.base)["systems"]
+    base_combo = int(plan.combo[int(np.argmax(plan.valid))])
+    for c, system in plan.systems.items():
+        if c != base_combo:
+            systems.setdefault(_combo_key(plan.combo_values[c]), system)
+
+
+def _combo_key(values: dict[str, Any]) -> str:
+    return json.dumps(values, sort_keys=True, default=str)
 
 
 def _system(context: dict[str, Any], config: dict[str, Any], values: dict[str, Any]) -> Any:
     """The system with a point's body and force values (built once per process and combination)."""
     if not values:
         return context["scene"].system
-    key = json.dumps(values, sort_keys=True, default=str)
+    key = _combo_key(values)
     system = context["systems"].get(key)
     if system is None:
         from gyrolab.engine.scene import Scene
@@ -218,8 +276,9 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
     from gyrolab.engine.batch import integrate_arrays
 
     start = time.perf_counter()
-    context = _context(task)
-    compiled, integrator = context["compiled"], context["scene"].integrator
+    context = _context(task.config_key, task.config)
+    compiled = context["compiled"]
+    integrator = task.integrator if task.integrator is not None else context["scene"].integrator
     if task.output == "indicator":
         kernel = time.perf_counter()
         outputs = indicator_outputs(compiled, integrator, task.times, task.y0, task.params)
@@ -227,20 +286,23 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
         failed = np.zeros(len(task.rows), dtype=bool)
         for out in outputs.values():
             failed |= ~np.isfinite(out.data.reshape(len(task.rows), -1)).all(axis=1)
+        settings = None
     else:
         solution = integrate_arrays(compiled, integrator, task.times, task.y0, task.params, failures="mark")
         kernel_time = solution.wall_time
         failed = np.asarray(solution.failed, dtype=bool)
+        settings = solution.settings
+        groups = [(_system(context, task.config, task.combos[int(c)]), np.flatnonzero(task.combo == c))
+                  for c in np.unique(task.combo)]
         with np.errstate(invalid="ignore"):   # every row, so that a chunk whose points all failed still has its
-            outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, np.arange(len(failed)),
-                                    lambda row: _system(context, task.config, task.combos[row]), compiled,
+            outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, groups, compiled,
                                     task.params)   # variables (the store is created from the first chunk's)
         for out in outputs.values():
             out.data[failed] = np.nan
     all_failed = np.zeros(task.n_rows, dtype=bool)
     all_failed[task.rows] = failed
     return ChunkResult(index=task.index, outputs=merge_rows(outputs, task.rows, task.n_rows), failed=all_failed,
-                       kernel_time=kernel_time, wall_time=time.perf_counter() - start)
+                       kernel_time=kernel_time, wall_time=time.perf_counter() - start, settings=settings)
 
 
 # ----------------------------------------------------------------------------- progress
@@ -253,11 +315,13 @@ class _Progress:
         self.n_chunks = n_chunks
         self.chunks = 0
         self.kernel = 0.0
+        self.in_chunks = 0.0
         self.start = time.perf_counter()
 
     def update(self, result: ChunkResult) -> None:
         self.chunks += 1
         self.kernel += result.kernel_time
+        self.in_chunks += result.wall_time
         elapsed = time.perf_counter() - self.start
         eta = elapsed / self.chunks * (self.n_chunks - self.chunks)
         log.info("batch: chunk %d/%d done (%.0f%%), %s elapsed, ETA %s", self.chunks, self.n_chunks,
@@ -268,4 +332,4 @@ class _Progress:
         if self.chunks:
             log.info("batch: %d chunks in %s, %.0f%% of it in the integration kernels", self.chunks,
                      duration(elapsed), 100.0 * self.kernel / max(elapsed, 1e-9))
-        return RunStats(path, self.chunks, self.kernel, elapsed)
+        return RunStats(path, self.chunks, self.kernel, elapsed, self.in_chunks)

@@ -25,6 +25,7 @@ import numpy as np
 from omegaconf import OmegaConf
 
 from gyrolab.batch.outputs import output_times
+from gyrolab.batch.plan import POINT
 from gyrolab.errors import ConfigError, OutputError
 from gyrolab.output.atomic import _fsync, _fsync_directory, reason
 from gyrolab.output.cf import CONVENTIONS, now_iso
@@ -50,6 +51,8 @@ class Store:
         self.journal = self.path.with_name(self.path.name + ".chunks")
         self.plan, self.identity, self.settings, self.messages = plan, identity, settings, messages
         self.nc: netCDF4.Dataset | None = None
+        #: the integrator's settings every chunk ran with (``auto``: its choice for the batch), as attributes
+        self.integrator_attributes: dict[str, Any] = {}
 
     # -- opening: new, resumed or already complete ---------------------------------------------------
     def open(self) -> set[int] | None:
@@ -140,27 +143,36 @@ class Store:
         self.nc = nc
         nc.set_auto_mask(False)
         system = _reference_system(plan)
+        if plan.points is not None:
+            nc.createDimension(POINT, plan.size)
+            var = nc.createVariable(POINT, "i4", (POINT,))
+            var[:] = np.arange(plan.size, dtype=np.int32)
+            var.setncatts({"long_name": "index of the point in the batch's list (a points file's data row, from 0)",
+                           "units": "1"})
         for name, dim in zip(plan.names, plan.dims):
-            nc.createDimension(name, len(dim.values))
+            if plan.points is None:
+                nc.createDimension(name, len(dim.values))
             values = dim.coordinate()
             if values.dtype.kind in "iu":
                 values = values.astype(np.int32) if np.abs(values).max() < 2**31 else values.astype(np.float64)
-            attrs = {"long_name": f"swept parameter {dim.key}", "override_key": dim.key, **_key_units(dim.key, system)}
+            attrs = {"long_name": f"swept parameter {dim.key}" + (" of each point" if plan.points else ""),
+                     "override_key": dim.key, **_key_units(dim.key, system)}
+            along = POINT if plan.points is not None else name
             if values.dtype.kind == "O":
-                _text_variable(nc, name, name, values, attrs)
+                _text_variable(nc, name, along, values, attrs)
             else:
-                var = nc.createVariable(name, values.dtype, (name,))
+                var = nc.createVariable(name, values.dtype, (along,))
                 var[:] = values
                 var.setncatts(attrs)
         nc.createDimension("error_kind", len(self.messages))
         _text_variable(nc, "error_message", "error_kind", self.messages,
                        {"long_name": "the one-sentence errors of the failed points (job_error indexes them)"})
-        grid = tuple(plan.names)
+        grid = plan.grid_dims
         # no fill value: every point's code is written below (a fill value would make readers mask the codes)
         status = nc.createVariable("job_status", "i1", grid, contiguous=True, fill_value=False)
-        status.setncatts(STATUS_ATTRS)
+        status.setncatts({**STATUS_ATTRS, **self._coordinates_attr()})
         error = nc.createVariable("job_error", "i4", grid, contiguous=True, fill_value=False)
-        error.setncatts(ERROR_ATTRS)
+        error.setncatts({**ERROR_ATTRS, **self._coordinates_attr()})
         shape = plan.shape
         # every point's validation outcome now (so a failed point's error is there whatever happens next)
         status[:] = np.where(plan.valid, 0, FAILED).astype(np.int8).reshape(shape)
@@ -179,11 +191,17 @@ class Store:
                 if dim not in nc.dimensions:
                     nc.createDimension(dim, size)
                     self._coordinate(dim, size, system)
-            var = nc.createVariable(name, "f8", tuple(plan.names) + tuple(out.dims), contiguous=True,
+            var = nc.createVariable(name, "f8", plan.grid_dims + tuple(out.dims), contiguous=True,
                                     fill_value=np.nan)
             var.setncatts({k: (v if not isinstance(v, (list, tuple)) else np.asarray(v)) for k, v in out.attrs.items()
                            if k != "_FillValue"})
+            var.setncatts(self._coordinates_attr())
             var[(0,) * var.ndim] = np.nan   # allocates the variable's storage now, not at a later chunk's write
+
+    def _coordinates_attr(self) -> dict[str, str]:
+        """A list of points: each per-point variable names the keys' values along ``point`` as its (CF auxiliary)
+        coordinates, so readers show them with it."""
+        return {"coordinates": " ".join(self.plan.names)} if self.plan.points is not None else {}
 
     def _coordinate(self, dim: str, size: int, system: Any) -> None:
         from gyrolab.output.dataset import time_attributes
@@ -201,12 +219,15 @@ class Store:
         created = now_iso()
         attrs: dict[str, Any] = {
             "Conventions": CONVENTIONS,
-            "title": f"gyrolab batch of {plan.size} points over {' × '.join(plan.names)}"
+            "title": (f"gyrolab batch of {plan.size} points over {' × '.join(plan.names)}" if plan.points is None
+                      else f"gyrolab batch of a list of {plan.size} points ({plan.points['kind']}) of "
+                           f"{', '.join(plan.names)}")
                      + (f": {system.title()}" if system is not None else ""),
             "date_created": created,
             "history": f"{created} written by gyrolab {gyrolab_version()}: batch ({settings.output})",
             "config": OmegaConf.to_yaml(OmegaConf.create(plan.plain)),
-            "batch_grid": json.dumps([[d.key, list(d.labels)] for d in plan.dims]),
+            "batch_grid": json.dumps([[d.key, list(d.labels)] for d in plan.dims]) if plan.points is None
+            else json.dumps([d.key for d in plan.dims]),
             "batch_identity": self.identity,
             "batch_output": settings.output,
             "n_points": plan.size,
@@ -215,7 +236,9 @@ class Store:
         }
         if settings.output == "decimated":
             attrs["batch_decimate"] = settings.decimate
-        for key, value in {**plan.attributes, **provenance()}.items():
+        for key, value in (plan.points or {}).items():   # kind (zip, points_file), the file and its SHA-256
+            attrs[f"batch_points_{key}" if key == "kind" else f"batch_{key}"] = value
+        for key, value in {**plan.attributes, **self.integrator_attributes, **provenance()}.items():
             if value is not None:
                 attrs[key] = int(value) if isinstance(value, (bool, np.bool_)) else value
         return attrs

@@ -10,16 +10,14 @@ system, the forces' list, the integrator and the output times are one for the wh
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from omegaconf import OmegaConf
-
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
 from gyrolab.batch.runner import RunStats, Settings, run_plan
 from gyrolab.engine.batch import BATCH_INTEGRATORS
-from gyrolab.engine import scene as scene_module
 from gyrolab.errors import ConfigError
 from gyrolab.output.lock import writing_in
 
@@ -39,20 +37,24 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
               plain: dict[str, Any] | None = None, lock: bool = True) -> RunStats:
     """The batch of grid ``dims`` over the config of ``fixed`` (or ``plain``), stored at ``path``; its
     directory is locked meanwhile unless ``lock`` is False (the caller holds the lock)."""
+    start = time.perf_counter()
     plan = make_plan(fixed, dims, plain=plain)
     settings = Settings.from_config(plan.plain.get("batch"))
     check_integrator(plan)
+    plan_time = time.perf_counter() - start
     if not lock:
-        return run_plan(plan, path, settings)
-    with writing_in(path.parent, "sweep directory"):  # after the cheap checks: a bad grid leaves no directory
-        return run_plan(plan, path, settings)
+        stats = run_plan(plan, path, settings)
+    else:
+        with writing_in(path.parent, "sweep directory"):  # after the cheap checks: a bad grid leaves no directory
+            stats = run_plan(plan, path, settings)
+    stats.plan_time = plan_time
+    return stats
 
 
 def check_integrator(plan: Plan) -> None:
     """A batch integrates with the compiled batch kernels only: scipy's integrators run one trajectory at a
     time in Python (a batch of them would be a slow multirun without its resume), so they are refused."""
-    node = OmegaConf.create(plan.plain).integrator
-    name = scene_module._plugin_class("integrator", node, "integrator").name
+    name = plan.integrator_name
     valid = BATCH_INTEGRATORS
     if name not in valid:
         raise ConfigError(f"integrator {name!r} has no batch kernel; a batch runs integrator={' | '.join(valid)} "

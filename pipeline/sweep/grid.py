@@ -53,8 +53,9 @@ class Grid:
         return tuple(len(d.labels) for d in self.dims)
 
     @classmethod
-    def from_overrides(cls, overrides: Sequence[str]) -> Grid:
-        """ConfigError for a malformed override, a non-discrete sweep or a value given twice."""
+    def from_overrides(cls, overrides: Sequence[str], *, repeats: bool = False) -> Grid:
+        """ConfigError for a malformed override, a non-discrete sweep or a value given twice (unless ``repeats``:
+        a batch's zipped keys may repeat values)."""
         parser = OverridesParser.create()
         try:
             parsed = parser.parse_overrides(list(overrides))
@@ -71,7 +72,8 @@ class Grid:
                 labels = list(o.sweep_string_iterator())
                 choices[key] = [f"{key}={label}" for label in labels]
                 typed[key] = list(o.sweep_iterator())
-                _refuse_repeats(key, labels, typed[key])
+                if not repeats:
+                    _refuse_repeats(key, labels, typed[key])
             else:
                 choices[key] = [f"{key}={o.get_value_element_as_str()}"]
                 typed.pop(key, None)

@@ -196,4 +196,7 @@ class FixedPoint(System):
 
 
 def _var(dims: str | tuple[str, ...], data: np.ndarray, units: str, long_name: str) -> xr.Variable:
-    return xr.Variable(dims, np.asarray(data, dtype=float), attrs={"units": units, "long_name": long_name})
+    # fastpath: the data is a float ndarray already, so xarray need not probe it for duck arrays (whose first
+    # probe imports dask.array, ~1 s, when dask is installed: a batch's final variables paid it)
+    attrs = {"units": units, "long_name": long_name}
+    return xr.Variable(dims, np.asarray(data, dtype=float), attrs=attrs, fastpath=True)

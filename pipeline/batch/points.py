@@ -1,0 +1,78 @@
+"""An explicit list of points from a CSV file (``batch.points_file=PATH``).
+
+The header names config keys (``initial.r0,initial.theta0,body.a``), each row is one point: the value of
+every key there, a finite number. The file is read whole (its SHA-256 goes into the batch's identity, so
+an edited file is another command); any problem is one sentence (ConfigError), before anything is written.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import io
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from gyrolab.errors import ConfigError, shorten
+from gyrolab.sweep.grid import Dim
+
+
+def read_points_file(path: str | Path, plain: dict[str, Any], sections: Sequence[str]) -> tuple[tuple[Dim, ...], str]:
+    """(one Dim per column: its key and its value at every point, labels empty; the file's SHA-256)."""
+    where = f"batch.points_file={shorten(str(path))}"
+    try:
+        data = Path(path).expanduser().read_bytes()
+        text = data.decode("utf-8-sig")
+    except OSError as error:
+        raise ConfigError(f"{where} cannot be read ({error.strerror or error}); give a CSV file whose header names "
+                          "config keys and whose rows are points") from None
+    except UnicodeDecodeError:
+        raise ConfigError(f"{where} is not UTF-8 text; give a CSV file whose header names config keys") from None
+    rows = [(number, row) for number, row in enumerate(csv.reader(io.StringIO(text)), start=1)
+            if row and any(cell.strip() for cell in row)]
+    if not rows:
+        raise ConfigError(f"{where} is empty; its first line names config keys (e.g. initial.r0,body.a), each "
+                          "further line is a point")
+    keys = [cell.strip() for cell in rows[0][1]]
+    for key in keys:
+        _check_key(key, keys, plain, sections, where)
+    if len(rows) == 1:
+        raise ConfigError(f"{where} has a header but no points; add one line of values per point")
+    columns: list[list[float]] = [[] for _ in keys]
+    for number, row in rows[1:]:
+        if len(row) != len(keys):
+            raise ConfigError(f"{where}, line {number}: {len(row)} value{'s' * (len(row) != 1)}, but the header names "
+                              f"{len(keys)} keys")
+        for column, key, cell in zip(columns, keys, row):
+            column.append(_number(cell, f"{where}, line {number}, {key}"))
+    digest = hashlib.sha256(data).hexdigest()
+    return tuple(Dim(key, (), tuple(column)) for key, column in zip(keys, columns)), digest
+
+
+def _check_key(key: str, keys: list[str], plain: dict[str, Any], sections: Sequence[str], where: str) -> None:
+    if not key:
+        raise ConfigError(f"{where}: the header has an empty column name; name a config key in every column")
+    if keys.count(key) > 1:
+        raise ConfigError(f"{where}: the header names {key} twice; give each key once")
+    if not key.startswith(tuple(sections)):
+        raise ConfigError(f"{where}: column {shorten(key)!r} is not a body, initial or force parameter, which are "
+                          "what a batch varies")
+    node: Any = plain
+    for part in key.split("."):
+        if not isinstance(node, dict) or part not in node:
+            raise ConfigError(f"{where}: column {shorten(key)!r} is not a key of this config (its forces included)")
+        node = node[part]
+    if isinstance(node, (dict, list)):
+        raise ConfigError(f"{where}: column {shorten(key)!r} is a group of settings, not one number")
+
+
+def _number(cell: str, where: str) -> float:
+    try:
+        value = float(cell.strip())
+    except ValueError:
+        raise ConfigError(f"{where}: {shorten(cell.strip())!r} is not a number") from None
+    if not math.isfinite(value):
+        raise ConfigError(f"{where}: {cell.strip()} is not a finite number")
+    return value
