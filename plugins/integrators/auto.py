@@ -65,6 +65,10 @@ CALIBRATION = 3.0
 #: a series' predicted error (its first omitted term) is an estimate: trusted to within this factor when ruling
 #: out the other orders of a regime whose orbit the scene misses
 MISS_MARGIN = 1000.0
+#: the screen before the series check (``Auto._misses_orbits``): its grid over the period range and the tolerance
+#: of its Taylor run (whose error, far below 1e3 × this on the one to four periods it covers, is added to its margin)
+SCREEN_POINTS = 2049
+SCREEN_TOLERANCE = 1e-12
 
 
 class Auto(Integrator):
@@ -181,10 +185,11 @@ class Auto(Integrator):
 
         span = t_out[-1] - t_out[0]
         candidates = []  # each regime's variants predicted to meet the target, lowest series order first
+        motion: list[Solution] = []  # the scene's own motion over the regimes' period ranges, integrated once
         for name in registry.names("regime"):
             try:
                 base = registry.load("regime", name)()
-                if self.system.name in base.systems:
+                if self.system.name in base.systems and not self._misses_orbits(base, fun, y0, compiled, span, motion):
                     ladder = getattr(base, "series_candidates", lambda system, accuracy: [(base, None)])
                     candidates += [(name, r, float("nan") if e is None else float(e))
                                    for r, e in ladder(self.system, self.accuracy / self.safety)]
@@ -236,6 +241,47 @@ class Auto(Integrator):
             return Solution(t_out, y, IntegratorStats(nfev=truth.stats.nfev, n_steps=0, n_rejected=0,
                                                       wall_time=time.perf_counter() - start))
         return None
+
+    def _misses_orbits(self, base: Any, fun: RightHandSide, y0: np.ndarray, compiled: CompiledModel,
+                       span: float, motion: list[Solution]) -> bool:
+        """Whether the scene is certainly on none of the orbits ``base``'s variants describe, from the scene's own
+        motion over one period: a necessary condition of the series check below, evaluated before any series
+        is built (it would cost ~2 ms warm, ~0.4 s on a process's first call, on the many scenes that start on
+        no regime's orbit).
+
+        The check below takes a variant only when the scene starts within accuracy/(10·safety) of the variant's
+        orbit (its start S(0)) and the variant stays within accuracy/safety of the scene's motion Φ over a window
+        ending at its period T_S (all of the period once the span covers it); the variant is periodic,
+        S(T_S) = S(0), hence |Φ(T_S) − y0| ≤ 1.1·accuracy/safety. The regime's ``period_spread`` bounds T_S to
+        [T/spread, T·spread] around its cheap ``period`` T, and Φ is sampled on a grid there: T_S is within
+        half a spacing h of a grid time, where Φ differs from Φ(T_S) by at most max|Φ'|·h/2. So a scene whose
+        motion stays farther than 1.1·accuracy/safety + max|Φ'|·h/2 (+ the integration error) from y0 over
+        the whole range cannot be taken, and the regime is skipped.
+        """
+        spread = getattr(base, "period_spread", None)
+        if spread is None:
+            return False
+        from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+        try:
+            with np.errstate(all="ignore"):
+                period = float(base.period(self.system))
+        except GyrolabError:
+            return False  # no cheap period: the full check decides (and refuses what does not apply)
+        lo, hi = period / spread, period * spread
+        if not (np.isfinite(hi) and 0 < lo) or hi > span:
+            return False  # the check's window is then the span, not a period: no periodicity to use
+        if not motion or motion[0].t[-1] < hi:
+            motion[:] = [Taylor(tol=SCREEN_TOLERANCE).integrate(fun, np.linspace(0.0, hi, SCREEN_POINTS), y0, None,
+                                                                compiled)]
+        t, y = motion[0].t, motion[0].y[:, :6]
+        h = t[1] - t[0]
+        # max|Φ'| from the secants, doubled: the secants' largest slope falls short of it by O(h²)
+        speed = 2 * float(np.max(np.abs(np.diff(y, axis=0)))) / h
+        inside = (t >= lo - h) & (t <= hi + h)
+        miss = float(np.min(np.max(np.abs(y[inside] - y0[:6]), axis=1)))
+        scale = max(1.0, float(np.max(np.abs(y0[:6]))))
+        return miss > 1.1 * self.accuracy / self.safety + speed * h / 2 + 1e3 * SCREEN_TOLERANCE * scale
 
     def _pilot(self, fun: RightHandSide, times: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                tau: float) -> tuple[float, float, int, bool, Solution]:
