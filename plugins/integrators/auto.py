@@ -59,6 +59,9 @@ FLOOR = 1e-15  # relative to the state's size: nothing in double precision reach
 MIN_TOLERANCE = 1e-13  # first pilot: tighter tolerances differ from τ/100 by round-off only on O(1) states
 MAX_TOLERANCE = 1e-5  # looser per-step tolerances take steps near the Taylor series' radius of convergence
 FIRST_RATIO = 1e-3  # first pilot tolerance relative to the accuracy (the typical error/tolerance ratio is 10–500)
+#: the pilot's tight run is at most accuracy/TIGHT_RATIO (final tolerances on the reference scene: accuracy/420 to
+#: accuracy/1300; the tight run is the start of the final one only when at least as accurate)
+TIGHT_RATIO = 3000.0
 #: actual / raw predicted final error, largest measured on the extremes matrix and the reference scene
 #: (accuracies 1e-4 to 1e-12), rounded up; the recorded prediction is the raw one times this.
 CALIBRATION = 3.0
@@ -126,9 +129,10 @@ class Auto(Integrator):
         tau, pilot_nfev = float(np.clip(self.accuracy * FIRST_RATIO, MIN_TOLERANCE, MAX_TOLERANCE / 10)), 0
         # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance
         self._order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
+        loose = None  # the previous round's loose run (tolerance, solution): the next round's tight run
         for _ in range(3):
-            pilot_tau = tau
-            per_tol, growth, nfev, measured, tight = self._pilot(fun, pilot_times, y0, compiled, tau)
+            per_tol, growth, nfev, measured, (tight_tol, tight), loose = self._pilot(fun, pilot_times, y0, compiled,
+                                                                                     tau, loose)
             pilot_nfev += nfev
             # per_tol bounds the truncation error even when the pilot saw only round-off
             chosen = min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
@@ -141,7 +145,7 @@ class Auto(Integrator):
         # Round-off of the compensated Taylor update grows as a random walk over the steps (see the module's
         # note), that of scipy's plain update by up to an ulp per step: a target below it cannot be met in
         # double precision, whatever the tolerance.
-        steps = self._pilot_steps / self.pilot_fraction * max(1.0, (pilot_tau / 100 / chosen) ** (1.0 / self._order))
+        steps = self._pilot_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / self._order))
         compensated = self._method(compiled, chosen).name == "taylor"
         roundoff = np.finfo(float).eps * scale * (math.sqrt(steps) if compensated else steps)
         if roundoff > self.accuracy:
@@ -150,7 +154,7 @@ class Auto(Integrator):
         if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         method = self._method(compiled, chosen)
-        if pilot_tau * 1e-2 <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
+        if tight_tol <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
             head = np.searchsorted(pilot_times, t_out[t_out < t_pilot])  # the outputs inside the pilot
             rest = t_out[t_out >= t_pilot]
             tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest,
@@ -286,11 +290,22 @@ class Auto(Integrator):
         return len(near) == 0
 
     def _pilot(self, fun: RightHandSide, times: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
-               tau: float) -> tuple[float, float, int, bool, Solution]:
+               tau: float, previous: tuple[float, Solution] | None
+               ) -> tuple[float, float, int, bool, tuple[float, Solution], tuple[float, Solution]]:
         """(raw predicted final error per unit tolerance, growth exponent q, evaluations, whether the pilot
-        measured an error above round-off, the τ/100 run) from runs at τ and τ/100."""
+        measured an error above round-off, the tight run and the loose run as (tolerance, solution)) from runs
+        at τ and a tighter τ_t: the previous round's loose run when τ_t ≤ τ/10 (a re-centred or loosened round
+        reuses it), else a new run at min(τ/100, accuracy/TIGHT_RATIO). The error at τ is then the runs' difference × τ/(τ − τ_t)."""
         loose = self._method(compiled, tau).integrate(fun, times, y0, None, compiled)
-        tight = self._method(compiled, tau * 1e-2).integrate(fun, times, y0, None, compiled)
+        if previous is not None and previous[0] <= tau / 10:
+            tight_tol, tight = previous
+            tight_nfev = 0
+        else:
+            # τ/100, or tighter where τ is held at MIN_TOLERANCE far above the final tolerance (~accuracy/1000): the
+            # tight run must be at least as accurate as the final one to be its start
+            tight_tol = min(tau * 1e-2, self.accuracy / TIGHT_RATIO)
+            tight = self._method(compiled, tight_tol).integrate(fun, times, y0, None, compiled)
+            tight_nfev = tight.stats.nfev
         # Envelope of the error: pointwise errors of periodic motions dip through zero.
         envelope = np.maximum.accumulate(np.max(np.abs(loose.y - tight.y), axis=1))
         # differences within a few hundred ulps are round-off, not a measurement of the truncation error
@@ -302,9 +317,9 @@ class Auto(Integrator):
         growth = MIN_GROWTH
         if np.all(envelope[late] > 0):
             growth = float(np.clip(_slope(np.log(elapsed[late]), np.log(envelope[late])), MIN_GROWTH, 4.0))
-        per_tol = envelope[-1] / tau * (1.0 / self.pilot_fraction) ** growth
+        per_tol = envelope[-1] / (tau - tight_tol) * (1.0 / self.pilot_fraction) ** growth
         self._pilot_steps = tight.stats.n_steps
-        return per_tol, growth, loose.stats.nfev + tight.stats.nfev, measured, tight
+        return per_tol, growth, loose.stats.nfev + tight_nfev, measured, (tight_tol, tight), (tau, loose)
 
     def attributes(self) -> dict[str, Any]:
         return {"accuracy": self.accuracy, **self.choice}
