@@ -135,7 +135,8 @@ class Auto(Integrator):
                                                                                      tau, loose)
             pilot_nfev += nfev
             # per_tol bounds the truncation error even when the pilot saw only round-off
-            chosen = min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
+            chosen = MAX_TOLERANCE if per_tol == 0 else \
+                min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
             if not measured and tau < MAX_TOLERANCE / 100:  # only round-off seen: measure with a looser pilot
                 tau *= 100
             elif chosen > 10 * tau:  # re-centre: never extrapolate far towards looser tolerances
