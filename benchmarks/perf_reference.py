@@ -3,6 +3,7 @@
     pip install -e ".[bench]"                      # heyoka (optional: its rows are skipped when absent)
     python benchmarks/perf_reference.py            # full tables (a few minutes)
     python benchmarks/perf_reference.py --quick    # fewer tolerances, fewer rounds
+    python benchmarks/perf_reference.py --calibration  # only the measurement behind auto's CALIBRATION
 
 Reference problem (issue 5, ``experiment=perf_reference``): nondimensional
 Euler–Poisson, A, B, C = 2, 1.5, 1, r_c = (0.3, 0.2, 0.9327…), k = 0.5,
@@ -203,6 +204,77 @@ def run_breakdown(rounds, quick):
         print(f"| {eps:.0e} | {' | '.join(f'{best[(part, eps)][0] * 1e3:.2f}' for part in parts)} |")
 
 
+def calibration(reference):
+    """Actual / raw predicted final error of ``integrator=auto`` (``Auto.raw_predicted_error``: before CALIBRATION
+    and round-off) over the extremes matrix of ``tests/test_extremes.py`` and the reference scene, accuracies 1e-3 to
+    1e-13: the measurement behind ``gyrolab.plugins.integrators.auto.CALIBRATION``. Extremes scenes are judged
+    against Taylor at tol 1e-17 (ratios marked * are within 100× of its disagreement with compiled DOP853 at 1e-13,
+    i.e. not measured); the reference scene against the extended-precision reference."""
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "tests"))
+    from test_extremes import SCENES
+
+    from gyrolab.plugins.integrators.auto import Auto
+    from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
+
+    cases = [(name, [*overrides, "time.n_output=51"]) for name, overrides in SCENES.items()]
+    cases.append(("reference scene", ["experiment=perf_reference"]))
+    accuracies = [10.0 ** -k for k in range(3, 14)]
+    print("\n`auto` calibration: actual / raw predicted final error (* not measurable: near the reference's own "
+          f"error)\n\n| scene | {' | '.join(f'{a:.0e}' for a in accuracies)} |\n| --- |{' --- |' * len(accuracies)}")
+    worst = (0.0, "")
+    for name, overrides in cases:
+        built = compose_scene([*overrides, "integrator=auto", "accuracy=1e-9"])
+        system, times, y0 = built.system, built.times, built.system.initial_state()
+        if name == "reference scene":
+            truth, floor = reference, 1e-15
+        else:
+            truth = Taylor(tol=1e-17).integrate(system.rhs, times[[0, -1]], y0, None, built.compiled).y[-1]
+            other = DOP853Numba(rtol=1e-13, atol=1e-13).integrate(system.rhs, times[[0, -1]], y0, None, built.compiled)
+            floor = float(np.max(np.abs(other.y[-1] - truth)))
+        cells = []
+        for accuracy in accuracies:
+            auto = Auto(accuracy=accuracy)
+            auto.prepare(system)
+            try:
+                solution = auto.integrate(system.rhs, times, y0, None, built.compiled)
+            except Exception as error:  # a refused accuracy (below the round-off floor)
+                cells.append(type(error).__name__)
+                continue
+            actual = float(np.max(np.abs(solution.y[-1][:len(truth)] - truth)))
+            ratio = actual / auto.raw_predicted_error
+            measured = actual > 100 * floor
+            if measured and ratio > worst[0]:
+                worst = (ratio, f"{name}, accuracy {accuracy:.0e}")
+            bound = "" if actual <= auto.choice["auto_predicted_error"] else " (prediction exceeded)"
+            cells.append(f"{ratio:.2f}{'' if measured else '*'}{bound}")
+        print(f"| {name} | {' | '.join(cells)} |")
+    print(f"\nlargest measured ratio: {worst[0]:.2f} ({worst[1]})")
+
+
+FIRST_CHECK = """
+import time, numpy as np
+from gyrolab import compose_scene
+from gyrolab.plugins.integrators.auto import Auto
+scene = compose_scene(["experiment=perf_reference", "accuracy=1e-8"])
+grid, y0, compiled = np.linspace(0.0, 300.0, 3001), scene.system.initial_state(), scene.compiled
+Auto(accuracy=1e-8).integrate(None, grid, y0, None, compiled)  # kernels loaded: what follows is the check alone
+auto = Auto(accuracy=1e-8)
+auto.prepare(scene.system)
+start = time.process_time()
+auto._series(None, grid, y0, compiled, 0.0)
+print(time.process_time() - start)
+"""
+
+
+def first_series_check():
+    """CPU seconds of auto's series check on its first call in a fresh process (regime modules imported, series
+    built if the scene is not ruled out first), median of three processes."""
+    times = sorted(float(subprocess.run([sys.executable, "-c", FIRST_CHECK], check=True, capture_output=True,
+                                        text=True, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"}).stdout)
+                   for _ in range(3))
+    return times[1]
+
+
 def batch_throughput(repeats):
     scene = compose_scene(["experiment=perf_reference", "integrator=rk4_numba", "integrator.step=0.01",
                            "time.end=10", "time.n_output=11"])
@@ -244,6 +316,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer tolerances and rounds")
     parser.add_argument("--wall", action="store_true", help="wall time instead of CPU time (an unloaded machine)")
+    parser.add_argument("--calibration", action="store_true",
+                        help="only the measurement behind auto's CALIBRATION (about 30 s)")
     args = parser.parse_args()
     global WALL
     WALL = args.wall
@@ -255,8 +329,13 @@ def main() -> None:
     start = time.perf_counter()
     reference = fixed_point_reference(INERTIA, R_C, K, Y0, [0.0, T_END])[-1].astype(float)
     print(f"# reference: extended-precision Taylor, {time.perf_counter() - start:.1f} s")
+    if args.calibration:
+        calibration(reference)
+        return
     peer_table(reference, rounds, args.quick)
     run_breakdown(rounds, args.quick)
+    print(f"\nauto's series check, first call in a process (regime modules imported then): "
+          f"{first_series_check() * 1e3:.0f} ms CPU (median of 3 processes)")
 
     rows = scipy_and_dop853_rows(reference, 2, args.quick)
     print("\nC-speed DOP853 and scipy (3,001 output times; gyrolab: Scene.run()):\n\n"

@@ -27,6 +27,12 @@ if TYPE_CHECKING:
 FRAME_AXES = ("x_radial", "y_along_track", "z_normal")
 
 
+#: label coordinates (``axis``, ``frame_axis``) of at most this length get one shared pandas index per process
+#: (xarray treats indexes as immutable and shares them between copies of a dataset itself)
+SMALL_COORDINATE = 16
+_LABEL_INDEXES: dict[tuple[Any, ...], Any] = {}
+
+
 def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
     system, integrator = scene.system, scene.integrator
     body = system.body
@@ -84,7 +90,13 @@ def assemble(variables: dict[str, xr.Variable], coords: dict[str, tuple[str, np.
     all_variables, indexes = dict(variables), {}
     for name, (dim, data, attrs) in coords.items():
         data = np.asarray(data)
-        indexes[name] = PandasIndex(data, dim, coord_dtype=data.dtype)
+        if len(data) <= SMALL_COORDINATE and data.dtype.kind == "U":  # the axis labels: the same index every run
+            key = (name, data.dtype.str, tuple(data.tolist()))
+            if key not in _LABEL_INDEXES:
+                _LABEL_INDEXES[key] = PandasIndex(data, dim, coord_dtype=data.dtype)
+            indexes[name] = _LABEL_INDEXES[key]
+        else:
+            indexes[name] = PandasIndex(data, dim, coord_dtype=data.dtype)
         all_variables.update(indexes[name].create_variables({name: xr.Variable(dim, data, attrs)}))
     try:
         return construct(all_variables, set(coords), sizes, None, indexes)

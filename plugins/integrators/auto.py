@@ -6,7 +6,7 @@ is 24 to 470 times its per-step tolerance depending on the order; on the
 extremes matrix the ratio spans four decades), and no per-step error control
 predicts how local errors grow into the global one. So ``auto`` measures
 that dependence on the scene itself with a short pilot: two runs over the
-first ``pilot_fraction`` of the time span, at tolerances τ and τ/100 and the
+first ``pilot_fraction`` of the time span, at tolerances τ and τ_t ≤ τ/10 and the
 same order, give the error of the τ run along the pilot (hence a growth
 exponent q, error ∝ t^q). At a fixed order the error is proportional to the
 tolerance (checked in the tests), so the full span at tolerance τ' is
@@ -15,19 +15,34 @@ non-symplectic method drifts in energy linearly on a near-integrable motion,
 so its phase error grows quadratically (measured on the reference problem:
 the error of Taylor at tol 1e-10 grows ×100 from t = 30 to t = 300).
 ``auto`` picks τ' to meet ``accuracy`` with a safety factor and records the
-prediction multiplied by ``CALIBRATION`` (the largest ratio of actual to
-raw predicted error measured on the extremes matrix and the reference
-scene, rounded up; ``tests/test_extremes.py`` checks that the recorded
-prediction bounds the actual error there). The pilot is not wasted: its τ/100
-run is at least as accurate as the final one, so it is the first
+prediction multiplied by ``CALIBRATION`` (``tests/test_extremes.py`` and
+``tests/test_compiled.py`` check that the recorded prediction bounds the actual
+error on the extremes matrix and the reference scene). The pilot is not wasted:
+its tight run is at least as accurate as the final one, so it is the first
 ``pilot_fraction`` of the trajectory and the final run continues from its end.
+A pilot round that re-centres τ (the first prediction asked for a tolerance
+more than 10× looser) or loosens it (only round-off seen) reuses the previous
+round's τ run as its tight run, so each later round costs one run, not two.
+
+Calibration, measured 2026-11-24 with ``python benchmarks/perf_reference.py
+--calibration`` (the pilot as it is now: re-centred rounds reuse their previous
+run, tight runs down to accuracy/3000): the largest ratio of the actual final
+error to the raw prediction (before CALIBRATION and round-off) over the
+extremes matrix and the reference scene at accuracies 1e-3 to 1e-13, counting
+only errors at least 100 times above the references' disagreement, is 0.94
+(reference scene, accuracy 1e-5); on the extremes scenes it is at most 0.19.
+The previous pilot gave 0.86 there. CALIBRATION = 3 leaves a factor 3.2.
 
 Candidates, fastest first: an expansion regime's analytic series (no
 integration at all), when the scene lies in the regime's domain, starts on the
 periodic orbit the series describes, and the series' error — measured over one
 period against a tight Taylor run and extrapolated linearly in time, as a
 phase drift — meets the target; then the compiled Taylor method when the
-scene has a compiled model; otherwise scipy's DOP853.
+scene has a compiled model; otherwise scipy's DOP853. Before any series is
+built, a regime that declares ``period_spread`` is ruled out when the scene's
+own motion never comes back near its start over the orbit's period range
+(``Auto._misses_orbits``: a necessary condition of the series check, ~0.5 ms;
+building and checking the series costs ~2 ms, 0.4 s on a process's first call).
 
 Round-off: the Taylor state update is compensated (Kahan), so round-off no
 longer grows by an ulp per step but as a random walk, about eps·|y|·√steps
@@ -59,12 +74,19 @@ FLOOR = 1e-15  # relative to the state's size: nothing in double precision reach
 MIN_TOLERANCE = 1e-13  # first pilot: tighter tolerances differ from τ/100 by round-off only on O(1) states
 MAX_TOLERANCE = 1e-5  # looser per-step tolerances take steps near the Taylor series' radius of convergence
 FIRST_RATIO = 1e-3  # first pilot tolerance relative to the accuracy (the typical error/tolerance ratio is 10–500)
-#: actual / raw predicted final error, largest measured on the extremes matrix and the reference scene
-#: (accuracies 1e-4 to 1e-12), rounded up; the recorded prediction is the raw one times this.
+#: the pilot's tight run is at most accuracy/TIGHT_RATIO (final tolerances on the reference scene: accuracy/420 to
+#: accuracy/1300; the tight run is the start of the final one only when at least as accurate)
+TIGHT_RATIO = 3000.0
+#: the recorded prediction is the raw one times this: the largest actual / raw predicted final error measured on the
+#: extremes matrix and the reference scene (accuracies 1e-3 to 1e-13) is 0.94 (module docstring)
 CALIBRATION = 3.0
 #: a series' predicted error (its first omitted term) is an estimate: trusted to within this factor when ruling
 #: out the other orders of a regime whose orbit the scene misses
 MISS_MARGIN = 1000.0
+#: the screen before the series check (``Auto._misses_orbits``): its grid over the period range and the tolerance
+#: of its Taylor run (whose error, far below 1e3 × this on the one to four periods it covers, is added to its margin)
+SCREEN_POINTS = 512
+SCREEN_TOLERANCE = 1e-9
 
 
 class Auto(Integrator):
@@ -122,12 +144,14 @@ class Auto(Integrator):
         tau, pilot_nfev = float(np.clip(self.accuracy * FIRST_RATIO, MIN_TOLERANCE, MAX_TOLERANCE / 10)), 0
         # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance
         self._order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
+        loose = None  # the previous round's loose run (tolerance, solution): the next round's tight run
         for _ in range(3):
-            pilot_tau = tau
-            per_tol, growth, nfev, measured, tight = self._pilot(fun, pilot_times, y0, compiled, tau)
+            per_tol, growth, nfev, measured, (tight_tol, tight), loose = self._pilot(fun, pilot_times, y0, compiled,
+                                                                                     tau, loose)
             pilot_nfev += nfev
             # per_tol bounds the truncation error even when the pilot saw only round-off
-            chosen = min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
+            chosen = MAX_TOLERANCE if per_tol == 0 else \
+                min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
             if not measured and tau < MAX_TOLERANCE / 100:  # only round-off seen: measure with a looser pilot
                 tau *= 100
             elif chosen > 10 * tau:  # re-centre: never extrapolate far towards looser tolerances
@@ -137,7 +161,7 @@ class Auto(Integrator):
         # Round-off of the compensated Taylor update grows as a random walk over the steps (see the module's
         # note), that of scipy's plain update by up to an ulp per step: a target below it cannot be met in
         # double precision, whatever the tolerance.
-        steps = self._pilot_steps / self.pilot_fraction * max(1.0, (pilot_tau / 100 / chosen) ** (1.0 / self._order))
+        steps = self._pilot_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / self._order))
         compensated = self._method(compiled, chosen).name == "taylor"
         roundoff = np.finfo(float).eps * scale * (math.sqrt(steps) if compensated else steps)
         if roundoff > self.accuracy:
@@ -146,7 +170,7 @@ class Auto(Integrator):
         if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         method = self._method(compiled, chosen)
-        if pilot_tau * 1e-2 <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
+        if tight_tol <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
             head = np.searchsorted(pilot_times, t_out[t_out < t_pilot])  # the outputs inside the pilot
             rest = t_out[t_out >= t_pilot]
             tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest,
@@ -157,6 +181,7 @@ class Auto(Integrator):
         else:
             solution = method.integrate(fun, t_out, y0, progress, compiled)
             y, final_stats, n_steps = solution.y, solution.stats, solution.stats.n_steps
+        self.raw_predicted_error = per_tol * chosen  # before CALIBRATION and round-off: what the calibration measures
         self.choice = {
             "auto_method": method.name,
             "auto_tolerance": chosen,
@@ -184,7 +209,7 @@ class Auto(Integrator):
         for name in registry.names("regime"):
             try:
                 base = registry.load("regime", name)()
-                if self.system.name in base.systems:
+                if self.system.name in base.systems and not self._misses_orbits(base, fun, y0, compiled, span):
                     ladder = getattr(base, "series_candidates", lambda system, accuracy: [(base, None)])
                     candidates += [(name, r, float("nan") if e is None else float(e))
                                    for r, e in ladder(self.system, self.accuracy / self.safety)]
@@ -237,12 +262,66 @@ class Auto(Integrator):
                                                       wall_time=time.perf_counter() - start))
         return None
 
+    def _misses_orbits(self, base: Any, fun: RightHandSide, y0: np.ndarray, compiled: CompiledModel,
+                       span: float) -> bool:
+        """Whether the scene is certainly on none of the orbits ``base``'s variants describe, from the scene's own
+        motion over one period: a necessary condition of the series check below, evaluated before any series
+        is built (it would cost ~2 ms warm, ~0.4 s on a process's first call, on the many scenes that start on
+        no regime's orbit).
+
+        The check below takes a variant only when the scene starts within accuracy/(10·safety) of the variant's
+        orbit (its start S(0)) and the variant stays within accuracy/safety of the scene's motion Φ over a window
+        ending at its period T_S (all of the period once the span covers it); the variant is periodic,
+        S(T_S) = S(0), hence |Φ(T_S) − y0| ≤ 1.1·accuracy/safety. The regime's ``period_spread`` bounds T_S to
+        [T/spread, T·spread] around its cheap ``period`` T, and Φ is sampled on a grid there: T_S is within
+        half a spacing h of a grid time, where Φ differs from Φ(T_S) by at most max|Φ'|·h/2. So a scene whose
+        motion stays farther than 1.1·accuracy/safety + max|Φ'|·h/2 (+ the integration error) from y0 over
+        the whole range cannot be taken, and the regime is skipped.
+        """
+        spread = getattr(base, "period_spread", None)
+        if spread is None:
+            return False
+        from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+        try:
+            with np.errstate(all="ignore"):
+                period = float(base.period(self.system))
+        except GyrolabError:
+            return False  # no cheap period: the full check decides (and refuses what does not apply)
+        lo, hi = period / spread, period * spread
+        if not (np.isfinite(hi) and 0 < lo) or hi > span:
+            return False  # the check's window is then the span, not a period: no periodicity to use
+        times = np.concatenate([[0.0], np.linspace(lo, hi, SCREEN_POINTS)])
+        y = Taylor(tol=SCREEN_TOLERANCE).integrate(fun, times, y0, None, compiled).y[1:, :6]
+        h = times[2] - times[1]
+        # max|Φ'| over the range from the secants, doubled: the secants' largest slope falls short of it by O(h²)
+        speed = 2 * float(np.max(np.abs(np.diff(y, axis=0)))) / h
+        scale = max(1.0, float(np.max(np.abs(y0[:6]))))
+        margin = 1.1 * self.accuracy / self.safety + speed * h / 2 + 1e3 * SCREEN_TOLERANCE * scale
+        # min over the grid of max over the components > margin; rows are ruled out one component at a time
+        # (numpy's row-wise max over 6 columns costs more than the integration)
+        near = np.arange(len(y))
+        for k in range(6):
+            near = near[np.abs(y[near, k] - y0[k]) <= margin]
+        return len(near) == 0
+
     def _pilot(self, fun: RightHandSide, times: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
-               tau: float) -> tuple[float, float, int, bool, Solution]:
+               tau: float, previous: tuple[float, Solution] | None
+               ) -> tuple[float, float, int, bool, tuple[float, Solution], tuple[float, Solution]]:
         """(raw predicted final error per unit tolerance, growth exponent q, evaluations, whether the pilot
-        measured an error above round-off, the τ/100 run) from runs at τ and τ/100."""
+        measured an error above round-off, the tight run and the loose run as (tolerance, solution)) from runs
+        at τ and a tighter τ_t: the previous round's loose run when τ_t ≤ τ/10 (a re-centred or loosened round
+        reuses it), else a new run at min(τ/100, accuracy/TIGHT_RATIO). The error at τ is then the runs' difference × τ/(τ − τ_t)."""
         loose = self._method(compiled, tau).integrate(fun, times, y0, None, compiled)
-        tight = self._method(compiled, tau * 1e-2).integrate(fun, times, y0, None, compiled)
+        if previous is not None and previous[0] <= tau / 10:
+            tight_tol, tight = previous
+            tight_nfev = 0
+        else:
+            # τ/100, or tighter where τ is held at MIN_TOLERANCE far above the final tolerance (~accuracy/1000): the
+            # tight run must be at least as accurate as the final one to be its start
+            tight_tol = min(tau * 1e-2, self.accuracy / TIGHT_RATIO)
+            tight = self._method(compiled, tight_tol).integrate(fun, times, y0, None, compiled)
+            tight_nfev = tight.stats.nfev
         # Envelope of the error: pointwise errors of periodic motions dip through zero.
         envelope = np.maximum.accumulate(np.max(np.abs(loose.y - tight.y), axis=1))
         # differences within a few hundred ulps are round-off, not a measurement of the truncation error
@@ -254,9 +333,9 @@ class Auto(Integrator):
         growth = MIN_GROWTH
         if np.all(envelope[late] > 0):
             growth = float(np.clip(_slope(np.log(elapsed[late]), np.log(envelope[late])), MIN_GROWTH, 4.0))
-        per_tol = envelope[-1] / tau * (1.0 / self.pilot_fraction) ** growth
+        per_tol = envelope[-1] / (tau - tight_tol) * (1.0 / self.pilot_fraction) ** growth
         self._pilot_steps = tight.stats.n_steps
-        return per_tol, growth, loose.stats.nfev + tight.stats.nfev, measured, tight
+        return per_tol, growth, loose.stats.nfev + tight_nfev, measured, (tight_tol, tight), (tau, loose)
 
     def attributes(self) -> dict[str, Any]:
         return {"accuracy": self.accuracy, **self.choice}

@@ -91,6 +91,11 @@ class FixedPointRegime(Regime):
     ``periods`` periods of the analytic orbit).
     """
 
+    #: Every orbit ``integrator=auto`` may take from this regime (each of ``series_candidates``) has its period
+    #: within this factor of ``period(system)``, which is cheap (no series built, no shooting); None: unknown or
+    #: expensive. auto then rules the regime out from one period of the scene's own motion (``Auto._misses_orbits``).
+    period_spread: float | None = None
+
     def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200) -> None:
         super().__init__(formula=formula)
         for key, value in (("periods", periods), ("samples_per_period", samples_per_period)):

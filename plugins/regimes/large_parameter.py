@@ -30,7 +30,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.physics import pendulum
 from gyrolab.physics.continuation import Section, _evaluate, shoot_section
 from gyrolab.physics.periodic import FixedPointModel
 from gyrolab.plugins.regimes import ismail2021 as paper
@@ -76,6 +75,8 @@ class SlowSpinSeries:
         """Five shootings; use ``series_for`` (cached per (a, b, k, θ0))."""
         model = FixedPointModel(np.array([a, b, 1.0]), np.array([0.0, 0.0, 1.0]), k)
         section = Section("turning", float(np.cos(theta0)))
+        from gyrolab.physics import pendulum  # scipy.special: imported when a series is built, not with the plugin
+
         T0 = pendulum.period(b, pendulum.kappa(a, k), theta0)
         swing = shoot_section(model, section, np.zeros(2), T0, 0.0)
         if abs(swing.period - T0) > 1e-9 * T0:
@@ -199,6 +200,8 @@ class LargeParameter(FixedPointRegime):
         if not MIN_TILT <= s.theta0 <= MAX_TILT:
             raise ConfigError(f"regime large_parameter needs a swing amplitude {MIN_TILT:g} ≤ θ0 ≤ {MAX_TILT:g}, got "
                               f"θ0={s.theta0:.4g}")
+        from gyrolab.physics import pendulum
+
         kap = pendulum.kappa(s.a, s.k)
         if not 1 + kap * np.cos(s.theta0) > 0 or not 1 + kap > 0:
             raise ConfigError(f"regime large_parameter needs a swing about the lowest position, 1 + κ cos θ > 0 with "
