@@ -47,86 +47,160 @@ LANES = 4  # trajectories advanced in lock step: one AVX2 vector of doubles
 TASK = 256  # trajectories per parallel task, at most
 STATE = 6  # (ω, γ)
 SUMS = 9  # Cauchy sums per order: pairs of ω (3), pairs of γ (3), γ × ω (3)
-RUNNING = -1  # a lane's trajectory after a step that did not reach the last output time
+
+
+def _vector_arrays(arrays) -> bool:
+    """The intrinsics' arrays: C-contiguous float64, lanes innermost."""
+    return all(isinstance(a, types.Array) and a.layout == "C" and a.dtype == types.float64 for a in arrays)
+
+
+class _Lanes:
+    """LLVM IR helpers of the intrinsics: arrays of doubles seen as rows of ``<LANES x double>`` vectors."""
+
+    def __init__(self, context, builder, signature, args):
+        self.builder = builder
+        self.vec = ir.VectorType(ir.DoubleType(), LANES)
+        self.arrays = [builder.bitcast(context.make_array(ty)(context, builder, value).data, self.vec.as_pointer())
+                       if isinstance(ty, types.Array) else value for ty, value in zip(signature.args, args)]
+
+    def ptr(self, array, row):
+        """Pointer to vector ``row`` (an int or an LLVM integer) of ``array`` (an argument's position)."""
+        index = ir.Constant(ir.IntType(64), row) if isinstance(row, int) else row
+        return self.builder.gep(self.arrays[array], [index])
+
+    def load(self, array, row):
+        return self.builder.load(self.ptr(array, row), align=8)
+
+    def store(self, value, array, row):
+        self.builder.store(value, self.ptr(array, row), align=8)
+
+    def row(self, index, column):
+        """The vector row of T[index, column]: index · STATE + column."""
+        b = self.builder
+        return b.add(b.mul(index, ir.Constant(index.type, STATE)), ir.Constant(index.type, column))
+
+    def splat(self, scalar):
+        b = self.builder
+        one = b.insert_element(ir.Constant(self.vec, ir.Undefined), scalar, ir.Constant(ir.IntType(32), 0))
+        return b.shuffle_vector(one, ir.Constant(self.vec, ir.Undefined), ir.Constant(ir.VectorType(ir.IntType(32), LANES),
+                                                                                      [0] * LANES))
+
+    def variables(self, count):
+        """Vector variables (stack slots that LLVM promotes to registers)."""
+        return [cgutils.alloca_once(self.builder, self.vec) for _ in range(count)]
+
+
+FUSE = ("contract",)  # the series' multiply and add may fuse (as in the scalar kernel's fastmath)
 
 
 @intrinsic
-def _cauchy_sums(typingctx, T, k, acc):
-    """acc[s, :] = the k-th coefficients of the nine quadratic products, every lane at once.
+def _series(typingctx, T, order, Q):
+    """Fill T[1..order] from T[0] in every lane: ``fixed_point.taylor_coefficients`` without α, lanes in columns.
 
-    T is C-contiguous (order+1, STATE, LANES) (rows 0..k filled), acc C-contiguous (SUMS, LANES):
-    acc[0:3] = Σ_j (ω1_j ω2_{k−j}, ω2_j ω0_{k−j}, ω0_j ω1_{k−j}), acc[3:6] the same for γ,
-    acc[6:9] = Σ_j γ_j × ω_{k−j}: the sums ``fixed_point.taylor_coefficients`` forms, per lane.
+    T is (order+1, STATE, LANES), Q (10, LANES) the lanes' constants (``_load``). Order k's coefficient is
+    F_k / (k + 1), with F_k from the Cauchy sums of the quadratic products, each a sum over j of
+    ω_j ω_{k−j}-type terms: pairs of ω (s0..s2), pairs of γ (s3..s5), γ × ω (s6..s8):
+    ω̇_x = (I_y − I_z)/I_x (ω_y ω_z − N_2 γ_y γ_z) + (U_y γ_z − U_z γ_y)/I_x (and cyclically), γ̇ = γ × ω.
+    The sums run over nine vector accumulators in registers, twelve vector loads and twelve fused
+    multiply-adds per term.
     """
-    if not (isinstance(T, types.Array) and T.ndim == 3 and T.layout == "C" and T.dtype == types.float64
-            and isinstance(acc, types.Array) and acc.ndim == 2 and acc.layout == "C" and acc.dtype == types.float64
-            and isinstance(k, types.Integer)):
+    if not (_vector_arrays([T, Q]) and T.ndim == 3 and Q.ndim == 2 and isinstance(order, types.Integer)):
         return None
-    sig = types.void(T, k, acc)
+    sig = types.void(T, order, Q)
 
     def codegen(context, builder, signature, args):
-        vec = ir.VectorType(ir.DoubleType(), LANES)
-        rows = builder.bitcast(context.make_array(signature.args[0])(context, builder, args[0]).data, vec.as_pointer())
-        out = builder.bitcast(context.make_array(signature.args[2])(context, builder, args[2]).data, vec.as_pointer())
-        order_k = context.cast(builder, args[1], signature.args[1], types.intp)
-        sums = [cgutils.alloca_once_value(builder, ir.Constant(vec, [0.0] * LANES)) for _ in range(SUMS)]
-        fuse = ("contract",)  # multiply and add may fuse (as in the scalar kernel's fastmath)
+        v = _Lanes(context, builder, signature, args)
+        b = builder
+        p = context.cast(builder, args[1], signature.args[1], types.intp)
+        q = [v.load(2, r) for r in range(10)]
+        sums = v.variables(SUMS)
+        zero = ir.Constant(v.vec, [0.0] * LANES)
 
-        def load(row, c):
-            return builder.load(builder.gep(rows, [builder.add(row, ir.Constant(row.type, c))]), align=8)
+        def add(s, x, y, subtract=False):
+            product = b.fmul(x, y, flags=FUSE)
+            old = b.load(sums[s])
+            b.store(b.fsub(old, product, flags=FUSE) if subtract else b.fadd(old, product, flags=FUSE), sums[s])
 
-        def accumulate(s, x, y, subtract=False):
-            product = builder.fmul(x, y, flags=fuse)
-            value = builder.load(sums[s])
-            value = builder.fsub(value, product, flags=fuse) if subtract else builder.fadd(value, product, flags=fuse)
-            builder.store(value, sums[s])
+        with cgutils.for_range(b, p) as order_loop:
+            k = order_loop.index
+            for s in sums:
+                b.store(zero, s)
+            with cgutils.for_range(b, b.add(k, ir.Constant(k.type, 1))) as term:
+                j = term.index
+                m = b.sub(k, j)
+                w0, w1, w2, g0, g1, g2 = [v.load(0, v.row(j, c)) for c in range(STATE)]
+                W0, W1, W2, G0, G1, G2 = [v.load(0, v.row(m, c)) for c in range(STATE)]
+                add(0, w1, W2)
+                add(1, w2, W0)
+                add(2, w0, W1)
+                add(3, g1, G2)
+                add(4, g2, G0)
+                add(5, g0, G1)
+                add(6, g1, W2)
+                add(6, g2, W1, subtract=True)
+                add(7, g2, W0)
+                add(7, g0, W2, subtract=True)
+                add(8, g0, W1)
+                add(8, g1, W0, subtract=True)
+            s = [b.load(x) for x in sums]
+            e0, e1, e2 = [v.load(0, v.row(k, c)) for c in (3, 4, 5)]
+            inv = v.splat(b.fdiv(ir.Constant(ir.DoubleType(), 1.0),
+                                  b.sitofp(b.add(k, ir.Constant(k.type, 1)), ir.DoubleType())))
+            k1 = b.add(k, ir.Constant(k.type, 1))
 
-        with cgutils.for_range(builder, builder.add(order_k, ir.Constant(order_k.type, 1))) as loop:
-            j = loop.index
-            row_j = builder.mul(j, ir.Constant(j.type, STATE))
-            row_m = builder.mul(builder.sub(order_k, j), ir.Constant(j.type, STATE))
-            w0, w1, w2, g0, g1, g2 = [load(row_j, c) for c in range(STATE)]
-            W0, W1, W2, G0, G1, G2 = [load(row_m, c) for c in range(STATE)]
-            accumulate(0, w1, W2)
-            accumulate(1, w2, W0)
-            accumulate(2, w0, W1)
-            accumulate(3, g1, G2)
-            accumulate(4, g2, G0)
-            accumulate(5, g0, G1)
-            accumulate(6, g1, W2)
-            accumulate(6, g2, W1, subtract=True)
-            accumulate(7, g2, W0)
-            accumulate(7, g0, W2, subtract=True)
-            accumulate(8, g0, W1)
-            accumulate(8, g1, W0, subtract=True)
-        for s in range(SUMS):
-            builder.store(builder.load(sums[s]), builder.gep(out, [ir.Constant(ir.IntType(64), s)]), align=8)
+            def mul(x, y):
+                return b.fmul(x, y, flags=FUSE)
+
+            def sub(x, y):
+                return b.fsub(x, y, flags=FUSE)
+
+            def plus(x, y):
+                return b.fadd(x, y, flags=FUSE)
+
+            rate = [plus(mul(q[0], sub(s[0], mul(q[3], s[3]))), sub(mul(q[4], e2), mul(q[5], e1))),
+                    plus(mul(q[1], sub(s[1], mul(q[3], s[4]))), sub(mul(q[6], e0), mul(q[7], e2))),
+                    plus(mul(q[2], sub(s[2], mul(q[3], s[5]))), sub(mul(q[8], e1), mul(q[9], e0))),
+                    s[6], s[7], s[8]]
+            for c in range(STATE):
+                v.store(mul(rate[c], inv), 0, v.row(k1, c))
         return context.get_dummy_value()
 
     return sig, codegen
 
 
-@kernel
-def _coefficients(P, T, order, acc):
-    """Fill T[1..order] from T[0] in every lane: ``fixed_point.taylor_coefficients`` without α, lanes in columns.
+@intrinsic
+def _update(typingctx, T, order, H, carry):
+    """Every lane's state T[0] += Σ_{k≥1} T[k] h^k (Horner), a compensated (Kahan) sum with ``carry``.
 
-    Y[k+1] = F_k / (k + 1), F_k from the Cauchy sums: ω̇ = I⁻¹((Iω) × ω + U_2 × γ + N_2 γ × Iγ), γ̇ = γ × ω.
+    H is (1, LANES): the lanes' steps (0 in idle lanes); carry (STATE, LANES). The Horner sums may fuse
+    multiply and add; the Kahan update is strict (``taylor.run``'s arithmetic), and the six components'
+    Horner chains interleave.
     """
-    for k in range(order):
-        _cauchy_sums(T, k, acc)
-        inv = 1.0 / (k + 1)
-        for lane in range(LANES):
-            I0, I1, I2 = P[0, lane], P[1, lane], P[2, lane]
-            d0, d1, d2 = I1 - I2, I2 - I0, I0 - I1  # ((Iω) × ω) = (d0 ω_y ω_z, d1 ω_z ω_x, d2 ω_x ω_y)
-            n2 = P[14, lane]
-            u0, u1, u2 = P[9, lane], P[10, lane], P[11, lane]
-            e0, e1, e2 = T[k, 3, lane], T[k, 4, lane], T[k, 5, lane]
-            T[k + 1, 0, lane] = (d0 * (acc[0, lane] - n2 * acc[3, lane]) + u1 * e2 - u2 * e1) * P[16, lane] * inv
-            T[k + 1, 1, lane] = (d1 * (acc[1, lane] - n2 * acc[4, lane]) + u2 * e0 - u0 * e2) * P[17, lane] * inv
-            T[k + 1, 2, lane] = (d2 * (acc[2, lane] - n2 * acc[5, lane]) + u0 * e1 - u1 * e0) * P[18, lane] * inv
-            T[k + 1, 3, lane] = acc[6, lane] * inv
-            T[k + 1, 4, lane] = acc[7, lane] * inv
-            T[k + 1, 5, lane] = acc[8, lane] * inv
+    if not (_vector_arrays([T, H, carry]) and T.ndim == 3 and isinstance(order, types.Integer)):
+        return None
+    sig = types.void(T, order, H, carry)
+
+    def codegen(context, builder, signature, args):
+        v = _Lanes(context, builder, signature, args)
+        b = builder
+        p = context.cast(builder, args[1], signature.args[1], types.intp)
+        h = v.load(2, 0)
+        acc = v.variables(STATE)
+        for c in range(STATE):
+            b.store(v.load(0, v.row(p, c)), acc[c])
+        with cgutils.for_range(b, b.sub(p, ir.Constant(p.type, 1))) as loop:
+            k = b.sub(b.sub(p, ir.Constant(p.type, 1)), loop.index)  # order − 1 … 1
+            for c in range(STATE):
+                b.store(b.fadd(b.fmul(b.load(acc[c]), h, flags=FUSE), v.load(0, v.row(k, c)), flags=FUSE), acc[c])
+        for c in range(STATE):
+            y = v.load(0, c)
+            inc = b.fsub(b.fmul(b.load(acc[c]), h), v.load(3, c))
+            total = b.fadd(y, inc)
+            v.store(b.fsub(b.fsub(total, y), inc), 3, c)
+            v.store(total, 0, c)
+        return context.get_dummy_value()
+
+    return sig, codegen
 
 
 def task_size(count: int) -> int:
@@ -150,13 +224,29 @@ def run_blocks(Params, order, tol, t_out, Y0, Y, steps, status, task_size):
 
 
 @kernel
-def _load(lane, j, Y0, Params, T, P, carry):
-    """Put trajectory j into ``lane`` (or, with j < 0, make the lane idle: a zero state, whose series is zero)."""
+def _load(lane, j, Y0, Params, T, Q, carry):
+    """Put trajectory j into ``lane`` (or, with j < 0, make the lane idle: a zero state, whose series is zero).
+
+    Q[:, lane] = the constants of its right-hand side (``_series``): (I_y − I_z)/I_x (and cyclically),
+    N_2, and U_2's components over the inertia, U_y/I_x, U_z/I_x, U_z/I_y, U_x/I_y, U_x/I_z, U_y/I_z.
+    """
     for c in range(STATE):
         T[0, c, lane] = Y0[j, c] if j >= 0 else 0.0
         carry[c, lane] = 0.0
-    for c in range(P.shape[0]):
-        P[c, lane] = Params[j, c] if j >= 0 else 0.0
+    if j < 0:
+        for r in range(Q.shape[0]):
+            Q[r, lane] = 0.0
+        return
+    p = Params[j]
+    I0, I1, I2 = p[0], p[1], p[2]
+    u0, u1, u2 = p[9], p[10], p[11]
+    Q[0, lane] = (I1 - I2) * p[16]
+    Q[1, lane] = (I2 - I0) * p[17]
+    Q[2, lane] = (I0 - I1) * p[18]
+    Q[3, lane] = p[14]
+    Q[4, lane], Q[5, lane] = u1 * p[16], u2 * p[16]
+    Q[6, lane], Q[7, lane] = u2 * p[17], u0 * p[17]
+    Q[8, lane], Q[9, lane] = u0 * p[18], u1 * p[18]
 
 
 @kernel
@@ -165,10 +255,11 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, first, stop):
     n_out = t_out.size
     t_end = t_out[n_out - 1]
     T = np.zeros((order + 1, STATE, LANES))
-    acc = np.zeros((SUMS, LANES))
-    P = np.zeros((Params.shape[1], LANES))
+    Q = np.zeros((10, LANES))
+    H = np.zeros((1, LANES))  # each lane's step (0 in idle lanes)
     carry = np.zeros((STATE, LANES))  # the Kahan compensation of each lane's state
     t = np.zeros(LANES)
+    t_next = np.zeros(LANES)
     index = np.zeros(LANES, dtype=np.int64)  # each lane's next output time
     traj = np.full(LANES, -1, dtype=np.int64)
     safety = math.exp(-0.7 / (order - 1))
@@ -176,48 +267,54 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, first, stop):
     for lane in range(LANES):
         if following < stop:
             traj[lane] = following
+            Y[following, 0] = Y0[following]
             following += 1
-        _load(lane, traj[lane], Y0, Params, T, P, carry)
+        _load(lane, traj[lane], Y0, Params, T, Q, carry)
         t[lane] = t_out[0]
         index[lane] = 1
-        if traj[lane] >= 0:
-            Y[traj[lane], 0] = Y0[traj[lane]]
     busy = min(LANES, stop - first)
     while busy > 0:
-        _coefficients(P, T, order, acc)
+        _series(T, order, Q)
+        for lane in range(LANES):
+            j = traj[lane]
+            if j >= 0:
+                t_next[lane] = _step(lane, T, order, tol, safety, t_out, t_end, t[lane], index, carry, Y[j])
+                H[0, lane] = t_next[lane] - t[lane]
+        _update(T, order, H, carry)
         for lane in range(LANES):
             j = traj[lane]
             if j < 0:
                 continue
-            code = _advance(lane, T, order, tol, safety, t_out, t_end, t, index, carry, Y[j])
-            if code == RUNNING:
+            finite = True
+            for c in range(STATE):
+                finite = finite and math.isfinite(T[0, c, lane])
+            if finite:
                 steps[j] += 1
-                continue
-            if code == NOT_FINITE:  # its outputs from the failed step on are NaN
+                t[lane] = t_next[lane]
+                if index[lane] < n_out:
+                    continue
+                status[j] = OK
+            else:  # its outputs from the failed step on are NaN
+                status[j] = NOT_FINITE
                 for i in range(index[lane], n_out):
                     for c in range(STATE):
                         Y[j, i, c] = np.nan
-            else:
-                steps[j] += 1
-            status[j] = code
             traj[lane] = following if following < stop else -1  # the lane takes the task's next trajectory
             if following < stop:
+                Y[following, 0] = Y0[following]
                 following += 1
-                Y[traj[lane], 0] = Y0[traj[lane]]
             else:
                 busy -= 1
-            _load(lane, traj[lane], Y0, Params, T, P, carry)
+            _load(lane, traj[lane], Y0, Params, T, Q, carry)
             t[lane] = t_out[0]
             index[lane] = 1
-
+            H[0, lane] = 0.0
 
 
 @kernel
-def _advance(lane, T, order, tol, safety, t_out, t_end, t, index, carry, Yj):
-    """One step of ``lane`` with its series T[:, :, lane]: ``taylor.run``'s step rule, dense output and Kahan update.
-
-    Returns RUNNING, OK (the last output time is filled) or NOT_FINITE (the state became non-finite).
-    """
+def _step(lane, T, order, tol, safety, t_out, t_end, t, index, carry, Yj):
+    """The end of ``lane``'s next step (``taylor.run``'s step rule from its series T[:, :, lane], starting at t)
+    and the outputs that step covers (Horner evaluation of the series, the Kahan carry subtracted, as there)."""
     scale = 1.0
     n1 = 0.0
     n2 = 0.0
@@ -231,15 +328,13 @@ def _advance(lane, T, order, tol, safety, t_out, t_end, t, index, carry, Yj):
     if n2 > 0:
         h = min(h, (tol * scale / n2) ** (1.0 / order))
     h *= safety
-    t0 = t[lane]
     if not h < np.inf:
-        h = t_end - t0
-    t_new = min(t0 + h, t_end)
-    h = t_new - t0
+        h = t_end - t
+    t_new = min(t + h, t_end)
     n_out = t_out.size
     i = index[lane]
     while i < n_out and t_out[i] <= t_new:
-        dt = t_out[i] - t0
+        dt = t_out[i] - t
         for c in range(STATE):
             v = T[order, c, lane]
             for k in range(order - 1, 0, -1):
@@ -247,21 +342,7 @@ def _advance(lane, T, order, tol, safety, t_out, t_end, t, index, carry, Yj):
             Yj[i, c] = T[0, c, lane] + (v * dt - carry[c, lane])
         i += 1
     index[lane] = i
-    finite = True
-    for c in range(STATE):
-        v = T[order, c, lane]
-        for k in range(order - 1, 0, -1):
-            v = v * h + T[k, c, lane]
-        y = T[0, c, lane]
-        inc = v * h - carry[c, lane]  # Kahan: y + v·h with the bits lost in earlier additions carried
-        s = y + inc
-        carry[c, lane] = (s - y) - inc
-        T[0, c, lane] = s
-        finite = finite and math.isfinite(s)
-    if not finite:
-        return NOT_FINITE
-    t[lane] = t_new
-    return OK if i >= n_out else RUNNING
+    return t_new
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
