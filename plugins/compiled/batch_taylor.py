@@ -43,6 +43,8 @@ from numba.extending import intrinsic
 from gyrolab.plugins.compiled import kernel, taylor
 from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK
 
+TOO_SMALL_STEP = 1  # a step that does not advance time (dop853's code; the single Taylor kernel has none)
+
 LANES = 4  # trajectories advanced in lock step: one AVX2 vector of doubles
 TASK = 256  # trajectories per parallel task, at most
 STATE = 6  # (ω, γ)
@@ -213,8 +215,9 @@ def task_size(count: int) -> int:
 def run_blocks(Params, order, tol, t_out, Y0, Y, steps, status, task_size):
     """Every trajectory j (initial (ω, γ) Y0[j], fixed-point parameters Params[j] without α) over t_out into Y[j].
 
-    steps[j] receives its number of steps, status[j] OK or NOT_FINITE (its outputs from the failed
-    step on are NaN). t_out has at least two times. Tasks of ``task_size`` trajectories run in parallel.
+    steps[j] receives its number of steps, status[j] OK, NOT_FINITE or TOO_SMALL_STEP (a step of a
+    huge series that does not advance time; the single kernel would loop forever); its outputs from the
+    failed step on are NaN. t_out has at least two times. Tasks of ``task_size`` trajectories run in parallel.
     """
     count = Y0.shape[0]
     n_tasks = (count + task_size - 1) // task_size
@@ -288,14 +291,14 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, first, stop):
             finite = True
             for c in range(STATE):
                 finite = finite and math.isfinite(T[0, c, lane])
-            if finite:
+            if finite and t_next[lane] > t[lane]:
                 steps[j] += 1
                 t[lane] = t_next[lane]
                 if index[lane] < n_out:
                     continue
                 status[j] = OK
-            else:  # its outputs from the failed step on are NaN
-                status[j] = NOT_FINITE
+            else:  # non-finite, or a step too small to advance time: its outputs from here on are NaN
+                status[j] = NOT_FINITE if not finite else TOO_SMALL_STEP
                 for i in range(index[lane], n_out):
                     for c in range(STATE):
                         Y[j, i, c] = np.nan
