@@ -70,16 +70,20 @@ def test_a_lane_does_not_depend_on_its_neighbours(integrator):
 
 def test_taylor_lanes_take_the_steps_of_the_single_trajectory_kernel():
     """The lane kernel against ``taylor.run`` on each trajectory (one per thread, ``run_each``), easy and hard
-    trajectories mixed: the same number of steps, and the same outputs to rounding (its vector sums fuse
-    multiply and add in another order; 1e-13 is a thousand tolerances below the 1e-10 asked)."""
+    trajectories mixed, each with its own A and Newtonian coefficient: the same number of steps, and the same
+    outputs to rounding (its vector sums fuse multiply and add in another order; 1e-13 is a thousand
+    tolerances below the 1e-10 asked)."""
     scene = _scene("taylor")
     y0s = _starts(scene, 11, seed=7)
     y0s[::3, 0:3] *= 4.0
-    batch = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s)
+    P = np.tile(scene.compiled.params, (len(y0s), 1))
+    P[:, 0] *= np.linspace(0.9, 1.1, len(y0s))  # A (and 1/A: parameters as fixed_point.pack lays them out)
+    P[:, 16] = 1.0 / P[:, 0]
+    P[:, 14] *= np.linspace(0.0, 2.0, len(y0s))  # N_2
+    batch = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s, P)
     out = np.empty_like(batch.y)
     out[:, 0] = y0s
     steps, status = np.zeros(len(y0s), dtype=np.int64), np.zeros(len(y0s), dtype=np.int64)
-    P = np.tile(scene.compiled.params, (len(y0s), 1))
     batch_taylor.run_each(scene.compiled.model, P, scene.integrator.order, scene.integrator.tol, scene.times, y0s,
                           out, steps, status)
     assert not status.any() and steps.min() < steps.max() / 2  # the mix: some take twice the steps of others
