@@ -2,28 +2,30 @@
 
 ``run_blocks`` (fixed-point (ω, γ) states) advances LANES = 4 trajectories in
 lock step, one AVX2 vector: their Taylor coefficients are stored
-[order, state, lane], lane innermost, and the Cauchy sums of all four lanes are
-computed together in 4-wide SIMD registers (``_cauchy_sums``). Each lane keeps
-its own time, step, Kahan carry and output index, with the single-trajectory
-kernel's step rule and dense output (``taylor.run``: same order, same
-Jorba–Zou step from the last two coefficients, Horner evaluation at the output
-times, compensated state update), so a lane takes the steps the single kernel
-takes on its trajectory, to rounding (the vector sums fuse multiply and add in
-another order than the scalar ones). A lane reads and writes only its own
-column, so its result does not depend on its neighbours. A lane whose
-trajectory has reached the last output time (or failed) takes the next
-trajectory of its task (``task_size`` trajectories; tasks run in parallel with
-``prange``), so easy and hard trajectories in one task leave no lane idle until
-the task's last trajectories.
+[order, state, lane], lane innermost, and the series of all four lanes are
+computed together in 4-wide SIMD registers (``_series``), as is the state
+update (``_update``). Each lane keeps its own time, step, Kahan carry and
+output index, with the single-trajectory kernel's step rule and dense output
+(``taylor.run``: same order, same Jorba–Zou step from the last two
+coefficients, Horner evaluation at the output times, compensated state
+update), so a lane takes the steps the single kernel takes on its trajectory,
+to rounding (the vector sums fuse multiply and add in another order than the
+scalar ones). A lane reads and writes only its own column, so its result does
+not depend on its neighbours. Taylor rejects no step: every busy lane advances
+at every step. A lane whose trajectory has reached the last output time (or
+failed) takes the next trajectory of its task (``task_size`` trajectories;
+tasks run in parallel with ``prange``), so easy and hard trajectories in one
+task leave no lane idle until the task's last trajectories.
 
-Why an LLVM intrinsic: written as numba loops, the Cauchy sums are reductions
+Why LLVM intrinsics: written as numba loops, the Cauchy sums are reductions
 whose accumulators LLVM keeps in memory when the loop over lanes is innermost
-(numba does not run LLVM's SLP vectoriser, and its loop vectoriser fully
-unrolls a 4-lane loop before it could vectorise it); such a lock-step kernel
-was 1.2–2× slower than one trajectory per thread. The intrinsic emits the sums
-over ``<4 x double>`` values directly: nine vector accumulators in registers,
-twelve vector loads and twelve fused multiply-adds per term of the sums, 2×
-faster per trajectory than the scalar sums (``docs/performance.md``).
+(numba does not run LLVM's SLP vectoriser, and a 4-iteration lane loop is
+unrolled before the loop vectoriser could vectorise it); such a lock-step
+kernel was 1.2–2× slower than one trajectory per thread. The intrinsics emit
+the arithmetic over ``<4 x double>`` values directly: nine vector accumulators
+in registers, twelve vector loads and twelve fused multiply-adds per term of
+the sums; a whole step costs 2.7× less per trajectory than one trajectory per
+thread (``docs/performance.md``, "Taylor lanes").
 
 ``run_each`` serves every other model with Taylor coefficients, one trajectory
 per thread, with the single-trajectory kernel itself.
@@ -49,6 +51,7 @@ LANES = 4  # trajectories advanced in lock step: one AVX2 vector of doubles
 TASK = 256  # trajectories per parallel task, at most
 STATE = 6  # (ω, γ)
 SUMS = 9  # Cauchy sums per order: pairs of ω (3), pairs of γ (3), γ × ω (3)
+CONSTANTS = 10  # a lane's right-hand-side constants (``_load``)
 
 
 def _vector_arrays(arrays) -> bool:
@@ -99,10 +102,11 @@ FUSE = ("contract",)  # the series' multiply and add may fuse (as in the scalar 
 def _series(typingctx, T, order, Q):
     """Fill T[1..order] from T[0] in every lane: ``fixed_point.taylor_coefficients`` without α, lanes in columns.
 
-    T is (order+1, STATE, LANES), Q (10, LANES) the lanes' constants (``_load``). Order k's coefficient is
+    T is (order+1, STATE, LANES), Q (CONSTANTS, LANES) the lanes' constants (``_load``). Order k's coefficient is
     F_k / (k + 1), with F_k from the Cauchy sums of the quadratic products, each a sum over j of
     ω_j ω_{k−j}-type terms: pairs of ω (s0..s2), pairs of γ (s3..s5), γ × ω (s6..s8):
-    ω̇_x = (I_y − I_z)/I_x (ω_y ω_z − N_2 γ_y γ_z) + (U_y γ_z − U_z γ_y)/I_x (and cyclically), γ̇ = γ × ω.
+    ω̇_x = (I_y − I_z)/I_x (ω_y ω_z − N_2 γ_y γ_z) + (U_y γ_z − U_z γ_y)/I_x (and cyclically; U = U_2, the
+    torque U_2 × γ, N_2 γ × Iγ the gradient torque), γ̇ = γ × ω: ``fixed_point.rhs`` without α.
     The sums run over nine vector accumulators in registers, twelve vector loads and twelve fused
     multiply-adds per term.
     """
@@ -114,7 +118,7 @@ def _series(typingctx, T, order, Q):
         v = _Lanes(context, builder, signature, args)
         b = builder
         p = context.cast(builder, args[1], signature.args[1], types.intp)
-        q = [v.load(2, r) for r in range(10)]
+        q = [v.load(2, r) for r in range(CONSTANTS)]
         sums = v.variables(SUMS)
         zero = ir.Constant(v.vec, [0.0] * LANES)
 
@@ -258,7 +262,7 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, first, stop):
     n_out = t_out.size
     t_end = t_out[n_out - 1]
     T = np.zeros((order + 1, STATE, LANES))
-    Q = np.zeros((10, LANES))
+    Q = np.zeros((CONSTANTS, LANES))
     H = np.zeros((1, LANES))  # each lane's step (0 in idle lanes)
     carry = np.zeros((STATE, LANES))  # the Kahan compensation of each lane's state
     t = np.zeros(LANES)
