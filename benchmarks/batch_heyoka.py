@@ -3,6 +3,7 @@
     pip install -e ".[bench]"                      # heyoka (optional: its rows are skipped when absent)
     python benchmarks/batch_heyoka.py              # N = 100,000 (a few minutes on 2 cores)
     python benchmarks/batch_heyoka.py --n 10000 --rounds 2
+    python benchmarks/batch_heyoka.py --n 4000 --order-scan   # gyrolab taylor only: orders 10–18 × tolerances
 
 Issue 14's target: max error 1e-10 over N trajectories of the reference scene's
 body (``experiment=perf_reference``: A, B, C = 2, 1.5, 1, r_c = (0.3, 0.2,
@@ -17,12 +18,14 @@ itself checked against scipy's DOP853 at rtol = atol = 1e-13 on a subsample
 Contestants (each setting once per round, rounds interleave all of them, a
 contestant's time is its minimum wall time over the rounds; compilation and
 heyoka's JIT happen before the first round):
-- gyrolab ``integrate_arrays`` with ``taylor`` (tol), ``dop853_numba`` (rtol = atol)
-  and ``auto`` (accuracy 1e-10; its pilot on a few trajectories is included);
+- gyrolab ``integrate_arrays`` with ``taylor`` (tol, order from the tolerance; and the two explicit
+  (order, tol) settings ``--order-scan`` found cheapest), ``dop853_numba`` (rtol = atol) and ``auto``
+  (accuracy 1e-10; its pilot on a few trajectories is included);
 - heyoka ``taylor_adaptive_batch`` (batch size 4 = one AVX2 vector, ``propagate_grid``
   on the 11 times), two threads, each with its own integrator, over its share of the
   batches (the GIL is released inside heyoka's propagation).
-The cheapest setting of each method whose error is ≤ 1e-10 is its result.
+The cheapest setting of each method whose error is ≤ 1e-10 is its result. CPU time (all threads,
+``time.process_time``) is printed beside the wall time: on a shared machine it is the steadier of the two.
 """
 
 from __future__ import annotations
@@ -49,6 +52,9 @@ TIMES = np.linspace(0.0, 10.0, 11)
 HEYOKA_LANES = 4
 THREADS = 2
 SUBSAMPLE = 20
+#: (order, tol) of gyrolab taylor beside the orders from the tolerance: the cheapest under 1e-10 in
+#: ``--order-scan`` (N = 4,000, shared machine: within ~15 % of each other and of order 13 at tol 1e-10)
+EXPLICIT_ORDERS = [(15, 3e-11), (17, 3e-11)]
 
 
 def problem(n: int):
@@ -114,10 +120,36 @@ def reference(compiled, y0s: np.ndarray) -> tuple[np.ndarray, float]:
     return final, float(np.max(np.abs(scipy_final - final[rows])))
 
 
+def order_scan(compiled, y0s: np.ndarray, ref: np.ndarray, rounds: int) -> None:
+    """Print gyrolab taylor's minimum wall time and max error for orders 10–18 × tolerances, and the cheapest under TARGET."""
+    rows = []
+    print("\n| order | tol | wall (s) | mean steps | max error over N |")
+    print("|---|---|---|---|---|")
+    for order in range(10, 19):
+        for tol in [3e-9, 1e-9, 3e-10, 1e-10, 3e-11, 1e-11]:
+            taylor = Taylor(order=order, tol=tol)
+            integrate_arrays(compiled, taylor, TIMES, y0s[:HEYOKA_LANES])  # compiles (once: the order is an argument)
+            wall = np.inf
+            for _ in range(rounds):
+                start = time.perf_counter()
+                batch = integrate_arrays(compiled, taylor, TIMES, y0s)
+                wall = min(wall, time.perf_counter() - start)
+            steps = batch.steps.mean()
+            error = float(np.max(np.abs(batch.y[:, -1] - ref)))
+            rows.append((wall, order, tol, error))
+            print(f"| {order} | {tol:.0e} | {wall:.3f} | {steps:.1f} | {error:.1e} |")
+            sys.stdout.flush()
+    print(f"\ncheapest (order, tol) with max error ≤ {TARGET:g}:")
+    for wall, order, tol, error in sorted(row for row in rows if row[3] <= TARGET)[:5]:
+        print(f"- order {order}, tol {tol:.0e}: {wall:.3f} s, error {error:.1e}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--n", type=int, default=100_000, help="trajectories (default 100,000)")
     parser.add_argument("--rounds", type=int, default=3, help="interleaved rounds (default 3)")
+    parser.add_argument("--order-scan", action="store_true",
+                        help="only gyrolab taylor: time and error over orders 10–18 and tolerances 3e-9…1e-11")
     args = parser.parse_args()
     if args.n < HEYOKA_LANES or args.n % HEYOKA_LANES:
         parser.error(f"--n={args.n} must be a positive multiple of heyoka's batch size {HEYOKA_LANES}")
@@ -128,9 +160,13 @@ def main() -> None:
     print(f"reference: gyrolab taylor tol 1e-15; max difference from scipy DOP853 (rtol=atol=1e-13) on "
           f"{min(SUBSAMPLE, args.n)} trajectories: {agreement:.1e}")
     contestants, settings = {}, {}
-    for tol in [1e-9, 3e-10, 1e-10, 3e-11, 1e-11]:
-        contestants[("gyrolab taylor", tol)] = gyrolab_contestant(compiled, y0s, Taylor(tol=tol))
-        settings[("gyrolab taylor", tol)] = f"tol={tol:.0e}, order {Taylor(tol=tol).order}"
+    if args.order_scan:
+        order_scan(compiled, y0s, ref, args.rounds)
+        return
+    for order, tol in [(None, 1e-9), (None, 3e-10), (None, 1e-10), (None, 3e-11), (None, 1e-11), *EXPLICIT_ORDERS]:
+        taylor = Taylor(order=order, tol=tol)
+        contestants[("gyrolab taylor", (tol, order))] = gyrolab_contestant(compiled, y0s, taylor)
+        settings[("gyrolab taylor", (tol, order))] = f"tol={tol:.0e}, order {taylor.order}" + (" (explicit)" if order else "")
     for tol in [3e-11, 1e-11, 3e-12, 1e-12]:
         contestants[("gyrolab dop853_numba", tol)] = gyrolab_contestant(compiled, y0s, DOP853Numba(rtol=tol, atol=tol))
         settings[("gyrolab dop853_numba", tol)] = f"rtol=atol={tol:.0e}"
@@ -149,35 +185,38 @@ def main() -> None:
             gyrolab_contestant(compiled, small, Taylor(tol=1e-10) if "taylor" in key[0] else
                                DOP853Numba(rtol=1e-10, atol=1e-10))()
     best = {key: (np.inf, None) for key in contestants}
+    cpu = {key: np.inf for key in contestants}
     for _ in range(args.rounds):
         for key, call in contestants.items():
-            start = time.perf_counter()
+            start, start_cpu = time.perf_counter(), time.process_time()
             final = call()
             elapsed = time.perf_counter() - start
+            cpu[key] = min(cpu[key], time.process_time() - start_cpu)
             best[key] = (min(best[key][0], elapsed), final)
     settings[("gyrolab auto", TARGET)] = f"accuracy={TARGET:g} → {auto.choice.get('auto_method')} " \
                                          f"tol={auto.choice.get('auto_tolerance', float('nan')):.1e}"
-    print("\n| method | setting | wall (s) | trajectories/s | max error over N |")
-    print("|---|---|---|---|---|")
+    print("\n| method | setting | wall (s) | CPU (s, all threads) | trajectories/s | max error over N |")
+    print("|---|---|---|---|---|---|")
     errors = {}
     for key, (wall, final) in best.items():
         errors[key] = float(np.max(np.abs(final - ref)))
-        print(f"| {key[0]} | {settings[key]} | {wall:.2f} | {args.n / wall:,.0f} | {errors[key]:.1e} |")
-    print(f"\ncheapest setting reaching max error ≤ {TARGET:g}:")
+        print(f"| {key[0]} | {settings[key]} | {wall:.2f} | {cpu[key]:.2f} | {args.n / wall:,.0f} | {errors[key]:.1e} |")
+    print(f"\ncheapest setting reaching max error ≤ {TARGET:g} (by wall time):")
     winners = {}
     for method in dict.fromkeys(key[0] for key in contestants):
         ok = [key for key in contestants if key[0] == method and errors[key] <= TARGET]
         if ok:
             winners[method] = min(ok, key=lambda key: best[key][0])
             key = winners[method]
-            print(f"- {method}: {best[key][0]:.2f} s ({settings[key]}, error {errors[key]:.1e})")
+            print(f"- {method}: {best[key][0]:.2f} s wall, {cpu[key]:.2f} s CPU ({settings[key]}, error {errors[key]:.1e})")
         else:
             print(f"- {method}: no setting reached it")
     if "heyoka batch" in winners:
-        peer = best[winners["heyoka batch"]][0]
+        peer = winners["heyoka batch"]
         for method, key in winners.items():
             if method != "heyoka batch":
-                print(f"  {method} / heyoka batch: {best[key][0] / peer:.2f}× the time")
+                print(f"  {method} / heyoka batch: {best[key][0] / best[peer][0]:.2f}× the wall time, "
+                      f"{cpu[key] / cpu[peer]:.2f}× the CPU time")
     print("\nwall times on a shared machine are noisy (other processes use the cores): compare within one run")
     sys.stdout.flush()
 

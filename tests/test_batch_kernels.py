@@ -8,10 +8,11 @@ from gyrolab import compose_scene
 from gyrolab.contracts import CompiledModel
 from gyrolab.engine.batch import integrate_arrays
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.plugins.compiled import batch_dop853, models
+from gyrolab.plugins.compiled import batch_dop853, batch_taylor, models
 
 SHORT = ["experiment=perf_reference", "time.end=2", "time.n_output=11"]
 SETTINGS = {"dop853_numba": ["integrator.rtol=1e-10", "integrator.atol=1e-10"], "taylor": ["integrator.tol=1e-10"]}
+LANE_KERNELS = {"dop853_numba": batch_dop853, "taylor": batch_taylor}  # the kernels advancing (ω, γ) lanes
 
 
 def _scene(integrator, euler_angles=False, extra=()):
@@ -42,15 +43,17 @@ def test_batch_equals_the_single_trajectory_kernel(integrator, euler_angles):
             assert batch.steps[j] == single.stats.n_steps
 
 
-def test_a_lane_does_not_depend_on_its_neighbours():
+@pytest.mark.parametrize("integrator", ["dop853_numba", "taylor"])
+def test_a_lane_does_not_depend_on_its_neighbours(integrator):
     """One trajectory alone, among easy ones and among hard ones (fast spins, many more steps), in the first lane
     and in a lane refilled after another trajectory finished: bit for bit the same result and steps."""
     import numba
 
-    scene = _scene("dop853_numba")
-    count = 8 * batch_dop853.LANES * numba.get_num_threads()  # tasks of more trajectories than lanes: refills
-    refilled = batch_dop853.LANES + 1
-    assert batch_dop853.task_size(count) > refilled
+    scene = _scene(integrator)
+    lanes = LANE_KERNELS[integrator]
+    count = 8 * lanes.LANES * numba.get_num_threads()  # tasks of more trajectories than lanes: refills
+    refilled = lanes.LANES + 1
+    assert lanes.task_size(count) > refilled
     probe = _starts(scene, 1, seed=1)
     easy = _starts(scene, count - 1, seed=2, scale=0.01)
     hard = _starts(scene, count - 1, seed=3)
@@ -63,6 +66,40 @@ def test_a_lane_does_not_depend_on_its_neighbours():
             np.testing.assert_array_equal(mixed.y[row], alone.y[0])
             assert mixed.steps[row] == alone.steps[0]
     assert integrate_arrays(scene.compiled, scene.integrator, scene.times, hard).steps.min() > alone.steps[0]
+
+
+def test_taylor_lanes_take_the_steps_of_the_single_trajectory_kernel():
+    """The lane kernel against ``taylor.run`` on each trajectory (one per thread, ``run_each``), easy and hard
+    trajectories mixed, each with its own A and Newtonian coefficient: the same number of steps, and the same
+    outputs to rounding (its vector sums fuse multiply and add in another order; 1e-13 is a thousand
+    tolerances below the 1e-10 asked)."""
+    scene = _scene("taylor")
+    y0s = _starts(scene, 11, seed=7)
+    y0s[::3, 0:3] *= 4.0
+    P = np.tile(scene.compiled.params, (len(y0s), 1))
+    P[:, 0] *= np.linspace(0.9, 1.1, len(y0s))  # A (and 1/A: parameters as fixed_point.pack lays them out)
+    P[:, 16] = 1.0 / P[:, 0]
+    P[:, 14] *= np.linspace(0.0, 2.0, len(y0s))  # N_2
+    batch = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s, P)
+    out = np.empty_like(batch.y)
+    out[:, 0] = y0s
+    steps, status = np.zeros(len(y0s), dtype=np.int64), np.zeros(len(y0s), dtype=np.int64)
+    batch_taylor.run_each(scene.compiled.model, P, scene.integrator.order, scene.integrator.tol, scene.times, y0s,
+                          out, steps, status)
+    assert not status.any() and steps.min() < steps.max() / 2  # the mix: some take twice the steps of others
+    np.testing.assert_array_equal(batch.steps, steps)
+    np.testing.assert_allclose(batch.y, out, rtol=0, atol=1e-13)
+
+
+def test_taylor_batch_reaches_1e_10_at_the_benchmark_setting():
+    """Issue 14's accuracy target at the benchmark's setting (``benchmarks/batch_heyoka.py``: perturbed ω0,
+    t ∈ [0, 10], tol 1e-10, order 13): every final state within 1e-10 of scipy's DOP853 at rtol = atol = 1e-13."""
+    scene = compose_scene(["experiment=perf_reference", "time.end=10", "time.n_output=11", "integrator=taylor",
+                           "integrator.tol=1e-10"])
+    y0s = _starts(scene, 3, seed=8)
+    batch = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s)
+    assert scene.integrator.order == 13 and batch.steps.min() > 50
+    assert np.max(np.abs(batch.y[:, -1] - _scipy_reference(scene, y0s))) <= 1e-10
 
 
 def _scipy_reference(scene, y0s):
@@ -94,17 +131,20 @@ def test_each_kernel_meets_its_tolerance_against_scipy(integrator):
     assert 0 < error <= 500 * 1e-10
 
 
-def test_a_failing_trajectory_is_marked_and_the_others_are_kept():
-    scene = _scene("dop853_numba")
-    y0s = _starts(scene, 3, seed=6)
+@pytest.mark.parametrize("integrator", ["dop853_numba", "taylor"])
+def test_a_failing_trajectory_is_marked_and_the_others_are_kept(integrator):
+    scene = _scene(integrator)
+    y0s = _starts(scene, 6, seed=6)
     bad = y0s.copy()
     bad[1, 0:3] = 1e200  # ω² overflows
     good = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s)
     marked = integrate_arrays(scene.compiled, scene.integrator, scene.times, bad, failures="mark")
-    assert marked.failed.tolist() == [False, True, False]
+    assert marked.failed.tolist() == [False, True, False, False, False, False]
     assert np.isnan(marked.y[1, 1:]).all()
-    np.testing.assert_array_equal(marked.y[[0, 2]], good.y[[0, 2]])
-    with pytest.raises(IntegrationError, match="^trajectory 1 of the batch failed with dop853_numba: it became non-finite$"):
+    kept = [0, 2, 3, 4, 5]  # the failed trajectory's lane takes the fifth and sixth
+    np.testing.assert_array_equal(marked.y[kept], good.y[kept])
+    with pytest.raises(IntegrationError, match=f"^trajectory 1 of the batch failed with {integrator}: it became "
+                                               "non-finite$"):
         integrate_arrays(scene.compiled, scene.integrator, scene.times, bad)
 
 

@@ -7,7 +7,9 @@ The compiled kernels run in parallel over trajectories (``numba.prange``):
 - ``dop853_numba``: adaptive, each trajectory with its own step control (scipy's controller,
   as the single run); fixed-point (ω, γ) states by blocks of lanes vectorised across
   trajectories (``plugins/compiled/batch_dop853.py``), other models one trajectory per thread.
-- ``taylor``: adaptive, one trajectory per thread (``plugins/compiled/batch_taylor.py`` says why).
+- ``taylor``: adaptive, each trajectory with the single run's order and step rule; fixed-point
+  (ω, γ) states by 4 lanes vectorised across trajectories (``plugins/compiled/batch_taylor.py``),
+  other models one trajectory per thread.
 - ``auto accuracy=ε``: chooses method and tolerance on a few trajectories of the batch with the
   single run's pilot (``auto.py``), the tightest tolerance for all, then runs that method's kernel.
 ``integrate_batch`` (a scene's batch, ``--batch``) falls back to one run per trajectory with the
@@ -147,7 +149,11 @@ def _adaptive(compiled: CompiledModel, integrator: Integrator, times: np.ndarray
         if compiled.model not in models.TAYLOR_MODELS:
             raise ConfigError("integrator taylor needs Taylor coefficients, which a compiled plugin torque does not "
                               "have; valid choices for this model: rk4_numba, dop853_numba, auto")
-        batch_taylor.run_each(compiled.model, P, integrator.order, integrator.tol, times, y0s, out, steps, status)
+        if _blockable(compiled, size):
+            batch_taylor.run_blocks(P, integrator.order, integrator.tol, times, y0s, out, steps, status,
+                                    batch_taylor.task_size(count))
+        else:
+            batch_taylor.run_each(compiled.model, P, integrator.order, integrator.tol, times, y0s, out, steps, status)
     elif len(times) > 1:
         rejected, nfev = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
         args = (times, y0s, out, integrator.rtol, integrator.atol, integrator.max_step, steps, rejected, nfev, status)
