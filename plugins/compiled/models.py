@@ -22,7 +22,7 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gyrolab.plugins.compiled import fixed_point, inline_kernel
+from gyrolab.plugins.compiled import fixed_point, inline_kernel, kernel
 from gyrolab.plugins.compiled.plugin_torque import ADDRESS
 
 FIXED_POINT = 0
@@ -81,6 +81,16 @@ def rhs(model, t, y, p, out):
         out[7] = x2 * w0 - x0 * w2
         out[8] = x0 * w1 - x1 * w0
         _call_torque(int(p[ADDRESS]), t, y, p, out)
+
+
+@kernel
+def evaluate(model, t, y, p, out):
+    """``rhs`` as a plain compiled call, for the cold paths (a first evaluation, the initial step).
+
+    ``rhs`` is inlined into its callers at numba's level, typed again in each: callers outside the
+    inner loops call this instead, so that the first compile types it once.
+    """
+    rhs(model, t, y, p, out)
 
 
 @inline_kernel
