@@ -9,11 +9,13 @@ state (t, y, f, |h|) lives in arrays the caller keeps between chunks.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from gyrolab.plugins.compiled import dop853_tableau as _c
 from gyrolab.plugins.compiled import kernel
-from gyrolab.plugins.compiled.models import rhs
+from gyrolab.plugins.compiled.models import evaluate, rhs
 
 N_STAGES = _c.N_STAGES  # 12
 N_EXTENDED = _c.N_STAGES_EXTENDED  # 16
@@ -30,23 +32,38 @@ OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2
 
 
 @kernel
-def _rms(x):
-    return np.sqrt(np.sum(x * x) / x.size)
+def _rms(x, x0, y, atol, rtol):
+    """RMS norm of (x − x0) / (atol + |y| rtol), summed in order (as numpy's sum in numba)."""
+    acc = 0.0
+    for m in range(x.size):
+        v = (x[m] - x0[m]) / (atol + abs(y[m]) * rtol)
+        acc += v * v
+    return math.sqrt(acc / x.size)
 
 
 @kernel
 def initial_step(model, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats):
-    """scipy.integrate._ivp.common.select_initial_step for order 7."""
+    """scipy.integrate._ivp.common.select_initial_step for order 7.
+
+    Scalar loops instead of numpy's array expressions, which numba compiles as separate kernels
+    (the bulk of the first compile); the same operations in the same order.
+    """
+    n = y0.size
+    zero = np.empty(n)
+    for m in range(n):
+        zero[m] = 0.0
     interval = abs(t_bound - t0)
-    scale = atol + np.abs(y0) * rtol
-    d0 = _rms(y0 / scale)
-    d1 = _rms(f0 / scale)
+    d0 = _rms(y0, zero, y0, atol, rtol)
+    d1 = _rms(f0, zero, y0, atol, rtol)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, interval)
-    f1 = np.empty_like(y0)
-    rhs(model, t0 + h0, y0 + h0 * f0, p, f1)
+    y1 = np.empty(n)
+    for m in range(n):
+        y1[m] = y0[m] + h0 * f0[m]
+    f1 = np.empty(n)
+    evaluate(model, t0 + h0, y1, p, f1)
     stats[0] += 1
-    d2 = _rms((f1 - f0) / scale) / h0
+    d2 = _rms(f1, f0, y0, atol, rtol) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
     else:
@@ -69,6 +86,9 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
 
     Returns (status, next output index). y and f are updated in place. The last step fills every
     output it covers, also beyond i_stop (the next call cannot go back): the next index can pass i_stop.
+
+    One loop evaluates every stage, the step's and (on a second pass, ``dense``) the dense output's,
+    so that ``models.rhs`` is inlined (and typed by the first compile) once instead of three times.
     """
     n = y.size
     K = np.empty((N_EXTENDED, n))
@@ -87,25 +107,35 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
         elif h_abs < min_step:
             h_abs = min_step
         rejected = False
+        dense = False
+        h = 0.0
+        t_new = t
         while True:
-            if h_abs < min_step:
-                state[0], state[1] = t, h_abs
-                return TOO_SMALL_STEP, i
-            t_new = t + h_abs
-            if t_new - t_bound > 0:
-                t_new = t_bound
-            h = t_new - t
-            h_abs = abs(h)
-            K[0] = f
-            for s in range(1, N_STAGES):
+            if dense:  # the step is accepted, and outputs lie inside it
+                first, stop = N_STAGES + 1, N_EXTENDED
+            else:
+                if h_abs < min_step:
+                    state[0], state[1] = t, h_abs
+                    return TOO_SMALL_STEP, i
+                t_new = t + h_abs
+                if t_new - t_bound > 0:
+                    t_new = t_bound
+                h = t_new - t
+                h_abs = abs(h)
+                for m in range(n):
+                    K[0, m] = f[m]
+                first, stop = 1, N_STAGES + 1
+            # stage s = f(t + C[s] h, y + h Σ_j A[s, j] K[j]); stage N_STAGES is y_new (A[N_STAGES] = B, C = 1)
+            for s in range(first, stop):
                 _stage_sum(K, s, A[s], n, dy)
                 for m in range(n):
                     ytmp[m] = y[m] + dy[m] * h
                 rhs(model, t + C[s] * h, ytmp, p, K[s])
-            _stage_sum(K, N_STAGES, B, n, dy)
+            if dense:
+                stats[0] += N_EXTENDED - N_STAGES - 1
+                break
             for m in range(n):
-                y_new[m] = y[m] + h * dy[m]
-            rhs(model, t + h, y_new, p, K[N_STAGES])
+                y_new[m] = ytmp[m]
             stats[0] += N_STAGES
             e5 = 0.0
             e3 = 0.0
@@ -123,30 +153,26 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
             if e5 == 0.0 and e3 == 0.0:
                 error_norm = 0.0
             else:
-                error_norm = h_abs * e5 / np.sqrt((e5 + 0.01 * e3) * n)
+                error_norm = h_abs * e5 / math.sqrt((e5 + 0.01 * e3) * n)
             if error_norm < 1.0:
                 factor = MAX_FACTOR if error_norm == 0.0 else min(MAX_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
                 if rejected:
                     factor = min(1.0, factor)
                 h_abs *= factor
+                stats[1] += 1
+                for m in range(n):
+                    if not math.isfinite(y_new[m]):
+                        state[0], state[1] = t, h_abs
+                        return NOT_FINITE, i
+                # dense output for the outputs inside (t, t_new] (then on to every one, past i_stop too)
+                if i < i_stop and t_out[i] <= t_new:
+                    dense = True
+                    continue
                 break
             h_abs *= max(MIN_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
             rejected = True
             stats[2] += 1
-        stats[1] += 1
-        for m in range(n):
-            if not np.isfinite(y_new[m]):
-                state[0], state[1] = t, h_abs
-                return NOT_FINITE, i
-        # dense output for the outputs inside (t, t_new]
-        if i < i_stop and t_out[i] <= t_new:  # (then on to every output inside the step, past i_stop too)
-            t_old = t
-            for s in range(N_STAGES + 1, N_EXTENDED):
-                _stage_sum(K, s, A[s], n, dy)
-                for m in range(n):
-                    ytmp[m] = y[m] + dy[m] * h
-                rhs(model, t_old + C[s] * h, ytmp, p, K[s])
-            stats[0] += N_EXTENDED - N_STAGES - 1
+        if dense:
             for m in range(n):
                 delta = y_new[m] - y[m]
                 F[0, m] = delta
@@ -159,9 +185,10 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
                     F[3 + r, m] = h * acc
             while i < t_out.size and t_out[i] <= t_new:
                 if t_out[i] == t_new:
-                    Y[i] = y_new
+                    for m in range(n):
+                        Y[i, m] = y_new[m]
                 else:
-                    x = (t_out[i] - t_old) / h
+                    x = (t_out[i] - t) / h
                     for m in range(n):
                         v = 0.0
                         for r in range(7):
@@ -170,7 +197,8 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
                         Y[i, m] = v + y[m]
                 i += 1
         t = t_new
-        y[:] = y_new
-        f[:] = K[N_STAGES]
+        for m in range(n):
+            y[m] = y_new[m]
+            f[m] = K[N_STAGES, m]
     state[0], state[1] = t, h_abs
     return OK, i

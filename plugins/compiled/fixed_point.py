@@ -31,27 +31,24 @@ def pack(inertia: np.ndarray, terms: list[CompiledTerms], carries_alpha: bool) -
 
 
 def compiled_model(inertia: np.ndarray, forces: list, carries_alpha: bool):
-    """The fixed-point system's compiled model: built-in torque forms packed, any other torque traced and compiled.
+    """The fixed-point system's compiled model: built-in torque forms packed, or all torques traced and compiled.
 
-    Forces with ``compiled_terms()`` fill the packed forms; the others' torques are traced together into
-    one compiled kernel (``plugin_torque``), whose address and constants extend the parameter array.
+    If every force has ``compiled_terms()``, they fill the packed forms. Otherwise all the torques, the
+    built-ins' too, are traced together into one compiled kernel (``plugin_torque``), whose address and
+    constants extend the parameter array (the plugin models then skip the packed forms: see ``models``).
     Raises ``plugin_torque.NotCompilable`` naming the construct that prevents compilation.
     """
     from gyrolab.contracts.integrator import CompiledModel
     from gyrolab.plugins.compiled import models, plugin_torque
 
-    terms, plugins = [], []
-    for force in forces:
-        term = force.compiled_terms()
-        if term is None:
-            plugins.append(force)
-        else:
-            terms.append(term)
-    p = pack(inertia, terms, carries_alpha)
-    if not plugins:
-        return CompiledModel(models.FIXED_POINT, p)
-    compiled = plugin_torque.compile_trace(plugin_torque.trace(plugins), [f.name for f in plugins])
-    return CompiledModel(models.FIXED_POINT_PLUGIN, np.concatenate([p, [float(compiled.address)], compiled.constants]))
+    terms = [force.compiled_terms() for force in forces]
+    if all(term is not None for term in terms):
+        return CompiledModel(models.FIXED_POINT, pack(inertia, terms, carries_alpha))
+    plugins = [force.name for force, term in zip(forces, terms) if term is None]
+    compiled = plugin_torque.compile_trace(plugin_torque.trace(forces), plugins)
+    model = models.FIXED_POINT_PLUGIN_ALPHA if carries_alpha else models.FIXED_POINT_PLUGIN
+    return CompiledModel(model, np.concatenate([pack(inertia, [], carries_alpha), [float(compiled.address)],
+                                                compiled.constants]))
 
 
 @inline_kernel

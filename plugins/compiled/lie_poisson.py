@@ -93,10 +93,13 @@ def run(p, t_out, steps_per_interval, w, y, Y, i_next, i_stop):
     """Fill Y[i_next:i_stop] (state ω, γ[, α]); y advanced in place. Returns the first non-finite index or i_stop."""
     has_alpha = p[15] != 0.0
     L = np.empty(3)
-    g = y[3:6].copy()
-    a = y[6:9].copy() if has_alpha else np.empty(3)
+    g = np.empty(3)
+    a = np.empty(3)
     for m in range(3):
         L[m] = p[m] * y[m]
+        g[m] = y[3 + m]
+        if has_alpha:
+            a[m] = y[6 + m]
     for i in range(i_next, i_stop):
         h = (t_out[i] - t_out[i - 1]) / steps_per_interval[i - 1]
         for _ in range(steps_per_interval[i - 1]):
@@ -108,7 +111,7 @@ def run(p, t_out, steps_per_interval, w, y, Y, i_next, i_stop):
             if has_alpha:
                 y[6 + m] = a[m]
         for m in range(y.size):
-            if not np.isfinite(y[m]):
+            if not math.isfinite(y[m]):
                 return i
-        Y[i] = y
+            Y[i, m] = y[m]
     return i_stop

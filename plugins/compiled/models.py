@@ -6,6 +6,13 @@ process), hence one dispatch on ``model`` instead of a callback. A force
 plugin's torque, compiled separately (``plugin_torque``), joins through its
 address, stored in the parameter array: the call is indirect, the kernels that
 make it are compiled and cached once for every plugin.
+
+A scene with a plugin traces all its forces, built-ins included, so the plugin
+models compute only the gyroscopic torque and the kinematics around that call,
+one model per state size. Measured (benchmarks/plugin_speed.py): the
+indirect call itself costs little; what made plugins 1.5–2× slower than the
+built-ins was the built-in form's code (its zero-filled torque terms and the
+run-time branch on α) inlined at every right-hand-side call of the kernels.
 """
 
 from __future__ import annotations
@@ -15,12 +22,15 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gyrolab.plugins.compiled import fixed_point, inline_kernel
+from gyrolab.plugins.compiled import fixed_point, inline_kernel, kernel
 from gyrolab.plugins.compiled.plugin_torque import ADDRESS
 
 FIXED_POINT = 0
-#: The fixed-point system with compiled plugin torques added (no Taylor coefficients: see docs/plugins.md).
+#: The fixed-point system (state ω, γ) with all its torques traced and compiled (no Taylor coefficients:
+#: see docs/plugins.md).
 FIXED_POINT_PLUGIN = 1
+#: The same with the state ω, γ, α.
+FIXED_POINT_PLUGIN_ALPHA = 2
 #: Models whose Taylor coefficients ``taylor_coefficients`` computes.
 TAYLOR_MODELS = (FIXED_POINT,)
 
@@ -44,12 +54,43 @@ def _call_torque(typingctx, address, t, y, p, out):
 
 
 @inline_kernel
+def _free(y, p, out):
+    """The torque-free fixed-point system: I⁻¹ (Iω × ω) and γ̇ = γ × ω (p laid out as fixed_point.pack)."""
+    w0, w1, w2 = y[0], y[1], y[2]
+    g0, g1, g2 = y[3], y[4], y[5]
+    out[0] = (p[1] - p[2]) * w1 * w2 * p[16]
+    out[1] = (p[2] - p[0]) * w2 * w0 * p[17]
+    out[2] = (p[0] - p[1]) * w0 * w1 * p[18]
+    out[3] = g1 * w2 - g2 * w1
+    out[4] = g2 * w0 - g0 * w2
+    out[5] = g0 * w1 - g1 * w0
+
+
+@inline_kernel
 def rhs(model, t, y, p, out):
     if model == FIXED_POINT:
         fixed_point.rhs(t, y, p, out)
     elif model == FIXED_POINT_PLUGIN:
-        fixed_point.rhs(t, y, p, out)
+        _free(y, p, out)
         _call_torque(int(p[ADDRESS]), t, y, p, out)
+    elif model == FIXED_POINT_PLUGIN_ALPHA:
+        _free(y, p, out)
+        w0, w1, w2 = y[0], y[1], y[2]
+        x0, x1, x2 = y[6], y[7], y[8]
+        out[6] = x1 * w2 - x2 * w1
+        out[7] = x2 * w0 - x0 * w2
+        out[8] = x0 * w1 - x1 * w0
+        _call_torque(int(p[ADDRESS]), t, y, p, out)
+
+
+@kernel
+def evaluate(model, t, y, p, out):
+    """``rhs`` as a plain compiled call, for the cold paths (a first evaluation, the initial step).
+
+    ``rhs`` is inlined into its callers at numba's level, typed again in each: callers outside the
+    inner loops call this instead, so that the first compile types it once.
+    """
+    rhs(model, t, y, p, out)
 
 
 @inline_kernel

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
@@ -10,37 +12,45 @@ from gyrolab.plugins.compiled.fixed_point import rhs_block
 from gyrolab.plugins.compiled.models import rhs
 
 
+#: Nodes of the four stages, as fractions of the step.
+NODES = np.array([0.0, 0.5, 0.5, 1.0])
+
+
 @kernel
-def _advance(model, p, t0, y, interval, steps, k1, k2, k3, k4, tmp):
+def _advance(model, p, t0, y, interval, steps, K, tmp):
+    """``steps`` RK4 steps over ``interval`` from t0; K (4 × n) holds the stages.
+
+    One loop over the stages, so that ``models.rhs`` is inlined (and typed, on the first compile)
+    once instead of four times; the arithmetic is the textbook one, operation for operation.
+    """
     h = interval / steps
     n = y.size
     for j in range(steps):
         t = t0 + j * h
-        rhs(model, t, y, p, k1)
+        for s in range(4):
+            if s == 0:
+                for m in range(n):
+                    tmp[m] = y[m]
+            else:
+                a = h if s == 3 else 0.5 * h
+                for m in range(n):
+                    tmp[m] = y[m] + a * K[s - 1, m]
+            rhs(model, t + NODES[s] * h, tmp, p, K[s])
         for m in range(n):
-            tmp[m] = y[m] + 0.5 * h * k1[m]
-        rhs(model, t + 0.5 * h, tmp, p, k2)
-        for m in range(n):
-            tmp[m] = y[m] + 0.5 * h * k2[m]
-        rhs(model, t + 0.5 * h, tmp, p, k3)
-        for m in range(n):
-            tmp[m] = y[m] + h * k3[m]
-        rhs(model, t + h, tmp, p, k4)
-        for m in range(n):
-            y[m] += (h / 6.0) * (k1[m] + 2.0 * k2[m] + 2.0 * k3[m] + k4[m])
+            y[m] += (h / 6.0) * (K[0, m] + 2.0 * K[1, m] + 2.0 * K[2, m] + K[3, m])
 
 
 @kernel
 def run(model, p, t_out, steps_per_interval, y, Y, i_next, i_stop):
     """Fill Y[i_next:i_stop]; y is advanced in place. Returns the first index left non-finite, or i_stop."""
     n = y.size
-    k1, k2, k3, k4, tmp = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    K, tmp = np.empty((4, n)), np.empty(n)
     for i in range(i_next, i_stop):
-        _advance(model, p, t_out[i - 1], y, t_out[i] - t_out[i - 1], steps_per_interval[i - 1], k1, k2, k3, k4, tmp)
+        _advance(model, p, t_out[i - 1], y, t_out[i] - t_out[i - 1], steps_per_interval[i - 1], K, tmp)
         for m in range(n):
-            if not np.isfinite(y[m]):
+            if not math.isfinite(y[m]):
                 return i
-        Y[i] = y
+            Y[i, m] = y[m]
     return i_stop
 
 
@@ -50,11 +60,10 @@ def run_batch(model, P, t_out, steps_per_interval, Y0, Y):
     count, n = Y0.shape
     for j in numba.prange(count):
         y = Y0[j].copy()
-        k1, k2, k3, k4, tmp = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+        K, tmp = np.empty((4, n)), np.empty(n)
         Y[j, 0] = y
         for i in range(1, t_out.size):
-            _advance(model, P[j], t_out[i - 1], y, t_out[i] - t_out[i - 1], steps_per_interval[i - 1],
-                     k1, k2, k3, k4, tmp)
+            _advance(model, P[j], t_out[i - 1], y, t_out[i] - t_out[i - 1], steps_per_interval[i - 1], K, tmp)
             Y[j, i] = y
 
 

@@ -138,7 +138,7 @@ class DOP853Numba(Tolerances, Integrator):
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         f = np.empty_like(y)
-        models.rhs(compiled.model, t_out[0], y, compiled.params, f)
+        models.evaluate(compiled.model, t_out[0], y, compiled.params, f)
         stats = np.zeros(3, dtype=np.int64)
         stats[0] = 1
         h0 = dop853.initial_step(compiled.model, compiled.params, t_out[0], y, f, t_out[-1], self.max_step,

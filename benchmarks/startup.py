@@ -1,0 +1,87 @@
+"""Start-up of the compiled integrators: first run on a fresh kernel cache, and a later process's cached load.
+
+    python benchmarks/startup.py                      # every compiled integrator, 1 round
+    python benchmarks/startup.py --rounds 3 taylor    # chosen integrators, best of 3 rounds
+
+Each measurement is a fresh Python process with its own empty ``NUMBA_CACHE_DIR`` (so nothing
+compiled by an earlier run or another checkout is reused), which composes the reference scene
+(``experiment=perf_reference``, shortened to t ∈ [0, 1]) and integrates it once: "cold" is that
+first process, "cached" a second process on the same cache directory. Times are CPU seconds of
+the child (``time.process_time``, so other work on a shared machine inflates them less than wall
+time), split into the import of gyrolab + numba and the first integration (compile or cache load,
+plus the microseconds of the run itself). ``plugin`` is ``dop853_numba`` on the same scene with its
+two torques written as a third-party plugin (benchmarks/plugin_speed.py), which adds the compile
+of the traced torque. Target (issue 12): first compiled run < 2 s, cached load < 0.15 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+INTEGRATORS = ("dop853_numba", "rk4_numba", "taylor", "lie_poisson", "plugin")
+
+CHILD = r'''
+import json, sys, time
+start = time.process_time()
+name, site = sys.argv[1], sys.argv[2]
+import numba  # noqa: F401
+from gyrolab import compose_scene
+imported = time.process_time()
+overrides = ["experiment=perf_reference", "time.end=1", "time.n_output=11"]
+if name == "plugin":
+    sys.path.insert(0, site)
+    overrides = ["body=asymmetric_top", "initial=fast_spin", "initial.theta0=null", "initial.phi0=null",
+                 "initial.gamma0=[0.8414709848078965,0.0,0.5403023058681398]", "time.end=1", "time.n_output=11",
+                 "output.euler_angles=false", "force=[plain_gravity,plain_newtonian]", "force.plain_newtonian.k=0.5",
+                 "integrator=dop853_numba"]
+else:
+    overrides.append(f"integrator={name}")
+scene = compose_scene(overrides)
+composed = time.process_time()
+scene.integrator.integrate(scene.system.rhs, scene.times, scene.system.initial_state(), None, scene.compiled)
+done = time.process_time()
+print(json.dumps({"import": imported - start, "first_run": done - composed, "total": done - start}))
+'''
+
+
+def measure(name: str, cache: str, site: str) -> dict[str, float]:
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    result = subprocess.run([sys.executable, "-c", CHILD, name, site], env=env, capture_output=True, text=True,
+                            check=True)
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("integrators", nargs="*", default=list(INTEGRATORS))
+    parser.add_argument("--rounds", type=int, default=1)
+    args = parser.parse_args()
+    site = tempfile.mkdtemp()
+    sys.path.insert(0, str(Path(__file__).parent))
+    from plugin_speed import _install
+
+    _install(Path(site))
+    print(f"{'integrator':>13} {'import s':>9} {'cold run s':>11} {'cold total s':>13} {'cached run s':>13} "
+          f"{'cached total s':>15}")
+    for name in args.integrators:
+        best: dict[str, float] = {}
+        for _ in range(args.rounds):
+            with tempfile.TemporaryDirectory() as cache:
+                cold, cached = measure(name, cache, site), measure(name, cache, site)
+            for key, value in (("import", min(cold["import"], cached["import"])), ("cold", cold["first_run"]),
+                               ("cold_total", cold["total"]), ("cached", cached["first_run"]),
+                               ("cached_total", cached["total"])):
+                best[key] = min(best.get(key, float("inf")), value)
+        print(f"{name:>13} {best['import']:9.2f} {best['cold']:11.2f} {best['cold_total']:13.2f} "
+              f"{best['cached']:13.2f} {best['cached_total']:15.2f}", flush=True)
+    print("\n(CPU seconds of fresh processes, best of the rounds; noisy on a shared machine)")
+
+
+if __name__ == "__main__":
+    main()
