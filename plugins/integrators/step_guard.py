@@ -51,7 +51,7 @@ def compiled_rhs(compiled) -> Callable[[float, np.ndarray], np.ndarray]:
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
         out = np.empty_like(y)
-        models.rhs(compiled.model, t, y, compiled.params, out)
+        models.evaluate(compiled.model, t, y, compiled.params, out)  # the compiled call the kernels share
         return out
 
     return fun
