@@ -69,13 +69,19 @@ class Scene:
                 f"choose dop853 (or rk45, rk4, lsoda, radau, bdf) or integrator=auto"
             )
         if scene.compiled is not None and integrator.name in ("taylor", "lie_poisson"):
-            from gyrolab.plugins.compiled import models
+            from gyrolab.plugins.compiled import models, plugin_taylor
 
-            if scene.compiled.model not in models.TAYLOR_MODELS:
+            if integrator.name == "lie_poisson" and scene.compiled.model != models.FIXED_POINT:
                 traced = ", ".join(f.name for f in system.forces if f.compiled_terms() is None)
                 raise ConfigError(
-                    f"integrator {integrator.name!r} evaluates the built-in torque forms only, and force {traced} "
-                    f"is a compiled plugin torque; choose dop853_numba, rk4_numba or integrator=auto"
+                    f"integrator 'lie_poisson' evaluates the built-in torque forms only, and force {traced} "
+                    f"is a compiled plugin torque; choose taylor, dop853_numba, rk4_numba or integrator=auto"
+                )
+            if not plugin_taylor.has_taylor(scene.compiled):
+                timed = ", ".join(f.name for f in system.forces if f.time_dependent)
+                raise ConfigError(
+                    f"integrator 'taylor' does not yet pass time to a plugin torque's series, and force {timed} "
+                    f"is time-dependent; choose dop853_numba, rk4_numba or integrator=auto"
                 )
         elif scene.compiled is None and integrator.prefers_compiled_model:
             reason = getattr(system, "compile_error", None)

@@ -15,14 +15,14 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gyrolab.plugins.compiled import fixed_point, inline_kernel
+from gyrolab.plugins.compiled import fixed_point, inline_kernel, plugin_taylor
 from gyrolab.plugins.compiled.plugin_torque import ADDRESS
 
 FIXED_POINT = 0
-#: The fixed-point system with compiled plugin torques added (no Taylor coefficients: see docs/plugins.md).
+#: The fixed-point system with compiled plugin torques added.
 FIXED_POINT_PLUGIN = 1
-#: Models whose Taylor coefficients ``taylor_coefficients`` computes.
-TAYLOR_MODELS = (FIXED_POINT,)
+#: Models whose Taylor coefficients ``taylor_coefficients`` computes (plugin torques: see plugin_taylor.has_taylor).
+TAYLOR_MODELS = (FIXED_POINT, FIXED_POINT_PLUGIN)
 
 
 @intrinsic
@@ -56,5 +56,7 @@ def rhs(model, t, y, p, out):
 def taylor_coefficients(model, p, Y, order, work):
     if model == FIXED_POINT:
         fixed_point.taylor_coefficients(p, Y, order, work)
-    else:  # a traced plugin torque has no Taylor coefficients (scenes refuse taylor for it; docs/plugins.md)
+    elif model == FIXED_POINT_PLUGIN:  # the traced torque's series by automatic propagation (plugin_taylor)
+        plugin_taylor.coefficients(p, Y, order, work, 0.0)
+    else:
         raise ValueError("this compiled model has no Taylor coefficients")

@@ -300,4 +300,7 @@ def compile_trace(result: Trace, names: list[str]) -> CompiledTorque:
         _LOADED[digest] = module.kernel  # the cfunc compiled (or loaded its cache) on import
         marker.touch()
     kernel = _LOADED[digest]
-    return CompiledTorque(kernel, int(kernel.address), np.array(result.graph.constants, dtype=float))
+    from gyrolab.plugins.compiled import plugin_taylor  # its Taylor kernel ends the constants (plugin_taylor.TAIL)
+
+    tail = plugin_taylor.compile_taylor(result, names)
+    return CompiledTorque(kernel, int(kernel.address), np.array(result.graph.constants + tail, dtype=float))
