@@ -40,16 +40,21 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import numba
 import numpy as np
 from llvmlite import ir
 from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gyrolab.plugins.compiled import fixed_point, kernel
+from gyrolab.plugins.compiled import fixed_point, inline_kernel
 from gyrolab.plugins.compiled.plugin_torque import FIRST_CONSTANT, INV_INERTIA, Expr, Trace
 
 log = logging.getLogger(__name__)
+
+# fixed_point's Cauchy helpers, compiled inline here: a call per helper per order costs as much as its sums
+_cauchy_cross = inline_kernel(fixed_point._cauchy_cross.py_func)
+_cauchy_pairs = inline_kernel(fixed_point._cauchy_pairs.py_func)
 
 #: Entries the Taylor kernel adds after the right-hand side's constants; they end the parameter array:
 #: p[-3] = its address, p[-2] = its work columns, p[-1] = 1 if the torque reads time (see ``has_taylor``).
@@ -226,7 +231,7 @@ _P = types.CPointer(types.float64)
 SIGNATURE = types.void(types.float64, types.int64, types.int64, _P, _P, _P, _P)
 
 
-@numba.cfunc(SIGNATURE, cache=True, error_model="numpy")
+@numba.cfunc(SIGNATURE, cache=True, error_model="numpy", fastmath={{"reassoc", "contract", "nsz"}})
 def kernel(t, k, n, Y, W, p, out):
 '''
 
@@ -295,7 +300,8 @@ def has_taylor(compiled: Any) -> bool:
         compiled.model != models.FIXED_POINT_PLUGIN or compiled.params[-1] == 0.0)
 
 
-@kernel
+# reassociated and contracted like fixed_point.taylor_coefficients (a coefficient's rounding enters the state times h^k)
+@numba.njit(cache=True, error_model="numpy", fastmath={"reassoc", "contract", "nsz"})
 def coefficients(p, Y, order, work, t):
     """Fill Y[1..order] from Y[0] for the fixed-point system with a traced plugin torque (model FIXED_POINT_PLUGIN).
 
@@ -315,14 +321,14 @@ def coefficients(p, Y, order, work, t):
     torque = np.empty(3)
     for k in range(order):
         _call(address, t, k, n, Y, W, p, torque)
-        fixed_point._cauchy_pairs(Y, 0, k, acc)  # (Iω) × ω = d ⊙ pairs of ω
+        _cauchy_pairs(Y, 0, k, acc)  # (Iω) × ω = d ⊙ pairs of ω
         acc[0] *= d0
         acc[1] *= d1
         acc[2] *= d2
         _gradient_and_linear(p, Y, 3, 9, 14, k, d0, d1, d2, acc, tmp)
         if has_alpha:
             work[k, 0] = work[k, 1] = work[k, 2] = 0.0  # β_k = Σ γ_j × α_{k−j}
-            fixed_point._cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, work[k])
+            _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, work[k])
             _gradient_and_linear(p, Y, 6, 3, 12, k, d0, d1, d2, acc, tmp)
             _gradient_and_linear(p, work, 0, 6, 13, k, d0, d1, d2, acc, tmp)
         inv = 1.0 / (k + 1)
@@ -330,12 +336,12 @@ def coefficients(p, Y, order, work, t):
             Y[k + 1, m] = (acc[m] * p[16 + m] + torque[m]) * inv
         for axis in range(3, n, 3):  # γ̇ = γ × ω (and α̇ = α × ω)
             tmp[0] = tmp[1] = tmp[2] = 0.0
-            fixed_point._cauchy_cross(Y, axis, Y, 0, k, 1.0, 1.0, 1.0, tmp)
+            _cauchy_cross(Y, axis, Y, 0, k, 1.0, 1.0, 1.0, tmp)
             for m in range(3):
                 Y[k + 1, axis + m] = tmp[m] * inv
 
 
-@kernel
+@inline_kernel
 def _gradient_and_linear(p, E, ie, iu, iN, k, d0, d1, d2, acc, tmp):
     """acc += U × e_k + N e × I e (k-th coefficients) for the axis e = E[:, ie:ie+3], U = p[iu:iu+3], N = p[iN]."""
     e0, e1, e2 = E[k, ie], E[k, ie + 1], E[k, ie + 2]
@@ -343,7 +349,7 @@ def _gradient_and_linear(p, E, ie, iu, iN, k, d0, d1, d2, acc, tmp):
     acc[1] += p[iu + 2] * e0 - p[iu] * e2
     acc[2] += p[iu] * e1 - p[iu + 1] * e0
     if p[iN] != 0.0:
-        fixed_point._cauchy_pairs(E, ie, k, tmp)  # e × I e = −d ⊙ pairs of e
+        _cauchy_pairs(E, ie, k, tmp)  # e × I e = −d ⊙ pairs of e
         acc[0] -= p[iN] * d0 * tmp[0]
         acc[1] -= p[iN] * d1 * tmp[1]
         acc[2] -= p[iN] * d2 * tmp[2]
