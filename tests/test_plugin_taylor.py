@@ -44,7 +44,7 @@ class OfTime(Force):
 def series(f, t0, order=ORDER):
     """The generated kernel's coefficients 0..order of the three functions f(t) about t0 (rows)."""
     result = plugin_torque.trace([OfTime(f)])
-    address, columns, _ = plugin_taylor.compile_taylor(result, ["of_time"])
+    address, columns = plugin_taylor.compile_taylor(result, ["of_time"])
     call = _KERNEL(int(address))
     p = np.zeros(plugin_torque.FIRST_CONSTANT + len(result.graph.constants))
     p[plugin_torque.INV_INERTIA:plugin_torque.INV_INERTIA + 3] = 1.0
@@ -159,6 +159,7 @@ def test_drag_under_taylor_and_auto_is_the_exact_decay():
         sys.path.pop(0)
     # A = B = C = 1: ω̇ = −c ω, ω(t) = ω0 exp(−c t) (the README's example plugin)
     model = fixed_point.compiled_model(np.ones(3), [ViscousDrag(None, coefficient=0.3)], False)
+    assert plugin_taylor.ready(model)  # compiles the Taylor kernel (a scene does this when taylor is chosen)
     y0 = np.array([0.1, -0.05, 5.0, 0.0, 0.6, 0.8])
     t = np.linspace(0.0, 5.0, 11)
     y = Taylor(tol=1e-15).integrate(None, t, y0, None, model).y
@@ -187,7 +188,7 @@ def test_plugins_repeating_the_builtin_arithmetic_follow_the_builtin_trajectory(
     beta.axis, beta.required_axes = 1, frozenset({1})  # the gradient torque about β = γ × α: every packed form
     builtin = fixed_point.compiled_model(system.inertia, system.forces, system.carries_alpha)
     plugin = fixed_point.compiled_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
-    assert (builtin.model, plugin.model, system.state_size) == (0, 1, 9)
+    assert (builtin.model, plugin.model, system.state_size) == (0, 1, 9) and plugin_taylor.ready(plugin)
     y0 = system.initial_state()
     runs = [Taylor(order=20, tol=1e-14).integrate(None, scene.times, y0, None, m).y for m in (builtin, plugin)]
     np.testing.assert_allclose(runs[1], runs[0], rtol=0, atol=1e-12)
@@ -218,7 +219,13 @@ def test_time_dependent_plugin_torques_are_refused_by_taylor_in_one_sentence():
             return -0.1 * np.sin(t) * omega
 
     model = fixed_point.compiled_model(np.array([1.0, 2.0, 3.0]), [Pulse()], False)
-    assert not plugin_taylor.has_taylor(model)
+    assert not plugin_taylor.ready(model)
+    from gyrolab.plugins.compiled import taylor
+
+    # the kernel called directly without a Taylor kernel: a non-finite status, not a jump to address 0
+    status, _ = taylor.run(model.model, model.params, 8, 1e-10, np.linspace(0.0, 1.0, 3), np.empty((3, 6)), 1, 3,
+                           np.zeros(1), np.ones(6), np.zeros(6), np.zeros(2, dtype=np.int64))
+    assert status == taylor.NOT_FINITE
     from gyrolab.engine.batch import integrate_arrays
 
     with pytest.raises(ConfigError, match="^integrator taylor does not yet pass time"):

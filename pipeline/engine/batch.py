@@ -144,7 +144,7 @@ def _adaptive(compiled: CompiledModel, integrator: Integrator, times: np.ndarray
     steps = np.zeros(count, dtype=np.int64)
     status = np.zeros(count, dtype=np.int64)
     if len(times) > 1 and integrator.name == "taylor":
-        if not plugin_taylor.has_taylor(compiled):
+        if not plugin_taylor.ready(compiled, P):
             raise ConfigError("integrator taylor does not yet pass time to a time-dependent plugin torque's series; "
                               "valid choices for this model: rk4_numba, dop853_numba, auto")
         batch_taylor.run_each(compiled.model, P, integrator.order, integrator.tol, times, y0s, out, steps, status)

@@ -77,7 +77,7 @@ class Scene:
                     f"integrator 'lie_poisson' evaluates the built-in torque forms only, and force {traced} "
                     f"is a compiled plugin torque; choose taylor, dop853_numba, rk4_numba or integrator=auto"
                 )
-            if not plugin_taylor.has_taylor(scene.compiled):
+            if integrator.name == "taylor" and not plugin_taylor.ready(scene.compiled):
                 timed = ", ".join(f.name for f in system.forces if f.time_dependent)
                 raise ConfigError(
                     f"integrator 'taylor' does not yet pass time to a plugin torque's series, and force {timed} "

@@ -21,7 +21,7 @@ from gyrolab.plugins.compiled.plugin_torque import ADDRESS
 FIXED_POINT = 0
 #: The fixed-point system with compiled plugin torques added.
 FIXED_POINT_PLUGIN = 1
-#: Models whose Taylor coefficients ``taylor_coefficients`` computes (plugin torques: see plugin_taylor.has_taylor).
+#: Models whose Taylor coefficients ``taylor_coefficients`` computes (plugin torques: see plugin_taylor.ready).
 TAYLOR_MODELS = (FIXED_POINT, FIXED_POINT_PLUGIN)
 
 

@@ -57,7 +57,8 @@ _cauchy_cross = inline_kernel(fixed_point._cauchy_cross.py_func)
 _cauchy_pairs = inline_kernel(fixed_point._cauchy_pairs.py_func)
 
 #: Entries the Taylor kernel adds after the right-hand side's constants; they end the parameter array:
-#: p[-3] = its address, p[-2] = its work columns, p[-1] = 1 if the torque reads time (see ``has_taylor``).
+#: p[-3] = its address, p[-2] = its work columns (both 0 until ``ready`` compiles it), p[-1] = 1 if the
+#: torque reads time (see ``ready``).
 TAIL = 3
 
 
@@ -236,10 +237,45 @@ def kernel(t, k, n, Y, W, p, out):
 '''
 
 _LOADED: dict[str, Any] = {}
+#: traces by the address of their right-hand side's kernel: the Taylor kernel compiles when first needed
+_TRACES: dict[int, tuple[Trace, list[str]]] = {}
+
+
+def register(address: int, result: Trace, names: list[str]) -> list[float]:
+    """The parameter array's tail (``TAIL``) for a traced torque whose right-hand side's kernel is at ``address``.
+
+    Nothing compiles here: most runs never use taylor, and a Taylor kernel's first compilation costs
+    seconds. ``ready`` compiles it when an integrator needs it.
+    """
+    _TRACES[address] = (result, names)
+    return [0.0, 0.0, float(result.uses_time)]
+
+
+def ready(compiled: Any, rows: np.ndarray | None = None) -> bool:
+    """Whether ``taylor`` can integrate a compiled model: the built-ins, and traced torques that do not read time.
+
+    For a traced torque this compiles (or loads) its Taylor kernel on first need and writes its address
+    into ``compiled.params`` (and into every row of ``rows``, a batch's per-trajectory parameters).
+    ``taylor.run`` does not pass the step's start time to the coefficients, so a time-dependent torque
+    has no Taylor form here yet.
+    """
+    from gyrolab.plugins.compiled import models
+    from gyrolab.plugins.compiled.plugin_torque import ADDRESS
+
+    if compiled.model != models.FIXED_POINT_PLUGIN:
+        return compiled.model in models.TAYLOR_MODELS
+    p = compiled.params
+    if p[-1] != 0.0:
+        return False
+    if p[-3] == 0.0:
+        p[-3:-1] = compile_taylor(*_TRACES[int(p[ADDRESS])])
+    if rows is not None:
+        rows[:, -3:-1] = p[-3:-1]
+    return True
 
 
 def compile_taylor(result: Trace, names: list[str]) -> list[float]:
-    """The parameter array's tail for a trace (``TAIL``), its Taylor kernel compiled once per form."""
+    """[address of the trace's Taylor kernel, its work columns], compiled once per form (cached on disk)."""
     text, columns = source(result)
     digest = hashlib.sha256(text.encode()).hexdigest()[:16]
     if digest not in _LOADED:
@@ -267,7 +303,7 @@ def compile_taylor(result: Trace, names: list[str]) -> list[float]:
         spec.loader.exec_module(module)
         _LOADED[digest] = module.kernel
         marker.touch()
-    return [float(_LOADED[digest].address), float(columns), float(result.uses_time)]
+    return [float(_LOADED[digest].address), float(columns)]
 
 
 @intrinsic
@@ -288,18 +324,6 @@ def _call(typingctx, address, t, k, n, Y, W, p, out):
     return sig, codegen
 
 
-def has_taylor(compiled: Any) -> bool:
-    """Whether ``taylor`` can integrate a compiled model: the built-ins, and traced torques that do not read time.
-
-    ``taylor.run`` does not pass the step's start time to the coefficients, so a time-dependent torque's
-    series would be taken at t = 0 on every step.
-    """
-    from gyrolab.plugins.compiled import models
-
-    return compiled.model in models.TAYLOR_MODELS and (
-        compiled.model != models.FIXED_POINT_PLUGIN or compiled.params[-1] == 0.0)
-
-
 # reassociated and contracted like fixed_point.taylor_coefficients (a coefficient's rounding enters the state times h^k)
 @numba.njit(cache=True, error_model="numpy", fastmath={"reassoc", "contract", "nsz"})
 def coefficients(p, Y, order, work, t):
@@ -312,6 +336,9 @@ def coefficients(p, Y, order, work, t):
     """
     n = Y.shape[1]
     address = int(p[p.size - 3])
+    if address == 0:  # the Taylor kernel was not compiled (``ready`` not called): no series, not a crash
+        Y[1:] = np.nan
+        return
     W = np.empty((order + 1) * int(p[p.size - 2]))
     I0, I1, I2 = p[0], p[1], p[2]
     d0, d1, d2 = I1 - I2, I2 - I0, I0 - I1

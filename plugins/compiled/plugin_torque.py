@@ -300,7 +300,7 @@ def compile_trace(result: Trace, names: list[str]) -> CompiledTorque:
         _LOADED[digest] = module.kernel  # the cfunc compiled (or loaded its cache) on import
         marker.touch()
     kernel = _LOADED[digest]
-    from gyrolab.plugins.compiled import plugin_taylor  # its Taylor kernel ends the constants (plugin_taylor.TAIL)
+    from gyrolab.plugins.compiled import plugin_taylor  # the Taylor kernel's entries end the constants
 
-    tail = plugin_taylor.compile_taylor(result, names)
+    tail = plugin_taylor.register(int(kernel.address), result, names)
     return CompiledTorque(kernel, int(kernel.address), np.array(result.graph.constants + tail, dtype=float))

@@ -90,11 +90,11 @@ class Auto(Integrator):
 
     def _method(self, compiled: CompiledModel | None, tol: float) -> Integrator:
         if compiled is not None:
-            from gyrolab.plugins.compiled.plugin_taylor import has_taylor
+            from gyrolab.plugins.compiled.plugin_taylor import ready
             from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
 
             # a time-dependent plugin torque has no Taylor coefficients yet: compiled DOP853 instead
-            if has_taylor(compiled):
+            if ready(compiled):
                 return Taylor(order=self._order, tol=tol)
             return DOP853Numba(rtol=tol, atol=tol)
         from gyrolab.plugins.integrators.scipy_solvers import DOP853
