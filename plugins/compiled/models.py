@@ -53,10 +53,10 @@ def rhs(model, t, y, p, out):
 
 
 @inline_kernel
-def taylor_coefficients(model, p, Y, order, work):
+def taylor_coefficients(model, p, Y, order, work, t=0.0):
     if model == FIXED_POINT:
         fixed_point.taylor_coefficients(p, Y, order, work)
     elif model == FIXED_POINT_PLUGIN:  # the traced torque's series by automatic propagation (plugin_taylor)
-        plugin_taylor.coefficients(p, Y, order, work, 0.0)
+        plugin_taylor.coefficients(p, Y, order, work, t)
     else:
         raise ValueError("this compiled model has no Taylor coefficients")

@@ -33,11 +33,7 @@ coefficients are inf/NaN and ``taylor`` stops with its one-sentence non-finite e
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
 import logging
-import sys
-from pathlib import Path
 from typing import Any
 
 import numba
@@ -48,7 +44,7 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from gyrolab.plugins.compiled import fixed_point, inline_kernel
-from gyrolab.plugins.compiled.plugin_torque import FIRST_CONSTANT, INV_INERTIA, Expr, Trace
+from gyrolab.plugins.compiled.plugin_torque import FIRST_CONSTANT, INV_INERTIA, Expr, Trace, load_generated
 
 log = logging.getLogger(__name__)
 
@@ -213,7 +209,7 @@ def source(result: Trace) -> tuple[str, int]:
     """The Taylor cfunc's source for a trace, and the number of columns of its work rows."""
     low = _Lowered(result)
     body = ["if k == 0:"] + [f"    {s}" for s in low.value]
-    body += ["    r = 0", "else:", f"    r = k * M"] + [f"    {s}" for s in low.step]
+    body += ["    r = 0", "else:", "    r = k * M"] + [f"    {s}" for s in low.step]
     for m, cols in enumerate(low.outputs):
         total = " + ".join(f"W[r + {c}]" for c in cols) or "0.0"
         body.append(f"out[{m}] = ({total}) * p[{INV_INERTIA + m}]")
@@ -236,7 +232,6 @@ SIGNATURE = types.void(types.float64, types.int64, types.int64, _P, _P, _P, _P)
 def kernel(t, k, n, Y, W, p, out):
 '''
 
-_LOADED: dict[str, Any] = {}
 #: traces by the address of their right-hand side's kernel: the Taylor kernel compiles when first needed
 _TRACES: dict[int, tuple[Trace, list[str]]] = {}
 
@@ -277,33 +272,8 @@ def ready(compiled: Any, rows: np.ndarray | None = None) -> bool:
 def compile_taylor(result: Trace, names: list[str]) -> list[float]:
     """[address of the trace's Taylor kernel, its work columns], compiled once per form (cached on disk)."""
     text, columns = source(result)
-    digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-    if digest not in _LOADED:
-        from gyrolab.output.atomic import atomic_path
-        from gyrolab.plugins.compiled import kernel_cache_dir
-
-        folder = Path(kernel_cache_dir()) / "forces"
-        try:
-            folder.mkdir(parents=True, exist_ok=True)
-        except OSError:  # a read-only cache: this machine's temporary directory (as plugin_torque)
-            import tempfile
-
-            folder = Path(tempfile.gettempdir()) / "gyrolab" / "forces"
-            folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"gyrolab_taylor_{digest}.py"
-        marker = path.with_suffix(".compiled")
-        if not path.exists() or path.read_text() != text:
-            with atomic_path(path) as tmp:
-                Path(tmp).write_text(text)
-        if not marker.exists():
-            log.info("compiling force %s (Taylor), once (cached for later runs)", " + ".join(names))
-        spec = importlib.util.spec_from_file_location(path.stem, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[path.stem] = module
-        spec.loader.exec_module(module)
-        _LOADED[digest] = module.kernel
-        marker.touch()
-    return [float(_LOADED[digest].address), float(columns)]
+    kernel = load_generated(text, "gyrolab_taylor", f"force {' + '.join(names)} (Taylor)")
+    return [float(kernel.address), float(columns)]
 
 
 @intrinsic
