@@ -230,3 +230,27 @@ def test_time_dependent_plugin_torques_are_refused_by_taylor_in_one_sentence():
 
     with pytest.raises(ConfigError, match="^integrator taylor does not yet pass time"):
         integrate_arrays(model, Taylor(), np.linspace(0, 1, 3), np.ones((1, 6)))
+
+
+def test_batch_sweep_of_a_plugin_parameter_under_taylor_is_the_exact_decay(cli, tmp_path, tmp_path_factory):
+    """``gyrolab --batch`` over the README's drag plugin: ω(t) = ω0 exp(−c t) on a spherical body, for every c."""
+    import tomllib
+    from pathlib import Path
+
+    import xarray as xr
+
+    example = Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"
+    project = tomllib.loads((example / "pyproject.toml").read_text())["project"]
+    with installed_distribution(tmp_path_factory.mktemp("site"), project["name"], project["version"],
+                                project["entry-points"]["gyrolab.forces"], [example]) as site:
+        done = cli("--batch", "force=[viscous_drag]", "force.viscous_drag.coefficient=0.2,0.5", "body.a=1", "body.b=1",
+                   "integrator=taylor", "integrator.tol=1e-14", "time.end=2", "time.n_output=5",
+                   "output.euler_angles=false", "output.figures=false", "batch.output=trajectory",
+                   "hydra.sweep.dir=batch", env_extra={"PYTHONPATH": f"{site}:{example}"})
+    assert done.returncode == 0, done.stderr[-2000:]
+    with xr.open_dataset(tmp_path / "batch" / "sweep.nc") as ds:
+        omega = ds.omega.transpose(..., "time", "axis")
+        assert omega.shape[:-2] == (2,) and int(ds.n_failed) == 0
+        c = np.asarray(omega[omega.dims[0]].values, dtype=float)
+        expected = omega.values[:, :1, :] * np.exp(-c[:, None, None] * ds.time.values[None, :, None])
+        np.testing.assert_allclose(omega.values, expected, rtol=1e-12, atol=1e-15)
