@@ -26,14 +26,14 @@ Recurrences (x, y the arguments, f the result, a sum over j written Σ_j):
   x^n (integer n): repeated Cauchy products (no division, so x_0 = 0 is fine), 1/x^|n| for n < 0;
   |x|: sign(x_0) x_k, exact wherever x_0 ≠ 0 (at x_0 = 0, |x| has no Taylor series);
   time: t_0 = t, t_1 = 1.
-The divisions make x/y, √x, log x, x^a (non-integer a) and arctan2 singular where their
-argument's value is 0 (as the functions themselves, or their derivatives, are): there the
-coefficients are inf/NaN and ``taylor`` stops with its one-sentence non-finite error.
+The divisions make x/y, √x, log x, x^a (a not an integer), x^y and arctan2 (at x = y = 0) singular
+where their argument's value is 0 (as the functions themselves, or their derivatives, are): there
+the coefficients are inf/NaN and ``taylor`` stops with its one-sentence non-finite error.
+The Taylor kernel compiles when a run first needs it (``ready``), not with the right-hand side's.
 """
 
 from __future__ import annotations
 
-import logging
 from typing import Any
 
 import numba
@@ -45,8 +45,6 @@ from numba.extending import intrinsic
 
 from gyrolab.plugins.compiled import fixed_point, inline_kernel
 from gyrolab.plugins.compiled.plugin_torque import FIRST_CONSTANT, INV_INERTIA, Expr, Trace, load_generated
-
-log = logging.getLogger(__name__)
 
 # fixed_point's Cauchy helpers, compiled inline here: a call per helper per order costs as much as its sums
 _cauchy_cross = inline_kernel(fixed_point._cauchy_cross.py_func)
