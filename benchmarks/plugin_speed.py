@@ -10,7 +10,8 @@ form), and with the same two torques written as a third-party plugin in plain Py
 under ``dop853_numba``, interleaved, integration time only (best of the repeats); the plugin also
 under scipy's DOP853 (gyrolab's ``dop853``: the Python right-hand side), at equal error.
 Error = max-norm of the final state's error against the extended-precision reference.
-Targets (issue 12): plugin ≤ 1.3× the built-in's time; ≥ 150× faster than scipy DOP853.
+Targets (issue 12): plugin ≤ 1.3× the built-in's time; ≥ 150× faster than scipy DOP853. Last, both
+under ``taylor`` (the plugin's Taylor coefficients propagated through its trace, ``plugin_taylor``).
 """
 
 from __future__ import annotations
@@ -150,6 +151,19 @@ def main() -> None:
             continue
         c_time, c_err = min(candidates)
         print(f"{tol:7.0e} {s_time:9.3f} {s_err:9.2e}   {c_time:17.5f} ({c_err:8.2e}) {s_time / c_time:8.0f}×")
+
+    print("\ntaylor (the plugin's series by automatic propagation, plugin_taylor) against the built-in's series:")
+    print(f"{'tol':>7} {'built-in s':>11} {'error':>9} {'plugin s':>9} {'error':>9} {'ratio':>6}")
+    for tol in ((1e-9, 1e-13) if args.quick else (1e-8, 1e-10, 1e-12, 1e-13)):
+        runs = {}
+        for _ in range(repeats):  # interleaved
+            for name, overrides in (("built-in", base), ("plugin", plugin)):
+                scene = compose_scene([*overrides, "integrator=taylor", f"integrator.tol={tol}"])
+                solution = scene.integrator.integrate(scene.system.rhs, scene.times, y0, None, scene.compiled)
+                best = min(runs.get(name, (np.inf,))[0], solution.stats.wall_time)
+                runs[name] = (best, float(np.max(np.abs(solution.y[-1] - truth))))
+        (b_time, b_err), (p_time, p_err) = runs["built-in"], runs["plugin"]
+        print(f"{tol:7.0e} {b_time:11.5f} {b_err:9.2e} {p_time:9.5f} {p_err:9.2e} {p_time / b_time:6.2f}")
 
 
 if __name__ == "__main__":

@@ -134,7 +134,7 @@ _REASONS = {1: "its step fell below the spacing of floating-point numbers", 2: "
 def _adaptive(compiled: CompiledModel, integrator: Integrator, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
               failures: str) -> BatchSolution:
     """The adaptive kernels: dop853_numba, taylor, and auto's choice between them."""
-    from gyrolab.plugins.compiled import batch_dop853, batch_taylor, models
+    from gyrolab.plugins.compiled import batch_dop853, batch_taylor, plugin_taylor
 
     start = time.perf_counter()
     settings = None
@@ -146,9 +146,9 @@ def _adaptive(compiled: CompiledModel, integrator: Integrator, times: np.ndarray
     steps = np.zeros(count, dtype=np.int64)
     status = np.zeros(count, dtype=np.int64)
     if len(times) > 1 and integrator.name == "taylor":
-        if compiled.model not in models.TAYLOR_MODELS:
-            raise ConfigError("integrator taylor needs Taylor coefficients, which a compiled plugin torque does not "
-                              "have; valid choices for this model: rk4_numba, dop853_numba, auto")
+        if not plugin_taylor.ready(compiled, P):
+            raise ConfigError("integrator taylor has no Taylor coefficients for this compiled model; "
+                              "valid choices for this model: rk4_numba, dop853_numba, auto")
         if _blockable(compiled, size):
             batch_taylor.run_blocks(P, integrator.order, integrator.tol, times, y0s, out, steps, status,
                                     batch_taylor.task_size(count))

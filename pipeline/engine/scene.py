@@ -69,13 +69,18 @@ class Scene:
                 f"choose dop853 (or rk45, rk4, lsoda, radau, bdf) or integrator=auto"
             )
         if scene.compiled is not None and integrator.name in ("taylor", "lie_poisson"):
-            from gyrolab.plugins.compiled import models
+            from gyrolab.plugins.compiled import models, plugin_taylor
 
-            if scene.compiled.model not in models.TAYLOR_MODELS:
+            if integrator.name == "lie_poisson" and scene.compiled.model != models.FIXED_POINT:
                 traced = ", ".join(f.name for f in system.forces if f.compiled_terms() is None)
                 raise ConfigError(
-                    f"integrator {integrator.name!r} evaluates the built-in torque forms only, and force {traced} "
-                    f"is a compiled plugin torque; choose dop853_numba, rk4_numba or integrator=auto"
+                    f"integrator 'lie_poisson' evaluates the built-in torque forms only, and force {traced} "
+                    f"is a compiled plugin torque; choose taylor, dop853_numba, rk4_numba or integrator=auto"
+                )
+            if integrator.name == "taylor" and not plugin_taylor.ready(scene.compiled):
+                raise ConfigError(
+                    f"integrator 'taylor' has no Taylor coefficients for system {system.name!r}'s compiled model; "
+                    f"choose dop853_numba, rk4_numba or integrator=auto"
                 )
         elif scene.compiled is None and integrator.prefers_compiled_model:
             reason = getattr(system, "compile_error", None)

@@ -22,17 +22,16 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gyrolab.plugins.compiled import fixed_point, inline_kernel, kernel
+from gyrolab.plugins.compiled import fixed_point, inline_kernel, kernel, plugin_taylor
 from gyrolab.plugins.compiled.plugin_torque import ADDRESS
 
 FIXED_POINT = 0
-#: The fixed-point system (state ω, γ) with all its torques traced and compiled (no Taylor coefficients:
-#: see docs/plugins.md).
+#: The fixed-point system (state ω, γ) with all its torques traced and compiled.
 FIXED_POINT_PLUGIN = 1
 #: The same with the state ω, γ, α.
 FIXED_POINT_PLUGIN_ALPHA = 2
-#: Models whose Taylor coefficients ``taylor_coefficients`` computes.
-TAYLOR_MODELS = (FIXED_POINT,)
+#: Models whose Taylor coefficients ``taylor_coefficients`` computes (plugin torques: see plugin_taylor.ready).
+TAYLOR_MODELS = (FIXED_POINT, FIXED_POINT_PLUGIN, FIXED_POINT_PLUGIN_ALPHA)
 
 
 @intrinsic
@@ -94,8 +93,10 @@ def evaluate(model, t, y, p, out):
 
 
 @inline_kernel
-def taylor_coefficients(model, p, Y, order, work):
+def taylor_coefficients(model, p, Y, order, work, t=0.0):
     if model == FIXED_POINT:
         fixed_point.taylor_coefficients(p, Y, order, work)
-    else:  # a traced plugin torque has no Taylor coefficients (scenes refuse taylor for it; docs/plugins.md)
+    elif model == FIXED_POINT_PLUGIN or model == FIXED_POINT_PLUGIN_ALPHA:  # the traced torque's series (plugin_taylor)
+        plugin_taylor.coefficients(p, Y, order, work, t)
+    else:
         raise ValueError("this compiled model has no Taylor coefficients")

@@ -270,9 +270,20 @@ _LOADED: dict[str, Any] = {}
 
 def compile_trace(result: Trace, names: list[str]) -> CompiledTorque:
     """The compiled kernel of a trace: generated once per form, compiled once per machine (cached on disk)."""
-    source = result.source()
+    kernel = load_generated(result.source(), "gyrolab_force", f"force {' + '.join(names)}")
+    from gyrolab.plugins.compiled import plugin_taylor  # the Taylor kernel's entries end the constants
+
+    tail = plugin_taylor.register(int(kernel.address), result, names)
+    return CompiledTorque(kernel, int(kernel.address), np.array(result.graph.constants + tail, dtype=float))
+
+
+def load_generated(source: str, prefix: str, what: str) -> Any:
+    """The ``kernel`` of a generated module: written to PREFIX_<hash of source>.py in the kernel cache, imported
+    (numba compiles it, or loads its cache) once per process; the first compilation on a machine logs
+    "compiling WHAT, once"."""
     digest = hashlib.sha256(source.encode()).hexdigest()[:16]
-    if digest not in _LOADED:
+    module_name = f"{prefix}_{digest}"
+    if module_name not in _LOADED:
         from gyrolab.plugins.compiled import kernel_cache_dir
 
         folder = Path(kernel_cache_dir()) / "forces"
@@ -283,7 +294,7 @@ def compile_trace(result: Trace, names: list[str]) -> CompiledTorque:
 
             folder = Path(tempfile.gettempdir()) / "gyrolab" / "forces"
             folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"gyrolab_force_{digest}.py"
+        path = folder / f"{module_name}.py"
         marker = path.with_suffix(".compiled")
         if not path.exists() or path.read_text() != source:
             from gyrolab.output.atomic import atomic_path
@@ -291,13 +302,11 @@ def compile_trace(result: Trace, names: list[str]) -> CompiledTorque:
             with atomic_path(path) as tmp:
                 Path(tmp).write_text(source)
         if not marker.exists():
-            log.info("compiling force %s, once (cached for later runs)", " + ".join(names))
-        module_name = f"gyrolab_force_{digest}"
+            log.info("compiling %s, once (cached for later runs)", what)
         spec = importlib.util.spec_from_file_location(module_name, path)
         module = importlib.util.module_from_spec(spec)
         sys.modules[module_name] = module
         spec.loader.exec_module(module)
-        _LOADED[digest] = module.kernel  # the cfunc compiled (or loaded its cache) on import
+        _LOADED[module_name] = module.kernel  # the cfunc compiled (or loaded its cache) on import
         marker.touch()
-    kernel = _LOADED[digest]
-    return CompiledTorque(kernel, int(kernel.address), np.array(result.graph.constants, dtype=float))
+    return _LOADED[module_name]

@@ -63,7 +63,7 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     while i < i_stop:
         for m in range(n):
             T[0, m] = y[m]
-        taylor_coefficients(model, p, T, order, work)
+        taylor_coefficients(model, p, T, order, work, t)
         stats[0] += 1
         scale = max(1.0, _norm_inf(y))
         n1 = _norm_inf(T[order - 1])

@@ -112,11 +112,11 @@ class Auto(Integrator):
 
     def _method(self, compiled: CompiledModel | None, tol: float) -> Integrator:
         if compiled is not None:
-            from gyrolab.plugins.compiled.models import TAYLOR_MODELS
+            from gyrolab.plugins.compiled.plugin_taylor import ready
             from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
 
-            # a compiled plugin torque has no Taylor coefficients: compiled DOP853 instead
-            if compiled.model in TAYLOR_MODELS:
+            # a compiled model without Taylor coefficients: compiled DOP853 instead
+            if ready(compiled):
                 return Taylor(order=self._order, tol=tol)
             return DOP853Numba(rtol=tol, atol=tol)
         from gyrolab.plugins.integrators.scipy_solvers import DOP853
@@ -197,10 +197,10 @@ class Auto(Integrator):
     def _series(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                 start: float) -> Solution | None:
         """The first regime whose analytic series is predicted to meet the accuracy on this scene, or None."""
-        from gyrolab.plugins.compiled.models import TAYLOR_MODELS
+        from gyrolab.plugins.compiled.models import FIXED_POINT
 
-        if self.system is None or compiled is None or t_out[0] != 0.0 or compiled.model not in TAYLOR_MODELS:
-            return None  # the truth check below integrates with Taylor
+        if self.system is None or compiled is None or t_out[0] != 0.0 or compiled.model != FIXED_POINT:
+            return None  # the regimes' series describe the built-in torques only
         from gyrolab.engine import registry
         from gyrolab.plugins.integrators.compiled_solvers import Taylor
 

@@ -1,0 +1,267 @@
+"""``taylor`` on plugin torques: Taylor coefficients propagated through the traced torque (plugin_taylor).
+
+Every expected number is independent of the code under test: each operation's series, generated
+for a function of time and summed, must reproduce the function itself evaluated by the math
+library a step away (and the first coefficients match the textbook series at 0); trajectories are
+checked against the exact solution of drag, against scipy's DOP853 on the plugin's Python torque,
+and against the built-in torques' own Taylor coefficients for plugins that repeat their arithmetic.
+"""
+
+import ctypes
+import math
+import textwrap
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from gyrolab.contracts import Force
+from gyrolab.engine.scene import compose_scene
+from gyrolab.errors import ConfigError
+from gyrolab.plugins.compiled import fixed_point, plugin_taylor, plugin_torque
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
+from tests.conftest import installed_distribution
+
+ORDER = 24
+_KERNEL = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int64, ctypes.c_int64, *[ctypes.POINTER(ctypes.c_double)] * 4)
+
+
+class OfTime(Force):
+    """Three functions of time as a 'torque' (the state is not read): their series come out of the kernel."""
+
+    name = "of_time"
+    required_axes = frozenset()
+    time_dependent = True
+    preserves_area_integral = False
+
+    def __init__(self, f):
+        self.f = f
+
+    def torque(self, omega, axes, t):
+        return np.array(self.f(t), dtype=object)
+
+
+def series(f, t0, order=ORDER):
+    """The generated kernel's coefficients 0..order of the three functions f(t) about t0 (rows)."""
+    result = plugin_torque.trace([OfTime(f)])
+    address, columns = plugin_taylor.compile_taylor(result, ["of_time"])
+    call = _KERNEL(int(address))
+    p = np.zeros(plugin_torque.FIRST_CONSTANT + len(result.graph.constants))
+    p[plugin_torque.INV_INERTIA:plugin_torque.INV_INERTIA + 3] = 1.0
+    p[plugin_torque.FIRST_CONSTANT:] = result.graph.constants
+    Y = np.zeros((order + 1, 6))
+    W = np.empty((order + 1) * int(columns))
+    out = np.empty((order + 1, 3))
+    ptr = [a.ctypes.data_as(ctypes.POINTER(ctypes.c_double)) for a in (Y, W, p)]
+    for k in range(order + 1):
+        call(t0, k, 6, *ptr, out[k].ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+    return out
+
+
+def _sum(coefficients, h):
+    return np.polynomial.polynomial.polyval(h, coefficients)
+
+
+# (numpy form for the trace, math form for the check); every operation the tracer records appears
+CASES = {
+    "exp, sin, cos": (lambda t: [np.exp(np.sin(t)), np.cos(3.0 * t) - t, np.sin(t) * np.cos(t)],
+                      lambda t: [math.exp(math.sin(t)), math.cos(3 * t) - t, math.sin(t) * math.cos(t)]),
+    "quotients, sqrt, log": (lambda t: [1.0 / (2.0 - t), np.sqrt(1.0 + t * t) / (2.0 + np.cos(t)), np.log(2.0 + t)],
+                             lambda t: [1 / (2 - t), math.sqrt(1 + t * t) / (2 + math.cos(t)), math.log(2 + t)]),
+    "tan, tanh, arctan": (lambda t: [np.tan(t), np.tanh(2.0 * t) * t, np.arctan(t) - t ** 3],
+                          lambda t: [math.tan(t), math.tanh(2 * t) * t, math.atan(t) - t ** 3]),
+    "powers": (lambda t: [(1.0 + t) ** 0.3, 2.0 ** t + (1.5 + t) ** t, (1.0 + t) ** -2 + (2.0 - t) ** 5],
+               lambda t: [(1 + t) ** 0.3, 2 ** t + (1.5 + t) ** t, (1 + t) ** -2 + (2 - t) ** 5]),
+    "arctan2, abs, neg": (lambda t: [np.arctan2(np.sin(t), np.cos(t) + 2.0), abs(t - 2.0), -np.exp(-t)],
+                          lambda t: [math.atan2(math.sin(t), math.cos(t) + 2), abs(t - 2), -math.exp(-t)]),
+}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_each_operations_series_sums_to_the_function(case):
+    traced, exact = CASES[case]
+    t0 = 0.3
+    c = series(traced, t0)
+    for h in (-0.15, 0.05, 0.2):  # every function is analytic within 0.8 of t0: the tail is below 1e-15
+        np.testing.assert_allclose(_sum(c, h), exact(t0 + h), rtol=0, atol=2e-14)
+    np.testing.assert_allclose(c[0], exact(t0), rtol=1e-15, atol=1e-16)
+
+
+def test_series_at_zero_are_the_textbook_ones():
+    c = series(lambda t: [np.tan(t), np.tanh(t), np.arctan(t)], 0.0, 9)
+    tan = [0, 1, 0, Fraction(1, 3), 0, Fraction(2, 15), 0, Fraction(17, 315), 0, Fraction(62, 2835)]
+    tanh = [(-1) ** (k // 2) * v for k, v in enumerate(tan)]
+    atan = [0 if k % 2 == 0 else Fraction((-1) ** (k // 2), k) for k in range(10)]
+    np.testing.assert_allclose(c, np.array([tan, tanh, atan], dtype=float).T, rtol=1e-14, atol=1e-16)
+    # x_0 = 0 for an integer power: products, no division; exp and 1/(1 − t)
+    c = series(lambda t: [t ** 3, np.exp(t), 1.0 / (1.0 - t)], 0.0, 8)
+    np.testing.assert_array_equal(c[:, 0], [0, 0, 0, 1, 0, 0, 0, 0, 0])
+    np.testing.assert_allclose(c[:, 1], [1 / math.factorial(k) for k in range(9)], rtol=1e-15)
+    np.testing.assert_array_equal(c[:, 2], np.ones(9))
+    c = series(lambda t: [np.sqrt(t), np.log(t), t / t], 0.0, 3)  # singular where the argument is 0
+    assert not np.all(np.isfinite(c[1:]))
+
+
+SHORT = ["time.end=4", "time.n_output=9", "output.euler_angles=false"]
+
+CENTRE = textwrap.dedent('''
+    import numpy as np
+    from gyrolab.contracts import Force
+    from gyrolab.physics.vectors import cross
+
+
+    class Centre(Force):
+        """An attracting centre off the vertical at c (fixed frame, in γ's components), plus a little drag on ω."""
+        name = "centre"
+        required_axes = frozenset({2})
+        preserves_area_integral = False
+
+        def __init__(self, body, *, k=0.6):
+            self.k = float(k)
+
+        def torque(self, omega, axes):
+            d = axes[2] - np.array([0.2, -0.1, 1.6])
+            r = np.sqrt(np.sum(d * d))
+            return self.k * cross(axes[2], d) / r ** 3 - 0.02 * np.sin(omega) * np.exp(-omega[2] ** 2)
+''')
+
+
+@pytest.fixture(scope="module")
+def centre(tmp_path_factory):
+    site = tmp_path_factory.mktemp("site")
+    (site / "taylor_centre.py").write_text(CENTRE)
+    with installed_distribution(site, "taylor-centre", "0.1", {"centre": "taylor_centre:Centre"}):
+        yield
+
+
+def _integrate(overrides):
+    scene = compose_scene([*overrides, *SHORT])
+    return scene, scene.integrator.integrate(scene.system.rhs, scene.times, scene.system.initial_state(), None,
+                                             scene.compiled).y
+
+
+def test_off_axis_centre_under_taylor_matches_scipy(centre):
+    scene, taylor = _integrate(["force=[uniform_gravity,centre]", "integrator=taylor", "integrator.tol=1e-15"])
+    assert scene.compiled.model == 1  # FIXED_POINT_PLUGIN: the traced torque, not scipy
+    _, scipy = _integrate(["force=[uniform_gravity,centre]", "integrator=dop853", "integrator.rtol=1e-12",
+                           "integrator.atol=1e-12"])
+    np.testing.assert_allclose(taylor, scipy, rtol=0, atol=1e-10)
+
+
+def test_drag_under_taylor_and_auto_is_the_exact_decay():
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"))
+    try:
+        from gyrolab_viscous_drag import ViscousDrag
+    finally:
+        sys.path.pop(0)
+    # A = B = C = 1: ω̇ = −c ω, ω(t) = ω0 exp(−c t) (the README's example plugin)
+    model = fixed_point.compiled_model(np.ones(3), [ViscousDrag(None, coefficient=0.3)], False)
+    assert plugin_taylor.ready(model)  # compiles the Taylor kernel (a scene does this when taylor is chosen)
+    y0 = np.array([0.1, -0.05, 5.0, 0.0, 0.6, 0.8])
+    t = np.linspace(0.0, 5.0, 11)
+    y = Taylor(tol=1e-15).integrate(None, t, y0, None, model).y
+    np.testing.assert_allclose(y[:, :3], y0[:3] * np.exp(-0.3 * t)[:, None], rtol=1e-13, atol=1e-15)
+
+
+class Traced(Force):
+    """A built-in force's torque with its compiled form withheld: gyrolab traces it as it would a plugin's."""
+
+    preserves_area_integral = False
+
+    def __init__(self, force):
+        self.force = force
+        self.name = f"traced_{force.name}"
+        self.required_axes = force.required_axes
+
+    def torque(self, omega, axes):
+        return self.force.torque(omega, axes)
+
+
+def test_plugins_repeating_the_builtin_arithmetic_follow_the_builtin_trajectory():
+    scene = compose_scene(["force=[uniform_gravity,newtonian,magnetic]", "force.magnetic.direction=[0.6,0.48,0.64]",
+                           "force.magnetic.moment=[0.3,0.2,1.0]", "integrator=taylor", *SHORT])
+    system = scene.system
+    beta = next(f for f in system.forces if f.name == "newtonian")
+    beta.axis, beta.required_axes = 1, frozenset({1})  # the gradient torque about β = γ × α: every packed form
+    builtin = fixed_point.compiled_model(system.inertia, system.forces, system.carries_alpha)
+    plugin = fixed_point.compiled_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
+    assert (builtin.model, plugin.model, system.state_size) == (0, 1, 9) and plugin_taylor.ready(plugin)
+    y0 = system.initial_state()
+    runs = [Taylor(order=20, tol=1e-14).integrate(None, scene.times, y0, None, m).y for m in (builtin, plugin)]
+    np.testing.assert_allclose(runs[1], runs[0], rtol=0, atol=1e-12)
+
+
+def test_batch_taylor_with_a_plugin_matches_single_runs(centre):
+    from gyrolab.engine.batch import integrate_batch
+
+    scene = compose_scene(["force=[centre]", "integrator=taylor", "integrator.tol=1e-13", *SHORT])
+    y0 = scene.system.initial_state()
+    y0s = np.stack([y0, y0 + np.r_[0.2, -0.1, 0.3, np.zeros(y0.size - 3)]])
+    batch = integrate_batch(scene, y0s)
+    for row, start in enumerate(y0s):
+        alone = scene.integrator.integrate(scene.system.rhs, scene.times, start, None, scene.compiled)
+        np.testing.assert_allclose(batch.y[row], alone.y, rtol=0, atol=1e-14)
+    auto = compose_scene(["force=[centre]", "integrator=auto", "integrator.accuracy=1e-8", *SHORT])
+    assert auto.integrator._method(auto.compiled, 1e-10).name == "taylor"
+
+
+def test_time_dependent_plugin_torque_under_taylor_against_the_equations_by_hand():
+    """A torque that reads time, −0.1 sin(t) ω, under taylor: the series get the step's start time. Reference:
+    Euler's equations I ω̇ = Iω × ω + T(t), γ̇ = γ × ω written out here, scipy DOP853 at rtol = atol = 1e-13."""
+    class Pulse(Force):
+        name = "pulse"
+        time_dependent = True
+        preserves_area_integral = False
+        required_axes = frozenset()
+
+        def torque(self, omega, axes, t):
+            return -0.1 * np.sin(t) * omega
+
+    inertia = np.array([1.0, 2.0, 3.0])
+    model = fixed_point.compiled_model(inertia, [Pulse()], False)
+    from gyrolab.plugins.compiled import taylor
+
+    # the kernel called directly before ``ready`` compiled the Taylor kernel: a non-finite status, not a jump to 0
+    status, _ = taylor.run(model.model, model.params, 8, 1e-10, np.linspace(0.0, 1.0, 3), np.empty((3, 6)), 1, 3,
+                           np.zeros(1), np.ones(6), np.zeros(6), np.zeros(2, dtype=np.int64))
+    assert status == taylor.NOT_FINITE
+    assert plugin_taylor.ready(model)
+
+    def by_hand(t, y):
+        w, g = y[:3], y[3:]
+        return np.concatenate([(np.cross(inertia * w, w) - 0.1 * np.sin(t) * w) / inertia, np.cross(g, w)])
+
+    times = np.linspace(0.0, 6.0, 13)
+    y0 = np.array([0.3, -0.2, 1.5, 0.0, 0.6, 0.8])
+    from gyrolab.engine.batch import integrate_arrays
+
+    got = integrate_arrays(model, Taylor(tol=1e-14), times, y0[None, :]).y[0]
+    ref = solve_ivp(by_hand, (0.0, 6.0), y0, method="DOP853", t_eval=times, rtol=1e-13, atol=1e-13).y.T
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10)
+
+
+def test_batch_sweep_of_a_plugin_parameter_under_taylor_is_the_exact_decay(cli, tmp_path, tmp_path_factory):
+    """``gyrolab --batch`` over the README's drag plugin: ω(t) = ω0 exp(−c t) on a spherical body, for every c."""
+    import tomllib
+    from pathlib import Path
+
+    import xarray as xr
+
+    example = Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"
+    project = tomllib.loads((example / "pyproject.toml").read_text())["project"]
+    with installed_distribution(tmp_path_factory.mktemp("site"), project["name"], project["version"],
+                                project["entry-points"]["gyrolab.forces"], [example]) as site:
+        done = cli("--batch", "force=[viscous_drag]", "force.viscous_drag.coefficient=0.2,0.5", "body.a=1", "body.b=1",
+                   "integrator=taylor", "integrator.tol=1e-14", "time.end=2", "time.n_output=5",
+                   "output.euler_angles=false", "output.figures=false", "batch.output=trajectory",
+                   "hydra.sweep.dir=batch", env_extra={"PYTHONPATH": f"{site}:{example}"})
+    assert done.returncode == 0, done.stderr[-2000:]
+    with xr.open_dataset(tmp_path / "batch" / "sweep.nc") as ds:
+        omega = ds.omega.transpose(..., "time", "axis")
+        assert omega.shape[:-2] == (2,) and int(ds.n_failed) == 0
+        c = np.asarray(omega[omega.dims[0]].values, dtype=float)
+        expected = omega.values[:, :1, :] * np.exp(-c[:, None, None] * ds.time.values[None, :, None])
+        np.testing.assert_allclose(omega.values, expected, rtol=1e-12, atol=1e-15)
