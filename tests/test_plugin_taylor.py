@@ -13,12 +13,13 @@ import textwrap
 from fractions import Fraction
 
 import numpy as np
+from scipy.integrate import solve_ivp
 import pytest
 
 from gyrolab.contracts import Force
 from gyrolab.engine.scene import compose_scene
 from gyrolab.errors import ConfigError
-from gyrolab.plugins.compiled import fixed_point, plugin_taylor, plugin_torque
+from gyrolab.plugins.compiled import fixed_point, models, plugin_taylor, plugin_torque
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from tests.conftest import installed_distribution
 
@@ -188,7 +189,8 @@ def test_plugins_repeating_the_builtin_arithmetic_follow_the_builtin_trajectory(
     beta.axis, beta.required_axes = 1, frozenset({1})  # the gradient torque about β = γ × α: every packed form
     builtin = fixed_point.compiled_model(system.inertia, system.forces, system.carries_alpha)
     plugin = fixed_point.compiled_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
-    assert (builtin.model, plugin.model, system.state_size) == (0, 1, 9) and plugin_taylor.ready(plugin)
+    assert (builtin.model, plugin.model, system.state_size) == (models.FIXED_POINT, models.FIXED_POINT_PLUGIN_ALPHA, 9)
+    assert plugin_taylor.ready(plugin)
     y0 = system.initial_state()
     runs = [Taylor(order=20, tol=1e-14).integrate(None, scene.times, y0, None, m).y for m in (builtin, plugin)]
     np.testing.assert_allclose(runs[1], runs[0], rtol=0, atol=1e-12)
