@@ -329,12 +329,7 @@ def _step(lane, T, order, tol, safety, t_out, t_end, t, index, carry, Yj):
         scale = max(scale, abs(T[0, c, lane]))
         n1 = max(n1, abs(T[order - 1, c, lane]))
         n2 = max(n2, abs(T[order, c, lane]))
-    h = np.inf
-    if n1 > 0:
-        h = min(h, (tol * scale / n1) ** (1.0 / (order - 1)))
-    if n2 > 0:
-        h = min(h, (tol * scale / n2) ** (1.0 / order))
-    h *= safety
+    h = taylor.step_size(tol, scale, n1, n2, order, safety)
     if not h < np.inf:
         h = t_end - t
     t_new = min(t + h, t_end)

@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from gyrolab.plugins.compiled import kernel
+from gyrolab.plugins.compiled import inline_kernel, kernel
 from gyrolab.plugins.compiled.models import taylor_coefficients
 
 OK, NOT_FINITE = 0, 2
@@ -40,6 +40,18 @@ def _norm_inf(row):
     for x in row:
         v = max(v, abs(x))
     return v
+
+
+@inline_kernel
+def step_size(tol, scale, n1, n2, order, safety):
+    """Jorba & Zou's step from the max norms n1, n2 of the last two coefficients (order − 1, order) and the
+    state's scale; inf when both vanish (the caller then steps to the end)."""
+    h = np.inf
+    if n1 > 0:
+        h = min(h, (tol * scale / n1) ** (1.0 / (order - 1)))
+    if n2 > 0:
+        h = min(h, (tol * scale / n2) ** (1.0 / order))
+    return h * safety
 
 
 @kernel
@@ -68,12 +80,7 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
         scale = max(1.0, _norm_inf(y))
         n1 = _norm_inf(T[order - 1])
         n2 = _norm_inf(T[order])
-        h = np.inf
-        if n1 > 0:
-            h = min(h, (tol * scale / n1) ** (1.0 / (order - 1)))
-        if n2 > 0:
-            h = min(h, (tol * scale / n2) ** (1.0 / order))
-        h *= safety
+        h = step_size(tol, scale, n1, n2, order, safety)
         if not h < np.inf:
             h = t_end - t
         t_new = min(t + h, t_end)
