@@ -186,13 +186,13 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
     """
     if plan.base is None or plan.integrator_name != "auto" or settings.output == "indicator":
         return None, {}
-    from gyrolab.engine.batch import _auto_choice
+    from gyrolab.engine.batch import auto_choice
     from gyrolab.engine.scene import Scene
 
     scene = Scene.from_config(OmegaConf.create(plan.base))
     valid = np.flatnonzero(plan.valid)
     start = time.perf_counter()
-    method, choice = _auto_choice(scene.system.compiled_model(), scene.integrator, plan.times, plan.y0[valid],
+    method, choice = auto_choice(scene.system.compiled_model(), scene.integrator, plan.times, plan.y0[valid],
                                   plan.combo_params[plan.combo[valid]])
     log.info("batch: auto chose %s at tolerance %.3g for every chunk (pilot on %d points, %.1f s)", method.name,
              choice["auto_tolerance"], choice.get("auto_sampled_trajectories", 0), time.perf_counter() - start)

@@ -139,7 +139,7 @@ def _adaptive(compiled: CompiledModel, integrator: Integrator, times: np.ndarray
     start = time.perf_counter()
     settings = None
     if integrator.name == "auto":
-        integrator, settings = _auto_choice(compiled, integrator, times, y0s, P)
+        integrator, settings = auto_choice(compiled, integrator, times, y0s, P)
     count, size = y0s.shape
     out = np.empty((count, len(times), size))
     out[:, 0] = y0s
@@ -170,7 +170,7 @@ def _adaptive(compiled: CompiledModel, integrator: Integrator, times: np.ndarray
                          settings or integrator.attributes())
 
 
-def _auto_choice(compiled: CompiledModel, auto: Integrator, times: np.ndarray, y0s: np.ndarray,
+def auto_choice(compiled: CompiledModel, auto: Integrator, times: np.ndarray, y0s: np.ndarray,
                  P: np.ndarray) -> tuple[Integrator, dict]:
     """``auto``'s method and tolerance for a batch: its single-run choice on a few trajectories, the tightest.
 
