@@ -171,7 +171,7 @@ def _adaptive(compiled: CompiledModel, integrator: Integrator, times: np.ndarray
 
 
 def auto_choice(compiled: CompiledModel, auto: Integrator, times: np.ndarray, y0s: np.ndarray,
-                 P: np.ndarray) -> tuple[Integrator, dict]:
+                P: np.ndarray) -> tuple[Integrator, dict]:
     """``auto``'s method and tolerance for a batch: its single-run choice on a few trajectories, the tightest.
 
     The sample is the first trajectory, the one with the largest state and the one whose parameters
