@@ -191,3 +191,25 @@ def test_a_scene_with_a_plugin_traces_every_force_and_its_compiled_rhs_is_the_py
         out = np.empty(size)
         models.evaluate(compiled.model, 0.1 * k, y, compiled.params, out)
         np.testing.assert_allclose(out, scene.system.rhs(0.1 * k, y), rtol=1e-13, atol=1e-13)
+
+
+def test_taylor_stops_with_one_sentence_when_its_step_cannot_advance_time():
+    """A step below the spacing of floating-point numbers at t (here forced by tol = 1e-300 at t = 1, where the
+    spacing is 2.2e-16 and the step ~1e-100) used to leave the kernel looping forever; it is a failure now,
+    with dop853's status code, and the integrator says so in one sentence."""
+    from gyrolab.errors import IntegrationError
+    from gyrolab.plugins.compiled import taylor
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    scene = compose_scene(["integrator=taylor", "time.end=2", "time.n_output=3"])
+    compiled, y0 = scene.compiled, scene.system.initial_state()
+    t_out = np.array([1.0, 1.5, 2.0])
+    out = np.empty((3, y0.size))
+    out[0] = y0
+    state, stats = np.array([1.0]), np.zeros(2, dtype=np.int64)
+    code, reached = taylor.run(compiled.model, compiled.params, 4, 1e-300, t_out, out, 1, 3, state,
+                               y0.copy(), np.zeros(y0.size), stats)
+    assert (code, reached, state[0], stats[1]) == (taylor.TOO_SMALL_STEP, 1, 1.0, 0)
+    with pytest.raises(IntegrationError, match="^taylor's step fell below the spacing of floating-point numbers "
+                                               "near t=1 "):
+        Taylor(order=4, tol=1e-300).integrate(None, t_out, y0, None, compiled)

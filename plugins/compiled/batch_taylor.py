@@ -43,9 +43,8 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from gyrolab.plugins.compiled import kernel, taylor
-from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK
+from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK, TOO_SMALL_STEP
 
-TOO_SMALL_STEP = 1  # a step that does not advance time (dop853's code; the single Taylor kernel has none)
 
 LANES = 4  # trajectories advanced in lock step: one AVX2 vector of doubles
 TASK = 256  # trajectories per parallel task, at most
@@ -351,7 +350,7 @@ def _step(lane, T, order, tol, safety, t_out, t_end, t, index, carry, Yj):
 def run_each(model, Params, order, tol, t_out, Y0, Y, steps, status):
     """Every trajectory j (initial state Y0[j], parameters Params[j]) over t_out into Y[j], one per thread.
 
-    steps[j] receives its number of steps, status[j] OK or NOT_FINITE (its outputs from the
+    steps[j] receives its number of steps, status[j] OK, NOT_FINITE or TOO_SMALL_STEP (its outputs from the
     failed step on are NaN). t_out has at least two times.
     """
     for j in numba.prange(Y0.shape[0]):  # the loop stays small: numba's parallel pass compiles slowly on big bodies

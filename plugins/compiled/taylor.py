@@ -25,7 +25,7 @@ import numpy as np
 from gyrolab.plugins.compiled import inline_kernel, kernel
 from gyrolab.plugins.compiled.models import taylor_coefficients
 
-OK, NOT_FINITE = 0, 2
+OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2  # dop853's codes
 MIN_ORDER, MAX_ORDER = 4, 60
 
 
@@ -85,6 +85,9 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
             h = t_end - t
         t_new = min(t + h, t_end)
         h = t_new - t
+        if h <= 0.0:  # the step is below the spacing of floating-point numbers at t: no progress is possible
+            state[0] = t
+            return TOO_SMALL_STEP, i
         while i < n_out and t_out[i] <= t_new:
             dt = t_out[i] - t
             for m in range(n):

@@ -229,6 +229,9 @@ class Taylor(Integrator):
                 continue  # a long step already filled this chunk's outputs
             status, reached = taylor.run(compiled.model, compiled.params, self.order, self.tol, t_out, out, reached,
                                          stop, state, y, carry, stats)
+            if status == taylor.TOO_SMALL_STEP:
+                raise IntegrationError(f"taylor's step fell below the spacing of floating-point numbers near "
+                                       f"t={state[0]:.6g} (a singularity of the solution, or integrator.tol too small)")
             if status != taylor.OK:
                 raise IntegrationError(f"taylor produced a non-finite state near t={state[0]:.6g}")
             if progress is not None:
