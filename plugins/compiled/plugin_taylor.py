@@ -51,9 +51,8 @@ _cauchy_cross = inline_kernel(fixed_point._cauchy_cross.py_func)
 _cauchy_pairs = inline_kernel(fixed_point._cauchy_pairs.py_func)
 
 #: Entries the Taylor kernel adds after the right-hand side's constants; they end the parameter array:
-#: p[-3] = its address, p[-2] = its work columns (both 0 until ``ready`` compiles it), p[-1] = 1 if the
-#: torque reads time (see ``ready``).
-TAIL = 3
+#: p[-2] = its address, p[-1] = its work columns (both 0 until ``ready`` compiles it).
+TAIL = 2
 
 
 class _Lowered:
@@ -241,7 +240,7 @@ def register(address: int, result: Trace, names: list[str]) -> list[float]:
     seconds. ``ready`` compiles it when an integrator needs it.
     """
     _TRACES[address] = (result, names)
-    return [0.0, 0.0, float(result.uses_time)]
+    return [0.0, 0.0]
 
 
 def ready(compiled: Any, rows: np.ndarray | None = None) -> bool:
@@ -256,10 +255,10 @@ def ready(compiled: Any, rows: np.ndarray | None = None) -> bool:
     if compiled.model not in (models.FIXED_POINT_PLUGIN, models.FIXED_POINT_PLUGIN_ALPHA):
         return compiled.model in models.TAYLOR_MODELS
     p = compiled.params
-    if p[-3] == 0.0:
-        p[-3:-1] = compile_taylor(*_TRACES[int(p[ADDRESS])])
+    if p[-2] == 0.0:
+        p[-2:] = compile_taylor(*_TRACES[int(p[ADDRESS])])
     if rows is not None:
-        rows[:, -3:-1] = p[-3:-1]
+        rows[:, -2:] = p[-2:]
     return True
 
 
@@ -296,14 +295,14 @@ def coefficients(p, Y, order, work, t):
     Per order k: the k-th coefficients of the built-in quadratic terms, (Iω) × ω + Σ U_i × e_i + Σ N_i e_i × I e_i
     (Cauchy sums, as ``fixed_point``), plus the plugin torque's k-th coefficient from its Taylor kernel, divided by
     I and k + 1; γ̇ = γ × ω and α̇ = α × ω likewise. ``work`` (order+1, 3) holds β = γ × α's series when α is
-    carried; the kernel's node series live in an array of p[-2] columns.
+    carried; the kernel's node series live in an array of p[-1] columns.
     """
     n = Y.shape[1]
-    address = int(p[p.size - 3])
+    address = int(p[p.size - 2])
     if address == 0:  # the Taylor kernel was not compiled (``ready`` not called): no series, not a crash
         Y[1:] = np.nan
         return
-    W = np.empty((order + 1) * int(p[p.size - 2]))
+    W = np.empty((order + 1) * int(p[p.size - 1]))
     I0, I1, I2 = p[0], p[1], p[2]
     d0, d1, d2 = I1 - I2, I2 - I0, I0 - I1
     has_alpha = p[15] != 0.0

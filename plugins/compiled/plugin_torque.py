@@ -175,7 +175,6 @@ class Trace:
     graph: Graph
     outputs: list[Any]
     needs_beta: bool
-    uses_time: bool
 
     def source(self) -> str:
         """The cfunc's Python source, with constants read from p (so it depends on the form only)."""
@@ -253,7 +252,7 @@ def trace(forces: list[Any]) -> Trace:
             raise NotCompilable(f"the torque of force {name!r} has shape {value.shape}, not (3,)")
         # a component that does not depend on the state is a number: a parameter too, unless exactly 0
         outputs.append([v if isinstance(v, Expr) or v == 0 else graph.lift(v) for v in value])
-    return Trace(graph, outputs, beta is not None, uses_time)
+    return Trace(graph, outputs, beta is not None)
 
 
 @dataclass
