@@ -128,6 +128,15 @@ def _batch(tmp_path, monkeypatch):
     return xr.load_dataset(path, decode_times=False), path
 
 
+def _batch_points(tmp_path, monkeypatch):
+    """A list of points (``batch.zip``): one dimension ``point``, the swept keys coordinates along it."""
+    path = run_batch_sweep(["integrator=rk4", "integrator.step=0.01", "batch.zip=true", "body.a=1.5,2",
+                            "initial.r0=5,8", "output.euler_angles=false", *TINY], tmp_path)
+    ds = xr.load_dataset(path, decode_times=False)
+    assert ds.a.dims == ds.r0.dims == ("point",)
+    return ds, path
+
+
 def _yehia(tmp_path, monkeypatch):
     """One case of the Yehia table (the full table integrates every case for several orbits)."""
     from gyrolab.experiments import yehia2021_precessions as yehia
@@ -156,6 +165,7 @@ KINDS = {
     "run_orbiting_gyrostat": _run(["body=gyrostat_symmetric", "force=[newtonian]", "force.newtonian.k=null"]),
     "sweep_multirun": _sweep,
     "sweep_batch": _batch,
+    "sweep_batch_points": _batch_points,
     "regime": _task("regime", [*overrides_000(20.0), "regime.periods=1", "regime.samples_per_period=50"]),
     "work_precision": _task("work_precision", [
         "experiment=work_precision", "time.end=1", "work_precision.repeats=1", "~work_precision.methods",
