@@ -87,6 +87,7 @@ MISS_MARGIN = 1000.0
 #: of its Taylor run (whose error, far below 1e3 × this on the one to four periods it covers, is added to its margin)
 SCREEN_POINTS = 512
 SCREEN_TOLERANCE = 1e-9
+EPS = float(np.finfo(float).eps)
 
 
 class Auto(Integrator):
@@ -106,17 +107,21 @@ class Auto(Integrator):
         self.system: Any = None
         self._pilot_steps = 0
         self._order: int | None = None
+        self._taylor: bool | None = None  # whether the compiled model has Taylor coefficients (asked once per run)
 
     def prepare(self, system: Any) -> None:
         self.system = system
 
     def _method(self, compiled: CompiledModel | None, tol: float) -> Integrator:
         if compiled is not None:
-            from gyrolab.plugins.compiled.plugin_taylor import ready
             from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
 
+            if self._taylor is None:
+                from gyrolab.plugins.compiled.plugin_taylor import ready
+
+                self._taylor = ready(compiled)
             # a compiled model without Taylor coefficients: compiled DOP853 instead
-            if ready(compiled):
+            if self._taylor:
                 return Taylor(order=self._order, tol=tol)
             return DOP853Numba(rtol=tol, atol=tol)
         from gyrolab.plugins.integrators.scipy_solvers import DOP853
@@ -129,7 +134,8 @@ class Auto(Integrator):
 
         start = time.perf_counter()
         t_out = np.asarray(t_out, dtype=float)
-        scale = max(1.0, float(np.max(np.abs(y0))))
+        self._taylor = None
+        scale = max(1.0, *map(abs, y0))  # a few components: Python's max is several times faster than numpy's
         if self.accuracy < FLOOR * scale:
             raise ConfigError(f"accuracy={self.accuracy:g} is below what double precision reaches on this scene "
                               f"(about {FLOOR * scale:.1g} for states of size {scale:.3g}); ask for more")
@@ -139,9 +145,9 @@ class Auto(Integrator):
         span = t_out[-1] - t_out[0]
         t_pilot = t_out[0] + span * self.pilot_fraction
         # the pilot's grid holds the output times it covers: its tight run is the start of the trajectory
-        pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * np.linspace(0.0, 1.0, PILOT_POINTS),
-                                 t_out[t_out < t_pilot])
-        tau, pilot_nfev = float(np.clip(self.accuracy * FIRST_RATIO, MIN_TOLERANCE, MAX_TOLERANCE / 10)), 0
+        inside = t_out[t_out < t_pilot]
+        pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * np.linspace(0.0, 1.0, PILOT_POINTS), inside)
+        tau, pilot_nfev = min(max(self.accuracy * FIRST_RATIO, MIN_TOLERANCE), MAX_TOLERANCE / 10), 0
         # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance
         self._order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
         loose = None  # the previous round's loose run (tolerance, solution): the next round's tight run
@@ -163,7 +169,7 @@ class Auto(Integrator):
         # double precision, whatever the tolerance.
         steps = self._pilot_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / self._order))
         compensated = self._method(compiled, chosen).name == "taylor"
-        roundoff = np.finfo(float).eps * scale * (math.sqrt(steps) if compensated else steps)
+        roundoff = EPS * scale * (math.sqrt(steps) if compensated else steps)
         if roundoff > self.accuracy:
             raise ConfigError(f"accuracy={self.accuracy:g} is below the round-off that double precision accumulates "
                               f"on this scene (about {roundoff:.1g} over ~{steps:.0f} steps); ask for at least that")
@@ -171,7 +177,7 @@ class Auto(Integrator):
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         method = self._method(compiled, chosen)
         if tight_tol <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
-            head = np.searchsorted(pilot_times, t_out[t_out < t_pilot])  # the outputs inside the pilot
+            head = np.searchsorted(pilot_times, inside)  # the outputs inside the pilot
             rest = t_out[t_out >= t_pilot]
             tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest,
                                     tight.y[-1], progress, compiled)
@@ -291,19 +297,11 @@ class Auto(Integrator):
         lo, hi = period / spread, period * spread
         if not (np.isfinite(hi) and 0 < lo) or hi > span:
             return False  # the check's window is then the span, not a period: no periodicity to use
-        times = np.concatenate([[0.0], np.linspace(lo, hi, SCREEN_POINTS)])
-        y = Taylor(tol=SCREEN_TOLERANCE).integrate(fun, times, y0, None, compiled).y[1:, :6]
-        h = times[2] - times[1]
-        # max|Φ'| over the range from the secants, doubled: the secants' largest slope falls short of it by O(h²)
-        speed = 2 * float(np.max(np.abs(np.diff(y, axis=0)))) / h
-        scale = max(1.0, float(np.max(np.abs(y0[:6]))))
-        margin = 1.1 * self.accuracy / self.safety + speed * h / 2 + 1e3 * SCREEN_TOLERANCE * scale
-        # min over the grid of max over the components > margin; rows are ruled out one component at a time
-        # (numpy's row-wise max over 6 columns costs more than the integration)
-        near = np.arange(len(y))
-        for k in range(6):
-            near = near[np.abs(y[near, k] - y0[k]) <= margin]
-        return len(near) == 0
+        times = np.empty(SCREEN_POINTS + 1)
+        times[0], times[1:] = 0.0, np.linspace(lo, hi, SCREEN_POINTS)
+        y = Taylor(tol=SCREEN_TOLERANCE).integrate(fun, times, y0, None, compiled).y
+        scale = max(1.0, *map(abs, y0[:6]))
+        return not _fast(_comes_back, compiled)(y, y0, 1.1 * self.accuracy / self.safety + 1e3 * SCREEN_TOLERANCE * scale)
 
     def _pilot(self, fun: RightHandSide, times: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                tau: float, previous: tuple[float, Solution] | None
@@ -322,18 +320,13 @@ class Auto(Integrator):
             tight_tol = min(tau * 1e-2, self.accuracy / TIGHT_RATIO)
             tight = self._method(compiled, tight_tol).integrate(fun, times, y0, None, compiled)
             tight_nfev = tight.stats.nfev
-        # Envelope of the error: pointwise errors of periodic motions dip through zero.
-        envelope = np.maximum.accumulate(np.max(np.abs(loose.y - tight.y), axis=1))
+        final, slope = _fast(_error_growth, compiled)(loose.y, tight.y, times)
         # differences within a few hundred ulps are round-off, not a measurement of the truncation error
-        measured = bool(envelope[-1] > 100 * np.finfo(float).eps * max(1.0, float(np.max(np.abs(y0)))))
-        elapsed = times - times[0]
-        late = elapsed >= elapsed[-1] / 4
+        measured = bool(final > 100 * EPS * max(1.0, *map(abs, y0)))
         # A non-symplectic method on a (near-)integrable motion drifts in energy linearly, hence in phase
         # quadratically: assume q = 2 unless the pilot shows faster growth (its early error is a plateau).
-        growth = MIN_GROWTH
-        if np.all(envelope[late] > 0):
-            growth = float(np.clip(_slope(np.log(elapsed[late]), np.log(envelope[late])), MIN_GROWTH, 4.0))
-        per_tol = envelope[-1] / (tau - tight_tol) * (1.0 / self.pilot_fraction) ** growth
+        growth = MIN_GROWTH if math.isnan(slope) else min(max(slope, MIN_GROWTH), 4.0)
+        per_tol = final / (tau - tight_tol) * (1.0 / self.pilot_fraction) ** growth
         self._pilot_steps = tight.stats.n_steps
         return per_tol, growth, loose.stats.nfev + tight_nfev, measured, (tight_tol, tight), (tau, loose)
 
@@ -341,8 +334,72 @@ class Auto(Integrator):
         return {"accuracy": self.accuracy, **self.choice}
 
 
-def _slope(x: np.ndarray, y: np.ndarray) -> float:
-    """Least-squares slope of y against x, in closed form: ``np.polyfit(x, y, 1)[0]`` to rounding, without
-    LAPACK (whose BLAS worker threads keep spinning after the call and bill the run for a second core)."""
-    dx = x - x.mean()
-    return float(np.sum(dx * (y - y.mean())) / np.sum(dx * dx))
+#: the statistics below compiled, by name (``_fast``)
+_COMPILED: dict[str, Any] = {}
+
+
+def _fast(function: Any, compiled: CompiledModel | None) -> Any:
+    """``function`` compiled with numba (cached on disk) when the scene runs compiled code, hence has numba loaded;
+    the same function in Python otherwise (scipy's runs around it take ~1000× longer). Written as loops over
+    small arrays: in numpy they were a dozen calls of ~5–15 µs each per pilot round, ~10 % of a millisecond run."""
+    if compiled is None:
+        return function
+    if function.__name__ not in _COMPILED:
+        from gyrolab.plugins.compiled import kernel
+
+        _COMPILED[function.__name__] = kernel(function)
+    return _COMPILED[function.__name__]
+
+
+def _error_growth(loose: np.ndarray, tight: np.ndarray, times: np.ndarray) -> tuple[float, float]:
+    """(E(T), q) for two runs on ``times``: E the envelope (running maximum) of their max-norm difference (pointwise
+    errors of periodic motions dip through zero), and q the least-squares slope of log E against log(t − t0)
+    over the last three quarters of the span (the early error is a plateau), or NaN where E is zero there.
+    The slope is centred, as ``np.polyfit(x, y, 1)[0]`` (no LAPACK call: BLAS threads spin after it)."""
+    n = loose.shape[0]
+    envelope = np.empty(n)
+    top = 0.0
+    for i in range(n):
+        for k in range(loose.shape[1]):
+            d = abs(loose[i, k] - tight[i, k])
+            if d > top or math.isnan(d):  # a NaN stays (as in np.maximum.accumulate)
+                top = d
+        envelope[i] = top
+    span = times[n - 1] - times[0]
+    first = 0
+    while times[first] - times[0] < span / 4:
+        first += 1
+    if not envelope[first] > 0:  # the envelope is non-decreasing: zero somewhere late, or NaN
+        return top, math.nan
+    m = n - first
+    x, y = np.empty(m), np.empty(m)
+    for i in range(m):
+        x[i] = math.log(times[first + i] - times[0])
+        y[i] = math.log(envelope[first + i])
+    x_mean, y_mean = np.mean(x), np.mean(y)
+    sxy = sxx = 0.0
+    for i in range(m):
+        sxy += (x[i] - x_mean) * (y[i] - y_mean)
+        sxx += (x[i] - x_mean) * (x[i] - x_mean)
+    return top, sxy / sxx
+
+
+def _comes_back(y: np.ndarray, y0: np.ndarray, margin: float) -> bool:
+    """Whether the motion sampled in ``y`` (row 0: the start y0; rows 1…: an equally spaced grid) comes within
+    ``margin`` + max|Φ'|·h/2 of y0 in every one of its first six components at some grid time. max|Φ'|·h/2 is
+    taken as the largest step between neighbouring rows: the secants' slope, doubled (it falls short of max|Φ'|
+    by O(h²)), times h/2."""
+    jump = 0.0
+    for i in range(2, y.shape[0]):
+        for k in range(6):
+            jump = max(jump, abs(y[i, k] - y[i - 1, k]))
+    limit = margin + jump
+    for i in range(1, y.shape[0]):
+        near = True
+        for k in range(6):
+            if not abs(y[i, k] - y0[k]) <= limit:
+                near = False
+                break
+        if near:
+            return True
+    return False

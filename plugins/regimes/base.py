@@ -7,6 +7,7 @@ units is mapped there and back: t' = c t, ω' = ω/c.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import Any
 
@@ -44,8 +45,20 @@ class NondimensionalScene:
         return float(np.cos(self.theta0))
 
 
+#: each system's nondimensional form, once computed: a system's body, forces and initial state are fixed when it is
+#: built, and ``integrator=auto``'s series check asks every regime for it (~40 µs each)
+_SCENES: weakref.WeakKeyDictionary[System, NondimensionalScene] = weakref.WeakKeyDictionary()
+
+
 def nondimensional_scene(system: System, regime: str) -> NondimensionalScene:
     """The scene's body, forces and initial spin/tilt in the papers' form; ConfigError for other forces."""
+    known = _SCENES.get(system)
+    if known is None:
+        known = _SCENES[system] = _nondimensional_scene(system, regime)
+    return known
+
+
+def _nondimensional_scene(system: System, regime: str) -> NondimensionalScene:
     names = [f.name for f in system.forces]
     foreign = [n for n in names if n not in SUPPORTED_FORCES]
     if foreign or not {"uniform_gravity", "magnetic"} & set(names):
