@@ -22,8 +22,14 @@ import math
 
 import numpy as np
 
-from gyrolab.plugins.compiled import inline_kernel, kernel
-from gyrolab.plugins.compiled.models import taylor_coefficients
+from llvmlite import ir
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
+
+from gyrolab.plugins.compiled import inline_kernel, kernel, simd
+from gyrolab.plugins.compiled.models import FIXED_POINT, taylor_coefficients
+from gyrolab.plugins.compiled.simd import LANES
 
 OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2  # dop853's codes
 MIN_ORDER, MAX_ORDER = 4, 60
@@ -63,7 +69,18 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     step passes is filled, also beyond i_stop. state = [t]; carry = the Kahan compensation of y (zeros
     at the start); stats = [coefficient evaluations, steps]. Returns (status, index of the next output
     time to fill).
+
+    The fixed-point model without α takes the vectorised step (``run_vector``), every other model
+    ``run_scalar``.
     """
+    if model == FIXED_POINT and p[15] == 0.0:
+        return run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
+    return run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
+
+
+@kernel
+def run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+    """``run`` with scalar arithmetic, for every model with Taylor coefficients (``models.taylor_coefficients``)."""
     n = y.size
     T = np.empty((order + 1, n))
     work = np.zeros((order + 1, 3))
@@ -114,3 +131,201 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
         stats[1] += 1
     state[0] = t
     return OK, i
+
+
+# The vectorised step of the fixed-point model without α: one trajectory, its components across the lanes of
+# ``<4 x double>`` vectors. Each order's coefficients are stored as ROWS vectors: ω = (ω_x, ω_y, ω_z, 0),
+# γ likewise, and their cyclic permutations ω⁽¹²⁰⁾ = (ω_y, ω_z, ω_x, 0), ω⁽²⁰¹⁾ = (ω_z, ω_x, ω_y, 0), so the
+# nine scalar Cauchy sums of ``fixed_point.taylor_coefficients`` become three vector sums, four fused
+# multiply-adds per term: pairs of ω Σ ω⁽¹²⁰⁾_j ⊙ ω⁽²⁰¹⁾_{k−j} (= (ω_y ω_z, ω_z ω_x, ω_x ω_y) terms), pairs of γ
+# likewise, γ × ω = Σ γ⁽¹²⁰⁾_j ⊙ ω⁽²⁰¹⁾_{k−j} − γ⁽²⁰¹⁾_j ⊙ ω⁽¹²⁰⁾_{k−j}.
+W, G, W120, G120, W201, G201 = range(6)
+ROWS = 6
+_CYCLE = {W120: (1, 2, 0, 3), W201: (2, 0, 1, 3)}
+
+
+@intrinsic
+def _coefficients(typingctx, T, order, Q):
+    """Fill T[1..order] from T[0] (rows W, G and their permutations; T is (order+1, ROWS, LANES)).
+
+    Q is (4, LANES): q = (I_y − I_z)/I_x (and cyclically), N_2 in every lane, and the torque U_2 × γ's
+    constants qa = (U_y/I_x, U_z/I_y, U_x/I_z), qb = (U_z/I_x, U_x/I_y, U_y/I_z) (``_constants``); the
+    fourth lane of each is 0. The rate is ``simd.Lanes.fixed_point_rate``, batch_taylor's arithmetic.
+    The cross product's sum runs in two accumulators (its plus and minus products), so that no chain
+    of dependent fused multiply-adds is longer than one per term.
+    """
+    if not (simd.vector_arrays([T, Q]) and T.ndim == 3 and Q.ndim == 2 and isinstance(order, types.Integer)):
+        return None
+    sig = types.void(T, order, Q)
+
+    def codegen(context, builder, signature, args):
+        v = simd.Lanes(context, builder, signature, args)
+        b = builder
+        p = context.cast(builder, args[1], signature.args[1], types.intp)
+        q, n, qa, qb = [v.load(2, r) for r in range(4)]
+        pairs_w, pairs_g, cross_plus, cross_minus = sums = v.variables(4)
+        zero = ir.Constant(v.vec, [0.0] * LANES)
+
+        def row(index, c):
+            return v.row(b, index, ROWS, c)
+
+        with cgutils.for_range(b, p) as order_loop:
+            k = order_loop.index
+            for s in sums:
+                b.store(zero, s)
+            with cgutils.for_range(b, b.add(k, ir.Constant(k.type, 1))) as term:
+                j = term.index
+                m = b.sub(k, j)
+                w120, g120, g201 = [v.load(0, row(j, c)) for c in (W120, G120, G201)]
+                W201_, G201_, W120_ = [v.load(0, row(m, c)) for c in (W201, G201, W120)]
+                v.fma_into(pairs_w, w120, W201_)
+                v.fma_into(pairs_g, g120, G201_)
+                v.fma_into(cross_plus, g120, W201_)
+                v.fma_into(cross_minus, g201, W120_)
+            inv = v.inverse(k)
+            omega = v.fixed_point_rate(q, n, b.load(pairs_w), b.load(pairs_g), qa, v.load(0, row(k, G201)), qb,
+                                       v.load(0, row(k, G120)), inv)
+            gamma = b.fmul(b.fsub(b.load(cross_plus), b.load(cross_minus), flags=simd.FUSE), inv, flags=simd.FUSE)
+            k1 = b.add(k, ir.Constant(k.type, 1))
+            for base, value in ((W, omega), (G, gamma)):
+                v.store(value, 0, row(k1, base))
+                for shift, lanes in _CYCLE.items():
+                    mask = ir.Constant(ir.VectorType(ir.IntType(32), LANES), list(lanes))
+                    v.store(b.shuffle_vector(value, value, mask), 0, row(k1, base + shift))
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@intrinsic
+def _dense(typingctx, T, order, dt, carry, out):
+    """out[0], out[1] = the state rows T[0, W], T[0, G] + (Σ_{k≥1} T[k] dt^k − carry): the series at t + dt,
+    Horner with strict arithmetic (``run_scalar``'s dense output, two components' chains at once)."""
+    if not (simd.vector_arrays([T, carry, out]) and T.ndim == 3 and isinstance(order, types.Integer)
+            and isinstance(dt, types.Float)):
+        return None
+    sig = types.void(T, order, types.float64, carry, out)
+
+    def codegen(context, builder, signature, args):
+        v = simd.Lanes(context, builder, signature, args)
+        b = builder
+        p = context.cast(builder, args[1], signature.args[1], types.intp)
+        h = v.splat(args[2])
+        acc = v.variables(2)
+        for c in (W, G):
+            b.store(v.load(0, v.row(b, p, ROWS, c)), acc[c])
+        with cgutils.for_range(b, b.sub(p, ir.Constant(p.type, 1))) as loop:
+            k = b.sub(b.sub(p, ir.Constant(p.type, 1)), loop.index)  # order − 1 … 1
+            for c in (W, G):
+                b.store(b.fadd(b.fmul(b.load(acc[c]), h), v.load(0, v.row(b, k, ROWS, c))), acc[c])
+        for c in (W, G):
+            v.store(b.fadd(v.load(0, c), b.fsub(b.fmul(b.load(acc[c]), h), v.load(3, c))), 4, c)
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+#: The state rows T[0, W], T[0, G] += Σ_{k≥1} T[k] h^k, compensated (``simd.update``: batch_taylor's update).
+_update = simd.update(ROWS, 2)
+
+
+@kernel
+def _constants(p, Q):
+    """``_coefficients``' constants from the parameters (``fixed_point.pack``), as batch_taylor._load forms them."""
+    I0, I1, I2 = p[0], p[1], p[2]
+    u0, u1, u2 = p[9], p[10], p[11]
+    Q[0, 0], Q[0, 1], Q[0, 2] = (I1 - I2) * p[16], (I2 - I0) * p[17], (I0 - I1) * p[18]
+    Q[1, 0] = Q[1, 1] = Q[1, 2] = p[14]
+    Q[2, 0], Q[2, 1], Q[2, 2] = u1 * p[16], u2 * p[17], u0 * p[18]
+    Q[3, 0], Q[3, 1], Q[3, 2] = u2 * p[16], u0 * p[17], u1 * p[18]
+
+
+@kernel
+def _set_state(T, y):
+    """T[0]'s rows (W, G and their permutations) from the state y = (ω, γ)."""
+    for m in range(3):
+        for base in (W, G):
+            T[0, base, m] = y[3 * base + m]
+            T[0, base + W120, m] = y[3 * base + (m + 1) % 3]
+            T[0, base + W201, m] = y[3 * base + (m + 2) % 3]
+
+
+@kernel
+def _norm_rows(T, k):
+    """The max norm of order k's coefficient (rows W and G, lanes 0..2)."""
+    v = 0.0
+    for base in (W, G):
+        for m in range(3):
+            v = max(v, abs(T[k, base, m]))
+    return v
+
+
+@kernel
+def series(p, y, order):
+    """The Taylor coefficients (order+1, 6) of the fixed-point state y without α from the vectorised sums."""
+    T = np.zeros((order + 1, ROWS, LANES))
+    Q = np.zeros((4, LANES))
+    _constants(p, Q)
+    _set_state(T, y)
+    _coefficients(T, order, Q)
+    out = np.empty((order + 1, 6))
+    for k in range(order + 1):
+        for m in range(3):
+            out[k, m] = T[k, W, m]
+            out[k, 3 + m] = T[k, G, m]
+    return out
+
+
+@kernel
+def run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+    """``run`` for the fixed-point model without α (p[15] = 0, y = (ω, γ)), the step vectorised across the
+    components: ``_coefficients``, the dense output (``_dense``) and the compensated update (``_update``) in
+    ``<4 x double>``. Same order, step rule, dense output, status codes and stats as ``run_scalar``; the
+    coefficients and the update's Horner sums round (fused multiply-adds) as batch_taylor's lanes do."""
+    T = np.zeros((order + 1, ROWS, LANES))
+    Q = np.zeros((4, LANES))
+    C = np.zeros((2, LANES))  # the Kahan compensation, rows W and G
+    H = np.zeros((1, LANES))
+    D = np.zeros((2, LANES))  # a dense output, rows W and G
+    _constants(p, Q)
+    for m in range(3):
+        C[0, m], C[1, m] = carry[m], carry[3 + m]
+    t = state[0]
+    n_out = t_out.size
+    t_end = t_out[n_out - 1]
+    i = i_next
+    safety = math.exp(-0.7 / (order - 1))
+    code = OK
+    while i < i_stop:
+        _set_state(T, y)
+        _coefficients(T, order, Q)
+        stats[0] += 1
+        scale = max(1.0, _norm_rows(T, 0))
+        h = step_size(tol, scale, _norm_rows(T, order - 1), _norm_rows(T, order), order, safety)
+        if not h < np.inf:
+            h = t_end - t
+        t_new = min(t + h, t_end)
+        h = t_new - t
+        if h <= 0.0:  # the step is below the spacing of floating-point numbers at t: no progress is possible
+            code = TOO_SMALL_STEP
+            break
+        while i < n_out and t_out[i] <= t_new:
+            _dense(T, order, t_out[i] - t, C, D)
+            for m in range(3):
+                Y[i, m], Y[i, 3 + m] = D[0, m], D[1, m]
+            i += 1
+        for m in range(3):
+            H[0, m] = h
+        _update(T, order, H, C)
+        finite = True
+        for m in range(3):
+            y[m], y[3 + m] = T[0, W, m], T[0, G, m]
+            carry[m], carry[3 + m] = C[0, m], C[1, m]
+            finite = finite and math.isfinite(y[m]) and math.isfinite(y[3 + m])
+        if not finite:
+            code = NOT_FINITE
+            break
+        t = t_new
+        stats[1] += 1
+    state[0] = t
+    return code, i
