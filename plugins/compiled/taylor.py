@@ -152,7 +152,8 @@ def _coefficients(typingctx, T, order, Q):
     constants qa = (U_y/I_x, U_z/I_y, U_x/I_z), qb = (U_z/I_x, U_x/I_y, U_y/I_z) (``_constants``); the
     fourth lane of each is 0. The rate is ``simd.Lanes.fixed_point_rate``, batch_taylor's arithmetic.
     The cross product's sum runs in two accumulators (its plus and minus products), so that no chain
-    of dependent fused multiply-adds is longer than one per term.
+    of dependent fused multiply-adds is longer than one per term; the terms that involve the newest
+    coefficient k come last (see the loop).
     """
     if not (simd.vector_arrays([T, Q]) and T.ndim == 3 and Q.ndim == 2 and isinstance(order, types.Integer)):
         return None
@@ -169,19 +170,26 @@ def _coefficients(typingctx, T, order, Q):
         def row(index, c):
             return v.row(b, index, ROWS, c)
 
+        def term(j, m):
+            w120, g120, g201 = [v.load(0, row(j, c)) for c in (W120, G120, G201)]
+            W201_, G201_, W120_ = [v.load(0, row(m, c)) for c in (W201, G201, W120)]
+            v.fma_into(pairs_w, w120, W201_)
+            v.fma_into(pairs_g, g120, G201_)
+            v.fma_into(cross_plus, g120, W201_)
+            v.fma_into(cross_minus, g201, W120_)
+
+        one = ir.Constant(p.type, 1)
         with cgutils.for_range(b, p) as order_loop:
             k = order_loop.index
             for s in sums:
                 b.store(zero, s)
-            with cgutils.for_range(b, b.add(k, ir.Constant(k.type, 1))) as term:
-                j = term.index
-                m = b.sub(k, j)
-                w120, g120, g201 = [v.load(0, row(j, c)) for c in (W120, G120, G201)]
-                W201_, G201_, W120_ = [v.load(0, row(m, c)) for c in (W201, G201, W120)]
-                v.fma_into(pairs_w, w120, W201_)
-                v.fma_into(pairs_g, g120, G201_)
-                v.fma_into(cross_plus, g120, W201_)
-                v.fma_into(cross_minus, g201, W120_)
+            # the terms of rows 1..k−1 first, those of the newest row k (j = 0 and j = k) last: the former do
+            # not wait for row k, so they overlap the computation of row k in the processor's pipeline
+            with cgutils.for_range(b, k, start=one) as middle:
+                term(middle.index, b.sub(k, middle.index))
+            term(ir.Constant(k.type, 0), k)
+            with b.if_then(b.icmp_signed(">", k, ir.Constant(k.type, 0))):
+                term(k, ir.Constant(k.type, 0))
             inv = v.inverse(k)
             omega = v.fixed_point_rate(q, n, b.load(pairs_w), b.load(pairs_g), qa, v.load(0, row(k, G201)), qb,
                                        v.load(0, row(k, G120)), inv)
