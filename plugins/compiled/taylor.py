@@ -170,14 +170,20 @@ def _coefficients(typingctx, T, order, Q):
         def row(index, c):
             return v.row(b, index, ROWS, c)
 
-        def term(j, m):
-            w120, g120, g201 = [v.load(0, row(j, c)) for c in (W120, G120, G201)]
-            W201_, G201_, W120_ = [v.load(0, row(m, c)) for c in (W201, G201, W120)]
-            v.fma_into(pairs_w, w120, W201_)
-            v.fma_into(pairs_g, g120, G201_)
-            v.fma_into(cross_plus, g120, W201_)
-            v.fma_into(cross_minus, g201, W120_)
+        def term(a, c):
+            """The sums' term of the rows a (index j) and c (index k − j), each given as its ROWS vectors."""
+            v.fma_into(pairs_w, a[W120], c[W201])
+            v.fma_into(pairs_g, a[G120], c[G201])
+            v.fma_into(cross_plus, a[G120], c[W201])
+            v.fma_into(cross_minus, a[W120], c[G201])  # Σ_j γ⁽²⁰¹⁾_{k−j} ⊙ ω⁽¹²⁰⁾_j: four loads per term
 
+        def load_row(index):
+            return [v.load(0, row(index, c)) for c in range(ROWS)]
+
+        first = load_row(ir.Constant(p.type, 0))
+        newest = v.variables(ROWS)  # row k, carried in registers from one order to the next
+        for c in range(ROWS):
+            b.store(first[c], newest[c])
         one = ir.Constant(p.type, 1)
         with cgutils.for_range(b, p) as order_loop:
             k = order_loop.index
@@ -186,20 +192,23 @@ def _coefficients(typingctx, T, order, Q):
             # the terms of rows 1..k−1 first, those of the newest row k (j = 0 and j = k) last: the former do
             # not wait for row k, so they overlap the computation of row k in the processor's pipeline
             with cgutils.for_range(b, k, start=one) as middle:
-                term(middle.index, b.sub(k, middle.index))
-            term(ir.Constant(k.type, 0), k)
+                term(load_row(middle.index), load_row(b.sub(k, middle.index)))
+            last = [b.load(x) for x in newest]
+            term(first, last)
             with b.if_then(b.icmp_signed(">", k, ir.Constant(k.type, 0))):
-                term(k, ir.Constant(k.type, 0))
+                term(last, first)
             inv = v.inverse(k)
-            omega = v.fixed_point_rate(q, n, b.load(pairs_w), b.load(pairs_g), qa, v.load(0, row(k, G201)), qb,
-                                       v.load(0, row(k, G120)), inv)
+            omega = v.fixed_point_rate(q, n, b.load(pairs_w), b.load(pairs_g), qa, last[G201], qb, last[G120], inv)
             gamma = b.fmul(b.fsub(b.load(cross_plus), b.load(cross_minus), flags=simd.FUSE), inv, flags=simd.FUSE)
             k1 = b.add(k, ir.Constant(k.type, 1))
             for base, value in ((W, omega), (G, gamma)):
-                v.store(value, 0, row(k1, base))
+                rows = {base: value}
                 for shift, lanes in _CYCLE.items():
                     mask = ir.Constant(ir.VectorType(ir.IntType(32), LANES), list(lanes))
-                    v.store(b.shuffle_vector(value, value, mask), 0, row(k1, base + shift))
+                    rows[base + shift] = b.shuffle_vector(value, value, mask)
+                for c, x in rows.items():
+                    v.store(x, 0, row(k1, c))
+                    b.store(x, newest[c])
         return context.get_dummy_value()
 
     return sig, codegen
