@@ -19,7 +19,6 @@ import argparse
 import math
 import os
 import sys
-import time
 
 import numba
 import numpy as np
@@ -77,7 +76,7 @@ def _run(kernel, params, order, tol):
 
 
 def step_table(params, rounds):
-    contestants, steps = {}, {}
+    contestants = {}
     for order in ORDERS:
         tol = math.exp(-2.0 * (order - 1.0)) * 1.01  # order_for(tol) = order
         assert taylor.order_for(tol) == order

@@ -25,7 +25,8 @@ kernel was 1.2–2× slower than one trajectory per thread. The intrinsics emit
 the arithmetic over ``<4 x double>`` values directly: nine vector accumulators
 in registers, twelve vector loads and twelve fused multiply-adds per term of
 the sums; a whole step costs 2.7× less per trajectory than one trajectory per
-thread (``docs/performance.md``, "Taylor lanes").
+thread (``docs/performance.md``, "Taylor lanes"). The IR helpers are shared with
+the single-trajectory kernel's vectorised step (``simd``).
 
 ``run_each`` serves every other model with Taylor coefficients, one trajectory
 per thread, with the single-trajectory kernel itself.
@@ -38,9 +39,7 @@ import math
 import numba
 import numpy as np
 from llvmlite import ir
-from numba import types
 from numba.core import cgutils
-from numba.extending import intrinsic
 
 from gyrolab.plugins.compiled import kernel, simd, taylor
 from gyrolab.plugins.compiled.simd import LANES  # trajectories advanced in lock step: one AVX2 vector of doubles
@@ -52,8 +51,8 @@ SUMS = 9  # Cauchy sums per order: pairs of ω (3), pairs of γ (3), γ × ω (3
 CONSTANTS = 10  # a lane's right-hand-side constants (``_load``)
 
 
-@intrinsic
-def _series(typingctx, T, order, Q):
+@simd.series(STATE)
+def _series(v, p, row):
     """Fill T[1..order] from T[0] in every lane: ``fixed_point.taylor_coefficients`` without α, lanes in columns.
 
     T is (order+1, STATE, LANES), Q (CONSTANTS, LANES) the lanes' constants (``_load``). Order k's coefficient is
@@ -64,49 +63,35 @@ def _series(typingctx, T, order, Q):
     The sums run over nine vector accumulators in registers, twelve vector loads and twelve fused
     multiply-adds per term.
     """
-    if not (simd.vector_arrays([T, Q]) and T.ndim == 3 and Q.ndim == 2 and isinstance(order, types.Integer)):
-        return None
-    sig = types.void(T, order, Q)
-
-    def codegen(context, builder, signature, args):
-        v = simd.Lanes(context, builder, signature, args)
-        b = builder
-        p = context.cast(builder, args[1], signature.args[1], types.intp)
-        q = [v.load(2, r) for r in range(CONSTANTS)]
-        sums = v.variables(SUMS)
-        zero = ir.Constant(v.vec, [0.0] * LANES)
-
-        def row(index, c):
-            return v.row(b, index, STATE, c)
-
-        with cgutils.for_range(b, p) as order_loop:
-            k = order_loop.index
-            for s in sums:
-                b.store(zero, s)
-            with cgutils.for_range(b, b.add(k, ir.Constant(k.type, 1))) as term:
-                j = term.index
-                m = b.sub(k, j)
-                w0, w1, w2, g0, g1, g2 = [v.load(0, row(j, c)) for c in range(STATE)]
-                W0, W1, W2, G0, G1, G2 = [v.load(0, row(m, c)) for c in range(STATE)]
-                for s, x, y, subtract in ((0, w1, W2, False), (1, w2, W0, False), (2, w0, W1, False),
-                                          (3, g1, G2, False), (4, g2, G0, False), (5, g0, G1, False),
-                                          (6, g1, W2, False), (6, g2, W1, True), (7, g2, W0, False),
-                                          (7, g0, W2, True), (8, g0, W1, False), (8, g1, W0, True)):
-                    v.fma_into(sums[s], x, y, subtract)
-            s = [b.load(x) for x in sums]
-            e0, e1, e2 = [v.load(0, row(k, c)) for c in (3, 4, 5)]
-            inv = v.inverse(k)
-            k1 = b.add(k, ir.Constant(k.type, 1))
-            rate = [v.fixed_point_rate(q[0], q[3], s[0], s[3], q[4], e2, q[5], e1, inv),
-                    v.fixed_point_rate(q[1], q[3], s[1], s[4], q[6], e0, q[7], e2, inv),
-                    v.fixed_point_rate(q[2], q[3], s[2], s[5], q[8], e1, q[9], e0, inv),
-                    b.fmul(s[6], inv, flags=simd.FUSE), b.fmul(s[7], inv, flags=simd.FUSE),
-                    b.fmul(s[8], inv, flags=simd.FUSE)]
-            for c in range(STATE):
-                v.store(rate[c], 0, row(k1, c))
-        return context.get_dummy_value()
-
-    return sig, codegen
+    b = v.builder
+    q = [v.load(2, r) for r in range(CONSTANTS)]
+    sums = v.variables(SUMS)
+    zero = ir.Constant(v.vec, [0.0] * LANES)
+    with cgutils.for_range(b, p) as order_loop:
+        k = order_loop.index
+        for s in sums:
+            b.store(zero, s)
+        with cgutils.for_range(b, b.add(k, ir.Constant(k.type, 1))) as term:
+            j = term.index
+            m = b.sub(k, j)
+            w0, w1, w2, g0, g1, g2 = [v.load(0, row(j, c)) for c in range(STATE)]
+            W0, W1, W2, G0, G1, G2 = [v.load(0, row(m, c)) for c in range(STATE)]
+            for s, x, y, subtract in ((0, w1, W2, False), (1, w2, W0, False), (2, w0, W1, False),
+                                      (3, g1, G2, False), (4, g2, G0, False), (5, g0, G1, False),
+                                      (6, g1, W2, False), (6, g2, W1, True), (7, g2, W0, False),
+                                      (7, g0, W2, True), (8, g0, W1, False), (8, g1, W0, True)):
+                v.fma_into(sums[s], x, y, subtract)
+        s = [b.load(x) for x in sums]
+        e0, e1, e2 = [v.load(0, row(k, c)) for c in (3, 4, 5)]
+        inv = v.inverse(k)
+        k1 = b.add(k, ir.Constant(k.type, 1))
+        rate = [v.fixed_point_rate(q[0], q[3], s[0], s[3], q[4], e2, q[5], e1, inv),
+                v.fixed_point_rate(q[1], q[3], s[1], s[4], q[6], e0, q[7], e2, inv),
+                v.fixed_point_rate(q[2], q[3], s[2], s[5], q[8], e1, q[9], e0, inv),
+                b.fmul(s[6], inv, flags=simd.FUSE), b.fmul(s[7], inv, flags=simd.FUSE),
+                b.fmul(s[8], inv, flags=simd.FUSE)]
+        for c in range(STATE):
+            v.store(rate[c], 0, row(k1, c))
 
 
 #: Every lane's state T[0] += Σ_{k≥1} T[k] h^k (Horner), a compensated (Kahan) sum with ``carry``: H is (1, LANES),

@@ -2,11 +2,12 @@
 
 Arrays of doubles are seen as rows of LANES-wide vectors: in ``batch_taylor`` a
 row holds one component of four trajectories, in ``taylor`` one 3-vector of one
-trajectory (and a zero). Both write the same arithmetic through these helpers:
-the fixed-point right-hand side's order-k coefficient from its Cauchy sums
-(``Lanes.fixed_point_rate``) and the compensated state update (``update``), so
-a trajectory advanced in a lane of ``batch_taylor`` and alone in ``taylor``
-takes the same steps bit for bit.
+trajectory (and a zero). Both form the fixed-point right-hand side's coefficient
+from its Cauchy sums with one expression (``Lanes.fixed_point_rate``) and update
+the state with one intrinsic (``update``: Horner, then Kahan). Their sums run in
+different orders (``taylor`` adds the newest coefficient's terms last and splits
+γ × ω's sum in two), so a trajectory in a lane and alone agree to rounding, not
+bit for bit.
 
 Why intrinsics: numba does not run LLVM's SLP vectoriser, and the Cauchy sums
 written as numba loops keep their accumulators in memory (``batch_taylor``'s
@@ -87,6 +88,30 @@ class Lanes:
         torque = b.fsub(b.fmul(qa, ea, flags=FUSE), b.fmul(qb, eb, flags=FUSE), flags=FUSE)
         inner = b.fsub(pairs_w, b.fmul(n, pairs_g, flags=FUSE), flags=FUSE)
         return b.fmul(b.fadd(b.fmul(q, inner, flags=FUSE), torque, flags=FUSE), inv, flags=FUSE)
+
+
+def series(stride):
+    """Decorator: an intrinsic ``(T, order, Q)`` (T: ``stride`` vector rows per order, Q: rows of constants) from
+    ``emit(v, order, row)``, which writes its IR with ``v`` (``Lanes``), ``order`` (an LLVM integer) and
+    ``row(index, column)`` (T's vector row of that order and column)."""
+
+    def wrap(emit):
+        def typer(typingctx, T, order, Q):
+            if not (vector_arrays([T, Q]) and T.ndim == 3 and Q.ndim == 2 and isinstance(order, types.Integer)):
+                return None
+
+            def codegen(context, builder, signature, args):
+                v = Lanes(context, builder, signature, args)
+                p = context.cast(builder, args[1], signature.args[1], types.intp)
+                emit(v, p, lambda index, column: v.row(builder, index, stride, column))
+                return context.get_dummy_value()
+
+            return types.void(T, order, Q), codegen
+
+        typer.__name__, typer.__doc__ = emit.__name__, emit.__doc__
+        return intrinsic(typer)
+
+    return wrap
 
 
 def update(stride, count):

@@ -14,6 +14,14 @@ next step, so round-off no longer grows as one ulp of the state per step (the
 floor of the uncompensated update was ~2e-12 over the 3,000 steps of the
 reference scene). Time needs no compensation: the step actually taken is
 h = fl(t + h) − t, exact in floating point, and the state advances by exactly it.
+
+The fixed-point model without α (the common case) takes a vectorised step
+(``run_vector``): the state's components across the lanes of ``<4 x double>``
+vectors, the nine scalar Cauchy sums as three vector sums (four fused
+multiply-adds per term instead of eighteen scalar products), and the dense output
+and the update over two vectors (ω, 0) and (γ, 0). It takes the same steps as
+the scalar step (``run_scalar``, every other model) to rounding, at about half
+the cost (``benchmarks/taylor_step.py``, docs/performance.md).
 """
 
 from __future__ import annotations
@@ -137,15 +145,16 @@ def run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, 
 # ``<4 x double>`` vectors. Each order's coefficients are stored as ROWS vectors: ω = (ω_x, ω_y, ω_z, 0),
 # γ likewise, and their cyclic permutations ω⁽¹²⁰⁾ = (ω_y, ω_z, ω_x, 0), ω⁽²⁰¹⁾ = (ω_z, ω_x, ω_y, 0), so the
 # nine scalar Cauchy sums of ``fixed_point.taylor_coefficients`` become three vector sums, four fused
-# multiply-adds per term: pairs of ω Σ ω⁽¹²⁰⁾_j ⊙ ω⁽²⁰¹⁾_{k−j} (= (ω_y ω_z, ω_z ω_x, ω_x ω_y) terms), pairs of γ
-# likewise, γ × ω = Σ γ⁽¹²⁰⁾_j ⊙ ω⁽²⁰¹⁾_{k−j} − γ⁽²⁰¹⁾_j ⊙ ω⁽¹²⁰⁾_{k−j}.
+# multiply-adds and four vector loads per term: pairs of ω Σ ω⁽¹²⁰⁾_j ⊙ ω⁽²⁰¹⁾_{k−j} (= (ω_y ω_z, ω_z ω_x, ω_x ω_y)
+# terms), pairs of γ likewise, γ × ω = Σ γ⁽¹²⁰⁾_j ⊙ ω⁽²⁰¹⁾_{k−j} − γ⁽²⁰¹⁾_j ⊙ ω⁽¹²⁰⁾_{k−j}, whose minus part is summed
+# as Σ ω⁽¹²⁰⁾_j ⊙ γ⁽²⁰¹⁾_{k−j} (j ↔ k − j).
 W, G, W120, G120, W201, G201 = range(6)
 ROWS = 6
 _CYCLE = {W120: (1, 2, 0, 3), W201: (2, 0, 1, 3)}
 
 
-@intrinsic
-def _coefficients(typingctx, T, order, Q):
+@simd.series(ROWS)
+def _coefficients(v, p, row):
     """Fill T[1..order] from T[0] (rows W, G and their permutations; T is (order+1, ROWS, LANES)).
 
     Q is (4, LANES): q = (I_y − I_z)/I_x (and cyclically), N_2 in every lane, and the torque U_2 × γ's
@@ -155,63 +164,50 @@ def _coefficients(typingctx, T, order, Q):
     of dependent fused multiply-adds is longer than one per term; the terms that involve the newest
     coefficient k come last (see the loop).
     """
-    if not (simd.vector_arrays([T, Q]) and T.ndim == 3 and Q.ndim == 2 and isinstance(order, types.Integer)):
-        return None
-    sig = types.void(T, order, Q)
+    b = v.builder
+    q, n, qa, qb = [v.load(2, r) for r in range(4)]
+    pairs_w, pairs_g, cross_plus, cross_minus = sums = v.variables(4)
+    zero = ir.Constant(v.vec, [0.0] * LANES)
 
-    def codegen(context, builder, signature, args):
-        v = simd.Lanes(context, builder, signature, args)
-        b = builder
-        p = context.cast(builder, args[1], signature.args[1], types.intp)
-        q, n, qa, qb = [v.load(2, r) for r in range(4)]
-        pairs_w, pairs_g, cross_plus, cross_minus = sums = v.variables(4)
-        zero = ir.Constant(v.vec, [0.0] * LANES)
+    def term(a, c):
+        """The sums' term of the rows a (index j) and c (index k − j), each given as its ROWS vectors."""
+        v.fma_into(pairs_w, a[W120], c[W201])
+        v.fma_into(pairs_g, a[G120], c[G201])
+        v.fma_into(cross_plus, a[G120], c[W201])
+        v.fma_into(cross_minus, a[W120], c[G201])  # Σ_j γ⁽²⁰¹⁾_{k−j} ⊙ ω⁽¹²⁰⁾_j: four loads per term
 
-        def row(index, c):
-            return v.row(b, index, ROWS, c)
+    def load_row(index):
+        return [v.load(0, row(index, c)) for c in range(ROWS)]
 
-        def term(a, c):
-            """The sums' term of the rows a (index j) and c (index k − j), each given as its ROWS vectors."""
-            v.fma_into(pairs_w, a[W120], c[W201])
-            v.fma_into(pairs_g, a[G120], c[G201])
-            v.fma_into(cross_plus, a[G120], c[W201])
-            v.fma_into(cross_minus, a[W120], c[G201])  # Σ_j γ⁽²⁰¹⁾_{k−j} ⊙ ω⁽¹²⁰⁾_j: four loads per term
-
-        def load_row(index):
-            return [v.load(0, row(index, c)) for c in range(ROWS)]
-
-        first = load_row(ir.Constant(p.type, 0))
-        newest = v.variables(ROWS)  # row k, carried in registers from one order to the next
-        for c in range(ROWS):
-            b.store(first[c], newest[c])
-        one = ir.Constant(p.type, 1)
-        with cgutils.for_range(b, p) as order_loop:
-            k = order_loop.index
-            for s in sums:
-                b.store(zero, s)
-            # the terms of rows 1..k−1 first, those of the newest row k (j = 0 and j = k) last: the former do
-            # not wait for row k, so they overlap the computation of row k in the processor's pipeline
-            with cgutils.for_range(b, k, start=one) as middle:
-                term(load_row(middle.index), load_row(b.sub(k, middle.index)))
-            last = [b.load(x) for x in newest]
-            term(first, last)
-            with b.if_then(b.icmp_signed(">", k, ir.Constant(k.type, 0))):
-                term(last, first)
-            inv = v.inverse(k)
-            omega = v.fixed_point_rate(q, n, b.load(pairs_w), b.load(pairs_g), qa, last[G201], qb, last[G120], inv)
-            gamma = b.fmul(b.fsub(b.load(cross_plus), b.load(cross_minus), flags=simd.FUSE), inv, flags=simd.FUSE)
-            k1 = b.add(k, ir.Constant(k.type, 1))
-            for base, value in ((W, omega), (G, gamma)):
-                rows = {base: value}
-                for shift, lanes in _CYCLE.items():
-                    mask = ir.Constant(ir.VectorType(ir.IntType(32), LANES), list(lanes))
-                    rows[base + shift] = b.shuffle_vector(value, value, mask)
-                for c, x in rows.items():
-                    v.store(x, 0, row(k1, c))
-                    b.store(x, newest[c])
-        return context.get_dummy_value()
-
-    return sig, codegen
+    first = load_row(ir.Constant(p.type, 0))
+    newest = v.variables(ROWS)  # row k, carried in registers from one order to the next
+    for c in range(ROWS):
+        b.store(first[c], newest[c])
+    one = ir.Constant(p.type, 1)
+    with cgutils.for_range(b, p) as order_loop:
+        k = order_loop.index
+        for s in sums:
+            b.store(zero, s)
+        # the terms of rows 1..k−1 first, those of the newest row k (j = 0 and j = k) last: the former do
+        # not wait for row k, so they overlap the computation of row k in the processor's pipeline
+        with cgutils.for_range(b, k, start=one) as middle:
+            term(load_row(middle.index), load_row(b.sub(k, middle.index)))
+        last = [b.load(x) for x in newest]
+        term(first, last)
+        with b.if_then(b.icmp_signed(">", k, ir.Constant(k.type, 0))):
+            term(last, first)
+        inv = v.inverse(k)
+        omega = v.fixed_point_rate(q, n, b.load(pairs_w), b.load(pairs_g), qa, last[G201], qb, last[G120], inv)
+        gamma = b.fmul(b.fsub(b.load(cross_plus), b.load(cross_minus), flags=simd.FUSE), inv, flags=simd.FUSE)
+        k1 = b.add(k, ir.Constant(k.type, 1))
+        for base, value in ((W, omega), (G, gamma)):
+            rows = {base: value}
+            for shift, lanes in _CYCLE.items():
+                mask = ir.Constant(ir.VectorType(ir.IntType(32), LANES), list(lanes))
+                rows[base + shift] = b.shuffle_vector(value, value, mask)
+            for c, x in rows.items():
+                v.store(x, 0, row(k1, c))
+                b.store(x, newest[c])
 
 
 @intrinsic
