@@ -1,15 +1,16 @@
 """The Taylor step's cost: scalar against vectorised (``taylor.run_scalar`` / ``run_vector``), and against heyoka.
 
     pip install -e ".[bench]"                  # heyoka (optional: its columns are skipped when absent)
-    python benchmarks/taylor_step.py           # about a minute
+    python benchmarks/taylor_step.py           # a few minutes
     python benchmarks/taylor_step.py --quick   # fewer rounds
 
 On the reference problem (``experiment=perf_reference``, ``benchmarks/perf_reference.py``: t ∈ [0, 300],
 3,001 output times): (1) the cost of one Taylor step at orders 8, 12, 16, 20, the coefficients alone
-(a compiled loop over one state, no step) and the whole ``taylor.run`` (coefficients, step size, dense
+(a compiled loop over one state, no step) and the whole run (``run_scalar`` / ``run_vector``: coefficients, step size, dense
 output at ~1 output per step, compensated update) divided by its steps, scalar and vectorised; (2) the
-``taylor`` integrator (``Integrator.integrate``, the vectorised step) against heyoka's ``propagate_grid`` on the same grid at
-tolerances 1e-8..1e-16, with the final errors against the extended-precision reference. CPU time
+``taylor`` integrator (``Integrator.integrate``, the vectorised step) and ``run_scalar`` against heyoka's
+``propagate_grid`` on the same grid at tolerances 1e-8..1e-16, and the time each needs to reach a final error
+≤ ε (1e-6..1e-13) against the extended-precision reference. CPU time
 (``time.process_time``), contestants interleaved, minima over the rounds.
 """
 
@@ -105,31 +106,47 @@ def peer_table(params, reference, rounds):
 
     scene = compose_scene(["experiment=perf_reference"])
     compiled = scene.compiled
-    tols = [10.0 ** -k for k in range(8, 17)]
+    tols = [10.0 ** -k for k in range(7, 18)]
     contestants = {}
     peers = heyoka_contestants()
     for tol in tols:
         integrator = Taylor(tol=tol)
         contestants[("taylor", tol)] = lambda t=integrator: t.integrate(None, GRID, Y0, None, compiled).y[-1]
         contestants[("scalar", tol)] = lambda t=integrator: _run(taylor.run_scalar, params, t.order, t.tol)[0]
-        if tol in peers:
-            contestants[("heyoka", tol)] = peers[tol][0]
+    for tol, (call, _) in peers.items():
+        contestants[("heyoka", tol)] = call
     interleaved(contestants, 1)
     best = interleaved(contestants, rounds)
     error = {key: float(np.max(np.abs(np.asarray(result)[:6] - reference))) for key, (_, result) in best.items()}
     print(f"\nThe reference scene, 3,001 output times: CPU ms (final error), minimum over {rounds} interleaved "
-          "rounds. taylor = the integrator (vectorised step); scalar = run_scalar at the same order.\n")
+          "rounds. taylor = the integrator (``Integrator.integrate``, vectorised step); scalar = ``run_scalar`` "
+          "at the same order, called directly.\n")
     print("| tol | order | taylor | taylor scalar | heyoka (order) | taylor / heyoka | scalar / heyoka |")
     print("| --- | --- | --- | --- | --- | --- | --- |")
-    for tol in tols:
+    for tol in tols[1:-1]:
         cells = [f"{best[(m, tol)][0] * 1e3:.2f} ({error[(m, tol)]:.1e})" for m in ("taylor", "scalar")]
         if ("heyoka", tol) in best:
             peer = best[("heyoka", tol)][0]
             ratios = [f"{best[(m, tol)][0] / peer:.2f}" for m in ("taylor", "scalar")]
             peer_cell = f"{peer * 1e3:.2f} ({error[('heyoka', tol)]:.1e}) ({peers[tol][1]})"
         else:
-            ratios, peer_cell = ["", ""], "not installed"
+            ratios, peer_cell = ["", ""], "not installed" if not peers else "(no such setting)"
         print(f"| {tol:.0e} | {taylor.order_for(tol)} | {cells[0]} | {cells[1]} | {peer_cell} | {' | '.join(ratios)} |")
+
+    def cheapest(method, eps):
+        ok = [key for key in best if key[0] == method and error[key] <= eps]
+        return min(ok, key=lambda key: best[key][0]) if ok else None
+
+    print("\nTime to reach a final error ≤ ε: each method's cheapest tolerance that reaches it (chosen in hindsight, "
+          "as in perf_reference.py's table), CPU ms (its tolerance).\n")
+    print("| ε | heyoka | taylor | taylor scalar | taylor / heyoka | scalar / heyoka |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    for eps in [10.0 ** -k for k in range(6, 14)]:
+        keys = [cheapest(m, eps) for m in ("heyoka", "taylor", "scalar")]
+        cells = ["not reached" if key is None else f"{best[key][0] * 1e3:.2f} ({key[1]:.0e})" for key in keys]
+        ratios = ["" if keys[0] is None or key is None else f"{best[key][0] / best[keys[0]][0]:.2f}"
+                  for key in keys[1:]]
+        print(f"| {eps:.0e} | {' | '.join(cells)} | {' | '.join(ratios)} |")
 
 
 def main() -> None:
