@@ -159,10 +159,11 @@ def _coefficients(v, p, row):
 
     Q is (4, LANES): q = (I_y − I_z)/I_x (and cyclically), N_2 in every lane, and the torque U_2 × γ's
     constants qa = (U_y/I_x, U_z/I_y, U_x/I_z), qb = (U_z/I_x, U_x/I_y, U_y/I_z) (``_constants``); the
-    fourth lane of each is 0. The rate is ``simd.Lanes.fixed_point_rate``, batch_taylor's arithmetic.
-    The cross product's sum runs in two accumulators (its plus and minus products), so that no chain
-    of dependent fused multiply-adds is longer than one per term; the terms that involve the newest
-    coefficient k come last (see the loop).
+    fourth lane of each is 0. The rate is ``simd.Lanes.fixed_point_rate``, batch_taylor's expression. The
+    cross product's sum runs in two accumulators (its plus and minus products), so that no chain of
+    dependent fused multiply-adds is longer than one per term; the terms that involve the newest
+    coefficient k come last (see the loop). Both orders differ from the scalar kernel's and the batch
+    lanes': the coefficients agree with theirs to rounding.
     """
     b = v.builder
     q, n, qa, qb = [v.load(2, r) for r in range(4)]
@@ -293,8 +294,9 @@ def series(p, y, order):
 def run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     """``run`` for the fixed-point model without α (p[15] = 0, y = (ω, γ)), the step vectorised across the
     components: ``_coefficients``, the dense output (``_dense``) and the compensated update (``_update``) in
-    ``<4 x double>``. Same order, step rule, dense output, status codes and stats as ``run_scalar``; the
-    coefficients and the update's Horner sums round (fused multiply-adds) as batch_taylor's lanes do."""
+    ``<4 x double>``. Same order, step rule, dense output (strict arithmetic), compensated update, status
+    codes, stats and chunking contract as ``run_scalar``; the coefficients and the update's Horner sums fuse
+    multiply and add (as batch_taylor's lanes do), so the results agree with ``run_scalar``'s to rounding."""
     T = np.zeros((order + 1, ROWS, LANES))
     Q = np.zeros((4, LANES))
     C = np.zeros((2, LANES))  # the Kahan compensation, rows W and G
