@@ -25,7 +25,8 @@ kernel was 1.2–2× slower than one trajectory per thread. The intrinsics emit
 the arithmetic over ``<4 x double>`` values directly: nine vector accumulators
 in registers, twelve vector loads and twelve fused multiply-adds per term of
 the sums; a whole step costs 2.7× less per trajectory than one trajectory per
-thread (``docs/performance.md``, "Taylor lanes").
+thread (``docs/performance.md``, "Taylor lanes"). The IR helpers are shared with
+the single-trajectory kernel's vectorised step (``simd``).
 
 ``run_each`` serves every other model with Taylor coefficients, one trajectory
 per thread, with the single-trajectory kernel itself.
@@ -38,67 +39,20 @@ import math
 import numba
 import numpy as np
 from llvmlite import ir
-from numba import types
 from numba.core import cgutils
-from numba.extending import intrinsic
 
-from gyrolab.plugins.compiled import kernel, taylor
+from gyrolab.plugins.compiled import kernel, simd, taylor
+from gyrolab.plugins.compiled.simd import LANES  # trajectories advanced in lock step: one AVX2 vector of doubles
 from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK, TOO_SMALL_STEP
 
-
-LANES = 4  # trajectories advanced in lock step: one AVX2 vector of doubles
 TASK = 256  # trajectories per parallel task, at most
 STATE = 6  # (ω, γ)
 SUMS = 9  # Cauchy sums per order: pairs of ω (3), pairs of γ (3), γ × ω (3)
 CONSTANTS = 10  # a lane's right-hand-side constants (``_load``)
 
 
-def _vector_arrays(arrays) -> bool:
-    """The intrinsics' arrays: C-contiguous float64, lanes innermost."""
-    return all(isinstance(a, types.Array) and a.layout == "C" and a.dtype == types.float64 for a in arrays)
-
-
-class _Lanes:
-    """LLVM IR helpers of the intrinsics: arrays of doubles seen as rows of ``<LANES x double>`` vectors."""
-
-    def __init__(self, context, builder, signature, args):
-        self.builder = builder
-        self.vec = ir.VectorType(ir.DoubleType(), LANES)
-        self.arrays = [builder.bitcast(context.make_array(ty)(context, builder, value).data, self.vec.as_pointer())
-                       if isinstance(ty, types.Array) else value for ty, value in zip(signature.args, args)]
-
-    def ptr(self, array, row):
-        """Pointer to vector ``row`` (an int or an LLVM integer) of ``array`` (an argument's position)."""
-        index = ir.Constant(ir.IntType(64), row) if isinstance(row, int) else row
-        return self.builder.gep(self.arrays[array], [index])
-
-    def load(self, array, row):
-        return self.builder.load(self.ptr(array, row), align=8)
-
-    def store(self, value, array, row):
-        self.builder.store(value, self.ptr(array, row), align=8)
-
-    def row(self, index, column):
-        """The vector row of T[index, column]: index · STATE + column."""
-        b = self.builder
-        return b.add(b.mul(index, ir.Constant(index.type, STATE)), ir.Constant(index.type, column))
-
-    def splat(self, scalar):
-        b = self.builder
-        one = b.insert_element(ir.Constant(self.vec, ir.Undefined), scalar, ir.Constant(ir.IntType(32), 0))
-        return b.shuffle_vector(one, ir.Constant(self.vec, ir.Undefined), ir.Constant(ir.VectorType(ir.IntType(32), LANES),
-                                                                                      [0] * LANES))
-
-    def variables(self, count):
-        """Vector variables (stack slots that LLVM promotes to registers)."""
-        return [cgutils.alloca_once(self.builder, self.vec) for _ in range(count)]
-
-
-FUSE = ("contract",)  # the series' multiply and add may fuse (as in the scalar kernel's fastmath)
-
-
-@intrinsic
-def _series(typingctx, T, order, Q):
+@simd.series(STATE)
+def _series(v, p, row):
     """Fill T[1..order] from T[0] in every lane: ``fixed_point.taylor_coefficients`` without α, lanes in columns.
 
     T is (order+1, STATE, LANES), Q (CONSTANTS, LANES) the lanes' constants (``_load``). Order k's coefficient is
@@ -109,103 +63,41 @@ def _series(typingctx, T, order, Q):
     The sums run over nine vector accumulators in registers, twelve vector loads and twelve fused
     multiply-adds per term.
     """
-    if not (_vector_arrays([T, Q]) and T.ndim == 3 and Q.ndim == 2 and isinstance(order, types.Integer)):
-        return None
-    sig = types.void(T, order, Q)
-
-    def codegen(context, builder, signature, args):
-        v = _Lanes(context, builder, signature, args)
-        b = builder
-        p = context.cast(builder, args[1], signature.args[1], types.intp)
-        q = [v.load(2, r) for r in range(CONSTANTS)]
-        sums = v.variables(SUMS)
-        zero = ir.Constant(v.vec, [0.0] * LANES)
-
-        def add(s, x, y, subtract=False):
-            product = b.fmul(x, y, flags=FUSE)
-            old = b.load(sums[s])
-            b.store(b.fsub(old, product, flags=FUSE) if subtract else b.fadd(old, product, flags=FUSE), sums[s])
-
-        with cgutils.for_range(b, p) as order_loop:
-            k = order_loop.index
-            for s in sums:
-                b.store(zero, s)
-            with cgutils.for_range(b, b.add(k, ir.Constant(k.type, 1))) as term:
-                j = term.index
-                m = b.sub(k, j)
-                w0, w1, w2, g0, g1, g2 = [v.load(0, v.row(j, c)) for c in range(STATE)]
-                W0, W1, W2, G0, G1, G2 = [v.load(0, v.row(m, c)) for c in range(STATE)]
-                add(0, w1, W2)
-                add(1, w2, W0)
-                add(2, w0, W1)
-                add(3, g1, G2)
-                add(4, g2, G0)
-                add(5, g0, G1)
-                add(6, g1, W2)
-                add(6, g2, W1, subtract=True)
-                add(7, g2, W0)
-                add(7, g0, W2, subtract=True)
-                add(8, g0, W1)
-                add(8, g1, W0, subtract=True)
-            s = [b.load(x) for x in sums]
-            e0, e1, e2 = [v.load(0, v.row(k, c)) for c in (3, 4, 5)]
-            inv = v.splat(b.fdiv(ir.Constant(ir.DoubleType(), 1.0),
-                                  b.sitofp(b.add(k, ir.Constant(k.type, 1)), ir.DoubleType())))
-            k1 = b.add(k, ir.Constant(k.type, 1))
-
-            def mul(x, y):
-                return b.fmul(x, y, flags=FUSE)
-
-            def sub(x, y):
-                return b.fsub(x, y, flags=FUSE)
-
-            def plus(x, y):
-                return b.fadd(x, y, flags=FUSE)
-
-            rate = [plus(mul(q[0], sub(s[0], mul(q[3], s[3]))), sub(mul(q[4], e2), mul(q[5], e1))),
-                    plus(mul(q[1], sub(s[1], mul(q[3], s[4]))), sub(mul(q[6], e0), mul(q[7], e2))),
-                    plus(mul(q[2], sub(s[2], mul(q[3], s[5]))), sub(mul(q[8], e1), mul(q[9], e0))),
-                    s[6], s[7], s[8]]
-            for c in range(STATE):
-                v.store(mul(rate[c], inv), 0, v.row(k1, c))
-        return context.get_dummy_value()
-
-    return sig, codegen
-
-
-@intrinsic
-def _update(typingctx, T, order, H, carry):
-    """Every lane's state T[0] += Σ_{k≥1} T[k] h^k (Horner), a compensated (Kahan) sum with ``carry``.
-
-    H is (1, LANES): the lanes' steps (0 in idle lanes); carry (STATE, LANES). The Horner sums may fuse
-    multiply and add; the Kahan update is strict (``taylor.run``'s arithmetic), and the six components'
-    Horner chains interleave.
-    """
-    if not (_vector_arrays([T, H, carry]) and T.ndim == 3 and isinstance(order, types.Integer)):
-        return None
-    sig = types.void(T, order, H, carry)
-
-    def codegen(context, builder, signature, args):
-        v = _Lanes(context, builder, signature, args)
-        b = builder
-        p = context.cast(builder, args[1], signature.args[1], types.intp)
-        h = v.load(2, 0)
-        acc = v.variables(STATE)
+    b = v.builder
+    q = [v.load(2, r) for r in range(CONSTANTS)]
+    sums = v.variables(SUMS)
+    zero = ir.Constant(v.vec, [0.0] * LANES)
+    with cgutils.for_range(b, p) as order_loop:
+        k = order_loop.index
+        for s in sums:
+            b.store(zero, s)
+        with cgutils.for_range(b, b.add(k, ir.Constant(k.type, 1))) as term:
+            j = term.index
+            m = b.sub(k, j)
+            w0, w1, w2, g0, g1, g2 = [v.load(0, row(j, c)) for c in range(STATE)]
+            W0, W1, W2, G0, G1, G2 = [v.load(0, row(m, c)) for c in range(STATE)]
+            for s, x, y, subtract in ((0, w1, W2, False), (1, w2, W0, False), (2, w0, W1, False),
+                                      (3, g1, G2, False), (4, g2, G0, False), (5, g0, G1, False),
+                                      (6, g1, W2, False), (6, g2, W1, True), (7, g2, W0, False),
+                                      (7, g0, W2, True), (8, g0, W1, False), (8, g1, W0, True)):
+                v.fma_into(sums[s], x, y, subtract)
+        s = [b.load(x) for x in sums]
+        e0, e1, e2 = [v.load(0, row(k, c)) for c in (3, 4, 5)]
+        inv = v.inverse(k)
+        k1 = b.add(k, ir.Constant(k.type, 1))
+        rate = [v.fixed_point_rate(q[0], q[3], s[0], s[3], q[4], e2, q[5], e1, inv),
+                v.fixed_point_rate(q[1], q[3], s[1], s[4], q[6], e0, q[7], e2, inv),
+                v.fixed_point_rate(q[2], q[3], s[2], s[5], q[8], e1, q[9], e0, inv),
+                b.fmul(s[6], inv, flags=simd.FUSE), b.fmul(s[7], inv, flags=simd.FUSE),
+                b.fmul(s[8], inv, flags=simd.FUSE)]
         for c in range(STATE):
-            b.store(v.load(0, v.row(p, c)), acc[c])
-        with cgutils.for_range(b, b.sub(p, ir.Constant(p.type, 1))) as loop:
-            k = b.sub(b.sub(p, ir.Constant(p.type, 1)), loop.index)  # order − 1 … 1
-            for c in range(STATE):
-                b.store(b.fadd(b.fmul(b.load(acc[c]), h, flags=FUSE), v.load(0, v.row(k, c)), flags=FUSE), acc[c])
-        for c in range(STATE):
-            y = v.load(0, c)
-            inc = b.fsub(b.fmul(b.load(acc[c]), h), v.load(3, c))
-            total = b.fadd(y, inc)
-            v.store(b.fsub(b.fsub(total, y), inc), 3, c)
-            v.store(total, 0, c)
-        return context.get_dummy_value()
+            v.store(rate[c], 0, row(k1, c))
 
-    return sig, codegen
+
+#: Every lane's state T[0] += Σ_{k≥1} T[k] h^k (Horner), a compensated (Kahan) sum with ``carry``: H is (1, LANES),
+#: the lanes' steps (0 in idle lanes); carry (STATE, LANES). The Horner sums may fuse multiply and add; the Kahan
+#: update is strict (``taylor.run``'s arithmetic), and the six components' Horner chains interleave.
+_update = simd.update(STATE, STATE)
 
 
 def task_size(count: int) -> int:

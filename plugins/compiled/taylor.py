@@ -14,6 +14,14 @@ next step, so round-off no longer grows as one ulp of the state per step (the
 floor of the uncompensated update was ~2e-12 over the 3,000 steps of the
 reference scene). Time needs no compensation: the step actually taken is
 h = fl(t + h) − t, exact in floating point, and the state advances by exactly it.
+
+The fixed-point model without α (the common case) takes a vectorised step
+(``run_vector``): the state's components across the lanes of ``<4 x double>``
+vectors, the nine scalar Cauchy sums as three vector sums (four fused
+multiply-adds per term instead of eighteen scalar products), and the dense output
+and the update over two vectors (ω, 0) and (γ, 0). It takes the same steps as
+the scalar step (``run_scalar``, every other model) to rounding, at about half
+the cost (``benchmarks/taylor_step.py``, docs/performance.md).
 """
 
 from __future__ import annotations
@@ -22,8 +30,14 @@ import math
 
 import numpy as np
 
-from gyrolab.plugins.compiled import inline_kernel, kernel
-from gyrolab.plugins.compiled.models import taylor_coefficients
+from llvmlite import ir
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
+
+from gyrolab.plugins.compiled import inline_kernel, kernel, simd
+from gyrolab.plugins.compiled.models import FIXED_POINT, taylor_coefficients
+from gyrolab.plugins.compiled.simd import LANES
 
 OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2  # dop853's codes
 MIN_ORDER, MAX_ORDER = 4, 60
@@ -63,7 +77,18 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     step passes is filled, also beyond i_stop. state = [t]; carry = the Kahan compensation of y (zeros
     at the start); stats = [coefficient evaluations, steps]. Returns (status, index of the next output
     time to fill).
+
+    The fixed-point model without α takes the vectorised step (``run_vector``), every other model
+    ``run_scalar``.
     """
+    if model == FIXED_POINT and p[15] == 0.0:
+        return run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
+    return run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
+
+
+@kernel
+def run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+    """``run`` with scalar arithmetic, for every model with Taylor coefficients (``models.taylor_coefficients``)."""
     n = y.size
     T = np.empty((order + 1, n))
     work = np.zeros((order + 1, 3))
@@ -114,3 +139,208 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
         stats[1] += 1
     state[0] = t
     return OK, i
+
+
+# The vectorised step of the fixed-point model without α: one trajectory, its components across the lanes of
+# ``<4 x double>`` vectors. Each order's coefficients are stored as ROWS vectors: ω = (ω_x, ω_y, ω_z, 0),
+# γ likewise, and their cyclic permutations ω⁽¹²⁰⁾ = (ω_y, ω_z, ω_x, 0), ω⁽²⁰¹⁾ = (ω_z, ω_x, ω_y, 0), so the
+# nine scalar Cauchy sums of ``fixed_point.taylor_coefficients`` become three vector sums, four fused
+# multiply-adds and four vector loads per term: pairs of ω Σ ω⁽¹²⁰⁾_j ⊙ ω⁽²⁰¹⁾_{k−j} (= (ω_y ω_z, ω_z ω_x, ω_x ω_y)
+# terms), pairs of γ likewise, γ × ω = Σ γ⁽¹²⁰⁾_j ⊙ ω⁽²⁰¹⁾_{k−j} − γ⁽²⁰¹⁾_j ⊙ ω⁽¹²⁰⁾_{k−j}, whose minus part is summed
+# as Σ ω⁽¹²⁰⁾_j ⊙ γ⁽²⁰¹⁾_{k−j} (j ↔ k − j).
+W, G, W120, G120, W201, G201 = range(6)
+ROWS = 6
+_CYCLE = {W120: (1, 2, 0, 3), W201: (2, 0, 1, 3)}
+
+
+@simd.series(ROWS)
+def _coefficients(v, p, row):
+    """Fill T[1..order] from T[0] (rows W, G and their permutations; T is (order+1, ROWS, LANES)).
+
+    Q is (4, LANES): q = (I_y − I_z)/I_x (and cyclically), N_2 in every lane, and the torque U_2 × γ's
+    constants qa = (U_y/I_x, U_z/I_y, U_x/I_z), qb = (U_z/I_x, U_x/I_y, U_y/I_z) (``_constants``); the
+    fourth lane of each is 0. The rate is ``simd.Lanes.fixed_point_rate``, batch_taylor's expression. The
+    cross product's sum runs in two accumulators (its plus and minus products), so that no chain of
+    dependent fused multiply-adds is longer than one per term; the terms that involve the newest
+    coefficient k come last (see the loop). Both orders differ from the scalar kernel's and the batch
+    lanes': the coefficients agree with theirs to rounding.
+    """
+    b = v.builder
+    q, n, qa, qb = [v.load(2, r) for r in range(4)]
+    pairs_w, pairs_g, cross_plus, cross_minus = sums = v.variables(4)
+    zero = ir.Constant(v.vec, [0.0] * LANES)
+
+    def term(a, c):
+        """The sums' term of the rows a (index j) and c (index k − j), each given as its ROWS vectors."""
+        v.fma_into(pairs_w, a[W120], c[W201])
+        v.fma_into(pairs_g, a[G120], c[G201])
+        v.fma_into(cross_plus, a[G120], c[W201])
+        v.fma_into(cross_minus, a[W120], c[G201])  # Σ_j γ⁽²⁰¹⁾_{k−j} ⊙ ω⁽¹²⁰⁾_j: four loads per term
+
+    def load_row(index):
+        return [v.load(0, row(index, c)) for c in range(ROWS)]
+
+    first = load_row(ir.Constant(p.type, 0))
+    newest = v.variables(ROWS)  # row k, carried in registers from one order to the next
+    for c in range(ROWS):
+        b.store(first[c], newest[c])
+    one = ir.Constant(p.type, 1)
+    with cgutils.for_range(b, p) as order_loop:
+        k = order_loop.index
+        for s in sums:
+            b.store(zero, s)
+        # the terms of rows 1..k−1 first, those of the newest row k (j = 0 and j = k) last: the former do
+        # not wait for row k, so they overlap the computation of row k in the processor's pipeline
+        with cgutils.for_range(b, k, start=one) as middle:
+            term(load_row(middle.index), load_row(b.sub(k, middle.index)))
+        last = [b.load(x) for x in newest]
+        term(first, last)
+        with b.if_then(b.icmp_signed(">", k, ir.Constant(k.type, 0))):
+            term(last, first)
+        inv = v.inverse(k)
+        omega = v.fixed_point_rate(q, n, b.load(pairs_w), b.load(pairs_g), qa, last[G201], qb, last[G120], inv)
+        gamma = b.fmul(b.fsub(b.load(cross_plus), b.load(cross_minus), flags=simd.FUSE), inv, flags=simd.FUSE)
+        k1 = b.add(k, ir.Constant(k.type, 1))
+        for base, value in ((W, omega), (G, gamma)):
+            rows = {base: value}
+            for shift, lanes in _CYCLE.items():
+                mask = ir.Constant(ir.VectorType(ir.IntType(32), LANES), list(lanes))
+                rows[base + shift] = b.shuffle_vector(value, value, mask)
+            for c, x in rows.items():
+                v.store(x, 0, row(k1, c))
+                b.store(x, newest[c])
+
+
+@intrinsic
+def _dense(typingctx, T, order, dt, carry, out):
+    """out[0], out[1] = the state rows T[0, W], T[0, G] + (Σ_{k≥1} T[k] dt^k − carry): the series at t + dt,
+    Horner with strict arithmetic (``run_scalar``'s dense output, two components' chains at once)."""
+    if not (simd.vector_arrays([T, carry, out]) and T.ndim == 3 and isinstance(order, types.Integer)
+            and isinstance(dt, types.Float)):
+        return None
+    sig = types.void(T, order, types.float64, carry, out)
+
+    def codegen(context, builder, signature, args):
+        v = simd.Lanes(context, builder, signature, args)
+        b = builder
+        p = context.cast(builder, args[1], signature.args[1], types.intp)
+        h = v.splat(args[2])
+        acc = v.variables(2)
+        for c in (W, G):
+            b.store(v.load(0, v.row(b, p, ROWS, c)), acc[c])
+        with cgutils.for_range(b, b.sub(p, ir.Constant(p.type, 1))) as loop:
+            k = b.sub(b.sub(p, ir.Constant(p.type, 1)), loop.index)  # order − 1 … 1
+            for c in (W, G):
+                b.store(b.fadd(b.fmul(b.load(acc[c]), h), v.load(0, v.row(b, k, ROWS, c))), acc[c])
+        for c in (W, G):
+            v.store(b.fadd(v.load(0, c), b.fsub(b.fmul(b.load(acc[c]), h), v.load(3, c))), 4, c)
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+#: The state rows T[0, W], T[0, G] += Σ_{k≥1} T[k] h^k, compensated (``simd.update``: batch_taylor's update).
+_update = simd.update(ROWS, 2)
+
+
+@kernel
+def _constants(p, Q):
+    """``_coefficients``' constants from the parameters (``fixed_point.pack``), as batch_taylor._load forms them."""
+    I0, I1, I2 = p[0], p[1], p[2]
+    u0, u1, u2 = p[9], p[10], p[11]
+    Q[0, 0], Q[0, 1], Q[0, 2] = (I1 - I2) * p[16], (I2 - I0) * p[17], (I0 - I1) * p[18]
+    Q[1, 0] = Q[1, 1] = Q[1, 2] = p[14]
+    Q[2, 0], Q[2, 1], Q[2, 2] = u1 * p[16], u2 * p[17], u0 * p[18]
+    Q[3, 0], Q[3, 1], Q[3, 2] = u2 * p[16], u0 * p[17], u1 * p[18]
+
+
+@kernel
+def _set_state(T, y):
+    """T[0]'s rows (W, G and their permutations) from the state y = (ω, γ)."""
+    for m in range(3):
+        for base in (W, G):
+            T[0, base, m] = y[3 * base + m]
+            T[0, base + W120, m] = y[3 * base + (m + 1) % 3]
+            T[0, base + W201, m] = y[3 * base + (m + 2) % 3]
+
+
+@kernel
+def _norm_rows(T, k):
+    """The max norm of order k's coefficient (rows W and G, lanes 0..2)."""
+    v = 0.0
+    for base in (W, G):
+        for m in range(3):
+            v = max(v, abs(T[k, base, m]))
+    return v
+
+
+@kernel
+def series(p, y, order):
+    """The Taylor coefficients (order+1, 6) of the fixed-point state y without α from the vectorised sums."""
+    T = np.zeros((order + 1, ROWS, LANES))
+    Q = np.zeros((4, LANES))
+    _constants(p, Q)
+    _set_state(T, y)
+    _coefficients(T, order, Q)
+    out = np.empty((order + 1, 6))
+    for k in range(order + 1):
+        for m in range(3):
+            out[k, m] = T[k, W, m]
+            out[k, 3 + m] = T[k, G, m]
+    return out
+
+
+@kernel
+def run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+    """``run`` for the fixed-point model without α (p[15] = 0, y = (ω, γ)), the step vectorised across the
+    components: ``_coefficients``, the dense output (``_dense``) and the compensated update (``_update``) in
+    ``<4 x double>``. Same order, step rule, dense output (strict arithmetic), compensated update, status
+    codes, stats and chunking contract as ``run_scalar``; the coefficients and the update's Horner sums fuse
+    multiply and add (as batch_taylor's lanes do), so the results agree with ``run_scalar``'s to rounding."""
+    T = np.zeros((order + 1, ROWS, LANES))
+    Q = np.zeros((4, LANES))
+    C = np.zeros((2, LANES))  # the Kahan compensation, rows W and G
+    H = np.zeros((1, LANES))
+    D = np.zeros((2, LANES))  # a dense output, rows W and G
+    _constants(p, Q)
+    for m in range(3):
+        C[0, m], C[1, m] = carry[m], carry[3 + m]
+    t = state[0]
+    n_out = t_out.size
+    t_end = t_out[n_out - 1]
+    i = i_next
+    safety = math.exp(-0.7 / (order - 1))
+    code = OK
+    while i < i_stop:
+        _set_state(T, y)
+        _coefficients(T, order, Q)
+        stats[0] += 1
+        scale = max(1.0, _norm_rows(T, 0))
+        h = step_size(tol, scale, _norm_rows(T, order - 1), _norm_rows(T, order), order, safety)
+        if not h < np.inf:
+            h = t_end - t
+        t_new = min(t + h, t_end)
+        h = t_new - t
+        if h <= 0.0:  # the step is below the spacing of floating-point numbers at t: no progress is possible
+            code = TOO_SMALL_STEP
+            break
+        while i < n_out and t_out[i] <= t_new:
+            _dense(T, order, t_out[i] - t, C, D)
+            for m in range(3):
+                Y[i, m], Y[i, 3 + m] = D[0, m], D[1, m]
+            i += 1
+        for m in range(3):
+            H[0, m] = h
+        _update(T, order, H, C)
+        finite = True
+        for m in range(3):
+            y[m], y[3 + m] = T[0, W, m], T[0, G, m]
+            carry[m], carry[3 + m] = C[0, m], C[1, m]
+            finite = finite and math.isfinite(y[m]) and math.isfinite(y[3 + m])
+        if not finite:
+            code = NOT_FINITE
+            break
+        t = t_new
+        stats[1] += 1
+    state[0] = t
+    return code, i
