@@ -88,6 +88,7 @@ MISS_MARGIN = 1000.0
 SCREEN_POINTS = 512
 SCREEN_TOLERANCE = 1e-9
 EPS = float(np.finfo(float).eps)
+_PILOT_GRID = np.linspace(0.0, 1.0, PILOT_POINTS)
 
 
 class Auto(Integrator):
@@ -146,7 +147,7 @@ class Auto(Integrator):
         t_pilot = t_out[0] + span * self.pilot_fraction
         # the pilot's grid holds the output times it covers: its tight run is the start of the trajectory
         inside = t_out[t_out < t_pilot]
-        pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * np.linspace(0.0, 1.0, PILOT_POINTS), inside)
+        pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * _PILOT_GRID, inside)
         tau, pilot_nfev = min(max(self.accuracy * FIRST_RATIO, MIN_TOLERANCE), MAX_TOLERANCE / 10), 0
         # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance
         self._order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
@@ -168,7 +169,7 @@ class Auto(Integrator):
         # note), that of scipy's plain update by up to an ulp per step: a target below it cannot be met in
         # double precision, whatever the tolerance.
         steps = self._pilot_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / self._order))
-        compensated = self._method(compiled, chosen).name == "taylor"
+        compensated = compiled is not None and bool(self._taylor)  # the compensated update is Taylor's
         roundoff = EPS * scale * (math.sqrt(steps) if compensated else steps)
         if roundoff > self.accuracy:
             raise ConfigError(f"accuracy={self.accuracy:g} is below the round-off that double precision accumulates "
