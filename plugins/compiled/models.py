@@ -28,7 +28,7 @@ from numba import types
 from numba.core import cgutils
 from numba.core.datamodel.models import OpaqueModel
 from numba.core.imputils import lower_constant
-from numba.extending import NativeValue, intrinsic, overload, register_model, typeof_impl, unbox
+from numba.extending import NativeValue, intrinsic, overload, register_model, unbox
 
 from gyrolab.plugins.compiled import fixed_point, inline_kernel, kernel, plugin_taylor
 from gyrolab.plugins.compiled.plugin_torque import ADDRESS
@@ -75,27 +75,27 @@ def _free(y, p, out):
     out[5] = g0 * w1 - g1 * w0
 
 
-class Form:
-    """A model as the kernels' argument: its form id becomes part of the argument's numba type (``FormType``)."""
-
-    __slots__ = ("id",)
-
-    def __init__(self, id: int) -> None:
-        self.id = id
-
-    def __repr__(self) -> str:
-        return f"Form({self.id})"
-
-
 class FormType(types.Type):
     def __init__(self, id: int) -> None:
         self.id = id
         super().__init__(name=f"gyrolab.Form({id})")
 
 
-@typeof_impl.register(Form)
-def _typeof_form(value, context):
-    return FormType(value.id)
+class Form:
+    """A model as the kernels' argument: its form id becomes part of the argument's numba type (``FormType``).
+
+    ``_numba_type_`` gives numba the type without a call back into Python (a call with a Form costs what one
+    with an int costs).
+    """
+
+    __slots__ = ("id", "_numba_type_")
+
+    def __init__(self, id: int) -> None:
+        self.id = id
+        self._numba_type_ = FormType(id)
+
+    def __repr__(self) -> str:
+        return f"Form({self.id})"
 
 
 register_model(FormType)(OpaqueModel)  # no data: everything is in the type
@@ -157,7 +157,7 @@ def rhs(model, t, y, p, out):
     raise TypeError("models.rhs is called from compiled kernels only (use models.evaluate)")
 
 
-@overload(rhs, inline="always")
+@overload(rhs, inline="never", jit_options={"error_model": "numpy"})
 def _rhs(model, t, y, p, out):
     if isinstance(model, FormType):
         f = _RHS[model.id]
@@ -192,7 +192,7 @@ def taylor_coefficients(model, p, Y, order, work, t=0.0):
     raise TypeError("models.taylor_coefficients is called from compiled kernels only")
 
 
-@overload(taylor_coefficients, inline="always")
+@overload(taylor_coefficients, inline="never", jit_options={"error_model": "numpy"})
 def _taylor_coefficients(model, p, Y, order, work, t=0.0):
     if isinstance(model, FormType):
         if model.id in (FIXED_POINT, FIXED_POINT_ALPHA):
