@@ -57,15 +57,16 @@ def _cross_add(u0, u1, u2, v0, v1, v2, s):
     return s * (u1 * v2 - u2 * v1), s * (u2 * v0 - u0 * v2), s * (u0 * v1 - u1 * v0)
 
 
-def _rhs_form(alpha: bool):
-    """The right-hand side for states (ω, γ, α) if ``alpha``, else (ω, γ).
+def _rhs_form(alpha: bool | None):
+    """The right-hand side for states (ω, γ, α) if ``alpha``, (ω, γ) if not, either by the flag p[15] if None.
 
-    ``if alpha`` tests a constant of the closure: numba drops the dead branch before typing, so the
-    (ω, γ) form types and compiles none of the α terms (``models.Form``: kernels compiled per model).
+    ``alpha`` is a constant of the closure: numba drops the dead branches before typing, so the (ω, γ)
+    form types and compiles none of the α terms (``models.Form``: kernels compiled per model).
     """
 
     @inline_kernel
     def rhs(t, y, p, out):
+        has_alpha = p[15] != 0.0 if alpha is None else alpha
         I0, I1, I2 = p[0], p[1], p[2]
         w0, w1, w2 = y[0], y[1], y[2]
         g0, g1, g2 = y[3], y[4], y[5]
@@ -82,7 +83,7 @@ def _rhs_form(alpha: bool):
         out[3] = g1 * w2 - g2 * w1
         out[4] = g2 * w0 - g0 * w2
         out[5] = g0 * w1 - g1 * w0
-        if alpha:
+        if has_alpha:
             x0, x1, x2 = y[6], y[7], y[8]
             b0, b1, b2 = g1 * x2 - g2 * x1, g2 * x0 - g0 * x2, g0 * x1 - g1 * x0
             c0, c1, c2 = _cross_add(p[3], p[4], p[5], x0, x1, x2, 1.0)
@@ -101,18 +102,10 @@ def _rhs_form(alpha: bool):
     return rhs
 
 
-#: The right-hand side of the state (ω, γ), and of (ω, γ, α).
+#: The right-hand side of the state (ω, γ), of (ω, γ, α), and of either (by p[15] at run time).
 rhs_gamma = _rhs_form(False)
 rhs_alpha = _rhs_form(True)
-
-
-@inline_kernel
-def rhs(t, y, p, out):
-    """Either form, chosen at run time by the flag p[15] (the state carries α)."""
-    if p[15] != 0.0:
-        rhs_alpha(t, y, p, out)
-    else:
-        rhs_gamma(t, y, p, out)
+rhs = _rhs_form(None)
 
 
 @kernel
@@ -152,8 +145,9 @@ def _cauchy_pairs(A, ia, k, out):
 # The Cauchy sums may be reassociated and contracted (fused multiply-add): ~15 % faster, and a coefficient's
 # rounding enters the state multiplied by h^k. The state update itself (``taylor.run``) stays strict: its
 # Kahan summation would be optimised away under reassociation.
-def _taylor_form(alpha: bool):
-    """``taylor_coefficients`` for states (ω, γ, α) if ``alpha``, else (ω, γ) (``if alpha``: as ``_rhs_form``)."""
+def _taylor_form(alpha: bool | None):
+    """``taylor_coefficients`` for states (ω, γ, α) if ``alpha``, (ω, γ) if not (the other form's code pruned as in
+    ``_rhs_form``), either by the flag p[15] if None."""
 
     @numba.njit(cache=True, error_model="numpy", fastmath={"reassoc", "contract", "nsz"})
     def taylor_coefficients(p, Y, order, work):
@@ -169,6 +163,7 @@ def _taylor_form(alpha: bool):
         """
         I0, I1, I2 = p[0], p[1], p[2]
         d0, d1, d2 = I1 - I2, I2 - I0, I0 - I1  # ((Iω) × ω) = (d0 ω_y ω_z, d1 ω_z ω_x, d2 ω_x ω_y)
+        has_alpha = p[15] != 0.0 if alpha is None else alpha
         n2 = p[14]
         acc = np.empty(3)
         tmp = np.empty(3)
@@ -196,7 +191,7 @@ def _taylor_form(alpha: bool):
             acc[0] = d0 * (w0 - n2 * g0) + p[10] * e2 - p[11] * e1
             acc[1] = d1 * (w1 - n2 * g1) + p[11] * e0 - p[9] * e2
             acc[2] = d2 * (w2 - n2 * g2) + p[9] * e1 - p[10] * e0
-            if alpha:
+            if has_alpha:
                 work[k, 0] = work[k, 1] = work[k, 2] = 0.0  # β_k = Σ γ_j × α_{k−j}
                 _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, work[k])
                 x0, x1, x2 = Y[k, 6], Y[k, 7], Y[k, 8]
@@ -220,7 +215,7 @@ def _taylor_form(alpha: bool):
             Y[k + 1, 2] = acc[2] * p[18] * inv
             # γ̇ = γ × ω, α̇ = α × ω
             Y[k + 1, 3], Y[k + 1, 4], Y[k + 1, 5] = c0 * inv, c1 * inv, c2 * inv
-            if alpha:
+            if has_alpha:
                 acc[0] = acc[1] = acc[2] = 0.0
                 _cauchy_cross(Y, 6, Y, 0, k, 1.0, 1.0, 1.0, acc)
                 Y[k + 1, 6], Y[k + 1, 7], Y[k + 1, 8] = acc[0] * inv, acc[1] * inv, acc[2] * inv
@@ -230,15 +225,7 @@ def _taylor_form(alpha: bool):
 
 taylor_gamma = _taylor_form(False)
 taylor_alpha = _taylor_form(True)
-
-
-@kernel
-def taylor_coefficients(p, Y, order, work):
-    """Either form, chosen at run time by the flag p[15] (the state carries α)."""
-    if p[15] != 0.0:
-        taylor_alpha(p, Y, order, work)
-    else:
-        taylor_gamma(p, Y, order, work)
+taylor_coefficients = _taylor_form(None)
 
 
 @kernel
