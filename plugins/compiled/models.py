@@ -192,7 +192,7 @@ def taylor_coefficients(model, p, Y, order, work, t=0.0):
     raise TypeError("models.taylor_coefficients is called from compiled kernels only")
 
 
-@overload(taylor_coefficients, inline="always")
+@overload(taylor_coefficients, inline="never", jit_options={"error_model": "numpy"})
 def _taylor_coefficients(model, p, Y, order, work, t=0.0):
     if isinstance(model, FormType):
         if model.id in (FIXED_POINT, FIXED_POINT_ALPHA):
