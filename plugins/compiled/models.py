@@ -138,16 +138,6 @@ def _plugin_alpha(t, y, p, out):
     _call_torque(int(p[ADDRESS]), t, y, p, out)
 
 
-@inline_kernel
-def _rhs_any(model, t, y, p, out):
-    if model == FIXED_POINT:
-        fixed_point.rhs(t, y, p, out)
-    elif model == FIXED_POINT_PLUGIN:
-        _plugin(t, y, p, out)
-    elif model == FIXED_POINT_PLUGIN_ALPHA:
-        _plugin_alpha(t, y, p, out)
-
-
 _RHS = {FIXED_POINT: fixed_point.rhs_gamma, FIXED_POINT_ALPHA: fixed_point.rhs_alpha,
         FIXED_POINT_PLUGIN: _plugin, FIXED_POINT_PLUGIN_ALPHA: _plugin_alpha}
 
@@ -158,10 +148,36 @@ def rhs(model, t, y, p, out):
 
 
 @overload(rhs, inline="never", jit_options={"error_model": "numpy"})
-def _rhs(model, t, y, p, out):
+def _rhs_form(model, t, y, p, out):
+    """A form's code as a plain call: compiled once per process and linked into every kernel."""
     if isinstance(model, FormType):
         f = _RHS[model.id]
         return lambda model, t, y, p, out: f(t, y, p, out)
+    return None
+
+
+_GAMMA, _ALPHA = FORMS[FIXED_POINT], FORMS[FIXED_POINT_ALPHA]
+_PLUGIN, _PLUGIN_ALPHA = FORMS[FIXED_POINT_PLUGIN], FORMS[FIXED_POINT_PLUGIN_ALPHA]
+
+
+@inline_kernel
+def _rhs_any(model, t, y, p, out):
+    """The run-time dispatch: a branch per form, each the form's plain call."""
+    if model == FIXED_POINT:
+        if p[15] != 0.0:
+            rhs(_ALPHA, t, y, p, out)
+        else:
+            rhs(_GAMMA, t, y, p, out)
+    elif model == FIXED_POINT_PLUGIN:
+        rhs(_PLUGIN, t, y, p, out)
+    elif model == FIXED_POINT_PLUGIN_ALPHA:
+        rhs(_PLUGIN_ALPHA, t, y, p, out)
+
+
+@overload(rhs, inline="always")
+def _rhs_any_model(model, t, y, p, out):
+    """The run-time dispatch (an int model), inlined at numba's level: compiled as one function calling every
+    form it was too large for LLVM to inline into the kernels' loops, which ran up to 1.7× slower."""
     if isinstance(model, types.Integer):
         return lambda model, t, y, p, out: _rhs_any(model, t, y, p, out)
     return None
