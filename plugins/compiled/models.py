@@ -84,8 +84,8 @@ class FormType(types.Type):
 class Form:
     """A model as the kernels' argument: its form id becomes part of the argument's numba type (``FormType``).
 
-    ``_numba_type_`` gives numba the type without a call back into Python (a call with a Form costs what one
-    with an int costs).
+    ``_numba_type_`` gives numba the type without a call back into Python: a kernel call with a Form costs
+    ~1 µs more than with an int (11 µs when numba had to ask a Python typing function).
     """
 
     __slots__ = ("id", "_numba_type_")
@@ -187,8 +187,8 @@ def _rhs_any_model(model, t, y, p, out):
 def evaluate(model, t, y, p, out):
     """``rhs`` as a plain compiled call, for the cold paths (a first evaluation, the initial step).
 
-    ``rhs`` is inlined into its callers at numba's level, typed again in each: callers outside the
-    inner loops call this instead, so that the first compile types it once.
+    With an int model ``rhs`` is inlined into its callers at numba's level, typed again in each: callers
+    outside the inner loops call this instead, so that the first compile types it once.
     """
     rhs(model, t, y, p, out)
 
