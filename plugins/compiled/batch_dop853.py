@@ -31,6 +31,7 @@ from gyrolab.plugins.compiled.fixed_point import rhs_block
 LANES = 32  # trajectories advanced in lock step
 TASK = 256  # trajectories per parallel task, at most
 RUNNING = -1  # status of a trajectory not finished yet
+_FIXED_POINT = models.FORMS[models.FIXED_POINT]  # the (ω, γ) form only (models.Form)
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -56,9 +57,9 @@ def _load(lane, traj, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t,
     y0 = Y0[traj].copy()
     p = Params[traj].copy()
     f0 = np.empty(n)
-    models.rhs(models.FIXED_POINT, t0, y0, p, f0)
+    models.rhs(_FIXED_POINT, t0, y0, p, f0)
     stats = np.zeros(3, dtype=np.int64)
-    h_abs[lane] = dop853.initial_step(models.FIXED_POINT, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats)
+    h_abs[lane] = dop853.initial_step(_FIXED_POINT, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats)
     nfev[traj] = 1 + stats[0]
     for c in range(n):
         y[c, lane] = y0[c]

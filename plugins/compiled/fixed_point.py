@@ -57,39 +57,55 @@ def _cross_add(u0, u1, u2, v0, v1, v2, s):
     return s * (u1 * v2 - u2 * v1), s * (u2 * v0 - u0 * v2), s * (u0 * v1 - u1 * v0)
 
 
-@inline_kernel
-def rhs(t, y, p, out):
-    I0, I1, I2 = p[0], p[1], p[2]
-    w0, w1, w2 = y[0], y[1], y[2]
-    g0, g1, g2 = y[3], y[4], y[5]
-    # gyroscopic torque (Iω) × ω
-    t0 = (I1 - I2) * w1 * w2
-    t1 = (I2 - I0) * w2 * w0
-    t2 = (I0 - I1) * w0 * w1
-    # U_2 × γ  and  N_2 γ × Iγ
-    a0, a1, a2 = _cross_add(p[9], p[10], p[11], g0, g1, g2, 1.0)
-    n = p[14]
-    t0 += a0 + n * (I2 - I1) * g1 * g2
-    t1 += a1 + n * (I0 - I2) * g2 * g0
-    t2 += a2 + n * (I1 - I0) * g0 * g1
-    out[3] = g1 * w2 - g2 * w1
-    out[4] = g2 * w0 - g0 * w2
-    out[5] = g0 * w1 - g1 * w0
-    if p[15] != 0.0:
-        x0, x1, x2 = y[6], y[7], y[8]
-        b0, b1, b2 = g1 * x2 - g2 * x1, g2 * x0 - g0 * x2, g0 * x1 - g1 * x0
-        c0, c1, c2 = _cross_add(p[3], p[4], p[5], x0, x1, x2, 1.0)
-        d0, d1, d2 = _cross_add(p[6], p[7], p[8], b0, b1, b2, 1.0)
-        nx, ny = p[12], p[13]
-        t0 += c0 + d0 + nx * (I2 - I1) * x1 * x2 + ny * (I2 - I1) * b1 * b2
-        t1 += c1 + d1 + nx * (I0 - I2) * x2 * x0 + ny * (I0 - I2) * b2 * b0
-        t2 += c2 + d2 + nx * (I1 - I0) * x0 * x1 + ny * (I1 - I0) * b0 * b1
-        out[6] = x1 * w2 - x2 * w1
-        out[7] = x2 * w0 - x0 * w2
-        out[8] = x0 * w1 - x1 * w0
-    out[0] = t0 * p[16]
-    out[1] = t1 * p[17]
-    out[2] = t2 * p[18]
+def _rhs_form(alpha: bool | None):
+    """The right-hand side for states (ω, γ, α) if ``alpha``, (ω, γ) if not, either by the flag p[15] if None.
+
+    ``alpha`` is a constant of the closure: numba drops the dead branches before typing, so the (ω, γ)
+    form types and compiles none of the α terms (``models.Form``: kernels compiled per model).
+    """
+
+    @inline_kernel
+    def rhs(t, y, p, out):
+        has_alpha = p[15] != 0.0 if alpha is None else alpha
+        I0, I1, I2 = p[0], p[1], p[2]
+        w0, w1, w2 = y[0], y[1], y[2]
+        g0, g1, g2 = y[3], y[4], y[5]
+        # gyroscopic torque (Iω) × ω
+        t0 = (I1 - I2) * w1 * w2
+        t1 = (I2 - I0) * w2 * w0
+        t2 = (I0 - I1) * w0 * w1
+        # U_2 × γ  and  N_2 γ × Iγ
+        a0, a1, a2 = _cross_add(p[9], p[10], p[11], g0, g1, g2, 1.0)
+        n = p[14]
+        t0 += a0 + n * (I2 - I1) * g1 * g2
+        t1 += a1 + n * (I0 - I2) * g2 * g0
+        t2 += a2 + n * (I1 - I0) * g0 * g1
+        out[3] = g1 * w2 - g2 * w1
+        out[4] = g2 * w0 - g0 * w2
+        out[5] = g0 * w1 - g1 * w0
+        if has_alpha:
+            x0, x1, x2 = y[6], y[7], y[8]
+            b0, b1, b2 = g1 * x2 - g2 * x1, g2 * x0 - g0 * x2, g0 * x1 - g1 * x0
+            c0, c1, c2 = _cross_add(p[3], p[4], p[5], x0, x1, x2, 1.0)
+            d0, d1, d2 = _cross_add(p[6], p[7], p[8], b0, b1, b2, 1.0)
+            nx, ny = p[12], p[13]
+            t0 += c0 + d0 + nx * (I2 - I1) * x1 * x2 + ny * (I2 - I1) * b1 * b2
+            t1 += c1 + d1 + nx * (I0 - I2) * x2 * x0 + ny * (I0 - I2) * b2 * b0
+            t2 += c2 + d2 + nx * (I1 - I0) * x0 * x1 + ny * (I1 - I0) * b0 * b1
+            out[6] = x1 * w2 - x2 * w1
+            out[7] = x2 * w0 - x0 * w2
+            out[8] = x0 * w1 - x1 * w0
+        out[0] = t0 * p[16]
+        out[1] = t1 * p[17]
+        out[2] = t2 * p[18]
+
+    return rhs
+
+
+#: The right-hand side of the state (ω, γ), of (ω, γ, α), and of either (by p[15] at run time).
+rhs_gamma = _rhs_form(False)
+rhs_alpha = _rhs_form(True)
+rhs = _rhs_form(None)
 
 
 @kernel
@@ -129,76 +145,87 @@ def _cauchy_pairs(A, ia, k, out):
 # The Cauchy sums may be reassociated and contracted (fused multiply-add): ~15 % faster, and a coefficient's
 # rounding enters the state multiplied by h^k. The state update itself (``taylor.run``) stays strict: its
 # Kahan summation would be optimised away under reassociation.
-@numba.njit(cache=True, error_model="numpy", fastmath={"reassoc", "contract", "nsz"})
-def taylor_coefficients(p, Y, order, work):
-    """Fill Y[1..order] (rows: Taylor coefficients of the state) from Y[0].
+def _taylor_form(alpha: bool | None):
+    """``taylor_coefficients`` for states (ω, γ, α) if ``alpha``, (ω, γ) if not (the other form's code pruned as in
+    ``_rhs_form``), either by the flag p[15] if None."""
 
-    The right-hand side is quadratic in the state, so the k-th coefficient of
-    every product is a Cauchy sum (Jorba & Zou 2005): Y[k+1] = F_k / (k + 1).
-    The gyroscopic and gradient torques use their component form,
-    ((Iω) × ω)_x = (I_y − I_z) ω_y ω_z, one product per term instead of two.
-    The sums over ω and γ (the products of (Iω) × ω, γ × Iγ and γ × ω) share one
-    pass over the coefficient rows. ``work`` (order+1, 3) holds the coefficients
-    of β = γ × α when α is carried.
-    """
-    I0, I1, I2 = p[0], p[1], p[2]
-    d0, d1, d2 = I1 - I2, I2 - I0, I0 - I1  # ((Iω) × ω) = (d0 ω_y ω_z, d1 ω_z ω_x, d2 ω_x ω_y)
-    has_alpha = p[15] != 0.0
-    n2 = p[14]
-    acc = np.empty(3)
-    tmp = np.empty(3)
-    for k in range(order):
-        # one pass: pairs of ω (w·), pairs of γ (g·), γ × ω (c·)
-        w0 = w1 = w2 = 0.0
-        g0 = g1 = g2 = 0.0
-        c0 = c1 = c2 = 0.0
-        for j in range(k + 1):
-            a0, a1, a2 = Y[j, 0], Y[j, 1], Y[j, 2]
-            b0, b1, b2 = Y[j, 3], Y[j, 4], Y[j, 5]
-            A0, A1, A2 = Y[k - j, 0], Y[k - j, 1], Y[k - j, 2]
-            B0, B1, B2 = Y[k - j, 3], Y[k - j, 4], Y[k - j, 5]
-            w0 += a1 * A2
-            w1 += a2 * A0
-            w2 += a0 * A1
-            g0 += b1 * B2
-            g1 += b2 * B0
-            g2 += b0 * B1
-            c0 += b1 * A2 - b2 * A1
-            c1 += b2 * A0 - b0 * A2
-            c2 += b0 * A1 - b1 * A0
-        e0, e1, e2 = Y[k, 3], Y[k, 4], Y[k, 5]
-        # (Iω) × ω + U_2 × γ − N_2 (d ⊙ pairs of γ)   (N_2 γ × Iγ = −N_2 d ⊙ pairs)
-        acc[0] = d0 * (w0 - n2 * g0) + p[10] * e2 - p[11] * e1
-        acc[1] = d1 * (w1 - n2 * g1) + p[11] * e0 - p[9] * e2
-        acc[2] = d2 * (w2 - n2 * g2) + p[9] * e1 - p[10] * e0
-        if has_alpha:
-            work[k, 0] = work[k, 1] = work[k, 2] = 0.0  # β_k = Σ γ_j × α_{k−j}
-            _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, work[k])
-            x0, x1, x2 = Y[k, 6], Y[k, 7], Y[k, 8]
-            b0, b1, b2 = work[k, 0], work[k, 1], work[k, 2]
-            acc[0] += p[4] * x2 - p[5] * x1 + p[7] * b2 - p[8] * b1
-            acc[1] += p[5] * x0 - p[3] * x2 + p[8] * b0 - p[6] * b2
-            acc[2] += p[3] * x1 - p[4] * x0 + p[6] * b1 - p[7] * b0
-            if p[12] != 0.0:
-                _cauchy_pairs(Y, 6, k, tmp)
-                acc[0] -= p[12] * d0 * tmp[0]
-                acc[1] -= p[12] * d1 * tmp[1]
-                acc[2] -= p[12] * d2 * tmp[2]
-            if p[13] != 0.0:
-                _cauchy_pairs(work, 0, k, tmp)
-                acc[0] -= p[13] * d0 * tmp[0]
-                acc[1] -= p[13] * d1 * tmp[1]
-                acc[2] -= p[13] * d2 * tmp[2]
-        inv = 1.0 / (k + 1)
-        Y[k + 1, 0] = acc[0] * p[16] * inv
-        Y[k + 1, 1] = acc[1] * p[17] * inv
-        Y[k + 1, 2] = acc[2] * p[18] * inv
-        # γ̇ = γ × ω, α̇ = α × ω
-        Y[k + 1, 3], Y[k + 1, 4], Y[k + 1, 5] = c0 * inv, c1 * inv, c2 * inv
-        if has_alpha:
-            acc[0] = acc[1] = acc[2] = 0.0
-            _cauchy_cross(Y, 6, Y, 0, k, 1.0, 1.0, 1.0, acc)
-            Y[k + 1, 6], Y[k + 1, 7], Y[k + 1, 8] = acc[0] * inv, acc[1] * inv, acc[2] * inv
+    @numba.njit(cache=True, error_model="numpy", fastmath={"reassoc", "contract", "nsz"})
+    def taylor_coefficients(p, Y, order, work):
+        """Fill Y[1..order] (rows: Taylor coefficients of the state) from Y[0].
+
+        The right-hand side is quadratic in the state, so the k-th coefficient of
+        every product is a Cauchy sum (Jorba & Zou 2005): Y[k+1] = F_k / (k + 1).
+        The gyroscopic and gradient torques use their component form,
+        ((Iω) × ω)_x = (I_y − I_z) ω_y ω_z, one product per term instead of two.
+        The sums over ω and γ (the products of (Iω) × ω, γ × Iγ and γ × ω) share one
+        pass over the coefficient rows. ``work`` (order+1, 3) holds the coefficients
+        of β = γ × α in the form with α.
+        """
+        I0, I1, I2 = p[0], p[1], p[2]
+        d0, d1, d2 = I1 - I2, I2 - I0, I0 - I1  # ((Iω) × ω) = (d0 ω_y ω_z, d1 ω_z ω_x, d2 ω_x ω_y)
+        has_alpha = p[15] != 0.0 if alpha is None else alpha
+        n2 = p[14]
+        acc = np.empty(3)
+        tmp = np.empty(3)
+        for k in range(order):
+            # one pass: pairs of ω (w·), pairs of γ (g·), γ × ω (c·)
+            w0 = w1 = w2 = 0.0
+            g0 = g1 = g2 = 0.0
+            c0 = c1 = c2 = 0.0
+            for j in range(k + 1):
+                a0, a1, a2 = Y[j, 0], Y[j, 1], Y[j, 2]
+                b0, b1, b2 = Y[j, 3], Y[j, 4], Y[j, 5]
+                A0, A1, A2 = Y[k - j, 0], Y[k - j, 1], Y[k - j, 2]
+                B0, B1, B2 = Y[k - j, 3], Y[k - j, 4], Y[k - j, 5]
+                w0 += a1 * A2
+                w1 += a2 * A0
+                w2 += a0 * A1
+                g0 += b1 * B2
+                g1 += b2 * B0
+                g2 += b0 * B1
+                c0 += b1 * A2 - b2 * A1
+                c1 += b2 * A0 - b0 * A2
+                c2 += b0 * A1 - b1 * A0
+            e0, e1, e2 = Y[k, 3], Y[k, 4], Y[k, 5]
+            # (Iω) × ω + U_2 × γ − N_2 (d ⊙ pairs of γ)   (N_2 γ × Iγ = −N_2 d ⊙ pairs)
+            acc[0] = d0 * (w0 - n2 * g0) + p[10] * e2 - p[11] * e1
+            acc[1] = d1 * (w1 - n2 * g1) + p[11] * e0 - p[9] * e2
+            acc[2] = d2 * (w2 - n2 * g2) + p[9] * e1 - p[10] * e0
+            if has_alpha:
+                work[k, 0] = work[k, 1] = work[k, 2] = 0.0  # β_k = Σ γ_j × α_{k−j}
+                _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, work[k])
+                x0, x1, x2 = Y[k, 6], Y[k, 7], Y[k, 8]
+                b0, b1, b2 = work[k, 0], work[k, 1], work[k, 2]
+                acc[0] += p[4] * x2 - p[5] * x1 + p[7] * b2 - p[8] * b1
+                acc[1] += p[5] * x0 - p[3] * x2 + p[8] * b0 - p[6] * b2
+                acc[2] += p[3] * x1 - p[4] * x0 + p[6] * b1 - p[7] * b0
+                if p[12] != 0.0:
+                    _cauchy_pairs(Y, 6, k, tmp)
+                    acc[0] -= p[12] * d0 * tmp[0]
+                    acc[1] -= p[12] * d1 * tmp[1]
+                    acc[2] -= p[12] * d2 * tmp[2]
+                if p[13] != 0.0:
+                    _cauchy_pairs(work, 0, k, tmp)
+                    acc[0] -= p[13] * d0 * tmp[0]
+                    acc[1] -= p[13] * d1 * tmp[1]
+                    acc[2] -= p[13] * d2 * tmp[2]
+            inv = 1.0 / (k + 1)
+            Y[k + 1, 0] = acc[0] * p[16] * inv
+            Y[k + 1, 1] = acc[1] * p[17] * inv
+            Y[k + 1, 2] = acc[2] * p[18] * inv
+            # γ̇ = γ × ω, α̇ = α × ω
+            Y[k + 1, 3], Y[k + 1, 4], Y[k + 1, 5] = c0 * inv, c1 * inv, c2 * inv
+            if has_alpha:
+                acc[0] = acc[1] = acc[2] = 0.0
+                _cauchy_cross(Y, 6, Y, 0, k, 1.0, 1.0, 1.0, acc)
+                Y[k + 1, 6], Y[k + 1, 7], Y[k + 1, 8] = acc[0] * inv, acc[1] * inv, acc[2] * inv
+
+    return taylor_coefficients
+
+
+taylor_gamma = _taylor_form(False)
+taylor_alpha = _taylor_form(True)
+taylor_coefficients = _taylor_form(None)
 
 
 @kernel

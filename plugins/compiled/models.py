@@ -13,6 +13,12 @@ one model per state size. Measured (benchmarks/plugin_speed.py): the
 indirect call itself costs little; what made plugins 1.5–2× slower than the
 built-ins was the built-in form's code (its zero-filled torque terms and the
 run-time branch on α) inlined at every right-hand-side call of the kernels.
+
+A kernel given the model as an int dispatches at run time, so every model's code
+is typed and compiled into it. Given a ``Form`` (``form(compiled)``), the model is
+part of the argument's type: numba compiles a specialisation of the kernel per form,
+containing that form's code only (a built-in (ω, γ) scene compiles neither the plugin
+models nor the α terms), and caches each on disk like any other signature.
 """
 
 from __future__ import annotations
@@ -20,7 +26,9 @@ from __future__ import annotations
 from llvmlite import ir
 from numba import types
 from numba.core import cgutils
-from numba.extending import intrinsic
+from numba.core.datamodel.models import OpaqueModel
+from numba.core.imputils import lower_constant
+from numba.extending import NativeValue, intrinsic, overload, register_model, unbox
 
 from gyrolab.plugins.compiled import fixed_point, inline_kernel, kernel, plugin_taylor
 from gyrolab.plugins.compiled.plugin_torque import ADDRESS
@@ -30,6 +38,8 @@ FIXED_POINT = 0
 FIXED_POINT_PLUGIN = 1
 #: The same with the state ω, γ, α.
 FIXED_POINT_PLUGIN_ALPHA = 2
+#: Not a model id (``CompiledModel.model`` is FIXED_POINT): the form of FIXED_POINT with the state ω, γ, α.
+FIXED_POINT_ALPHA = 3
 #: Models whose Taylor coefficients ``taylor_coefficients`` computes (plugin torques: see plugin_taylor.ready).
 TAYLOR_MODELS = (FIXED_POINT, FIXED_POINT_PLUGIN, FIXED_POINT_PLUGIN_ALPHA)
 
@@ -65,38 +75,146 @@ def _free(y, p, out):
     out[5] = g0 * w1 - g1 * w0
 
 
+class FormType(types.Type):
+    def __init__(self, id: int) -> None:
+        self.id = id
+        super().__init__(name=f"gyrolab.Form({id})")
+
+
+class Form:
+    """A model as the kernels' argument: its form id becomes part of the argument's numba type (``FormType``).
+
+    ``_numba_type_`` gives numba the type without a call back into Python: a kernel call with a Form costs
+    ~1 µs more than with an int (11 µs when numba had to ask a Python typing function).
+    """
+
+    __slots__ = ("id", "_numba_type_")
+
+    def __init__(self, id: int) -> None:
+        self.id = id
+        self._numba_type_ = FormType(id)
+
+    def __repr__(self) -> str:
+        return f"Form({self.id})"
+
+
+register_model(FormType)(OpaqueModel)  # no data: everything is in the type
+
+
+@unbox(FormType)
+def _unbox_form(typ, obj, c):
+    return NativeValue(c.context.get_dummy_value())
+
+
+@lower_constant(FormType)
+def _constant_form(context, builder, ty, value):
+    return context.get_dummy_value()
+
+
+FORMS = {i: Form(i) for i in (FIXED_POINT, FIXED_POINT_PLUGIN, FIXED_POINT_PLUGIN_ALPHA, FIXED_POINT_ALPHA)}
+
+
+def form(compiled) -> Form:
+    """The kernels' model argument for a ``CompiledModel``: compiles and runs its form's code only."""
+    if compiled.model == FIXED_POINT and compiled.params[15] != 0.0:
+        return FORMS[FIXED_POINT_ALPHA]
+    return FORMS[compiled.model]
+
+
 @inline_kernel
+def _plugin(t, y, p, out):
+    _free(y, p, out)
+    _call_torque(int(p[ADDRESS]), t, y, p, out)
+
+
+@inline_kernel
+def _plugin_alpha(t, y, p, out):
+    _free(y, p, out)
+    w0, w1, w2 = y[0], y[1], y[2]
+    x0, x1, x2 = y[6], y[7], y[8]
+    out[6] = x1 * w2 - x2 * w1
+    out[7] = x2 * w0 - x0 * w2
+    out[8] = x0 * w1 - x1 * w0
+    _call_torque(int(p[ADDRESS]), t, y, p, out)
+
+
+_RHS = {FIXED_POINT: fixed_point.rhs_gamma, FIXED_POINT_ALPHA: fixed_point.rhs_alpha,
+        FIXED_POINT_PLUGIN: _plugin, FIXED_POINT_PLUGIN_ALPHA: _plugin_alpha}
+
+
 def rhs(model, t, y, p, out):
+    """out = f(t, y) of ``model`` (an int: dispatch at run time; a ``Form``: that form's code only). Compiled code only."""
+    raise TypeError("models.rhs is called from compiled kernels only (use models.evaluate)")
+
+
+@overload(rhs, inline="never", jit_options={"error_model": "numpy"})
+def _rhs_form(model, t, y, p, out):
+    """A form's code as a plain call: compiled once per process and linked into every kernel."""
+    if isinstance(model, FormType):
+        f = _RHS[model.id]
+        return lambda model, t, y, p, out: f(t, y, p, out)
+    return None
+
+
+_GAMMA, _ALPHA = FORMS[FIXED_POINT], FORMS[FIXED_POINT_ALPHA]
+_PLUGIN, _PLUGIN_ALPHA = FORMS[FIXED_POINT_PLUGIN], FORMS[FIXED_POINT_PLUGIN_ALPHA]
+
+
+@inline_kernel
+def _rhs_any(model, t, y, p, out):
+    """The run-time dispatch: a branch per form, each the form's plain call."""
     if model == FIXED_POINT:
-        fixed_point.rhs(t, y, p, out)
+        if p[15] != 0.0:
+            rhs(_ALPHA, t, y, p, out)
+        else:
+            rhs(_GAMMA, t, y, p, out)
     elif model == FIXED_POINT_PLUGIN:
-        _free(y, p, out)
-        _call_torque(int(p[ADDRESS]), t, y, p, out)
+        rhs(_PLUGIN, t, y, p, out)
     elif model == FIXED_POINT_PLUGIN_ALPHA:
-        _free(y, p, out)
-        w0, w1, w2 = y[0], y[1], y[2]
-        x0, x1, x2 = y[6], y[7], y[8]
-        out[6] = x1 * w2 - x2 * w1
-        out[7] = x2 * w0 - x0 * w2
-        out[8] = x0 * w1 - x1 * w0
-        _call_torque(int(p[ADDRESS]), t, y, p, out)
+        rhs(_PLUGIN_ALPHA, t, y, p, out)
+
+
+@overload(rhs, inline="always")
+def _rhs_any_model(model, t, y, p, out):
+    """The run-time dispatch (an int model), inlined at numba's level: compiled as one function calling every
+    form it was too large for LLVM to inline into the kernels' loops, which ran up to 1.7× slower."""
+    if isinstance(model, types.Integer):
+        return lambda model, t, y, p, out: _rhs_any(model, t, y, p, out)
+    return None
 
 
 @kernel
 def evaluate(model, t, y, p, out):
     """``rhs`` as a plain compiled call, for the cold paths (a first evaluation, the initial step).
 
-    ``rhs`` is inlined into its callers at numba's level, typed again in each: callers outside the
-    inner loops call this instead, so that the first compile types it once.
+    With an int model ``rhs`` is inlined into its callers at numba's level, typed again in each: callers
+    outside the inner loops call this instead, so that the first compile types it once.
     """
     rhs(model, t, y, p, out)
 
 
 @inline_kernel
-def taylor_coefficients(model, p, Y, order, work, t=0.0):
+def _taylor_any(model, p, Y, order, work, t):
     if model == FIXED_POINT:
         fixed_point.taylor_coefficients(p, Y, order, work)
     elif model == FIXED_POINT_PLUGIN or model == FIXED_POINT_PLUGIN_ALPHA:  # the traced torque's series (plugin_taylor)
         plugin_taylor.coefficients(p, Y, order, work, t)
     else:
         raise ValueError("this compiled model has no Taylor coefficients")
+
+
+def taylor_coefficients(model, p, Y, order, work, t=0.0):
+    """Fill Y[1..order] from Y[0] (``model`` as in ``rhs``). Compiled code only."""
+    raise TypeError("models.taylor_coefficients is called from compiled kernels only")
+
+
+@overload(taylor_coefficients, inline="never", jit_options={"error_model": "numpy"})
+def _taylor_coefficients(model, p, Y, order, work, t=0.0):
+    if isinstance(model, FormType):
+        if model.id in (FIXED_POINT, FIXED_POINT_ALPHA):
+            f = fixed_point.taylor_gamma if model.id == FIXED_POINT else fixed_point.taylor_alpha
+            return lambda model, p, Y, order, work, t=0.0: f(p, Y, order, work)
+        return lambda model, p, Y, order, work, t=0.0: plugin_taylor.coefficients(p, Y, order, work, t)
+    if isinstance(model, types.Integer):
+        return lambda model, p, Y, order, work, t=0.0: _taylor_any(model, p, Y, order, work, t)
+    return None

@@ -29,7 +29,8 @@ import numba
 import numpy as np
 
 from gyrolab.plugins.compiled import dop853, inline_kernel, kernel
-from gyrolab.plugins.compiled.fixed_point import rhs, rhs_block
+from gyrolab.plugins.compiled.fixed_point import rhs_block
+from gyrolab.plugins.compiled.fixed_point import rhs_gamma as rhs  # (ω, γ) states only
 
 #: unknowns of the augmented system: x (6), δ (6), the MEGNO quadratures a and b
 AUGMENTED = 14

@@ -137,18 +137,19 @@ class DOP853Numba(Tolerances, Integrator):
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
+        form = models.form(compiled)  # kernels compiled for this model only
         f = np.empty_like(y)
-        models.evaluate(compiled.model, t_out[0], y, compiled.params, f)
+        models.evaluate(form, t_out[0], y, compiled.params, f)
         stats = np.zeros(3, dtype=np.int64)
         stats[0] = 1
-        h0 = dop853.initial_step(compiled.model, compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
+        h0 = dop853.initial_step(form, compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
                                  self.rtol, self.atol, stats)
         state = np.array([t_out[0], h0])
         reached = 1
         for first, stop in _Chunks(len(t_out)):
             if reached >= stop:
                 continue  # a long step already filled this chunk's outputs
-            status, reached = dop853.run(compiled.model, compiled.params, t_out, out, reached, stop, state, y, f,
+            status, reached = dop853.run(form, compiled.params, t_out, out, reached, stop, state, y, f,
                                          t_out[-1], self.rtol, self.atol, self.max_step, stats)
             if status != dop853.OK:
                 reason = "the step size fell below the spacing of floating-point numbers" \
@@ -171,13 +172,14 @@ class RK4Numba(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from gyrolab.plugins.compiled import rk4
+        from gyrolab.plugins.compiled import models, rk4
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         steps = steps_per_interval(t_out, self.step)
         fun = compiled_rhs(compiled)
-        reached = _fixed_step(lambda grid, n, rows, first, stop: rk4.run(compiled.model, compiled.params, grid, n,
+        form = models.form(compiled)  # kernels compiled for this model only
+        reached = _fixed_step(lambda grid, n, rows, first, stop: rk4.run(form, compiled.params, grid, n,
                                                                          y, rows, first, stop),
                               self.name, fun, t_out, steps, y, out, progress)
         if reached != len(t_out):

@@ -49,9 +49,11 @@ def compiled_rhs(compiled) -> Callable[[float, np.ndarray], np.ndarray]:
     """The compiled model's right-hand side as a Python callable (for occasional checks only)."""
     from gyrolab.plugins.compiled import models
 
+    form = models.form(compiled)
+
     def fun(t: float, y: np.ndarray) -> np.ndarray:
         out = np.empty_like(y)
-        models.evaluate(compiled.model, t, y, compiled.params, out)  # the compiled call the kernels share
+        models.evaluate(form, t, y, compiled.params, out)  # the compiled call the kernels share
         return out
 
     return fun
