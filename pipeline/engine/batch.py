@@ -110,7 +110,7 @@ def integrate_arrays(compiled: CompiledModel, integrator: Integrator, times: np.
         raise ConfigError("times must be a non-empty 1-D array of finite, strictly increasing output times")
     if integrator.name in ADAPTIVE:
         return _adaptive(compiled, integrator, times, y0s, P, failures)
-    from gyrolab.plugins.compiled import rk4
+    from gyrolab.plugins.compiled import models, rk4
     from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
 
     start = time.perf_counter()
@@ -120,7 +120,7 @@ def integrate_arrays(compiled: CompiledModel, integrator: Integrator, times: np.
     if _blockable(compiled, size):
         rk4.run_batch_blocks(P, times, steps, y0s, out)
     else:
-        rk4.run_batch(compiled.model, P, times, steps, y0s, out)
+        rk4.run_batch(models.form(compiled), P, times, steps, y0s, out)
     failed = ~np.all(np.isfinite(out), axis=(1, 2))
     if failures == "raise":
         _require_finite_out(out)
@@ -134,7 +134,7 @@ _REASONS = {1: "its step fell below the spacing of floating-point numbers", 2: "
 def _adaptive(compiled: CompiledModel, integrator: Integrator, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
               failures: str) -> BatchSolution:
     """The adaptive kernels: dop853_numba, taylor, and auto's choice between them."""
-    from gyrolab.plugins.compiled import batch_dop853, batch_taylor, plugin_taylor
+    from gyrolab.plugins.compiled import batch_dop853, batch_taylor, models, plugin_taylor
 
     start = time.perf_counter()
     settings = None
@@ -153,14 +153,15 @@ def _adaptive(compiled: CompiledModel, integrator: Integrator, times: np.ndarray
             batch_taylor.run_blocks(P, integrator.order, integrator.tol, times, y0s, out, steps, status,
                                     batch_taylor.task_size(count))
         else:
-            batch_taylor.run_each(compiled.model, P, integrator.order, integrator.tol, times, y0s, out, steps, status)
+            batch_taylor.run_each(models.form(compiled), P, integrator.order, integrator.tol, times, y0s, out, steps,
+                                  status)
     elif len(times) > 1:
         rejected, nfev = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
         args = (times, y0s, out, integrator.rtol, integrator.atol, integrator.max_step, steps, rejected, nfev, status)
         if _blockable(compiled, size):
             batch_dop853.run_blocks(P, *args, batch_dop853.task_size(count))
         else:
-            batch_dop853.run_each(compiled.model, P, *args)
+            batch_dop853.run_each(models.form(compiled), P, *args)
     failed = status != 0
     if failures == "raise" and failed.any():
         bad = int(np.argmax(failed))

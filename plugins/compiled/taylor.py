@@ -33,10 +33,10 @@ import numpy as np
 from llvmlite import ir
 from numba import types
 from numba.core import cgutils
-from numba.extending import intrinsic
+from numba.extending import intrinsic, overload
 
 from gyrolab.plugins.compiled import inline_kernel, kernel, simd
-from gyrolab.plugins.compiled.models import FIXED_POINT, taylor_coefficients
+from gyrolab.plugins.compiled.models import FIXED_POINT, FormType, taylor_coefficients
 from gyrolab.plugins.compiled.simd import LANES
 
 OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2  # dop853's codes
@@ -79,11 +79,35 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     time to fill).
 
     The fixed-point model without α takes the vectorised step (``run_vector``), every other model
-    ``run_scalar``.
+    ``run_scalar``. ``model`` is a ``models.Form`` (the choice is made when the kernel is compiled, which
+    then compiles that form's step only) or an int (the choice is made at run time: every form compiled).
     """
-    if model == FIXED_POINT and p[15] == 0.0:
-        return run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
-    return run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
+    return _route(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
+
+
+def _route(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+    """``run``'s choice of step; compiled code only (the overload below)."""
+    raise TypeError("taylor._route is called from compiled kernels only")
+
+
+@overload(_route, jit_options={"error_model": "numpy"})
+def _route_by_model(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+    if isinstance(model, FormType):
+        if model.id == FIXED_POINT:
+            def vector(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+                return run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
+            return vector
+
+        def scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+            return run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
+        return scalar
+    if isinstance(model, types.Integer):
+        def either(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+            if model == FIXED_POINT and p[15] == 0.0:
+                return run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
+            return run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
+        return either
+    return None
 
 
 @kernel

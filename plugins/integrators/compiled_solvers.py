@@ -218,9 +218,10 @@ class Taylor(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from gyrolab.plugins.compiled import taylor
+        from gyrolab.plugins.compiled import models, taylor
 
         start = time.perf_counter()
+        form = models.form(compiled)  # the kernel compiles this model's step only
         t_out, y, out = _outputs(t_out, y0)
         state = np.array([t_out[0]])
         carry = np.zeros_like(y)
@@ -229,8 +230,8 @@ class Taylor(Integrator):
         for first, stop in _Chunks(len(t_out)):
             if reached >= stop:
                 continue  # a long step already filled this chunk's outputs
-            status, reached = taylor.run(compiled.model, compiled.params, self.order, self.tol, t_out, out, reached,
-                                         stop, state, y, carry, stats)
+            status, reached = taylor.run(form, compiled.params, self.order, self.tol, t_out, out, reached, stop, state,
+                                         y, carry, stats)
             if status == taylor.TOO_SMALL_STEP:
                 raise IntegrationError(f"taylor's step fell below the spacing of floating-point numbers near "
                                        f"t={state[0]:.6g} (a singularity of the solution, or integrator.tol too small)")
