@@ -41,7 +41,7 @@ phase drift — meets the target; then the compiled Taylor method when the
 scene has a compiled model; otherwise scipy's DOP853. Before any series is
 built, a regime that declares ``period_spread`` is ruled out when the scene's
 own motion never comes back near its start over the orbit's period range
-(``Auto._misses_orbits``: a necessary condition of the series check, ~0.5 ms;
+(``Auto._misses_orbits``: a necessary condition of the series check, ~0.25 ms;
 building and checking the series costs ~2 ms, 0.4 s on a process's first call).
 
 Round-off: the Taylor state update is compensated (Kahan), so round-off no
