@@ -169,7 +169,7 @@ class Auto(Integrator):
         # note), that of scipy's plain update by up to an ulp per step: a target below it cannot be met in
         # double precision, whatever the tolerance.
         steps = self._pilot_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / self._order))
-        compensated = compiled is not None and bool(self._taylor)  # the compensated update is Taylor's
+        compensated = bool(self._taylor)  # Taylor's update is compensated (None: no compiled model, scipy's DOP853)
         roundoff = EPS * scale * (math.sqrt(steps) if compensated else steps)
         if roundoff > self.accuracy:
             raise ConfigError(f"accuracy={self.accuracy:g} is below the round-off that double precision accumulates "
@@ -301,8 +301,8 @@ class Auto(Integrator):
         times = np.empty(SCREEN_POINTS + 1)
         times[0], times[1:] = 0.0, np.linspace(lo, hi, SCREEN_POINTS)
         y = Taylor(tol=SCREEN_TOLERANCE).integrate(fun, times, y0, None, compiled).y
-        scale = max(1.0, *map(abs, y0[:6]))
-        return not _fast(_comes_back, compiled)(y, y0, 1.1 * self.accuracy / self.safety + 1e3 * SCREEN_TOLERANCE * scale)
+        margin = 1.1 * self.accuracy / self.safety + 1e3 * SCREEN_TOLERANCE * max(1.0, *map(abs, y0[:6]))
+        return not _fast(_comes_back, compiled)(y, y0, margin)
 
     def _pilot(self, fun: RightHandSide, times: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                tau: float, previous: tuple[float, Solution] | None
