@@ -89,24 +89,34 @@ def assemble(variables: dict[str, xr.Variable], coords: dict[str, tuple[str, np.
             consistent = consistent and all(sizes.get(d) == n for d, n in zip(v.dims, v.shape))
     if not consistent:
         return xr.Dataset(variables, coords=coords)
-    import pandas as pd
-    from xarray.indexes import PandasIndex
-
     all_variables, indexes = dict(variables), {}
     for name, (dim, data, attrs) in coords.items():
         data = np.asarray(data)
         if len(data) <= SMALL_COORDINATE and data.dtype.kind == "U":  # the axis labels: the same index every run
             key = (name, data.dtype.str, tuple(data.tolist()))
             if key not in _LABEL_INDEXES:
-                _LABEL_INDEXES[key] = PandasIndex(data, dim, coord_dtype=data.dtype)
+                _LABEL_INDEXES[key] = _index(data, name, dim)
             indexes[name] = _LABEL_INDEXES[key]
-        else:  # an index already named: PandasIndex would copy an unnamed one to name it (half its ~60 µs)
-            indexes[name] = PandasIndex(pd.Index(data, name=name, copy=False), dim, coord_dtype=data.dtype)
-        all_variables.update(indexes[name].create_variables({name: xr.Variable(dim, data, attrs)}))
+        else:
+            indexes[name] = _index(data, name, dim)
+        # fastpath: data is an ndarray, so xarray need not probe it for duck arrays (the first probe imports
+        # dask.array, ~1 s of a process's first run, when dask is installed)
+        variable = xr.Variable(dim, data, attrs, fastpath=True)
+        all_variables.update(indexes[name].create_variables({name: variable}))
     try:
         return construct(all_variables, set(coords), sizes, None, indexes)
     except TypeError:  # a future xarray changed its private constructor: the public one still works
         return xr.Dataset(variables, coords=coords)
+
+
+def _index(data: np.ndarray, name: str, dim: str) -> Any:
+    """xarray's index of a coordinate, built from a pandas index already named ``name``: given an array, PandasIndex
+    copies the index it makes to name it (half of its ~60 µs), and first probes the array for chunked duck arrays,
+    which imports dask.array (~1 s of a process's first run) when dask is installed."""
+    import pandas as pd
+    from xarray.indexes import PandasIndex
+
+    return PandasIndex(pd.Index(data, name=name, copy=False), dim, coord_dtype=data.dtype)
 
 
 def time_attributes(body: ModelUnits) -> dict[str, str]:
