@@ -129,3 +129,17 @@ def test_auto_evaluates_at_most_one_series_order_off_the_orbit(monkeypatch, end,
     ds = scene.run()
     assert ds.attrs["auto_method"] == "taylor"
     assert len([order for order in starts if order is not None]) == evaluated
+
+
+def test_a_run_does_not_import_dask_array():
+    # xarray probes a plain array for chunked duck arrays by importing dask.array (~1 s) when dask is installed; the
+    # run's dataset is built from ndarrays and named pandas indexes, which need no probe
+    pytest.importorskip("dask")
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom gyrolab import compose_scene\n"
+            "compose_scene(['time.end=1', 'time.n_output=11', 'integrator=rk4', 'integrator.step=0.01']).run()\n"
+            "print('dask.array' in sys.modules)")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert result.stdout.strip() == "False", result.stdout + result.stderr
