@@ -147,7 +147,7 @@ class Auto(Integrator):
         t_pilot = t_out[0] + span * self.pilot_fraction
         # the pilot's grid holds the output times it covers: its tight run is the start of the trajectory
         inside = t_out[t_out < t_pilot]
-        pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * _PILOT_GRID, inside)
+        pilot_times = _union(t_out[0] + span * self.pilot_fraction * _PILOT_GRID, inside)
         tau, pilot_nfev = min(max(self.accuracy * FIRST_RATIO, MIN_TOLERANCE), MAX_TOLERANCE / 10), 0
         # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance
         self._order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
@@ -288,7 +288,7 @@ class Auto(Integrator):
         spread = getattr(base, "period_spread", None)
         if spread is None:
             return False
-        from gyrolab.plugins.integrators.compiled_solvers import Taylor
+        from gyrolab.plugins.integrators.compiled_solvers import taylor_samples
 
         try:
             with np.errstate(all="ignore"):
@@ -298,9 +298,10 @@ class Auto(Integrator):
         lo, hi = period / spread, period * spread
         if not (np.isfinite(hi) and 0 < lo) or hi > span:
             return False  # the check's window is then the span, not a period: no periodicity to use
-        times = np.empty(SCREEN_POINTS + 1)
-        times[0], times[1:] = 0.0, np.linspace(lo, hi, SCREEN_POINTS)
-        y = Taylor(tol=SCREEN_TOLERANCE).integrate(fun, times, y0, None, compiled).y
+        times = np.empty(SCREEN_POINTS + 1)  # 0, then np.linspace(lo, hi, SCREEN_POINTS)'s values in a third of its time
+        times[0], times[1:] = 0.0, np.arange(SCREEN_POINTS) * ((hi - lo) / (SCREEN_POINTS - 1)) + lo
+        times[-1] = hi
+        y = taylor_samples(compiled, SCREEN_TOLERANCE, times, y0)
         margin = 1.1 * self.accuracy / self.safety + 1e3 * SCREEN_TOLERANCE * max(1.0, *map(abs, y0[:6]))
         return not _fast(_comes_back, compiled)(y, y0, margin)
 
@@ -383,6 +384,16 @@ def _error_growth(loose: np.ndarray, tight: np.ndarray, times: np.ndarray) -> tu
         sxy += (x[i] - x_mean) * (y[i] - y_mean)
         sxx += (x[i] - x_mean) * (x[i] - x_mean)
     return top, sxy / sxx
+
+
+def _union(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.union1d(a, b)`` (sorted, without repeats) in half its time: the pilot's grid, once per run."""
+    merged = np.concatenate((a, b))
+    merged.sort()
+    keep = np.empty(len(merged), dtype=bool)
+    keep[:1] = True
+    np.not_equal(merged[1:], merged[:-1], out=keep[1:])
+    return merged[keep]
 
 
 def _comes_back(y: np.ndarray, y0: np.ndarray, margin: float) -> bool:
