@@ -106,7 +106,7 @@ def _difference(old: xr.DataArray, new: xr.DataArray) -> str:
         return f"shape {dict(zip(old.dims, a.shape))} in the dataset, {dict(zip(new.dims, b.shape))} in the rerun"
     if a.dtype.kind in "fc" and b.dtype.kind in "fc":
         a, b = a.astype(np.float64), b.astype(np.float64)
-        if a.view(np.uint8).tobytes() == b.view(np.uint8).tobytes():
+        if a.tobytes() == b.tobytes():  # the bits in C order, whatever either array's memory layout
             return ""
         nan_a, nan_b = np.isnan(a), np.isnan(b)
         if (nan_a != nan_b).any():
