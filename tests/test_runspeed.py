@@ -143,3 +143,15 @@ def test_a_run_does_not_import_dask_array():
             "print('dask.array' in sys.modules)")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.strip() == "False", result.stdout + result.stderr
+
+
+def test_the_scene_attributes_are_computed_once_and_shared_read_only():
+    scene = compose_scene(FIXED_POINT)
+    first, second = scene.run(), scene.run()
+    assert list(first.attrs) == list(second.attrs)  # the same attributes in the same order
+    assert first.attrs["title"] == second.attrs["title"] and first.attrs["config"] == second.attrs["config"]
+    stored = first.attrs["initial_omega"]
+    assert stored is not scene.system.initial.omega  # a copy: the system's initial state stays its own
+    np.testing.assert_array_equal(stored, scene.system.initial.omega)
+    with pytest.raises(ValueError, match="read-only"):
+        stored[0] = 1.0  # shared by every run's dataset: not to be changed through one of them

@@ -15,7 +15,7 @@ from omegaconf import DictConfig, OmegaConf
 from gyrolab.engine import registry
 from gyrolab.engine.config import compose_config
 from gyrolab.contracts import CompiledModel, Integrator, System
-from gyrolab.output.dataset import build_dataset
+from gyrolab.output.dataset import build_dataset, scene_attributes
 from gyrolab.errors import ConfigError, as_number, require_finite
 from gyrolab.engine.progress import Progress
 
@@ -95,6 +95,12 @@ class Scene:
     def config_yaml(self) -> str:
         """The resolved config as YAML (stored in every dataset; computed once per scene)."""
         return OmegaConf.to_yaml(self.config, resolve=True)
+
+    @cached_property
+    def dataset_attributes(self) -> tuple[dict[str, Any], dict[str, Any]]:
+        """The run dataset's attributes that depend on the scene alone (``output.dataset.scene_attributes``),
+        computed once per scene as ``config_yaml``."""
+        return scene_attributes(self)
 
     @cached_property
     def compiled(self) -> CompiledModel | None:

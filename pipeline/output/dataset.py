@@ -53,20 +53,35 @@ def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
             "units": "1", "long_name": "frame axis: orbital (radial, along-track, orbit normal) or inertial (X, Y, Z: "
                                        "the orbital axes at t = 0)"})
     ds = assemble(variables, coords)
-    attrs: dict[str, Any] = {
+    before, after = scene.dataset_attributes  # the scene's own, once per scene
+    ds.attrs.update(before)
+    ds.attrs.update(integrator.attributes())
+    ds.attrs.update(solution.stats.attributes())
+    ds.attrs.update(after)
+    return conform(ds, source=f"run of system {system.name} with integrator {integrator.name}")
+
+
+def scene_attributes(scene: Scene) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The run dataset's global attributes that depend on the scene alone: those that go before the integrator's
+    record and those after it. ``Scene.dataset_attributes`` computes them once per scene (~0.1 ms of a run);
+    every run's dataset then shares their values, so arrays among them are read-only copies."""
+    system = scene.system
+    before: dict[str, Any] = {
         "title": system.title(),
         "config": scene.config_yaml,
         "monitored_invariants": " ".join(system.invariants),
-        "integrator": integrator.name,
+        "integrator": scene.integrator.name,
     }
-    attrs.update(provenance())
-    attrs.update(system.attributes())
-    attrs.update(integrator.attributes())
-    attrs.update(solution.stats.attributes())
-    attrs.update(unit_attributes(body))
-    attrs.update(scene.sampling_attributes())
-    ds.attrs.update(attrs)
-    return conform(ds, source=f"run of system {system.name} with integrator {integrator.name}")
+    before.update(provenance())
+    before.update(system.attributes())
+    after = unit_attributes(system.body)
+    after.update(scene.sampling_attributes())
+    for part in (before, after):
+        for key, value in part.items():
+            if isinstance(value, np.ndarray):
+                part[key] = value = value.copy()  # not the system's own array (its initial state, say)
+                value.flags.writeable = False
+    return before, after
 
 
 def assemble(variables: dict[str, xr.Variable], coords: dict[str, tuple[str, np.ndarray, dict[str, Any]]]) -> xr.Dataset:
