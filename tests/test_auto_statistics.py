@@ -1,5 +1,6 @@
 """auto's pilot and screen statistics (``_error_growth``, ``_comes_back``): the compiled form and the Python form
-(used without a compiled model) agree with each other and with numpy written out independently."""
+(used without a compiled model) agree with each other and with numpy written out independently; and when the
+pilot measures again (``RECENTRE``), its recorded prediction still bounds the error."""
 
 import numpy as np
 import pytest
@@ -55,3 +56,31 @@ def test_comes_back_within_the_margin_plus_the_grid_step():
         assert not form(y, y0, nearest - jump - 1e-12)
         shifted = y0 + np.array([0, 0, 0, 0, 0, 0.5])  # far in the sixth component only
         assert not form(y, shifted, 0.1)
+
+
+SLOW_SPIN = ["initial.r0=1e-3", "initial.p0=0", "initial.q0=0", "time.end=20", "time.n_output=51"]
+
+
+@pytest.mark.parametrize("overrides, accuracy, rounds", [
+    (SLOW_SPIN, 1e-6, 2),  # the first prediction is ~170× looser than the pilot's τ: measured again there
+    (["experiment=perf_reference"], 1e-6, 1),  # 13× looser: within RECENTRE, taken from the first round
+], ids=["re-measured", "extrapolated"])
+def test_a_prediction_far_looser_than_the_pilot_is_measured_again(monkeypatch, overrides, accuracy, rounds):
+    from gyrolab import compose_scene
+    from gyrolab.plugins.integrators import auto
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    taus, pilot = [], auto.Auto._pilot
+    monkeypatch.setattr(auto.Auto, "_pilot", lambda self, *a: taus.append(a[4]) or pilot(self, *a))
+    scene = compose_scene([*overrides, "integrator=auto", f"accuracy={accuracy}"])
+    y0 = scene.system.initial_state()
+    method = auto.Auto(accuracy=accuracy)
+    method.prepare(scene.system)
+    solution = method.integrate(scene.system.rhs, scene.times, y0, None, scene.compiled)
+    assert len(taus) == rounds
+    if rounds == 2:
+        assert taus[1] > auto.RECENTRE * taus[0]
+    # either way the recorded prediction bounds the actual error (truth: Taylor at tol 1e-17, error ~1e-14)
+    truth = Taylor(tol=1e-17).integrate(scene.system.rhs, scene.times[[0, -1]], y0, None, scene.compiled).y[-1]
+    error = float(np.max(np.abs(solution.y[-1] - truth)))
+    assert error <= method.choice["auto_predicted_error"] <= accuracy
