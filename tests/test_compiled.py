@@ -213,3 +213,7 @@ def test_taylor_stops_with_one_sentence_when_its_step_cannot_advance_time():
     with pytest.raises(IntegrationError, match="^taylor's step fell below the spacing of floating-point numbers "
                                                "near t=1 "):
         Taylor(order=4, tol=1e-300).integrate(None, t_out, y0, None, compiled)
+    from gyrolab.plugins.integrators.compiled_solvers import taylor_samples  # auto's screen: a failure is one sentence too
+
+    with pytest.raises(IntegrationError, match=r"^taylor stopped over t=\[1, 2\]: the state became non-finite"):
+        taylor_samples(compiled, 1e-9, t_out, np.where(np.arange(y0.size) == 0, np.nan, y0))

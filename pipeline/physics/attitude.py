@@ -58,7 +58,8 @@ def euler_angles(alpha: np.ndarray, gamma: np.ndarray) -> tuple[np.ndarray, np.n
 
 
 def unwrap(angle: np.ndarray) -> np.ndarray:
-    """``np.unwrap(angle)`` for a 1-d array, bit for bit, in ~1/3 of its time (a run's angles: 0.1 ms of a 3 ms run).
+    """``np.unwrap(angle)`` for a 1-d array, bit for bit, in less time the fewer the jumps (the reference run's φ, a
+    jump every six samples: 0.077 against 0.096 ms of a ~2.5 ms run).
 
     np.unwrap computes its correction, ((d + π) mod 2π) − π − d for each difference d of neighbours, on every
     difference and then zeroes it wherever |d| < π; here it is computed on the others only (a few per turn),

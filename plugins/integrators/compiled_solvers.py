@@ -257,7 +257,9 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
     status, _ = taylor.run(models.form(compiled), compiled.params, taylor.order_for(tol), tol, t_out, out, 1,
                            len(t_out), np.array([t_out[0]]), y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
     if status != taylor.OK:
-        raise IntegrationError(f"taylor failed (status {status}) over t=[{t_out[0]:.6g}, {t_out[-1]:.6g}]")
+        reason = "its step fell below the spacing of floating-point numbers" if status == taylor.TOO_SMALL_STEP \
+            else "the state became non-finite"
+        raise IntegrationError(f"taylor stopped over t=[{t_out[0]:.6g}, {t_out[-1]:.6g}]: {reason}")
     return out
 
 
