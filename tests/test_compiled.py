@@ -215,5 +215,5 @@ def test_taylor_stops_with_one_sentence_when_its_step_cannot_advance_time():
         Taylor(order=4, tol=1e-300).integrate(None, t_out, y0, None, compiled)
     from gyrolab.plugins.integrators.compiled_solvers import taylor_samples  # auto's screen: a failure is one sentence too
 
-    with pytest.raises(IntegrationError, match=r"^taylor stopped over t=\[1, 2\]: the state became non-finite"):
+    with pytest.raises(IntegrationError, match=r"^taylor produced a non-finite state near t=1$"):
         taylor_samples(compiled, 1e-9, t_out, np.where(np.arange(y0.size) == 0, np.nan, y0))

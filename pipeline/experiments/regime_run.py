@@ -171,12 +171,12 @@ def angles_from_states(t: np.ndarray, y: np.ndarray, psi0: float) -> dict[str, n
     period against ψ from α, tests/test_regime_experiments.py) — for states that come without the fixed axis α."""
     from scipy.interpolate import CubicSpline
 
-    from gyrolab.physics.attitude import nutation_and_spin, unwrap
+    from gyrolab.physics.attitude import nutation_and_spin
 
     theta, phi = nutation_and_spin(y[:, 3:6])
     rate = (y[:, 0] * y[:, 3] + y[:, 1] * y[:, 4]) / (1.0 - y[:, 5] ** 2)
     psi = psi0 + CubicSpline(t, rate).antiderivative()(t)
-    return {"psi": psi, "theta": theta, "phi": unwrap(phi)}
+    return {"psi": psi, "theta": theta, "phi": np.unwrap(phi)}
 
 
 def errors(result: dict[str, Any], against: str = "orbit") -> dict[str, float]:

@@ -54,28 +54,4 @@ def euler_angles(alpha: np.ndarray, gamma: np.ndarray) -> tuple[np.ndarray, np.n
     psi_minus_phi = np.arctan2(beta[:, 0] + alpha[:, 1], alpha[:, 0] - beta[:, 1])
     psi = np.where(upper, psi_plus_phi - phi, psi_minus_phi + phi)
     psi = np.angle(np.exp(1j * psi))  # wrap to (−π, π] before unwrapping
-    return unwrap(psi), theta, unwrap(phi)
-
-
-def unwrap(angle: np.ndarray) -> np.ndarray:
-    """``np.unwrap(angle)`` for a 1-d array, bit for bit, in less time the fewer the jumps (the reference run's φ, a
-    jump every six samples: 0.077 against 0.096 ms of a ~2.5 ms run).
-
-    np.unwrap computes its correction, ((d + π) mod 2π) − π − d for each difference d of neighbours, on every
-    difference and then zeroes it wherever |d| < π; here it is computed on the others only (a few per turn),
-    with the same operations, and summed as np.unwrap sums it (the exact zeros between change no sum)."""
-    angle = np.asarray(angle, dtype=float)
-    if angle.ndim != 1:
-        return np.unwrap(angle)
-    step = np.diff(angle)
-    jumps = np.flatnonzero(~(np.abs(step) < np.pi))  # NaN differences too: np.unwrap keeps their NaN correction
-    correction = np.zeros_like(step)
-    if len(jumps):
-        d = step[jumps]
-        wrapped = np.mod(d + np.pi, 2 * np.pi) - np.pi
-        wrapped[(wrapped == -np.pi) & (d > 0)] = np.pi
-        correction[jumps] = wrapped - d
-    out = np.empty_like(angle)
-    out[:1] = angle[:1]
-    out[1:] = angle[1:] + np.cumsum(correction)
-    return out
+    return np.unwrap(psi), theta, np.unwrap(phi)

@@ -153,7 +153,7 @@ class Auto(Integrator):
         t_pilot = t_out[0] + span * self.pilot_fraction
         # the pilot's grid holds the output times it covers: its tight run is the start of the trajectory
         inside = t_out[t_out < t_pilot]
-        pilot_times = _union(t_out[0] + span * self.pilot_fraction * _PILOT_GRID, inside)
+        pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * _PILOT_GRID, inside)
         tau, pilot_nfev = min(max(self.accuracy * FIRST_RATIO, MIN_TOLERANCE), MAX_TOLERANCE / 10), 0
         # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance
         self._order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
@@ -390,16 +390,6 @@ def _error_growth(loose: np.ndarray, tight: np.ndarray, times: np.ndarray) -> tu
         sxy += (x[i] - x_mean) * (y[i] - y_mean)
         sxx += (x[i] - x_mean) * (x[i] - x_mean)
     return top, sxy / sxx
-
-
-def _union(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``np.union1d(a, b)`` (sorted, without repeats) in half its time: the pilot's grid, once per run."""
-    merged = np.concatenate((a, b))
-    merged.sort()
-    keep = np.empty(len(merged), dtype=bool)
-    keep[:1] = True
-    np.not_equal(merged[1:], merged[:-1], out=keep[1:])
-    return merged[keep]
 
 
 def _comes_back(y: np.ndarray, y0: np.ndarray, margin: float) -> bool:

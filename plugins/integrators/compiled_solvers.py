@@ -232,11 +232,8 @@ class Taylor(Integrator):
                 continue  # a long step already filled this chunk's outputs
             status, reached = taylor.run(form, compiled.params, self.order, self.tol, t_out, out, reached, stop, state,
                                          y, carry, stats)
-            if status == taylor.TOO_SMALL_STEP:
-                raise IntegrationError(f"taylor's step fell below the spacing of floating-point numbers near "
-                                       f"t={state[0]:.6g} (a singularity of the solution, or integrator.tol too small)")
             if status != taylor.OK:
-                raise IntegrationError(f"taylor produced a non-finite state near t={state[0]:.6g}")
+                raise _taylor_failure(status, state[0])
             if progress is not None:
                 progress(state[0])
         # one Taylor step costs about as much as `order` right-hand-side evaluations; report the series count
@@ -254,13 +251,22 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
     from gyrolab.plugins.compiled import models, taylor
 
     t_out, y, out = _outputs(t_out, y0)
+    state = np.array([t_out[0]])
     status, _ = taylor.run(models.form(compiled), compiled.params, taylor.order_for(tol), tol, t_out, out, 1,
-                           len(t_out), np.array([t_out[0]]), y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
+                           len(t_out), state, y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
     if status != taylor.OK:
-        reason = "its step fell below the spacing of floating-point numbers" if status == taylor.TOO_SMALL_STEP \
-            else "the state became non-finite"
-        raise IntegrationError(f"taylor stopped over t=[{t_out[0]:.6g}, {t_out[-1]:.6g}]: {reason}")
+        raise _taylor_failure(status, state[0])
     return out
+
+
+def _taylor_failure(status: int, t: float) -> IntegrationError:
+    """The one-sentence error for a Taylor kernel's non-OK ``status``, stopped at time ``t``."""
+    from gyrolab.plugins.compiled import taylor
+
+    if status == taylor.TOO_SMALL_STEP:
+        return IntegrationError(f"taylor's step fell below the spacing of floating-point numbers near t={t:.6g} "
+                                "(a singularity of the solution, or integrator.tol too small)")
+    return IntegrationError(f"taylor produced a non-finite state near t={t:.6g}")
 
 
 class LiePoisson(Integrator):

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.physics.attitude import euler_angles, frame_from_angles, nutation_and_spin, unwrap
+from gyrolab.physics.attitude import euler_angles, frame_from_angles, nutation_and_spin
 from gyrolab.physics.body import Body
 from gyrolab.contracts.force import Force
 from gyrolab.contracts.integrator import CompiledModel
@@ -162,7 +162,7 @@ class FixedPoint(System):
             out["psi"] = _var("time", psi, "rad", "precession angle ψ (unwrapped)")
         else:
             theta, phi = nutation_and_spin(gamma)
-            phi = unwrap(phi)
+            phi = np.unwrap(phi)
         out["theta"] = _var("time", theta, "rad", "nutation angle θ")
         out["phi"] = _var("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
         return out
