@@ -19,7 +19,8 @@ and ``auto`` integrating on that grid (``Integrator.integrate``) and the whole
 that of its cheapest setting whose final error is ≤ ε (``auto`` has one
 setting per ε: ε itself). Every contestant runs once per round, rounds
 interleave all of them (a shared machine slows all alike), and a contestant's
-time is its minimum over the rounds. The scipy baseline is what a researcher
+time is its minimum over the rounds; the peer table is printed again with the
+rounds' medians. The scipy baseline is what a researcher
 would write: ``solve_ivp`` with a plain numpy right-hand side.
 """
 
@@ -63,6 +64,7 @@ def plain_numpy_rhs(t, y):
 GRID = np.linspace(0.0, T_END, 3001)
 EPSILONS = [10.0 ** -k for k in range(6, 14)]
 WALL = False  # set by --wall
+MEDIANS = {}  # contestant -> median time over the rounds of its last ``interleaved`` call
 
 
 def heyoka_contestants():
@@ -100,12 +102,15 @@ def interleaved(contestants, rounds):
     """
     clock = time.perf_counter if WALL else time.process_time
     best = {key: (np.inf, None) for key in contestants}
+    times = {key: [] for key in contestants}
     for _ in range(rounds):
         for key, fn in contestants.items():
             start = clock()
             result = fn()
             elapsed = clock() - start
+            times[key].append(elapsed)
             best[key] = (min(best[key][0], elapsed), result)
+    MEDIANS.update({key: float(np.median(values)) for key, values in times.items()})
     return best
 
 
@@ -166,6 +171,20 @@ def peer_table(reference, rounds, quick):
                   for key in (auto_key, run_key, taylor)]
         print(f"| {eps:.0e} | {cell(peer) if has_peer else 'not installed'} | {cell(auto_key)} | {cell(run_key)} | "
               f"{cell(taylor)} | {' | '.join(ratios)} |")
+    print(f"\nThe same rounds' medians, ms (heyoka and taylor: the setting with the smallest median reaching ε):\n")
+    print("| ε | heyoka | auto, integration | auto, Scene.run() | taylor | auto / heyoka | Scene.run() / heyoka | "
+          "taylor / heyoka |\n| --- | --- | --- | --- | --- | --- | --- | --- |")
+    for eps in epsilons:
+        def fastest(method):
+            ok = [key for key in best if key[0] == method and errors[key] <= eps]
+            return min(ok, key=MEDIANS.get) if ok else None
+        keys = [fastest("heyoka"), *[key if errors[key] <= eps else None for key in (("auto", eps),
+                                                                                      ("auto Scene.run()", eps))],
+                fastest("taylor")]
+        cells = ["not reached" if key is None else f"{MEDIANS[key] * 1e3:.2f}" for key in keys]
+        ratios = ["" if keys[0] is None or key is None else f"{MEDIANS[key] / MEDIANS[keys[0]]:.2f}"
+                  for key in keys[1:]]
+        print(f"| {eps:.0e} | {' | '.join(cells)} | {' | '.join(ratios)} |")
     print("\nEvery setting measured:\n\n| method | setting | final error | time [ms] |\n| --- | --- | --- | --- |")
     for key in sorted(best, key=lambda key: (key[0], -key[1])):
         print(f"| {key[0]} | {settings[key]} | {errors[key]:.2e} | {best[key][0] * 1e3:.2f} |")
