@@ -42,7 +42,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from gyrolab import compose_scene
-from gyrolab.engine.batch import integrate_arrays
+from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.plugins.integrators.auto import Auto
 from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
 from gyrolab.plugins.integrators.step_guard import compiled_rhs

@@ -50,7 +50,7 @@ def grid(n: int) -> list[str]:
 
 def child(n: int, out: str, launched: float) -> None:
     from gyrolab.batch.plan import split_overrides
-    from gyrolab.sweep.batch import run_batch
+    from gyrolab.batch.sweep import run_batch
 
     fixed, dims = split_overrides(FIXED + grid(n))
     start = time.time()

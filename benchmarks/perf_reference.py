@@ -39,7 +39,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from gyrolab import compose_scene
-from gyrolab.engine.batch import integrate_batch
+from gyrolab.batch.integrate import integrate_batch
 from gyrolab.physics.reference import fixed_point_reference
 
 INERTIA = np.array([2.0, 1.5, 1.0])

@@ -20,7 +20,7 @@ from gyrolab import compose_scene
 from gyrolab.figures.stability_map import draw
 from gyrolab.output.atomic import atomic_path
 from gyrolab.physics.attitude import gamma_from_angles
-from gyrolab.physics.chaos import indicator_outputs, section_dataset
+from gyrolab.analysis.chaos import indicator_outputs, section_dataset
 
 T_END, STEP = 300.0, 0.01
 SECTIONS = ((0.6, 3.0), (1.0, 1.5), (0.4, 0.5))  # (θ0, r0/c): regular fast spin, chaotic, regular slow spin

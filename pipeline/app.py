@@ -27,7 +27,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import hydra
-from hydra._internal.utils import get_args_parser
 from hydra.core.hydra_config import HydraConfig
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override
@@ -36,6 +35,7 @@ from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.engine.budget import check_budget, check_tolerances
+from gyrolab.engine.hydra_private import get_args_parser
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
     ConfigSource,
@@ -490,7 +490,7 @@ def _batch(overrides: Sequence[str]) -> int:
     """``gyrolab --batch KEY=V1,V2 ... [hydra.sweep.dir=DIR]``: the grid in one batch, one sweep.nc (resumable)."""
     from datetime import datetime
 
-    from gyrolab.sweep.batch import run_batch_sweep
+    from gyrolab.batch.sweep import run_batch_sweep
 
     out_dir = Path(f"outputs/batch/{datetime.now():%Y-%m-%d}/{datetime.now():%H-%M-%S}")
     scene_overrides = []
@@ -551,6 +551,9 @@ def main() -> None:
         if status is not None:
             sys.exit(status)
         register_plugin_configs()
+        from gyrolab.sweep.sweeper import register_plugin
+
+        register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), before Hydra instantiates it
         sys.argv[1:] = preflight(argv)
     except GyrolabError as error:
         fail(error)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from gyrolab import compose_scene
-from gyrolab.engine.batch import integrate_batch
+from gyrolab.batch.integrate import integrate_batch
 from gyrolab.errors import ConfigError
 
 SHORT = ["time.end=2", "time.n_output=11", "integrator.step=0.01"]

@@ -5,7 +5,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from gyrolab import compose_scene
-from gyrolab.engine.batch import integrate_arrays
+from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.plugins.compiled import batch_dop853, batch_taylor
 

@@ -13,11 +13,11 @@ from gyrolab import compose_scene
 from gyrolab.batch import outputs
 from gyrolab.batch.plan import plan_from_overrides, split_overrides
 from gyrolab.batch.runner import chunks
-from gyrolab.engine.batch import integrate_arrays
+from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError, GyrolabError
-from gyrolab.sweep.batch import run_batch, run_batch_sweep
+from gyrolab.batch.sweep import run_batch, run_batch_sweep
 
 FIXED = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=1", "time.n_output=11", "output.figures=false"]
 
@@ -131,7 +131,7 @@ def test_batch_refuses_scipy_integrators_and_another_command_in_its_directory(tm
 KILLED = textwrap.dedent("""
     import os, signal, sys
     from gyrolab.batch import store
-    from gyrolab.sweep.batch import run_batch_sweep
+    from gyrolab.batch.sweep import run_batch_sweep
 
     written = store.Store._write
     calls = []
@@ -173,7 +173,7 @@ def test_kill_minus_9_then_the_same_command_resumes(tmp_path, caplog):
 def test_stability_map_is_a_theta0_r0_batch_that_a_rerun_finds_complete(tmp_path, caplog):
     """The experiment's grid (batch.points as a square grid, r0 geometric) runs as one batch into stability_map.nc
     with dims (theta0, r0) and the chosen points' Poincaré sections; the indicator's values are
-    gyrolab.physics.chaos's (tested there)."""
+    gyrolab.analysis.chaos's (tested there)."""
     from gyrolab.experiments import stability_map
 
     cfg = compose_config(["experiment=stability_map", "batch.points=9", "time.end=1", "stability_map.section_time=20",

@@ -37,7 +37,7 @@ from gyrolab.engine.config import compose_config  # noqa: E402
 from gyrolab.experiments import TASKS, run_task  # noqa: E402
 from gyrolab.output.dataset import write_dataset  # noqa: E402
 from gyrolab.sweep.aggregate import FINISHED, JobResult, assemble  # noqa: E402
-from gyrolab.sweep.batch import run_batch_sweep  # noqa: E402
+from gyrolab.batch.sweep import run_batch_sweep  # noqa: E402
 from gyrolab.sweep.grid import Grid  # noqa: E402
 from tests.test_regime_helpers import overrides_000  # noqa: E402
 
@@ -140,8 +140,8 @@ def _batch_points(tmp_path, monkeypatch):
 def _yehia(tmp_path, monkeypatch):
     """One case of the Yehia table (the full table integrates every case for several orbits)."""
     from gyrolab.experiments import yehia2021_precessions as yehia
-    from gyrolab.physics.precession.cases import CASES
-    from gyrolab.physics.precession.closed_forms import check_closed_forms
+    from gyrolab.analysis.precession.cases import CASES
+    from gyrolab.analysis.precession.closed_forms import check_closed_forms
 
     cfg = compose_config(["experiment=yehia2021_precessions", "yehia2021.orbits=0.1"])
     row, _ = yehia.evaluate(cfg, CASES[0], 0.1, 1e-10)

@@ -1,4 +1,4 @@
-"""Chaos indicators (gyrolab.physics.chaos): the variational equations, MEGNO and FLI on scenes whose answer is known.
+"""Chaos indicators (gyrolab.analysis.chaos): the variational equations, MEGNO and FLI on scenes whose answer is known.
 
 Known answers, none taken from the kernel under test:
 * the Jacobian: central finite differences of the compiled right-hand side;
@@ -15,9 +15,9 @@ import xarray as xr
 from scipy.integrate import solve_ivp
 
 from gyrolab import compose_scene
-from gyrolab.engine.batch import integrate_arrays
+from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.errors import ConfigError
-from gyrolab.physics.chaos import indicator_outputs, megno_run, poincare_section, section_dataset
+from gyrolab.analysis.chaos import indicator_outputs, megno_run, poincare_section, section_dataset
 from gyrolab.plugins.compiled import fixed_point, variational
 
 BASE = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=1", "time.n_output=11", "output.euler_angles=false"]

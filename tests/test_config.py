@@ -6,7 +6,7 @@ import pytest
 
 from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
-from gyrolab.engine.registry import BUILTINS, names
+from gyrolab.contracts.registry import BUILTINS, names
 
 CONF = Path(__file__).resolve().parent.parent / "conf"
 

@@ -167,7 +167,7 @@ def test_a_batch_on_separately_started_workers_writes_the_same_dataset(scheduler
     CLI-started scheduler and workers gives the dataset of the same batch run in this process."""
     import xarray as xr
 
-    from gyrolab.sweep.batch import run_batch_sweep
+    from gyrolab.batch.sweep import run_batch_sweep
 
     grid = [*OVERRIDES, "batch.output=final", "batch.chunk=4", "initial.r0=2,3,5", "initial.theta0=0.3,0.6,0.9"]
     here = run_batch_sweep(grid, tmp_path / "here")

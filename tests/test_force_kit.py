@@ -212,7 +212,7 @@ def test_auto_batch_taylor_and_untraceable_torques(kit_forces):
     fallback = compose_scene(["force=[branchy]", "integrator=auto", "integrator.accuracy=1e-6", *SHORT])
     assert fallback.compiled is None  # auto runs scipy's DOP853 on the Python torque
 
-    from gyrolab.engine.batch import integrate_batch
+    from gyrolab.batch.integrate import integrate_batch
 
     scene = compose_scene(["force=[uniform_gravity,tilted]", "integrator=rk4_numba", "integrator.step=0.01", *SHORT])
     y0 = scene.system.initial_state()

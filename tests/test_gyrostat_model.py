@@ -6,13 +6,13 @@ import pytest
 
 from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
-from gyrolab.physics.precession.cases import BY_LABEL, CASES
-from gyrolab.physics.precession.finder import find_normal_rests, find_precessions
-from gyrolab.physics.precession.classify import classify
-from gyrolab.physics.precession.motion import Precession, build_system, states, theta_deviation, vector_residual, window
-from gyrolab.physics.precession.stability import body_frame_period, floquet, monodromy_multipliers
+from gyrolab.analysis.precession.cases import BY_LABEL, CASES
+from gyrolab.analysis.precession.finder import find_normal_rests, find_precessions
+from gyrolab.analysis.precession.classify import classify
+from gyrolab.analysis.precession.motion import Precession, build_system, states, theta_deviation, vector_residual, window
+from gyrolab.analysis.precession.stability import body_frame_period, floquet, monodromy_multipliers
 from gyrolab.plugins.integrators.scipy_solvers import DOP853
-from gyrolab.plugins.systems.gyrostat_euler import GyrostatParameters, kinematic_matrix, lagrange_equations
+from gyrolab.physics.gyrostat_euler import GyrostatParameters, kinematic_matrix, lagrange_equations
 
 GYROSTAT = ["body=gyrostat_asymmetric", "initial=gyrostat_precession", "force=[newtonian,magnetic]",
             "force.newtonian.k=null"]

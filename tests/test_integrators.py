@@ -6,7 +6,7 @@ from scipy.integrate import solve_ivp
 
 from gyrolab import compose_scene, run
 from gyrolab.errors import IntegrationError
-from gyrolab.engine.registry import load, names
+from gyrolab.contracts.registry import load, names
 
 SHORT = ["time.end=5", "time.n_output=11"]
 

@@ -2,20 +2,15 @@
 
 Truths: the corrected closed forms of seed 000 (report docs/derivations/seed000_large_parameter.md §5, derived by
 hand and checked against exact orbits in tests/test_regime_small_parameter.py), the exact periodic orbits of the
-full model (Newton shooting, gyrolab.physics.periodic), and the Lagrange top's steady precession, whose frequency
+full model (Newton shooting, gyrolab.analysis.periodic), and the Lagrange top's steady precession, whose frequency
 is known in closed form: aγ0''ψ̇² ∓ r0ψ̇ + 1 = 0 (c = 1), so Ω(ε) has its branch point at ε = 1/(2√(aγ0'')).
 """
 
 import numpy as np
 import pytest
 from gyrolab.errors import ConfigError
-from gyrolab.physics.lindstedt import (
-    Body,
-    error_ladder,
-    exact_orbit,
-    series,
-    series_error,
-)
+from gyrolab.analysis.lindstedt_check import error_ladder, exact_orbit, series_error
+from gyrolab.physics.lindstedt import Body, series
 from gyrolab.plugins.regimes import ismail2021 as paper
 
 from tests.test_regime_helpers import slope

@@ -13,7 +13,7 @@ import gyrolab.experiments as experiments
 from gyrolab.engine.config import compose_config
 from gyrolab.errors import ConfigError
 from gyrolab.physics import pendulum
-from gyrolab.physics.continuation import FamilyPoint, bifurcations
+from gyrolab.analysis.continuation import FamilyPoint, bifurcations
 
 FAMILY = ["experiment=orbit_family", "~orbit_family.families.default_body", "~orbit_family.families.ismail2021_body_I",
           "orbit_family.families.pendulum_body.r0_end=0.1", "orbit_family.families.pendulum_body.max_points=12"]

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from gyrolab.engine import registry
+from gyrolab.contracts import registry
 from gyrolab.errors import ConfigError
 
 REPO = Path(__file__).resolve().parent.parent

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from gyrolab.physics.periodic import FixedPointModel, shoot
+from gyrolab.analysis.periodic import FixedPointModel, shoot
 
 # Seed 001 report §9: B1 body at μ = 0.1 (r0 = √0.8/0.1): exact period 0.70318806/c and
 # initial state (0.0310965218, 0.0380844784, 8.94427191, 0.6, 0, 0.8) found by an independent

@@ -197,7 +197,7 @@ def test_plugins_repeating_the_builtin_arithmetic_follow_the_builtin_trajectory(
 
 
 def test_batch_taylor_with_a_plugin_matches_single_runs(centre):
-    from gyrolab.engine.batch import integrate_batch
+    from gyrolab.batch.integrate import integrate_batch
 
     scene = compose_scene(["force=[centre]", "integrator=taylor", "integrator.tol=1e-13", *SHORT])
     y0 = scene.system.initial_state()
@@ -238,7 +238,7 @@ def test_time_dependent_plugin_torque_under_taylor_against_the_equations_by_hand
 
     times = np.linspace(0.0, 6.0, 13)
     y0 = np.array([0.3, -0.2, 1.5, 0.0, 0.6, 0.8])
-    from gyrolab.engine.batch import integrate_arrays
+    from gyrolab.batch.integrate import integrate_arrays
 
     got = integrate_arrays(model, Taylor(tol=1e-14), times, y0[None, :]).y[0]
     ref = solve_ivp(by_hand, (0.0, 6.0), y0, method="DOP853", t_eval=times, rtol=1e-13, atol=1e-13).y.T

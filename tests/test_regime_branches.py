@@ -14,7 +14,7 @@ import pytest
 
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.experiments.regime_run import errors
-from gyrolab.physics.periodic import FixedPointModel, shoot
+from gyrolab.analysis.periodic import FixedPointModel, shoot
 from gyrolab.plugins.regimes import shaker_omega3 as paper
 from gyrolab.plugins.regimes.resonant_omega3 import ResonantOmega3
 from tests.test_regime_helpers import B1, overrides_001, run_case, slope
@@ -54,7 +54,7 @@ def test_erratum_001_6_branches_ii_iv_are_not_periodic_solutions(mu, branch, sig
     C = CONSTANTS.as_printed().on_branch(branch, sign, np.radians(phase_deg))
     if outcome == "no orbit":
         # Newton stalls far above its acceptance (1e-11) and above the 1e-10 return residual that points
-        # near the amplitude circle can have without being on an orbit (gyrolab.physics.periodic.shoot)
+        # near the amplitude circle can have without being on an orbit (gyrolab.analysis.periodic.shoot)
         with pytest.raises(IntegrationError, match="Newton shooting did not converge") as failed:
             _orbit_from(C, mu)
         stall = float(re.search(r"return residual ([0-9.e+-]+)", str(failed.value)).group(1))

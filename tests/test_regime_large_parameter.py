@@ -13,8 +13,8 @@ from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError
 from gyrolab.experiments.regime_run import compute, errors, prepare
 from gyrolab.physics import pendulum
-from gyrolab.physics.continuation import Section, shoot_section
-from gyrolab.physics.periodic import FixedPointModel
+from gyrolab.analysis.continuation import Section, shoot_section
+from gyrolab.analysis.periodic import FixedPointModel
 from gyrolab.plugins.regimes import ismail2021 as paper
 from gyrolab.plugins.regimes.base import nondimensional_scene
 from gyrolab.plugins.regimes.large_parameter import _sample, printed_reading_state, series_for

@@ -1,7 +1,7 @@
 """small_parameter across its excluded resonances ω → 1, 2: the error grows toward them, the refusal band is where it is large.
 
 Every error is the analytic solution's distance to the exact periodic orbit of the full model (Newton
-shooting, pipeline/physics/periodic.py) over one period, relative to c (p, q), r0 (r) and the period; ω is set through
+shooting, pipeline/analysis/periodic.py) over one period, relative to c (p, q), r0 (r) and the period; ω is set through
 the body's a at fixed b = 0.6, c/r0 = 0.05, Γ = 0.5 (conf/experiment/regime_validity.yaml).
 """
 

@@ -112,7 +112,7 @@ def test_constants_match_the_report():
 def test_reduced_rhs_001_eq1_is_the_full_model_rescaled():
     # seed 001 eq. (1)/(5): d/dτ of the scaled variables equals the Euler–Poisson right-hand side rescaled
     # (p = c√γ0'' p1, r = r0 r1, γ = γ0'' γ1, τ = r0 t, k = k_gt γ0''); c = 1 here
-    from gyrolab.physics.periodic import FixedPointModel
+    from gyrolab.analysis.periodic import FixedPointModel
 
     C = paper.Constants(B1["a"], B1["b"], *B1["rc"], B1["k"], B1["theta0"])
     model = FixedPointModel(np.array([C.a, C.b, 1.0]), np.array([C.x0, C.y0, C.z0]), C.k_gt)

@@ -306,7 +306,7 @@ def test_auto_takes_the_lowest_series_order_that_meets_the_target():
     # the numeric series can; auto records the order it used, and the result meets the target against the
     # extended-precision reference.
     from gyrolab import compose_scene
-    from gyrolab.physics.periodic import FixedPointModel, shoot
+    from gyrolab.analysis.periodic import FixedPointModel, shoot
     from gyrolab.physics.reference import fixed_point_reference
     from gyrolab.plugins.regimes.small_parameter import SmallParameter
 

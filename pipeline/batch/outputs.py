@@ -5,7 +5,7 @@
 * ``final``: the final state's variables (angles wrapped to (−π, π]);
 * ``reductions``: ``final`` plus each monitored invariant's ``<name>_max_abs_drift`` (max over the stored
   samples of |I(t) − I(0)|) and ``max_nutation_deviation`` (max |θ(t) − θ(0)|);
-* ``indicator``: the chaos indicator and the max nutation deviation of ``gyrolab.physics.chaos``, from the
+* ``indicator``: the chaos indicator and the max nutation deviation of ``gyrolab.analysis.chaos``, from the
   variational equations (``indicator_outputs``).
 
 Each output is ``Output(dims, data, attrs)``: ``dims`` the trailing dimensions after the point's (grid)
@@ -222,8 +222,8 @@ def _place(outputs: dict[str, Output], part: Mapping[str, tuple], index: np.ndar
 
 def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray,
                       params: np.ndarray) -> dict[str, Output]:
-    """The chaos indicator's outputs (``gyrolab.physics.chaos.indicator_outputs``, imported here only)."""
-    from gyrolab.physics.chaos import indicator_outputs as compute
+    """The chaos indicator's outputs (``gyrolab.analysis.chaos.indicator_outputs``, imported here only)."""
+    from gyrolab.analysis.chaos import indicator_outputs as compute
 
     out = {}
     for name, (data, attrs) in compute(compiled, integrator, times, y0s, params).items():

@@ -74,7 +74,7 @@ class RunStats:
     kernel_time: float = 0.0    # inside the integration kernels (``integrate_arrays``; its first call loads them)
     wall_time: float = 0.0      # the chunks' phase: from the first task handed over to the file renamed
     chunk_time: float = 0.0     # the chunks' own wall time (kernels plus their outputs), summed
-    plan_time: float = 0.0      # the plan (``gyrolab.sweep.batch.run_batch`` sets it)
+    plan_time: float = 0.0      # the plan (``gyrolab.batch.sweep.run_batch`` sets it)
 
 
 @dataclass(frozen=True)
@@ -179,14 +179,14 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
 def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any]]:
     """(the integrator every chunk runs, its dataset attributes); None: the config's own (a fixed choice).
 
-    ``auto`` chooses here, once for the batch, on the batch's valid points (``gyrolab.engine.batch``'s
+    ``auto`` chooses here, once for the batch, on the batch's valid points (``gyrolab.batch.integrate``'s
     choice for array batches: its pilot on the first point, the largest state and the most unusual
     parameters, the tightest tolerance): every chunk then runs the same method at the same tolerance.
     (The chaos indicator takes no ``auto``: its kernels refuse it, in their own sentence.)
     """
     if plan.base is None or plan.integrator_name != "auto" or settings.output == "indicator":
         return None, {}
-    from gyrolab.engine.batch import auto_choice
+    from gyrolab.batch.integrate import auto_choice
     from gyrolab.engine.scene import Scene
 
     scene = Scene.from_config(OmegaConf.create(plan.base))
@@ -273,7 +273,7 @@ def _system(context: dict[str, Any], config: dict[str, Any], values: dict[str, A
 
 def run_chunk(task: ChunkTask) -> ChunkResult:
     """Integrate one chunk's valid points and compute what ``task.output`` stores."""
-    from gyrolab.engine.batch import integrate_arrays
+    from gyrolab.batch.integrate import integrate_arrays
 
     start = time.perf_counter()
     context = _context(task.config_key, task.config)

@@ -19,7 +19,6 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
-from hydra._internal.utils import create_automatic_config_search_path
 from hydra.core.config_search_path import ConfigSearchPath, SearchPathQuery
 from hydra.core.config_store import ConfigStore
 from hydra.core.global_hydra import GlobalHydra
@@ -28,7 +27,8 @@ from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
-from gyrolab.engine import registry
+from gyrolab.contracts import registry
+from gyrolab.engine.hydra_private import create_automatic_config_search_path
 from gyrolab.errors import ConfigError, choices, shorten
 
 CONFIG_MODULE = "gyrolab.conf"
@@ -97,7 +97,7 @@ def current_source() -> ConfigSource:
 @contextmanager
 def hydra_for(source: ConfigSource | None = None) -> Iterator[None]:
     """A Hydra initialised on ``source`` (default: the current one) for the duration of the block."""
-    from hydra._internal.hydra import Hydra
+    from gyrolab.engine.hydra_private import Hydra
 
     GlobalHydra.instance().clear()
     Hydra.create_main_hydra2(task_name="app", config_search_path=(source or _source).search_path())

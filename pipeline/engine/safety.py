@@ -11,7 +11,7 @@ configures logging, and by ``--reproduce`` and ``--batch`` to the configs they b
 
 - every ``_target_`` anywhere must be on an allowlist: under ``hydra`` gyrolab's sweep
   callback and the installed Hydra launchers and sweepers; elsewhere a registered
-  gyrolab plugin (``gyrolab.engine.registry``);
+  gyrolab plugin (``gyrolab.contracts.registry``);
 - Hydra's logging configs (``hydra.job_logging``, ``hydra.hydra_logging``) may name only
   the standard logging handler, formatter and filter classes (``()`` and ``class`` keys),
   no ``.`` attribute setters, no ``ext://`` object other than ``sys.stdout``/``sys.stderr``,
@@ -40,11 +40,12 @@ from typing import Any
 from omegaconf import DictConfig, ListConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 
-from gyrolab.engine import registry
+from gyrolab.contracts import registry
 from gyrolab.errors import ConfigError, shorten
 
 #: ``_target_`` values allowed under ``hydra`` besides the installed launchers and sweepers
-HYDRA_TARGETS = frozenset({"gyrolab.sweep.callbacks.SweepCallback"})
+#: (gyrolab's sweep callback and sweeper are named, not imported: the engine sits below gyrolab.sweep)
+HYDRA_TARGETS = frozenset({"gyrolab.sweep.callbacks.SweepCallback", "hydra_plugins.gyrolab_sweeper.GyrolabSweeper"})
 #: classes a logging config may name with ``class`` or ``()``
 LOGGING_CLASSES = frozenset({
     "logging.StreamHandler", "logging.FileHandler", "logging.NullHandler",
@@ -61,14 +62,11 @@ LAUNCHER_SHELL_KEYS = ("setup", "srun_args", "additional_parameters")
 
 @cache
 def hydra_targets() -> frozenset[str]:
-    """gyrolab's callback and every installed Hydra launcher and sweeper class."""
+    """gyrolab's callback and sweeper and every installed Hydra launcher and sweeper class."""
     from hydra.core.plugins import Plugins
     from hydra.plugins.launcher import Launcher
     from hydra.plugins.sweeper import Sweeper
 
-    from gyrolab.sweep.sweeper import register_plugin
-
-    register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), whatever the install
     found = {f"{cls.__module__}.{cls.__qualname__}" for kind in (Launcher, Sweeper)
              for cls in Plugins.instance().discover(kind)}
     return HYDRA_TARGETS | found
@@ -165,12 +163,10 @@ def check_output_dir(text: str, key: str) -> None:
 
 @cache
 def _protected_dirs() -> tuple[Path, ...]:
-    import gyrolab
-
     dirs = set()
     for path in [*site.getsitepackages(), site.getusersitepackages(),
                  *(sysconfig.get_paths().get(k) for k in ("purelib", "platlib", "stdlib", "platstdlib")),
-                 os.path.dirname(gyrolab.__file__)]:
+                 str(Path(__file__).resolve().parents[1])]:  # the last one: gyrolab's own folder
         if path:
             dirs.add(Path(os.path.abspath(path)))
     return tuple(sorted(dirs))

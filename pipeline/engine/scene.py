@@ -12,7 +12,7 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.engine import registry
+from gyrolab.contracts import registry
 from gyrolab.engine.config import compose_config
 from gyrolab.contracts import CompiledModel, Integrator, System
 from gyrolab.output.dataset import build_dataset, scene_attributes

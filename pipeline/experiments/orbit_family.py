@@ -2,7 +2,7 @@
 
 For each family of ``orbit_family.families`` (a body, a tilt θ0 = arccos γ''(0), a section and a start): the orbit is
 found by shooting at the start spin (from the fast-spin series of ``small_parameter`` at r0/c = 100, or from the
-pendulum swing at r0/c = 0.01) and continued by pseudo-arclength in ln r0 (``gyrolab.physics.continuation``) toward
+pendulum swing at r0/c = 0.01) and continued by pseudo-arclength in ln r0 (``gyrolab.analysis.continuation``) toward
 the other end. Per point: r0/c, period, initial state, Floquet multipliers, stability index s = ρ + 1/ρ, stable,
 the nutation amplitude (max θ − min θ), the bifurcations met (fold, branch point, period doubling), and the
 relative error of the series against the point (max of |Δy(0)|/max(1, |y(0)|) and |ΔT|/T): the fast-spin series
@@ -27,8 +27,8 @@ from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
 from gyrolab.physics import pendulum
-from gyrolab.physics.continuation import FamilyPoint, Section, bifurcations, continue_family, shoot_section
-from gyrolab.physics.periodic import FixedPointModel
+from gyrolab.analysis.continuation import FamilyPoint, Section, bifurcations, continue_family, shoot_section
+from gyrolab.analysis.periodic import FixedPointModel
 from gyrolab.plugins.regimes import large_parameter as slow
 from gyrolab.plugins.regimes.base import NondimensionalScene
 from gyrolab.plugins.regimes.small_parameter import SmallParameter

@@ -7,7 +7,7 @@ periods with
 * the full model integrated from the analytic orbit's own t = 0 state with
   the scene's integrator ("full"), and
 * the exact periodic orbit of the full model through the same r0, θ0, γ'(0) = 0
-  (Newton shooting from the analytic one, ``gyrolab.physics.periodic``), sampled with
+  (Newton shooting from the analytic one, ``gyrolab.analysis.periodic``), sampled with
   the compiled Taylor method ("orbit"), and
 * the regime's reduced system (``regime.reduced_rhs``: Ismail (2021) eq. 14, Shaker et al. eq. 1) integrated
   with the scene's integrator plugin from its own τ = 0 state and mapped back ("reduced"), for regimes
@@ -27,12 +27,13 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.engine import registry
+from gyrolab.contracts import registry
 from gyrolab.contracts.regime import Regime
 from gyrolab.output.cf import conform, unit_attributes
 from gyrolab.output.dataset import time_attributes, write_dataset
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.physics.periodic import FixedPointModel, PeriodicOrbit, shoot
+from gyrolab.analysis.periodic import FixedPointModel, PeriodicOrbit, shoot
+from gyrolab.physics.attitude import angles_from_states  # noqa: F401  (imported from here by earlier code)
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
@@ -163,20 +164,6 @@ def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[np.nd
                  f"{label}, which integrates compiled models of the full equations only)")
     solution = integrator.integrate(rhs_t, np.asarray(t, dtype=float), np.asarray(Z0, dtype=float))
     return to_model(solution.y.T), label
-
-
-def angles_from_states(t: np.ndarray, y: np.ndarray, psi0: float) -> dict[str, np.ndarray]:
-    """Euler angles of sampled (ω, γ) states: θ and φ from γ, ψ by quadrature of ψ̇ = (pγ + qγ')/(1 − γ''²)
-    (Shaker et al. eq. 29) with a cubic spline through the samples (error ~ h⁴: 7e-11 rad at 200 samples per
-    period against ψ from α, tests/test_regime_experiments.py) — for states that come without the fixed axis α."""
-    from scipy.interpolate import CubicSpline
-
-    from gyrolab.physics.attitude import nutation_and_spin
-
-    theta, phi = nutation_and_spin(y[:, 3:6])
-    rate = (y[:, 0] * y[:, 3] + y[:, 1] * y[:, 4]) / (1.0 - y[:, 5] ** 2)
-    psi = psi0 + CubicSpline(t, rate).antiderivative()(t)
-    return {"psi": psi, "theta": theta, "phi": np.unwrap(phi)}
 
 
 def errors(result: dict[str, Any], against: str = "orbit") -> dict[str, float]:

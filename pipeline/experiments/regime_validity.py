@@ -277,7 +277,7 @@ def _resonance_dataset(sweep: dict) -> xr.Dataset:
 
 
 def _regime_class(name: str):
-    from gyrolab.engine import registry
+    from gyrolab.contracts import registry
 
     return registry.load("regime", name)
 

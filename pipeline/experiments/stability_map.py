@@ -1,8 +1,8 @@
 """``gyrolab experiment=stability_map``: the chaos indicator over a grid θ0 × r0 as one resumable batch.
 
 The grid (``stability_map.theta0``/``r0`` ranges, ``n_theta0`` × ``n_r0`` points, or ``batch.points`` as a
-square grid) is run by ``gyrolab.sweep.batch.run_batch`` with ``batch.output=indicator``
-(``gyrolab.physics.chaos.indicator_outputs``: MEGNO and the max nutation deviation per point) into
+square grid) is run by ``gyrolab.batch.sweep.run_batch`` with ``batch.output=indicator``
+(``gyrolab.analysis.chaos.indicator_outputs``: MEGNO and the max nutation deviation per point) into
 ``stability_map.nc`` with dimensions (``theta0``, ``r0``); rerunning the same command in the same run
 directory continues a killed map. The figure is ``gyrolab.figures.stability_map.draw``.
 """
@@ -55,7 +55,7 @@ def grid(cfg: DictConfig) -> list[Dim]:
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
-    from gyrolab.sweep.batch import run_batch
+    from gyrolab.batch.sweep import run_batch
 
     plain = OmegaConf.to_container(cfg, resolve=True)
     plain.pop("hydra", None)
@@ -71,7 +71,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
 def _add_sections(path: Path, plain: dict, points: Sequence[Sequence[float]], t_end: float) -> None:
     """Poincaré sections of the chosen (θ0, r0) points, integrated by the chaos kernel with the map's step, added to
     the map's file (rewritten atomically; a rerun replaces them)."""
-    from gyrolab.physics.chaos import section_dataset
+    from gyrolab.analysis.chaos import section_dataset
 
     if not t_end > 0:
         raise ConfigError(f"stability_map.section_time={t_end!r} must be a positive time")

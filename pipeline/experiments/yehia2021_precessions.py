@@ -1,6 +1,6 @@
 """Every regular-precession case of Yehia & El-kenani (2021), sections 4.1.1, 4.1.2, 4.2, checked on the full model.
 
-For each case of ``gyrolab.physics.precession.cases`` (concrete parameters satisfying the printed — or, in an
+For each case of ``gyrolab.analysis.precession.cases`` (concrete parameters satisfying the printed — or, in an
 extra row, the corrected — conditions): (a) the residual along ψ = nt + ψ0, θ = θ0, φ = mt of the vector
 equations (the ``orbiting_gyrostat`` system with its force plugins) and of the Euler-angle equations;
 (b) a scene of the configured integrator from the precession's initial state, max |θ − θ0| over
@@ -27,11 +27,11 @@ from gyrolab.output.atomic import atomic_open
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError, as_number
-from gyrolab.physics.precession.cases import CASES, Case
-from gyrolab.physics.precession.classify import classify
-from gyrolab.physics.precession.closed_forms import check_closed_forms
-from gyrolab.physics.precession.motion import body_config, euler_residual, magnetic_config, vector_residual, window
-from gyrolab.physics.precession.stability import Floquet, floquet
+from gyrolab.analysis.precession.cases import CASES, Case
+from gyrolab.analysis.precession.classify import classify
+from gyrolab.analysis.precession.closed_forms import check_closed_forms
+from gyrolab.analysis.precession.motion import body_config, euler_residual, magnetic_config, vector_residual, window
+from gyrolab.analysis.precession.stability import Floquet, floquet
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene

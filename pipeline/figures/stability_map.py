@@ -4,7 +4,7 @@ Left: the indicator (MEGNO ⟨Y⟩ by default) as a colour map, clipped at ``CLI
 over any useful span; the colour bar's upper end is open), the contour ⟨Y⟩ = ``REGULAR_EDGE`` separating regular
 (⟨Y⟩ → 2) from chaotic motion, the regimes' domains of ``docs/regimes.md`` (small parameter: r0/c ≥ 5, large
 parameter: r0/c ≤ 0.2, resonance ω = 3: a body property, noted) and the seeds' example scenes. Right: the max
-deviation of the nutation angle. Below, when the dataset has them (``gyrolab.physics.chaos.section_dataset``):
+deviation of the nutation angle. Below, when the dataset has them (``gyrolab.analysis.chaos.section_dataset``):
 the Poincaré sections of a few points, marked on the map by number.
 """
 

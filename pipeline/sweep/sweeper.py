@@ -30,7 +30,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from hydra._internal.config_loader_impl import ConfigLoaderImpl
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override, OverrideType
 from hydra.plugins.launcher import Launcher
@@ -38,6 +37,7 @@ from hydra.plugins.sweeper import Sweeper
 from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf
 
+from gyrolab.engine.hydra_private import ConfigLoaderImpl
 from gyrolab.sweep.identity import code_version, job_identity
 from gyrolab.sweep.job import mark_skipped
 from gyrolab.sweep.record import JobRecord, read_record
@@ -77,7 +77,7 @@ class ResumingSweeper(Sweeper):
 
     def sweep(self, arguments: list[str]) -> Any:
         assert self.config is not None and self.launcher is not None and self.hydra_context is not None
-        from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
+        from gyrolab.engine.hydra_private import BasicSweeper
 
         parser = OverridesParser.create(config_loader=self.hydra_context.config_loader)
         params = [f"{key}={value}" for key, value in self.params.items()]  # as the basic sweeper: params first

@@ -22,6 +22,7 @@ a float (``float()``, ``math.*``), and numpy functions without an object-array f
 from __future__ import annotations
 
 import hashlib
+import os
 import importlib.util
 import logging
 import math
@@ -296,10 +297,11 @@ def load_generated(source: str, prefix: str, what: str) -> Any:
         path = folder / f"{module_name}.py"
         marker = path.with_suffix(".compiled")
         if not path.exists() or path.read_text() != source:
-            from gyrolab.output.atomic import atomic_path
-
-            with atomic_path(path) as tmp:
-                Path(tmp).write_text(source)
+            # written beside its final name and renamed, so a concurrent process never imports half a file
+            # (the kernels sit below gyrolab.output, whose atomic_path does the same with more ceremony)
+            tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+            tmp.write_text(source)
+            os.replace(tmp, path)
         if not marker.exists():
             log.info("compiling %s, once (cached for later runs)", what)
         spec = importlib.util.spec_from_file_location(module_name, path)

@@ -214,7 +214,7 @@ class Auto(Integrator):
 
         if self.system is None or compiled is None or t_out[0] != 0.0 or compiled.model != FIXED_POINT:
             return None  # the regimes' series describe the built-in torques only
-        from gyrolab.engine import registry
+        from gyrolab.contracts import registry
         from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
         span = t_out[-1] - t_out[0]

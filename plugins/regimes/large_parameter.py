@@ -8,7 +8,7 @@ the motion by O(1). This plugin is the slow-spin regime built from the right gen
   z tilted by θ0 about the body y axis (φ0 = ±π/2), the motion is an exact planar physical pendulum
   (``gyrolab.physics.pendulum``: period by quadrature, elliptic functions for k = 0).
 * **Family**: the periodic orbit through the swing's turning point, q(0) = 0, r(0) = r0, γ''(0) = cos θ0
-  (``gyrolab.physics.continuation``, section ``turning``), continues the swing for small r0/c: the shooting
+  (``gyrolab.analysis.continuation``, section ``turning``), continues the swing for small r0/c: the shooting
   Jacobian is regular at r0 = 0 unless the swing has an out-of-plane Floquet multiplier 1.
 * **Series** in ε = r0/c (numeric, ``SlowSpinSeries``): at fixed phase q, γ, γ'' and the period are even in ε,
   p, r, γ' odd (time reversal and the body's mirror symmetry). Zeroth order: the swing; first order: the
@@ -30,8 +30,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.physics.continuation import Section, _evaluate, shoot_section
-from gyrolab.physics.periodic import FixedPointModel
+from gyrolab.analysis.continuation import Section, _evaluate, shoot_section
+from gyrolab.analysis.periodic import FixedPointModel
+from gyrolab.physics.attitude import angles_from_states
 from gyrolab.plugins.regimes import ismail2021 as paper
 from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
 
@@ -239,8 +240,6 @@ class LargeParameter(FixedPointRegime):
     def _euler(self, s, t):
         if self.formula == "printed":
             return paper.printed_euler(t, self._printed_params(s))
-        from gyrolab.experiments.regime_run import angles_from_states
-
         T = self._period(s)
         t = np.asarray(t, dtype=float)
         dense = np.linspace(0.0, max(float(t.max()), T), 1000 * int(np.ceil(max(float(t.max()), T) / T)) + 1)

@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 from gyrolab.errors import ConfigError
+from gyrolab.analysis import lindstedt_check
 from gyrolab.physics import lindstedt
 from gyrolab.plugins.regimes import ismail2021 as paper
 from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
@@ -311,7 +312,7 @@ def series_diagnostics(regime: SmallParameter, system) -> tuple[dict[str, Any], 
     N = regime.series_order
     radius = sol.radius()
     R = sol.radius_of_convergence()
-    ladder = lindstedt.error_ladder(sol, N, float(s.gamma0pp))
+    ladder = lindstedt_check.error_ladder(sol, N, float(s.gamma0pp))
     k = np.arange(sol.max_order + 1)
     data = {
         "series_coefficient_norm": ("series_order", sol.norms(), {

@@ -30,8 +30,8 @@ from gyrolab.contracts.system import System
 from gyrolab.errors import ConfigError, as_vector3
 from gyrolab.physics.initial import InitialAttitude
 from gyrolab.physics.vectors import cross, dot, norm
-from gyrolab.plugins.systems.gyrostat_body import GyrostatBody
-from gyrolab.plugins.systems.gyrostat_euler import GyrostatParameters, kinematic_matrix
+from gyrolab.physics.gyrostat_body import GyrostatBody
+from gyrolab.physics.gyrostat_euler import GyrostatParameters, kinematic_matrix
 
 INITIAL_KEYS = ("p0", "q0", "r0", "psi0", "theta0", "phi0", "gamma0", "euler_rates0")
 

@@ -14,7 +14,8 @@ Run: python docs/derivations/scripts/seed000/lindstedt_resonances.py   (about 20
 
 import numpy as np
 from gyrolab.errors import GyrolabError
-from gyrolab.physics.lindstedt import Body, exact_orbit, series, series_error
+from gyrolab.analysis.lindstedt_check import exact_orbit, series_error
+from gyrolab.physics.lindstedt import Body, series
 from gyrolab.plugins.regimes.small_parameter import divisor_threshold
 
 Z0 = float(np.sqrt(1 - 0.34))

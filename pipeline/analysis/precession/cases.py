@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gyrolab.physics.precession.motion import Precession
-from gyrolab.plugins.systems.gyrostat_euler import GyrostatParameters
+from gyrolab.analysis.precession.motion import Precession
+from gyrolab.physics.gyrostat_euler import GyrostatParameters
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ from typing import Any
 
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
 from gyrolab.batch.runner import RunStats, Settings, run_plan
-from gyrolab.engine.batch import BATCH_INTEGRATORS
+from gyrolab.batch.integrate import BATCH_INTEGRATORS
 from gyrolab.errors import ConfigError
 from gyrolab.output.lock import writing_in
 

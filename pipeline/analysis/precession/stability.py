@@ -28,7 +28,7 @@ from fractions import Fraction
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from gyrolab.physics.precession.motion import Precession, states
+from gyrolab.analysis.precession.motion import Precession, states
 from gyrolab.plugins.systems.orbiting_gyrostat import OrbitingGyrostat
 
 TOLERANCE_FACTOR = 10.0  # tolerance = TOLERANCE_FACTOR · max(√rtol, δ)

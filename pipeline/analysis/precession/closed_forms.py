@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from gyrolab.physics.attitude import frame_from_angles
-from gyrolab.plugins.systems.gyrostat_euler import kinematic_matrix
+from gyrolab.physics.gyrostat_euler import kinematic_matrix
 
 c, s = np.cos, np.sin
 R3 = np.sqrt(3.0)

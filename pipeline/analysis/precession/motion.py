@@ -3,7 +3,7 @@
 (a) residual of the equations of motion along the prescribed motion, max over a time window:
     vector form — the ``orbiting_gyrostat`` system's own right-hand side (with its force plugins)
     against the exact derivative of the prescribed state; Euler-angle form — the Lagrange
-    equations of ``gyrolab.plugins.systems.gyrostat_euler`` (blind to one direction of the vector
+    equations of ``gyrolab.physics.gyrostat_euler`` (blind to one direction of the vector
     residual at θ0 ∈ {0, π}, where det J = −sin θ0 = 0).
 (b) integration of the full vector equations from the precession's initial state, max |θ − θ0|.
 """
@@ -19,8 +19,8 @@ from gyrolab.contracts.integrator import Integrator
 from gyrolab.errors import ConfigError, as_number
 from gyrolab.plugins.forces.magnetic import Magnetic
 from gyrolab.plugins.forces.newtonian import Newtonian
-from gyrolab.plugins.systems.gyrostat_body import GyrostatBody
-from gyrolab.plugins.systems.gyrostat_euler import GyrostatParameters, lagrange_equations
+from gyrolab.physics.gyrostat_body import GyrostatBody
+from gyrolab.physics.gyrostat_euler import GyrostatParameters, lagrange_equations
 from gyrolab.plugins.systems.orbiting_gyrostat import OrbitingGyrostat
 
 

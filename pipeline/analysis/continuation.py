@@ -3,7 +3,7 @@ pseudo-arclength continuation in the spin r0, with Floquet stability and bifurca
 
 A section fixes γ''(0) = cos θ0 and r(0) = r0 and one more coordinate, leaving two state unknowns and the period:
 
-* ``"gamma_prime"`` — γ'(0) = 0, unknowns (p0, q0): the seeds' section (``gyrolab.physics.periodic.shoot``);
+* ``"gamma_prime"`` — γ'(0) = 0, unknowns (p0, q0): the seeds' section (``gyrolab.analysis.periodic.shoot``);
 * ``"turning"`` — q(0) = 0, unknowns (p0, γ'0): the turning point of a swing about the body y axis, the section
   that stays transversal at r0 = 0, where the seeds' one contains the whole planar pendulum orbit (γ' ≡ 0).
 
@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.physics.periodic import FixedPointModel
+from gyrolab.analysis.periodic import FixedPointModel
 
 SECTIONS = ("gamma_prime", "turning")
 MAX_LOG_STEP = 0.5

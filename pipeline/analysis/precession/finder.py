@@ -19,8 +19,8 @@ from scipy.optimize import least_squares
 from scipy.stats import qmc
 
 from gyrolab.errors import ConfigError
-from gyrolab.physics.precession.motion import Precession, build_system, states, vector_residual
-from gyrolab.plugins.systems.gyrostat_euler import GyrostatParameters
+from gyrolab.analysis.precession.motion import Precession, build_system, states, vector_residual
+from gyrolab.physics.gyrostat_euler import GyrostatParameters
 
 MOTION = ("n", "m", "theta0", "psi0")
 

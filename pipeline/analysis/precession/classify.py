@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gyrolab.physics.precession.motion import Precession
+from gyrolab.analysis.precession.motion import Precession
 
 TOL = 1e-10
 

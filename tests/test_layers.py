@@ -1,0 +1,146 @@
+"""The package's layers: each sub-package imports only the layers below it, function-level imports included.
+
+The table is the architecture (``gyrolab/__init__``'s docstring says it in words). An import that is only
+read by type checkers (under ``if TYPE_CHECKING:``) never runs and is not counted; loading a plugin by name
+through ``gyrolab.contracts.registry`` is not an import. A strict order forbids every cycle between
+sub-packages.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SOURCES = {"pipeline": "gyrolab", "plugins": "gyrolab.plugins"}
+
+#: sub-package -> layer; an import must go to a strictly lower layer or stay inside its own sub-package
+LAYERS = {
+    "gyrolab.errors": 0,
+    "gyrolab.physics": 1,
+    "gyrolab.contracts": 2,
+    "gyrolab.plugins.compiled": 3,
+    "gyrolab.plugins.forces": 4,
+    "gyrolab.plugins.systems": 4,
+    "gyrolab.plugins.integrators": 5,
+    "gyrolab.analysis": 6,
+    "gyrolab.plugins.regimes": 7,
+    "gyrolab.output": 8,
+    "gyrolab.figures": 9,
+    "gyrolab.engine": 10,
+    "gyrolab.sweep": 11,
+    "gyrolab.batch": 12,
+    "gyrolab.experiments": 13,
+    "gyrolab.testing": 14,
+    "gyrolab.scaffold": 14,
+    "gyrolab.app": 15,
+    "gyrolab.__main__": 16,
+    "gyrolab": 16,
+    "gyrolab.plugins": 16,
+}
+
+
+def _module_name(path: Path) -> str:
+    folder, _, rest = path.relative_to(ROOT).as_posix().partition("/")
+    dotted = rest[:-3].replace("/", ".")
+    dotted = dotted.removesuffix("__init__").rstrip(".")
+    return f"{SOURCES[folder]}.{dotted}".rstrip(".")
+
+
+def _unit(module: str) -> str:
+    """The layer a module belongs to: the longest entry of LAYERS that is the module or a package of it."""
+    parts = module.split(".")
+    for n in range(len(parts), 0, -1):
+        candidate = ".".join(parts[:n])
+        if candidate in LAYERS:
+            return candidate
+    raise AssertionError(f"{module} belongs to no layer of tests/test_layers.py's LAYERS: add it")
+
+
+def _type_checking_lines(tree: ast.AST) -> set[int]:
+    lines: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            for child in node.body:
+                lines.update(range(child.lineno, (child.end_lineno or child.lineno) + 1))
+    return lines
+
+
+def _imports(path: Path) -> list[tuple[str, int]]:
+    """Every gyrolab module a file imports (``from gyrolab import x`` names gyrolab.x), with its line."""
+    tree = ast.parse(path.read_text(), str(path))
+    skipped = _type_checking_lines(tree)
+    found = []
+    for node in ast.walk(tree):
+        if getattr(node, "lineno", None) in skipped:
+            continue
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").startswith("gyrolab"):
+            if node.module == "gyrolab" or node.module == "gyrolab.plugins":
+                found += [(f"{node.module}.{alias.name}", node.lineno) for alias in node.names]
+            else:
+                found.append((node.module, node.lineno))
+        elif isinstance(node, ast.Import):
+            found += [(alias.name, node.lineno) for alias in node.names if alias.name.startswith("gyrolab")]
+    return found
+
+
+def _violations() -> list[str]:
+    bad = []
+    for folder in SOURCES:
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            here = _unit(_module_name(path))
+            for target, line in _imports(path):
+                there = _unit(target)
+                if there != here and LAYERS[there] >= LAYERS[here]:
+                    bad.append(f"{path.relative_to(ROOT)}:{line}: {here} (layer {LAYERS[here]}) imports {target} "
+                               f"(layer {LAYERS[there]})")
+    return bad
+
+
+def test_every_import_goes_down_the_layers():
+    bad = _violations()
+    assert not bad, "imports against the layers:\n" + "\n".join(bad)
+
+
+def test_physics_imports_nothing_of_gyrolab_but_errors():
+    for path in sorted((ROOT / "pipeline" / "physics").rglob("*.py")):
+        for target, line in _imports(path):
+            assert target.startswith(("gyrolab.physics", "gyrolab.errors")), f"{path.name}:{line} imports {target}"
+
+
+def test_the_checker_sees_a_function_level_import(tmp_path):
+    # the rule must be able to fail: an upward import hidden in a function body is found
+    tree = ast.parse("def f():\n    from gyrolab.engine.scene import Scene\n")
+    imported = [n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
+    assert imported == ["gyrolab.engine.scene"]
+    assert LAYERS[_unit("gyrolab.engine.scene")] > LAYERS[_unit("gyrolab.physics.body")]
+
+
+@pytest.mark.parametrize("old, new", [
+    ("gyrolab.physics.chaos", "gyrolab.analysis.chaos"),
+    ("gyrolab.physics.periodic", "gyrolab.analysis.periodic"),
+    ("gyrolab.physics.precession.cases", "gyrolab.analysis.precession.cases"),
+    ("gyrolab.engine.batch", "gyrolab.batch.integrate"),
+    ("gyrolab.sweep.batch", "gyrolab.batch.sweep"),
+    ("gyrolab.engine.registry", "gyrolab.contracts.registry"),
+    ("gyrolab.plugins.systems.gyrostat_euler", "gyrolab.physics.gyrostat_euler"),
+])
+def test_moved_modules_keep_their_old_names(old, new):
+    import importlib
+
+    assert importlib.import_module(old) is importlib.import_module(new)
+
+
+def test_hydra_private_api_behind_one_module():
+    for folder in SOURCES:
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            if path.name == "hydra_private.py":
+                continue
+            tree = ast.parse(path.read_text())
+            for node in ast.walk(tree):
+                names = [node.module or ""] if isinstance(node, ast.ImportFrom) else \
+                    [a.name for a in node.names] if isinstance(node, ast.Import) else []
+                assert not any(n.startswith("hydra._internal") for n in names), \
+                    f"{path.relative_to(ROOT)}:{node.lineno} imports Hydra's private API; use gyrolab.engine.hydra_private"
