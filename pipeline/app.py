@@ -22,6 +22,7 @@ import logging
 import os
 import sys
 import tempfile
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -47,7 +48,7 @@ from gyrolab.engine.config import (
     use_source,
 )
 from gyrolab.engine.safety import check_config, check_output_dir
-from gyrolab.errors import ConfigError, GyrolabError, choices, require_finite, shorten
+from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
 from gyrolab.engine.progress import allow_bars, on_terminal
 from gyrolab.engine.scene import Scene
@@ -64,6 +65,23 @@ log = logging.getLogger("gyrolab")
 def fail(error: GyrolabError) -> None:
     print(f"gyrolab: error: {error}", file=sys.stderr)
     sys.exit(error.exit_code)
+
+
+def show_warnings_in_one_line() -> None:
+    """Print gyrolab's own warnings (``GyrolabWarning``: a plugin that cannot be used, ...) as one line,
+    ``gyrolab: warning: <message>``, not Python's two (file, line and source); others as Python does."""
+    shown = warnings.showwarning
+    if getattr(shown, "gyrolab_one_line", False):
+        return
+
+    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001 - warnings' signature
+        if issubclass(category, GyrolabWarning):
+            print(f"gyrolab: warning: {message}", file=sys.stderr if file is None else file)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    show.gyrolab_one_line = True
+    warnings.showwarning = show
 
 
 def preflight(argv: Sequence[str]) -> list[str]:
@@ -540,6 +558,7 @@ def main() -> None:
     # ~1 s of every command's wall time (0.1 s after a freeze, measured). Files are closed explicitly, so
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
+    show_warnings_in_one_line()
     argv = sys.argv[1:] = absolute_config_path(sys.argv[1:])
     if argv[:1] in (["--version"], ["-V"]):
         from gyrolab.output.provenance import gyrolab_version

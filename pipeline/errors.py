@@ -36,6 +36,10 @@ class OutputError(GyrolabError, OSError):
     exit_code = 3
 
 
+class GyrolabWarning(UserWarning):
+    """A warning the command line prints as one line, ``gyrolab: warning: <message>``."""
+
+
 #: the largest integer a float64 can hold (a longer integer cannot be used as a number)
 MAX_FLOAT_INT = int(1.7976931348623157e308)
 

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from gyrolab.contracts.claims import _rotation, axes_of as _axes, random_states, rotation_torque  # noqa: F401
 from gyrolab.contracts.force import Force
 from gyrolab.errors import ConfigError
 
@@ -48,44 +49,6 @@ def _test_body():
     from gyrolab.physics.body import Body
 
     return Body.from_config({"units": "nondimensional", "a": 0.7, "b": 0.9, "com_direction": [0.3, 0.4, 0.866025403784]})
-
-
-def random_states(n: int = 20, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """``n`` random angular velocities (n, 3) and attitudes (n, 3, 3): rows α, β, γ, a right-handed frame."""
-    rng = np.random.default_rng(seed)
-    frames = np.empty((n, 3, 3))
-    for k in range(n):
-        q, r = np.linalg.qr(rng.normal(size=(3, 3)))
-        q = q * np.sign(np.diag(r))
-        if np.linalg.det(q) < 0:
-            q[:, 0] = -q[:, 0]
-        frames[k] = q.T  # rows e_0, e_1, e_2 with e_0 × e_1 = e_2
-    return rng.normal(scale=2.0, size=(n, 3)), frames
-
-
-def _axes(force: Force, frame: np.ndarray) -> tuple:
-    return tuple(frame[..., i, :] if i in force.required_axes else None for i in range(3))
-
-
-def _rotation(axis: int, angle: float) -> np.ndarray:
-    """Rotation matrix about body axis ``axis``: v → v + angle ê × v to first order."""
-    c, s = math.cos(angle), math.sin(angle)
-    i, j = (axis + 1) % 3, (axis + 2) % 3
-    r = np.eye(3)
-    r[i, i], r[i, j], r[j, i], r[j, j] = c, -s, s, c
-    return r
-
-
-def rotation_torque(force: Force, frame: np.ndarray, h: float = 1e-5) -> np.ndarray:
-    """Σ e_i × ∂V/∂e_i by central differences: component k is dV/dε for the axes rotated by ε about body axis k."""
-    out = np.empty(3)
-    for k in range(3):
-        plus = frame @ _rotation(k, h).T  # rows e_i → R e_i
-        minus = frame @ _rotation(k, -h).T
-        v_plus = np.asarray(force.potential(_axes(force, plus[None])), dtype=float)
-        v_minus = np.asarray(force.potential(_axes(force, minus[None])), dtype=float)
-        out[k] = float((v_plus - v_minus).reshape(-1)[0]) / (2 * h)
-    return out
 
 
 def _call(force: Force, omega: np.ndarray, frame: np.ndarray, t: float) -> Any:

@@ -9,6 +9,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from gyrolab.contracts.integrator_rules import checked
+
 RightHandSide = Callable[[float, np.ndarray], np.ndarray]
 ProgressCallback = Callable[[float], None]
 
@@ -73,7 +75,23 @@ class Integrator(ABC):
        instead of calling ``fun``; the scene refuses it, before integrating,
        for a system or force that has no compiled form.
     7. ``attributes()`` gives its settings for the dataset.
+    8. ``prepare(system)`` is called once by the scene before integrating
+       (default: nothing); ``auto`` uses it to consult the system's regimes.
+
+    What gyrolab enforces (``gyrolab.contracts.integrator_rules``): every
+    subclass's ``integrate`` — built-in or third-party, under its own name —
+    is wrapped when the class is defined, so that each call checks y0 (finite,
+    1-D) and ``t_out`` (strictly increasing), then the returned ``Solution``
+    (``t`` of len(t_out), ``y`` of shape (len(t_out), len(y0)), all finite,
+    ``IntegratorStats``). A violation, or any exception that is not a
+    ``gyrolab.errors.GyrolabError``, ends the run as one ``IntegrationError``
+    sentence naming the integrator (exit code 3); nothing is written.
     """
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if "integrate" in cls.__dict__:  # the class's own integrate, not an inherited (already wrapped) one
+            cls.integrate = checked(cls.__dict__["integrate"])
 
     name: ClassVar[str]
     adaptive: ClassVar[bool]

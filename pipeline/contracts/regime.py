@@ -39,6 +39,18 @@ class Regime(ABC):
     6. ``euler_angles(system, t)`` returns ``{"psi", "theta", "phi"}`` of the
        analytic solution (ψ(0) = scene's ψ0).
     7. ``attributes()`` describes the regime for the dataset (netCDF-safe values).
+    8. Optionally, ``diagnostics(system)`` returns extra evidence for a
+       regime run's dataset as (data variables, coordinates, attributes)
+       (``gyrolab.experiments.regime_run``); the default has none.
+    9. Optionally, ``series_candidates(system, accuracy)`` lists variants of
+       the regime (lowest series order first) with their predicted max error
+       (NaN: not predicted), for ``integrator=auto``; the default is the
+       regime itself, unpredicted.
+    10. Optionally, ``period_spread`` (a class attribute ≥ 1) bounds the
+        scene's true period to [T/spread, T·spread] around ``period(system)``;
+        ``integrator=auto`` then rules the regime out cheaply when the scene's
+        motion never comes back near its start over that range. None (the
+        default): no such screen.
     """
 
     name: ClassVar[str]
@@ -47,6 +59,8 @@ class Regime(ABC):
     parameter_long_name: ClassVar[str]
     #: the theory's error order of each variable in the parameter (error ∝ parameter**order)
     order: ClassVar[dict[str, float]] = {}
+    #: rule 10: bound of the true period around ``period(system)``, or None (no screen)
+    period_spread: ClassVar[float | None] = None
 
     def __init__(self, *, formula: str = "corrected") -> None:
         if formula not in FORMULAS:
@@ -76,6 +90,14 @@ class Regime(ABC):
     @abstractmethod
     def euler_angles(self, system: System, t: np.ndarray) -> dict[str, np.ndarray]:
         """ψ, θ, φ of the analytic solution at times t."""
+
+    def diagnostics(self, system: System) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
+        """Rule 8: (data variables, coordinates, attributes) of extra evidence; none by default."""
+        return {}, {}, {}
+
+    def series_candidates(self, system: System, accuracy: float) -> list[tuple[Regime, float]]:
+        """Rule 9: variants predicted to meet ``accuracy`` with their predicted max error; itself, unpredicted."""
+        return [(self, float("nan"))]
 
     def attributes(self) -> dict[str, Any]:
         return {"regime": self.name, "regime_formula": self.formula, "regime_parameter": self.parameter}

@@ -4,6 +4,14 @@ Names are listed without importing anything; a plugin's module is imported
 the first time a scene asks for it. A config's ``_target_`` may only name a
 registered class of the group's contract, so a YAML file cannot make gyrolab
 call arbitrary code.
+
+A third-party plugin that cannot be used — its module fails to import (any
+exception), its entry point names no subclass of the contract, or its
+``__init__`` takes ``**params`` — never breaks a command that does not use it:
+``load`` raises one ``ConfigError`` naming the plugin, its distribution, its
+entry point and the error, and whoever lists every plugin (the config
+composition) turns that into one ``PluginLoadWarning`` and goes on, as xarray
+does with its backends.
 """
 
 from __future__ import annotations
@@ -16,7 +24,7 @@ from importlib.metadata import entry_points
 from typing import Any
 
 from gyrolab.contracts import Force, Integrator, Regime, System
-from gyrolab.errors import ConfigError, choices
+from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
 
 #: config group -> (entry-point group, contract class)
 GROUPS: dict[str, tuple[str, type]] = {
@@ -70,11 +78,19 @@ def _normalise(target: str) -> str:
     return target
 
 
+class PluginLoadWarning(GyrolabWarning):
+    """A third-party plugin cannot be used; every command that does not use it goes on."""
+
+
+#: the entry points behind ``external(group)``, refreshed with it (``origin`` names their distributions)
+_ENTRY_POINTS: dict[str, dict[str, Any]] = {}
+
+
 @cache
 def external(group: str) -> dict[str, str]:
     """Entry-point plugins of a group: name -> 'module:Class' (nothing imported)."""
     ep_group, _ = GROUPS[group]
-    found: dict[str, str] = {}
+    found: dict[str, Any] = {}
     for ep in entry_points(group=ep_group):
         if ep.name in BUILTINS[group] or ep.name in found:
             warnings.warn(
@@ -82,8 +98,26 @@ def external(group: str) -> dict[str, str]:
                 stacklevel=2,
             )
             continue
-        found[ep.name] = ep.value
-    return found
+        found[ep.name] = ep
+    _ENTRY_POINTS[group] = found
+    return {name: ep.value for name, ep in found.items()}
+
+
+def origin(group: str, name: str) -> str:
+    """Where a registered plugin comes from, for error sentences: "distribution 'x' (entry point a = m:C)"."""
+    external(group)  # (re)reads the entry points when the cache was cleared
+    ep = _ENTRY_POINTS.get(group, {}).get(name)
+    if ep is None:
+        return f"gyrolab's built-in {BUILTINS[group].get(name, '?')}"
+    dist = getattr(ep, "dist", None)
+    dist_name = getattr(dist, "name", None) if dist is not None else None
+    where = f"distribution {dist_name!r}" if dist_name else "an unknown distribution"
+    return f"{where} (entry point {ep.name} = {ep.value})"
+
+
+def unusable_warning(group: str, name: str, error: ConfigError) -> None:
+    """One warning line for a third-party plugin that cannot be used (``load`` said why)."""
+    warnings.warn(f"{error}; gyrolab goes on without it", PluginLoadWarning, stacklevel=2)
 
 
 def targets(group: str) -> dict[str, str]:
@@ -106,15 +140,28 @@ def _import(target: str) -> type:
 
 
 def load(group: str, name: str) -> type:
-    """The plugin class registered under ``name``; ConfigError listing the valid names otherwise."""
+    """The plugin class registered under ``name``; one ConfigError sentence otherwise.
+
+    The sentence lists the valid names for an unknown one; for a third-party plugin that cannot be
+    used it names the plugin, its distribution and entry point, and the error (import errors of any
+    type: a plugin's module may raise anything while it is imported).
+    """
     registered = targets(group)
     if name not in registered:
         raise ConfigError(f"unknown {group} {name!r}; valid choices: {choices(registered)}")
-    cls = _import(registered[name])
+    try:
+        cls = _import(registered[name])
+    except Exception as exc:  # noqa: BLE001 - a third-party module may raise anything on import
+        if name in BUILTINS[group]:
+            raise  # gyrolab's own: a bug, with its traceback
+        raise ConfigError(
+            f"{group} plugin {name!r} from {origin(group, name)} cannot be imported "
+            f"({type(exc).__name__}: {shorten(str(exc), 160)}); fix or uninstall that distribution"
+        ) from None
     _, contract = GROUPS[group]
     if not (inspect.isclass(cls) and issubclass(cls, contract)):
         raise ConfigError(
-            f"{group} plugin {name!r} ({registered[name]}) is not a {contract.__name__} subclass; "
+            f"{group} plugin {name!r} from {origin(group, name)} is not a {contract.__name__} subclass; "
             "fix the plugin package's entry point"
         )
     return cls
@@ -133,9 +180,22 @@ def resolve_target(group: str, target: Any, where: str) -> tuple[str, type]:
 
 
 def default_params(cls: type) -> dict[str, Any]:
-    """A plugin's config parameters and defaults, read from its ``__init__`` keywords."""
+    """A plugin's config parameters and defaults, read from its ``__init__`` keywords.
+
+    The signature is the plugin's config schema, so it must be explicit: an ``__init__`` taking
+    ``**params`` would accept any key (a typo included) and advertise none, and is refused in one
+    sentence (as xarray's backends ``detect_parameters`` refuses ``**kwargs``).
+    """
     params: dict[str, Any] = {}
-    for p in inspect.signature(cls.__init__).parameters.values():
+    signature = inspect.signature(cls.__init__)
+    variadic = [p.name for p in signature.parameters.values() if p.kind is p.VAR_KEYWORD]
+    if variadic:
+        raise ConfigError(
+            f"plugin {getattr(cls, 'name', cls.__name__)!r} ({cls.__module__}.{cls.__qualname__}) takes "
+            f"**{variadic[0]} in __init__, so its parameters are unknown; declare each parameter as a keyword "
+            "with a default (def __init__(self, body, *, coefficient=0.1))"
+        )
+    for p in signature.parameters.values():
         if p.kind is p.KEYWORD_ONLY or (p.kind is p.POSITIONAL_OR_KEYWORD and p.default is not p.empty):
             params[p.name] = None if p.default is p.empty else p.default
     return params

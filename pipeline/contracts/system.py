@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, ClassVar
 
 import numpy as np
@@ -35,11 +35,40 @@ class System(ABC):
        for the dataset; ``title()`` names the scene in a few words for figures.
     6. Optionally, ``compiled_model()`` returns the system (with its forces)
        in the compiled kernels' form, or None when some part has none; the
-       compiled integrators need it.
+       compiled integrators need it. When it returns None it sets
+       ``compile_error`` to one sentence saying why (the scene and ``--batch``
+       quote it when a compiled integrator is asked for); None: no reason known.
+    7. Optionally, ``invariant_values(y)`` returns each monitored invariant
+       (``invariants``) along states of shape (..., state size), vectorised
+       over any leading dimensions; ``--batch`` (``gyrolab.batch.outputs``)
+       uses it for the drifts of many trajectories at once. None (the
+       default): ``--batch`` computes them from ``variables``, one trajectory
+       at a time.
+    8. Optionally, ``initial_states(initial, columns)`` returns
+       ``initial_state()`` for many points at once (``gyrolab.batch.plan``):
+       ``initial`` is the config's initial node, ``columns`` maps initial keys
+       to arrays (one value per point); it returns the states (points × state
+       size) and a boolean array of valid rows. None (the default): the batch
+       builds one system per distinct point.
+    9. Optionally, ``reference_frame(y)`` returns the body components of the
+       reference axes at state ``y`` as a (3, 3) array (rows α, β, γ), or
+       None when the state does not carry them (the default). The scene checks
+       a third-party force's claims (``gyrolab.contracts.claims``) at the
+       initial state's frame when it is known, and at seeded random frames.
+    10. ``_batch_units`` is a cache the batch owns (the units of the system's
+        variables, ``gyrolab.batch.outputs``); implementers leave it alone.
     """
 
     name: ClassVar[str]
     body_type: ClassVar[type]
+    #: rule 6: why ``compiled_model()`` returned None, or None
+    compile_error: str | None = None
+    #: rule 7: ``invariant_values(y) -> {name: values}``, or None when the system has no vectorised form
+    invariant_values: Callable[[np.ndarray], dict[str, np.ndarray]] | None = None
+    #: rule 8: ``initial_states(initial, columns) -> (states, valid)``, or None when the system has no batch form
+    initial_states: Callable[..., tuple[np.ndarray, np.ndarray]] | None = None
+    #: rule 10: the batch's cache of the variables' units
+    _batch_units: dict[str, str] | None = None
 
     def __init__(self, body: Any, forces: Sequence[Force], initial: Any, output: Any) -> None:
         self.body = body
@@ -72,6 +101,10 @@ class System(ABC):
 
     def compiled_model(self) -> CompiledModel | None:
         """The system in compiled form, or None (then only Python integrators run it)."""
+        return None
+
+    def reference_frame(self, y: np.ndarray) -> np.ndarray | None:
+        """Rule 9: rows α, β, γ (body components of the reference axes) at state ``y``, or None."""
         return None
 
     def title(self) -> str:

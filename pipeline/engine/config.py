@@ -113,12 +113,19 @@ def register_plugin_configs() -> None:
 
     Built-in plugins have YAML files in ``conf/``; a plugin package only
     registers an entry point, and this makes ``force=[..., its_name]`` work.
+    A plugin that cannot be used (its module fails to import, ``**params``, ...) costs one
+    ``PluginLoadWarning`` and gets a node without parameters, so that a scene naming it composes
+    and is then refused by ``registry.load`` in one sentence, while every other command works.
     """
     store = ConfigStore.instance()
     for group in registry.GROUPS:
         for name, target in registry.external(group).items():
-            cls = registry.load(group, name)
-            node = {"_target_": target, **registry.default_params(cls)}
+            try:
+                params = registry.default_params(registry.load(group, name))
+            except ConfigError as error:
+                registry.unusable_warning(group, name, error)
+                params = {}
+            node = {"_target_": target, **params}
             # A force option nests under its own name so that several can be selected at once.
             store.store(group=group, name=name, node={name: node} if group == "force" else node)
 

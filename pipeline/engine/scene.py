@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import logging
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
@@ -16,7 +16,8 @@ from gyrolab.contracts import registry
 from gyrolab.engine.config import compose_config
 from gyrolab.contracts import CompiledModel, Integrator, System
 from gyrolab.output.dataset import build_dataset, scene_attributes
-from gyrolab.errors import ConfigError, as_number, require_finite
+from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite, shorten
+from gyrolab.engine.force_guard import GuardedRhs, plugin_forces
 from gyrolab.engine.progress import Progress
 
 log = logging.getLogger(__name__)
@@ -53,6 +54,7 @@ class Scene:
             for name, node in (cfg.get("force") or {}).items()
         ]
         system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
+        check_force_claims(system, float(plain["time"].get("start", 0.0) or 0.0))
         timed = [f.name for f in forces if f.time_dependent]
         if timed and system.name != "fixed_point":
             raise ConfigError(f"force {timed[0]!r} is time-dependent, which system {system.name!r} does not support; "
@@ -63,7 +65,7 @@ class Scene:
         integrator.prepare(system)
         scene = cls(config=cfg, system=system, integrator=integrator, times=times, n_output_requested=requested)
         if integrator.needs_compiled_model and scene.compiled is None:
-            reason = getattr(system, "compile_error", None) or f"system {system.name!r} has no compiled form"
+            reason = system.compile_error or f"system {system.name!r} has no compiled form"
             raise ConfigError(
                 f"integrator {integrator.name!r} runs compiled models only, and {reason}; "
                 f"choose dop853 (or rk45, rk4, lsoda, radau, bdf) or integrator=auto"
@@ -83,7 +85,7 @@ class Scene:
                     f"choose dop853_numba, rk4_numba or integrator=auto"
                 )
         elif scene.compiled is None and integrator.prefers_compiled_model:
-            reason = getattr(system, "compile_error", None)
+            reason = system.compile_error
             if reason:
                 log.info("%s; %s runs scipy's integrators", reason, integrator.name)
         warning = scene.sampling_warning()
@@ -108,6 +110,13 @@ class Scene:
         integrator = self.integrator
         wants = integrator.needs_compiled_model or integrator.prefers_compiled_model
         return self.system.compiled_model() if wants else None
+
+    @cached_property
+    def rhs(self) -> Callable[[float, np.ndarray], np.ndarray]:
+        """The Python right-hand side the integrator calls: the system's own, guarded when a third-party force
+        takes part (``gyrolab.engine.force_guard``: its torque's faults become one sentence naming it)."""
+        plugins = plugin_forces(self.system.forces)
+        return GuardedRhs(self.system, plugins) if plugins else self.system.rhs
 
     @cached_property
     def fastest_rate(self) -> float | None:
@@ -149,8 +158,7 @@ class Scene:
                      self.integrator.name, self.times[0], self.times[-1], len(self.times))
         compiled = self.compiled  # a plugin's torque compiles here (once), before progress is timed
         progress = Progress(self.integrator.name, self.times[0], self.times[-1])
-        solution = self.integrator.integrate(self.system.rhs, self.times, self.system.initial_state(), progress,
-                                             compiled)
+        solution = self.integrator.integrate(self.rhs, self.times, self.system.initial_state(), progress, compiled)
         stats = solution.stats
         log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
                  "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)
@@ -175,8 +183,8 @@ def _plugin_class(group: str, node: Any, where: str) -> type:
     return cls
 
 
-def _build(cls: type, node: DictConfig, where: str, *args: Any) -> Any:
-    """Instantiate a registered plugin class with its config parameters (no nested instantiation)."""
+def _params(cls: type, node: DictConfig, where: str) -> dict[str, Any]:
+    """A plugin's config parameters, each one a keyword of its ``__init__`` (no nested instantiation)."""
     params = {k: v for k, v in OmegaConf.to_container(node, resolve=True).items() if k != "_target_"}
     for key, value in params.items():
         if isinstance(value, dict) and "_target_" in value:
@@ -186,29 +194,52 @@ def _build(cls: type, node: DictConfig, where: str, *args: Any) -> Any:
     if unknown:
         raise ConfigError(f"{where}.{unknown[0]} is not a parameter of {cls.__name__}; valid parameters: "
                           f"{', '.join(sorted(accepted)) or '(none)'}")
-    return cls(*args, **params)
+    return params
+
+
+def _build(cls: type, node: DictConfig, where: str, *args: Any) -> Any:
+    """Instantiate a registered plugin class with its config parameters; whatever its ``__init__`` raises
+    (RuntimeError, ImportError, SyntaxError, ...) becomes one ConfigError naming the plugin."""
+    params = _params(cls, node, where)
+    try:
+        return cls(*args, **params)
+    except GyrolabError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a plugin may raise anything; the user gets one sentence
+        raise init_failure(cls, where, exc) from exc
+
+
+def init_failure(cls: type, where: str, exc: BaseException) -> ConfigError:
+    """One sentence for a plugin ``__init__`` that raised something other than gyrolab's ConfigError."""
+    name = getattr(cls, "name", cls.__name__)
+    return ConfigError(f"{where}: plugin {name!r} ({cls.__module__}.{cls.__qualname__}) failed to build: "
+                       f"{type(exc).__name__}: {shorten(str(exc), 160) or '(no message)'}; its __init__ should "
+                       "raise gyrolab.errors.ConfigError naming the bad value")
 
 
 def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
     """Instantiate a force plugin; its ValueError/TypeError becomes one ConfigError naming the parameter.
 
     ``node`` is the force's config (a DictConfig or a dict of parameters). The culprit is found by
-    building the force with each given parameter alone; the force must declare its area-integral flag.
+    building the force with each given parameter alone; any other exception becomes one sentence
+    naming the plugin (``init_failure``); the force must declare its area-integral flag.
     """
     from gyrolab.contracts.force import check_declared
 
     if not isinstance(node, DictConfig):
         node = OmegaConf.create(dict(node))
+    params = _params(cls, node, where)
     try:
-        force = _build(cls, node, where, body)
+        force = cls(body, **params)
+    except GyrolabError:
+        raise
     except (ValueError, TypeError) as exc:
-        if isinstance(exc, ConfigError):
-            raise
-        params = {k: v for k, v in OmegaConf.to_container(node, resolve=True).items() if k != "_target_"}
         culprit = next((key for key in params if _fails(cls, body, {key: params[key]})), None)
         named = f"{where}.{culprit}={params[culprit]!r}" if culprit else \
             f"{where} ({', '.join(f'{k}={v!r}' for k, v in params.items()) or 'defaults'})"
         raise ConfigError(f"{named} is not valid for {cls.__name__}: {type(exc).__name__}: {exc}") from None
+    except Exception as exc:  # noqa: BLE001 - RuntimeError, ImportError, SyntaxError, ... from a plugin
+        raise init_failure(cls, where, exc) from exc
     check_declared(force, where)
     return force
 
@@ -216,9 +247,26 @@ def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
 def _fails(cls: type, body: Any, params: dict[str, Any]) -> bool:
     try:
         cls(body, **params)
-    except (ValueError, TypeError):
+    except Exception:  # noqa: BLE001 - only which parameter fails matters here
         return True
     return False
+
+
+def check_force_claims(system: System, t0: float = 0.0) -> None:
+    """ConfigError when a third-party force's potential does not belong to its torque, or its
+    ``preserves_area_integral = True`` is false (``gyrolab.contracts.claims``), at the initial state and
+    seeded random states. gyrolab's own forces are tested against closed forms and skipped."""
+    plugins = plugin_forces(system.forces)
+    if not plugins:
+        return
+    from gyrolab.contracts.claims import check_claims, claim_states
+
+    y0 = np.asarray(system.initial_state(), dtype=float)
+    frame0 = system.reference_frame(y0)
+    omegas, frames = claim_states(y0[:3], frame0)
+    for force in plugins:
+        if force.preserves_area_integral or force.conservative:
+            check_claims(force, omegas, frames, t0, f"force.{force.name}", initial=frame0 is not None)
 
 
 def fastest_rate(system: System) -> float | None:

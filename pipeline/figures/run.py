@@ -74,11 +74,14 @@ def draw_invariants(ds: xr.Dataset) -> plt.Figure:
     """Absolute drift |I(t) − I(0)| of every monitored first integral (log scale; exact zeros are gaps)."""
     fig, axes = subplots(1, 1, width=SINGLE, height=2.9)
     ax = axes[0, 0]
-    exact = []
+    exact, violated = [], []
     for name in ds.attrs.get("monitored_invariants", "").split():
         if name not in ds:
             continue
         symbol, kind = INVARIANTS.get(name, (ds[name].attrs.get("long_name", name), "1"))
+        if ds[name].attrs.get("invariant_check") == "violated":  # run.nc says the run does not conserve it
+            violated.append(symbol)
+            continue
         values = ds[name].values
         drift = log_positive(np.abs(values - values[0]))
         if not np.isfinite(drift).any():
@@ -91,6 +94,8 @@ def draw_invariants(ds: xr.Dataset) -> plt.Figure:
     ax.grid(True, which="both", alpha=0.25)
     if exact:
         panel_note(ax, f"conserved exactly (not drawn): {', '.join(exact)}")
+    if violated:
+        panel_note(ax, f"NOT conserved by this run (flagged violated in run.nc, not drawn): {', '.join(violated)}")
     legend_outside(fig, [ax], ncols=1)
     return fig
 

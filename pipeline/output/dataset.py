@@ -7,6 +7,7 @@ its own dataset (``Scene.from_config(OmegaConf.create(ds.attrs["config"]))``).
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -17,11 +18,14 @@ from gyrolab.contracts.integrator import Solution
 from gyrolab.errors import ConfigError
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.cf import conform, unit_attributes
+from gyrolab.output.invariant_check import violated_invariants, violation_sentence
 from gyrolab.output.provenance import provenance
 
 if TYPE_CHECKING:
     from gyrolab.engine.scene import Scene
     from gyrolab.physics.body import ModelUnits
+
+log = logging.getLogger(__name__)
 
 #: labels of the ``frame_axis`` dimension (the orbiting gyrostat's orbital and inertial frames)
 FRAME_AXES = ("x_radial", "y_along_track", "z_normal")
@@ -58,7 +62,26 @@ def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
     ds.attrs.update(integrator.attributes())
     ds.attrs.update(solution.stats.attributes())
     ds.attrs.update(after)
+    flag_violated_invariants(ds, system.invariants, integrator.adaptive)
     return conform(ds, source=f"run of system {system.name} with integrator {integrator.name}")
+
+
+def flag_violated_invariants(ds: xr.Dataset, invariants: tuple[str, ...], adaptive: bool) -> list[str]:
+    """Flag each monitored invariant whose drift the integration error does not explain
+    (``gyrolab.output.invariant_check``): one warning each, ``invariant_check = "violated"`` and a ``comment``
+    on its variable, and the names in the dataset attribute ``violated_invariants``. The figures do not
+    draw a flagged invariant as conserved. Returns the flagged names."""
+    span = float(ds["time"].values[-1] - ds["time"].values[0]) if ds.sizes.get("time", 0) else 0.0
+    series = {name: ds[name].values for name in invariants if name in ds}
+    found = violated_invariants(series, invariants, ds.attrs, adaptive, span)
+    for name, (drift, allowed) in found.items():
+        sentence = violation_sentence(name, drift, allowed)
+        log.warning("%s", sentence)
+        ds[name].attrs.update({"invariant_check": "violated", "invariant_allowed_drift": allowed,
+                               "comment": sentence})
+    if found:
+        ds.attrs["violated_invariants"] = " ".join(found)
+    return list(found)
 
 
 def scene_attributes(scene: Scene) -> tuple[dict[str, Any], dict[str, Any]]:

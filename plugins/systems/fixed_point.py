@@ -88,6 +88,17 @@ class FixedPoint(System):
         beta = cross(gamma, alpha) if self.needs_beta else None
         return alpha, beta, gamma
 
+    def reference_frame(self, y: np.ndarray) -> np.ndarray:
+        """Rows α, β, γ at state ``y``. Without α in the state every force reads γ only, so any frame with
+        that γ serves (α is then the unit vector of e × γ, e the body axis least aligned with γ)."""
+        gamma = np.asarray(y[3:6], dtype=float)
+        if self.carries_alpha:
+            alpha = np.asarray(y[6:9], dtype=float)
+        else:
+            alpha = np.cross(np.eye(3)[int(np.argmin(np.abs(gamma)))], gamma)
+            alpha = alpha / np.linalg.norm(alpha)
+        return np.array([alpha, np.cross(gamma, alpha), gamma])
+
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         omega = y[0:3]
         axes = self._axes(y)

@@ -70,6 +70,11 @@ class OrbitingGyrostat(System):
         alpha, gamma = y[..., 3:6], y[..., 6:9]
         return alpha, (cross(gamma, alpha) if self.needs_beta else None), gamma
 
+    def reference_frame(self, y: np.ndarray) -> np.ndarray:
+        """Rows α (radial), β (along-track), γ (orbit normal) at state ``y``."""
+        alpha, gamma = np.asarray(y[3:6], dtype=float), np.asarray(y[6:9], dtype=float)
+        return np.array([alpha, np.cross(gamma, alpha), gamma])
+
     def derivative(self, y: np.ndarray) -> np.ndarray:
         """dy/dt for one state (9,) or a stack (n, 9); real or complex (complex-step Jacobians)."""
         omega = y[..., 0:3]

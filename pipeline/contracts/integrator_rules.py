@@ -1,0 +1,89 @@
+"""The integrator contract's rules, checked on every call of every ``Integrator.integrate``.
+
+``Integrator.__init_subclass__`` wraps each subclass's own ``integrate`` with :func:`checked`, so the
+rules hold for gyrolab's integrators and third-party ones alike without asking anyone to rename a
+method (as scipy's ``OdeSolver.step`` owns the checks around a solver's ``_step_impl``). The checks
+are vectorised: for a 2,001 × 6 output they cost a few microseconds of a ~2 ms compiled run.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from gyrolab.errors import GyrolabError, IntegrationError, shorten
+
+#: marks a wrapped ``integrate`` so that it is never wrapped twice
+_CHECKED = "__gyrolab_checked__"
+
+
+def checked(integrate: Callable[..., Any]) -> Callable[..., Any]:
+    """``integrate`` with the contract's rules checked before and after it (see ``Integrator``'s rules 2–4)."""
+    if getattr(integrate, _CHECKED, False):
+        return integrate
+
+    @functools.wraps(integrate)
+    def wrapper(self: Any, fun: Any, t_out: Any, y0: Any, *args: Any, **kwargs: Any) -> Any:
+        name = _name(self)
+        t_out, y0 = check_inputs(name, t_out, y0)
+        try:
+            solution = integrate(self, fun, t_out, y0, *args, **kwargs)
+        except GyrolabError:
+            raise  # already one sentence (a force's torque named by the scene's guard, a failed step, ...)
+        except Exception as exc:  # noqa: BLE001 - a plugin may raise anything; the user gets one sentence
+            raise IntegrationError(f"integrator {name!r} raised {type(exc).__name__}: "
+                                   f"{shorten(str(exc), 200) or '(no message)'}") from exc
+        check_solution(name, solution, t_out, len(y0))
+        return solution
+
+    setattr(wrapper, _CHECKED, True)
+    return wrapper
+
+
+def _name(integrator: Any) -> str:
+    return str(getattr(integrator, "name", type(integrator).__name__))
+
+
+def check_inputs(name: str, t_out: Any, y0: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``t_out`` and ``y0`` as float arrays; IntegrationError unless y0 is finite and 1-D and t_out increases."""
+    t_out = np.asarray(t_out, dtype=float)
+    y0 = np.asarray(y0, dtype=float)
+    if y0.ndim != 1 or not np.isfinite(y0).all():
+        raise IntegrationError(f"integrator {name!r} was given an initial state of shape {y0.shape} "
+                               f"({np.count_nonzero(~np.isfinite(y0))} non-finite values); it takes one finite "
+                               "1-D state")
+    if t_out.ndim != 1 or len(t_out) < 1 or not np.isfinite(t_out).all() or (np.diff(t_out) <= 0).any():
+        raise IntegrationError(f"integrator {name!r} was given output times that are not finite and strictly "
+                               f"increasing (shape {t_out.shape}); t_out[0] is the initial time, then increasing")
+    return t_out, y0
+
+
+def check_solution(name: str, solution: Any, t_out: np.ndarray, size: int) -> None:
+    """IntegrationError (one sentence naming the integrator and what is wrong) unless ``solution`` keeps the
+    contract: a ``Solution`` with ``t`` of len(t_out), ``y`` of shape (len(t_out), size), all finite, and stats."""
+    from gyrolab.contracts.integrator import IntegratorStats, Solution
+
+    rule = "(gyrolab.contracts.Integrator, rules 2–4)"
+    if not isinstance(solution, Solution):
+        raise IntegrationError(f"integrator {name!r} returned {type(solution).__name__}, not a "
+                               f"gyrolab.contracts.Solution {rule}")
+    n = len(t_out)
+    t, y = np.asarray(solution.t), np.asarray(solution.y)
+    if t.shape != (n,):
+        raise IntegrationError(f"integrator {name!r} returned times of shape {t.shape} for {n} output times; "
+                               f"Solution.t must be t_out {rule}")
+    if y.shape != (n, size):
+        raise IntegrationError(f"integrator {name!r} returned states of shape {y.shape}; Solution.y must be "
+                               f"{n}×{size} (one state of size {size} per output time) {rule}")
+    if not isinstance(solution.stats, IntegratorStats):
+        raise IntegrationError(f"integrator {name!r} returned stats of type {type(solution.stats).__name__}; "
+                               f"Solution.stats must be an IntegratorStats (evaluations, steps, wall time) {rule}")
+    if not np.isfinite(y).all():  # one vectorised pass; the rest runs only on failure
+        bad = ~np.isfinite(y)
+        first = int(np.argmax(bad.any(axis=1)))
+        raise IntegrationError(f"integrator {name!r} returned {int(bad.sum())} non-finite values of {n}×{size} "
+                               f"(from t = {t_out[first]:.6g}); an integrator must raise IntegrationError saying "
+                               f"when and why instead {rule}")

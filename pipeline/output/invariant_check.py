@@ -1,0 +1,89 @@
+"""Is a monitored invariant really conserved? Its drift against what the integration error explains.
+
+A scene monitors an invariant because its forces claim it (``Force`` rules 5 and 6). The scene checks a
+third-party force's claims when it is built (``gyrolab.contracts.claims``); this is the check of the run
+itself, made where the drifts are computed (``gyrolab.output.dataset``). An invariant ``I`` is flagged
+*violated* when its largest drift exceeds every bound the integration error could explain:
+
+    max_t |I(t) − I(0)|  >  S · max(FLOOR, E_tol, E_step, E_kin)
+
+* ``S = max(1, max_t |I(t)|)``: the invariant's scale (at least one model or SI unit: generous for
+  small quantities, never tighter than FLOOR in absolute terms);
+* ``FLOOR = 1e-6``: below that no drift is called a violation;
+* ``E_tol = EXPLAINED × τ × max(1, n_steps)`` for adaptive methods with a known tolerance τ
+  (``integrator_rtol``/``integrator_atol``, ``integrator_tol``, ``auto_tolerance``): each step's local
+  error is within about τ of the state's scale, and a non-symplectic method adds them up;
+* ``E_step = (h ν)² · ν T`` for fixed-step methods of step h (``integrator_step``) on a scene whose
+  fastest rate ν is known (``sampling_fastest_rate``), over the span T: the global error of any method
+  of order ≥ 2 with hν < 1, with its constant taken as one (an upper bound for RK4, Lie–Poisson);
+* ``E_kin = EXPLAINED × (the drift of |γ| and of the frame's orthonormality)``: those are conserved
+  whatever the torque, so their drift is the integration error this run actually made.
+
+``EXPLAINED = 1e3``. A run whose integrator says nothing it could be judged by (an adaptive method
+without a tolerance attribute, a fixed-step one without ``integrator_step`` and no kinematic invariant)
+is not judged. The kinematic invariants themselves are never flagged: they are the yardstick.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+import numpy as np
+
+#: invariants every torque conserves (the kinematics of the frame): the measure of the integration error
+KINEMATIC = ("gamma_norm", "frame_error")
+FLOOR = 1e-6
+EXPLAINED = 1e3
+#: attributes that give an adaptive method's tolerance (the largest is used)
+TOLERANCE_ATTRIBUTES = ("integrator_rtol", "integrator_atol", "integrator_tol", "auto_tolerance")
+
+
+def explained_error(attrs: Mapping[str, Any], adaptive: bool, kinematic_drift: float | None,
+                    span: float) -> float | None:
+    """The relative error the integration explains (max of E_tol, E_step, E_kin, FLOOR), or None: not judged."""
+    bounds = []
+    if adaptive:
+        tolerances = [float(attrs[k]) for k in TOLERANCE_ATTRIBUTES if k in attrs]
+        if tolerances:
+            bounds.append(EXPLAINED * max(tolerances) * max(1.0, float(attrs.get("integrator_n_steps", 1))))
+    else:
+        step, rate = attrs.get("integrator_step"), attrs.get("sampling_fastest_rate")
+        if step is not None and rate is not None:
+            h_nu = float(step) * float(rate)
+            bounds.append(h_nu * h_nu * max(1.0, float(rate) * span))
+    if kinematic_drift is not None:
+        bounds.append(EXPLAINED * kinematic_drift)
+    return max(FLOOR, *bounds) if bounds else None
+
+
+def violated_invariants(series: Mapping[str, np.ndarray], invariants: Iterable[str], attrs: Mapping[str, Any],
+                        adaptive: bool, span: float) -> dict[str, tuple[float, float]]:
+    """{name: (max drift, allowed drift)} of the monitored invariants whose drift the integration does not
+    explain (module docstring); ``series`` holds each invariant's values along the run."""
+    invariants = list(invariants)
+    kinematic = [_drift(series[k]) for k in KINEMATIC if k in invariants and k in series]
+    error = explained_error(attrs, adaptive, max(kinematic) if kinematic else None, span)
+    if error is None:
+        return {}
+    out = {}
+    for name in invariants:
+        if name in KINEMATIC or name not in series:
+            continue
+        values = np.asarray(series[name], dtype=float)
+        allowed = error * max(1.0, float(np.max(np.abs(values))))
+        drift = _drift(values)
+        if drift > allowed:
+            out[name] = (drift, allowed)
+    return out
+
+
+def _drift(values: np.ndarray) -> float:
+    values = np.asarray(values, dtype=float)
+    return float(max(values.max() - values[0], values[0] - values.min()))
+
+
+def violation_sentence(name: str, drift: float, allowed: float) -> str:
+    return (f"invariant {name!r} drifts by {drift:.3g}, more than the {allowed:.3g} the integration error explains; "
+            "a force's claim (its potential or preserves_area_integral) is likely false, so it is flagged "
+            "violated in run.nc and not drawn as conserved")
