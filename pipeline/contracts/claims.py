@@ -121,8 +121,9 @@ def check_claims(force: Any, omegas: np.ndarray, frames: np.ndarray, t0: float =
     if bool(force.preserves_area_integral):
         along = np.abs(np.einsum("ij,ij->i", torques, frames[:, 2, :]))
         size = np.linalg.norm(torques, axis=1)
-        worst = int(np.argmax(along - AREA_RTOL * size))
-        if along[worst] > AREA_RTOL * size[worst]:
+        broken = np.flatnonzero(along > AREA_RTOL * size)
+        if broken.size:
+            worst = int(broken[0])  # the first state that breaks the claim: the initial one when it does
             raise ConfigError(
                 f"{where}: force {force.name!r} declares preserves_area_integral = True, but its torque has the "
                 f"component torque·γ = {along[worst]:.3g} along the vertical γ (|torque| = {size[worst]:.3g}, "

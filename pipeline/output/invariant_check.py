@@ -13,11 +13,14 @@ itself, made where the drifts are computed (``gyrolab.output.dataset``). An inva
 * ``E_tol = EXPLAINED × τ × max(1, n_steps)`` for adaptive methods with a known tolerance τ
   (``integrator_rtol``/``integrator_atol``, ``integrator_tol``, ``auto_tolerance``): each step's local
   error is within about τ of the state's scale, and a non-symplectic method adds them up;
-* ``E_step = (h ν)² · ν T`` for fixed-step methods of step h (``integrator_step``) on a scene whose
-  fastest rate ν is known (``sampling_fastest_rate``), over the span T: the global error of any method
-  of order ≥ 2 with hν < 1, with its constant taken as one (an upper bound for RK4, Lie–Poisson);
+* ``E_step = (h ν)^p · max(1, ν T)`` for fixed-step methods of step h (``integrator_step``) on a scene
+  whose fastest rate ν is known (``sampling_fastest_rate``), over the span T: the global error of a
+  method of order p (``integrator_order`` when the dataset states it, else 2 — an upper bound for every
+  method of order ≥ 2 while hν < 1), with its constant taken as one. It matters for methods that keep
+  |γ| exactly (Lie–Poisson), whose kinematic drift says nothing of the energy's;
 * ``E_kin = EXPLAINED × (the drift of |γ| and of the frame's orthonormality)``: those are conserved
-  whatever the torque, so their drift is the integration error this run actually made.
+  whatever the torque, so their drift is the integration error this run actually made (a method that
+  does not keep them by construction errs on them as on the dynamics).
 
 ``EXPLAINED = 1e3``. A run whose integrator says nothing it could be judged by (an adaptive method
 without a tolerance attribute, a fixed-step one without ``integrator_step`` and no kinematic invariant)
@@ -50,8 +53,8 @@ def explained_error(attrs: Mapping[str, Any], adaptive: bool, kinematic_drift: f
     else:
         step, rate = attrs.get("integrator_step"), attrs.get("sampling_fastest_rate")
         if step is not None and rate is not None:
-            h_nu = float(step) * float(rate)
-            bounds.append(h_nu * h_nu * max(1.0, float(rate) * span))
+            order = float(attrs.get("integrator_order", 2))
+            bounds.append((float(step) * float(rate)) ** order * max(1.0, float(rate) * span))
     if kinematic_drift is not None:
         bounds.append(EXPLAINED * kinematic_drift)
     return max(FLOOR, *bounds) if bounds else None
