@@ -78,6 +78,14 @@ PLUGINS = textwrap.dedent('''
             return np.full(3, np.nan) * omega
 
 
+    class SqrtNegative(_Drag):
+        """NaN from a formula (not a NaN constant, which does not trace): the compiled kernel meets it."""
+        name = "sqrt_negative"
+
+        def torque(self, omega, axes):
+            return self.c * np.sqrt(-1.0 - dot(omega, omega)) * omega
+
+
     class NanLater(_Drag):
         """Finite at the start, NaN once the body has turned: log of a component that changes sign."""
         name = "nan_later"
@@ -198,6 +206,7 @@ PLUGINS = textwrap.dedent('''
             return None
 ''')
 FORCES = ("raising", "returns_none", "returns_string", "wrong_shape", "one_component", "nan_torque", "nan_later",
+          "sqrt_negative",
           "area_liar", "tilted", "half_potential", "init_fails", "variadic")
 INTEGRATORS = ("midpoint", "half_nan", "wrong_rows", "crashing", "no_solution")
 SHORT = ["time.end=2", "time.n_output=21", "output.figures=false"]
@@ -503,3 +512,18 @@ def test_a_bad_torque_through_the_real_command_line(plugins, cli, tmp_path):
     assert len(errors) == 1 and "torque of force 'nan_torque' returned the non-finite torque" in errors[0]
     assert "Traceback" not in done.stderr
     assert not list(tmp_path.rglob("run.nc"))
+
+
+def test_a_nan_torque_on_the_compiled_path_is_named_too(plugins):
+    with pytest.raises(ConfigError, match="force 'nan_torque' cannot be compiled: it uses the non-finite number"):
+        compose_scene(["force=[uniform_gravity,nan_torque]", "integrator=dop853_numba", *SHORT])  # refused at build
+    scene = compose_scene(["force=[uniform_gravity,sqrt_negative]", "integrator=dop853_numba", *SHORT])
+    assert scene.compiled is not None  # the formula traces: the compiled kernel meets the NaN
+    with pytest.raises(IntegrationError) as caught:
+        scene.run()
+    assert "torque of force 'sqrt_negative' returned the non-finite torque" in one_sentence(caught.value)
+    later = compose_scene(["force=[uniform_gravity,nan_later]", "integrator=dop853_numba", *SHORT, "time.end=20",
+                           "initial.r0=3"])
+    with pytest.raises(IntegrationError) as caught:  # NaN only later: the kernel's own sentence
+        later.run()
+    assert "dop853_numba failed near t=" in one_sentence(caught.value)

@@ -32,13 +32,15 @@ class Force(ABC):
 
     Rules for implementers (``gyrolab.testing.check_force`` checks them; run it in your tests):
 
-    1. ``__init__(self, body, **params)`` takes the system's body (in model
-       units, see ``gyrolab.physics.body``) and the plugin's config parameters as
-       keyword arguments with defaults; it validates them and raises
+    1. ``__init__(self, body, *, coefficient=0.1, ...)`` takes the system's
+       body (in model units, see ``gyrolab.physics.body``) and the plugin's
+       config parameters, each declared as a keyword with a default (the
+       defaults are the plugin's default config; ``**params`` is refused, as it
+       would accept any key and advertise none); it validates them and raises
        ``gyrolab.errors.ConfigError`` (one sentence, naming the bad value) on
-       bad input. The keyword defaults are the plugin's default config. A
-       ``ValueError`` or ``TypeError`` escaping ``__init__`` (``float("abc")``)
-       is reported by gyrolab as one sentence naming the parameter.
+       bad input. A ``ValueError`` or ``TypeError`` escaping ``__init__``
+       (``float("abc")``) is reported by gyrolab as one sentence naming the
+       parameter; any other exception as one sentence naming the plugin.
     2. ``required_axes`` names the reference-frame axes (0, 1, 2) whose body
        components ``torque`` and ``potential`` read. A system carries an axis
        only if some force (or the output) needs it, so ask for no more; an axis
@@ -74,6 +76,17 @@ class Force(ABC):
        evaluates; a traced torque (rule 3) runs with ``dop853_numba``,
        ``rk4_numba``, ``--batch`` and ``auto`` (through DOP853), not ``taylor``
        or ``lie_poisson``.
+
+    What gyrolab enforces on a third-party force (gyrolab's own are trusted),
+    each failure one sentence naming the force (docs/plugins.md, "What the
+    engine checks"): when the scene is built, the claims of rules 5 and 6 are
+    measured at the initial state and seeded random states
+    (``gyrolab.contracts.claims``; a false one is a ConfigError); during a run
+    on the Python right-hand side, a torque that raises or breaks rule 3
+    (None, a string, a wrong shape, NaN) ends the run as an IntegrationError
+    (``gyrolab.engine.force_guard``); after it, an invariant whose drift the
+    integration error does not explain is flagged in ``run.nc``
+    (``gyrolab.output.invariant_check``).
     """
 
     name: ClassVar[str]

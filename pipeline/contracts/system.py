@@ -20,9 +20,10 @@ class System(ABC):
 
     1. ``body_type`` is the class that reads the ``body`` config section
        (``body_type.from_config(cfg)``); forces are built with that body.
-    2. ``__init__(self, body, forces, initial, output, **params)`` receives
-       the body, the built forces, the ``initial`` and ``output`` config
-       sections and the system's own parameters; it validates the initial
+    2. ``__init__(self, body, forces, initial, output, *, param=default, ...)``
+       receives the body, the built forces, the ``initial`` and ``output``
+       config sections and the system's own parameters (each a keyword with a
+       default: ``**params`` is refused); it validates the initial
        state (one-sentence ``ConfigError``) and decides the state layout.
        It carries only the state its forces and requested outputs need.
     3. ``initial_state()`` returns y0; ``rhs(t, y)`` returns dy/dt (model

@@ -16,7 +16,7 @@ from gyrolab.contracts import registry
 from gyrolab.engine.config import compose_config
 from gyrolab.contracts import CompiledModel, Integrator, System
 from gyrolab.output.dataset import build_dataset, scene_attributes
-from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite, shorten
+from gyrolab.errors import ConfigError, GyrolabError, IntegrationError, as_number, require_finite, shorten
 from gyrolab.engine.force_guard import GuardedRhs, plugin_forces
 from gyrolab.engine.progress import Progress
 
@@ -62,7 +62,12 @@ class Scene:
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
         requested = plain["time"].get("n_output", AUTO)
         times = _output_times(plain["time"], fastest_rate(system))
-        integrator.prepare(system)
+        try:
+            integrator.prepare(system)
+        except GyrolabError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - a third-party integrator's prepare: one sentence naming it
+            raise init_failure(type(integrator), "integrator", exc) from exc
         scene = cls(config=cfg, system=system, integrator=integrator, times=times, n_output_requested=requested)
         if integrator.needs_compiled_model and scene.compiled is None:
             reason = system.compile_error or f"system {system.name!r} has no compiled form"
@@ -158,7 +163,15 @@ class Scene:
                      self.integrator.name, self.times[0], self.times[-1], len(self.times))
         compiled = self.compiled  # a plugin's torque compiles here (once), before progress is timed
         progress = Progress(self.integrator.name, self.times[0], self.times[-1])
-        solution = self.integrator.integrate(self.rhs, self.times, self.system.initial_state(), progress, compiled)
+        y0 = self.system.initial_state()
+        try:
+            solution = self.integrator.integrate(self.rhs, self.times, y0, progress, compiled)
+        except IntegrationError:
+            if compiled is not None and isinstance(self.rhs, GuardedRhs):
+                # the compiled path ran a plugin's traced torque: name the force when its Python torque is at
+                # fault at the start (the usual case: NaN or inf in its formula)
+                GuardedRhs(self.system, self.rhs.plugins).inspect(float(self.times[0]), y0)
+            raise
         stats = solution.stats
         log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
                  "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)
