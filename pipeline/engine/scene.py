@@ -16,7 +16,7 @@ from gyrolab.contracts import registry
 from gyrolab.engine.config import compose_config
 from gyrolab.contracts import CompiledModel, Integrator, System
 from gyrolab.output.dataset import build_dataset, scene_attributes
-from gyrolab.errors import ConfigError, GyrolabError, IntegrationError, as_number, require_finite, shorten
+from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite, shorten
 from gyrolab.engine.force_guard import GuardedRhs, plugin_forces
 from gyrolab.engine.progress import Progress
 
@@ -164,14 +164,11 @@ class Scene:
         compiled = self.compiled  # a plugin's torque compiles here (once), before progress is timed
         progress = Progress(self.integrator.name, self.times[0], self.times[-1])
         y0 = self.system.initial_state()
-        try:
-            solution = self.integrator.integrate(self.rhs, self.times, y0, progress, compiled)
-        except IntegrationError:
-            if compiled is not None and isinstance(self.rhs, GuardedRhs):
-                # the compiled path ran a plugin's traced torque: name the force when its Python torque is at
-                # fault at the start (the usual case: NaN or inf in its formula)
-                GuardedRhs(self.system, self.rhs.plugins).inspect(float(self.times[0]), y0)
-            raise
+        if compiled is not None and isinstance(self.rhs, GuardedRhs):
+            # the compiled path runs a plugin's traced torque, unguarded: one Python evaluation first names the
+            # force whose torque is already at fault at the start (the usual case: NaN or inf in its formula)
+            self.rhs.inspect(float(self.times[0]), y0)
+        solution = self.integrator.integrate(self.rhs, self.times, y0, progress, compiled)
         stats = solution.stats
         log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
                  "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)

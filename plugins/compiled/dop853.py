@@ -154,6 +154,9 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
                 error_norm = 0.0
             else:
                 error_norm = h_abs * e5 / math.sqrt((e5 + 0.01 * e3) * n)
+            if error_norm != error_norm:  # NaN in a stage: no step size fixes it, and a NaN step would loop forever
+                state[0], state[1] = t, h_abs
+                return NOT_FINITE, i
             if error_norm < 1.0:
                 factor = MAX_FACTOR if error_norm == 0.0 else min(MAX_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
                 if rejected:
