@@ -39,7 +39,7 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
     A state that carries the fixed horizontal axis α (9 components) is accepted when no torque depends on α:
     (ω, γ) is then a closed system and α (the precession angle's axis) does not enter the indicators.
     """
-    from gyrolab.plugins.compiled import fixed_point, models
+    from gyrolab.plugins.compiled import fixed_point, layout, models
 
     if compiled is None or compiled.model != models.FIXED_POINT:
         raise ConfigError("chaos indicators need the fixed-point system with built-in torques only "
@@ -52,11 +52,11 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
     P = np.tile(compiled.params, (len(y0s), 1)) if params is None else np.ascontiguousarray(params, dtype=float)
     if P.shape != (len(y0s), fixed_point.N_PARAMS):
         raise ConfigError(f"params has shape {P.shape}; it must be ({len(y0s)}, {fixed_point.N_PARAMS})")
-    if np.any(P[:, 3:9] != 0.0) or np.any(P[:, 12:14] != 0.0):
+    if layout.torques_on_horizontal_axes(P):
         raise ConfigError("chaos indicators need torques about the vertical only (uniform gravity, Newtonian "
                           "attraction along Z); a torque on the fixed horizontal axes is not supported")
     P = P.copy()
-    P[:, 15] = 0.0  # α is not carried into the kernels (nothing depends on it: checked above)
+    P[:, layout.CARRIES_ALPHA] = 0.0  # α is not carried into the kernels (nothing depends on it: checked above)
     gamma = np.linalg.norm(y0s[:, 3:6], axis=1)
     if np.any(np.abs(gamma - 1.0) > 1e-9):
         raise ConfigError(f"an initial γ has norm {gamma[np.argmax(np.abs(gamma - 1.0))]:.12g}; |γ| must be 1 within 1e-9")

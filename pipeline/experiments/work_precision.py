@@ -54,13 +54,15 @@ def _final(ds: xr.Dataset) -> np.ndarray:
 def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
     """Final (ω, γ) of the scene from the most accurate reference available, and its name."""
     compiled = scene.system.compiled_model()
-    if compiled is None or compiled.model != 0:  # 0: models.FIXED_POINT, the built-in torque forms only
+    from gyrolab.plugins.compiled import layout, models
+
+    if compiled is None or compiled.model != models.FIXED_POINT:  # the built-in torque forms only
         raise ConfigError("work_precision needs a scene whose forces have compiled forms (for its reference run)")
     p = compiled.params
-    extra = np.any(p[3:9] != 0) or np.any(p[12:14] != 0)  # torques along non-vertical axes
     y0 = scene.system.initial_state()[:6]
-    if not extra:
-        ref = fixed_point_reference(p[0:3], p[9:12], p[14], y0, scene.times[[0, -1]])
+    if not layout.torques_on_horizontal_axes(p):
+        ref = fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3],
+                                    p[layout.N_Z], y0, scene.times[[0, -1]])
         return ref[-1].astype(float), "extended-precision Taylor (gyrolab.physics.reference)"
     from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
