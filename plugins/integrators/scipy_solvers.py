@@ -11,6 +11,7 @@ costs exactly ``n_stages`` evaluations, so the evaluations spent inside one
 from __future__ import annotations
 
 import time
+import warnings
 from typing import ClassVar
 
 import numpy as np
@@ -33,8 +34,11 @@ class ScipySolver(Tolerances, Integrator):
         t_out = np.asarray(t_out, dtype=float)
         out = np.empty((len(t_out), len(y0)))
         out[0] = y0
-        solver = self.solver_class(fun, t_out[0], np.array(y0, dtype=float), t_out[-1],
-                                   rtol=self.rtol, atol=self.atol, max_step=self.max_step)
+        with warnings.catch_warnings():  # scipy warns when it raises rtol to its floor: said below, once
+            warnings.simplefilter("ignore", UserWarning)
+            solver = self.solver_class(fun, t_out[0], np.array(y0, dtype=float), t_out[-1],
+                                       rtol=self.rtol, atol=self.atol, max_step=self.max_step)
+        self.record_used_tolerances(float(np.max(solver.rtol)), float(np.max(solver.atol)))
         stages = getattr(self.solver_class, "n_stages", None)
         n_steps, n_rejected, filled = 0, 0, 1
         while solver.status == "running" and filled < len(t_out):
