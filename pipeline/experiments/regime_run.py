@@ -166,6 +166,21 @@ def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[np.nd
     return to_model(solution.y.T), label
 
 
+def _reduced_or_why_not(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[tuple[np.ndarray, str] | None, str]:
+    """``reduced_solution``, or None and one sentence saying why it is left out (it diverged or failed)."""
+    try:
+        reduced = reduced_solution(scene, regime, t)
+    except IntegrationError as error:
+        return None, (f"{regime.name}: the reduced system could not be integrated over the window ({error}); the "
+                      "comparison with it is left out, the analytic series and the full model are not affected")
+    if reduced is not None and not np.all(np.isfinite(reduced[0])):
+        bad = int(np.argmax(~np.all(np.isfinite(reduced[0]), axis=1)))
+        return None, (f"{regime.name}: the reduced system diverges (non-finite from t = {t[bad]:.4g} of the "
+                      f"{t[-1]:.4g} window at {regime.parameter} = {regime.parameter_value(scene.system):.4g}); the "
+                      "comparison with it is left out, the analytic series and the full model are not affected")
+    return reduced, ""
+
+
 def errors(result: dict[str, Any], against: str = "orbit") -> dict[str, float]:
     """Max errors of the analytic solution over the window, per group of variables (model units)."""
     a, b = result["states"]["analytic"], result["states"][against]
@@ -183,11 +198,16 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     T = regime.period(system)
     t = np.linspace(0.0, regime.periods * T, regime.periods * regime.samples_per_period + 1)
     result = compute(scene, regime, t, allow_no_orbit=True)
-    reduced = reduced_solution(scene, regime, t)
+    reduced, reduced_failure = _reduced_or_why_not(scene, regime, t)
     if reduced is not None:
         result["states"]["reduced"], result["reduced_method"] = reduced
         psi0 = float(result["angles"]["analytic"]["psi"][0])
         result["angles"]["reduced"] = angles_from_states(t, result["states"]["reduced"], psi0)
+    elif reduced_failure:
+        # the reduced system is a comparison, not the result: its failure is recorded and the run goes on
+        warnings = [*warnings, reduced_failure]
+        log.warning("%s", reduced_failure)
+        result["reduced_method"] = f"none: {reduced_failure}"
     orbit = result["orbit"]
     if orbit is not None:
         log.info("%s (%s): %s = %.4g, analytic period %.10g, exact %.10g, Newton residuals %s", regime.name,
