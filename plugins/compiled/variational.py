@@ -189,6 +189,19 @@ def run_indicators_dop853(P, t_out, Y0, D0, rtol, atol, max_step, megno, fli, de
                            steps, j)
 
 
+def tangent_growth(p: np.ndarray, y0: np.ndarray, t_end: float, tol: float) -> float:
+    """max ln|δ(t)| over [0, t_end] of the unit tangent vector ``initial_tangent`` of the (ω, γ) state ``y0`` (the
+    fast Lyapunov indicator), by DOP853 at rtol = atol = ``tol`` in this thread (no thread pool: one trajectory);
+    ``p`` with CARRIES_ALPHA = 0. NaN when the integration fails."""
+    y = np.ascontiguousarray(y0[:6], dtype=float)
+    d = initial_tangent(y[None, :])[0]
+    megno, fli, deviation = np.empty(1), np.empty(1), np.empty(1)
+    final, steps = np.empty(6), np.zeros(1, dtype=np.int64)
+    _dop853_trajectory(np.ascontiguousarray(p, dtype=float), np.array([0.0, float(t_end)]), y, d, tol, tol, np.inf,
+                       megno, fli, deviation, final, steps, 0)
+    return float(fli[0]) if steps[0] > 0 else float("nan")
+
+
 @kernel
 def _dop853_trajectory(p, t_out, y0, d0, rtol, atol, max_step, megno, fli, deviation, final, steps, j):
     n = AUGMENTED

@@ -67,9 +67,25 @@ from gyrolab.contracts.integrator import (
     Solution,
 )
 from gyrolab.errors import ConfigError, GyrolabError, as_number
+from gyrolab.plugins.integrators.amplification import amplification
 
 PILOT_POINTS = 65
 MIN_GROWTH = 2.0
+#: the pilot's power law t^q is capped at this q; an amplification beyond (1/pilot_fraction)^MAX_GROWTH after the
+#: pilot is exponential growth: a chaotic scene
+MAX_GROWTH = 4.0
+#: what ``auto_predicted_error`` is, stored beside it in every run
+PREDICTION_MEANING = ("an upper estimate of the max-norm error of the final state against the exact solution (model "
+                      "units): the pilot's measured error extrapolated over the span, raised by the amplification of "
+                      "perturbations measured over the whole span (chaotic scenes), times a calibration factor, plus "
+                      "the round-off of double precision (amplified likewise)")
+#: on a chaotic scene the amplification (and the round-off it carries) is taken this many times larger: one tangent
+#: run's growth factor scatters by up to e^2 ≈ 7 between nearby tolerances (``amplification.TANGENT_TOLERANCE``),
+#: and the round-off estimate is an estimate (benchmarks/chaos_promise.py: with no margin, slow_spin at t = 300
+#: was accepted at 1e-6 and ended at 1.4e-6)
+CHAOS_MARGIN = 10.0
+#: tolerance of the shadow pair that measures the amplification where the variational equations do not apply
+SHADOW_TOLERANCE = 1e-9
 FLOOR = 1e-15  # relative to the state's size: nothing in double precision reaches below this
 MIN_TOLERANCE = 1e-13  # first pilot: tighter tolerances differ from τ/100 by round-off only on O(1) states
 MAX_TOLERANCE = 1e-5  # looser per-step tolerances take steps near the Taylor series' radius of convergence
@@ -111,6 +127,7 @@ class Auto(Integrator):
             raise ConfigError(f"integrator.pilot_fraction={pilot_fraction} must be below 1")
         self.safety = as_number(safety, "integrator.safety", positive=True)
         self.choice: dict[str, Any] = {}
+        self.chaos: dict[str, Any] = {}  # the amplification measured over the span (auto_lyapunov_exponent, ...)
         self.system: Any = None
         self._pilot_steps = 0
         self._order: int | None = None
@@ -157,10 +174,13 @@ class Auto(Integrator):
         tau, pilot_nfev = min(max(self.accuracy * FIRST_RATIO, MIN_TOLERANCE), MAX_TOLERANCE / 10), 0
         # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance
         self._order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
+        # how much the motion amplifies an error present at the pilot's end by the end of the span (chaos: e^{λt})
+        amp = amplification(compiled, fun, y0, t_out[0], t_pilot, t_out[-1], self._method(compiled, SHADOW_TOLERANCE))
         loose = None  # the previous round's loose run (tolerance, solution): the next round's tight run
         for _ in range(3):
             per_tol, growth, nfev, measured, (tight_tol, tight), loose = self._pilot(fun, pilot_times, y0, compiled,
                                                                                      tau, loose)
+            per_tol = _amplified(per_tol, growth, amp.factor, self.pilot_fraction, CHAOS_MARGIN)
             pilot_nfev += nfev
             # per_tol bounds the truncation error even when the pilot saw only round-off
             chosen = MAX_TOLERANCE if per_tol == 0 else \
@@ -177,7 +197,22 @@ class Auto(Integrator):
         steps = self._pilot_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / self._order))
         compensated = bool(self._taylor)  # Taylor's update is compensated (None: no compiled model, scipy's DOP853)
         roundoff = EPS * scale * (math.sqrt(steps) if compensated else steps)
+        chaotic = amp.factor > (1.0 / self.pilot_fraction) ** MAX_GROWTH  # faster than any power law the pilot fits
+        if chaotic:  # round-off committed early grows with the perturbations: up to e^{max ln|δ|}
+            roundoff *= CHAOS_MARGIN * math.exp(min(max(amp.log_span, 0.0), 700.0))
+        self.chaos = {"auto_lyapunov_exponent": amp.lyapunov, "auto_amplification": amp.factor,
+                      "auto_amplification_method": amp.how, "auto_chaotic": int(chaotic)}
+        if chaotic:
+            self.chaos["auto_precision_horizon"] = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
         if roundoff > self.accuracy:
+            if chaotic:
+                horizon = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
+                raise ConfigError(
+                    f"accuracy={self.accuracy:g} cannot be reached in double precision on this chaotic scene: "
+                    f"λ ≈ {amp.lyapunov:.2g}, so round-off grows ~{amp.factor:.1g}× after the pilot and double "
+                    f"precision keeps {self.accuracy:g} only to t ≈ {t_out[0] + horizon:.4g} of {t_out[-1]:.4g}; ask "
+                    f"for accuracy ≥ {roundoff:.1g}, a shorter time.end, or integrator=taylor "
+                    f"integrator.precision=double-double")
             raise ConfigError(f"accuracy={self.accuracy:g} is below the round-off that double precision accumulates "
                               f"on this scene (about {roundoff:.1g} over ~{steps:.0f} steps); ask for at least that")
         if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
@@ -199,8 +234,10 @@ class Auto(Integrator):
             "auto_method": method.name,
             "auto_tolerance": chosen,
             "auto_predicted_error": CALIBRATION * per_tol * chosen + roundoff,
+            "auto_predicted_error_bounds": PREDICTION_MEANING,
             "auto_error_growth_exponent": growth,
             "auto_pilot_nfev": pilot_nfev,
+            **self.chaos,
             **{f"auto_{k.removeprefix('integrator_')}": v for k, v in method.attributes().items()},
         }
         return Solution(t_out, y, IntegratorStats(
@@ -333,13 +370,26 @@ class Auto(Integrator):
         measured = bool(final > 100 * EPS * max(1.0, *map(abs, y0)))
         # A non-symplectic method on a (near-)integrable motion drifts in energy linearly, hence in phase
         # quadratically: assume q = 2 unless the pilot shows faster growth (its early error is a plateau).
-        growth = MIN_GROWTH if math.isnan(slope) else min(max(slope, MIN_GROWTH), 4.0)
+        growth = MIN_GROWTH if math.isnan(slope) else min(max(slope, MIN_GROWTH), MAX_GROWTH)
         per_tol = final / (tau - tight_tol) * (1.0 / self.pilot_fraction) ** growth
         self._pilot_steps = tight.stats.n_steps
         return per_tol, growth, loose.stats.nfev + tight_nfev, measured, (tight_tol, tight), (tau, loose)
 
     def attributes(self) -> dict[str, Any]:
         return {"accuracy": self.accuracy, **self.choice}
+
+
+def _amplified(per_tol: float, growth: float, factor: float, fraction: float, margin: float) -> float:
+    """The pilot's predicted final error per unit tolerance, raised where the motion amplifies errors faster than
+    the pilot's power law: an error E present at the pilot's end grows by up to ``factor`` (the tangent flow's
+    growth after the pilot, ``amplification``), and the 1/fraction − 1 later stretches each commit as much again
+    at most, so the final error is at most E · factor / fraction, against E · (1/fraction)^growth extrapolated.
+    Beyond the pilot's largest power law (a chaotic scene) the factor carries ``margin``: it is measured along one
+    numerical trajectory, which a chaotic flow lets scatter."""
+    extrapolated = (1.0 / fraction) ** growth
+    if factor > (1.0 / fraction) ** MAX_GROWTH:
+        factor *= margin
+    return per_tol / extrapolated * max(extrapolated, factor / fraction)
 
 
 #: the statistics below compiled, by name (``_fast``)
