@@ -13,6 +13,7 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.contracts import registry
+from gyrolab.engine import error_estimate
 from gyrolab.engine.config import compose_config
 from gyrolab.contracts import CompiledModel, Integrator, System
 from gyrolab.output.dataset import build_dataset, scene_attributes
@@ -154,7 +155,10 @@ class Scene:
         stats = solution.stats
         log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
                  "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)
-        return build_dataset(self, solution)
+        ds = build_dataset(self, solution)
+        if error_estimate.wanted(self):  # a companion run measures the stored trajectory's error
+            ds = error_estimate.add_error_estimate(ds, self, solution.y, stats.wall_time)
+        return ds
 
 
 def compose_scene(overrides: Sequence[str] = ()) -> Scene:

@@ -1,0 +1,159 @@
+"""A measured error for the stored trajectory (``output.error_estimate``): a companion run on the same output times.
+
+A tolerance is not an error, and a recorded prediction is only a prediction; what a user can check is a measurement.
+The companion integrates the same scene with the same method, made more accurate by a known factor:
+
+* a method with tolerances (``rtol``/``atol``, or the Taylor method's ``tol``): the same method at tolerances
+  ``TIGHTER`` times smaller; its error is then ~``TIGHTER`` times smaller, so |y − y_companion| estimates the
+  stored run's error to within ~1/``TIGHTER``;
+* a fixed-step method of order p (``step``, ``order``; RK4 is 4): the same method at half the step, and
+  Richardson's estimate of the coarse run's error, |y_h − y_{h/2}| · 2^p / (2^p − 1);
+* ``auto``: the method it chose, at its chosen tolerance over ``TIGHTER`` (or, when it took a regime's analytic
+  series, the compiled Taylor method at tol 1e-15 against the series).
+
+Where the companion cannot be made ``TIGHTER`` times more accurate (a tolerance already at its method's floor), the
+compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model; otherwise the dataset says the
+estimate is not available and why. The estimate costs one more integration (about 1.2–2× the run's time for a
+tolerance-controlled method, 2× for a fixed step): it is on by default for ``integrator=auto`` only
+(``output.error_estimate: null``), ``true``/``false`` choose it for any integrator.
+
+The estimate is stored as ``error_estimate_omega`` (the angular velocity's max-norm error at each output time, in
+ω's units) and ``error_estimate_attitude`` (the direction cosines' max-norm error, dimensionless) for systems whose
+state starts with ω; as ``error_estimate`` (the whole state's max-norm error) for other systems.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+log = logging.getLogger(__name__)
+
+#: the companion's tolerances are this many times smaller than the run's
+TIGHTER = 1000.0
+#: tolerances below these a method cannot honour (scipy raises rtol to 100 eps; the compiled kernels' step control
+#: stops gaining below ~1e-15 relative)
+SCIPY_FLOOR = 100 * float(np.finfo(float).eps)
+COMPILED_FLOOR = 1e-16
+
+
+@dataclass(frozen=True)
+class Companion:
+    integrator: Any
+    scale: float  # error of the stored run ≈ scale · |y − y_companion|
+    how: str
+
+
+def wanted(scene: Any) -> bool:
+    """Whether the scene's run carries an error estimate: ``output.error_estimate`` true/false, or by default
+    (null) for ``integrator=auto`` only."""
+    choice = (scene.config.get("output") or {}).get("error_estimate")
+    if choice is None:
+        return getattr(scene.integrator, "name", "") == "auto"
+    return bool(choice)
+
+
+def companion(integrator: Any, has_compiled: bool) -> Companion | None:
+    """The more accurate run that measures ``integrator``'s error, or None when none can be built."""
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    choice = getattr(integrator, "choice", None)
+    if getattr(integrator, "name", "") == "auto" and choice:
+        method = str(choice.get("auto_method", ""))
+        if method.startswith("regime"):
+            return Companion(Taylor(tol=1e-15), 1.0, f"compiled Taylor at tol 1e-15 against auto's {method} series")
+        return _tighter(_auto_method(choice), has_compiled, f"auto's choice ({method})")
+    return _tighter(integrator, has_compiled, getattr(integrator, "name", type(integrator).__name__))
+
+
+def _auto_method(choice: dict[str, Any]) -> Any:
+    from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
+    from gyrolab.plugins.integrators.scipy_solvers import DOP853
+
+    tol = float(choice["auto_tolerance"])
+    method = choice["auto_method"]
+    if method == "taylor":
+        return Taylor(order=int(choice["auto_order"]), tol=tol)
+    return (DOP853Numba if method == "dop853_numba" else DOP853)(rtol=tol, atol=tol)
+
+
+def _tighter(integrator: Any, has_compiled: bool, label: str) -> Companion | None:
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    cls = type(integrator)
+    if isinstance(integrator, Taylor):
+        tol = integrator.tol / TIGHTER
+        if tol >= COMPILED_FLOOR:
+            return Companion(Taylor(order=integrator.order, tol=tol), 1.0,
+                             f"{label} at tol {tol:.3g} ({TIGHTER:g}× tighter), same order")
+    elif hasattr(integrator, "rtol") and hasattr(integrator, "atol"):
+        rtol, atol = integrator.rtol / TIGHTER, integrator.atol / TIGHTER
+        floor = SCIPY_FLOOR if cls.__module__.endswith("scipy_solvers") else COMPILED_FLOOR
+        if rtol >= floor:
+            kwargs = {"rtol": rtol, "atol": atol}
+            if np.isfinite(getattr(integrator, "max_step", np.inf)):
+                kwargs["max_step"] = integrator.max_step
+            return Companion(cls(**kwargs), 1.0, f"{label} at rtol {rtol:.3g}, atol {atol:.3g} ({TIGHTER:g}× tighter)")
+    elif hasattr(integrator, "step"):
+        order = int(getattr(integrator, "order", 4) or 4)
+        kwargs = {"step": integrator.step / 2}
+        if "order" in getattr(cls.__init__, "__code__", type("", (), {"co_varnames": ()})).co_varnames:
+            kwargs["order"] = order
+        scale = 2.0 ** order / (2.0 ** order - 1.0)
+        return Companion(cls(**kwargs), scale,
+                         f"{label} at half the step ({integrator.step / 2:.3g}), Richardson's estimate for order {order}")
+    at_floor = isinstance(integrator, Taylor) and integrator.tol <= COMPILED_FLOOR * TIGHTER
+    if has_compiled and not at_floor:
+        return Companion(Taylor(tol=COMPILED_FLOOR), 1.0,
+                         f"compiled Taylor at tol {COMPILED_FLOOR:g} ({label} cannot be made {TIGHTER:g}× tighter)")
+    return None
+
+
+def add_error_estimate(ds: xr.Dataset, scene: Any, y: np.ndarray, wall_time: float) -> xr.Dataset:
+    """``ds`` with the error-estimate variables and attributes of a run whose stored states are ``y``."""
+    compiled_model = scene.system.compiled_model()
+    pick = companion(scene.integrator, compiled_model is not None)
+    name = getattr(scene.integrator, "name", type(scene.integrator).__name__)
+    if pick is None:
+        reason = (f"not available: integrator {name!r} already runs at the compiled Taylor method's floor in double "
+                  "precision (nothing more accurate to compare with)" if _at_taylor_floor(scene.integrator) else
+                  f"not available: integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
+                  "compiled model for the Taylor method")
+        log.warning("output.error_estimate: %s", reason)
+        ds.attrs["error_estimate_method"] = reason
+        return ds
+    needs_model = getattr(pick.integrator, "needs_compiled_model", False) or \
+        getattr(pick.integrator, "prefers_compiled_model", False)
+    start = time.perf_counter()
+    other = pick.integrator.integrate(scene.system.rhs, scene.times, scene.system.initial_state(), None,
+                                      compiled_model if needs_model else None).y
+    spent = time.perf_counter() - start
+    y = np.asarray(y, dtype=float)
+    difference = pick.scale * np.abs(y - other)
+    ds.attrs["error_estimate_method"] = pick.how
+    ds.attrs["error_estimate_cost_ratio"] = float(spent / max(wall_time, 1e-9))
+    omega = ds.get("omega")
+    if omega is not None and omega.shape == (len(y), 3) and np.array_equal(omega.values, y[:, :3]):
+        parts = {"omega": (difference[:, :3], omega.attrs.get("units", "1"), "angular velocity ω"),
+                 "attitude": (difference[:, 3:], "1", "direction cosines (γ, and α where carried)")}
+    else:  # a state whose layout this module does not know: one max-norm over all of it
+        parts = {"": (difference, "1", "state (model units)")}
+    for part, (values, units, what) in parts.items():
+        series = values.max(axis=1)
+        key = f"error_estimate_{part}" if part else "error_estimate"
+        ds[key] = xr.Variable("time", series, {
+            "units": units, "long_name": f"estimated max-norm error of the stored {what} at each output time",
+            "comment": pick.how})
+        ds.attrs[f"error_estimate_max_{part}" if part else "error_estimate_max"] = float(series.max())
+    return ds
+
+
+def _at_taylor_floor(integrator: Any) -> bool:
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    return isinstance(integrator, Taylor) and integrator.tol / TIGHTER < COMPILED_FLOOR
