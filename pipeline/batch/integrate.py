@@ -19,12 +19,10 @@ from gyrolab.contracts import CompiledModel, Integrator
 from gyrolab.contracts.integrator import BATCH_KERNEL, CHOOSES_METHOD, BatchSolution, RightHandSide
 from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.plugins.integrators.auto import AUTO_SAMPLE  # auto's pilot sample of a batch (importable here, as before)
 
 __all__ = ["AUTO_SAMPLE", "BATCH_INTEGRATORS", "BatchSolution", "auto_choice", "batch_kernel_integrators",
            "integrate_arrays", "integrate_batch", "integrate_points"]
-
-#: trajectories of a batch on which ``auto`` runs its pilot (kept here for callers of the old module)
-AUTO_SAMPLE = 3
 
 
 def batch_kernel_integrators() -> list[str]:

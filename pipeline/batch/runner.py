@@ -1,4 +1,6 @@
-"""Running a plan: chunks of points, each a picklable task integrated by the compiled batch kernels.
+"""Running a plan: chunks of points, each a picklable task integrated by the integrator's batch kernel (capability
+BATCH_KERNEL), or by one ``integrate`` call per point with that point's system (``integrate_points``) for an
+integrator without one.
 
 ``run_plan(plan, path, settings)`` cuts the grid into chunks (each a block of the grid, so that it is one
 hyperslab of the stored dataset), skips the chunks a killed run of the same command already stored,
