@@ -42,6 +42,7 @@ MIDPOINT = textwrap.dedent('''
 
     import numpy as np
 
+    from gyrolab.contracts import Force
     from gyrolab.contracts.integrator import COMPILED_MODEL, TIME_DEPENDENT, Integrator, IntegratorStats, Solution
     from gyrolab.errors import IntegrationError, as_number
 
@@ -83,6 +84,20 @@ MIDPOINT = textwrap.dedent('''
         @classmethod
         def refusal(cls, compiled, system=None):
             return "refuses every compiled model, as a test"
+
+
+    class Pulse(Force):
+        """A torque about the body's z axis oscillating in time: a time-dependent force."""
+        name = "pulse"
+        required_axes = frozenset()
+        time_dependent = True
+        preserves_area_integral = False
+
+        def __init__(self, body, *, amplitude=0.01):
+            self.amplitude = float(amplitude)
+
+        def torque(self, omega, axes, t):
+            return np.array([0.0, 0.0, self.amplitude]) * np.cos(t)
 ''')
 SHORT = ["time.end=2", "time.n_output=11", "output.euler_angles=false", "output.figures=false"]
 
@@ -92,9 +107,9 @@ def midpoint(tmp_path_factory):
     """The site holding the plugin module and its .dist-info (its ``gyrolab.integrators`` entry points)."""
     site = tmp_path_factory.mktemp("site")
     (site / "midpoint_plugin.py").write_text(MIDPOINT)
-    with installed_distribution(site, "gyrolab-midpoint", "0.1",
-                                {"midpoint": "midpoint_plugin:Midpoint", "picky": "midpoint_plugin:Picky"},
-                                group="gyrolab.integrators"):
+    with installed_distribution(site, "gyrolab-midpoint", "0.1", {
+            "gyrolab.integrators": {"midpoint": "midpoint_plugin:Midpoint", "picky": "midpoint_plugin:Picky"},
+            "gyrolab.forces": {"pulse": "midpoint_plugin:Pulse"}}):
         yield site
 
 
@@ -172,6 +187,45 @@ def test_the_scene_asks_a_compiled_integrator_whether_it_runs_the_model(midpoint
     with pytest.raises(ConfigError, match=r"^integrator 'picky' refuses every compiled model, as a test; choose "
                                           r"rk4_numba, lie_poisson, dop853_numba, taylor or auto$"):
         compose_scene(["integrator=picky", *SHORT])
+
+
+def test_time_dependent_forces_need_the_capability(midpoint):
+    """The midpoint declares TIME_DEPENDENT and integrates a time-dependent force; lie_poisson does not: one sentence."""
+    forced = compose_scene(["integrator=midpoint", "force=[uniform_gravity,pulse]", *SHORT]).run()
+    free = compose_scene(["integrator=midpoint", "force=[uniform_gravity]", *SHORT]).run()
+    assert not np.array_equal(forced.omega.values, free.omega.values)
+    with pytest.raises(ConfigError) as refused:
+        compose_scene(["integrator=lie_poisson", "force=[uniform_gravity,pulse]", *SHORT])
+    assert str(refused.value) == ("integrator 'lie_poisson' does not integrate time-dependent forces (capability "
+                                  "time_dependent) and force 'pulse' is one; valid choices: rk4, rk4_numba, midpoint, "
+                                  "rk45, dop853, lsoda, radau, bdf, dop853_numba, taylor or auto")
+
+
+def test_a_batch_kernel_hook_runs_through_integrate_arrays():
+    """BATCH_KERNEL: integrate_arrays validates the arrays, calls the hook, and holds failures="raise" to its rule
+    even for a kernel that only marks its failures."""
+    from gyrolab.batch.integrate import integrate_arrays
+    from gyrolab.contracts.integrator import BatchSolution
+    from gyrolab.errors import IntegrationError
+    from gyrolab.plugins.integrators.compiled_solvers import RK4Numba
+
+    class Marker(Integrator):
+        name, adaptive, capabilities = "marker", False, frozenset({COMPILED_MODEL, BATCH_KERNEL})
+
+        def integrate(self, fun, t_out, y0, progress=None, compiled=None):
+            raise NotImplementedError
+
+        def integrate_batch(self, compiled, times, y0s, params, failures):
+            solution = RK4Numba(step=0.01).integrate_batch(compiled, times, y0s, params, "mark")
+            solution.failed = np.arange(len(y0s)) == 1   # pretend the second trajectory failed
+            return solution
+
+    scene = compose_scene(["integrator=rk4_numba", *SHORT])
+    y0s = np.stack([scene.system.initial_state()] * 3)
+    marked = integrate_arrays(scene.compiled, Marker(), scene.times, y0s, failures="mark")
+    np.testing.assert_array_equal(marked.y, integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s).y)
+    with pytest.raises(IntegrationError, match="^trajectory 1 of the batch failed with marker$"):
+        integrate_arrays(scene.compiled, Marker(), scene.times, y0s)
 
 
 def test_capabilities_and_their_boolean_aliases():

@@ -62,8 +62,9 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
     # (and may take a regime's analytic series); integrate_arrays runs one choice for a whole array batch.
     if not integrator.supports(BATCH_KERNEL) or integrator.supports(CHOOSES_METHOD) or compiled is None:
         if params is not None:
-            raise ConfigError(f"per-trajectory params need an integrator with a compiled batch kernel "
-                              f"({_kernel_choices()}), not {integrator.name}")
+            raise ConfigError(f"per-trajectory params need an integrator with a compiled batch kernel that does not "
+                              f"choose its method per trajectory ({_kernel_choices(choosers=False)}), "
+                              f"not {integrator.name}")
         _require_finite(y0s)
         solution = integrate_points(integrator, lambda j: scene.system.rhs, scene.times, y0s,
                                     scene.compiled, None, failures="raise")
@@ -153,10 +154,11 @@ def auto_choice(compiled: CompiledModel, auto: Integrator, times: np.ndarray, y0
     return auto.choose_batch_method(compiled, times, y0s, P)
 
 
-def _kernel_choices() -> str:
-    from gyrolab.contracts.capabilities import or_list
+def _kernel_choices(choosers: bool = True) -> str:
+    """The integrators with a batch kernel as "a, b or c" (without those that choose their method: ``choosers``)."""
+    from gyrolab.contracts.capabilities import integrators_with, or_list
 
-    return or_list(batch_kernel_integrators())
+    return or_list(integrators_with(BATCH_KERNEL, accept=None if choosers else lambda c: not c.supports(CHOOSES_METHOD)))
 
 
 def _require_finite(y0s: np.ndarray) -> None:

@@ -239,6 +239,7 @@ class Integrator(ABC):
 
     def choose_batch_method(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray,
                             params: np.ndarray) -> tuple[Integrator, dict[str, Any]]:
-        """CHOOSES_METHOD: (the BATCH_KERNEL integrator every trajectory of this batch runs, the choice as dataset
-        attributes), chosen once for the batch of initial states ``y0s`` with parameters ``params`` (one row each)."""
+        """CHOOSES_METHOD: (the integrator every trajectory of this batch runs, best one with a batch kernel; the
+        choice as dataset attributes), chosen once for the batch of initial states ``y0s`` with parameters
+        ``params`` (one row each)."""
         raise NotImplementedError(f"integrator {self.name!r} does not choose a method")
