@@ -198,9 +198,10 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
     start = time.perf_counter()
     method, choice = scene.integrator.choose_batch_method(scene.system.compiled_model(), plan.times, plan.y0[valid],
                                                           plan.combo_params[plan.combo[valid]])
-    log.info("batch: %s chose %s at tolerance %s for every chunk (pilot on %d points, %.1f s)", plan.integrator_name,
-             method.name, f"{choice['auto_tolerance']:.3g}" if "auto_tolerance" in choice else "(its own)",
-             choice.get("auto_sampled_trajectories", 0), time.perf_counter() - start)
+    settings_text = ", ".join(f"{k.removeprefix('integrator_')}={v:.3g}" if isinstance(v, float)
+                              else f"{k.removeprefix('integrator_')}={v}" for k, v in method.attributes().items())
+    log.info("batch: %s chose %s (%s) for every chunk, in %.1f s", plan.integrator_name, method.name, settings_text,
+             time.perf_counter() - start)
     return method, {**{k: v for k, v in choice.items() if v is not None},
                     "batch_path": batch_path(type(method), settings)}
 
