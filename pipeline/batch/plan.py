@@ -100,8 +100,13 @@ class Plan:
     @property
     def integrator_name(self) -> str:
         """The integrator plugin's name (``rk4_numba``, ``auto``, ...)."""
+        return self.integrator_class.name
+
+    @property
+    def integrator_class(self) -> type:
+        """The integrator plugin's class (what the batch asks for capabilities)."""
         node = OmegaConf.create(self.plain).integrator
-        return scene_module._plugin_class("integrator", node, "integrator").name
+        return scene_module._plugin_class("integrator", node, "integrator")
 
     def params(self, start: int, stop: int) -> np.ndarray:
         return self.combo_params[self.combo[start:stop]]

@@ -29,6 +29,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.contracts import registry
 from gyrolab.contracts.regime import Regime
+from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL
 from gyrolab.output.cf import conform, unit_attributes
 from gyrolab.output.dataset import time_attributes, write_dataset
 from gyrolab.errors import ConfigError, IntegrationError
@@ -91,7 +92,7 @@ def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = Fal
 
         return Taylor(order=24, tol=1e-16).integrate(system.rhs, t, y0, None, system.compiled_model()).y
     integrator = scene.integrator
-    wants = integrator.needs_compiled_model or integrator.prefers_compiled_model
+    wants = integrator.supports(COMPILED_MODEL) or integrator.supports(PREFERS_COMPILED_MODEL)
     return integrator.integrate(system.rhs, t, y0, None, system.compiled_model() if wants else None).y
 
 
@@ -155,12 +156,13 @@ def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[np.nd
 
     integrator = scene.integrator
     label = integrator.name
-    if integrator.needs_compiled_model or integrator.name == "auto":  # auto's choices are made for the full model
+    # a compiled-only integrator has no model of the reduced system; one that chooses its method chose for the full one
+    if integrator.supports(COMPILED_MODEL) or integrator.supports(CHOOSES_METHOD):
         from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
         settings = {k: getattr(integrator, k, 1e-12) for k in ("rtol", "atol")}
         integrator = DOP853(**settings)
-        label = (f"dop853 rtol={settings['rtol']:g} atol={settings['atol']:g} (standing in for the scene's "
+        label = (f"{DOP853.name} rtol={settings['rtol']:g} atol={settings['atol']:g} (standing in for the scene's "
                  f"{label}, which integrates compiled models of the full equations only)")
     solution = integrator.integrate(rhs_t, np.asarray(t, dtype=float), np.asarray(Z0, dtype=float))
     return to_model(solution.y.T), label

@@ -59,6 +59,12 @@ from typing import Any
 import numpy as np
 
 from gyrolab.contracts.integrator import (
+    BATCH_KERNEL,
+    CHOOSES_METHOD,
+    PREFERS_COMPILED_MODEL,
+    TIME_DEPENDENT,
+    VECTOR_LANES,
+    BatchSolution,
     CompiledModel,
     Integrator,
     IntegratorStats,
@@ -110,13 +116,17 @@ MISS_MARGIN = 1000.0
 SCREEN_POINTS = 512
 SCREEN_TOLERANCE = 1e-9
 EPS = float(np.finfo(float).eps)
+#: trajectories of a batch on which ``auto`` runs its pilot (the first, the largest state, the most unusual parameters)
+AUTO_SAMPLE = 3
 _PILOT_GRID = np.linspace(0.0, 1.0, PILOT_POINTS)
 
 
 class Auto(Integrator):
     name = "auto"
     adaptive = True
-    prefers_compiled_model = True
+    # a batch runs its choice's kernel (Taylor or DOP853, both vectorised across trajectories)
+    capabilities = frozenset({PREFERS_COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, CHOOSES_METHOD})
+    evaluation_label = "pilot and chosen method's evaluations"
 
     def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 1.0) -> None:
         if accuracy is None:
@@ -377,6 +387,47 @@ class Auto(Integrator):
 
     def attributes(self) -> dict[str, Any]:
         return {"accuracy": self.accuracy, **self.choice}
+
+    def choose_batch_method(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray,
+                            params: np.ndarray) -> tuple[Integrator, dict[str, Any]]:
+        """The method and tolerance for a batch: the single-run choice on a few trajectories, the tightest.
+
+        The sample is the first trajectory, the one with the largest state and the one whose parameters
+        lie farthest from the batch's mean (up to AUTO_SAMPLE distinct ones). Each runs the pilot and final
+        run; the batch then runs the chosen method at the smallest tolerance chosen. A trajectory harder
+        than every sampled one may miss the accuracy: sample it (pass it first) when you know it.
+        """
+        from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
+        from gyrolab.plugins.integrators.step_guard import compiled_rhs
+
+        P = params
+        spread = np.abs(P - P.mean(axis=0)).max(axis=1) if len(P) > 1 else np.zeros(1)
+        sample = list(dict.fromkeys([0, int(np.argmax(np.abs(y0s).max(axis=1))), int(np.argmax(spread))]))[:AUTO_SAMPLE]
+        choices = []
+        for j in sample:
+            single = type(self)(accuracy=self.accuracy, pilot_fraction=self.pilot_fraction, safety=self.safety)
+            model = CompiledModel(compiled.model, P[j])
+            single.integrate(compiled_rhs(model), times, y0s[j], None, model)
+            choices.append(single.choice)
+        choice = min(choices, key=lambda c: c["auto_tolerance"])
+        tol = float(choice["auto_tolerance"])
+        method = Taylor(order=choice["auto_order"], tol=tol) if choice["auto_method"] == Taylor.name \
+            else DOP853Numba(rtol=tol, atol=tol)
+        settings = {"accuracy": self.accuracy,
+                    **{k: v.item() if isinstance(v, np.generic) else v for k, v in choice.items()},
+                    "auto_sampled_trajectories": len(sample)}
+        self.choice = {k: v for k, v in settings.items() if k != "accuracy"}
+        return method, settings
+
+    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
+                        failures: str) -> BatchSolution:
+        """The batch's choice (``choose_batch_method``), then that method's kernel; the wall time includes the pilot."""
+        start = time.perf_counter()
+        method, settings = self.choose_batch_method(compiled, times, y0s, params)
+        solution = method.integrate_batch(compiled, times, y0s, params, failures)
+        solution.wall_time = time.perf_counter() - start
+        solution.settings = settings
+        return solution
 
 
 def _amplified(per_tol: float, growth: float, factor: float, fraction: float, margin: float) -> float:

@@ -14,14 +14,22 @@ from typing import Any
 import numpy as np
 
 from gyrolab.contracts.integrator import (
+    BATCH_KERNEL,
+    COMPILED_MODEL,
+    TIME_DEPENDENT,
+    VARIATIONAL,
+    VECTOR_LANES,
+    BatchSolution,
     CompiledModel,
     Integrator,
     IntegratorStats,
     ProgressCallback,
     RightHandSide,
     Solution,
+    VariationalSettings,
 )
 from gyrolab.errors import ConfigError, IntegrationError, as_number
+from gyrolab.plugins.integrators import batch_kernels
 from gyrolab.plugins.integrators.tolerances import Tolerances
 from gyrolab.plugins.integrators.step_guard import check_step, compiled_rhs
 
@@ -129,7 +137,14 @@ def _fixed_step(kernel: Any, name: str, fun: RightHandSide, t_out: np.ndarray, s
 class DOP853Numba(Tolerances, Integrator):
     name = "dop853_numba"
     adaptive = True
-    needs_compiled_model = True
+    capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL})
+
+    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
+                        failures: str) -> BatchSolution:
+        return batch_kernels.dop853_batch(self, compiled, times, y0s, params, failures)
+
+    def variational_settings(self) -> VariationalSettings:
+        return VariationalSettings(rtol=self.rtol, atol=self.atol, max_step=self.max_step)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
@@ -165,10 +180,17 @@ class DOP853Numba(Tolerances, Integrator):
 class RK4Numba(Integrator):
     name = "rk4_numba"
     adaptive = False
-    needs_compiled_model = True
+    capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL})
 
     def __init__(self, *, step: float = 0.01) -> None:
         self.step = as_number(step, "integrator.step", positive=True)
+
+    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
+                        failures: str) -> BatchSolution:
+        return batch_kernels.rk4_batch(compiled, self.step, times, y0s, params, failures)
+
+    def variational_settings(self) -> VariationalSettings:
+        return VariationalSettings(step=self.step)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
@@ -203,7 +225,22 @@ class Taylor(Integrator):
 
     name = "taylor"
     adaptive = True
-    needs_compiled_model = True
+    capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES})
+    # one Taylor step costs about as much as `order` right-hand-side evaluations; nfev counts the series
+    evaluation_label = "Taylor series evaluations"
+
+    @classmethod
+    def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
+        from gyrolab.plugins.compiled import plugin_taylor
+
+        if plugin_taylor.ready(compiled):   # (compiles a traced torque's Taylor kernel, once)
+            return None
+        named = f"system {system.name!r}'s" if system is not None else "this"
+        return f"has no Taylor coefficients for {named} compiled model"
+
+    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
+                        failures: str) -> BatchSolution:
+        return batch_kernels.taylor_batch(self, compiled, times, y0s, params, failures)
 
     def __init__(self, *, order: int | None = None, tol: float = 1e-16) -> None:
         from gyrolab.plugins.compiled.taylor import MAX_ORDER, MIN_ORDER, order_for
@@ -274,8 +311,19 @@ class LiePoisson(Integrator):
 
     name = "lie_poisson"
     adaptive = False
-    needs_compiled_model = True
+    capabilities = frozenset({COMPILED_MODEL})
+    evaluation_label = "exact sub-flow evaluations"
     ORDERS = (2, 4, 6)
+
+    @classmethod
+    def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
+        from gyrolab.plugins.compiled import models
+
+        if compiled.model == models.FIXED_POINT:
+            return None
+        traced = ", ".join(f.name for f in system.forces if f.compiled_terms() is None) if system is not None else ""
+        return ("evaluates the built-in torque forms only, and "
+                + (f"force {traced} is a compiled plugin torque" if traced else "this compiled model is not one of them"))
 
     def __init__(self, *, step: float = 0.01, order: int = 4) -> None:
         self.step = as_number(step, "integrator.step", positive=True)

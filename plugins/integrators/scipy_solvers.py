@@ -17,7 +17,17 @@ from typing import ClassVar
 import numpy as np
 from scipy import integrate
 
-from gyrolab.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
+from gyrolab.contracts.integrator import (
+    TIME_DEPENDENT,
+    VARIATIONAL,
+    CompiledModel,
+    Integrator,
+    IntegratorStats,
+    ProgressCallback,
+    RightHandSide,
+    Solution,
+    VariationalSettings,
+)
 from gyrolab.errors import IntegrationError
 from gyrolab.plugins.integrators.tolerances import Tolerances
 
@@ -26,6 +36,7 @@ class ScipySolver(Tolerances, Integrator):
     """Adaptive scipy solver; subclasses name the scipy class."""
 
     adaptive = True
+    capabilities = frozenset({TIME_DEPENDENT})
     solver_class: ClassVar[type]
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
@@ -77,7 +88,12 @@ class RK45(ScipySolver):
 
 class DOP853(ScipySolver):
     name = "dop853"
+    # the chaos indicators' compiled DOP853 takes scipy's steps (dop853_numba is scipy's method, compiled)
+    capabilities = frozenset({TIME_DEPENDENT, VARIATIONAL})
     solver_class = integrate.DOP853
+
+    def variational_settings(self) -> VariationalSettings:
+        return VariationalSettings(rtol=self.rtol, atol=self.atol, max_step=self.max_step)
 
 
 class LSODA(ScipySolver):
