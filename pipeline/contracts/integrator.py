@@ -153,6 +153,8 @@ class Integrator(ABC):
        instead of calling ``fun``; the scene refuses it, before integrating,
        for a system or force that has no compiled form.
     7. ``attributes()`` gives its settings for the dataset.
+    9. ``more_accurate(factor)``, optional: a more accurate run of the same method, which
+       ``output.error_estimate`` compares with this one to measure the stored trajectory's error.
     8. It declares what it can do in ``capabilities`` (a frozenset of the module's capability constants)
        and the engine asks ``supports(capability)``, never for an integrator's name:
 
@@ -236,6 +238,14 @@ class Integrator(ABC):
     def variational_settings(self) -> VariationalSettings:
         """VARIATIONAL: how the chaos indicators' variational kernels run with this integrator's method and settings."""
         raise NotImplementedError(f"integrator {self.name!r} declares no variational equations")
+
+    def more_accurate(self, factor: float) -> tuple[Integrator, float, str] | None:
+        """Rule 9 (``output.error_estimate``): (the same method about ``factor`` times more accurate, the number that
+        turns the two runs' difference into this run's error estimate, a few words saying how), or None when it
+        cannot be made so (a tolerance already at its floor, or nothing to tighten). A method with tolerances
+        divides them by ``factor`` (the number is 1); a fixed-step method of order p halves its step (the number is
+        Richardson's 2^p / (2^p − 1)); a method that chooses (CHOOSES_METHOD) answers for the method it ran."""
+        return None
 
     def choose_batch_method(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray,
                             params: np.ndarray) -> tuple[Integrator, dict[str, Any]]:

@@ -1,15 +1,16 @@
 """A measured error for the stored trajectory (``output.error_estimate``): a companion run on the same output times.
 
 A tolerance is not an error, and a recorded prediction is only a prediction; what a user can check is a measurement.
-The companion integrates the same scene with the same method, made more accurate by a known factor:
+The companion integrates the same scene with the same method, made more accurate by a known factor; each
+integrator says how (``Integrator.more_accurate``, rule 9 of its contract):
 
 * a method with tolerances (``rtol``/``atol``, or the Taylor method's ``tol``): the same method at tolerances
   ``TIGHTER`` times smaller; its error is then ~``TIGHTER`` times smaller, so |y − y_companion| estimates the
   stored run's error to within ~1/``TIGHTER``;
-* a fixed-step method of order p (``step``, ``order``; RK4 is 4): the same method at half the step, and
-  Richardson's estimate of the coarse run's error, |y_h − y_{h/2}| · 2^p / (2^p − 1);
-* ``auto``: the method it chose, at its chosen tolerance over ``TIGHTER`` (or, when it took a regime's analytic
-  series, the compiled Taylor method at tol 1e-15 against the series).
+* a fixed-step method of order p (RK4: 4): the same method at half the step, and Richardson's estimate of the
+  coarse run's error, |y_h − y_{h/2}| · 2^p / (2^p − 1);
+* ``auto``: the method it chose, made more accurate the same way (or, when it took a regime's analytic series,
+  the compiled Taylor method at tol 1e-15 against the series).
 
 Where the companion cannot be made ``TIGHTER`` times more accurate (a tolerance already at its method's floor), the
 compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model; otherwise the dataset says the
@@ -32,14 +33,12 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from gyrolab.contracts.integrator import CHOOSES_METHOD
+
 log = logging.getLogger(__name__)
 
-#: the companion's tolerances are this many times smaller than the run's
+#: the companion is this many times more accurate than the run (tolerances this many times smaller)
 TIGHTER = 1000.0
-#: tolerances below these a method cannot honour (scipy raises rtol to 100 eps; the compiled kernels' step control
-#: stops gaining below ~1e-15 relative)
-SCIPY_FLOOR = 100 * float(np.finfo(float).eps)
-COMPILED_FLOOR = 1e-16
 
 
 @dataclass(frozen=True)
@@ -51,66 +50,24 @@ class Companion:
 
 def wanted(scene: Any) -> bool:
     """Whether the scene's run carries an error estimate: ``output.error_estimate`` true/false, or by default
-    (null) for ``integrator=auto`` only."""
+    (null) for the integrators that choose their method for a target accuracy (CHOOSES_METHOD: ``auto``)."""
     choice = (scene.config.get("output") or {}).get("error_estimate")
     if choice is None:
-        return getattr(scene.integrator, "name", "") == "auto"
+        return scene.integrator.supports(CHOOSES_METHOD)
     return bool(choice)
 
 
 def companion(integrator: Any, has_compiled: bool) -> Companion | None:
-    """The more accurate run that measures ``integrator``'s error, or None when none can be built."""
+    """The more accurate run that measures ``integrator``'s error (its ``more_accurate``, rule 9 of the contract;
+    else the compiled Taylor method at its floor when the scene has a compiled model), or None."""
     from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
-    choice = getattr(integrator, "choice", None)
-    if getattr(integrator, "name", "") == "auto" and choice:
-        method = str(choice.get("auto_method", ""))
-        if method.startswith("regime"):
-            return Companion(Taylor(tol=1e-15), 1.0, f"compiled Taylor at tol 1e-15 against auto's {method} series")
-        return _tighter(_auto_method(choice), has_compiled, f"auto's choice ({method})")
-    return _tighter(integrator, has_compiled, getattr(integrator, "name", type(integrator).__name__))
-
-
-def _auto_method(choice: dict[str, Any]) -> Any:
-    from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
-    from gyrolab.plugins.integrators.scipy_solvers import DOP853
-
-    tol = float(choice["auto_tolerance"])
-    method = choice["auto_method"]
-    if method == "taylor":
-        return Taylor(order=int(choice["auto_order"]), tol=tol)
-    return (DOP853Numba if method == "dop853_numba" else DOP853)(rtol=tol, atol=tol)
-
-
-def _tighter(integrator: Any, has_compiled: bool, label: str) -> Companion | None:
-    from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
-    cls = type(integrator)
-    if isinstance(integrator, Taylor):
-        tol = integrator.tol / TIGHTER
-        if tol >= COMPILED_FLOOR:
-            return Companion(Taylor(order=integrator.order, tol=tol), 1.0,
-                             f"{label} at tol {tol:.3g} ({TIGHTER:g}× tighter), same order")
-    elif hasattr(integrator, "rtol") and hasattr(integrator, "atol"):
-        rtol, atol = integrator.rtol / TIGHTER, integrator.atol / TIGHTER
-        floor = SCIPY_FLOOR if cls.__module__.endswith("scipy_solvers") else COMPILED_FLOOR
-        if rtol >= floor:
-            kwargs = {"rtol": rtol, "atol": atol}
-            if np.isfinite(getattr(integrator, "max_step", np.inf)):
-                kwargs["max_step"] = integrator.max_step
-            return Companion(cls(**kwargs), 1.0, f"{label} at rtol {rtol:.3g}, atol {atol:.3g} ({TIGHTER:g}× tighter)")
-    elif hasattr(integrator, "step"):
-        order = int(getattr(integrator, "order", 4) or 4)
-        kwargs = {"step": integrator.step / 2}
-        if "order" in getattr(cls.__init__, "__code__", type("", (), {"co_varnames": ()})).co_varnames:
-            kwargs["order"] = order
-        scale = 2.0 ** order / (2.0 ** order - 1.0)
-        return Companion(cls(**kwargs), scale,
-                         f"{label} at half the step ({integrator.step / 2:.3g}), Richardson's estimate for order {order}")
-    at_floor = isinstance(integrator, Taylor) and integrator.tol <= COMPILED_FLOOR * TIGHTER
-    if has_compiled and not at_floor:
-        return Companion(Taylor(tol=COMPILED_FLOOR), 1.0,
-                         f"compiled Taylor at tol {COMPILED_FLOOR:g} ({label} cannot be made {TIGHTER:g}× tighter)")
+    finer = integrator.more_accurate(TIGHTER)
+    if finer is not None:
+        return Companion(*finer)
+    if has_compiled and not _at_taylor_floor(integrator):
+        return Companion(Taylor(tol=Taylor.TOLERANCE_FLOOR), 1.0, f"compiled Taylor at tol {Taylor.TOLERANCE_FLOOR:g} "
+                         f"({integrator.name} cannot be made {TIGHTER:g}× more accurate)")
     return None
 
 
@@ -156,4 +113,4 @@ def add_error_estimate(ds: xr.Dataset, scene: Any, y: np.ndarray, wall_time: flo
 def _at_taylor_floor(integrator: Any) -> bool:
     from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
-    return isinstance(integrator, Taylor) and integrator.tol / TIGHTER < COMPILED_FLOOR
+    return isinstance(integrator, Taylor) and integrator.tol / TIGHTER < Taylor.TOLERANCE_FLOOR

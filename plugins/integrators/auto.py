@@ -138,6 +138,7 @@ class Auto(Integrator):
         self.safety = as_number(safety, "integrator.safety", positive=True)
         self.choice: dict[str, Any] = {}
         self.chaos: dict[str, Any] = {}  # the amplification measured over the span (auto_lyapunov_exponent, ...)
+        self.chosen: Integrator | None = None  # the method the last integrate ran (None: an analytic series)
         self.system: Any = None
         self._pilot_steps = 0
         self._order: int | None = None
@@ -228,6 +229,7 @@ class Auto(Integrator):
         if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         method = self._method(compiled, chosen)
+        self.chosen = method  # what ran: more_accurate answers for it
         if tight_tol <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
             head = np.searchsorted(pilot_times, inside)  # the outputs inside the pilot
             rest = t_out[t_out >= t_pilot]
@@ -315,6 +317,7 @@ class Auto(Integrator):
                 alpha = np.stack([frame_from_angles(a, b, c)[0] for a, b, c in
                                   zip(angles["psi"], angles["theta"], angles["phi"])])
                 y = np.concatenate([y, alpha], axis=1)
+            self.chosen = None  # an analytic series: more_accurate is the full model by a tight Taylor run
             self.choice = {"auto_method": f"regime {name}", "auto_predicted_error": predicted,
                            "auto_series_error_one_period": measured, "auto_check_nfev": truth.stats.nfev,
                            **regime.attributes()}
@@ -387,6 +390,20 @@ class Auto(Integrator):
 
     def attributes(self) -> dict[str, Any]:
         return {"accuracy": self.accuracy, **self.choice}
+
+    def more_accurate(self, factor: float):
+        """Rule 9 for the method it ran (after ``integrate``): that method ``factor`` times more accurate; for an
+        analytic series, the full model by the compiled Taylor method at tol 1e-15 (the series' check run)."""
+        if not self.choice:
+            return None
+        if self.chosen is None:
+            from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+            return Taylor(tol=1e-15), 1.0, f"compiled Taylor at tol 1e-15 against auto's {self.choice['auto_method']}"
+        finer = self.chosen.more_accurate(factor)
+        if finer is None:
+            return None
+        return finer[0], finer[1], f"auto's choice, {finer[2]}"
 
     def choose_batch_method(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray,
                             params: np.ndarray) -> tuple[Integrator, dict[str, Any]]:

@@ -30,6 +30,7 @@ from gyrolab.contracts.integrator import (
 )
 from gyrolab.errors import ConfigError, IntegrationError, as_number
 from gyrolab.plugins.integrators import batch_kernels
+from gyrolab.plugins.integrators.refinement import half_step
 from gyrolab.plugins.integrators.tolerances import Tolerances
 from gyrolab.plugins.integrators.step_guard import check_step, compiled_rhs
 
@@ -138,6 +139,7 @@ class DOP853Numba(Tolerances, Integrator):
     name = "dop853_numba"
     adaptive = True
     capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL})
+    tolerance_floor = 1e-16  # the compiled controller has no floor of its own; below this it gains nothing
 
     def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
                         failures: str) -> BatchSolution:
@@ -184,6 +186,9 @@ class RK4Numba(Integrator):
 
     def __init__(self, *, step: float = 0.01) -> None:
         self.step = as_number(step, "integrator.step", positive=True)
+
+    def more_accurate(self, factor: float):
+        return half_step(self, 4)
 
     def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
                         failures: str) -> BatchSolution:
@@ -277,6 +282,15 @@ class Taylor(Integrator):
         return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
                                                     wall_time=time.perf_counter() - start))
 
+    #: below this tol the double-precision kernel gains nothing (round-off)
+    TOLERANCE_FLOOR = 1e-16
+
+    def more_accurate(self, factor: float):
+        tol = self.tol / factor
+        if tol < self.TOLERANCE_FLOOR:
+            return None
+        return Taylor(order=self.order, tol=tol), 1.0, f"taylor at tol {tol:.3g} ({factor:g}× tighter), same order"
+
     def attributes(self) -> dict[str, Any]:
         return {"integrator_order": self.order, "integrator_tol": self.tol}
 
@@ -327,9 +341,12 @@ class LiePoisson(Integrator):
 
     def __init__(self, *, step: float = 0.01, order: int = 4) -> None:
         self.step = as_number(step, "integrator.step", positive=True)
-        if order not in self.ORDERS:
+        if order not in self.ORDERS:  # (more_accurate below halves the step at the same order)
             raise ConfigError(f"integrator.order={order!r} is not available; valid choices: 2, 4, 6")
         self.order = order
+
+    def more_accurate(self, factor: float):
+        return half_step(self, self.order, order=self.order)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:

@@ -28,6 +28,7 @@ from gyrolab.contracts.integrator import (
     VariationalSettings,
 )
 from gyrolab.errors import IntegrationError, as_number
+from gyrolab.plugins.integrators.refinement import half_step
 from gyrolab.plugins.integrators.step_guard import check_step
 
 GUARD_CHECKS = 50  # as often as the compiled methods check (once per output chunk)
@@ -42,6 +43,9 @@ class RK4(Integrator):
 
     def __init__(self, *, step: float = 0.01) -> None:
         self.step = as_number(step, "integrator.step", positive=True)
+
+    def more_accurate(self, factor: float):
+        return half_step(self, 4)
 
     def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
                         failures: str) -> BatchSolution:

@@ -49,7 +49,10 @@ class ScipySolver(Tolerances, Integrator):
             warnings.simplefilter("ignore", UserWarning)
             solver = self.solver_class(fun, t_out[0], np.array(y0, dtype=float), t_out[-1],
                                        rtol=self.rtol, atol=self.atol, max_step=self.max_step)
-        self.record_used_tolerances(float(np.max(solver.rtol)), float(np.max(solver.atol)))
+        # scipy's Runge-Kutta, Radau and BDF solvers keep the tolerances they apply (raised to their floor);
+        # LSODA hands them to ODEPACK unchanged
+        self.record_used_tolerances(float(np.max(getattr(solver, "rtol", self.rtol))),
+                                    float(np.max(getattr(solver, "atol", self.atol))))
         stages = getattr(self.solver_class, "n_stages", None)
         n_steps, n_rejected, filled = 0, 0, 1
         while solver.status == "running" and filled < len(t_out):

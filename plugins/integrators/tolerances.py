@@ -30,6 +30,17 @@ class Tolerances:
                         getattr(self, "name", type(self).__name__), rtol, atol, self.rtol, self.atol)
         self.used_rtol, self.used_atol = rtol, atol
 
+    #: the smallest rtol the method honours (scipy raises a smaller one to 100 machine epsilons)
+    tolerance_floor: float = 100 * float(np.finfo(float).eps)
+
+    def more_accurate(self, factor: float):
+        """The same method at tolerances ``factor`` times smaller (rule 9), or None below its floor."""
+        rtol, atol = self.rtol / factor, self.atol / factor
+        if rtol < self.tolerance_floor:
+            return None
+        kwargs = {"rtol": rtol, "atol": atol, **({"max_step": self.max_step} if np.isfinite(self.max_step) else {})}
+        return type(self)(**kwargs), 1.0, f"{self.name} at rtol {rtol:.3g}, atol {atol:.3g} ({factor:g}× tighter)"
+
     def attributes(self) -> dict[str, Any]:
         attrs: dict[str, Any] = {"integrator_rtol": self.used_rtol, "integrator_atol": self.used_atol}
         if (self.used_rtol, self.used_atol) != (self.rtol, self.atol):
