@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.contracts.integrator import CHOOSES_METHOD
+from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL
 
 log = logging.getLogger(__name__)
 
@@ -84,11 +84,19 @@ def add_error_estimate(ds: xr.Dataset, scene: Any, y: np.ndarray, wall_time: flo
         log.warning("output.error_estimate: %s", reason)
         ds.attrs["error_estimate_method"] = reason
         return ds
-    needs_model = getattr(pick.integrator, "needs_compiled_model", False) or \
-        getattr(pick.integrator, "prefers_compiled_model", False)
+    companion_model = None
+    if pick.integrator.supports(COMPILED_MODEL) or pick.integrator.supports(PREFERS_COMPILED_MODEL):
+        # the scene's own model is prepared for its integrator (a plugin torque's Taylor kernel compiled); another
+        # one is prepared by the companion's refusal hook, which also says when it cannot run it
+        companion_model = scene.compiled if scene.compiled is not None else compiled_model
+        refusal = pick.integrator.refusal(companion_model, scene.system) if companion_model is not None else None
+        if refusal:
+            ds.attrs["error_estimate_method"] = f"not available: the companion ({pick.how}) {refusal}"
+            log.warning("output.error_estimate: %s", ds.attrs["error_estimate_method"])
+            return ds
     start = time.perf_counter()
     other = pick.integrator.integrate(scene.system.rhs, scene.times, scene.system.initial_state(), None,
-                                      compiled_model if needs_model else None).y
+                                      companion_model).y
     spent = time.perf_counter() - start
     y = np.asarray(y, dtype=float)
     difference = pick.scale * np.abs(y - other)
