@@ -247,10 +247,17 @@ class Taylor(Integrator):
                         failures: str) -> BatchSolution:
         return batch_kernels.taylor_batch(self, compiled, times, y0s, params, failures)
 
-    def __init__(self, *, order: int | None = None, tol: float = 1e-16) -> None:
+    def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = "double") -> None:
         from gyrolab.plugins.compiled.taylor import MAX_ORDER, MIN_ORDER, order_for
 
+        self.precision = _taylor_precision(precision)
         self.tol = as_number(tol, "integrator.tol", positive=True)
+        if self.precision == DOUBLE_DOUBLE:
+            from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+
+            if self.tol < MIN_TOL:
+                raise ConfigError(f"integrator.tol={tol!r} is below double-double's resolution; with "
+                                  f"integrator.precision=double-double it must be at least {MIN_TOL:g}")
         if order is None:
             order = order_for(self.tol)
         if isinstance(order, bool) or not isinstance(order, int) or not MIN_ORDER <= order <= MAX_ORDER:
@@ -262,6 +269,8 @@ class Taylor(Integrator):
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         from gyrolab.plugins.compiled import models, taylor
 
+        if self.precision == DOUBLE_DOUBLE:
+            return _taylor_double_double(self, fun, t_out, y0, progress, compiled)
         start = time.perf_counter()
         form = models.form(compiled)  # the kernel compiles this model's step only
         t_out, y, out = _outputs(t_out, y0)
@@ -292,7 +301,61 @@ class Taylor(Integrator):
         return Taylor(order=self.order, tol=tol), 1.0, f"taylor at tol {tol:.3g} ({factor:g}× tighter), same order"
 
     def attributes(self) -> dict[str, Any]:
-        return {"integrator_order": self.order, "integrator_tol": self.tol}
+        return {"integrator_order": self.order, "integrator_tol": self.tol, "integrator_precision": self.precision}
+
+
+#: ``Taylor``'s arithmetic: ``integrator.precision``
+DOUBLE, DOUBLE_DOUBLE = "double", "double-double"
+PRECISIONS = (DOUBLE, DOUBLE_DOUBLE)
+
+
+def _taylor_precision(precision: Any) -> str:
+    """``integrator.precision`` checked: one of ``PRECISIONS``, else one ConfigError sentence listing them."""
+    if not isinstance(precision, str) or precision not in PRECISIONS:
+        raise ConfigError(f"integrator.precision={precision!r} is not available; valid choices: "
+                          f"{', '.join(PRECISIONS)}")
+    return precision
+
+
+def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+                          progress: ProgressCallback | None, compiled: CompiledModel) -> Solution:
+    """``Taylor.integrate`` in double-double (``gyrolab.plugins.compiled.taylor_dd``): the state carried in
+    double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded to
+    double. The initial state is a double, hence exact; a compiled plugin torque is refused."""
+    from gyrolab.plugins.compiled import models, taylor, taylor_dd
+
+    if compiled.model != models.FIXED_POINT:
+        raise _double_double_refusal(fun)
+    start = time.perf_counter()
+    t_out, y, out = _outputs(t_out, y0)
+    low = np.zeros(len(y))  # the state's low parts
+    no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
+    state = np.array([t_out[0]])
+    stats = np.zeros(2, dtype=np.int64)
+    reached = 1
+    for first, stop in _Chunks(len(t_out)):
+        if reached >= stop:
+            continue  # a long step already filled this chunk's outputs
+        status, reached = taylor_dd.run(compiled.params, method.order, method.tol, t_out, out, no_low, reached, stop,
+                                        state, y, low, stats)
+        if status != taylor.OK:
+            raise _taylor_failure(status, state[0])
+        if progress is not None:
+            progress(state[0])
+    return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
+                                                wall_time=time.perf_counter() - start))
+
+
+def _double_double_refusal(fun: RightHandSide) -> ConfigError:
+    """The sentence refusing a compiled plugin torque in double-double, naming the force when the right-hand side
+    is a system's bound method (as the scene passes it)."""
+    forces = getattr(getattr(fun, "__self__", None), "forces", None) or []
+    plugins = [force.name for force in forces if force.compiled_terms() is None]
+    what = (f"force {', '.join(repr(name) for name in plugins)} is a compiled plugin torque" if plugins
+            else "this scene's compiled model has a compiled plugin torque")
+    return ConfigError(f"integrator.precision=double-double evaluates the fixed-point model's built-in torque forms "
+                       f"only (uniform_gravity, newtonian, magnetic), and {what}; valid choices: "
+                       f"integrator.precision=double")
 
 
 def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: np.ndarray) -> np.ndarray:
