@@ -246,7 +246,6 @@ def _errors(hi, lo, exact):
             for rh, rl, re in zip(hi, lo, exact)]
 
 
-@pytest.mark.slow
 def test_double_double_taylor_matches_a_50_digit_reference_where_double_precision_cannot(chaotic, reference):
     p, y0 = chaotic
     t_out, exact = reference
