@@ -102,7 +102,7 @@ def _relative_errors(out, exact):
     return [abs(_exact(*r) - e) / abs(e) for r, e in zip(out, exact) if e != 0]
 
 
-def test_double_double_operations_round_to_a_few_units_of_2_to_the_minus_104():
+def test_double_double_operations_round_to_one_unit_of_2_to_the_minus_104():
     n = 2000
     ah, al = _dd_numbers(n)
     bh, bl = _dd_numbers(n)
@@ -125,7 +125,7 @@ def test_double_double_operations_round_to_a_few_units_of_2_to_the_minus_104():
         out = _apply(op, np.column_stack(args))
         _assert_normalised(out)
         bounds[name] = max(_relative_errors(out, exact)) / U2
-    assert all(bound <= 3 for bound in bounds.values()), bounds
+    assert all(bound <= 1 for bound in bounds.values()), bounds  # measured ≤ 0.62 (2.5 u²)
 
 
 @numba.njit
