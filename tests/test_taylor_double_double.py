@@ -383,3 +383,15 @@ def test_batch_refuses_double_double():
     with pytest.raises(ConfigError, match="double precision only"):
         integrate_arrays(scene.compiled, scene.integrator, np.array([0.0, 1.0]), scene.system.initial_state()[None])
 
+
+
+def test_the_one_call_samples_for_auto_equal_the_integrator(chaotic):
+    from gyrolab.plugins.integrators.compiled_solvers import taylor_dd_samples
+
+    p, y0 = chaotic
+    model, t_out = CompiledModel(models.FIXED_POINT, p), np.linspace(0.0, 20.0, 41)
+    samples = taylor_dd_samples(model, 1e-26, t_out, y0)
+    np.testing.assert_array_equal(samples, Taylor(precision="double-double", tol=1e-26).integrate(
+        None, t_out, y0, None, model).y)
+    with pytest.raises(ConfigError, match="valid choices: integrator.precision=double"):
+        taylor_dd_samples(CompiledModel(models.FIXED_POINT_PLUGIN, p), 1e-26, t_out, y0)

@@ -346,7 +346,27 @@ def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray,
                                                 wall_time=time.perf_counter() - start))
 
 
-def _double_double_refusal(fun: RightHandSide) -> ConfigError:
+def taylor_dd_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: np.ndarray,
+                      order: int | None = None) -> np.ndarray:
+    """``taylor_samples`` in double-double: the states at ``t_out`` (rounded to double) of the double-double Taylor
+    method at ``tol`` (≥ ``taylor_dd.MIN_TOL``) and ``order`` (None: its optimal order), in one call into the
+    kernel, for a method choosing its setting from short runs (``auto``'s pilot). Built-in torque forms only
+    (a plugin model raises ConfigError); a failed step raises IntegrationError."""
+    from gyrolab.plugins.compiled import models, taylor, taylor_dd
+
+    if compiled.model != models.FIXED_POINT:
+        raise _double_double_refusal(None)
+    t_out, y, out = _outputs(t_out, y0)
+    state = np.array([t_out[0]])
+    order = taylor.order_for(tol) if order is None else order
+    status, _ = taylor_dd.run(compiled.params, order, tol, t_out, out, np.empty((0, len(y))), 1, len(t_out), state,
+                              y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
+    if status != taylor.OK:
+        raise _taylor_failure(status, state[0])
+    return out
+
+
+def _double_double_refusal(fun: RightHandSide | None) -> ConfigError:
     """The sentence refusing a compiled plugin torque in double-double, naming the force when the right-hand side
     is a system's bound method (as the scene passes it)."""
     forces = getattr(getattr(fun, "__self__", None), "forces", None) or []
