@@ -371,17 +371,43 @@ def test_a_compiled_plugin_torque_is_refused_in_double_double_naming_the_force()
             raise AssertionError("not called")
 
     model = CompiledModel(models.FIXED_POINT_PLUGIN, np.zeros(N_PARAMS + 4))
-    with pytest.raises(ConfigError, match=r"force 'my_drag' is a compiled plugin torque; valid choices: "
-                                          r"integrator.precision=double$"):
-        Taylor(precision="double-double").integrate(System().rhs, np.array([0.0, 1.0]), np.ones(6), None, model)
+    taylor = Taylor(precision="double-double")
+    # the scene asks before integrating (contract rule 8, C1) and puts the clause into its one sentence
+    assert taylor.refusal(model, System()) == (
+        "in double-double precision evaluates the fixed-point model's built-in torque forms only (uniform_gravity, "
+        "newtonian, magnetic), and force 'my_drag' is a compiled plugin torque (integrator.precision=double runs it)")
+    assert taylor.refusal(CompiledModel(models.FIXED_POINT, np.zeros(N_PARAMS)), System()) is None
+    # called directly, integrate refuses too
+    with pytest.raises(ConfigError, match=r"^integrator 'taylor' in double-double precision .* force 'my_drag' is a "
+                                          r"compiled plugin torque \(integrator.precision=double runs it\); valid "
+                                          r"choices: integrator.precision=double$"):
+        taylor.integrate(System().rhs, np.array([0.0, 1.0]), np.ones(6), None, model)
 
 
-def test_batch_refuses_double_double():
-    from gyrolab.batch.integrate import integrate_arrays
+def test_capabilities_batch_points_and_the_error_estimates_companion():
+    from gyrolab.batch.integrate import integrate_arrays, integrate_batch
+    from gyrolab.contracts.integrator import BATCH_KERNEL, COMPILED_MODEL, TIME_DEPENDENT
+    from gyrolab.plugins.integrators.compiled_solvers import TaylorDoubleDouble
 
-    scene = compose_scene(["output.euler_angles=false", "integrator=taylor", "integrator.precision=double-double"])
-    with pytest.raises(ConfigError, match="double precision only"):
-        integrate_arrays(scene.compiled, scene.integrator, np.array([0.0, 1.0]), scene.system.initial_state()[None])
+    taylor = Taylor(precision="double-double", tol=1e-24)
+    assert isinstance(taylor, TaylorDoubleDouble) and type(Taylor()) is Taylor and taylor.name == "taylor"
+    assert taylor.supports(COMPILED_MODEL) and not taylor.supports(BATCH_KERNEL)
+    assert not taylor.supports(TIME_DEPENDENT) and Taylor().supports(BATCH_KERNEL)
+    # the error estimate's companion stays in double-double, 1000x tighter, down to the floor
+    companion, factor, _ = taylor.more_accurate(1000.0)
+    assert (type(companion), companion.order, factor) == (TaylorDoubleDouble, taylor.order, 1.0)
+    assert companion.tol == pytest.approx(1e-27, rel=1e-12)
+    assert Taylor(precision="double-double", tol=1e-30).more_accurate(1000.0) is None
+    # --batch: one integrate() per point, each exactly a single run (no double-precision batch kernel)
+    scene = compose_scene(["initial=slow_spin", "output.euler_angles=false", "time.end=20", "time.n_output=21",
+                           "integrator=taylor", "integrator.precision=double-double", "integrator.tol=1e-24"])
+    y0s = np.array([scene.system.initial_state(), scene.system.initial_state() * [1.01, 1, 1, 1, 1, 1]])
+    batch = integrate_batch(scene, y0s)
+    for j in range(2):
+        single = scene.integrator.integrate(None, scene.times, y0s[j], None, scene.compiled).y
+        np.testing.assert_array_equal(batch.y[j], single)
+    with pytest.raises(ConfigError, match="not taylor"):
+        integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s)
 
 
 
@@ -395,3 +421,19 @@ def test_the_one_call_samples_for_auto_equal_the_integrator(chaotic):
         None, t_out, y0, None, model).y)
     with pytest.raises(ConfigError, match="valid choices: integrator.precision=double"):
         taylor_dd_samples(CompiledModel(models.FIXED_POINT_PLUGIN, p), 1e-26, t_out, y0)
+
+
+def test_the_scene_refuses_a_plugin_torque_in_double_double_before_integrating(tmp_path):
+    from pathlib import Path
+
+    from tests.conftest import installed_distribution
+
+    example = Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"
+    with installed_distribution(tmp_path, "gyrolab-viscous-drag", "0.1",
+                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, paths=[example]):
+        with pytest.raises(ConfigError, match=r"^integrator 'taylor' in double-double precision evaluates the "
+                                              r"fixed-point model's built-in torque forms only .* force 'viscous_drag' "
+                                              r"is a compiled plugin torque \(integrator.precision=double runs it\); "
+                                              r"choose .*taylor"):
+            compose_scene(["force=[uniform_gravity,viscous_drag]", "integrator=taylor",
+                           "integrator.precision=double-double"])

@@ -247,6 +247,12 @@ class Taylor(Integrator):
                         failures: str) -> BatchSolution:
         return batch_kernels.taylor_batch(self, compiled, times, y0s, params, failures)
 
+    def __new__(cls, *args: Any, precision: str = "double", **kwargs: Any) -> Taylor:
+        """``precision="double-double"`` makes a ``TaylorDoubleDouble``: the same settings, its own capabilities."""
+        if cls is Taylor and precision == DOUBLE_DOUBLE:
+            cls = TaylorDoubleDouble
+        return super().__new__(cls)
+
     def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = "double") -> None:
         from gyrolab.plugins.compiled.taylor import MAX_ORDER, MIN_ORDER, order_for
 
@@ -269,8 +275,6 @@ class Taylor(Integrator):
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         from gyrolab.plugins.compiled import models, taylor
 
-        if self.precision == DOUBLE_DOUBLE:
-            return _taylor_double_double(self, fun, t_out, y0, progress, compiled)
         start = time.perf_counter()
         form = models.form(compiled)  # the kernel compiles this model's step only
         t_out, y, out = _outputs(t_out, y0)
@@ -315,6 +319,39 @@ def _taylor_precision(precision: Any) -> str:
         raise ConfigError(f"integrator.precision={precision!r} is not available; valid choices: "
                           f"{', '.join(PRECISIONS)}")
     return precision
+
+
+class TaylorDoubleDouble(Taylor):
+    """``Taylor(precision="double-double")`` (``integrator=taylor integrator.precision=double-double``): the Taylor
+    method in double-double arithmetic (``gyrolab.plugins.compiled.taylor_dd``, ≈ 32 digits), same settings,
+    order rule, chunks and progress as ``Taylor``. Capabilities: the compiled model only — built-in torque forms
+    (a traced plugin torque is refused, naming the force), no time-dependent forces, no batch kernel (``--batch``
+    runs one ``integrate`` per point, each exactly a single run)."""
+
+    capabilities = frozenset({COMPILED_MODEL})
+
+    @classmethod
+    def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
+        from gyrolab.plugins.compiled import models
+
+        if compiled.model == models.FIXED_POINT:
+            return None
+        return _double_double_clause(getattr(system, "forces", None))
+
+    integrate_batch = Integrator.integrate_batch  # no batch kernel
+
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+        return _taylor_double_double(self, fun, t_out, y0, progress, compiled)
+
+    def more_accurate(self, factor: float):
+        from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+
+        tol = self.tol / factor
+        if tol < MIN_TOL:
+            return None
+        return (Taylor(order=self.order, tol=tol, precision=DOUBLE_DOUBLE), 1.0,
+                f"taylor double-double at tol {tol:.3g} ({factor:g}× tighter), same order")
 
 
 def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
@@ -366,16 +403,20 @@ def taylor_dd_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0
     return out
 
 
+def _double_double_clause(forces: list | None) -> str:
+    """Why double-double cannot run a traced plugin torque, naming the plugin forces among ``forces`` (if known)."""
+    plugins = [force.name for force in forces or [] if force.compiled_terms() is None]
+    what = (f"force {', '.join(repr(name) for name in plugins)} is a compiled plugin torque" if plugins
+            else "this model has a compiled plugin torque")
+    return (f"in double-double precision evaluates the fixed-point model's built-in torque forms only (uniform_gravity, "
+            f"newtonian, magnetic), and {what} (integrator.precision=double runs it)")
+
+
 def _double_double_refusal(fun: RightHandSide | None) -> ConfigError:
     """The sentence refusing a compiled plugin torque in double-double, naming the force when the right-hand side
     is a system's bound method (as the scene passes it)."""
-    forces = getattr(getattr(fun, "__self__", None), "forces", None) or []
-    plugins = [force.name for force in forces if force.compiled_terms() is None]
-    what = (f"force {', '.join(repr(name) for name in plugins)} is a compiled plugin torque" if plugins
-            else "this scene's compiled model has a compiled plugin torque")
-    return ConfigError(f"integrator.precision=double-double evaluates the fixed-point model's built-in torque forms "
-                       f"only (uniform_gravity, newtonian, magnetic), and {what}; valid choices: "
-                       f"integrator.precision=double")
+    clause = _double_double_clause(getattr(getattr(fun, "__self__", None), "forces", None))
+    return ConfigError(f"integrator 'taylor' {clause}; valid choices: integrator.precision=double")
 
 
 def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: np.ndarray) -> np.ndarray:
