@@ -2,7 +2,7 @@
 
     pip install -e ".[bench]"                         # heyoka (its rows are skipped when absent)
     python benchmarks/extended_precision.py           # about a minute
-    python benchmarks/extended_precision.py --quick   # fewer settings and rounds
+    python benchmarks/extended_precision.py --quick   # fewer settings and rounds, results not written
 
 Scene (issue 22 item 3): the default body and forces, ``initial=slow_spin time.end=300``, state (ω, γ)
 (``output.euler_angles=false``: heyoka integrates the same six equations), the scene's own output
@@ -230,6 +230,9 @@ def main() -> None:
             print(f"| {name} | {' | '.join(f'{e:.1e}' for e in err)} |")
     load_end = os.getloadavg()
     print(f"\nload average {load_end[0]:.2f} at the end; versions: {versions}")
+    if args.quick:
+        print(f"(--quick: {RESULTS.name} not rewritten)")
+        return
     RESULTS.parent.mkdir(exist_ok=True)
     RESULTS.write_text(json.dumps({
         "date_utc": f"{datetime.datetime.now(datetime.UTC):%Y-%m-%dT%H:%MZ}", "cpu_model": cpu_model(),
