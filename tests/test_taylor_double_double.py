@@ -421,6 +421,8 @@ def test_the_one_call_samples_for_auto_equal_the_integrator(chaotic):
         None, t_out, y0, None, model).y)
     with pytest.raises(ConfigError, match="valid choices: integrator.precision=double"):
         taylor_dd_samples(CompiledModel(models.FIXED_POINT_PLUGIN, p), 1e-26, t_out, y0)
+    with pytest.raises(ConfigError, match="at least 1e-32"):
+        taylor_dd_samples(model, 1e-33, t_out, y0)
 
 
 def test_the_scene_refuses_a_plugin_torque_in_double_double_before_integrating(tmp_path):

@@ -393,6 +393,8 @@ def taylor_dd_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0
 
     if compiled.model != models.FIXED_POINT:
         raise _double_double_refusal(None)
+    if not tol >= taylor_dd.MIN_TOL:
+        raise ConfigError(f"tol={tol!r} is below double-double's resolution; it must be at least {taylor_dd.MIN_TOL:g}")
     t_out, y, out = _outputs(t_out, y0)
     state = np.array([t_out[0]])
     order = taylor.order_for(tol) if order is None else order
