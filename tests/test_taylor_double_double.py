@@ -439,3 +439,18 @@ def test_the_scene_refuses_a_plugin_torque_in_double_double_before_integrating(t
                                               r"choose .*taylor"):
             compose_scene(["force=[uniform_gravity,viscous_drag]", "integrator=taylor",
                            "integrator.precision=double-double"])
+
+
+def test_the_batch_plan_asks_the_double_double_class_for_capabilities():
+    from gyrolab.batch.plan import Plan
+    from gyrolab.batch.runner import batch_path
+    from gyrolab.plugins.integrators.compiled_solvers import TaylorDoubleDouble
+
+    for precision, cls in (("double", Taylor), ("double-double", TaylorDoubleDouble)):
+        plan = Plan.__new__(Plan)
+        plan.plain = {"integrator": {"_target_": "gyrolab.plugins.integrators.compiled_solvers.Taylor", "order": None,
+                                     "tol": 1e-20, "precision": precision}}
+        assert plan.integrator_class is cls
+    from types import SimpleNamespace
+
+    assert batch_path(TaylorDoubleDouble, SimpleNamespace(output="final")) == "one integrate() call per point"
