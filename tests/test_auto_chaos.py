@@ -60,3 +60,18 @@ def test_a_regular_scene_is_not_called_chaotic_and_records_its_growth():
     assert 0 < ds.attrs["auto_lyapunov_exponent"] < 0.03  # ln(growth)/t of a shear: small, and shrinking with t
     assert "auto_precision_horizon" not in ds.attrs
     assert "max-norm error of the final state" in ds.attrs["auto_predicted_error_bounds"]
+
+
+def test_extended_precision_meets_what_double_precision_refuses():
+    # the chaotic top to t = 110 at 1e-9 is refused in double precision (above); allowed to, auto runs the
+    # double-double Taylor method and ends below ε and its bound (long-double reference: error ~1e-12 here)
+    overrides = [*CHAOTIC_TOP, "time.end=110"]
+    truth = _reference(overrides)
+    with pytest.raises(ConfigError, match="integrator.extended_precision=true"):
+        compose_scene(["integrator=auto", "accuracy=1e-9", "time.n_output=2", *overrides]).run()
+    ds = compose_scene(["integrator=auto", "accuracy=1e-9", "integrator.extended_precision=true", "time.n_output=2",
+                        *overrides]).run()
+    assert ds.attrs["auto_precision"] == "double-double"
+    final = np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
+    actual = float(np.max(np.abs(final - truth)))
+    assert actual <= 1e-9 and actual <= ds.attrs["auto_predicted_error"]

@@ -34,7 +34,7 @@ import numpy as np
 #: factor). On the reference scene (regular, t = 300) the growth after the pilot is e^2.28 at 1e-5 and e^2.26 at
 #: 1e-4, for 0.69 and 0.56 ms (both runs); but on chaotic scenes a looser run follows another chaotic trajectory
 #: sooner and its estimate scatters more: on slow_spin over t = 300, e^19.3 at 1e-5, e^17.4 at 1e-4, e^23.3 at 1e-3
-#: (Xeon, 2026-11-26)
+#: (AMD EPYC with AVX-512, 2026-11-26)
 TANGENT_TOLERANCE = 1e-5
 #: the shadow pair's initial separation, relative to the state's size, and its renormalisation chunks
 SHADOW_OFFSET = 1e-7

@@ -116,6 +116,8 @@ MISS_MARGIN = 1000.0
 SCREEN_POINTS = 512
 SCREEN_TOLERANCE = 1e-9
 EPS = float(np.finfo(float).eps)
+#: the unit round-off of double-double arithmetic (a 106-bit significand), for auto's extended-precision choice
+DOUBLE_DOUBLE_EPS = 2.0 ** -104
 #: trajectories of a batch on which ``auto`` runs its pilot (the first, the largest state, the most unusual parameters)
 AUTO_SAMPLE = 3
 _PILOT_GRID = np.linspace(0.0, 1.0, PILOT_POINTS)
@@ -128,7 +130,8 @@ class Auto(Integrator):
     capabilities = frozenset({PREFERS_COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, CHOOSES_METHOD})
     evaluation_label = "pilot and chosen method's evaluations"
 
-    def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 1.0) -> None:
+    def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 1.0,
+                 extended_precision: bool = False) -> None:
         if accuracy is None:
             raise ConfigError("integrator=auto needs a target: set accuracy=... (max-norm error of the final state)")
         self.accuracy = as_number(accuracy, "accuracy", positive=True)
@@ -136,6 +139,11 @@ class Auto(Integrator):
         if self.pilot_fraction >= 1:
             raise ConfigError(f"integrator.pilot_fraction={pilot_fraction} must be below 1")
         self.safety = as_number(safety, "integrator.safety", positive=True)
+        if not isinstance(extended_precision, (bool, np.bool_)):
+            raise ConfigError(f"integrator.extended_precision={extended_precision!r} must be true or false")
+        #: whether a target double precision cannot reach may be met in double-double (integrator=taylor
+        #: integrator.precision=double-double) instead of being refused
+        self.extended_precision = bool(extended_precision)
         self.choice: dict[str, Any] = {}
         self.chaos: dict[str, Any] = {}  # the amplification measured over the span (auto_lyapunov_exponent, ...)
         self.chosen: Integrator | None = None  # the method the last integrate ran (None: an analytic series)
@@ -215,22 +223,34 @@ class Auto(Integrator):
                       "auto_amplification_method": amp.how, "auto_chaotic": int(chaotic)}
         if chaotic:
             self.chaos["auto_precision_horizon"] = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
-        if roundoff > self.accuracy:
+        extended = None
+        if roundoff > self.accuracy and self.extended_precision:
+            extended = self._extended(compiled, per_tol, roundoff)
+        if roundoff > self.accuracy and extended is None:
+            roundoff_dd = roundoff * DOUBLE_DOUBLE_EPS / EPS
+            if self.extended_precision and compiled is not None and roundoff_dd > self.accuracy:
+                raise ConfigError(
+                    f"accuracy={self.accuracy:g} cannot be reached even in double-double on this scene (λ ≈ "
+                    f"{amp.lyapunov:.2g}, perturbations grow ~{amp.factor:.1g}× after the pilot: round-off about "
+                    f"{roundoff_dd:.1g}); ask for accuracy ≥ {roundoff_dd:.1g} or a shorter time.end")
             if chaotic:
                 horizon = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
                 raise ConfigError(
                     f"accuracy={self.accuracy:g} cannot be reached in double precision on this chaotic scene: "
                     f"λ ≈ {amp.lyapunov:.2g}, so round-off grows ~{amp.factor:.1g}× after the pilot and double "
                     f"precision keeps {self.accuracy:g} only to t ≈ {t_out[0] + horizon:.4g} of {t_out[-1]:.4g}; ask "
-                    f"for accuracy ≥ {roundoff:.1g}, a shorter time.end, or integrator=taylor "
-                    f"integrator.precision=double-double")
+                    f"for accuracy ≥ {roundoff:.1g}, a shorter time.end, integrator.extended_precision=true (auto then "
+                    f"runs double-double where it can) or integrator=taylor integrator.precision=double-double")
             raise ConfigError(f"accuracy={self.accuracy:g} is below the round-off that double precision accumulates "
                               f"on this scene (about {roundoff:.1g} over ~{steps:.0f} steps); ask for at least that")
-        if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
+        if extended is not None:  # double-double: its own round-off, its own tolerance, from the start
+            method, chosen, roundoff = extended
+        elif CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
-        method = self._method(compiled, chosen)
+        if extended is None:
+            method = self._method(compiled, chosen)
         self.chosen = method  # what ran: more_accurate answers for it
-        if tight_tol <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
+        if tight_tol <= chosen and extended is None:  # the pilot's tight run is as accurate: continue from its end
             head = np.searchsorted(pilot_times, inside)  # the outputs inside the pilot
             rest = t_out[t_out >= t_pilot]
             tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest,
@@ -255,6 +275,30 @@ class Auto(Integrator):
         return Solution(t_out, y, IntegratorStats(
             nfev=final_stats.nfev + pilot_nfev, n_steps=n_steps, n_rejected=final_stats.n_rejected,
             wall_time=time.perf_counter() - start, njev=final_stats.njev, nlu=final_stats.nlu))
+
+    def _extended(self, compiled: CompiledModel | None, per_tol: float,
+                  roundoff: float) -> tuple[Integrator, float, float] | None:
+        """(the double-double Taylor method, its tolerance, its round-off) that meets the accuracy where double
+        precision cannot, or None when the model has no double-double kernel or even it cannot.
+
+        The truncation error per unit tolerance is the pilot's (measured at its order; the double-double run takes
+        the optimal, higher order for its tolerance, hence fewer and larger steps: no more error per unit
+        tolerance); the round-off is double precision's estimate scaled by the ratio of the two unit round-offs."""
+        if compiled is None:
+            return None
+        from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+        from gyrolab.plugins.integrators.compiled_solvers import DOUBLE_DOUBLE, Taylor, TaylorDoubleDouble
+
+        if TaylorDoubleDouble.refusal(compiled, self.system) is not None:
+            return None
+        roundoff_dd = roundoff * DOUBLE_DOUBLE_EPS / EPS
+        if roundoff_dd > self.accuracy:
+            return None
+        tol = (self.accuracy - roundoff_dd) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
+        tol = min(max(tol, MIN_TOL), MAX_TOLERANCE)
+        if CALIBRATION * per_tol * tol + roundoff_dd > self.accuracy:
+            return None
+        return Taylor(tol=tol, precision=DOUBLE_DOUBLE), tol, roundoff_dd
 
     def _series(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                 start: float) -> Solution | None:
