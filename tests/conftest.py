@@ -23,16 +23,16 @@ def cli(tmp_path):
 
 
 @contextlib.contextmanager
-def installed_distribution(site, name, version, forces, paths=()):
+def installed_distribution(site, name, version, forces, paths=(), group="gyrolab.forces"):
     """A distribution laid out the way pip does it: ``site``/NAME-VERSION.dist-info with its
-    ``gyrolab.forces`` entry points (dict name -> "module:Class"), ``site`` and ``paths`` on sys.path,
-    gyrolab's plugin registry refreshed on entry and on exit."""
+    entry points of ``group`` (``forces``: dict name -> "module:Class"; any gyrolab.* group), ``site`` and
+    ``paths`` on sys.path, gyrolab's plugin registry refreshed on entry and on exit."""
     from gyrolab.engine import config, registry
 
     info = site / f"{name.replace('-', '_')}-{version}.dist-info"
     info.mkdir()
     (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: {version}\n")
-    (info / "entry_points.txt").write_text("[gyrolab.forces]\n" + "".join(f"{k} = {v}\n" for k, v in forces.items()))
+    (info / "entry_points.txt").write_text(f"[{group}]\n" + "".join(f"{k} = {v}\n" for k, v in forces.items()))
     mp = pytest.MonkeyPatch()
     for path in (*paths, site):
         mp.syspath_prepend(str(path))
