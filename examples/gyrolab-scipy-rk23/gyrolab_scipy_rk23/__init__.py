@@ -22,22 +22,25 @@ class ScipyRK23(Integrator):
         start = time.perf_counter()
         t_out = np.asarray(t_out, dtype=float)
 
-        def counted(t, y):                # progress on every evaluation is cheap: the callback rate-limits itself
+        latest = [t_out[0]]               # where the solver got to (with t_eval, done.t holds only the output times)
+
+        def fun_seen(t, y):               # progress on every evaluation is cheap: the callback rate-limits itself
+            latest[0] = t
             if progress is not None:
                 progress(t)
             return fun(t, y)
 
         # t_eval lands the samples on the requested times (dense output of each step, nothing else stored)
         with np.errstate(over="ignore", invalid="ignore"):   # a blow-up is reported below, in one sentence
-            done = solve_ivp(counted, (t_out[0], t_out[-1]), np.array(y0, dtype=float), method="RK23",
+            done = solve_ivp(fun_seen, (t_out[0], t_out[-1]), np.array(y0, dtype=float), method="RK23",
                              t_eval=t_out, rtol=self.rtol, atol=self.atol)
         if done.status != 0 or done.y.shape[1] != len(t_out) or not np.all(np.isfinite(done.y)):
-            reached = done.t[-1] if len(done.t) else t_out[0]
-            raise IntegrationError(f"scipy_rk23 stopped near t={reached:.6g} of {t_out[-1]:.6g} with rtol="
+            raise IntegrationError(f"scipy_rk23 stopped near t={latest[0]:.6g} of {t_out[-1]:.6g} with rtol="
                                    f"{self.rtol:g}: {done.message if done.status else 'the state became non-finite'}")
         y = done.y.T.copy()
         y[0] = y0                         # t_out[0] is the initial time: the state there is y0 itself
-        stats = IntegratorStats(nfev=int(done.nfev), n_steps=max(1, (int(done.nfev) - 1) // 3), n_rejected=None,
+        # solve_ivp does not report steps: each attempt costs 3 evaluations after the 2 that choose the first step
+        stats = IntegratorStats(nfev=int(done.nfev), n_steps=max(1, (int(done.nfev) - 2) // 3), n_rejected=None,
                                 wall_time=time.perf_counter() - start)
         return Solution(t=t_out, y=y, stats=stats)
 
