@@ -118,11 +118,13 @@ def test_regime_runs_from_the_api(installed):
 def test_integrator_and_system_run_from_the_command_line(installed, cli, tmp_path):
     env = {"PYTHONPATH": ":".join(installed)}
     done = cli("body=rotor_body", "force=[]", "integrator=scipy_rk23", "integrator.rtol=1e-8", "time.end=2",
-               "time.n_output=21", "output.figures=false", "hydra.run.dir=out", env_extra=env)
+               "time.n_output=21", "hydra.run.dir=out", env_extra=env)
     assert done.returncode == 0, done.stderr
     with xr.open_dataset(tmp_path / "out" / "run.nc") as ds:
         assert ds.attrs["system"] == "rotor_body" and ds.attrs["integrator"] == "scipy_rk23"
         assert ds.kinetic_energy.attrs["units"] == "J"
+    figures = {p.stem for p in (tmp_path / "out" / "figures").glob("*.png")}
+    assert figures == {"state", "invariant_drift", "euler_angles", "body_axis_sphere"}
     typo = cli("body=rotor_body", "force=[]", "body.rotor_momentm=[0,0,1]", env_extra=env)
     assert typo.returncode == 2 and "did you mean `body.rotor_momentum`?" in typo.stderr
 
@@ -206,3 +208,14 @@ def test_regime_kit_fails_when_the_solution_does_not_start_at_the_initial_state(
     with pytest.raises(AssertionError, match=r"^OffStart: solution\(system, \[0\]\) = .* differs from initial_state"):
         check_regime(OffStart)
     check_regime(SmallParameter)  # the unbroken regime passes
+
+
+def test_regime_runs_from_the_command_line(installed, cli, tmp_path):
+    done = cli("regime=steady_precession", "regime.branch=fast", *LAGRANGE_TOP, "initial.r0=5", "initial.theta0=2.5",
+               "output.figures=false", "hydra.run.dir=out", env_extra={"PYTHONPATH": ":".join(installed)})
+    assert done.returncode == 0, done.stderr
+    with xr.open_dataset(tmp_path / "out" / "regime.nc") as ds:
+        assert ds.attrs["regime"] == "steady_precession" and ds.attrs["regime_branch"] == "fast"
+        assert ds.attrs["exact_orbit"] == "found"
+        assert float(ds.max_error_vs_orbit.max()) < 1e-9   # Newton shooting lands on the analytic orbit
+        assert float(ds.max_error_vs_full.max()) < 1e-7    # the scene's dop853 at its default rtol = 1e-10

@@ -16,6 +16,7 @@ import xarray as xr
 
 from gyrolab.contracts import System
 from gyrolab.errors import ConfigError
+from gyrolab.physics.attitude import nutation_and_spin
 from gyrolab.physics.initial import InitialAttitude
 
 from gyrolab_rotor_body.body import DEFAULT_BODY, RotorBody
@@ -53,6 +54,7 @@ class RotorBodySystem(System):
     def variables(self, t, y):
         omega, gamma = y[:, 0:3], y[:, 3:6]
         momentum = self.inertia * omega + self.h
+        theta, phi = nutation_and_spin(gamma)
         return {
             "omega": _var(("time", "axis"), omega, "rad s-1", "angular velocity (p, q, r) of the body in body axes"),
             "gamma": _var(("time", "axis"), gamma, "1", "direction cosines of the fixed Z axis in body axes"),
@@ -61,6 +63,9 @@ class RotorBodySystem(System):
             "momentum_squared": _var("time", np.sum(momentum * momentum, axis=1), "kg2 m4 s-2",
                                      "squared total angular momentum |Iω + h|²"),
             "gamma_norm": _var("time", np.linalg.norm(gamma, axis=1), "1", "norm of the direction cosines |γ|"),
+            # the angles γ alone fixes (ψ needs a second fixed axis, which this state does not carry)
+            "theta": _var("time", theta, "rad", "nutation angle θ: body z axis from the fixed Z axis"),
+            "phi": _var("time", np.unwrap(phi), "rad", "proper-rotation angle φ (unwrapped)"),
         }
 
     def attributes(self):
