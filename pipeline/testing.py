@@ -205,15 +205,7 @@ def _netcdf_safe(value: Any) -> bool:
 
 
 def _check_attributes(cls: type, force: Force) -> None:
-    attrs = force.attributes()
-    if not isinstance(attrs, dict):
-        raise _fail(cls, f"attributes() returned {type(attrs).__name__}, not a dict")
-    for key, value in attrs.items():
-        if not isinstance(key, str) or not _NAME.match(key):
-            raise _fail(cls, f"attributes() key {key!r} is not a netCDF-safe name (letters, digits, _)")
-        if not _netcdf_safe(value):
-            raise _fail(cls, f"attributes()[{key!r}] = {value!r} is not netCDF-safe; use str, int, float or a "
-                             "non-empty list of finite numbers (no bool, None or dict)")
+    _check_mapping(cls, force.attributes(), "attributes()")
 
 
 def _check_bad_parameters(cls: type, body: Any, where: str, params: dict[str, Any]) -> None:
@@ -323,7 +315,7 @@ def check_integrator(cls: type, **params: Any) -> None:
     if not isinstance(capabilities, frozenset) or not all(isinstance(c, str) for c in capabilities):
         raise _fail(cls, f"capabilities={capabilities!r} must be a frozenset of capability names (str)")
     params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
-    integrator = _build_plugin(cls, params, "integrator")
+    integrator = _build_plugin(cls, params)
     _check_bad_plugin_parameters(cls, params, "integrator")
     if not cls.needs_compiled_model:
         stats = _check_oscillator(cls, integrator)
@@ -332,7 +324,8 @@ def check_integrator(cls: type, **params: Any) -> None:
     _check_mapping(cls, integrator.attributes(), "attributes()")
 
 
-def _build_plugin(cls: type, params: dict[str, Any], group: str, *args: Any) -> Any:
+def _build_plugin(cls: type, params: dict[str, Any], *args: Any) -> Any:
+    """The plugin built with ``params`` (after the positional ``args`` a scene passes: a system's body, ...)."""
     try:
         return cls(*args, **params)
     except ConfigError as exc:
@@ -414,6 +407,7 @@ def _check_blow_up(cls: type, integrator: Any) -> None:
 
 
 def _check_mapping(cls: type, attrs: Any, what: str) -> None:
+    """``attrs`` (a plugin's ``attributes()``) are netCDF-safe: names of letters, digits and _, values ``_netcdf_safe``."""
     if not isinstance(attrs, dict):
         raise _fail(cls, f"{what} returned {type(attrs).__name__}, not a dict")
     for key, value in attrs.items():
@@ -421,7 +415,7 @@ def _check_mapping(cls: type, attrs: Any, what: str) -> None:
             raise _fail(cls, f"{what} key {key!r} is not a netCDF-safe name (letters, digits, _)")
         if not _netcdf_safe(value):
             raise _fail(cls, f"{what}[{key!r}] = {value!r} is not netCDF-safe; use str, int, float or a non-empty "
-                             "array of finite numbers (no bool, None or dict)")
+                             "list of finite numbers (no bool, None or dict)")
 
 
 def _check_bad_plugin_parameters(cls: type, params: dict[str, Any], group: str, *args: Any) -> None:
@@ -493,7 +487,8 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
     built_forces = [build_force(force_cls, dict(force_params), f"force.{force_cls.name}", built_body)
                     for force_cls, force_params in forces]
     output = {"euler_angles": True} if output is None else dict(output)
-    system = _build_plugin(cls, params, "system", built_body, built_forces, dict(initial), output)
+    system = _build_plugin(cls, params, built_body, built_forces, dict(initial), output)
+    _check_bad_plugin_parameters(cls, params, "system", built_body, built_forces, dict(initial), output)
     y0 = _check_state(cls, system)
     t, y = _integrate_tightly(cls, system, y0, span)
     _check_variables(cls, system, t, y)
@@ -606,7 +601,7 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
         raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Regime")
     _check_regime_declarations(cls)
     params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
-    regime = _build_plugin(cls, params, "regime")
+    regime = _build_plugin(cls, params)
     _check_bad_plugin_parameters(cls, params, "regime")
     if isinstance(scene, System):
         system = scene
@@ -624,7 +619,7 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     value = regime.parameter_value(system)
     if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) or not math.isfinite(float(value)):
         raise _fail(cls, f"parameter_value(system) returned {value!r}, not a finite number")
-    y0 = _check_regime_start(cls, regime, system)
+    _check_regime_start(cls, regime, system)
     period = regime.period(system)
     if isinstance(period, bool) or not isinstance(period, (int, float, np.number)) or not 0 < float(period) < math.inf:
         raise _fail(cls, f"period(system) returned {period!r}; it must be a finite number > 0")
@@ -635,7 +630,6 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
                          f"{'' if np.all(np.isfinite(y)) else ' with non-finite values'}; it must be finite, (n, 6)")
     _check_euler_angles(cls, regime, system, t)
     _check_mapping(cls, regime.attributes(), "attributes()")
-    del y0
 
 
 def _check_regime_declarations(cls: type) -> None:
@@ -654,12 +648,11 @@ def _check_regime_declarations(cls: type) -> None:
         raise _fail(cls, f"order={order!r} must be a dict of variable name → error order in the parameter")
 
 
-def _check_regime_start(cls: type, regime: Any, system: Any) -> np.ndarray:
+def _check_regime_start(cls: type, regime: Any, system: Any) -> None:
     y0 = np.asarray(regime.initial_state(system))
     if y0.shape != (6,) or not np.issubdtype(y0.dtype, np.floating) or not np.all(np.isfinite(y0)):
         raise _fail(cls, f"initial_state(system) returned shape {y0.shape}, dtype {y0.dtype}; it must be the "
                          "orbit's finite (ω, γ) at t = 0, a float array of shape (6,)")
-    y0 = y0.copy()
     start = np.asarray(regime.solution(system, np.array([0.0])))
     if start.shape != (1, 6):
         raise _fail(cls, f"solution(system, [0]) returned shape {start.shape}, not (1, 6)")
@@ -667,7 +660,6 @@ def _check_regime_start(cls: type, regime: Any, system: Any) -> np.ndarray:
     if not gap <= REGIME_START_TOLERANCE * max(1.0, float(np.max(np.abs(y0)))):
         raise _fail(cls, f"solution(system, [0]) = {np.round(start[0], 12).tolist()} differs from initial_state = "
                          f"{np.round(y0, 12).tolist()} by {gap:.3g}; the solution must start at its initial state")
-    return y0
 
 
 def _check_euler_angles(cls: type, regime: Any, system: Any, t: np.ndarray) -> None:

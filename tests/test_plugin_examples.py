@@ -177,6 +177,48 @@ class OffStart(SmallParameter):
         return super().initial_state(system) + np.array([0.0, 0.0, 1e-6, 0.0, 0.0, 0.0])
 
 
+class Silent(DOP853):
+    """Never reports progress."""
+
+    name = "silent"
+
+    def integrate(self, fun, t_out, y0, progress=None, compiled=None):
+        return super().integrate(fun, t_out, y0, None, compiled)
+
+
+class Sloppy(DOP853):
+    """States rtol = 1e-10 but integrates at 1e-3."""
+
+    name = "sloppy"
+
+    def integrate(self, fun, t_out, y0, progress=None, compiled=None):
+        return DOP853(rtol=1e-3, atol=1e-3).integrate(fun, t_out, y0, progress, compiled)
+
+
+class Unvalidated(DOP853):
+    """Takes any step without checking it."""
+
+    name = "unvalidated"
+
+    def __init__(self, *, rtol=1e-10, atol=1e-10, first_step=0.1):
+        super().__init__(rtol=rtol, atol=atol)
+        self.first_step = first_step
+
+
+class NoUnits(FixedPoint):
+    def variables(self, t, y):
+        out = super().variables(t, y)
+        del out["theta"].attrs["units"]
+        return out
+
+
+class TwoAngles(SmallParameter):
+    def euler_angles(self, system, t):
+        angles = super().euler_angles(system, t)
+        del angles["phi"]
+        return angles
+
+
 BODY = {"units": "nondimensional", "a": 2.0, "b": 1.5, "com_direction": [0.3, 0.2, 0.9327379053088815]}
 INITIAL = {"p0": 0.1, "q0": -0.05, "r0": 5.0, "theta0": 1.0, "phi0": 1.57, "psi0": 0.0}
 
@@ -219,3 +261,15 @@ def test_regime_runs_from_the_command_line(installed, cli, tmp_path):
         assert ds.attrs["exact_orbit"] == "found"
         assert float(ds.max_error_vs_orbit.max()) < 1e-9   # Newton shooting lands on the analytic orbit
         assert float(ds.max_error_vs_full.max()) < 1e-7    # the scene's dop853 at its default rtol = 1e-10
+
+
+@pytest.mark.parametrize("check, expected", [
+    (lambda: check_integrator(Silent), r"^Silent: integrate never called progress\(t\)"),
+    (lambda: check_integrator(Sloppy), r"^Sloppy: its error on the harmonic oscillator x'' = −x is .* above 1e-07"),
+    (lambda: check_integrator(Unvalidated), r"^Unvalidated: integrator\.first_step='abc' was accepted"),
+    (lambda: check_system(NoUnits, BODY, INITIAL), r"^NoUnits: variable 'theta' has no CF units"),
+    (lambda: check_regime(TwoAngles), r"^TwoAngles: euler_angles\(system, t\) returned keys \['psi', 'theta'\]"),
+])
+def test_kits_name_the_rule_a_broken_plugin_violates(check, expected):
+    with pytest.raises(AssertionError, match=expected):
+        check()
