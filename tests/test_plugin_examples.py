@@ -107,12 +107,19 @@ def test_system_body_typo_is_one_sentence(installed):
 
 
 def test_regime_runs_from_the_api(installed):
+    # regime=steady_precession in a scene's config; the scene run from the regime's own t = 0 state follows it
+    scene = [*LAGRANGE_TOP, "regime=steady_precession", "regime.branch=fast", "initial.theta0=2.5", "initial.r0=3"]
     regime_cls = registry.load("regime", "steady_precession")
-    scene = compose_scene([*LAGRANGE_TOP, "regime=steady_precession", "regime.branch=fast"])
-    regime = regime_cls(**{k: v for k, v in scene.config.regime.items() if k != "_target_"})
-    assert regime.branch == "fast" and regime.check_domain(scene.system)  # p0, q0 are reseated: one warning
-    y = regime.solution(scene.system, np.linspace(0.0, regime.period(scene.system), 5))
-    np.testing.assert_allclose(y[-1], y[0], atol=1e-12)  # periodic in the body frame
+    composed = compose_scene(scene)
+    regime = regime_cls(**{k: v for k, v in composed.config.regime.items() if k != "_target_"})
+    assert regime.branch == "fast" and regime.check_domain(composed.system)  # p0, q0 are reseated: one warning
+    y0, period = regime.initial_state(composed.system), regime.period(composed.system)
+    ds = compose_scene([*scene, f"initial.p0={float(y0[0])!r}", f"initial.q0={float(y0[1])!r}",
+                        f"time.end={2 * float(period)!r}", "time.n_output=101"]).run()
+    expected = regime.solution(composed.system, ds.time.values)
+    np.testing.assert_allclose(ds.omega.values, expected[:, :3], atol=1e-8)   # dop853 at its default rtol = 1e-10
+    np.testing.assert_allclose(ds.gamma.values, expected[:, 3:], atol=1e-8)
+    np.testing.assert_allclose(expected[-1], expected[0], atol=1e-12)          # periodic in the body frame
 
 
 def test_integrator_and_system_run_from_the_command_line(installed, cli, tmp_path):

@@ -132,7 +132,7 @@ def register_plugin_configs() -> None:
 
 def plugin_default_body(group: str, cls: type) -> dict[str, Any] | None:
     """A third-party system's ``default_body`` (its body section), None for other plugins or without one."""
-    body = getattr(cls, "default_body", None) if group == "system" else None
+    body = cls.default_body if group == "system" else None
     if body is None:
         return None
     if not isinstance(body, dict) or not all(isinstance(k, str) for k in body):
