@@ -7,7 +7,7 @@ the body's total angular momentum is L = Iω + h and, with no external torque, L
 
 γ being the body components of a direction fixed in space (the Z axis). State y = (ω, γ).
 First integrals: the body's kinetic energy ½ ω·Iω (the rotor's relative spin energy is constant, left out)
-and |Iω + h|², whose direction L = Iω + h is fixed in space.
+and |L|², L = Iω + h being fixed in space.
 """
 
 from typing import Any
