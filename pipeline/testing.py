@@ -34,6 +34,7 @@ import inspect
 import math
 import re
 import warnings
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -271,9 +272,58 @@ OSCILLATOR_TIMES = np.array([0.5, 0.6, 1.0, 2.5, 4.0, 4.1, 7.3, 10.5])
 BLOW_UP_TIMES = np.array([0.0, 0.5, 2.0])
 
 
+@dataclass(frozen=True)
+class ExactProblem:
+    """An initial-value problem with a known solution, for ``check_integrator``.
+
+    ``exact(t)`` gives the columns ``compared`` of the solution from ``y0`` at ``t_out[0]``; ``compiled`` is the
+    problem in the compiled kernels' form (None for a Python-only problem).
+    """
+
+    description: str
+    fun: Any
+    y0: np.ndarray
+    exact: Any
+    compared: slice
+    compiled: Any = None
+
+
 def _oscillator(t: float, y: np.ndarray) -> np.ndarray:
     """x'' = −x written as y = (x, v): the exact solution from (1, 0) at t0 is (cos(t − t0), −sin(t − t0))."""
     return np.array([y[1], -y[0]])
+
+
+def oscillator_problem() -> ExactProblem:
+    def exact(t: np.ndarray) -> np.ndarray:
+        dt = t - OSCILLATOR_TIMES[0]
+        return np.stack([np.cos(dt), -np.sin(dt)], axis=1)
+
+    return ExactProblem("the harmonic oscillator x'' = −x", _oscillator, np.array([1.0, 0.0]), exact, slice(0, 2))
+
+
+#: The free symmetric top of ``free_top_problem``: A = B = 0.8 C, no torque, ω0 = (0.1, −0.05, 5).
+FREE_TOP_A, FREE_TOP_OMEGA0 = 0.8, (0.1, -0.05, 5.0)
+
+
+def free_top_problem() -> ExactProblem:
+    """The torque-free symmetric top as gyrolab's fixed-point system, with its compiled model: I ω̇ = (Iω) × ω with
+    A = B gives r constant and (p, q) turning at λ = (C − A) r / A (ṗ = −λ q, q̇ = λ p)."""
+    from gyrolab.physics.body import Body
+    from gyrolab.plugins.systems.fixed_point import FixedPoint
+
+    body = Body.from_config({"units": "nondimensional", "a": FREE_TOP_A, "b": FREE_TOP_A,
+                             "com_direction": [0.0, 0.0, 0.0]})
+    p0, q0, r0 = FREE_TOP_OMEGA0
+    system = FixedPoint(body, [], {"p0": p0, "q0": q0, "r0": r0, "theta0": 1.0, "phi0": 0.3, "psi0": 0.0},
+                        {"euler_angles": False})
+    lam = (1.0 - FREE_TOP_A) * r0 / FREE_TOP_A
+
+    def exact(t: np.ndarray) -> np.ndarray:
+        c, s = np.cos(lam * (t - OSCILLATOR_TIMES[0])), np.sin(lam * (t - OSCILLATOR_TIMES[0]))
+        return np.stack([p0 * c - q0 * s, p0 * s + q0 * c, np.full_like(t, r0)], axis=1)
+
+    return ExactProblem("the free symmetric top (gyrolab's fixed-point system, compiled)", system.rhs,
+                        system.initial_state(), exact, slice(0, 3), system.compiled_model())
 
 
 def _blow_up(t: float, y: np.ndarray) -> np.ndarray:
@@ -299,8 +349,10 @@ def check_integrator(cls: type, **params: Any) -> None:
        returns non-finite values, and never returns a finite "solution" past the blow-up;
     8. ``attributes()`` and ``stats.attributes()`` are netCDF-safe.
 
-    A compiled integrator (``needs_compiled_model``) integrates a compiled model, not the kit's Python problems:
-    the kit then checks rules 1, 2 and 8 only (its numerics are gyrolab's tests' business).
+    A compiled integrator (``needs_compiled_model``) integrates the compiled model it is given, not ``fun``: rules
+    3–6 are then checked on the free symmetric top (``free_top_problem``: gyrolab's fixed-point system with A = B
+    and no torque, whose ω turns at a constant rate), ``nfev`` > 0 only, and rule 7 is skipped (a blow-up has no
+    compiled model).
     """
     from gyrolab.contracts.integrator import Integrator
 
@@ -317,10 +369,12 @@ def check_integrator(cls: type, **params: Any) -> None:
     params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
     integrator = _build_plugin(cls, params)
     _check_bad_plugin_parameters(cls, params, "integrator")
-    if not cls.needs_compiled_model:
-        stats = _check_oscillator(cls, integrator)
+    if cls.needs_compiled_model:
+        stats = _check_exact_problem(cls, integrator, free_top_problem())
+    else:
+        stats = _check_exact_problem(cls, integrator, oscillator_problem())
         _check_blow_up(cls, integrator)
-        _check_mapping(cls, stats.attributes(), "stats.attributes()")
+    _check_mapping(cls, stats.attributes(), "stats.attributes()")
     _check_mapping(cls, integrator.attributes(), "attributes()")
 
 
@@ -332,49 +386,51 @@ def _build_plugin(cls: type, params: dict[str, Any], *args: Any) -> Any:
         raise _fail(cls, f"building it with {params} raised ConfigError: {exc}") from None
 
 
-def _check_oscillator(cls: type, integrator: Any) -> Any:
+def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> Any:
+    """Rules 3–6 of ``check_integrator`` on one problem with a known solution; returns the run's stats."""
     from gyrolab.contracts.integrator import IntegratorStats, Solution
 
     calls = [0]
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
         calls[0] += 1
-        return _oscillator(t, y)
+        return problem.fun(t, y)
 
     reported: list[float] = []
-    t_out = OSCILLATOR_TIMES.copy()
-    y0 = np.array([1.0, 0.0])
-    solution = integrator.integrate(fun, t_out, y0, reported.append, None)
+    t_out, y0 = OSCILLATOR_TIMES.copy(), problem.y0.copy()
+    solution = integrator.integrate(fun, t_out, y0, reported.append, problem.compiled)
+    on = f"on {problem.description}"
     if not isinstance(solution, Solution):
         raise _fail(cls, f"integrate returned {type(solution).__name__}, not gyrolab.contracts.Solution")
-    if not np.array_equal(y0, [1.0, 0.0]) or not np.array_equal(t_out, OSCILLATOR_TIMES):
+    if not np.array_equal(y0, problem.y0) or not np.array_equal(t_out, OSCILLATOR_TIMES):
         raise _fail(cls, "integrate modified its input y0 or t_out in place; work on copies")
     t, y = np.asarray(solution.t), np.asarray(solution.y)
     if t.shape != t_out.shape or not np.array_equal(t, t_out):
         raise _fail(cls, f"Solution.t is {np.round(t, 12).tolist()}, not the requested t_out "
                          f"{t_out.tolist()}; sample the state at exactly the requested times")
-    if y.shape != (len(t_out), 2):
-        raise _fail(cls, f"Solution.y has shape {y.shape}, not (len(t_out), state size) = ({len(t_out)}, 2)")
+    if y.shape != (len(t_out), len(y0)):
+        raise _fail(cls, f"Solution.y has shape {y.shape}, not (len(t_out), state size) = ({len(t_out)}, {len(y0)})")
     if not np.all(np.isfinite(y)):
-        raise _fail(cls, "Solution.y has non-finite values on the harmonic oscillator; raise IntegrationError instead")
-    if np.max(np.abs(y[0] - y0)) > 1e-14:
+        raise _fail(cls, f"Solution.y has non-finite values {on}; raise IntegrationError instead")
+    if np.max(np.abs(y[0] - y0)) > 1e-14 * max(1.0, float(np.max(np.abs(y0)))):
         raise _fail(cls, f"Solution.y[0] = {y[0].tolist()} is not y0 = {y0.tolist()} at t_out[0], the initial time")
-    dt = t_out - t_out[0]
-    error = float(np.max(np.abs(y - np.stack([np.cos(dt), -np.sin(dt)], axis=1))))
+    error = float(np.max(np.abs(y[:, problem.compared] - problem.exact(t_out))))
     rtol, atol = getattr(integrator, "rtol", None), getattr(integrator, "atol", None)
     if cls.adaptive and rtol is not None and atol is not None:
         allowed, why = ERROR_FACTOR * max(float(rtol), float(atol)), f"{ERROR_FACTOR:g} × max(rtol, atol)"
     else:
         allowed, why = FIXED_STEP_ERROR, "the kit's bound for methods without rtol/atol"
     if not error <= allowed:
-        raise _fail(cls, f"its error on the harmonic oscillator x'' = −x is {error:.3g}, above {allowed:.3g} "
-                         f"({why}); it does not integrate to its own tolerance")
+        raise _fail(cls, f"its error {on} is {error:.3g}, above {allowed:.3g} ({why}); it does not integrate to its "
+                         "own tolerance")
     stats = solution.stats
     if not isinstance(stats, IntegratorStats):
         raise _fail(cls, f"Solution.stats is {type(stats).__name__}, not gyrolab.contracts.IntegratorStats")
-    if not isinstance(stats.nfev, (int, np.integer)) or not 0 < stats.nfev <= calls[0]:
-        raise _fail(cls, f"stats.nfev={stats.nfev!r}, but the right-hand side was called {calls[0]} times; count "
-                         "the evaluations (an integer > 0, at most the calls made)")
+    if not isinstance(stats.nfev, (int, np.integer)) or stats.nfev <= 0:
+        raise _fail(cls, f"stats.nfev={stats.nfev!r} must count the right-hand-side evaluations (an integer > 0)")
+    if problem.compiled is None and stats.nfev > calls[0]:
+        raise _fail(cls, f"stats.nfev={stats.nfev}, but the right-hand side was called {calls[0]} times; count the "
+                         "evaluations made, no more")
     if not isinstance(stats.n_steps, (int, np.integer)) or stats.n_steps < 1:
         raise _fail(cls, f"stats.n_steps={stats.n_steps!r} must be the number of steps taken (an integer ≥ 1)")
     if not reported:

@@ -249,6 +249,12 @@ def test_integrator_kit_passes_gyrolab_own(name, params):
     check_integrator(registry.load("integrator", name), **params)
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["dop853_numba", "rk4_numba", "taylor", "lie_poisson"])
+def test_integrator_kit_checks_compiled_integrators_on_the_free_top(name):
+    check_integrator(registry.load("integrator", name))  # numba's kernels: compiled once, cached for every test
+
+
 def test_system_kit_fails_on_a_drifting_invariant():
     from gyrolab.plugins.forces.uniform_gravity import UniformGravity
 
