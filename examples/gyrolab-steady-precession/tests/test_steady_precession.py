@@ -9,6 +9,9 @@ from gyrolab.testing import check_regime
 from gyrolab_steady_precession import SteadyPrecession
 
 LAGRANGE_TOP = ["body=lagrange_top", "force=[uniform_gravity]", "initial.phi0=1.5707963267948966"]
+#: the same kind of top in SI units (A = B = 0.02 kg m², C = 0.01 kg m², M g ℓ = 0.0981 N m): c = √(Mgℓ/C) ≠ 1
+SI_TOP = ["body=si_gyroscope", "body.inertia=[0.02,0.02,0.01]", "body.com=[0,0,0.01]", "force=[uniform_gravity]",
+          "initial.phi0=1.5707963267948966"]
 
 
 def test_contract():
@@ -25,13 +28,14 @@ def test_outside_the_domain_is_one_sentence():
         SteadyPrecession().check_domain(slow_top)
 
 
-@pytest.mark.parametrize("branch, theta0, r0", [("slow", 1.0, 5.0), ("fast", 1.0, 5.0), ("slow", 2.5, 3.0),
-                                                ("fast", 2.5, -3.0)])
-def test_solution_is_the_full_model(branch, theta0, r0):
+@pytest.mark.parametrize("top, branch, theta0, r0", [
+    ("lagrange", "slow", 1.0, 5.0), ("lagrange", "fast", 1.0, 5.0), ("lagrange", "slow", 2.5, 3.0),
+    ("lagrange", "fast", 2.5, -3.0), ("si", "slow", 0.7, 30.0), ("si", "fast", 2.0, 20.0)])
+def test_solution_is_the_full_model(top, branch, theta0, r0):
     # The full Euler–Poisson equations from the regime's own t = 0 state (p0, q0 from it; r0, θ0 the scene's)
     # follow the analytic solution, and its Euler angles, over three periods.
     regime = SteadyPrecession(branch=branch)
-    scene = [*LAGRANGE_TOP, f"initial.theta0={theta0}", f"initial.r0={r0}"]
+    scene = [*(LAGRANGE_TOP if top == "lagrange" else SI_TOP), f"initial.theta0={theta0}", f"initial.r0={r0}"]
     y0 = regime.initial_state(compose_scene(scene).system)
     period = regime.period(compose_scene(scene).system)
     full = compose_scene([*scene, f"initial.p0={float(y0[0])!r}", f"initial.q0={float(y0[1])!r}", "integrator=dop853",
