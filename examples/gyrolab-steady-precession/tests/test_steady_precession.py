@@ -57,3 +57,13 @@ def test_fast_top_precesses_slowly_at_the_gyroscopic_rate():
     system = compose_scene([*LAGRANGE_TOP, "initial.r0=1000"]).system
     n, _ = SteadyPrecession().rates(SteadyPrecession().scene(system))
     assert n == pytest.approx(-1e-3, rel=1e-6)
+
+
+def test_textbook_condition():
+    # Textbook convention: θ from the upward vertical, ψ̇ about it (θ_up = π − θ, ψ̇ = −n). M g ℓ = 1 and C = 1 here.
+    system = compose_scene([*LAGRANGE_TOP, "initial.theta0=1.0", "initial.r0=5"]).system
+    n, sigma = SteadyPrecession().rates(SteadyPrecession().scene(system))
+    a, r0, psi_dot, cos_up = 0.8, 5.0, -n, np.cos(np.pi - 1.0)
+    assert psi_dot * (r0 - a * psi_dot * cos_up) == pytest.approx(1.0, rel=1e-14)               # with r0: A
+    assert psi_dot * (sigma + (1 - a) * psi_dot * cos_up) == pytest.approx(1.0, rel=1e-14)      # with φ̇ = σ: C − A
+    assert psi_dot * (r0 - (1 - a) * psi_dot * cos_up) != pytest.approx(1.0, rel=1e-3)          # the mixed form fails
