@@ -290,3 +290,13 @@ def test_regime_runs_from_the_command_line(installed, cli, tmp_path):
 def test_kits_name_the_rule_a_broken_plugin_violates(check, expected):
     with pytest.raises(AssertionError, match=expected):
         check()
+
+
+def test_plugins_sweep_from_the_command_line(installed, cli, tmp_path):
+    done = cli("-m", "body=rotor_body", "force=[]", "integrator=scipy_rk23", "integrator.rtol=1e-6,1e-8", "time.end=2",
+               "time.n_output=21", "output.figures=false", "hydra.sweep.dir=sw",
+               env_extra={"PYTHONPATH": ":".join(installed)})
+    assert done.returncode == 0, done.stderr
+    with xr.open_dataset(tmp_path / "sw" / "sweep.nc") as sweep:
+        assert sweep.sizes["rtol"] == 2                                  # the swept key is a dimension
+        assert sweep.kinetic_energy_max_abs_drift.dims == ("rtol",)      # the plugin system's invariants, per job
