@@ -15,8 +15,8 @@ class ScipyRK23(Integrator):
     capabilities = frozenset()            # no compiled model, no batch kernel: it integrates the Python rhs
 
     def __init__(self, *, rtol=1e-6, atol=1e-9):   # keyword defaults are the plugin's config
-        self.rtol = as_number(rtol, "integrator.scipy_rk23.rtol", positive=True)
-        self.atol = as_number(atol, "integrator.scipy_rk23.atol", positive=True)
+        self.rtol = as_number(rtol, "integrator.rtol", positive=True)
+        self.atol = as_number(atol, "integrator.atol", positive=True)
 
     def integrate(self, fun, t_out, y0, progress=None, compiled=None):
         start = time.perf_counter()

@@ -19,7 +19,7 @@ def test_declares_no_capabilities():
 
 
 def test_bad_tolerance_is_one_sentence():
-    with pytest.raises(ConfigError, match=r"^integrator\.scipy_rk23\.rtol=-1 must be positive$"):
+    with pytest.raises(ConfigError, match=r"^integrator\.rtol=-1 must be positive$"):
         ScipyRK23(rtol=-1)
 
 
