@@ -16,7 +16,7 @@ FORMULAS = ("corrected", "printed")
 class Regime(ABC):
     """An asymptotic expansion of a system's motion (a paper's analytic periodic solution).
 
-    Rules for implementers:
+    Rules for implementers (``gyrolab.testing.check_regime`` checks them; run it in your tests):
 
     1. ``__init__(self, *, formula="corrected", **params)`` takes the plugin's
        config; ``formula`` selects the corrected formulas or the paper's
@@ -39,6 +39,10 @@ class Regime(ABC):
     6. ``euler_angles(system, t)`` returns ``{"psi", "theta", "phi"}`` of the
        analytic solution (ψ(0) = scene's ψ0).
     7. ``attributes()`` describes the regime for the dataset (netCDF-safe values).
+    8. A regime run (``gyrolab regime=NAME``) also reads ``periods``,
+       ``samples_per_period`` and ``full_initial_state(system)``: a fixed-point
+       regime subclasses ``gyrolab.plugins.regimes.base.FixedPointRegime``, which
+       provides them (docs/plugins.md, "Regime plugins").
     """
 
     name: ClassVar[str]

@@ -211,6 +211,7 @@ def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
 
     ``node`` is the force's config (a DictConfig or a dict of parameters). The culprit is found by
     building the force with each given parameter alone; the force must declare its area-integral flag.
+    An AttributeError (the force reads something the system's body does not have) is one ConfigError too.
     """
     from gyrolab.contracts.force import check_declared
 
@@ -218,6 +219,9 @@ def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
         node = OmegaConf.create(dict(node))
     try:
         force = _build(cls, node, where, body)
+    except AttributeError as exc:  # a force reading what this system's body lacks (a third-party system's body)
+        raise ConfigError(f"{where} ({cls.__name__}) cannot act on a {type(body).__name__} body ({exc}); choose "
+                          "the forces the system supports (force=[] for none)") from None
     except (ValueError, TypeError) as exc:
         if isinstance(exc, ConfigError):
             raise

@@ -56,13 +56,16 @@ class ScipySolver(Tolerances, Integrator):
         stages = getattr(self.solver_class, "n_stages", None)
         n_steps, n_rejected, filled = 0, 0, 1
         while solver.status == "running" and filled < len(t_out):
-            nfev_before = solver.nfev
+            nfev_before, t_before = solver.nfev, solver.t
             try:
                 message = solver.step()
             except (ValueError, ArithmeticError, np.linalg.LinAlgError) as error:  # e.g. LU of a NaN Jacobian
                 raise IntegrationError(f"{self.name} failed near t={solver.t:.6g}: {error}") from None
             if solver.status == "failed":
                 raise IntegrationError(f"{self.name} failed near t={solver.t:.6g}: {message}")
+            if solver.t == t_before:  # LSODA near a blow-up: its step size reaches 0 and it "succeeds" forever
+                raise IntegrationError(f"{self.name} stalled at t={solver.t:.6g}: its step size fell to zero "
+                                       "(a singularity of the solution?)")
             if not np.all(np.isfinite(solver.y)):
                 raise IntegrationError(f"{self.name} produced a non-finite state at t={solver.t:.6g}")
             n_steps += 1
