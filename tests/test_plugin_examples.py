@@ -94,6 +94,20 @@ def test_integrator_runs_from_the_api(installed):
     assert ds.attrs["integrator"] == "scipy_rk23"
 
 
+def test_example_integrator_joins_batch_with_its_single_runs_numbers(installed, tmp_path):
+    # issue 21's "done when": an external integrator from examples/ runs --batch (no batch kernel: one integrate()
+    # call per point), with the numbers of its single runs
+    from gyrolab.batch.sweep import run_batch_sweep
+
+    scene = ["integrator=scipy_rk23", "integrator.rtol=1e-9", "time.end=2", "time.n_output=21"]
+    path = run_batch_sweep([*scene, "batch.output=trajectory", "initial.r0=1,3"], tmp_path / "grid")
+    with xr.open_dataset(path) as ds:
+        assert ds.attrs["batch_path"] == "one integrate() call per point"
+        for i, r0 in enumerate([1, 3]):
+            single = compose_scene([*scene, f"initial.r0={r0}"]).run()
+            np.testing.assert_array_equal(ds.omega[i].values, single.omega.values)
+
+
 def test_system_runs_from_the_api(installed):
     ds = compose_scene(["body=rotor_body", "force=[]", "integrator=dop853", "time.end=5", "time.n_output=51"]).run()
     assert ds.attrs["system"] == "rotor_body"
