@@ -205,7 +205,6 @@ def test_a_batch_kernel_hook_runs_through_integrate_arrays():
     """BATCH_KERNEL: integrate_arrays validates the arrays, calls the hook, and holds failures="raise" to its rule
     even for a kernel that only marks its failures."""
     from gyrolab.batch.integrate import integrate_arrays
-    from gyrolab.contracts.integrator import BatchSolution
     from gyrolab.errors import IntegrationError
     from gyrolab.plugins.integrators.compiled_solvers import RK4Numba
 

@@ -21,7 +21,8 @@ from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.plugins.integrators.auto import AUTO_SAMPLE  # auto's pilot sample of a batch (importable here, as before)
 
-__all__ = ["AUTO_SAMPLE", "BATCH_INTEGRATORS", "BatchSolution", "auto_choice", "batch_kernel_integrators",
+# BATCH_INTEGRATORS (like FAST_PATH, ADAPTIVE) is computed from the registry's capabilities by __getattr__ below
+__all__ = ["AUTO_SAMPLE", "BATCH_INTEGRATORS", "BatchSolution",  # noqa: F822 "auto_choice", "batch_kernel_integrators",
            "integrate_arrays", "integrate_batch", "integrate_points"]
 
 

@@ -14,7 +14,6 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.contracts.integrator import Solution
-from gyrolab.errors import ConfigError
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.cf import conform, unit_attributes
 from gyrolab.output.provenance import provenance
