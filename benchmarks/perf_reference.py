@@ -171,7 +171,7 @@ def peer_table(reference, rounds, quick):
                   for key in (auto_key, run_key, taylor)]
         print(f"| {eps:.0e} | {cell(peer) if has_peer else 'not installed'} | {cell(auto_key)} | {cell(run_key)} | "
               f"{cell(taylor)} | {' | '.join(ratios)} |")
-    print(f"\nThe same rounds' medians, ms (heyoka and taylor: the setting with the smallest median reaching ε):\n")
+    print("\nThe same rounds' medians, ms (heyoka and taylor: the setting with the smallest median reaching ε):\n")
     print("| ε | heyoka | auto, integration | auto, Scene.run() | taylor | auto / heyoka | Scene.run() / heyoka | "
           "taylor / heyoka |\n| --- | --- | --- | --- | --- | --- | --- | --- |")
     for eps in epsilons:

@@ -1,8 +1,14 @@
-"""Contract checks for force-plugin authors: ``check_force(ForceClass, **params)`` in your own tests.
+"""Contract checks for plugin authors, one kit per plugin kind, to call in your own tests.
 
-Like scikit-learn's ``check_estimator``: it builds the force on a triaxial test body and checks the
-rules of ``gyrolab.contracts.Force`` one by one, raising ``AssertionError`` that names the first
-violation:
+Like scikit-learn's ``check_estimator``: each kit builds the plugin and checks its contract's rules
+one by one, raising ``AssertionError`` that names the first violation.
+
+* ``check_force(ForceClass, **params)`` (below), ``gyrolab.contracts.Force``;
+* ``check_integrator(IntegratorClass, **params)``, ``gyrolab.contracts.Integrator``;
+* ``check_system(SystemClass, body, initial, **params)``, ``gyrolab.contracts.System``;
+* ``check_regime(RegimeClass, scene=OVERRIDES, **params)``, ``gyrolab.contracts.Regime``.
+
+``check_force`` builds the force on a triaxial test body and checks:
 
 1. the force builds with ``params``, declares ``preserves_area_integral`` (a bool) and
    ``required_axes`` within {0, 1, 2};
@@ -28,15 +34,17 @@ import inspect
 import math
 import re
 import warnings
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from gyrolab.contracts.claims import _rotation, axes_of as _axes, random_states, rotation_torque  # noqa: F401
 from gyrolab.contracts.force import Force
+from gyrolab.contracts.integrator_rules import unchecked
 from gyrolab.errors import ConfigError
 
-__all__ = ["check_force", "random_states", "rotation_torque"]
+__all__ = ["check_force", "check_integrator", "check_regime", "check_system", "random_states", "rotation_torque"]
 
 #: Relative tolerance of the finite-difference potential check (central differences, h = 1e-5).
 POTENTIAL_RTOL = 1e-6
@@ -162,15 +170,7 @@ def _netcdf_safe(value: Any) -> bool:
 
 
 def _check_attributes(cls: type, force: Force) -> None:
-    attrs = force.attributes()
-    if not isinstance(attrs, dict):
-        raise _fail(cls, f"attributes() returned {type(attrs).__name__}, not a dict")
-    for key, value in attrs.items():
-        if not isinstance(key, str) or not _NAME.match(key):
-            raise _fail(cls, f"attributes() key {key!r} is not a netCDF-safe name (letters, digits, _)")
-        if not _netcdf_safe(value):
-            raise _fail(cls, f"attributes()[{key!r}] = {value!r} is not netCDF-safe; use str, int, float or a "
-                             "non-empty list of finite numbers (no bool, None or dict)")
+    _check_mapping(cls, force.attributes(), "attributes()")
 
 
 def _check_bad_parameters(cls: type, body: Any, where: str, params: dict[str, Any]) -> None:
@@ -221,3 +221,475 @@ def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, fram
         if not np.allclose(out, expected, rtol=1e-12, atol=1e-14 * max(1.0, np.max(np.abs(expected)))):
             raise _fail(cls, f"the compiled torque {out.tolist()} differs from the Python torque {expected.tolist()} "
                              f"at ω={omega.tolist()}; report this to gyrolab with the plugin's torque")
+
+
+# ---- integrators --------------------------------------------------------------------------------------------
+
+#: An adaptive integrator's error on the kit's oscillator may exceed max(rtol, atol) by this factor (global error
+#: accumulates over the ~1.6 periods integrated; scipy's own methods stay within 10-50x).
+ERROR_FACTOR = 1000.0
+#: A fixed-step integrator states no tolerance: the kit only checks that it integrates the right equation.
+FIXED_STEP_ERROR = 1e-3
+#: Output times of the kit's problems: not starting at 0, unevenly spaced, so that a method that assumes either fails.
+OSCILLATOR_TIMES = np.array([0.5, 0.6, 1.0, 2.5, 4.0, 4.1, 7.3, 10.5])
+#: y' = y² from y(0) = 1 is y = 1/(1 − t): it blows up at t = 1, inside these output times.
+BLOW_UP_TIMES = np.array([0.0, 0.5, 2.0])
+
+
+@dataclass(frozen=True)
+class ExactProblem:
+    """An initial-value problem with a known solution, for ``check_integrator``.
+
+    ``exact(t)`` gives the columns ``compared`` of the solution from ``y0`` at ``t_out[0]``; ``compiled`` is the
+    problem in the compiled kernels' form (None for a Python-only problem).
+    """
+
+    description: str
+    fun: Any
+    y0: np.ndarray
+    exact: Any
+    compared: slice
+    compiled: Any = None
+
+
+def _oscillator(t: float, y: np.ndarray) -> np.ndarray:
+    """x'' = −x written as y = (x, v): the exact solution from (1, 0) at t0 is (cos(t − t0), −sin(t − t0))."""
+    return np.array([y[1], -y[0]])
+
+
+def oscillator_problem() -> ExactProblem:
+    def exact(t: np.ndarray) -> np.ndarray:
+        dt = t - OSCILLATOR_TIMES[0]
+        return np.stack([np.cos(dt), -np.sin(dt)], axis=1)
+
+    return ExactProblem("the harmonic oscillator x'' = −x", _oscillator, np.array([1.0, 0.0]), exact, slice(0, 2))
+
+
+#: The free symmetric top of ``free_top_problem``: A = B = 0.8 C, no torque, ω0 = (0.1, −0.05, 5).
+FREE_TOP_A, FREE_TOP_OMEGA0 = 0.8, (0.1, -0.05, 5.0)
+
+
+def free_top_problem() -> ExactProblem:
+    """The torque-free symmetric top as gyrolab's fixed-point system, with its compiled model: I ω̇ = (Iω) × ω with
+    A = B gives r constant and (p, q) turning at λ = (C − A) r / A (ṗ = −λ q, q̇ = λ p)."""
+    from gyrolab.physics.body import Body
+    from gyrolab.plugins.systems.fixed_point import FixedPoint
+
+    body = Body.from_config({"units": "nondimensional", "a": FREE_TOP_A, "b": FREE_TOP_A,
+                             "com_direction": [0.0, 0.0, 0.0]})
+    p0, q0, r0 = FREE_TOP_OMEGA0
+    system = FixedPoint(body, [], {"p0": p0, "q0": q0, "r0": r0, "theta0": 1.0, "phi0": 0.3, "psi0": 0.0},
+                        {"euler_angles": False})
+    lam = (1.0 - FREE_TOP_A) * r0 / FREE_TOP_A
+
+    def exact(t: np.ndarray) -> np.ndarray:
+        c, s = np.cos(lam * (t - OSCILLATOR_TIMES[0])), np.sin(lam * (t - OSCILLATOR_TIMES[0]))
+        return np.stack([p0 * c - q0 * s, p0 * s + q0 * c, np.full_like(t, r0)], axis=1)
+
+    return ExactProblem("the free symmetric top (gyrolab's fixed-point system, compiled)", system.rhs,
+                        system.initial_state(), exact, slice(0, 3), system.compiled_model())
+
+
+def _blow_up(t: float, y: np.ndarray) -> np.ndarray:
+    return y * y
+
+
+def check_integrator(cls: type, **params: Any) -> None:
+    """Check an integrator plugin class against the Integrator contract; AssertionError names the first violation.
+
+    ``params`` are the plugin's keyword parameters for the checks (its defaults when omitted). The rules:
+
+    1. ``name`` is a config key, ``adaptive`` a bool, ``capabilities`` (when declared) a frozenset of str;
+    2. it builds with ``params``; every keyword parameter given a nonsense value ("abc") raises gyrolab's
+       one-sentence ``ConfigError`` naming the parameter;
+    3. on the harmonic oscillator x'' = −x from t = 0.5 to 10.5 it returns a ``Solution`` at exactly the requested
+       ``t_out`` (the same values), with ``y`` of shape (n, 2), finite, ``y[0]`` = y0, the input y0 left unchanged;
+    4. its error against cos, −sin is within ``ERROR_FACTOR`` × max(rtol, atol) (adaptive methods with ``rtol``
+       and ``atol`` attributes), or below ``FIXED_STEP_ERROR`` (others);
+    5. it counts its work: ``stats`` is an ``IntegratorStats`` with 0 < ``nfev`` ≤ the calls of ``fun`` the kit
+       counted (it never counts evaluations it did not make) and ``n_steps`` ≥ 1;
+    6. it calls ``progress(t)`` when given, with times within the integration interval;
+    7. on y' = y², y(0) = 1, which blows up at t = 1, it raises ``gyrolab.errors.IntegrationError`` (one line), never
+       returns non-finite values, and never returns a finite "solution" past the blow-up;
+    8. ``attributes()`` and ``stats.attributes()`` are netCDF-safe.
+
+    A compiled integrator (``needs_compiled_model``) integrates the compiled model it is given, not ``fun``: rules
+    3–6 are then checked on the free symmetric top (``free_top_problem``: gyrolab's fixed-point system with A = B
+    and no torque, whose ω turns at a constant rate), ``nfev`` > 0 only, and rule 7 is skipped (a blow-up has no
+    compiled model).
+    """
+    from gyrolab.contracts.integrator import Integrator
+
+    if not (isinstance(cls, type) and issubclass(cls, Integrator)):
+        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Integrator")
+    name = getattr(cls, "name", None)
+    if not isinstance(name, str) or not _NAME.match(name):
+        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config's integrator=NAME)")
+    if not isinstance(getattr(cls, "adaptive", None), bool):
+        raise _fail(cls, f"adaptive={getattr(cls, 'adaptive', None)!r} must be declared True or False")
+    capabilities = getattr(cls, "capabilities", frozenset())
+    if not isinstance(capabilities, frozenset) or not all(isinstance(c, str) for c in capabilities):
+        raise _fail(cls, f"capabilities={capabilities!r} must be a frozenset of capability names (str)")
+    params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
+    integrator = _build_plugin(cls, params)
+    _check_bad_plugin_parameters(cls, params, "integrator")
+    if cls.needs_compiled_model:
+        stats = _check_exact_problem(cls, integrator, free_top_problem())
+    else:
+        stats = _check_exact_problem(cls, integrator, oscillator_problem())
+        _check_blow_up(cls, integrator)
+    _check_mapping(cls, stats.attributes(), "stats.attributes()")
+    _check_mapping(cls, integrator.attributes(), "attributes()")
+
+
+def _build_plugin(cls: type, params: dict[str, Any], *args: Any) -> Any:
+    """The plugin built with ``params`` (after the positional ``args`` a scene passes: a system's body, ...)."""
+    try:
+        return cls(*args, **params)
+    except ConfigError as exc:
+        raise _fail(cls, f"building it with {params} raised ConfigError: {exc}") from None
+
+
+def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> Any:
+    """Rules 3–6 of ``check_integrator`` on one problem with a known solution; returns the run's stats."""
+    from gyrolab.contracts.integrator import IntegratorStats, Solution
+
+    calls = [0]
+
+    def fun(t: float, y: np.ndarray) -> np.ndarray:
+        calls[0] += 1
+        return problem.fun(t, y)
+
+    reported: list[float] = []
+    t_out, y0 = OSCILLATOR_TIMES.copy(), problem.y0.copy()
+    solution = unchecked(integrator)(fun, t_out, y0, reported.append, problem.compiled)  # the plugin's own result
+    on = f"on {problem.description}"
+    if not isinstance(solution, Solution):
+        raise _fail(cls, f"integrate returned {type(solution).__name__}, not gyrolab.contracts.Solution")
+    if not np.array_equal(y0, problem.y0) or not np.array_equal(t_out, OSCILLATOR_TIMES):
+        raise _fail(cls, "integrate modified its input y0 or t_out in place; work on copies")
+    t, y = np.asarray(solution.t), np.asarray(solution.y)
+    if t.shape != t_out.shape or not np.array_equal(t, t_out):
+        raise _fail(cls, f"Solution.t is {np.round(t, 12).tolist()}, not the requested t_out "
+                         f"{t_out.tolist()}; sample the state at exactly the requested times")
+    if y.shape != (len(t_out), len(y0)):
+        raise _fail(cls, f"Solution.y has shape {y.shape}, not (len(t_out), state size) = ({len(t_out)}, {len(y0)})")
+    if not np.all(np.isfinite(y)):
+        raise _fail(cls, f"Solution.y has non-finite values {on}; raise IntegrationError instead")
+    if np.max(np.abs(y[0] - y0)) > 1e-14 * max(1.0, float(np.max(np.abs(y0)))):
+        raise _fail(cls, f"Solution.y[0] = {y[0].tolist()} is not y0 = {y0.tolist()} at t_out[0], the initial time")
+    error = float(np.max(np.abs(y[:, problem.compared] - problem.exact(t_out))))
+    rtol, atol = getattr(integrator, "rtol", None), getattr(integrator, "atol", None)
+    if cls.adaptive and rtol is not None and atol is not None:
+        allowed, why = ERROR_FACTOR * max(float(rtol), float(atol)), f"{ERROR_FACTOR:g} × max(rtol, atol)"
+    else:
+        allowed, why = FIXED_STEP_ERROR, "the kit's bound for methods without rtol/atol"
+    if not error <= allowed:
+        raise _fail(cls, f"its error {on} is {error:.3g}, above {allowed:.3g} ({why}); it does not integrate to its "
+                         "own tolerance")
+    stats = solution.stats
+    if not isinstance(stats, IntegratorStats):
+        raise _fail(cls, f"Solution.stats is {type(stats).__name__}, not gyrolab.contracts.IntegratorStats")
+    if not isinstance(stats.nfev, (int, np.integer)) or stats.nfev <= 0:
+        raise _fail(cls, f"stats.nfev={stats.nfev!r} must count the right-hand-side evaluations (an integer > 0)")
+    if problem.compiled is None and stats.nfev > calls[0]:
+        raise _fail(cls, f"stats.nfev={stats.nfev}, but the right-hand side was called {calls[0]} times; count the "
+                         "evaluations made, no more")
+    if not isinstance(stats.n_steps, (int, np.integer)) or stats.n_steps < 1:
+        raise _fail(cls, f"stats.n_steps={stats.n_steps!r} must be the number of steps taken (an integer ≥ 1)")
+    if not reported:
+        raise _fail(cls, "integrate never called progress(t); call it every few steps when it is given")
+    outside = [r for r in reported if not t_out[0] <= float(r) <= t_out[-1]]
+    if outside:
+        raise _fail(cls, f"progress was called with t={outside[0]!r}, outside the interval [{t_out[0]}, {t_out[-1]}]")
+    return stats
+
+
+def _check_blow_up(cls: type, integrator: Any) -> None:
+    from gyrolab.errors import IntegrationError
+
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            solution = unchecked(integrator)(_blow_up, BLOW_UP_TIMES.copy(), np.array([1.0]), None, None)
+    except IntegrationError as exc:
+        if "\n" in str(exc).strip():
+            raise _fail(cls, f"its IntegrationError on y' = y² is not one line: {str(exc)!r}") from None
+        return
+    except Exception as exc:  # noqa: BLE001  (anything but IntegrationError is the violation)
+        raise _fail(cls, f"on y' = y², y(0) = 1 (blow-up at t = 1) it raised {type(exc).__name__}: {exc}; raise "
+                         "gyrolab.errors.IntegrationError saying when and why") from None
+    y = np.asarray(solution.y)
+    if not np.all(np.isfinite(y)):
+        raise _fail(cls, "on y' = y², y(0) = 1 (blow-up at t = 1) it returned non-finite values; raise "
+                         "gyrolab.errors.IntegrationError instead")
+    raise _fail(cls, f"on y' = y², y(0) = 1 it returned y(2) = {float(y[-1, 0]):.6g}, but the solution 1/(1 − t) "
+                     "blows up at t = 1; detect the failure and raise gyrolab.errors.IntegrationError")
+
+
+def _check_mapping(cls: type, attrs: Any, what: str) -> None:
+    """``attrs`` (a plugin's ``attributes()``) are netCDF-safe: names of letters, digits and _, values ``_netcdf_safe``."""
+    if not isinstance(attrs, dict):
+        raise _fail(cls, f"{what} returned {type(attrs).__name__}, not a dict")
+    for key, value in attrs.items():
+        if not isinstance(key, str) or not _NAME.match(key):
+            raise _fail(cls, f"{what} key {key!r} is not a netCDF-safe name (letters, digits, _)")
+        if not _netcdf_safe(value):
+            raise _fail(cls, f"{what}[{key!r}] = {value!r} is not netCDF-safe; use str, int, float or a non-empty "
+                             "list of finite numbers (no bool, None or dict)")
+
+
+def _check_bad_plugin_parameters(cls: type, params: dict[str, Any], group: str, *args: Any) -> None:
+    """Every keyword parameter set to "abc" must raise one ConfigError line naming it (as ``check_force`` rule 6)."""
+    for key, param in inspect.signature(cls.__init__).parameters.items():
+        if param.kind is not inspect.Parameter.KEYWORD_ONLY or (param.default is None and key not in params):
+            continue
+        try:
+            cls(*args, **{**params, key: "abc"})
+        except ConfigError as exc:
+            message = str(exc)
+            if key not in message or "\n" in message.strip():
+                raise _fail(cls, f"{group}.{key}='abc' raised a ConfigError that does not name the parameter in "
+                                 f"one line: {message!r}") from None
+            continue
+        except Exception as exc:  # noqa: BLE001
+            raise _fail(cls, f"{group}.{key}='abc' raised {type(exc).__name__}: {exc}; raise gyrolab.errors."
+                             "ConfigError naming the parameter (gyrolab.errors.as_number validates numbers)") from None
+        raise _fail(cls, f"{group}.{key}='abc' was accepted; validate the parameter and raise gyrolab.errors."
+                         "ConfigError (gyrolab.errors.as_number does it for numbers)")
+
+
+# ---- systems ------------------------------------------------------------------------------------------------
+
+#: The kit integrates the system over [0, SYSTEM_SPAN] with scipy's DOP853 at rtol = atol = SYSTEM_RTOL ...
+SYSTEM_SPAN = 2.0
+SYSTEM_RTOL = 1e-12
+#: ... and requires each monitored invariant to stay within this of its initial value (relative to max(1, |v0|)).
+INVARIANT_TOLERANCE = 1e-9
+
+
+def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, forces: Any = (),
+                 output: dict[str, Any] | None = None, span: float = SYSTEM_SPAN,
+                 invariant_tolerance: float = INVARIANT_TOLERANCE, **params: Any) -> None:
+    """Check a system plugin class against the System contract; AssertionError names the first violation.
+
+    ``body`` and ``initial`` are the config sections a scene would give (``body_type.from_config(body)`` builds the
+    body); ``forces`` is a sequence of ``(ForceClass, params)`` pairs built on that body (none by default);
+    ``output`` the output section (``{"euler_angles": True}`` by default); ``params`` the system's own parameters.
+    The rules:
+
+    1. ``name`` is a config key; ``body_type`` has ``from_config``, which builds the body from ``body``;
+    2. the system builds with (body, forces, initial, output, **params);
+    3. ``state_size`` is a positive int; ``initial_state()`` a finite float array of shape (state_size,);
+    4. ``rhs(t, y0)`` is a finite float array of shape (state_size,) and leaves y0 unchanged;
+    5. ``invariants`` is a tuple of str; ``variables(t, y)`` of a trajectory is a dict of ``xarray.Variable`` on
+       dims starting with ``time``, each with CF ``units`` and ``long_name`` (non-empty str), and every invariant is
+       one of them, on dims ``("time",)``;
+    6. integrated over [0, ``span``] with scipy's DOP853 at rtol = atol = 1e-12, every invariant stays within
+       ``invariant_tolerance`` × max(1, |v0|) of its initial value (an invariant that drifts is no invariant);
+    7. ``attributes()`` is netCDF-safe; ``title()`` a non-empty one-line str.
+    """
+    from gyrolab.contracts.system import System
+
+    if not (isinstance(cls, type) and issubclass(cls, System)):
+        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.System")
+    name = getattr(cls, "name", None)
+    if not isinstance(name, str) or not _NAME.match(name):
+        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config's system=NAME)")
+    body_type = getattr(cls, "body_type", None)
+    if not callable(getattr(body_type, "from_config", None)):
+        raise _fail(cls, f"body_type={body_type!r} must be a class with from_config(body section)")
+    try:
+        built_body = body_type.from_config(dict(body))
+    except ConfigError as exc:
+        raise _fail(cls, f"body_type.from_config({body}) raised ConfigError: {exc}") from None
+    from gyrolab.engine.scene import build_force
+
+    built_forces = [build_force(force_cls, dict(force_params), f"force.{force_cls.name}", built_body)
+                    for force_cls, force_params in forces]
+    output = {"euler_angles": True} if output is None else dict(output)
+    system = _build_plugin(cls, params, built_body, built_forces, dict(initial), output)
+    _check_bad_plugin_parameters(cls, params, "system", built_body, built_forces, dict(initial), output)
+    y0 = _check_state(cls, system)
+    t, y = _integrate_tightly(cls, system, y0, span)
+    _check_variables(cls, system, t, y)
+    _check_invariants_conserved(cls, system, t, y, invariant_tolerance)
+    _check_mapping(cls, system.attributes(), "attributes()")
+    title = system.title()
+    if not isinstance(title, str) or not title.strip() or "\n" in title:
+        raise _fail(cls, f"title() returned {title!r}; it must name the scene in a few words, on one line")
+
+
+def _check_state(cls: type, system: Any) -> np.ndarray:
+    size = system.state_size
+    if isinstance(size, bool) or not isinstance(size, (int, np.integer)) or size < 1:
+        raise _fail(cls, f"state_size={size!r} must be a positive integer")
+    y0 = np.asarray(system.initial_state())
+    if y0.shape != (size,) or not np.issubdtype(y0.dtype, np.floating) or not np.all(np.isfinite(y0)):
+        raise _fail(cls, f"initial_state() returned shape {y0.shape}, dtype {y0.dtype}; it must be a finite float "
+                         f"array of shape (state_size,) = ({size},)")
+    kept = y0.copy()
+    dy = np.asarray(system.rhs(0.0, y0))
+    if dy.shape != (size,) or not np.issubdtype(dy.dtype, np.floating):
+        raise _fail(cls, f"rhs(t, y0) returned shape {dy.shape} and dtype {dy.dtype}; it must be a float array of "
+                         f"shape (state_size,) = ({size},)")
+    if not np.all(np.isfinite(dy)):
+        raise _fail(cls, f"rhs(t, y0) is not finite at y0={y0.tolist()}: {dy.tolist()}")
+    if not np.array_equal(y0, kept):
+        raise _fail(cls, "rhs(t, y) modified the state y in place; integrators pass their own arrays")
+    return kept
+
+
+def _integrate_tightly(cls: type, system: Any, y0: np.ndarray, span: float) -> tuple[np.ndarray, np.ndarray]:
+    from scipy.integrate import solve_ivp
+
+    t = np.linspace(0.0, span, 41)
+    done = solve_ivp(system.rhs, (0.0, span), y0, method="DOP853", t_eval=t, rtol=SYSTEM_RTOL, atol=SYSTEM_RTOL)
+    if not done.success or not np.all(np.isfinite(done.y)):
+        raise _fail(cls, f"scipy's DOP853 could not integrate rhs over [0, {span:g}] from initial_state() "
+                         f"({done.message}); the kit needs a state that stays finite that long")
+    return t, np.ascontiguousarray(done.y.T)
+
+
+def _check_variables(cls: type, system: Any, t: np.ndarray, y: np.ndarray) -> None:
+    import xarray as xr
+
+    invariants = system.invariants
+    if not isinstance(invariants, tuple) or not all(isinstance(n, str) for n in invariants):
+        raise _fail(cls, f"invariants={invariants!r} must be a tuple of dataset variable names (str)")
+    variables = system.variables(t, y)
+    if not isinstance(variables, dict):
+        raise _fail(cls, f"variables(t, y) returned {type(variables).__name__}, not a dict of xarray.Variable")
+    for key, variable in variables.items():
+        if not isinstance(variable, xr.Variable):
+            raise _fail(cls, f"variables(t, y)[{key!r}] is {type(variable).__name__}, not an xarray.Variable")
+        if not variable.dims or variable.dims[0] != "time" or variable.shape[0] != len(t):
+            raise _fail(cls, f"variable {key!r} has dims {variable.dims} and shape {variable.shape}; its first "
+                             f"dimension must be time, of length {len(t)}")
+        for attr in ("units", "long_name"):
+            value = variable.attrs.get(attr)
+            if not isinstance(value, str) or not value.strip():
+                raise _fail(cls, f"variable {key!r} has no CF {attr} (got {value!r}); give every variable units "
+                                 "and long_name")
+    for name in invariants:
+        if name not in variables:
+            raise _fail(cls, f"invariant {name!r} is not among variables(t, y) ({', '.join(variables)}); every "
+                             "monitored invariant must be a dataset variable")
+        if variables[name].dims != ("time",):
+            raise _fail(cls, f"invariant {name!r} has dims {variables[name].dims}, not ('time',)")
+
+
+def _check_invariants_conserved(cls: type, system: Any, t: np.ndarray, y: np.ndarray, tolerance: float) -> None:
+    variables = system.variables(t, y)
+    for name in system.invariants:
+        values = np.asarray(variables[name].values, dtype=float)
+        drift = float(np.max(np.abs(values - values[0])))
+        if not drift <= tolerance * max(1.0, abs(float(values[0]))):
+            raise _fail(cls, f"invariant {name!r} drifts by {drift:.3g} from {float(values[0]):.6g} over "
+                             f"t = [0, {t[-1]:g}] (DOP853 at rtol = atol = {SYSTEM_RTOL:g}), above "
+                             f"{tolerance:g} × max(1, |v0|); it is not conserved by rhs")
+
+
+# ---- regimes ------------------------------------------------------------------------------------------------
+
+#: ``solution(system, [0])`` must equal ``initial_state(system)`` to this (relative to max(1, |y|)).
+REGIME_START_TOLERANCE = 1e-12
+EULER_KEYS = frozenset({"psi", "theta", "phi"})
+
+
+def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
+    """Check a regime plugin class against the Regime contract; AssertionError names the first violation.
+
+    ``scene`` is the scene the regime is checked on: a list of overrides for ``gyrolab.compose_scene`` (the default
+    scene when empty) or a built system; ``params`` are the regime's keyword parameters. The rules:
+
+    1. ``name`` is a config key; ``systems`` a non-empty tuple of system names; ``parameter`` and
+       ``parameter_long_name`` str; ``order`` a dict of variable name → number;
+    2. it builds with ``params``; every keyword parameter given a nonsense value ("abc") raises gyrolab's
+       one-sentence ``ConfigError`` naming the parameter;
+    3. the scene's system is one of ``systems``; ``check_domain(system)`` returns a list of one-line str;
+    4. ``parameter_value(system)`` is a finite number;
+    5. ``initial_state(system)`` is a finite float array of shape (6,), and ``solution(system, [0])`` (shape (1, 6))
+       equals it;
+    6. ``period(system)`` is finite and > 0; ``solution(system, t)`` over one period has shape (n, 6), finite;
+    7. ``euler_angles(system, t)`` has exactly the keys psi, theta, phi, each a finite array of shape (n,);
+    8. ``attributes()`` is netCDF-safe.
+    """
+    from gyrolab.contracts.regime import Regime
+    from gyrolab.contracts.system import System
+
+    if not (isinstance(cls, type) and issubclass(cls, Regime)):
+        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Regime")
+    _check_regime_declarations(cls)
+    params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
+    regime = _build_plugin(cls, params)
+    _check_bad_plugin_parameters(cls, params, "regime")
+    if isinstance(scene, System):
+        system = scene
+    else:
+        from gyrolab.engine.scene import compose_scene
+
+        system = compose_scene(list(scene)).system
+    if system.name not in cls.systems:
+        raise _fail(cls, f"the kit's scene has system {system.name!r}, not one of systems={cls.systems}; give a "
+                         "scene the regime is derived for (scene=[...overrides...])")
+    warnings_ = regime.check_domain(system)
+    if not isinstance(warnings_, list) or not all(isinstance(w, str) and "\n" not in w.strip() for w in warnings_):
+        raise _fail(cls, f"check_domain returned {warnings_!r}; it must return a list of one-line warnings (str) "
+                         "and raise ConfigError outside the domain")
+    value = regime.parameter_value(system)
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) or not math.isfinite(float(value)):
+        raise _fail(cls, f"parameter_value(system) returned {value!r}, not a finite number")
+    _check_regime_start(cls, regime, system)
+    period = regime.period(system)
+    if isinstance(period, bool) or not isinstance(period, (int, float, np.number)) or not 0 < float(period) < math.inf:
+        raise _fail(cls, f"period(system) returned {period!r}; it must be a finite number > 0")
+    t = np.linspace(0.0, float(period), 9)
+    y = np.asarray(regime.solution(system, t))
+    if y.shape != (len(t), 6) or not np.all(np.isfinite(y)):
+        raise _fail(cls, f"solution(system, t) for {len(t)} times returned shape {y.shape}"
+                         f"{'' if np.all(np.isfinite(y)) else ' with non-finite values'}; it must be finite, (n, 6)")
+    _check_euler_angles(cls, regime, system, t)
+    _check_mapping(cls, regime.attributes(), "attributes()")
+
+
+def _check_regime_declarations(cls: type) -> None:
+    name = getattr(cls, "name", None)
+    if not isinstance(name, str) or not _NAME.match(name):
+        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config's regime=NAME)")
+    systems = getattr(cls, "systems", None)
+    if not isinstance(systems, tuple) or not systems or not all(isinstance(s, str) for s in systems):
+        raise _fail(cls, f"systems={systems!r} must be a non-empty tuple of the system names it is derived for")
+    for attr in ("parameter", "parameter_long_name"):
+        if not isinstance(getattr(cls, attr, None), str):
+            raise _fail(cls, f"{attr}={getattr(cls, attr, None)!r} must be a str naming the expansion's parameter")
+    order = getattr(cls, "order", None)
+    if not isinstance(order, dict) or not all(isinstance(k, str) and isinstance(v, (int, float))
+                                              for k, v in order.items()):
+        raise _fail(cls, f"order={order!r} must be a dict of variable name → error order in the parameter")
+
+
+def _check_regime_start(cls: type, regime: Any, system: Any) -> None:
+    y0 = np.asarray(regime.initial_state(system))
+    if y0.shape != (6,) or not np.issubdtype(y0.dtype, np.floating) or not np.all(np.isfinite(y0)):
+        raise _fail(cls, f"initial_state(system) returned shape {y0.shape}, dtype {y0.dtype}; it must be the "
+                         "orbit's finite (ω, γ) at t = 0, a float array of shape (6,)")
+    start = np.asarray(regime.solution(system, np.array([0.0])))
+    if start.shape != (1, 6):
+        raise _fail(cls, f"solution(system, [0]) returned shape {start.shape}, not (1, 6)")
+    gap = float(np.max(np.abs(start[0] - y0)))
+    if not gap <= REGIME_START_TOLERANCE * max(1.0, float(np.max(np.abs(y0)))):
+        raise _fail(cls, f"solution(system, [0]) = {np.round(start[0], 12).tolist()} differs from initial_state = "
+                         f"{np.round(y0, 12).tolist()} by {gap:.3g}; the solution must start at its initial state")
+
+
+def _check_euler_angles(cls: type, regime: Any, system: Any, t: np.ndarray) -> None:
+    angles = regime.euler_angles(system, t)
+    if not isinstance(angles, dict) or set(angles) != EULER_KEYS:
+        raise _fail(cls, f"euler_angles(system, t) returned keys {sorted(angles) if isinstance(angles, dict) else angles!r}; "
+                         "it must return exactly psi, theta, phi")
+    for key, values in angles.items():
+        values = np.asarray(values)
+        if values.shape != t.shape or not np.all(np.isfinite(values)):
+            raise _fail(cls, f"euler_angles(system, t)[{key!r}] has shape {values.shape}"
+                             f"{'' if np.all(np.isfinite(values)) else ' with non-finite values'}; it must be finite, "
+                             f"of shape ({len(t)},)")

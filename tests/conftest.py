@@ -23,18 +23,21 @@ def cli(tmp_path):
 
 
 @contextlib.contextmanager
-def installed_distribution(site, name, version, forces, paths=(), integrators=None):
-    """A distribution laid out the way pip does it: ``site``/NAME-VERSION.dist-info with its
-    ``gyrolab.forces`` entry points (dict name -> "module:Class") and, when given, ``gyrolab.integrators``
-    ones, ``site`` and ``paths`` on sys.path, gyrolab's plugin registry refreshed on entry and on exit."""
+def installed_distribution(site, name, version, plugins=None, paths=(), group="gyrolab.forces", *, forces=None):
+    """A distribution laid out the way pip does it: ``site``/NAME-VERSION.dist-info with entry points ``plugins``
+    (dict name -> "module:Class") in the entry-point ``group`` (``gyrolab.forces`` unless given: ``gyrolab.integrators``,
+    ...; or ``plugins`` as a dict group -> {name: "module:Class"} for several groups), ``site`` and ``paths`` on
+    sys.path, gyrolab's plugin registry refreshed on entry and on exit. ``forces=`` is the older name of
+    ``plugins``."""
     from gyrolab.engine import config, registry
 
+    plugins = forces if plugins is None else plugins
+    groups = plugins if plugins and all(isinstance(v, dict) for v in plugins.values()) else {group: plugins}
     info = site / f"{name.replace('-', '_')}-{version}.dist-info"
     info.mkdir()
     (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: {version}\n")
-    groups = {"gyrolab.forces": forces, "gyrolab.integrators": integrators or {}}
-    (info / "entry_points.txt").write_text("".join(f"[{group}]\n" + "".join(f"{k} = {v}\n" for k, v in eps.items())
-                                                   for group, eps in groups.items() if eps))
+    (info / "entry_points.txt").write_text("".join(
+        f"[{g}]\n" + "".join(f"{k} = {v}\n" for k, v in entries.items()) for g, entries in groups.items()))
     mp = pytest.MonkeyPatch()
     for path in (*paths, site):
         mp.syspath_prepend(str(path))

@@ -58,11 +58,15 @@ def test_comes_back_within_the_margin_plus_the_grid_step():
         assert not form(y, shifted, 0.1)
 
 
-SLOW_SPIN = ["initial.r0=1e-3", "initial.p0=0", "initial.q0=0", "time.end=20", "time.n_output=51"]
+
+
+#: a slow swing over a short span: the perturbations grow ~3.5× after the pilot (the tangent flow), no more than the
+#: pilot's power law already assumes (over t = 20 the swing amplifies them 118×, and the prediction is then tighter)
+SHORT_SWING = ["initial.r0=1e-3", "initial.p0=0", "initial.q0=0", "time.end=5", "time.n_output=51"]
 
 
 @pytest.mark.parametrize("overrides, accuracy, rounds", [
-    (SLOW_SPIN, 1e-6, 2),  # the first prediction is ~170× looser than the pilot's τ: measured again there
+    (SHORT_SWING, 1e-6, 2),  # the first prediction is ~180× looser than the pilot's τ: measured again there
     (["experiment=perf_reference"], 1e-6, 1),  # 13× looser: within RECENTRE, taken from the first round
 ], ids=["re-measured", "extrapolated"])
 def test_a_prediction_far_looser_than_the_pilot_is_measured_again(monkeypatch, overrides, accuracy, rounds):

@@ -120,9 +120,18 @@ def test_a_chunk_whose_trajectories_all_fail_is_stored_as_failed_points(tmp_path
         assert np.isnan(ds.omega.values[:2]).all() and np.isfinite(ds.omega.values[2]).all()
 
 
-def test_batch_refuses_scipy_integrators_and_another_command_in_its_directory(tmp_path):
-    with pytest.raises(ConfigError, match=r"integrator 'dop853' has no batch kernel; a batch runs integrator=rk4"):
-        run_batch_sweep(["integrator=dop853", "initial.r0=1,2"], tmp_path / "a")
+def test_scipy_integrators_run_per_point_and_another_command_in_its_directory_is_refused(tmp_path):
+    # no batch kernel (capability batch_kernel): one integrate() per point, each a single run's numbers
+    scipy = ["integrator=rk45", "time.end=1", "time.n_output=11", "output.euler_angles=false"]
+    with xr.open_dataset(run_batch_sweep([*scipy, "initial.r0=1,2"], tmp_path / "a")) as ds:
+        assert ds.attrs["batch_path"] == "one integrate() call per point"
+        for i, r0 in enumerate([1, 2]):
+            single = compose_scene([*scipy, f"initial.r0={r0}"]).run()
+            np.testing.assert_array_equal(ds.omega[i].values, single.omega[-1].values)
+    with pytest.raises(ConfigError, match=r"^integrator 'rk45' has no variational equations \(capability variational\), "
+                                          r"which the chaos indicators of batch.output=indicator need; valid choices: "
+                                          r"rk4, rk4_numba, dop853 or dop853_numba$"):
+        run_batch_sweep([*scipy, "batch.output=indicator", "initial.r0=1,2"], tmp_path / "c")
     run_batch_sweep([*FIXED, "initial.r0=1,2"], tmp_path / "b")
     with pytest.raises(ConfigError, match="holds another batch"):
         run_batch_sweep([*FIXED, "initial.r0=1,3"], tmp_path / "b")

@@ -34,3 +34,6 @@ def test_experiment_writes_the_case_table(tmp_path):
     with xr.open_dataset(tmp_path / "precession_cases.nc") as ds:
         assert float(ds.floquet_tolerance.max()) < 1e-4  # tied to the integration accuracy, not a fixed 1e-3
         assert float(ds.floquet_uncertainty.max()) < 1e-5
+        # the verdict is spectral stability, and the data says so (issue 22: marginal equilibria drift secularly)
+        assert ds.stable.attrs["long_name"].startswith("spectrally stable")
+        assert "Jordan block" in ds.stable.attrs["comment"] and "not sufficient" in ds.stable.attrs["comment"]

@@ -88,3 +88,17 @@ def test_progress_reaches_the_end(name):
     seen = []
     scene.integrator.integrate(scene.system.rhs, scene.times, scene.system.initial_state(), seen.append)
     assert seen and seen[-1] == pytest.approx(5.0) and seen == sorted(seen)
+
+
+def test_a_tolerance_below_scipys_floor_is_stored_as_used(caplog):
+    # scipy raises rtol below 100 machine epsilons to that floor (scipy.integrate._ivp.common.validate_tol): the
+    # dataset must store the tolerance the method ran with, and keep the request beside it (issue 22)
+    from gyrolab import run
+
+    with caplog.at_level("WARNING"):
+        ds = run(["integrator=dop853", "integrator.rtol=1e-20", "time.end=0.5", "time.n_output=11"])
+    assert ds.attrs["integrator_rtol"] == pytest.approx(100 * np.finfo(float).eps)
+    assert ds.attrs["integrator_rtol_requested"] == 1e-20
+    assert sum("not the requested rtol" in r.getMessage() for r in caplog.records) == 1
+    plain = run(["integrator=dop853", "integrator.rtol=1e-9", "time.end=0.5", "time.n_output=11"])
+    assert plain.attrs["integrator_rtol"] == 1e-9 and "integrator_rtol_requested" not in plain.attrs

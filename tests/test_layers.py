@@ -144,3 +144,28 @@ def test_hydra_private_api_behind_one_module():
                     [a.name for a in node.names] if isinstance(node, ast.Import) else []
                 assert not any(n.startswith("hydra._internal") for n in names), \
                     f"{path.relative_to(ROOT)}:{node.lineno} imports Hydra's private API; use gyrolab.engine.hydra_private"
+
+
+def test_the_compiled_parameter_array_is_read_by_name():
+    """The fixed-point model's parameter array is laid out in plugins/compiled/layout.py; code reads it by those
+    names (p[U_Z + 1]), never by bare numbers (p[10]) that silently break when the layout changes."""
+    import io
+    import re
+    import tokenize
+
+    # p[3], params[3], P[:, 3] (rows of parameters) and P[3, j] (a transposed table): the parameter index as a number
+    pattern = re.compile(r"\b(p\[\d|params\[\d|P\[:, *\d|P\[\d+, *j\])")
+    bad = []
+    for folder in SOURCES:
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            if path.name == "layout.py":
+                continue
+            source = path.read_text()
+            for tok in tokenize.generate_tokens(io.StringIO(source).readline):
+                # code only: a docstring or comment may quote the numbers
+                if tok.type not in (tokenize.STRING, tokenize.COMMENT) and tok.type == tokenize.NAME \
+                        and tok.string in ("p", "P", "params"):
+                    line = tok.line[tok.start[1]:]
+                    if pattern.match(line):
+                        bad.append(f"{path.relative_to(ROOT)}:{tok.start[0]}: {tok.line.strip()}")
+    assert not bad, "bare indices of the compiled parameter array:\n" + "\n".join(bad)

@@ -65,3 +65,32 @@ def test_a_family_needs_its_settings():
     with pytest.raises(ConfigError, match="theta0"):
         experiments.run_task("orbit_family", compose_config([*FAMILY, "orbit_family.families.pendulum_body.theta0=x"]),
                              "unused")
+
+
+def _monodromy_by_scipy(y0, period, h=1e-6):
+    """Φ(T) by central differences of the flow of the Euler–Poisson equations written above (scipy's DOP853)."""
+    columns = []
+    for j in range(6):
+        ends = []
+        for sign in (1, -1):
+            y = np.array(y0, dtype=float)
+            y[j] += sign * h
+            ends.append(solve_ivp(euler_poisson, (0, period), y, method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1])
+        columns.append((ends[0] - ends[1]) / (2 * h))
+    return np.column_stack(columns)
+
+
+@pytest.mark.slow
+def test_branch_points_are_located_where_the_multipliers_cross_one(tmp_path):
+    # issue 22: the labels sat on the next family point (0.380, 1.139, 1.579); an independent review found the
+    # multipliers crossing +1 at r0/c = 0.266, 0.973, 1.237 on the pendulum body's family
+    family = ["experiment=orbit_family", "~orbit_family.families.default_body",
+              "~orbit_family.families.ismail2021_body_I", "orbit_family.families.pendulum_body.r0_end=1.6"]
+    experiments.run_task("orbit_family", compose_config(family), tmp_path)
+    with xr.open_dataset(tmp_path / "orbit_family.nc") as ds:
+        branch = ds.event_kind.values == "branch point"
+        np.testing.assert_allclose(ds.event_r0_over_c.values[branch], [0.266, 0.973, 1.237], rtol=2e-3)
+        np.testing.assert_allclose(ds.event_stability_index.values[branch], 2.0, atol=1e-4)
+        # at the located orbit, the monodromy matrix computed independently has tr Φ − 4 = ρ + 1/ρ = 2
+        y0, period = ds.event_initial_state.values[branch][0], float(ds.event_period.values[branch][0])
+        assert np.trace(_monodromy_by_scipy(y0, period)) - 4 == pytest.approx(2.0, abs=1e-4)

@@ -221,8 +221,8 @@ def plugins(tmp_path_factory):
     site = tmp_path_factory.mktemp("site")
     (site / "contract_plugins.py").write_text(PLUGINS)
     with installed_distribution(site, "gyrolab-contract-plugins", "0.1",
-                                {n: f"contract_plugins:{_class_name(n)}" for n in FORCES},
-                                integrators={n: f"contract_plugins:{_class_name(n)}" for n in INTEGRATORS}):
+                                {"gyrolab.forces": {n: f"contract_plugins:{_class_name(n)}" for n in FORCES},
+                                 "gyrolab.integrators": {n: f"contract_plugins:{_class_name(n)}" for n in INTEGRATORS}}):
         with pytest.warns(Warning):  # variadic's **params: one warning while composing, the rest works
             compose_scene(SHORT)
         yield site

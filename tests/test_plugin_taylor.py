@@ -18,7 +18,6 @@ import pytest
 
 from gyrolab.contracts import Force
 from gyrolab.engine.scene import compose_scene
-from gyrolab.errors import ConfigError
 from gyrolab.plugins.compiled import fixed_point, models, plugin_taylor, plugin_torque
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from tests.conftest import installed_distribution

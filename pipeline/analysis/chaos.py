@@ -23,8 +23,6 @@ import xarray as xr
 
 from gyrolab.errors import ConfigError, IntegrationError
 
-FIXED_STEP = ("rk4", "rk4_numba")
-ADAPTIVE = ("dop853", "dop853_numba")
 INDICATOR_NAME = "MEGNO"
 INDICATOR_DEFINITION = ("MEGNO <Y>(t_end) (Cincotta & Simo 2000): time mean of Y(t) = (2/t) int_0^t s d'.d/d.d ds "
                         "along the tangent vector d of the variational equations; regular quasi-periodic -> 2, "
@@ -39,7 +37,7 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
     A state that carries the fixed horizontal axis α (9 components) is accepted when no torque depends on α:
     (ω, γ) is then a closed system and α (the precession angle's axis) does not enter the indicators.
     """
-    from gyrolab.plugins.compiled import fixed_point, models
+    from gyrolab.plugins.compiled import fixed_point, layout, models
 
     if compiled is None or compiled.model != models.FIXED_POINT:
         raise ConfigError("chaos indicators need the fixed-point system with built-in torques only "
@@ -52,25 +50,41 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
     P = np.tile(compiled.params, (len(y0s), 1)) if params is None else np.ascontiguousarray(params, dtype=float)
     if P.shape != (len(y0s), fixed_point.N_PARAMS):
         raise ConfigError(f"params has shape {P.shape}; it must be ({len(y0s)}, {fixed_point.N_PARAMS})")
-    if np.any(P[:, 3:9] != 0.0) or np.any(P[:, 12:14] != 0.0):
+    if layout.torques_on_horizontal_axes(P):
         raise ConfigError("chaos indicators need torques about the vertical only (uniform gravity, Newtonian "
                           "attraction along Z); a torque on the fixed horizontal axes is not supported")
     P = P.copy()
-    P[:, 15] = 0.0  # α is not carried into the kernels (nothing depends on it: checked above)
+    P[:, layout.CARRIES_ALPHA] = 0.0  # α is not carried into the kernels (nothing depends on it: checked above)
     gamma = np.linalg.norm(y0s[:, 3:6], axis=1)
     if np.any(np.abs(gamma - 1.0) > 1e-9):
         raise ConfigError(f"an initial γ has norm {gamma[np.argmax(np.abs(gamma - 1.0))]:.12g}; |γ| must be 1 within 1e-9")
     return np.ascontiguousarray(y0s[:, :6]), P
 
 
+def variational_settings(integrator: Any) -> Any:
+    """How the variational kernels run with ``integrator`` (its ``variational_settings()``); one ConfigError naming it,
+    the capability and the registered integrators that have it when it does not declare VARIATIONAL."""
+    from gyrolab.contracts.integrator import VARIATIONAL
+
+    supports = getattr(integrator, "supports", None)
+    if supports is None or not supports(VARIATIONAL):
+        from gyrolab.contracts.capabilities import integrators_with, or_list
+
+        name = getattr(integrator, "name", None) or integrator
+        raise ConfigError(f"integrator {name!r} has no variational equations (capability {VARIATIONAL}), which the "
+                          f"chaos indicators need; valid choices: {or_list(integrators_with(VARIATIONAL))}")
+    return integrator.variational_settings()
+
+
 def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray,
               params: np.ndarray | None = None, every_time: bool = True) -> dict[str, np.ndarray]:
     """MEGNO ⟨Y⟩ at every output time, FLI, max |θ − θ0| and the final state of each trajectory.
 
-    ``integrator`` rk4/rk4_numba: fixed-step RK4 with the batch kernels' steps (``integrate_arrays``: the fewest
-    equal steps no longer than ``integrator.step`` in each output interval), by blocks of trajectories;
-    dop853/dop853_numba: adaptive DOP853 with its rtol, atol and max_step, steps landing on every output time,
-    one trajectory per thread (``steps``: accepted steps per trajectory). Returns arrays ``megno`` (trajectories, times; with
+    ``integrator`` declares VARIATIONAL and says how (``variational_settings()``): fixed-step RK4 with the batch
+    kernels' steps (``integrate_arrays``: the fewest equal steps no longer than its ``step`` in each output
+    interval), by blocks of trajectories (rk4, rk4_numba); or adaptive DOP853 with its rtol, atol and max_step,
+    steps landing on every output time, one trajectory per thread (dop853, dop853_numba; ``steps``: accepted
+    steps per trajectory). Any other integrator is refused in one sentence listing those that have it. Returns arrays ``megno`` (trajectories, times; with
     ``every_time=False`` (trajectories, 1): ⟨Y⟩ at the last time only), ``fli``, ``max_nutation_deviation`` (trajectories,),
     ``final_state`` (trajectories, 6) and ``failed`` (trajectories,) True where the trajectory became
     non-finite (its values are then NaN).
@@ -82,22 +96,19 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
     times = np.ascontiguousarray(times, dtype=float)
     if times.ndim != 1 or times.size < 2 or not np.all(np.diff(times) > 0):
         raise ConfigError("times must be at least two increasing output times")
-    name = getattr(integrator, "name", None)
+    settings = variational_settings(integrator)
     n = len(y0)
     megno = np.empty((n, times.size if every_time else 1))
     fli, deviation, final = np.empty(n), np.empty(n), np.empty((n, 6))
     tangent = variational.initial_tangent(y0)
-    if name in FIXED_STEP:
-        grid = steps_per_interval(times, float(integrator.step))
+    if settings.fixed_step:
+        grid = steps_per_interval(times, float(settings.step))
         variational.run_indicators(P, times, grid, y0, tangent, megno, fli, deviation, final)
         steps = np.full(n, int(grid.sum()))
-    elif name in ADAPTIVE:
-        steps = np.zeros(n, dtype=np.int64)
-        variational.run_indicators_dop853(P, times, y0, tangent, float(integrator.rtol), float(integrator.atol),
-                                          float(integrator.max_step), megno, fli, deviation, final, steps)
     else:
-        raise ConfigError(f"chaos indicators run with integrator rk4, rk4_numba (fixed step) or dop853, dop853_numba "
-                          f"(adaptive), not {name or integrator}")
+        steps = np.zeros(n, dtype=np.int64)
+        variational.run_indicators_dop853(P, times, y0, tangent, float(settings.rtol), float(settings.atol),
+                                          float(settings.max_step), megno, fli, deviation, final, steps)
     return {"megno": megno, "fli": fli, "max_nutation_deviation": deviation, "final_state": final,
             "failed": ~np.isfinite(megno[:, -1]), "steps": steps}
 
@@ -106,7 +117,7 @@ def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np
                       params: np.ndarray | None = None) -> dict[str, tuple[np.ndarray, dict[str, Any]]]:
     """Per-trajectory chaos indicators with their CF attributes (first axis = trajectory).
 
-    ``integrator``: rk4/rk4_numba (fixed step) or dop853/dop853_numba (adaptive), see ``megno_run``.
+    ``integrator``: one that declares VARIATIONAL (fixed-step RK4 or adaptive DOP853), see ``megno_run``.
     ``indicator``: MEGNO ⟨Y⟩ at ``times[-1]``; ``fli``: the fast Lyapunov indicator; ``max_nutation_deviation``:
     max |θ − θ0| over the integration steps (rad, θ from γ3 = cos θ). A trajectory that becomes non-finite
     gets NaN in all three (the caller marks it failed).

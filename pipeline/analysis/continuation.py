@@ -164,14 +164,21 @@ def _tangent(model, section, z, previous=None):
     return t
 
 
+class Family(list):
+    """The points of a continued family, in order; ``stop_reason`` says why the continuation ended."""
+
+    stop_reason: str = ""
+
+
 def continue_family(model: FixedPointModel, section: Section, start: FamilyPoint, r0_end: float, *,
                     step: float = 0.1, max_step: float = 0.4, min_step: float = 1e-4, max_points: int = 400,
-                    max_period: float = 200.0) -> list[FamilyPoint]:
+                    max_period: float = 200.0) -> Family:
     """Pseudo-arclength continuation from ``start`` (r0 > 0) until ln r0 passes ln ``r0_end``.
 
     Step control: grow by 1.3 after an easy correction (≤ 4 iterations), halve after a failure; stops (and
     returns what it has) below ``min_step``, after ``max_points`` points or when the period exceeds ``max_period``
-    (an orbit approaching an equilibrium or a homoclinic loop: the period diverges).
+    (an orbit approaching an equilibrium or a homoclinic loop: the period diverges). The returned ``Family``'s
+    ``stop_reason`` names which of these ended it ("reached r0_end" when none did).
     """
     if start.r0 <= 0 or r0_end <= 0:
         raise ConfigError("continuation in ln r0 needs r0 > 0 at both ends")
@@ -182,29 +189,140 @@ def continue_family(model: FixedPointModel, section: Section, start: FamilyPoint
     if t[3] * direction < 0:
         t = -t
     start.tangent = t
-    points = [start]
+    points = Family([start])
     h = step
-    while len(points) < max_points and (np.log(r0_end) - z[3]) * direction > 0:
+    points.stop_reason = "reached r0_end"
+    while (np.log(r0_end) - z[3]) * direction > 0:
+        if len(points) >= max_points:
+            points.stop_reason = f"{max_points} points (orbit_family max_points)"
+            break
         anchor = z + h * t
         try:
             z_new, norm, y0, phi = _newton(model, section, anchor.copy(), tangent=t, anchor=anchor, max_iter=12)
-        except IntegrationError:
+        except IntegrationError as error:
             h *= 0.5
             if h < min_step:
+                points.stop_reason = f"the corrector failed down to the smallest step {min_step:g} ({error})"
                 break
             continue
         t_new = _tangent(model, section, z_new, t)
         if np.arccos(np.clip(t_new @ t, -1, 1)) > 0.3 or (z_new - z) @ t <= 0.2 * h:  # sharp turn or going back
             h *= 0.5
             if h < min_step:
+                points.stop_reason = (f"the family turns too sharply to follow with the smallest step {min_step:g} "
+                                      "(a cusp, or a branch the tangent cannot choose)")
                 break
             continue
         if np.exp(z_new[2]) > max_period:
+            points.stop_reason = (f"the period {np.exp(z_new[2]):.4g} passed the period limit {max_period:g} "
+                                  "(an orbit approaching an equilibrium or a homoclinic loop)")
             break
         z, t = z_new, t_new
         points.append(FamilyPoint(float(np.exp(z[3])), float(np.exp(z[2])), y0, phi, norm, t))
         h = min(max_step, 1.3 * h)
     return points
+
+
+@dataclass(frozen=True)
+class Event:
+    """A bifurcation located on a family: ``index`` the point after it, ``r0`` where it happens."""
+
+    index: int
+    kind: str  # "fold", "branch point", "period doubling"
+    r0: float
+    stability_index: float  # s at r0: ±2 for a located branch point or period doubling
+    period: float
+    located: str  # how r0 was found
+    y0: np.ndarray = field(default_factory=lambda: np.full(6, np.nan))  # the orbit's state at the event (NaN: fold)
+
+
+def locate_events(model: FixedPointModel, section: Section, points: list[FamilyPoint],
+                  events: list[tuple[int, str]] | None = None, tol: float = 1e-9) -> list[Event]:
+    """Each bifurcation of ``bifurcations(points)`` located in r0, not just bracketed by two family points.
+
+    A branch point or a period doubling is where s = ρ + 1/ρ crosses +2 or −2 between two points: the crossing
+    is solved for by regula falsi (Illinois) along the family between the two points, each trial an orbit of the
+    family found by the continuation's corrector, to |s ∓ 2| < ``tol`` (the points themselves may lie 40 % apart
+    in r0). A fold is
+    where ln r0 turns along the family: the vertex of the parabola through the three points around it.
+    """
+    located = []
+    for index, kind in bifurcations(points) if events is None else events:
+        a, b = points[index - 1], points[index]
+        if kind == "fold":
+            located.append(_fold(points, index))
+            continue
+        target = 2.0 if kind == "branch point" else -2.0
+        try:
+            try:
+                located.append(_crossing(model, section, a, b, index, kind, target, tol))
+            except IntegrationError:  # the chord strays too far from a long arc: follow the arc in small steps
+                located.append(_crossing_on_dense_arc(model, section, a, b, index, kind, target, tol))
+        except IntegrationError as error:  # shooting failed inside the bracket: keep the bracket, say so
+            r0 = float(np.sqrt(a.r0 * b.r0))
+            located.append(Event(index, kind, r0, float("nan"), float(np.sqrt(a.period * b.period)),
+                                 f"bracketed only, between r0/c = {a.r0:.6g} and {b.r0:.6g} ({error})"))
+    return located
+
+
+def _family_z(section: Section, point: FamilyPoint) -> np.ndarray:
+    """The continuation unknowns z = (p0, x, ln T, ln r0) of a family point."""
+    x = point.y0[1] if section.kind == "gamma_prime" else point.y0[4]
+    return np.array([point.y0[0], x, np.log(point.period), np.log(point.r0)])
+
+
+def _crossing(model, section, a, b, index, kind, target, tol) -> Event:
+    """s = target between family points a and b, by regula falsi (Illinois) in λ along the chord z_a → z_b: each
+    trial is the family's orbit on the hyperplane through z_a + λ (z_b − z_a) normal to the chord (the corrector
+    of the continuation), which stays well posed at a fold, where shooting at a fixed r0 does not."""
+    za, zb = _family_z(section, a), _family_z(section, b)
+    chord = (zb - za) / np.linalg.norm(zb - za)
+    lo, hi = 0.0, 1.0
+    f_lo, f_hi = a.stability_index - target, b.stability_index - target
+    best, side = None, 0
+    for _ in range(60):
+        lam = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+        anchor = za + lam * (zb - za)
+        z, norm, y0, phi = _newton(model, section, anchor.copy(), tangent=chord, anchor=anchor)
+        best = FamilyPoint(float(np.exp(z[3])), float(np.exp(z[2])), y0, phi, norm)
+        f = best.stability_index - target
+        if abs(f) < tol or hi - lo < 1e-14:
+            break
+        if f * f_lo > 0:
+            lo, f_lo = lam, f
+            f_hi = f_hi / 2 if side == -1 else f_hi  # Illinois: halve the stale end's value
+            side = -1
+        else:
+            hi, f_hi = lam, f
+            f_lo = f_lo / 2 if side == 1 else f_lo
+            side = 1
+    return Event(index, kind, best.r0, best.stability_index, best.period,
+                 f"regula falsi on s {'-' if target > 0 else '+'} 2 along the family between its points (|residual| "
+                 f"{abs(best.stability_index - target):.1e})", np.array(best.y0, dtype=float))
+
+
+def _crossing_on_dense_arc(model, section, a, b, index, kind, target, tol) -> Event:
+    """``_crossing`` on the pair of points that brackets s = target once the arc from a to b is continued again in
+    small steps (for two family points far apart along a curved arc)."""
+    dense = continue_family(model, section, a, b.r0, step=0.005, max_step=0.02, max_points=400)
+    for c, d in zip(dense, dense[1:]):
+        if (c.stability_index - target) * (d.stability_index - target) < 0:
+            return _crossing(model, section, c, d, index, kind, target, tol)
+    raise IntegrationError(f"no crossing of s = {target:g} found on the arc continued again in small steps "
+                           f"({len(dense)} points)")
+
+
+def _fold(points, index) -> Event:
+    i = min(max(index, 1), len(points) - 2)
+    trio = points[i - 1:i + 2]
+    x = np.log([p.r0 for p in trio])
+    s = np.arange(3.0)  # the three points' order along the family stands in for arclength
+    c = np.polyfit(s, x, 2)
+    vertex = -c[1] / (2 * c[0]) if c[0] != 0 else 1.0
+    r0 = float(np.exp(np.polyval(c, vertex))) if 0 <= vertex <= 2 else points[index].r0
+    near = points[index]
+    return Event(index, "fold", r0, near.stability_index, near.period,
+                 "vertex of the parabola of ln r0 through the three points around the turn")
 
 
 def bifurcations(points: list[FamilyPoint]) -> list[tuple[int, str]]:

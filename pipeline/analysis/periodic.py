@@ -146,13 +146,16 @@ class FixedPointModel:
     @classmethod
     def from_system(cls, system) -> FixedPointModel:
         compiled = system.compiled_model()
-        if compiled is None or compiled.model != 0:  # 0: models.FIXED_POINT, the built-in torque forms only
+        from gyrolab.plugins.compiled import layout, models
+
+        if compiled is None or compiled.model != models.FIXED_POINT:  # the built-in torque forms only
             raise ConfigError("periodic orbits need forces with compiled forms; valid forces: uniform_gravity, newtonian")
         p = compiled.params
-        if np.any(p[3:9] != 0) or np.any(p[12:14] != 0):
+        if layout.torques_on_horizontal_axes(p):
             raise ConfigError("periodic orbits are computed for fields symmetric about the vertical only; "
                               "valid forces: uniform_gravity, newtonian")
-        return cls(np.array(p[0:3]), np.array(p[9:12]), float(p[14]))
+        return cls(np.array(p[layout.INERTIA:layout.INERTIA + 3]), np.array(p[layout.U_Z:layout.U_Z + 3]),
+                   float(p[layout.N_Z]))
 
     def rhs(self, y: np.ndarray) -> np.ndarray:
         w, g = y[:3], y[3:6]

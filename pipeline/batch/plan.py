@@ -100,8 +100,19 @@ class Plan:
     @property
     def integrator_name(self) -> str:
         """The integrator plugin's name (``rk4_numba``, ``auto``, ...)."""
+        return self.integrator_class.name
+
+    @property
+    def integrator_class(self) -> type:
+        """The integrator plugin's class (what the batch asks for capabilities)."""
         node = OmegaConf.create(self.plain).integrator
-        return scene_module._plugin_class("integrator", node, "integrator").name
+        cls = scene_module._plugin_class("integrator", node, "integrator")
+        if cls.__new__ is not object.__new__:
+            # a plugin whose construction picks a class by its settings (taylor's integrator.precision): that class,
+            # without running its __init__
+            settings = {k: v for k, v in (self.plain.get("integrator") or {}).items() if not k.startswith("_")}
+            return type(cls.__new__(cls, **settings))
+        return cls
 
     def params(self, start: int, stop: int) -> np.ndarray:
         return self.combo_params[self.combo[start:stop]]

@@ -1,4 +1,6 @@
-"""Running a plan: chunks of points, each a picklable task integrated by the compiled batch kernels.
+"""Running a plan: chunks of points, each a picklable task integrated by the integrator's batch kernel (capability
+BATCH_KERNEL), or by one ``integrate`` call per point with that point's system (``integrate_points``) for an
+integrator without one.
 
 ``run_plan(plan, path, settings)`` cuts the grid into chunks (each a block of the grid, so that it is one
 hyperslab of the stored dataset), skips the chunks a killed run of the same command already stored,
@@ -24,6 +26,7 @@ from gyrolab.batch import executors
 from gyrolab.batch.outputs import MODES, Output, indicator_outputs, merge_rows, state_outputs
 from gyrolab.batch.plan import Plan, _with_values
 from gyrolab.batch.store import Store
+from gyrolab.contracts.integrator import BATCH_KERNEL, CHOOSES_METHOD, VECTOR_LANES
 from gyrolab.engine.progress import duration
 from gyrolab.errors import ConfigError
 
@@ -179,24 +182,37 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
 def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any]]:
     """(the integrator every chunk runs, its dataset attributes); None: the config's own (a fixed choice).
 
-    ``auto`` chooses here, once for the batch, on the batch's valid points (``gyrolab.batch.integrate``'s
-    choice for array batches: its pilot on the first point, the largest state and the most unusual
-    parameters, the tightest tolerance): every chunk then runs the same method at the same tolerance.
-    (The chaos indicator takes no ``auto``: its kernels refuse it, in their own sentence.)
+    An integrator that chooses its method (CHOOSES_METHOD: ``auto``) chooses here, once for the batch, on the
+    batch's valid points (its ``choose_batch_method``; ``auto``: its pilot on the first point, the largest state
+    and the most unusual parameters, the tightest tolerance): every chunk then runs the same method at the
+    same tolerance. (The chaos indicator needs VARIATIONAL, which such an integrator lacks: refused before.)
+    The attributes always say how the points ran (``batch_path``: the integrator's batch kernel, vectorised
+    or not, or one ``integrate`` call per point).
     """
-    if plan.base is None or plan.integrator_name != "auto" or settings.output == "indicator":
-        return None, {}
-    from gyrolab.batch.integrate import auto_choice
+    if plan.base is None or settings.output == "indicator" or not plan.integrator_class.supports(CHOOSES_METHOD):
+        return None, {} if plan.base is None else {"batch_path": batch_path(plan.integrator_class, settings)}
     from gyrolab.engine.scene import Scene
 
     scene = Scene.from_config(OmegaConf.create(plan.base))
     valid = np.flatnonzero(plan.valid)
     start = time.perf_counter()
-    method, choice = auto_choice(scene.system.compiled_model(), scene.integrator, plan.times, plan.y0[valid],
-                                  plan.combo_params[plan.combo[valid]])
-    log.info("batch: auto chose %s at tolerance %.3g for every chunk (pilot on %d points, %.1f s)", method.name,
-             choice["auto_tolerance"], choice.get("auto_sampled_trajectories", 0), time.perf_counter() - start)
-    return method, {k: v for k, v in choice.items() if v is not None}
+    method, choice = scene.integrator.choose_batch_method(scene.system.compiled_model(), plan.times, plan.y0[valid],
+                                                          plan.combo_params[plan.combo[valid]])
+    settings_text = ", ".join(f"{k.removeprefix('integrator_')}={v:.3g}" if isinstance(v, float)
+                              else f"{k.removeprefix('integrator_')}={v}" for k, v in method.attributes().items())
+    log.info("batch: %s chose %s (%s) for every chunk, in %.1f s", plan.integrator_name, method.name, settings_text,
+             time.perf_counter() - start)
+    return method, {**{k: v for k, v in choice.items() if v is not None},
+                    "batch_path": batch_path(type(method), settings)}
+
+
+def batch_path(integrator: type, settings: Settings) -> str:
+    """How a batch's points run with ``integrator`` (stored as the dataset's ``batch_path`` attribute)."""
+    if settings.output == "indicator":
+        return "variational kernel"
+    if not integrator.supports(BATCH_KERNEL):
+        return "one integrate() call per point"
+    return "batch kernel, vectorised across trajectories" if integrator.supports(VECTOR_LANES) else "batch kernel"
 
 
 def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integrator: Any = None) -> ChunkTask | None:
@@ -273,7 +289,7 @@ def _system(context: dict[str, Any], config: dict[str, Any], values: dict[str, A
 
 def run_chunk(task: ChunkTask) -> ChunkResult:
     """Integrate one chunk's valid points and compute what ``task.output`` stores."""
-    from gyrolab.batch.integrate import integrate_arrays
+    from gyrolab.batch.integrate import integrate_arrays, integrate_points
 
     start = time.perf_counter()
     context = _context(task.config_key, task.config)
@@ -288,12 +304,19 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
             failed |= ~np.isfinite(out.data.reshape(len(task.rows), -1)).all(axis=1)
         settings = None
     else:
-        solution = integrate_arrays(compiled, integrator, task.times, task.y0, task.params, failures="mark")
+        groups = [(_system(context, task.config, task.combos[int(c)]), np.flatnonzero(task.combo == c))
+                  for c in np.unique(task.combo)]
+        if integrator.supports(BATCH_KERNEL):
+            solution = integrate_arrays(compiled, integrator, task.times, task.y0, task.params, failures="mark")
+        else:   # one integrate() call per point, each with its own system's right-hand side: a single run's numbers
+            system_of_row = np.empty(len(task.rows), dtype=object)
+            for system, rows in groups:
+                system_of_row[rows] = system
+            solution = integrate_points(integrator, lambda j: system_of_row[j].rhs, task.times, task.y0, compiled,
+                                        task.params, failures="mark")
         kernel_time = solution.wall_time
         failed = np.asarray(solution.failed, dtype=bool)
         settings = solution.settings
-        groups = [(_system(context, task.config, task.combos[int(c)]), np.flatnonzero(task.combo == c))
-                  for c in np.unique(task.combo)]
         with np.errstate(invalid="ignore"):   # every row, so that a chunk whose points all failed still has its
             outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, groups, compiled,
                                     task.params)   # variables (the store is created from the first chunk's)

@@ -2,7 +2,8 @@
 
 The grid becomes arrays (``gyrolab.batch.plan``: one composed config, initial states and compiled-model
 parameters for every point, each invalid point a failed entry with the single run's error), runs in chunks
-on the compiled batch kernels (``gyrolab.batch.runner``) and streams to one dataset whose dimensions are
+on the integrator's compiled batch kernel, or one ``integrate`` call per point for an integrator without one
+(``gyrolab.batch.runner``), and streams to one dataset whose dimensions are
 the swept parameters (``gyrolab.batch.store``). Rerunning the same command resumes; ``batch.output`` says
 what is stored per point. Only parameters of the body, the initial state and the forces may vary: the
 system, the forces' list, the integrator and the output times are one for the whole batch.
@@ -17,7 +18,7 @@ from typing import Any
 
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
 from gyrolab.batch.runner import RunStats, Settings, run_plan
-from gyrolab.batch.integrate import BATCH_INTEGRATORS
+from gyrolab.contracts.integrator import VARIATIONAL
 from gyrolab.errors import ConfigError
 from gyrolab.output.lock import writing_in
 
@@ -40,7 +41,7 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
     start = time.perf_counter()
     plan = make_plan(fixed, dims, plain=plain)
     settings = Settings.from_config(plan.plain.get("batch"))
-    check_integrator(plan)
+    check_integrator(plan, settings)
     plan_time = time.perf_counter() - start
     if not lock:
         stats = run_plan(plan, path, settings)
@@ -51,11 +52,15 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
     return stats
 
 
-def check_integrator(plan: Plan) -> None:
-    """A batch integrates with the compiled batch kernels only: scipy's integrators run one trajectory at a
-    time in Python (a batch of them would be a slow multirun without its resume), so they are refused."""
-    name = plan.integrator_name
-    valid = BATCH_INTEGRATORS
-    if name not in valid:
-        raise ConfigError(f"integrator {name!r} has no batch kernel; a batch runs integrator={' | '.join(valid)} "
-                          "(or sweep with gyrolab -m, which runs any integrator)")
+def check_integrator(plan: Plan, settings: Settings | None = None) -> None:
+    """Refuse, in one sentence, an integrator that lacks a capability the batch needs: the chaos indicators
+    (``batch.output=indicator``) need VARIATIONAL. Any integrator runs the other outputs: one with a batch kernel
+    (BATCH_KERNEL) in one call per chunk, any other with one ``integrate`` call per point."""
+    from gyrolab.contracts.capabilities import integrators_with, or_list
+
+    output = settings.output if settings is not None else Settings.from_config(plan.plain.get("batch")).output
+    integrator = plan.integrator_class
+    if output == "indicator" and not integrator.supports(VARIATIONAL):
+        raise ConfigError(f"integrator {plan.integrator_name!r} has no variational equations (capability "
+                          f"{VARIATIONAL}), which the chaos indicators of batch.output=indicator need; valid choices: "
+                          f"{or_list(integrators_with(VARIATIONAL))}")

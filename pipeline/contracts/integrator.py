@@ -50,6 +50,86 @@ class Solution:
     stats: IntegratorStats
 
 
+# ----------------------------------------------------------------------------------------------------------
+# Capabilities: what an integrator can do, declared by the integrator and asked for by the engine (which never
+# tests an integrator's name). Each is a rule of the contract (C1-C7 in ``Integrator``'s docstring); docs/plugins.md,
+# "Integrator capabilities", says what the engine does with each and which built-ins have it.
+
+#: C1: integrates the system's compiled model (``compiled``) instead of calling ``fun`` (alias: ``needs_compiled_model``)
+COMPILED_MODEL = "compiled_model"
+#: C2: integrates the compiled model when the system has one, ``fun`` otherwise (alias: ``prefers_compiled_model``)
+PREFERS_COMPILED_MODEL = "prefers_compiled_model"
+#: C3: passes the true time to the right-hand side, so it integrates time-dependent forces
+TIME_DEPENDENT = "time_dependent"
+#: C4: has a compiled batch kernel, ``integrate_batch``: many trajectories of one compiled model in one call
+BATCH_KERNEL = "batch_kernel"
+#: C5: its batch kernel advances several trajectories at once in SIMD lanes (vectorised across trajectories)
+VECTOR_LANES = "vector_lanes"
+#: C6: the chaos indicators' variational equations can run with its method (``variational_settings``)
+VARIATIONAL = "variational"
+#: C7: picks a method and tolerance itself, per scene (``integrate``) and per batch (``choose_batch_method``)
+CHOOSES_METHOD = "chooses_method"
+#: every capability, in the order the documentation lists them
+CAPABILITIES = (COMPILED_MODEL, PREFERS_COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL,
+                CHOOSES_METHOD)
+#: the run dataset's attribute holding the integrator's ``evaluation_label`` (what ``integrator_nfev`` counts)
+NFEV_COUNTS_ATTRIBUTE = "integrator_nfev_counts"
+#: the boolean class attributes of older integrators that declare a capability (third-party code may set them)
+_ALIASES = {COMPILED_MODEL: "needs_compiled_model", PREFERS_COMPILED_MODEL: "prefers_compiled_model"}
+
+
+class _CapabilityFlag:
+    """A boolean alias of a capability: reads True when the class declares the capability. A subclass that sets the
+    attribute itself (``needs_compiled_model = True``, the older way) declares the capability that way."""
+
+    def __init__(self, capability: str) -> None:
+        self.capability = capability
+
+    def __get__(self, instance: Any, owner: type) -> bool:
+        return self.capability in getattr(owner, "capabilities", ())
+
+
+@dataclass
+class BatchSolution:
+    """Many trajectories of one compiled model, from one call of a batch kernel (``Integrator.integrate_batch``)."""
+
+    t: np.ndarray  # (n_out,)
+    y: np.ndarray  # (trajectories, n_out, state size)
+    n_steps: int  # per trajectory (adaptive kernels: the largest number of any trajectory)
+    wall_time: float
+    #: (trajectories,) True where the trajectory failed (non-finite, or an adaptive step below the
+    #: spacing of floating-point numbers; its rows from then on are NaN); only with ``failures="mark"``,
+    #: else all False (a failure raised instead)
+    failed: np.ndarray | None = None
+    #: (trajectories,) accepted steps of each trajectory (adaptive kernels; None for fixed steps)
+    steps: np.ndarray | None = None
+    #: the integrator settings the kernel ran with (``auto``: its choice, e.g. ``auto_method``, ``auto_tolerance``)
+    settings: dict | None = None
+
+    @property
+    def trajectory_steps_per_second(self) -> float:
+        total = self.y.shape[0] * self.n_steps if self.steps is None else int(self.steps.sum())
+        return total / self.wall_time
+
+
+@dataclass(frozen=True)
+class VariationalSettings:
+    """How the chaos indicators' compiled variational kernels run for a VARIATIONAL integrator: fixed-step RK4 with
+    ``step`` (the fewest equal steps no longer than it in each output interval), or, with ``step`` None, adaptive
+    DOP853 with ``rtol``, ``atol`` and ``max_step``."""
+
+    step: float | None = None
+    rtol: float = 1e-10
+    atol: float = 1e-10
+    max_step: float = np.inf
+
+    @property
+    def fixed_step(self) -> bool:
+        return self.step is not None
+
+# ----------------------------------------------------------------------------------------------------------
+
+
 class Integrator(ABC):
     """A method that integrates an initial-value problem.
 
@@ -75,8 +155,35 @@ class Integrator(ABC):
        instead of calling ``fun``; the scene refuses it, before integrating,
        for a system or force that has no compiled form.
     7. ``attributes()`` gives its settings for the dataset.
-    8. ``prepare(system)`` is called once by the scene before integrating
-       (default: nothing); ``auto`` uses it to consult the system's regimes.
+    9. ``more_accurate(factor)``, optional: a more accurate run of the same method, which
+       ``output.error_estimate`` compares with this one to measure the stored trajectory's error.
+    8. It declares what it can do in ``capabilities`` (a frozenset of the module's capability constants)
+       and the engine asks ``supports(capability)``, never for an integrator's name:
+
+       C1. ``COMPILED_MODEL``: it integrates the ``compiled`` model it is given (rule 6; the older
+           ``needs_compiled_model = True`` declares it too). The scene refuses it for a system without
+           a compiled form, and asks ``refusal(compiled, system)`` whether it can run the one it has.
+       C2. ``PREFERS_COMPILED_MODEL``: it takes the compiled model when the system has one, else calls
+           ``fun`` (``prefers_compiled_model = True`` declares it too).
+       C3. ``TIME_DEPENDENT``: it passes the true time to ``fun`` (and to a compiled model), so the scene
+           lets it integrate time-dependent forces; others are refused for them.
+       C4. ``BATCH_KERNEL``: ``integrate_batch(compiled, times, y0s, params, failures)`` integrates many
+           trajectories of a compiled model in one call; ``--batch`` and
+           ``gyrolab.batch.integrate.integrate_arrays`` call it. Without it ``--batch`` still runs the
+           integrator, with one ``integrate`` call per point.
+       C5. ``VECTOR_LANES``: its batch kernel advances trajectories together in SIMD lanes (a batch
+           dataset's ``batch_path`` attribute says so).
+       C6. ``VARIATIONAL``: ``variational_settings()`` says how the chaos indicators' compiled variational
+           equations run with its method (fixed-step RK4 or adaptive DOP853, and with which step or
+           tolerances); the indicators are refused for other integrators.
+       C7. ``CHOOSES_METHOD``: it chooses a method and tolerance itself: per scene in ``integrate``, per
+           batch in ``choose_batch_method(compiled, times, y0s, params)``, which ``--batch`` calls once
+           before the chunks; its evaluation counts include that choice's pilot runs.
+
+       ``evaluation_label``, when set, says what its evaluation count ``nfev`` counts where that is not
+       right-hand-side calls (run datasets store it as ``integrator_nfev_counts``; figures read it).
+    10. ``prepare(system)`` is called once by the scene before integrating
+        (default: nothing); ``auto`` uses it to consult the system's regimes.
 
     What gyrolab enforces (``gyrolab.contracts.integrator_rules``): every
     subclass's ``integrate`` — built-in or third-party, under its own name —
@@ -95,8 +202,8 @@ class Integrator(ABC):
 
     name: ClassVar[str]
     adaptive: ClassVar[bool]
-    needs_compiled_model: ClassVar[bool] = False
-    prefers_compiled_model: ClassVar[bool] = False  # use the compiled model when the system has one
+    needs_compiled_model: ClassVar[bool] = _CapabilityFlag(COMPILED_MODEL)
+    prefers_compiled_model: ClassVar[bool] = _CapabilityFlag(PREFERS_COMPILED_MODEL)
 
     @abstractmethod
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
@@ -109,3 +216,58 @@ class Integrator(ABC):
 
     def attributes(self) -> dict[str, Any]:
         return {}
+
+    # ------------------------------------------------------------------------------------------------------
+    # Capabilities (rule 8): the declaration and the hooks that go with them.
+
+    #: what this integrator can do: capability constants of this module (rule 8)
+    capabilities: ClassVar[frozenset[str]] = frozenset()
+    #: what ``nfev`` counts where it is not right-hand-side calls (e.g. "Taylor series evaluations"); None: calls
+    evaluation_label: ClassVar[str | None] = None
+
+    @classmethod
+    def supports(cls, capability: str) -> bool:
+        """Whether the integrator declares ``capability`` (in ``capabilities``, or through a boolean alias)."""
+        if capability not in CAPABILITIES:
+            raise ValueError(f"capability {capability!r} is not one of gyrolab's; valid: {', '.join(CAPABILITIES)}")
+        alias = _ALIASES.get(capability)
+        return capability in cls.capabilities or (alias is not None and getattr(cls, alias) is True)
+
+    @classmethod
+    def declared_capabilities(cls) -> frozenset[str]:
+        """Every capability the integrator declares, aliases included."""
+        return frozenset(c for c in CAPABILITIES if cls.supports(c))
+
+    @classmethod
+    def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
+        """Why this integrator cannot run the compiled model ``compiled`` (of ``system``, for naming its forces), as a
+        clause that follows the integrator's name ("evaluates the built-in torque forms only, and ..."); None: it can.
+        The scene calls it once, before integrating; an integrator may prepare the model here (compile a kernel)."""
+        return None
+
+    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
+                        failures: str) -> BatchSolution:
+        """BATCH_KERNEL: the trajectories from the rows of ``y0s`` (trajectories × state size) of ``compiled`` with the
+        parameters ``params`` (trajectories × ``compiled.params.size``, one row each), sampled at ``times``.
+        The caller has validated the arrays. ``failures="raise"``: a failed trajectory raises IntegrationError;
+        ``"mark"``: it is marked in ``BatchSolution.failed`` (NaN rows from its failure on), the others kept."""
+        raise NotImplementedError(f"integrator {self.name!r} declares no batch kernel")
+
+    def variational_settings(self) -> VariationalSettings:
+        """VARIATIONAL: how the chaos indicators' variational kernels run with this integrator's method and settings."""
+        raise NotImplementedError(f"integrator {self.name!r} declares no variational equations")
+
+    def more_accurate(self, factor: float) -> tuple[Integrator, float, str] | None:
+        """Rule 9 (``output.error_estimate``): (the same method about ``factor`` times more accurate, the number that
+        turns the two runs' difference into this run's error estimate, a few words saying how), or None when it
+        cannot be made so (a tolerance already at its floor, or nothing to tighten). A method with tolerances
+        divides them by ``factor`` (the number is 1); a fixed-step method of order p halves its step (the number is
+        Richardson's 2^p / (2^p − 1)); a method that chooses (CHOOSES_METHOD) answers for the method it ran."""
+        return None
+
+    def choose_batch_method(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray,
+                            params: np.ndarray) -> tuple[Integrator, dict[str, Any]]:
+        """CHOOSES_METHOD: (the integrator every trajectory of this batch runs, best one with a batch kernel; the
+        choice as dataset attributes), chosen once for the batch of initial states ``y0s`` with parameters
+        ``params`` (one row each)."""
+        raise NotImplementedError(f"integrator {self.name!r} does not choose a method")

@@ -16,7 +16,7 @@ FORMULAS = ("corrected", "printed")
 class Regime(ABC):
     """An asymptotic expansion of a system's motion (a paper's analytic periodic solution).
 
-    Rules for implementers:
+    Rules for implementers (``gyrolab.testing.check_regime`` checks them; run it in your tests):
 
     1. ``__init__(self, *, formula="corrected", **params)`` takes the plugin's
        config; ``formula`` selects the corrected formulas or the paper's
@@ -39,14 +39,18 @@ class Regime(ABC):
     6. ``euler_angles(system, t)`` returns ``{"psi", "theta", "phi"}`` of the
        analytic solution (ψ(0) = scene's ψ0).
     7. ``attributes()`` describes the regime for the dataset (netCDF-safe values).
-    8. Optionally, ``diagnostics(system)`` returns extra evidence for a
+    8. A regime run (``gyrolab regime=NAME``) also reads ``periods``,
+       ``samples_per_period`` and ``full_initial_state(system)``: a fixed-point
+       regime subclasses ``gyrolab.plugins.regimes.base.FixedPointRegime``, which
+       provides them (docs/plugins.md, "Regime plugins").
+    9. Optionally, ``diagnostics(system)`` returns extra evidence for a
        regime run's dataset as (data variables, coordinates, attributes)
        (``gyrolab.experiments.regime_run``); the default has none.
-    9. Optionally, ``series_candidates(system, accuracy)`` lists variants of
+    10. Optionally, ``series_candidates(system, accuracy)`` lists variants of
        the regime (lowest series order first) with their predicted max error
        (NaN: not predicted), for ``integrator=auto``; the default is the
        regime itself, unpredicted.
-    10. Optionally, ``period_spread`` (a class attribute ≥ 1) bounds the
+    11. Optionally, ``period_spread`` (a class attribute ≥ 1) bounds the
         scene's true period to [T/spread, T·spread] around ``period(system)``;
         ``integrator=auto`` then rules the regime out cheaply when the scene's
         motion never comes back near its start over that range. None (the

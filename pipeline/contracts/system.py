@@ -16,10 +16,13 @@ from gyrolab.contracts.integrator import CompiledModel
 class System(ABC):
     """The equations of motion of one kind of body, with their outputs and invariants.
 
-    Rules for implementers:
+    Rules for implementers (``gyrolab.testing.check_system`` checks them; run it in your tests):
 
     1. ``body_type`` is the class that reads the ``body`` config section
        (``body_type.from_config(cfg)``); forces are built with that body.
+       A third-party system declares its default ``body`` section as
+       ``default_body`` (a dict): gyrolab registers it as the option
+       ``body=NAME``, which selects the system, and its keys as valid body keys.
     2. ``__init__(self, body, forces, initial, output, *, param=default, ...)``
        receives the body, the built forces, the ``initial`` and ``output``
        config sections and the system's own parameters (each a keyword with a
@@ -70,6 +73,7 @@ class System(ABC):
     initial_states: Callable[..., tuple[np.ndarray, np.ndarray]] | None = None
     #: rule 10: the batch's cache of the variables' units
     _batch_units: dict[str, str] | None = None
+    default_body: ClassVar[dict[str, Any] | None] = None  # a third-party system's body section (rule 1)
 
     def __init__(self, body: Any, forces: Sequence[Force], initial: Any, output: Any) -> None:
         self.body = body

@@ -113,6 +113,9 @@ def register_plugin_configs() -> None:
 
     Built-in plugins have YAML files in ``conf/``; a plugin package only
     registers an entry point, and this makes ``force=[..., its_name]`` work.
+    A system plugin that declares ``default_body`` (its ``body`` section, a dict) also
+    gets the body option ``body=NAME``, which selects the system as ``conf/body/gyrostat_*.yaml``
+    select theirs (Hydra cannot let a system option override the body group that follows it).
     A plugin that cannot be used (its module fails to import, ``**params``, ...) costs one
     ``PluginLoadWarning`` and gets a node without parameters, so that a scene naming it composes
     and is then refused by ``registry.load`` in one sentence, while every other command works.
@@ -121,13 +124,41 @@ def register_plugin_configs() -> None:
     for group in registry.GROUPS:
         for name, target in registry.external(group).items():
             try:
-                params = registry.default_params(registry.load(group, name))
+                cls = registry.load(group, name)
+                params = registry.default_params(cls)
             except ConfigError as error:
                 registry.unusable_warning(group, name, error)
-                params = {}
+                cls, params = None, {}
             node = {"_target_": target, **params}
             # A force option nests under its own name so that several can be selected at once.
             store.store(group=group, name=name, node={name: node} if group == "force" else node)
+            body = plugin_default_body(group, cls) if cls is not None else None
+            if body is not None:
+                store.store(group="body", name=name, package="_global_",
+                            node={"defaults": [{"override /system": name}], "body": body})
+
+
+def plugin_default_body(group: str, cls: type) -> dict[str, Any] | None:
+    """A third-party system's ``default_body`` (its body section), None for other plugins or without one."""
+    body = cls.default_body if group == "system" else None
+    if body is None:
+        return None
+    if not isinstance(body, dict) or not all(isinstance(k, str) for k in body):
+        raise ConfigError(f"system plugin {cls.__name__}.default_body={shorten(repr(body))} must be a dict of "
+                          "body keys to values (its body section); fix the plugin package")
+    return dict(body)
+
+
+def plugin_body_keys() -> set[str]:
+    """The body keys third-party systems' ``default_body`` sections use (valid in ``body`` besides the packaged ones)."""
+    keys: set[str] = set()
+    for name in registry.external("system"):
+        try:
+            cls = registry.load("system", name)
+        except ConfigError:
+            continue  # an unusable plugin: register_plugin_configs warned, and a scene naming it is refused
+        keys |= set(plugin_default_body("system", cls) or {})
+    return keys
 
 
 def group_options(group: str) -> list[str]:
@@ -337,6 +368,8 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
             raise ConfigError(f"{section}={shorten(repr(plain[section]))}: `{section}` is a section, not a value; "
                               f"set one of its keys (e.g. {section}.{_example_key(section)}=...)")
         valid = (ref["defaults"][section] if section in _CLOSED_SECTIONS else ref["sections"][section])
+        if section == "body":
+            valid = valid | plugin_body_keys()  # a third-party system's body keys (register_plugin_configs)
         for key, value in plain[section].items():
             if key not in valid:
                 raise ConfigError(unknown_key_sentence(f"{section}.{key}", [f"{section}.{k}" for k in valid]))

@@ -18,7 +18,8 @@ from __future__ import annotations
 from hydra._internal.config_loader_impl import ConfigLoaderImpl
 from hydra._internal.utils import create_automatic_config_search_path, get_args_parser
 
-__all__ = ["BasicSweeper", "ConfigLoaderImpl", "Hydra", "create_automatic_config_search_path", "get_args_parser"]
+# BasicSweeper and Hydra are served by __getattr__ below
+__all__ = ["ConfigLoaderImpl", "create_automatic_config_search_path", "get_args_parser"]
 
 
 def __getattr__(name: str):

@@ -13,8 +13,15 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.contracts import registry
+from gyrolab.engine import error_estimate
 from gyrolab.engine.config import compose_config
 from gyrolab.contracts import CompiledModel, Integrator, System
+from gyrolab.contracts.integrator import (
+    COMPILED_MODEL,
+    NFEV_COUNTS_ATTRIBUTE,
+    PREFERS_COMPILED_MODEL,
+    TIME_DEPENDENT,
+)
 from gyrolab.output.dataset import build_dataset, scene_attributes
 from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite, shorten
 from gyrolab.engine.force_guard import GuardedRhs, plugin_forces
@@ -60,6 +67,10 @@ class Scene:
             raise ConfigError(f"force {timed[0]!r} is time-dependent, which system {system.name!r} does not support; "
                               "valid systems: fixed_point")
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
+        if timed and not integrator.supports(TIME_DEPENDENT):
+            raise ConfigError(f"integrator {integrator.name!r} does not integrate time-dependent forces (capability "
+                              f"{TIME_DEPENDENT}) and force {timed[0]!r} is one; valid choices: "
+                              f"{_choices_with(TIME_DEPENDENT)}")
         requested = plain["time"].get("n_output", AUTO)
         times = _output_times(plain["time"], fastest_rate(system))
         try:
@@ -69,27 +80,20 @@ class Scene:
         except Exception as exc:  # noqa: BLE001 - a third-party integrator's prepare: one sentence naming it
             raise init_failure(type(integrator), "integrator", exc) from exc
         scene = cls(config=cfg, system=system, integrator=integrator, times=times, n_output_requested=requested)
-        if integrator.needs_compiled_model and scene.compiled is None:
+        if integrator.supports(COMPILED_MODEL) and scene.compiled is None:
             reason = system.compile_error or f"system {system.name!r} has no compiled form"
             raise ConfigError(
                 f"integrator {integrator.name!r} runs compiled models only, and {reason}; "
-                f"choose dop853 (or rk45, rk4, lsoda, radau, bdf) or integrator=auto"
+                f"choose {_choices_with(accept=lambda c: not c.supports(COMPILED_MODEL))}"
             )
-        if scene.compiled is not None and integrator.name in ("taylor", "lie_poisson"):
-            from gyrolab.plugins.compiled import models, plugin_taylor
-
-            if integrator.name == "lie_poisson" and scene.compiled.model != models.FIXED_POINT:
-                traced = ", ".join(f.name for f in system.forces if f.compiled_terms() is None)
-                raise ConfigError(
-                    f"integrator 'lie_poisson' evaluates the built-in torque forms only, and force {traced} "
-                    f"is a compiled plugin torque; choose taylor, dop853_numba, rk4_numba or integrator=auto"
-                )
-            if integrator.name == "taylor" and not plugin_taylor.ready(scene.compiled):
-                raise ConfigError(
-                    f"integrator 'taylor' has no Taylor coefficients for system {system.name!r}'s compiled model; "
-                    f"choose dop853_numba, rk4_numba or integrator=auto"
-                )
-        elif scene.compiled is None and integrator.prefers_compiled_model:
+        if scene.compiled is not None:
+            refusal = integrator.refusal(scene.compiled, system)
+            if refusal:
+                compiled = scene.compiled
+                valid = _choices_with(accept=lambda c: (c.supports(COMPILED_MODEL) or c.supports(PREFERS_COMPILED_MODEL))
+                                      and c is not type(integrator) and c.refusal(compiled, system) is None)
+                raise ConfigError(f"integrator {integrator.name!r} {refusal}; choose {valid}")
+        elif integrator.supports(PREFERS_COMPILED_MODEL):
             reason = system.compile_error
             if reason:
                 log.info("%s; %s runs scipy's integrators", reason, integrator.name)
@@ -106,14 +110,17 @@ class Scene:
     @cached_property
     def dataset_attributes(self) -> tuple[dict[str, Any], dict[str, Any]]:
         """The run dataset's attributes that depend on the scene alone (``output.dataset.scene_attributes``),
-        computed once per scene as ``config_yaml``."""
-        return scene_attributes(self)
+        computed once per scene as ``config_yaml``; plus ``integrator_nfev_counts``, what the integrator's evaluation
+        count counts where that is not right-hand-side calls (its ``evaluation_label``: figures read it)."""
+        before, after = scene_attributes(self)
+        label = self.integrator.evaluation_label
+        return before, ({**after, NFEV_COUNTS_ATTRIBUTE: label} if label else after)
 
     @cached_property
     def compiled(self) -> CompiledModel | None:
         """The system's compiled model, when the integrator uses one (packed once per scene)."""
         integrator = self.integrator
-        wants = integrator.needs_compiled_model or integrator.prefers_compiled_model
+        wants = integrator.supports(COMPILED_MODEL) or integrator.supports(PREFERS_COMPILED_MODEL)
         return self.system.compiled_model() if wants else None
 
     @cached_property
@@ -172,7 +179,10 @@ class Scene:
         stats = solution.stats
         log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
                  "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)
-        return build_dataset(self, solution)
+        ds = build_dataset(self, solution)
+        if error_estimate.wanted(self):  # a companion run measures the stored trajectory's error
+            ds = error_estimate.add_error_estimate(ds, self, solution.y, stats.wall_time)
+        return ds
 
 
 def compose_scene(overrides: Sequence[str] = ()) -> Scene:
@@ -183,6 +193,13 @@ def compose_scene(overrides: Sequence[str] = ()) -> Scene:
 def run(overrides: Sequence[str] = ()) -> xr.Dataset:
     """``compose_scene(overrides).run()``."""
     return compose_scene(overrides).run()
+
+
+def _choices_with(*capabilities: str, accept: Any = None) -> str:
+    """The registered integrators with ``capabilities`` (and passing ``accept``), as "a, b or c"."""
+    from gyrolab.contracts.capabilities import integrators_with, or_list
+
+    return or_list(integrators_with(*capabilities, accept=accept))
 
 
 def _plugin_class(group: str, node: Any, where: str) -> type:
@@ -233,6 +250,7 @@ def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
     ``node`` is the force's config (a DictConfig or a dict of parameters). The culprit is found by
     building the force with each given parameter alone; any other exception becomes one sentence
     naming the plugin (``init_failure``); the force must declare its area-integral flag.
+    An AttributeError (the force reads something the system's body does not have) is one ConfigError too.
     """
     from gyrolab.contracts.force import check_declared
 
@@ -243,6 +261,9 @@ def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
         force = cls(body, **params)
     except GyrolabError:
         raise
+    except AttributeError as exc:  # a force reading what this system's body lacks (a third-party system's body)
+        raise ConfigError(f"{where} ({cls.__name__}) cannot act on a {type(body).__name__} body ({exc}); choose "
+                          "the forces the system supports (force=[] for none)") from None
     except (ValueError, TypeError) as exc:
         culprit = next((key for key in params if _fails(cls, body, {key: params[key]})), None)
         named = f"{where}.{culprit}={params[culprit]!r}" if culprit else \

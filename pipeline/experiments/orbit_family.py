@@ -27,7 +27,7 @@ from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
 from gyrolab.physics import pendulum
-from gyrolab.analysis.continuation import FamilyPoint, Section, bifurcations, continue_family, shoot_section
+from gyrolab.analysis.continuation import FamilyPoint, Section, bifurcations, continue_family, locate_events, shoot_section
 from gyrolab.analysis.periodic import FixedPointModel
 from gyrolab.plugins.regimes import large_parameter as slow
 from gyrolab.plugins.regimes.base import NondimensionalScene
@@ -114,17 +114,18 @@ def trace(name: str, f: dict) -> dict[str, Any]:
     points = continue_family(model, section, start, f["r0_end"], max_points=f["max_points"],
                              max_period=f["max_period"])
     events = bifurcations(points)
+    located = locate_events(model, section, points, events)
     reached = points[-1].r0
     ended = ("reached r0/c = {:.4g}".format(reached) if (np.log(f["r0_end"]) - np.log(reached))
              * np.sign(np.log(f["r0_end"]) - np.log(f["r0_start"])) <= 0 else
-             f"stopped at r0/c = {reached:.4g} with period {points[-1].period:.4g} (period limit {f['max_period']:g} "
-             f"or {f['max_points']} points)")
+             f"stopped at r0/c = {reached:.4g} with period {points[-1].period:.4g}: {points.stop_reason}")
     errors = {f"order_{o or 'paper'}": [fast_spin_error(f, p, o) if p.r0 >= 1 else np.nan for p in points]
               for o in fast_spin_orders()}
     errors["slow"] = [slow_spin_error(f, p) for p in points]
     log.info("family %s: %d points, %s; bifurcations: %s", name, len(points), ended,
-             ", ".join(f"{label} at r0/c = {points[i].r0:.5g}" for i, label in events) or "none")
-    return {"name": name, "label": f["label"], "points": points, "events": events, "ended": ended,
+             ", ".join(f"{e.kind} at r0/c = {e.r0:.5g}" for e in located) or "none")
+    return {"name": name, "label": f["label"], "points": points, "events": events, "located": located,
+            "ended": ended,
             "amplitude": [amplitude(model, p) for p in points], "errors": errors}
 
 
@@ -167,7 +168,8 @@ def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
         "floquet_multiplier_imag": (("point", "multiplier"), multipliers.imag, {"units": "1", "long_name": "Floquet multiplier, imaginary part"}),
         "stability_index": ("point", np.array([p.stability_index for p in points]),
                             {"units": "1", "long_name": "s = tr(monodromy) − 4 = ρ + 1/ρ of the non-trivial pair"}),
-        "stable": ("point", np.array([int(p.stable) for p in points]), {"units": "1", "long_name": "linearly stable (|s| ≤ 2): 1, else 0"}),
+        "stable": ("point", np.array([int(p.stable) for p in points]), {"units": "1", "long_name": "spectrally stable (|s| ≤ 2, the multipliers on the unit circle): 1, else 0",
+                            "comment": "spectral (linear) stability: necessary, not sufficient for stability"}),
         "amplitude": ("point", np.concatenate([tr["amplitude"] for tr in traces]), {"units": "rad", "long_name": "nutation amplitude max θ − min θ"}),
         "return_residual": ("point", np.array([p.residual for p in points]), {"units": "1", "long_name": "relative return residual of the shooting"}),
         "family": ("point", family, {"units": "1", "long_name": "family name (orbit_family.families)"}),
@@ -186,12 +188,35 @@ def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
     coords = {"point": ("point", np.arange(len(points)), {"units": "1", "long_name": "point along the families"}),
               "component": ("component", np.array(COMPONENTS), {"units": "1", "long_name": "state component"}),
               "multiplier": ("multiplier", np.arange(6), {"units": "1", "long_name": "Floquet multiplier index"})}
+    starts = np.cumsum([0] + [len(tr["points"]) for tr in traces])
+    located = [(tr["name"], e) for tr in traces for e in tr["located"]]
+    after = [int(start + e.index) for start, tr in zip(starts, traces) for e in tr["located"]]
+    data.update({
+        "event_point": ("event", np.array(after, dtype=np.int64), {
+            "units": "1", "long_name": "index along point of the family point right after the bifurcation"}),
+        "event_family": ("event", np.array([n for n, _ in located], dtype=str), {
+            "units": "1", "long_name": "family of the located bifurcation"}),
+        "event_kind": ("event", np.array([e.kind for _, e in located], dtype=str), {
+            "units": "1", "long_name": "bifurcation: fold (r0 turns), branch point (s = +2), period doubling (s = -2)"}),
+        "event_r0_over_c": ("event", np.array([e.r0 for _, e in located], dtype=float), {
+            "units": "1", "long_name": "spin r0/c where the bifurcation happens (located, not the next family point)"}),
+        "event_stability_index": ("event", np.array([e.stability_index for _, e in located], dtype=float), {
+            "units": "1", "long_name": "s = rho + 1/rho at the located bifurcation (+2 or -2 for a crossing)"}),
+        "event_period": ("event", np.array([e.period for _, e in located], dtype=float), {
+            "units": "1", "long_name": "period of the orbit at the located bifurcation (units of 1/c)"}),
+        "event_initial_state": (("event", "component"), np.array([e.y0 for _, e in located]).reshape(-1, 6), {
+            "units": "1", "long_name": "state (p, q, r, γ, γ', γ'') at t = 0 of the orbit at the located bifurcation "
+                                       "(NaN for a fold, located by interpolation)"}),
+        "event_method": ("event", np.array([e.located for _, e in located], dtype=str), {
+            "units": "1", "long_name": "how the bifurcation was located"}),
+    })
+    coords["event"] = ("event", np.arange(len(located)), {"units": "1", "long_name": "located bifurcation index"})
     ds = xr.Dataset(data, coords=coords)
     summary = []
     for tr in traces:
         r0 = np.array([p.r0 for p in tr["points"]])
         parts = [f"{tr['name']}: {tr['ended']}"]
-        parts += [f"{label} at r0/c = {tr['points'][i].r0:.5g}" for i, label in tr["events"][:6]]
+        parts += [f"{e.kind} at r0/c = {e.r0:.5g}" for e in tr["located"][:6]]
         for key, errs in tr["errors"].items():
             parts.append(f"{key} series within " + ", ".join(f"{tol:g}: {bands(r0, np.array(errs), tol)}" for tol in BANDS))
         summary.append("; ".join(parts))

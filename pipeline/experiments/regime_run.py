@@ -29,6 +29,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.contracts import registry
 from gyrolab.contracts.regime import Regime
+from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL
 from gyrolab.output.cf import conform, unit_attributes
 from gyrolab.output.dataset import time_attributes, write_dataset
 from gyrolab.errors import ConfigError, IntegrationError
@@ -91,7 +92,7 @@ def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = Fal
 
         return Taylor(order=24, tol=1e-16).integrate(system.rhs, t, y0, None, system.compiled_model()).y
     integrator = scene.integrator
-    wants = integrator.needs_compiled_model or integrator.prefers_compiled_model
+    wants = integrator.supports(COMPILED_MODEL) or integrator.supports(PREFERS_COMPILED_MODEL)
     return integrator.integrate(system.rhs, t, y0, None, system.compiled_model() if wants else None).y
 
 
@@ -155,15 +156,31 @@ def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[np.nd
 
     integrator = scene.integrator
     label = integrator.name
-    if integrator.needs_compiled_model or integrator.name == "auto":  # auto's choices are made for the full model
+    # a compiled-only integrator has no model of the reduced system; one that chooses its method chose for the full one
+    if integrator.supports(COMPILED_MODEL) or integrator.supports(CHOOSES_METHOD):
         from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
         settings = {k: getattr(integrator, k, 1e-12) for k in ("rtol", "atol")}
         integrator = DOP853(**settings)
-        label = (f"dop853 rtol={settings['rtol']:g} atol={settings['atol']:g} (standing in for the scene's "
+        label = (f"{DOP853.name} rtol={settings['rtol']:g} atol={settings['atol']:g} (standing in for the scene's "
                  f"{label}, which integrates compiled models of the full equations only)")
     solution = integrator.integrate(rhs_t, np.asarray(t, dtype=float), np.asarray(Z0, dtype=float))
     return to_model(solution.y.T), label
+
+
+def _reduced_or_why_not(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[tuple[np.ndarray, str] | None, str]:
+    """``reduced_solution``, or None and one sentence saying why it is left out (it diverged or failed)."""
+    try:
+        reduced = reduced_solution(scene, regime, t)
+    except IntegrationError as error:
+        return None, (f"{regime.name}: the reduced system could not be integrated over the window ({error}); the "
+                      "comparison with it is left out, the analytic series and the full model are not affected")
+    if reduced is not None and not np.all(np.isfinite(reduced[0])):
+        bad = int(np.argmax(~np.all(np.isfinite(reduced[0]), axis=1)))
+        return None, (f"{regime.name}: the reduced system diverges (non-finite from t = {t[bad]:.4g} of the "
+                      f"{t[-1]:.4g} window at {regime.parameter} = {regime.parameter_value(scene.system):.4g}); the "
+                      "comparison with it is left out, the analytic series and the full model are not affected")
+    return reduced, ""
 
 
 def errors(result: dict[str, Any], against: str = "orbit") -> dict[str, float]:
@@ -183,11 +200,16 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     T = regime.period(system)
     t = np.linspace(0.0, regime.periods * T, regime.periods * regime.samples_per_period + 1)
     result = compute(scene, regime, t, allow_no_orbit=True)
-    reduced = reduced_solution(scene, regime, t)
+    reduced, reduced_failure = _reduced_or_why_not(scene, regime, t)
     if reduced is not None:
         result["states"]["reduced"], result["reduced_method"] = reduced
         psi0 = float(result["angles"]["analytic"]["psi"][0])
         result["angles"]["reduced"] = angles_from_states(t, result["states"]["reduced"], psi0)
+    elif reduced_failure:
+        # the reduced system is a comparison, not the result: its failure is recorded and the run goes on
+        warnings = [*warnings, reduced_failure]
+        log.warning("%s", reduced_failure)
+        result["reduced_method"] = f"none: {reduced_failure}"
     orbit = result["orbit"]
     if orbit is not None:
         log.info("%s (%s): %s = %.4g, analytic period %.10g, exact %.10g, Newton residuals %s", regime.name,

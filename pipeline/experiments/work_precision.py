@@ -20,6 +20,7 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
+from gyrolab.contracts.integrator import NFEV_COUNTS_ATTRIBUTE
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError
@@ -54,13 +55,15 @@ def _final(ds: xr.Dataset) -> np.ndarray:
 def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
     """Final (ω, γ) of the scene from the most accurate reference available, and its name."""
     compiled = scene.system.compiled_model()
-    if compiled is None or compiled.model != 0:  # 0: models.FIXED_POINT, the built-in torque forms only
+    from gyrolab.plugins.compiled import layout, models
+
+    if compiled is None or compiled.model != models.FIXED_POINT:  # the built-in torque forms only
         raise ConfigError("work_precision needs a scene whose forces have compiled forms (for its reference run)")
     p = compiled.params
-    extra = np.any(p[3:9] != 0) or np.any(p[12:14] != 0)  # torques along non-vertical axes
     y0 = scene.system.initial_state()[:6]
-    if not extra:
-        ref = fixed_point_reference(p[0:3], p[9:12], p[14], y0, scene.times[[0, -1]])
+    if not layout.torques_on_horizontal_axes(p):
+        ref = fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3],
+                                    p[layout.N_Z], y0, scene.times[[0, -1]])
         return ref[-1].astype(float), "extended-precision Taylor (gyrolab.physics.reference)"
     from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
@@ -93,7 +96,8 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
             error = float(np.max(np.abs(_final(ds) - reference)))
             drift = float(ds.energy.attrs["max_abs_drift"]) if "energy" in ds else np.nan
             rows.append({"method": method, "setting": f"{key}={value:g}", "error": error, "wall_time": best,
-                         "nfev": int(ds.attrs["integrator_nfev"]), "energy_drift": drift})
+                         "nfev": int(ds.attrs["integrator_nfev"]), "energy_drift": drift,
+                         "nfev_counts": str(ds.attrs.get(NFEV_COUNTS_ATTRIBUTE, ""))})
             log.info("%-13s %-14s error %.2e  %.4f s  nfev %d", method, f"{key}={value:g}", error, best,
                      rows[-1]["nfev"])
     result = _dataset(rows, cfg, reference_name)
@@ -111,6 +115,8 @@ def _dataset(rows: list[dict[str, Any]], cfg: DictConfig, reference_name: str) -
     data = {name: ("run", np.array([r[name] for r in rows]), {"units": u, "long_name": ln})
             for name, (u, ln) in units.items()}
     data["method"] = ("run", np.array([r["method"] for r in rows]), {"units": "1", "long_name": "integrator"})
+    data["nfev_counts"] = ("run", np.array([r["nfev_counts"] for r in rows]), {
+        "units": "1", "long_name": "what nfev counts where not right-hand-side calls (empty: right-hand-side calls)"})
     data["setting"] = ("run", np.array([r["setting"] for r in rows]), {"units": "1", "long_name": "its setting"})
     ds = xr.Dataset(data, coords={"run": ("run", np.arange(len(rows), dtype=np.int32),
                                           {"units": "1", "long_name": "run index"})})

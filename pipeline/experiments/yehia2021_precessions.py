@@ -37,6 +37,11 @@ from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 
 log = logging.getLogger(__name__)
+#: what ``stable`` asserts, said in the data (the multipliers decide spectral stability only)
+STABILITY_COMMENT = ("stable means spectrally stable: every Floquet multiplier |rho| <= 1 + floquet_tolerance. It is "
+                     "necessary, not sufficient: a multiplier 1 in a Jordan block (a marginal equilibrium, e.g. the "
+                     "double zero pitch eigenvalue of an A = B satellite in a gravity gradient) is spectrally stable "
+                     "and still drifts secularly")
 COLUMNS = ("case", "formula", "residual_vector", "residual_euler_angles", "max_theta_deviation", "stable", "verdict",
            "condition", "stability_note")
 
@@ -168,12 +173,13 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
             "orbital_frame": "kind of precession in the orbital frame",
             "inertial_frame": "kind of precession in the inertial frame",
             "geometric": "surface the body z axis sweeps in inertial space (cylindrical, conical, ...)",
-            "floquet_kind": "linear stability class from the Floquet multipliers",
+            "floquet_kind": "spectral stability class from the Floquet multipliers",
             "stability_note": "why the stability was not analysed, if it was not"}
     for name, long_name in text.items():
         data[name] = ("case", np.array([str(r[name]) for r in rows]), {"units": "1", "long_name": long_name})
     data["stable"] = ("case", np.array([-1 if r["stable"] is None else int(r["stable"]) for r in rows], dtype=np.int32),
-                      {"units": "1", "long_name": "linearly stable (1), unstable (0), not analysed or not a solution (-1)"})
+                      {"units": "1", "long_name": "spectrally stable (1), spectrally unstable (0), not analysed or not a solution (-1)",
+                       "comment": STABILITY_COMMENT})
     for key in closed[0]:
         if key != "solution":
             data[f"closed_form_{key}"] = ("closed_form", np.array([float(c[key]) for c in closed]),

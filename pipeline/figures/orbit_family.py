@@ -1,7 +1,8 @@
 """Figure of ``orbit_family.nc``: the exact periodic-orbit families from fast spin to slow spin.
 
 Period and nutation amplitude against r0/c (filled markers: linearly stable, open: unstable;
-bifurcations labelled F fold, BP branch point, PD period doubling), and the error of each series
+bifurcations drawn where they were located: squares folds, diamonds branch points, triangles period doublings,
+explained in the legend), and the error of each series
 against the exact orbit with the 1e-6 and 1e-3 levels that bound the bands in ``docs/regimes.md``.
 """
 
@@ -14,6 +15,8 @@ import xarray as xr
 from gyrolab.figures.style import DOUBLE, legend_outside, styled, subplots
 
 MARKS = {"fold": "F", "branch point": "BP", "period doubling": "PD"}
+#: the located bifurcations are drawn as markers explained in the legend (text labels of nearby events overprint)
+EVENT_MARKERS = {"fold": "s", "branch point": "D", "period doubling": "v"}
 LEVELS = (1e-6, 1e-3)
 
 
@@ -23,6 +26,18 @@ def _series_label(name: str) -> str:
         return "slow-spin series"
     order = name.rsplit("order_", 1)[-1]
     return f"fast-spin series, order {order}" if order.isdigit() else "fast-spin series, the paper's order"
+
+
+def _located_events(ds: xr.Dataset, family: str) -> list[tuple[str, float, int]]:
+    """(kind, located r0/c, index of the point after it) of a family's bifurcations; from the point labels (at the
+    point after the event) for datasets written before events were located."""
+    if "event_r0_over_c" in ds:
+        mine = np.flatnonzero(ds["event_family"].values == family)
+        return [(str(ds["event_kind"].values[k]), float(ds["event_r0_over_c"].values[k]),
+                 int(ds["event_point"].values[k])) for k in mine]
+    at = np.flatnonzero(ds["family"].values == family)
+    return [(part.strip(), float(ds["r0_over_c"].values[i]), int(i)) for i in at[1:]
+            for part in str(ds["bifurcation"].values[i]).split(",") if part.strip()]
 
 
 @styled
@@ -38,15 +53,19 @@ def draw_orbit_family(ds: xr.Dataset) -> plt.Figure:
         colour = f"C{n}"
         r0 = ds["r0_over_c"].values[at]
         stable = ds["stable"].values[at].astype(bool)
-        marks = ds["bifurcation"].values[at]
+        events = _located_events(ds, family)
         for ax, values in ((period_ax, ds["period"].values[at]), (amplitude_ax, ds["amplitude"].values[at])):
             ax.plot(r0, values, "-", color=colour, lw=0.8, label=str(labels[at[0]]))
             ax.plot(r0[stable], values[stable], "o", ms=3, color=colour, ls="none")
             ax.plot(r0[~stable], values[~stable], "o", ms=3, mfc="none", mec=colour, ls="none")
-            for i in np.flatnonzero([bool(str(m)) for m in marks])[:4]:  # the first few: near a homoclinic end they pile up
-                text = ",".join(MARKS.get(part.strip(), part.strip()) for part in str(marks[i]).split(","))
-                ax.annotate(text, (r0[i], values[i]), xytext=(3, 3), textcoords="offset points", fontsize=6,
-                            color=colour)
+            for kind, where, point in events[:4]:  # the first few: near a homoclinic end they pile up
+                # on the segment between the two family points that bracket it, at the located r0
+                i = int(np.searchsorted(at, point))
+                w = np.clip((np.log(where) - np.log(r0[i - 1])) / (np.log(r0[i]) - np.log(r0[i - 1])), 0, 1) \
+                    if r0[i] != r0[i - 1] else 0.0
+                y = np.exp((1 - w) * np.log(values[i - 1]) + w * np.log(values[i])) if ax is period_ax \
+                    else (1 - w) * values[i - 1] + w * values[i]
+                ax.plot([where], [y], marker=EVENT_MARKERS[kind], ms=5, color=colour, ls="none")
         for k, name in enumerate(series):
             errors = ds[name].values[at]
             if np.isfinite(errors).any():
@@ -57,6 +76,8 @@ def draw_orbit_family(ds: xr.Dataset) -> plt.Figure:
     for k, name in enumerate(series):  # line style = series, colour = family
         error_ax.plot([], [], styles[k % len(styles)], color="0.3", lw=0.8, label=_series_label(str(name)))
     period_ax.plot([], [], "o", ms=3, color="0.3", ls="none", label="stable (filled) / unstable (open)")
+    for kind, marker in EVENT_MARKERS.items():
+        period_ax.plot([], [], marker=marker, ms=5, color="0.3", ls="none", label=f"{kind} (located)")
     period_ax.set_yscale("log")
     period_ax.set_ylabel("period (units of 1/c)")
     amplitude_ax.set_ylabel("nutation amplitude (rad)")

@@ -18,6 +18,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
+from gyrolab.figures.evaluations import nfev_notes
 from gyrolab.figures.labels import GAMMA, OMEGA, label, unit
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.run import INVARIANTS
@@ -26,9 +27,6 @@ from gyrolab.figures.style import DOUBLE, SINGLE, legend_outside, panel_note, st
 
 MAX_SERIES = 8
 MARKERS = "osD^v<>p"
-#: what an integrator's evaluation count means, where it is not right-hand-side calls
-NOT_RHS_CALLS = {"taylor": "Taylor series evaluations", "lie_poisson": "exact sub-flow evaluations",
-                 "auto": "pilot and chosen method's evaluations"}
 
 Panel = tuple[str, xr.DataArray, bool]
 
@@ -113,8 +111,7 @@ def draw_invariant_drift(ds: xr.Dataset) -> plt.Figure:
 def draw_cost(ds: xr.Dataset) -> plt.Figure:
     """Integrator evaluations and wall time against the swept values (log scale)."""
     fig = _draw(ds, _cost(ds), "Cost")
-    swept = {str(v) for d in ds.attrs["sweep_dims"].split() for v in np.atleast_1d(ds[d].values)}
-    notes = [f"{name}: {what}" for name, what in NOT_RHS_CALLS.items() if name in swept]
+    notes = [f"{name}: {what}" for name, what in nfev_notes(ds).items()]   # what each integrator's count counts
     if notes and "integrator_nfev" in ds:
         panel_note(fig.axes[0], "evaluations are right-hand-side calls, except " + "; ".join(notes))
     return fig

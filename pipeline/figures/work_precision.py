@@ -19,7 +19,7 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.figures.style import SINGLE, legend_outside, log_positive, panel_note, styled, subplots
-from gyrolab.figures.sweep import NOT_RHS_CALLS
+from gyrolab.figures.evaluations import chooses_method, nfev_counts
 
 MARKERS = "osD^v<>ph*"
 
@@ -71,8 +71,9 @@ def _draw(ds: xr.Dataset, x: str, methods: list[str], xlabel: str) -> plt.Figure
 def draw_error_vs_wall_time(ds: xr.Dataset) -> plt.Figure:
     """Error against the best wall time of a whole run, every method (auto: pilot runs included)."""
     fig = _draw(ds, "wall_time", _methods(ds), "wall time of one run (s), best of the repeats")
-    if "auto" in _methods(ds):
-        panel_note(fig.axes[0], "auto: its pilot runs included")
+    choosers = [m for m in _methods(ds) if chooses_method(m)]
+    if choosers:
+        panel_note(fig.axes[0], f"{', '.join(choosers)}: {'its' if len(choosers) == 1 else 'their'} pilot runs included")
     fig.suptitle("Work against precision: wall time")
     return fig
 
@@ -81,14 +82,26 @@ def draw_error_vs_wall_time(ds: xr.Dataset) -> plt.Figure:
 def draw_error_vs_nfev(ds: xr.Dataset) -> plt.Figure:
     """Error against right-hand-side calls, for the methods whose evaluations are right-hand-side calls."""
     methods = _methods(ds)
-    counted = [m for m in methods if m not in NOT_RHS_CALLS]
+    counts = _nfev_counts(ds)
+    counted = [m for m in methods if not counts[m]]
     fig = _draw(ds, "nfev", counted, "right-hand-side evaluations")
-    left_out = [m for m in methods if m in NOT_RHS_CALLS]
+    left_out = [m for m in methods if counts[m]]
     if left_out:
         panel_note(fig.axes[0], f"not shown: {', '.join(left_out)} (their evaluations are not\n"
                                 "right-hand-side calls; compare them in wall time)")
     fig.suptitle("Work against precision: right-hand-side calls")
     return fig
+
+
+def _nfev_counts(ds: xr.Dataset) -> dict[str, str]:
+    """Method -> what its ``nfev`` counts where not right-hand-side calls ('' for calls): the experiment's record
+    (variable ``nfev_counts``), else the integrator class of that name (datasets written before the record)."""
+    if "nfev_counts" in ds:
+        recorded: dict[str, str] = {}
+        for method, label in zip(ds["method"].values, ds["nfev_counts"].values):
+            recorded[str(method)] = recorded.get(str(method)) or str(label)
+        return recorded
+    return {m: nfev_counts(m) for m in _methods(ds)}
 
 
 FIGURES = {"error_vs_wall_time": draw_error_vs_wall_time, "error_vs_nfev": draw_error_vs_nfev}

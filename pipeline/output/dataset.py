@@ -15,7 +15,6 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.contracts.integrator import Solution
-from gyrolab.errors import ConfigError
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.cf import conform, unit_attributes
 from gyrolab.output.invariant_check import violated_invariants, violation_sentence

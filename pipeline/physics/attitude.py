@@ -54,7 +54,26 @@ def euler_angles(alpha: np.ndarray, gamma: np.ndarray) -> tuple[np.ndarray, np.n
     psi_minus_phi = np.arctan2(beta[:, 0] + alpha[:, 1], alpha[:, 0] - beta[:, 1])
     psi = np.where(upper, psi_plus_phi - phi, psi_minus_phi + phi)
     psi = np.angle(np.exp(1j * psi))  # wrap to (−π, π] before unwrapping
-    return np.unwrap(psi), theta, np.unwrap(phi)
+    phi = np.unwrap(phi)
+    return unwrap_with_pole_combination(psi, phi, upper), theta, phi
+
+
+def unwrap_with_pole_combination(psi: np.ndarray, phi: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """ψ unwrapped so that the combination defined at the nearer pole stays continuous: ψ + φ where ``upper``
+    (θ ≤ π/2), ψ − φ elsewhere; ``phi`` is already unwrapped.
+
+    Passing near a pole, φ and ψ each turn by about π between two samples, in opposite senses, and only their
+    sum (θ = 0) or difference (θ = π) is defined. Unwrapping ψ and φ separately picks each 2π branch on its own,
+    so a jump of slightly more than π in one and slightly less in the other makes the defined combination jump
+    by 2π. Here ψ's branch at each sample is the one that keeps that combination's step smallest (below π);
+    away from the poles φ moves little between samples and this is ``np.unwrap(psi)``.
+    """
+    if psi.size < 2:
+        return psi
+    sign = np.where(upper[1:], 1.0, -1.0)
+    step = np.diff(psi) + sign * np.diff(phi)  # the combination's step with ψ's raw (wrapped) branch
+    turns = -np.round(step / (2.0 * np.pi))
+    return psi + 2.0 * np.pi * np.concatenate(([0.0], np.cumsum(turns)))
 
 
 def angles_from_states(t: np.ndarray, y: np.ndarray, psi0: float) -> dict[str, np.ndarray]:

@@ -24,7 +24,7 @@ import numba
 import numpy as np
 
 from gyrolab.plugins.compiled import dop853, models
-from gyrolab.plugins.compiled.dop853 import (A, B, C, D, E3, E5, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, N_EXTENDED,
+from gyrolab.plugins.compiled.dop853 import (A, B, D, E3, E5, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, N_EXTENDED,
                                              N_STAGES, NOT_FINITE, OK, SAFETY, TOO_SMALL_STEP)
 from gyrolab.plugins.compiled.fixed_point import rhs_block
 

@@ -41,6 +41,7 @@ import numpy as np
 from llvmlite import ir
 from numba.core import cgutils
 
+from gyrolab.plugins.compiled.layout import INERTIA, INV_INERTIA, N_Z, U_Z
 from gyrolab.plugins.compiled import kernel, simd, taylor
 from gyrolab.plugins.compiled.simd import LANES  # trajectories advanced in lock step: one AVX2 vector of doubles
 from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK, TOO_SMALL_STEP
@@ -136,15 +137,15 @@ def _load(lane, j, Y0, Params, T, Q, carry):
             Q[r, lane] = 0.0
         return
     p = Params[j]
-    I0, I1, I2 = p[0], p[1], p[2]
-    u0, u1, u2 = p[9], p[10], p[11]
-    Q[0, lane] = (I1 - I2) * p[16]
-    Q[1, lane] = (I2 - I0) * p[17]
-    Q[2, lane] = (I0 - I1) * p[18]
-    Q[3, lane] = p[14]
-    Q[4, lane], Q[5, lane] = u1 * p[16], u2 * p[16]
-    Q[6, lane], Q[7, lane] = u2 * p[17], u0 * p[17]
-    Q[8, lane], Q[9, lane] = u0 * p[18], u1 * p[18]
+    I0, I1, I2 = p[INERTIA], p[INERTIA + 1], p[INERTIA + 2]
+    u0, u1, u2 = p[U_Z], p[U_Z + 1], p[U_Z + 2]
+    Q[0, lane] = (I1 - I2) * p[INV_INERTIA]
+    Q[1, lane] = (I2 - I0) * p[INV_INERTIA + 1]
+    Q[2, lane] = (I0 - I1) * p[INV_INERTIA + 2]
+    Q[3, lane] = p[N_Z]
+    Q[4, lane], Q[5, lane] = u1 * p[INV_INERTIA], u2 * p[INV_INERTIA]
+    Q[6, lane], Q[7, lane] = u2 * p[INV_INERTIA + 1], u0 * p[INV_INERTIA + 1]
+    Q[8, lane], Q[9, lane] = u0 * p[INV_INERTIA + 2], u1 * p[INV_INERTIA + 2]
 
 
 @kernel

@@ -1,9 +1,9 @@
 """Compiled (numba) kernels of the fixed-point system: right-hand side and Taylor coefficients.
 
-Parameters are one float array ``p`` (see ``pack``): inertia I (3), the
-linear-torque vectors U_i (torque U_i × e_i, 3×3), the gradient coefficients
-N_i (torque N_i e_i × I e_i, 3) a flag saying whether the state carries α, and 1/I (3).
-e_0 = α (fixed X), e_1 = β = γ × α (fixed Y), e_2 = γ (vertical).
+Parameters are one float array ``p`` (``pack`` writes it), laid out and named in ``layout``: inertia I,
+the linear-torque vectors U_i (torque U_i × e_i), the gradient coefficients N_i (torque N_i e_i × I e_i),
+a flag saying whether the state carries α, and 1/I. e_0 = α (fixed X), e_1 = β = γ × α (fixed Y),
+e_2 = γ (vertical).
 """
 
 from __future__ import annotations
@@ -13,20 +13,21 @@ import numpy as np
 
 from gyrolab.contracts.force import CompiledTerms
 from gyrolab.plugins.compiled import inline_kernel, kernel
-
-N_PARAMS = 19
+from gyrolab.plugins.compiled.layout import (  # noqa: F401  (N_PARAMS: fixed_point.N_PARAMS for callers)
+    CARRIES_ALPHA, GRADIENT, INERTIA, INV_INERTIA, LINEAR, N_PARAMS, N_X, N_Y, N_Z, U_X, U_Y, U_Z,
+)
 
 
 def pack(inertia: np.ndarray, terms: list[CompiledTerms], carries_alpha: bool) -> np.ndarray:
     p = np.zeros(N_PARAMS)
-    p[0:3] = inertia
+    p[INERTIA:INERTIA + 3] = inertia
     for term in terms:
         for axis, u in term.linear.items():
-            p[3 + 3 * axis: 6 + 3 * axis] += u
+            p[LINEAR[axis]:LINEAR[axis] + 3] += u
         for axis, n in term.gradient.items():
-            p[12 + axis] += n
-    p[15] = 1.0 if carries_alpha else 0.0
-    p[16:19] = 1.0 / inertia  # multiplications in the inner loop, not divisions
+            p[GRADIENT[axis]] += n
+    p[CARRIES_ALPHA] = 1.0 if carries_alpha else 0.0
+    p[INV_INERTIA:INV_INERTIA + 3] = 1.0 / inertia  # multiplications in the inner loop, not divisions
     return p
 
 
@@ -58,7 +59,7 @@ def _cross_add(u0, u1, u2, v0, v1, v2, s):
 
 
 def _rhs_form(alpha: bool | None):
-    """The right-hand side for states (ω, γ, α) if ``alpha``, (ω, γ) if not, either by the flag p[15] if None.
+    """The right-hand side for states (ω, γ, α) if ``alpha``, (ω, γ) if not, either by the flag p[CARRIES_ALPHA] if None.
 
     ``alpha`` is a constant of the closure: numba drops the dead branches before typing, so the (ω, γ)
     form types and compiles none of the α terms (``models.Form``: kernels compiled per model).
@@ -66,8 +67,8 @@ def _rhs_form(alpha: bool | None):
 
     @inline_kernel
     def rhs(t, y, p, out):
-        has_alpha = p[15] != 0.0 if alpha is None else alpha
-        I0, I1, I2 = p[0], p[1], p[2]
+        has_alpha = p[CARRIES_ALPHA] != 0.0 if alpha is None else alpha
+        I0, I1, I2 = p[INERTIA], p[INERTIA + 1], p[INERTIA + 2]
         w0, w1, w2 = y[0], y[1], y[2]
         g0, g1, g2 = y[3], y[4], y[5]
         # gyroscopic torque (Iω) × ω
@@ -75,8 +76,8 @@ def _rhs_form(alpha: bool | None):
         t1 = (I2 - I0) * w2 * w0
         t2 = (I0 - I1) * w0 * w1
         # U_2 × γ  and  N_2 γ × Iγ
-        a0, a1, a2 = _cross_add(p[9], p[10], p[11], g0, g1, g2, 1.0)
-        n = p[14]
+        a0, a1, a2 = _cross_add(p[U_Z], p[U_Z + 1], p[U_Z + 2], g0, g1, g2, 1.0)
+        n = p[N_Z]
         t0 += a0 + n * (I2 - I1) * g1 * g2
         t1 += a1 + n * (I0 - I2) * g2 * g0
         t2 += a2 + n * (I1 - I0) * g0 * g1
@@ -86,23 +87,23 @@ def _rhs_form(alpha: bool | None):
         if has_alpha:
             x0, x1, x2 = y[6], y[7], y[8]
             b0, b1, b2 = g1 * x2 - g2 * x1, g2 * x0 - g0 * x2, g0 * x1 - g1 * x0
-            c0, c1, c2 = _cross_add(p[3], p[4], p[5], x0, x1, x2, 1.0)
-            d0, d1, d2 = _cross_add(p[6], p[7], p[8], b0, b1, b2, 1.0)
-            nx, ny = p[12], p[13]
+            c0, c1, c2 = _cross_add(p[U_X], p[U_X + 1], p[U_X + 2], x0, x1, x2, 1.0)
+            d0, d1, d2 = _cross_add(p[U_Y], p[U_Y + 1], p[U_Y + 2], b0, b1, b2, 1.0)
+            nx, ny = p[N_X], p[N_Y]
             t0 += c0 + d0 + nx * (I2 - I1) * x1 * x2 + ny * (I2 - I1) * b1 * b2
             t1 += c1 + d1 + nx * (I0 - I2) * x2 * x0 + ny * (I0 - I2) * b2 * b0
             t2 += c2 + d2 + nx * (I1 - I0) * x0 * x1 + ny * (I1 - I0) * b0 * b1
             out[6] = x1 * w2 - x2 * w1
             out[7] = x2 * w0 - x0 * w2
             out[8] = x0 * w1 - x1 * w0
-        out[0] = t0 * p[16]
-        out[1] = t1 * p[17]
-        out[2] = t2 * p[18]
+        out[0] = t0 * p[INV_INERTIA]
+        out[1] = t1 * p[INV_INERTIA + 1]
+        out[2] = t2 * p[INV_INERTIA + 2]
 
     return rhs
 
 
-#: The right-hand side of the state (ω, γ), of (ω, γ, α), and of either (by p[15] at run time).
+#: The right-hand side of the state (ω, γ), of (ω, γ, α), and of either (by p[CARRIES_ALPHA] at run time).
 rhs_gamma = _rhs_form(False)
 rhs_alpha = _rhs_form(True)
 rhs = _rhs_form(None)
@@ -147,7 +148,7 @@ def _cauchy_pairs(A, ia, k, out):
 # Kahan summation would be optimised away under reassociation.
 def _taylor_form(alpha: bool | None):
     """``taylor_coefficients`` for states (ω, γ, α) if ``alpha``, (ω, γ) if not (the other form's code pruned as in
-    ``_rhs_form``), either by the flag p[15] if None."""
+    ``_rhs_form``), either by the flag p[CARRIES_ALPHA] if None."""
 
     @numba.njit(cache=True, error_model="numpy", fastmath={"reassoc", "contract", "nsz"})
     def taylor_coefficients(p, Y, order, work):
@@ -161,10 +162,10 @@ def _taylor_form(alpha: bool | None):
         pass over the coefficient rows. ``work`` (order+1, 3) holds the coefficients
         of β = γ × α in the form with α.
         """
-        I0, I1, I2 = p[0], p[1], p[2]
+        I0, I1, I2 = p[INERTIA], p[INERTIA + 1], p[INERTIA + 2]
         d0, d1, d2 = I1 - I2, I2 - I0, I0 - I1  # ((Iω) × ω) = (d0 ω_y ω_z, d1 ω_z ω_x, d2 ω_x ω_y)
-        has_alpha = p[15] != 0.0 if alpha is None else alpha
-        n2 = p[14]
+        has_alpha = p[CARRIES_ALPHA] != 0.0 if alpha is None else alpha
+        n2 = p[N_Z]
         acc = np.empty(3)
         tmp = np.empty(3)
         for k in range(order):
@@ -188,31 +189,31 @@ def _taylor_form(alpha: bool | None):
                 c2 += b0 * A1 - b1 * A0
             e0, e1, e2 = Y[k, 3], Y[k, 4], Y[k, 5]
             # (Iω) × ω + U_2 × γ − N_2 (d ⊙ pairs of γ)   (N_2 γ × Iγ = −N_2 d ⊙ pairs)
-            acc[0] = d0 * (w0 - n2 * g0) + p[10] * e2 - p[11] * e1
-            acc[1] = d1 * (w1 - n2 * g1) + p[11] * e0 - p[9] * e2
-            acc[2] = d2 * (w2 - n2 * g2) + p[9] * e1 - p[10] * e0
+            acc[0] = d0 * (w0 - n2 * g0) + p[U_Z + 1] * e2 - p[U_Z + 2] * e1
+            acc[1] = d1 * (w1 - n2 * g1) + p[U_Z + 2] * e0 - p[U_Z] * e2
+            acc[2] = d2 * (w2 - n2 * g2) + p[U_Z] * e1 - p[U_Z + 1] * e0
             if has_alpha:
                 work[k, 0] = work[k, 1] = work[k, 2] = 0.0  # β_k = Σ γ_j × α_{k−j}
                 _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, work[k])
                 x0, x1, x2 = Y[k, 6], Y[k, 7], Y[k, 8]
                 b0, b1, b2 = work[k, 0], work[k, 1], work[k, 2]
-                acc[0] += p[4] * x2 - p[5] * x1 + p[7] * b2 - p[8] * b1
-                acc[1] += p[5] * x0 - p[3] * x2 + p[8] * b0 - p[6] * b2
-                acc[2] += p[3] * x1 - p[4] * x0 + p[6] * b1 - p[7] * b0
-                if p[12] != 0.0:
+                acc[0] += p[U_X + 1] * x2 - p[U_X + 2] * x1 + p[U_Y + 1] * b2 - p[U_Y + 2] * b1
+                acc[1] += p[U_X + 2] * x0 - p[U_X] * x2 + p[U_Y + 2] * b0 - p[U_Y] * b2
+                acc[2] += p[U_X] * x1 - p[U_X + 1] * x0 + p[U_Y] * b1 - p[U_Y + 1] * b0
+                if p[N_X] != 0.0:
                     _cauchy_pairs(Y, 6, k, tmp)
-                    acc[0] -= p[12] * d0 * tmp[0]
-                    acc[1] -= p[12] * d1 * tmp[1]
-                    acc[2] -= p[12] * d2 * tmp[2]
-                if p[13] != 0.0:
+                    acc[0] -= p[N_X] * d0 * tmp[0]
+                    acc[1] -= p[N_X] * d1 * tmp[1]
+                    acc[2] -= p[N_X] * d2 * tmp[2]
+                if p[N_Y] != 0.0:
                     _cauchy_pairs(work, 0, k, tmp)
-                    acc[0] -= p[13] * d0 * tmp[0]
-                    acc[1] -= p[13] * d1 * tmp[1]
-                    acc[2] -= p[13] * d2 * tmp[2]
+                    acc[0] -= p[N_Y] * d0 * tmp[0]
+                    acc[1] -= p[N_Y] * d1 * tmp[1]
+                    acc[2] -= p[N_Y] * d2 * tmp[2]
             inv = 1.0 / (k + 1)
-            Y[k + 1, 0] = acc[0] * p[16] * inv
-            Y[k + 1, 1] = acc[1] * p[17] * inv
-            Y[k + 1, 2] = acc[2] * p[18] * inv
+            Y[k + 1, 0] = acc[0] * p[INV_INERTIA] * inv
+            Y[k + 1, 1] = acc[1] * p[INV_INERTIA + 1] * inv
+            Y[k + 1, 2] = acc[2] * p[INV_INERTIA + 2] * inv
             # γ̇ = γ × ω, α̇ = α × ω
             Y[k + 1, 3], Y[k + 1, 4], Y[k + 1, 5] = c0 * inv, c1 * inv, c2 * inv
             if has_alpha:
@@ -238,12 +239,12 @@ def rhs_block(Y, P, out, count):
     for j in range(count):
         w0, w1, w2 = Y[0, j], Y[1, j], Y[2, j]
         g0, g1, g2 = Y[3, j], Y[4, j], Y[5, j]
-        I0, I1, I2 = P[0, j], P[1, j], P[2, j]
-        n = P[14, j]
-        u0, u1, u2 = P[9, j], P[10, j], P[11, j]
-        out[0, j] = ((I1 - I2) * w1 * w2 + u1 * g2 - u2 * g1 + n * (I2 - I1) * g1 * g2) * P[16, j]
-        out[1, j] = ((I2 - I0) * w2 * w0 + u2 * g0 - u0 * g2 + n * (I0 - I2) * g2 * g0) * P[17, j]
-        out[2, j] = ((I0 - I1) * w0 * w1 + u0 * g1 - u1 * g0 + n * (I1 - I0) * g0 * g1) * P[18, j]
+        I0, I1, I2 = P[INERTIA, j], P[INERTIA + 1, j], P[INERTIA + 2, j]
+        n = P[N_Z, j]
+        u0, u1, u2 = P[U_Z, j], P[U_Z + 1, j], P[U_Z + 2, j]
+        out[0, j] = ((I1 - I2) * w1 * w2 + u1 * g2 - u2 * g1 + n * (I2 - I1) * g1 * g2) * P[INV_INERTIA, j]
+        out[1, j] = ((I2 - I0) * w2 * w0 + u2 * g0 - u0 * g2 + n * (I0 - I2) * g2 * g0) * P[INV_INERTIA + 1, j]
+        out[2, j] = ((I0 - I1) * w0 * w1 + u0 * g1 - u1 * g0 + n * (I1 - I0) * g0 * g1) * P[INV_INERTIA + 2, j]
         out[3, j] = g1 * w2 - g2 * w1
         out[4, j] = g2 * w0 - g0 * w2
         out[5, j] = g0 * w1 - g1 * w0

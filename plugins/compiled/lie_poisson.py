@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from gyrolab.plugins.compiled.layout import CARRIES_ALPHA, INERTIA, INV_INERTIA, N_X, N_Y, N_Z, U_X, U_Y, U_Z
 from gyrolab.plugins.compiled import inline_kernel, kernel
 
 # Yoshida (1990) triple-jump weights: order 2 -> 4 -> 6
@@ -48,7 +49,7 @@ def _rotate(v, i, j, angle_cos, angle_sin):
 @inline_kernel
 def _free_rotation(axis, tau, L, g, a, p, has_alpha):
     """Exact flow of L_axis²/(2 I_axis) for time tau: v̇ = v × (L_axis/I_axis) e_axis for v = L, γ, α."""
-    rate = L[axis] * p[16 + axis] * tau
+    rate = L[axis] * p[INV_INERTIA + axis] * tau
     c, s = math.cos(rate), math.sin(rate)
     # v̇ = c0 v × e_x: (y, z) rotate with +; e_y: (z, x); e_z: (x, y)
     i, j = (1, 2) if axis == 0 else ((2, 0) if axis == 1 else (0, 1))
@@ -61,17 +62,17 @@ def _free_rotation(axis, tau, L, g, a, p, has_alpha):
 @inline_kernel
 def _kick(tau, L, g, a, p, has_alpha):
     """Exact flow of the potential: L += tau · (U2 × γ + N2 γ × Iγ [+ U0 × α + U1 × β + N0 α × Iα + N1 β × Iβ])."""
-    I0, I1, I2 = p[0], p[1], p[2]
+    I0, I1, I2 = p[INERTIA], p[INERTIA + 1], p[INERTIA + 2]
     g0, g1, g2 = g[0], g[1], g[2]
-    t0 = p[10] * g2 - p[11] * g1 + p[14] * (I2 - I1) * g1 * g2
-    t1 = p[11] * g0 - p[9] * g2 + p[14] * (I0 - I2) * g2 * g0
-    t2 = p[9] * g1 - p[10] * g0 + p[14] * (I1 - I0) * g0 * g1
+    t0 = p[U_Z + 1] * g2 - p[U_Z + 2] * g1 + p[N_Z] * (I2 - I1) * g1 * g2
+    t1 = p[U_Z + 2] * g0 - p[U_Z] * g2 + p[N_Z] * (I0 - I2) * g2 * g0
+    t2 = p[U_Z] * g1 - p[U_Z + 1] * g0 + p[N_Z] * (I1 - I0) * g0 * g1
     if has_alpha:
         x0, x1, x2 = a[0], a[1], a[2]
         b0, b1, b2 = g1 * x2 - g2 * x1, g2 * x0 - g0 * x2, g0 * x1 - g1 * x0
-        t0 += p[4] * x2 - p[5] * x1 + p[7] * b2 - p[8] * b1 + (I2 - I1) * (p[12] * x1 * x2 + p[13] * b1 * b2)
-        t1 += p[5] * x0 - p[3] * x2 + p[8] * b0 - p[6] * b2 + (I0 - I2) * (p[12] * x2 * x0 + p[13] * b2 * b0)
-        t2 += p[3] * x1 - p[4] * x0 + p[6] * b1 - p[7] * b0 + (I1 - I0) * (p[12] * x0 * x1 + p[13] * b0 * b1)
+        t0 += p[U_X + 1] * x2 - p[U_X + 2] * x1 + p[U_Y + 1] * b2 - p[U_Y + 2] * b1 + (I2 - I1) * (p[N_X] * x1 * x2 + p[N_Y] * b1 * b2)
+        t1 += p[U_X + 2] * x0 - p[U_X] * x2 + p[U_Y + 2] * b0 - p[U_Y] * b2 + (I0 - I2) * (p[N_X] * x2 * x0 + p[N_Y] * b2 * b0)
+        t2 += p[U_X] * x1 - p[U_X + 1] * x0 + p[U_Y] * b1 - p[U_Y + 1] * b0 + (I1 - I0) * (p[N_X] * x0 * x1 + p[N_Y] * b0 * b1)
     L[0] += tau * t0
     L[1] += tau * t1
     L[2] += tau * t2
@@ -91,7 +92,7 @@ def _strang(h, L, g, a, p, has_alpha):
 @kernel
 def run(p, t_out, steps_per_interval, w, y, Y, i_next, i_stop):
     """Fill Y[i_next:i_stop] (state ω, γ[, α]); y advanced in place. Returns the first non-finite index or i_stop."""
-    has_alpha = p[15] != 0.0
+    has_alpha = p[CARRIES_ALPHA] != 0.0
     L = np.empty(3)
     g = np.empty(3)
     a = np.empty(3)
@@ -106,7 +107,7 @@ def run(p, t_out, steps_per_interval, w, y, Y, i_next, i_stop):
             for weight in w:
                 _strang(weight * h, L, g, a, p, has_alpha)
         for m in range(3):
-            y[m] = L[m] * p[16 + m]
+            y[m] = L[m] * p[INV_INERTIA + m]
             y[3 + m] = g[m]
             if has_alpha:
                 y[6 + m] = a[m]

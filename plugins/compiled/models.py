@@ -30,6 +30,7 @@ from numba.core.datamodel.models import OpaqueModel
 from numba.core.imputils import lower_constant
 from numba.extending import NativeValue, intrinsic, overload, register_model, unbox
 
+from gyrolab.plugins.compiled.layout import CARRIES_ALPHA, INERTIA, INV_INERTIA
 from gyrolab.plugins.compiled import fixed_point, inline_kernel, kernel, plugin_taylor
 from gyrolab.plugins.compiled.plugin_torque import ADDRESS
 
@@ -67,9 +68,9 @@ def _free(y, p, out):
     """The torque-free fixed-point system: I⁻¹ (Iω × ω) and γ̇ = γ × ω (p laid out as fixed_point.pack)."""
     w0, w1, w2 = y[0], y[1], y[2]
     g0, g1, g2 = y[3], y[4], y[5]
-    out[0] = (p[1] - p[2]) * w1 * w2 * p[16]
-    out[1] = (p[2] - p[0]) * w2 * w0 * p[17]
-    out[2] = (p[0] - p[1]) * w0 * w1 * p[18]
+    out[0] = (p[INERTIA + 1] - p[INERTIA + 2]) * w1 * w2 * p[INV_INERTIA]
+    out[1] = (p[INERTIA + 2] - p[INERTIA]) * w2 * w0 * p[INV_INERTIA + 1]
+    out[2] = (p[INERTIA] - p[INERTIA + 1]) * w0 * w1 * p[INV_INERTIA + 2]
     out[3] = g1 * w2 - g2 * w1
     out[4] = g2 * w0 - g0 * w2
     out[5] = g0 * w1 - g1 * w0
@@ -116,7 +117,7 @@ FORMS = {i: Form(i) for i in (FIXED_POINT, FIXED_POINT_PLUGIN, FIXED_POINT_PLUGI
 
 def form(compiled) -> Form:
     """The kernels' model argument for a ``CompiledModel``: compiles and runs its form's code only."""
-    if compiled.model == FIXED_POINT and compiled.params[15] != 0.0:
+    if compiled.model == FIXED_POINT and compiled.params[CARRIES_ALPHA] != 0.0:
         return FORMS[FIXED_POINT_ALPHA]
     return FORMS[compiled.model]
 
@@ -164,7 +165,7 @@ _PLUGIN, _PLUGIN_ALPHA = FORMS[FIXED_POINT_PLUGIN], FORMS[FIXED_POINT_PLUGIN_ALP
 def _rhs_any(model, t, y, p, out):
     """The run-time dispatch: a branch per form, each the form's plain call."""
     if model == FIXED_POINT:
-        if p[15] != 0.0:
+        if p[CARRIES_ALPHA] != 0.0:
             rhs(_ALPHA, t, y, p, out)
         else:
             rhs(_GAMMA, t, y, p, out)

@@ -44,7 +44,10 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from gyrolab.plugins.compiled import fixed_point, inline_kernel
-from gyrolab.plugins.compiled.plugin_torque import FIRST_CONSTANT, INV_INERTIA, Expr, Trace, load_generated
+from gyrolab.plugins.compiled.layout import (
+    ALPHA, CARRIES_ALPHA, FIRST_CONSTANT, GAMMA, INERTIA, INV_INERTIA, N_X, N_Y, N_Z, U_X, U_Y, U_Z,
+)
+from gyrolab.plugins.compiled.plugin_torque import Expr, Trace, load_generated
 
 # fixed_point's Cauchy helpers, compiled inline here: a call per helper per order costs as much as its sums
 _cauchy_cross = inline_kernel(fixed_point._cauchy_cross.py_func)
@@ -303,9 +306,9 @@ def coefficients(p, Y, order, work, t):
         Y[1:] = np.nan
         return
     W = np.empty((order + 1) * int(p[p.size - 1]))
-    I0, I1, I2 = p[0], p[1], p[2]
+    I0, I1, I2 = p[INERTIA], p[INERTIA + 1], p[INERTIA + 2]
     d0, d1, d2 = I1 - I2, I2 - I0, I0 - I1
-    has_alpha = p[15] != 0.0
+    has_alpha = p[CARRIES_ALPHA] != 0.0
     acc = np.empty(3)
     tmp = np.empty(3)
     torque = np.empty(3)
@@ -315,15 +318,15 @@ def coefficients(p, Y, order, work, t):
         acc[0] *= d0
         acc[1] *= d1
         acc[2] *= d2
-        _gradient_and_linear(p, Y, 3, 9, 14, k, d0, d1, d2, acc, tmp)
+        _gradient_and_linear(p, Y, GAMMA, U_Z, N_Z, k, d0, d1, d2, acc, tmp)
         if has_alpha:
             work[k, 0] = work[k, 1] = work[k, 2] = 0.0  # β_k = Σ γ_j × α_{k−j}
             _cauchy_cross(Y, 3, Y, 6, k, 1.0, 1.0, 1.0, work[k])
-            _gradient_and_linear(p, Y, 6, 3, 12, k, d0, d1, d2, acc, tmp)
-            _gradient_and_linear(p, work, 0, 6, 13, k, d0, d1, d2, acc, tmp)
+            _gradient_and_linear(p, Y, ALPHA, U_X, N_X, k, d0, d1, d2, acc, tmp)
+            _gradient_and_linear(p, work, 0, U_Y, N_Y, k, d0, d1, d2, acc, tmp)  # β_k is work[k, 0:3]
         inv = 1.0 / (k + 1)
         for m in range(3):
-            Y[k + 1, m] = (acc[m] * p[16 + m] + torque[m]) * inv
+            Y[k + 1, m] = (acc[m] * p[INV_INERTIA + m] + torque[m]) * inv
         for axis in range(3, n, 3):  # γ̇ = γ × ω (and α̇ = α × ω)
             tmp[0] = tmp[1] = tmp[2] = 0.0
             _cauchy_cross(Y, axis, Y, 0, k, 1.0, 1.0, 1.0, tmp)

@@ -35,10 +35,8 @@ import numpy as np
 
 log = logging.getLogger(__name__)
 
-#: Layout of the fixed-point parameter array that the generated code reads (see fixed_point.pack).
-INV_INERTIA = 16
-ADDRESS = 19
-FIRST_CONSTANT = 20
+# the generated code reads the fixed-point parameter array by the names of its layout
+from gyrolab.plugins.compiled.layout import ADDRESS, FIRST_CONSTANT, INV_INERTIA  # noqa: E402, F401
 
 _UNARY = {"neg": "-{0}", "sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
           "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})", "arctan": "math.atan({0})",

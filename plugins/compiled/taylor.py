@@ -35,6 +35,7 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic, overload
 
+from gyrolab.plugins.compiled.layout import CARRIES_ALPHA, INERTIA, INV_INERTIA, N_Z, U_Z
 from gyrolab.plugins.compiled import inline_kernel, kernel, simd
 from gyrolab.plugins.compiled.models import FIXED_POINT, FormType, taylor_coefficients
 from gyrolab.plugins.compiled.simd import LANES
@@ -103,7 +104,7 @@ def _route_by_model(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, ca
         return scalar
     if isinstance(model, types.Integer):
         def either(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
-            if model == FIXED_POINT and p[15] == 0.0:
+            if model == FIXED_POINT and p[CARRIES_ALPHA] == 0.0:
                 return run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
             return run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
         return either
@@ -270,12 +271,12 @@ _update = simd.update(ROWS, 2)
 @kernel
 def _constants(p, Q):
     """``_coefficients``' constants from the parameters (``fixed_point.pack``), as batch_taylor._load forms them."""
-    I0, I1, I2 = p[0], p[1], p[2]
-    u0, u1, u2 = p[9], p[10], p[11]
-    Q[0, 0], Q[0, 1], Q[0, 2] = (I1 - I2) * p[16], (I2 - I0) * p[17], (I0 - I1) * p[18]
-    Q[1, 0] = Q[1, 1] = Q[1, 2] = p[14]
-    Q[2, 0], Q[2, 1], Q[2, 2] = u1 * p[16], u2 * p[17], u0 * p[18]
-    Q[3, 0], Q[3, 1], Q[3, 2] = u2 * p[16], u0 * p[17], u1 * p[18]
+    I0, I1, I2 = p[INERTIA], p[INERTIA + 1], p[INERTIA + 2]
+    u0, u1, u2 = p[U_Z], p[U_Z + 1], p[U_Z + 2]
+    Q[0, 0], Q[0, 1], Q[0, 2] = (I1 - I2) * p[INV_INERTIA], (I2 - I0) * p[INV_INERTIA + 1], (I0 - I1) * p[INV_INERTIA + 2]
+    Q[1, 0] = Q[1, 1] = Q[1, 2] = p[N_Z]
+    Q[2, 0], Q[2, 1], Q[2, 2] = u1 * p[INV_INERTIA], u2 * p[INV_INERTIA + 1], u0 * p[INV_INERTIA + 2]
+    Q[3, 0], Q[3, 1], Q[3, 2] = u2 * p[INV_INERTIA], u0 * p[INV_INERTIA + 1], u1 * p[INV_INERTIA + 2]
 
 
 @kernel
@@ -316,7 +317,7 @@ def series(p, y, order):
 
 @kernel
 def run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
-    """``run`` for the fixed-point model without α (p[15] = 0, y = (ω, γ)), the step vectorised across the
+    """``run`` for the fixed-point model without α (p[CARRIES_ALPHA] = 0, y = (ω, γ)), the step vectorised across the
     components: ``_coefficients``, the dense output (``_dense``) and the compensated update (``_update``) in
     ``<4 x double>``. Same order, step rule, dense output (strict arithmetic), compensated update, status
     codes, stats and chunking contract as ``run_scalar``; the coefficients and the update's Horner sums fuse

@@ -1,7 +1,7 @@
 """Variational equations of the fixed-point system, and the chaos indicators they give (compiled, batched).
 
 State x = (ω, γ) of the Euler–Poisson equations with the built-in torques acting on the vertical
-(``fixed_point.pack``: uniform gravity U × γ with U = p[9:12], Newtonian N γ × Iγ with N = p[14]):
+(``fixed_point.pack``: uniform gravity U × γ with U = p[U_Z:U_Z + 3], Newtonian N γ × Iγ with N = p[N_Z]):
 
     I ω̇ = (Iω) × ω + U × γ + N γ × Iγ,        γ̇ = γ × ω.
 
@@ -19,7 +19,7 @@ The constraint |γ| = 1 is an invariant of the flow, and the linearised flow kee
 (d/dt(γ·δγ) = (γ×ω)·δγ + γ·(δγ×ω) = 0), so a tangent vector whose δγ starts tangent to the sphere
 stays tangent: δ lives on the constraint manifold. The initial δ is chosen so (``initial_tangent``).
 
-Only 6-D (ω, γ) states with p[15] = 0 (α not carried): torques on the fixed horizontal axes (which need α) are
+Only 6-D (ω, γ) states with p[CARRIES_ALPHA] = 0 (α not carried): torques on the fixed horizontal axes (which need α) are
 refused by the caller.
 """
 
@@ -28,6 +28,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from gyrolab.plugins.compiled.layout import INERTIA, INV_INERTIA, N_Z, U_Z
 from gyrolab.plugins.compiled import dop853, inline_kernel, kernel
 from gyrolab.plugins.compiled.fixed_point import rhs_block
 from gyrolab.plugins.compiled.fixed_point import rhs_gamma as rhs  # (ω, γ) states only
@@ -49,10 +50,10 @@ def initial_tangent(y0s: np.ndarray) -> np.ndarray:
 
 def jacobian(y: np.ndarray, p: np.ndarray) -> np.ndarray:
     """The 6×6 Jacobian ∂f/∂(ω, γ) at state y, written out entry by entry (rows: ω̇, γ̇)."""
-    I0, I1, I2 = p[0:3]
+    I0, I1, I2 = p[INERTIA:INERTIA + 3]
     w0, w1, w2, g0, g1, g2 = y[:6]
-    u0, u1, u2 = p[9:12]
-    n = p[14]
+    u0, u1, u2 = p[U_Z:U_Z + 3]
+    n = p[N_Z]
     J = np.zeros((6, 6))
     J[0, 1:3] = (I1 - I2) * w2, (I1 - I2) * w1
     J[1, 0], J[1, 2] = (I2 - I0) * w2, (I2 - I0) * w0
@@ -84,14 +85,14 @@ def _augmented_block(s, Z, P, out, count):
     trajectory j): the loop runs across trajectories, so the arithmetic vectorises. ẋ is ``fixed_point.rhs_block``."""
     rhs_block(Z, P, out, count)  # rows 0-5: the state's right-hand side
     for j in range(count):
-        I0, I1, I2 = P[0, j], P[1, j], P[2, j]
-        u0, u1, u2 = P[9, j], P[10, j], P[11, j]
-        n = P[14, j]
+        I0, I1, I2 = P[INERTIA, j], P[INERTIA + 1, j], P[INERTIA + 2, j]
+        u0, u1, u2 = P[U_Z, j], P[U_Z + 1, j], P[U_Z + 2, j]
+        n = P[N_Z, j]
         w0, w1, w2, g0, g1, g2 = Z[0, j], Z[1, j], Z[2, j], Z[3, j], Z[4, j], Z[5, j]
         a0, a1, a2, c0, c1, c2 = Z[6, j], Z[7, j], Z[8, j], Z[9, j], Z[10, j], Z[11, j]
-        d0 = ((I1 - I2) * (a1 * w2 + w1 * a2) + u1 * c2 - u2 * c1 + n * (I2 - I1) * (c1 * g2 + g1 * c2)) * P[16, j]
-        d1 = ((I2 - I0) * (a2 * w0 + w2 * a0) + u2 * c0 - u0 * c2 + n * (I0 - I2) * (c2 * g0 + g2 * c0)) * P[17, j]
-        d2 = ((I0 - I1) * (a0 * w1 + w0 * a1) + u0 * c1 - u1 * c0 + n * (I1 - I0) * (c0 * g1 + g0 * c1)) * P[18, j]
+        d0 = ((I1 - I2) * (a1 * w2 + w1 * a2) + u1 * c2 - u2 * c1 + n * (I2 - I1) * (c1 * g2 + g1 * c2)) * P[INV_INERTIA, j]
+        d1 = ((I2 - I0) * (a2 * w0 + w2 * a0) + u2 * c0 - u0 * c2 + n * (I0 - I2) * (c2 * g0 + g2 * c0)) * P[INV_INERTIA + 1, j]
+        d2 = ((I0 - I1) * (a0 * w1 + w0 * a1) + u0 * c1 - u1 * c0 + n * (I1 - I0) * (c0 * g1 + g0 * c1)) * P[INV_INERTIA + 2, j]
         e0 = c1 * w2 + g1 * a2 - c2 * w1 - g2 * a1
         e1 = c2 * w0 + g2 * a0 - c0 * w2 - g0 * a2
         e2 = c0 * w1 + g0 * a1 - c1 * w0 - g1 * a0
@@ -188,12 +189,26 @@ def run_indicators_dop853(P, t_out, Y0, D0, rtol, atol, max_step, megno, fli, de
                            steps, j)
 
 
+def tangent_growth(p: np.ndarray, y0: np.ndarray, t_end: float, tol: float) -> float:
+    """max ln|δ(t)| over [0, t_end] of the unit tangent vector ``initial_tangent`` of the (ω, γ) state ``y0`` (the
+    fast Lyapunov indicator), by DOP853 at rtol = atol = ``tol`` in this thread (no thread pool: one trajectory);
+    ``p`` with CARRIES_ALPHA = 0. NaN when the integration fails."""
+    y = np.ascontiguousarray(y0[:6], dtype=float)
+    d = initial_tangent(y[None, :])[0]
+    megno, fli, deviation = np.empty(1), np.empty(1), np.empty(1)
+    final, steps = np.empty(6), np.zeros(1, dtype=np.int64)
+    _dop853_trajectory(np.ascontiguousarray(p, dtype=float), np.array([0.0, float(t_end)]), y, d, tol, tol, np.inf,
+                       megno, fli, deviation, final, steps, 0)
+    return float(fli[0]) if steps[0] > 0 else float("nan")
+
+
 @kernel
 def _dop853_trajectory(p, t_out, y0, d0, rtol, atol, max_step, megno, fli, deviation, final, steps, j):
     n = AUGMENTED
     controlled = 12  # x and δ
-    P = np.empty((p.size, 1))
-    P[:, 0] = p
+    P = np.empty((p.size, 1))  # the parameters as the single column of a transposed (parameter, trajectory) table
+    for i in range(p.size):
+        P[i, 0] = p[i]
     y = np.zeros((n, 1))
     y[0:6, 0] = y0
     y[6:12, 0] = d0

@@ -59,6 +59,12 @@ from typing import Any
 import numpy as np
 
 from gyrolab.contracts.integrator import (
+    BATCH_KERNEL,
+    CHOOSES_METHOD,
+    PREFERS_COMPILED_MODEL,
+    TIME_DEPENDENT,
+    VECTOR_LANES,
+    BatchSolution,
     CompiledModel,
     Integrator,
     IntegratorStats,
@@ -67,9 +73,25 @@ from gyrolab.contracts.integrator import (
     Solution,
 )
 from gyrolab.errors import ConfigError, GyrolabError, as_number
+from gyrolab.plugins.integrators.amplification import amplification
 
 PILOT_POINTS = 65
 MIN_GROWTH = 2.0
+#: the pilot's power law t^q is capped at this q; an amplification beyond (1/pilot_fraction)^MAX_GROWTH after the
+#: pilot is exponential growth: a chaotic scene
+MAX_GROWTH = 4.0
+#: what ``auto_predicted_error`` is, stored beside it in every run
+PREDICTION_MEANING = ("an upper estimate of the max-norm error of the final state against the exact solution (model "
+                      "units): the pilot's measured error extrapolated over the span, raised by the amplification of "
+                      "perturbations measured over the whole span (chaotic scenes), times a calibration factor, plus "
+                      "the round-off of double precision (amplified likewise)")
+#: on a chaotic scene the amplification (and the round-off it carries) is taken this many times larger: one tangent
+#: run's growth factor scatters by up to e^2 ≈ 7 between nearby tolerances (``amplification.TANGENT_TOLERANCE``),
+#: and the round-off estimate is an estimate (benchmarks/chaos_promise.py: with no margin, slow_spin at t = 300
+#: was accepted at 1e-6 and ended at 1.4e-6)
+CHAOS_MARGIN = 10.0
+#: tolerance of the shadow pair that measures the amplification where the variational equations do not apply
+SHADOW_TOLERANCE = 1e-9
 FLOOR = 1e-15  # relative to the state's size: nothing in double precision reaches below this
 MIN_TOLERANCE = 1e-13  # first pilot: tighter tolerances differ from τ/100 by round-off only on O(1) states
 MAX_TOLERANCE = 1e-5  # looser per-step tolerances take steps near the Taylor series' radius of convergence
@@ -94,15 +116,22 @@ MISS_MARGIN = 1000.0
 SCREEN_POINTS = 512
 SCREEN_TOLERANCE = 1e-9
 EPS = float(np.finfo(float).eps)
+#: the unit round-off of double-double arithmetic (a 106-bit significand), for auto's extended-precision choice
+DOUBLE_DOUBLE_EPS = 2.0 ** -104
+#: trajectories of a batch on which ``auto`` runs its pilot (the first, the largest state, the most unusual parameters)
+AUTO_SAMPLE = 3
 _PILOT_GRID = np.linspace(0.0, 1.0, PILOT_POINTS)
 
 
 class Auto(Integrator):
     name = "auto"
     adaptive = True
-    prefers_compiled_model = True
+    # a batch runs its choice's kernel (Taylor or DOP853, both vectorised across trajectories)
+    capabilities = frozenset({PREFERS_COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, CHOOSES_METHOD})
+    evaluation_label = "pilot and chosen method's evaluations"
 
-    def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 1.0) -> None:
+    def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 1.0,
+                 extended_precision: bool = False) -> None:
         if accuracy is None:
             raise ConfigError("integrator=auto needs a target: set accuracy=... (max-norm error of the final state)")
         self.accuracy = as_number(accuracy, "accuracy", positive=True)
@@ -110,7 +139,14 @@ class Auto(Integrator):
         if self.pilot_fraction >= 1:
             raise ConfigError(f"integrator.pilot_fraction={pilot_fraction} must be below 1")
         self.safety = as_number(safety, "integrator.safety", positive=True)
+        if not isinstance(extended_precision, (bool, np.bool_)):
+            raise ConfigError(f"integrator.extended_precision={extended_precision!r} must be true or false")
+        #: whether a target double precision cannot reach may be met in double-double (integrator=taylor
+        #: integrator.precision=double-double) instead of being refused
+        self.extended_precision = bool(extended_precision)
         self.choice: dict[str, Any] = {}
+        self.chaos: dict[str, Any] = {}  # the amplification measured over the span (auto_lyapunov_exponent, ...)
+        self.chosen: Integrator | None = None  # the method the last integrate ran (None: an analytic series)
         self.system: Any = None
         self._pilot_steps = 0
         self._order: int | None = None
@@ -157,10 +193,13 @@ class Auto(Integrator):
         tau, pilot_nfev = min(max(self.accuracy * FIRST_RATIO, MIN_TOLERANCE), MAX_TOLERANCE / 10), 0
         # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance
         self._order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
+        # how much the motion amplifies an error present at the pilot's end by the end of the span (chaos: e^{λt})
+        amp = amplification(compiled, fun, y0, t_out[0], t_pilot, t_out[-1], self._method(compiled, SHADOW_TOLERANCE))
         loose = None  # the previous round's loose run (tolerance, solution): the next round's tight run
         for _ in range(3):
             per_tol, growth, nfev, measured, (tight_tol, tight), loose = self._pilot(fun, pilot_times, y0, compiled,
                                                                                      tau, loose)
+            per_tol = _amplified(per_tol, growth, amp.factor, self.pilot_fraction, CHAOS_MARGIN)
             pilot_nfev += nfev
             # per_tol bounds the truncation error even when the pilot saw only round-off
             chosen = MAX_TOLERANCE if per_tol == 0 else \
@@ -177,13 +216,41 @@ class Auto(Integrator):
         steps = self._pilot_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / self._order))
         compensated = bool(self._taylor)  # Taylor's update is compensated (None: no compiled model, scipy's DOP853)
         roundoff = EPS * scale * (math.sqrt(steps) if compensated else steps)
-        if roundoff > self.accuracy:
+        chaotic = amp.factor > (1.0 / self.pilot_fraction) ** MAX_GROWTH  # faster than any power law the pilot fits
+        if chaotic:  # round-off committed early grows with the perturbations: up to e^{max ln|δ|}
+            roundoff *= CHAOS_MARGIN * math.exp(min(max(amp.log_span, 0.0), 700.0))
+        self.chaos = {"auto_lyapunov_exponent": amp.lyapunov, "auto_amplification": amp.factor,
+                      "auto_amplification_method": amp.how, "auto_chaotic": int(chaotic)}
+        if chaotic:
+            self.chaos["auto_precision_horizon"] = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
+        extended = None
+        if roundoff > self.accuracy and self.extended_precision:
+            extended = self._extended(compiled, per_tol, roundoff)
+        if roundoff > self.accuracy and extended is None:
+            roundoff_dd = roundoff * DOUBLE_DOUBLE_EPS / EPS
+            if self.extended_precision and compiled is not None and roundoff_dd > self.accuracy:
+                raise ConfigError(
+                    f"accuracy={self.accuracy:g} cannot be reached even in double-double on this scene (λ ≈ "
+                    f"{amp.lyapunov:.2g}, perturbations grow ~{amp.factor:.1g}× after the pilot: round-off about "
+                    f"{roundoff_dd:.1g}); ask for accuracy ≥ {roundoff_dd:.1g} or a shorter time.end")
+            if chaotic:
+                horizon = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
+                raise ConfigError(
+                    f"accuracy={self.accuracy:g} cannot be reached in double precision on this chaotic scene: "
+                    f"λ ≈ {amp.lyapunov:.2g}, so round-off grows ~{amp.factor:.1g}× after the pilot and double "
+                    f"precision keeps {self.accuracy:g} only to t ≈ {t_out[0] + horizon:.4g} of {t_out[-1]:.4g}; ask "
+                    f"for accuracy ≥ {roundoff:.1g}, a shorter time.end, integrator.extended_precision=true (auto then "
+                    f"runs double-double where it can) or integrator=taylor integrator.precision=double-double")
             raise ConfigError(f"accuracy={self.accuracy:g} is below the round-off that double precision accumulates "
                               f"on this scene (about {roundoff:.1g} over ~{steps:.0f} steps); ask for at least that")
-        if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
+        if extended is not None:  # double-double: its own round-off, its own tolerance, from the start
+            method, chosen, roundoff = extended
+        elif CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
-        method = self._method(compiled, chosen)
-        if tight_tol <= chosen:  # the pilot's tight run is at least as accurate: continue from its end
+        if extended is None:
+            method = self._method(compiled, chosen)
+        self.chosen = method  # what ran: more_accurate answers for it
+        if tight_tol <= chosen and extended is None:  # the pilot's tight run is as accurate: continue from its end
             head = np.searchsorted(pilot_times, inside)  # the outputs inside the pilot
             rest = t_out[t_out >= t_pilot]
             tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest,
@@ -199,13 +266,39 @@ class Auto(Integrator):
             "auto_method": method.name,
             "auto_tolerance": chosen,
             "auto_predicted_error": CALIBRATION * per_tol * chosen + roundoff,
+            "auto_predicted_error_bounds": PREDICTION_MEANING,
             "auto_error_growth_exponent": growth,
             "auto_pilot_nfev": pilot_nfev,
+            **self.chaos,
             **{f"auto_{k.removeprefix('integrator_')}": v for k, v in method.attributes().items()},
         }
         return Solution(t_out, y, IntegratorStats(
             nfev=final_stats.nfev + pilot_nfev, n_steps=n_steps, n_rejected=final_stats.n_rejected,
             wall_time=time.perf_counter() - start, njev=final_stats.njev, nlu=final_stats.nlu))
+
+    def _extended(self, compiled: CompiledModel | None, per_tol: float,
+                  roundoff: float) -> tuple[Integrator, float, float] | None:
+        """(the double-double Taylor method, its tolerance, its round-off) that meets the accuracy where double
+        precision cannot, or None when the model has no double-double kernel or even it cannot.
+
+        The truncation error per unit tolerance is the pilot's (measured at its order; the double-double run takes
+        the optimal, higher order for its tolerance, hence fewer and larger steps: no more error per unit
+        tolerance); the round-off is double precision's estimate scaled by the ratio of the two unit round-offs."""
+        if compiled is None:
+            return None
+        from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+        from gyrolab.plugins.integrators.compiled_solvers import DOUBLE_DOUBLE, Taylor, TaylorDoubleDouble
+
+        if TaylorDoubleDouble.refusal(compiled, self.system) is not None:
+            return None
+        roundoff_dd = roundoff * DOUBLE_DOUBLE_EPS / EPS
+        if roundoff_dd > self.accuracy:
+            return None
+        tol = (self.accuracy - roundoff_dd) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
+        tol = min(max(tol, MIN_TOL), MAX_TOLERANCE)
+        if CALIBRATION * per_tol * tol + roundoff_dd > self.accuracy:
+            return None
+        return Taylor(tol=tol, precision=DOUBLE_DOUBLE), tol, roundoff_dd
 
     def _series(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                 start: float) -> Solution | None:
@@ -268,6 +361,7 @@ class Auto(Integrator):
                 alpha = np.stack([frame_from_angles(a, b, c)[0] for a, b, c in
                                   zip(angles["psi"], angles["theta"], angles["phi"])])
                 y = np.concatenate([y, alpha], axis=1)
+            self.chosen = None  # an analytic series: more_accurate is the full model by a tight Taylor run
             self.choice = {"auto_method": f"regime {name}", "auto_predicted_error": predicted,
                            "auto_series_error_one_period": measured, "auto_check_nfev": truth.stats.nfev,
                            **regime.attributes()}
@@ -333,13 +427,81 @@ class Auto(Integrator):
         measured = bool(final > 100 * EPS * max(1.0, *map(abs, y0)))
         # A non-symplectic method on a (near-)integrable motion drifts in energy linearly, hence in phase
         # quadratically: assume q = 2 unless the pilot shows faster growth (its early error is a plateau).
-        growth = MIN_GROWTH if math.isnan(slope) else min(max(slope, MIN_GROWTH), 4.0)
+        growth = MIN_GROWTH if math.isnan(slope) else min(max(slope, MIN_GROWTH), MAX_GROWTH)
         per_tol = final / (tau - tight_tol) * (1.0 / self.pilot_fraction) ** growth
         self._pilot_steps = tight.stats.n_steps
         return per_tol, growth, loose.stats.nfev + tight_nfev, measured, (tight_tol, tight), (tau, loose)
 
     def attributes(self) -> dict[str, Any]:
         return {"accuracy": self.accuracy, **self.choice}
+
+    def more_accurate(self, factor: float):
+        """Rule 9 for the method it ran (after ``integrate``): that method ``factor`` times more accurate; for an
+        analytic series, the full model by the compiled Taylor method at tol 1e-15 (the series' check run)."""
+        if not self.choice:
+            return None
+        if self.chosen is None:
+            from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+            return Taylor(tol=1e-15), 1.0, f"compiled Taylor at tol 1e-15 against auto's {self.choice['auto_method']}"
+        finer = self.chosen.more_accurate(factor)
+        if finer is None:
+            return None
+        return finer[0], finer[1], f"auto's choice, {finer[2]}"
+
+    def choose_batch_method(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray,
+                            params: np.ndarray) -> tuple[Integrator, dict[str, Any]]:
+        """The method and tolerance for a batch: the single-run choice on a few trajectories, the tightest.
+
+        The sample is the first trajectory, the one with the largest state and the one whose parameters
+        lie farthest from the batch's mean (up to AUTO_SAMPLE distinct ones). Each runs the pilot and final
+        run; the batch then runs the chosen method at the smallest tolerance chosen. A trajectory harder
+        than every sampled one may miss the accuracy: sample it (pass it first) when you know it.
+        """
+        from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
+        from gyrolab.plugins.integrators.step_guard import compiled_rhs
+
+        P = params
+        spread = np.abs(P - P.mean(axis=0)).max(axis=1) if len(P) > 1 else np.zeros(1)
+        sample = list(dict.fromkeys([0, int(np.argmax(np.abs(y0s).max(axis=1))), int(np.argmax(spread))]))[:AUTO_SAMPLE]
+        choices = []
+        for j in sample:
+            single = type(self)(accuracy=self.accuracy, pilot_fraction=self.pilot_fraction, safety=self.safety)
+            model = CompiledModel(compiled.model, P[j])
+            single.integrate(compiled_rhs(model), times, y0s[j], None, model)
+            choices.append(single.choice)
+        choice = min(choices, key=lambda c: c["auto_tolerance"])
+        tol = float(choice["auto_tolerance"])
+        method = Taylor(order=choice["auto_order"], tol=tol) if choice["auto_method"] == Taylor.name \
+            else DOP853Numba(rtol=tol, atol=tol)
+        settings = {"accuracy": self.accuracy,
+                    **{k: v.item() if isinstance(v, np.generic) else v for k, v in choice.items()},
+                    "auto_sampled_trajectories": len(sample)}
+        self.choice = {k: v for k, v in settings.items() if k != "accuracy"}
+        return method, settings
+
+    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
+                        failures: str) -> BatchSolution:
+        """The batch's choice (``choose_batch_method``), then that method's kernel; the wall time includes the pilot."""
+        start = time.perf_counter()
+        method, settings = self.choose_batch_method(compiled, times, y0s, params)
+        solution = method.integrate_batch(compiled, times, y0s, params, failures)
+        solution.wall_time = time.perf_counter() - start
+        solution.settings = settings
+        return solution
+
+
+def _amplified(per_tol: float, growth: float, factor: float, fraction: float, margin: float) -> float:
+    """The pilot's predicted final error per unit tolerance, raised where the motion amplifies errors faster than
+    the pilot's power law: an error E present at the pilot's end grows by up to ``factor`` (the tangent flow's
+    growth after the pilot, ``amplification``), and the 1/fraction − 1 later stretches each commit as much again
+    at most, so the final error is at most E · factor / fraction, against E · (1/fraction)^growth extrapolated.
+    Beyond the pilot's largest power law (a chaotic scene) the factor carries ``margin``: it is measured along one
+    numerical trajectory, which a chaotic flow lets scatter."""
+    extrapolated = (1.0 / fraction) ** growth
+    if factor > (1.0 / fraction) ** MAX_GROWTH:
+        factor *= margin
+    return per_tol / extrapolated * max(extrapolated, factor / fraction)
 
 
 #: the statistics below compiled, by name (``_fast``)

@@ -14,14 +14,23 @@ from typing import Any
 import numpy as np
 
 from gyrolab.contracts.integrator import (
+    BATCH_KERNEL,
+    COMPILED_MODEL,
+    TIME_DEPENDENT,
+    VARIATIONAL,
+    VECTOR_LANES,
+    BatchSolution,
     CompiledModel,
     Integrator,
     IntegratorStats,
     ProgressCallback,
     RightHandSide,
     Solution,
+    VariationalSettings,
 )
 from gyrolab.errors import ConfigError, IntegrationError, as_number
+from gyrolab.plugins.integrators import batch_kernels
+from gyrolab.plugins.integrators.refinement import half_step
 from gyrolab.plugins.integrators.tolerances import Tolerances
 from gyrolab.plugins.integrators.step_guard import check_step, compiled_rhs
 
@@ -129,7 +138,15 @@ def _fixed_step(kernel: Any, name: str, fun: RightHandSide, t_out: np.ndarray, s
 class DOP853Numba(Tolerances, Integrator):
     name = "dop853_numba"
     adaptive = True
-    needs_compiled_model = True
+    capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL})
+    tolerance_floor = 1e-16  # the compiled controller has no floor of its own; below this it gains nothing
+
+    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
+                        failures: str) -> BatchSolution:
+        return batch_kernels.dop853_batch(self, compiled, times, y0s, params, failures)
+
+    def variational_settings(self) -> VariationalSettings:
+        return VariationalSettings(rtol=self.rtol, atol=self.atol, max_step=self.max_step)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
@@ -165,10 +182,20 @@ class DOP853Numba(Tolerances, Integrator):
 class RK4Numba(Integrator):
     name = "rk4_numba"
     adaptive = False
-    needs_compiled_model = True
+    capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL})
 
     def __init__(self, *, step: float = 0.01) -> None:
         self.step = as_number(step, "integrator.step", positive=True)
+
+    def more_accurate(self, factor: float):
+        return half_step(self, 4)
+
+    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
+                        failures: str) -> BatchSolution:
+        return batch_kernels.rk4_batch(compiled, self.step, times, y0s, params, failures)
+
+    def variational_settings(self) -> VariationalSettings:
+        return VariationalSettings(step=self.step)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
@@ -203,12 +230,40 @@ class Taylor(Integrator):
 
     name = "taylor"
     adaptive = True
-    needs_compiled_model = True
+    capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES})
+    # one Taylor step costs about as much as `order` right-hand-side evaluations; nfev counts the series
+    evaluation_label = "Taylor series evaluations"
 
-    def __init__(self, *, order: int | None = None, tol: float = 1e-16) -> None:
+    @classmethod
+    def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
+        from gyrolab.plugins.compiled import plugin_taylor
+
+        if plugin_taylor.ready(compiled):   # (compiles a traced torque's Taylor kernel, once)
+            return None
+        named = f"system {system.name!r}'s" if system is not None else "this"
+        return f"has no Taylor coefficients for {named} compiled model"
+
+    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
+                        failures: str) -> BatchSolution:
+        return batch_kernels.taylor_batch(self, compiled, times, y0s, params, failures)
+
+    def __new__(cls, *args: Any, precision: str = "double", **kwargs: Any) -> Taylor:
+        """``precision="double-double"`` makes a ``TaylorDoubleDouble``: the same settings, its own capabilities."""
+        if cls is Taylor and precision == DOUBLE_DOUBLE:
+            cls = TaylorDoubleDouble
+        return super().__new__(cls)
+
+    def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = "double") -> None:
         from gyrolab.plugins.compiled.taylor import MAX_ORDER, MIN_ORDER, order_for
 
+        self.precision = _taylor_precision(precision)
         self.tol = as_number(tol, "integrator.tol", positive=True)
+        if self.precision == DOUBLE_DOUBLE:
+            from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+
+            if self.tol < MIN_TOL:
+                raise ConfigError(f"integrator.tol={tol!r} is below double-double's resolution; with "
+                                  f"integrator.precision=double-double it must be at least {MIN_TOL:g}")
         if order is None:
             order = order_for(self.tol)
         if isinstance(order, bool) or not isinstance(order, int) or not MIN_ORDER <= order <= MAX_ORDER:
@@ -240,8 +295,130 @@ class Taylor(Integrator):
         return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
                                                     wall_time=time.perf_counter() - start))
 
+    #: below this tol the double-precision kernel gains nothing (round-off)
+    TOLERANCE_FLOOR = 1e-16
+
+    def more_accurate(self, factor: float):
+        tol = self.tol / factor
+        if tol < self.TOLERANCE_FLOOR:
+            return None
+        return Taylor(order=self.order, tol=tol), 1.0, f"taylor at tol {tol:.3g} ({factor:g}× tighter), same order"
+
     def attributes(self) -> dict[str, Any]:
-        return {"integrator_order": self.order, "integrator_tol": self.tol}
+        return {"integrator_order": self.order, "integrator_tol": self.tol, "integrator_precision": self.precision}
+
+
+#: ``Taylor``'s arithmetic: ``integrator.precision``
+DOUBLE, DOUBLE_DOUBLE = "double", "double-double"
+PRECISIONS = (DOUBLE, DOUBLE_DOUBLE)
+
+
+def _taylor_precision(precision: Any) -> str:
+    """``integrator.precision`` checked: one of ``PRECISIONS``, else one ConfigError sentence listing them."""
+    if not isinstance(precision, str) or precision not in PRECISIONS:
+        raise ConfigError(f"integrator.precision={precision!r} is not available; valid choices: "
+                          f"{', '.join(PRECISIONS)}")
+    return precision
+
+
+class TaylorDoubleDouble(Taylor):
+    """``Taylor(precision="double-double")`` (``integrator=taylor integrator.precision=double-double``): the Taylor
+    method in double-double arithmetic (``gyrolab.plugins.compiled.taylor_dd``, ≈ 32 digits), same settings,
+    order rule, chunks and progress as ``Taylor``. Capabilities: the compiled model only — built-in torque forms
+    (a traced plugin torque is refused, naming the force), no time-dependent forces, no batch kernel (``--batch``
+    runs one ``integrate`` per point, each exactly a single run)."""
+
+    capabilities = frozenset({COMPILED_MODEL})
+
+    @classmethod
+    def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
+        from gyrolab.plugins.compiled import models
+
+        if compiled.model == models.FIXED_POINT:
+            return None
+        return _double_double_clause(getattr(system, "forces", None))
+
+    integrate_batch = Integrator.integrate_batch  # no batch kernel
+
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+        return _taylor_double_double(self, fun, t_out, y0, progress, compiled)
+
+    def more_accurate(self, factor: float):
+        from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+
+        tol = self.tol / factor
+        if tol < MIN_TOL:
+            return None
+        return (Taylor(order=self.order, tol=tol, precision=DOUBLE_DOUBLE), 1.0,
+                f"taylor double-double at tol {tol:.3g} ({factor:g}× tighter), same order")
+
+
+def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+                          progress: ProgressCallback | None, compiled: CompiledModel) -> Solution:
+    """``Taylor.integrate`` in double-double (``gyrolab.plugins.compiled.taylor_dd``): the state carried in
+    double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded to
+    double. The initial state is a double, hence exact; a compiled plugin torque is refused."""
+    from gyrolab.plugins.compiled import models, taylor, taylor_dd
+
+    if compiled.model != models.FIXED_POINT:
+        raise _double_double_refusal(fun)
+    start = time.perf_counter()
+    t_out, y, out = _outputs(t_out, y0)
+    low = np.zeros(len(y))  # the state's low parts
+    no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
+    state = np.array([t_out[0]])
+    stats = np.zeros(2, dtype=np.int64)
+    reached = 1
+    for first, stop in _Chunks(len(t_out)):
+        if reached >= stop:
+            continue  # a long step already filled this chunk's outputs
+        status, reached = taylor_dd.run(compiled.params, method.order, method.tol, t_out, out, no_low, reached, stop,
+                                        state, y, low, stats)
+        if status != taylor.OK:
+            raise _taylor_failure(status, state[0])
+        if progress is not None:
+            progress(state[0])
+    return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
+                                                wall_time=time.perf_counter() - start))
+
+
+def taylor_dd_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: np.ndarray,
+                      order: int | None = None) -> np.ndarray:
+    """``taylor_samples`` in double-double: the states at ``t_out`` (rounded to double) of the double-double Taylor
+    method at ``tol`` (≥ ``taylor_dd.MIN_TOL``) and ``order`` (None: its optimal order), in one call into the
+    kernel, for a method choosing its setting from short runs (``auto``'s pilot). Built-in torque forms only
+    (a plugin model raises ConfigError); a failed step raises IntegrationError."""
+    from gyrolab.plugins.compiled import models, taylor, taylor_dd
+
+    if compiled.model != models.FIXED_POINT:
+        raise _double_double_refusal(None)
+    if not tol >= taylor_dd.MIN_TOL:
+        raise ConfigError(f"tol={tol!r} is below double-double's resolution; it must be at least {taylor_dd.MIN_TOL:g}")
+    t_out, y, out = _outputs(t_out, y0)
+    state = np.array([t_out[0]])
+    order = taylor.order_for(tol) if order is None else order
+    status, _ = taylor_dd.run(compiled.params, order, tol, t_out, out, np.empty((0, len(y))), 1, len(t_out), state,
+                              y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
+    if status != taylor.OK:
+        raise _taylor_failure(status, state[0])
+    return out
+
+
+def _double_double_clause(forces: list | None) -> str:
+    """Why double-double cannot run a traced plugin torque, naming the plugin forces among ``forces`` (if known)."""
+    plugins = [force.name for force in forces or [] if force.compiled_terms() is None]
+    what = (f"force {', '.join(repr(name) for name in plugins)} is a compiled plugin torque" if plugins
+            else "this model has a compiled plugin torque")
+    return (f"in double-double precision evaluates the fixed-point model's built-in torque forms only (uniform_gravity, "
+            f"newtonian, magnetic), and {what} (integrator.precision=double runs it)")
+
+
+def _double_double_refusal(fun: RightHandSide | None) -> ConfigError:
+    """The sentence refusing a compiled plugin torque in double-double, naming the force when the right-hand side
+    is a system's bound method (as the scene passes it)."""
+    clause = _double_double_clause(getattr(getattr(fun, "__self__", None), "forces", None))
+    return ConfigError(f"integrator 'taylor' {clause}; valid choices: integrator.precision=double")
 
 
 def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: np.ndarray) -> np.ndarray:
@@ -274,14 +451,28 @@ class LiePoisson(Integrator):
 
     name = "lie_poisson"
     adaptive = False
-    needs_compiled_model = True
+    capabilities = frozenset({COMPILED_MODEL})
+    evaluation_label = "exact sub-flow evaluations"
     ORDERS = (2, 4, 6)
+
+    @classmethod
+    def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
+        from gyrolab.plugins.compiled import models
+
+        if compiled.model == models.FIXED_POINT:
+            return None
+        traced = ", ".join(f.name for f in system.forces if f.compiled_terms() is None) if system is not None else ""
+        return ("evaluates the built-in torque forms only, and "
+                + (f"force {traced} is a compiled plugin torque" if traced else "this compiled model is not one of them"))
 
     def __init__(self, *, step: float = 0.01, order: int = 4) -> None:
         self.step = as_number(step, "integrator.step", positive=True)
-        if order not in self.ORDERS:
+        if order not in self.ORDERS:  # (more_accurate below halves the step at the same order)
             raise ConfigError(f"integrator.order={order!r} is not available; valid choices: 2, 4, 6")
         self.order = order
+
+    def more_accurate(self, factor: float):
+        return half_step(self, self.order, order=self.order)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:

@@ -13,8 +13,22 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
+from gyrolab.contracts.integrator import (
+    BATCH_KERNEL,
+    TIME_DEPENDENT,
+    VARIATIONAL,
+    VECTOR_LANES,
+    BatchSolution,
+    CompiledModel,
+    Integrator,
+    IntegratorStats,
+    ProgressCallback,
+    RightHandSide,
+    Solution,
+    VariationalSettings,
+)
 from gyrolab.errors import IntegrationError, as_number
+from gyrolab.plugins.integrators.refinement import half_step
 from gyrolab.plugins.integrators.step_guard import check_step
 
 GUARD_CHECKS = 50  # as often as the compiled methods check (once per output chunk)
@@ -24,9 +38,23 @@ PROGRESS_STEPS = 1000  # steps between calls of the progress callback within an 
 class RK4(Integrator):
     name = "rk4"
     adaptive = False
+    # a batch runs the compiled RK4 kernel (the same method and steps as this one, compiled)
+    capabilities = frozenset({TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL})
 
     def __init__(self, *, step: float = 0.01) -> None:
         self.step = as_number(step, "integrator.step", positive=True)
+
+    def more_accurate(self, factor: float):
+        return half_step(self, 4)
+
+    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
+                        failures: str) -> BatchSolution:
+        from gyrolab.plugins.integrators.batch_kernels import rk4_batch
+
+        return rk4_batch(compiled, self.step, times, y0s, params, failures)
+
+    def variational_settings(self) -> VariationalSettings:
+        return VariationalSettings(step=self.step)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:

@@ -11,12 +11,23 @@ costs exactly ``n_stages`` evaluations, so the evaluations spent inside one
 from __future__ import annotations
 
 import time
+import warnings
 from typing import ClassVar
 
 import numpy as np
 from scipy import integrate
 
-from gyrolab.contracts.integrator import CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution
+from gyrolab.contracts.integrator import (
+    TIME_DEPENDENT,
+    VARIATIONAL,
+    CompiledModel,
+    Integrator,
+    IntegratorStats,
+    ProgressCallback,
+    RightHandSide,
+    Solution,
+    VariationalSettings,
+)
 from gyrolab.errors import IntegrationError
 from gyrolab.plugins.integrators.tolerances import Tolerances
 
@@ -25,6 +36,7 @@ class ScipySolver(Tolerances, Integrator):
     """Adaptive scipy solver; subclasses name the scipy class."""
 
     adaptive = True
+    capabilities = frozenset({TIME_DEPENDENT})
     solver_class: ClassVar[type]
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
@@ -33,18 +45,27 @@ class ScipySolver(Tolerances, Integrator):
         t_out = np.asarray(t_out, dtype=float)
         out = np.empty((len(t_out), len(y0)))
         out[0] = y0
-        solver = self.solver_class(fun, t_out[0], np.array(y0, dtype=float), t_out[-1],
-                                   rtol=self.rtol, atol=self.atol, max_step=self.max_step)
+        with warnings.catch_warnings():  # scipy warns when it raises rtol to its floor: said below, once
+            warnings.simplefilter("ignore", UserWarning)
+            solver = self.solver_class(fun, t_out[0], np.array(y0, dtype=float), t_out[-1],
+                                       rtol=self.rtol, atol=self.atol, max_step=self.max_step)
+        # scipy's Runge-Kutta, Radau and BDF solvers keep the tolerances they apply (raised to their floor);
+        # LSODA hands them to ODEPACK unchanged
+        self.record_used_tolerances(float(np.max(getattr(solver, "rtol", self.rtol))),
+                                    float(np.max(getattr(solver, "atol", self.atol))))
         stages = getattr(self.solver_class, "n_stages", None)
         n_steps, n_rejected, filled = 0, 0, 1
         while solver.status == "running" and filled < len(t_out):
-            nfev_before = solver.nfev
+            nfev_before, t_before = solver.nfev, solver.t
             try:
                 message = solver.step()
             except (ValueError, ArithmeticError, np.linalg.LinAlgError) as error:  # e.g. LU of a NaN Jacobian
                 raise IntegrationError(f"{self.name} failed near t={solver.t:.6g}: {error}") from None
             if solver.status == "failed":
                 raise IntegrationError(f"{self.name} failed near t={solver.t:.6g}: {message}")
+            if solver.t == t_before:  # LSODA near a blow-up: its step size reaches 0 and it "succeeds" forever
+                raise IntegrationError(f"{self.name} stalled at t={solver.t:.6g}: its step size fell to zero "
+                                       "(a singularity of the solution?)")
             if not np.all(np.isfinite(solver.y)):
                 raise IntegrationError(f"{self.name} produced a non-finite state at t={solver.t:.6g}")
             n_steps += 1
@@ -73,7 +94,12 @@ class RK45(ScipySolver):
 
 class DOP853(ScipySolver):
     name = "dop853"
+    # the chaos indicators' compiled DOP853 takes scipy's steps (dop853_numba is scipy's method, compiled)
+    capabilities = frozenset({TIME_DEPENDENT, VARIATIONAL})
     solver_class = integrate.DOP853
+
+    def variational_settings(self) -> VariationalSettings:
+        return VariationalSettings(rtol=self.rtol, atol=self.atol, max_step=self.max_step)
 
 
 class LSODA(ScipySolver):

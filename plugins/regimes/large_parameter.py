@@ -189,6 +189,11 @@ class LargeParameter(FixedPointRegime):
             if not s.r0 > 0:
                 raise ConfigError(f"regime large_parameter with formula=printed needs r0 > 0 (μ = c/r0), got "
                                   f"r0/c={s.r0:.4g}")
+            frequency = paper.printed_frequency(self._printed_params(s))
+            if frequency < 0:
+                return [PRINTED_WARNING, f"the printed frequency 2π/(2π + α) is negative here (α = "
+                        f"{paper.printed_period_correction(self._printed_params(s)):.4g} < −2π, Ω = {frequency:.4g}): "
+                        f"the printed period is {2 * np.pi / (frequency * s.r0):.6g}/c; its magnitude sets the window"]
             return [PRINTED_WARNING]
         if abs(s.x0) > 1e-9 or abs(s.y0) > 1e-9 or s.z0 < 0:
             raise ConfigError(f"regime large_parameter (slow spin, a perturbed pendulum) is derived for a centre of "
@@ -234,7 +239,8 @@ class LargeParameter(FixedPointRegime):
 
     def _period(self, s):
         if self.formula == "printed":
-            return 2 * np.pi / (paper.printed_frequency(self._printed_params(s)) * s.r0)
+            # the printed frequency can be negative (check_domain says so): a period is a length of time
+            return abs(2 * np.pi / (paper.printed_frequency(self._printed_params(s)) * s.r0))
         return self.series(s).period(s.r0)
 
     def _euler(self, s, t):

@@ -1,0 +1,124 @@
+"""A measured error for the stored trajectory (``output.error_estimate``): a companion run on the same output times.
+
+A tolerance is not an error, and a recorded prediction is only a prediction; what a user can check is a measurement.
+The companion integrates the same scene with the same method, made more accurate by a known factor; each
+integrator says how (``Integrator.more_accurate``, rule 9 of its contract):
+
+* a method with tolerances (``rtol``/``atol``, or the Taylor method's ``tol``): the same method at tolerances
+  ``TIGHTER`` times smaller; its error is then ~``TIGHTER`` times smaller, so |y − y_companion| estimates the
+  stored run's error to within ~1/``TIGHTER``;
+* a fixed-step method of order p (RK4: 4): the same method at half the step, and Richardson's estimate of the
+  coarse run's error, |y_h − y_{h/2}| · 2^p / (2^p − 1);
+* ``auto``: the method it chose, made more accurate the same way (or, when it took a regime's analytic series,
+  the compiled Taylor method at tol 1e-15 against the series).
+
+Where the companion cannot be made ``TIGHTER`` times more accurate (a tolerance already at its method's floor), the
+compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model; otherwise the dataset says the
+estimate is not available and why. The estimate costs one more integration (about 1.2–2× the run's time for a
+tolerance-controlled method, 2× for a fixed step): it is on by default for ``integrator=auto`` only
+(``output.error_estimate: null``), ``true``/``false`` choose it for any integrator.
+
+The estimate is stored as ``error_estimate_omega`` (the angular velocity's max-norm error at each output time, in
+ω's units) and ``error_estimate_attitude`` (the direction cosines' max-norm error, dimensionless) for systems whose
+state starts with ω; as ``error_estimate`` (the whole state's max-norm error) for other systems.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL
+
+log = logging.getLogger(__name__)
+
+#: the companion is this many times more accurate than the run (tolerances this many times smaller)
+TIGHTER = 1000.0
+
+
+@dataclass(frozen=True)
+class Companion:
+    integrator: Any
+    scale: float  # error of the stored run ≈ scale · |y − y_companion|
+    how: str
+
+
+def wanted(scene: Any) -> bool:
+    """Whether the scene's run carries an error estimate: ``output.error_estimate`` true/false, or by default
+    (null) for the integrators that choose their method for a target accuracy (CHOOSES_METHOD: ``auto``)."""
+    choice = (scene.config.get("output") or {}).get("error_estimate")
+    if choice is None:
+        return scene.integrator.supports(CHOOSES_METHOD)
+    return bool(choice)
+
+
+def companion(integrator: Any, has_compiled: bool) -> Companion | None:
+    """The more accurate run that measures ``integrator``'s error (its ``more_accurate``, rule 9 of the contract;
+    else the compiled Taylor method at its floor when the scene has a compiled model), or None."""
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    finer = integrator.more_accurate(TIGHTER)
+    if finer is not None:
+        return Companion(*finer)
+    if has_compiled and not _at_taylor_floor(integrator):
+        return Companion(Taylor(tol=Taylor.TOLERANCE_FLOOR), 1.0, f"compiled Taylor at tol {Taylor.TOLERANCE_FLOOR:g} "
+                         f"({integrator.name} cannot be made {TIGHTER:g}× more accurate)")
+    return None
+
+
+def add_error_estimate(ds: xr.Dataset, scene: Any, y: np.ndarray, wall_time: float) -> xr.Dataset:
+    """``ds`` with the error-estimate variables and attributes of a run whose stored states are ``y``."""
+    compiled_model = scene.system.compiled_model()
+    pick = companion(scene.integrator, compiled_model is not None)
+    name = getattr(scene.integrator, "name", type(scene.integrator).__name__)
+    if pick is None:
+        reason = (f"not available: integrator {name!r} already runs at the compiled Taylor method's floor in double "
+                  "precision (nothing more accurate to compare with)" if _at_taylor_floor(scene.integrator) else
+                  f"not available: integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
+                  "compiled model for the Taylor method")
+        log.warning("output.error_estimate: %s", reason)
+        ds.attrs["error_estimate_method"] = reason
+        return ds
+    companion_model = None
+    if pick.integrator.supports(COMPILED_MODEL) or pick.integrator.supports(PREFERS_COMPILED_MODEL):
+        # the scene's own model is prepared for its integrator (a plugin torque's Taylor kernel compiled); another
+        # one is prepared by the companion's refusal hook, which also says when it cannot run it
+        companion_model = scene.compiled if scene.compiled is not None else compiled_model
+        refusal = pick.integrator.refusal(companion_model, scene.system) if companion_model is not None else None
+        if refusal:
+            ds.attrs["error_estimate_method"] = f"not available: the companion ({pick.how}) {refusal}"
+            log.warning("output.error_estimate: %s", ds.attrs["error_estimate_method"])
+            return ds
+    start = time.perf_counter()
+    other = pick.integrator.integrate(scene.system.rhs, scene.times, scene.system.initial_state(), None,
+                                      companion_model).y
+    spent = time.perf_counter() - start
+    y = np.asarray(y, dtype=float)
+    difference = pick.scale * np.abs(y - other)
+    ds.attrs["error_estimate_method"] = pick.how
+    ds.attrs["error_estimate_cost_ratio"] = float(spent / max(wall_time, 1e-9))
+    omega = ds.get("omega")
+    if omega is not None and omega.shape == (len(y), 3) and np.array_equal(omega.values, y[:, :3]):
+        parts = {"omega": (difference[:, :3], omega.attrs.get("units", "1"), "angular velocity ω"),
+                 "attitude": (difference[:, 3:], "1", "direction cosines (γ, and α where carried)")}
+    else:  # a state whose layout this module does not know: one max-norm over all of it
+        parts = {"": (difference, "1", "state (model units)")}
+    for part, (values, units, what) in parts.items():
+        series = values.max(axis=1)
+        key = f"error_estimate_{part}" if part else "error_estimate"
+        ds[key] = xr.Variable("time", series, {
+            "units": units, "long_name": f"estimated max-norm error of the stored {what} at each output time",
+            "comment": pick.how})
+        ds.attrs[f"error_estimate_max_{part}" if part else "error_estimate_max"] = float(series.max())
+    return ds
+
+
+def _at_taylor_floor(integrator: Any) -> bool:
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    return isinstance(integrator, Taylor) and integrator.tol / TIGHTER < Taylor.TOLERANCE_FLOOR

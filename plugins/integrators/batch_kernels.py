@@ -1,0 +1,126 @@
+"""The built-in integrators' batch kernels (capability BATCH_KERNEL): many trajectories of one compiled model per call.
+
+The compiled kernels run in parallel over trajectories (``numba.prange``):
+- RK4 (``rk4``, ``rk4_numba``): fixed step; fixed-point (ω, γ) states go by blocks of trajectories stored
+  column-wise, so the arithmetic vectorises across trajectories (7× faster than one trajectory per thread);
+  other compiled models one trajectory per thread.
+- DOP853 (``dop853_numba``): adaptive, each trajectory with its own step control (scipy's controller, as the
+  single run); fixed-point (ω, γ) states by blocks of lanes vectorised across trajectories
+  (``plugins/compiled/batch_dop853.py``), other models one trajectory per thread.
+- Taylor (``taylor``): adaptive, each trajectory with the single run's order and step rule; fixed-point (ω, γ)
+  states by 4 lanes vectorised across trajectories (``plugins/compiled/batch_taylor.py``), other models one
+  trajectory per thread.
+
+Each function is an integrator's ``integrate_batch``: the arrays come validated from
+``gyrolab.batch.integrate.integrate_arrays``.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from gyrolab.contracts.integrator import BatchSolution, CompiledModel
+from gyrolab.errors import ConfigError, IntegrationError
+
+#: why an adaptive batch kernel stopped a trajectory, by its status code
+_REASONS = {1: "its step fell below the spacing of floating-point numbers", 2: "it became non-finite"}
+
+
+def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
+              failures: str) -> BatchSolution:
+    """Fixed-step RK4 with the fewest equal steps no longer than ``step`` in each output interval."""
+    from gyrolab.plugins.compiled import models, rk4
+    from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
+
+    start = time.perf_counter()
+    steps = steps_per_interval(times, step)
+    size = y0s.shape[1]
+    out = np.empty((len(y0s), len(times), size))
+    if blockable(compiled, size):
+        rk4.run_batch_blocks(P, times, steps, y0s, out)
+    else:
+        rk4.run_batch(models.form(compiled), P, times, steps, y0s, out)
+    failed = ~np.all(np.isfinite(out), axis=(1, 2))
+    if failures == "raise":
+        require_finite_out(out)
+    return BatchSolution(np.asarray(times), out, int(steps.sum()), time.perf_counter() - start, failed)
+
+
+def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
+                 failures: str) -> BatchSolution:
+    """The Taylor method at ``integrator.order`` and ``integrator.tol`` (``Taylor``'s settings)."""
+    from gyrolab.plugins.compiled import batch_taylor, models, plugin_taylor
+
+    def kernel(out: np.ndarray, steps: np.ndarray, status: np.ndarray) -> None:
+        if not plugin_taylor.ready(compiled, P):
+            raise ConfigError(f"integrator {integrator.name} has no Taylor coefficients for this compiled model; "
+                              f"valid choices for this model: {_batch_alternatives(compiled)}")
+        count, size = y0s.shape
+        if blockable(compiled, size):
+            batch_taylor.run_blocks(P, integrator.order, integrator.tol, times, y0s, out, steps, status,
+                                    batch_taylor.task_size(count))
+        else:
+            batch_taylor.run_each(models.form(compiled), P, integrator.order, integrator.tol, times, y0s, out, steps,
+                                  status)
+
+    return _adaptive(integrator, kernel, times, y0s, failures)
+
+
+def dop853_batch(integrator: object, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
+                 failures: str) -> BatchSolution:
+    """DOP853 with ``integrator.rtol``, ``atol`` and ``max_step`` (scipy's step control)."""
+    from gyrolab.plugins.compiled import batch_dop853, models
+
+    def kernel(out: np.ndarray, steps: np.ndarray, status: np.ndarray) -> None:
+        count, size = y0s.shape
+        rejected, nfev = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
+        args = (times, y0s, out, integrator.rtol, integrator.atol, integrator.max_step, steps, rejected, nfev, status)
+        if blockable(compiled, size):
+            batch_dop853.run_blocks(P, *args, batch_dop853.task_size(count))
+        else:
+            batch_dop853.run_each(models.form(compiled), P, *args)
+
+    return _adaptive(integrator, kernel, times, y0s, failures)
+
+
+def _adaptive(integrator: object, kernel: object, times: np.ndarray, y0s: np.ndarray, failures: str) -> BatchSolution:
+    """An adaptive kernel's common frame: outputs, per-trajectory steps and status, the failure sentence."""
+    start = time.perf_counter()
+    count, size = y0s.shape
+    out = np.empty((count, len(times), size))
+    out[:, 0] = y0s
+    steps = np.zeros(count, dtype=np.int64)
+    status = np.zeros(count, dtype=np.int64)
+    if len(times) > 1:
+        kernel(out, steps, status)
+    failed = status != 0
+    if failures == "raise" and failed.any():
+        bad = int(np.argmax(failed))
+        raise IntegrationError(f"trajectory {bad} of the batch failed with {integrator.name}: "
+                               f"{_REASONS.get(int(status[bad]), 'unknown status')}")
+    return BatchSolution(times, out, int(steps.max(initial=0)), time.perf_counter() - start, failed, steps,
+                         integrator.attributes())
+
+
+def _batch_alternatives(compiled: CompiledModel) -> str:
+    """The registered integrators with a batch kernel that can run ``compiled``."""
+    from gyrolab.contracts.capabilities import integrators_with, or_list
+    from gyrolab.contracts.integrator import BATCH_KERNEL
+
+    return or_list(integrators_with(BATCH_KERNEL, accept=lambda cls: cls.refusal(compiled) is None))
+
+
+def require_finite_out(out: np.ndarray) -> None:
+    """IntegrationError naming the first trajectory of ``out`` (trajectories × times × state) that is not finite."""
+    if not np.all(np.isfinite(out)):
+        bad = int(np.argmax(~np.all(np.isfinite(out), axis=(1, 2))))
+        raise IntegrationError(f"trajectory {bad} of the batch became non-finite; reduce integrator.step")
+
+
+def blockable(compiled: CompiledModel, size: int) -> bool:
+    """The block kernels cover the fixed-point model with state (ω, γ)."""
+    from gyrolab.plugins.compiled import models
+
+    return compiled.model == models.FIXED_POINT and size == 6

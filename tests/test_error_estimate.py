@@ -1,0 +1,49 @@
+"""output.error_estimate: the stored trajectory's error measured by a companion run, against the long-double reference
+of ``gyrolab.physics.reference`` (a Taylor method in plain numpy on np.longdouble, independent of the kernels)."""
+
+import numpy as np
+import pytest
+
+from gyrolab import run
+from gyrolab.physics.reference import fixed_point_reference
+from gyrolab.plugins.compiled import layout
+from gyrolab import compose_scene
+
+SCENE = ["experiment=perf_reference", "time.end=60", "time.n_output=31", "output.euler_angles=false"]
+
+
+def _actual(ds, overrides):
+    scene = compose_scene(overrides)
+    p = scene.system.compiled_model().params
+    truth = fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3], p[layout.N_Z],
+                                  scene.system.initial_state()[:6], scene.times).astype(float)
+    states = np.concatenate([ds.omega.values, ds.gamma.values], axis=1)
+    return np.abs(states - truth)
+
+
+@pytest.mark.parametrize("integrator", [
+    ["integrator=auto", "accuracy=1e-8"],                       # on by default for auto
+    ["integrator=dop853", "integrator.rtol=1e-8", "integrator.atol=1e-8", "output.error_estimate=true"],
+    ["integrator=rk4", "integrator.step=0.002", "output.error_estimate=true"],
+    ["integrator=taylor", "integrator.tol=1e-9", "output.error_estimate=true"],
+])
+def test_the_estimate_measures_the_actual_error(integrator):
+    overrides = [*SCENE, *integrator]
+    ds = run(overrides)
+    actual = _actual(ds, overrides)
+    for part, columns in (("omega", slice(0, 3)), ("attitude", slice(3, 6))):
+        estimate = ds[f"error_estimate_{part}"].values
+        real = actual[:, columns].max(axis=1)
+        assert ds[f"error_estimate_{part}"].attrs["units"] and ds[f"error_estimate_{part}"].attrs["long_name"]
+        # where the error is above round-off, the estimate is the actual error to within a factor of two
+        resolved = real > 1e-12
+        assert resolved[-1]
+        np.testing.assert_allclose(estimate[resolved], real[resolved], rtol=0.5)
+    assert ds.attrs["error_estimate_method"] and ds.attrs["error_estimate_cost_ratio"] > 0
+
+
+def test_off_by_default_except_for_auto_and_says_why_when_unavailable():
+    assert "error_estimate_omega" not in run([*SCENE, "integrator=dop853"])
+    at_floor = run([*SCENE, "integrator=taylor", "output.error_estimate=true"])  # tol 1e-16: nothing tighter
+    assert "error_estimate_omega" not in at_floor
+    assert at_floor.attrs["error_estimate_method"].startswith("not available")
