@@ -135,10 +135,12 @@ class Integrator(ABC):
 
     Rules for implementers:
 
-    1. ``__init__(self, **params)`` takes the plugin's config parameters as
-       keyword arguments with defaults (``rtol``/``atol`` for adaptive
-       methods, ``step`` for fixed-step ones), validates them and raises
-       ``gyrolab.errors.ConfigError`` on bad values.
+    1. ``__init__(self, *, rtol=1e-10, ...)`` takes the plugin's config
+       parameters, each a keyword argument with a default (``rtol``/``atol``
+       for adaptive methods, ``step`` for fixed-step ones; ``**params`` is
+       refused, its keys being unknown), validates them and raises
+       ``gyrolab.errors.ConfigError`` on bad values; any other exception is
+       reported as one sentence naming the plugin.
     2. ``integrate(fun, t_out, y0)`` returns the state at every time in
        ``t_out`` (increasing, ``t_out[0]`` is the initial time), computed by
        dense output or by landing on those times, never by storing every

@@ -18,9 +18,10 @@ class Regime(ABC):
 
     Rules for implementers (``gyrolab.testing.check_regime`` checks them; run it in your tests):
 
-    1. ``__init__(self, *, formula="corrected", **params)`` takes the plugin's
-       config; ``formula`` selects the corrected formulas or the paper's
-       printed ones (``FORMULAS``); bad values raise ``ConfigError``.
+    1. ``__init__(self, *, formula="corrected", param=default, ...)`` takes
+       the plugin's config, each parameter a keyword with a default
+       (``**params`` is refused); ``formula`` selects the corrected formulas or
+       the paper's printed ones (``FORMULAS``); bad values raise ``ConfigError``.
     2. ``systems`` lists the system names the expansion is derived for; a
        scene pairing it with another system is refused before integrating.
     3. ``parameter``/``parameter_long_name`` name the expansion's small or
