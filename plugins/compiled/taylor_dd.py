@@ -34,7 +34,7 @@ from gyrolab.plugins.compiled.double_double import (
 from gyrolab.plugins.compiled.layout import (
     ALPHA, CARRIES_ALPHA, GAMMA, INERTIA, N_X, N_Y, N_Z, OMEGA, U_X, U_Y, U_Z,
 )
-from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, step_size
+from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, _norm_inf, step_size
 
 #: the smallest tolerance the double-double kernel takes (its unit round-off is 2^-106 ≈ 1.2e-32)
 MIN_TOL = 1e-32
@@ -169,14 +169,6 @@ def _horner(Th, Tl, order, m, hh, hl):
         ph, pl = dd_mul(vh, vl, hh, hl)
         vh, vl = dd_add(ph, pl, Th[k, m], Tl[k, m])
     return vh, vl
-
-
-@kernel
-def _norm_inf(row):
-    v = 0.0
-    for x in row:
-        v = max(v, abs(x))
-    return v
 
 
 @kernel
