@@ -210,7 +210,7 @@ class Store:
             times = output_times(self.plan.times, self.settings.output, self.settings.decimate)
             var = self.nc.createVariable("time", "f8", ("time",))
             var[:] = times
-            var.setncatts(time_attributes(system.body) if system is not None else {"long_name": "time"})
+            var.setncatts(time_attributes(system.body) if system is not None else {"long_name": "time", "axis": "T"})
         elif dim == "axis" and size == 3:
             _text_variable(self.nc, "axis", "axis", ["x", "y", "z"], {"units": "1", "long_name": "principal body axis"})
 
