@@ -487,6 +487,8 @@ def _plot(argv: Sequence[str]) -> int:
     datasets under PATH (``gyrolab.figures.redraw``) with the current style, formats and dpi; nothing is integrated."""
     _, _, value = argv[0].partition("=")
     rest = ([value] if value else []) + list(argv[1:])
+    if "--animate" in rest or any(a.startswith("--animate=") for a in rest):
+        return _animate(rest)
     paths = [a for a in rest if "=" not in a]
     overrides = [a for a in rest if "=" in a]
     if len(paths) != 1:
@@ -501,6 +503,42 @@ def _plot(argv: Sequence[str]) -> int:
     formats, dpi = figure_options(compose_config(overrides).output)
     for path in redraw(Path(paths[0]), formats, dpi):
         log.info("wrote %s", path)
+    return 0
+
+
+#: ``gyrolab --plot --animate PATH`` options -> ``gyrolab.figures.animation.animate`` keywords
+ANIMATE_OPTIONS = {"--format": "fmt", "--frames": "frames", "--fps": "fps", "--output": "output"}
+
+
+def _animate(rest: Sequence[str]) -> int:
+    """``gyrolab --plot --animate PATH [--format=gif|mp4] [--frames=N] [--fps=N] [--output=FILE]``: an animation
+    of the run at PATH (``gyrolab.figures.animation``)."""
+    usage = "usage: gyrolab --plot --animate PATH [--format=gif|mp4] [--frames=N] [--fps=N] [--output=FILE]"
+    paths, options = [], {}
+    for arg in rest:
+        option, has_value, value = arg.partition("=")
+        if option == "--animate":
+            if has_value:
+                paths.append(value)
+        elif option in ANIMATE_OPTIONS and has_value:
+            options[ANIMATE_OPTIONS[option]] = value
+        elif option.startswith("-") or has_value:
+            raise ConfigError(f"--animate does not take {shorten(arg)!r}; {usage}")
+        else:
+            paths.append(arg)
+    if len(paths) != 1:
+        raise ConfigError(f"--animate takes exactly one path (got {len(paths)}: {shorten(' '.join(paths)) or 'none'}); "
+                          f"{usage}")
+    for key, kind in (("frames", int), ("fps", float)):
+        if key in options:
+            try:
+                options[key] = kind(options[key])
+            except ValueError:
+                raise ConfigError(f"--{key}={options[key]!r} is not a number; {usage}") from None
+    from gyrolab.figures.animation import animate
+
+    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
+    animate(paths[0], **options)   # logs the file it wrote
     return 0
 
 
