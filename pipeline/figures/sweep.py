@@ -28,7 +28,10 @@ from gyrolab.figures.style import DOUBLE, SINGLE, legend_outside, panel_note, st
 MAX_SERIES = 8
 MARKERS = "osD^v<>p"
 
-Panel = tuple[str, xr.DataArray, bool]
+#: (panel title: the quantity, y label: what is plotted and its unit, values, log scale)
+Panel = tuple[str, str, xr.DataArray, bool]
+#: a y label longer than this puts its unit on a second line (a 3-column panel is ~1.6 in tall)
+LABEL_WIDTH = 22
 
 
 def choose_x(ds: xr.Dataset, dims: list[str]) -> str:
@@ -55,7 +58,7 @@ def _final_state(ds: xr.Dataset) -> list[Panel]:
             continue
         final = final_values(ds[name])
         for i, symbol in enumerate(symbols):
-            panels.append((label(f"{symbol} at the end", unit(ds, ds[name].attrs.get("units"), kind)),
+            panels.append((f"{symbol} at the end", _ylabel(symbol, unit(ds, ds[name].attrs.get("units"), kind)),
                            final.isel(axis=i), False))
     return panels
 
@@ -66,17 +69,24 @@ def _drift(ds: xr.Dataset) -> list[Panel]:
         if str(name).endswith("_max_abs_drift"):
             base = str(name).removesuffix("_max_abs_drift")
             symbol, kind = INVARIANTS.get(base, (base.replace("_", " "), "1"))
-            panels.append((label(f"max drift of {symbol}", unit(ds, ds[name].attrs.get("units"), kind)), ds[name], True))
+            panels.append((symbol, _ylabel("max |I(t) − I(0)|", unit(ds, ds[name].attrs.get("units"), kind)),
+                           ds[name], True))
     return panels
 
 
 def _cost(ds: xr.Dataset) -> list[Panel]:
     panels = []
     if "integrator_nfev" in ds:
-        panels.append(("integrator evaluations", ds["integrator_nfev"], True))
+        panels.append(("integrator evaluations", "evaluations", ds["integrator_nfev"], True))
     if "integrator_wall_time" in ds:
-        panels.append(("integrator wall time (s)", ds["integrator_wall_time"], True))
+        panels.append(("integrator wall time", "wall time (s)", ds["integrator_wall_time"], True))
     return panels
+
+
+def _ylabel(name: str, unit_text: str) -> str:
+    """'name (unit)', the unit on its own line when the label would overrun its panel."""
+    text = label(name, unit_text)
+    return text if len(text) <= LABEL_WIDTH or not unit_text else f"{name}\n({unit_text})"
 
 
 def _draw(ds: xr.Dataset, panels: list[Panel], title: str) -> plt.Figure:
@@ -85,8 +95,9 @@ def _draw(ds: xr.Dataset, panels: list[Panel], title: str) -> plt.Figure:
     ncols = min(3, len(panels))
     nrows = -(-len(panels) // ncols)
     fig, axes = subplots(nrows, ncols, width=SINGLE if ncols == 1 else DOUBLE, height=0.9 + 1.9 * nrows)
-    for ax, (ylabel, da, log) in zip(axes.flat, panels):
+    for ax, (quantity, ylabel, da, log) in zip(axes.flat, panels):
         _panel(ax, da, xdim, log)
+        ax.set_title(quantity, loc="left", fontsize=7.5)  # left: a panel_note (sweep_cost) goes under it
         ax.set_ylabel(ylabel)
     for ax in list(axes.flat)[len(panels):]:
         ax.set_visible(False)
