@@ -268,7 +268,7 @@ def validate_scene(scene_cfg: DictConfig) -> None:
     if task_of(scene_cfg) == "regime":  # the regime's domain is checked before anything is written
         from gyrolab.experiments.regime_run import prepare
 
-        prepare(scene_cfg)
+        prepare(scene_cfg, report=False)   # the run reports the domain warnings (once)
     else:
         Scene.from_config(scene_cfg)
 
