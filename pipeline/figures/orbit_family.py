@@ -60,16 +60,19 @@ def _on_family(r0: np.ndarray, values: np.ndarray, point: int, where: float, at:
 def zoom_window(ds: xr.Dataset, families: list[str]) -> tuple[tuple[float, float], tuple[float, float]] | None:
     """(r0/c range, amplitude range) of the families' arcs past their first fold (where they turn back and their
     events crowd), with a margin; None when no family turns."""
-    turned = []
+    turned, located = [], []
     for family in families:
         at = np.flatnonzero(ds["family"].values == family)
-        folds = [point for kind, _, point in _located_events(ds, family) if kind == "fold"]
+        events = _located_events(ds, family)
+        folds = [point for kind, _, point in events if kind == "fold"]
         if folds:
             turned += list(at[at >= min(folds) - 1])
+            # a fold is located at the extreme r0 of the turn, just beyond the points that bracket it
+            located += [where for _, where, point in events if point >= min(folds)]
     if not turned:
         return None
     ranges = []
-    for values in (ds["r0_over_c"].values[turned], ds["amplitude"].values[turned]):
+    for values in (np.concatenate([ds["r0_over_c"].values[turned], located]), ds["amplitude"].values[turned]):
         low, high = float(values.min()), float(values.max())
         pad = ZOOM_MARGIN * (high - low or abs(high) or 1.0)
         ranges.append((low - pad, high + pad))
