@@ -31,8 +31,7 @@ def test_every_numeric_variable_and_coordinate_has_units_and_long_name(kind, tmp
     for name, variable in ds.variables.items():
         if not str(variable.attrs.get("long_name", "")).strip():
             missing.append(f"{name}: no long_name")
-        if _numeric(variable) and "flag_values" not in variable.attrs \
-                and not str(variable.attrs.get("units", "")).strip():
+        if _numeric(variable) and not str(variable.attrs.get("units", "")).strip():
             missing.append(f"{name}: no units")
     for dim in ds.dims:
         if dim not in ds.variables and f"{dim}_description" not in ds.attrs:

@@ -172,7 +172,7 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
         job_ids[grid.index[n]] = result.job_id
         job_dirs[grid.index[n]] = result.job_dir
     data_vars["job_status"] = (grid_dims, statuses, {
-        "long_name": "how the job ended", "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8),
+        "long_name": "how the job ended", "units": "1", "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8),
         "flag_meanings": " ".join(STATUS_FLAGS)})
     data_vars["job_id"] = (grid_dims, job_ids, {"long_name": "hash of the job's resolved config and code version"})
     data_vars["job_dir"] = (grid_dims, job_dirs, {"long_name": "job directory, relative to the sweep directory"})
