@@ -76,3 +76,21 @@ def test_sweep_of_the_nondimensional_body_is_in_pure_numbers():
     ds = _sweep_of(["body.a=1.5,2", "initial.theta0=0.5,1"])
     assert ds["a"].attrs["units"] == "1" and ds["theta0"].attrs["units"] == "rad"
     assert ds["body_a"].attrs["units"] == "1" and ds["body_nondim_a"].attrs["units"] == "1"
+
+
+@pytest.mark.parametrize("key, si, nondimensional", [
+    ("initial.r0", "rad s-1", "1"),            # an angular velocity
+    ("initial.theta0", "rad", "rad"),          # an angle, in either form
+    ("time.end", "s", "1"),
+    ("body.inertia", "kg m2", "1"),
+    ("body.a", "1", "1"),                      # A/C: a ratio in either form
+    ("integrator.rtol", "1", "1"),
+    ("integrator.atol", None, "1"),            # on a state of mixed SI units: no one unit
+    ("integrator_wall_time", "s", "s"),        # wall-clock time is seconds even for a nondimensional body
+    ("force.my_plugin.strength", None, "1"),   # unknown: every nondimensional quantity is a pure number
+])
+def test_quantity_units(key, si, nondimensional):
+    from gyrolab.output.units import quantity_units
+
+    assert quantity_units(key, "si") == si
+    assert quantity_units(key, "nondimensional") == nondimensional

@@ -14,11 +14,14 @@ units for an SI body (``None``): gyrolab does not guess a dimension.
 
 from __future__ import annotations
 
-SI = {"1": "1", "rad": "rad", "time": "s", "rate": "rad s-1", "rate2": "s-2", "energy": "J", "torque": "N m",
-      "momentum": "kg m2 s-1", "inertia": "kg m2", "mass": "kg", "length": "m", "acceleration": "m s-2",
-      "wall": "s"}
+SI: dict[str, str | None] = {
+    "1": "1", "rad": "rad", "time": "s", "rate": "rad s-1", "rate2": "s-2", "energy": "J", "torque": "N m",
+    "momentum": "kg m2 s-1", "inertia": "kg m2", "mass": "kg", "length": "m", "acceleration": "m s-2", "wall": "s",
+    # an absolute tolerance on the whole state, whose components have different SI units: no one unit
+    "state": None}
 #: nondimensional form: pure numbers, angles in radians, wall-clock seconds still seconds
-NONDIMENSIONAL = {kind: ("rad" if kind == "rad" else "s" if kind == "wall" else "1") for kind in SI}
+NONDIMENSIONAL: dict[str, str | None] = {kind: ("rad" if kind == "rad" else "s" if kind == "wall" else "1")
+                                         for kind in SI}
 
 #: quantity name -> kind (keys of ``SI``)
 KINDS = {
@@ -38,7 +41,7 @@ KINDS = {
     # time and integrator settings
     "time_start": "time", "time_end": "time", "time_n_output": "1", "integrator_step": "time",
     "integrator_max_step": "time", "integrator_first_step": "time", "integrator_rtol": "1",
-    "integrator_atol": "1", "integrator_order": "1", "integrator_tol": "1",
+    "integrator_atol": "state", "integrator_order": "1", "integrator_tol": "1",
     # integrator statistics
     "integrator_nfev": "1", "integrator_n_steps": "1", "integrator_n_rejected": "1", "integrator_njev": "1",
     "integrator_nlu": "1", "integrator_wall_time": "wall",
@@ -56,5 +59,5 @@ def quantity_units(name: str, body_units: str | None) -> str | None:
     if kind is not None:
         if table is not None:
             return table[kind]
-        return SI[kind] if SI[kind] == NONDIMENSIONAL[kind] else None   # the same in either system
+        return SI[kind] if SI[kind] == NONDIMENSIONAL[kind] else None   # known only if the same in either system
     return "1" if body_units == "nondimensional" else None
