@@ -1,6 +1,6 @@
 """Every dataset kind gyrolab writes passes compliance-checker's CF-1.8 suite without errors.
 
-One small dataset of each kind (run.nc of both systems, a multirun sweep.nc, a --batch sweep.nc,
+One small dataset of each kind (run.nc of both systems, a multirun sweep.nc, --batch sweep.nc files,
 regime.nc, work_precision.nc, regime_validity.nc, ismail2021_tables.nc, shaker_omega3.nc,
 precession_cases.nc, orbit_family.nc, stability_map.nc) is built in-process, written with ``write_dataset`` and checked with
 ``compliance_checker``'s ``cf:1.8`` suite. The experiments run their real code up to the dataset
@@ -138,6 +138,15 @@ def _batch(tmp_path, monkeypatch):
     return xr.load_dataset(path, decode_times=False), path
 
 
+def _batch_trajectory(tmp_path, monkeypatch):
+    """A batch that stores whole trajectories: a time axis, as in a run."""
+    path = run_batch_sweep(["integrator=rk4", "integrator.step=0.01", "batch.output=trajectory", "body.a=1.5,2",
+                            "output.euler_angles=false", *TINY], tmp_path)
+    ds = xr.load_dataset(path, decode_times=False)
+    assert "time" in ds.dims
+    return ds, path
+
+
 def _batch_points(tmp_path, monkeypatch):
     """A list of points (``batch.zip``): one dimension ``point``, the swept keys coordinates along it."""
     path = run_batch_sweep(["integrator=rk4", "integrator.step=0.01", "batch.zip=true", "body.a=1.5,2",
@@ -176,6 +185,7 @@ KINDS = {
     "sweep_multirun": _sweep,
     "sweep_batch": _batch,
     "sweep_batch_points": _batch_points,
+    "sweep_batch_trajectory": _batch_trajectory,
     "regime": _task("regime", [*overrides_000(20.0), "regime.periods=1", "regime.samples_per_period=50"]),
     "work_precision": _task("work_precision", [
         "experiment=work_precision", "time.end=1", "work_precision.repeats=1", "~work_precision.methods",

@@ -16,8 +16,24 @@ pytest.importorskip("compliance_checker", reason="compliance-checker is not inst
 
 from tests.test_cf_compliance import KINDS, _run  # noqa: E402
 
+
+
+def _batch_output(output):
+    """A --batch sweep.nc with another ``batch.output`` (the CF test covers the default reductions)."""
+    def build(tmp_path, monkeypatch):
+        import xarray as xr
+
+        from gyrolab.batch.sweep import run_batch_sweep
+
+        path = run_batch_sweep(["integrator=rk4", "integrator.step=0.01", "body.a=1.5,2", f"batch.output={output}",
+                                "time.end=1", "time.n_output=11", "output.figures=false"], tmp_path)
+        return xr.load_dataset(path, decode_times=False), path
+    return build
+
+
 #: the gyrostat experiment is a scene: its dataset is a run.nc of the orbiting gyrostat with its own options
-ALL_KINDS = {**KINDS, "gyrostat": _run(["experiment=gyrostat"])}
+ALL_KINDS = {**KINDS, "gyrostat": _run(["experiment=gyrostat"]),
+             **{f"sweep_batch_{output}": _batch_output(output) for output in ("decimated", "final")}}
 
 
 def _numeric(variable) -> bool:
