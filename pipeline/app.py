@@ -515,26 +515,27 @@ def _animate(rest: Sequence[str]) -> int:
     of the run at PATH (``gyrolab.figures.animation``)."""
     usage = "usage: gyrolab --plot --animate PATH [--format=gif|mp4] [--frames=N] [--fps=N] [--output=FILE]"
     paths, options = [], {}
-    for arg in rest:
-        option, has_value, value = arg.partition("=")
+    args = list(rest)
+    while args:
+        option, has_value, value = args.pop(0).partition("=")
         if option == "--animate":
             if has_value:
                 paths.append(value)
-        elif option in ANIMATE_OPTIONS and has_value:
-            options[ANIMATE_OPTIONS[option]] = value
+        elif option in ANIMATE_OPTIONS and (has_value or args):   # --frames=60 or --frames 60
+            options[ANIMATE_OPTIONS[option]] = value if has_value else args.pop(0)
         elif option.startswith("-") or has_value:
-            raise ConfigError(f"--animate does not take {shorten(arg)!r}; {usage}")
+            raise ConfigError(f"--animate does not take {shorten(option + has_value + value)!r}; {usage}")
         else:
-            paths.append(arg)
+            paths.append(option)
     if len(paths) != 1:
         raise ConfigError(f"--animate takes exactly one path (got {len(paths)}: {shorten(' '.join(paths)) or 'none'}); "
                           f"{usage}")
-    for key, kind in (("frames", int), ("fps", float)):
+    for key, kind, what in (("frames", int, "a whole number"), ("fps", float, "a number")):
         if key in options:
             try:
                 options[key] = kind(options[key])
             except ValueError:
-                raise ConfigError(f"--{key}={options[key]!r} is not a number; {usage}") from None
+                raise ConfigError(f"--{key}={options[key]!r} is not {what}; {usage}") from None
     from gyrolab.figures.animation import animate
 
     logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")

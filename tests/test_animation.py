@@ -111,7 +111,7 @@ def test_mp4_with_ffmpeg(run_dir, tmp_path):
 
 def test_command_line_end_to_end(run_dir, tmp_path):
     out = tmp_path / "cli.gif"
-    done = subprocess.run([sys.executable, "-m", "gyrolab", "--plot", "--animate", str(run_dir), "--frames=6",
+    done = subprocess.run([sys.executable, "-m", "gyrolab", "--plot", "--animate", str(run_dir), "--frames", "6",
                            "--fps=12", f"--output={out}"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert _frames(out) == 6
@@ -119,3 +119,17 @@ def test_command_line_end_to_end(run_dir, tmp_path):
                          capture_output=True, text=True, timeout=300)
     assert bad.returncode != 0 and bad.stderr.strip().splitlines() == [
         "gyrolab: error: animation format 'webm' is not one of gif, mp4"]
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--bogus", "3"], "does not take '--bogus'"),
+    (["--frames", "2.5"], "not a whole number"),
+    (["--fps=fast"], "not a number"),
+    (["second_path"], "exactly one path"),
+])
+def test_command_line_refusals_are_one_sentence(run_dir, args, words):
+    from gyrolab.app import run_command
+
+    with pytest.raises(ConfigError, match=words) as error:
+        run_command(["--plot", "--animate", str(run_dir), *args])
+    assert "\n" not in str(error.value)
