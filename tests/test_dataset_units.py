@@ -59,13 +59,12 @@ SI_TOP = ["body.units=si", "body.a=null", "body.b=null", "body.com_direction=nul
           "body.mass=0.5", "body.com=[0,0,0.1]", "body.g=9.81", "force=[uniform_gravity]"]
 
 
-def _sweep_of(overrides):
+def _sweep_of(overrides, tail=("time.end=0.5", "time.n_output=5")):
     from gyrolab import run
     from gyrolab.sweep.aggregate import FINISHED, JobResult, assemble
     from gyrolab.sweep.grid import Grid
 
-    grid = Grid.from_overrides([*overrides, "output.euler_angles=false", "time.end=0.5", "time.n_output=5",
-                                "output.figures=false"])
+    grid = Grid.from_overrides([*overrides, "output.euler_angles=false", *tail, "output.figures=false"])
     results = []
     for n, job in enumerate(grid.jobs):
         ds = run(list(job))
@@ -110,3 +109,12 @@ def test_quantity_units(key, si, nondimensional):
 
     assert quantity_units(key, "si") == si
     assert quantity_units(key, "nondimensional") == nondimensional
+
+
+def test_sweep_whose_jobs_differ_in_output_times_explains_its_sample_dimension():
+    ds = _sweep_of(["time.end=0.5,1"], tail=("time.n_output=5",))
+    assert "sample" in ds.dims and "sample" not in ds.coords
+    assert "output times" in ds.attrs["sample_description"]
+    assert ds["time"].dims[-1] == "sample" and ds["time"].attrs["units"] == "1"
+    assert ds["end"].attrs["units"] == "1"                 # time.end of a nondimensional body
+    assert "axis" not in ds["time"].attrs                   # a variable over the jobs, not the T coordinate

@@ -140,6 +140,7 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
                 _index_coordinate(coords, variable, f"{name}_{attr}")
         if sample == "sample":
             data_vars["time"] = _stack(done, "time", shape, grid_dims, sample)
+            data_vars["time"][2].pop("axis", None)   # a variable over the jobs now, not the T coordinate (CF §4)
         for name in _union([list(ds.data_vars) for _, ds in done]):
             data_vars[name] = _stack(done, name, shape, grid_dims, sample)
             for attr, variable in _per_job_attrs(done, name, shape, grid_dims, body_units).items():
@@ -184,6 +185,8 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
     ds.attrs.update({
         "failed_job_description": "dimension failed_job: one entry per failed job, in job order (the failed_job_* "
                                   "variables are its table)",
+        **({"sample_description": "dimension sample: each job's output times in order (the jobs' output times "
+                                  "differ: the variable time holds each job's own)"} if sample == "sample" else {}),
         "title": f"gyrolab sweep over {' × '.join(grid_dims) or 'no parameter'} ({len(results)} jobs)",
         "sweep_dims": " ".join(grid_dims),
         "sweep_keys": " ".join(d.key for d in grid.dims),
