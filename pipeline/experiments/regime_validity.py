@@ -42,6 +42,8 @@ def _prepare(sub: DictConfig, where: str):
     scene, regime, warnings = prepare(sub, report=False)
     _expected.extend(f"{where}: {regime.name}: {warning}" for warning in warnings)
     return scene, regime, warnings
+
+
 KEYS = ("pq", "r", "gamma", "gamma3", "period")
 LONG = {"pq": "p, q", "r": "r", "gamma": "γ, γ'", "gamma3": "γ''", "period": "period"}
 
