@@ -42,6 +42,7 @@ from compliance_checker.runner import CheckSuite  # noqa: E402
 from gyrolab import run  # noqa: E402
 from gyrolab.engine.config import compose_config  # noqa: E402
 from gyrolab.experiments import TASKS, run_task  # noqa: E402
+from gyrolab.output.cf import conform  # noqa: E402
 from gyrolab.output.dataset import write_dataset  # noqa: E402
 from gyrolab.sweep.aggregate import FINISHED, JobResult, assemble  # noqa: E402
 from gyrolab.batch.sweep import run_batch_sweep  # noqa: E402
@@ -157,14 +158,17 @@ def _batch_points(tmp_path, monkeypatch):
 
 
 def _yehia(tmp_path, monkeypatch):
-    """One case of the Yehia table (the full table integrates every case for several orbits)."""
+    """One case of the Yehia table with its trace (the full table integrates every case for several orbits)."""
     from gyrolab.experiments import yehia2021_precessions as yehia
     from gyrolab.analysis.precession.cases import CASES
     from gyrolab.analysis.precession.closed_forms import check_closed_forms
 
     cfg = compose_config(["experiment=yehia2021_precessions", "yehia2021.orbits=0.1"])
-    row, _ = yehia.evaluate(cfg, CASES[0], 0.1, 1e-10)
-    ds = yehia._dataset([row], check_closed_forms(), cfg)
+    row, trace = yehia.evaluate(cfg, CASES[0], 0.1, 1e-10)
+    traced = yehia.trace_variables([row], {row["label"]: trace})
+    ds = yehia._dataset([row], check_closed_forms(), cfg).merge(traced, combine_attrs="override")
+    ds.attrs.update(traced.attrs)
+    ds = conform(ds, source="yehia2021_precessions experiment")
     return ds, write_dataset(ds, tmp_path / "precession_cases.nc")
 
 
@@ -234,7 +238,7 @@ def test_dataset_kind_is_cf_1_8(kind, tmp_path, monkeypatch):
 
     with xr.open_dataset(path, decode_times=False) as back:                     # still round-trips identically
         xr.testing.assert_identical(back.load(), ds)
-    if "frame_axis" in ds.dims:   # the gyrostat's frames are labelled; the orbital z component is γ'' (orbit normal)
+    if "frame_axis" in ds.dims and "gamma" in ds:   # the gyrostat's frames are labelled; the orbital z component is γ'' (orbit normal)
         assert list(ds.frame_axis.values) == ["x_radial", "y_along_track", "z_normal"]
         np.testing.assert_array_equal(ds.body_axis_orbital.sel(frame_axis="z_normal").values, ds.gamma.values[:, 2])
 
