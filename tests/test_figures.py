@@ -265,3 +265,18 @@ def test_regime_figure_states_the_normalised_start(norm, stated, outside):
         assert "γ(0) normalised" in full and stated in full
     notes = " ".join(ax.get_title(loc="left") for ax in fig.axes)
     assert ("outside its domain" in notes) == outside
+
+
+@pytest.mark.parametrize("key, units, expected", [
+    ("initial.r0", "1", "initial.r0 (units of c)"),       # a nondimensional spin is in units of c
+    ("initial.r0", "rad s-1", "initial.r0 (rad/s)"),
+    ("initial.theta0", "rad", "initial.theta0 (rad)"),
+    ("body.a", "1", "body.a"),                            # a ratio: no unit
+    ("initial.r0", None, "initial.r0"),                   # a sweep.nc written before swept keys had units
+])
+def test_sweep_x_label_gives_the_swept_keys_unit(key, units, expected):
+    from gyrolab.figures.sweep import draw_invariant_drift
+
+    ds = _drift_sweep()
+    ds["r0"].attrs.update({"override_key": key, **({"units": units} if units else {})})
+    assert draw_invariant_drift(ds).axes[0].get_xlabel() == expected

@@ -24,6 +24,7 @@ from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.run import INVARIANTS
 from gyrolab.figures.save import save_all
 from gyrolab.figures.style import DOUBLE, SINGLE, legend_outside, panel_note, styled, subplots
+from gyrolab.output.units import KINDS
 
 MAX_SERIES = 8
 MARKERS = "osD^v<>p"
@@ -96,7 +97,7 @@ def _draw(ds: xr.Dataset, panels: list[Panel], title: str) -> plt.Figure:
     nrows = -(-len(panels) // ncols)
     fig, axes = subplots(nrows, ncols, width=SINGLE if ncols == 1 else DOUBLE, height=0.9 + 1.9 * nrows)
     for ax, (quantity, ylabel, da, log) in zip(axes.flat, panels):
-        _panel(ax, da, xdim, log)
+        _panel(ax, da, xdim, log, ds)
         ax.set_title(quantity, loc="left", fontsize=7.5)  # left: a panel_note (sweep_cost) goes under it
         ax.set_ylabel(ylabel)
     for ax in list(axes.flat)[len(panels):]:
@@ -128,7 +129,7 @@ def draw_cost(ds: xr.Dataset) -> plt.Figure:
     return fig
 
 
-def _panel(ax: plt.Axes, da: xr.DataArray, xdim: str, log: bool) -> None:
+def _panel(ax: plt.Axes, da: xr.DataArray, xdim: str, log: bool, ds: xr.Dataset) -> None:
     x = da[xdim].values
     numeric = x.dtype.kind in "iuf"
     positions = x.astype(float) if numeric else np.arange(len(x), dtype=float)
@@ -164,7 +165,16 @@ def _panel(ax: plt.Axes, da: xr.DataArray, xdim: str, log: bool) -> None:
         ax.set_xlim(positions[0] - 0.5, positions[-1] + 0.5)
     elif len(positions) > 1 and positions.min() > 0 and positions.max() / positions.min() > 50:
         ax.set_xscale("log")
-    ax.set_xlabel(str(da[xdim].attrs.get("override_key", xdim)))
+    ax.set_xlabel(_xlabel(ds, da[xdim], xdim))
+
+
+def _xlabel(ds: xr.Dataset, coord: xr.DataArray, xdim: str) -> str:
+    """The swept key with its unit: SI as stored, a nondimensional rate or time in units of c (or Ω), none for
+    a pure number (gyrolab.output.units knows which kind a key is)."""
+    key = str(coord.attrs.get("override_key", xdim))
+    units = coord.attrs.get("units")
+    kind = KINDS.get(key.lstrip("+~").replace(".", "_"), "1")
+    return label(key, unit(ds, units, kind) if units is not None else "")
 
 
 FIGURES = {"sweep_final_state": (draw_final_state, _final_state), "sweep_invariant_drift": (draw_invariant_drift, _drift),
