@@ -268,7 +268,7 @@ def validate_scene(scene_cfg: DictConfig) -> None:
     if task_of(scene_cfg) == "regime":  # the regime's domain is checked before anything is written
         from gyrolab.experiments.regime_run import prepare
 
-        prepare(scene_cfg)
+        prepare(scene_cfg, report=False)   # the run reports the domain warnings (once)
     else:
         Scene.from_config(scene_cfg)
 
@@ -487,6 +487,8 @@ def _plot(argv: Sequence[str]) -> int:
     datasets under PATH (``gyrolab.figures.redraw``) with the current style, formats and dpi; nothing is integrated."""
     _, _, value = argv[0].partition("=")
     rest = ([value] if value else []) + list(argv[1:])
+    if "--animate" in rest or any(a.startswith("--animate=") for a in rest):
+        return _animate(rest)
     paths = [a for a in rest if "=" not in a]
     overrides = [a for a in rest if "=" in a]
     if len(paths) != 1:
@@ -501,6 +503,43 @@ def _plot(argv: Sequence[str]) -> int:
     formats, dpi = figure_options(compose_config(overrides).output)
     for path in redraw(Path(paths[0]), formats, dpi):
         log.info("wrote %s", path)
+    return 0
+
+
+#: ``gyrolab --plot --animate PATH`` options -> ``gyrolab.figures.animation.animate`` keywords
+ANIMATE_OPTIONS = {"--format": "fmt", "--frames": "frames", "--fps": "fps", "--output": "output"}
+
+
+def _animate(rest: Sequence[str]) -> int:
+    """``gyrolab --plot --animate PATH [--format=gif|mp4] [--frames=N] [--fps=N] [--output=FILE]``: an animation
+    of the run at PATH (``gyrolab.figures.animation``)."""
+    usage = "usage: gyrolab --plot --animate PATH [--format=gif|mp4] [--frames=N] [--fps=N] [--output=FILE]"
+    paths, options = [], {}
+    args = list(rest)
+    while args:
+        option, has_value, value = args.pop(0).partition("=")
+        if option == "--animate":
+            if has_value:
+                paths.append(value)
+        elif option in ANIMATE_OPTIONS and (has_value or args):   # --frames=60 or --frames 60
+            options[ANIMATE_OPTIONS[option]] = value if has_value else args.pop(0)
+        elif option.startswith("-") or has_value:
+            raise ConfigError(f"--animate does not take {shorten(option + has_value + value)!r}; {usage}")
+        else:
+            paths.append(option)
+    if len(paths) != 1:
+        raise ConfigError(f"--animate takes exactly one path (got {len(paths)}: {shorten(' '.join(paths)) or 'none'}); "
+                          f"{usage}")
+    for key, kind, what in (("frames", int, "a whole number"), ("fps", float, "a number")):
+        if key in options:
+            try:
+                options[key] = kind(options[key])
+            except ValueError:
+                raise ConfigError(f"--{key}={options[key]!r} is not {what}; {usage}") from None
+    from gyrolab.figures.animation import animate
+
+    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
+    animate(paths[0], **options)   # logs the file it wrote
     return 0
 
 

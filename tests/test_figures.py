@@ -155,3 +155,128 @@ def test_exact_zeros_are_gaps_not_a_floor(tmp_path):
     finite = drawn[np.isfinite(drawn)]
     assert finite.min() > 1e-12 and np.isnan(drawn).any()
     assert any("exactly 0" in t.get_text() for t in fig.legends[0].get_texts())
+
+
+def _drift_sweep():
+    """A sweep over r0 × integrator with the heavy body's four invariants (nondimensional: units of C c for Iω·γ)."""
+    r0, integrators = [2.0, 5.0, 10.0], ["rk4", "dop853"]
+    drift = np.array([[1e-10, 1e-7, 1e-5], [1e-9, 1e-9, 1e-9]])
+    variables = {f"{name}_max_abs_drift": (("integrator", "r0"), drift, {"units": "1"})
+                 for name in ("energy", "area_integral", "gamma_norm", "frame_error")}
+    return xr.Dataset(variables, coords={"integrator": integrators, "r0": ("r0", r0, {"override_key": "initial.r0"})},
+                      attrs={"sweep_dims": "integrator r0", "n_finished": 6, "n_failed": 0, "rate_unit": "c",
+                             "energy_unit": "C c2", "time_unit": "1/c"})
+
+
+def _overlap(a, b) -> bool:
+    return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
+
+
+def test_sweep_labels_stay_inside_their_panels_and_clear_of_the_title():
+    """The area-integral y label overran its panel and the figure title: every y label now fits the height of its
+    panel, touches no other panel and no title; the quantity names the panel."""
+    from gyrolab.figures.sweep import draw_invariant_drift
+
+    fig = draw_invariant_drift(_drift_sweep())
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    title = fig._suptitle.get_window_extent(renderer)
+    titles = {ax.get_title(loc="left") for ax in axes}
+    assert {"energy E", "area integral Iω·γ", "norm |γ|", "frame orthonormality error"} <= titles
+    for ax in axes:
+        ylabel = ax.yaxis.label.get_window_extent(renderer)
+        box = ax.get_window_extent(renderer)
+        assert ylabel.height <= box.height, f"{ax.get_ylabel()!r} is taller than its panel"
+        assert not _overlap(ylabel, title), f"{ax.get_ylabel()!r} runs into the title"
+        for other in axes:
+            if other is not ax:
+                assert not _overlap(ylabel, other.get_window_extent(renderer)), f"{ax.get_ylabel()!r} runs into a panel"
+                assert not _overlap(ylabel, other._left_title.get_window_extent(renderer)), \
+                    f"{ax.get_ylabel()!r} runs into another panel's title"
+    area = next(ax for ax in axes if ax.get_title(loc="left") == "area integral Iω·γ")
+    assert "units of C c" in area.get_ylabel()
+
+
+def _orbit_family(crowded: bool):
+    """Two families; crowded: the second turns back (a fold) and has a fold, a branch point and a period doubling
+    within 0.01 of r0/c, two of them at the same orbit, as near a homoclinic end; else no fold, events far apart."""
+    r0 = [100.0, 10.0, 2.0, 1.0, 0.5, 100.0, 10.0, 3.0, 1.7, 1.75, 1.72, 1.74]
+    family = ["slow"] * 5 + ["turning"] * 7
+    n = len(r0)
+    amplitude = [0.01, 0.05, 0.2, 0.5, 0.9, 0.01, 0.05, 0.3, 0.8, 1.2, 1.5, 1.7]
+    events = {"event_family": ("event", ["slow", "turning", "turning", "turning", "turning"]),
+              "event_kind": ("event", ["branch point", "fold", "fold", "period doubling", "branch point"] if crowded
+                             else ["branch point", "period doubling", "branch point", "period doubling", "branch point"]),
+              "event_r0_over_c": ("event", [1.5, 1.69, 1.745, 1.745, 1.735] if crowded else [1.5, 1.69, 5, 6, 7]),
+              "event_point": ("event", [3, 9, 10, 10, 11] if crowded else [3, 9, 7, 7, 7])}
+    return xr.Dataset({"family": ("point", family), "family_label": ("point", family),
+                       "r0_over_c": ("point", r0), "period": ("point", np.linspace(0.1, 20, n)),
+                       "amplitude": ("point", amplitude), "stable": ("point", [1, 0] * (n // 2)), **events})
+
+
+def test_orbit_family_events_are_legend_markers_and_crowded_ones_get_an_inset():
+    from gyrolab.figures.orbit_family import draw_orbit_family
+
+    fig = draw_orbit_family(_orbit_family(crowded=True))
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert not {"F", "BP", "PD"} & set(texts)                      # no overprinting text labels
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    for kind in ("fold", "branch point", "period doubling"):
+        assert f"{kind} (located)" in legend                        # every marker is explained
+    assert len(fig.axes[1].child_axes) == 1                         # an inset of the amplitude panel
+    zoom = fig.axes[1].child_axes[0]
+    low, high = zoom.get_xlim()
+    assert zoom.get_xscale() == "linear" and low <= 1.69 and high >= 1.75 and high - low < 0.2
+    markers = [line for line in zoom.get_lines() if line.get_marker() in ("s", "D", "v") and len(line.get_xdata()) == 1]
+    assert len(markers) == 4                                        # the turning family's four events, each once
+    sizes = {line.get_marker(): line.get_markersize() for line in markers}
+    assert sizes["s"] > sizes["D"] > sizes["v"]                     # nested: co-located events stay visible
+
+    fig = draw_orbit_family(_orbit_family(crowded=False))
+    assert not fig.axes[1].child_axes                               # no family turns back: no inset
+    drawn = [line for ax in fig.axes for line in ax.get_lines() if line.get_marker() in ("D", "v")
+             and len(line.get_xdata()) == 1]
+    assert len(drawn) == 2 * 5                                      # every event in the period and amplitude panels
+
+
+def _regime(norm):
+    t = np.linspace(0, 1, 11)
+    wave = np.stack([np.sin(t), np.cos(t), 20 + 0 * t], axis=1)
+    gamma = np.stack([np.cos(t), 0 * t, 0.07 + 0 * t], axis=1)
+    data = {f"omega_{s}": (("time", "axis"), wave, {"units": "1"}) for s in ("analytic", "full", "orbit")}
+    data.update({f"gamma_{s}": (("time", "axis"), gamma, {"units": "1"}) for s in ("analytic", "full", "orbit")})
+    attrs = {"regime": "small_parameter", "rate_unit": "c"}
+    if norm is not None:
+        attrs["analytic_gamma0_norm"] = norm
+    return xr.Dataset(data, coords={"time": ("time", t, {"units": "1", "long_name": "time [1/c]"})}, attrs=attrs)
+
+
+@pytest.mark.parametrize("norm, stated, outside", [(1.0106, "0.011", True), (1.0000031, "3.1e-06", False),
+                                                   (1.0, None, False), (None, None, False)])
+def test_regime_figure_states_the_normalised_start(norm, stated, outside):
+    from gyrolab.figures.regime import draw_regime_comparison
+
+    fig = draw_regime_comparison(_regime(norm))
+    full = [t.get_text() for t in fig.legends[0].get_texts() if t.get_text().startswith("full model")][0]
+    if stated is None:
+        assert "normalised" not in full
+    else:
+        assert "γ(0) normalised" in full and stated in full
+    notes = " ".join(ax.get_title(loc="left") for ax in fig.axes)
+    assert ("outside its domain" in notes) == outside
+
+
+@pytest.mark.parametrize("key, units, expected", [
+    ("initial.r0", "1", "initial.r0 (units of c)"),       # a nondimensional spin is in units of c
+    ("initial.r0", "rad s-1", "initial.r0 (rad/s)"),
+    ("initial.theta0", "rad", "initial.theta0 (rad)"),
+    ("body.a", "1", "body.a"),                            # a ratio: no unit
+    ("initial.r0", None, "initial.r0"),                   # a sweep.nc written before swept keys had units
+])
+def test_sweep_x_label_gives_the_swept_keys_unit(key, units, expected):
+    from gyrolab.figures.sweep import draw_invariant_drift
+
+    ds = _drift_sweep()
+    ds["r0"].attrs.update({"override_key": key, **({"units": units} if units else {})})
+    assert draw_invariant_drift(ds).axes[0].get_xlabel() == expected

@@ -39,9 +39,6 @@ FINISHED, FAILED = STATUS_FLAGS[record.FINISHED], STATUS_FLAGS[record.FAILED]
 STATUS_ATTRS = {"long_name": "how the point ended: 0 not run, 1 finished, 2 failed", "units": "1",
                 "flag_values": np.array([0, 1, 2], dtype=np.int8), "flag_meanings": "missing finished failed"}
 ERROR_ATTRS = {"long_name": "the point's error: index into error_message, -1 for none", "units": "1"}
-#: units of swept initial-state keys (the body's rate unit for the angular velocity)
-ANGLE_KEYS = ("theta0", "phi0", "psi0")
-RATE_KEYS = ("p0", "q0", "r0")
 
 
 class Store:
@@ -210,7 +207,7 @@ class Store:
             times = output_times(self.plan.times, self.settings.output, self.settings.decimate)
             var = self.nc.createVariable("time", "f8", ("time",))
             var[:] = times
-            var.setncatts(time_attributes(system.body) if system is not None else {"long_name": "time"})
+            var.setncatts(time_attributes(system.body) if system is not None else {"long_name": "time", "axis": "T"})
         elif dim == "axis" and size == 3:
             _text_variable(self.nc, "axis", "axis", ["x", "y", "z"], {"units": "1", "long_name": "principal body axis"})
 
@@ -231,6 +228,8 @@ class Store:
             "batch_identity": self.identity,
             "batch_output": settings.output,
             "n_points": plan.size,
+            "error_kind_description": "dimension error_kind: one entry per distinct error message of the failed "
+                                      "points; job_error holds each point's entry (-1: no error)",
             "sweep_launcher": "batch",
             "integrator": str((plan.plain.get("integrator") or {}).get("_target_", "")).rsplit(".", 1)[-1],
         }
@@ -299,12 +298,9 @@ def _reference_system(plan: Any) -> Any:
 
 
 def _key_units(key: str, system: Any) -> dict[str, str]:
-    """CF units of a swept key where gyrolab knows them (angles, the angular velocity, nondimensional ratios)."""
-    section, _, name = key.lstrip("+~").rpartition(".")
-    if section == "initial" and name in ANGLE_KEYS:
-        return {"units": "rad"}
-    if section == "initial" and name in RATE_KEYS and system is not None:
-        return {"units": system.body.rate_unit}
-    if section == "body" and name in ("a", "b"):
-        return {"units": "1"}
-    return {}
+    """CF units of a swept key where gyrolab knows them (``gyrolab.output.units``: every key of a nondimensional
+    body, the known keys of an SI one)."""
+    from gyrolab.output.units import quantity_units
+
+    units = quantity_units(key, system.body.units if system is not None else None)
+    return {"units": units} if units else {}

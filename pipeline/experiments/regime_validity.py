@@ -31,6 +31,19 @@ from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 
 log = logging.getLogger(__name__)
+
+#: the domain warnings of the points this experiment probes on purpose (near resonances, at the edge of a domain,
+#: non-physical bodies): collected, not printed one by one; their text goes into the dataset, a count to the log
+_expected: list[str] = []
+
+
+def _prepare(sub: DictConfig, where: str):
+    """``prepare`` without its per-warning log lines; the warnings are collected in ``_expected``."""
+    scene, regime, warnings = prepare(sub, report=False)
+    _expected.extend(f"{where}: {regime.name}: {warning}" for warning in warnings)
+    return scene, regime, warnings
+
+
 KEYS = ("pq", "r", "gamma", "gamma3", "period")
 LONG = {"pq": "p, q", "r": "r", "gamma": "γ, γ'", "gamma3": "γ''", "period": "period"}
 
@@ -81,6 +94,7 @@ def _r0_for(regime: str, value: float, cfg: DictConfig) -> float:
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     spec = cfg.regime_validity
     rows, verdicts = [], []
+    _expected.clear()
     for regime_name in spec.regimes:
         values = [float(v) for v in spec[regime_name]["values"]]
         fit_below = float(spec[regime_name]["fit_below"])
@@ -90,7 +104,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         for value in values:
             sub = _cfg_for(cfg, regime_name, _r0_for(regime_name, value, cfg))
             try:
-                scene, regime, _ = prepare(sub)
+                scene, regime, _ = _prepare(sub, f"{regime_name} at {spec[regime_name]['parameter']} = {value:g}")
             except ConfigError as error:
                 status.append(f"refused: {error}")
                 _append_missing(errs)
@@ -142,9 +156,15 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     ds = _dataset(rows, verdicts, cfg)
     if sweep is not None:
         ds = ds.merge(_resonance_dataset(sweep))
+    ds.attrs["n_expected_warnings"] = len(_expected)
+    ds.attrs["expected_warnings"] = "\n".join(_expected) or "none"
     conform(ds, source="regime_validity experiment")
     written = [write_dataset(ds, Path(out_dir) / "regime_validity.nc")]
     written += draw_figures("regime_validity.nc", ds, out_dir, cfg.get("output"))
+    if _expected:
+        log.warning("%d expected domain warnings (points probed on purpose near resonances, at the edge of a "
+                    "regime's domain or with non-physical bodies); their text is in %s (attribute expected_warnings)",
+                    len(_expected), written[0])
     return written
 
 
@@ -174,7 +194,7 @@ def resonance_point(cfg: DictConfig, omega: float, *, check: bool = True) -> tup
     nan = {k: np.nan for k in KEYS}
     try:
         if check:
-            scene, regime, _ = prepare(sub)
+            scene, regime, _ = _prepare(sub, f"resonance sweep at ω = {float(omega):g}")
         else:
             from gyrolab.experiments.regime_run import build_regime
             from gyrolab.engine.scene import Scene

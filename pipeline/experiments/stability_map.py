@@ -22,6 +22,14 @@ from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError, as_number
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.cf import conform
+
+#: what the index dimensions of the Poincaré sections count (they have no coordinate: an index is all they are)
+SECTION_DIMENSIONS = {
+    "section_point_description": "dimension section_point: one entry per stability_map.sections initial condition "
+                                 "[theta0, r0], in the config's order",
+    "crossing_description": "dimension crossing: the upward crossings of the section by that point's trajectory, "
+                            "in time order (NaN past its last crossing)",
+}
 from gyrolab.output.dataset import write_dataset
 from gyrolab.sweep.grid import Dim
 
@@ -91,4 +99,6 @@ def _add_sections(path: Path, plain: dict, points: Sequence[Sequence[float]], t_
                                step, np.stack([s.system.compiled_model().params for s in scenes]),
                                rate_units=ds.r0.attrs.get("units", "1"))
     # conform: the rewrite must stay CF-1.8 like the store's file (no _FillValue on the coordinates, history)
-    write_dataset(conform(ds.merge(sections, combine_attrs="drop_conflicts"), source="Poincaré sections added"), path)
+    merged = ds.merge(sections, combine_attrs="drop_conflicts")
+    merged.attrs.update(SECTION_DIMENSIONS)
+    write_dataset(conform(merged, source="Poincaré sections added"), path)

@@ -25,7 +25,7 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.cf import conform
-from gyrolab.output.dataset import write_dataset
+from gyrolab.output.dataset import FRAME_AXES, write_dataset
 from gyrolab.errors import ConfigError, as_number
 from gyrolab.analysis.precession.cases import CASES, Case
 from gyrolab.analysis.precession.classify import classify
@@ -133,8 +133,10 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                              f"{row['residual_euler_angles']:.3e}", f"{row['max_theta_deviation']:.3e}",
                              {True: "true", False: "false", None: ""}[row["stable"]], row["verdict"], row["condition"],
                              row["stability_note"]])
-    ds = conform(_dataset(rows, closed, cfg).merge(trace_variables(rows, traces), combine_attrs="override"),
-                 source="yehia2021_precessions experiment")
+    traced = trace_variables(rows, traces)
+    ds = _dataset(rows, closed, cfg).merge(traced, combine_attrs="override")
+    ds.attrs.update(traced.attrs)
+    ds = conform(ds, source="yehia2021_precessions experiment")
     written = [csv_path, write_dataset(ds, out_dir / "precession_cases.nc")]
     written += draw_figures("precession_cases.nc", ds, out_dir, cfg.get("output"))
     return written
@@ -152,7 +154,22 @@ def trace_variables(rows: list[dict[str, Any]], traces: dict[str, xr.Dataset]) -
             values[i, : len(trace)] = trace
         data[name] = (("case", "sample", "frame_axis"), values, {
             "units": "1", "long_name": first.attrs.get("long_name", name) + ", over the integration of each case"})
-    return xr.Dataset(data, coords={"case": ("case", np.array([r["label"] for r in rows]), {"long_name": "case label"})})
+    # the output times of each case's integration (they differ between cases: a variable along sample, NaN-padded)
+    first_time = traces[rows[0]["label"]]["time"]
+    times = np.full((len(rows), data["body_axis_orbital"][1].shape[1]), np.nan)
+    for i, row in enumerate(rows):
+        t = traces[row["label"]]["time"].values
+        times[i, : len(t)] = t
+    data["trace_time"] = (("case", "sample"), times, {
+        "units": first_time.attrs.get("units", "1"),
+        "long_name": f"{first_time.attrs.get('long_name', 'time')} of each case's integration (NaN past its end)"})
+    coords = {"case": ("case", np.array([r["label"] for r in rows]), {"long_name": "case label"}),
+              "frame_axis": ("frame_axis", np.array(FRAME_AXES), {
+                  "units": "1", "long_name": "frame axis: orbital (radial, along-track, orbit normal) or inertial "
+                                             "(X, Y, Z: the orbital axes at t = 0)"})}
+    return xr.Dataset(data, coords=coords, attrs={
+        "sample_description": "dimension sample: the output times of each case's integration, in order "
+                              "(trace_time holds them)"})
 
 
 def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) -> xr.Dataset:

@@ -11,6 +11,8 @@ without integrating anything:
 * ``work_precision``  -- ``work_precision.nc``: error against wall time and right-hand-side calls
 * ``tables``          -- ``ismail2021_tables.nc``; ``precessions`` -- ``precession_cases.nc``;
   ``shaker``          -- ``shaker_omega3.nc``
+* ``animation``       -- ``run.nc``: the body turning about the fixed point, as a GIF or MP4
+  (``gyrolab --plot --animate PATH``)
 
 ``style`` holds the one figure style (``gyrolab.mplstyle``, journal column widths) and ``save``
 writes a figure in the configured formats with the dataset's provenance in the file metadata.

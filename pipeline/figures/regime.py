@@ -16,6 +16,13 @@ SOURCES = {"orbit": ("exact periodic orbit (Newton shooting)", dict(ls="-", lw=2
            "reduced": ("reduced system, integrated", dict(ls=":", lw=1.4, color="C2"))}
 
 
+#: a rescaling of the series' γ(0) smaller than this is rounding, not worth a word
+RESCALE_SHOWN = 1e-9
+#: further than this from 1 (gyrolab.experiments.regime_run.NORM_WARNING), the panel of γ₃ says the scene is outside
+#: the series' domain
+OUTSIDE_NOTE = 1e-3
+
+
 @styled
 def draw_regime_comparison(ds: xr.Dataset) -> plt.Figure:
     rate = unit(ds, ds["omega_analytic"].attrs.get("units"), "rate")
@@ -23,10 +30,14 @@ def draw_regime_comparison(ds: xr.Dataset) -> plt.Figure:
               ("gamma", 2, "γ₃ = cos θ")]
     fig, axes = subplots(2, 2, width=DOUBLE, height=4.6, sharex=True)
     t = ds["time"].values
+    names = {source: name for source, (name, _) in SOURCES.items()}
+    norm = ds.attrs.get("analytic_gamma0_norm")
+    if norm is not None and abs(float(norm) - 1.0) > RESCALE_SHOWN:   # the full model's start was rescaled: say so
+        names["full"] += f", γ(0) normalised (series |γ| − 1 = {float(norm) - 1:.2g})"
     for ax, (var, i, ylabel) in zip(axes.flat, panels):
-        for source, (name, style) in SOURCES.items():
+        for source, (_, style) in SOURCES.items():
             if f"{var}_{source}" in ds:
-                ax.plot(t, ds[f"{var}_{source}"].values[:, i], label=name, **style)
+                ax.plot(t, ds[f"{var}_{source}"].values[:, i], label=names[source], **style)
         ax.set_ylabel(ylabel)
     for ax in axes[1]:
         ax.set_xlabel(time_label(ds))
@@ -38,6 +49,8 @@ def draw_regime_comparison(ds: xr.Dataset) -> plt.Figure:
         panel_note(axes[0, 1], f"order-{ds.attrs['series_order']} series: error slope "
                                f"{float(ds.attrs['series_error_slope']):.2f}, radius of convergence c/r₀ = "
                                f"{float(ds.attrs['series_radius_of_convergence']):.3g}")
+    if norm is not None and abs(float(norm) - 1.0) > OUTSIDE_NOTE:
+        panel_note(axes[1, 1], f"series |γ(0)| = {float(norm):.5g}: outside its domain")
     legend_outside(fig, ncols=2)
     fig.suptitle(f"Regime {regime}: analytic solution against the full model")
     return fig

@@ -24,11 +24,15 @@ from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.run import INVARIANTS
 from gyrolab.figures.save import save_all
 from gyrolab.figures.style import DOUBLE, SINGLE, legend_outside, panel_note, styled, subplots
+from gyrolab.output.units import KINDS
 
 MAX_SERIES = 8
 MARKERS = "osD^v<>p"
 
-Panel = tuple[str, xr.DataArray, bool]
+#: (panel title: the quantity, y label: what is plotted and its unit, values, log scale)
+Panel = tuple[str, str, xr.DataArray, bool]
+#: a y label longer than this puts its unit on a second line (a 3-column panel is ~1.6 in tall)
+LABEL_WIDTH = 22
 
 
 def choose_x(ds: xr.Dataset, dims: list[str]) -> str:
@@ -55,7 +59,7 @@ def _final_state(ds: xr.Dataset) -> list[Panel]:
             continue
         final = final_values(ds[name])
         for i, symbol in enumerate(symbols):
-            panels.append((label(f"{symbol} at the end", unit(ds, ds[name].attrs.get("units"), kind)),
+            panels.append((f"{symbol} at the end", _ylabel(symbol, unit(ds, ds[name].attrs.get("units"), kind)),
                            final.isel(axis=i), False))
     return panels
 
@@ -66,17 +70,24 @@ def _drift(ds: xr.Dataset) -> list[Panel]:
         if str(name).endswith("_max_abs_drift"):
             base = str(name).removesuffix("_max_abs_drift")
             symbol, kind = INVARIANTS.get(base, (base.replace("_", " "), "1"))
-            panels.append((label(f"max drift of {symbol}", unit(ds, ds[name].attrs.get("units"), kind)), ds[name], True))
+            panels.append((symbol, _ylabel("max |I(t) − I(0)|", unit(ds, ds[name].attrs.get("units"), kind)),
+                           ds[name], True))
     return panels
 
 
 def _cost(ds: xr.Dataset) -> list[Panel]:
     panels = []
     if "integrator_nfev" in ds:
-        panels.append(("integrator evaluations", ds["integrator_nfev"], True))
+        panels.append(("integrator evaluations", "evaluations", ds["integrator_nfev"], True))
     if "integrator_wall_time" in ds:
-        panels.append(("integrator wall time (s)", ds["integrator_wall_time"], True))
+        panels.append(("integrator wall time", "wall time (s)", ds["integrator_wall_time"], True))
     return panels
+
+
+def _ylabel(name: str, unit_text: str) -> str:
+    """'name (unit)', the unit on its own line when the label would overrun its panel."""
+    text = label(name, unit_text)
+    return text if len(text) <= LABEL_WIDTH or not unit_text else f"{name}\n({unit_text})"
 
 
 def _draw(ds: xr.Dataset, panels: list[Panel], title: str) -> plt.Figure:
@@ -85,8 +96,9 @@ def _draw(ds: xr.Dataset, panels: list[Panel], title: str) -> plt.Figure:
     ncols = min(3, len(panels))
     nrows = -(-len(panels) // ncols)
     fig, axes = subplots(nrows, ncols, width=SINGLE if ncols == 1 else DOUBLE, height=0.9 + 1.9 * nrows)
-    for ax, (ylabel, da, log) in zip(axes.flat, panels):
-        _panel(ax, da, xdim, log)
+    for ax, (quantity, ylabel, da, log) in zip(axes.flat, panels):
+        _panel(ax, da, xdim, log, ds)
+        ax.set_title(quantity, loc="left", fontsize=7.5)  # left: a panel_note (sweep_cost) goes under it
         ax.set_ylabel(ylabel)
     for ax in list(axes.flat)[len(panels):]:
         ax.set_visible(False)
@@ -117,7 +129,7 @@ def draw_cost(ds: xr.Dataset) -> plt.Figure:
     return fig
 
 
-def _panel(ax: plt.Axes, da: xr.DataArray, xdim: str, log: bool) -> None:
+def _panel(ax: plt.Axes, da: xr.DataArray, xdim: str, log: bool, ds: xr.Dataset) -> None:
     x = da[xdim].values
     numeric = x.dtype.kind in "iuf"
     positions = x.astype(float) if numeric else np.arange(len(x), dtype=float)
@@ -153,7 +165,16 @@ def _panel(ax: plt.Axes, da: xr.DataArray, xdim: str, log: bool) -> None:
         ax.set_xlim(positions[0] - 0.5, positions[-1] + 0.5)
     elif len(positions) > 1 and positions.min() > 0 and positions.max() / positions.min() > 50:
         ax.set_xscale("log")
-    ax.set_xlabel(str(da[xdim].attrs.get("override_key", xdim)))
+    ax.set_xlabel(_xlabel(ds, da[xdim], xdim))
+
+
+def _xlabel(ds: xr.Dataset, coord: xr.DataArray, xdim: str) -> str:
+    """The swept key with its unit: SI as stored, a nondimensional rate or time in units of c (or Ω), none for
+    a pure number (gyrolab.output.units knows which kind a key is)."""
+    key = str(coord.attrs.get("override_key", xdim))
+    units = coord.attrs.get("units")
+    kind = KINDS.get(key.lstrip("+~").replace(".", "_"), "1")
+    return label(key, unit(ds, units, kind) if units is not None else "")
 
 
 FIGURES = {"sweep_final_state": (draw_final_state, _final_state), "sweep_invariant_drift": (draw_invariant_drift, _drift),

@@ -15,8 +15,10 @@ experiments). It makes the netCDF file a CF-1.8 file without changing what the d
   arrives only with CF-1.9), or float64 (exact to 2**53) when a value is outside the int32 range;
 * ``standard_name: time`` is dropped wherever the units are not ``<unit> since <epoch>``: gyrolab's
   time is elapsed model time (s, or a nondimensional unit), not a calendar date (CF §4.4). The
-  one message compliance-checker (6.x) still prints comes from its §5.1 heuristic that a dimension
-  named ``time`` must carry that standard name; claiming a calendar would be false, so it stays;
+  ``time`` coordinate carries ``axis: T`` (CF §4: axis identifies a coordinate's direction without
+  claiming a calendar). The one message compliance-checker (6.x) still prints comes from its §5.1
+  heuristic that a dimension named ``time`` must carry that standard name; claiming a calendar would
+  be false, so it stays (docs/datasets.md);
 * every variable and coordinate has a ``long_name`` (CF §3.3 wants one where there is no
   ``standard_name``): one a builder forgot (a third-party system's variable, say) becomes the
   variable's name, logged; gyrolab's own builders give real ones (tests/test_cf_compliance.py).
@@ -70,6 +72,8 @@ def conform(ds: xr.Dataset, title: str | None = None, source: str = "") -> xr.Da
             log.info("dataset variable %r has no long_name; its name stands in", name)
             attrs["long_name"] = str(name)
         if name in ds.coords:
+            if name == "time":  # elapsed model time is the T axis (no calendar claimed: see the docstring)
+                attrs.setdefault("axis", "T")
             variable.encoding["_FillValue"] = None
             if _is_text(variable):
                 variable.encoding["dtype"] = "S1"

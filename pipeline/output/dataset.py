@@ -158,8 +158,9 @@ def _index(data: np.ndarray, name: str, dim: str) -> Any:
 
 def time_attributes(body: ModelUnits) -> dict[str, str]:
     """CF attributes of a time coordinate in ``body``'s model units: elapsed time, not a calendar date
-    (so no ``standard_name: time``, which CF reserves for ``<unit> since <epoch>``)."""
-    return {"units": body.time_unit, "long_name": f"time [{body.time_label}]"}
+    (so no ``standard_name: time``, which CF reserves for ``<unit> since <epoch>``), marked as the T axis
+    (CF §4: ``axis`` identifies the time coordinate without claiming a calendar)."""
+    return {"units": body.time_unit, "long_name": f"time [{body.time_label}]", "axis": "T"}
 
 
 def write_dataset(ds: xr.Dataset, path: Path) -> Path:

@@ -41,6 +41,7 @@ from omegaconf import OmegaConf
 from gyrolab.contracts.integrator import IntegratorStats
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
+from gyrolab.output.units import quantity_units
 from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
 from gyrolab.errors import ConfigError
 from gyrolab.sweep.grid import Grid
@@ -69,7 +70,7 @@ PER_JOB_METADATA = {
     "integrator_wall_time": ("s", "integrator wall time"),
     "integrator_njev": ("1", "Jacobian evaluations of the integrator"),
     "integrator_nlu": ("1", "LU decompositions of the integrator"),
-    "sampling_fastest_rate": (None, "upper estimate of the fastest angular frequency (model rate units)"),
+    "sampling_fastest_rate": (None, "upper estimate of the fastest angular frequency"),
     "sampling_samples_per_period": ("1", "stored samples per period of the fastest motion"),
     "sampling_n_output_requested": (None, "time.n_output as the config gave it"),
     "sampling_warning": (None, "warning when the output times undersample the motion"),
@@ -115,9 +116,11 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
     names = _dim_names(grid, [ds for _, ds in done])
     grid_dims = tuple(names)
     shape = grid.shape
+    body_units = _body_units([ds for _, ds in done])
     coords: dict[str, Any] = {
-        name: (name, dim.coordinate(), {"long_name": f"swept parameter {dim.key}", "override_key": dim.key})
-        for name, dim in zip(names, grid.dims)
+        name: (name, values, {"long_name": f"swept parameter {dim.key}", "override_key": dim.key,
+                              **_units(values, quantity_units(dim.key, body_units))})
+        for name, dim in zip(names, grid.dims) for values in [dim.coordinate()]
     }
     data_vars: dict[str, Any] = {}
 
@@ -132,14 +135,17 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
                     raise ConfigError(f"jobs of this sweep disagree on coordinate {name!r}; they cannot share "
                                       "one sweep.nc")
             coords[name] = (coord.dims, coord.values, _common_attrs([ds[name] for _, ds in done]))
-            for attr, variable in _per_job_attrs(done, name, shape, grid_dims).items():
+            for attr, variable in _per_job_attrs(done, name, shape, grid_dims, body_units).items():
                 data_vars[f"{name}_{attr}"] = variable
+                _index_coordinate(coords, variable, f"{name}_{attr}")
         if sample == "sample":
             data_vars["time"] = _stack(done, "time", shape, grid_dims, sample)
+            data_vars["time"][2].pop("axis", None)   # a variable over the jobs now, not the T coordinate (CF §4)
         for name in _union([list(ds.data_vars) for _, ds in done]):
             data_vars[name] = _stack(done, name, shape, grid_dims, sample)
-            for attr, variable in _per_job_attrs(done, name, shape, grid_dims).items():
+            for attr, variable in _per_job_attrs(done, name, shape, grid_dims, body_units).items():
                 data_vars[f"{name}_{attr}"] = variable
+                _index_coordinate(coords, variable, f"{name}_{attr}")
 
     taken = set(coords) | set(data_vars) | set(grid_dims) | {"sample", "failed_job", "job_status", "job_dir",
                                                               "job_id", "title", "Conventions"}
@@ -154,9 +160,10 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
         name = key if key not in taken else f"run_{key}"
         data_vars[name] = _cell_variable(values, shape, grid_dims, name)
         units, long_name = PER_JOB_METADATA.get(key, (None, f"run attribute {key}, per job"))
-        data_vars[name][2].update({"long_name": long_name} if units is None or data_vars[name][1].dtype == object
-                                  else {"long_name": long_name, "units": units})
+        data_vars[name][2].update({"long_name": long_name, **_units(data_vars[name][1],
+                                                                    units or quantity_units(key, body_units))})
         taken.add(name)
+        _index_coordinate(coords, data_vars[name], key)
 
     statuses = np.zeros(shape, dtype=np.int8)
     job_ids = np.full(shape, "", dtype=object)
@@ -166,7 +173,7 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
         job_ids[grid.index[n]] = result.job_id
         job_dirs[grid.index[n]] = result.job_dir
     data_vars["job_status"] = (grid_dims, statuses, {
-        "long_name": "how the job ended", "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8),
+        "long_name": "how the job ended", "units": "1", "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8),
         "flag_meanings": " ".join(STATUS_FLAGS)})
     data_vars["job_id"] = (grid_dims, job_ids, {"long_name": "hash of the job's resolved config and code version"})
     data_vars["job_dir"] = (grid_dims, job_dirs, {"long_name": "job directory, relative to the sweep directory"})
@@ -176,6 +183,10 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
     counts = {status: sum(r.status == status for r in results) for status in STATUS_FLAGS}
     ds.attrs.update(common)
     ds.attrs.update({
+        "failed_job_description": "dimension failed_job: one entry per failed job, in job order (the failed_job_* "
+                                  "variables are its table)",
+        **({"sample_description": "dimension sample: each job's output times in order (the jobs' output times "
+                                  "differ: the variable time holds each job's own)"} if sample == "sample" else {}),
         "title": f"gyrolab sweep over {' × '.join(grid_dims) or 'no parameter'} ({len(results)} jobs)",
         "sweep_dims": " ".join(grid_dims),
         "sweep_keys": " ".join(d.key for d in grid.dims),
@@ -244,8 +255,30 @@ def _common_attrs(arrays: Sequence[xr.DataArray]) -> dict[str, Any]:
             and all(k in da.attrs and _same(v, da.attrs[k]) for da in arrays)}
 
 
+def _body_units(datasets: Sequence[xr.Dataset]) -> str | None:
+    """The jobs' body unit system (``si``/``nondimensional``), None when they differ or do not say."""
+    systems = {ds.attrs.get("body_units") for ds in datasets}
+    return systems.pop() if len(systems) == 1 else None
+
+
+def _units(values: Any, units: str | None) -> dict[str, str]:
+    """``{"units": units}`` for numeric values whose units are known; text has none."""
+    numeric = np.asarray(values).dtype.kind in "iufb"
+    return {"units": units} if numeric and units else {}
+
+
+def _index_coordinate(coords: dict[str, Any], variable: tuple, key: str) -> None:
+    """A per-job vector attribute (``initial_omega``) lies along ``<name>_index``: give that dimension a coordinate
+    (component 0, 1, 2, ...) that says what it counts."""
+    for dim, size in zip(variable[0], np.shape(variable[1])):
+        if dim.endswith("_index") and dim not in coords:
+            coords[dim] = (dim, np.arange(size, dtype=np.int32), {
+                "long_name": f"component of run attribute {key} (as stored in each job's run.nc, from 0)",
+                "units": "1"})
+
+
 def _per_job_attrs(done: Sequence[tuple[tuple[int, ...], xr.Dataset]], name: str, shape: tuple[int, ...],
-                   grid_dims: tuple[str, ...]) -> dict[str, tuple]:
+                   grid_dims: tuple[str, ...], body_units: str | None = None) -> dict[str, tuple]:
     having = [(index, ds[name]) for index, ds in done if name in ds.variables]
     out = {}
     for attr in _union([list(da.attrs) for _, da in having]):
@@ -256,7 +289,10 @@ def _per_job_attrs(done: Sequence[tuple[tuple[int, ...], xr.Dataset]], name: str
                 out[attr][2].update({"long_name": f"max |{name}(t) − {name}(0)|",
                                      "units": having[0][1].attrs.get("units", "1")})
             else:
-                out[attr][2]["long_name"] = f"attribute {attr} of {name}, per job"
+                units = (having[0][1].attrs.get("units") if attr == "invariant_allowed_drift"
+                         else quantity_units(attr, body_units))
+                out[attr][2].update({"long_name": f"attribute {attr} of {name}, per job",
+                                     **_units(out[attr][1], units)})
     return out
 
 
@@ -294,7 +330,7 @@ def _failure_table(grid: Grid, results: Sequence[JobResult]) -> dict[str, tuple]
         "failed_job_error_type": (dim, np.array([r.error_type for _, r in failed], dtype=object),
                                   {"long_name": "error class"}),
         "failed_job_exit_code": (dim, np.array([r.exit_code for _, r in failed], dtype=np.int32),
-                                 {"long_name": "exit code the single-run command would give"}),
+                                 {"long_name": "exit code the single-run command would give", "units": "1"}),
     }
 
 
