@@ -45,6 +45,8 @@ MEMORY_MARGIN_MIB = 1024
 #: seconds for apt-get (a fresh machine downloads about 20 MB) and for the node to become idle
 INSTALL_TIMEOUT = 600
 START_TIMEOUT = 60
+NOT_ROOT = ("SLURM tests need root (they install slurm-wlm and munge with apt-get when missing and start "
+            "munged, slurmctld and slurmd as root)")
 
 
 class Unavailable(RuntimeError):
@@ -62,6 +64,7 @@ class Cluster:
     processes: dict[str, subprocess.Popen] = field(default_factory=dict)
     install_seconds: float = 0.0
     start_seconds: float = 0.0
+    previous_conf: str | None = None   # SLURM_CONF before start(), restored by stop()
 
     def env(self) -> dict[str, str]:
         """The environment for a SLURM client (sbatch, sinfo, …) of this cluster."""
@@ -105,10 +108,17 @@ class Cluster:
                     process.wait(timeout=10)
         _kill_processes_naming(self.directory)   # slurmstepd and job steps left behind
         shutil.rmtree(self.directory, ignore_errors=True)
+        if os.environ.get("SLURM_CONF") == str(self.conf):
+            if self.previous_conf is None:
+                del os.environ["SLURM_CONF"]
+            else:
+                os.environ["SLURM_CONF"] = self.previous_conf
 
 
 def start(base: Path | None = None) -> Cluster:
     """Install (if needed) and start a single-node cluster; ``Unavailable`` when it cannot run here."""
+    if os.geteuid() != 0:
+        raise Unavailable(NOT_ROOT)
     install_seconds = install()
     base = Path(base or tempfile.gettempdir())
     clean_leftovers(base)
@@ -134,6 +144,7 @@ def start(base: Path | None = None) -> Cluster:
     except BaseException:
         cluster.stop()
         raise
+    cluster.previous_conf = os.environ.get("SLURM_CONF")
     os.environ["SLURM_CONF"] = str(conf)
     cluster.start_seconds = time.monotonic() - began
     return cluster
@@ -144,8 +155,7 @@ def install() -> float:
     if all(shutil.which(program, path=_sbin_path()) for program in PROGRAMS):
         return 0.0
     if os.geteuid() != 0:
-        raise Unavailable("SLURM tests need root (they install slurm-wlm and munge with apt-get and start "
-                          "slurmctld, slurmd and munged)")
+        raise Unavailable(NOT_ROOT)
     if shutil.which("apt-get") is None:
         raise Unavailable("SLURM tests need apt-get to install slurm-wlm and munge (Debian or Ubuntu)")
     began = time.monotonic()
@@ -215,7 +225,7 @@ def clean_leftovers(base: Path) -> None:
             owner = int((directory / "owner").read_text())
         except (OSError, ValueError):
             owner = None
-        if owner is not None and _alive(owner):
+        if owner is not None and alive(owner):
             continue
         _kill_processes_naming(directory)
         shutil.rmtree(directory, ignore_errors=True)
@@ -274,14 +284,13 @@ def _ancestors() -> set[int]:
     return pids
 
 
-def _alive(pid: int) -> bool:
+def alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie, dead but not reaped by its parent, does not)."""
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
+        stat = (Path("/proc") / str(pid) / "stat").read_text()
+    except OSError:
         return False
-    except PermissionError:
-        return True
-    return True
+    return stat.rsplit(")", 1)[1].split()[0] != "Z"
 
 
 def _free_ports(count: int) -> list[int]:

@@ -8,7 +8,9 @@ reason; CI runs as root on Debian, so there they run. The commands are docs/clus
 launcher, the batch in this process), never from a stored file.
 """
 
+import contextlib
 import os
+import socket
 import subprocess
 import sys
 import time
@@ -60,12 +62,11 @@ def comparable(path):
     return ds
 
 
-def test_the_cluster_runs_a_job(slurm, tmp_path):
-    """The fixture's cluster itself: a batch job runs on the node and sees the partition."""
-    out = tmp_path / "job.out"
-    slurm.run("sbatch", "--wait", "--partition", slurm.partition, "--output", str(out),
-              "--wrap", "echo $SLURM_JOB_PARTITION $SLURM_JOB_NODELIST", timeout=60)
-    assert out.read_text().split() == [slurm.partition, slurm.node]
+def test_the_cluster_runs_a_job(slurm):
+    """The fixture's cluster itself: a job step runs on the node, in the partition."""
+    where = slurm.run("srun", "--partition", slurm.partition, "--ntasks", "1", "--time", "1",
+                      "sh", "-c", "echo $SLURM_JOB_PARTITION $SLURMD_NODENAME", timeout=60)
+    assert where.split() == [slurm.partition, slurm.node]
 
 
 def test_submitit_launcher_sweep_equals_the_local_sweep(slurm, tmp_path):
@@ -120,3 +121,35 @@ def test_dask_jobqueue_batch_equals_the_local_batch(slurm, tmp_path):
     assert len(workers) == 2
     assert chunk_tasks is not None and chunk_tasks.duration_average > 0
     xr.testing.assert_identical(comparable(tmp_path / "slurm" / "sweep.nc"), comparable(tmp_path / "local" / "sweep.nc"))
+
+
+def test_a_killed_sessions_cluster_is_ended_by_the_next_start(slurm, tmp_path):
+    """A session killed with SIGKILL leaves its daemons running; the next start ends them and removes their
+    directory, and starts although SLURM's default ports (6817, 6818) are taken."""
+    code = ("import sys, time, slurm_cluster; cluster = slurm_cluster.start(sys.argv[1]); "
+            "print(cluster.directory, flush=True); time.sleep(600)")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).parent), os.environ.get("PYTHONPATH", "")])}
+    child = subprocess.Popen([sys.executable, "-c", code, str(tmp_path)], stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        directory = Path(child.stdout.readline().strip())
+        daemons = {name: int((directory / f"{name}.pid").read_text()) for name in ("munged", "slurmctld", "slurmd")}
+    finally:
+        child.kill()
+        child.wait()
+    assert all(slurm_cluster.alive(pid) for pid in daemons.values()), daemons   # left behind
+    with contextlib.ExitStack() as stack:
+        for port in (6817, 6818):
+            taken = stack.enter_context(socket.socket())
+            with contextlib.suppress(OSError):   # already taken by something else: as good
+                taken.bind(("0.0.0.0", port))
+                taken.listen()
+        again = slurm_cluster.start(tmp_path)
+    try:
+        assert not directory.exists()
+        assert not [name for name, pid in daemons.items() if slurm_cluster.alive(pid)]
+        assert again.node_state() == "idle"
+        assert os.environ["SLURM_CONF"] == str(again.conf)
+    finally:
+        again.stop()
+    assert os.environ["SLURM_CONF"] == str(slurm.conf)   # the session's cluster is the clients' one again
+    assert slurm.node_state() == "idle"
