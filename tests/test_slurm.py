@@ -10,6 +10,7 @@ launcher, the batch in this process), never from a stored file.
 
 import contextlib
 import os
+import shlex
 import socket
 import subprocess
 import sys
@@ -23,10 +24,8 @@ import slurm_cluster
 
 pytestmark = pytest.mark.slurm
 
-# The recipe's sweep (docs/cluster.md): two tiny scenes, one SLURM array task each.
-SWEEP = ["initial.r0=1,2", "time.end=1", "time.n_output=11", "output.figures=false"]
-# The recipe's batch: four points in four chunks, so that both workers get chunks.
-BATCH = ["integrator=rk4_numba", "initial.r0=1,2,3,4", "time.end=1", "time.n_output=11", "batch.chunk=1"]
+# docs/cluster.md, "SLURM, tested": the tests run its blocks verbatim, so the page is the tested recipe.
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "cluster.md"
 # What legitimately differs between two runs of the same command: when, how long, which launcher.
 VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
 VOLATILE_VARIABLES = ("integrator_wall_time",)
@@ -49,9 +48,25 @@ def slurm(tmp_path_factory):
         print(f"slurm: stopped in {time.monotonic() - began:.1f} s")
 
 
-def gyrolab(*args, cwd, env=None):
-    return subprocess.run([sys.executable, "-m", "gyrolab", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=300, env=env)
+def recipe(name):
+    """The fenced block of docs/cluster.md after ``<!-- tests/test_slurm.py runs the next block: NAME -->``."""
+    marker = f"<!-- tests/test_slurm.py runs the next block: {name} -->"
+    text = DOCS.read_text()
+    assert marker in text, f"docs/cluster.md has no block {name!r}"
+    block = text.split(marker, 1)[1].split("```", 2)[1]
+    return block.split("\n", 1)[1]   # without the fence's language
+
+
+def commands(name):
+    """The recipe's command lines, each split as the shell splits it."""
+    return [shlex.split(line) for line in recipe(name).splitlines() if line.strip()]
+
+
+def gyrolab(command, cwd):
+    """A recipe line ``gyrolab ...``, run with this Python (this venv's gyrolab)."""
+    assert command[0] == "gyrolab", command
+    return subprocess.run([sys.executable, "-m", "gyrolab", *command[1:]], cwd=cwd, capture_output=True,
+                          text=True, timeout=300)
 
 
 def comparable(path):
@@ -70,55 +85,37 @@ def test_the_cluster_runs_a_job(slurm):
 
 
 def test_submitit_launcher_sweep_equals_the_local_sweep(slurm, tmp_path):
-    for where in ("local", "slurm"):
-        (tmp_path / where).mkdir()
-    local = gyrolab("-m", *SWEEP, "hydra.sweep.dir=sweep", cwd=tmp_path / "local")
-    assert local.returncode == 0, local.stderr[-3000:]
+    local, on_slurm = commands("sweep")
+    assert "hydra/launcher=slurm" in on_slurm and f"hydra.launcher.partition={slurm.partition}" in on_slurm
+    done = gyrolab(local, tmp_path)
+    assert done.returncode == 0, done.stderr[-3000:]
     began = time.monotonic()
-    on_slurm = gyrolab("-m", "hydra/launcher=slurm", f"hydra.launcher.partition={slurm.partition}",
-                       "hydra.launcher.mem_gb=1", *SWEEP, "hydra.sweep.dir=sweep",
-                       cwd=tmp_path / "slurm")
+    done = gyrolab(on_slurm, tmp_path)
     print(f"slurm: the sweep through submitit took {time.monotonic() - began:.1f} s")
-    assert on_slurm.returncode == 0, on_slurm.stderr[-3000:] + slurm.logs()
-    # the jobs ran as SLURM jobs, not here: submitit's logs carry SLURM's job ids
-    logs = list((tmp_path / "slurm" / "sweep" / ".submitit").rglob("*_log.out"))
-    assert len(logs) == 2, logs
-    ran = comparable(tmp_path / "slurm" / "sweep" / "sweep.nc")
-    assert xr.load_dataset(tmp_path / "slurm" / "sweep" / "sweep.nc").attrs["sweep_launcher"] == "SlurmLauncher"
-    xr.testing.assert_identical(ran, comparable(tmp_path / "local" / "sweep" / "sweep.nc"))
+    assert done.returncode == 0, done.stderr[-3000:] + slurm.logs()
+    sweep = tmp_path / "slurm"
+    # the jobs ran as SLURM jobs: submitit's folder has one log per SLURM array task
+    assert len(list((sweep / ".submitit").rglob("*_log.out"))) == 2
+    assert xr.load_dataset(sweep / "sweep.nc").attrs["sweep_launcher"] == "SlurmLauncher"
+    xr.testing.assert_identical(comparable(sweep / "sweep.nc"), comparable(tmp_path / "local" / "sweep.nc"))
 
 
-def test_dask_jobqueue_batch_equals_the_local_batch(slurm, tmp_path):
-    from dask_jobqueue import SLURMCluster
-    from distributed import Client
-
-    local = gyrolab("--batch", *BATCH, "hydra.sweep.dir=local", cwd=tmp_path)
-    assert local.returncode == 0, local.stderr[-3000:]
+def test_dask_jobqueue_batch_equals_the_local_batch(slurm, tmp_path, monkeypatch):
+    local, on_slurm = commands("batch")
+    assert on_slurm[:2] == ["python", "slurm_batch.py"]
+    done = gyrolab(local, tmp_path)
+    assert done.returncode == 0, done.stderr[-3000:]
+    # python slurm_batch.py ..., in this process, so that the test can ask its Dask scheduler what ran
+    monkeypatch.chdir(tmp_path)   # SLURM writes the workers' slurm-JOBID.out here
+    monkeypatch.setattr(sys, "argv", on_slurm[1:])
+    script = {"__name__": "__main__"}
     began = time.monotonic()
-    # docs/cluster.md, "SLURM, tested": the same lines, with this test cluster's partition
-    cluster = SLURMCluster(
-        cores=1, processes=1, memory="2GB",               # one single-threaded worker per SLURM job
-        walltime="00:30:00", queue=slurm.partition,
-        python=sys.executable,                            # the workers run this Python (this venv)
-        job_script_prologue=["export NUMBA_NUM_THREADS=1 OMP_NUM_THREADS=1"],
-        scheduler_options={"dashboard_address": None},
-    )
-    try:
-        cluster.scale(jobs=2)
-        with Client(cluster) as client:
-            client.wait_for_workers(2, timeout=120)
-        started = time.monotonic() - began
-        env = {**os.environ, "DASK_SCHEDULER_ADDRESS": cluster.scheduler_address}
-        on_slurm = gyrolab("--batch", *BATCH, "hydra.sweep.dir=slurm", cwd=tmp_path, env=env)
-        with Client(cluster) as client:   # the chunks ran on the SLURM jobs' workers
-            workers = client.scheduler_info()["workers"]
-        # the scheduler timed gyrolab's chunk tasks (map_chunks' keys) on those workers
-        chunk_tasks = cluster.scheduler.task_prefixes.get("gyrolab-chunk")
-    finally:
-        cluster.close()
-    print(f"slurm: SLURMCluster with 2 workers up in {started:.1f} s, batch on it {time.monotonic() - began - started:.1f} s")
-    assert on_slurm.returncode == 0, on_slurm.stderr[-3000:] + slurm.logs()
-    assert len(workers) == 2
+    with pytest.raises(SystemExit) as exited:
+        exec(compile(recipe("slurm_batch.py"), "slurm_batch.py", "exec"), script)
+    print(f"slurm: slurm_batch.py (2 SLURM jobs as Dask workers, the batch on them) took {time.monotonic() - began:.1f} s")
+    assert exited.value.code == 0, slurm.logs()
+    # the scheduler the script started timed gyrolab's chunk tasks (map_chunks' keys): they ran on its workers
+    chunk_tasks = script["cluster"].scheduler.task_prefixes.get("gyrolab-chunk")
     assert chunk_tasks is not None and chunk_tasks.duration_average > 0
     xr.testing.assert_identical(comparable(tmp_path / "slurm" / "sweep.nc"), comparable(tmp_path / "local" / "sweep.nc"))
 
