@@ -42,6 +42,8 @@ PREFIX = "gyrolab-slurm-"
 PARTITION = "debug"
 #: memory left to the operating system and the test process (MiB)
 MEMORY_MARGIN_MIB = 1024
+#: a Unix socket's path (sockaddr_un.sun_path) holds at most 107 bytes and the terminating NUL
+SOCKET_PATH_MAX = 108
 #: seconds for apt-get (a fresh machine downloads about 20 MB) and for the node to become idle
 INSTALL_TIMEOUT = 600
 START_TIMEOUT = 60
@@ -83,11 +85,12 @@ class Cluster:
     def logs(self) -> str:
         """The tail of each daemon's log, for a failure message."""
         parts = []
-        for name in ("munged.log", "slurmctld.log", "slurmd.log"):
+        for name in ("munged.stdout", "munged.log", "slurmctld.stdout", "slurmctld.log", "slurmd.stdout", "slurmd.log"):
             path = self.directory / name
             if path.is_file():
                 lines = path.read_text(errors="replace").splitlines()[-15:]
-                parts.append(f"--- {name}\n" + "\n".join(lines))
+                if lines:
+                    parts.append(f"--- {name}\n" + "\n".join(lines))
         return "\n".join(parts)
 
     def stop(self) -> None:
@@ -124,6 +127,10 @@ def start(base: Path | None = None) -> Cluster:
     clean_leftovers(base)
     began = time.monotonic()
     directory = Path(tempfile.mkdtemp(prefix=PREFIX, dir=base))
+    if len(str(directory / "munge.socket")) >= SOCKET_PATH_MAX:
+        shutil.rmtree(directory)
+        raise ValueError(f"{directory} is too long a path for munged's socket (at most {SOCKET_PATH_MAX - 1} "
+                         "bytes in all); start the cluster under a shorter directory")
     (directory / "owner").write_text(str(os.getpid()))
     node = socket.gethostname().split(".")[0]
     conf = directory / "slurm.conf"
@@ -227,6 +234,8 @@ def clean_leftovers(base: Path) -> None:
             owner = None
         if owner is not None and alive(owner):
             continue
+        if owner is None and _age(directory) < 60:   # another session is creating it right now
+            continue
         _kill_processes_naming(directory)
         shutil.rmtree(directory, ignore_errors=True)
 
@@ -291,6 +300,13 @@ def alive(pid: int) -> bool:
     except OSError:
         return False
     return stat.rsplit(")", 1)[1].split()[0] != "Z"
+
+
+def _age(path: Path) -> float:
+    try:
+        return time.time() - path.stat().st_mtime
+    except OSError:
+        return 0.0
 
 
 def _free_ports(count: int) -> list[int]:

@@ -11,9 +11,11 @@ launcher, the batch in this process), never from a stored file.
 import contextlib
 import os
 import shlex
+import shutil
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -31,9 +33,12 @@ VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
 VOLATILE_VARIABLES = ("integrator_wall_time",)
 
 
-@pytest.fixture(scope="session")
-def slurm(tmp_path_factory):
-    """A running single-node SLURM for the session; its daemons are ended at teardown, pass or fail."""
+@pytest.fixture(scope="module")
+def slurm():
+    """A running single-node SLURM for this file's tests; its daemons are ended at teardown, pass or fail.
+
+    Module scope, not session: under ``pytest -n N --dist loadfile`` this file runs in one worker, which may go
+    on with other files; the cluster (and ``SLURM_CONF`` in the environment) ends with this file."""
     try:
         cluster = slurm_cluster.start()
     except slurm_cluster.Unavailable as reason:
@@ -120,13 +125,14 @@ def test_dask_jobqueue_batch_equals_the_local_batch(slurm, tmp_path, monkeypatch
     xr.testing.assert_identical(comparable(tmp_path / "slurm" / "sweep.nc"), comparable(tmp_path / "local" / "sweep.nc"))
 
 
-def test_a_killed_sessions_cluster_is_ended_by_the_next_start(slurm, tmp_path):
+def test_a_killed_sessions_cluster_is_ended_by_the_next_start(slurm):
     """A session killed with SIGKILL leaves its daemons running; the next start ends them and removes their
     directory, and starts although SLURM's default ports (6817, 6818) are taken."""
+    base = Path(tempfile.mkdtemp(prefix="gyrolab-test-slurm-"))   # short: munged's socket path is in it
     code = ("import sys, time, slurm_cluster; cluster = slurm_cluster.start(sys.argv[1]); "
             "print(cluster.directory, flush=True); time.sleep(600)")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).parent), os.environ.get("PYTHONPATH", "")])}
-    child = subprocess.Popen([sys.executable, "-c", code, str(tmp_path)], stdout=subprocess.PIPE, text=True, env=env)
+    child = subprocess.Popen([sys.executable, "-c", code, str(base)], stdout=subprocess.PIPE, text=True, env=env)
     try:
         directory = Path(child.stdout.readline().strip())
         daemons = {name: int((directory / f"{name}.pid").read_text()) for name in ("munged", "slurmctld", "slurmd")}
@@ -140,7 +146,7 @@ def test_a_killed_sessions_cluster_is_ended_by_the_next_start(slurm, tmp_path):
             with contextlib.suppress(OSError):   # already taken by something else: as good
                 taken.bind(("0.0.0.0", port))
                 taken.listen()
-        again = slurm_cluster.start(tmp_path)
+        again = slurm_cluster.start(base)
     try:
         assert not directory.exists()
         assert not [name for name, pid in daemons.items() if slurm_cluster.alive(pid)]
@@ -148,5 +154,6 @@ def test_a_killed_sessions_cluster_is_ended_by_the_next_start(slurm, tmp_path):
         assert os.environ["SLURM_CONF"] == str(again.conf)
     finally:
         again.stop()
+        shutil.rmtree(base, ignore_errors=True)
     assert os.environ["SLURM_CONF"] == str(slurm.conf)   # the session's cluster is the clients' one again
     assert slurm.node_state() == "idle"
