@@ -3,8 +3,8 @@ the same command gives locally.
 
 The cluster is a single node on this machine (tests/slurm_cluster.py: Debian's slurm-wlm and munge,
 installed with apt-get when missing, started as root). Without root or apt-get the tests skip with the
-reason; CI runs as root on Debian, so there they run. The commands are docs/cluster.md's recipe
-("SLURM, tested"); the expected datasets come from the same commands run locally (Hydra's basic
+reason (or fail, when GYROLAB_REQUIRE_SLURM is set); CI runs as root on Debian, so there they run. The
+commands are read from docs/cluster.md ("SLURM, tested") and run as written; the expected datasets come from the same commands run locally (Hydra's basic
 launcher, the batch in this process), never from a stored file.
 """
 
@@ -28,6 +28,8 @@ pytestmark = pytest.mark.slurm
 
 # docs/cluster.md, "SLURM, tested": the tests run its blocks verbatim, so the page is the tested recipe.
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "cluster.md"
+# set (to anything but 0) where the SLURM tests must run, e.g. in CI: then a cluster that cannot start fails them
+REQUIRED = "GYROLAB_REQUIRE_SLURM"
 # What legitimately differs between two runs of the same command: when, how long, which launcher.
 VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
 VOLATILE_VARIABLES = ("integrator_wall_time",)
@@ -42,6 +44,8 @@ def slurm():
     try:
         cluster = slurm_cluster.start()
     except slurm_cluster.Unavailable as reason:
+        if os.environ.get(REQUIRED, "0") not in ("", "0"):
+            pytest.fail(f"{REQUIRED} is set and {reason}")
         pytest.skip(str(reason))
     print(f"\nslurm: apt-get install {cluster.install_seconds:.1f} s, start {cluster.start_seconds:.1f} s "
           f"(node {cluster.node}, partition {cluster.partition}, {cluster.directory})")
