@@ -12,10 +12,12 @@ import contextlib
 import os
 import shlex
 import shutil
+import signal
 import socket
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -33,6 +35,8 @@ REQUIRED = "GYROLAB_REQUIRE_SLURM"
 # What legitimately differs between two runs of the same command: when, how long, which launcher.
 VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
 VOLATILE_VARIABLES = ("integrator_wall_time",)
+# ... and what follows the source tree (attributes, or variables when a sweep's jobs ran under several versions)
+CODE_DEPENDENT = ("git_commit", "git_dirty", "git_diff_sha256", "job_id")
 
 
 @pytest.fixture(scope="module")
@@ -78,12 +82,36 @@ def gyrolab(command, cwd):
                           text=True, timeout=300)
 
 
-def comparable(path):
-    ds = xr.load_dataset(path, decode_times=False, decode_timedelta=False)
-    ds = ds.drop_vars([v for v in VOLATILE_VARIABLES if v in ds.variables])
-    for key in VOLATILE_ATTRS:
-        ds.attrs.pop(key, None)
-    return ds
+@contextlib.contextmanager
+def children_killed_after(seconds):
+    """A hung recipe must not hang the suite: SIGKILL this process's children (the script's gyrolab) after
+    ``seconds``, as ``subprocess.run(timeout=...)`` does for the commands run here."""
+    def kill_children():
+        for entry in Path("/proc").iterdir():
+            with contextlib.suppress(OSError, ValueError, IndexError):
+                if entry.name.isdigit() and int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1]) == os.getpid():
+                    os.kill(int(entry.name), signal.SIGKILL)
+
+    timer = threading.Timer(seconds, kill_children)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+
+
+def assert_same_dataset(ran, expected):
+    """The dataset at ``ran`` equals the one at ``expected`` exactly (values, coordinates, attributes), except
+    for what says when and how long, and the code's provenance (git_*, job_id) where it differs: the working
+    tree changed between the two runs (someone editing it meanwhile)."""
+    a, b = (xr.load_dataset(p, decode_times=False, decode_timedelta=False) for p in (ran, expected))
+    provenance = [k for k in CODE_DEPENDENT if a.attrs.get(k) != b.attrs.get(k)
+                  or (k in a.variables and k in b.variables and not a[k].equals(b[k]))]
+    for ds in (a, b):
+        ds.attrs = {k: v for k, v in ds.attrs.items() if k not in VOLATILE_ATTRS and k not in provenance}
+    a, b = (ds.drop_vars([v for v in (*VOLATILE_VARIABLES, *provenance) if v in ds.variables]) for ds in (a, b))
+    xr.testing.assert_identical(a, b)
 
 
 def test_the_cluster_runs_a_job(slurm):
@@ -106,7 +134,7 @@ def test_submitit_launcher_sweep_equals_the_local_sweep(slurm, tmp_path):
     # the jobs ran as SLURM jobs: submitit's folder has one log per SLURM array task
     assert len(list((sweep / ".submitit").rglob("*_log.out"))) == 2
     assert xr.load_dataset(sweep / "sweep.nc").attrs["sweep_launcher"] == "SlurmLauncher"
-    xr.testing.assert_identical(comparable(sweep / "sweep.nc"), comparable(tmp_path / "local" / "sweep.nc"))
+    assert_same_dataset(sweep / "sweep.nc", tmp_path / "local" / "sweep.nc")
 
 
 def test_dask_jobqueue_batch_equals_the_local_batch(slurm, tmp_path, monkeypatch):
@@ -119,14 +147,14 @@ def test_dask_jobqueue_batch_equals_the_local_batch(slurm, tmp_path, monkeypatch
     monkeypatch.setattr(sys, "argv", on_slurm[1:])
     script = {"__name__": "__main__"}
     began = time.monotonic()
-    with pytest.raises(SystemExit) as exited:
+    with pytest.raises(SystemExit) as exited, children_killed_after(300):
         exec(compile(recipe("slurm_batch.py"), "slurm_batch.py", "exec"), script)
     print(f"slurm: slurm_batch.py (2 SLURM jobs as Dask workers, the batch on them) took {time.monotonic() - began:.1f} s")
     assert exited.value.code == 0, slurm.logs()
     # the scheduler the script started timed gyrolab's chunk tasks (map_chunks' keys): they ran on its workers
     chunk_tasks = script["cluster"].scheduler.task_prefixes.get("gyrolab-chunk")
     assert chunk_tasks is not None and chunk_tasks.duration_average > 0
-    xr.testing.assert_identical(comparable(tmp_path / "slurm" / "sweep.nc"), comparable(tmp_path / "local" / "sweep.nc"))
+    assert_same_dataset(tmp_path / "slurm" / "sweep.nc", tmp_path / "local" / "sweep.nc")
 
 
 def test_a_killed_sessions_cluster_is_ended_by_the_next_start(slurm):
