@@ -12,6 +12,9 @@ runs its chunks in other processes or on other machines:
 - ``"tcp://HOST:PORT"`` (or ``tls://``): an existing Dask scheduler and its workers (``dask scheduler``,
   ``dask worker``, a dask-jobqueue ``SLURMCluster``: docs/cluster.md).
 
+``scheduler`` None (``batch.scheduler`` unset) with ``DASK_SCHEDULER_ADDRESS`` set in the environment (Dask's
+own variable, which ``distributed.Client()`` reads too): that scheduler.
+
 At most a few chunks per worker are submitted at a time, so memory is bounded by a few chunks, not by
 the batch. A chunk that fails stops the batch with one sentence naming the chunk.
 
@@ -37,6 +40,8 @@ Result = TypeVar("Result")
 
 IN_PROCESS = ("process", "")
 LOCAL = "local"
+#: Dask's own environment variable for a scheduler's address, read when batch.scheduler is unset
+SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
 #: seconds to wait for a scheduler to answer before saying it cannot be reached
 CONNECT_TIMEOUT = 10
 #: chunks submitted per worker thread at a time: one running, one queued (memory: a few chunks per worker)
@@ -49,6 +54,7 @@ def map_chunks(function: Callable[[Task], Result], tasks: Iterable[Task],
                on_result: Callable[[int, Result], None], scheduler: str | None = None) -> None:
     """Run ``function`` on every task where ``scheduler`` says; ``on_result(index, result)`` for each result,
     in this process, in the order they complete (in task order when they run here)."""
+    scheduler = chosen_scheduler(scheduler)
     kind = scheduler_kind(scheduler)
     if kind == "process":
         for index, task in enumerate(tasks):
@@ -62,8 +68,16 @@ def map_chunks(function: Callable[[Task], Result], tasks: Iterable[Task],
         _map_on(client, function, tasks, on_result, where=_where(kind, str(scheduler)))
 
 
+def chosen_scheduler(scheduler: str | None) -> str | None:
+    """``scheduler``, or when it is None the environment's ``DASK_SCHEDULER_ADDRESS`` (a SLURM recipe sets it)."""
+    if scheduler is None:
+        return os.environ.get(SCHEDULER_ENV, "").strip() or None
+    return scheduler
+
+
 def scheduler_kind(scheduler: str | None) -> str:
     """``"process"``, ``"local"`` or ``"address"``; ConfigError for anything else, or when Dask is missing."""
+    scheduler = chosen_scheduler(scheduler)
     if scheduler is None or str(scheduler).strip() in IN_PROCESS:
         return "process"
     text = str(scheduler).strip()
@@ -143,4 +157,4 @@ def _map_on(client: Any, function: Callable[[Task], Result], tasks: Iterable[Tas
         pending.clear()
 
 
-__all__ = ["chunk_error", "map_chunks", "scheduler_kind"]
+__all__ = ["chosen_scheduler", "chunk_error", "map_chunks", "scheduler_kind"]
