@@ -342,8 +342,9 @@ def _task(cfg: DictConfig) -> None:
     if hydra_cfg.mode == RunMode.MULTIRUN:
         allow_bars(False)  # the sweep shows one bar for all its jobs
         _quiet_console()
+        job_figures = bool(cfg.output.get("job_figures", False))
         run_sweep_job(cfg, out_dir, list(hydra_cfg.overrides.task), hydra_cfg.job.num,
-                      lambda job_id: _run_one(cfg, out_dir, job_id))
+                      lambda job_id: _run_one(cfg, out_dir, job_id, figures=job_figures))
         return
     try:
         _run_one(cfg, out_dir)
@@ -351,8 +352,10 @@ def _task(cfg: DictConfig) -> None:
         fail(error)
 
 
-def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
+def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None, figures: bool = True) -> Path:
     """Run the scene, write ``run.nc`` (and figures) in ``out_dir``; GyrolabError on bad input or a failed run.
+
+    ``figures=False`` (a multirun's jobs unless ``output.job_figures``): the scene's figures are not drawn.
 
     ``out_dir`` is locked meanwhile (a second run into it is refused in one sentence) and cleared of
     the temporary files that killed writes left there (``gyrolab.output.lock.writing_in``).
@@ -360,10 +363,10 @@ def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None) -> Path:
     from gyrolab.output.lock import writing_in
 
     with writing_in(out_dir):
-        return _run_locked(cfg, out_dir, job_id)
+        return _run_locked(cfg, out_dir, job_id, figures)
 
 
-def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None) -> Path:
+def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: bool) -> Path:
     from gyrolab.output.dataset import write_dataset
 
     task = task_of(cfg)
@@ -380,6 +383,8 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None) -> Path:
     ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
     path = write_dataset(ds, out_dir / "run.nc")
     log.info("wrote %s", path)
+    if not figures:
+        return path
     from gyrolab.figures.redraw import draw_figures  # matplotlib only when figures are drawn
 
     for figure in draw_figures("run.nc", ds, out_dir, cfg.output):
