@@ -150,13 +150,14 @@ _gyrolab() {
             *) candidates="";;
         esac
         if [[ "$command" == run && $overrides -eq 0 ]]; then
-            candidates="${_gyrolab_commands// /$'\n'}"$'\n'"$candidates"
+            local nl=$'\n'
+            candidates="${_gyrolab_commands// /$nl}$nl$candidates"
         fi
     fi
     COMPREPLY=()
     local IFS=$'\n'
     for c in $candidates; do
-        [[ "$c" == "$cur"* ]] || continue
+        [[ "$c" == "$cur"* && ( "$c" != "$cur" || "$c" != *[=.] ) ]] || continue
         rest="${c#"$cur"}"
         rest="${rest%[=.]}"
         [[ "$rest" == *[=.]* ]] && continue   # one level at a time: time. before time.end=
@@ -167,7 +168,7 @@ _gyrolab() {
     fi
     if [[ ${#COMPREPLY[@]} -gt 0 ]] && type compopt >/dev/null 2>&1; then
         for c in "${COMPREPLY[@]}"; do
-            [[ "$c" == *[=./] ]] && { compopt -o nospace; break; }
+            [[ "$c" == *[=./] ]] && { compopt -o nospace 2>/dev/null; break; }
         done
     fi
     return 0

@@ -11,6 +11,7 @@ are the same command).
 from __future__ import annotations
 
 import argparse
+import difflib
 from collections.abc import Sequence
 
 from gyrolab.errors import ConfigError, shorten
@@ -33,7 +34,7 @@ ALIASES = {"--batch": "batch", "--plot": "plot", "--reproduce": "reproduce", "--
 #: options whose value is the next word (so that word is not read as a subcommand)
 VALUE_OPTIONS = {"--config-dir", "-cd", "--config-path", "-cp", "--config-name", "-cn", "--cfg", "-c",
                  "--package", "-p", "--scheduler", "--animate", "--format", "--frames", "--fps", "-o", "--output",
-                 "--experimental-rerun", "--shell-completion", "-sc"}
+                 "--experimental-rerun", "--shell-completion", "-sc", "--info", "-i"}
 
 #: where logs and results go, said in every --help
 LOGGING_CONVENTION = ("Log lines and progress go to stderr; results (the paths written, reports) go to stdout, "
@@ -63,6 +64,11 @@ def split_command(argv: Sequence[str]) -> tuple[str, list[str]]:
             continue
         elif bare_words_allowed and arg in COMMANDS:
             return arg, argv[:i] + argv[i + 1:]
+        elif bare_words_allowed and "=" not in arg and not arg.startswith(("~", "+")):
+            close = difflib.get_close_matches(arg, list(COMMANDS), n=1)
+            hint = f"did you mean gyrolab {close[0]}? " if close else ""
+            raise ConfigError(f"unknown subcommand {shorten(repr(arg))} (an override is key=value); {hint}valid "
+                              f"choices: {', '.join(COMMANDS)}")
         else:
             bare_words_allowed = False  # an override (or a path): a later word is a value, not a subcommand
     return "run", argv
