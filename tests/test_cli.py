@@ -1,8 +1,12 @@
 """The gyrolab command: default scene, figures, multirun; subcommands, help, batch's sweep, the logging convention."""
 
 import sys
+from pathlib import Path
 
 import xarray as xr
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
 
 FIGURES = ["body_axis_sphere.png", "euler_angles.png", "invariant_drift.png", "state.png"]
 
@@ -191,12 +195,15 @@ def test_the_command_line_overrides_the_yaml_sweep_of_the_same_key(usercfg, cli,
 
 
 def test_batch_runs_the_default_integrator(cli, tmp_path):
-    """The default config's integrator (dop853, no batch kernel) runs one integrate() per point."""
+    """The default config's integrator (dop853 today: no batch kernel) runs, one integrate() per point."""
     done = cli("batch", "initial.r0=1,2", "time.end=1", "time.n_output=11", "hydra.sweep.dir=grid")
     assert done.returncode == 0, done.stderr[-2000:]
     with xr.open_dataset(tmp_path / "grid" / "sweep.nc") as ds:
-        assert ds.sizes["r0"] == 2
-        assert "dop853" in str(ds.attrs)
+        assert ds.sizes["r0"] == 2 and int(ds.attrs["n_finished"]) == 2
+        integrator = yaml.safe_load(ds.attrs["config"])["integrator"]["_target_"]
+    defaults = yaml.safe_load((ROOT / "conf" / "config.yaml").read_text())["defaults"]
+    default = next(entry["integrator"] for entry in defaults if isinstance(entry, dict) and "integrator" in entry)
+    assert integrator == yaml.safe_load((ROOT / "conf" / "integrator" / f"{default}.yaml").read_text())["_target_"]
 
 
 def test_batch_scheduler_option_is_batch_scheduler(cli):
