@@ -6,9 +6,13 @@ directory — into one sentence and a non-zero exit, so that no run directory
 with a partial ``run.nc`` is left behind.
 
 In a multirun each job is resumable and a failing job is recorded, not fatal
-(``gyrolab.sweep.job``); the sweep callback then writes ``sweep.nc``. Two
-more commands work on results: ``gyrolab --reproduce PATH/run.nc`` and
-``gyrolab --aggregate SWEEP_DIR``.
+(``gyrolab.sweep.job``); the sweep callback then writes ``sweep.nc``.
+
+This module is ``gyrolab run``, the default subcommand, and ``main``; the package holds the rest of the
+command line: ``parser`` (which subcommand a command line names, one argparse parser per other
+subcommand), ``commands`` (``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``, ``completion``)
+and ``completion`` (the bash and zsh script). Logs go to stderr, results to stdout
+(``gyrolab.output.written``).
 """
 
 from __future__ import annotations

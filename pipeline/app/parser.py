@@ -40,11 +40,6 @@ VALUE_OPTIONS = {"--config-dir", "-cd", "--config-path", "-cp", "--config-name",
 LOGGING_CONVENTION = ("Log lines and progress go to stderr; results (the paths written, reports) go to stdout, "
                       "so `gyrolab ... > written.txt` keeps a list of the files.")
 
-#: Hydra's options that choose where configs come from, long and short
-SOURCE_OPTIONS = {"--config-dir": "config_dir", "-cd": "config_dir", "--config-path": "config_path",
-                  "-cp": "config_path", "--config-name": "config_name", "-cn": "config_name"}
-
-
 def split_command(argv: Sequence[str]) -> tuple[str, list[str]]:
     """(the subcommand ``argv`` names, the rest of ``argv``): a subcommand word before the first override,
     or an old ``--batch``-style spelling anywhere (``--plot=PATH`` keeps PATH); ``run`` when none is named."""
@@ -164,28 +159,9 @@ def parse(command: str, argv: Sequence[str]) -> argparse.Namespace:
     return parser.parse_intermixed_args(list(argv))
 
 
-def source_argv(args: argparse.Namespace) -> list[str]:
-    """The config-source options of parsed ``args`` as Hydra spells them."""
-    out = []
-    for option, attribute in (("--config-dir", "config_dir"), ("--config-path", "config_path"),
-                              ("--config-name", "config_name")):
-        if getattr(args, attribute, None):
-            out += [option, getattr(args, attribute)]
-    return out
-
-
 def one_path(command: str, paths: Sequence[str], usage: str) -> str:
     """The single path a subcommand takes, or one sentence."""
     if len(paths) != 1:
         raise ConfigError(f"{command} takes exactly one path (got {len(paths)}: "
                           f"{shorten(' '.join(paths)) or 'none'}); usage: gyrolab {usage}")
     return paths[0]
-
-
-def top_level_help() -> str:
-    """The subcommands, for ``gyrolab --help`` (Hydra's app help adds the run options and config groups)."""
-    width = max(len(name) for name in COMMANDS)
-    lines = ["usage: gyrolab [run] [OPTIONS] [KEY=VALUE ...]", "       gyrolab SUBCOMMAND [OPTIONS] ...", "",
-             "subcommands (each has its own --help; the old spellings --batch, --plot, ... still work):"]
-    lines += [f"  {name:<{width}}  {text}" for name, text in COMMANDS.items()]
-    return "\n".join(lines)
