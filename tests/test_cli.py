@@ -206,10 +206,15 @@ def test_batch_runs_the_default_integrator(cli, tmp_path):
     assert integrator == yaml.safe_load((ROOT / "conf" / "integrator" / f"{default}.yaml").read_text())["_target_"]
 
 
-def test_batch_scheduler_option_is_batch_scheduler(cli):
-    done = cli("batch", "initial.r0=1,2", "--scheduler", "nonsense", "hydra.sweep.dir=grid")
-    assert done.returncode != 0
-    assert done.stderr.strip().splitlines()[-1].startswith("gyrolab: error: batch.scheduler='nonsense' is not a")
+def test_batch_scheduler_option_reaches_the_batch(cli, tmp_path):
+    done = cli("batch", "initial.r0=1,2", "--scheduler", "process", "time.end=1", "time.n_output=11",
+               "hydra.sweep.dir=grid")
+    assert done.returncode == 0, done.stderr[-2000:]
+    refused = cli("batch", "initial.r0=1,2", "--scheduler", "nonsense", "hydra.sweep.dir=other")
+    assert refused.returncode != 0
+    last = refused.stderr.strip().splitlines()[-1]
+    assert last.startswith("gyrolab: error: ") and "nonsense" in last and "Traceback" not in refused.stderr
+    assert not (tmp_path / "other" / "sweep.nc").exists()
 
 
 # ---- one logging convention: logs and progress on stderr, results on stdout ---------------------------------------

@@ -38,8 +38,13 @@ def batch(args: argparse.Namespace) -> int:
     from gyrolab.figures.options import figure_options
 
     overrides = list(args.overrides)
-    if args.scheduler is not None:
-        overrides.append(f"batch.scheduler={_quoted(args.scheduler)}")
+    try:  # the command line's own route to a Dask scheduler, where gyrolab has one (issue 23: trusted only here)
+        from gyrolab.batch.scheduler import use_command_line_scheduler
+    except ImportError:
+        if args.scheduler is not None:
+            overrides.append(f"batch.scheduler={_quoted(args.scheduler)}")
+    else:
+        use_command_line_scheduler(args.scheduler)  # None when not given: no value left from an earlier command
     now = datetime.now()
     out_dir = Path(f"outputs/batch/{now:%Y-%m-%d}/{now:%H-%M-%S}")
     scene_overrides = []
