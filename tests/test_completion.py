@@ -85,3 +85,25 @@ def test_hydras_spelling_prints_the_same_script(cli):
     assert done.stdout.strip() == script("bash").strip()
     refused = cli("--shell-completion", "install=fish")
     assert refused.returncode != 0 and "gyrolab completion bash" in refused.stderr
+
+
+@pytest.mark.parametrize("line, offered", [("gyrolab integrator=ta", "taylor"), ("gyrolab -cd myconf b", "batch"),
+                                           ("gyrolab batch time.", "time.end=")])
+def test_bash_completes_from_the_line_readline_passes(line, offered, scripts):
+    """Readline also passes the whole line and the cursor (COMP_LINE, COMP_POINT); the words are split at '='."""
+    words = line.replace("=", " = ").split() if line.endswith("ta") else line.split()
+    program = (f"source {scripts / 'gyrolab.bash'}\nCOMP_LINE='{line}'; COMP_POINT={len(line)}\n"
+               f"COMP_WORDS=({' '.join(repr(w) for w in words)}); COMP_CWORD={len(words) - 1}\n"
+               "_gyrolab\nprintf '%s\\n' \"${COMPREPLY[@]}\"\n")
+    done = subprocess.run(["bash", "--norc", "-c", program], capture_output=True, text=True, timeout=60)
+    assert offered in done.stdout.splitlines(), (done.stdout, done.stderr)
+
+
+def test_bash_completes_option_values(scripts, tmp_path, monkeypatch):
+    (tmp_path / "myconf").mkdir()
+    (tmp_path / "myfile.txt").write_text("")
+    monkeypatch.chdir(tmp_path)
+    assert _bash(scripts, ["gyrolab", "--config-dir", "my"]) == {"myconf"}          # directories only
+    assert _bash(scripts, ["gyrolab", "--cfg", ""]) == {"job", "hydra", "all"}
+    assert _bash(scripts, ["gyrolab", "plot", "--format", ""]) == {"gif", "mp4"}
+    assert "batch" in _bash(scripts, ["gyrolab", "--config-dir", "myconf", "b"])    # a value is not an override

@@ -80,7 +80,7 @@ def option_words() -> dict[str, list[str]]:
 
 def script(shell: str) -> str:
     """The completion script for ``shell`` (bash, or zsh through its bash compatibility)."""
-    from gyrolab.app.parser import ALIASES, COMMANDS
+    from gyrolab.app.parser import ALIASES, COMMANDS, VALUE_OPTIONS
 
     if shell not in SHELLS:
         raise ConfigError(f"no completion for shell {shell!r}; valid choices: {', '.join(SHELLS)}")
@@ -100,6 +100,7 @@ def script(shell: str) -> str:
         f"_gyrolab_config={_quote(chr(10).join(config))}",
         f"_gyrolab_plot_config={_quote(chr(10).join(plot_words))}",
         f"_gyrolab_path_commands={_quote(' '.join(PATH_COMMANDS))}",
+        f"_gyrolab_value_options={_quote(' '.join(sorted(VALUE_OPTIONS)))}",
     ]
     for name, words in options.items():
         lines.append(f"_gyrolab_options_{name.replace('-', '_')}={_quote(chr(10).join(words))}")
@@ -131,7 +132,10 @@ _gyrolab() {
     fi
     set -- ${line% *}
     shift   # the command's own name
+    local value_next=0
     for w in "$@"; do
+        if [[ $value_next -eq 1 ]]; then value_next=0; continue; fi   # the value of --config-dir DIR, ...
+        if [[ " $_gyrolab_value_options " == *" $w "* ]]; then value_next=1; continue; fi
         case " $_gyrolab_aliases " in *" ${w%%=*} "*) command="${w#--}"; command="${command%%=*}"; continue;; esac
         if [[ -z "$command" && $overrides -eq 0 && "$w" != -* && " $_gyrolab_commands " == *" $w "* ]]; then
             command="$w"
@@ -140,6 +144,18 @@ _gyrolab() {
         fi
     done
     [[ -z "$command" ]] && command=run
+    if [[ $value_next -eq 1 ]]; then   # the cursor is on an option's value
+        local IFS=$'\n'
+        case "$w" in
+            --config-dir|-cd|--config-path|-cp) COMPREPLY=($(compgen -d -- "$cur"));;
+            --animate|-o|--output|--experimental-rerun) COMPREPLY=($(compgen -f -- "$cur"));;
+            --format) COMPREPLY=($(compgen -W $'gif\nmp4' -- "$cur"));;
+            --cfg|-c) COMPREPLY=($(compgen -W $'job\nhydra\nall' -- "$cur"));;
+            --info|-i) COMPREPLY=($(compgen -W $'all\nconfig\ndefaults\ndefaults-tree\nplugins\nsearchpath' -- "$cur"));;
+            *) COMPREPLY=();;
+        esac
+        return 0
+    fi
     if [[ "$cur" == -* ]]; then
         candidates="$(eval "printf '%s' \"\$_gyrolab_options_${command//-/_}\"")"
     else
