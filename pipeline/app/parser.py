@@ -76,6 +76,10 @@ class _Parser(argparse.ArgumentParser):
         raise ConfigError(f"{message}; see {self.prog} --help")
 
 
+def _sentence(text: str) -> str:
+    return text[:1].upper() + text[1:]
+
+
 def _source_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("where configs come from (as for gyrolab run)")
     group.add_argument("--config-dir", "-cd", metavar="DIR",
@@ -96,7 +100,7 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
     parsers: dict[str, argparse.ArgumentParser] = {}
 
     batch = _Parser(prog="gyrolab batch", formatter_class=formatter, epilog=epilog,
-                    description=COMMANDS["batch"] + ".\nThe sweep comes from the same place as for -m: the command "
+                    description=_sentence(COMMANDS["batch"]) + ".\nThe sweep comes from the same place as for -m: the command "
                     "line (initial.r0=1,2,3 body.a=range(1,2,0.25)) and hydra.sweeper.params of the config or an "
                     "experiment. Only body, initial and force parameters may vary (docs/batch.md).\n"
                     "Example: gyrolab batch initial.r0=10,20,40 time.end=20 hydra.sweep.dir=grid")
@@ -110,7 +114,7 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
     parsers["batch"] = batch
 
     plot = _Parser(prog="gyrolab plot", formatter_class=formatter, epilog=epilog,
-                   description=COMMANDS["plot"] + "; nothing is integrated.\n"
+                   description=_sentence(COMMANDS["plot"]) + "; nothing is integrated.\n"
                    "Examples: gyrolab plot outputs/ output.figure_formats=[png,pdf] output.dpi=300\n"
                    "          gyrolab plot --animate outputs/2026-01-01/12-00-00/run.nc")
     plot.add_argument("arguments", nargs="*", metavar="PATH | output.KEY=VALUE",
@@ -127,23 +131,23 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
     parsers["plot"] = plot
 
     reproduce = _Parser(prog="gyrolab reproduce", formatter_class=formatter, epilog=epilog,
-                        description=COMMANDS["reproduce"] + ".\nExit status 0: identical; 1: it differs "
+                        description=_sentence(COMMANDS["reproduce"]) + ".\nExit status 0: identical; 1: it differs "
                         "(the report on stdout says where).")
     reproduce.add_argument("paths", nargs="*", metavar="PATH", help="a run.nc or sweep.nc written by gyrolab")
     parsers["reproduce"] = reproduce
 
     aggregate = _Parser(prog="gyrolab aggregate", formatter_class=formatter, epilog=epilog,
-                        description=COMMANDS["aggregate"] + " (after an interrupted multirun, or a full disk).")
+                        description=_sentence(COMMANDS["aggregate"]) + " (after an interrupted multirun, or a full disk).")
     aggregate.add_argument("paths", nargs="*", metavar="SWEEP_DIR", help="the folder of a multirun (hydra.sweep.dir)")
     parsers["aggregate"] = aggregate
 
     new_force = _Parser(prog="gyrolab new-force", formatter_class=formatter, epilog=epilog,
-                        description=COMMANDS["new-force"] + " (a package with its tests, docs/plugins.md).")
+                        description=_sentence(COMMANDS["new-force"]) + " (a package with its tests, docs/plugins.md).")
     new_force.add_argument("names", nargs="*", metavar="NAME", help="the force's name (a Python identifier)")
     parsers["new-force"] = new_force
 
     completion = _Parser(prog="gyrolab completion", formatter_class=formatter,
-                         description=COMMANDS["completion"] + ".\nbash: eval \"$(gyrolab completion bash)\" "
+                         description=_sentence(COMMANDS["completion"]) + ".\nbash: eval \"$(gyrolab completion bash)\" "
                          "(in ~/.bashrc); zsh: eval \"$(gyrolab completion zsh)\" (in ~/.zshrc).\n"
                          "It completes subcommands, options, config groups, their options and config keys; "
                          "run it again after installing a plugin.")
