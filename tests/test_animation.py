@@ -117,19 +117,21 @@ def test_command_line_end_to_end(run_dir, tmp_path):
     assert _frames(out) == 6
     bad = subprocess.run([sys.executable, "-m", "gyrolab", "--plot", "--animate", str(run_dir), "--format=webm"],
                          capture_output=True, text=True, timeout=300)
-    assert bad.returncode != 0 and bad.stderr.strip().splitlines() == [
-        "gyrolab: error: animation format 'webm' is not one of gif, mp4"]
+    lines = bad.stderr.strip().splitlines()
+    assert bad.returncode != 0 and len(lines) == 1 and lines[0].startswith("gyrolab: error:"), bad.stderr
+    assert all(word in lines[0] for word in ("webm", "gif", "mp4"))
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--bogus", "3"], "does not take '--bogus'"),
-    (["--frames", "2.5"], "not a whole number"),
-    (["--fps=fast"], "not a number"),
-    (["second_path"], "exactly one path"),
+    (["--bogus", "3"], "--bogus"),
+    (["--frames", "2.5"], "2.5"),
+    (["--fps=fast"], "fast"),
+    (["second_path"], "second_path"),
 ])
-def test_command_line_refusals_are_one_sentence(run_dir, args, words):
-    from gyrolab.app import run_command
-
-    with pytest.raises(ConfigError, match=words) as error:
-        run_command(["--plot", "--animate", str(run_dir), *args])
-    assert "\n" not in str(error.value)
+def test_command_line_refusals_are_one_sentence(run_dir, tmp_path, args, words):
+    done = subprocess.run([sys.executable, "-m", "gyrolab", "plot", "--animate", str(run_dir), *args],
+                          capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode != 0 and len(lines) == 1 and lines[0].startswith("gyrolab: error:"), done.stderr
+    assert words in lines[0] and "Traceback" not in done.stderr
+    assert not list(tmp_path.iterdir())

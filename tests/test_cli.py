@@ -1,6 +1,14 @@
-"""The gyrolab command: default scene, figures, multirun."""
+"""The gyrolab command: default scene, figures, multirun; subcommands, help, batch's sweep, the logging convention."""
+
+import sys
+from pathlib import Path
 
 import xarray as xr
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+
+FIGURES = ["body_axis_sphere.png", "euler_angles.png", "invariant_drift.png", "state.png"]
 
 
 def test_default_run_writes_dataset_and_figures(cli, tmp_path):
@@ -10,7 +18,7 @@ def test_default_run_writes_dataset_and_figures(cli, tmp_path):
         assert ds.sizes["time"] == 101
         assert "hydra_overrides" in ds.attrs and "time.end=5" in ds.attrs["hydra_overrides"]
     figures = sorted(p.name for p in (tmp_path / "out" / "figures").iterdir())
-    assert figures == ["body_axis_sphere.png", "euler_angles.png", "invariant_drift.png", "state.png"]
+    assert figures == FIGURES
 
 
 def test_multirun_writes_one_dataset_per_job(cli, tmp_path):
@@ -53,3 +61,188 @@ def test_every_experiment_runs_from_the_command_line(selector, cli, tmp_path):
     assert any(p.suffix in (".nc", ".csv") for p in written), written
     for name in expected:
         assert (tmp_path / "out" / name).exists(), name
+
+
+# ---- the command line's grammar: subcommands, old spellings, options anywhere ------------------------------------
+
+from gyrolab.app.parser import ALIASES, COMMANDS, build_parsers, split_command  # noqa: E402
+from gyrolab.errors import ConfigError  # noqa: E402
+
+
+@pytest.mark.parametrize("argv, command, rest", [
+    ([], "run", []),
+    (["-m", "integrator=rk4,dop853"], "run", ["-m", "integrator=rk4,dop853"]),
+    (["experiment=x"], "run", ["experiment=x"]),
+    (["run", "time.end=1"], "run", ["time.end=1"]),
+    (["--config-dir", "run", "run"], "run", ["--config-dir", "run"]),         # a folder named like a subcommand
+    (["batch", "a=1,2"], "batch", ["a=1,2"]),
+    (["--batch", "--config-dir", "usercfg", "experiment=r0_scan"], "batch",
+     ["--config-dir", "usercfg", "experiment=r0_scan"]),
+    (["--config-dir", "usercfg", "--batch", "experiment=r0_scan"], "batch",
+     ["--config-dir", "usercfg", "experiment=r0_scan"]),
+    (["experiment=r0_scan", "--batch", "-cd", "usercfg"], "batch", ["experiment=r0_scan", "-cd", "usercfg"]),
+    (["-cd", "usercfg", "batch", "x=1"], "batch", ["-cd", "usercfg", "x=1"]),
+    (["--plot=out", "output.dpi=50"], "plot", ["out", "output.dpi=50"]),
+    (["--new-force=drag"], "new-force", ["drag"]),
+    (["--reproduce", "run.nc"], "reproduce", ["run.nc"]),
+    (["aggregate", "sweep"], "aggregate", ["sweep"]),
+    (["time.end=1", "plot"], "run", ["time.end=1", "plot"]),                  # after an override, a word is a value
+])
+def test_the_subcommand_is_found_wherever_it_is_spelled(argv, command, rest):
+    assert split_command(argv) == (command, rest)
+
+
+def test_an_unknown_subcommand_is_one_sentence_with_the_choices():
+    with pytest.raises(ConfigError, match="unknown subcommand 'bach'.*did you mean gyrolab batch\\?.*aggregate"):
+        split_command(["bach", "initial.r0=1,2"])
+
+
+def test_every_old_spelling_names_a_subcommand():
+    assert set(ALIASES.values()) <= set(COMMANDS)
+
+
+#: options each subcommand's --help must list (typed here, not read from the parser under test)
+HELP_OPTIONS = {
+    "batch": ["--scheduler", "--config-dir", "-cd", "--config-name", "-m", "--multirun", "KEY=VALUE"],
+    "plot": ["--animate", "--format", "--frames", "--fps", "--output", "--config-dir", "output.dpi"],
+    "reproduce": ["PATH"],
+    "aggregate": ["SWEEP_DIR"],
+    "new-force": ["NAME"],
+    "completion": ["bash", "zsh"],
+}
+
+
+@pytest.mark.parametrize("command", HELP_OPTIONS)
+def test_each_subcommands_help_lists_its_options(command, monkeypatch, capsys):
+    from gyrolab import app
+
+    monkeypatch.setattr(sys, "argv", ["gyrolab", command, "--help"])
+    with pytest.raises(SystemExit) as done:
+        app.main()
+    assert done.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"usage: gyrolab {command}")
+    for option in [*HELP_OPTIONS[command], "--help"]:
+        assert option in out, option
+    if command != "completion":
+        assert "stderr" in out and "stdout" in out  # the logging convention is stated
+
+
+def test_every_subcommand_has_a_parser_and_a_runner():
+    from gyrolab.app.commands import RUNNERS
+
+    assert set(build_parsers()) == set(RUNNERS) == set(COMMANDS) - {"run"}
+
+
+def test_gyrolab_help_lists_subcommands_and_hydras_options(cli):
+    done = cli("--help")
+    assert done.returncode == 0, done.stderr
+    for word in [*COMMANDS, "--config-dir", "--multirun", "--cfg", "--info", "--shell-completion", "--version",
+                 "integrator: ", "stderr"]:
+        assert word in done.stdout, word
+    assert cli("run", "--help").stdout == done.stdout
+
+
+def test_an_unknown_option_of_a_subcommand_is_one_sentence(cli):
+    done = cli("batch", "--bogus", "initial.r0=1,2")
+    assert done.returncode != 0
+    assert done.stderr.strip().splitlines() == [
+        "gyrolab: error: unrecognized arguments: --bogus; see gyrolab batch --help"]
+
+
+# ---- batch: the sweep from the same place as -m, options anywhere ------------------------------------------------
+
+SWEEP_IN_YAML = """# @package _global_
+time:
+  end: 1
+  n_output: 11
+output:
+  figures: false
+hydra:
+  sweeper:
+    params:
+      initial.r0: 1,2,3
+"""
+
+
+@pytest.fixture
+def usercfg(tmp_path):
+    (tmp_path / "usercfg" / "experiment").mkdir(parents=True)
+    (tmp_path / "usercfg" / "experiment" / "r0_scan.yaml").write_text(SWEEP_IN_YAML)
+    return tmp_path / "usercfg"
+
+
+@pytest.mark.parametrize("argv", [
+    ["--batch", "--config-dir", "usercfg", "experiment=r0_scan"],         # the issue's command, refused before
+    ["batch", "experiment=r0_scan", "hydra.sweep.dir=grid", "-cd", "usercfg"],
+])
+def test_batch_reads_the_sweep_declared_in_yaml(argv, usercfg, cli, tmp_path):
+    if "hydra.sweep.dir=grid" not in argv:
+        argv = [*argv, "hydra.sweep.dir=grid"]
+    done = cli(*argv)
+    assert done.returncode == 0, done.stderr[-2000:]
+    with xr.open_dataset(tmp_path / "grid" / "sweep.nc") as ds:
+        assert list(ds["r0"].values) == [1.0, 2.0, 3.0]
+    assert done.stdout.splitlines() == ["wrote grid/sweep.nc"]            # results on stdout, the log on stderr
+    assert "[gyrolab.batch][INFO]" in done.stderr
+
+
+def test_the_command_line_overrides_the_yaml_sweep_of_the_same_key(usercfg, cli, tmp_path):
+    done = cli("batch", "-cd", "usercfg", "experiment=r0_scan", "initial.r0=5,6", "hydra.sweep.dir=grid")
+    assert done.returncode == 0, done.stderr[-2000:]
+    with xr.open_dataset(tmp_path / "grid" / "sweep.nc") as ds:
+        assert list(ds["r0"].values) == [5.0, 6.0]
+
+
+def test_batch_runs_the_default_integrator(cli, tmp_path):
+    """The default config's integrator (dop853 today: no batch kernel) runs, one integrate() per point."""
+    done = cli("batch", "initial.r0=1,2", "time.end=1", "time.n_output=11", "hydra.sweep.dir=grid")
+    assert done.returncode == 0, done.stderr[-2000:]
+    with xr.open_dataset(tmp_path / "grid" / "sweep.nc") as ds:
+        assert ds.sizes["r0"] == 2 and int(ds.attrs["n_finished"]) == 2
+        integrator = yaml.safe_load(ds.attrs["config"])["integrator"]["_target_"]
+    defaults = yaml.safe_load((ROOT / "conf" / "config.yaml").read_text())["defaults"]
+    default = next(entry["integrator"] for entry in defaults if isinstance(entry, dict) and "integrator" in entry)
+    assert integrator == yaml.safe_load((ROOT / "conf" / "integrator" / f"{default}.yaml").read_text())["_target_"]
+
+
+def test_batch_scheduler_option_reaches_the_batch(cli, tmp_path):
+    done = cli("batch", "initial.r0=1,2", "--scheduler", "process", "time.end=1", "time.n_output=11",
+               "hydra.sweep.dir=grid")
+    assert done.returncode == 0, done.stderr[-2000:]
+    refused = cli("batch", "initial.r0=1,2", "--scheduler", "nonsense", "hydra.sweep.dir=other")
+    assert refused.returncode != 0
+    last = refused.stderr.strip().splitlines()[-1]
+    assert last.startswith("gyrolab: error: ") and "nonsense" in last and "Traceback" not in refused.stderr
+    assert not (tmp_path / "other" / "sweep.nc").exists()
+
+
+# ---- one logging convention: logs and progress on stderr, results on stdout ---------------------------------------
+
+def test_logs_go_to_stderr_and_results_to_stdout(cli, tmp_path):
+    run = cli("run", "hydra.run.dir=out", "time.end=1", "time.n_output=11")
+    assert run.returncode == 0, run.stderr
+    written = run.stdout.splitlines()
+    assert written[0] == f"wrote {tmp_path / 'out' / 'run.nc'}"
+    assert all(line.startswith("wrote ") for line in written) and len(written) == 5   # run.nc and 4 figures
+    assert "[gyrolab.engine.scene][INFO]" in run.stderr and "[INFO]" not in run.stdout
+
+    plot = cli("plot", "out", "output.dpi=40")
+    assert plot.returncode == 0, plot.stderr
+    assert sorted(plot.stdout.splitlines()) == [f"wrote out/figures/{name}" for name in FIGURES]
+    reproduce = cli("reproduce", "out/run.nc")
+    assert reproduce.returncode == 0, reproduce.stderr
+    assert reproduce.stdout.startswith("reproducing out/run.nc") and "identical" in reproduce.stdout
+    assert "[INFO]" not in reproduce.stdout
+
+    sweep = cli("-m", "initial.r0=1,2", "time.end=1", "time.n_output=11", "output.figures=false",
+                "hydra.sweep.dir=sweep")
+    assert sweep.returncode == 0, sweep.stderr
+    assert {f"wrote {tmp_path / 'sweep' / job / 'run.nc'}" for job in "01"} <= set(sweep.stdout.splitlines())
+    assert "wrote sweep/sweep.nc" in sweep.stdout.splitlines() or \
+        f"wrote {tmp_path / 'sweep' / 'sweep.nc'}" in sweep.stdout.splitlines()
+    assert "[INFO]" not in sweep.stdout and "[INFO]" in sweep.stderr
+    aggregate = cli("aggregate", "sweep")
+    assert aggregate.returncode == 0, aggregate.stderr
+    assert aggregate.stdout.splitlines() == ["wrote sweep/sweep.nc"]
+    assert "[INFO]" in aggregate.stderr

@@ -37,7 +37,7 @@ PACKAGED_PATH = f"pkg://{CONFIG_MODULE}"
 #: groups whose options are chosen by name on the command line
 SELECTABLE_GROUPS = ("system", "body", "initial", "force", "integrator", "regime", "experiment")
 #: the file of ``@hydra.main``: Hydra resolves a relative ``--config-path`` against its folder
-_APP_FILE = str(Path(__file__).resolve().parent.parent / "app.py")
+_APP_FILE = str(Path(__file__).resolve().parent.parent / "app" / "__init__.py")
 
 
 @dataclass(frozen=True)

@@ -43,6 +43,7 @@ from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.units import quantity_units
 from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
+from gyrolab.output.written import announce_written
 from gyrolab.errors import ConfigError
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
@@ -456,6 +457,6 @@ def log_summary(summary: SweepSummary) -> None:
              summary.n_jobs, summary.finished, summary.failed, summary.missing, summary.skipped)
     for overrides, error in summary.failures:
         log.warning("failed job (%s): %s", overrides, error)
-    log.info("wrote %s", summary.path)
+    announce_written(summary.path)  # results to stdout (gyrolab.output.written)
     for figure in summary.figures:
-        log.info("wrote %s", figure)
+        announce_written(figure)

@@ -6,9 +6,13 @@ directory — into one sentence and a non-zero exit, so that no run directory
 with a partial ``run.nc`` is left behind.
 
 In a multirun each job is resumable and a failing job is recorded, not fatal
-(``gyrolab.sweep.job``); the sweep callback then writes ``sweep.nc``. Two
-more commands work on results: ``gyrolab --reproduce PATH/run.nc`` and
-``gyrolab --aggregate SWEEP_DIR``.
+(``gyrolab.sweep.job``); the sweep callback then writes ``sweep.nc``.
+
+This module is ``gyrolab run``, the default subcommand, and ``main``; the package holds the rest of the
+command line: ``parser`` (which subcommand a command line names, one argparse parser per other
+subcommand), ``commands`` (``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``, ``completion``)
+and ``completion`` (the bash and zsh script). Logs go to stderr, results to stdout
+(``gyrolab.output.written``).
 """
 
 from __future__ import annotations
@@ -51,6 +55,7 @@ from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
 from gyrolab.engine.progress import allow_bars, on_terminal
+from gyrolab.output.written import announce_written
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
@@ -375,20 +380,20 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
 
         written = run_task(task, cfg, out_dir)
         for path in written:
-            log.info("wrote %s", path)
+            announce_written(path)
         return written[0]
     scene = Scene.from_config(cfg)
     ds = scene.run()
     ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
     ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
     path = write_dataset(ds, out_dir / "run.nc")
-    log.info("wrote %s", path)
+    announce_written(path)
     if not figures:
         return path
     from gyrolab.figures.redraw import draw_figures  # matplotlib only when figures are drawn
 
     for figure in draw_figures("run.nc", ds, out_dir, cfg.output):
-        log.info("wrote %s", figure)
+        announce_written(figure)
     return path
 
 
@@ -408,46 +413,24 @@ def _quiet_console() -> None:
 
 
 def run_command(argv: Sequence[str]) -> int | None:
-    """``--reproduce PATH``, ``--aggregate SWEEP_DIR``, ``--batch OVERRIDES``, ``--new-force NAME``, ``--plot PATH``:
-    exit status, or None for a Hydra run.
+    """The subcommand ``argv`` names (``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``,
+    ``completion``, or an old spelling ``--batch``, ...; options in any position): its exit status, or None for
+    ``run`` (Hydra's app, the default)."""
+    from gyrolab.app.parser import split_command
 
-    Hydra's config options (``--config-dir``, ``--config-path``, ``--config-name``) may come first.
-    """
-    source, argv = split_source_options(argv)
-    if argv and argv[0] == "--batch":
-        use_source(source)
-        return _batch(argv[1:])
-    if argv and argv[0].split("=", 1)[0] == "--new-force":
-        from gyrolab.scaffold import new_force_package
+    command, rest = split_command(argv)
+    return None if command == "run" else run_subcommand(command, rest)
 
-        name = argv[0].partition("=")[2] or (argv[1] if len(argv) == 2 else "")
-        if len(argv) > (1 if "=" in argv[0] else 2):
-            raise ConfigError("--new-force takes one name; usage: gyrolab --new-force NAME")
-        root = new_force_package(name)
-        print(f"wrote {root}/: pip install -e {root} && python -m pytest {root}/tests")
-        return 0
-    if argv and argv[0].split("=", 1)[0] == "--plot":
-        use_source(source)
-        return _plot(argv)
-    if not argv or argv[0].split("=", 1)[0] not in ("--reproduce", "--aggregate"):
-        return None
-    option, _, value = argv[0].partition("=")
-    rest = ([value] if value else []) + list(argv[1:])
-    if len(rest) != 1:
-        raise ConfigError(f"{option} takes exactly one path (got {len(rest)}: {shorten(' '.join(rest)) or 'none'}); "
-                          f"usage: gyrolab {option} {'PATH/run.nc' if option == '--reproduce' else 'SWEEP_DIR'}")
-    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
-    if option == "--reproduce":
-        from gyrolab.sweep.reproduce import report, reproduce
 
-        comparison, stored = reproduce(Path(rest[0]))
-        print("\n".join(report(Path(rest[0]), comparison, stored)))
-        return 0 if comparison.identical else 1
-    from gyrolab.sweep.aggregate import aggregate_sweep, log_summary
+def run_subcommand(command: str, argv: Sequence[str]) -> int:
+    """Parse ``argv`` with ``command``'s parser (``gyrolab.app.parser``) and run it (``gyrolab.app.commands``)."""
+    from gyrolab.app.commands import RUNNERS
+    from gyrolab.app.parser import parse
 
-    summary = aggregate_sweep(Path(rest[0]))
-    log_summary(summary)
-    return _sweep_status(summary)
+    args = parse(command, argv)
+    if hasattr(args, "config_dir"):
+        use_source(ConfigSource.from_args(args.config_path, args.config_name, args.config_dir))
+    return RUNNERS[command](args)
 
 
 #: Hydra's options that choose where configs come from, long and short
@@ -488,96 +471,13 @@ def absolute_config_path(argv: Sequence[str]) -> list[str]:
 
 
 def _plot(argv: Sequence[str]) -> int:
-    """``gyrolab --plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]``: redraw every figure of the
-    datasets under PATH (``gyrolab.figures.redraw``) with the current style, formats and dpi; nothing is integrated."""
-    _, _, value = argv[0].partition("=")
-    rest = ([value] if value else []) + list(argv[1:])
-    if "--animate" in rest or any(a.startswith("--animate=") for a in rest):
-        return _animate(rest)
-    paths = [a for a in rest if "=" not in a]
-    overrides = [a for a in rest if "=" in a]
-    if len(paths) != 1:
-        raise ConfigError(f"--plot takes exactly one path (got {len(paths)}: {shorten(' '.join(paths)) or 'none'}); "
-                          "usage: gyrolab --plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]")
-    foreign = [o for o in overrides if not o.startswith("output.")]
-    if foreign:
-        raise ConfigError(f"--plot {shorten(foreign[0])!r}: a redraw takes output.* settings only (figure_formats, dpi)")
-    from gyrolab.figures.redraw import redraw
-
-    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
-    formats, dpi = figure_options(compose_config(overrides).output)
-    for path in redraw(Path(paths[0]), formats, dpi):
-        log.info("wrote %s", path)
-    return 0
-
-
-#: ``gyrolab --plot --animate PATH`` options -> ``gyrolab.figures.animation.animate`` keywords
-ANIMATE_OPTIONS = {"--format": "fmt", "--frames": "frames", "--fps": "fps", "--output": "output"}
-
-
-def _animate(rest: Sequence[str]) -> int:
-    """``gyrolab --plot --animate PATH [--format=gif|mp4] [--frames=N] [--fps=N] [--output=FILE]``: an animation
-    of the run at PATH (``gyrolab.figures.animation``)."""
-    usage = "usage: gyrolab --plot --animate PATH [--format=gif|mp4] [--frames=N] [--fps=N] [--output=FILE]"
-    paths, options = [], {}
-    args = list(rest)
-    while args:
-        option, has_value, value = args.pop(0).partition("=")
-        if option == "--animate":
-            if has_value:
-                paths.append(value)
-        elif option in ANIMATE_OPTIONS and (has_value or args):   # --frames=60 or --frames 60
-            options[ANIMATE_OPTIONS[option]] = value if has_value else args.pop(0)
-        elif option.startswith("-") or has_value:
-            raise ConfigError(f"--animate does not take {shorten(option + has_value + value)!r}; {usage}")
-        else:
-            paths.append(option)
-    if len(paths) != 1:
-        raise ConfigError(f"--animate takes exactly one path (got {len(paths)}: {shorten(' '.join(paths)) or 'none'}); "
-                          f"{usage}")
-    for key, kind, what in (("frames", int, "a whole number"), ("fps", float, "a number")):
-        if key in options:
-            try:
-                options[key] = kind(options[key])
-            except ValueError:
-                raise ConfigError(f"--{key}={options[key]!r} is not {what}; {usage}") from None
-    from gyrolab.figures.animation import animate
-
-    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
-    animate(paths[0], **options)   # logs the file it wrote
-    return 0
+    """``--plot PATH ...`` (kept for callers of the old function): ``gyrolab plot``."""
+    return run_subcommand("plot", [a for a in (argv[0].partition("=")[2], *argv[1:]) if a])
 
 
 def _batch(overrides: Sequence[str]) -> int:
-    """``gyrolab --batch KEY=V1,V2 ... [hydra.sweep.dir=DIR]``: the grid in one batch, one sweep.nc (resumable)."""
-    from datetime import datetime
-
-    from gyrolab.batch.sweep import run_batch_sweep
-
-    out_dir = Path(f"outputs/batch/{datetime.now():%Y-%m-%d}/{datetime.now():%H-%M-%S}")
-    scene_overrides = []
-    for override in overrides:
-        if override.startswith("hydra.sweep.dir="):
-            out_dir = Path(override.split("=", 1)[1])
-        elif override.startswith("hydra."):
-            raise ConfigError(f"{shorten(override)!r}: a batch sweep runs in one process; of Hydra's settings it "
-                              "takes hydra.sweep.dir only")
-        else:
-            scene_overrides.append(override)
-    parsed = parse_overrides(scene_overrides)
-    check_output_dir(str(out_dir), "hydra.sweep.dir")
-    first = compose_config(_job_overrides(parsed, {}))
-    check_config(first)
-    # the checks of the whole batch; each point's scene is validated by the batch's plan (an invalid point,
-    # the first included, is a failed entry, not a refused batch)
-    plain = check_scene_config(first)
-    figure_options(plain.get("output"))
-    check_tolerances(plain)
-    check_writable(out_dir)
-    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
-    path = run_batch_sweep(scene_overrides, out_dir)
-    log.info("wrote %s", path)
-    return 0
+    """``--batch OVERRIDES`` (kept for callers of the old function): ``gyrolab batch``."""
+    return run_subcommand("batch", list(overrides))
 
 
 def _sweep_status(summary: SweepSummary | None = None) -> int:
@@ -596,23 +496,45 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
     return 1
 
 
+def shell_completion(argv: Sequence[str]) -> int:
+    """Hydra's ``--shell-completion install=bash`` (or ``zsh``, ``uninstall=...``): gyrolab's own completion
+    script (``gyrolab.app.completion``), which knows the subcommands; Hydra's cannot see an installed app."""
+    from gyrolab.app.completion import SHELLS, script
+
+    args, _ = get_args_parser().parse_known_args(list(argv))
+    args_list = list(args.overrides)
+    action, _, shell = (args_list[0] if len(args_list) == 1 else "").partition("=")
+    if action not in ("install", "uninstall") or shell not in SHELLS:
+        raise ConfigError(f"--shell-completion takes install=SHELL or uninstall=SHELL with SHELL one of "
+                          f"{', '.join(SHELLS)} (got {shorten(' '.join(args_list)) or 'nothing'}); "
+                          f'e.g. eval "$(gyrolab --shell-completion install=bash)", the same as gyrolab completion bash')
+    print(script(shell) if action == "install" else "complete -r gyrolab")
+    return 0
+
+
 def main() -> None:
-    """Console entry point ``gyrolab`` (also ``python -m gyrolab``)."""
+    """Console entry point ``gyrolab`` (also ``python -m gyrolab``): the subcommand named on the command line
+    (``gyrolab.app.parser``), by default ``run``, Hydra's app (preflight, then ``_task``)."""
     # The interpreter's last garbage collection walks every object numba, scipy, xarray and Hydra created:
     # ~1 s of every command's wall time (0.1 s after a freeze, measured). Files are closed explicitly, so
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
     show_warnings_in_one_line()
-    argv = sys.argv[1:] = absolute_config_path(sys.argv[1:])
-    if argv[:1] in (["--version"], ["-V"]):
-        from gyrolab.output.provenance import gyrolab_version
-
-        print(f"gyrolab {gyrolab_version()}")
-        sys.exit(0)
+    argv = absolute_config_path(sys.argv[1:])
     try:
-        status = run_command(argv)
-        if status is not None:
-            sys.exit(status)
+        from gyrolab.app.parser import split_command
+
+        command, argv = split_command(argv)
+        sys.argv[1:] = argv
+        if command == "run" and ("--version" in argv or "-V" in argv):
+            from gyrolab.output.provenance import gyrolab_version
+
+            print(f"gyrolab {gyrolab_version()}")
+            sys.exit(0)
+        if command != "run":
+            sys.exit(run_subcommand(command, argv))
+        if "--shell-completion" in argv or "-sc" in argv:
+            sys.exit(shell_completion(argv))
         register_plugin_configs()
         from gyrolab.sweep.sweeper import register_plugin
 

@@ -1,0 +1,176 @@
+"""The subcommands other than ``run``: ``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``, ``completion``.
+
+Each takes its parsed options (``gyrolab.app.parser``) and returns the exit status; bad input is a
+GyrolabError (one sentence). Logs go to stderr, results (paths written, reports) to stdout
+(``gyrolab.output.written``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from pathlib import Path
+
+from gyrolab.errors import ConfigError, shorten
+from gyrolab.output.written import announce_written
+
+log = logging.getLogger("gyrolab")
+
+LOG_FORMAT = "[%(asctime)s][%(name)s][%(levelname)s] - %(message)s"
+
+
+def log_to_stderr() -> None:
+    """The log format of a Hydra run, on stderr (the convention: logs to stderr, results to stdout)."""
+    logging.basicConfig(level=logging.INFO, format=LOG_FORMAT, stream=sys.stderr)
+
+
+def batch(args: argparse.Namespace) -> int:
+    """``gyrolab batch KEY=V1,V2 ... [hydra.sweep.dir=DIR] [--scheduler ADDRESS]``: the grid in one batch, one
+    sweep.nc (resumable). The sweep is the command line's plus the config's ``hydra.sweeper.params``, as for -m."""
+    from datetime import datetime
+
+    from gyrolab.app import (_job_overrides, _sweeper_params, check_writable, parse_overrides)
+    from gyrolab.batch.sweep import run_batch_sweep
+    from gyrolab.engine.config import check_scene_config, compose_config
+    from gyrolab.engine.budget import check_tolerances
+    from gyrolab.engine.safety import check_config, check_output_dir
+    from gyrolab.figures.options import figure_options
+
+    overrides = list(args.overrides)
+    try:  # the command line's own route to a Dask scheduler, where gyrolab has one (issue 23: trusted only here)
+        from gyrolab.batch.scheduler import use_command_line_scheduler
+    except ImportError:
+        if args.scheduler is not None:
+            overrides.append(f"batch.scheduler={_quoted(args.scheduler)}")
+    else:
+        use_command_line_scheduler(args.scheduler)  # None when not given: no value left from an earlier command
+    now = datetime.now()
+    out_dir = Path(f"outputs/batch/{now:%Y-%m-%d}/{now:%H-%M-%S}")
+    scene_overrides = []
+    for override in overrides:
+        if override.startswith("hydra.sweep.dir="):
+            out_dir = Path(override.split("=", 1)[1])
+        elif override.startswith("hydra."):
+            raise ConfigError(f"{shorten(override)!r}: a batch sweep runs in one process; of Hydra's settings it "
+                              "takes hydra.sweep.dir only")
+        else:
+            scene_overrides.append(override)
+    parsed = parse_overrides(scene_overrides)
+    check_output_dir(str(out_dir), "hydra.sweep.dir")
+    first_overrides = _job_overrides(parsed, {})
+    with_hydra = compose_config(first_overrides, return_hydra_config=True)
+    given = {o.key_or_group for o in parsed}
+    # the sweep a config declares (hydra.sweeper.params), unless the command line sets the same key, as Hydra does
+    declared = [o for o in _sweeper_params(with_hydra) if o.key_or_group not in given]
+    scene_overrides += [o.input_line for o in declared]
+    first = compose_config(first_overrides)
+    check_config(first)
+    # the checks of the whole batch; each point's scene is validated by the batch's plan (an invalid point,
+    # the first included, is a failed entry, not a refused batch)
+    plain = check_scene_config(first)
+    figure_options(plain.get("output"))
+    check_tolerances(plain)
+    check_writable(out_dir)
+    log_to_stderr()
+    if declared:
+        log.info("batch: the sweep declared in hydra.sweeper.params: %s", " ".join(o.input_line for o in declared))
+    path = run_batch_sweep(scene_overrides, out_dir)
+    announce_written(path)
+    return 0
+
+
+def _quoted(value: str) -> str:
+    """A value as a quoted Hydra override value (an address's ``:`` and ``/`` are not plain override text)."""
+    return f"'{value}'" if "'" not in value else f'"{value}"'
+
+
+def plot(args: argparse.Namespace) -> int:
+    """``gyrolab plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]``: redraw every figure of the
+    datasets under PATH (``gyrolab.figures.redraw``) with the current style, formats and dpi; nothing is
+    integrated. ``--animate RUN`` animates a run instead (``gyrolab.figures.animation``)."""
+    from gyrolab.app.parser import one_path
+    from gyrolab.engine.config import compose_config
+    from gyrolab.figures.options import figure_options
+
+    paths = [a for a in args.arguments if "=" not in a]
+    overrides = [a for a in args.arguments if "=" in a]
+    foreign = [o for o in overrides if not o.startswith("output.")]
+    if foreign:
+        raise ConfigError(f"plot {shorten(foreign[0])!r}: a redraw takes output.* settings only (figure_formats, dpi)")
+    if args.animate is not None:
+        if paths:
+            raise ConfigError(f"plot --animate takes the run to animate as its value; drop "
+                              f"{shorten(' '.join(paths))!r} or redraw it with a separate gyrolab plot PATH")
+        return _animate(args)
+    animation_options = [name for name in ("format", "frames", "fps", "output") if getattr(args, name) is not None]
+    if animation_options:
+        raise ConfigError(f"plot --{animation_options[0]} is an option of --animate; usage: gyrolab plot "
+                          f"--animate RUN --{animation_options[0]} ...")
+    path = one_path("plot", paths, "plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]")
+    from gyrolab.figures.redraw import redraw
+
+    log_to_stderr()
+    formats, dpi = figure_options(compose_config(overrides).output)
+    for written in redraw(Path(path), formats, dpi):
+        announce_written(written)
+    return 0
+
+
+def _animate(args: argparse.Namespace) -> int:
+    from gyrolab.figures.animation import animate  # matplotlib's writers only when an animation is asked for
+    options = {"output": args.output, "fmt": args.format, "frames": args.frames, "fps": args.fps}
+    log_to_stderr()
+    written = animate(args.animate, **{k: v for k, v in options.items() if v is not None})
+    announce_written(written)
+    return 0
+
+
+def reproduce(args: argparse.Namespace) -> int:
+    """``gyrolab reproduce PATH/run.nc``: the comparison report on stdout; 0 if identical, else 1."""
+    from gyrolab.app.parser import one_path
+    from gyrolab.sweep.reproduce import report, reproduce as rerun
+
+    path = Path(one_path("reproduce", args.paths, "reproduce PATH/run.nc"))
+    log_to_stderr()
+    comparison, stored = rerun(path)
+    print("\n".join(report(path, comparison, stored)))
+    return 0 if comparison.identical else 1
+
+
+def aggregate(args: argparse.Namespace) -> int:
+    """``gyrolab aggregate SWEEP_DIR``: (re)write SWEEP_DIR/sweep.nc; 0 if every job finished, else 1."""
+    from gyrolab.app import _sweep_status
+    from gyrolab.app.parser import one_path
+    from gyrolab.sweep.aggregate import aggregate_sweep, log_summary
+
+    path = Path(one_path("aggregate", args.paths, "aggregate SWEEP_DIR"))
+    log_to_stderr()
+    summary = aggregate_sweep(path)
+    log_summary(summary)
+    return _sweep_status(summary)
+
+
+def new_force(args: argparse.Namespace) -> int:
+    """``gyrolab new-force NAME``: a force plugin package to start from, with its tests."""
+    from gyrolab.scaffold import new_force_package
+
+    if len(args.names) != 1:
+        raise ConfigError("new-force takes one name; usage: gyrolab new-force NAME")
+    root = new_force_package(args.names[0])
+    announce_written(f"{root}/")
+    print(f"next: pip install -e {root} && python -m pytest {root}/tests")
+    return 0
+
+
+def completion(args: argparse.Namespace) -> int:
+    """``gyrolab completion bash|zsh``: the completion script on stdout (eval it in the shell's rc file)."""
+    from gyrolab.app.completion import script
+
+    print(script(args.shell))
+    return 0
+
+
+#: subcommand -> what runs it (``run`` is Hydra's app, in gyrolab.app)
+RUNNERS = {"batch": batch, "plot": plot, "reproduce": reproduce, "aggregate": aggregate, "new-force": new_force,
+           "completion": completion}
