@@ -30,6 +30,7 @@ from omegaconf.errors import OmegaConfBaseException
 from gyrolab.contracts import registry
 from gyrolab.engine.hydra_private import create_automatic_config_search_path
 from gyrolab.errors import ConfigError, choices, shorten
+from gyrolab.engine.user_yaml import check_user_config_dir
 
 CONFIG_MODULE = "gyrolab.conf"
 CONFIG_NAME = "config"
@@ -58,11 +59,13 @@ class ConfigSource:
             if not os.path.isdir(config_dir):
                 raise ConfigError(f"--config-dir {config_dir!r} is not a directory; give the folder that holds "
                                   "your YAML files (e.g. --config-dir myconf)")
+            check_user_config_dir(config_dir, "--config-dir")
         if config_path is not None and not config_path.startswith("pkg://"):
             config_path = os.path.abspath(config_path)
             if not os.path.isdir(config_path):
                 raise ConfigError(f"--config-path {config_path!r} is not a directory; give the folder that holds "
                                   "your primary config (e.g. --config-path myconf --config-name mine)")
+            check_user_config_dir(config_path, "--config-path")
         if config_name is not None:
             config_name = config_name.removesuffix(".yaml")
             if not config_name or "\0" in config_name:
