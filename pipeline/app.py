@@ -35,7 +35,7 @@ from hydra.errors import OverrideParseException
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from gyrolab.engine.budget import check_budget, check_tolerances
+from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
 from gyrolab.engine.hydra_private import get_args_parser
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
@@ -115,6 +115,7 @@ def preflight(argv: Sequence[str]) -> list[str]:
     check_launcher_installed(overrides)
     if sweeping:
         _refuse_swept_hydra_settings(overrides)
+        check_sweep_size(overrides)  # before anything expands a range(0,1e12,1)
         Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
     with hydra_for(source):
         # One job composed and validated: the first value of every sweep (each group choice checked for safety).
@@ -136,6 +137,9 @@ def preflight(argv: Sequence[str]) -> list[str]:
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     validate_scene(_without_hydra(cfg))
+    from gyrolab.experiments import check_task
+
+    check_task(task_of(cfg), _without_hydra(cfg), run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
     return argv
 
@@ -521,6 +525,7 @@ def _batch(overrides: Sequence[str]) -> int:
         else:
             scene_overrides.append(override)
     parsed = parse_overrides(scene_overrides)
+    check_sweep_size(parsed)  # before anything expands a range(0,1e12,1)
     check_output_dir(str(out_dir), "hydra.sweep.dir")
     first = compose_config(_job_overrides(parsed, {}))
     check_config(first)

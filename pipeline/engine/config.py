@@ -314,6 +314,12 @@ def _first_line(error: Exception) -> str:
     """The first line of a Hydra/OmegaConf message, without its pointer to the online docs."""
     lines = [line.strip() for line in str(error).strip().splitlines() if line.strip()]
     line = lines[0] if lines else type(error).__name__
+    if line.endswith(":") and len(lines) > 1:  # "In 'experiment/x': ConfigTypeError raised while composing config:"
+        line = f"{line} {lines[1]}"
+    line = line.replace("Cannot merge DictConfig with ListConfig",
+                        "a list is given where the config has a section (a mapping)")
+    line = line.replace("Cannot merge ListConfig with DictConfig",
+                        "a section (a mapping) is given where the config has a list")
     return line.split(" See https://")[0]
 
 
@@ -395,12 +401,57 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
     for key in ("task",):
         if key in plain and not isinstance(plain[key], str):
             raise ConfigError(f"{key}={shorten(repr(plain[key]))} must be a task name (a string)")
+    n_output = plain["time"].get("n_output")
+    if n_output is not None and n_output != "auto" and (isinstance(n_output, bool) or not isinstance(n_output, int)):
+        raise ConfigError(f"time.n_output={shorten(repr(n_output))} must be an integer (the samples stored) or auto")
+    for section in ("time", "body", "initial", "force", "integrator", "system", "regime", "batch"):
+        _check_magnitudes(section, plain.get(section))
+    _check_degenerate_vectors(plain)
     accuracy = plain.get("accuracy")
     if accuracy is not None:
         check_type("accuracy", accuracy, 0.0)
     if "allow_large" in plain:
         check_type("allow_large", plain["allow_large"], False)
     return plain
+
+
+def _check_degenerate_vectors(plain: dict[str, Any]) -> None:
+    """A zero centre-of-mass vector under uniform gravity is a torque that silently vanishes: refused.
+
+    (Zero field directions and axes are refused by the plugins that normalise them.)
+    """
+    forces = plain.get("force") or {}
+    if not isinstance(forces, dict) or "uniform_gravity" not in forces:
+        return
+    body = plain.get("body") or {}
+    key = "com" if body.get("units") == "si" else "com_direction"
+    vector = body.get(key)
+    if isinstance(vector, list) and vector and all(isinstance(v, (int, float)) and v == 0 for v in vector):
+        raise ConfigError(f"body.{key}={vector} is a zero vector, so uniform gravity would exert no torque; give the "
+                          f"centre of mass's direction (e.g. body.{key}=[0,0,1]), or to run without gravity torque "
+                          "leave uniform_gravity out of the forces (force=[] for the torque-free Euler top)")
+
+
+#: no physical setting of a scene is this large; beyond it squares and products overflow a double
+MAX_MAGNITUDE = 1e100
+
+
+def _check_magnitudes(where: str, node: Any) -> None:
+    """ConfigError for a number beyond :data:`MAX_MAGNITUDE` (``initial.r0=1e300`` overflows the first product)."""
+    if isinstance(node, dict):
+        for key, value in node.items():
+            _check_magnitudes(f"{where}.{key}", value)
+    elif isinstance(node, list):
+        for i, value in enumerate(node):
+            _check_magnitudes(f"{where}[{i}]", value)
+    elif isinstance(node, (int, float)) and not isinstance(node, bool):
+        try:
+            large = MAX_MAGNITUDE < abs(float(node)) < float("inf")  # inf and nan: require_finite says so
+        except OverflowError:
+            large = True
+        if large:
+            raise ConfigError(f"{where}={shorten(repr(node), 40)} is too large; gyrolab takes numbers up to "
+                              f"{MAX_MAGNITUDE:.0e} in magnitude (use nondimensional or scaled units)")
 
 
 def _plugin_keys(group: str, target: Any) -> set[str]:

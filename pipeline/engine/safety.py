@@ -155,10 +155,29 @@ def check_output_dir(text: str, key: str) -> None:
     if resolved == cwd or resolved in cwd.parents:
         raise ConfigError(f"{key}={shorten(text)} is the working directory or one of its parents; give a "
                           f"directory of its own for the results, e.g. {key}=outputs/run1")
+    try:  # through symbolic links: a link into site-packages is where it points
+        real = Path(os.path.realpath(resolved, strict=False))
+    except (OSError, RuntimeError):  # a symlink loop (RuntimeError before Python 3.13)
+        raise ConfigError(f"{key}={shorten(text)} cannot be resolved (a loop of symbolic links?); give a directory "
+                          f"for the results, e.g. {key}=outputs/run1") from None
+    _refuse_link_loop(resolved, key, text)
     for protected in _protected_dirs():
-        if resolved == protected or protected in resolved.parents:
-            raise ConfigError(f"{key}={shorten(text)} is inside {protected}, where Python loads code from; give a "
-                              f"directory for results, e.g. {key}=outputs/run1")
+        for candidate in (resolved, real):
+            if candidate == protected or protected in candidate.parents:
+                raise ConfigError(f"{key}={shorten(text)} is inside {protected}, where Python loads code from; "
+                                  f"give a directory for results, e.g. {key}=outputs/run1")
+
+
+def _refuse_link_loop(path: Path, key: str, text: str) -> None:
+    """ConfigError when an existing part of ``path`` is a loop of symbolic links (realpath does not say so)."""
+    for part in (path, *path.parents):
+        if os.path.islink(part):
+            try:
+                os.stat(part)
+            except OSError as error:
+                if error.errno == 40:  # ELOOP
+                    raise ConfigError(f"{key}={shorten(text)} goes through a loop of symbolic links ({part}); give a "
+                                      f"directory for the results, e.g. {key}=outputs/run1") from None
 
 
 @cache
@@ -169,6 +188,7 @@ def _protected_dirs() -> tuple[Path, ...]:
                  str(Path(__file__).resolve().parents[1])]:  # the last one: gyrolab's own folder
         if path:
             dirs.add(Path(os.path.abspath(path)))
+            dirs.add(Path(os.path.realpath(path)))
     return tuple(sorted(dirs))
 
 
@@ -312,3 +332,29 @@ def _check_launcher_shell(launcher: dict[str, Any], command_line: Sequence[str])
             raise ConfigError(f"hydra.launcher.{key}={shorten(repr(value))} comes from a config file; shell lines and "
                               f"scheduler arguments run as you, so give them on the command line "
                               f"(hydra.launcher.{key}=...)")
+
+
+def confined_output_path(out_dir: str | os.PathLike[str], name: Any, key: str) -> Path:
+    """``out_dir/name`` when it stays inside ``out_dir`` (symlinks resolved), else one ConfigError sentence.
+
+    Every file a config names for writing (``stability_map.file``) goes through here: a relative path
+    without ``..``, ending in ``.nc``, whose resolved location (through any symlink already in the run
+    directory) is inside the resolved run directory — so ``../elsewhere/x.pth`` or a link into
+    site-packages cannot make gyrolab write a file Python would load.
+    """
+    text = str(name) if isinstance(name, (str, os.PathLike)) else ""
+    parts = Path(text).parts
+    if (not text.strip() or Path(text).is_absolute() or ".." in parts or text.startswith("~") or "\0" in text
+            or not text.endswith(".nc") or len(text) > 255):
+        raise ConfigError(f"{key}={shorten(repr(name))} must be a file name ending in .nc inside the run directory "
+                          f"(no '/..', no absolute path), e.g. {key}=stability_map.nc")
+    base = Path(out_dir).resolve()
+    target = (base / text).resolve()
+    if base not in target.parents:
+        raise ConfigError(f"{key}={shorten(text)} leads outside the run directory through a symbolic link; "
+                          f"give a file name inside it, e.g. {key}=stability_map.nc")
+    for protected in _protected_dirs():
+        if target == protected or protected in target.parents:
+            raise ConfigError(f"{key}={shorten(text)} lands inside {protected}, where Python loads code from; "
+                              f"choose a run directory for results")
+    return base / text
