@@ -402,7 +402,7 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
         if key in plain and not isinstance(plain[key], str):
             raise ConfigError(f"{key}={shorten(repr(plain[key]))} must be a task name (a string)")
     n_output = plain["time"].get("n_output")
-    if n_output is not None and n_output != "auto" and (isinstance(n_output, bool) or not isinstance(n_output, int)):
+    if n_output != "auto" and (isinstance(n_output, bool) or not isinstance(n_output, int)):
         raise ConfigError(f"time.n_output={shorten(repr(n_output))} must be an integer (the samples stored) or auto")
     for section in ("time", "body", "initial", "force", "integrator", "system", "regime", "batch"):
         _check_magnitudes(section, plain.get(section))

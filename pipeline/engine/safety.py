@@ -334,6 +334,10 @@ def _check_launcher_shell(launcher: dict[str, Any], command_line: Sequence[str])
                               f"(hydra.launcher.{key}=...)")
 
 
+#: a file name a config may give for an output: plain names and folders, ending in .nc
+_OUTPUT_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.+-]*(/[A-Za-z0-9_][A-Za-z0-9_.+-]*)*\.nc$")
+
+
 def confined_output_path(out_dir: str | os.PathLike[str], name: Any, key: str) -> Path:
     """``out_dir/name`` when it stays inside ``out_dir`` (symlinks resolved), else one ConfigError sentence.
 
@@ -344,8 +348,7 @@ def confined_output_path(out_dir: str | os.PathLike[str], name: Any, key: str) -
     """
     text = str(name) if isinstance(name, (str, os.PathLike)) else ""
     parts = Path(text).parts
-    if (not text.strip() or Path(text).is_absolute() or ".." in parts or text.startswith("~") or "\0" in text
-            or not text.endswith(".nc") or len(text) > 255):
+    if not _OUTPUT_NAME.match(text) or ".." in parts or len(text) > 255:
         raise ConfigError(f"{key}={shorten(repr(name))} must be a file name ending in .nc inside the run directory "
                           f"(no '/..', no absolute path), e.g. {key}=stability_map.nc")
     base = Path(out_dir).resolve()

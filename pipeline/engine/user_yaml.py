@@ -21,6 +21,9 @@ import yaml
 from gyrolab.errors import ConfigError, shorten
 
 MAX_FILE_BYTES = 1024 * 1024
+#: the tags YAML's core schema resolves plain values to; any other (!!python/..., !custom) is refused
+CORE_TAGS = frozenset(f"tag:yaml.org,2002:{t}" for t in
+                      ("str", "int", "float", "bool", "null", "map", "seq", "merge", "timestamp", "binary"))
 MAX_FILES = 2000
 #: nodes of a file with every alias expanded (gyrolab's largest packaged file has a few hundred)
 MAX_EXPANDED_NODES = 100_000
@@ -73,6 +76,10 @@ def check_user_yaml(path: Path) -> None:
         raise ConfigError(f"{where}, line {node.start_mark.line + 1}: the file is {kind}, not a mapping of settings "
                           "(key: value lines); every config file is a mapping")
     _check_nodes(node, where)
+    for key, value in node.value:
+        if key.value == "defaults" and not isinstance(value, yaml.SequenceNode):
+            raise ConfigError(f"{where}, line {value.start_mark.line + 1}: `defaults` must be a list (- group: option "
+                              "lines), as in Hydra's defaults list")
 
 
 def _sentence(where: str, error: yaml.MarkedYAMLError) -> str:
@@ -106,9 +113,15 @@ def _check_nodes(root: yaml.Node, where: str) -> None:
             raise ConfigError(f"{where}, line {node.start_mark.line + 1}: an alias refers to itself; "
                               "a config file cannot be recursive")
         on_path.add(key)
+        if node.tag not in CORE_TAGS:
+            raise ConfigError(f"{where}, line {node.start_mark.line + 1}: the YAML tag {shorten(node.tag, 60)!r} is not "
+                              "allowed; a config file holds plain values (numbers, strings, lists, mappings)")
         if isinstance(node, yaml.MappingNode):
             seen: dict[object, int] = {}
             for k, _ in node.value:
+                if not isinstance(k, yaml.ScalarNode):
+                    raise ConfigError(f"{where}, line {k.start_mark.line + 1}: a key is a list or a mapping; keys of a "
+                                      "config are plain names")
                 if isinstance(k, yaml.ScalarNode):
                     if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
                         raise ConfigError(f"{where}, line {k.start_mark.line + 1}: the key {shorten(k.value, 60)!r} "

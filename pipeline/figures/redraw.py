@@ -15,7 +15,8 @@ from pathlib import Path
 import xarray as xr
 from omegaconf import OmegaConf
 
-from gyrolab.errors import ConfigError, OutputError
+from gyrolab.errors import ConfigError
+from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 
 #: dataset file name -> the gyrolab.figures module that draws its figures
@@ -38,11 +39,12 @@ def draw_dataset(path: Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int 
     path = Path(path)
     if path.name not in KINDS:
         raise ConfigError(f"{str(path)!r} is not a dataset gyrolab draws figures from; known: {', '.join(KINDS)}")
+    expected = f"a {path.name} that gyrolab wrote"
+    ds = load_dataset(path, expected)
     try:
-        ds = xr.load_dataset(path)
-    except (OSError, ValueError) as error:
-        raise OutputError(f"cannot read {str(path)!r}: {error}") from None
-    return save_kind(path.name, ds, path.parent / "figures", tuple(formats), dpi)
+        return save_kind(path.name, ds, path.parent / "figures", tuple(formats), dpi)
+    except FOREIGN_ERRORS as error:  # a variable or attribute gyrolab's datasets have is missing
+        raise not_gyrolabs(path, error, expected) from None
 
 
 def save_kind(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ...], dpi: int) -> list[Path]:
