@@ -588,7 +588,12 @@ def main() -> None:
     # allowed again (a multirun job turns them off)
     callbacks.reset()
     allow_bars(True)
-    _task()
+    from gyrolab.output.lock import release_all
+
+    try:
+        _task()
+    finally:
+        release_all()  # a failed run's lock too (Hydra skips the callback's on_run_end when the job exits)
     status = _sweep_status()
     if status:
         sys.exit(status)

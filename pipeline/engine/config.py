@@ -384,6 +384,10 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
                 raise ConfigError(unknown_key_sentence(f"{section}.{key}", [f"{section}.{k}" for k in valid]))
             if section in _CLOSED_SECTIONS:
                 check_type(f"{section}.{key}", value, ref["defaults"][section][key])
+    for group in ("integrator", "system", "regime", "force", "batch"):
+        if plain.get(group) is not None and not isinstance(plain[group], dict):
+            raise ConfigError(f"{group}={shorten(repr(plain[group]))}: `{group}` is a section (a mapping), not a "
+                              f"value; choose an option ({group}=NAME) or set its keys ({group}.KEY=...)")
     for group in ("integrator", "system", "regime"):
         node = plain.get(group)
         if isinstance(node, dict) and "_target_" in node and _plugin_keys(group, node["_target_"]):

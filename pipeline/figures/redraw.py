@@ -33,6 +33,9 @@ KINDS = {
     "stability_map.nc": "stability_map",
 }
 
+#: a variable every dataset of a kind has, for kinds whose figures would otherwise quietly draw nothing
+SIGNATURES = {"run.nc": "time", "sweep.nc": "job_status"}
+
 
 def draw_dataset(path: Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int = DEFAULT_DPI) -> list[Path]:
     """Redraw the figures of one dataset file into ``figures/`` beside it."""
@@ -41,6 +44,9 @@ def draw_dataset(path: Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int 
         raise ConfigError(f"{str(path)!r} is not a dataset gyrolab draws figures from; known: {', '.join(KINDS)}")
     expected = f"a {path.name} that gyrolab wrote"
     ds = load_dataset(path, expected)
+    needed = SIGNATURES.get(path.name)
+    if needed is not None and needed not in ds.variables:
+        raise not_gyrolabs(path, KeyError(needed), expected)
     try:
         return save_kind(path.name, ds, path.parent / "figures", tuple(formats), dpi)
     except FOREIGN_ERRORS as error:  # a variable or attribute gyrolab's datasets have is missing
