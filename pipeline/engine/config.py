@@ -316,10 +316,9 @@ def _first_line(error: Exception) -> str:
     line = lines[0] if lines else type(error).__name__
     if line.endswith(":") and len(lines) > 1:  # "In 'experiment/x': ConfigTypeError raised while composing config:"
         line = f"{line} {lines[1]}"
-    line = line.replace("Cannot merge DictConfig with ListConfig",
-                        "a list is given where the config has a section (a mapping)")
-    line = line.replace("Cannot merge ListConfig with DictConfig",
-                        "a section (a mapping) is given where the config has a list")
+    for merge in ("Cannot merge DictConfig with ListConfig", "Cannot merge ListConfig with DictConfig"):
+        line = line.replace(merge, "a list and a section (a mapping) do not match: one is given where the config "
+                                   "has the other")
     return line.split(" See https://")[0]
 
 

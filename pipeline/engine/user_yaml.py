@@ -45,7 +45,7 @@ def check_user_config_dir(directory: str, option: str) -> None:
 
 
 def check_user_yaml(path: Path) -> None:
-    where = shorten(str(path))
+    where = _display(path)
     try:
         if path.stat().st_size > MAX_FILE_BYTES:
             raise ConfigError(f"{where} is larger than {MAX_FILE_BYTES // 1024} KiB; a config file is a short "
@@ -80,6 +80,17 @@ def check_user_yaml(path: Path) -> None:
         if key.value == "defaults" and not isinstance(value, yaml.SequenceNode):
             raise ConfigError(f"{where}, line {value.start_mark.line + 1}: `defaults` must be a list (- group: option "
                               "lines), as in Hydra's defaults list")
+
+
+def _display(path: Path) -> str:
+    """The file as the user can find it: relative to the working directory when inside it."""
+    text = str(path)
+    try:
+        relative = os.path.relpath(path)
+        text = relative if not relative.startswith("..") else text
+    except ValueError:
+        pass
+    return shorten(text, 200)
 
 
 def _sentence(where: str, error: yaml.MarkedYAMLError) -> str:

@@ -15,7 +15,7 @@ from pathlib import Path
 import xarray as xr
 from omegaconf import OmegaConf
 
-from gyrolab.errors import ConfigError
+from gyrolab.errors import ConfigError, GyrolabError
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 
@@ -49,6 +49,8 @@ def draw_dataset(path: Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int 
         raise not_gyrolabs(path, KeyError(needed), expected)
     try:
         return save_kind(path.name, ds, path.parent / "figures", tuple(formats), dpi)
+    except GyrolabError:
+        raise
     except FOREIGN_ERRORS as error:  # a variable or attribute gyrolab's datasets have is missing
         raise not_gyrolabs(path, error, expected) from None
 

@@ -18,7 +18,7 @@ import xarray as xr
 from gyrolab.errors import ConfigError, shorten
 
 #: what a figure module or a rerun raises when a dataset lacks what gyrolab's datasets have
-FOREIGN_ERRORS = (KeyError, IndexError, ValueError, TypeError, AttributeError, LookupError)
+FOREIGN_ERRORS = (LookupError, ValueError, TypeError, AttributeError, ArithmeticError)
 
 
 def load_dataset(path: str | os.PathLike[str], expected: str, **options) -> xr.Dataset:

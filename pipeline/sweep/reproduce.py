@@ -17,7 +17,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.engine.budget import check_budget
 from gyrolab.engine.safety import check_stored_config
-from gyrolab.errors import ConfigError, shorten
+from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
@@ -127,11 +127,15 @@ def reproduce(path: Path) -> tuple[Comparison, xr.Dataset]:
     expected = "a run.nc that gyrolab wrote"
     try:
         scene = Scene.from_config(stored_config(stored))
+    except GyrolabError:
+        raise
     except FOREIGN_ERRORS as error:  # a stored config without what gyrolab's runs always have
         raise not_gyrolabs(path, error, expected) from None
     new = scene.run()
     try:
         return compare(stored, new), stored
+    except GyrolabError:
+        raise
     except FOREIGN_ERRORS as error:  # variables that gyrolab's runs always have are missing
         raise not_gyrolabs(path, error, expected) from None
 
