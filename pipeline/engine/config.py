@@ -366,10 +366,12 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
     for key in cfg.keys():
         if key not in ref["top"]:
             raise ConfigError(unknown_key_sentence(str(key), sorted(ref["top"])))
-    for section in ("time", "output", "body", "initial"):
+    for section in ("time", "output", "body", "initial", "system", "integrator"):
         if section not in cfg or cfg[section] is None:
+            how = (f"set its keys instead (e.g. {section}.{_example_key(section)}=...)" if _example_key(section)
+                   else f"choose one ({section}=NAME)")
             raise ConfigError(f"the config has no `{section}` section (deleted with ~{section}?); every run needs "
-                              f"it: set its keys instead (e.g. {section}.{_example_key(section)}=...)")
+                              f"it: {how}")
     plain = resolve_plain(cfg)
     for section in ("time", "output", "body", "initial"):
         if not isinstance(plain[section], dict):
@@ -407,8 +409,8 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
     n_output = plain["time"].get("n_output")
     if n_output != "auto" and (isinstance(n_output, bool) or not isinstance(n_output, int)):
         raise ConfigError(f"time.n_output={shorten(repr(n_output))} must be an integer (the samples stored) or auto")
-    for section in ("time", "body", "initial", "force", "integrator", "system", "regime", "batch"):
-        _check_magnitudes(section, plain.get(section))
+    for section, node in plain.items():
+        _check_magnitudes(str(section), node)
     _check_degenerate_vectors(plain)
     accuracy = plain.get("accuracy")
     if accuracy is not None:
@@ -424,15 +426,27 @@ def _check_degenerate_vectors(plain: dict[str, Any]) -> None:
     (Zero field directions and axes are refused by the plugins that normalise them.)
     """
     forces = plain.get("force") or {}
-    if not isinstance(forces, dict) or "uniform_gravity" not in forces:
+    if not isinstance(forces, dict):
+        return
+    magnetic = forces.get("magnetic")
+    if isinstance(magnetic, dict) and _is_zero(magnetic.get("moment")):
+        raise ConfigError(f"force.magnetic.moment={magnetic['moment']} is a zero vector, so the magnetic force would "
+                          "exert no torque; give the body's magnetic moment (e.g. force.magnetic.moment=[0,0,1]), or "
+                          "leave magnetic out of the forces (force=[uniform_gravity])")
+    if "uniform_gravity" not in forces:
         return
     body = plain.get("body") or {}
     key = "com" if body.get("units") == "si" else "com_direction"
     vector = body.get(key)
-    if isinstance(vector, list) and vector and all(isinstance(v, (int, float)) and v == 0 for v in vector):
+    if _is_zero(vector):
         raise ConfigError(f"body.{key}={vector} is a zero vector, so uniform gravity would exert no torque; give the "
                           f"centre of mass's direction (e.g. body.{key}=[0,0,1]), or to run without gravity torque "
                           "leave uniform_gravity out of the forces (force=[] for the torque-free Euler top)")
+
+
+def _is_zero(vector: Any) -> bool:
+    return isinstance(vector, list) and bool(vector) and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) and v == 0 for v in vector)
 
 
 #: no physical setting of a scene is this large; beyond it squares and products overflow a double
@@ -466,7 +480,7 @@ def _plugin_keys(group: str, target: Any) -> set[str]:
 
 
 def _example_key(section: str) -> str:
-    return {"time": "end", "output": "figures", "body": "a", "initial": "r0"}[section]
+    return {"time": "end", "output": "figures", "body": "a", "initial": "r0"}.get(section, "")
 
 
 def check_type(where: str, value: Any, default: Any) -> None:

@@ -27,6 +27,8 @@ CORE_TAGS = frozenset(f"tag:yaml.org,2002:{t}" for t in
 MAX_FILES = 2000
 #: nodes of a file with every alias expanded (gyrolab's largest packaged file has a few hundred)
 MAX_EXPANDED_NODES = 100_000
+#: nesting of lists and mappings (gyrolab's deepest packaged file: 5; Python's recursion ends near 1000)
+MAX_DEPTH = 32
 
 
 def check_user_config_dir(directory: str, option: str) -> None:
@@ -105,10 +107,13 @@ def _sentence(where: str, error: yaml.MarkedYAMLError) -> str:
 def _check_nodes(root: yaml.Node, where: str) -> None:
     """Duplicate keys, and the size of the file with its aliases expanded (a shared node counts every time)."""
     sizes: dict[int, int] = {}
-    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
+    stack: list[tuple[yaml.Node, bool, int]] = [(root, False, 0)]
     on_path: set[int] = set()
     while stack:
-        node, done = stack.pop()
+        node, done, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise ConfigError(f"{where}, line {node.start_mark.line + 1}: lists and mappings nested more than "
+                              f"{MAX_DEPTH} deep; a config file is a short mapping of settings")
         key = id(node)
         if done:
             on_path.discard(key)
@@ -139,8 +144,8 @@ def _check_nodes(root: yaml.Node, where: str) -> None:
                                           f"is given twice in one mapping (first on line {seen[k.value]}); "
                                           "give each key once")
                     seen[k.value] = k.start_mark.line + 1
-        stack.append((node, True))
-        stack.extend((c, False) for c in _children(node) if id(c) not in sizes)
+        stack.append((node, True, depth))
+        stack.extend((c, False, depth + 1) for c in _children(node) if id(c) not in sizes)
 
 
 def _children(node: yaml.Node) -> list[yaml.Node]:

@@ -51,6 +51,9 @@ def grid(cfg: DictConfig) -> list[Dim]:
         if len(span) != 2:
             raise ConfigError(f"stability_map.{key}={list(span)!r} must be [first, last]")
         first, last = (as_number(v, f"stability_map.{key}") for v in span)
+        if n > 1 and first == last:
+            raise ConfigError(f"stability_map.{key}={list(span)!r} is one value, but n_{key}={n} points are asked; "
+                              f"give [first, last] with first ≠ last, or n_{key}=1")
         spacing = settings.get(f"{key}_spacing", "linear")
         if spacing not in ("linear", "log") or (spacing == "log" and not 0 < first < last):
             raise ConfigError(f"stability_map.{key}_spacing={spacing!r} must be linear or log (log: 0 < first < last)")
