@@ -5,6 +5,7 @@ import sys
 import pytest
 
 from gyrolab import app
+from gyrolab.errors import ConfigError
 
 CASES = {
     "unknown integrator": (["integrator=foo"], ["'foo'", "dop853", "rk4"]),
@@ -406,6 +407,12 @@ def test_a_run_directory_linked_into_site_packages_is_refused(tmp_path, monkeypa
     _one_sentence(["hydra.run.dir=innocent/out"], {}, "where Python loads code", tmp_path, monkeypatch, capsys)
 
 
+def test_a_config_file_linked_to_a_device_is_refused_without_blocking(tmp_path, monkeypatch, capsys):
+    (tmp_path / "cd" / "experiment").mkdir(parents=True)
+    (tmp_path / "cd" / "experiment" / "zero.yaml").symlink_to("/dev/zero")
+    _one_sentence(["--config-dir", "cd", "experiment=zero"], {}, "not a regular file", tmp_path, monkeypatch, capsys)
+
+
 def test_the_whole_corpus_is_large():
     assert len(CORPUS) + len(CASES) + len(FILE_CORPUS) + len(FOREIGN) + len(OVERRIDE_CORPUS) >= 200
 
@@ -429,3 +436,20 @@ def test_a_failed_run_leaves_no_lock(cli, tmp_path):
     assert (tmp_path / "out").is_dir()
     assert not (tmp_path / "out" / ".gyrolab.lock").exists()
     assert not list((tmp_path / "out").rglob("*.part")) and not (tmp_path / "out" / "run.nc").exists()
+
+
+def test_an_output_file_through_a_symlink_out_of_the_run_directory_is_refused(tmp_path, monkeypatch, capsys):
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "link").symlink_to(tmp_path / "elsewhere")
+    _one_sentence(["experiment=stability_map", "stability_map.file=link/x.nc"], {}, "through a symbolic link",
+                  tmp_path, monkeypatch, capsys)
+
+
+def test_confined_output_path_keeps_a_plain_name_inside(tmp_path):
+    from gyrolab.engine.safety import confined_output_path
+
+    assert confined_output_path(tmp_path, "maps/a.nc", "k") == tmp_path.resolve() / "maps" / "a.nc"
+    for bad in ("../a.nc", "/abs/a.nc", "a.pth", "", None, "a/../../b.nc", "~/a.nc", "a\\b.nc", 5):
+        with pytest.raises(ConfigError):
+            confined_output_path(tmp_path, bad, "k")

@@ -14,6 +14,7 @@ loader; any problem is one ConfigError sentence naming the file and line, never 
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
 import yaml
@@ -49,6 +50,8 @@ def check_user_config_dir(directory: str, option: str) -> None:
 def check_user_yaml(path: Path) -> None:
     where = _display(path)
     try:
+        if not stat.S_ISREG(path.stat().st_mode):  # a FIFO or a link to /dev/zero would block the read forever
+            raise ConfigError(f"{where} is not a regular file; a config folder holds YAML files")
         if path.stat().st_size > MAX_FILE_BYTES:
             raise ConfigError(f"{where} is larger than {MAX_FILE_BYTES // 1024} KiB; a config file is a short "
                               "YAML mapping of settings")
