@@ -389,6 +389,12 @@ OVERRIDE_CORPUS = [
     (["--batch", "initial.r0=range(0,1e6)", "body.a=range(1,1000,1)", "hydra.sweep.dir=b"], "beyond the budget"),
     (["--batch", "initial.r0=range(0,1,0)", "hydra.sweep.dir=b"], "step must not be 0"),
     (["--batch", "time.n_output=abc", "hydra.sweep.dir=b"], "time.n_output"),
+    ([f"hydra.run.dir={'x' * 5000}"], "not a usable path"), (["hydra.run.dir=/etc/gyrolab_test_out"], "system directory"),
+    (["hydra.run.dir=/proc/self/x"], "system directory"),
+    (["hydra.run.dir=venv/lib/python3.11/site-packages/gyrolab_test_out"], "where Python loads code"),
+    (["hydra.mode=MULTIRUN"], "disagrees with the command line"),
+    (["experiment=stability_map", "stability_map.sections=[[1]]"], "must be [theta0, r0]"),
+    (["experiment=stability_map", "stability_map.section_time=-1"], "must be a positive time"),
 ]
 
 

@@ -80,11 +80,19 @@ class ConfigSource:
             search_path.prepend(provider="command-line", path=f"file://{self.config_dir}",
                                 anchor=SearchPathQuery(provider="schema"))
         for path in self.searchpath:
+            if str(path).startswith("file://"):  # a config's hydra.searchpath: the user's files, checked as -cd's
+                _check_search_dir(str(path)[len("file://"):])
             search_path.append(provider="main", path=path)
         return search_path
 
 
 _source = ConfigSource()
+
+
+@cache
+def _check_search_dir(directory: str) -> None:
+    if os.path.isdir(directory):
+        check_user_config_dir(os.path.abspath(directory), "hydra.searchpath")
 
 
 def use_source(source: ConfigSource) -> None:

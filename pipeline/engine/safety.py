@@ -105,6 +105,10 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
             raise ConfigError(f"{path}={shorten(repr(value))} is not allowed; under hydra a config may name only "
                               f"gyrolab's sweep callback and the installed launchers and sweepers "
                               f"({', '.join(sorted(t.rsplit('.', 1)[1] for t in allowed))})")
+    mode = str(plain_hydra.get("mode") or "")
+    if mode.endswith("MULTIRUN") != job_subdir and mode not in ("", "None"):
+        raise ConfigError(f"hydra.mode={mode.rsplit('.', 1)[-1]} disagrees with the command line; start a sweep "
+                          "with -m (gyrolab -m KEY=V1,V2 ...) and a single run without it")
     _check_paths(plain_hydra, Path(run_dir))
     out = _output_dir(run_dir, plain_hydra, job_subdir)
     for name in ("job_logging", "hydra_logging"):
@@ -150,6 +154,9 @@ def check_output_dir(text: str, key: str) -> None:
     if not text.strip() or text.strip() in (".", "./"):
         raise ConfigError(f"{key}={text!r} would write into the working directory itself; give a directory "
                           f"for the results, e.g. {key}=outputs/run1")
+    if "\0" in text or len(text) > 4096 or any(len(part) > 255 for part in directory.parts):
+        raise ConfigError(f"{key}={shorten(repr(text))} is not a usable path (a NUL byte, a name longer than 255 "
+                          f"characters or a path longer than 4096); give a directory, e.g. {key}=outputs/run1")
     resolved = Path(os.path.abspath(directory))
     cwd = Path(os.getcwd())
     if resolved == cwd or resolved in cwd.parents:
@@ -161,11 +168,30 @@ def check_output_dir(text: str, key: str) -> None:
         raise ConfigError(f"{key}={shorten(text)} cannot be resolved (a loop of symbolic links?); give a directory "
                           f"for the results, e.g. {key}=outputs/run1") from None
     _refuse_link_loop(resolved, key, text)
+    for candidate in (resolved, real):
+        if _is_system_dir(candidate):
+            raise ConfigError(f"{key}={shorten(text)} is inside a system directory ({candidate.parts[1]}); give a "
+                              f"directory for results, e.g. {key}=outputs/run1")
+    for candidate in (resolved, real):
+        if {"site-packages", "dist-packages"} & set(candidate.parts):  # any Python's, not only this one's
+            raise ConfigError(f"{key}={shorten(text)} is inside a site-packages folder, where Python loads code "
+                              f"from; give a directory for results, e.g. {key}=outputs/run1")
     for protected in _protected_dirs():
         for candidate in (resolved, real):
             if candidate == protected or protected in candidate.parents:
                 raise ConfigError(f"{key}={shorten(text)} is inside {protected}, where Python loads code from; "
                                   f"give a directory for results, e.g. {key}=outputs/run1")
+
+
+#: top-level folders of the operating system: results never go there (gyrolab may run as root in a container)
+SYSTEM_DIRS = frozenset({"bin", "boot", "dev", "etc", "lib", "lib32", "lib64", "proc", "run", "sbin", "sys", "usr"})
+
+
+def _is_system_dir(path: Path) -> bool:
+    parts = path.parts
+    if os.name != "posix" or len(parts) < 2 or parts[1] not in SYSTEM_DIRS:
+        return False
+    return not (parts[1] == "usr" and len(parts) > 2 and parts[2] == "local")  # /usr/local: the admin's own
 
 
 def _refuse_link_loop(path: Path, key: str, text: str) -> None:

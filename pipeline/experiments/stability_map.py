@@ -21,7 +21,7 @@ from omegaconf import DictConfig, OmegaConf
 from gyrolab.engine.budget import check_points
 from gyrolab.engine.safety import confined_output_path
 from gyrolab.engine.scene import Scene
-from gyrolab.errors import ConfigError, as_number
+from gyrolab.errors import ConfigError, as_number, shorten
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
@@ -68,6 +68,16 @@ def check(cfg: DictConfig, out_dir: Path) -> None:
     the grid (its size against the budget) and the map's file name (inside the run directory)."""
     grid(cfg)
     confined_output_path(out_dir, cfg.stability_map.get("file"), "stability_map.file")
+    sections = cfg.stability_map.get("sections") or []
+    if sections:
+        t_end = as_number(cfg.stability_map.get("section_time"), "stability_map.section_time")
+        if not t_end > 0:
+            raise ConfigError(f"stability_map.section_time={t_end!r} must be a positive time")
+        for n, point in enumerate(sections):
+            if isinstance(point, (str, bytes)) or not hasattr(point, "__len__") or len(point) != 2:
+                raise ConfigError(f"stability_map.sections[{n}]={shorten(repr(point))} must be [theta0, r0]")
+            for v in point:
+                as_number(v, f"stability_map.sections[{n}]")
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
