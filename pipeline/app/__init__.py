@@ -39,7 +39,7 @@ from hydra.errors import OverrideParseException
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from gyrolab.engine.budget import check_budget, check_tolerances
+from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
 from gyrolab.engine.hydra_private import get_args_parser
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
@@ -120,6 +120,7 @@ def preflight(argv: Sequence[str]) -> list[str]:
     check_launcher_installed(overrides)
     if sweeping:
         _refuse_swept_hydra_settings(overrides)
+        check_sweep_size(overrides)  # before anything expands a range(0,1e12,1)
         Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
     with hydra_for(source):
         # One job composed and validated: the first value of every sweep (each group choice checked for safety).
@@ -141,6 +142,9 @@ def preflight(argv: Sequence[str]) -> list[str]:
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     validate_scene(_without_hydra(cfg))
+    from gyrolab.experiments import check_task
+
+    check_task(task_of(cfg), _without_hydra(cfg), run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
     return argv
 
@@ -549,7 +553,12 @@ def main() -> None:
     # allowed again (a multirun job turns them off)
     callbacks.reset()
     allow_bars(True)
-    _task()
+    from gyrolab.output.lock import release_all
+
+    try:
+        _task()
+    finally:
+        release_all()  # a failed run's lock too (Hydra skips the callback's on_run_end when the job exits)
     status = _sweep_status()
     if status:
         sys.exit(status)

@@ -33,7 +33,7 @@ def batch(args: argparse.Namespace) -> int:
     from gyrolab.app import (_job_overrides, _sweeper_params, check_writable, parse_overrides)
     from gyrolab.batch.sweep import run_batch_sweep
     from gyrolab.engine.config import check_scene_config, compose_config
-    from gyrolab.engine.budget import check_tolerances
+    from gyrolab.engine.budget import check_sweep_size, check_tolerances
     from gyrolab.engine.safety import check_config, check_output_dir
     from gyrolab.figures.options import figure_options
 
@@ -57,6 +57,7 @@ def batch(args: argparse.Namespace) -> int:
         else:
             scene_overrides.append(override)
     parsed = parse_overrides(scene_overrides)
+    check_sweep_size(parsed)  # before anything expands a range(0,1e12,1)
     check_output_dir(str(out_dir), "hydra.sweep.dir")
     first_overrides = _job_overrides(parsed, {})
     with_hydra = compose_config(first_overrides, return_hydra_config=True)
@@ -64,6 +65,8 @@ def batch(args: argparse.Namespace) -> int:
     # the sweep a config declares (hydra.sweeper.params), unless the command line sets the same key, as Hydra does
     declared = [o for o in _sweeper_params(with_hydra) if o.key_or_group not in given]
     scene_overrides += [o.input_line for o in declared]
+    if declared:
+        check_sweep_size([*parsed, *declared])  # the config's sweep counts too
     first = compose_config(first_overrides)
     check_config(first)
     # the checks of the whole batch; each point's scene is validated by the batch's plan (an invalid point,
