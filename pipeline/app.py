@@ -566,6 +566,9 @@ def main() -> None:
         print(f"gyrolab {gyrolab_version()}")
         sys.exit(0)
     try:
+        from gyrolab.batch.scheduler import take_scheduler_option
+
+        argv = sys.argv[1:] = take_scheduler_option(argv)  # --scheduler ADDRESS: the only config-free way to Dask
         status = run_command(argv)
         if status is not None:
             sys.exit(status)
