@@ -508,7 +508,7 @@ def _batch(overrides: Sequence[str]) -> int:
     """``gyrolab --batch KEY=V1,V2 ... [hydra.sweep.dir=DIR]``: the grid in one batch, one sweep.nc (resumable)."""
     from datetime import datetime
 
-    from gyrolab.batch.sweep import run_batch_sweep
+    from gyrolab.batch.sweep import failed_points, run_batch_sweep
 
     out_dir = Path(f"outputs/batch/{datetime.now():%Y-%m-%d}/{datetime.now():%H-%M-%S}")
     scene_overrides = []
@@ -533,7 +533,10 @@ def _batch(overrides: Sequence[str]) -> int:
     logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
     path = run_batch_sweep(scene_overrides, out_dir)
     log.info("wrote %s", path)
-    return 0
+    failed = failed_points(path)
+    if failed:   # as gyrolab -m exits 1 when a job failed
+        print(f"gyrolab: {failed}", file=sys.stderr)
+    return 1 if failed else 0
 
 
 def _sweep_status(summary: SweepSummary | None = None) -> int:

@@ -34,6 +34,18 @@ def run_batch_sweep(overrides: Sequence[str], out_dir: Path) -> Path:
     return run_batch(fixed, dims, Path(out_dir) / SWEEP_NAME).path
 
 
+def failed_points(path: Path) -> str | None:
+    """One sentence when points of the finished batch at ``path`` failed (the command then exits 1), else None."""
+    import netCDF4
+
+    with netCDF4.Dataset(path, "r") as nc:
+        failed, total = int(getattr(nc, "n_failed", 0)), int(getattr(nc, "n_points", 0))
+    if not failed:
+        return None
+    return (f"{failed} of {total} points failed; their errors are error_message[job_error] where job_status is 2 "
+            f"in {path}")
+
+
 def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
               plain: dict[str, Any] | None = None, lock: bool = True) -> RunStats:
     """The batch of grid ``dims`` over the config of ``fixed`` (or ``plain``), stored at ``path``; its
