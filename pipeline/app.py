@@ -550,6 +550,11 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
     if summary is None or not (summary.failed or summary.missing):
         return 0
     missing = f" and {summary.missing} did not run" if summary.missing else ""
+    if summary.write_failures:   # a full disk: exit 3 as for any failed write; the jobs run again on resume
+        print(f"gyrolab: error: {summary.failed} of {summary.n_jobs} jobs failed{missing}, {summary.write_failures} "
+              f"of them because their results could not be written (see failed_job_error in {summary.path}); "
+              "rerun the same command once there is room", file=sys.stderr)
+        return 3
     print(f"gyrolab: {summary.failed} of {summary.n_jobs} jobs failed{missing}; see failed_job_error and "
           f"job_status in {summary.path}", file=sys.stderr)
     return 1

@@ -298,3 +298,19 @@ def test_a_batch_with_failed_points_exits_1_saying_how_many(tmp_path):
     lines = [line for line in done.stderr.splitlines() if line.startswith("gyrolab:")]
     assert len(lines) == 1 and "2 of 4 points failed" in lines[0] and "Traceback" not in done.stderr
     assert (tmp_path / "out" / "sweep.nc").is_file()
+
+
+# ----------------------------------------------------------------------------- a multirun on a full disk
+
+
+def test_a_multirun_whose_job_results_cannot_be_written_exits_3_and_the_rerun_completes_identically(tmp_path):
+    sweep = ["-m", *SMALL, "time.n_output=2001", "initial.r0=2,3"]
+    whole = cli([*sweep, "hydra.sweep.dir=whole"], tmp_path)
+    assert whole.returncode == 0, whole.stderr[-2000:]
+    done = cli([*sweep, "hydra.sweep.dir=full"], tmp_path, limit=150_000)   # above Hydra's files, below run.nc
+    one_sentence(done, 3, "2 of 2 jobs failed", "could not be written", "rerun the same command")
+    again = cli([*sweep, "hydra.sweep.dir=full"], tmp_path)
+    assert again.returncode == 0, again.stderr[-2000:]
+    a, b = data_of(tmp_path / "whole" / "sweep.nc"), data_of(tmp_path / "full" / "sweep.nc")
+    for name in ("omega", "gamma", "job_status"):
+        assert equal(a[name], b[name]), name
