@@ -149,9 +149,9 @@ def probe(address: str, source: str, timeout: float = CONNECT_TIMEOUT) -> None:
             connection = _tls_context().wrap_socket(connection, server_hostname=host)
         greeting = _greeting(connection, deadline)
     except (TimeoutError, socket.timeout):
-        raise ConfigError(f"the peer {where} accepted the connection but sent nothing within {timeout:g} s, as a Dask "
-                          "scheduler would; check the address and port (a tls:// scheduler needs a tls:// address)") \
-            from None
+        raise ConfigError(f"the peer {where} accepted the connection but sent nothing within {timeout:g} s (a Dask "
+                          "scheduler greets at once); check the address and port (a tls:// scheduler needs a tls:// "
+                          "address)") from None
     except ssl.SSLError as error:
         raise ConfigError(f"the TLS handshake with {address} (from {source}) failed ({shorten(str(error), 100)}); "
                           "check Dask's distributed.comm.tls settings (docs/cluster.md)") from None

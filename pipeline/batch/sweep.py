@@ -16,8 +16,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from gyrolab.batch import executors
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
 from gyrolab.batch.runner import RunStats, Settings, run_plan
+from gyrolab.batch.scheduler import probe
 from gyrolab.contracts.integrator import VARIATIONAL
 from gyrolab.errors import ConfigError
 from gyrolab.output.lock import writing_in
@@ -54,6 +56,8 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
     plan = make_plan(fixed, dims, plain=plain)
     settings = Settings.from_config(plan.plain.get("batch"))
     check_integrator(plan, settings)
+    if executors.scheduler_kind(settings.scheduler) == "address":   # a bad peer is refused before any directory
+        probe(str(settings.scheduler), settings.scheduler_source, executors.CONNECT_TIMEOUT)
     plan_time = time.perf_counter() - start
     if not lock:
         stats = run_plan(plan, path, settings)
