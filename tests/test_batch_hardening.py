@@ -316,3 +316,37 @@ def test_a_multirun_whose_job_results_cannot_be_written_exits_3_and_the_rerun_co
     a, b = data_of(tmp_path / "whole" / "sweep.nc"), data_of(tmp_path / "full" / "sweep.nc")
     for name in ("omega", "gamma", "job_status"):
         assert equal(a[name], b[name]), name
+
+
+@pytest.fixture
+def small_tmpfs(tmp_path):
+    """A 512 KiB tmpfs (needs root and mount(8)); skipped where it cannot be mounted."""
+    mount_point = tmp_path / "small"
+    mount_point.mkdir()
+    if os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root")
+    try:
+        done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=512k", "tmpfs", str(mount_point)],
+                              capture_output=True, timeout=10)
+    except (OSError, subprocess.TimeoutExpired):
+        pytest.skip("mount(8) is not available")
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode().strip()}")
+    yield mount_point
+    subprocess.run(["umount", "-l", str(mount_point)], capture_output=True, timeout=10)
+
+
+def test_a_really_full_disk_in_a_batch_is_one_sentence_and_the_rerun_with_room_completes(small_tmpfs, tmp_path,
+                                                                                         uninterrupted):
+    stats = os.statvfs(small_tmpfs)
+    free = stats.f_bavail * stats.f_frsize
+    filler = small_tmpfs / "filler"
+    filler.write_bytes(bytes(max(0, free - 64 * 1024)))   # 64 KiB left: the batch's file needs ~170 KiB
+    before = files(small_tmpfs)
+    done = cli(["--batch", *GRID, f"hydra.sweep.dir={small_tmpfs}"], tmp_path)
+    one_sentence(done, 3, "sweep.nc.part", "no space left on device", "rerun the same command")
+    assert [f for f in files(small_tmpfs) if f not in before and f != ".gyrolab.lock"] == []
+    filler.unlink()   # room again
+    again = cli(["--batch", *GRID, f"hydra.sweep.dir={small_tmpfs}"], tmp_path)
+    assert again.returncode == 0, again.stderr[-2000:]
+    assert_same_data(data_of(small_tmpfs / "sweep.nc"), uninterrupted)
