@@ -248,12 +248,14 @@ def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
 
 def validate_scene(scene_cfg: DictConfig) -> None:
     """The checks every run's scene config passes: schema, tolerances, budget, the scene's own validation."""
+    from gyrolab.batch.scheduler import choose_scheduler
     from gyrolab.experiments import TASKS
 
     plain = check_scene_config(scene_cfg)
     require_finite(plain, "")
     figure_options(plain.get("output"))  # figure formats and dpi, before anything runs
     check_tolerances(plain)
+    choose_scheduler((plain.get("batch") or {}).get("scheduler"))  # an address in a config: refused before any directory
     task = task_of(scene_cfg)
     if task not in ("scene", *TASKS):
         close = difflib.get_close_matches(task, ["scene", *TASKS], n=1)

@@ -350,3 +350,16 @@ def test_a_really_full_disk_in_a_batch_is_one_sentence_and_the_rerun_with_room_c
     again = cli(["--batch", *GRID, f"hydra.sweep.dir={small_tmpfs}"], tmp_path)
     assert again.returncode == 0, again.stderr[-2000:]
     assert_same_data(data_of(small_tmpfs / "sweep.nc"), uninterrupted)
+
+
+def test_an_experiment_with_an_address_is_refused_before_its_run_directory_exists(tmp_path):
+    done = cli(["experiment=stability_map", "batch.scheduler=tcp://127.0.0.1:8786", "hydra.run.dir=map"], tmp_path)
+    one_sentence(done, 2, "batch.scheduler=", "run code", "--scheduler")
+    assert files(tmp_path) == []
+
+
+def test_the_option_reaches_an_experiment_run_by_hydra(tmp_path):
+    address = f"tcp://127.0.0.1:{free_port()}"
+    done = cli(["--scheduler", address, "experiment=stability_map", "stability_map.n_theta0=2",
+                "stability_map.n_r0=2", "time.end=1", "output.figures=false", "hydra.run.dir=map"], tmp_path)
+    one_sentence(done, 2, address, "the command line (--scheduler)", "no Dask scheduler answers")
