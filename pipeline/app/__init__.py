@@ -257,12 +257,14 @@ def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
 
 def validate_scene(scene_cfg: DictConfig) -> None:
     """The checks every run's scene config passes: schema, tolerances, budget, the scene's own validation."""
+    from gyrolab.batch.scheduler import choose_scheduler
     from gyrolab.experiments import TASKS
 
     plain = check_scene_config(scene_cfg)
     require_finite(plain, "")
     figure_options(plain.get("output"))  # figure formats and dpi, before anything runs
     check_tolerances(plain)
+    choose_scheduler((plain.get("batch") or {}).get("scheduler"))  # an address in a config: refused before any directory
     task = task_of(scene_cfg)
     if task not in ("scene", *TASKS):
         close = difflib.get_close_matches(task, ["scene", *TASKS], n=1)
@@ -495,6 +497,11 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
     if summary is None or not (summary.failed or summary.missing):
         return 0
     missing = f" and {summary.missing} did not run" if summary.missing else ""
+    if summary.write_failures:   # a full disk: exit 3 as for any failed write; the jobs run again on resume
+        print(f"gyrolab: error: {summary.failed} of {summary.n_jobs} jobs failed{missing}, {summary.write_failures} "
+              f"of them because their results could not be written (see failed_job_error in {summary.path}); "
+              "rerun the same command once there is room", file=sys.stderr)
+        return 3
     print(f"gyrolab: {summary.failed} of {summary.n_jobs} jobs failed{missing}; see failed_job_error and "
           f"job_status in {summary.path}", file=sys.stderr)
     return 1
@@ -529,6 +536,10 @@ def main() -> None:
         from gyrolab.app.parser import split_command
 
         command, argv = split_command(argv)
+        if command == "run":  # --scheduler ADDRESS: the only config-free way to Dask, for experiments run by Hydra too
+            from gyrolab.batch.scheduler import take_scheduler_option
+
+            argv = take_scheduler_option(argv)
         sys.argv[1:] = argv
         if command == "run" and ("--version" in argv or "-V" in argv):
             from gyrolab.output.provenance import gyrolab_version

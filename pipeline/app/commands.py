@@ -31,20 +31,17 @@ def batch(args: argparse.Namespace) -> int:
     from datetime import datetime
 
     from gyrolab.app import (_job_overrides, _sweeper_params, check_writable, parse_overrides)
-    from gyrolab.batch.sweep import run_batch_sweep
+    from gyrolab.batch.scheduler import use_command_line_scheduler
+    from gyrolab.batch.sweep import failed_points, run_batch_sweep
     from gyrolab.engine.config import check_scene_config, compose_config
     from gyrolab.engine.budget import check_sweep_size, check_tolerances
     from gyrolab.engine.safety import check_config, check_output_dir
     from gyrolab.figures.options import figure_options
 
     overrides = list(args.overrides)
-    try:  # the command line's own route to a Dask scheduler, where gyrolab has one (issue 23: trusted only here)
-        from gyrolab.batch.scheduler import use_command_line_scheduler
-    except ImportError:
-        if args.scheduler is not None:
-            overrides.append(f"batch.scheduler={_quoted(args.scheduler)}")
-    else:
-        use_command_line_scheduler(args.scheduler)  # None when not given: no value left from an earlier command
+    # the command line's own route to a Dask scheduler (issue 23: trusted only here and in the environment);
+    # None when not given, so no value is left from an earlier command
+    use_command_line_scheduler(args.scheduler)
     now = datetime.now()
     out_dir = Path(f"outputs/batch/{now:%Y-%m-%d}/{now:%H-%M-%S}")
     scene_overrides = []
@@ -80,7 +77,10 @@ def batch(args: argparse.Namespace) -> int:
         log.info("batch: the sweep declared in hydra.sweeper.params: %s", " ".join(o.input_line for o in declared))
     path = run_batch_sweep(scene_overrides, out_dir)
     announce_written(path)
-    return 0
+    failed = failed_points(path)
+    if failed:   # as gyrolab -m exits 1 when a job failed
+        print(f"gyrolab: {failed}", file=sys.stderr)
+    return 1 if failed else 0
 
 
 def _quoted(value: str) -> str:

@@ -10,7 +10,8 @@ runs its chunks in other processes or on other machines:
 - ``"local"``: a Dask ``LocalCluster`` on this machine, one single-threaded worker process per core
   (numba limited to one thread per worker, so the workers do not oversubscribe the cores);
 - ``"tcp://HOST:PORT"`` (or ``tls://``): an existing Dask scheduler and its workers (``dask scheduler``,
-  ``dask worker``, a dask-jobqueue ``SLURMCluster``: docs/cluster.md).
+  ``dask worker``, a dask-jobqueue ``SLURMCluster``: docs/cluster.md). Which addresses a batch may trust,
+  and the bounded check that the peer is a scheduler, are ``gyrolab.batch.scheduler``'s.
 
 ``scheduler`` None (``batch.scheduler`` unset) with ``DASK_SCHEDULER_ADDRESS`` set in the environment (Dask's
 own variable, which ``distributed.Client()`` reads too): that scheduler.
@@ -33,17 +34,16 @@ from collections.abc import Callable, Iterable
 from importlib.util import find_spec
 from typing import Any, TypeVar
 
+from gyrolab.batch import scheduler as scheduler_module
 from gyrolab.errors import ConfigError, GyrolabError, shorten
 
 Task = TypeVar("Task")
 Result = TypeVar("Result")
 
-IN_PROCESS = ("process", "")
-LOCAL = "local"
-#: Dask's own environment variable for a scheduler's address, read when batch.scheduler is unset
-SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
+IN_PROCESS = scheduler_module.IN_PROCESS
+LOCAL = scheduler_module.LOCAL
 #: seconds to wait for a scheduler to answer before saying it cannot be reached
-CONNECT_TIMEOUT = 10
+CONNECT_TIMEOUT = scheduler_module.CONNECT_TIMEOUT
 #: chunks submitted per worker thread at a time: one running, one queued (memory: a few chunks per worker)
 CHUNKS_PER_THREAD = 2
 #: environment of local-cluster workers: one thread each for numba and the BLAS libraries
@@ -51,10 +51,11 @@ WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_TH
 
 
 def map_chunks(function: Callable[[Task], Result], tasks: Iterable[Task],
-               on_result: Callable[[int, Result], None], scheduler: str | None = None) -> None:
+               on_result: Callable[[int, Result], None], scheduler: str | None = None,
+               source: str = "the caller") -> None:
     """Run ``function`` on every task where ``scheduler`` says; ``on_result(index, result)`` for each result,
-    in this process, in the order they complete (in task order when they run here)."""
-    scheduler = chosen_scheduler(scheduler)
+    in this process, in the order they complete (in task order when they run here). ``source`` says where
+    the scheduler's address came from (named in the log and in the sentence when it cannot be reached)."""
     kind = scheduler_kind(scheduler)
     if kind == "process":
         for index, task in enumerate(tasks):
@@ -64,20 +65,12 @@ def map_chunks(function: Callable[[Task], Result], tasks: Iterable[Task],
                 raise chunk_error(index, error, "in this process") from error
             on_result(index, result)
         return
-    with _client(kind, str(scheduler)) as client:
+    with _client(kind, str(scheduler), source) as client:
         _map_on(client, function, tasks, on_result, where=_where(kind, str(scheduler)))
-
-
-def chosen_scheduler(scheduler: str | None) -> str | None:
-    """``scheduler``, or when it is None the environment's ``DASK_SCHEDULER_ADDRESS`` (a SLURM recipe sets it)."""
-    if scheduler is None:
-        return os.environ.get(SCHEDULER_ENV, "").strip() or None
-    return scheduler
 
 
 def scheduler_kind(scheduler: str | None) -> str:
     """``"process"``, ``"local"`` or ``"address"``; ConfigError for anything else, or when Dask is missing."""
-    scheduler = chosen_scheduler(scheduler)
     if scheduler is None or str(scheduler).strip() in IN_PROCESS:
         return "process"
     text = str(scheduler).strip()
@@ -86,11 +79,11 @@ def scheduler_kind(scheduler: str | None) -> str:
     elif text.startswith(("tcp://", "tls://")) and len(text) > len("tcp://"):
         kind = "address"
     else:
-        raise ConfigError(f"batch.scheduler={shorten(text)!r} is not a scheduler; valid: process (this process), "
+        raise ConfigError(f"scheduler {shorten(text)!r} is not a scheduler; valid: process (this process), "
                           "local (a Dask cluster on this machine) or the address of a running Dask scheduler "
-                          "(tcp://HOST:PORT)")
+                          "(tcp://HOST:PORT or tls://HOST:PORT)")
     if find_spec("distributed") is None:
-        raise ConfigError(f"batch.scheduler={text} runs chunks on Dask, which is not installed; install it with: "
+        raise ConfigError(f"scheduler {text} runs chunks on Dask, which is not installed; install it with: "
                           'pip install "gyrolab[cluster]"')
     return kind
 
@@ -107,8 +100,12 @@ def _where(kind: str, scheduler: str) -> str:
     return "on the local Dask cluster" if kind == "local" else f"on the Dask cluster at {scheduler}"
 
 
-def _client(kind: str, scheduler: str) -> Any:
-    """A connected ``distributed.Client`` (closing it also closes a local cluster it started)."""
+def _client(kind: str, scheduler: str, source: str) -> Any:
+    """A connected ``distributed.Client`` (closing it also closes a local cluster it started).
+
+    An address is first probed (``gyrolab.batch.scheduler.probe``: a silent peer or one that is not a Dask
+    scheduler is one sentence within ``CONNECT_TIMEOUT``), then connected with the same bound.
+    """
     import logging
 
     from distributed import Client, LocalCluster
@@ -117,11 +114,12 @@ def _client(kind: str, scheduler: str) -> Any:
         cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True,
                                dashboard_address=None, silence_logs=logging.ERROR, env=dict(WORKER_ENV))
         return Client(cluster, set_as_default=False)
+    scheduler_module.probe(scheduler, source, CONNECT_TIMEOUT)
     try:
         return Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError) as error:
         reason = " ".join(str(error).split()).rstrip(".") or type(error).__name__
-        raise ConfigError(f"no Dask scheduler answers at batch.scheduler={scheduler} within {CONNECT_TIMEOUT} s "
+        raise ConfigError(f"no Dask scheduler answers at {scheduler} (from {source}) within {CONNECT_TIMEOUT} s "
                           f"({shorten(reason, 120)}); start one (dask scheduler) or give its address") from None
 
 
@@ -157,4 +155,4 @@ def _map_on(client: Any, function: Callable[[Task], Result], tasks: Iterable[Tas
         pending.clear()
 
 
-__all__ = ["chosen_scheduler", "chunk_error", "map_chunks", "scheduler_kind"]
+__all__ = ["chunk_error", "map_chunks", "scheduler_kind"]

@@ -25,6 +25,7 @@ from omegaconf import OmegaConf
 from gyrolab.batch import executors
 from gyrolab.batch.outputs import MODES, Output, indicator_outputs, merge_rows, state_outputs
 from gyrolab.batch.plan import Plan, _with_values
+from gyrolab.batch.scheduler import choose_scheduler
 from gyrolab.batch.store import Store
 from gyrolab.contracts.integrator import BATCH_KERNEL, CHOOSES_METHOD, VECTOR_LANES
 from gyrolab.engine.progress import duration
@@ -45,7 +46,8 @@ class Settings:
     decimate: int = 10
     chunk: int | None = None        # None: from ``memory``
     memory: float = DEFAULT_MEMORY_MIB
-    scheduler: str | None = None
+    scheduler: str | None = None    # never from a config: ``gyrolab.batch.scheduler.choose_scheduler``
+    scheduler_source: str = "the default"
 
     @classmethod
     def from_config(cls, node: Any) -> Settings:
@@ -64,8 +66,9 @@ class Settings:
         memory = node.get("memory", cls.memory)
         if isinstance(memory, bool) or not isinstance(memory, (int, float)) or not memory > 0:
             raise ConfigError(f"batch.memory={memory!r} must be a positive number of MiB")
-        return cls(output=output, decimate=decimate, chunk=chunk, memory=float(memory),
-                   scheduler=node.get("scheduler") or None)
+        where = choose_scheduler(node.get("scheduler"))
+        return cls(output=output, decimate=decimate, chunk=chunk, memory=float(memory), scheduler=where.scheduler,
+                   scheduler_source=where.source)
 
 
 @dataclass
@@ -167,14 +170,18 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     for i in empty:   # no valid point: only the points' errors, which the store wrote when it was created
         store.chunk_done(i, blocks[i], None)
     progress = _Progress(len(tasks))
-    if tasks and executors.scheduler_kind(settings.scheduler) == "process":
+    kind = executors.scheduler_kind(settings.scheduler)
+    if tasks and kind == "process":
         _share_systems(plan)
+    if tasks:
+        log.info("batch: chunks run %s (from %s)", {"process": "in this process", "local": "on a local Dask cluster"}
+                 .get(kind, f"on the Dask scheduler at {settings.scheduler}"), settings.scheduler_source)
 
     def on_result(_: int, result: ChunkResult) -> None:
         store.chunk_done(result.index, blocks[result.index], result)
         progress.update(result)
 
-    executors.map_chunks(run_chunk, tasks, on_result, scheduler=settings.scheduler)
+    executors.map_chunks(run_chunk, tasks, on_result, scheduler=settings.scheduler, source=settings.scheduler_source)
     store.finish()
     return progress.summary(path)
 

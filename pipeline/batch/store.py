@@ -10,6 +10,12 @@ the file is created, so a chunk's write changes data, never the file's structure
 leaves a file that opens. After a chunk's data is synced to disk its index is appended to ``NAME.chunks``
 (the journal, fsynced); a rerun with the same identity continues after the journaled chunks. When every
 chunk is stored the file is closed, synced and renamed to ``NAME``, and the journal removed.
+
+A failed write (a full disk, a quota, a file-size limit) is one ``OutputError`` sentence (exit 3) that
+keeps the finished work: the chunks already journaled stay in ``NAME.part``, and rerunning the same
+command continues after them. Only complete journal lines count, and a torn last line is cut off before
+the journal is appended to again. A ``NAME.part`` that cannot be opened any more (its creation failed, or
+a failure broke the library's metadata) is replaced by a new one, with a warning naming the chunks lost.
 """
 
 from __future__ import annotations
@@ -27,7 +33,7 @@ from omegaconf import OmegaConf
 from gyrolab.batch.outputs import output_times
 from gyrolab.batch.plan import POINT
 from gyrolab.errors import ConfigError, OutputError
-from gyrolab.output.atomic import _fsync, _fsync_directory, reason
+from gyrolab.output.atomic import TEMP_SUFFIX, _fsync, _fsync_directory, _library_failure, diagnose, reason
 from gyrolab.output.cf import CONVENTIONS, now_iso
 from gyrolab.output.provenance import gyrolab_version, provenance
 from gyrolab.sweep import record
@@ -39,6 +45,8 @@ FINISHED, FAILED = STATUS_FLAGS[record.FINISHED], STATUS_FLAGS[record.FAILED]
 STATUS_ATTRS = {"long_name": "how the point ended: 0 not run, 1 finished, 2 failed", "units": "1",
                 "flag_values": np.array([0, 1, 2], dtype=np.int8), "flag_meanings": "missing finished failed"}
 ERROR_ATTRS = {"long_name": "the point's error: index into error_message, -1 for none", "units": "1"}
+#: the counts ``finish`` stores; created (as 0) with the file, so that finishing overwrites them in place
+COUNT_ATTRS = ("n_missing", "n_finished", "n_failed")
 
 
 class Store:
@@ -65,21 +73,81 @@ class Store:
         if not self.part.exists():
             self.journal.unlink(missing_ok=True)
             return set()
-        found = _identity_of(self.part)
+        try:
+            found = _identity_of(self.part)
+        except OutputError:
+            self._replace_unreadable_part()
+            return set()
         if found != self.identity:
             raise ConfigError(f"{self.part} is an unfinished batch of another command or gyrolab version (identity "
                               f"{found}, this one is {self.identity}); rerun that command to finish it, or give "
                               "another directory")
         done = _read_journal(self.journal, self.identity)
-        if not done:   # killed before its first chunk was journaled: the journal starts again
-            _start_journal(self.journal, self.identity)
-        self.nc = _open(self.part, "a")
+        try:
+            if not done:   # killed before its first chunk was journaled: the journal starts again
+                _start_journal(self.journal, self.identity)
+            else:          # a write that failed mid-line leaves a torn last line: cut it before appending
+                _cut_torn_line(self.journal)
+            self.nc = _open(self.part, "a")
+        except OutputError:
+            raise
+        except OSError as error:
+            raise self._failed(error, done) from None
         log.info("batch: resuming %s (%d chunks stored)", self.part, len(done))
         return done
 
+    def _replace_unreadable_part(self) -> None:
+        """A ``.part`` that no longer opens holds nothing recoverable: start it again (saying what is lost)."""
+        lost = _read_journal(self.journal, self.identity)
+        if lost:
+            log.warning("batch: %s cannot be read any more (a write to it failed); its %d stored chunks are run "
+                        "again", self.part, len(lost))
+        else:
+            log.info("batch: %s was left unfinished before its first chunk; starting it again", self.part)
+        self.part.unlink(missing_ok=True)
+        self.journal.unlink(missing_ok=True)
+
+    def _failed(self, error: BaseException, done: set[int] | None = None) -> OutputError:
+        """The sentence of a failed write (the file closed; the journaled chunks kept for the rerun)."""
+        # the reason is probed beside the file, never in it (a probe write must not touch the stored chunks)
+        probe = self.part.with_name(f".{self.part.name}.probe{TEMP_SUFFIX}")
+        try:
+            size = self.part.stat().st_size
+        except OSError:
+            size = None
+        try:
+            why = diagnose(error, probe, size)
+        finally:
+            probe.unlink(missing_ok=True)
+        self._close_quietly()
+        kept = len(_read_journal(self.journal, self.identity)) if done is None else len(done)
+        keep = (f"the {kept} chunks already stored are kept: rerun the same command to continue once there is room"
+                if kept else "nothing was finished yet: rerun the same command once there is room")
+        return OutputError(f"could not write {self.part}: {why}; {keep}")
+
+    def _close_quietly(self) -> None:
+        nc, self.nc = self.nc, None
+        if nc is not None:
+            try:
+                nc.close()
+            except (OSError, RuntimeError):
+                pass   # the write already failed; the journal says which chunks are whole
+
     # -- writing ----------------------------------------------------------------------------------------
     def chunk_done(self, index: int, chunk: Any, result: Any) -> None:
-        """Store a chunk's result (None: a chunk without a valid point) and journal it."""
+        """Store a chunk's result (None: a chunk without a valid point) and journal it; OutputError (the
+        journaled chunks kept) when a write fails."""
+        try:
+            self._store_chunk(index, chunk, result)
+        except OutputError:
+            self._close_quietly()
+            raise
+        except (OSError, RuntimeError) as error:
+            if not isinstance(error, OSError) and not _library_failure(error):
+                raise
+            raise self._failed(error) from None
+
+    def _store_chunk(self, index: int, chunk: Any, result: Any) -> None:
         if self.nc is None:
             self._create(result)
         if result is not None:
@@ -93,23 +161,31 @@ class Store:
             for name, out in result.outputs.items():
                 if name in self.nc.variables:
                     self._write(name, chunk, out.data)
-        try:
-            self.nc.sync()
-            _fsync(self.part)
-            with open(self.journal, "a", encoding="utf-8") as journal:
-                journal.write(f"{index}\n")
-                journal.flush()
-                os.fsync(journal.fileno())
-        except OSError as error:
-            raise OutputError(f"could not write {self.part}: {reason(error)}") from None
+        self.nc.sync()
+        _fsync(self.part)
+        with open(self.journal, "a", encoding="utf-8") as journal:
+            journal.write(f"{index}\n")
+            journal.flush()
+            os.fsync(journal.fileno())
 
     def finish(self) -> None:
-        """Close the complete file and give it its final name."""
+        """Close the complete file and give it its final name (OutputError, the chunks kept, if that fails)."""
+        try:
+            self._finish()
+        except OutputError:
+            self._close_quietly()
+            raise
+        except (OSError, RuntimeError) as error:
+            if not isinstance(error, OSError) and not _library_failure(error):
+                raise
+            raise self._failed(error) from None
+
+    def _finish(self) -> None:
         if self.nc is None:
             self._create(None)
         status = self.nc["job_status"][:]
         status = np.asarray(status.filled(0) if np.ma.isMaskedArray(status) else status)
-        counts = {name: int(np.count_nonzero(status == code))
+        counts = {name: np.int64(np.count_nonzero(status == code))
                   for name, code in (("n_missing", 0), ("n_finished", FINISHED), ("n_failed", FAILED))}
         self.nc.setncatts(counts)
         if counts["n_failed"]:
@@ -117,12 +193,9 @@ class Store:
                      counts["n_failed"], status.size)
         self.nc.close()
         self.nc = None
-        try:
-            _fsync(self.part)
-            os.replace(self.part, self.path)
-            _fsync_directory(self.path.parent)
-        except OSError as error:
-            raise OutputError(f"could not write {self.path}: {reason(error)}") from None
+        _fsync(self.part)
+        os.replace(self.part, self.path)
+        _fsync_directory(self.path.parent)
         self.journal.unlink(missing_ok=True)
 
     def _write(self, name: str, chunk: Any, data: np.ndarray) -> None:
@@ -131,12 +204,22 @@ class Store:
 
     # -- creating ------------------------------------------------------------------------------------------
     def _create(self, result: Any) -> None:
-        plan = self.plan
+        """Create ``.part`` whole (every variable's storage allocated); a failure leaves neither it nor a journal
+        (nothing was finished), so the rerun starts cleanly."""
         try:
-            self.part.parent.mkdir(parents=True, exist_ok=True)
-            nc = netCDF4.Dataset(self.part, "w", format="NETCDF4")
-        except OSError as error:
-            raise OutputError(f"could not write {self.part}: {reason(error)}") from None
+            self._create_file(result)
+        except (OSError, RuntimeError) as error:
+            if not isinstance(error, OSError) and not _library_failure(error):
+                raise
+            failure = self._failed(error, set())
+            self.part.unlink(missing_ok=True)
+            self.journal.unlink(missing_ok=True)
+            raise failure from None
+
+    def _create_file(self, result: Any) -> None:
+        plan = self.plan
+        self.part.parent.mkdir(parents=True, exist_ok=True)
+        nc = netCDF4.Dataset(self.part, "w", format="NETCDF4")
         self.nc = nc
         nc.set_auto_mask(False)
         system = _reference_system(plan)
@@ -176,7 +259,7 @@ class Store:
         error[:] = plan.error.reshape(shape)
         if result is not None:
             self._create_variables(result, system)
-        nc.setncatts(self._attributes(system))
+        nc.setncatts({**self._attributes(system), **{name: np.int64(0) for name in COUNT_ATTRS}})
         nc.sync()
         _fsync(self.part)
         _start_journal(self.journal, self.identity)
@@ -258,7 +341,7 @@ def _open(path: Path, mode: str) -> netCDF4.Dataset:
     try:
         nc = netCDF4.Dataset(path, mode)
     except OSError as error:
-        raise OutputError(f"could not open {path}: {reason(error)}; remove it to start the batch again") from None
+        raise OutputError(f"could not open {path}: {reason(error)}") from None
     nc.set_auto_mask(False)
     return nc
 
@@ -281,12 +364,24 @@ def _start_journal(path: Path, identity: str) -> None:
 def _read_journal(path: Path, identity: str) -> set[int]:
     """The chunks a journal records (none if it is missing or belongs to another identity)."""
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
+        text = path.read_text(encoding="utf-8", errors="replace")
     except FileNotFoundError:
         return set()
+    lines = text.splitlines()
     if not lines or lines[0] != f"identity {identity}":
         return set()
-    return {int(line) for line in lines[1:] if line.strip().isdigit()}
+    complete = lines[1:] if text.endswith("\n") else lines[1:-1]   # a torn last line is not a journaled chunk
+    return {int(line) for line in complete if line.strip().isdigit()}
+
+
+def _cut_torn_line(path: Path) -> None:
+    """Cut a journal's unterminated last line (a write that failed half-way), so that appending stays exact."""
+    data = path.read_bytes()
+    if data and not data.endswith(b"\n"):
+        with open(path, "r+b") as journal:
+            journal.truncate(data.rfind(b"\n") + 1)
+            journal.flush()
+            os.fsync(journal.fileno())
 
 
 def _reference_system(plan: Any) -> Any:
