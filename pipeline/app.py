@@ -54,7 +54,7 @@ from gyrolab.engine.progress import allow_bars, on_terminal
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
-from gyrolab.sweep.job import run_sweep_job
+from gyrolab.sweep.job import draws_job_figures, run_sweep_job
 
 if TYPE_CHECKING:
     from gyrolab.sweep.aggregate import SweepSummary
@@ -380,6 +380,8 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None) -> Path:
     ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
     path = write_dataset(ds, out_dir / "run.nc")
     log.info("wrote %s", path)
+    if job_id is not None and not draws_job_figures(cfg.output):
+        return path  # a sweep job: no figures unless output.job_figures (gyrolab --plot draws them later)
     from gyrolab.figures.redraw import draw_figures  # matplotlib only when figures are drawn
 
     for figure in draw_figures("run.nc", ds, out_dir, cfg.output):

@@ -227,3 +227,15 @@ def test_provenance_names_every_declared_dependency_and_the_code_state():
     if attrs["git_dirty"] >= 0:
         assert re.fullmatch(r"[0-9a-f]{40}", attrs["git_commit"])
     assert bool(re.fullmatch(r"[0-9a-f]{64}", attrs["git_diff_sha256"])) == (attrs["git_dirty"] == 1)
+
+
+def test_first_progress_line_gives_no_estimate_only_a_measured_stretch_does(caplog):
+    """Issue 24 item 5: the time before the first report includes compilation, so no ETA from it."""
+    quiet = io.StringIO()
+    logged = progress.Progress("taylor", 0.0, 10.0, every=0.0, stream=quiet)
+    with caplog.at_level(logging.INFO, logger="gyrolab.progress"):
+        for t in (2.5, 5.0, 7.5):
+            logged(t)
+    first, *later = [r.getMessage() for r in caplog.records]
+    assert "to go" not in first and "compilation included" in first and "measuring the pace" in first
+    assert len(later) == 2 and all("to go" in line and "compilation" not in line for line in later)

@@ -78,10 +78,15 @@ class Progress:
             return
         fraction = (t - self.t_start) / (self.t_end - self.t_start)
         elapsed = now - self._began
-        # the remaining time at the pace since the last report (a compiled method's first report includes
-        # its compilation), or since the start at the first report
-        since, t_since = (self._last, self._t_last) if self._t_last is not None else (self._began, self.t_start)
+        first = self._t_last is None
+        since, t_since = self._last, self._t_last
         self._last, self._t_last = now, t
+        if first:
+            # the time before the first report includes a compiled method's compilation (and its start-up):
+            # a pace from it is no pace of the integration, so no estimate until a stretch has been measured
+            log.info("%s: %3.0f%% (t=%.6g of %.6g), %s elapsed (compilation included), measuring the pace",
+                     self.label, 100 * fraction, t, self.t_end, duration(elapsed))
+            return
         pace = (t - t_since) / (now - since) if now > since else 0.0
         remaining = (self.t_end - t) / pace if pace > 0 else float("nan")
         log.info("%s: %3.0f%% (t=%.6g of %.6g), %s elapsed, ~%s to go",
