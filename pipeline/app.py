@@ -50,7 +50,7 @@ from gyrolab.engine.config import (
 from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
-from gyrolab.engine.progress import allow_bars, on_terminal
+from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
@@ -575,7 +575,8 @@ def main() -> None:
         from gyrolab.sweep.sweeper import register_plugin
 
         register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), before Hydra instantiates it
-        sys.argv[1:] = preflight(argv)
+        with compile_notes_on_console():  # the preflight may compile a force plugin's torque
+            sys.argv[1:] = preflight(argv)
     except GyrolabError as error:
         fail(error)
     from gyrolab.sweep import callbacks
