@@ -54,12 +54,12 @@ from gyrolab.engine.config import (
 from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
-from gyrolab.engine.progress import allow_bars, on_terminal
+from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
 from gyrolab.output.written import announce_written
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
-from gyrolab.sweep.job import run_sweep_job
+from gyrolab.sweep.job import draws_job_figures, run_sweep_job
 
 if TYPE_CHECKING:
     from gyrolab.sweep.aggregate import SweepSummary
@@ -353,7 +353,7 @@ def _task(cfg: DictConfig) -> None:
     if hydra_cfg.mode == RunMode.MULTIRUN:
         allow_bars(False)  # the sweep shows one bar for all its jobs
         _quiet_console()
-        job_figures = bool(cfg.output.get("job_figures", False))
+        job_figures = draws_job_figures(cfg.output)
         run_sweep_job(cfg, out_dir, list(hydra_cfg.overrides.task), hydra_cfg.job.num,
                       lambda job_id: _run_one(cfg, out_dir, job_id, figures=job_figures))
         return
@@ -554,7 +554,8 @@ def main() -> None:
         from gyrolab.sweep.sweeper import register_plugin
 
         register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), before Hydra instantiates it
-        sys.argv[1:] = preflight(argv)
+        with compile_notes_on_console():  # the preflight may compile a force plugin's torque
+            sys.argv[1:] = preflight(argv)
     except GyrolabError as error:
         fail(error)
     from gyrolab.sweep import callbacks

@@ -120,6 +120,8 @@ class ChunkResult:
     wall_time: float
     #: the integrator settings the chunk ran with (adaptive kernels; None for fixed steps and the indicator)
     settings: dict | None = None
+    #: the first chunk of its process: its kernel time includes loading (or compiling) the kernels
+    first_in_process: bool = False
 
 
 def chunk_size(plan: Plan, settings: Settings) -> int:
@@ -294,10 +296,19 @@ def _system(context: dict[str, Any], config: dict[str, Any], values: dict[str, A
     return system
 
 
+_kernels_called = False   # whether this process has run a chunk (its kernels are loaded)
+
+
 def run_chunk(task: ChunkTask) -> ChunkResult:
     """Integrate one chunk's valid points and compute what ``task.output`` stores."""
     from gyrolab.batch.integrate import integrate_arrays, integrate_points
 
+    global _kernels_called
+    first, _kernels_called = not _kernels_called, True
+    # reported when it starts, not only when it ends: a one-chunk batch would otherwise say nothing for minutes
+    log.info("batch: chunk %d: integrating %d points%s", task.index + 1, len(task.rows),
+             " (the first chunk of this process loads the integration kernels, and compiles them once on a fresh "
+             "cache: minutes)" if first else "")
     start = time.perf_counter()
     context = _context(task.config_key, task.config)
     compiled = context["compiled"]
@@ -332,7 +343,8 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
     all_failed = np.zeros(task.n_rows, dtype=bool)
     all_failed[task.rows] = failed
     return ChunkResult(index=task.index, outputs=merge_rows(outputs, task.rows, task.n_rows), failed=all_failed,
-                       kernel_time=kernel_time, wall_time=time.perf_counter() - start, settings=settings)
+                       kernel_time=kernel_time, wall_time=time.perf_counter() - start, settings=settings,
+                       first_in_process=first)
 
 
 # ----------------------------------------------------------------------------- progress
@@ -347,10 +359,12 @@ class _Progress:
         self.kernel = 0.0
         self.in_chunks = 0.0
         self.start = time.perf_counter()
+        self.loading = 0.0   # kernel time of chunks that were their process's first (loading or compiling)
 
     def update(self, result: ChunkResult) -> None:
         self.chunks += 1
         self.kernel += result.kernel_time
+        self.loading += result.kernel_time if result.first_in_process else 0.0
         self.in_chunks += result.wall_time
         elapsed = time.perf_counter() - self.start
         eta = elapsed / self.chunks * (self.n_chunks - self.chunks)
@@ -360,6 +374,8 @@ class _Progress:
     def summary(self, path: Path) -> RunStats:
         elapsed = time.perf_counter() - self.start
         if self.chunks:
-            log.info("batch: %d chunks in %s, %.0f%% of it in the integration kernels", self.chunks,
-                     duration(elapsed), 100.0 * self.kernel / max(elapsed, 1e-9))
+            log.info("batch: %d chunks in %s, %.0f%% of it in the integration kernels%s", self.chunks,
+                     duration(elapsed), 100.0 * self.kernel / max(elapsed, 1e-9),
+                     f" (of which {duration(self.loading)} in the first chunk of each process, loading or compiling "
+                     "them)" if self.loading else "")
         return RunStats(path, self.chunks, self.kernel, elapsed, self.in_chunks)

@@ -3,8 +3,7 @@
 PATH is a run directory (``run.nc``), a regime run, an experiment or sweep directory, or one ``.nc``
 file. Each dataset's figures are written to ``figures/`` beside it, with the current style, formats
 and dpi. Datasets directly in PATH are always drawn; in a sweep directory the jobs' ``run.nc`` are
-redrawn only where the job drew figures in the first place (``output.figures`` and ``output.job_figures``
-in its stored config); ``gyrolab --plot SWEEP_DIR/N`` draws job N's figures in any case.
+redrawn only where the job drew figures in the first place (``output.figures`` in its stored config).
 """
 
 from __future__ import annotations
@@ -68,13 +67,11 @@ def save_kind(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ..
 
 
 def _drew_figures(path: Path) -> bool:
-    """Whether the sweep job stored at ``path`` drew figures: its stored config's ``output.figures`` and
-    ``output.job_figures`` (runs older than ``job_figures`` drew them whenever ``output.figures`` was on)."""
+    """Whether the run stored at ``path`` drew figures (its stored config's ``output.figures``)."""
     try:
         with xr.open_dataset(path) as ds:
-            config = OmegaConf.create(ds.attrs.get("config", ""))
-        return bool(OmegaConf.select(config, "output.figures", default=True)) and bool(
-            OmegaConf.select(config, "output.job_figures", default=True))
+            config = ds.attrs.get("config", "")
+        return bool(OmegaConf.select(OmegaConf.create(config), "output.figures", default=True))
     except Exception:  # noqa: BLE001 -- unreadable: leave it alone
         return False
 
