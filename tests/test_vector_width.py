@@ -1,0 +1,59 @@
+"""The CPU's vector width (doubles per register) and the batch kernels' lane width, detected and recorded."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from gyrolab.plugins.compiled import vector_width
+
+
+@pytest.mark.parametrize("features, width", [
+    ({"sse2", "avx", "avx2", "fma", "avx512f", "avx512dq"}, 8),   # AVX-512: 512 bits / 64
+    ({"sse2", "avx", "avx2", "fma"}, 4),                          # AVX2: 256 bits
+    ({"sse2", "sse4.2"}, 2),                                      # SSE: 128 bits
+    ({"neon"}, 2),                                                # Arm NEON: 128 bits
+    (set(), 1),
+])
+def test_vector_doubles_from_features(features, width):
+    assert vector_width.vector_doubles(features) == width
+
+
+def _cpuinfo_flags() -> set[str] | None:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("flags"):
+                return set(line.split(":", 1)[1].split())
+    except OSError:
+        return None
+    return None
+
+
+def test_host_width_agrees_with_the_kernel_cpu_flags():
+    """LLVM's view of the host (what numba compiles for) and /proc/cpuinfo give the same width on x86."""
+    flags = _cpuinfo_flags()
+    if flags is None or "sse2" not in flags:
+        pytest.skip("no x86 /proc/cpuinfo flags here")
+    expected = 8 if "avx512f" in flags else 4 if "avx" in flags else 2
+    assert vector_width.host_vector_doubles() == expected
+
+
+def test_lane_attributes_name_the_compiled_lanes():
+    from gyrolab.plugins.compiled.simd import LANES
+
+    record = vector_width.lane_attributes()
+    assert record["batch_lanes"] == LANES
+    assert record["host_vector_doubles"] == vector_width.host_vector_doubles()
+
+
+def test_batch_dataset_records_lane_width(tmp_path):
+    """A vectorised batch's dataset says the lane width it ran with and the CPU's vector width."""
+    from gyrolab.batch.runner import batch_integrator, lane_record
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor, DOP853Numba
+    from types import SimpleNamespace
+
+    for cls in (Taylor, DOP853Numba):
+        assert lane_record(cls, SimpleNamespace(output="final")) == vector_width.lane_attributes()
+        assert lane_record(cls, SimpleNamespace(output="indicator")) == {}
+    assert batch_integrator is not None
