@@ -47,13 +47,28 @@ def test_lane_attributes_name_the_compiled_lanes():
     assert record["host_vector_doubles"] == vector_width.host_vector_doubles()
 
 
-def test_batch_dataset_records_lane_width(tmp_path):
-    """A vectorised batch's dataset says the lane width it ran with and the CPU's vector width."""
-    from gyrolab.batch.runner import batch_integrator, lane_record
-    from gyrolab.plugins.integrators.compiled_solvers import Taylor, DOP853Numba
+def test_lane_record_only_for_vectorised_kernels():
     from types import SimpleNamespace
+
+    from gyrolab.batch.runner import lane_record
+    from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
+    from gyrolab.plugins.integrators.scipy_solvers import RK45
 
     for cls in (Taylor, DOP853Numba):
         assert lane_record(cls, SimpleNamespace(output="final")) == vector_width.lane_attributes()
         assert lane_record(cls, SimpleNamespace(output="indicator")) == {}
-    assert batch_integrator is not None
+    assert lane_record(RK45, SimpleNamespace(output="final")) == {}
+
+
+def test_batch_dataset_records_lane_width(tmp_path):
+    """A vectorised batch's dataset says the lane width it ran with and the CPU's vector width."""
+    import xarray as xr
+
+    from gyrolab.batch.sweep import run_batch_sweep
+
+    overrides = ["integrator=taylor", "integrator.tol=1e-8", "time.end=1", "time.n_output=3",
+                 "output.euler_angles=false", "initial.r0=1,2"]
+    with xr.open_dataset(run_batch_sweep(overrides, tmp_path / "a")) as ds:
+        assert ds.attrs["batch_path"] == "batch kernel, vectorised across trajectories"
+        assert ds.attrs["batch_lanes"] == vector_width.lane_attributes()["batch_lanes"]
+        assert ds.attrs["host_vector_doubles"] == vector_width.host_vector_doubles()
