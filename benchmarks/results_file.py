@@ -22,6 +22,16 @@ RESULTS = Path(__file__).resolve().parent / "results"
 LOAD_AT_IMPORT = os.getloadavg()  # the load when the benchmark started
 
 
+def _lanes_at_import() -> dict[str, int]:
+    # read when the benchmark imports this module, with the kernels it runs (not when it writes, minutes later)
+    from gyrolab.plugins.compiled.vector_width import lane_attributes
+
+    return lane_attributes()
+
+
+LANES_AT_IMPORT = _lanes_at_import()
+
+
 def cpu_model() -> str:
     """The CPU's model name (/proc/cpuinfo; the platform's processor string elsewhere)."""
     try:
@@ -44,11 +54,14 @@ def _commit() -> str:
     return out.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "") if out.returncode == 0 else "unknown"
 
 
+COMMIT_AT_IMPORT = _commit()  # the code the benchmark runs, not what the worktree holds when it writes
+
+
 def versions() -> dict[str, str]:
     """Library versions of this process (a library not installed is left out)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    found = {"python": platform.python_version(), "gyrolab_commit": _commit()}
+    found = {"python": platform.python_version(), "gyrolab_commit": COMMIT_AT_IMPORT}
     for name in ("gyrolab", "numpy", "numba", "llvmlite", "scipy", "heyoka"):
         try:
             found[name] = version(name)
@@ -59,10 +72,8 @@ def versions() -> dict[str, str]:
 
 def machine() -> dict[str, Any]:
     """What a timing depends on: CPU, vector and lane widths, cores, threads, load, versions."""
-    from gyrolab.plugins.compiled.vector_width import lane_attributes
-
     record = {"cpu_model": cpu_model(), "machine": platform.machine(), "cores": os.cpu_count(),
-              **lane_attributes(), "load_average_start": list(LOAD_AT_IMPORT),
+              **LANES_AT_IMPORT, "load_average_start": list(LOAD_AT_IMPORT),
               "load_average_end": list(os.getloadavg()), "versions": versions()}
     try:
         import numba

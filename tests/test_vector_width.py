@@ -40,11 +40,32 @@ def test_host_width_agrees_with_the_kernel_cpu_flags():
 
 
 def test_lane_attributes_name_the_compiled_lanes():
-    from gyrolab.plugins.compiled.simd import LANES
+    from gyrolab.plugins.compiled.batch_taylor import LANES
 
     record = vector_width.lane_attributes()
-    assert record["batch_lanes"] == LANES
+    assert record["batch_lanes"] == LANES == max(4, vector_width.host_vector_doubles())
     assert record["host_vector_doubles"] == vector_width.host_vector_doubles()
+
+
+def test_numba_cache_key_carries_the_features_the_width_follows_from():
+    """numba keys a cached kernel by its target's (triple, CPU, features): a kernel compiled for another vector
+    width (another feature set) is not loaded. The width must follow from exactly those features."""
+    from numba.core.registry import cpu_target
+
+    triple, cpu, features = cpu_target.target_context.codegen().magic_tuple()
+    enabled = {f[1:] for f in features.split(",") if f.startswith("+")}
+    if features:  # numba passes the host's features explicitly
+        assert vector_width.vector_doubles(enabled) == vector_width.host_vector_doubles()
+
+
+def test_numba_cpu_features_override_sets_the_width(monkeypatch):
+    monkeypatch.setenv("NUMBA_CPU_FEATURES", "+sse2,+avx,+avx2,-avx512f")
+    vector_width.host_features.cache_clear()
+    try:
+        assert vector_width.host_vector_doubles() == 4 and vector_width.batch_lanes() == 4
+    finally:
+        monkeypatch.delenv("NUMBA_CPU_FEATURES")
+        vector_width.host_features.cache_clear()
 
 
 def test_lane_record_only_for_vectorised_kernels():

@@ -1,8 +1,7 @@
 """The host CPU's vector width in doubles, and the lane width the batch kernels were compiled for.
 
-The batch kernels (``batch_taylor``, ``batch_dop853``) advance ``simd.LANES`` trajectories in lock step.
-Whether that fills the CPU's vector registers depends on the CPU: 8 doubles on AVX-512, 4 on AVX/AVX2,
-2 on SSE2 or NEON. The width is read from the features LLVM compiles for (llvmlite's
+The batch Taylor kernel (``batch_taylor``) advances ``batch_lanes()`` trajectories in lock step, one
+vector register of doubles: 8 on AVX-512, 4 on AVX/AVX2 (2 on SSE2 or NEON, where it keeps 4). The width is read from the features LLVM compiles for (llvmlite's
 ``get_host_cpu_features``, which is what numba targets), so it describes the code numba emits, not
 only what /proc/cpuinfo claims. Both numbers are recorded next to every batch result and benchmark,
 so that a timing says on which vector width it was measured.
@@ -11,6 +10,7 @@ so that a timing says on which vector width it was measured.
 from __future__ import annotations
 
 import functools
+import os
 
 #: doubles per vector register for each feature, widest first
 WIDTHS = (("avx512f", 8), ("avx", 4), ("sse2", 2), ("neon", 2), ("asimd", 2))
@@ -26,7 +26,11 @@ def vector_doubles(features: set[str] | frozenset[str]) -> int:
 
 @functools.cache
 def host_features() -> frozenset[str]:
-    """The host CPU features LLVM enables (``+name`` entries of llvmlite's feature map)."""
+    """The CPU features numba compiles for: NUMBA_CPU_FEATURES when set (``+avx2,-avx512f,...``; numba's
+    portable-cache setting), else the host's as LLVM sees them (llvmlite's ``get_host_cpu_features``)."""
+    override = os.environ.get("NUMBA_CPU_FEATURES", "").strip()
+    if override:
+        return frozenset(f[1:] for f in override.split(",") if f.startswith("+"))
     try:
         from llvmlite import binding
 
@@ -41,8 +45,11 @@ def host_vector_doubles() -> int:
     return vector_doubles(host_features())
 
 
-def lane_attributes() -> dict[str, int]:
-    """The batch kernels' lane width and the host's vector width, as recorded in datasets and results."""
-    from gyrolab.plugins.compiled.simd import LANES
+def batch_lanes() -> int:
+    """Trajectories per lane group of the batch Taylor kernel: one vector register of doubles, at least 4."""
+    return max(4, host_vector_doubles())
 
-    return {"batch_lanes": int(LANES), "host_vector_doubles": host_vector_doubles()}
+
+def lane_attributes() -> dict[str, int]:
+    """The batch Taylor kernel's lane width and the CPU's vector width, as recorded in datasets and results."""
+    return {"batch_lanes": batch_lanes(), "host_vector_doubles": host_vector_doubles()}
