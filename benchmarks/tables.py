@@ -44,7 +44,7 @@ def machine_line(record: dict[str, Any]) -> str:
     load_end = record.get("load_average_end") or load
     lanes = record.get("batch_lanes")
     width = (f", {record['host_vector_doubles']} doubles per vector register"
-             + (f" (batch kernels compiled for {lanes} lanes)" if lanes else "")) if "host_vector_doubles" in record else ""
+             + (f" (batch Taylor kernel compiled for {lanes} lanes)" if lanes else "")) if "host_vector_doubles" in record else ""
     return (f"Measured {record.get('date_utc', '?')} on {record.get('cpu_model', '?')}{width}, "
             f"{record.get('cores', '?')} cores, load average {load[0]:.1f} → {load_end[0]:.1f}; "
             f"{libs}{commit}; clock: {record.get('clock', '?')}. "
