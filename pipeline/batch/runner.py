@@ -199,7 +199,8 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
     or not, or one ``integrate`` call per point).
     """
     if plan.base is None or settings.output == "indicator" or not plan.integrator_class.supports(CHOOSES_METHOD):
-        return None, {} if plan.base is None else {"batch_path": batch_path(plan.integrator_class, settings)}
+        return None, {} if plan.base is None else {"batch_path": batch_path(plan.integrator_class, settings),
+                                                   **lane_record(plan.integrator_class, settings)}
     from gyrolab.engine.scene import Scene
 
     scene = Scene.from_config(OmegaConf.create(plan.base))
@@ -212,7 +213,7 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
     log.info("batch: %s chose %s (%s) for every chunk, in %.1f s", plan.integrator_name, method.name, settings_text,
              time.perf_counter() - start)
     return method, {**{k: v for k, v in choice.items() if v is not None},
-                    "batch_path": batch_path(type(method), settings)}
+                    "batch_path": batch_path(type(method), settings), **lane_record(type(method), settings)}
 
 
 def batch_path(integrator: type, settings: Settings) -> str:
@@ -222,6 +223,15 @@ def batch_path(integrator: type, settings: Settings) -> str:
     if not integrator.supports(BATCH_KERNEL):
         return "one integrate() call per point"
     return "batch kernel, vectorised across trajectories" if integrator.supports(VECTOR_LANES) else "batch kernel"
+
+
+def lane_record(integrator: type, settings: Settings) -> dict[str, int]:
+    """The lane width a vectorised batch kernel was compiled for and the CPU's vector width (empty otherwise)."""
+    if settings.output == "indicator" or not integrator.supports(BATCH_KERNEL) or not integrator.supports(VECTOR_LANES):
+        return {}
+    from gyrolab.plugins.compiled.vector_width import lane_attributes
+
+    return lane_attributes()
 
 
 def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integrator: Any = None) -> ChunkTask | None:
