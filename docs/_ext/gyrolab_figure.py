@@ -26,7 +26,7 @@ from sphinx.util.docutils import SphinxDirective
 _RUN_CACHE: dict[str, Path] = {}
 
 
-def _run(command: str, outdir: Path) -> Path:
+def _run(command: str) -> Path:
     """Run ``command`` (it must start with ``gyrolab``) in a fresh directory; return that directory."""
     if command in _RUN_CACHE:
         return _RUN_CACHE[command]
@@ -34,7 +34,9 @@ def _run(command: str, outdir: Path) -> Path:
     if not words or words[0] != "gyrolab":
         raise ValueError(f"gyrolab-figure runs gyrolab commands only, not {command!r}")
     workdir = Path(tempfile.mkdtemp(prefix="gyrolab-figure-"))
-    argv = [sys.executable, "-m", "gyrolab", *words[1:], f"hydra.run.dir={workdir / 'run'}"]
+    # a single run writes to hydra.run.dir, a sweep (-m) to hydra.sweep.dir: give both, one is unused
+    argv = [sys.executable, "-m", "gyrolab", *words[1:], f"hydra.run.dir={workdir / 'run'}",
+            f"hydra.sweep.dir={workdir / 'run'}"]
     done = subprocess.run(argv, cwd=workdir, capture_output=True, text=True)
     if done.returncode != 0:
         raise RuntimeError(f"{command!r} failed (exit {done.returncode}): {done.stderr.strip()[-2000:]}")
@@ -47,11 +49,11 @@ class GyrolabFigure(SphinxDirective):
     final_argument_whitespace = True
     option_spec = {"figure": directives.unchanged_required, "width": directives.unchanged, "alt": directives.unchanged}
 
-    def run(self) -> list[nodes.Node]:
+    def run(self) -> list[nodes.Node]:  # noqa: D102
         command = self.arguments[0].strip()
         figure_name = self.options["figure"]
         try:
-            rundir = _run(command, Path(self.env.srcdir))
+            rundir = _run(command)
         except (RuntimeError, ValueError) as err:
             raise self.error(str(err)) from err
         found = sorted(rundir.rglob(figure_name))
@@ -71,6 +73,13 @@ class GyrolabFigure(SphinxDirective):
         return [block, image]
 
 
+def _remove_run_dirs(app, exception) -> None:
+    for rundir in _RUN_CACHE.values():
+        shutil.rmtree(rundir.parent, ignore_errors=True)
+    _RUN_CACHE.clear()
+
+
 def setup(app):
     app.add_directive("gyrolab-figure", GyrolabFigure)
+    app.connect("build-finished", _remove_run_dirs)
     return {"version": "1", "parallel_read_safe": True}
