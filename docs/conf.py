@@ -51,7 +51,7 @@ _LITERAL = re.compile(r"(``.*?``)")
 
 
 def _escape_bars(app, what, name, obj, options, lines):
-    in_block = False
+    in_block, block_indent = False, 0
     for i, line in enumerate(lines):
         stripped = line.strip()
         if in_block and stripped and not line.startswith(" " * (block_indent + 1)):
