@@ -65,5 +65,16 @@ def _escape_bars(app, what, name, obj, options, lines):
         lines[i] = "".join(p if p.startswith("``") else p.replace("|", r"\|") for p in pieces)
 
 
+# A page added to docs/ (docs/cli.md, docs/datasets.md, ...) joins the user guide without editing index.md:
+# the UNLISTED-PAGES line of its user-guide toctree becomes every top-level page index.md does not name.
+def _unlisted_pages(app, docname, source):
+    if docname != "index":
+        return
+    listed = set(re.findall(r"(?m)^([\w-]+)$", source[0]))
+    pages = sorted(path.stem for path in Path(app.srcdir).glob("*.md") if path.stem not in listed | {"index"})
+    source[0] = source[0].replace("UNLISTED-PAGES\n", "".join(f"{page}\n" for page in pages))
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", _escape_bars)
+    app.connect("source-read", _unlisted_pages)
