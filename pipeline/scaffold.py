@@ -41,8 +41,10 @@ packages = ["gyrolab_viscous_drag"]
 
 TEMPLATES['README.md'] = r'''# gyrolab-viscous-drag
 
-An example force plugin for gyrolab: linear viscous drag, torque −c ω. It is the package the
-gyrolab README's "Adding a force plugin" section shows, tested by gyrolab's own test suite.
+A force plugin for gyrolab, made by `gyrolab --new-force viscous_drag` from gyrolab's example
+plugin. It starts as that example's torque, linear viscous drag −c ω: edit the torque, its
+parameters, `preserves_area_integral` and the tests' exact solution (gyrolab's documentation,
+"Adding a force plugin", explains each part).
 
     pip install -e .          # registers force "viscous_drag" through its entry point
     python -m pytest tests    # gyrolab.testing.check_force plus the exact solution

@@ -478,7 +478,7 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
     The rules:
 
     1. ``name`` is a config key; ``body_type`` has ``from_config``, which builds the body from ``body``;
-    2. the system builds with (body, forces, initial, output, **params);
+    2. the system builds with ``(body, forces, initial, output, **params)``;
     3. ``state_size`` is a positive int; ``initial_state()`` a finite float array of shape (state_size,);
     4. ``rhs(t, y0)`` is a finite float array of shape (state_size,) and leaves y0 unchanged;
     5. ``invariants`` is a tuple of str; ``variables(t, y)`` of a trajectory is a dict of ``xarray.Variable`` on

@@ -2,7 +2,7 @@
 
 It is installed the way pip lays a distribution out (its package on the path, a .dist-info with
 its entry points), found through the entry point, run from the API and the command line; the
-README's plugin section is its literal content; ``gyrolab --new-force`` reproduces it; its own
+The plugin page's (docs/writing-a-force.md) example is its literal content; ``gyrolab --new-force`` reproduces it; its own
 tests (gyrolab's contract kit and the exact solution of drag) run here.
 """
 
@@ -38,9 +38,9 @@ def _example_tests():
     return module
 
 
-def test_readme_plugin_section_is_the_example_package():
-    readme = (REPO / "README.md").read_text()
-    section = readme[readme.index("## Adding a force plugin"):readme.index("## Layout")]
+def test_plugin_page_is_the_example_package():
+    readme = (REPO / "docs" / "writing-a-force.md").read_text()
+    section = readme[readme.index("## Adding a force plugin"):]
     blocks = re.findall(r"`examples/gyrolab-viscous-drag/([^`]+)`:\n\n```\w+\n(.*?)```\n", section, re.S)
     assert {path for path, _ in blocks} >= {"gyrolab_viscous_drag/__init__.py", "pyproject.toml",
                                            "tests/test_viscous_drag.py"}

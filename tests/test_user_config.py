@@ -1,4 +1,4 @@
-"""A user's own config directory works everywhere the packaged one does (README "Your own configs").
+"""A user's own config directory works everywhere the packaged one does (docs/configs.md "Your own configs").
 
 Everything runs from a temporary directory outside the source tree, on a copy of
 examples/myconf (the README's example), in this process (a handful of steps keeps it fast).

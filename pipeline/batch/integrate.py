@@ -50,8 +50,30 @@ def __getattr__(name: str) -> object:
 def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray | None = None) -> BatchSolution:
     """Integrate ``scene`` from each row of ``initial_states`` over ``scene.times``.
 
-    ``params`` (trajectories × n) optionally replaces the compiled model's
-    parameters per trajectory (see ``gyrolab.plugins.compiled.fixed_point.pack``).
+    With an integrator that has a compiled batch kernel (``rk4``, ``rk4_numba``, ``dop853_numba``,
+    ``taylor``), the trajectories run together in one call; otherwise (and with ``auto``, which
+    chooses its method per trajectory) one integration per row.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (from `compose_scene`): its system, integrator and output times.
+    initial_states : numpy.ndarray
+        Shape (trajectories, state size): one initial state per row, finite.
+    params : numpy.ndarray, optional
+        Shape (trajectories, n): replaces the compiled model's parameters per trajectory (see
+        ``gyrolab.plugins.compiled.fixed_point.pack``); only with a compiled batch kernel.
+
+    Returns
+    -------
+    BatchSolution
+        ``t`` (n_out,), ``y`` (trajectories, n_out, state size), step counts and wall time.
+
+    Raises
+    ------
+    gyrolab.errors.ConfigError
+        ``initial_states`` of the wrong shape or not finite, or ``params`` with an integrator
+        that has no compiled batch kernel.
     """
     size = scene.system.state_size
     y0s = np.ascontiguousarray(initial_states, dtype=float)

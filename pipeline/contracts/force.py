@@ -41,6 +41,18 @@ class Force(ABC):
        bad input. A ``ValueError`` or ``TypeError`` escaping ``__init__``
        (``float("abc")``) is reported by gyrolab as one sentence naming the
        parameter; any other exception as one sentence naming the plugin.
+
+       What ``body`` offers (read it in ``__init__``, keep what the torque
+       needs as plain floats or arrays): for ``system=fixed_point`` a
+       ``gyrolab.physics.body.Body`` with ``units`` (``"si"`` or
+       ``"nondimensional"``), ``inertia`` (A, B, C), ``weight_moment``
+       (M g r_c, a torque), ``g`` (SI only, else None), ``nonphysical``,
+       ``source`` (the config as given) and the unit names ``time_unit``,
+       ``rate_unit``, ``torque_unit``, ``energy_unit``, ``momentum_unit``
+       (for ``attributes()``); for ``system=orbiting_gyrostat`` a
+       ``gyrolab.physics.gyrostat_body.GyrostatBody`` (``inertia``,
+       ``gyrostatic_momentum``, ``orbit_rate``, ``units``, the same unit
+       names); a system plugin passes its own ``body_type``.
     2. ``required_axes`` names the reference-frame axes (0, 1, 2) whose body
        components ``torque`` and ``potential`` read. A system carries an axis
        only if some force (or the output) needs it, so ask for no more; an axis
@@ -74,8 +86,9 @@ class Force(ABC):
     8. Optionally, ``compiled_terms()`` returns the torque as ``CompiledTerms``,
        the built-in forms every compiled integrator (Taylor and Lie–Poisson too)
        evaluates; a traced torque (rule 3) runs with ``dop853_numba``,
-       ``rk4_numba``, ``--batch`` and ``auto`` (through DOP853), not ``taylor``
-       or ``lie_poisson``.
+       ``rk4_numba``, ``taylor`` (its Taylor coefficients propagated through the
+       trace; not with ``integrator.precision=double-double``), ``--batch`` and
+       ``auto``, but not with ``lie_poisson``, which takes the built-in forms only.
 
     What gyrolab enforces on a third-party force (gyrolab's own are trusted),
     each failure one sentence naming the force (docs/plugins.md, "What the

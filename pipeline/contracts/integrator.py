@@ -157,8 +157,6 @@ class Integrator(ABC):
        instead of calling ``fun``; the scene refuses it, before integrating,
        for a system or force that has no compiled form.
     7. ``attributes()`` gives its settings for the dataset.
-    9. ``more_accurate(factor)``, optional: a more accurate run of the same method, which
-       ``output.error_estimate`` compares with this one to measure the stored trajectory's error.
     8. It declares what it can do in ``capabilities`` (a frozenset of the module's capability constants)
        and the engine asks ``supports(capability)``, never for an integrator's name:
 
@@ -184,6 +182,8 @@ class Integrator(ABC):
 
        ``evaluation_label``, when set, says what its evaluation count ``nfev`` counts where that is not
        right-hand-side calls (run datasets store it as ``integrator_nfev_counts``; figures read it).
+    9. ``more_accurate(factor)``, optional: a more accurate run of the same method, which
+       ``output.error_estimate`` compares with this one to measure the stored trajectory's error.
     10. ``prepare(system)`` is called once by the scene before integrating
         (default: nothing); ``auto`` uses it to consult the system's regimes.
 

@@ -48,9 +48,9 @@ class Regime(ABC):
        regime run's dataset as (data variables, coordinates, attributes)
        (``gyrolab.experiments.regime_run``); the default has none.
     10. Optionally, ``series_candidates(system, accuracy)`` lists variants of
-       the regime (lowest series order first) with their predicted max error
-       (NaN: not predicted), for ``integrator=auto``; the default is the
-       regime itself, unpredicted.
+        the regime (lowest series order first) with their predicted max error
+        (NaN: not predicted), for ``integrator=auto``; the default is the
+        regime itself, unpredicted.
     11. Optionally, ``period_spread`` (a class attribute ≥ 1) bounds the
         scene's true period to [T/spread, T·spread] around ``period(system)``;
         ``integrator=auto`` then rules the regime out cheaply when the scene's

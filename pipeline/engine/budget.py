@@ -1,6 +1,6 @@
 """Requests gyrolab refuses before anything runs: tolerances outside (0, 1), and plainly infeasible work.
 
-The budget (README "Your own configs"): the state array of one run at most
+The budget (docs/configs.md "Your own configs"): the state array of one run at most
 :data:`MAX_STATE_BYTES` (n_output × state size × 8 bytes), and at most
 :data:`MAX_STEPS` integrator steps, estimated from below:
 

@@ -41,7 +41,25 @@ MIN_SAMPLES_PER_PERIOD = 2
 
 @dataclass
 class Scene:
-    """Everything one run needs, built and validated once; ``run()`` integrates and writes nothing."""
+    """Everything one run needs, built and validated once; ``run()`` integrates and writes nothing.
+
+    Build one with `compose_scene` (from Hydra overrides) or ``Scene.from_config`` (from a composed
+    config). A scene is reusable: ``run()`` may be called again, and `integrate_batch` integrates it
+    from many initial states.
+
+    Attributes
+    ----------
+    config : omegaconf.DictConfig
+        The resolved config the scene was built from (stored in every dataset it writes).
+    system : gyrolab.contracts.System
+        The equations of motion with the body, forces and initial state.
+    integrator : gyrolab.contracts.Integrator
+        The integrator, configured.
+    times : numpy.ndarray
+        The output times (model time units).
+    n_output_requested : int or str
+        ``time.n_output`` as the config gave it: ``"auto"`` or a number of samples.
+    """
 
     config: DictConfig
     system: System
@@ -164,7 +182,19 @@ class Scene:
         return attrs
 
     def run(self) -> xr.Dataset:
-        """Integrate the full equations of motion and return the self-describing dataset."""
+        """Integrate the full equations of motion and return the self-describing dataset.
+
+        Returns
+        -------
+        xarray.Dataset
+            What ``run.nc`` holds: the trajectory, the Euler angles, the monitored first integrals,
+            the resolved config and provenance (nothing is written to disk).
+
+        Raises
+        ------
+        gyrolab.errors.GyrolabError
+            A subclass naming what went wrong (an integration that fails, a torque that is not finite).
+        """
         if log.isEnabledFor(logging.INFO):  # the title is worth building only when someone reads it
             log.info("integrating %s with %s over t=[%g, %g] (%d output times)", self.system.title(),
                      self.integrator.name, self.times[0], self.times[-1], len(self.times))
@@ -186,12 +216,47 @@ class Scene:
 
 
 def compose_scene(overrides: Sequence[str] = ()) -> Scene:
-    """Compose gyrolab's config with Hydra overrides, validate it and build the scene (once)."""
+    """Compose gyrolab's config with Hydra overrides, validate it and build the scene (once).
+
+    Parameters
+    ----------
+    overrides : sequence of str
+        Hydra overrides, exactly as on the command line (``"integrator=rk4"``, ``"initial.r0=5"``).
+
+    Returns
+    -------
+    Scene
+        The validated scene; ``scene.run()`` integrates it.
+
+    Raises
+    ------
+    gyrolab.errors.ConfigError
+        A bad value, key or choice, in one sentence naming it and the valid choices.
+
+    Examples
+    --------
+    >>> from gyrolab import compose_scene
+    >>> scene = compose_scene(["body=lagrange_top", "time.end=5", "time.n_output=51"])
+    >>> ds = scene.run()
+    >>> ds.sizes["time"]
+    51
+    """
     return Scene.from_config(compose_config(overrides))
 
 
 def run(overrides: Sequence[str] = ()) -> xr.Dataset:
-    """``compose_scene(overrides).run()``."""
+    """Compose, build and integrate a scene: ``compose_scene(overrides).run()``.
+
+    Parameters
+    ----------
+    overrides : sequence of str
+        Hydra overrides, as for `compose_scene`.
+
+    Returns
+    -------
+    xarray.Dataset
+        The run's dataset (what ``run.nc`` holds); nothing is written to disk.
+    """
     return compose_scene(overrides).run()
 
 

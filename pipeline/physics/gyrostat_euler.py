@@ -70,6 +70,20 @@ def kinematic_matrix(theta: float, phi: float) -> np.ndarray:
 
 
 def mass_matrix(q: np.ndarray, p: GyrostatParameters) -> np.ndarray:
+    """The kinetic energy's matrix M(q) in the Euler-angle rates: T = ½ q̇ᵀ M(q) q̇ + (lower order).
+
+    Parameters
+    ----------
+    q : numpy.ndarray
+        The Euler angles (ψ, θ, φ), shape (3,).
+    p : GyrostatParameters
+        The gyrostat (its principal moments ``I`` = (A, B, C)).
+
+    Returns
+    -------
+    numpy.ndarray
+        The symmetric 3 × 3 matrix Jᵀ diag(A, B, C) J with J the `kinematic_matrix`.
+    """
     A, B, C = p.I
     _, th, ph = q
     st, ct = np.sin(th), np.cos(th)

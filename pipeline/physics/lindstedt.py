@@ -13,7 +13,7 @@ scaling γ0'' = Γ/μ, eq. 28) is sought as Y = Σ ε^k Y_k(s), s = Ωτ, Ω = �
 polynomial held by its samples on a uniform grid in s (products are exact: the grid resolves twice the highest
 harmonic). No computer algebra: every coefficient is a number.
 
-Order k is linear in Y_k around the generating motion Y_0 = (0, 0, 1, ρ cos s, −ρ sin s, g), ρ = √(1 − g²):
+Order k is linear in Y_k around the generating motion Y_0 = (0, 0, 1, ρ cos s, −ρ sin s, g), ρ = √(1 − g²)::
 
     (p, q):  p_k' + A1 q_k = R_p,  q_k' + B1 p_k = R_q   → harmonic n: p_n = (A1 R_q,n − in R_p,n)/(n² − ω²)
     r, γ'':  r_k' = R_r,  γ''_k' = R_γ''                  (integrated; constants from r1(0) = 1, γ''(0) = γ0'')

@@ -33,6 +33,22 @@ def kappa(a: float, k: float) -> float:
 
 
 def check_libration(b: float, kap: float, theta_a: float) -> None:
+    """Refuse a pendulum swing that is not a libration about the lowest position.
+
+    Parameters
+    ----------
+    b : float
+        B/C, which must be positive.
+    kap : float
+        κ = k (a − 1) (see `kappa`).
+    theta_a : float
+        The swing's amplitude θa, in (0, π).
+
+    Raises
+    ------
+    gyrolab.errors.ConfigError
+        When θa is outside (0, π), when 1 + κ cos θ is not positive over the swing, or when b ≤ 0.
+    """
     if not 0.0 < theta_a < np.pi:
         raise ConfigError(f"the pendulum swing needs an amplitude 0 < θ0 < π, got θ0={theta_a:.6g}")
     if not 1.0 + kap * np.cos(theta_a) > 0 or not 1.0 + kap > 0:

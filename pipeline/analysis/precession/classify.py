@@ -57,6 +57,23 @@ def _kind(rate: float, motion: Precession, along_normal: bool) -> str:
 
 
 def classify(motion: Precession, Omega: float) -> Classification:
+    """Classify a regular precession of the satellite-gyrostat (Yehia & El-kenani 2021).
+
+    Parameters
+    ----------
+    motion : Precession
+        The precession (its rates ``n`` about the orbit normal and ``m`` about the body axis).
+    Omega : float
+        The orbit rate Ω (> 0), which turns the orbital-frame rate n into the inertial one n + Ω.
+
+    Returns
+    -------
+    Classification
+        The kind of motion in the orbital frame and in the inertial frame (permanent rotation or
+        regular precession) and the geometric class of the body axis' path: ``"cylindrical"``
+        (along the orbit normal), ``"conical"``, ``"hyperboloidal"``, or ``"axis moves in the
+        orbital frame"``.
+    """
     e3 = body_axis_orbital(motion)
     along_normal = bool(np.hypot(e3[0], e3[1]) < TOL)
     if along_normal:
