@@ -162,16 +162,34 @@ def test_scheduler_values_and_missing_dask(monkeypatch):
     assert ran == [(0, 2), (1, 1)]
 
 
-def test_a_batch_on_separately_started_workers_writes_the_same_dataset(scheduler, tmp_path):
+@pytest.mark.parametrize("route", ["command line", "environment"])
+def test_a_batch_on_separately_started_workers_writes_the_same_dataset(scheduler, tmp_path, monkeypatch, route,
+                                                                       caplog):
     """The whole --batch path (plan, chunk tasks, workers rebuilding the scene, the streamed store) on the
-    CLI-started scheduler and workers gives the dataset of the same batch run in this process."""
+    CLI-started scheduler and workers gives the dataset of the same batch run in this process; the address
+    comes from the command line (``--scheduler``) or the environment (``DASK_SCHEDULER_ADDRESS``), and the
+    log says which."""
+    import logging
+
     import xarray as xr
 
+    from gyrolab.batch.scheduler import use_command_line_scheduler
     from gyrolab.batch.sweep import run_batch_sweep
 
     grid = [*OVERRIDES, "batch.output=final", "batch.chunk=4", "initial.r0=2,3,5", "initial.theta0=0.3,0.6,0.9"]
+    monkeypatch.delenv("DASK_SCHEDULER_ADDRESS", raising=False)
     here = run_batch_sweep(grid, tmp_path / "here")
-    there = run_batch_sweep([*grid, f"batch.scheduler={scheduler}"], tmp_path / "there")
+    if route == "command line":
+        use_command_line_scheduler(scheduler)
+    else:
+        monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", scheduler)
+    try:
+        with caplog.at_level(logging.INFO, logger="gyrolab.batch"):
+            there = run_batch_sweep(grid, tmp_path / "there")
+    finally:
+        use_command_line_scheduler(None)
+    said = "the command line (--scheduler)" if route == "command line" else "the environment (DASK_SCHEDULER_ADDRESS)"
+    assert f"on the Dask scheduler at {scheduler} (from {said})" in caplog.text
     with xr.open_dataset(here) as a, xr.open_dataset(there) as b:
         assert int(a.job_status.min()) == 1 and a.sizes["theta0"] == 3
         states = [name for name in a.data_vars if "job_" not in name and name != "error_message"]

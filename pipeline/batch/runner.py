@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from omegaconf import OmegaConf
 
-from gyrolab.batch import executors
+from gyrolab.batch import executors, scheduler
 from gyrolab.batch.outputs import MODES, Output, indicator_outputs, merge_rows, state_outputs
 from gyrolab.batch.plan import Plan, _with_values
 from gyrolab.batch.store import Store
@@ -45,6 +45,8 @@ class Settings:
     decimate: int = 10
     chunk: int | None = None        # None: from ``memory``
     memory: float = DEFAULT_MEMORY_MIB
+    #: ``batch.scheduler`` as configured: process or local only (an address comes from the command line, the
+    #: environment or Dask's configuration: ``gyrolab.batch.scheduler``); read so that a refusal can name it
     scheduler: str | None = None
 
     @classmethod
@@ -149,6 +151,8 @@ def chunks(shape: tuple[int, ...], size: int) -> list[Chunk]:
 def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     """Integrate every valid point of ``plan``, streaming to ``path`` (resuming a killed run of the same
     command)."""
+    where = scheduler.resolve(settings.scheduler)   # a refused address: before any file is written
+    kind = executors.scheduler_kind(where)
     size = chunk_size(plan, settings)
     blocks = chunks(plan.shape, size)
     identity = plan.identity(size)
@@ -167,14 +171,18 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     for i in empty:   # no valid point: only the points' errors, which the store wrote when it was created
         store.chunk_done(i, blocks[i], None)
     progress = _Progress(len(tasks))
-    if tasks and executors.scheduler_kind(settings.scheduler) == "process":
+    if tasks:
+        log.info("batch: chunks run %s (from %s)", "in this process" if kind == "process" else
+                 "on a local Dask cluster" if kind == "local" else f"on the Dask scheduler at {where.scheduler}",
+                 where.source)
+    if tasks and kind == "process":
         _share_systems(plan)
 
     def on_result(_: int, result: ChunkResult) -> None:
         store.chunk_done(result.index, blocks[result.index], result)
         progress.update(result)
 
-    executors.map_chunks(run_chunk, tasks, on_result, scheduler=settings.scheduler)
+    executors.map_chunks(run_chunk, tasks, on_result, scheduler=where)
     store.finish()
     return progress.summary(path)
 

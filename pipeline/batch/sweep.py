@@ -17,7 +17,9 @@ from pathlib import Path
 from typing import Any
 
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
+from gyrolab.batch.executors import scheduler_kind
 from gyrolab.batch.runner import RunStats, Settings, run_plan
+from gyrolab.batch.scheduler import resolve
 from gyrolab.contracts.integrator import VARIATIONAL
 from gyrolab.errors import ConfigError
 from gyrolab.output.lock import writing_in
@@ -42,6 +44,7 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
     plan = make_plan(fixed, dims, plain=plain)
     settings = Settings.from_config(plan.plain.get("batch"))
     check_integrator(plan, settings)
+    scheduler_kind(resolve(settings.scheduler))   # a refused or unknown scheduler: before the directory exists
     plan_time = time.perf_counter() - start
     if not lock:
         stats = run_plan(plan, path, settings)

@@ -1,0 +1,189 @@
+"""Issue 23, items 1 and 3: whom a batch trusts, and what a full disk costs.
+
+- A Dask scheduler's address comes only from the command line, the environment or Dask's configuration, never
+  from a config, an experiment or an override of ``batch.scheduler`` (connecting trusts the peer with code
+  execution). A silent peer, a peer that is not a scheduler and a refused port are one sentence each, within
+  the promised time.
+- A failed write (a file-size limit, ENOSPC) in ``--batch``, a multirun sweep or a stability map is one sentence,
+  exit 3, and loses no finished chunk: the next run completes bit-identical to an uninterrupted one.
+- ``--batch`` exits non-zero when points failed, saying how many.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+
+from gyrolab.batch import executors, scheduler
+from gyrolab.errors import ConfigError
+
+TINY = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=1", "time.n_output=11",
+        "output.euler_angles=false", "output.figures=false"]
+
+
+def last_line(done) -> str:
+    return done.stderr.strip().splitlines()[-1] if done.stderr.strip() else ""
+
+
+def one_sentence(done, *fragments) -> str:
+    line = last_line(done)
+    assert line.startswith("gyrolab: error: "), done.stderr[-3000:]
+    assert "Traceback" not in done.stderr, done.stderr[-3000:]
+    for fragment in fragments:
+        assert fragment in line, line
+    return line
+
+
+# ---- 1. the trust model ---------------------------------------------------------------------------------------------
+
+@pytest.fixture
+def clean_sources(monkeypatch):
+    """No scheduler from the environment, Dask's configuration or an earlier command line."""
+    monkeypatch.delenv(scheduler.SCHEDULER_ENV, raising=False)
+    monkeypatch.setattr(scheduler, "_dask_config_address", lambda: None)
+    scheduler.use_command_line_scheduler(None)
+    yield
+    scheduler.use_command_line_scheduler(None)
+
+
+def test_an_address_from_a_config_is_refused_in_one_sentence(clean_sources):
+    for address in ("tcp://127.0.0.1:8786", "tls://head:8786", "localhost:8786"):
+        with pytest.raises(ConfigError) as caught:
+            scheduler.resolve(address)
+        message = str(caught.value)
+        assert "batch.scheduler=" in message and "--scheduler" in message and "DASK_SCHEDULER_ADDRESS" in message
+        assert "\n" not in message
+
+
+def test_the_sources_in_order_and_named(clean_sources, monkeypatch):
+    assert scheduler.resolve(None) == scheduler.Choice(None, scheduler.DEFAULT)
+    assert scheduler.resolve("local") == scheduler.Choice("local", scheduler.CONFIG)
+    monkeypatch.setattr(scheduler, "_dask_config_address", lambda: "tcp://from-dask:1")
+    assert scheduler.resolve(None) == scheduler.Choice("tcp://from-dask:1", scheduler.DASK_CONFIG)
+    monkeypatch.setenv(scheduler.SCHEDULER_ENV, "tcp://from-env:2")
+    assert scheduler.resolve(None) == scheduler.Choice("tcp://from-env:2", scheduler.ENVIRONMENT)
+    assert scheduler.resolve("process").scheduler == "process"  # a config's process/local wins over the environment
+    scheduler.use_command_line_scheduler("tcp://from-cli:3")
+    assert scheduler.resolve("tcp://anything:4") == scheduler.Choice("tcp://from-cli:3", scheduler.COMMAND_LINE)
+
+
+def test_dask_configuration_is_read(clean_sources, monkeypatch):
+    import dask
+
+    monkeypatch.undo()  # the real reader, the environment still clean
+    monkeypatch.delenv(scheduler.SCHEDULER_ENV, raising=False)
+    scheduler.use_command_line_scheduler(None)
+    with dask.config.set({"scheduler-address": "tcp://configured:8786"}):
+        assert scheduler.resolve(None) == scheduler.Choice("tcp://configured:8786", scheduler.DASK_CONFIG)
+
+
+def test_parse_scheduler_option():
+    assert scheduler.parse_scheduler_option(["a=1", "--scheduler", "tcp://h:1", "b=2"]) == ("tcp://h:1", ["a=1", "b=2"])
+    assert scheduler.parse_scheduler_option(["--scheduler=local"]) == ("local", [])
+    assert scheduler.parse_scheduler_option(["a=1"]) == (None, ["a=1"])
+    with pytest.raises(ConfigError, match="--scheduler needs a value"):
+        scheduler.parse_scheduler_option(["--scheduler"])
+
+
+class Peer:
+    """A TCP server on localhost that accepts and then stays silent or sends garbage."""
+
+    def __init__(self, garbage: bytes | None) -> None:
+        self.server = socket.socket()
+        self.server.bind(("127.0.0.1", 0))
+        self.server.listen(8)
+        self.address = f"tcp://127.0.0.1:{self.server.getsockname()[1]}"
+        self.garbage, self.connections = garbage, []
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self) -> None:
+        while True:
+            try:
+                connection, _ = self.server.accept()
+            except OSError:
+                return
+            self.connections.append(connection)
+            if self.garbage is not None:
+                try:
+                    connection.sendall(self.garbage)
+                except OSError:
+                    pass
+
+    def close(self) -> None:
+        for connection in self.connections:
+            connection.close()
+        self.server.close()
+
+
+def refused_port() -> str:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return f"tcp://127.0.0.1:{probe.getsockname()[1]}"
+
+
+@pytest.mark.parametrize("peer", ["silent", "http", "zeros", "refused"])
+def test_a_peer_that_is_not_a_scheduler_is_one_sentence_in_bounded_time(peer, clean_sources, monkeypatch):
+    pytest.importorskip("distributed")
+    monkeypatch.setattr(executors, "CONNECT_TIMEOUT", 1)
+    garbage = {"silent": None, "http": b"HTTP/1.1 400 Bad Request\r\n\r\n" * 40, "zeros": b"\0" * 4096}
+    server = Peer(garbage[peer]) if peer != "refused" else None
+    address = server.address if server else refused_port()
+    scheduler.use_command_line_scheduler(address)
+    done = threading.Event()
+    outcome = {}
+
+    def attempt():
+        try:
+            executors.map_chunks(len, ["ab"], lambda i, r: None)
+        except BaseException as error:  # noqa: BLE001 - the test looks at what came out
+            outcome["error"] = error
+        done.set()
+
+    threading.Thread(target=attempt, daemon=True).start()
+    try:
+        # the bound: the promised second plus slack for a loaded machine; without it a silent peer held for minutes
+        assert done.wait(60), f"a {peer} peer held the batch"
+    finally:
+        if server:
+            server.close()
+    error = outcome.get("error")
+    assert isinstance(error, ConfigError), repr(error)
+    message = str(error)
+    assert address in message and "the command line (--scheduler)" in message and "\n" not in message
+    expected = {"silent": "did not answer within 1 s", "http": "is not a Dask scheduler",
+                "zeros": "is not a Dask scheduler", "refused": "no Dask scheduler answers"}[peer]
+    assert expected in message, message
+
+
+def test_an_address_from_the_environment_is_named_as_such(clean_sources, monkeypatch):
+    pytest.importorskip("distributed")
+    monkeypatch.setattr(executors, "CONNECT_TIMEOUT", 1)
+    address = refused_port()
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", address)
+    with pytest.raises(ConfigError) as caught:
+        executors.map_chunks(len, ["ab"], lambda i, r: None)
+    assert "(from the environment (DASK_SCHEDULER_ADDRESS))" in str(caught.value)
+    assert "batch.scheduler" not in str(caught.value)
+
+
+def test_gyrolab_batch_refuses_an_address_in_a_config_and_leaves_nothing(cli, tmp_path):
+    env = {k: v for k, v in os.environ.items() if k != "DASK_SCHEDULER_ADDRESS"}
+    refused = cli("--batch", *TINY, "initial.r0=1,2", "batch.scheduler=tcp://127.0.0.1:9", "hydra.sweep.dir=grid",
+                  env_extra={"DASK_SCHEDULER_ADDRESS": ""})
+    assert refused.returncode == 2
+    one_sentence(refused, "batch.scheduler=", "--scheduler", "DASK_SCHEDULER_ADDRESS")
+    assert not (tmp_path / "grid").exists()
+    del env
+
+
+def test_gyrolab_batch_scheduler_option_names_its_source(cli, tmp_path):
+    pytest.importorskip("distributed")
+    address = refused_port()
+    done = cli("--batch", *TINY, "initial.r0=1,2", "--scheduler", address, "hydra.sweep.dir=grid")
+    assert done.returncode == 2
+    one_sentence(done, address, "from the command line (--scheduler)")
