@@ -187,3 +187,17 @@ def test_gyrolab_batch_scheduler_option_names_its_source(cli, tmp_path):
     done = cli("--batch", *TINY, "initial.r0=1,2", "--scheduler", address, "hydra.sweep.dir=grid")
     assert done.returncode == 2
     one_sentence(done, address, "from the command line (--scheduler)")
+
+
+# ---- --batch's exit status ------------------------------------------------------------------------------------------
+
+def test_batch_with_failed_points_exits_1_saying_how_many(cli, tmp_path):
+    """RK4 with a step far too long for a fast spin overflows (two of three points), as -m exits 1 for a failed
+    job; the dataset is complete all the same."""
+    done = cli("--batch", "integrator=rk4_numba", "integrator.step=0.9", "time.end=200", "time.n_output=3",
+               "output.euler_angles=false", "batch.chunk=1", "initial.r0=500,400,0.1", "hydra.sweep.dir=grid")
+    assert done.returncode == 1, done.stderr[-2000:]
+    assert last_line(done).startswith("gyrolab: 2 of 3 points failed") and "Traceback" not in done.stderr
+    assert (tmp_path / "grid" / "sweep.nc").is_file()
+    fine = cli("--batch", *TINY, "initial.r0=1,2", "hydra.sweep.dir=fine")
+    assert fine.returncode == 0 and "failed" not in fine.stderr, fine.stderr[-2000:]

@@ -77,7 +77,12 @@ def batch(args: argparse.Namespace) -> int:
         log.info("batch: the sweep declared in hydra.sweeper.params: %s", " ".join(o.input_line for o in declared))
     path = run_batch_sweep(scene_overrides, out_dir)
     announce_written(path)
-    return 0
+    from gyrolab.batch.sweep import failed_points_line
+
+    failed = failed_points_line(path)   # failed points: exit 1, as -m with a failed job
+    if failed:
+        print(failed, file=sys.stderr)
+    return 1 if failed else 0
 
 
 def _quoted(value: str) -> str:

@@ -55,6 +55,19 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
     return stats
 
 
+def failed_points_line(path: Path) -> str | None:
+    """One line saying how many points of the finished batch at ``path`` failed and where their errors are
+    (None when none failed): a batch with failed points exits 1, as a multirun with a failed job does."""
+    import netCDF4
+
+    with netCDF4.Dataset(path, "r") as nc:
+        failed, total = int(getattr(nc, "n_failed", 0)), int(getattr(nc, "n_points", 0))
+    if not failed:
+        return None
+    return (f"gyrolab: {failed} of {total} points failed; see error_message[job_error] where job_status is 2 "
+            f"in {path}")
+
+
 def check_integrator(plan: Plan, settings: Settings | None = None) -> None:
     """Refuse, in one sentence, an integrator that lacks a capability the batch needs: the chaos indicators
     (``batch.output=indicator``) need VARIATIONAL. Any integrator runs the other outputs: one with a batch kernel
