@@ -10,6 +10,13 @@ the file is created, so a chunk's write changes data, never the file's structure
 leaves a file that opens. After a chunk's data is synced to disk its index is appended to ``NAME.chunks``
 (the journal, fsynced); a rerun with the same identity continues after the journaled chunks. When every
 chunk is stored the file is closed, synced and renamed to ``NAME``, and the journal removed.
+
+A full disk (or a file-size limit, a quota) loses no finished chunk. The file reaches its full size when it
+is created (every variable's storage written with its fill value, the point counts written as placeholders),
+so a chunk's write and the final counts overwrite bytes already on disk. A write that fails anyway is one
+``OutputError`` sentence (exit 3) saying how many chunks are kept; the journal lists only chunks whose data
+was synced, so the same command, rerun with more space, runs the others and ends with the file an
+uninterrupted run writes. A file whose creation failed holds no finished chunk: the rerun creates it again.
 """
 
 from __future__ import annotations
@@ -27,7 +34,7 @@ from omegaconf import OmegaConf
 from gyrolab.batch.outputs import output_times
 from gyrolab.batch.plan import POINT
 from gyrolab.errors import ConfigError, OutputError
-from gyrolab.output.atomic import _fsync, _fsync_directory, reason
+from gyrolab.output.atomic import _fsync, _fsync_directory, _library_failure, diagnose, reason
 from gyrolab.output.cf import CONVENTIONS, now_iso
 from gyrolab.output.provenance import gyrolab_version, provenance
 from gyrolab.sweep import record
@@ -65,6 +72,13 @@ class Store:
         if not self.part.exists():
             self.journal.unlink(missing_ok=True)
             return set()
+        if not _read_journal(self.journal, None) and not _opens(self.part):
+            # no chunk was ever journaled in it and it does not open: a creation that failed (a full disk)
+            log.info("batch: %s holds no finished chunk and does not open (its creation failed); creating it again",
+                     self.part)
+            self.part.unlink()
+            self.journal.unlink(missing_ok=True)
+            return set()
         found = _identity_of(self.part)
         if found != self.identity:
             raise ConfigError(f"{self.part} is an unfinished batch of another command or gyrolab version (identity "
@@ -82,26 +96,26 @@ class Store:
         """Store a chunk's result (None: a chunk without a valid point) and journal it."""
         if self.nc is None:
             self._create(result)
-        if result is not None:
-            valid = self.plan.valid[chunk.start:chunk.stop]
-            status = np.where(valid, FINISHED, FAILED).astype(np.int8)
-            error = self.plan.error[chunk.start:chunk.stop].copy()
-            status[result.failed] = FAILED
-            error[result.failed] = len(self.messages) - 1   # the integration failure's sentence
-            self._write("job_status", chunk, status)
-            self._write("job_error", chunk, error)
-            for name, out in result.outputs.items():
-                if name in self.nc.variables:
-                    self._write(name, chunk, out.data)
         try:
+            if result is not None:
+                valid = self.plan.valid[chunk.start:chunk.stop]
+                status = np.where(valid, FINISHED, FAILED).astype(np.int8)
+                error = self.plan.error[chunk.start:chunk.stop].copy()
+                status[result.failed] = FAILED
+                error[result.failed] = len(self.messages) - 1   # the integration failure's sentence
+                self._write("job_status", chunk, status)
+                self._write("job_error", chunk, error)
+                for name, out in result.outputs.items():
+                    if name in self.nc.variables:
+                        self._write(name, chunk, out.data)
             self.nc.sync()
             _fsync(self.part)
             with open(self.journal, "a", encoding="utf-8") as journal:
                 journal.write(f"{index}\n")
                 journal.flush()
                 os.fsync(journal.fileno())
-        except OSError as error:
-            raise OutputError(f"could not write {self.part}: {reason(error)}") from None
+        except (OSError, RuntimeError) as error:
+            self._fail(error, self.part)
 
     def finish(self) -> None:
         """Close the complete file and give it its final name."""
@@ -109,21 +123,44 @@ class Store:
             self._create(None)
         status = self.nc["job_status"][:]
         status = np.asarray(status.filled(0) if np.ma.isMaskedArray(status) else status)
-        counts = {name: int(np.count_nonzero(status == code))
+        counts = {name: np.int64(np.count_nonzero(status == code))
                   for name, code in (("n_missing", 0), ("n_finished", FINISHED), ("n_failed", FAILED))}
-        self.nc.setncatts(counts)
+        try:
+            self.nc.setncatts(counts)   # in place of the placeholders written at creation: no new space
+            self.nc.close()
+            self.nc = None
+            _fsync(self.part)
+        except (OSError, RuntimeError) as error:
+            self._fail(error, self.part)
         if counts["n_failed"]:
             log.info("batch: %d of %d points failed; their errors are error_message[job_error] where job_status is 2",
                      counts["n_failed"], status.size)
-        self.nc.close()
-        self.nc = None
         try:
-            _fsync(self.part)
             os.replace(self.part, self.path)
             _fsync_directory(self.path.parent)
         except OSError as error:
             raise OutputError(f"could not write {self.path}: {reason(error)}") from None
         self.journal.unlink(missing_ok=True)
+
+    def _fail(self, error: BaseException, path: Path) -> None:
+        """A failed write to the partial store: one OutputError sentence saying what is kept (a library error
+        that is not a failed write is a bug, raised as it is)."""
+        if not isinstance(error, OSError) and not _library_failure(error):
+            raise error
+        why = diagnose(error, path, keep=True)
+        self._close_quietly()
+        kept = len(_read_journal(self.journal, self.identity))
+        raise OutputError(f"could not write {path}: {why}; the {kept} finished chunk{'s' if kept != 1 else ''} "
+                          "stored in it are kept: free some space and rerun the same command to finish the batch") \
+            from None
+
+    def _close_quietly(self) -> None:
+        nc, self.nc = self.nc, None
+        if nc is not None:
+            try:
+                nc.close()
+            except (OSError, RuntimeError):   # the disk is full: what the journal lists is on disk already
+                pass
 
     def _write(self, name: str, chunk: Any, data: np.ndarray) -> None:
         data = np.asarray(data)
@@ -131,12 +168,23 @@ class Store:
 
     # -- creating ------------------------------------------------------------------------------------------
     def _create(self, result: Any) -> None:
-        plan = self.plan
+        """Create the partial store at its full size; a failure removes it (no chunk is in it yet)."""
         try:
-            self.part.parent.mkdir(parents=True, exist_ok=True)
-            nc = netCDF4.Dataset(self.part, "w", format="NETCDF4")
-        except OSError as error:
-            raise OutputError(f"could not write {self.part}: {reason(error)}") from None
+            self._create_file(result)
+        except (OSError, RuntimeError) as error:
+            if not isinstance(error, OSError) and not _library_failure(error):
+                raise
+            why = diagnose(error, self.part, keep=True)
+            self._close_quietly()
+            self.part.unlink(missing_ok=True)
+            self.journal.unlink(missing_ok=True)
+            raise OutputError(f"could not create {self.part}: {why}; no chunk was finished yet: free some space and "
+                              "rerun the same command") from None
+
+    def _create_file(self, result: Any) -> None:
+        plan = self.plan
+        self.part.parent.mkdir(parents=True, exist_ok=True)
+        nc = netCDF4.Dataset(self.part, "w", format="NETCDF4")
         self.nc = nc
         nc.set_auto_mask(False)
         system = _reference_system(plan)
@@ -177,6 +225,8 @@ class Store:
         if result is not None:
             self._create_variables(result, system)
         nc.setncatts(self._attributes(system))
+        # the point counts as placeholders of their final type: ``finish`` overwrites them in place
+        nc.setncatts({name: np.int64(0) for name in ("n_missing", "n_finished", "n_failed")})
         nc.sync()
         _fsync(self.part)
         _start_journal(self.journal, self.identity)
@@ -263,6 +313,14 @@ def _open(path: Path, mode: str) -> netCDF4.Dataset:
     return nc
 
 
+def _opens(path: Path) -> bool:
+    try:
+        netCDF4.Dataset(path, "r").close()
+    except OSError:
+        return False
+    return True
+
+
 def _identity_of(path: Path) -> str:
     nc = _open(path, "r")
     try:
@@ -278,13 +336,13 @@ def _start_journal(path: Path, identity: str) -> None:
         os.fsync(journal.fileno())
 
 
-def _read_journal(path: Path, identity: str) -> set[int]:
-    """The chunks a journal records (none if it is missing or belongs to another identity)."""
+def _read_journal(path: Path, identity: str | None) -> set[int]:
+    """The chunks a journal records (none if it is missing or belongs to another identity; None: any)."""
     try:
         lines = path.read_text(encoding="utf-8").splitlines()
     except FileNotFoundError:
         return set()
-    if not lines or lines[0] != f"identity {identity}":
+    if not lines or (identity is not None and lines[0] != f"identity {identity}"):
         return set()
     return {int(line) for line in lines[1:] if line.strip().isdigit()}
 
