@@ -201,3 +201,135 @@ def test_batch_with_failed_points_exits_1_saying_how_many(cli, tmp_path):
     assert (tmp_path / "grid" / "sweep.nc").is_file()
     fine = cli("--batch", *TINY, "initial.r0=1,2", "hydra.sweep.dir=fine")
     assert fine.returncode == 0 and "failed" not in fine.stderr, fine.stderr[-2000:]
+
+
+# ---- 3. a full disk loses nothing -----------------------------------------------------------------------------------
+
+GRID = [*TINY, "time.end=2", "time.n_output=51", "batch.output=trajectory", "batch.chunk=4",
+        "initial.r0=range(1,3,0.25)", "initial.theta0=0.3,0.6"]   # 16 points, 4 chunks
+
+
+def data_variables(path: Path) -> dict:
+    import xarray as xr
+
+    with xr.open_dataset(path) as ds:
+        return {name: ds[name].values.copy() for name in ds.data_vars}
+
+
+def assert_same_data(path: Path, reference: Path) -> None:
+    import numpy as np
+
+    got, want = data_variables(path), data_variables(reference)
+    assert sorted(got) == sorted(want)
+    for name, values in want.items():
+        np.testing.assert_array_equal(got[name], values, err_msg=name)   # exact: bit for bit (NaN where NaN)
+
+
+def with_file_size_limit(limit: int):
+    """A subprocess's preexec_fn: a file-size limit of ``limit`` bytes, SIGXFSZ ignored so that a write past it
+    is an OSError (EFBIG) in Python, as a full disk is (ENOSPC)."""
+    def limit_files() -> None:
+        import resource
+        import signal
+
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+    return limit_files
+
+
+def gyrolab_limited(cwd: Path, limit: int | None, *args: str):
+    import subprocess
+
+    return subprocess.run([sys.executable, "-m", "gyrolab", *args], cwd=cwd, capture_output=True, text=True,
+                          timeout=600, preexec_fn=with_file_size_limit(limit) if limit else None)
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    from gyrolab.batch.sweep import run_batch_sweep
+
+    return run_batch_sweep(GRID, tmp_path_factory.mktemp("uninterrupted"))
+
+
+def test_a_chunk_write_failing_for_want_of_space_keeps_the_finished_chunks(tmp_path, monkeypatch, uninterrupted):
+    """ENOSPC on the third chunk's write: one sentence, exit status 3, two chunks kept in the journal; the rerun
+    runs the others only and ends with the data of an uninterrupted run, bit for bit."""
+    import errno
+
+    from gyrolab.batch import runner, store
+    from gyrolab.batch.sweep import run_batch_sweep
+    from gyrolab.errors import OutputError
+
+    real_write, calls = store.Store._write, []
+
+    def full_disk(self, name, chunk, data):
+        calls.append(name)
+        if calls.count("job_status") == 3:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real_write(self, name, chunk, data)
+
+    monkeypatch.setattr(store.Store, "_write", full_disk)
+    with pytest.raises(OutputError) as caught:
+        run_batch_sweep(GRID, tmp_path)
+    message = str(caught.value)
+    assert caught.value.exit_code == 3 and "\n" not in message
+    assert "no space left on device" in message and "the 2 finished chunks" in message and "rerun" in message
+    part = tmp_path / "sweep.nc.part"
+    assert part.is_file() and not (tmp_path / "sweep.nc").exists()
+    monkeypatch.setattr(store.Store, "_write", real_write)
+    ran = []
+    real_run_chunk = runner.run_chunk
+    monkeypatch.setattr(runner, "run_chunk", lambda task: ran.append(task.index) or real_run_chunk(task))
+    path = run_batch_sweep(GRID, tmp_path)
+    assert sorted(ran) == [2, 3]   # the two finished chunks are not run again
+    assert not part.exists()
+    assert_same_data(path, uninterrupted)
+
+
+def test_the_last_sync_failing_keeps_every_chunk(tmp_path, monkeypatch, uninterrupted):
+    """The last step (the counts written and the file synced) fails: every chunk stays journaled, the rerun only
+    finishes the file."""
+    import errno
+
+    from gyrolab.batch import runner, store
+    from gyrolab.batch.sweep import run_batch_sweep
+    from gyrolab.errors import OutputError
+
+    real_fsync, calls = store._fsync, []
+
+    def full_disk_at_the_end(path):
+        calls.append(path)
+        if len(calls) == 6:   # the creation, four chunks, then the finish
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real_fsync(path)
+
+    monkeypatch.setattr(store, "_fsync", full_disk_at_the_end)
+    with pytest.raises(OutputError, match="the 4 finished chunks"):
+        run_batch_sweep(GRID, tmp_path)
+    monkeypatch.setattr(store, "_fsync", real_fsync)
+    monkeypatch.setattr(runner, "run_chunk", lambda task: pytest.fail("a finished chunk ran again"))
+    assert_same_data(run_batch_sweep(GRID, tmp_path), uninterrupted)
+
+
+@pytest.mark.parametrize("fraction", [0.2, 0.95])
+def test_gyrolab_batch_under_a_file_size_limit_is_one_sentence_and_resumes(tmp_path, fraction, uninterrupted):
+    """A real file-size limit (setrlimit in the child): exit 3, one sentence naming the limit, no traceback, no
+    partial store that blocks the rerun; the rerun with no limit completes, bit-identical."""
+    args = ["--batch", *GRID, "hydra.sweep.dir=grid"]
+    limit = int(fraction * uninterrupted.stat().st_size)
+    failed = gyrolab_limited(tmp_path, limit, *args)
+    assert failed.returncode == 3, failed.stderr[-3000:]
+    one_sentence(failed, "sweep.nc.part", "file-size limit")
+    assert not (tmp_path / "grid" / "sweep.nc").exists()
+    done = gyrolab_limited(tmp_path, None, *args)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert_same_data(tmp_path / "grid" / "sweep.nc", uninterrupted)
+
+
+def test_an_unreadable_part_that_never_held_a_chunk_is_created_again(tmp_path, uninterrupted):
+    """A partial store left by an older gyrolab whose creation failed (truncated, no journaled chunk) does not
+    block the batch."""
+    from gyrolab.batch.sweep import run_batch_sweep
+
+    (tmp_path / "sweep.nc.part").write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(100))
+    assert_same_data(run_batch_sweep(GRID, tmp_path), uninterrupted)
