@@ -333,3 +333,61 @@ def test_an_unreadable_part_that_never_held_a_chunk_is_created_again(tmp_path, u
 
     (tmp_path / "sweep.nc.part").write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(100))
     assert_same_data(run_batch_sweep(GRID, tmp_path), uninterrupted)
+
+
+SWEEP = ["-m", "time.end=2", "time.n_output=201", "output.figures=false", "initial.r0=1,2,3"]
+
+
+@pytest.fixture(scope="module")
+def uninterrupted_sweep(tmp_path_factory):
+    where = tmp_path_factory.mktemp("sweep")
+    done = gyrolab_limited(where, None, *SWEEP, "hydra.sweep.dir=ms")
+    assert done.returncode == 0, done.stderr[-3000:]
+    return where / "ms"
+
+
+@pytest.mark.parametrize("fraction", [0.25, 0.6])
+def test_a_multirun_under_a_file_size_limit_exits_3_and_resumes(tmp_path, fraction, uninterrupted_sweep):
+    """Per-job run.nc (a limit below a run's size) or sweep.nc (below the sweep's size): exit 3 with one sentence;
+    the rerun with room runs what is missing and ends with the uninterrupted sweep's data, bit for bit."""
+    run_size = (uninterrupted_sweep / "0" / "run.nc").stat().st_size
+    sweep_size = (uninterrupted_sweep / "sweep.nc").stat().st_size
+    limit = int(fraction * run_size) if fraction < 0.5 else max(run_size + 4096, int(fraction * sweep_size))
+    if limit >= sweep_size:
+        pytest.skip("the sweep's file is not larger than a run's here")
+    failed = gyrolab_limited(tmp_path, limit, *SWEEP, "hydra.sweep.dir=ms")
+    assert failed.returncode == 3, failed.stderr[-3000:]
+    one_sentence(failed, "file-size limit")
+    done = gyrolab_limited(tmp_path, None, *SWEEP, "hydra.sweep.dir=ms")
+    assert done.returncode == 0, done.stderr[-3000:]
+    variables = data_variables(uninterrupted_sweep / "sweep.nc")
+    got = data_variables(tmp_path / "ms" / "sweep.nc")
+    import numpy as np
+
+    for name in variables:
+        if "time" in name or name.startswith(("job_", "failed_")):
+            continue   # wall times and the job bookkeeping differ between sessions by design
+        np.testing.assert_array_equal(got[name], variables[name], err_msg=name)
+
+
+STABILITY = ["experiment=stability_map", "batch.points=16", "hydra.run.dir=sm"]
+
+
+@pytest.fixture(scope="module")
+def uninterrupted_map(tmp_path_factory):
+    where = tmp_path_factory.mktemp("map")
+    done = gyrolab_limited(where, None, *STABILITY)
+    assert done.returncode == 0, done.stderr[-3000:]
+    return where / "sm" / "stability_map.nc"
+
+
+@pytest.mark.parametrize("fraction", [0.3, 0.7])
+def test_a_stability_map_under_a_file_size_limit_exits_3_and_resumes(tmp_path, fraction, uninterrupted_map):
+    """The map's store (0.3) or its Poincaré sections' rewrite (0.7) fails: exit 3, one sentence; the rerun
+    completes with the uninterrupted map's data, bit for bit."""
+    failed = gyrolab_limited(tmp_path, int(fraction * uninterrupted_map.stat().st_size), *STABILITY)
+    assert failed.returncode == 3, failed.stderr[-3000:]
+    one_sentence(failed, "file-size limit", "rerun")
+    done = gyrolab_limited(tmp_path, None, *STABILITY)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert_same_data(tmp_path / "sm" / "stability_map.nc", uninterrupted_map)

@@ -490,6 +490,11 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
     summary = summary or callbacks.last_summary
     if summary is None or not (summary.failed or summary.missing):
         return 0
+    if summary.write_failures:   # a full disk: exit 3 as a single run's failed write; the finished jobs are kept
+        print(f"gyrolab: error: {len(summary.write_failures)} of {summary.n_jobs} jobs could not write their "
+              f"results ({summary.write_failures[0][1].rstrip('.')}); the {summary.finished} finished jobs are kept: "
+              "free some space and rerun the same command to run the others", file=sys.stderr)
+        return 3
     missing = f" and {summary.missing} did not run" if summary.missing else ""
     print(f"gyrolab: {summary.failed} of {summary.n_jobs} jobs failed{missing}; see failed_job_error and "
           f"job_status in {summary.path}", file=sys.stderr)

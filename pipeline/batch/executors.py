@@ -33,6 +33,7 @@ reuses it for the next chunks.
 from __future__ import annotations
 
 import asyncio
+import errno
 import itertools
 import os
 import uuid
@@ -41,13 +42,16 @@ from importlib.util import find_spec
 from typing import Any, TypeVar
 
 from gyrolab.batch.scheduler import SCHEDULER_ENV, Choice, resolve
-from gyrolab.errors import ConfigError, GyrolabError, shorten
+from gyrolab.errors import ConfigError, GyrolabError, OutputError, shorten
+from gyrolab.output.atomic import reason
 
 Task = TypeVar("Task")
 Result = TypeVar("Result")
 
 IN_PROCESS = ("process", "")
 LOCAL = "local"
+#: the errnos of a write that failed for want of space: a chunk failing so is an OutputError (exit 3)
+FULL_DISK = (errno.ENOSPC, errno.EFBIG, errno.EDQUOT)
 #: seconds to wait for a scheduler to answer before saying it cannot be reached
 CONNECT_TIMEOUT = 10
 #: chunks submitted per worker thread at a time: one running, one queued (memory: a few chunks per worker)
@@ -114,6 +118,9 @@ def chunk_error(index: int, error: BaseException, where: str) -> GyrolabError:
     message = " ".join(str(error).split()) or type(error).__name__
     if isinstance(error, GyrolabError):
         return type(error)(f"chunk {index} of the batch failed {where}: {message}")
+    if isinstance(error, OSError) and error.errno in FULL_DISK:   # e.g. numba writing its cache: exit 3
+        return OutputError(f"chunk {index} of the batch failed {where}: a file could not be written ({reason(error)}); "
+                           "the finished chunks are kept: free some space and rerun the same command")
     return GyrolabError(f"chunk {index} of the batch failed {where} ({type(error).__name__}: {message})")
 
 
