@@ -391,3 +391,12 @@ def test_a_stability_map_under_a_file_size_limit_exits_3_and_resumes(tmp_path, f
     done = gyrolab_limited(tmp_path, None, *STABILITY)
     assert done.returncode == 0, done.stderr[-3000:]
     assert_same_data(tmp_path / "sm" / "stability_map.nc", uninterrupted_map)
+
+
+def test_a_run_that_recorded_an_address_still_reproduces(cli, tmp_path):
+    """batch.scheduler is not used by a single run, and an old dataset's stored config may name an address: the
+    key stays readable, so reproducing it works (only running a batch with it is refused)."""
+    done = cli(*TINY, "batch.scheduler=tcp://127.0.0.1:9", "hydra.run.dir=old")
+    assert done.returncode == 0, done.stderr[-2000:]
+    again = cli("--reproduce", "old/run.nc")
+    assert again.returncode == 0, again.stderr[-2000:]

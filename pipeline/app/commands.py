@@ -38,13 +38,11 @@ def batch(args: argparse.Namespace) -> int:
     from gyrolab.figures.options import figure_options
 
     overrides = list(args.overrides)
-    try:  # the command line's own route to a Dask scheduler, where gyrolab has one (issue 23: trusted only here)
-        from gyrolab.batch.scheduler import use_command_line_scheduler
-    except ImportError:
-        if args.scheduler is not None:
-            overrides.append(f"batch.scheduler={_quoted(args.scheduler)}")
-    else:
-        use_command_line_scheduler(args.scheduler)  # None when not given: no value left from an earlier command
+    # the command line is the one place a config cannot reach: a Dask scheduler's address is trusted only here
+    # (or from the environment, Dask's configuration: gyrolab.batch.scheduler); None: no value left from before
+    from gyrolab.batch.scheduler import use_command_line_scheduler
+
+    use_command_line_scheduler(args.scheduler)
     now = datetime.now()
     out_dir = Path(f"outputs/batch/{now:%Y-%m-%d}/{now:%H-%M-%S}")
     scene_overrides = []
@@ -83,11 +81,6 @@ def batch(args: argparse.Namespace) -> int:
     if failed:
         print(failed, file=sys.stderr)
     return 1 if failed else 0
-
-
-def _quoted(value: str) -> str:
-    """A value as a quoted Hydra override value (an address's ``:`` and ``/`` are not plain override text)."""
-    return f"'{value}'" if "'" not in value else f'"{value}"'
 
 
 def plot(args: argparse.Namespace) -> int:

@@ -42,11 +42,6 @@ class Choice:
     scheduler: str | None
     source: str
 
-    def describe(self) -> str:
-        """``--scheduler=tcp://...`` style text for messages: the value and where it came from."""
-        value = self.scheduler or "process"
-        return f"{value} (from {self.source})" if self.source not in (CONFIG, DEFAULT) else f"batch.scheduler={value}"
-
 
 def use_command_line_scheduler(address: str | None) -> None:
     """The scheduler the command line gives (``--scheduler ADDRESS``); None: the command line gives none."""
