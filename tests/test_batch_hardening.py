@@ -187,6 +187,7 @@ def test_gyrolab_batch_scheduler_option_names_its_source(cli, tmp_path):
     done = cli("--batch", *TINY, "initial.r0=1,2", "--scheduler", address, "hydra.sweep.dir=grid")
     assert done.returncode == 2
     one_sentence(done, address, "from the command line (--scheduler)")
+    assert not (tmp_path / "grid").exists()   # probed before the sweep directory is made
 
 
 # ---- --batch's exit status ------------------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
-from gyrolab.batch.executors import scheduler_kind
+from gyrolab.batch.executors import probe_scheduler, scheduler_kind
 from gyrolab.batch.runner import RunStats, Settings, run_plan
 from gyrolab.batch.scheduler import resolve
 from gyrolab.contracts.integrator import VARIATIONAL
@@ -44,7 +44,9 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
     plan = make_plan(fixed, dims, plain=plain)
     settings = Settings.from_config(plan.plain.get("batch"))
     check_integrator(plan, settings)
-    scheduler_kind(resolve(settings.scheduler))   # a refused or unknown scheduler: before the directory exists
+    where = resolve(settings.scheduler)
+    if scheduler_kind(where) == "address" and not path.exists():   # unreachable: before any directory is made
+        probe_scheduler(str(where.scheduler), where.source)
     plan_time = time.perf_counter() - start
     if not lock:
         stats = run_plan(plan, path, settings)
