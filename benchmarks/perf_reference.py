@@ -185,9 +185,52 @@ def peer_table(reference, rounds, quick):
         ratios = ["" if keys[0] is None or key is None else f"{MEDIANS[key] / MEDIANS[keys[0]]:.2f}"
                   for key in keys[1:]]
         print(f"| {eps:.0e} | {' | '.join(cells)} | {' | '.join(ratios)} |")
+    run_ratios = {}
+    for eps in epsilons:
+        peer = min((key for key in best if key[0] == "heyoka" and errors[key] <= eps), key=MEDIANS.get, default=None)
+        run_key = ("auto Scene.run()", eps)
+        if peer is not None:
+            run_ratios[eps] = MEDIANS[run_key] / MEDIANS[peer] if errors[run_key] <= eps else float("inf")
+    print_verdict(run_ratios)
     print("\nEvery setting measured:\n\n| method | setting | final error | time [ms] |\n| --- | --- | --- | --- |")
     for key in sorted(best, key=lambda key: (key[0], -key[1])):
         print(f"| {key[0]} | {settings[key]} | {errors[key]:.2e} | {best[key][0] * 1e3:.2f} |")
+
+
+TARGET = 1.0  # issue 24: auto's whole Scene.run() (dataset and error estimate included) ≤ 1.0× heyoka's time
+
+
+def print_verdict(run_ratios):
+    """One line per ε (median Scene.run() / heyoka) and PASS/FAIL against ``TARGET`` at every ε."""
+    if not run_ratios:
+        print("\nScene.run() / heyoka: heyoka not installed, no verdict")
+        return
+    print("\nauto Scene.run() / heyoka propagate_grid (medians, dataset and error estimate included):")
+    for eps, ratio in run_ratios.items():
+        print(f"  ε = {eps:.0e}: {ratio:.2f}×{'' if ratio <= TARGET else '  (over)'}")
+    worst = max(run_ratios.values())
+    print(f"{'PASS' if worst <= TARGET else 'FAIL'}: auto Scene.run() ≤ {TARGET}× heyoka at every ε "
+          f"(worst {worst:.2f}×)")
+
+
+def scene_run_only(reference, rounds):
+    """Only what issue 24's verdict needs: heyoka at every tolerance and auto's Scene.run() per ε, interleaved."""
+    contestants = {("heyoka", tol): call for tol, (call, _) in heyoka_contestants().items()}
+    for eps in EPSILONS:
+        scene = compose_scene(["experiment=perf_reference", f"accuracy={eps}"])
+        contestants[("auto Scene.run()", eps)] = lambda s=scene: final_state(s.run())
+    interleaved(contestants, 1)
+    best = interleaved(contestants, rounds)
+    errors = {key: float(np.max(np.abs(np.asarray(result)[:6] - reference))) for key, (_, result) in best.items()}
+    ratios = {}
+    for eps in EPSILONS:
+        peer = min((key for key in best if key[0] == "heyoka" and errors[key] <= eps), key=MEDIANS.get, default=None)
+        run_key = ("auto Scene.run()", eps)
+        if peer is not None:
+            ratios[eps] = MEDIANS[run_key] / MEDIANS[peer] if errors[run_key] <= eps else float("inf")
+            print(f"ε = {eps:.0e}: heyoka {MEDIANS[peer] * 1e3:.2f} ms ({errors[peer]:.1e}), auto Scene.run() "
+                  f"{MEDIANS[run_key] * 1e3:.2f} ms ({errors[run_key]:.1e})")
+    print_verdict(ratios)
 
 
 def run_breakdown(rounds, quick):
@@ -337,6 +380,8 @@ def main() -> None:
     parser.add_argument("--wall", action="store_true", help="wall time instead of CPU time (an unloaded machine)")
     parser.add_argument("--calibration", action="store_true",
                         help="only the measurement behind auto's CALIBRATION (about 30 s)")
+    parser.add_argument("--scene-run", action="store_true",
+                        help="only heyoka against auto's Scene.run() per ε, with the PASS/FAIL verdict (issue 24)")
     args = parser.parse_args()
     global WALL
     WALL = args.wall
@@ -350,6 +395,9 @@ def main() -> None:
     print(f"# reference: extended-precision Taylor, {time.perf_counter() - start:.1f} s")
     if args.calibration:
         calibration(reference)
+        return
+    if args.scene_run:
+        scene_run_only(reference, rounds)
         return
     peer_table(reference, rounds, args.quick)
     run_breakdown(rounds, args.quick)

@@ -25,6 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from results_file import write_results  # noqa: E402  (benchmarks/ is not a package)
+
 PLUGIN = textwrap.dedent('''
     from gyrolab.contracts import Force
     from gyrolab.physics.vectors import cross
@@ -130,7 +133,7 @@ def main() -> None:
         timed(overrides, 1e-6, 1)  # compile (or load) the kernels outside the timing
     rhs_cost([*base, "integrator=dop853_numba"], [*plugin, "integrator=dop853_numba"], compose_scene)
     print(f"{'tol':>7} {'built-in s':>11} {'error':>9} {'plugin s':>9} {'error':>9} {'ratio':>6}")
-    rows = []
+    rows, dop_rows, taylor_rows = [], [], []
     for tol in tols:
         b_time = p_time = np.inf
         for _ in range(repeats):  # interleaved: the machine's load hits both alike
@@ -138,6 +141,8 @@ def main() -> None:
             pt, p_err = timed([*plugin, "integrator=dop853_numba"], tol, 1)
             b_time, p_time = min(b_time, bt), min(p_time, pt)
         rows.append((tol, p_time, p_err))
+        dop_rows.append([f"{tol:.0e}", f"{b_time * 1e3:.2f}", f"{b_err:.1e}", f"{p_time * 1e3:.2f}", f"{p_err:.1e}",
+                         f"{p_time / b_time:.2f}×"])
         print(f"{tol:7.0e} {b_time:11.5f} {b_err:9.2e} {p_time:9.5f} {p_err:9.2e} {p_time / b_time:6.2f}")
 
     print("\nscipy DOP853 (gyrolab dop853, Python right-hand side) on the plugin scene, at equal error:")
@@ -164,6 +169,18 @@ def main() -> None:
                 runs[name] = (best, float(np.max(np.abs(solution.y[-1] - truth))))
         (b_time, b_err), (p_time, p_err) = runs["built-in"], runs["plugin"]
         print(f"{tol:7.0e} {b_time:11.5f} {b_err:9.2e} {p_time:9.5f} {p_err:9.2e} {p_time / b_time:6.2f}")
+        taylor_rows.append([f"{tol:.0e}", f"{b_time * 1e3:.2f}", f"{b_err:.1e}", f"{p_time * 1e3:.2f}", f"{p_err:.1e}",
+                            f"{p_time / b_time:.2f}×"])
+    if args.quick:
+        return
+    header = ["tol", "built-in ms", "error", "plugin ms", "error", "plugin / built-in"]
+    caption = ("`experiment=perf_reference` (t ∈ [0, 300], 3,001 outputs), gravity + Newtonian as built-ins and as "
+               "a plain-Python plugin with the same arithmetic; integration time (the solution's wall_time), "
+               f"minimum of {repeats} interleaved repeats; error against the extended-precision reference.")
+    write_results("plugin_speed", {"repeats": repeats, "dop853_numba": dop_rows, "taylor": taylor_rows},
+                  {"plugin_speed_dop853": {"caption": "`dop853_numba`: " + caption, "header": header, "rows": dop_rows},
+                   "plugin_speed_taylor": {"caption": "`taylor`: " + caption, "header": header, "rows": taylor_rows}},
+                  clock="the integrator's wall_time (time.perf_counter), minimum of interleaved repeats")
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 
     python benchmarks/startup.py                      # every compiled integrator, 1 round
     python benchmarks/startup.py --rounds 3 taylor    # chosen integrators, best of 3 rounds
+    python benchmarks/startup.py --default-run        # `import gyrolab` breakdown, default `gyrolab` PASS/FAIL
 
 Each measurement is a fresh Python process with its own empty ``NUMBA_CACHE_DIR`` (so nothing
 compiled by an earlier run or another checkout is reused), which composes the reference scene
@@ -57,7 +58,60 @@ def measure(name: str, cache: str, site: str) -> dict[str, float]:
     return json.loads(result.stdout.strip().splitlines()[-1])
 
 
+#: issue 24 item 4: the default ``gyrolab`` end to end on an idle 2-core machine, CPU s (process and children)
+DEFAULT_TARGETS = {"true": 2.5, "false": 1.5}
+
+
+def import_breakdown(top: int = 12) -> None:
+    """``import gyrolab`` in a fresh process: its CPU time, and the largest imports (``python -X importtime``,
+    cumulative µs of wall time, first-level packages only so that nested modules are not counted twice)."""
+    cpu = subprocess.run([sys.executable, "-c", "import time; s = time.process_time(); import gyrolab; "
+                          "print(time.process_time() - s)"], capture_output=True, text=True, check=True)
+    print(f"import gyrolab: {float(cpu.stdout):.2f} s CPU")
+    trace = subprocess.run([sys.executable, "-X", "importtime", "-c", "import gyrolab"], capture_output=True,
+                           text=True, check=True).stderr
+    rows = []
+    for line in trace.splitlines():
+        if not line.startswith("import time:") or "cumulative" in line:
+            continue
+        _, cumulative, name = line.removeprefix("import time:").split("|")
+        rows.append((int(cumulative), name))
+    packages = {}
+    for cumulative, name in rows:
+        root = name.strip().split(".")[0]
+        packages[root] = max(packages.get(root, 0), cumulative)
+    print("largest packages imported (cumulative wall ms, -X importtime):")
+    for root, cumulative in sorted(packages.items(), key=lambda item: -item[1])[:top]:
+        print(f"  {root:<16} {cumulative / 1e3:8.1f}")
+
+
+def default_run() -> None:
+    """CPU s of the default ``gyrolab`` (its process and figure workers), with and without figures, best of 2."""
+    import resource
+
+    verdicts = []
+    for figures, target in DEFAULT_TARGETS.items():
+        best = float("inf")
+        for _ in range(2):
+            with tempfile.TemporaryDirectory() as tmp:
+                usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+                before = usage.ru_utime + usage.ru_stime
+                subprocess.run([sys.executable, "-m", "gyrolab", f"hydra.run.dir={tmp}/run",
+                                f"output.figures={figures}"], check=True, capture_output=True, cwd=tmp)
+                usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+                best = min(best, usage.ru_utime + usage.ru_stime - before)
+        verdicts.append(best <= target)
+        print(f"default gyrolab, output.figures={figures}: {best:.2f} s CPU (target ≤ {target} s)")
+    print(f"{'PASS' if all(verdicts) else 'FAIL'}: default run within its targets")
+
+
 def main() -> None:
+    if "--default-run" in sys.argv[1:]:
+        print(f"# load average {os.getloadavg()[0]:.1f} at start, {os.cpu_count()} cores (targets are for an idle "
+              "machine)")
+        import_breakdown()
+        default_run()
+        return
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("integrators", nargs="*", default=list(INTEGRATORS))
     parser.add_argument("--rounds", type=int, default=1)

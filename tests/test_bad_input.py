@@ -5,6 +5,7 @@ import sys
 import pytest
 
 from gyrolab import app
+from gyrolab.errors import ConfigError
 
 CASES = {
     "unknown integrator": (["integrator=foo"], ["'foo'", "dop853", "rk4"]),
@@ -201,3 +202,260 @@ def test_corpus_of_bad_inputs(argv, phrase, tmp_path, monkeypatch, capsys):
 
 def test_corpus_has_at_least_100_cases():
     assert len(CORPUS) + len(CASES) >= 100
+
+
+# ---- the hostile corpus (issue 23): user files, oversize requests, foreign datasets, degenerate vectors, paths ----
+
+G = "# @package _global_\n"
+BOMB = G + "".join(f"{c}: &{c} [{', '.join([f'*{p}'] * 9) if p else ', '.join(['x'] * 9)}]\n"
+                   for p, c in zip(["", "a", "b", "c", "d", "e", "f"], "abcdefg"))
+
+
+def _user_file(text, selected="experiment=bad", name="experiment/bad.yaml"):
+    """A --config-dir holding one file ``name``, and the command line that reads it."""
+    return ["--config-dir", "cd", selected], {f"cd/{name}": text}
+
+
+#: (command line, files to create first (relative to the working directory), a phrase the sentence must contain)
+FILE_CORPUS = [
+    # YAML syntax and structure in a user's --config-dir: one sentence with file and line
+    (*_user_file(G + "time:\n  end: [1\n"), "bad.yaml, line 4: not valid YAML"),
+    (*_user_file(G + "time:\n\tend: 1\n"), "a tab"),
+    (*_user_file(G + "time:\n  end: 1\n  end: 2\n"), "line 4: the key 'end' is given twice"),
+    (*_user_file(G + "time: {end: 1, end: 2}\n"), "given twice"),
+    (*_user_file((G + "time:\n  end: 1\x00\n").encode()), "line 3: a control character (code 0)"),
+    (*_user_file(G + "x: \x07\n"), "control character (code 7)"),
+    (*_user_file(b"\xff\xfe\x00garbage"), "not UTF-8 text"),
+    (*_user_file(G + "5\n"), "a single value, not a mapping"),
+    (*_user_file(G + "'just a string'\n"), "a single value, not a mapping"),
+    (*_user_file(G + "- 1\n- 2\n"), "a list, not a mapping"),
+    (*_user_file(BOMB), "anchors and aliases expand to more than"),
+    (*_user_file(G + "a: &a\n  b: *a\n"), "refers to itself"),
+    (*_user_file(G + "a: *undefined\n"), "not valid YAML"),
+    (*_user_file(G + "key: 'unterminated\n"), "not valid YAML"),
+    (*_user_file(G + "time:\n  end: 1\n   start: 2\n"), "not valid YAML"),
+    (*_user_file(G + "time:\n  end: !!python/object/apply:os.system ['echo hi']\n"), "YAML tag"),
+    (*_user_file(G + "time:\n  end: !custom 5\n"), "YAML tag"),
+    (*_user_file(G + "? [a, b]\n: 1\n"), "a key is a list or a mapping"),
+    (*_user_file(G + "%YAML 9.9\n---\na: 1\n"), "not valid YAML"),
+    (*_user_file(G + "a: 1\n---\nb: 2\n"), "not valid YAML"),
+    (*_user_file(G + "defaults: 5\n"), "`defaults` must be a list"),
+    (*_user_file(G + "a: " + "[" * 200 + "]" * 200 + "\n"), "nested more than"),
+    (*_user_file(G + "a: " + "{b: " * 200 + "1" + "}" * 200 + "\n"), "nested more than"),
+    (*_user_file(G + "a: 1\n" * 2), "given twice"),
+    (*_user_file(G + "".join(f"a{i}: 1\n" for i in range(120_000))), "larger than"),
+    (*_user_file(G + "initial: [1]\n"), "a list and a section (a mapping)"),
+    (*_user_file(G + "time:\n  end: .inf\n"), "finite"),
+    (*_user_file(G + "task: {a: 1}\n"), "task"),
+    (["--config-path", "cp", "--config-name", "bad"], {"cp/bad.yaml": "defaults:\n  - _self_\ntime: [1\n"},
+     "bad.yaml, line 4"),
+    (["--config-path", "cp", "--config-name", "bad"], {"cp/bad.yaml": "5\n"}, "not a mapping"),
+    (*_user_file("time:\n  end: [1\n", "time.end=1", "config.yaml"), "config.yaml, line 3"),
+    # a list where a mapping belongs, and a value where a section belongs
+    (*_user_file(G + "time: [1, 2]\n"), "a list and a section (a mapping)"),
+    (*_user_file(G + "body: [1, 2, 3]\n"), "a list and a section (a mapping)"),
+    (*_user_file(G + "body:\n  com_direction: {a: 1}\n"), "a list and a section (a mapping)"),
+    (*_user_file(G + "time: 5\n"), "time"),
+    (*_user_file(G + "force: 5\n"), "`force` is a section"),
+    (*_user_file(G + "integrator: 5\n"), "`integrator` is a section"),
+    (*_user_file(G + "initial:\n  r0: 1e300\n"), "too large"),
+    (*_user_file(G + "time:\n  n_output: abc\n"), "time.n_output='abc' must be an integer"),
+    (*_user_file(G + "body:\n  com_direction: [0, 0, 0]\n"), "zero vector"),
+    # points files: read as CSV of known keys; their contents never echoed
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"], {"p.csv": "SECRET LINE\n1,2\n"}, "header column 1"),
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"], {"p.csv": b"\x89PNG\x00\x01secret"}, "not UTF-8"),
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"], {"p.csv": b"initial.r0\n1\x00\n"}, "not UTF-8"),
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"], {"p.csv": "initial.r0\nsecret value here\n"},
+     "the value is not a number"),
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"], {"p.csv": "initial.r0\n1e300\n"}, "too large"),
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"], {"p.csv": "initial.r0\ninf\n"}, "finite"),
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"],
+     {"p.csv": "-----BEGIN OPENSSH PRIVATE KEY-----\nb3BlbnNzaC1rZXktdjEAAAAA\n"}, "not a dotted key name"),
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"], {"p.csv": "<html>secret</html>\n"}, "header column"),
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"], {"p.csv": ""}, "is empty"),
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"], {"p.csv": "initial.r0\n"}, "no points"),
+    (["--batch", "batch.points_file=p.csv", "hydra.sweep.dir=b"], {"p.csv": "time.end\n5\n"}, "header column"),
+    (["--batch", "batch.points_file=/etc/passwd", "hydra.sweep.dir=b"], {}, "not a dotted key name"),
+    (["--batch", "batch.points_file=d", "hydra.sweep.dir=b"], {"d/x": ""}, "cannot be read"),
+    (["--batch", "batch.points_file=/dev/zero", "hydra.sweep.dir=b"], {}, "cannot be read"),
+    (["--batch", "batch.points_file=missing.csv", "hydra.sweep.dir=b"], {}, "cannot be read"),
+    # datasets that are not gyrolab's
+    (["--plot", "ds/run.nc"], {"ds/run.nc": "hello, not netCDF\n"}, "not a netCDF file"),
+    (["--plot", "ds"], {"ds/run.nc": b""}, "is empty"),
+    (["--plot", "ds/run.nc"], {"ds/run.nc": b"CDF\x01" + bytes(range(200))}, "not a netCDF file"),
+    (["--reproduce", "ds/run.nc"], {"ds/run.nc": "hello, not netCDF\n"}, "not a netCDF file"),
+    (["--reproduce", "ds/run.nc"], {"ds/run.nc": b""}, "is empty"),
+    (["--reproduce", "ds"], {"ds/x": ""}, "not a regular file"),
+    (["--plot", "/dev/null"], {}, "neither a directory nor a dataset file"),
+    (["--reproduce", "/dev/null"], {}, "not a regular file"),
+]
+
+#: netCDF files that are not gyrolab's: (command, file name, attributes, a phrase)
+FOREIGN = [
+    ("--plot", "run.nc", {}, "not a dataset gyrolab wrote"),
+    ("--plot", "sweep.nc", {}, "not a dataset gyrolab wrote"),
+    ("--plot", "regime.nc", {}, "not a dataset gyrolab wrote"),
+    ("--plot", "work_precision.nc", {}, "not a dataset gyrolab wrote"),
+    ("--plot", "stability_map.nc", {}, "a stability map needs a variable 'indicator'"),
+    ("--plot", "regime_validity.nc", {}, "not a dataset gyrolab wrote"),
+    ("--plot", "orbit_family.nc", {}, "not a dataset gyrolab wrote"),
+    ("--plot", "foreign.nc", {}, "not a dataset gyrolab draws figures from"),
+    ("--reproduce", "run.nc", {}, "no 'config' attribute"),
+    ("--reproduce", "run.nc", {"config": "time: 5"}, "not a dataset gyrolab wrote"),
+    ("--reproduce", "run.nc", {"config": "!!python/object/apply:os.system ['id']"}, "not plain YAML"),
+    ("--reproduce", "run.nc", {"config": "[1, 2]"}, "not a YAML mapping"),
+]
+
+
+def _created(root):
+    return {p for p in root.rglob("*")}
+
+
+def _one_sentence(argv, files, phrase, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    for name, content in files.items():
+        path = tmp_path / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(content) if isinstance(content, bytes) else path.write_text(content)
+    before = _created(tmp_path)
+    extra = [] if argv[0] in ("--batch", "--plot", "--reproduce") or "hydra.run.dir" in " ".join(argv) else \
+        ["hydra.run.dir=out"]
+    code, err = run_main([*argv, *extra], monkeypatch, capsys)
+    assert code not in (0, None)
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("gyrolab: error: "), err
+    assert phrase in lines[0], (phrase, lines[0])
+    assert "secret" not in lines[0].lower() and "PRIVATE" not in lines[0], lines[0]
+    assert _created(tmp_path) == before
+
+
+@pytest.mark.parametrize("argv, files, phrase", FILE_CORPUS, ids=[f"{i}-{p[:40]}" for i, (_, _, p) in
+                                                                 enumerate(FILE_CORPUS)])
+def test_file_corpus_of_bad_inputs(argv, files, phrase, tmp_path, monkeypatch, capsys):
+    _one_sentence(argv, files, phrase, tmp_path, monkeypatch, capsys)
+
+
+@pytest.mark.parametrize("command, name, attrs, phrase", FOREIGN, ids=[f"{c}-{n}-{p[:20]}" for c, n, _, p in FOREIGN])
+def test_a_dataset_that_is_not_gyrolabs_is_one_sentence(command, name, attrs, phrase, tmp_path, monkeypatch, capsys):
+    import numpy as np
+    import xarray as xr
+
+    (tmp_path / "ds").mkdir()
+    xr.Dataset({"x": ("t", np.arange(3.0))}, attrs=attrs).to_netcdf(tmp_path / "ds" / name)
+    _one_sentence([command, f"ds/{name}"], {}, phrase, tmp_path, monkeypatch, capsys)
+
+
+#: overrides caught before any directory exists: budgets, magnitudes, degenerate vectors, output names
+OVERRIDE_CORPUS = [
+    (["time.n_output=abc"], "time.n_output='abc' must be an integer"),
+    (["time.n_output=null"], "time.n_output=None must be an integer"),
+    (["time.n_output=[1,2]"], "time.n_output"), (["time.n_output=1.5"], "time.n_output"),
+    (["initial.r0=1e300"], "too large"), (["initial.r0=-1e300"], "too large"), (["initial.p0=1e200"], "too large"),
+    (["body.a=1e300"], "too large"), (["time.end=1e300"], "too large"), (["accuracy=1e300"], "accuracy"),
+    (["initial.r0=[1,2,3]"], "initial.r0"), (["initial.r0={x: 1}"], "initial.r0"),
+    (["body.com_direction=[0,0,0]"], "force=[] for the torque-free Euler top"),
+    (["body.com_direction=[0.0,0.0,0.0]"], "zero vector"),
+    (["body=si_gyroscope", "body.com=[0,0,0]"], "body.com=[0, 0, 0] is a zero vector"),
+    (["body.com_direction=[1e300,0,0]"], "too large"), (["body.com_direction=[nan,0,1]"], "finite"),
+    (["force=[magnetic]", "force.magnetic.direction=[0,0,0]"], "unit vector"),
+    (["initial.gamma0=[0,0,0]", "initial.theta0=null", "initial.phi0=null"], "|γ0| = 1"),
+    (["integrator=auto", "accuracy=1e-30"], "below what double precision reaches"),
+    (["force=[uniform_gravity,magnetic]", "force.magnetic.moment=[0,0,0]"], "leave magnetic out of the forces"),
+    (["system=[]"], "no `system` section"), (["~integrator"], "integrator"),
+    (["experiment=stability_map", "stability_map.theta0=[0,0]"], "one value"),
+    (["experiment=stability_map", "stability_map.theta0=[1e300,1e301]"], "too large"),
+    (["experiment=stability_map", "stability_map.file=a b.nc"], "stability_map.file"),
+    (["experiment=stability_map", f"stability_map.file={'x' * 300}.nc"], "stability_map.file"),
+    (["--batch", "experiment=stability_map", "batch.points=1000000000000", "hydra.sweep.dir=b"], "swept key"),
+    (["integrator=auto", "accuracy=1e-17"], "below what double precision reaches"),
+    (["experiment=stability_map", "batch.points=0"], "batch.points=0 must be a positive integer"),
+    (["experiment=stability_map", "batch.points=-5"], "must be a positive integer"),
+    (["experiment=stability_map", "batch.points=1000000000000"], "beyond the budget of 1e+08 points"),
+    (["experiment=stability_map", "stability_map.n_theta0=100000", "stability_map.n_r0=100000"], "budget"),
+    (["experiment=stability_map", "stability_map.n_theta0=0"], "positive integer"),
+    (["experiment=stability_map", "stability_map.file=../elsewhere/x.pth"], "inside the run directory"),
+    (["experiment=stability_map", "stability_map.file=/tmp/x.nc"], "inside the run directory"),
+    (["experiment=stability_map", "stability_map.file=x.pth"], "ending in .nc"),
+    (["experiment=stability_map", "stability_map.file=sub/../../x.nc"], "no '/..'"),
+    (["experiment=stability_map", "stability_map.file=~/x.nc"], "stability_map.file"),
+    (["experiment=stability_map", "stability_map.file=''"], "stability_map.file"),
+    (["experiment=stability_map", "stability_map.file=a\\\\b.nc"], "stability_map.file"),
+    (["-m", "initial.r0=range(0,1e12,1)", "hydra.sweep.dir=sw"], "beyond the budget"),
+    (["-m", "initial.r0=range(0,10000,1)", "body.a=range(1,100001,1)", "hydra.sweep.dir=sw"], "beyond the budget"),
+    (["-m", "initial.r0=range(0,1,0)", "hydra.sweep.dir=sw"], "step must not be 0"),
+    (["--batch", "initial.r0=range(0,1e12,1)", "hydra.sweep.dir=b"], "1e+12 points"),
+    (["--batch", "initial.r0=range(0,1e9)", "hydra.sweep.dir=b"], "beyond the budget"),
+    (["--batch", "initial.r0=range(0,1e6)", "body.a=range(1,1000,1)", "hydra.sweep.dir=b"], "beyond the budget"),
+    (["--batch", "initial.r0=range(0,1,0)", "hydra.sweep.dir=b"], "step must not be 0"),
+    (["--batch", "time.n_output=abc", "hydra.sweep.dir=b"], "time.n_output"),
+    ([f"hydra.run.dir={'x' * 5000}"], "not a usable path"), (["hydra.run.dir=/etc/gyrolab_test_out"], "system directory"),
+    (["hydra.run.dir=/proc/self/x"], "system directory"),
+    (["hydra.run.dir=venv/lib/python3.11/site-packages/gyrolab_test_out"], "where Python loads code"),
+    (["hydra.mode=MULTIRUN"], "disagrees with the command line"),
+    (["experiment=stability_map", "stability_map.sections=[[1]]"], "must be [theta0, r0]"),
+    (["experiment=stability_map", "stability_map.section_time=-1"], "must be a positive time"),
+]
+
+
+@pytest.mark.parametrize("argv, phrase", OVERRIDE_CORPUS, ids=[" ".join(a)[:60] for a, _ in OVERRIDE_CORPUS])
+def test_override_corpus_is_refused_before_any_directory(argv, phrase, tmp_path, monkeypatch, capsys):
+    _one_sentence(argv, {}, phrase, tmp_path, monkeypatch, capsys)
+
+
+def test_a_symlink_loop_as_run_directory_is_one_sentence(tmp_path, monkeypatch, capsys):
+    (tmp_path / "loop").symlink_to("loop")
+    _one_sentence(["hydra.run.dir=loop/x"], {}, "loop of symbolic links", tmp_path, monkeypatch, capsys)
+
+
+def test_a_run_directory_linked_into_site_packages_is_refused(tmp_path, monkeypatch, capsys):
+    (tmp_path / "innocent").symlink_to(SITE)
+    _one_sentence(["hydra.run.dir=innocent/out"], {}, "where Python loads code", tmp_path, monkeypatch, capsys)
+
+
+def test_a_config_file_linked_to_a_device_is_refused_without_blocking(tmp_path, monkeypatch, capsys):
+    (tmp_path / "cd" / "experiment").mkdir(parents=True)
+    (tmp_path / "cd" / "experiment" / "zero.yaml").symlink_to("/dev/zero")
+    _one_sentence(["--config-dir", "cd", "experiment=zero"], {}, "not a regular file", tmp_path, monkeypatch, capsys)
+
+
+def test_the_whole_corpus_is_large():
+    assert len(CORPUS) + len(CASES) + len(FILE_CORPUS) + len(FOREIGN) + len(OVERRIDE_CORPUS) >= 200
+
+
+# ---- exit paths (subprocess): no hang, and no lock left behind by a failed run ----------------------------------
+
+def test_an_alias_bomb_in_a_config_dir_does_not_hang(cli, tmp_path):
+    (tmp_path / "cd" / "experiment").mkdir(parents=True)
+    (tmp_path / "cd" / "experiment" / "bomb.yaml").write_text(BOMB)
+    done = cli("--config-dir", "cd", "experiment=bomb", "hydra.run.dir=out")  # the fixture's timeout bounds it
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert done.stderr.strip().splitlines() == [next(iter(done.stderr.strip().splitlines()))]
+    assert "anchors and aliases" in done.stderr and not (tmp_path / "out").exists()
+
+
+def test_a_failed_run_leaves_no_lock(cli, tmp_path):
+    # a step too long for the spin is found when the integration starts, after the run directory exists
+    done = cli("integrator=rk4", "integrator.step=5", "initial.r0=50", "time.end=2000", "output.figures=false",
+               "hydra.run.dir=out")
+    assert done.returncode != 0 and done.stderr.strip().splitlines()[-1].startswith("gyrolab: error: ")
+    assert (tmp_path / "out").is_dir()
+    assert not (tmp_path / "out" / ".gyrolab.lock").exists()
+    assert not list((tmp_path / "out").rglob("*.part")) and not (tmp_path / "out" / "run.nc").exists()
+
+
+def test_an_output_file_through_a_symlink_out_of_the_run_directory_is_refused(tmp_path, monkeypatch, capsys):
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "link").symlink_to(tmp_path / "elsewhere")
+    _one_sentence(["experiment=stability_map", "stability_map.file=link/x.nc"], {}, "through a symbolic link",
+                  tmp_path, monkeypatch, capsys)
+
+
+def test_confined_output_path_keeps_a_plain_name_inside(tmp_path):
+    from gyrolab.engine.safety import confined_output_path
+
+    assert confined_output_path(tmp_path, "maps/a.nc", "k") == tmp_path.resolve() / "maps" / "a.nc"
+    for bad in ("../a.nc", "/abs/a.nc", "a.pth", "", None, "a/../../b.nc", "~/a.nc", "a\\b.nc", 5):
+        with pytest.raises(ConfigError):
+            confined_output_path(tmp_path, bad, "k")

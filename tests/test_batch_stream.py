@@ -299,3 +299,19 @@ def test_auto_chooses_once_for_the_whole_batch(tmp_path, monkeypatch):
         tol = "integrator_tol" if seen[0][0] == "taylor" else "integrator_rtol"
         assert seen[0][1][tol] == ds.attrs["auto_tolerance"]
         assert int(ds.job_status.min()) == 1
+
+
+def test_batch_reports_each_chunk_as_it_starts_and_names_the_kernels_first_load(tmp_path, caplog, monkeypatch):
+    """Issue 24 item 5: a chunk is reported when it starts (a one-chunk batch is not silent until it ends); the
+    first chunk of a process says it loads (or compiles) the kernels, and the summary separates that time."""
+    from gyrolab.batch import runner
+
+    monkeypatch.setattr(runner, "_kernels_called", False)   # as in a fresh process
+    grid = [*FIXED, "output.euler_angles=false", "batch.output=final", "batch.chunk=2", "initial.r0=1,2,3"]
+    with caplog.at_level("INFO", logger="gyrolab.batch"):
+        run_batch_sweep(grid, tmp_path / "run")
+    lines = [r.getMessage() for r in caplog.records]
+    starts = [line for line in lines if "batch: chunk" in line and "integrating" in line]
+    assert [line.split(":")[1].strip() for line in starts] == ["chunk 1", "chunk 2"]
+    assert "loads the integration kernels" in starts[0] and "loads" not in starts[1]
+    assert any("loading or compiling" in line for line in lines if "in the integration kernels" in line)

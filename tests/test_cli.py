@@ -32,6 +32,26 @@ def test_multirun_writes_one_dataset_per_job(cli, tmp_path):
     assert names == ["rk4", "dop853"]
 
 
+
+def test_multirun_jobs_draw_no_figures_unless_asked(cli, tmp_path):
+    """Issue 24 item 3: a sweep's jobs skip their own figures by default (the sweep's figures stay);
+    ``output.job_figures=true`` draws them, and ``gyrolab --plot`` draws them later from the datasets."""
+    done = cli("-m", "initial.r0=1,2", "time.end=1", "time.n_output=11", "hydra.sweep.dir=sweep")
+    assert done.returncode == 0, done.stderr
+    for job in ("0", "1"):
+        assert (tmp_path / "sweep" / job / "run.nc").is_file()
+        assert not (tmp_path / "sweep" / job / "figures").exists()
+    assert any((tmp_path / "sweep" / "figures").iterdir())          # the sweep's own figures
+    later = cli("--plot", "sweep")
+    assert later.returncode == 0, later.stderr
+    assert (tmp_path / "sweep" / "0" / "figures" / "state.png").is_file()
+
+    asked = cli("-m", "initial.r0=1", "time.end=1", "time.n_output=11", "output.job_figures=true",
+                "hydra.sweep.dir=asked")
+    assert asked.returncode == 0, asked.stderr
+    assert (tmp_path / "asked" / "0" / "figures" / "state.png").is_file()
+
+
 import pytest  # noqa: E402
 
 EXPERIMENTS = {

@@ -162,34 +162,22 @@ def test_scheduler_values_and_missing_dask(monkeypatch):
     assert ran == [(0, 2), (1, 1)]
 
 
-@pytest.mark.parametrize("route", ["command line", "environment"])
-def test_a_batch_on_separately_started_workers_writes_the_same_dataset(scheduler, tmp_path, monkeypatch, route,
-                                                                       caplog):
+def test_a_batch_on_separately_started_workers_writes_the_same_dataset(scheduler, tmp_path):
     """The whole --batch path (plan, chunk tasks, workers rebuilding the scene, the streamed store) on the
-    CLI-started scheduler and workers gives the dataset of the same batch run in this process; the address
-    comes from the command line (``--scheduler``) or the environment (``DASK_SCHEDULER_ADDRESS``), and the
-    log says which."""
-    import logging
-
+    CLI-started scheduler and workers gives the dataset of the same batch run in this process."""
     import xarray as xr
 
-    from gyrolab.batch.scheduler import use_command_line_scheduler
     from gyrolab.batch.sweep import run_batch_sweep
 
     grid = [*OVERRIDES, "batch.output=final", "batch.chunk=4", "initial.r0=2,3,5", "initial.theta0=0.3,0.6,0.9"]
-    monkeypatch.delenv("DASK_SCHEDULER_ADDRESS", raising=False)
     here = run_batch_sweep(grid, tmp_path / "here")
-    if route == "command line":
-        use_command_line_scheduler(scheduler)
-    else:
-        monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", scheduler)
+    from gyrolab.batch.scheduler import use_command_line_scheduler
+
+    use_command_line_scheduler(scheduler)   # what gyrolab --batch --scheduler ADDRESS does (never a config key)
     try:
-        with caplog.at_level(logging.INFO, logger="gyrolab.batch"):
-            there = run_batch_sweep(grid, tmp_path / "there")
+        there = run_batch_sweep(grid, tmp_path / "there")
     finally:
         use_command_line_scheduler(None)
-    said = "the command line (--scheduler)" if route == "command line" else "the environment (DASK_SCHEDULER_ADDRESS)"
-    assert f"on the Dask scheduler at {scheduler} (from {said})" in caplog.text
     with xr.open_dataset(here) as a, xr.open_dataset(there) as b:
         assert int(a.job_status.min()) == 1 and a.sizes["theta0"] == 3
         states = [name for name in a.data_vars if "job_" not in name and name != "error_message"]
@@ -201,3 +189,28 @@ def test_a_batch_on_separately_started_workers_writes_the_same_dataset(scheduler
     with Client(scheduler, timeout=30, set_as_default=False) as client:  # the chunks ran there: scenes rebuilt
         built = client.run(lambda: len(__import__("gyrolab.batch.runner").batch.runner._CONTEXTS))
     assert sum(built.values()) >= 1
+
+
+@pytest.mark.parametrize("how", ["command line", "environment"])
+def test_the_command_runs_on_a_scheduler_named_on_its_command_line_or_in_the_environment(scheduler, tmp_path, how):
+    """``gyrolab --batch --scheduler ADDRESS`` and ``DASK_SCHEDULER_ADDRESS=ADDRESS gyrolab --batch``: the batch
+    runs there (the log names the source) and gives the dataset of the same batch in this process."""
+    import xarray as xr
+
+    grid = [*OVERRIDES, "batch.output=final", "batch.chunk=4", "initial.r0=2,3,5", "initial.theta0=0.3,0.6,0.9"]
+    option = ["--scheduler", scheduler] if how == "command line" else []
+    env = {**os.environ, **({"DASK_SCHEDULER_ADDRESS": scheduler} if how == "environment" else {})}
+    env.pop("DASK_SCHEDULER_ADDRESS", None) if how == "command line" else None
+    runs = {}
+    for name, extra, environment in (("here", [], {k: v for k, v in env.items() if k != "DASK_SCHEDULER_ADDRESS"}),
+                                     ("there", option, env)):
+        done = subprocess.run([sys.executable, "-m", "gyrolab", "--batch", *extra, *grid, f"hydra.sweep.dir={name}"],
+                              cwd=tmp_path, env=environment, capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, done.stderr[-2000:]
+        runs[name] = done.stderr
+    source = "the command line (--scheduler)" if how == "command line" else "the environment (DASK_SCHEDULER_ADDRESS)"
+    assert f"on the Dask scheduler at {scheduler} (from {source})" in runs["there"]
+    assert "in this process (from the default)" in runs["here"]
+    with xr.open_dataset(tmp_path / "here" / "sweep.nc") as a, xr.open_dataset(tmp_path / "there" / "sweep.nc") as b:
+        for name in ("omega", "gamma", "energy"):
+            np.testing.assert_array_equal(b[name].values, a[name].values)   # bit for bit

@@ -240,22 +240,3 @@ def test_aggregate_command_rewrites_the_same_sweep_nc(basic, tmp_path):
     done = gyrolab("--aggregate", str(sweep_dir), cwd=tmp_path)
     assert done.returncode == 1, done.stderr   # two jobs failed
     assert_same_sweep(basic[0], sweep_dir)
-
-
-def test_sweep_draws_its_summary_figures_but_not_each_jobs_unless_asked(tmp_path):
-    """Per-job figures cost a sweep most of its time (issue 24): off by default in a multirun, on with
-    output.job_figures=true, and drawable afterwards from a job's run.nc with --plot."""
-    sweep = ["initial.r0=1,2", "time.end=1", "time.n_output=11"]
-    default = gyrolab("-m", *sweep, f"hydra.sweep.dir={tmp_path / 'default'}", cwd=tmp_path)
-    assert default.returncode == 0, default.stderr
-    assert list((tmp_path / "default" / "figures").glob("sweep_*.png")), "the sweep's own figures stay"
-    assert not list((tmp_path / "default").glob("*/figures")), "no job drew its own figures"
-
-    asked = gyrolab("-m", *sweep, "output.job_figures=true", f"hydra.sweep.dir={tmp_path / 'asked'}", cwd=tmp_path)
-    assert asked.returncode == 0, asked.stderr
-    assert sorted(p.parent.parent.name for p in (tmp_path / "asked").glob("*/figures/state.png")) == ["0", "1"]
-
-    later = gyrolab("--plot", str(tmp_path / "default" / "1"), cwd=tmp_path)
-    assert later.returncode == 0, later.stderr
-    assert (tmp_path / "default" / "1" / "figures" / "state.png").is_file()
-    assert not (tmp_path / "default" / "0" / "figures").exists()

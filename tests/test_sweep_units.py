@@ -227,3 +227,37 @@ def test_provenance_names_every_declared_dependency_and_the_code_state():
     if attrs["git_dirty"] >= 0:
         assert re.fullmatch(r"[0-9a-f]{40}", attrs["git_commit"])
     assert bool(re.fullmatch(r"[0-9a-f]{64}", attrs["git_diff_sha256"])) == (attrs["git_dirty"] == 1)
+
+
+def test_first_progress_line_gives_no_estimate_only_a_measured_stretch_does(caplog):
+    """Issue 24 item 5: the time before the first report includes compilation, so no ETA from it."""
+    quiet = io.StringIO()
+    logged = progress.Progress("taylor", 0.0, 10.0, every=0.0, stream=quiet)
+    with caplog.at_level(logging.INFO, logger="gyrolab.progress"):
+        for t in (2.5, 5.0, 7.5):
+            logged(t)
+    first, *later = [r.getMessage() for r in caplog.records]
+    assert "to go" not in first and "compilation included" in first and "measuring the pace" in first
+    assert len(later) == 2 and all("to go" in line and "compilation" not in line for line in later)
+
+
+def test_compile_notes_reach_the_console_before_logging_is_configured(monkeypatch):
+    """Issue 24 item 5: the preflight compiles a force plugin's torque before Hydra configures logging; its note
+    "compiling force NAME, once" is shown then (Python would drop the INFO record), and only while unconfigured."""
+    from gyrolab.plugins.compiled import plugin_torque
+
+    assert plugin_torque.log.name in progress.COMPILE_LOGGERS   # the logger that writes the note
+    monkeypatch.setattr(logging.getLogger(), "handlers", [])     # as before Hydra configures logging
+    screen = io.StringIO()
+    with progress.compile_notes_on_console(screen):
+        plugin_torque.log.info("compiling %s, once (cached for later runs)", "force spin_damping")
+        logging.getLogger("gyrolab.sweep").info("not a compile note")
+    plugin_torque.log.info("after the preflight: Hydra's handlers")
+    assert screen.getvalue() == "gyrolab: compiling force spin_damping, once (cached for later runs)\n"
+    assert not plugin_torque.log.handlers
+
+    monkeypatch.setattr(logging.getLogger(), "handlers", [logging.NullHandler()])   # configured: left alone
+    configured = io.StringIO()
+    with progress.compile_notes_on_console(configured):
+        plugin_torque.log.info("compiling force x, once")
+    assert configured.getvalue() == ""

@@ -39,7 +39,7 @@ from hydra.errors import OverrideParseException
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from gyrolab.engine.budget import check_budget, check_tolerances
+from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
 from gyrolab.engine.hydra_private import get_args_parser
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
@@ -54,12 +54,12 @@ from gyrolab.engine.config import (
 from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
-from gyrolab.engine.progress import allow_bars, on_terminal
+from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
 from gyrolab.output.written import announce_written
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
-from gyrolab.sweep.job import run_sweep_job
+from gyrolab.sweep.job import draws_job_figures, run_sweep_job
 
 if TYPE_CHECKING:
     from gyrolab.sweep.aggregate import SweepSummary
@@ -120,6 +120,7 @@ def preflight(argv: Sequence[str]) -> list[str]:
     check_launcher_installed(overrides)
     if sweeping:
         _refuse_swept_hydra_settings(overrides)
+        check_sweep_size(overrides)  # before anything expands a range(0,1e12,1)
         Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
     with hydra_for(source):
         # One job composed and validated: the first value of every sweep (each group choice checked for safety).
@@ -141,6 +142,9 @@ def preflight(argv: Sequence[str]) -> list[str]:
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     validate_scene(_without_hydra(cfg))
+    from gyrolab.experiments import check_task
+
+    check_task(task_of(cfg), _without_hydra(cfg), run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
     return argv
 
@@ -253,12 +257,14 @@ def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
 
 def validate_scene(scene_cfg: DictConfig) -> None:
     """The checks every run's scene config passes: schema, tolerances, budget, the scene's own validation."""
+    from gyrolab.batch.scheduler import choose_scheduler
     from gyrolab.experiments import TASKS
 
     plain = check_scene_config(scene_cfg)
     require_finite(plain, "")
     figure_options(plain.get("output"))  # figure formats and dpi, before anything runs
     check_tolerances(plain)
+    choose_scheduler((plain.get("batch") or {}).get("scheduler"))  # an address in a config: refused before any directory
     task = task_of(scene_cfg)
     if task not in ("scene", *TASKS):
         close = difflib.get_close_matches(task, ["scene", *TASKS], n=1)
@@ -347,7 +353,7 @@ def _task(cfg: DictConfig) -> None:
     if hydra_cfg.mode == RunMode.MULTIRUN:
         allow_bars(False)  # the sweep shows one bar for all its jobs
         _quiet_console()
-        job_figures = bool(cfg.output.get("job_figures", False))
+        job_figures = draws_job_figures(cfg.output)
         run_sweep_job(cfg, out_dir, list(hydra_cfg.overrides.task), hydra_cfg.job.num,
                       lambda job_id: _run_one(cfg, out_dir, job_id, figures=job_figures))
         return
@@ -490,12 +496,12 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
     summary = summary or callbacks.last_summary
     if summary is None or not (summary.failed or summary.missing):
         return 0
-    if summary.write_failures:   # a full disk: exit 3 as a single run's failed write; the finished jobs are kept
-        print(f"gyrolab: error: {len(summary.write_failures)} of {summary.n_jobs} jobs could not write their "
-              f"results ({summary.write_failures[0][1].rstrip('.')}); the {summary.finished} finished jobs are kept: "
-              "free some space and rerun the same command to run the others", file=sys.stderr)
-        return 3
     missing = f" and {summary.missing} did not run" if summary.missing else ""
+    if summary.write_failures:   # a full disk: exit 3 as for any failed write; the jobs run again on resume
+        print(f"gyrolab: error: {summary.failed} of {summary.n_jobs} jobs failed{missing}, {summary.write_failures} "
+              f"of them because their results could not be written (see failed_job_error in {summary.path}); "
+              "rerun the same command once there is room", file=sys.stderr)
+        return 3
     print(f"gyrolab: {summary.failed} of {summary.n_jobs} jobs failed{missing}; see failed_job_error and "
           f"job_status in {summary.path}", file=sys.stderr)
     return 1
@@ -530,6 +536,10 @@ def main() -> None:
         from gyrolab.app.parser import split_command
 
         command, argv = split_command(argv)
+        if command == "run":  # --scheduler ADDRESS: the only config-free way to Dask, for experiments run by Hydra too
+            from gyrolab.batch.scheduler import take_scheduler_option
+
+            argv = take_scheduler_option(argv)
         sys.argv[1:] = argv
         if command == "run" and ("--version" in argv or "-V" in argv):
             from gyrolab.output.provenance import gyrolab_version
@@ -544,7 +554,8 @@ def main() -> None:
         from gyrolab.sweep.sweeper import register_plugin
 
         register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), before Hydra instantiates it
-        sys.argv[1:] = preflight(argv)
+        with compile_notes_on_console():  # the preflight may compile a force plugin's torque
+            sys.argv[1:] = preflight(argv)
     except GyrolabError as error:
         fail(error)
     from gyrolab.sweep import callbacks
@@ -554,7 +565,12 @@ def main() -> None:
     # allowed again (a multirun job turns them off)
     callbacks.reset()
     allow_bars(True)
-    _task()
+    from gyrolab.output.lock import release_all
+
+    try:
+        _task()
+    finally:
+        release_all()  # a failed run's lock too (Hydra skips the callback's on_run_end when the job exits)
     status = _sweep_status()
     if status:
         sys.exit(status)

@@ -31,17 +31,16 @@ def batch(args: argparse.Namespace) -> int:
     from datetime import datetime
 
     from gyrolab.app import (_job_overrides, _sweeper_params, check_writable, parse_overrides)
-    from gyrolab.batch.sweep import run_batch_sweep
+    from gyrolab.batch.scheduler import use_command_line_scheduler
+    from gyrolab.batch.sweep import failed_points, run_batch_sweep
     from gyrolab.engine.config import check_scene_config, compose_config
-    from gyrolab.engine.budget import check_tolerances
+    from gyrolab.engine.budget import check_sweep_size, check_tolerances
     from gyrolab.engine.safety import check_config, check_output_dir
     from gyrolab.figures.options import figure_options
 
     overrides = list(args.overrides)
-    # the command line is the one place a config cannot reach: a Dask scheduler's address is trusted only here
-    # (or from the environment, Dask's configuration: gyrolab.batch.scheduler); None: no value left from before
-    from gyrolab.batch.scheduler import use_command_line_scheduler
-
+    # the command line's own route to a Dask scheduler (issue 23: trusted only here and in the environment);
+    # None when not given, so no value is left from an earlier command
     use_command_line_scheduler(args.scheduler)
     now = datetime.now()
     out_dir = Path(f"outputs/batch/{now:%Y-%m-%d}/{now:%H-%M-%S}")
@@ -55,6 +54,7 @@ def batch(args: argparse.Namespace) -> int:
         else:
             scene_overrides.append(override)
     parsed = parse_overrides(scene_overrides)
+    check_sweep_size(parsed)  # before anything expands a range(0,1e12,1)
     check_output_dir(str(out_dir), "hydra.sweep.dir")
     first_overrides = _job_overrides(parsed, {})
     with_hydra = compose_config(first_overrides, return_hydra_config=True)
@@ -62,6 +62,8 @@ def batch(args: argparse.Namespace) -> int:
     # the sweep a config declares (hydra.sweeper.params), unless the command line sets the same key, as Hydra does
     declared = [o for o in _sweeper_params(with_hydra) if o.key_or_group not in given]
     scene_overrides += [o.input_line for o in declared]
+    if declared:
+        check_sweep_size([*parsed, *declared])  # the config's sweep counts too
     first = compose_config(first_overrides)
     check_config(first)
     # the checks of the whole batch; each point's scene is validated by the batch's plan (an invalid point,
@@ -75,12 +77,15 @@ def batch(args: argparse.Namespace) -> int:
         log.info("batch: the sweep declared in hydra.sweeper.params: %s", " ".join(o.input_line for o in declared))
     path = run_batch_sweep(scene_overrides, out_dir)
     announce_written(path)
-    from gyrolab.batch.sweep import failed_points_line
-
-    failed = failed_points_line(path)   # failed points: exit 1, as -m with a failed job
-    if failed:
-        print(failed, file=sys.stderr)
+    failed = failed_points(path)
+    if failed:   # as gyrolab -m exits 1 when a job failed
+        print(f"gyrolab: {failed}", file=sys.stderr)
     return 1 if failed else 0
+
+
+def _quoted(value: str) -> str:
+    """A value as a quoted Hydra override value (an address's ``:`` and ``/`` are not plain override text)."""
+    return f"'{value}'" if "'" not in value else f'"{value}"'
 
 
 def plot(args: argparse.Namespace) -> int:

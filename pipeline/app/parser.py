@@ -107,8 +107,7 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
     _overrides(batch, "overrides and sweeps (a=1,2 b=range(0,1,0.1)); hydra.sweep.dir=DIR names the output folder")
     batch.add_argument("--scheduler", metavar="ADDRESS",
                        help="where chunks run: process (this process, the default), local (a local Dask cluster) "
-                            "or a Dask scheduler's address tcp://HOST:PORT or tls://HOST:PORT (only here, in "
-                            "DASK_SCHEDULER_ADDRESS or in Dask's configuration: docs/cluster.md)")
+                            "or a Dask scheduler's address tcp://HOST:PORT (the same as batch.scheduler=...)")
     batch.add_argument("-m", "--multirun", action="store_true",
                        help="accepted for symmetry with gyrolab run -m: a batch is always a sweep")
     _source_options(batch)

@@ -59,9 +59,12 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
         raise ConfigError(f"initial_states has shape {y0s.shape}; it must be (trajectories, {size})")
     compiled = scene.system.compiled_model()
     integrator = scene.integrator
-    # An integrator that chooses its method stays one run per trajectory here: each trajectory gets its own choice
-    # (and may take a regime's analytic series); integrate_arrays runs one choice for a whole array batch.
-    if not integrator.supports(BATCH_KERNEL) or integrator.supports(CHOOSES_METHOD) or compiled is None:
+    # An integrator that chooses its method (auto) chooses once for the batch, on a few of its trajectories
+    # (its choose_batch_method: the tightest of their choices), and runs that choice's vectorised kernel over all
+    # of them; one run per trajectory in Python cost ~23x the CPU. Only a choice that may leave double precision
+    # (auto's extended_precision) keeps one run, and one choice, per trajectory.
+    per_point = integrator.supports(CHOOSES_METHOD) and getattr(integrator, "extended_precision", False)
+    if not integrator.supports(BATCH_KERNEL) or per_point or compiled is None:
         if params is not None:
             raise ConfigError(f"per-trajectory params need an integrator with a compiled batch kernel that does not "
                               f"choose its method per trajectory ({_kernel_choices(choosers=False)}), "

@@ -22,9 +22,10 @@ from typing import Any
 import numpy as np
 from omegaconf import OmegaConf
 
-from gyrolab.batch import executors, scheduler
+from gyrolab.batch import executors
 from gyrolab.batch.outputs import MODES, Output, indicator_outputs, merge_rows, state_outputs
 from gyrolab.batch.plan import Plan, _with_values
+from gyrolab.batch.scheduler import choose_scheduler
 from gyrolab.batch.store import Store
 from gyrolab.contracts.integrator import BATCH_KERNEL, CHOOSES_METHOD, VECTOR_LANES
 from gyrolab.engine.progress import duration
@@ -45,9 +46,8 @@ class Settings:
     decimate: int = 10
     chunk: int | None = None        # None: from ``memory``
     memory: float = DEFAULT_MEMORY_MIB
-    #: ``batch.scheduler`` as configured: process or local only (an address comes from the command line, the
-    #: environment or Dask's configuration: ``gyrolab.batch.scheduler``); read so that a refusal can name it
-    scheduler: str | None = None
+    scheduler: str | None = None    # never from a config: ``gyrolab.batch.scheduler.choose_scheduler``
+    scheduler_source: str = "the default"
 
     @classmethod
     def from_config(cls, node: Any) -> Settings:
@@ -66,8 +66,9 @@ class Settings:
         memory = node.get("memory", cls.memory)
         if isinstance(memory, bool) or not isinstance(memory, (int, float)) or not memory > 0:
             raise ConfigError(f"batch.memory={memory!r} must be a positive number of MiB")
-        return cls(output=output, decimate=decimate, chunk=chunk, memory=float(memory),
-                   scheduler=node.get("scheduler") or None)
+        where = choose_scheduler(node.get("scheduler"))
+        return cls(output=output, decimate=decimate, chunk=chunk, memory=float(memory), scheduler=where.scheduler,
+                   scheduler_source=where.source)
 
 
 @dataclass
@@ -119,6 +120,8 @@ class ChunkResult:
     wall_time: float
     #: the integrator settings the chunk ran with (adaptive kernels; None for fixed steps and the indicator)
     settings: dict | None = None
+    #: the first chunk of its process: its kernel time includes loading (or compiling) the kernels
+    first_in_process: bool = False
 
 
 def chunk_size(plan: Plan, settings: Settings) -> int:
@@ -151,8 +154,6 @@ def chunks(shape: tuple[int, ...], size: int) -> list[Chunk]:
 def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     """Integrate every valid point of ``plan``, streaming to ``path`` (resuming a killed run of the same
     command)."""
-    where = scheduler.resolve(settings.scheduler)   # a refused address: before any file is written
-    kind = executors.scheduler_kind(where)
     size = chunk_size(plan, settings)
     blocks = chunks(plan.shape, size)
     identity = plan.identity(size)
@@ -171,18 +172,18 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     for i in empty:   # no valid point: only the points' errors, which the store wrote when it was created
         store.chunk_done(i, blocks[i], None)
     progress = _Progress(len(tasks))
-    if tasks:
-        log.info("batch: chunks run %s (from %s)", "in this process" if kind == "process" else
-                 "on a local Dask cluster" if kind == "local" else f"on the Dask scheduler at {where.scheduler}",
-                 where.source)
+    kind = executors.scheduler_kind(settings.scheduler)
     if tasks and kind == "process":
         _share_systems(plan)
+    if tasks:
+        log.info("batch: chunks run %s (from %s)", {"process": "in this process", "local": "on a local Dask cluster"}
+                 .get(kind, f"on the Dask scheduler at {settings.scheduler}"), settings.scheduler_source)
 
     def on_result(_: int, result: ChunkResult) -> None:
         store.chunk_done(result.index, blocks[result.index], result)
         progress.update(result)
 
-    executors.map_chunks(run_chunk, tasks, on_result, scheduler=where)
+    executors.map_chunks(run_chunk, tasks, on_result, scheduler=settings.scheduler, source=settings.scheduler_source)
     store.finish()
     return progress.summary(path)
 
@@ -198,7 +199,8 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
     or not, or one ``integrate`` call per point).
     """
     if plan.base is None or settings.output == "indicator" or not plan.integrator_class.supports(CHOOSES_METHOD):
-        return None, {} if plan.base is None else {"batch_path": batch_path(plan.integrator_class, settings)}
+        return None, {} if plan.base is None else {"batch_path": batch_path(plan.integrator_class, settings),
+                                                   **lane_record(plan.integrator_class, settings)}
     from gyrolab.engine.scene import Scene
 
     scene = Scene.from_config(OmegaConf.create(plan.base))
@@ -211,7 +213,7 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
     log.info("batch: %s chose %s (%s) for every chunk, in %.1f s", plan.integrator_name, method.name, settings_text,
              time.perf_counter() - start)
     return method, {**{k: v for k, v in choice.items() if v is not None},
-                    "batch_path": batch_path(type(method), settings)}
+                    "batch_path": batch_path(type(method), settings), **lane_record(type(method), settings)}
 
 
 def batch_path(integrator: type, settings: Settings) -> str:
@@ -221,6 +223,15 @@ def batch_path(integrator: type, settings: Settings) -> str:
     if not integrator.supports(BATCH_KERNEL):
         return "one integrate() call per point"
     return "batch kernel, vectorised across trajectories" if integrator.supports(VECTOR_LANES) else "batch kernel"
+
+
+def lane_record(integrator: type, settings: Settings) -> dict[str, int]:
+    """The lane width a vectorised batch kernel was compiled for and the CPU's vector width (empty otherwise)."""
+    if settings.output == "indicator" or not integrator.supports(BATCH_KERNEL) or not integrator.supports(VECTOR_LANES):
+        return {}
+    from gyrolab.plugins.compiled.vector_width import lane_attributes
+
+    return lane_attributes()
 
 
 def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integrator: Any = None) -> ChunkTask | None:
@@ -295,10 +306,19 @@ def _system(context: dict[str, Any], config: dict[str, Any], values: dict[str, A
     return system
 
 
+_kernels_called = False   # whether this process has run a chunk (its kernels are loaded)
+
+
 def run_chunk(task: ChunkTask) -> ChunkResult:
     """Integrate one chunk's valid points and compute what ``task.output`` stores."""
     from gyrolab.batch.integrate import integrate_arrays, integrate_points
 
+    global _kernels_called
+    first, _kernels_called = not _kernels_called, True
+    # reported when it starts, not only when it ends: a one-chunk batch would otherwise say nothing for minutes
+    log.info("batch: chunk %d: integrating %d points%s", task.index + 1, len(task.rows),
+             " (the first chunk of this process loads the integration kernels, and compiles them once on a fresh "
+             "cache: minutes)" if first else "")
     start = time.perf_counter()
     context = _context(task.config_key, task.config)
     compiled = context["compiled"]
@@ -333,7 +353,8 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
     all_failed = np.zeros(task.n_rows, dtype=bool)
     all_failed[task.rows] = failed
     return ChunkResult(index=task.index, outputs=merge_rows(outputs, task.rows, task.n_rows), failed=all_failed,
-                       kernel_time=kernel_time, wall_time=time.perf_counter() - start, settings=settings)
+                       kernel_time=kernel_time, wall_time=time.perf_counter() - start, settings=settings,
+                       first_in_process=first)
 
 
 # ----------------------------------------------------------------------------- progress
@@ -348,10 +369,12 @@ class _Progress:
         self.kernel = 0.0
         self.in_chunks = 0.0
         self.start = time.perf_counter()
+        self.loading = 0.0   # kernel time of chunks that were their process's first (loading or compiling)
 
     def update(self, result: ChunkResult) -> None:
         self.chunks += 1
         self.kernel += result.kernel_time
+        self.loading += result.kernel_time if result.first_in_process else 0.0
         self.in_chunks += result.wall_time
         elapsed = time.perf_counter() - self.start
         eta = elapsed / self.chunks * (self.n_chunks - self.chunks)
@@ -361,6 +384,8 @@ class _Progress:
     def summary(self, path: Path) -> RunStats:
         elapsed = time.perf_counter() - self.start
         if self.chunks:
-            log.info("batch: %d chunks in %s, %.0f%% of it in the integration kernels", self.chunks,
-                     duration(elapsed), 100.0 * self.kernel / max(elapsed, 1e-9))
+            log.info("batch: %d chunks in %s, %.0f%% of it in the integration kernels%s", self.chunks,
+                     duration(elapsed), 100.0 * self.kernel / max(elapsed, 1e-9),
+                     f" (of which {duration(self.loading)} in the first chunk of each process, loading or compiling "
+                     "them)" if self.loading else "")
         return RunStats(path, self.chunks, self.kernel, elapsed, self.in_chunks)

@@ -1,119 +1,221 @@
-"""Which Dask scheduler a batch trusts, and where its address came from.
+"""Which Dask scheduler a batch trusts, and a check, bounded in time, that the peer is one.
 
-Connecting to a Dask scheduler trusts it with code execution: the client unpickles what the scheduler and
-its workers send back. So a scheduler's address is taken only from places the user controls for this
-invocation — the command line (``gyrolab batch --scheduler ADDRESS``, ``gyrolab --batch --scheduler ...``),
-the environment (``DASK_SCHEDULER_ADDRESS``) and Dask's own configuration (``scheduler-address`` in
-``~/.config/dask/*.yaml`` or ``DASK_SCHEDULER_ADDRESS``) — never from a config file, an experiment or an
-override of ``batch.scheduler``, which a shared experiment file could set. ``batch.scheduler`` keeps the
-two values that trust nobody: ``process`` (this process) and ``local`` (a Dask cluster this process starts).
+Connecting to a Dask scheduler trusts it with code execution: what the scheduler and its workers send
+back is unpickled in this process. So a scheduler's address comes only from places the user sets
+directly for this command — the command line (``gyrolab --batch --scheduler ADDRESS ...``), the
+environment (``DASK_SCHEDULER_ADDRESS``) or Dask's own configuration (``scheduler-address`` in its
+YAML files) — never from a gyrolab config file, an experiment or an override, which are shared and
+copied between people. ``batch.scheduler`` in a config may still say ``process`` or ``local`` (a
+cluster this process starts itself trusts nobody); an address there is refused in one sentence that
+says where to put it.
 
-``resolve(configured)`` gives the choice and its source (the log names it; error messages name it).
+Before ``distributed`` is handed the address, ``probe`` opens the connection itself and reads the
+peer's greeting with a deadline, without unpickling anything: a silent peer or one that is not a
+Dask scheduler is one sentence after at most ``CONNECT_TIMEOUT`` seconds (``distributed`` alone
+waits minutes for a silent peer and fails with a traceback on garbage).
 """
 
 from __future__ import annotations
 
 import os
+import socket
+import ssl
+import struct
+import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib.util import find_spec
 
 from gyrolab.errors import ConfigError, shorten
 
-#: Dask's own environment variable for a scheduler's address (``distributed.Client()`` reads it too)
-SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
-#: the key of Dask's configuration that holds a scheduler's address
-DASK_CONFIG_KEY = "scheduler-address"
-#: the values of ``batch.scheduler`` a config may give: they connect to nobody
-CONFIG_VALUES = ("process", "local")
-
-COMMAND_LINE = "the command line (--scheduler)"
-ENVIRONMENT = f"the environment ({SCHEDULER_ENV})"
-DASK_CONFIG = f"Dask's configuration ({DASK_CONFIG_KEY})"
-CONFIG = "batch.scheduler"
-DEFAULT = "the default"
+#: the command-line option that names the scheduler
+OPTION = "--scheduler"
+#: Dask's own environment variable (it feeds Dask's ``scheduler-address`` setting)
+ENVIRONMENT = "DASK_SCHEDULER_ADDRESS"
+IN_PROCESS = ("process", "")
+LOCAL = "local"
+#: seconds a scheduler has to greet us before it is called silent
+CONNECT_TIMEOUT = 10
+#: a scheduler's greeting (Dask's handshake: compression, python and pickle versions) is a few hundred bytes
+MAX_GREETING_BYTES = 1 << 16
+DEFAULT_PORT = 8786
+WHERE_TO_PUT_IT = (f"give it on the command line (gyrolab --batch {OPTION} ADDRESS ...), in {ENVIRONMENT} or in "
+                   "Dask's configuration (scheduler-address; docs/cluster.md)")
 
 _command_line: str | None = None
 
 
 @dataclass(frozen=True)
 class Choice:
-    """Where the chunks run (None: this process) and the source that said so."""
+    """Where a batch's chunks run (None: this process) and where that came from, for the log."""
 
     scheduler: str | None
     source: str
 
 
-def use_command_line_scheduler(address: str | None) -> None:
-    """The scheduler the command line gives (``--scheduler ADDRESS``); None: the command line gives none."""
+def split_scheduler_option(argv: Sequence[str]) -> tuple[str | None, list[str]]:
+    """(the value of ``--scheduler VALUE`` or ``--scheduler=VALUE`` anywhere in ``argv``, the other arguments).
+
+    No override starts with ``--``, so the option can be taken out wherever it stands.
+    """
+    value, rest, args = None, [], list(argv)
+    while args:
+        arg = args.pop(0)
+        option, has_value, text = arg.partition("=")
+        if option != OPTION:
+            rest.append(arg)
+            continue
+        if not has_value:
+            if not args or args[0].startswith("-"):
+                raise ConfigError(f"{OPTION} needs a value: process, local or a Dask scheduler's address "
+                                  f"(e.g. {OPTION} tcp://HOST:8786)")
+            text = args.pop(0)
+        if value is not None:
+            raise ConfigError(f"{OPTION} is given twice ({shorten(value)} and {shorten(text)}); give it once")
+        value = text
+    return value, rest
+
+
+def take_scheduler_option(argv: Sequence[str]) -> list[str]:
+    """``argv`` without ``--scheduler``; its value (or none) becomes the command line's scheduler."""
     global _command_line
-    _command_line = None if address is None else str(address).strip() or None
+    _command_line, rest = split_scheduler_option(argv)
+    return rest
 
 
-def command_line_scheduler() -> str | None:
-    return _command_line
+def use_command_line_scheduler(value: str | None) -> None:
+    """Set the command line's scheduler (what ``--scheduler VALUE`` does; None: not given)."""
+    global _command_line
+    _command_line = value
 
 
-def parse_scheduler_option(argv: list[str]) -> tuple[str | None, list[str]]:
-    """``--scheduler ADDRESS`` or ``--scheduler=ADDRESS`` taken out of ``argv``: (the address, the rest).
+def choose_scheduler(configured: object = None) -> Choice:
+    """The scheduler of a batch: the command line's, else ``batch.scheduler``'s ``process``/``local``, else
+    Dask's own (``DASK_SCHEDULER_ADDRESS``, then Dask's configuration files), else this process.
 
-    For command lines parsed by hand (``gyrolab --batch ...`` without a subcommand parser); a parser
-    (argparse) that has its own ``--scheduler`` option passes its value to ``use_command_line_scheduler``.
+    ``configured`` is ``batch.scheduler`` from the config: an address there is refused (module docstring).
     """
-    rest: list[str] = []
-    address = None
-    items = iter(argv)
-    for item in items:
-        if item == "--scheduler":
-            address = next(items, None)
-            if address is None or address.startswith("-"):
-                raise ConfigError("--scheduler needs a value: process, local or a Dask scheduler's address "
-                                  "(tcp://HOST:PORT or tls://HOST:PORT)")
-        elif item.startswith("--scheduler="):
-            address = item.split("=", 1)[1]
-        else:
-            rest.append(item)
-    return address, rest
-
-
-def resolve(configured: str | None) -> Choice:
-    """The scheduler to use given ``batch.scheduler`` (``configured``) and this invocation's trusted sources.
-
-    The command line wins; then a config's ``process`` or ``local``; then the environment; then Dask's
-    configuration; else this process. A config (or experiment, or override) giving an address is refused
-    in one sentence that says where the address belongs.
-    """
-    if _command_line is not None:
-        return Choice(_command_line, COMMAND_LINE)
     text = "" if configured is None else str(configured).strip()
-    if text:
-        if text in CONFIG_VALUES:
-            return Choice(text, CONFIG)
-        refuse_configured(text)
-    environment = os.environ.get(SCHEDULER_ENV, "").strip()
-    if environment:
-        return Choice(environment, ENVIRONMENT)
-    from_dask = _dask_config_address()
-    if from_dask:
-        return Choice(from_dask, DASK_CONFIG)
-    return Choice(None, DEFAULT)
+    if text not in (*IN_PROCESS, LOCAL):
+        raise ConfigError(f"batch.scheduler={shorten(text)!r} is not read from a config: connecting to a Dask "
+                          f"scheduler lets it run code in this process, so a config file or an experiment may only "
+                          f"say process or local; {WHERE_TO_PUT_IT}")
+    if _command_line is not None:
+        return Choice(_command_line or None, f"the command line ({OPTION})")
+    if configured is not None and text:
+        return Choice(None if text in IN_PROCESS else text, "batch.scheduler")
+    address = os.environ.get(ENVIRONMENT, "").strip()
+    if address:
+        return Choice(address, f"the environment ({ENVIRONMENT})")
+    address = _dask_configured()
+    if address:
+        return Choice(address, "Dask's configuration (scheduler-address)")
+    return Choice(None, "the default")
 
 
-def refuse_configured(text: str) -> None:
-    raise ConfigError(f"batch.scheduler={shorten(text)!r} is refused: connecting to a Dask scheduler trusts it to run "
-                      "code in this process, so a config, an experiment or an override may only say process or local, "
-                      "and an address goes on the command line (gyrolab batch --scheduler ADDRESS), in "
-                      f"{SCHEDULER_ENV} or in Dask's configuration ({DASK_CONFIG_KEY}; docs/cluster.md)")
-
-
-def _dask_config_address() -> str | None:
-    """``scheduler-address`` of Dask's configuration (its YAML files and ``DASK_*`` variables), if Dask is here."""
+def _dask_configured() -> str:
+    """Dask's ``scheduler-address`` setting (its YAML files), read only when Dask is installed."""
     if find_spec("dask") is None:
-        return None
+        return ""
     import dask.config
 
-    value = dask.config.get(DASK_CONFIG_KEY, default=None) or dask.config.get("scheduler_address", default=None)
-    return str(value).strip() or None if value else None
+    return str(dask.config.get("scheduler-address", None) or "").strip()
 
 
-__all__ = ["Choice", "command_line_scheduler", "parse_scheduler_option", "refuse_configured", "resolve",
+# ----------------------------------------------------------------------------- is the peer a scheduler?
+
+
+def probe(address: str, source: str, timeout: float = CONNECT_TIMEOUT) -> None:
+    """ConfigError in one sentence unless a Dask scheduler greets us at ``address`` within ``timeout`` s.
+
+    Reads the first message a Dask peer sends on a new connection (its handshake: a length-prefixed
+    msgpack mapping with the keys ``compression`` and ``python``), decoded with plain msgpack, which
+    never runs code. Over ``tls://`` the connection uses Dask's TLS settings (``distributed.comm.tls``).
+    """
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    where = f"at {address} (from {source})"
+    scheme, location = parse_address(address)
+    host, port = parse_host_port(location, DEFAULT_PORT)
+    deadline = time.monotonic() + timeout
+    try:
+        connection = socket.create_connection((host, port), timeout=timeout)
+    except OSError as error:
+        reason = " ".join(str(error.strerror or error).split()) or type(error).__name__
+        raise ConfigError(f"no Dask scheduler answers {where} within {timeout:g} s ({shorten(reason, 80)}); start "
+                          "one (dask scheduler) or give the address of a running one") from None
+    try:
+        if scheme == "tls":
+            connection = _tls_context().wrap_socket(connection, server_hostname=host)
+        greeting = _greeting(connection, deadline)
+    except (TimeoutError, socket.timeout):
+        raise ConfigError(f"the peer {where} accepted the connection but sent nothing within {timeout:g} s (a Dask "
+                          "scheduler greets at once); check the address and port (a tls:// scheduler needs a tls:// "
+                          "address)") from None
+    except ssl.SSLError as error:
+        raise ConfigError(f"the TLS handshake with {address} (from {source}) failed ({shorten(str(error), 100)}); "
+                          "check Dask's distributed.comm.tls settings (docs/cluster.md)") from None
+    except OSError as error:
+        reason = " ".join(str(error.strerror or error).split()) or type(error).__name__
+        raise ConfigError(f"the peer {where} closed the connection before greeting as a Dask scheduler would "
+                          f"({shorten(reason, 80)}); check the address and port") from None
+    finally:
+        connection.close()
+    if greeting is None:
+        raise ConfigError(f"the peer {where} is not a Dask scheduler (what it sent is not Dask's handshake); check "
+                          "the address and port")
+
+
+def _greeting(connection: socket.socket, deadline: float) -> dict | None:
+    """The peer's handshake mapping, or None when what it sends is not one."""
+    import msgpack
+
+    (size,) = struct.unpack("Q", _receive(connection, 8, deadline))
+    if not 16 <= size <= MAX_GREETING_BYTES:
+        return None
+    body = _receive(connection, size, deadline)
+    (n_frames,) = struct.unpack_from("Q", body)
+    if not 1 <= n_frames <= 16 or len(body) < 8 * (n_frames + 1):
+        return None
+    lengths = struct.unpack_from(f"{n_frames}Q", body, 8)
+    start = 8 * (n_frames + 1)
+    if start + lengths[0] > len(body):
+        return None
+    try:
+        message = msgpack.unpackb(body[start:start + lengths[0]], raw=False, strict_map_key=False)
+    except Exception:  # noqa: BLE001 - any decoding failure means: not Dask's handshake
+        return None
+    if not isinstance(message, dict) or not {"compression", "python"} <= set(message):
+        return None
+    return message
+
+
+def _receive(connection: socket.socket, n: int, deadline: float) -> bytes:
+    """Exactly ``n`` bytes before ``deadline`` (TimeoutError), or OSError when the peer closes first."""
+    data = bytearray()
+    while len(data) < n:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise TimeoutError
+        connection.settimeout(left)
+        piece = connection.recv(n - len(data))
+        if not piece:
+            raise ConnectionResetError(0, "connection closed by the peer")
+        data += piece
+    return bytes(data)
+
+
+def _tls_context() -> ssl.SSLContext:
+    """The client's TLS context from Dask's configuration (``distributed.comm.tls.*``)."""
+    from distributed.security import Security
+
+    context = Security().get_connection_args("client").get("ssl_context")
+    if context is None:
+        raise ConfigError("a tls:// scheduler needs Dask's TLS settings (distributed.comm.tls.ca-file, "
+                          "distributed.comm.tls.client.cert and .key, or the DASK_DISTRIBUTED__COMM__TLS__* "
+                          "variables; docs/cluster.md)")
+    return context
+
+
+__all__ = ["Choice", "choose_scheduler", "probe", "split_scheduler_option", "take_scheduler_option",
            "use_command_line_scheduler"]

@@ -11,12 +11,11 @@ leaves a file that opens. After a chunk's data is synced to disk its index is ap
 (the journal, fsynced); a rerun with the same identity continues after the journaled chunks. When every
 chunk is stored the file is closed, synced and renamed to ``NAME``, and the journal removed.
 
-A full disk (or a file-size limit, a quota) loses no finished chunk. The file reaches its full size when it
-is created (every variable's storage written with its fill value, the point counts written as placeholders),
-so a chunk's write and the final counts overwrite bytes already on disk. A write that fails anyway is one
-``OutputError`` sentence (exit 3) saying how many chunks are kept; the journal lists only chunks whose data
-was synced, so the same command, rerun with more space, runs the others and ends with the file an
-uninterrupted run writes. A file whose creation failed holds no finished chunk: the rerun creates it again.
+A failed write (a full disk, a quota, a file-size limit) is one ``OutputError`` sentence (exit 3) that
+keeps the finished work: the chunks already journaled stay in ``NAME.part``, and rerunning the same
+command continues after them. Only complete journal lines count, and a torn last line is cut off before
+the journal is appended to again. A ``NAME.part`` that cannot be opened any more (its creation failed, or
+a failure broke the library's metadata) is replaced by a new one, with a warning naming the chunks lost.
 """
 
 from __future__ import annotations
@@ -34,7 +33,7 @@ from omegaconf import OmegaConf
 from gyrolab.batch.outputs import output_times
 from gyrolab.batch.plan import POINT
 from gyrolab.errors import ConfigError, OutputError
-from gyrolab.output.atomic import _fsync, _fsync_directory, _library_failure, diagnose, reason
+from gyrolab.output.atomic import TEMP_SUFFIX, _fsync, _fsync_directory, _library_failure, diagnose, reason
 from gyrolab.output.cf import CONVENTIONS, now_iso
 from gyrolab.output.provenance import gyrolab_version, provenance
 from gyrolab.sweep import record
@@ -46,6 +45,8 @@ FINISHED, FAILED = STATUS_FLAGS[record.FINISHED], STATUS_FLAGS[record.FAILED]
 STATUS_ATTRS = {"long_name": "how the point ended: 0 not run, 1 finished, 2 failed", "units": "1",
                 "flag_values": np.array([0, 1, 2], dtype=np.int8), "flag_meanings": "missing finished failed"}
 ERROR_ATTRS = {"long_name": "the point's error: index into error_message, -1 for none", "units": "1"}
+#: the counts ``finish`` stores; created (as 0) with the file, so that finishing overwrites them in place
+COUNT_ATTRS = ("n_missing", "n_finished", "n_failed")
 
 
 class Store:
@@ -72,95 +73,130 @@ class Store:
         if not self.part.exists():
             self.journal.unlink(missing_ok=True)
             return set()
-        if not _read_journal(self.journal, None) and not _opens(self.part):
-            # no chunk was ever journaled in it and it does not open: a creation that failed (a full disk)
-            log.info("batch: %s holds no finished chunk and does not open (its creation failed); creating it again",
-                     self.part)
-            self.part.unlink()
-            self.journal.unlink(missing_ok=True)
+        try:
+            found = _identity_of(self.part)
+        except OutputError:
+            self._replace_unreadable_part()
             return set()
-        found = _identity_of(self.part)
         if found != self.identity:
             raise ConfigError(f"{self.part} is an unfinished batch of another command or gyrolab version (identity "
                               f"{found}, this one is {self.identity}); rerun that command to finish it, or give "
                               "another directory")
         done = _read_journal(self.journal, self.identity)
-        if not done:   # killed before its first chunk was journaled: the journal starts again
-            _start_journal(self.journal, self.identity)
-        self.nc = _open(self.part, "a")
+        try:
+            if not done:   # killed before its first chunk was journaled: the journal starts again
+                _start_journal(self.journal, self.identity)
+            else:          # a write that failed mid-line leaves a torn last line: cut it before appending
+                _cut_torn_line(self.journal)
+            self.nc = _open(self.part, "a")
+        except OutputError:
+            raise
+        except OSError as error:
+            raise self._failed(error, done) from None
         log.info("batch: resuming %s (%d chunks stored)", self.part, len(done))
         return done
 
-    # -- writing ----------------------------------------------------------------------------------------
-    def chunk_done(self, index: int, chunk: Any, result: Any) -> None:
-        """Store a chunk's result (None: a chunk without a valid point) and journal it."""
-        if self.nc is None:
-            self._create(result)
-        try:
-            if result is not None:
-                valid = self.plan.valid[chunk.start:chunk.stop]
-                status = np.where(valid, FINISHED, FAILED).astype(np.int8)
-                error = self.plan.error[chunk.start:chunk.stop].copy()
-                status[result.failed] = FAILED
-                error[result.failed] = len(self.messages) - 1   # the integration failure's sentence
-                self._write("job_status", chunk, status)
-                self._write("job_error", chunk, error)
-                for name, out in result.outputs.items():
-                    if name in self.nc.variables:
-                        self._write(name, chunk, out.data)
-            self.nc.sync()
-            _fsync(self.part)
-            with open(self.journal, "a", encoding="utf-8") as journal:
-                journal.write(f"{index}\n")
-                journal.flush()
-                os.fsync(journal.fileno())
-        except (OSError, RuntimeError) as error:
-            self._fail(error, self.part)
-
-    def finish(self) -> None:
-        """Close the complete file and give it its final name."""
-        if self.nc is None:
-            self._create(None)
-        status = self.nc["job_status"][:]
-        status = np.asarray(status.filled(0) if np.ma.isMaskedArray(status) else status)
-        counts = {name: np.int64(np.count_nonzero(status == code))
-                  for name, code in (("n_missing", 0), ("n_finished", FINISHED), ("n_failed", FAILED))}
-        try:
-            self.nc.setncatts(counts)   # in place of the placeholders written at creation: no new space
-            self.nc.close()
-            self.nc = None
-            _fsync(self.part)
-        except (OSError, RuntimeError) as error:
-            self._fail(error, self.part)
-        if counts["n_failed"]:
-            log.info("batch: %d of %d points failed; their errors are error_message[job_error] where job_status is 2",
-                     counts["n_failed"], status.size)
-        try:
-            os.replace(self.part, self.path)
-            _fsync_directory(self.path.parent)
-        except OSError as error:
-            raise OutputError(f"could not write {self.path}: {reason(error)}") from None
+    def _replace_unreadable_part(self) -> None:
+        """A ``.part`` that no longer opens holds nothing recoverable: start it again (saying what is lost)."""
+        lost = _read_journal(self.journal, self.identity)
+        if lost:
+            log.warning("batch: %s cannot be read any more (a write to it failed); its %d stored chunks are run "
+                        "again", self.part, len(lost))
+        else:
+            log.info("batch: %s was left unfinished before its first chunk; starting it again", self.part)
+        self.part.unlink(missing_ok=True)
         self.journal.unlink(missing_ok=True)
 
-    def _fail(self, error: BaseException, path: Path) -> None:
-        """A failed write to the partial store: one OutputError sentence saying what is kept (a library error
-        that is not a failed write is a bug, raised as it is)."""
-        if not isinstance(error, OSError) and not _library_failure(error):
-            raise error
-        why = diagnose(error, path, keep=True)
+    def _failed(self, error: BaseException, done: set[int] | None = None) -> OutputError:
+        """The sentence of a failed write (the file closed; the journaled chunks kept for the rerun)."""
+        # the reason is probed beside the file, never in it (a probe write must not touch the stored chunks)
+        probe = self.part.with_name(f".{self.part.name}.probe{TEMP_SUFFIX}")
+        try:
+            size = self.part.stat().st_size
+        except OSError:
+            size = None
+        try:
+            why = diagnose(error, probe, size)
+        finally:
+            probe.unlink(missing_ok=True)
         self._close_quietly()
-        kept = len(_read_journal(self.journal, self.identity))
-        raise OutputError(f"could not write {path}: {why}; the {kept} finished chunk{'s' if kept != 1 else ''} "
-                          "stored in it are kept: free some space and rerun the same command to finish the batch") \
-            from None
+        kept = len(_read_journal(self.journal, self.identity)) if done is None else len(done)
+        keep = (f"the {kept} chunks already stored are kept: rerun the same command to continue once there is room"
+                if kept else "nothing was finished yet: rerun the same command once there is room")
+        return OutputError(f"could not write {self.part}: {why}; {keep}")
 
     def _close_quietly(self) -> None:
         nc, self.nc = self.nc, None
         if nc is not None:
             try:
                 nc.close()
-            except (OSError, RuntimeError):   # the disk is full: what the journal lists is on disk already
-                pass
+            except (OSError, RuntimeError):
+                pass   # the write already failed; the journal says which chunks are whole
+
+    # -- writing ----------------------------------------------------------------------------------------
+    def chunk_done(self, index: int, chunk: Any, result: Any) -> None:
+        """Store a chunk's result (None: a chunk without a valid point) and journal it; OutputError (the
+        journaled chunks kept) when a write fails."""
+        try:
+            self._store_chunk(index, chunk, result)
+        except OutputError:
+            self._close_quietly()
+            raise
+        except (OSError, RuntimeError) as error:
+            if not isinstance(error, OSError) and not _library_failure(error):
+                raise
+            raise self._failed(error) from None
+
+    def _store_chunk(self, index: int, chunk: Any, result: Any) -> None:
+        if self.nc is None:
+            self._create(result)
+        if result is not None:
+            valid = self.plan.valid[chunk.start:chunk.stop]
+            status = np.where(valid, FINISHED, FAILED).astype(np.int8)
+            error = self.plan.error[chunk.start:chunk.stop].copy()
+            status[result.failed] = FAILED
+            error[result.failed] = len(self.messages) - 1   # the integration failure's sentence
+            self._write("job_status", chunk, status)
+            self._write("job_error", chunk, error)
+            for name, out in result.outputs.items():
+                if name in self.nc.variables:
+                    self._write(name, chunk, out.data)
+        self.nc.sync()
+        _fsync(self.part)
+        with open(self.journal, "a", encoding="utf-8") as journal:
+            journal.write(f"{index}\n")
+            journal.flush()
+            os.fsync(journal.fileno())
+
+    def finish(self) -> None:
+        """Close the complete file and give it its final name (OutputError, the chunks kept, if that fails)."""
+        try:
+            self._finish()
+        except OutputError:
+            self._close_quietly()
+            raise
+        except (OSError, RuntimeError) as error:
+            if not isinstance(error, OSError) and not _library_failure(error):
+                raise
+            raise self._failed(error) from None
+
+    def _finish(self) -> None:
+        if self.nc is None:
+            self._create(None)
+        status = self.nc["job_status"][:]
+        status = np.asarray(status.filled(0) if np.ma.isMaskedArray(status) else status)
+        counts = {name: np.int64(np.count_nonzero(status == code))
+                  for name, code in (("n_missing", 0), ("n_finished", FINISHED), ("n_failed", FAILED))}
+        self.nc.setncatts(counts)
+        if counts["n_failed"]:
+            log.info("batch: %d of %d points failed; their errors are error_message[job_error] where job_status is 2",
+                     counts["n_failed"], status.size)
+        self.nc.close()
+        self.nc = None
+        _fsync(self.part)
+        os.replace(self.part, self.path)
+        _fsync_directory(self.path.parent)
+        self.journal.unlink(missing_ok=True)
 
     def _write(self, name: str, chunk: Any, data: np.ndarray) -> None:
         data = np.asarray(data)
@@ -168,18 +204,17 @@ class Store:
 
     # -- creating ------------------------------------------------------------------------------------------
     def _create(self, result: Any) -> None:
-        """Create the partial store at its full size; a failure removes it (no chunk is in it yet)."""
+        """Create ``.part`` whole (every variable's storage allocated); a failure leaves neither it nor a journal
+        (nothing was finished), so the rerun starts cleanly."""
         try:
             self._create_file(result)
         except (OSError, RuntimeError) as error:
             if not isinstance(error, OSError) and not _library_failure(error):
                 raise
-            why = diagnose(error, self.part, keep=True)
-            self._close_quietly()
+            failure = self._failed(error, set())
             self.part.unlink(missing_ok=True)
             self.journal.unlink(missing_ok=True)
-            raise OutputError(f"could not create {self.part}: {why}; no chunk was finished yet: free some space and "
-                              "rerun the same command") from None
+            raise failure from None
 
     def _create_file(self, result: Any) -> None:
         plan = self.plan
@@ -224,9 +259,7 @@ class Store:
         error[:] = plan.error.reshape(shape)
         if result is not None:
             self._create_variables(result, system)
-        nc.setncatts(self._attributes(system))
-        # the point counts as placeholders of their final type: ``finish`` overwrites them in place
-        nc.setncatts({name: np.int64(0) for name in ("n_missing", "n_finished", "n_failed")})
+        nc.setncatts({**self._attributes(system), **{name: np.int64(0) for name in COUNT_ATTRS}})
         nc.sync()
         _fsync(self.part)
         _start_journal(self.journal, self.identity)
@@ -308,17 +341,9 @@ def _open(path: Path, mode: str) -> netCDF4.Dataset:
     try:
         nc = netCDF4.Dataset(path, mode)
     except OSError as error:
-        raise OutputError(f"could not open {path}: {reason(error)}; remove it to start the batch again") from None
+        raise OutputError(f"could not open {path}: {reason(error)}") from None
     nc.set_auto_mask(False)
     return nc
-
-
-def _opens(path: Path) -> bool:
-    try:
-        netCDF4.Dataset(path, "r").close()
-    except OSError:
-        return False
-    return True
 
 
 def _identity_of(path: Path) -> str:
@@ -336,15 +361,27 @@ def _start_journal(path: Path, identity: str) -> None:
         os.fsync(journal.fileno())
 
 
-def _read_journal(path: Path, identity: str | None) -> set[int]:
-    """The chunks a journal records (none if it is missing or belongs to another identity; None: any)."""
+def _read_journal(path: Path, identity: str) -> set[int]:
+    """The chunks a journal records (none if it is missing or belongs to another identity)."""
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
+        text = path.read_text(encoding="utf-8", errors="replace")
     except FileNotFoundError:
         return set()
-    if not lines or (identity is not None and lines[0] != f"identity {identity}"):
+    lines = text.splitlines()
+    if not lines or lines[0] != f"identity {identity}":
         return set()
-    return {int(line) for line in lines[1:] if line.strip().isdigit()}
+    complete = lines[1:] if text.endswith("\n") else lines[1:-1]   # a torn last line is not a journaled chunk
+    return {int(line) for line in complete if line.strip().isdigit()}
+
+
+def _cut_torn_line(path: Path) -> None:
+    """Cut a journal's unterminated last line (a write that failed half-way), so that appending stays exact."""
+    data = path.read_bytes()
+    if data and not data.endswith(b"\n"):
+        with open(path, "r+b") as journal:
+            journal.truncate(data.rfind(b"\n") + 1)
+            journal.flush()
+            os.fsync(journal.fileno())
 
 
 def _reference_system(plan: Any) -> Any:

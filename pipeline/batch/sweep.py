@@ -16,10 +16,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from gyrolab.batch import executors
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
-from gyrolab.batch.executors import probe_scheduler, scheduler_kind
 from gyrolab.batch.runner import RunStats, Settings, run_plan
-from gyrolab.batch.scheduler import resolve
+from gyrolab.batch.scheduler import probe
 from gyrolab.contracts.integrator import VARIATIONAL
 from gyrolab.errors import ConfigError
 from gyrolab.output.lock import writing_in
@@ -36,6 +36,18 @@ def run_batch_sweep(overrides: Sequence[str], out_dir: Path) -> Path:
     return run_batch(fixed, dims, Path(out_dir) / SWEEP_NAME).path
 
 
+def failed_points(path: Path) -> str | None:
+    """One sentence when points of the finished batch at ``path`` failed (the command then exits 1), else None."""
+    import netCDF4
+
+    with netCDF4.Dataset(path, "r") as nc:
+        failed, total = int(getattr(nc, "n_failed", 0)), int(getattr(nc, "n_points", 0))
+    if not failed:
+        return None
+    return (f"{failed} of {total} points failed; their errors are error_message[job_error] where job_status is 2 "
+            f"in {path}")
+
+
 def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
               plain: dict[str, Any] | None = None, lock: bool = True) -> RunStats:
     """The batch of grid ``dims`` over the config of ``fixed`` (or ``plain``), stored at ``path``; its
@@ -44,9 +56,8 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
     plan = make_plan(fixed, dims, plain=plain)
     settings = Settings.from_config(plan.plain.get("batch"))
     check_integrator(plan, settings)
-    where = resolve(settings.scheduler)
-    if scheduler_kind(where) == "address" and not path.exists():   # unreachable: before any directory is made
-        probe_scheduler(str(where.scheduler), where.source)
+    if executors.scheduler_kind(settings.scheduler) == "address":   # a bad peer is refused before any directory
+        probe(str(settings.scheduler), settings.scheduler_source, executors.CONNECT_TIMEOUT)
     plan_time = time.perf_counter() - start
     if not lock:
         stats = run_plan(plan, path, settings)
@@ -55,19 +66,6 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
             stats = run_plan(plan, path, settings)
     stats.plan_time = plan_time
     return stats
-
-
-def failed_points_line(path: Path) -> str | None:
-    """One line saying how many points of the finished batch at ``path`` failed and where their errors are
-    (None when none failed): a batch with failed points exits 1, as a multirun with a failed job does."""
-    import netCDF4
-
-    with netCDF4.Dataset(path, "r") as nc:
-        failed, total = int(getattr(nc, "n_failed", 0)), int(getattr(nc, "n_points", 0))
-    if not failed:
-        return None
-    return (f"gyrolab: {failed} of {total} points failed; see error_message[job_error] where job_status is 2 "
-            f"in {path}")
 
 
 def check_integrator(plan: Plan, settings: Settings | None = None) -> None:

@@ -103,3 +103,53 @@ def _duration(seconds: float) -> str:
         if seconds >= scale:
             return f"{seconds / scale:.3g} {unit}"
     return f"{seconds:.3g} s"
+
+
+#: points of one batch, a stability map or a sweep: beyond it even 1 ms a point is more than a day of CPU time
+MAX_POINTS = 100_000_000
+
+
+def check_points(n: float, why: str, *, allow_large: bool = False) -> None:
+    """ConfigError when ``n`` points (a grid, a batch) exceed :data:`MAX_POINTS`; ``why`` names the settings."""
+    if allow_large or n <= MAX_POINTS:
+        return
+    raise ConfigError(f"{why} makes {n:.3g} points, beyond the budget of {MAX_POINTS:.0e} points "
+                      f"({_duration(n * 1e-3)} even at 1 ms a point); use fewer points or {ESCAPE}")
+
+
+def sweep_points(overrides: Any) -> tuple[float, str]:
+    """(the number of points the sweeps of ``overrides`` (Hydra ``Override`` objects) make, the sweeps' text),
+    counted without expanding them: ``range(0,1e12,1)`` is 1e12 points, not a list of them."""
+    total, named = 1.0, []
+    for o in overrides:
+        if not o.is_sweep_override():
+            continue
+        total *= _sweep_length(o)
+        named.append(o.input_line)
+    return total, " ".join(named)
+
+
+def _sweep_length(o: Any) -> float:
+    from hydra.core.override_parser.types import ChoiceSweep, RangeSweep
+
+    value = o.value()
+    if isinstance(value, RangeSweep):
+        start, stop, step = (float(v) if v is not None else None for v in (value.start, value.stop, value.step))
+        step = 1.0 if step is None else step
+        if step == 0:
+            raise ConfigError(f"{o.input_line!r}: a range's step must not be 0, e.g. range(0,1,0.1)")
+        if not all(math.isfinite(v) for v in (start, stop, step)):
+            raise ConfigError(f"{o.input_line!r}: a range's start, stop and step must be finite numbers")
+        return max(0.0, math.ceil((stop - start) / step))
+    if isinstance(value, ChoiceSweep):
+        return float(len(value.list))
+    return 1.0
+
+
+def check_sweep_size(overrides: Any) -> None:
+    """ConfigError before any expansion when the sweeps of the command line make more than MAX_POINTS points
+    (unless the command line says ``allow_large=true``)."""
+    allow_large = any(o.key_or_group == "allow_large" and not o.is_sweep_override() and o.value() is True
+                      for o in overrides)
+    n, named = sweep_points(overrides)
+    check_points(n, named, allow_large=allow_large)

@@ -30,6 +30,7 @@ from omegaconf.errors import OmegaConfBaseException
 from gyrolab.contracts import registry
 from gyrolab.engine.hydra_private import create_automatic_config_search_path
 from gyrolab.errors import ConfigError, choices, shorten
+from gyrolab.engine.user_yaml import check_user_config_dir
 
 CONFIG_MODULE = "gyrolab.conf"
 CONFIG_NAME = "config"
@@ -58,11 +59,13 @@ class ConfigSource:
             if not os.path.isdir(config_dir):
                 raise ConfigError(f"--config-dir {config_dir!r} is not a directory; give the folder that holds "
                                   "your YAML files (e.g. --config-dir myconf)")
+            check_user_config_dir(config_dir, "--config-dir")
         if config_path is not None and not config_path.startswith("pkg://"):
             config_path = os.path.abspath(config_path)
             if not os.path.isdir(config_path):
                 raise ConfigError(f"--config-path {config_path!r} is not a directory; give the folder that holds "
                                   "your primary config (e.g. --config-path myconf --config-name mine)")
+            check_user_config_dir(config_path, "--config-path")
         if config_name is not None:
             config_name = config_name.removesuffix(".yaml")
             if not config_name or "\0" in config_name:
@@ -77,11 +80,19 @@ class ConfigSource:
             search_path.prepend(provider="command-line", path=f"file://{self.config_dir}",
                                 anchor=SearchPathQuery(provider="schema"))
         for path in self.searchpath:
+            if str(path).startswith("file://"):  # a config's hydra.searchpath: the user's files, checked as -cd's
+                _check_search_dir(str(path)[len("file://"):])
             search_path.append(provider="main", path=path)
         return search_path
 
 
 _source = ConfigSource()
+
+
+@cache
+def _check_search_dir(directory: str) -> None:
+    if os.path.isdir(directory):
+        check_user_config_dir(os.path.abspath(directory), "hydra.searchpath")
 
 
 def use_source(source: ConfigSource) -> None:
@@ -311,6 +322,11 @@ def _first_line(error: Exception) -> str:
     """The first line of a Hydra/OmegaConf message, without its pointer to the online docs."""
     lines = [line.strip() for line in str(error).strip().splitlines() if line.strip()]
     line = lines[0] if lines else type(error).__name__
+    if line.endswith(":") and len(lines) > 1:  # "In 'experiment/x': ConfigTypeError raised while composing config:"
+        line = f"{line} {lines[1]}"
+    for merge in ("Cannot merge DictConfig with ListConfig", "Cannot merge ListConfig with DictConfig"):
+        line = line.replace(merge, "a list and a section (a mapping) do not match: one is given where the config "
+                                   "has the other")
     return line.split(" See https://")[0]
 
 
@@ -358,10 +374,12 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
     for key in cfg.keys():
         if key not in ref["top"]:
             raise ConfigError(unknown_key_sentence(str(key), sorted(ref["top"])))
-    for section in ("time", "output", "body", "initial"):
+    for section in ("time", "output", "body", "initial", "system", "integrator"):
         if section not in cfg or cfg[section] is None:
+            how = (f"set its keys instead (e.g. {section}.{_example_key(section)}=...)" if _example_key(section)
+                   else f"choose one ({section}=NAME)")
             raise ConfigError(f"the config has no `{section}` section (deleted with ~{section}?); every run needs "
-                              f"it: set its keys instead (e.g. {section}.{_example_key(section)}=...)")
+                              f"it: {how}")
     plain = resolve_plain(cfg)
     for section in ("time", "output", "body", "initial"):
         if not isinstance(plain[section], dict):
@@ -375,6 +393,10 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
                 raise ConfigError(unknown_key_sentence(f"{section}.{key}", [f"{section}.{k}" for k in valid]))
             if section in _CLOSED_SECTIONS:
                 check_type(f"{section}.{key}", value, ref["defaults"][section][key])
+    for group in ("integrator", "system", "regime", "force", "batch"):
+        if plain.get(group) is not None and not isinstance(plain[group], dict):
+            raise ConfigError(f"{group}={shorten(repr(plain[group]))}: `{group}` is a section (a mapping), not a "
+                              f"value; choose an option ({group}=NAME) or set its keys ({group}.KEY=...)")
     for group in ("integrator", "system", "regime"):
         node = plain.get(group)
         if isinstance(node, dict) and "_target_" in node and _plugin_keys(group, node["_target_"]):
@@ -392,12 +414,69 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
     for key in ("task",):
         if key in plain and not isinstance(plain[key], str):
             raise ConfigError(f"{key}={shorten(repr(plain[key]))} must be a task name (a string)")
+    n_output = plain["time"].get("n_output")
+    if n_output != "auto" and (isinstance(n_output, bool) or not isinstance(n_output, int)):
+        raise ConfigError(f"time.n_output={shorten(repr(n_output))} must be an integer (the samples stored) or auto")
+    for section, node in plain.items():
+        _check_magnitudes(str(section), node)
+    _check_degenerate_vectors(plain)
     accuracy = plain.get("accuracy")
     if accuracy is not None:
         check_type("accuracy", accuracy, 0.0)
     if "allow_large" in plain:
         check_type("allow_large", plain["allow_large"], False)
     return plain
+
+
+def _check_degenerate_vectors(plain: dict[str, Any]) -> None:
+    """A zero centre-of-mass vector under uniform gravity is a torque that silently vanishes: refused.
+
+    (Zero field directions and axes are refused by the plugins that normalise them.)
+    """
+    forces = plain.get("force") or {}
+    if not isinstance(forces, dict):
+        return
+    magnetic = forces.get("magnetic")
+    if isinstance(magnetic, dict) and _is_zero(magnetic.get("moment")):
+        raise ConfigError(f"force.magnetic.moment={magnetic['moment']} is a zero vector, so the magnetic force would "
+                          "exert no torque; give the body's magnetic moment (e.g. force.magnetic.moment=[0,0,1]), or "
+                          "leave magnetic out of the forces (force=[uniform_gravity])")
+    if "uniform_gravity" not in forces:
+        return
+    body = plain.get("body") or {}
+    key = "com" if body.get("units") == "si" else "com_direction"
+    vector = body.get(key)
+    if _is_zero(vector):
+        raise ConfigError(f"body.{key}={vector} is a zero vector, so uniform gravity would exert no torque; give the "
+                          f"centre of mass's direction (e.g. body.{key}=[0,0,1]), or to run without gravity torque "
+                          "leave uniform_gravity out of the forces (force=[] for the torque-free Euler top)")
+
+
+def _is_zero(vector: Any) -> bool:
+    return isinstance(vector, list) and bool(vector) and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) and v == 0 for v in vector)
+
+
+#: no physical setting of a scene is this large; beyond it squares and products overflow a double
+MAX_MAGNITUDE = 1e100
+
+
+def _check_magnitudes(where: str, node: Any) -> None:
+    """ConfigError for a number beyond :data:`MAX_MAGNITUDE` (``initial.r0=1e300`` overflows the first product)."""
+    if isinstance(node, dict):
+        for key, value in node.items():
+            _check_magnitudes(f"{where}.{key}", value)
+    elif isinstance(node, list):
+        for i, value in enumerate(node):
+            _check_magnitudes(f"{where}[{i}]", value)
+    elif isinstance(node, (int, float)) and not isinstance(node, bool):
+        try:
+            large = MAX_MAGNITUDE < abs(float(node)) < float("inf")  # inf and nan: require_finite says so
+        except OverflowError:
+            large = True
+        if large:
+            raise ConfigError(f"{where}={shorten(repr(node), 40)} is too large; gyrolab takes numbers up to "
+                              f"{MAX_MAGNITUDE:.0e} in magnitude (use nondimensional or scaled units)")
 
 
 def _plugin_keys(group: str, target: Any) -> set[str]:
@@ -409,7 +488,7 @@ def _plugin_keys(group: str, target: Any) -> set[str]:
 
 
 def _example_key(section: str) -> str:
-    return {"time": "end", "output": "figures", "body": "a", "initial": "r0"}[section]
+    return {"time": "end", "output": "figures", "body": "a", "initial": "r0"}.get(section, "")
 
 
 def check_type(where: str, value: Any, default: Any) -> None:

@@ -9,17 +9,51 @@ off (``allow_bars(False)``): the sweep shows one bar for all its jobs.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from typing import Any, TextIO
 
 log = logging.getLogger("gyrolab.progress")
 
 BAR_DELAY = 2.0
 _bars_allowed = True
+
+
+#: loggers whose INFO notes say that something is being compiled ("compiling force NAME, once")
+COMPILE_LOGGERS = ("gyrolab.plugins.compiled.plugin_torque",)
+
+
+@contextlib.contextmanager
+def compile_notes_on_console(stream: TextIO | None = None) -> Iterator[None]:
+    """Show the compile notes of ``COMPILE_LOGGERS`` on ``stream`` (stderr) while logging is not configured yet.
+
+    The command's preflight builds the scene before Hydra configures logging, and building it compiles a force
+    plugin's torque (once; later processes load the cache). Without a handler Python drops an INFO record, and
+    the run itself no longer compiles: the note "compiling force NAME, once" was never seen. Nothing changes
+    when logging is configured already (a handler on the root logger).
+    """
+    if logging.getLogger().handlers:
+        yield
+        return
+    handler = logging.StreamHandler(sys.stderr if stream is None else stream)
+    handler.setFormatter(logging.Formatter("gyrolab: %(message)s"))
+    loggers = [logging.getLogger(name) for name in COMPILE_LOGGERS]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.addHandler(handler)
+        if logger.getEffectiveLevel() > logging.INFO:
+            logger.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        for logger, level in zip(loggers, levels):
+            logger.removeHandler(handler)
+            logger.setLevel(level)
 
 
 def allow_bars(allowed: bool) -> None:
@@ -78,10 +112,15 @@ class Progress:
             return
         fraction = (t - self.t_start) / (self.t_end - self.t_start)
         elapsed = now - self._began
-        # the remaining time at the pace since the last report (a compiled method's first report includes
-        # its compilation), or since the start at the first report
-        since, t_since = (self._last, self._t_last) if self._t_last is not None else (self._began, self.t_start)
+        first = self._t_last is None
+        since, t_since = self._last, self._t_last
         self._last, self._t_last = now, t
+        if first:
+            # the time before the first report includes a compiled method's compilation (and its start-up):
+            # a pace from it is no pace of the integration, so no estimate until a stretch has been measured
+            log.info("%s: %3.0f%% (t=%.6g of %.6g), %s elapsed (compilation included), measuring the pace",
+                     self.label, 100 * fraction, t, self.t_end, duration(elapsed))
+            return
         pace = (t - t_since) / (now - since) if now > since else 0.0
         remaining = (self.t_end - t) / pace if pace > 0 else float("nan")
         log.info("%s: %3.0f%% (t=%.6g of %.6g), %s elapsed, ~%s to go",

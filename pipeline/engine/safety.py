@@ -105,6 +105,10 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
             raise ConfigError(f"{path}={shorten(repr(value))} is not allowed; under hydra a config may name only "
                               f"gyrolab's sweep callback and the installed launchers and sweepers "
                               f"({', '.join(sorted(t.rsplit('.', 1)[1] for t in allowed))})")
+    mode = str(plain_hydra.get("mode") or "")
+    if mode.endswith("MULTIRUN") != job_subdir and mode not in ("", "None"):
+        raise ConfigError(f"hydra.mode={mode.rsplit('.', 1)[-1]} disagrees with the command line; start a sweep "
+                          "with -m (gyrolab -m KEY=V1,V2 ...) and a single run without it")
     _check_paths(plain_hydra, Path(run_dir))
     out = _output_dir(run_dir, plain_hydra, job_subdir)
     for name in ("job_logging", "hydra_logging"):
@@ -150,15 +154,56 @@ def check_output_dir(text: str, key: str) -> None:
     if not text.strip() or text.strip() in (".", "./"):
         raise ConfigError(f"{key}={text!r} would write into the working directory itself; give a directory "
                           f"for the results, e.g. {key}=outputs/run1")
+    if "\0" in text or len(text) > 4096 or any(len(part) > 255 for part in directory.parts):
+        raise ConfigError(f"{key}={shorten(repr(text))} is not a usable path (a NUL byte, a name longer than 255 "
+                          f"characters or a path longer than 4096); give a directory, e.g. {key}=outputs/run1")
     resolved = Path(os.path.abspath(directory))
     cwd = Path(os.getcwd())
     if resolved == cwd or resolved in cwd.parents:
         raise ConfigError(f"{key}={shorten(text)} is the working directory or one of its parents; give a "
                           f"directory of its own for the results, e.g. {key}=outputs/run1")
-    for protected in _protected_dirs():
-        if resolved == protected or protected in resolved.parents:
-            raise ConfigError(f"{key}={shorten(text)} is inside {protected}, where Python loads code from; give a "
+    try:  # through symbolic links: a link into site-packages is where it points
+        real = Path(os.path.realpath(resolved, strict=False))
+    except (OSError, RuntimeError):  # a symlink loop (RuntimeError before Python 3.13)
+        raise ConfigError(f"{key}={shorten(text)} cannot be resolved (a loop of symbolic links?); give a directory "
+                          f"for the results, e.g. {key}=outputs/run1") from None
+    _refuse_link_loop(resolved, key, text)
+    for candidate in (resolved, real):
+        if _is_system_dir(candidate):
+            raise ConfigError(f"{key}={shorten(text)} is inside a system directory ({candidate.parts[1]}); give a "
                               f"directory for results, e.g. {key}=outputs/run1")
+    for candidate in (resolved, real):
+        if {"site-packages", "dist-packages"} & set(candidate.parts):  # any Python's, not only this one's
+            raise ConfigError(f"{key}={shorten(text)} is inside a site-packages folder, where Python loads code "
+                              f"from; give a directory for results, e.g. {key}=outputs/run1")
+    for protected in _protected_dirs():
+        for candidate in (resolved, real):
+            if candidate == protected or protected in candidate.parents:
+                raise ConfigError(f"{key}={shorten(text)} is inside {protected}, where Python loads code from; "
+                                  f"give a directory for results, e.g. {key}=outputs/run1")
+
+
+#: top-level folders of the operating system: results never go there (gyrolab may run as root in a container)
+SYSTEM_DIRS = frozenset({"bin", "boot", "dev", "etc", "lib", "lib32", "lib64", "proc", "run", "sbin", "sys", "usr"})
+
+
+def _is_system_dir(path: Path) -> bool:
+    parts = path.parts
+    if os.name != "posix" or len(parts) < 2 or parts[1] not in SYSTEM_DIRS:
+        return False
+    return not (parts[1] == "usr" and len(parts) > 2 and parts[2] == "local")  # /usr/local: the admin's own
+
+
+def _refuse_link_loop(path: Path, key: str, text: str) -> None:
+    """ConfigError when an existing part of ``path`` is a loop of symbolic links (realpath does not say so)."""
+    for part in (path, *path.parents):
+        if os.path.islink(part):
+            try:
+                os.stat(part)
+            except OSError as error:
+                if error.errno == 40:  # ELOOP
+                    raise ConfigError(f"{key}={shorten(text)} goes through a loop of symbolic links ({part}); give a "
+                                      f"directory for the results, e.g. {key}=outputs/run1") from None
 
 
 @cache
@@ -169,6 +214,7 @@ def _protected_dirs() -> tuple[Path, ...]:
                  str(Path(__file__).resolve().parents[1])]:  # the last one: gyrolab's own folder
         if path:
             dirs.add(Path(os.path.abspath(path)))
+            dirs.add(Path(os.path.realpath(path)))
     return tuple(sorted(dirs))
 
 
@@ -312,3 +358,32 @@ def _check_launcher_shell(launcher: dict[str, Any], command_line: Sequence[str])
             raise ConfigError(f"hydra.launcher.{key}={shorten(repr(value))} comes from a config file; shell lines and "
                               f"scheduler arguments run as you, so give them on the command line "
                               f"(hydra.launcher.{key}=...)")
+
+
+#: a file name a config may give for an output: plain names and folders, ending in .nc
+_OUTPUT_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.+-]*(/[A-Za-z0-9_][A-Za-z0-9_.+-]*)*\.nc$")
+
+
+def confined_output_path(out_dir: str | os.PathLike[str], name: Any, key: str) -> Path:
+    """``out_dir/name`` when it stays inside ``out_dir`` (symlinks resolved), else one ConfigError sentence.
+
+    Every file a config names for writing (``stability_map.file``) goes through here: a relative path
+    without ``..``, ending in ``.nc``, whose resolved location (through any symlink already in the run
+    directory) is inside the resolved run directory — so ``../elsewhere/x.pth`` or a link into
+    site-packages cannot make gyrolab write a file Python would load.
+    """
+    text = str(name) if isinstance(name, (str, os.PathLike)) else ""
+    parts = Path(text).parts
+    if not _OUTPUT_NAME.match(text) or ".." in parts or len(text) > 255:
+        raise ConfigError(f"{key}={shorten(repr(name))} must be a file name ending in .nc inside the run directory "
+                          f"(no '/..', no absolute path), e.g. {key}=stability_map.nc")
+    base = Path(out_dir).resolve()
+    target = (base / text).resolve()
+    if base not in target.parents:
+        raise ConfigError(f"{key}={shorten(text)} leads outside the run directory through a symbolic link; "
+                          f"give a file name inside it, e.g. {key}=stability_map.nc")
+    for protected in _protected_dirs():
+        if target == protected or protected in target.parents:
+            raise ConfigError(f"{key}={shorten(text)} lands inside {protected}, where Python loads code from; "
+                              f"choose a run directory for results")
+    return base / text

@@ -29,6 +29,15 @@ TASKS = {
 }
 
 
+def check_task(name: str, cfg: DictConfig, out_dir: Path) -> None:
+    """The refusals an experiment can make before anything runs (its module's ``check(cfg, out_dir)``, if any):
+    the preflight calls it, so that a bad grid or output name leaves no run directory behind."""
+    if name in TASKS:
+        check = getattr(importlib.import_module(TASKS[name]), "check", None)
+        if check is not None:
+            check(cfg, out_dir)
+
+
 def run_task(name: str, cfg: DictConfig, out_dir: Path) -> list[Path]:
     """Run experiment task ``name``; returns the files it wrote."""
     if name not in TASKS:

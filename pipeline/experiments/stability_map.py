@@ -18,8 +18,10 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
+from gyrolab.engine.budget import check_points
+from gyrolab.engine.safety import confined_output_path
 from gyrolab.engine.scene import Scene
-from gyrolab.errors import ConfigError, OutputError, as_number
+from gyrolab.errors import ConfigError, as_number, shorten
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.cf import conform
 
@@ -43,6 +45,7 @@ def grid(cfg: DictConfig) -> list[Dim]:
     if points is not None:
         if isinstance(points, bool) or not isinstance(points, int) or points < 1:
             raise ConfigError(f"batch.points={points!r} must be a positive integer (the map's number of points)")
+        check_points(points, f"batch.points={points}", allow_large=cfg.get("allow_large") is True)
         n_theta = n_r = max(1, round(math.sqrt(points)))
     else:
         n_theta, n_r = settings.n_theta0, settings.n_r0
@@ -50,9 +53,15 @@ def grid(cfg: DictConfig) -> list[Dim]:
     for key, span, n in (("theta0", settings.theta0, n_theta), ("r0", settings.r0, n_r)):
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise ConfigError(f"stability_map.n_{key}={n!r} must be a positive integer")
+        if points is None and key == "r0":
+            check_points(float(n_theta) * n_r, f"stability_map.n_theta0={n_theta} × n_r0={n_r}",
+                         allow_large=cfg.get("allow_large") is True)
         if len(span) != 2:
             raise ConfigError(f"stability_map.{key}={list(span)!r} must be [first, last]")
         first, last = (as_number(v, f"stability_map.{key}") for v in span)
+        if n > 1 and first == last:
+            raise ConfigError(f"stability_map.{key}={list(span)!r} is one value, but n_{key}={n} points are asked; "
+                              f"give [first, last] with first ≠ last, or n_{key}=1")
         spacing = settings.get(f"{key}_spacing", "linear")
         if spacing not in ("linear", "log") or (spacing == "log" and not 0 < first < last):
             raise ConfigError(f"stability_map.{key}_spacing={spacing!r} must be linear or log (log: 0 < first < last)")
@@ -62,21 +71,33 @@ def grid(cfg: DictConfig) -> list[Dim]:
     return dims
 
 
+def check(cfg: DictConfig, out_dir: Path) -> None:
+    """The refusals of :func:`run` that need no integration, made by the preflight before the run directory exists:
+    the grid (its size against the budget) and the map's file name (inside the run directory)."""
+    grid(cfg)
+    confined_output_path(out_dir, cfg.stability_map.get("file"), "stability_map.file")
+    sections = cfg.stability_map.get("sections") or []
+    if sections:
+        t_end = as_number(cfg.stability_map.get("section_time"), "stability_map.section_time")
+        if not t_end > 0:
+            raise ConfigError(f"stability_map.section_time={t_end!r} must be a positive time")
+        for n, point in enumerate(sections):
+            if isinstance(point, (str, bytes)) or not hasattr(point, "__len__") or len(point) != 2:
+                raise ConfigError(f"stability_map.sections[{n}]={shorten(repr(point))} must be [theta0, r0]")
+            for v in point:
+                as_number(v, f"stability_map.sections[{n}]")
+
+
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     from gyrolab.batch.sweep import run_batch
 
     plain = OmegaConf.to_container(cfg, resolve=True)
     plain.pop("hydra", None)
-    path = Path(out_dir) / cfg.stability_map.file
+    path = confined_output_path(out_dir, cfg.stability_map.file, "stability_map.file")
     run_batch([], grid(cfg), path, plain=plain, lock=False)   # the app holds the run directory's lock
     sections = cfg.stability_map.get("sections") or []
     if sections:
-        try:
-            _add_sections(path, plain, sections,
-                          as_number(cfg.stability_map.section_time, "stability_map.section_time"))
-        except OutputError as error:   # a full disk: the map is complete on disk; the rerun adds the sections
-            raise OutputError(f"{str(error).rstrip('.')}; the map itself is kept: free some space and rerun the "
-                              "same command to add its Poincaré sections") from None
+        _add_sections(path, plain, sections, as_number(cfg.stability_map.section_time, "stability_map.section_time"))
     with xr.open_dataset(path) as ds:
         return [path, *draw_figures("stability_map.nc", ds.load(), out_dir, cfg.get("output"))]
 

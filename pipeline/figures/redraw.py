@@ -3,8 +3,7 @@
 PATH is a run directory (``run.nc``), a regime run, an experiment or sweep directory, or one ``.nc``
 file. Each dataset's figures are written to ``figures/`` beside it, with the current style, formats
 and dpi. Datasets directly in PATH are always drawn; in a sweep directory the jobs' ``run.nc`` are
-redrawn only where the job drew figures in the first place (``output.figures`` and ``output.job_figures``
-in its stored config); ``gyrolab --plot SWEEP_DIR/N`` draws job N's figures in any case.
+redrawn only where the job drew figures in the first place (``output.figures`` in its stored config).
 """
 
 from __future__ import annotations
@@ -16,7 +15,8 @@ from pathlib import Path
 import xarray as xr
 from omegaconf import OmegaConf
 
-from gyrolab.errors import ConfigError, OutputError
+from gyrolab.errors import ConfigError, GyrolabError
+from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 
 #: dataset file name -> the gyrolab.figures module that draws its figures
@@ -33,17 +33,26 @@ KINDS = {
     "stability_map.nc": "stability_map",
 }
 
+#: a variable every dataset of a kind has, for kinds whose figures would otherwise quietly draw nothing
+SIGNATURES = {"run.nc": "time", "sweep.nc": "job_status"}
+
 
 def draw_dataset(path: Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int = DEFAULT_DPI) -> list[Path]:
     """Redraw the figures of one dataset file into ``figures/`` beside it."""
     path = Path(path)
     if path.name not in KINDS:
         raise ConfigError(f"{str(path)!r} is not a dataset gyrolab draws figures from; known: {', '.join(KINDS)}")
+    expected = f"a {path.name} that gyrolab wrote"
+    ds = load_dataset(path, expected)
+    needed = SIGNATURES.get(path.name)
+    if needed is not None and needed not in ds.variables:
+        raise not_gyrolabs(path, KeyError(needed), expected)
     try:
-        ds = xr.load_dataset(path)
-    except (OSError, ValueError) as error:
-        raise OutputError(f"cannot read {str(path)!r}: {error}") from None
-    return save_kind(path.name, ds, path.parent / "figures", tuple(formats), dpi)
+        return save_kind(path.name, ds, path.parent / "figures", tuple(formats), dpi)
+    except GyrolabError:
+        raise
+    except FOREIGN_ERRORS as error:  # a variable or attribute gyrolab's datasets have is missing
+        raise not_gyrolabs(path, error, expected) from None
 
 
 def save_kind(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ...], dpi: int) -> list[Path]:
@@ -58,13 +67,11 @@ def save_kind(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ..
 
 
 def _drew_figures(path: Path) -> bool:
-    """Whether the sweep job stored at ``path`` drew figures: its stored config's ``output.figures`` and
-    ``output.job_figures`` (runs older than ``job_figures`` drew them whenever ``output.figures`` was on)."""
+    """Whether the run stored at ``path`` drew figures (its stored config's ``output.figures``)."""
     try:
         with xr.open_dataset(path) as ds:
-            config = OmegaConf.create(ds.attrs.get("config", ""))
-        return bool(OmegaConf.select(config, "output.figures", default=True)) and bool(
-            OmegaConf.select(config, "output.job_figures", default=True))
+            config = ds.attrs.get("config", "")
+        return bool(OmegaConf.select(OmegaConf.create(config), "output.figures", default=True))
     except Exception:  # noqa: BLE001 -- unreadable: leave it alone
         return False
 

@@ -113,10 +113,9 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w", **kwargs) -> Iter
 _TRUSTED = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS)
 
 
-def diagnose(error: BaseException, tmp: Path, expected_bytes: int | None = None, *, keep: bool = False) -> str:
+def diagnose(error: BaseException, tmp: Path, expected_bytes: int | None = None) -> str:
     """Why writing ``tmp`` failed: the error's own errno when it is unambiguous, else what the file system
-    says now (file-size limit, a probe write, the free space), else the error's own reason. ``keep``: ``tmp``
-    holds finished work (a batch's partial store), so the probe goes to a file of its own beside it."""
+    says now (file-size limit, a probe write, the free space), else the error's own reason."""
     if isinstance(error, OSError) and error.errno in _TRUSTED:
         return reason(error)
     try:
@@ -126,18 +125,14 @@ def diagnose(error: BaseException, tmp: Path, expected_bytes: int | None = None,
     limit, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
     if limit != resource.RLIM_INFINITY and max(written + PROBE_BYTES, expected_bytes or 0) >= limit:
         return f"file too large for the process's file-size limit of {_size(limit)} (ulimit -f)"
-    probe_path = tmp.with_name(f".{tmp.name}.probe{TEMP_SUFFIX}") if keep else tmp
     try:  # a full disk or quota fails this small write too, with the errno the library did not report
-        with open(probe_path, "ab") as handle:
+        with open(tmp, "ab") as handle:
             handle.write(bytes(PROBE_BYTES))
             handle.flush()
             os.fsync(handle.fileno())
     except OSError as probe:
         if probe.errno in _TRUSTED:
             return reason(probe)
-    finally:
-        if keep:
-            probe_path.unlink(missing_ok=True)
     try:
         stats = os.statvfs(tmp.parent)
     except OSError:

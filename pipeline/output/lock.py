@@ -17,6 +17,7 @@ job that holds its directory can call code that locks the same directory.
 
 from __future__ import annotations
 
+import atexit
 import errno
 import fcntl
 import logging
@@ -24,6 +25,7 @@ import os
 import socket
 from collections.abc import Iterator
 from contextlib import contextmanager
+from functools import cache
 from pathlib import Path
 
 from gyrolab.errors import ConfigError, OutputError
@@ -70,8 +72,27 @@ def try_lock(directory: str | os.PathLike[str], *, blocking: bool = False) -> bo
         raise OutputError(f"cannot lock {str(directory)!r}: {reason(error)}") from None
     if fd is None:
         return False
+    if not _held:
+        _release_at_exit()
     _held[key] = [fd, 1]
     return True
+
+
+def release_all() -> None:
+    """Release every lock this process holds and remove its lock file (the end of a command, however it ends).
+
+    A single run's directory is locked by Hydra's ``on_run_start`` callback, whose ``on_run_end`` Hydra
+    skips when the job exits with an error: without this, a failed run left its ``.gyrolab.lock``.
+    """
+    for key in list(_held):
+        _held[key][1] = 1
+        unlock(key)
+
+
+@cache
+def _release_at_exit() -> None:
+    """Release the held locks on every exit Python sees (sys.exit, an uncaught exception, Ctrl-C)."""
+    atexit.register(release_all)
 
 
 def unlock(directory: str | os.PathLike[str]) -> None:

@@ -103,9 +103,9 @@ class SweepSummary:
     missing: int
     skipped: int
     failures: list[tuple[str, str]] = field(default_factory=list)   # (overrides, error)
+    #: failed jobs whose result could not be written (a full disk: OutputError), retried on resume
+    write_failures: int = 0
     figures: list[Path] = field(default_factory=list)
-    #: the failed jobs whose result could not be written (a full disk: OutputError), retried on the next run
-    write_failures: list[tuple[str, str]] = field(default_factory=list)   # (overrides, error)
 
 
 # ----------------------------------------------------------------------------- assembling
@@ -431,8 +431,7 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
         path=path, n_jobs=len(results), finished=int(ds.attrs["n_finished"]), failed=int(ds.attrs["n_failed"]),
         missing=int(ds.attrs["n_missing"]), skipped=sum(r.skipped for r in results),
         failures=[(" ".join(grid.jobs[n]), r.error) for n, r in enumerate(results) if r.status == FAILED],
-        write_failures=[(" ".join(grid.jobs[n]), r.error) for n, r in enumerate(results)
-                        if r.status == FAILED and r.error_type == "OutputError"])
+        write_failures=sum(r.status == FAILED and r.error_type == "OutputError" for r in results))
     if figures and grid.dims and summary.finished:
         from gyrolab.sweep.figures import save_sweep_figures  # matplotlib only when figures are drawn
 

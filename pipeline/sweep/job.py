@@ -36,6 +36,19 @@ from gyrolab.sweep.record import (
 log = logging.getLogger("gyrolab.sweep")
 
 
+def draws_job_figures(output: object) -> bool:
+    """Whether a sweep job draws its own figures: only with ``output.job_figures=true`` (and figures on).
+
+    Off by default so that a sweep does not wait on pictures (four figures cost ~2 CPU s per job, the
+    integration of a short scene ~0.1 s); the sweep's own figures are drawn as before, and
+    ``gyrolab --plot SWEEP_DIR`` draws every job's figures from its ``run.nc`` when they are wanted.
+    """
+    get = getattr(output, "get", None)
+    if get is None:
+        return False
+    return bool(get("figures", True)) and bool(get("job_figures", False))
+
+
 def run_sweep_job(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_num: int | None,
                   work: Callable[[str], Path]) -> JobRecord:
     """Run ``work(job_id)`` (which writes the job's dataset and returns its path) unless already done.

@@ -17,7 +17,8 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.engine.budget import check_budget
 from gyrolab.engine.safety import check_stored_config
-from gyrolab.errors import ConfigError, shorten
+from gyrolab.errors import ConfigError, GyrolabError
+from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 
@@ -39,13 +40,7 @@ class Comparison:
 
 def load_run(path: Path) -> xr.Dataset:
     path = Path(path)
-    try:
-        ds = xr.load_dataset(path, decode_times=False, decode_timedelta=False)
-    except (OSError, ValueError, RuntimeError, KeyError, TypeError) as error:
-        reason = (getattr(error, "strerror", None) or "it is not a netCDF file" if isinstance(error, (OSError, ValueError))
-                  else shorten(str(error).splitlines()[0] if str(error) else type(error).__name__, 120))
-        raise ConfigError(f"cannot read {str(path)!r} as a netCDF dataset ({reason}); give a run.nc that "
-                          "gyrolab wrote") from None
+    ds = load_dataset(path, "a run.nc that gyrolab wrote", decode_times=False, decode_timedelta=False)
     if "config" not in ds.attrs and "job_status" in ds:
         raise ConfigError(f"{str(path)!r} is a sweep dataset, not a run; give one job's run.nc (sweep.nc's "
                           "job_dir variable names each job's directory)")
@@ -129,7 +124,20 @@ def _difference(old: xr.DataArray, new: xr.DataArray) -> str:
 
 def reproduce(path: Path) -> tuple[Comparison, xr.Dataset]:
     stored = load_run(path)
-    return compare(stored, rerun(stored)), stored
+    expected = "a run.nc that gyrolab wrote"
+    try:
+        scene = Scene.from_config(stored_config(stored))
+    except GyrolabError:
+        raise
+    except FOREIGN_ERRORS as error:  # a stored config without what gyrolab's runs always have
+        raise not_gyrolabs(path, error, expected) from None
+    new = scene.run()
+    try:
+        return compare(stored, new), stored
+    except GyrolabError:
+        raise
+    except FOREIGN_ERRORS as error:  # variables that gyrolab's runs always have are missing
+        raise not_gyrolabs(path, error, expected) from None
 
 
 def report(path: Path, comparison: Comparison, stored: xr.Dataset) -> list[str]:

@@ -1,6 +1,6 @@
 """The Taylor method (``taylor``) for many trajectories at once: per-trajectory steps, vectorised across them.
 
-``run_blocks`` (fixed-point (ω, γ) states) advances LANES = 4 trajectories in
+``run_blocks`` (fixed-point (ω, γ) states) advances LANES (8 on AVX-512, 4 on AVX2) trajectories in
 lock step, one AVX2 vector: their Taylor coefficients are stored
 [order, state, lane], lane innermost, and the series of all four lanes are
 computed together in 4-wide SIMD registers (``_series``), as is the state
@@ -43,7 +43,13 @@ from numba.core import cgutils
 
 from gyrolab.plugins.compiled.layout import INERTIA, INV_INERTIA, N_Z, U_Z
 from gyrolab.plugins.compiled import kernel, simd, taylor
-from gyrolab.plugins.compiled.simd import LANES  # trajectories advanced in lock step: one AVX2 vector of doubles
+from gyrolab.plugins.compiled.vector_width import batch_lanes
+
+#: trajectories advanced in lock step: one vector register of doubles of the CPU numba compiles for (8 with
+#: AVX-512, 4 with AVX2; never fewer than 4). Fixed when this module is imported, so frozen into the compiled
+#: kernels; numba's cache keys every kernel by the target CPU's name and features (its ``magic_tuple``), from
+#: which the width follows, so a cache written for another width is not loaded.
+LANES = batch_lanes()
 from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK, TOO_SMALL_STEP
 
 TASK = 256  # trajectories per parallel task, at most
@@ -52,7 +58,7 @@ SUMS = 9  # Cauchy sums per order: pairs of ω (3), pairs of γ (3), γ × ω (3
 CONSTANTS = 10  # a lane's right-hand-side constants (``_load``)
 
 
-@simd.series(STATE)
+@simd.series(STATE, LANES)
 def _series(v, p, row):
     """Fill T[1..order] from T[0] in every lane: ``fixed_point.taylor_coefficients`` without α, lanes in columns.
 
@@ -98,7 +104,7 @@ def _series(v, p, row):
 #: Every lane's state T[0] += Σ_{k≥1} T[k] h^k (Horner), a compensated (Kahan) sum with ``carry``: H is (1, LANES),
 #: the lanes' steps (0 in idle lanes); carry (STATE, LANES). The Horner sums may fuse multiply and add; the Kahan
 #: update is strict (``taylor.run``'s arithmetic), and the six components' Horner chains interleave.
-_update = simd.update(STATE, STATE)
+_update = simd.update(STATE, STATE, LANES)
 
 
 def task_size(count: int) -> int:

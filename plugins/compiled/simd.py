@@ -22,7 +22,7 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-LANES = 4  # one AVX2 vector of doubles
+LANES = 4  # one AVX2 vector of doubles: the single trajectory's (x, y, z, 0) rows (``taylor``)
 FUSE = ("contract",)  # the series' multiply and add may fuse (as in the scalar kernel's fastmath)
 
 
@@ -34,9 +34,10 @@ def vector_arrays(arrays) -> bool:
 class Lanes:
     """LLVM IR helpers of the intrinsics: arrays of doubles seen as rows of ``<LANES x double>`` vectors."""
 
-    def __init__(self, context, builder, signature, args):
+    def __init__(self, context, builder, signature, args, width=LANES):
         self.builder = builder
-        self.vec = ir.VectorType(ir.DoubleType(), LANES)
+        self.width = width
+        self.vec = ir.VectorType(ir.DoubleType(), width)
         self.arrays = [builder.bitcast(context.make_array(ty)(context, builder, value).data, self.vec.as_pointer())
                        if isinstance(ty, types.Array) else value for ty, value in zip(signature.args, args)]
 
@@ -59,8 +60,8 @@ class Lanes:
     def splat(self, scalar):
         b = self.builder
         one = b.insert_element(ir.Constant(self.vec, ir.Undefined), scalar, ir.Constant(ir.IntType(32), 0))
-        return b.shuffle_vector(one, ir.Constant(self.vec, ir.Undefined), ir.Constant(ir.VectorType(ir.IntType(32), LANES),
-                                                                                      [0] * LANES))
+        return b.shuffle_vector(one, ir.Constant(self.vec, ir.Undefined), ir.Constant(ir.VectorType(ir.IntType(32), self.width),
+                                                                                      [0] * self.width))
 
     def variables(self, count):
         """Vector variables (stack slots that LLVM promotes to registers)."""
@@ -90,7 +91,7 @@ class Lanes:
         return b.fmul(b.fadd(b.fmul(q, inner, flags=FUSE), torque, flags=FUSE), inv, flags=FUSE)
 
 
-def series(stride):
+def series(stride, width=LANES):
     """Decorator: an intrinsic ``(T, order, Q)`` (T: ``stride`` vector rows per order, Q: rows of constants) from
     ``emit(v, order, row)``, which writes its IR with ``v`` (``Lanes``), ``order`` (an LLVM integer) and
     ``row(index, column)`` (T's vector row of that order and column)."""
@@ -101,7 +102,7 @@ def series(stride):
                 return None
 
             def codegen(context, builder, signature, args):
-                v = Lanes(context, builder, signature, args)
+                v = Lanes(context, builder, signature, args, width)
                 p = context.cast(builder, args[1], signature.args[1], types.intp)
                 emit(v, p, lambda index, column: v.row(builder, index, stride, column))
                 return context.get_dummy_value()
@@ -114,7 +115,7 @@ def series(stride):
     return wrap
 
 
-def update(stride, count):
+def update(stride, count, width=LANES):
     """An intrinsic ``(T, order, H, carry)``: the state rows T[0, 0..count−1] += Σ_{k≥1} T[k, c] h^k (Horner,
     multiply and add may fuse), a compensated (Kahan, strict arithmetic) sum with carry's rows 0..count−1.
 
@@ -129,7 +130,7 @@ def update(stride, count):
         sig = types.void(T, order, H, carry)
 
         def codegen(context, builder, signature, args):
-            v = Lanes(context, builder, signature, args)
+            v = Lanes(context, builder, signature, args, width)
             b = builder
             p = context.cast(builder, args[1], signature.args[1], types.intp)
             h = v.load(2, 0)

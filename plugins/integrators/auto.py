@@ -154,6 +154,11 @@ class Auto(Integrator):
 
     def prepare(self, system: Any) -> None:
         self.system = system
+        # the floor of integrate(), checked when the scene is built: a refusal before the run directory exists
+        scale = max(1.0, *map(abs, system.initial_state()))
+        if self.accuracy < FLOOR * scale:
+            raise ConfigError(f"accuracy={self.accuracy:g} is below what double precision reaches on this scene "
+                              f"(about {FLOOR * scale:.1g} for states of size {scale:.3g}); ask for more")
 
     def _method(self, compiled: CompiledModel | None, tol: float) -> Integrator:
         if compiled is not None:

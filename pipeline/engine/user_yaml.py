@@ -1,0 +1,159 @@
+"""A user's YAML files (``--config-dir``, ``--config-path``) read as what they claim to be, before Hydra reads them.
+
+Hydra turns a YAML problem into a 65–104-line traceback, and expands anchors and aliases without
+bound (a "billion laughs" file hangs it). Each file is checked here first with PyYAML's safe
+loader; any problem is one ConfigError sentence naming the file and line, never its contents:
+
+- syntax errors, tabs, control characters (a NUL byte), text that is not UTF-8;
+- a duplicate key in a mapping (YAML forbids it; Hydra refuses it with a traceback);
+- a file that is not a mapping (a scalar or a list at the top): Hydra's config files are mappings;
+- alias expansion beyond :data:`MAX_EXPANDED_NODES` nodes, a file beyond :data:`MAX_FILE_BYTES`,
+  a folder with more than :data:`MAX_FILES` YAML files.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+import yaml
+
+from gyrolab.errors import ConfigError, shorten
+
+MAX_FILE_BYTES = 1024 * 1024
+#: the tags YAML's core schema resolves plain values to; any other (!!python/..., !custom) is refused
+CORE_TAGS = frozenset(f"tag:yaml.org,2002:{t}" for t in
+                      ("str", "int", "float", "bool", "null", "map", "seq", "merge", "timestamp", "binary"))
+MAX_FILES = 2000
+#: nodes of a file with every alias expanded (gyrolab's largest packaged file has a few hundred)
+MAX_EXPANDED_NODES = 100_000
+#: nesting of lists and mappings (gyrolab's deepest packaged file: 5; Python's recursion ends near 1000)
+MAX_DEPTH = 32
+
+
+def check_user_config_dir(directory: str, option: str) -> None:
+    """ConfigError (one sentence, file and line) for the first YAML file under ``directory`` that Hydra cannot read."""
+    count = 0
+    for root, dirs, files in os.walk(directory, followlinks=False):
+        dirs.sort()
+        for name in sorted(files):
+            if not name.endswith((".yaml", ".yml")):
+                continue
+            count += 1
+            if count > MAX_FILES:
+                raise ConfigError(f"{option} {shorten(directory)!r} holds more than {MAX_FILES} YAML files; give the "
+                                  "folder of your configs only")
+            check_user_yaml(Path(root) / name)
+
+
+def check_user_yaml(path: Path) -> None:
+    where = _display(path)
+    try:
+        if not stat.S_ISREG(path.stat().st_mode):  # a FIFO or a link to /dev/zero would block the read forever
+            raise ConfigError(f"{where} is not a regular file; a config folder holds YAML files")
+        if path.stat().st_size > MAX_FILE_BYTES:
+            raise ConfigError(f"{where} is larger than {MAX_FILE_BYTES // 1024} KiB; a config file is a short "
+                              "YAML mapping of settings")
+        data = path.read_bytes()
+    except OSError as error:
+        raise ConfigError(f"{where} cannot be read ({error.strerror or error}); a config folder holds readable "
+                          "YAML files") from None
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        line = data[:error.start].count(b"\n") + 1
+        raise ConfigError(f"{where}, line {line}: not UTF-8 text; a config file is a YAML text file") from None
+    bad = next((i for i, c in enumerate(text) if (ord(c) < 32 and c not in "\t\n\r") or c == "\x7f"), None)
+    if bad is not None:
+        raise ConfigError(f"{where}, line {text.count(chr(10), 0, bad) + 1}: a control character (code "
+                          f"{ord(text[bad])}) that YAML does not allow; a config file is plain text")
+    try:
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.MarkedYAMLError as error:
+        raise ConfigError(_sentence(where, error)) from None
+    except yaml.YAMLError as error:
+        raise ConfigError(f"{where} is not valid YAML ({shorten(type(error).__name__)})") from None
+    if node is None:
+        return  # an empty file is an empty config
+    if not isinstance(node, yaml.MappingNode):
+        kind = "a list" if isinstance(node, yaml.SequenceNode) else "a single value"
+        raise ConfigError(f"{where}, line {node.start_mark.line + 1}: the file is {kind}, not a mapping of settings "
+                          "(key: value lines); every config file is a mapping")
+    _check_nodes(node, where)
+    for key, value in node.value:
+        if key.value == "defaults" and not isinstance(value, yaml.SequenceNode):
+            raise ConfigError(f"{where}, line {value.start_mark.line + 1}: `defaults` must be a list (- group: option "
+                              "lines), as in Hydra's defaults list")
+
+
+def _display(path: Path) -> str:
+    """The file as the user can find it: relative to the working directory when inside it."""
+    text = str(path)
+    try:
+        relative = os.path.relpath(path)
+        text = relative if not relative.startswith("..") else text
+    except ValueError:
+        pass
+    return shorten(text, 200)
+
+
+def _sentence(where: str, error: yaml.MarkedYAMLError) -> str:
+    mark = error.problem_mark or error.context_mark
+    at = f", line {mark.line + 1}" if mark is not None else ""
+    problem = str(error.problem or error.context or "syntax error")
+    if "'\\t'" in problem:
+        problem = "a tab, which YAML does not allow for indentation (use spaces)"
+    return f"{where}{at}: not valid YAML ({shorten(problem, 120)}); fix the file or remove it from the folder"
+
+
+def _check_nodes(root: yaml.Node, where: str) -> None:
+    """Duplicate keys, and the size of the file with its aliases expanded (a shared node counts every time)."""
+    sizes: dict[int, int] = {}
+    stack: list[tuple[yaml.Node, bool, int]] = [(root, False, 0)]
+    on_path: set[int] = set()
+    while stack:
+        node, done, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise ConfigError(f"{where}, line {node.start_mark.line + 1}: lists and mappings nested more than "
+                              f"{MAX_DEPTH} deep; a config file is a short mapping of settings")
+        key = id(node)
+        if done:
+            on_path.discard(key)
+            children = _children(node)
+            sizes[key] = 1 + sum(sizes[id(c)] for c in children)
+            if sizes[key] > MAX_EXPANDED_NODES:
+                raise ConfigError(f"{where}, line {node.start_mark.line + 1}: its anchors and aliases expand to more "
+                                  f"than {MAX_EXPANDED_NODES} values; a config file is a short mapping of settings")
+            continue
+        if key in sizes:
+            continue
+        if key in on_path:
+            raise ConfigError(f"{where}, line {node.start_mark.line + 1}: an alias refers to itself; "
+                              "a config file cannot be recursive")
+        on_path.add(key)
+        if node.tag not in CORE_TAGS:
+            raise ConfigError(f"{where}, line {node.start_mark.line + 1}: the YAML tag {shorten(node.tag, 60)!r} is not "
+                              "allowed; a config file holds plain values (numbers, strings, lists, mappings)")
+        if isinstance(node, yaml.MappingNode):
+            seen: dict[object, int] = {}
+            for k, _ in node.value:
+                if not isinstance(k, yaml.ScalarNode):
+                    raise ConfigError(f"{where}, line {k.start_mark.line + 1}: a key is a list or a mapping; keys of a "
+                                      "config are plain names")
+                if isinstance(k, yaml.ScalarNode):
+                    if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
+                        raise ConfigError(f"{where}, line {k.start_mark.line + 1}: the key {shorten(k.value, 60)!r} "
+                                          f"is given twice in one mapping (first on line {seen[k.value]}); "
+                                          "give each key once")
+                    seen[k.value] = k.start_mark.line + 1
+        stack.append((node, True, depth))
+        stack.extend((c, False, depth + 1) for c in _children(node) if id(c) not in sizes)
+
+
+def _children(node: yaml.Node) -> list[yaml.Node]:
+    if isinstance(node, yaml.MappingNode):
+        return [n for pair in node.value for n in pair]
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    return []

@@ -1,0 +1,96 @@
+"""The speed tables' generator (benchmarks/tables.py) on a fixture results file, and the results file's machine record."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
+
+
+def _module(name: str):
+    spec = importlib.util.spec_from_file_location(f"_bench_{name}", BENCHMARKS / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+RECORD = {
+    "benchmark": "benchmarks/batch_heyoka.py", "date_utc": "2026-11-26T22:00Z", "cpu_model": "Fixture CPU 9000",
+    "cores": 2, "host_vector_doubles": 8, "batch_lanes": 4, "load_average_start": [3.25, 3, 3],
+    "load_average_end": [4.5, 4, 4], "clock": "time.process_time",
+    "versions": {"gyrolab": "0.1.0", "gyrolab_commit": "abc1234", "numba": "0.68.1", "numpy": "2.4.6", "heyoka": "7.13.2"},
+    "tables": {"batch_heyoka": {"caption": "CPU s at max error 1e-10.", "header": ["contestant", "CPU s"],
+                                "rows": [["heyoka, batch 8", "1.00"], ["gyrolab taylor", "0.45"]]}},
+}
+
+
+@pytest.fixture
+def tree(tmp_path):
+    (tmp_path / "docs").mkdir()
+    results = tmp_path / "benchmarks" / "results"
+    results.mkdir(parents=True)
+    (results / "batch_heyoka.json").write_text(json.dumps(RECORD))
+    (tmp_path / "README.md").write_text("# front page\n\nno blocks here\n")
+    (tmp_path / "docs" / "performance.md").write_text(
+        "intro\n<!-- generated: batch_heyoka -->\nold table\n<!-- /generated -->\nbetween\n"
+        "<!-- generated: nobody_has_this -->\nkept\n<!-- /generated -->\nend\n")
+    return tmp_path
+
+
+def test_blocks_are_rewritten_from_the_results_file_wherever_they_are(tree):
+    tables = _module("tables")
+    written, missing, changed = tables.regenerate(tree, tree / "benchmarks" / "results")
+    assert written == ["batch_heyoka"] and missing == ["nobody_has_this"]
+    assert changed == [tree / "docs" / "performance.md"]
+    text = (tree / "docs" / "performance.md").read_text()
+    assert "old table" not in text and "\nkept\n" in text and text.startswith("intro\n") and text.endswith("end\n")
+    block = text.split("<!-- generated: batch_heyoka -->\n")[1].split("<!-- /generated -->")[0]
+    assert "Fixture CPU 9000" in block and "8 doubles per vector register" in block and "4 lanes" in block
+    assert "2 cores" in block and "load average 3.2" in block and "commit abc1234" in block and "heyoka 7.13.2" in block
+    assert "| contestant | CPU s |\n| --- | --- |\n| heyoka, batch 8 | 1.00 |\n| gyrolab taylor | 0.45 |\n" in block
+    # a second run changes nothing, and --check agrees
+    assert tables.regenerate(tree, tree / "benchmarks" / "results")[2] == []
+    assert tables.main(["--root", str(tree), "--check"]) == 0
+
+
+def test_check_reports_a_stale_block_without_writing(tree):
+    tables = _module("tables")
+    before = (tree / "docs" / "performance.md").read_text()
+    assert tables.main(["--root", str(tree), "--check"]) == 1
+    assert (tree / "docs" / "performance.md").read_text() == before
+
+
+def test_a_table_moved_to_the_readme_is_found_there(tree):
+    tables = _module("tables")
+    (tree / "docs" / "performance.md").write_text("nothing\n")
+    (tree / "README.md").write_text("top\n<!-- generated: batch_heyoka -->\n<!-- /generated -->\n")
+    written, _, changed = tables.regenerate(tree, tree / "benchmarks" / "results")
+    assert written == ["batch_heyoka"] and changed == [tree / "README.md"]
+    assert "| gyrolab taylor | 0.45 |" in (tree / "README.md").read_text()
+
+
+def test_a_ragged_row_is_refused(tree):
+    tables = _module("tables")
+    record = dict(RECORD, tables={"batch_heyoka": {"header": ["a", "b"], "rows": [["1"]]}})
+    (tree / "benchmarks" / "results" / "batch_heyoka.json").write_text(json.dumps(record))
+    with pytest.raises(SystemExit):
+        tables.regenerate(tree, tree / "benchmarks" / "results")
+
+
+def test_results_file_records_the_machine(tmp_path, monkeypatch):
+    results_file = _module("results_file")
+    monkeypatch.setattr(results_file, "RESULTS", tmp_path)
+    path = results_file.write_results("fixture", {"x": 1.5}, {"t": {"header": ["a"], "rows": [["1"]]}})
+    record = json.loads(path.read_text())
+    for key in ("cpu_model", "cores", "host_vector_doubles", "batch_lanes", "load_average_start",
+                "load_average_end", "clock", "date_utc"):
+        assert key in record
+    assert record["numbers"] == {"x": 1.5} and record["benchmark"] == "benchmarks/fixture.py"
+    for lib in ("gyrolab", "numpy", "numba", "gyrolab_commit"):
+        assert lib in record["versions"]
