@@ -426,3 +426,20 @@ def test_a_stability_map_whose_sections_cannot_be_added_keeps_the_map_and_resume
     assert set(a) == set(b) and "section_phi" in a
     for name in a:
         assert equal(a[name], b[name]), name
+
+
+def test_an_old_run_whose_config_records_an_address_still_reproduces(tmp_path):
+    """The key stays readable: a dataset written before the trust model, whose stored config names a scheduler's
+    address in batch.scheduler, reproduces (a single run never connects to it)."""
+    import netCDF4
+    import yaml
+
+    done = cli([*SMALL, "time.end=1", "time.n_output=11", "hydra.run.dir=old"], tmp_path)
+    assert done.returncode == 0, done.stderr[-2000:]
+    with netCDF4.Dataset(tmp_path / "old" / "run.nc", "a") as nc:
+        config = yaml.safe_load(nc.getncattr("config"))
+        config.setdefault("batch", {})["scheduler"] = "tcp://127.0.0.1:9"
+        nc.setncattr("config", yaml.safe_dump(config))
+    again = cli(["--reproduce", "old/run.nc"], tmp_path)
+    assert again.returncode == 0, again.stderr[-2000:]
+    assert "identical" in again.stdout + again.stderr
