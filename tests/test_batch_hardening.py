@@ -363,3 +363,83 @@ def test_the_option_reaches_an_experiment_run_by_hydra(tmp_path):
     done = cli(["--scheduler", address, "experiment=stability_map", "stability_map.n_theta0=2",
                 "stability_map.n_r0=2", "time.end=1", "output.figures=false", "hydra.run.dir=map"], tmp_path)
     one_sentence(done, 2, address, "the command line (--scheduler)", "no Dask scheduler answers")
+
+
+# ----------------------------------------------------------------------------- follow-ups (harden-batch2)
+
+
+def test_a_chunk_that_cannot_write_its_own_files_is_exit_3_and_the_rerun_completes(tmp_path, monkeypatch,
+                                                                                   uninterrupted):
+    """A chunk whose own write fails for want of space (numba writing its cache in a worker, say) is a full disk,
+    not a bug: one OutputError sentence, exit 3, the finished chunks kept for the rerun."""
+    from gyrolab.batch import runner
+
+    real = runner.run_chunk
+
+    def cache_write_fails(task):
+        if task.index == 2:
+            raise OSError(errno.EFBIG, "File too large")
+        return real(task)
+
+    monkeypatch.setattr(runner, "run_chunk", cache_write_fails)
+    with pytest.raises(OutputError) as caught:
+        run_batch_sweep(GRID, tmp_path)
+    assert caught.value.exit_code == 3 and "chunk 2" in str(caught.value) and "\n" not in str(caught.value)
+    monkeypatch.setattr(runner, "run_chunk", real)
+    assert_same_data(data_of(run_batch_sweep(GRID, tmp_path)), uninterrupted)
+
+
+def test_the_last_sync_failing_keeps_every_chunk(tmp_path, monkeypatch, uninterrupted):
+    """The finish (counts written, file synced) fails on a full disk: every chunk stays journaled and the rerun
+    only finishes the file, running no chunk again."""
+    from gyrolab.batch import runner
+
+    real_fsync, calls = store._fsync, []
+
+    def full_at_the_end(path):
+        calls.append(path)
+        if len(calls) == 6:   # the creation, four chunks, then the finish
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real_fsync(path)
+
+    monkeypatch.setattr(store, "_fsync", full_at_the_end)
+    with pytest.raises(OutputError) as caught:
+        run_batch_sweep(GRID, tmp_path)
+    assert caught.value.exit_code == 3 and "no space left on device" in str(caught.value)
+    monkeypatch.setattr(store, "_fsync", real_fsync)
+    monkeypatch.setattr(runner, "run_chunk", lambda task: pytest.fail("a finished chunk ran again"))
+    assert_same_data(data_of(run_batch_sweep(GRID, tmp_path)), uninterrupted)
+
+
+def test_a_stability_map_whose_sections_cannot_be_added_keeps_the_map_and_resumes_identically(tmp_path):
+    """A limit above the map's store but below the file with its Poincaré sections: exit 3 in one sentence; the
+    rerun adds the sections and ends with the uninterrupted map, bit for bit."""
+    args = ["experiment=stability_map", "batch.points=16", "output.figures=false", "hydra.run.dir=map"]
+    whole = cli([*args[:-1], "hydra.run.dir=whole"], tmp_path)
+    assert whole.returncode == 0, whole.stderr[-2000:]
+    final = tmp_path / "whole" / "stability_map.nc"
+    done = cli(args, tmp_path, limit=int(0.7 * final.stat().st_size))
+    one_sentence(done, 3, "stability_map.nc", "file-size limit", "the map itself is kept")
+    again = cli(args, tmp_path)
+    assert again.returncode == 0, again.stderr[-2000:]
+    a, b = data_of(final), data_of(tmp_path / "map" / "stability_map.nc")
+    assert set(a) == set(b) and "section_phi" in a
+    for name in a:
+        assert equal(a[name], b[name]), name
+
+
+def test_an_old_run_whose_config_records_an_address_still_reproduces(tmp_path):
+    """The key stays readable: a dataset written before the trust model, whose stored config names a scheduler's
+    address in batch.scheduler, reproduces (a single run never connects to it)."""
+    import netCDF4
+    import yaml
+
+    done = cli([*SMALL, "time.end=1", "time.n_output=11", "hydra.run.dir=old"], tmp_path)
+    assert done.returncode == 0, done.stderr[-2000:]
+    with netCDF4.Dataset(tmp_path / "old" / "run.nc", "a") as nc:
+        config = yaml.safe_load(nc.getncattr("config"))
+        config.setdefault("batch", {})["scheduler"] = "tcp://127.0.0.1:9"
+        nc.setncattr("config", yaml.safe_dump(config))
+    again = cli(["--reproduce", "old/run.nc"], tmp_path)
+    assert again.returncode == 0, again.stderr[-2000:]
+    assert "identical" in again.stdout + again.stderr

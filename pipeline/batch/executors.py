@@ -27,6 +27,7 @@ reuses it for the next chunks.
 
 from __future__ import annotations
 
+import errno
 import itertools
 import os
 import uuid
@@ -35,7 +36,8 @@ from importlib.util import find_spec
 from typing import Any, TypeVar
 
 from gyrolab.batch import scheduler as scheduler_module
-from gyrolab.errors import ConfigError, GyrolabError, shorten
+from gyrolab.errors import ConfigError, GyrolabError, OutputError, shorten
+from gyrolab.output.atomic import reason
 
 Task = TypeVar("Task")
 Result = TypeVar("Result")
@@ -46,6 +48,8 @@ LOCAL = scheduler_module.LOCAL
 CONNECT_TIMEOUT = scheduler_module.CONNECT_TIMEOUT
 #: chunks submitted per worker thread at a time: one running, one queued (memory: a few chunks per worker)
 CHUNKS_PER_THREAD = 2
+#: the errnos of a write that failed for want of space: a chunk failing so is a full disk (exit 3), not a bug
+FULL_DISK = (errno.ENOSPC, errno.EFBIG, errno.EDQUOT)
 #: environment of local-cluster workers: one thread each for numba and the BLAS libraries
 WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
@@ -93,6 +97,9 @@ def chunk_error(index: int, error: BaseException, where: str) -> GyrolabError:
     message = " ".join(str(error).split()) or type(error).__name__
     if isinstance(error, GyrolabError):
         return type(error)(f"chunk {index} of the batch failed {where}: {message}")
+    if isinstance(error, OSError) and error.errno in FULL_DISK:   # e.g. numba writing its cache in a worker
+        return OutputError(f"chunk {index} of the batch failed {where}: a file could not be written ({reason(error)}); "
+                           "the finished chunks are kept: free some space and rerun the same command")
     return GyrolabError(f"chunk {index} of the batch failed {where} ({type(error).__name__}: {message})")
 
 

@@ -21,7 +21,7 @@ from omegaconf import DictConfig, OmegaConf
 from gyrolab.engine.budget import check_points
 from gyrolab.engine.safety import confined_output_path
 from gyrolab.engine.scene import Scene
-from gyrolab.errors import ConfigError, as_number, shorten
+from gyrolab.errors import ConfigError, OutputError, as_number, shorten
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.cf import conform
 
@@ -97,7 +97,12 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     run_batch([], grid(cfg), path, plain=plain, lock=False)   # the app holds the run directory's lock
     sections = cfg.stability_map.get("sections") or []
     if sections:
-        _add_sections(path, plain, sections, as_number(cfg.stability_map.section_time, "stability_map.section_time"))
+        try:
+            _add_sections(path, plain, sections,
+                          as_number(cfg.stability_map.section_time, "stability_map.section_time"))
+        except OutputError as error:   # a full disk: the map is complete on disk; the rerun adds the sections
+            raise OutputError(f"{str(error).rstrip('.')}; the map itself is kept: free some space and rerun the "
+                              "same command to add its Poincaré sections") from None
     with xr.open_dataset(path) as ds:
         return [path, *draw_figures("stability_map.nc", ds.load(), out_dir, cfg.get("output"))]
 
