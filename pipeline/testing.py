@@ -71,8 +71,22 @@ def _fail(cls: type, message: str) -> AssertionError:
 def check_force(cls: type, body: Any = None, *, n_states: int = 20, **params: Any) -> None:
     """Check a force plugin class against the Force contract; AssertionError names the first violation.
 
-    ``params`` are the plugin's keyword parameters for the checks (its defaults when omitted);
-    ``body`` defaults to a triaxial nondimensional body with an off-axis centre of mass.
+    Parameters
+    ----------
+    cls : type
+        The force plugin class (a subclass of ``gyrolab.contracts.Force``).
+    body : optional
+        The body the force is built on; by default a triaxial nondimensional body with an off-axis
+        centre of mass.
+    n_states : int
+        How many random states the torque is checked on.
+    **params
+        The plugin's keyword parameters for the checks (its defaults when omitted).
+
+    Raises
+    ------
+    AssertionError
+        Naming the first rule the plugin breaks.
     """
     from gyrolab.engine.scene import build_force
 
@@ -297,7 +311,22 @@ def _blow_up(t: float, y: np.ndarray) -> np.ndarray:
 def check_integrator(cls: type, **params: Any) -> None:
     """Check an integrator plugin class against the Integrator contract; AssertionError names the first violation.
 
-    ``params`` are the plugin's keyword parameters for the checks (its defaults when omitted). The rules:
+    Parameters
+    ----------
+    cls : type
+        The integrator plugin class (a subclass of ``gyrolab.contracts.Integrator``).
+    **params
+        The plugin's keyword parameters for the checks (its defaults when omitted).
+
+    Raises
+    ------
+    AssertionError
+        Naming the first rule the plugin breaks.
+
+    Notes
+    -----
+    The rules checked, in order:
+
 
     1. ``name`` is a config key, ``adaptive`` a bool, ``capabilities`` (when declared) a frozenset of str;
     2. it builds with ``params``; every keyword parameter given a nonsense value ("abc") raises gyrolab's
@@ -472,10 +501,34 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
                  invariant_tolerance: float = INVARIANT_TOLERANCE, **params: Any) -> None:
     """Check a system plugin class against the System contract; AssertionError names the first violation.
 
-    ``body`` and ``initial`` are the config sections a scene would give (``body_type.from_config(body)`` builds the
-    body); ``forces`` is a sequence of ``(ForceClass, params)`` pairs built on that body (none by default);
-    ``output`` the output section (``{"euler_angles": True}`` by default); ``params`` the system's own parameters.
-    The rules:
+    Parameters
+    ----------
+    cls : type
+        The system plugin class (a subclass of ``gyrolab.contracts.System``).
+    body : dict
+        The ``body`` config section a scene would give; ``cls.body_type.from_config(body)`` builds the body.
+    initial : dict
+        The ``initial`` config section.
+    forces : sequence of (type, dict)
+        ``(ForceClass, params)`` pairs built on that body (none by default).
+    output : dict, optional
+        The ``output`` section (``{"euler_angles": True}`` by default).
+    span : float
+        The time span of the invariant check (rule 6).
+    invariant_tolerance : float
+        Relative drift allowed to each invariant over ``span`` (rule 6).
+    **params
+        The system's own parameters.
+
+    Raises
+    ------
+    AssertionError
+        Naming the first rule the plugin breaks.
+
+    Notes
+    -----
+    The rules checked, in order:
+
 
     1. ``name`` is a config key; ``body_type`` has ``from_config``, which builds the body from ``body``;
     2. the system builds with ``(body, forces, initial, output, **params)``;
@@ -599,8 +652,25 @@ EULER_KEYS = frozenset({"psi", "theta", "phi"})
 def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     """Check a regime plugin class against the Regime contract; AssertionError names the first violation.
 
-    ``scene`` is the scene the regime is checked on: a list of overrides for ``gyrolab.compose_scene`` (the default
-    scene when empty) or a built system; ``params`` are the regime's keyword parameters. The rules:
+    Parameters
+    ----------
+    cls : type
+        The regime plugin class (a subclass of ``gyrolab.contracts.Regime``).
+    scene : list of str or System
+        The scene the regime is checked on: overrides for ``gyrolab.compose_scene`` (the
+        default scene when empty) or a built system.
+    **params
+        The regime's keyword parameters.
+
+    Raises
+    ------
+    AssertionError
+        Naming the first rule the plugin breaks.
+
+    Notes
+    -----
+    The rules checked, in order:
+
 
     1. ``name`` is a config key; ``systems`` a non-empty tuple of system names; ``parameter`` and
        ``parameter_long_name`` str; ``order`` a dict of variable name → number;

@@ -100,16 +100,37 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
 
 def integrate_arrays(compiled: CompiledModel, integrator: Integrator, times: np.ndarray, initial_states: np.ndarray,
                      params: np.ndarray | None = None, failures: str = "raise") -> BatchSolution:
-    """The batch kernel entry point: no scene, only arrays.
+    """Integrate many trajectories on an integrator's batch kernel: no scene, only arrays.
 
-    ``compiled`` is a system's compiled model (its ``params`` are used for every trajectory unless
-    ``params``, trajectories × ``compiled.params.size``, gives them per trajectory), ``integrator``
-    an integrator plugin with a batch kernel (capability BATCH_KERNEL: its ``integrate_batch`` and settings
-    run the batch), ``times`` the output times and ``initial_states`` (trajectories × state size) one row per
-    trajectory. A trajectory that fails (becomes non-finite; for adaptive kernels also a step below the
-    spacing of floating-point numbers) raises IntegrationError (``failures="raise"``) or is marked in
-    ``BatchSolution.failed`` (``failures="mark"``: a batch keeps its other trajectories). An integrator
-    without a batch kernel runs through ``integrate_points`` instead.
+    Parameters
+    ----------
+    compiled : CompiledModel
+        A system's compiled model; its ``params`` are used for every trajectory unless ``params`` is given.
+    integrator : Integrator
+        An integrator plugin with a batch kernel (capability ``BATCH_KERNEL``: its ``integrate_batch`` and
+        settings run the batch). An integrator without one runs through :func:`integrate_points` instead.
+    times : numpy.ndarray
+        The output times, 1-D, finite and strictly increasing.
+    initial_states : numpy.ndarray
+        One row per trajectory, shape (trajectories, state size).
+    params : numpy.ndarray, optional
+        Per-trajectory parameters, shape (trajectories, ``compiled.params.size``).
+    failures : {"raise", "mark"}
+        What a failed trajectory (non-finite, or for adaptive kernels a step below the spacing of
+        floating-point numbers) does: raise ``IntegrationError``, or be marked in ``BatchSolution.failed``
+        while the batch keeps its other trajectories.
+
+    Returns
+    -------
+    BatchSolution
+        The states at ``times`` for every trajectory, with the steps taken and the failed mask.
+
+    Raises
+    ------
+    gyrolab.errors.ConfigError
+        On arrays of the wrong shape, non-finite initial states, or an integrator without a batch kernel.
+    gyrolab.errors.IntegrationError
+        When a trajectory fails and ``failures="raise"``.
     """
     y0s = np.ascontiguousarray(initial_states, dtype=float)
     if y0s.ndim != 2:
@@ -136,11 +157,33 @@ def integrate_arrays(compiled: CompiledModel, integrator: Integrator, times: np.
 def integrate_points(integrator: Integrator, rhs_of: Callable[[int], RightHandSide], times: np.ndarray,
                      y0s: np.ndarray, compiled: CompiledModel | None, params: np.ndarray | None,
                      failures: str = "raise") -> BatchSolution:
-    """A batch for an integrator without a batch kernel: one ``integrate`` call per trajectory, each exactly a
-    single run's (its right-hand side ``rhs_of(j)``; the compiled model with ``params[j]`` when the integrator
-    uses compiled models). A trajectory whose integration raises IntegrationError (or, against the contract,
-    returns non-finite values) fails: ``failures="raise"`` re-raises, ``"mark"`` marks it (NaN after its
-    initial state) and goes on."""
+    """Integrate many trajectories with an integrator that has no batch kernel, one ``integrate`` call each.
+
+    Each trajectory is exactly a single run's, so a third-party integrator joins a batch unchanged.
+
+    Parameters
+    ----------
+    integrator : Integrator
+        Any integrator plugin.
+    rhs_of : callable
+        ``rhs_of(j)`` is the right-hand side of trajectory ``j``.
+    times : numpy.ndarray
+        The output times, 1-D and strictly increasing.
+    y0s : numpy.ndarray
+        Initial states, shape (trajectories, state size).
+    compiled : CompiledModel or None
+        The system's compiled model, used when the integrator integrates compiled models.
+    params : numpy.ndarray or None
+        Per-trajectory compiled parameters (``params[j]`` for trajectory ``j``); None: the model's own.
+    failures : {"raise", "mark"}
+        A trajectory whose integration raises ``IntegrationError`` (or, against the contract, returns
+        non-finite values) re-raises, or is marked (NaN after its initial state) while the others go on.
+
+    Returns
+    -------
+    BatchSolution
+        The states at ``times`` for every trajectory, the steps taken and the failed mask.
+    """
     from gyrolab.contracts.integrator import COMPILED_MODEL, PREFERS_COMPILED_MODEL
     from gyrolab.plugins.integrators.batch_kernels import require_finite_out
 
