@@ -20,12 +20,36 @@ from gyrolab.physics.vectors import cross
 
 
 def gamma_from_angles(theta: float, phi: float) -> np.ndarray:
-    """Body components of the fixed vertical: γ = (sin θ sin φ, sin θ cos φ, cos θ)."""
+    """Body components of the fixed vertical: γ = (sin θ sin φ, sin θ cos φ, cos θ).
+
+    Parameters
+    ----------
+    theta : float
+        Nutation θ (rad).
+    phi : float
+        Proper rotation φ (rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        γ, shape (3,), a unit vector.
+    """
     return np.array([np.sin(theta) * np.sin(phi), np.sin(theta) * np.cos(phi), np.cos(theta)])
 
 
 def frame_from_angles(psi: float, theta: float, phi: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Body components (α, β, γ) of the fixed axes X, Y, Z for Euler angles (ψ, θ, φ)."""
+    """Body components (α, β, γ) of the fixed axes X, Y, Z for Euler angles (ψ, θ, φ) (z-x-z convention).
+
+    Parameters
+    ----------
+    psi, theta, phi : float
+        Precession ψ, nutation θ and proper rotation φ (rad).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        α, β, γ, each of shape (3,): the rows of a proper rotation matrix.
+    """
     sp, cp = np.sin(psi), np.cos(psi)
     st, ct = np.sin(theta), np.cos(theta)
     sf, cf = np.sin(phi), np.cos(phi)
@@ -36,7 +60,18 @@ def frame_from_angles(psi: float, theta: float, phi: float) -> tuple[np.ndarray,
 
 
 def nutation_and_spin(gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """θ and φ (wrapped to (−π, π]) from γ alone, for arrays of shape (..., 3)."""
+    """θ and φ from γ alone.
+
+    Parameters
+    ----------
+    gamma : numpy.ndarray
+        Body components of the fixed vertical, shape (..., 3).
+
+    Returns
+    -------
+    theta, phi : numpy.ndarray
+        Nutation θ in [0, π] and proper rotation φ wrapped to (−π, π], shape (...).
+    """
     horizontal = np.hypot(gamma[..., 0], gamma[..., 1])
     theta = np.arctan2(horizontal, gamma[..., 2])
     phi = np.arctan2(gamma[..., 0], gamma[..., 1])
@@ -44,7 +79,20 @@ def nutation_and_spin(gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def euler_angles(alpha: np.ndarray, gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Unwrapped (ψ, θ, φ) along a trajectory from α and γ of shape (n, 3)."""
+    """Unwrapped Euler angles (ψ, θ, φ) along a trajectory.
+
+    Parameters
+    ----------
+    alpha : numpy.ndarray
+        Body components of the fixed X axis, shape (n, 3).
+    gamma : numpy.ndarray
+        Body components of the fixed Z axis (the vertical), shape (n, 3).
+
+    Returns
+    -------
+    psi, theta, phi : numpy.ndarray
+        Each of shape (n,); ψ and φ unwrapped (continuous through the poles θ = 0 and θ = π).
+    """
     alpha = np.atleast_2d(alpha)
     gamma = np.atleast_2d(gamma)
     beta = cross(gamma, alpha)

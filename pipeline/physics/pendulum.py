@@ -28,7 +28,20 @@ _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(64)
 
 
 def kappa(a: float, k: float) -> float:
-    """κ = k (a − 1): the Newtonian term's share of the restoring torque (a = A/C, k = N/c²)."""
+    """κ = k (a − 1): the Newtonian term's share of the restoring torque.
+
+    Parameters
+    ----------
+    a : float
+        A/C, the body's first principal moment over its third.
+    k : float
+        N/c², the Newtonian field's strength over the squared gravity frequency.
+
+    Returns
+    -------
+    float
+        κ; the swing's restoring torque is ∝ sin θ (1 + κ cos θ).
+    """
     return float(k) * (float(a) - 1.0)
 
 
@@ -59,7 +72,27 @@ def check_libration(b: float, kap: float, theta_a: float) -> None:
 
 
 def period(b: float, kap: float, theta_a: float) -> float:
-    """Period T0 of the swing of amplitude θa (quadrature above; 4√b K(m) when κ = 0)."""
+    """Period T0 of the plane swing (pendulum libration) of amplitude θa.
+
+    Parameters
+    ----------
+    b : float
+        B/C, positive.
+    kap : float
+        κ = k (a − 1) (see `kappa`).
+    theta_a : float
+        The amplitude θa, in (0, π).
+
+    Returns
+    -------
+    float
+        T0 by 64-point Gauss–Legendre quadrature of the energy integral; 4√b K(m), m = sin²(θa/2), when κ = 0.
+
+    Raises
+    ------
+    gyrolab.errors.ConfigError
+        When the swing is not a libration about the lowest position (`check_libration`).
+    """
     check_libration(b, kap, theta_a)
     m = np.sin(theta_a / 2) ** 2
     s = 0.25 * np.pi * (_NODES + 1.0)
@@ -69,7 +102,27 @@ def period(b: float, kap: float, theta_a: float) -> float:
 
 
 def swing(t: np.ndarray, b: float, theta_a: float) -> np.ndarray:
-    """(p, q, r, γ, γ', γ'') of the κ = 0 swing released from rest at θ(0) = θa, shape (n, 6) (elliptic functions)."""
+    """The κ = 0 swing released from rest at θ(0) = θa, in closed form (Jacobi elliptic functions).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Times, shape (n,).
+    b : float
+        B/C, positive.
+    theta_a : float
+        The amplitude θa, in (0, π).
+
+    Returns
+    -------
+    numpy.ndarray
+        (p, q, r, γ, γ', γ'') at ``t``, shape (n, 6).
+
+    Raises
+    ------
+    gyrolab.errors.ConfigError
+        When the swing is not a libration about the lowest position (`check_libration`).
+    """
     check_libration(b, 0.0, theta_a)
     m = np.sin(theta_a / 2) ** 2
     K = ellipk(m)
