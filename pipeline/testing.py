@@ -327,7 +327,6 @@ def check_integrator(cls: type, **params: Any) -> None:
     -----
     The rules checked, in order:
 
-
     1. ``name`` is a config key, ``adaptive`` a bool, ``capabilities`` (when declared) a frozenset of str;
     2. it builds with ``params``; every keyword parameter given a nonsense value ("abc") raises gyrolab's
        one-sentence ``ConfigError`` naming the parameter;
@@ -529,7 +528,6 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
     -----
     The rules checked, in order:
 
-
     1. ``name`` is a config key; ``body_type`` has ``from_config``, which builds the body from ``body``;
     2. the system builds with ``(body, forces, initial, output, **params)``;
     3. ``state_size`` is a positive int; ``initial_state()`` a finite float array of shape (state_size,);
@@ -670,7 +668,6 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     Notes
     -----
     The rules checked, in order:
-
 
     1. ``name`` is a config key; ``systems`` a non-empty tuple of system names; ``parameter`` and
        ``parameter_long_name`` str; ``order`` a dict of variable name → number;

@@ -137,15 +137,7 @@ class Store:
     def chunk_done(self, index: int, chunk: Any, result: Any) -> None:
         """Store a chunk's result (None: a chunk without a valid point) and journal it; OutputError (the
         journaled chunks kept) when a write fails."""
-        try:
-            self._store_chunk(index, chunk, result)
-        except OutputError:
-            self._close_quietly()
-            raise
-        except (OSError, RuntimeError) as error:
-            if not isinstance(error, OSError) and not _library_failure(error):
-                raise
-            raise self._failed(error) from None
+        self._guarded(self._store_chunk, index, chunk, result)
 
     def _store_chunk(self, index: int, chunk: Any, result: Any) -> None:
         if self.nc is None:
@@ -170,8 +162,13 @@ class Store:
 
     def finish(self) -> None:
         """Close the complete file and give it its final name (OutputError, the chunks kept, if that fails)."""
+        self._guarded(self._finish)
+
+    def _guarded(self, write: Any, *args: Any) -> None:
+        """``write(*args)``; a failed write (an OSError, or the netCDF library's RuntimeError for one) becomes
+        one OutputError sentence with the journaled chunks kept, and the file is closed."""
         try:
-            self._finish()
+            write(*args)
         except OutputError:
             self._close_quietly()
             raise
