@@ -25,6 +25,8 @@ from gyrolab.batch.runner import Settings, run_chunk
 from gyrolab.batch.sweep import run_batch_sweep
 from gyrolab.errors import ConfigError, OutputError
 
+pytestmark = pytest.mark.slow  # subprocesses under file-size limits, silent peers with their 10 s deadline
+
 GYROLAB = [sys.executable, "-m", "gyrolab"]
 SMALL = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=2", "time.n_output=41", "output.euler_angles=false",
          "output.figures=false"]

@@ -3,6 +3,7 @@
 import sys
 from pathlib import Path
 
+import pytest
 import xarray as xr
 import yaml
 
@@ -33,6 +34,7 @@ def test_multirun_writes_one_dataset_per_job(cli, tmp_path):
 
 
 
+@pytest.mark.slow
 def test_multirun_jobs_draw_no_figures_unless_asked(cli, tmp_path):
     """Issue 24 item 3: a sweep's jobs skip their own figures by default (the sweep's figures stay);
     ``output.job_figures=true`` draws them, and ``gyrolab --plot`` draws them later from the datasets."""
@@ -52,7 +54,6 @@ def test_multirun_jobs_draw_no_figures_unless_asked(cli, tmp_path):
     assert (tmp_path / "asked" / "0" / "figures" / "state.png").is_file()
 
 
-import pytest  # noqa: E402
 
 EXPERIMENTS = {
     # experiment (or regime) -> (extra overrides keeping it small, files it must write)
@@ -239,6 +240,7 @@ def test_batch_scheduler_option_reaches_the_batch(cli, tmp_path):
 
 # ---- one logging convention: logs and progress on stderr, results on stdout ---------------------------------------
 
+@pytest.mark.slow
 def test_logs_go_to_stderr_and_results_to_stdout(cli, tmp_path):
     run = cli("run", "hydra.run.dir=out", "time.end=1", "time.n_output=11")
     assert run.returncode == 0, run.stderr

@@ -2,10 +2,12 @@
 
 import csv
 
+import pytest
 import gyrolab.experiments as experiments
 from gyrolab.engine.config import compose_config
 
 
+@pytest.mark.slow
 def test_experiment_writes_the_case_table(tmp_path):
     cfg = compose_config(["experiment=yehia2021_precessions", "yehia2021.orbits=2"])
     written = experiments.run_task("yehia2021_precessions", cfg, tmp_path)

@@ -105,6 +105,7 @@ def test_shaker_omega3_euler_angles_match_the_report(tmp_path):
     assert ds.attrs["period_exact"] == pytest.approx(0.70318806, abs=1e-8)
 
 
+@pytest.mark.slow
 def test_regime_validity_verdict(tmp_path):
     cfg = compose_config(["experiment=regime_validity",
                           "regime_validity.small_parameter.values=[2.0,0.0625,0.03125,0.015625]",

@@ -26,7 +26,7 @@ import xarray as xr
 
 import slurm_cluster
 
-pytestmark = pytest.mark.slurm
+pytestmark = [pytest.mark.slurm, pytest.mark.slow]  # a real cluster: end to end, seconds per test
 
 # docs/cluster.md, "SLURM, tested": the tests run its blocks verbatim, so the page is the tested recipe.
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "cluster.md"

@@ -136,6 +136,7 @@ def test_failing_jobs_are_recorded_not_fatal(basic):
         assert (job_dir / "run.nc").exists() == ("body.a=3" not in overrides)
 
 
+@pytest.mark.slow
 def test_joblib_launcher_gives_the_same_sweep_nc(basic, tmp_path):
     done = gyrolab("-m", *SWEEP, "hydra.sweep.dir=sweep", "hydra/launcher=joblib", "hydra.launcher.n_jobs=2",
                    cwd=tmp_path)

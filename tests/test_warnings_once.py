@@ -6,6 +6,8 @@ together, so the tests hold whichever stream a logging convention sends log line
 
 from __future__ import annotations
 
+import pytest
+
 import re
 import subprocess
 import sys
@@ -40,6 +42,7 @@ def test_a_regime_run_inside_the_domain_has_no_domain_warning(tmp_path):
         assert abs(ds.attrs["analytic_gamma0_norm"] - 1) < 1e-4
 
 
+@pytest.mark.slow
 def test_regime_validity_ends_with_one_line_counting_its_expected_warnings(tmp_path):
     lines = _gyrolab("experiment=regime_validity", "output.figures=false", f"hydra.run.dir={tmp_path}")
     counted = [line for line in lines if re.search(r"\d+ expected domain warnings", line)]
