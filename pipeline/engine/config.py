@@ -289,7 +289,7 @@ def unknown_key_sentence(key: str, known: Sequence[str], override: str = "", cau
                 f"(e.g. {next((k for k in known if k.startswith(key + '.')), key + '.KEY')}=...)")
     if close:
         return f"`{shorten(key)}` is not a key of {where}; did you mean `{close[0]}`?"
-    siblings = sorted(k.rpartition(".")[2] for k in known if k.rpartition(".")[0] == parent)
+    siblings = sorted({k.rpartition(".")[2] for k in known if k.rpartition(".")[0] == parent})  # a key once
     return (f"`{shorten(key)}` is not a key of {where}; valid keys: "
             f"{shorten(', '.join(siblings) or '(none)', 300)}")
 
