@@ -41,22 +41,13 @@ from gyrolab import compose_scene
 from gyrolab.plugins.compiled import taylor_dd
 from gyrolab.plugins.compiled.layout import INERTIA, N_Z, U_Z
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
+from results_file import cpu_model  # noqa: E402  (benchmarks/ is not a package; run as a script)
 
 SCENE = ["initial=slow_spin", "time.end=300", "output.euler_angles=false", "output.figures=false",
          "integrator=taylor", "integrator.precision=double-double"]
 TARGETS = [1e-8, 1e-10, 1e-12, 1e-14]
 RESULTS = Path(__file__).resolve().parent / "results" / "extended_precision.json"
 HORIZON_TIMES = [0.0, 50.0, 100.0, 150.0, 200.0, 250.0, 300.0]
-
-
-def cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or platform.machine()
 
 
 def heyoka_system(p: np.ndarray, fp_type):

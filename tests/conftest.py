@@ -49,3 +49,25 @@ def installed_distribution(site, name, version, plugins=None, paths=(), group="g
         mp.undo()
         registry.external.cache_clear()
         config.register_plugin_configs.cache_clear()
+
+
+@contextlib.contextmanager
+def mounted_tmpfs(directory, size):
+    """A tmpfs of ``size`` (e.g. "256k") mounted at a new ``directory`` for a really full disk (needs root and
+    mount(8)); the test is skipped where it cannot be mounted."""
+    import subprocess
+
+    directory.mkdir()
+    if os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root")
+    try:
+        done = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(directory)],
+                              capture_output=True, timeout=10)
+    except (OSError, subprocess.TimeoutExpired):
+        pytest.skip("mount(8) is not available")
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode().strip()}")
+    try:
+        yield directory
+    finally:
+        subprocess.run(["umount", "-l", str(directory)], capture_output=True, timeout=10)

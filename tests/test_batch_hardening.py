@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tests.conftest import mounted_tmpfs
 import xarray as xr
 
 from gyrolab.batch import executors, scheduler, store
@@ -322,20 +323,9 @@ def test_a_multirun_whose_job_results_cannot_be_written_exits_3_and_the_rerun_co
 
 @pytest.fixture
 def small_tmpfs(tmp_path):
-    """A 512 KiB tmpfs (needs root and mount(8)); skipped where it cannot be mounted."""
-    mount_point = tmp_path / "small"
-    mount_point.mkdir()
-    if os.geteuid() != 0:
-        pytest.skip("mounting a tmpfs needs root")
-    try:
-        done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=512k", "tmpfs", str(mount_point)],
-                              capture_output=True, timeout=10)
-    except (OSError, subprocess.TimeoutExpired):
-        pytest.skip("mount(8) is not available")
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode().strip()}")
-    yield mount_point
-    subprocess.run(["umount", "-l", str(mount_point)], capture_output=True, timeout=10)
+    """A 512 KiB tmpfs (conftest.mounted_tmpfs); skipped where it cannot be mounted."""
+    with mounted_tmpfs(tmp_path / "small", "512k") as mount_point:
+        yield mount_point
 
 
 def test_a_really_full_disk_in_a_batch_is_one_sentence_and_the_rerun_with_room_completes(small_tmpfs, tmp_path,

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tests.conftest import mounted_tmpfs
 import xarray as xr
 
 from gyrolab.errors import OutputError
@@ -114,20 +115,9 @@ def test_a_file_size_limit_is_named_and_leaves_no_file(tmp_path):
 
 @pytest.fixture
 def tiny_tmpfs(tmp_path):
-    """A 256 KiB tmpfs (needs root and mount(8)); skipped where it cannot be mounted."""
-    mount_point = tmp_path / "small"
-    mount_point.mkdir()
-    if os.geteuid() != 0:
-        pytest.skip("mounting a tmpfs needs root")
-    try:
-        done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(mount_point)],
-                              capture_output=True, timeout=10)
-    except (OSError, subprocess.TimeoutExpired):
-        pytest.skip("mount(8) is not available")
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode().strip()}")
-    yield mount_point
-    subprocess.run(["umount", "-l", str(mount_point)], capture_output=True, timeout=10)
+    """A 256 KiB tmpfs (conftest.mounted_tmpfs); skipped where it cannot be mounted."""
+    with mounted_tmpfs(tmp_path / "small", "256k") as mount_point:
+        yield mount_point
 
 
 def test_a_really_full_disk_is_one_sentence(tiny_tmpfs):
