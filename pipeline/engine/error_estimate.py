@@ -72,7 +72,21 @@ def companion(integrator: Any, has_compiled: bool) -> Companion | None:
 
 
 def add_error_estimate(ds: xr.Dataset, scene: Any, y: np.ndarray, wall_time: float) -> xr.Dataset:
-    """``ds`` with the error-estimate variables and attributes of a run whose stored states are ``y``."""
+    """``ds`` with the error-estimate variables and attributes of a run whose stored states are ``y`` (``measure``
+    then one insertion per variable; ``Scene.run`` passes ``measure`` to ``build_dataset`` instead, which puts
+    them in while the dataset is assembled: inserting into a built dataset aligns and merges, ~0.4 ms each)."""
+    variables, attrs = measure(scene, y, wall_time, {name: ds[name].variable for name in ds.data_vars})
+    ds.attrs.update(attrs)
+    for key, variable in variables.items():
+        ds[key] = variable
+    return ds
+
+
+def measure(scene: Any, y: np.ndarray, wall_time: float,
+            stored: dict[str, xr.Variable]) -> tuple[dict[str, xr.Variable], dict[str, Any]]:
+    """(variables, attributes) of the error estimate of a run whose stored states are ``y`` and whose dataset
+    variables are ``stored`` (read to tell whether the state starts with ω): the companion run's measured error,
+    or no variables and an attribute saying why no estimate is available."""
     compiled_model = scene.system.compiled_model()
     pick = companion(scene.integrator, compiled_model is not None)
     name = getattr(scene.integrator, "name", type(scene.integrator).__name__)
@@ -82,8 +96,7 @@ def add_error_estimate(ds: xr.Dataset, scene: Any, y: np.ndarray, wall_time: flo
                   f"not available: integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
                   "compiled model for the Taylor method")
         log.warning("output.error_estimate: %s", reason)
-        ds.attrs["error_estimate_method"] = reason
-        return ds
+        return {}, {"error_estimate_method": reason}
     companion_model = None
     if pick.integrator.supports(COMPILED_MODEL) or pick.integrator.supports(PREFERS_COMPILED_MODEL):
         # the scene's own model is prepared for its integrator (a plugin torque's Taylor kernel compiled); another
@@ -91,31 +104,32 @@ def add_error_estimate(ds: xr.Dataset, scene: Any, y: np.ndarray, wall_time: flo
         companion_model = scene.compiled if scene.compiled is not None else compiled_model
         refusal = pick.integrator.refusal(companion_model, scene.system) if companion_model is not None else None
         if refusal:
-            ds.attrs["error_estimate_method"] = f"not available: the companion ({pick.how}) {refusal}"
-            log.warning("output.error_estimate: %s", ds.attrs["error_estimate_method"])
-            return ds
+            reason = f"not available: the companion ({pick.how}) {refusal}"
+            log.warning("output.error_estimate: %s", reason)
+            return {}, {"error_estimate_method": reason}
     start = time.perf_counter()
     other = pick.integrator.integrate(scene.system.rhs, scene.times, scene.system.initial_state(), None,
                                       companion_model).y
     spent = time.perf_counter() - start
     y = np.asarray(y, dtype=float)
     difference = pick.scale * np.abs(y - other)
-    ds.attrs["error_estimate_method"] = pick.how
-    ds.attrs["error_estimate_cost_ratio"] = float(spent / max(wall_time, 1e-9))
-    omega = ds.get("omega")
+    attrs: dict[str, Any] = {"error_estimate_method": pick.how,
+                             "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
+    omega = stored.get("omega")
     if omega is not None and omega.shape == (len(y), 3) and np.array_equal(omega.values, y[:, :3]):
         parts = {"omega": (difference[:, :3], omega.attrs.get("units", "1"), "angular velocity ω"),
                  "attitude": (difference[:, 3:], "1", "direction cosines (γ, and α where carried)")}
     else:  # a state whose layout this module does not know: one max-norm over all of it
         parts = {"": (difference, "1", "state (model units)")}
+    variables = {}
     for part, (values, units, what) in parts.items():
         series = values.max(axis=1)
         key = f"error_estimate_{part}" if part else "error_estimate"
-        ds[key] = xr.Variable("time", series, {
+        variables[key] = xr.Variable("time", series, {
             "units": units, "long_name": f"estimated max-norm error of the stored {what} at each output time",
-            "comment": pick.how})
-        ds.attrs[f"error_estimate_max_{part}" if part else "error_estimate_max"] = float(series.max())
-    return ds
+            "comment": pick.how}, fastpath=True)
+        attrs[f"error_estimate_max_{part}" if part else "error_estimate_max"] = float(series.max())
+    return variables, attrs
 
 
 def _at_taylor_floor(integrator: Any) -> bool:

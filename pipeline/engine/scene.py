@@ -209,10 +209,11 @@ class Scene:
         stats = solution.stats
         log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", self.integrator.name, stats.n_steps,
                  "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)
-        ds = build_dataset(self, solution)
+        add = None
         if error_estimate.wanted(self):  # a companion run measures the stored trajectory's error
-            ds = error_estimate.add_error_estimate(ds, self, solution.y, stats.wall_time)
-        return ds
+            def add(variables):
+                return error_estimate.measure(self, solution.y, stats.wall_time, variables)
+        return build_dataset(self, solution, add)
 
 
 def compose_scene(overrides: Sequence[str] = ()) -> Scene:

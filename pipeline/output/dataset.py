@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import logging
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 import xarray as xr
@@ -36,7 +36,11 @@ SMALL_COORDINATE = 16
 _LABEL_INDEXES: dict[tuple[Any, ...], Any] = {}
 
 
-def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
+def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.Variable]], tuple[
+        dict[str, xr.Variable], dict[str, Any]]] | None = None) -> xr.Dataset:
+    """The run dataset of ``scene`` from ``solution``; ``add`` (given the trajectory's variables) returns more
+    variables and attributes to put in while it is assembled (``Scene.run``'s error estimate): inserting a
+    variable into a built dataset aligns and merges (~0.4 ms each, more than the whole assembly)."""
     system, integrator = scene.system, scene.integrator
     body = system.body
     # each state component contiguous (column-major): the derived variables' arithmetic, one component at a time,
@@ -47,6 +51,10 @@ def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
         # max |v − v0| from the extremes: subtracting v0 is monotone in floating point, so this is the value of
         # np.max(np.abs(values - values[0])) without its two temporaries
         variables[name].attrs["max_abs_drift"] = float(max(values.max() - values[0], values[0] - values.min()))
+    added_attrs: dict[str, Any] = {}
+    if add is not None:
+        added, added_attrs = add(variables)
+        variables.update(added)
     coords = {
         "time": ("time", solution.t, time_attributes(body)),
         "axis": ("axis", np.array(["x", "y", "z"]), {"units": "1", "long_name": "principal body axis"}),
@@ -61,6 +69,7 @@ def build_dataset(scene: Scene, solution: Solution) -> xr.Dataset:
     ds.attrs.update(integrator.attributes())
     ds.attrs.update(solution.stats.attributes())
     ds.attrs.update(after)
+    ds.attrs.update(added_attrs)
     flag_violated_invariants(ds, system.invariants, integrator.adaptive)
     return conform(ds, source=f"run of system {system.name} with integrator {integrator.name}")
 
