@@ -25,6 +25,7 @@ state starts with ω; as ``error_estimate`` (the whole state's max-norm error) f
 
 from __future__ import annotations
 
+import functools
 import logging
 import time
 from dataclasses import dataclass
@@ -119,14 +120,16 @@ def measure(scene: Any, y: np.ndarray, wall_time: float,
     attrs: dict[str, Any] = {"error_estimate_method": pick.how,
                              "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
     omega = stored.get("omega")
-    if omega is not None and omega.shape == (len(y), 3) and np.array_equal(omega.values, y[:, :3]):
+    if omega is not None and omega.shape == (len(y), 3) and bool((omega.values == y[:, :3]).all()):
         parts = {"omega": (difference[:, :3], omega.attrs.get("units", "1"), "angular velocity ω"),
                  "attitude": (difference[:, 3:], "1", "direction cosines (γ, and α where carried)")}
     else:  # a state whose layout this module does not know: one max-norm over all of it
         parts = {"": (difference, "1", "state (model units)")}
     variables = {}
     for part, (values, units, what) in parts.items():
-        series = values.max(axis=1)
+        # the max-norm over the part's components, column by column: numpy reduces a short last axis row by row
+        # (~0.1 ms for 3,001 × 3, 15× the time of two np.maximum over columns)
+        series = functools.reduce(np.maximum, (values[:, k] for k in range(values.shape[1])))
         key = f"error_estimate_{part}" if part else "error_estimate"
         variables[key] = xr.Variable("time", series, {
             "units": units, "long_name": f"estimated max-norm error of the stored {what} at each output time",
