@@ -42,6 +42,9 @@ from gyrolab import compose_scene
 from gyrolab.batch.integrate import integrate_batch
 from gyrolab.physics.reference import fixed_point_reference
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from results_file import write_results  # noqa: E402  (benchmarks/ is not a package)
+
 INERTIA = np.array([2.0, 1.5, 1.0])
 R_C = np.array([0.3, 0.2, 0.9327379053088815])
 K = 0.5
@@ -174,6 +177,7 @@ def peer_table(reference, rounds, quick):
     print("\nThe same rounds' medians, ms (heyoka and taylor: the setting with the smallest median reaching ε):\n")
     print("| ε | heyoka | auto, integration | auto, Scene.run() | taylor | auto / heyoka | Scene.run() / heyoka | "
           "taylor / heyoka |\n| --- | --- | --- | --- | --- | --- | --- | --- |")
+    median_rows = []
     for eps in epsilons:
         def fastest(method):
             ok = [key for key in best if key[0] == method and errors[key] <= eps]
@@ -185,6 +189,7 @@ def peer_table(reference, rounds, quick):
         ratios = ["" if keys[0] is None or key is None else f"{MEDIANS[key] / MEDIANS[keys[0]]:.2f}"
                   for key in keys[1:]]
         print(f"| {eps:.0e} | {' | '.join(cells)} | {' | '.join(ratios)} |")
+        median_rows.append([f"{eps:.0e}", *cells, *(f"{r}×" if r else "" for r in ratios)])
     run_ratios = {}
     for eps in epsilons:
         peer = min((key for key in best if key[0] == "heyoka" and errors[key] <= eps), key=MEDIANS.get, default=None)
@@ -192,11 +197,25 @@ def peer_table(reference, rounds, quick):
         if peer is not None:
             run_ratios[eps] = MEDIANS[run_key] / MEDIANS[peer] if errors[run_key] <= eps else float("inf")
     print_verdict(run_ratios)
+    if not quick and has_peer:
+        write_results("perf_reference", {"rounds": rounds, "errors": {f"{k[0]} {k[1]:.0e}": v for k, v in errors.items()},
+                                         "cpu_ms_min": {f"{k[0]} {k[1]:.0e}": best[k][0] * 1e3 for k in best},
+                                         "cpu_ms_median": {f"{k[0]} {k[1]:.0e}": MEDIANS[k] * 1e3 for k in best}},
+                      {"perf_reference": {
+                          "caption": f"Time to reach a final error ≤ ε on the reference scene (t ∈ [0, 300], 3,001 "
+                                     f"output times), CPU ms, medians of {rounds} interleaved rounds; heyoka's "
+                                     f"`propagate_grid` and gyrolab's `taylor` at their cheapest tolerance reaching ε, "
+                                     f"`auto` at accuracy ε; `Scene.run()` includes the dataset and `auto`'s default "
+                                     f"error estimate (a companion run).",
+                          "header": ["ε", "heyoka", "`auto`, integration", "`auto`, `Scene.run()`", "`taylor`",
+                                     "`auto` / heyoka", "`Scene.run()` / heyoka", "`taylor` / heyoka"],
+                          "rows": median_rows}})
     print("\nEvery setting measured:\n\n| method | setting | final error | time [ms] |\n| --- | --- | --- | --- |")
     for key in sorted(best, key=lambda key: (key[0], -key[1])):
         print(f"| {key[0]} | {settings[key]} | {errors[key]:.2e} | {best[key][0] * 1e3:.2f} |")
 
 
+NO_ESTIMATE = "auto Scene.run(), output.error_estimate=false"
 TARGET = 1.0  # issue 24: auto's whole Scene.run() (dataset and error estimate included) ≤ 1.0× heyoka's time
 
 
@@ -219,18 +238,37 @@ def scene_run_only(reference, rounds):
     for eps in EPSILONS:
         scene = compose_scene(["experiment=perf_reference", f"accuracy={eps}"])
         contestants[("auto Scene.run()", eps)] = lambda s=scene: final_state(s.run())
+        bare = compose_scene(["experiment=perf_reference", f"accuracy={eps}", "output.error_estimate=false"])
+        contestants[(NO_ESTIMATE, eps)] = lambda s=bare: final_state(s.run())
     interleaved(contestants, 1)
     best = interleaved(contestants, rounds)
     errors = {key: float(np.max(np.abs(np.asarray(result)[:6] - reference))) for key, (_, result) in best.items()}
-    ratios = {}
+    ratios, rows = {}, []
     for eps in EPSILONS:
         peer = min((key for key in best if key[0] == "heyoka" and errors[key] <= eps), key=MEDIANS.get, default=None)
-        run_key = ("auto Scene.run()", eps)
+        run_key, bare_key = ("auto Scene.run()", eps), (NO_ESTIMATE, eps)
         if peer is not None:
             ratios[eps] = MEDIANS[run_key] / MEDIANS[peer] if errors[run_key] <= eps else float("inf")
             print(f"ε = {eps:.0e}: heyoka {MEDIANS[peer] * 1e3:.2f} ms ({errors[peer]:.1e}), auto Scene.run() "
-                  f"{MEDIANS[run_key] * 1e3:.2f} ms ({errors[run_key]:.1e})")
+                  f"{MEDIANS[run_key] * 1e3:.2f} ms ({errors[run_key]:.1e}), without the error estimate "
+                  f"{MEDIANS[bare_key] * 1e3:.2f} ms ({errors[bare_key]:.1e})")
+            rows.append([f"{eps:.0e}", f"{MEDIANS[peer] * 1e3:.2f} ({errors[peer]:.1e})",
+                         f"{MEDIANS[run_key] * 1e3:.2f} ({errors[run_key]:.1e})", f"{ratios[eps]:.2f}×",
+                         f"{MEDIANS[bare_key] * 1e3:.2f}", f"{MEDIANS[bare_key] / MEDIANS[peer]:.2f}×"])
     print_verdict(ratios)
+    if rows:
+        write_results("perf_reference_scene_run", {"rounds": rounds, "ratios": {f"{e:.0e}": r for e, r in ratios.items()}},
+                      {"scene_run_verdict": {
+                          "caption": f"Issue 24's verdict: `auto`'s whole `Scene.run()` (dataset and default error "
+                                     f"estimate included; beside it with `output.error_estimate=false`) against "
+                                     f"heyoka's `propagate_grid` at its cheapest tolerance reaching ε, on the reference "
+                                     f"scene's 3,001 output times; CPU ms, medians of {rounds} interleaved rounds "
+                                     f"(final error reached). Target ≤ {TARGET}× at every ε: "
+                                     f"{'PASS' if max(ratios.values()) <= TARGET else 'FAIL'}.",
+                          "header": ["ε", "heyoka", "auto `Scene.run()`", "/ heyoka", "without error estimate",
+                                     "/ heyoka"],
+                          "rows": rows}},
+                      command="benchmarks/perf_reference.py --scene-run")
 
 
 def run_breakdown(rounds, quick):
