@@ -116,3 +116,22 @@ def _state_rhs(y, p):
     omega, gamma = y[:3], y[3:6]
     torque = np.cross(inertia * omega, omega) + np.cross(u, gamma) + n * np.cross(gamma, inertia * gamma)
     return np.concatenate([torque / inertia, np.cross(gamma, omega)])
+
+
+def test_the_tangent_growth_kernel_takes_the_steps_of_the_indicator_kernel():
+    # auto.CHAOS_MARGIN is calibrated on the growth the MEGNO/FLI kernel gives (run_indicators_dop853): on a chaotic
+    # scene any change of the steps moves it by up to e^±4, so the lean kernel must reproduce it exactly
+    from gyrolab.plugins.compiled import variational
+
+    built = compose_scene(["integrator=taylor", *SLOW_SPIN, "time.end=300"])
+    p = np.array(built.compiled.params, dtype=float)
+    p[layout.CARRIES_ALPHA] = 0.0
+    y0 = built.system.initial_state()[:6]
+    expected = []
+    for end in (30.0, 300.0):
+        megno, fli, deviation, final = np.empty((1, 1)), np.empty(1), np.empty(1), np.empty((1, 6))
+        variational.run_indicators_dop853(p[None, :], np.array([0.0, end]), y0[None, :],
+                                          variational.initial_tangent(y0[None, :]), 1e-5, 1e-5, np.inf, megno, fli,
+                                          deviation, final, np.zeros(1, dtype=np.int64))
+        expected.append(float(fli[0]))
+    assert variational.tangent_growths(p, y0, 30.0, 300.0, 1e-5) == tuple(expected)

@@ -191,26 +191,38 @@ def run_indicators_dop853(P, t_out, Y0, D0, rtol, atol, max_step, megno, fli, de
 
 def tangent_growths(p: np.ndarray, y0: np.ndarray, t_pilot: float, t_end: float, tol: float) -> tuple[float, float]:
     """(max ln|δ(t)| over [0, t_pilot], over [0, t_end]) of the unit tangent vector ``initial_tangent`` of the (ω, γ)
-    state ``y0``, in one DOP853 run at rtol = atol = ``tol`` whose steps land on t_pilot, in this thread (no thread pool: one
-    trajectory). ``_tangent_pair`` carries the 12 unknowns of state and tangent only (no MEGNO quadratures, flat
-    arrays): 0.47 ms on the reference scene where two runs of ``_dop853_trajectory`` (to t_pilot, to t_end) took
-    0.77 ms (AMD EPYC with AVX-512, 2026-11-27). ``p`` with CARRIES_ALPHA = 0; NaNs when the run fails."""
+    state ``y0``, by DOP853 at rtol = atol = ``tol`` in this thread (no thread pool: one trajectory). ``p`` with
+    CARRIES_ALPHA = 0; NaNs when a run fails.
+
+    Two runs, one to each end, as ``auto`` has always measured them: on a chaotic scene the growth over the span
+    of a run at this loose tolerance scatters by up to e^±4 with any change of its steps (slow_spin over t = 300
+    at 1e-5: e^19.6 from a run to t_end, e^15.0 from one whose steps land on t_pilot on the way), and
+    ``auto.CHAOS_MARGIN`` is calibrated on the former (benchmarks/chaos_promise.py broke 3 of 40 promises with
+    the latter). ``_tangent_run`` carries the 12 unknowns of state and tangent only (no MEGNO quadratures, flat
+    arrays) and takes the steps of ``_dop853_trajectory``: 0.47 ms for both runs on the reference scene where
+    ``_dop853_trajectory`` took 0.77 ms (AMD EPYC with AVX-512, 2026-11-27)."""
     y = np.ascontiguousarray(y0[:6], dtype=float)
-    out = np.empty(2)
-    ok = _tangent_pair(np.ascontiguousarray(p, dtype=float), y, initial_tangent(y[None, :])[0], float(t_pilot),
-                       float(t_end), float(tol), out)
-    return (float(out[0]), float(out[1])) if ok else (float("nan"), float("nan"))
+    d = initial_tangent(y[None, :])[0]
+    p = np.ascontiguousarray(p, dtype=float)
+    logs = (_tangent_run(p, y, d, float(t_pilot), float(tol)), _tangent_run(p, y, d, float(t_end), float(tol)))
+    return logs[0], logs[1]
 
 
 @inline_kernel
 def _state_and_tangent(y, p, out):
-    """ẋ = f(x) (``rhs``) and δ̇ = J(x) δ for y = (x, δ): the tangent rows of ``_augmented_block``, one trajectory."""
-    rhs(0.0, y, p, out)
+    """ẋ = f(x) and δ̇ = J(x) δ for y = (x, δ), one trajectory: the arithmetic of ``_augmented_block`` (and of
+    ``fixed_point.rhs_block``) term for term, so that a tangent run takes the same steps as there."""
     I0, I1, I2 = p[INERTIA], p[INERTIA + 1], p[INERTIA + 2]
     u0, u1, u2 = p[U_Z], p[U_Z + 1], p[U_Z + 2]
     n = p[N_Z]
     w0, w1, w2, g0, g1, g2 = y[0], y[1], y[2], y[3], y[4], y[5]
     a0, a1, a2, c0, c1, c2 = y[6], y[7], y[8], y[9], y[10], y[11]
+    out[0] = ((I1 - I2) * w1 * w2 + u1 * g2 - u2 * g1 + n * (I2 - I1) * g1 * g2) * p[INV_INERTIA]
+    out[1] = ((I2 - I0) * w2 * w0 + u2 * g0 - u0 * g2 + n * (I0 - I2) * g2 * g0) * p[INV_INERTIA + 1]
+    out[2] = ((I0 - I1) * w0 * w1 + u0 * g1 - u1 * g0 + n * (I1 - I0) * g0 * g1) * p[INV_INERTIA + 2]
+    out[3] = g1 * w2 - g2 * w1
+    out[4] = g2 * w0 - g0 * w2
+    out[5] = g0 * w1 - g1 * w0
     out[6] = ((I1 - I2) * (a1 * w2 + w1 * a2) + u1 * c2 - u2 * c1 + n * (I2 - I1) * (c1 * g2 + g1 * c2)) * p[INV_INERTIA]
     out[7] = ((I2 - I0) * (a2 * w0 + w2 * a0) + u2 * c0 - u0 * c2 + n * (I0 - I2) * (c2 * g0 + g2 * c0)) * p[INV_INERTIA + 1]
     out[8] = ((I0 - I1) * (a0 * w1 + w0 * a1) + u0 * c1 - u1 * c0 + n * (I1 - I0) * (c0 * g1 + g0 * c1)) * p[INV_INERTIA + 2]
@@ -220,9 +232,10 @@ def _state_and_tangent(y, p, out):
 
 
 @kernel
-def _tangent_pair(p, y0, d0, t_pilot, t_end, tol, out):
-    """DOP853 on (x, δ) with scipy's controller on all 12 unknowns (as ``_dop853_trajectory``), δ renormalised after
-    every step; out = (max ln|δ| up to t_pilot, up to t_end). Returns False when the run fails."""
+def _tangent_run(p, y0, d0, t_end, tol):
+    """max ln|δ| over [0, t_end] by DOP853 on (x, δ), with scipy's controller on all 12 unknowns and δ renormalised
+    after every step: the steps and arithmetic of ``_dop853_trajectory`` without its MEGNO rows. NaN when the run
+    fails."""
     n = 12
     K = np.empty((dop853.N_STAGES + 1, n))
     y, f, ytmp, y_new = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
@@ -239,65 +252,61 @@ def _tangent_pair(p, y0, d0, t_pilot, t_end, tol, out):
     h_abs = min(h_abs, t_end)
     t = 0.0
     log_norm = best = 0.0
-    out[0] = out[1] = np.nan
-    for leg in range(2):
-        t_bound = t_pilot if leg == 0 else t_end
-        while t < t_bound:
-            min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
-            h_abs = max(h_abs, min_step)
-            rejected = False
-            while True:
-                if h_abs < min_step or not np.isfinite(h_abs):
-                    return False
-                t_new = min(t + h_abs, t_bound)
-                h = t_new - t
-                K[0] = f
-                for s in range(1, dop853.N_STAGES):
-                    for m in range(n):
-                        acc = 0.0
-                        for q in range(s):
-                            acc += K[q, m] * dop853.A[s, q]
-                        ytmp[m] = y[m] + acc * h
-                    _state_and_tangent(ytmp, p, K[s])
+    while t < t_end:
+        min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+        h_abs = max(h_abs, min_step)
+        rejected = False
+        while True:
+            if h_abs < min_step or not np.isfinite(h_abs):
+                return np.nan
+            t_new = min(t + h_abs, t_end)
+            h = t_new - t
+            K[0] = f
+            for s in range(1, dop853.N_STAGES):
                 for m in range(n):
                     acc = 0.0
-                    for q in range(dop853.N_STAGES):
-                        acc += K[q, m] * dop853.B[q]
-                    y_new[m] = y[m] + h * acc
-                _state_and_tangent(y_new, p, K[dop853.N_STAGES])
-                e5 = 0.0
-                e3 = 0.0
-                for m in range(n):
-                    sc = tol + max(abs(y[m]), abs(y_new[m])) * tol
-                    a5 = 0.0
-                    a3 = 0.0
-                    for q in range(dop853.N_STAGES + 1):
-                        a5 += K[q, m] * dop853.E5[q]
-                        a3 += K[q, m] * dop853.E3[q]
-                    e5 += (a5 / sc) ** 2
-                    e3 += (a3 / sc) ** 2
-                error = 0.0 if e5 == 0.0 and e3 == 0.0 else abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
-                if not np.isfinite(error):
-                    return False
-                if error < 1.0:
-                    factor = dop853.MAX_FACTOR if error == 0.0 else min(
-                        dop853.MAX_FACTOR, dop853.SAFETY * error ** dop853.ERROR_EXPONENT)
-                    h_abs *= min(1.0, factor) if rejected else factor
-                    break
-                h_abs *= max(dop853.MIN_FACTOR, dop853.SAFETY * error ** dop853.ERROR_EXPONENT)
-                rejected = True
-            t = t_new
-            norm = 0.0
-            for m in range(6, 12):
-                norm += y_new[m] * y_new[m]
-            norm = np.sqrt(norm)
+                    for q in range(s):
+                        acc += K[q, m] * dop853.A[s, q]
+                    ytmp[m] = y[m] + acc * h
+                _state_and_tangent(ytmp, p, K[s])
             for m in range(n):
-                y[m] = y_new[m] / norm if m >= 6 else y_new[m]
-            log_norm += np.log(norm)
-            best = max(best, log_norm)
-            _state_and_tangent(y, p, f)  # δ rescaled: its derivative too
-        out[leg] = best
-    return bool(np.isfinite(log_norm + y[0] + y[1] + y[2]))
+                acc = 0.0
+                for q in range(dop853.N_STAGES):
+                    acc += K[q, m] * dop853.B[q]
+                y_new[m] = y[m] + h * acc
+            _state_and_tangent(y_new, p, K[dop853.N_STAGES])
+            e5 = 0.0
+            e3 = 0.0
+            for m in range(n):
+                sc = tol + max(abs(y[m]), abs(y_new[m])) * tol
+                a5 = 0.0
+                a3 = 0.0
+                for q in range(dop853.N_STAGES + 1):
+                    a5 += K[q, m] * dop853.E5[q]
+                    a3 += K[q, m] * dop853.E3[q]
+                e5 += (a5 / sc) ** 2
+                e3 += (a3 / sc) ** 2
+            error = 0.0 if e5 == 0.0 and e3 == 0.0 else abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
+            if not np.isfinite(error):
+                return np.nan
+            if error < 1.0:
+                factor = dop853.MAX_FACTOR if error == 0.0 else min(
+                    dop853.MAX_FACTOR, dop853.SAFETY * error ** dop853.ERROR_EXPONENT)
+                h_abs *= min(1.0, factor) if rejected else factor
+                break
+            h_abs *= max(dop853.MIN_FACTOR, dop853.SAFETY * error ** dop853.ERROR_EXPONENT)
+            rejected = True
+        t = t_new
+        norm = 0.0
+        for m in range(6, 12):
+            norm += y_new[m] * y_new[m]
+        norm = np.sqrt(norm)
+        for m in range(n):
+            y[m] = y_new[m] / norm if m >= 6 else y_new[m]
+        log_norm += np.log(norm)
+        best = max(best, log_norm)
+        _state_and_tangent(y, p, f)  # δ rescaled: its derivative too
+    return best if np.isfinite(log_norm + y[0] + y[1] + y[2]) else np.nan
 
 
 @kernel
