@@ -135,3 +135,55 @@ def test_the_tangent_growth_kernel_takes_the_steps_of_the_indicator_kernel():
                                           deviation, final, np.zeros(1, dtype=np.int64))
         expected.append(float(fli[0]))
     assert variational.tangent_growths(p, y0, 30.0, 300.0, 1e-5) == tuple(expected)
+
+
+def _no_growth(monkeypatch):
+    """auto's amplification measured as none: its prediction then misses the chaos (as a tangent run whose growth
+    scatters low would make it miss)."""
+    import gyrolab.plugins.integrators.auto as auto_module
+    from gyrolab.plugins.integrators.amplification import Amplification
+
+    monkeypatch.setattr(auto_module, "amplification",
+                        lambda compiled, fun, y0, t0, t_pilot, t_end, method: Amplification(0.0, 0.0, t_end - t0,
+                                                                                           "none (test)"))
+
+
+def test_a_run_whose_measured_error_breaks_the_prediction_is_run_again_more_accurately(monkeypatch):
+    # rule 11: with no amplification the chaotic top at t = 110 ends with 2e-6 where 1e-6 is asked and predicted;
+    # the error estimate measures it and auto runs its method again, more accurately, keeping the promise against
+    # the long-double reference
+    _no_growth(monkeypatch)
+    overrides = [*CHAOTIC_TOP, "time.end=110"]
+    truth = _reference(overrides)
+    ds = compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", *overrides]).run()
+    final = np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
+    actual = float(np.max(np.abs(final - truth)))
+    assert actual <= 1e-6 and actual <= ds.attrs["auto_predicted_error"], (actual, ds.attrs["auto_predicted_error"])
+    assert ds.attrs["accuracy"] == 1e-6
+    assert ds.attrs["auto_measured_error_before_recheck"][0] > 1e-6  # the first run did break it
+    assert ds.attrs["error_estimate_max_omega"] <= ds.attrs["auto_predicted_error"]
+
+
+def test_without_the_error_estimate_nothing_catches_a_prediction_that_misses(monkeypatch):
+    # the same scene with output.error_estimate=false: the safety net above is the measurement, so the broken
+    # prediction stands (what this test shows is why the estimate is on by default for auto)
+    _no_growth(monkeypatch)
+    overrides = [*CHAOTIC_TOP, "time.end=110"]
+    truth = _reference(overrides)
+    ds = compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", "output.error_estimate=false",
+                        *overrides]).run()
+    final = np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
+    assert float(np.max(np.abs(final - truth))) > 1e-6
+    assert "auto_measured_error_before_recheck" not in ds.attrs
+
+
+def test_a_promise_the_reruns_cannot_keep_is_one_sentence(monkeypatch):
+    import gyrolab.plugins.integrators.auto as auto_module
+
+    _no_growth(monkeypatch)
+    monkeypatch.setattr(auto_module, "MAX_RECHECKS", 0)
+    with pytest.raises(ConfigError) as refused:
+        compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", *CHAOTIC_TOP, "time.end=110"]).run()
+    message = str(refused.value)
+    assert message.startswith("accuracy=1e-06 is not met on this scene") and "\n" not in message
+    assert "integrator.extended_precision=true" in message

@@ -186,6 +186,10 @@ class Integrator(ABC):
        ``output.error_estimate`` compares with this one to measure the stored trajectory's error.
     10. ``prepare(system)`` is called once by the scene before integrating
         (default: nothing); ``auto`` uses it to consult the system's regimes.
+    11. ``tightened_for(measured_error)``, optional (CHOOSES_METHOD): when ``output.error_estimate``
+        measured the last run's error above what the integrator promised, the same integrator aimed
+        tighter, which the scene runs instead (a promise resting on a measurement, not only on a
+        prediction); None when the promise holds (the default).
 
     What gyrolab enforces (``gyrolab.contracts.integrator_rules``): every
     subclass's ``integrate`` — built-in or third-party, under its own name —
@@ -265,6 +269,11 @@ class Integrator(ABC):
         cannot be made so (a tolerance already at its floor, or nothing to tighten). A method with tolerances
         divides them by ``factor`` (the number is 1); a fixed-step method of order p halves its step (the number is
         Richardson's 2^p / (2^p − 1)); a method that chooses (CHOOSES_METHOD) answers for the method it ran."""
+        return None
+
+    def tightened_for(self, measured_error: float) -> Integrator | None:
+        """Rule 11 (CHOOSES_METHOD): the same integrator aimed tighter when ``measured_error`` (the largest error
+        ``output.error_estimate`` measured on its last run's stored states) breaks what it promised, else None."""
         return None
 
     def choose_batch_method(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray,

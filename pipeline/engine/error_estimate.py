@@ -77,8 +77,8 @@ def companion(integrator: Any, has_compiled: bool) -> Companion | None:
 
 def add_error_estimate(ds: xr.Dataset, scene: Any, y: np.ndarray, wall_time: float) -> xr.Dataset:
     """``ds`` with the error-estimate variables and attributes of a run whose stored states are ``y`` (``measure``
-    then one insertion per variable; ``Scene.run`` passes ``measure`` to ``build_dataset`` instead, which puts
-    them in while the dataset is assembled: inserting into a built dataset aligns and merges, ~0.4 ms each)."""
+    then one insertion per variable; ``Scene.run`` passes them to ``build_dataset`` instead, which puts them in
+    while the dataset is assembled: inserting into a built dataset aligns and merges, ~0.4 ms each)."""
     variables, attrs = measure(scene, y, wall_time, {name: ds[name].variable for name in ds.data_vars})
     ds.attrs.update(attrs)
     for key, variable in variables.items():
@@ -88,19 +88,67 @@ def add_error_estimate(ds: xr.Dataset, scene: Any, y: np.ndarray, wall_time: flo
 
 def measure(scene: Any, y: np.ndarray, wall_time: float,
             stored: dict[str, xr.Variable]) -> tuple[dict[str, xr.Variable], dict[str, Any]]:
-    """(variables, attributes) of the error estimate of a run whose stored states are ``y`` and whose dataset
-    variables are ``stored`` (read to tell whether the state starts with ω): the companion run's measured error,
-    or no variables and an attribute saying why no estimate is available."""
+    """(variables, attributes) of the error estimate of the scene's run whose stored states are ``y`` and whose
+    dataset variables are ``stored``: ``compare`` then ``Comparison.variables``."""
+    return compare(scene, scene.integrator, y, wall_time).variables(stored)
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """A run against its companion: ``difference`` (the estimated error of every stored component at every output
+    time, None when no companion could run) and the attributes saying how (or why not)."""
+
+    difference: np.ndarray | None
+    how: str
+    attrs: dict[str, Any]
+    #: the run's stored states (to tell whether a dataset's ω is their first three components)
+    y: np.ndarray | None = None
+
+    @property
+    def max_error(self) -> float | None:
+        """The largest estimated error over every component and output time (None: not measured)."""
+        return None if self.difference is None else float(np.max(self.difference))
+
+    def variables(self, stored: dict[str, xr.Variable]) -> tuple[dict[str, xr.Variable], dict[str, Any]]:
+        """(variables, attributes) for the dataset whose trajectory variables are ``stored`` (read to tell whether
+        the state starts with ω: ω's error and the attitude's are then stored apart)."""
+        attrs = dict(self.attrs)
+        if self.difference is None:
+            return {}, attrs
+        difference = self.difference
+        omega = stored.get("omega")
+        if (omega is not None and omega.shape == (len(difference), 3)
+                and bool((omega.values == self.y[:, :3]).all())):
+            parts = {"omega": (difference[:, :3], omega.attrs.get("units", "1"), "angular velocity ω"),
+                     "attitude": (difference[:, 3:], "1", "direction cosines (γ, and α where carried)")}
+        else:  # a state whose layout this module does not know: one max-norm over all of it
+            parts = {"": (difference, "1", "state (model units)")}
+        variables = {}
+        for part, (values, units, what) in parts.items():
+            # the max-norm over the part's components, column by column: numpy reduces a short last axis row by
+            # row (~0.1 ms for 3,001 × 3, 15× the time of two np.maximum over columns)
+            series = functools.reduce(np.maximum, (values[:, k] for k in range(values.shape[1])))
+            key = f"error_estimate_{part}" if part else "error_estimate"
+            variables[key] = xr.Variable("time", series, {
+                "units": units, "long_name": f"estimated max-norm error of the stored {what} at each output time",
+                "comment": self.how}, fastpath=True)
+            attrs[f"error_estimate_max_{part}" if part else "error_estimate_max"] = float(series.max())
+        return variables, attrs
+
+
+def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Comparison:
+    """Run the companion of ``integrator``'s run of ``scene`` (stored states ``y``, integration time ``wall_time``)
+    and compare: the measured error estimate, or why none is available."""
     compiled_model = scene.system.compiled_model()
-    pick = companion(scene.integrator, compiled_model is not None)
-    name = getattr(scene.integrator, "name", type(scene.integrator).__name__)
+    pick = companion(integrator, compiled_model is not None)
+    name = getattr(integrator, "name", type(integrator).__name__)
     if pick is None:
         reason = (f"not available: integrator {name!r} already runs at the compiled Taylor method's floor in double "
-                  "precision (nothing more accurate to compare with)" if _at_taylor_floor(scene.integrator) else
+                  "precision (nothing more accurate to compare with)" if _at_taylor_floor(integrator) else
                   f"not available: integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
                   "compiled model for the Taylor method")
         log.warning("output.error_estimate: %s", reason)
-        return {}, {"error_estimate_method": reason}
+        return Comparison(None, reason, {"error_estimate_method": reason})
     companion_model = None
     if pick.integrator.supports(COMPILED_MODEL) or pick.integrator.supports(PREFERS_COMPILED_MODEL):
         # the scene's own model is prepared for its integrator (a plugin torque's Taylor kernel compiled); another
@@ -110,32 +158,14 @@ def measure(scene: Any, y: np.ndarray, wall_time: float,
         if refusal:
             reason = f"not available: the companion ({pick.how}) {refusal}"
             log.warning("output.error_estimate: %s", reason)
-            return {}, {"error_estimate_method": reason}
+            return Comparison(None, reason, {"error_estimate_method": reason})
     start = time.perf_counter()
-    other = pick.integrator.integrate(scene.system.rhs, scene.times, scene.system.initial_state(), None,
-                                      companion_model).y
+    y0 = scene.system.initial_state()
+    other = pick.integrator.integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
     spent = time.perf_counter() - start
     y = np.asarray(y, dtype=float)
-    difference = pick.scale * np.abs(y - other)
-    attrs: dict[str, Any] = {"error_estimate_method": pick.how,
-                             "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
-    omega = stored.get("omega")
-    if omega is not None and omega.shape == (len(y), 3) and bool((omega.values == y[:, :3]).all()):
-        parts = {"omega": (difference[:, :3], omega.attrs.get("units", "1"), "angular velocity ω"),
-                 "attitude": (difference[:, 3:], "1", "direction cosines (γ, and α where carried)")}
-    else:  # a state whose layout this module does not know: one max-norm over all of it
-        parts = {"": (difference, "1", "state (model units)")}
-    variables = {}
-    for part, (values, units, what) in parts.items():
-        # the max-norm over the part's components, column by column: numpy reduces a short last axis row by row
-        # (~0.1 ms for 3,001 × 3, 15× the time of two np.maximum over columns)
-        series = functools.reduce(np.maximum, (values[:, k] for k in range(values.shape[1])))
-        key = f"error_estimate_{part}" if part else "error_estimate"
-        variables[key] = xr.Variable("time", series, {
-            "units": units, "long_name": f"estimated max-norm error of the stored {what} at each output time",
-            "comment": pick.how}, fastpath=True)
-        attrs[f"error_estimate_max_{part}" if part else "error_estimate_max"] = float(series.max())
-    return variables, attrs
+    attrs = {"error_estimate_method": pick.how, "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
+    return Comparison(pick.scale * np.abs(y - other), pick.how, attrs, y)
 
 
 def _at_taylor_floor(integrator: Any) -> bool:
