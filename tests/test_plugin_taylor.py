@@ -23,7 +23,7 @@ from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from tests.conftest import installed_distribution
 
 ORDER = 24
-_KERNEL = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int64, ctypes.c_int64, *[ctypes.POINTER(ctypes.c_double)] * 4)
+_KERNEL = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int64, *[ctypes.POINTER(ctypes.c_double)] * 3)
 
 
 class OfTime(Force):
@@ -42,20 +42,21 @@ class OfTime(Force):
 
 
 def series(f, t0, order=ORDER):
-    """The generated kernel's coefficients 0..order of the three functions f(t) about t0 (rows)."""
+    """The generated kernel's coefficients 0..order of the three functions f(t) about t0 (rows).
+
+    The kernel fills the state's series: with the state 0, I = 0 and I⁻¹ = 1 (as parameters), ω's coefficient
+    k + 1 is the torque's coefficient k over k + 1.
+    """
     result = plugin_torque.trace([OfTime(f)])
     address, columns = plugin_taylor.compile_taylor(result, ["of_time"])
     call = _KERNEL(int(address))
     p = np.zeros(plugin_torque.FIRST_CONSTANT + len(result.graph.constants))
     p[plugin_torque.INV_INERTIA:plugin_torque.INV_INERTIA + 3] = 1.0
     p[plugin_torque.FIRST_CONSTANT:] = result.graph.constants
-    Y = np.zeros((order + 1, 6))
+    Y = np.zeros((order + 2, 6))
     W = np.empty((order + 1) * int(columns))
-    out = np.empty((order + 1, 3))
-    ptr = [a.ctypes.data_as(ctypes.POINTER(ctypes.c_double)) for a in (Y, W, p)]
-    for k in range(order + 1):
-        call(t0, k, 6, *ptr, out[k].ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
-    return out
+    call(t0, order + 1, *[a.ctypes.data_as(ctypes.POINTER(ctypes.c_double)) for a in (Y, W, p)])
+    return Y[1:, :3] * np.arange(1, order + 2)[:, None]
 
 
 def _sum(coefficients, h):
