@@ -224,7 +224,7 @@ def _chunks(start: int, n: int) -> list[tuple[int, int]]:
 
 @intrinsic
 def cauchy_sums(typingctx, W, k, columns, base, left, right):
-    """The k-th coefficients (k ≥ 1) of n products at once: Σ_{j=0..k} L_j ⊙ R_{k−j}, as an n-tuple.
+    """The k-th coefficients of n products at once: Σ_{j=0..k} L_j ⊙ R_{k−j}, as an n-tuple.
 
     The products' first operands' coefficients sit side by side in W's rows (``columns`` wide) from column
     ``base``, their second operands' after them (from base + n); rows 0..k−1 are filled, row k is given as the n-tuples ``left`` and ``right``, stored here as vectors.
@@ -274,21 +274,23 @@ def cauchy_sums(typingctx, W, k, columns, base, left, right):
                                      b.load(at(b.sub(k_, j), first + n + lane, size), align=8), flags=_FUSE)
                     b.store(b.fadd(b.load(acc[lane][which]), product, flags=_FUSE), acc[lane][which])
 
-            middle = b.sub(k_, one)  # rows 1..k−1, two at a time
+            zero = ir.Constant(i64, 0)
+            middle = b.sub(k_, one)  # rows 1..k−1, two at a time (none at k = 0)
+            middle = b.select(b.icmp_signed(">", middle, zero), middle, zero)
             with cgutils.for_range(b, b.sdiv(middle, two)) as loop:
                 j = b.add(b.mul(loop.index, two), one)
                 terms(j, 0)
                 terms(b.add(j, one), 1)
             with b.if_then(b.icmp_signed("!=", b.srem(middle, two), ir.Constant(i64, 0))):
                 terms(middle, 0)
-            zero = ir.Constant(i64, 0)
             for lane, size in chunks:
                 a0 = b.fadd(b.load(acc[lane][0]), b.fmul(b.load(at(zero, first + lane, size), align=8),
                                                          newest_vectors[1][lane], flags=_FUSE), flags=_FUSE)
                 a1 = b.fadd(b.load(acc[lane][1]), b.fmul(newest_vectors[0][lane],
                                                          b.load(at(zero, first + n + lane, size), align=8),
                                                          flags=_FUSE), flags=_FUSE)
-                total = b.fadd(a0, a1, flags=_FUSE)
+                # (at k = 0, row 0 is row k: a0 = a1 = the one term L_0 R_0)
+                total = b.select(b.icmp_signed("==", k_, zero), a0, b.fadd(a0, a1, flags=_FUSE))
                 sums += [b.extract_element(total, ir.Constant(i32, i)) for i in range(size)]
         return context.make_tuple(b, signature.return_type, sums)
 
@@ -504,15 +506,11 @@ class _Program:
                 lines.append(f"s{i} = t" if first else f"s{i} = 1.0 if k == 1 else 0.0")
         for d in range(1, depth + 1):
             products = slots[d]
-            width = len(products)
             pairs = [self.series[i].args for i, _ in products]
             left, right = [operand(x) for x, _ in pairs], [operand(y) for _, y in pairs]
-            if first:  # the operands into their slots, row 0; the products
-                for (i, column), x, y in zip(products, left, right):
-                    lines += [f"W[{column}] = {x}", f"W[{column + width}] = {y}", f"s{i} = {x} * {y}"]
-            elif products:  # the depth's Cauchy sums at once, in vectors (``cauchy_sums`` stores row k's operands)
+            if products:  # the depth's Cauchy sums at once, in vectors (``cauchy_sums`` stores row k's operands)
                 names = ", ".join(f"s{i}" for i, _ in products)
-                lines.append(f"{names}, = cauchy_sums(W, k, {self.columns}, {products[0][1]}, "
+                lines.append(f"{names}, = cauchy_sums(W, {0 if first else 'k'}, {self.columns}, {products[0][1]}, "
                              f"({', '.join(left)},), ({', '.join(right)},))")
             for i, s in enumerate(self.series):
                 if s.depth != d or s.op in ("mul", "cos"):
@@ -616,55 +614,53 @@ def compile_taylor(result: Trace, names: list[str], size: int = 6) -> list[float
     return [float(kernel.address), float(columns)]
 
 
-#: W (``order`` rows of the kernel's columns) lives on the caller's stack up to this many doubles (256 KiB),
-#: on the heap beyond: an allocation per step would cost as much as a low order's Cauchy sums
+#: W (``order`` rows of the kernel's columns) lives on the caller's stack up to this many doubles (256 KiB), on
+#: the heap beyond: an allocation per step (np.empty) would cost as much as a low order's Cauchy sums
 _STACK_DOUBLES = 32768
 
 
 @intrinsic
 def _call(typingctx, address, t, order, size, Y, p):
     """Call ``void f(double t, int64 order, double* Y, double* W, double* p)`` at ``address`` with W a scratch
-    array of ``size`` doubles on the stack (freed when the call returns)."""
+    array of ``size`` doubles, freed when the call returns: on the stack up to ``_STACK_DOUBLES``, else on
+    numba's heap. (Code here, not in the calling kernel: an allocation or any call that takes the arrays
+    there, even on a branch not taken, costs the kernel their reference counting, ~12 ns a step.)"""
     sig = types.void(types.int64, types.float64, types.int64, types.int64, Y, p)
 
     def codegen(context, builder, signature, args):
+        b = builder
         address_, t_, order_, size_, Y_, p_ = args
-        double_ptr = ir.DoubleType().as_pointer()
-        i64 = ir.IntType(64)
-        fnty = ir.FunctionType(ir.VoidType(), [ir.DoubleType(), i64, double_ptr, double_ptr, double_ptr])
-        y, pp = [builder.bitcast(cgutils.create_struct_proxy(ty)(context, builder, value=v).data, double_ptr)
+        double, i64 = ir.DoubleType(), ir.IntType(64)
+        double_ptr, byte_ptr = double.as_pointer(), ir.IntType(8).as_pointer()
+        fnty = ir.FunctionType(ir.VoidType(), [double, i64, double_ptr, double_ptr, double_ptr])
+        y, pp = [b.bitcast(cgutils.create_struct_proxy(ty)(context, b, value=v).data, double_ptr)
                  for ty, v in ((signature.args[4], Y_), (signature.args[5], p_))]
-        # stacksave/stackrestore: the allocation is freed at once, not when the calling kernel returns
-        byte_ptr = ir.IntType(8).as_pointer()
-        save = cgutils.get_or_insert_function(builder.module, ir.FunctionType(byte_ptr, []), "llvm.stacksave")
-        restore = cgutils.get_or_insert_function(builder.module, ir.FunctionType(ir.VoidType(), [byte_ptr]),
+        # stacksave/stackrestore: the stack's allocation is freed at once, not when the calling kernel returns
+        save = cgutils.get_or_insert_function(b.module, ir.FunctionType(byte_ptr, []), "llvm.stacksave")
+        restore = cgutils.get_or_insert_function(b.module, ir.FunctionType(ir.VoidType(), [byte_ptr]),
                                                  "llvm.stackrestore")
-        saved = builder.call(save, [])
-        W = builder.alloca(ir.DoubleType(), size=size_)
-        builder.call(builder.inttoptr(address_, fnty.as_pointer()), [t_, order_, y, W, pp])
-        builder.call(restore, [saved])
+        small = b.icmp_signed("<=", size_, ir.Constant(i64, _STACK_DOUBLES))
+        saved = b.call(save, [])
+        with b.if_else(small) as (on_stack, on_heap):
+            with on_stack:
+                stack_w = b.alloca(double, size=size_)
+                stack_block = b.block
+            with on_heap:
+                heap_w = b.bitcast(context.nrt.allocate(b, b.mul(size_, ir.Constant(i64, 8))), double_ptr)
+                heap_block = b.block
+        W = b.phi(double_ptr)
+        W.add_incoming(stack_w, stack_block)
+        W.add_incoming(heap_w, heap_block)
+        b.call(b.inttoptr(address_, fnty.as_pointer()), [t_, order_, y, W, pp])
+        with b.if_then(b.not_(small)):
+            context.nrt.free(b, b.bitcast(W, byte_ptr))
+        b.call(restore, [saved])
         return context.get_dummy_value()
 
     return sig, codegen
 
 
-@intrinsic
-def _call_heap(typingctx, address, t, order, Y, W, p):
-    """The same call with W an array the caller allocated."""
-    sig = types.void(types.int64, types.float64, types.int64, Y, W, p)
-
-    def codegen(context, builder, signature, args):
-        double_ptr = ir.DoubleType().as_pointer()
-        fnty = ir.FunctionType(ir.VoidType(), [ir.DoubleType(), ir.IntType(64), double_ptr, double_ptr, double_ptr])
-        data = [builder.bitcast(cgutils.create_struct_proxy(ty)(context, builder, value=v).data, double_ptr)
-                for ty, v in zip(signature.args[3:], args[3:])]
-        builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [args[1], args[2]] + data)
-        return context.get_dummy_value()
-
-    return sig, codegen
-
-
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def coefficients(p, Y, order, work, t):
     """Fill Y[1..order] from Y[0] for the fixed-point system with a traced plugin torque (models FIXED_POINT_PLUGIN
     and FIXED_POINT_PLUGIN_ALPHA): one call of the generated kernel (``source``), whose address ``ready`` wrote
@@ -673,8 +669,4 @@ def coefficients(p, Y, order, work, t):
     if address == 0:  # the Taylor kernel was not compiled (``ready`` not called): no series, not a crash
         Y[1:] = np.nan
         return
-    size = order * int(p[p.size - 1])
-    if size <= _STACK_DOUBLES:
-        _call(address, t, order, size, Y, p)
-    else:
-        _call_heap(address, t, order, Y, np.empty(size), p)
+    _call(address, t, order, order * int(p[p.size - 1]), Y, p)
