@@ -155,7 +155,7 @@ class _Series:
     __slots__ = ("op", "args", "extra", "depth", "columns")
 
     def __init__(self, op: str, args: tuple[int, ...], extra: Any, depth: int) -> None:
-        self.op = op  # "y", "time", "mul", or a function (see _FUNCTIONS)
+        self.op = op  # "y", "time", "mul", or a function (see _VALUES)
         self.args = args  # operand ids (``_Program.operands``)
         self.extra = extra  # the state index of "y"; the exponent (a number's local) of "pow"
         self.depth = depth  # 0 for state and time; 1 + the deepest operand's for the others
@@ -206,6 +206,8 @@ _AUXILIARY = {"tan": "1.0 + W[{c}] * W[{c}]", "tanh": "1.0 - W[{c}] * W[{c}]", "
               "arctan2": "W[{x}] * W[{x}] + W[{y}] * W[{y}]"}
 
 
+_FUSE = ("contract",)  # a product and its sum may fuse (as the built-in's fastmath)
+
 #: ``cauchy_sums``' vectors: at most _LANES lanes each (a power of two: the compiler splits other lengths into
 #: pairs of lanes), at most _GROUP lanes summed in one loop (the accumulators stay in registers)
 _LANES = 8
@@ -227,10 +229,12 @@ def cauchy_sums(typingctx, W, k, columns, base, left, right):
     """The k-th coefficients of n products at once: Σ_{j=0..k} L_j ⊙ R_{k−j}, as an n-tuple.
 
     The products' first operands' coefficients sit side by side in W's rows (``columns`` wide) from column
-    ``base``, their second operands' after them (from base + n); rows 0..k−1 are filled, row k is given as the n-tuples ``left`` and ``right``, stored here as vectors.
-    The sums run in vectors, so the compiler emits packed fused multiply-adds (the built-in's ``taylor.run_vector``
-    does the same by hand): the terms of rows 1..k−1 first, alternately into two accumulators (two chains of
-    dependent additions, half as long), then those with row k (j = 0 and j = k).
+    ``base``, their second operands' after them (from base + n); rows 0..k−1 are filled, row k is given as the
+    n-tuples ``left`` and ``right`` and stored here, as vectors (a vector load of what scalar stores wrote
+    would wait for them to reach the cache). The sums run in vectors, so the compiler emits packed fused
+    multiply-adds (the built-in's ``taylor.run_vector`` does the same by hand): the terms of rows 1..k−1 first,
+    alternately into two accumulators (two chains of dependent additions, half as long), then those with
+    row k (j = 0 and j = k) from the registers it was packed in.
     """
     if not (isinstance(columns, types.IntegerLiteral) and isinstance(base, types.IntegerLiteral)):
         return None
@@ -297,9 +301,6 @@ def cauchy_sums(typingctx, W, k, columns, base, left, right):
     return sig, codegen
 
 
-_FUSE = ("contract",)  # a product and its sum may fuse (as the built-in's fastmath)
-
-
 class _Program:
     """A traced torque and the fixed-point system's other terms, lowered to series and their generated code."""
 
@@ -325,10 +326,11 @@ class _Program:
     def _state(self, index: int) -> _Lin:
         return self._make("y", (), index, depth=0)
 
-    def _make(self, op: str, operands: tuple[_Lin, ...], extra: Any, key_extra: Any = None, depth: int | None = None,
+    def _make(self, op: str, operands: tuple[_Lin, ...], extra: Any, depth: int | None = None,
               pair: str | None = None) -> _Lin:
+        """The series ``op`` of ``operands`` (one per distinct op, operands and extra), as a value."""
         ids = tuple(self._operand(v) for v in operands)
-        key = (op, ids, extra if key_extra is None else key_extra)
+        key = (op, ids, extra)
         if key not in self.found:
             if depth is None:
                 depth = 1 + max((self._depth(v) for v in operands), default=0)
