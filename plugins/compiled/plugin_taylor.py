@@ -616,9 +616,10 @@ def compile_taylor(result: Trace, names: list[str], size: int = 6) -> list[float
     return [float(kernel.address), float(columns)]
 
 
-#: W (``order`` rows of the kernel's columns) lives on the caller's stack up to this many doubles (256 KiB), on
-#: the heap beyond: an allocation per step (np.empty) would cost as much as a low order's Cauchy sums
-_STACK_DOUBLES = 32768
+#: W (``order`` rows of the kernel's columns) lives on the caller's stack up to this many doubles (128 KiB: a
+#: quarter of the smallest default thread stack, macOS's 512 KiB, for a batch's threads), on the heap beyond:
+#: an allocation per step (np.empty) would cost as much as a low order's Cauchy sums
+_STACK_DOUBLES = 16384
 
 
 @intrinsic
