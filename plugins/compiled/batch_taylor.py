@@ -39,7 +39,9 @@ import math
 import numba
 import numpy as np
 from llvmlite import ir
+from numba import types
 from numba.core import cgutils
+from numba.extending import intrinsic
 
 from gyrolab.plugins.compiled.layout import INERTIA, INV_INERTIA, N_Z, U_Z
 from gyrolab.plugins.compiled import kernel, simd, taylor
@@ -54,8 +56,13 @@ from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK, TOO_SMALL_STEP
 
 TASK = 256  # trajectories per parallel task, at most
 STATE = 6  # (ω, γ)
-SUMS = 9  # Cauchy sums per order: pairs of ω (3), pairs of γ (3), γ × ω (3)
 CONSTANTS = 10  # a lane's right-hand-side constants (``_load``)
+
+
+#: The twelve Cauchy sums of a term, as (x, y) component pairs of the state (ω_x, ω_y, ω_z, γ_x, γ_y, γ_z = 0..5):
+#: Σ_j x_j y_{k−j}. Pairs of ω (0..2), pairs of γ (3..5), then γ × ω's two halves per component (6..11):
+#: γ̇_x = γ_y ω_z − γ_z ω_y (and cyclically), each half summed on its own so no sum waits for another.
+PRODUCTS = ((1, 2), (2, 0), (0, 1), (4, 5), (5, 3), (3, 4), (4, 2), (5, 1), (5, 0), (3, 2), (3, 1), (4, 0))
 
 
 @simd.series(STATE, LANES)
@@ -63,40 +70,47 @@ def _series(v, p, row):
     """Fill T[1..order] from T[0] in every lane: ``fixed_point.taylor_coefficients`` without α, lanes in columns.
 
     T is (order+1, STATE, LANES), Q (CONSTANTS, LANES) the lanes' constants (``_load``). Order k's coefficient is
-    F_k / (k + 1), with F_k from the Cauchy sums of the quadratic products, each a sum over j of
-    ω_j ω_{k−j}-type terms: pairs of ω (s0..s2), pairs of γ (s3..s5), γ × ω (s6..s8):
+    F_k / (k + 1), with F_k from the Cauchy sums of the quadratic products (``PRODUCTS``):
     ω̇_x = (I_y − I_z)/I_x (ω_y ω_z − N_2 γ_y γ_z) + (U_y γ_z − U_z γ_y)/I_x (and cyclically; U = U_2, the
     torque U_2 × γ, N_2 γ × Iγ the gradient torque), γ̇ = γ × ω: ``fixed_point.rhs`` without α.
-    The sums run over nine vector accumulators in registers, twelve vector loads and twelve fused
-    multiply-adds per term.
+
+    Each sum Σ_{j=0..k} x_j y_{k−j} runs over the pairs (j, k−j) with j < k − j, adding x_j y_{k−j} + x_{k−j} y_j
+    (and the middle term x_{k/2} y_{k/2} when k is even): the twelve vectors loaded for a pair serve 24 fused
+    multiply-adds into twelve accumulators, so the loop is bound by the FMA units, not by loads or by the
+    latency of one accumulator's chain.
     """
     b = v.builder
     q = [v.load(2, r) for r in range(CONSTANTS)]
-    sums = v.variables(SUMS)
+    sums = v.variables(len(PRODUCTS))
     zero = ir.Constant(v.vec, [0.0] * LANES)
+    one = ir.Constant(p.type, 1)
     with cgutils.for_range(b, p) as order_loop:
         k = order_loop.index
         for s in sums:
             b.store(zero, s)
-        with cgutils.for_range(b, b.add(k, ir.Constant(k.type, 1))) as term:
-            j = term.index
+        k1 = b.add(k, one)
+        pairs = b.lshr(k1, one)
+        with cgutils.for_range(b, pairs) as term:  # the pairs j < k − j, the newest coefficient (j = 0) last
+            j = b.sub(b.sub(pairs, one), term.index)
             m = b.sub(k, j)
-            w0, w1, w2, g0, g1, g2 = [v.load(0, row(j, c)) for c in range(STATE)]
-            W0, W1, W2, G0, G1, G2 = [v.load(0, row(m, c)) for c in range(STATE)]
-            for s, x, y, subtract in ((0, w1, W2, False), (1, w2, W0, False), (2, w0, W1, False),
-                                      (3, g1, G2, False), (4, g2, G0, False), (5, g0, G1, False),
-                                      (6, g1, W2, False), (6, g2, W1, True), (7, g2, W0, False),
-                                      (7, g0, W2, True), (8, g0, W1, False), (8, g1, W0, True)):
-                v.fma_into(sums[s], x, y, subtract)
+            low = [v.load(0, row(j, c)) for c in range(STATE)]
+            high = [v.load(0, row(m, c)) for c in range(STATE)]
+            for s, (x, y) in zip(sums, PRODUCTS):
+                v.fma_into(s, low[x], high[y])
+                v.fma_into(s, high[x], low[y])
+        even = b.icmp_unsigned("==", b.and_(k, one), ir.Constant(p.type, 0))
+        with b.if_then(even):  # the middle term j = k − j = k/2
+            half = [v.load(0, row(b.lshr(k, one), c)) for c in range(STATE)]
+            for s, (x, y) in zip(sums, PRODUCTS):
+                v.fma_into(s, half[x], half[y])
         s = [b.load(x) for x in sums]
+        cross = [b.fsub(s[6 + 2 * c], s[7 + 2 * c], flags=simd.FUSE) for c in range(3)]
         e0, e1, e2 = [v.load(0, row(k, c)) for c in (3, 4, 5)]
         inv = v.inverse(k)
-        k1 = b.add(k, ir.Constant(k.type, 1))
         rate = [v.fixed_point_rate(q[0], q[3], s[0], s[3], q[4], e2, q[5], e1, inv),
                 v.fixed_point_rate(q[1], q[3], s[1], s[4], q[6], e0, q[7], e2, inv),
                 v.fixed_point_rate(q[2], q[3], s[2], s[5], q[8], e1, q[9], e0, inv),
-                b.fmul(s[6], inv, flags=simd.FUSE), b.fmul(s[7], inv, flags=simd.FUSE),
-                b.fmul(s[8], inv, flags=simd.FUSE)]
+                *(b.fmul(x, inv, flags=simd.FUSE) for x in cross)]
         for c in range(STATE):
             v.store(rate[c], 0, row(k1, c))
 
@@ -105,6 +119,86 @@ def _series(v, p, row):
 #: the lanes' steps (0 in idle lanes); carry (STATE, LANES). The Horner sums may fuse multiply and add; the Kahan
 #: update is strict (``taylor.run``'s arithmetic), and the six components' Horner chains interleave.
 _update = simd.update(STATE, STATE, LANES)
+
+
+@intrinsic
+def _step_sizes(typingctx, T, order, K, S):
+    """Every lane's Jorba–Zou step (``taylor.step_size``) from its series T[:, :, lane], in vector registers.
+
+    K is (4, LANES): tol, the safety factor, 1/(order − 1), 1/order in every lane. S (2, LANES) receives in row 0
+    h = safety · min_k (tol · scale / n_k)^(1/k), k = order − 1, order (scale = max(1, ‖T[0]‖∞), n_k = ‖T[k]‖∞;
+    a vanishing n_k drops its term) through 2^(log2(·)/k) (``simd.Lanes.log2``, ``exp2``: a few ulps from the
+    scalar power), and in row 1 a flag (1.0) where that path does not apply: a non-finite coefficient, a ratio
+    outside the normal doubles, both n_k zero or a step beyond 2^±1000. There the caller takes the scalar rule,
+    so every lane steps as ``taylor.run`` would, to rounding. The scalar rule took 2 powers per lane, a quarter
+    of the lanes' step.
+    """
+    if not (simd.vector_arrays([T, K, S]) and T.ndim == 3 and isinstance(order, types.Integer)):
+        return None
+    sig = types.void(T, order, K, S)
+
+    def codegen(context, builder, signature, args):
+        v = simd.Lanes(context, builder, signature, args, LANES)
+        b = builder
+        p = context.cast(builder, args[1], signature.args[1], types.intp)
+        tol, safety, inv1, inv2 = [v.load(2, r) for r in range(4)]
+        zero, one = v.constant(0.0), v.constant(1.0)
+        scale, n1, n2, probe = one, zero, zero, zero
+        last = b.sub(p, ir.Constant(p.type, 1))
+        for c in range(STATE):
+            x0, x1, x2 = (v.load(0, v.row(b, index, STATE, c)) for index in (ir.Constant(p.type, 0), last, p))
+            a0, a1, a2 = (v.call("fabs", x) for x in (x0, x1, x2))
+            scale = b.select(b.fcmp_ordered(">", a0, scale), a0, scale)
+            n1 = b.select(b.fcmp_ordered(">", a1, n1), a1, n1)
+            n2 = b.select(b.fcmp_ordered(">", a2, n2), a2, n2)
+            for x in (x0, x1, x2):  # stays 0 unless a value is inf or NaN (x · 0 is NaN then)
+                probe = b.fadd(probe, b.fmul(x, zero))
+        special = b.fcmp_unordered("!=", probe, zero)
+        smallest, huge, inf = v.constant(2.0 ** -1021), v.constant(1000.0), v.constant(math.inf)
+        exponents = []
+        for n, inv in ((n1, inv1), (n2, inv2)):
+            ratio = b.fdiv(b.fmul(tol, scale), n)
+            present = b.fcmp_ordered(">", n, zero)
+            normal = b.and_(b.fcmp_ordered(">=", ratio, smallest), b.fcmp_ordered("<", ratio, inf))
+            special = b.or_(special, b.and_(present, b.not_(normal)))
+            exponents.append(b.select(present, b.fmul(v.log2(ratio), inv), inf))
+        y = b.select(b.fcmp_ordered("<", exponents[1], exponents[0]), exponents[1], exponents[0])
+        in_range = b.and_(b.fcmp_ordered("<", y, huge), b.fcmp_ordered(">", y, b.fneg(huge)))
+        special = b.or_(special, b.not_(in_range))
+        y = b.select(in_range, y, zero)
+        v.store(b.fmul(v.exp2(y), safety), 3, 0)
+        v.store(b.select(special, one, zero), 3, 1)
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@intrinsic
+def _dense(typingctx, T, order, D, carry, O):
+    """O[c] = T[0, c] + (Σ_{k≥1} T[k, c] dt^k − carry[c]) in every lane, dt = D[0] (one per lane): each lane's
+    series at its own t + dt, Horner in strict arithmetic, the six components' chains interleaved. Lane for
+    lane the arithmetic of the scalar dense output of ``taylor.run``."""
+    if not (simd.vector_arrays([T, D, carry, O]) and T.ndim == 3 and isinstance(order, types.Integer)):
+        return None
+    sig = types.void(T, order, D, carry, O)
+
+    def codegen(context, builder, signature, args):
+        v = simd.Lanes(context, builder, signature, args, LANES)
+        b = builder
+        p = context.cast(builder, args[1], signature.args[1], types.intp)
+        dt = v.load(2, 0)
+        acc = v.variables(STATE)
+        for c in range(STATE):
+            b.store(v.load(0, v.row(b, p, STATE, c)), acc[c])
+        with cgutils.for_range(b, b.sub(p, ir.Constant(p.type, 1))) as loop:
+            k = b.sub(b.sub(p, ir.Constant(p.type, 1)), loop.index)  # order − 1 … 1
+            for c in range(STATE):
+                b.store(b.fadd(b.fmul(b.load(acc[c]), dt), v.load(0, v.row(b, k, STATE, c))), acc[c])
+        for c in range(STATE):
+            v.store(b.fadd(v.load(0, c), b.fsub(b.fmul(b.load(acc[c]), dt), v.load(3, c))), 4, c)
+        return context.get_dummy_value()
+
+    return sig, codegen
 
 
 def task_size(count: int) -> int:
@@ -168,6 +262,11 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, first, stop):
     index = np.zeros(LANES, dtype=np.int64)  # each lane's next output time
     traj = np.full(LANES, -1, dtype=np.int64)
     safety = math.exp(-0.7 / (order - 1))
+    K = np.empty((4, LANES))  # _step_sizes' constants
+    K[0], K[1], K[2], K[3] = tol, safety, 1.0 / (order - 1), 1.0 / order
+    S = np.zeros((2, LANES))  # each lane's step from _step_sizes, and where the scalar rule must take over
+    D = np.zeros((1, LANES))  # each lane's time from its step's start to its next output time (_dense)
+    O = np.zeros((STATE, LANES))  # the lanes' states there
     following = first
     for lane in range(LANES):
         if following < stop:
@@ -180,11 +279,19 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, first, stop):
     busy = min(LANES, stop - first)
     while busy > 0:
         _series(T, order, Q)
-        for lane in range(LANES):
+        _step_sizes(T, order, K, S)
+        for lane in range(LANES):  # each lane's step (``taylor.run``'s rule) and the outputs it covers
             j = traj[lane]
-            if j >= 0:
-                t_next[lane] = _step(lane, T, order, tol, safety, t_out, t_end, t[lane], index, carry, Y[j])
-                H[0, lane] = t_next[lane] - t[lane]
+            if j < 0:
+                continue
+            h = S[0, lane] if S[1, lane] == 0.0 else _scalar_step_size(lane, T, order, tol, safety)
+            if not h < np.inf:
+                h = t_end - t[lane]
+            t_new = min(t[lane] + h, t_end)
+            t_next[lane] = t_new
+            H[0, lane] = t_new - t[lane]
+
+        _outputs(T, order, t_out, t, t_next, traj, index, carry, D, O, Y)
         _update(T, order, H, carry)
         for lane in range(LANES):
             j = traj[lane]
@@ -217,9 +324,9 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, first, stop):
 
 
 @kernel
-def _step(lane, T, order, tol, safety, t_out, t_end, t, index, carry, Yj):
-    """The end of ``lane``'s next step (``taylor.run``'s step rule from its series T[:, :, lane], starting at t)
-    and the outputs that step covers (Horner evaluation of the series, the Kahan carry subtracted, as there)."""
+def _scalar_step_size(lane, T, order, tol, safety):
+    """``taylor.run``'s step rule on ``lane``'s series T[:, :, lane], in scalar arithmetic (where ``_step_sizes``
+    flags the lane)."""
     scale = 1.0
     n1 = 0.0
     n2 = 0.0
@@ -227,22 +334,30 @@ def _step(lane, T, order, tol, safety, t_out, t_end, t, index, carry, Yj):
         scale = max(scale, abs(T[0, c, lane]))
         n1 = max(n1, abs(T[order - 1, c, lane]))
         n2 = max(n2, abs(T[order, c, lane]))
-    h = taylor.step_size(tol, scale, n1, n2, order, safety)
-    if not h < np.inf:
-        h = t_end - t
-    t_new = min(t + h, t_end)
+    return taylor.step_size(tol, scale, n1, n2, order, safety)
+
+
+@kernel
+def _outputs(T, order, t_out, t, t_next, traj, index, carry, D, O, Y):
+    """The outputs of every lane's step from t to t_next: its series at each output time the step covers
+    (``_dense``, all lanes at once; a lane without an output in this step is evaluated and ignored)."""
     n_out = t_out.size
-    i = index[lane]
-    while i < n_out and t_out[i] <= t_new:
-        dt = t_out[i] - t
-        for c in range(STATE):
-            v = T[order, c, lane]
-            for k in range(order - 1, 0, -1):
-                v = v * dt + T[k, c, lane]
-            Yj[i, c] = T[0, c, lane] + (v * dt - carry[c, lane])
-        i += 1
-    index[lane] = i
-    return t_new
+    while True:
+        due = False
+        for lane in range(LANES):
+            D[0, lane] = 0.0
+            if traj[lane] >= 0 and index[lane] < n_out and t_out[index[lane]] <= t_next[lane]:
+                D[0, lane] = t_out[index[lane]] - t[lane]
+                due = True
+        if not due:
+            return
+        _dense(T, order, D, carry, O)
+        for lane in range(LANES):
+            j = traj[lane]
+            if j >= 0 and index[lane] < n_out and t_out[index[lane]] <= t_next[lane]:
+                for c in range(STATE):
+                    Y[j, index[lane], c] = O[c, lane]
+                index[lane] += 1
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
