@@ -56,63 +56,126 @@ from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK, TOO_SMALL_STEP
 
 TASK = 256  # trajectories per parallel task, at most
 STATE = 6  # (ω, γ)
-CONSTANTS = 10  # a lane's right-hand-side constants (``_load``)
+CONSTANTS = 12  # a lane's right-hand-side constants (``_load``)
 
 
 #: The twelve Cauchy sums of a term, as (x, y) component pairs of the state (ω_x, ω_y, ω_z, γ_x, γ_y, γ_z = 0..5):
 #: Σ_j x_j y_{k−j}. Pairs of ω (0..2), pairs of γ (3..5), then γ × ω's two halves per component (6..11):
 #: γ̇_x = γ_y ω_z − γ_z ω_y (and cyclically), each half summed on its own so no sum waits for another.
 PRODUCTS = ((1, 2), (2, 0), (0, 1), (4, 5), (5, 3), (3, 4), (4, 2), (5, 1), (5, 0), (3, 2), (3, 1), (4, 0))
+#: The six Cauchy sums of the split form (``_series``), as (a, b) pairs of Z's rows (P_x, P_y, P_z, M_x, M_y, M_z =
+#: 0..5): Σ_j P_a,j M_b,k−j for a ≠ b, in the order (y, z), (z, y), (z, x), (x, z), (x, y), (y, x).
+SPLIT_PRODUCTS = ((1, 5), (2, 4), (2, 3), (0, 5), (0, 4), (1, 3))
+#: Orders computed in the direct form before the split form takes over (``_series``): a coefficient of order k
+#: weighs about (h/ρ)^k ≈ tol^(k/order) in a step (≈ 0.23^k at the benchmark's setting), so the split form's
+#: larger rounding (``split_ready``) stays far below one ulp of the state from order SPLIT + 1 on.
+SPLIT = 6
 
 
-@simd.series(STATE, LANES)
-def _series(v, p, row):
+@intrinsic
+def _series(typingctx, T, Z, order, Q, split):
     """Fill T[1..order] from T[0] in every lane: ``fixed_point.taylor_coefficients`` without α, lanes in columns.
 
-    T is (order+1, STATE, LANES), Q (CONSTANTS, LANES) the lanes' constants (``_load``). Order k's coefficient is
-    F_k / (k + 1), with F_k from the Cauchy sums of the quadratic products (``PRODUCTS``):
+    T and Z are (order+1, STATE, LANES), Q (CONSTANTS, LANES) the lanes' constants (``_load``). Order k's
+    coefficient is F_k / (k + 1), from the Cauchy sums of the right-hand side's quadratic products:
     ω̇_x = (I_y − I_z)/I_x (ω_y ω_z − N_2 γ_y γ_z) + (U_y γ_z − U_z γ_y)/I_x (and cyclically; U = U_2, the
     torque U_2 × γ, N_2 γ × Iγ the gradient torque), γ̇ = γ × ω: ``fixed_point.rhs`` without α.
 
+    Orders k < split take the direct form: the twelve sums of ``PRODUCTS``. Orders k ≥ split take the split form,
+    six sums instead of twelve: with a = √N_2 and the series P = ω + a γ, M = ω − a γ (kept in Z),
+    P_y M_z + P_z M_y = 2 (ω_y ω_z − N_2 γ_y γ_z) and P_y M_z − P_z M_y = 2 a (γ_y ω_z − γ_z ω_y), so the six
+    sums Σ P_a M_b (a ≠ b) give both the ω and the γ rates. It needs N_2 > 0 in every lane; its rounding grows
+    with |ω| / (a |γ|) (``split_ready`` decides; split = order keeps the direct form throughout).
+
     Each sum Σ_{j=0..k} x_j y_{k−j} runs over the pairs (j, k−j) with j < k − j, adding x_j y_{k−j} + x_{k−j} y_j
-    (and the middle term x_{k/2} y_{k/2} when k is even): the twelve vectors loaded for a pair serve 24 fused
-    multiply-adds into twelve accumulators, so the loop is bound by the FMA units, not by loads or by the
-    latency of one accumulator's chain.
+    (and the middle term x_{k/2} y_{k/2} when k is even), the pair with the newest coefficient (j = 0) last: the
+    vectors loaded for a pair serve twice as many fused multiply-adds, the FMA units bound the loop, and the
+    next order's older terms overlap the newest coefficient's computation in the processor's pipeline.
     """
-    b = v.builder
-    q = [v.load(2, r) for r in range(CONSTANTS)]
-    sums = v.variables(len(PRODUCTS))
-    zero = ir.Constant(v.vec, [0.0] * LANES)
-    one = ir.Constant(p.type, 1)
-    with cgutils.for_range(b, p) as order_loop:
-        k = order_loop.index
-        for s in sums:
-            b.store(zero, s)
-        k1 = b.add(k, one)
-        pairs = b.lshr(k1, one)
-        with cgutils.for_range(b, pairs) as term:  # the pairs j < k − j, the newest coefficient (j = 0) last
-            j = b.sub(b.sub(pairs, one), term.index)
-            m = b.sub(k, j)
-            low = [v.load(0, row(j, c)) for c in range(STATE)]
-            high = [v.load(0, row(m, c)) for c in range(STATE)]
-            for s, (x, y) in zip(sums, PRODUCTS):
-                v.fma_into(s, low[x], high[y])
-                v.fma_into(s, high[x], low[y])
-        even = b.icmp_unsigned("==", b.and_(k, one), ir.Constant(p.type, 0))
-        with b.if_then(even):  # the middle term j = k − j = k/2
-            half = [v.load(0, row(b.lshr(k, one), c)) for c in range(STATE)]
-            for s, (x, y) in zip(sums, PRODUCTS):
-                v.fma_into(s, half[x], half[y])
-        s = [b.load(x) for x in sums]
-        cross = [b.fsub(s[6 + 2 * c], s[7 + 2 * c], flags=simd.FUSE) for c in range(3)]
-        e0, e1, e2 = [v.load(0, row(k, c)) for c in (3, 4, 5)]
-        inv = v.inverse(k)
-        rate = [v.fixed_point_rate(q[0], q[3], s[0], s[3], q[4], e2, q[5], e1, inv),
-                v.fixed_point_rate(q[1], q[3], s[1], s[4], q[6], e0, q[7], e2, inv),
-                v.fixed_point_rate(q[2], q[3], s[2], s[5], q[8], e1, q[9], e0, inv),
-                *(b.fmul(x, inv, flags=simd.FUSE) for x in cross)]
-        for c in range(STATE):
-            v.store(rate[c], 0, row(k1, c))
+    if not (simd.vector_arrays([T, Z, Q]) and T.ndim == 3 and Z.ndim == 3 and Q.ndim == 2
+            and isinstance(order, types.Integer) and isinstance(split, types.Integer)):
+        return None
+    sig = types.void(T, Z, order, Q, split)
+
+    def codegen(context, builder, signature, args):
+        v = simd.Lanes(context, builder, signature, args, LANES)
+        b = builder
+        p = context.cast(builder, args[2], signature.args[2], types.intp)
+        cut = context.cast(builder, args[4], signature.args[4], types.intp)
+        cut = b.select(b.icmp_signed("<", cut, p), cut, p)
+        q = [v.load(3, r) for r in range(CONSTANTS)]
+        a, half_inv_a, half = q[10], q[11], v.constant(0.5)
+        zero = v.constant(0.0)
+        one = ir.Constant(p.type, 1)
+        sums = v.variables(len(PRODUCTS))
+
+        def row(index, column):
+            return v.row(b, index, STATE, column)
+
+        def split_rows(index):
+            """Z[index] = (ω + a γ, ω − a γ) from T[index]."""
+            x = [v.load(0, row(index, c)) for c in range(STATE)]
+            for c in range(3):
+                ag = b.fmul(a, x[3 + c], flags=simd.FUSE)
+                v.store(b.fadd(x[c], ag, flags=simd.FUSE), 1, row(index, c))
+                v.store(b.fsub(x[c], ag, flags=simd.FUSE), 1, row(index, 3 + c))
+
+        def cauchy(k, array, products):
+            """Σ_j x_j y_{k−j} over ``array``'s rows (x, y) = products[i], by pairs (j, k − j). With six
+            products, the two halves of a pair go to two accumulators (twelve in all), so no accumulator takes
+            two dependent fused multiply-adds per pair."""
+            twin = len(products) * 2 <= len(sums)
+            used = sums[:2 * len(products)] if twin else sums[:len(products)]
+            for s in used:
+                b.store(zero, s)
+            pairs = b.lshr(b.add(k, one), one)
+            with cgutils.for_range(b, pairs) as term:
+                j = b.sub(b.sub(pairs, one), term.index)  # the pair with the newest coefficient (j = 0) last
+                low = [v.load(array, row(j, c)) for c in range(STATE)]
+                high = [v.load(array, row(b.sub(k, j), c)) for c in range(STATE)]
+                for i, (x, y) in enumerate(products):
+                    v.fma_into(sums[i], low[x], high[y])
+                    v.fma_into(sums[i + len(products)] if twin else sums[i], high[x], low[y])
+            with b.if_then(b.icmp_unsigned("==", b.and_(k, one), ir.Constant(p.type, 0))):  # the middle term
+                middle = [v.load(array, row(b.lshr(k, one), c)) for c in range(STATE)]
+                for s, (x, y) in zip(sums, products):
+                    v.fma_into(s, middle[x], middle[y])
+            total = [b.load(x) for x in sums[:len(products)]]
+            if twin:
+                total = [b.fadd(x, b.load(y), flags=simd.FUSE) for x, y in zip(total, sums[len(products):])]
+            return total
+
+        def store_rates(k, pairs, cross):
+            """T[k+1] from the ω sums' combinations ``pairs`` (ω_y ω_z − N_2 γ_y γ_z, cyclically) and γ × ω's
+            ``cross``; Z[k+1] from T[k+1]."""
+            e0, e1, e2 = [v.load(0, row(k, c)) for c in (3, 4, 5)]
+            inv = v.inverse(k)
+            torque = ((q[4], e2, q[5], e1), (q[6], e0, q[7], e2), (q[8], e1, q[9], e0))
+            k1 = b.add(k, one)
+            for c in range(3):
+                qa, ea, qb, eb = torque[c]
+                moment = b.fsub(b.fmul(qa, ea, flags=simd.FUSE), b.fmul(qb, eb, flags=simd.FUSE), flags=simd.FUSE)
+                rate = b.fmul(b.fadd(b.fmul(q[c], pairs[c], flags=simd.FUSE), moment, flags=simd.FUSE), inv,
+                              flags=simd.FUSE)
+                v.store(rate, 0, row(k1, c))
+                v.store(b.fmul(cross[c], inv, flags=simd.FUSE), 0, row(k1, 3 + c))
+            split_rows(k1)
+
+        split_rows(ir.Constant(p.type, 0))
+        with cgutils.for_range(b, cut) as direct:  # orders k < split: the twelve sums of PRODUCTS
+            s = cauchy(direct.index, 0, PRODUCTS)
+            pairs = [b.fsub(s[c], b.fmul(q[3], s[3 + c], flags=simd.FUSE), flags=simd.FUSE) for c in range(3)]
+            cross = [b.fsub(s[6 + 2 * c], s[7 + 2 * c], flags=simd.FUSE) for c in range(3)]
+            store_rates(direct.index, pairs, cross)
+        with cgutils.for_range(b, p, start=cut) as fast:  # orders k ≥ split: the six sums of SPLIT_PRODUCTS
+            s = cauchy(fast.index, 1, SPLIT_PRODUCTS)
+            pairs = [b.fmul(b.fadd(s[2 * c], s[2 * c + 1], flags=simd.FUSE), half, flags=simd.FUSE) for c in range(3)]
+            cross = [b.fmul(b.fsub(s[2 * c], s[2 * c + 1], flags=simd.FUSE), half_inv_a, flags=simd.FUSE)
+                     for c in range(3)]
+            store_rates(fast.index, pairs, cross)
+        return context.get_dummy_value()
+
+    return sig, codegen
 
 
 #: Every lane's state T[0] += Σ_{k≥1} T[k] h^k (Horner), a compensated (Kahan) sum with ``carry``: H is (1, LANES),
@@ -207,8 +270,45 @@ def task_size(count: int) -> int:
     return int(max(LANES, min(TASK, -(-count // (4 * numba.get_num_threads())))))
 
 
+#: The split form's bound on |ω| / (√N_2 |γ|) (``split_ready``): its rounding in a coefficient grows about as this
+#: ratio; from order SPLIT on, 1024 times an ulp weighs less than 1e-2 ulp of the state in a step.
+SPLIT_RATIO = 1024.0
+
+
+def split_ready(Params: np.ndarray, Y0: np.ndarray) -> np.ndarray:
+    """Which trajectories take the split form from order SPLIT on (``_series``): N_2 > 0, and |ω| stays within
+    SPLIT_RATIO · √N_2 |γ| over the whole trajectory. The bound on |ω| is energy's: ½ ω·Iω changes by at most the
+    potential's range, 2 |U_2| |γ| (torque U_2 × γ) plus ½ |N_2| (I_max − I_min) |γ|² (torque N_2 γ × Iγ), so
+    I_min |ω|² ≤ ω0·Iω0 + 4 |U_2| |γ| + |N_2| (I_max − I_min) |γ|²; |γ| is constant."""
+    inertia = Params[:, INERTIA:INERTIA + 3]
+    n2 = Params[:, N_Z]
+    u = np.linalg.norm(Params[:, U_Z:U_Z + 3], axis=1)
+    gamma = np.linalg.norm(Y0[:, 3:6], axis=1)
+    low, high = inertia.min(axis=1), inertia.max(axis=1)
+    with np.errstate(all="ignore"):
+        kinetic = np.sum(inertia * Y0[:, 0:3] ** 2, axis=1)
+        omega_max2 = (kinetic + 4.0 * u * gamma + np.abs(n2) * (high - low) * gamma ** 2) / low
+        return (n2 > 0.0) & (low > 0.0) & np.isfinite(omega_max2) & (omega_max2 <= SPLIT_RATIO ** 2 * n2 * gamma ** 2)
+
+
+def run_lanes(Params, order, tol, t_out, Y0, Y, steps, status):
+    """``run_blocks`` on every trajectory: those ``split_ready`` with the split form from order SPLIT on, the
+    others with the direct form throughout (two calls when the batch mixes them). A trajectory's arithmetic
+    depends on its own parameters and state only."""
+    ready = split_ready(Params, Y0)
+    for chosen, split in ((ready, SPLIT), (~ready, order)):
+        if chosen.all():
+            run_blocks(Params, order, tol, t_out, Y0, Y, steps, status, task_size(len(Y0)), split)
+        elif chosen.any():
+            rows = np.flatnonzero(chosen)
+            part_y, part_steps, part_status = Y[rows], steps[rows], status[rows]
+            run_blocks(np.ascontiguousarray(Params[rows]), order, tol, t_out, np.ascontiguousarray(Y0[rows]), part_y,
+                       part_steps, part_status, task_size(len(rows)), split)
+            Y[rows], steps[rows], status[rows] = part_y, part_steps, part_status
+
+
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def run_blocks(Params, order, tol, t_out, Y0, Y, steps, status, task_size):
+def run_blocks(Params, order, tol, t_out, Y0, Y, steps, status, task_size, split):
     """Every trajectory j (initial (ω, γ) Y0[j], fixed-point parameters Params[j] without α) over t_out into Y[j].
 
     steps[j] receives its number of steps, status[j] OK, NOT_FINITE or TOO_SMALL_STEP (a step of a
@@ -218,7 +318,7 @@ def run_blocks(Params, order, tol, t_out, Y0, Y, steps, status, task_size):
     count = Y0.shape[0]
     n_tasks = (count + task_size - 1) // task_size
     for task in numba.prange(n_tasks):  # the loop stays small: numba's parallel pass compiles slowly on big bodies
-        _task(Params, order, tol, t_out, Y0, Y, steps, status, task * task_size,
+        _task(Params, order, tol, t_out, Y0, Y, steps, status, split, task * task_size,
               min(task * task_size + task_size, count))
 
 
@@ -227,7 +327,8 @@ def _load(lane, j, Y0, Params, T, Q, carry):
     """Put trajectory j into ``lane`` (or, with j < 0, make the lane idle: a zero state, whose series is zero).
 
     Q[:, lane] = the constants of its right-hand side (``_series``): (I_y − I_z)/I_x (and cyclically),
-    N_2, and U_2's components over the inertia, U_y/I_x, U_z/I_x, U_z/I_y, U_x/I_y, U_x/I_z, U_y/I_z.
+    N_2, U_2's components over the inertia, U_y/I_x, U_z/I_x, U_z/I_y, U_x/I_y, U_x/I_z, U_y/I_z, and the split
+    form's a = √N_2 and 1/(2a) (0 where N_2 ≤ 0: such a lane runs the direct form only, ``split_ready``).
     """
     for c in range(STATE):
         T[0, c, lane] = Y0[j, c] if j >= 0 else 0.0
@@ -246,14 +347,18 @@ def _load(lane, j, Y0, Params, T, Q, carry):
     Q[4, lane], Q[5, lane] = u1 * p[INV_INERTIA], u2 * p[INV_INERTIA]
     Q[6, lane], Q[7, lane] = u2 * p[INV_INERTIA + 1], u0 * p[INV_INERTIA + 1]
     Q[8, lane], Q[9, lane] = u0 * p[INV_INERTIA + 2], u1 * p[INV_INERTIA + 2]
+    a = math.sqrt(p[N_Z]) if p[N_Z] > 0.0 else 0.0  # the split form's a = √N_2 and 1/(2a) (``_series``)
+    Q[10, lane] = a
+    Q[11, lane] = 0.5 / a if a > 0.0 else 0.0
 
 
 @kernel
-def _task(Params, order, tol, t_out, Y0, Y, steps, status, first, stop):
+def _task(Params, order, tol, t_out, Y0, Y, steps, status, split, first, stop):
     """``run_blocks`` for the trajectories first..stop−1, LANES at a time."""
     n_out = t_out.size
     t_end = t_out[n_out - 1]
     T = np.zeros((order + 1, STATE, LANES))
+    Z = np.zeros((order + 1, STATE, LANES))  # the split form's series ω ± √N_2 γ (``_series``)
     Q = np.zeros((CONSTANTS, LANES))
     H = np.zeros((1, LANES))  # each lane's step (0 in idle lanes)
     carry = np.zeros((STATE, LANES))  # the Kahan compensation of each lane's state
@@ -278,7 +383,7 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, first, stop):
         index[lane] = 1
     busy = min(LANES, stop - first)
     while busy > 0:
-        _series(T, order, Q)
+        _series(T, Z, order, Q, split)
         _step_sizes(T, order, K, S)
         for lane in range(LANES):  # each lane's step (``taylor.run``'s rule) and the outputs it covers
             j = traj[lane]

@@ -57,10 +57,8 @@ def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
         if not plugin_taylor.ready(compiled, P):
             raise ConfigError(f"integrator {integrator.name} has no Taylor coefficients for this compiled model; "
                               f"valid choices for this model: {_batch_alternatives(compiled)}")
-        count, size = y0s.shape
-        if blockable(compiled, size):
-            batch_taylor.run_blocks(P, integrator.order, integrator.tol, times, y0s, out, steps, status,
-                                    batch_taylor.task_size(count))
+        if blockable(compiled, y0s.shape[1]):
+            batch_taylor.run_lanes(P, integrator.order, integrator.tol, times, y0s, out, steps, status)
         else:
             batch_taylor.run_each(models.form(compiled), P, integrator.order, integrator.tol, times, y0s, out, steps,
                                   status)
