@@ -178,10 +178,44 @@ def _series(typingctx, T, Z, order, Q, split):
     return sig, codegen
 
 
-#: Every lane's state T[0] += Σ_{k≥1} T[k] h^k (Horner), a compensated (Kahan) sum with ``carry``: H is (1, LANES),
-#: the lanes' steps (0 in idle lanes); carry (STATE, LANES). The Horner sums may fuse multiply and add; the Kahan
-#: update is strict (``taylor.run``'s arithmetic), and the six components' Horner chains interleave.
-_update = simd.update(STATE, STATE, LANES)
+@intrinsic
+def _advance(typingctx, T, order, H, carry, D, O):
+    """Every lane's output at its own t + dt and its step: O[c] = T[0, c] + (Σ_{k≥1} T[k, c] dt^k − carry[c])
+    with dt = D[0] (Horner in strict arithmetic, ``_dense``'s), then the state T[0] += Σ_{k≥1} T[k] h^k with
+    h = H[0] (Horner, multiply and add may fuse), a compensated (Kahan, strict) sum with ``carry``
+    (``simd.update``'s arithmetic). The twelve Horner chains share their loads of T and interleave: the output
+    costs little beside the update. Idle lanes have h = 0; a lane without an output ignores O."""
+    if not (simd.vector_arrays([T, H, carry, D, O]) and T.ndim == 3 and isinstance(order, types.Integer)):
+        return None
+    sig = types.void(T, order, H, carry, D, O)
+
+    def codegen(context, builder, signature, args):
+        v = simd.Lanes(context, builder, signature, args, LANES)
+        b = builder
+        p = context.cast(builder, args[1], signature.args[1], types.intp)
+        h, dt = v.load(2, 0), v.load(4, 0)
+        step, output = v.variables(STATE), v.variables(STATE)
+        for c in range(STATE):
+            top = v.load(0, v.row(b, p, STATE, c))
+            b.store(top, step[c])
+            b.store(top, output[c])
+        last = b.sub(p, ir.Constant(p.type, 1))
+        with cgutils.for_range(b, last) as loop:
+            k = b.sub(last, loop.index)  # order − 1 … 1
+            for c in range(STATE):
+                x = v.load(0, v.row(b, k, STATE, c))
+                b.store(b.fadd(b.fmul(b.load(step[c]), h, flags=simd.FUSE), x, flags=simd.FUSE), step[c])
+                b.store(b.fadd(b.fmul(b.load(output[c]), dt), x), output[c])
+        for c in range(STATE):
+            y, old = v.load(0, c), v.load(3, c)
+            v.store(b.fadd(y, b.fsub(b.fmul(b.load(output[c]), dt), old)), 5, c)
+            inc = b.fsub(b.fmul(b.load(step[c]), h), old)
+            total = b.fadd(y, inc)
+            v.store(b.fsub(b.fsub(total, y), inc), 3, c)
+            v.store(total, 0, c)
+        return context.get_dummy_value()
+
+    return sig, codegen
 
 
 @intrinsic
@@ -383,6 +417,7 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, split, first, stop):
     S = _rows(1, 2)[0]  # each lane's step from _step_sizes, and where the scalar rule must take over
     D = _rows(1, 1)[0]  # each lane's time from its step's start to its next output time (_dense)
     O = _rows(1, STATE)[0]  # the lanes' states there
+    due = np.zeros(LANES, dtype=np.bool_)  # the lanes with an output in this step
     following = first
     for lane in range(LANES):
         if following < stop:
@@ -396,7 +431,9 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, split, first, stop):
     while busy > 0:
         _series(T, Z, order, Q, split)
         _step_sizes(T, order, K, S)
+        several = False
         for lane in range(LANES):  # each lane's step (``taylor.run``'s rule) and the outputs it covers
+            due[lane] = False
             j = traj[lane]
             if j < 0:
                 continue
@@ -406,9 +443,20 @@ def _task(Params, order, tol, t_out, Y0, Y, steps, status, split, first, stop):
             t_new = min(t[lane] + h, t_end)
             t_next[lane] = t_new
             H[0, lane] = t_new - t[lane]
-
-        _outputs(T, order, t_out, t, t_next, traj, index, carry, D, O, Y)
-        _update(T, order, H, carry)
+            i = index[lane]  # a busy lane has an output time left: i < n_out
+            due[lane] = t_out[i] <= t_new
+            D[0, lane] = t_out[i] - t[lane] if due[lane] else 0.0
+            several = several or (due[lane] and i + 1 < n_out and t_out[i + 1] <= t_new)
+        if several:  # a step over two output times or more (rare): all its outputs first, then the step alone
+            _outputs(T, order, t_out, t, t_next, traj, index, carry, D, O, Y)
+            due[:] = False
+            D[0, :] = 0.0
+        _advance(T, order, H, carry, D, O)
+        for lane in range(LANES):
+            if due[lane]:
+                for c in range(STATE):
+                    Y[traj[lane], index[lane], c] = O[c, lane]
+                index[lane] += 1
         for lane in range(LANES):
             j = traj[lane]
             if j < 0:
