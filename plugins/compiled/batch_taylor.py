@@ -1,35 +1,34 @@
 """The Taylor method (``taylor``) for many trajectories at once: per-trajectory steps, vectorised across them.
 
-``run_blocks`` (fixed-point (ω, γ) states) advances LANES (8 on AVX-512, 4 on AVX2) trajectories in
-lock step, one AVX2 vector: their Taylor coefficients are stored
-[order, state, lane], lane innermost, and the series of all four lanes are
-computed together in 4-wide SIMD registers (``_series``), as is the state
-update (``_update``). Each lane keeps its own time, step, Kahan carry and
-output index, with the single-trajectory kernel's step rule and dense output
-(``taylor.run``: same order, same Jorba–Zou step from the last two
-coefficients, Horner evaluation at the output times, compensated state
-update), so a lane takes the steps the single kernel takes on its trajectory,
-to rounding (the vector sums fuse multiply and add in another order than the
-scalar ones). A lane reads and writes only its own column, so its result does
-not depend on its neighbours. Taylor rejects no step: every busy lane advances
-at every step. A lane whose trajectory has reached the last output time (or
-failed) takes the next trajectory of its task (``task_size`` trajectories;
-tasks run in parallel with ``prange``), so easy and hard trajectories in one
-task leave no lane idle until the task's last trajectories.
+``run_lanes`` (fixed-point (ω, γ) states) advances LANES trajectories in lock step, one vector register of
+doubles (8 on AVX-512, 4 on AVX2): their Taylor coefficients are stored [order, state, lane], lane innermost,
+and every part of a step runs over all lanes at once in vector registers: the series (``_series``), the step
+sizes (``_step_sizes``), the outputs and the state update (``_advance``). Each lane keeps its own time, step,
+Kahan carry and output index, with the single-trajectory kernel's step rule and dense output (``taylor.run``:
+same order, same Jorba–Zou step from the last two coefficients, Horner evaluation at the output times,
+compensated state update), so a lane takes the steps the single kernel takes on its trajectory, to rounding
+(the vector sums add in another order than the scalar ones; the step rule's powers go through a vector
+log2/exp2 a few ulps from libm's). A lane reads and writes only its own column, and its arithmetic follows
+from its own parameters and state (``split_ready``), so its result does not depend on its neighbours. Taylor
+rejects no step: every busy lane advances at every step. A lane whose trajectory has reached the last output
+time (or failed) takes the next trajectory of its task (``task_size`` trajectories; tasks run in parallel with
+``prange``), so easy and hard trajectories in one task leave no lane idle until the task's last trajectories.
 
-Why LLVM intrinsics: written as numba loops, the Cauchy sums are reductions
-whose accumulators LLVM keeps in memory when the loop over lanes is innermost
-(numba does not run LLVM's SLP vectoriser, and a 4-iteration lane loop is
-unrolled before the loop vectoriser could vectorise it); such a lock-step
-kernel was 1.2–2× slower than one trajectory per thread. The intrinsics emit
-the arithmetic over ``<4 x double>`` values directly: nine vector accumulators
-in registers, twelve vector loads and twelve fused multiply-adds per term of
-the sums; a whole step costs 2.7× less per trajectory than one trajectory per
-thread (``docs/performance.md``, "Taylor lanes"). The IR helpers are shared with
-the single-trajectory kernel's vectorised step (``simd``).
+Where a step's time goes (AVX-512, order 17, one thread; ``docs/performance.md``, "Batch Taylor"): the series
+about half, the step sizes, the lanes' bookkeeping and the update with the outputs a tenth or so each. The
+series is bound by its vector loads, so its forms are chosen to load less per fused multiply-add: the Cauchy
+sums run over pairs (j, k − j) (twelve loads serve 24 FMAs), and from order SPLIT on over the series
+ω ± √N₂ γ, six sums instead of twelve (``_series``). The work arrays start on 64-byte boundaries (``_rows``).
 
-``run_each`` serves every other model with Taylor coefficients, one trajectory
-per thread, with the single-trajectory kernel itself.
+Why LLVM intrinsics: written as numba loops, the Cauchy sums are reductions whose accumulators LLVM keeps in
+memory when the loop over lanes is innermost (numba does not run LLVM's SLP vectoriser, and a short lane loop
+is unrolled before the loop vectoriser could vectorise it); such a lock-step kernel was 1.2–2× slower than one
+trajectory per thread. The intrinsics emit the arithmetic over ``<LANES x double>`` values directly, the
+accumulators in registers. The IR helpers are shared with the single-trajectory kernel's vectorised step
+(``simd``).
+
+``run_each`` serves every other model with Taylor coefficients, one trajectory per thread, with the
+single-trajectory kernel itself.
 """
 
 from __future__ import annotations
@@ -343,7 +342,8 @@ def run_lanes(Params, order, tol, t_out, Y0, Y, steps, status):
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
 def run_blocks(Params, order, tol, t_out, Y0, Y, steps, status, task_size, split):
-    """Every trajectory j (initial (ω, γ) Y0[j], fixed-point parameters Params[j] without α) over t_out into Y[j].
+    """Every trajectory j (initial (ω, γ) Y0[j], fixed-point parameters Params[j] without α) over t_out into Y[j],
+    the split form from order ``split`` on (``_series``; ``split`` = order: the direct form throughout).
 
     steps[j] receives its number of steps, status[j] OK, NOT_FINITE or TOO_SMALL_STEP (a step of a
     huge series that does not advance time; the single kernel would loop forever); its outputs from the

@@ -8,8 +8,8 @@ The compiled kernels run in parallel over trajectories (``numba.prange``):
   single run); fixed-point (ω, γ) states by blocks of lanes vectorised across trajectories
   (``plugins/compiled/batch_dop853.py``), other models one trajectory per thread.
 - Taylor (``taylor``): adaptive, each trajectory with the single run's order and step rule; fixed-point (ω, γ)
-  states by 4 lanes vectorised across trajectories (``plugins/compiled/batch_taylor.py``), other models one
-  trajectory per thread.
+  states by lanes of one vector register (8 on AVX-512, 4 on AVX2) vectorised across trajectories
+  (``plugins/compiled/batch_taylor.py``), other models one trajectory per thread.
 
 Each function is an integrator's ``integrate_batch``: the arrays come validated from
 ``gyrolab.batch.integrate.integrate_arrays``.
