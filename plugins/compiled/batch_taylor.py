@@ -343,7 +343,8 @@ def run_lanes(Params, order, tol, t_out, Y0, Y, steps, status):
 @numba.njit(cache=True, parallel=True, error_model="numpy")
 def run_blocks(Params, order, tol, t_out, Y0, Y, steps, status, task_size, split):
     """Every trajectory j (initial (ω, γ) Y0[j], fixed-point parameters Params[j] without α) over t_out into Y[j],
-    the split form from order ``split`` on (``_series``; ``split`` = order: the direct form throughout).
+    the split form from order ``split`` on (``_series``; ``split`` = order: the direct form throughout). The split
+    form is for ``split_ready`` trajectories only: ``run_lanes`` sorts them.
 
     steps[j] receives its number of steps, status[j] OK, NOT_FINITE or TOO_SMALL_STEP (a step of a
     huge series that does not advance time; the single kernel would loop forever); its outputs from the
@@ -362,7 +363,7 @@ def _load(lane, j, Y0, Params, T, Q, carry):
 
     Q[:, lane] = the constants of its right-hand side (``_series``): (I_y − I_z)/I_x (and cyclically),
     N_2, U_2's components over the inertia, U_y/I_x, U_z/I_x, U_z/I_y, U_x/I_y, U_x/I_z, U_y/I_z, and the split
-    form's a = √N_2 and 1/(2a) (0 where N_2 ≤ 0: such a lane runs the direct form only, ``split_ready``).
+    form's a = √N_2 and 1/(2a) (0 and NaN where N_2 ≤ 0: such a lane runs the direct form only, ``split_ready``).
     """
     for c in range(STATE):
         T[0, c, lane] = Y0[j, c] if j >= 0 else 0.0
@@ -383,7 +384,8 @@ def _load(lane, j, Y0, Params, T, Q, carry):
     Q[8, lane], Q[9, lane] = u0 * p[INV_INERTIA + 2], u1 * p[INV_INERTIA + 2]
     a = math.sqrt(p[N_Z]) if p[N_Z] > 0.0 else 0.0  # the split form's a = √N_2 and 1/(2a) (``_series``)
     Q[10, lane] = a
-    Q[11, lane] = 0.5 / a if a > 0.0 else 0.0
+    Q[11, lane] = 0.5 / a if a > 0.0 else np.nan  # unused by the direct form; the split form would give NaN, not
+    # silently wrong rates, were such a lane given to it
 
 
 @kernel
