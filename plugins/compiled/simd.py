@@ -1,13 +1,12 @@
-"""LLVM IR helpers for the Taylor kernels' ``<4 x double>`` intrinsics (``batch_taylor``, ``taylor``).
+"""LLVM IR helpers for the Taylor kernels' vector intrinsics (``batch_taylor``, ``taylor``).
 
-Arrays of doubles are seen as rows of LANES-wide vectors: in ``batch_taylor`` a
-row holds one component of four trajectories, in ``taylor`` one 3-vector of one
-trajectory (and a zero). Both form the fixed-point right-hand side's coefficient
-from its Cauchy sums with one expression (``Lanes.fixed_point_rate``) and update
-the state with one intrinsic (``update``: Horner, then Kahan). Their sums run in
-different orders (``taylor`` adds the newest coefficient's terms last and splits
-γ × ω's sum in two), so a trajectory in a lane and alone agree to rounding, not
-bit for bit.
+Arrays of doubles are seen as rows of vectors: in ``batch_taylor`` a row holds one component of LANES
+trajectories (8 on AVX-512, 4 on AVX2), in ``taylor`` one 3-vector of one trajectory (and a zero) in a
+``<4 x double>``. ``taylor`` forms the fixed-point right-hand side's coefficient from its Cauchy sums with
+``Lanes.fixed_point_rate`` and updates the state with ``update`` (Horner, then Kahan); ``batch_taylor`` uses
+the same arithmetic in its own intrinsics, with its sums in another order (by pairs, and from order 6 on in a
+split form), so a trajectory in a lane and alone agree to rounding, not bit for bit. ``Lanes.log2`` and
+``Lanes.exp2`` are vector powers for the lanes' step rule.
 
 Why intrinsics: numba does not run LLVM's SLP vectoriser, and the Cauchy sums
 written as numba loops keep their accumulators in memory (``batch_taylor``'s
@@ -89,6 +88,60 @@ class Lanes:
         torque = b.fsub(b.fmul(qa, ea, flags=FUSE), b.fmul(qb, eb, flags=FUSE), flags=FUSE)
         inner = b.fsub(pairs_w, b.fmul(n, pairs_g, flags=FUSE), flags=FUSE)
         return b.fmul(b.fadd(b.fmul(q, inner, flags=FUSE), torque, flags=FUSE), inv, flags=FUSE)
+
+
+    # Vector log2 and exp2 (the Taylor step rule's powers, ``batch_taylor._step_sizes``): relative error a few
+    # ulps for normal positive x and for 2^y in [2^−1022, 2^1023]; the callers route other values elsewhere.
+    _LN2 = 0.6931471805599453
+    _SQRT2 = 1.4142135623730951
+
+    def _bits(self, x):
+        return self.builder.bitcast(x, ir.VectorType(ir.IntType(64), self.width))
+
+    def _ints(self, value):
+        return ir.Constant(ir.VectorType(ir.IntType(64), self.width), [value] * self.width)
+
+    def constant(self, value):
+        return ir.Constant(self.vec, [float(value)] * self.width)
+
+    def call(self, name, *args):
+        """The LLVM vector intrinsic ``llvm.NAME.vWf64`` (fabs, rint, ...) on ``args``."""
+        function = cgutils.get_or_insert_function(self.builder.module, ir.FunctionType(self.vec, [self.vec] * len(args)),
+                                                  f"llvm.{name}.v{self.width}f64")
+        return self.builder.call(function, list(args))
+
+    def log2(self, x):
+        """log2(x) for positive normal x: x = 2^e m, m in [√½, √2), ln m = 2 atanh(s), s = (m − 1)/(m + 1),
+        |s| ≤ 0.172, by its series to s²¹ (the next term is below 1e-18 of the sum)."""
+        b = self.builder
+        bits = self._bits(x)
+        e = b.sitofp(b.sub(b.lshr(bits, self._ints(52)), self._ints(1023)), self.vec)
+        m = b.bitcast(b.or_(b.and_(bits, self._ints((1 << 52) - 1)), self._ints(1023 << 52)), self.vec)
+        big = b.fcmp_ordered(">", m, self.constant(self._SQRT2))
+        m = b.select(big, b.fmul(m, self.constant(0.5)), m)
+        e = b.select(big, b.fadd(e, self.constant(1.0)), e)
+        s = b.fdiv(b.fsub(m, self.constant(1.0)), b.fadd(m, self.constant(1.0)))
+        z = b.fmul(s, s)
+        poly = self.constant(1.0 / 21.0)
+        for n in range(9, -1, -1):
+            poly = b.fadd(b.fmul(poly, z, flags=FUSE), self.constant(1.0 / (2 * n + 1)), flags=FUSE)
+        ln_m = b.fmul(b.fmul(s, poly), self.constant(2.0))
+        return b.fadd(e, b.fmul(ln_m, self.constant(1.0 / self._LN2)))
+
+    def exp2(self, y):
+        """2^y for y in [−1022, 1023]: y = n + f, n the nearest integer, |f| ≤ ½; 2^f = exp(f ln 2) by its
+        Taylor series to the 13th power (the next term is below 1e-17), times 2^n from its bits."""
+        b = self.builder
+        n = self.call("rint", y)
+        g = b.fmul(b.fsub(y, n), self.constant(self._LN2))
+        poly = self.constant(1.0 / 6227020800.0)  # 1/13!
+        factorial = 6227020800.0
+        for k in range(12, -1, -1):
+            factorial /= (k + 1)
+            poly = b.fadd(b.fmul(poly, g, flags=FUSE), self.constant(1.0 / factorial), flags=FUSE)
+        scale = b.bitcast(b.shl(b.add(b.fptosi(n, ir.VectorType(ir.IntType(64), self.width)), self._ints(1023)),
+                                self._ints(52)), self.vec)
+        return b.fmul(poly, scale)
 
 
 def series(stride, width=LANES):

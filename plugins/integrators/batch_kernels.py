@@ -8,8 +8,8 @@ The compiled kernels run in parallel over trajectories (``numba.prange``):
   single run); fixed-point (ω, γ) states by blocks of lanes vectorised across trajectories
   (``plugins/compiled/batch_dop853.py``), other models one trajectory per thread.
 - Taylor (``taylor``): adaptive, each trajectory with the single run's order and step rule; fixed-point (ω, γ)
-  states by 4 lanes vectorised across trajectories (``plugins/compiled/batch_taylor.py``), other models one
-  trajectory per thread.
+  states by lanes of one vector register (8 on AVX-512, 4 on AVX2) vectorised across trajectories
+  (``plugins/compiled/batch_taylor.py``), other models one trajectory per thread.
 
 Each function is an integrator's ``integrate_batch``: the arrays come validated from
 ``gyrolab.batch.integrate.integrate_arrays``.
@@ -57,10 +57,8 @@ def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
         if not plugin_taylor.ready(compiled, P):
             raise ConfigError(f"integrator {integrator.name} has no Taylor coefficients for this compiled model; "
                               f"valid choices for this model: {_batch_alternatives(compiled)}")
-        count, size = y0s.shape
-        if blockable(compiled, size):
-            batch_taylor.run_blocks(P, integrator.order, integrator.tol, times, y0s, out, steps, status,
-                                    batch_taylor.task_size(count))
+        if blockable(compiled, y0s.shape[1]):
+            batch_taylor.run_lanes(P, integrator.order, integrator.tol, times, y0s, out, steps, status)
         else:
             batch_taylor.run_each(models.form(compiled), P, integrator.order, integrator.tol, times, y0s, out, steps,
                                   status)
