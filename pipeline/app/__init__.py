@@ -40,6 +40,7 @@ from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
+from gyrolab.engine.composition import composing_once
 from gyrolab.engine.hydra_private import get_args_parser
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
@@ -531,7 +532,11 @@ def main() -> None:
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
     show_warnings_in_one_line()
-    argv = absolute_config_path(sys.argv[1:])
+    with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
+        _main(absolute_config_path(sys.argv[1:]))
+
+
+def _main(argv: list[str]) -> None:
     try:
         from gyrolab.app.parser import split_command
 
