@@ -56,6 +56,7 @@ from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
 from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
+from gyrolab.output.netcdf_scheduler import skip_scheduler_question
 from gyrolab.output.written import announce_written
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
@@ -258,14 +259,14 @@ def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
 
 def validate_scene(scene_cfg: DictConfig) -> None:
     """The checks every run's scene config passes: schema, tolerances, budget, the scene's own validation."""
-    from gyrolab.batch.scheduler import choose_scheduler
+    from gyrolab.batch.scheduler import check_configured
     from gyrolab.experiments import TASKS
 
     plain = check_scene_config(scene_cfg)
     require_finite(plain, "")
     figure_options(plain.get("output"))  # figure formats and dpi, before anything runs
     check_tolerances(plain)
-    choose_scheduler((plain.get("batch") or {}).get("scheduler"))  # an address in a config: refused before any directory
+    check_configured((plain.get("batch") or {}).get("scheduler"))  # an address in a config: refused before any directory
     task = task_of(scene_cfg)
     if task not in ("scene", *TASKS):
         close = difflib.get_close_matches(task, ["scene", *TASKS], n=1)
@@ -532,6 +533,7 @@ def main() -> None:
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
     show_warnings_in_one_line()
+    skip_scheduler_question()  # run.nc and sweep.nc hold numpy arrays: xarray need not import distributed to write them
     with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
         _main(absolute_config_path(sys.argv[1:]))
 
