@@ -69,14 +69,14 @@ class CompositionMemo:
         self.requests += 1
         loader.ensure_main_config_source_available()
         parsed = OverridesParser.create().parse_overrides(overrides=overrides)
-        if validate_sweep_overrides:
-            loader.validate_sweep_overrides_legal(overrides=parsed, run_mode=run_mode, from_shell=from_shell)
         place = (_search_path_key(loader), config_name, _searchpath_override(parsed))
         repo = self.repositories.get(place)
-        if repo is None:
+        if repo is None:  # (Hydra's order: the repository, then the sweep check)
             _, repo = loader._parse_overrides_and_create_caching_repo(
                 config_name, [o.input_line for o in parsed if o.get_key_element() == "hydra.searchpath"])
             self.repositories[place] = repo
+        if validate_sweep_overrides:
+            loader.validate_sweep_overrides_legal(overrides=parsed, run_mode=run_mode, from_shell=from_shell)
         shaping, config_overrides = _classify(parsed, repo)
         skeleton = self._skeleton(loader, place, config_name, parsed, shaping, config_overrides, run_mode)
 
