@@ -198,3 +198,15 @@ def test_a_value_sweep_composes_once(tmp_path, monkeypatch):
         assert job.job.override_dirname == f"initial.r0={r0},output.figures=False,time.end=1,time.n_output=11"
         assert OmegaConf.load(sweep / str(num) / ".hydra" / "config.yaml").initial.r0 == r0
     assert Path(sweep / "sweep.nc").is_file()
+
+
+def test_the_sweep_figures_take_the_sweeps_formats_from_its_config(tmp_path, monkeypatch):
+    # the callback hands the sweep's output section to the figures (multirun.yaml is not read again)
+    monkeypatch.chdir(tmp_path)
+    sweep = tmp_path / "sweep"
+    code = gyrolab_in_process(monkeypatch, "-m", "time.end=1", "time.n_output=11", "initial.r0=1,2",
+                              "output.figure_formats=[svg]", "output.dpi=50", f"hydra.sweep.dir={sweep}")
+    assert code in (0, None)
+    drawn = sorted(p.name for p in (sweep / "figures").iterdir())
+    assert drawn and all(name.endswith(".svg") for name in drawn), drawn
+    assert OmegaConf.load(sweep / "multirun.yaml").output.figure_formats == ["svg"]
