@@ -95,7 +95,8 @@ def preflight(argv: Sequence[str]) -> list[str]:
     """Validate the command line before Hydra creates any output directory; the command line Hydra should run.
 
     The config is composed exactly as Hydra will compose it (the same search path,
-    primary config and overrides, from a user's ``--config-dir`` too), checked by
+    primary config and overrides, from a user's ``--config-dir`` too; inside ``main``, Hydra's run is
+    then served from this composition, ``gyrolab.engine.composition``), checked by
     ``gyrolab.engine.safety`` (no config can run code), against the schema (unknown
     keys, types), the budget, and the scene's own validation.
     """
