@@ -210,3 +210,20 @@ def test_the_sweep_figures_take_the_sweeps_formats_from_its_config(tmp_path, mon
     drawn = sorted(p.name for p in (sweep / "figures").iterdir())
     assert drawn and all(name.endswith(".svg") for name in drawn), drawn
     assert OmegaConf.load(sweep / "multirun.yaml").output.figure_formats == ["svg"]
+
+
+def test_a_first_composition_that_hydra_splits_otherwise_is_hydras(monkeypatch):
+    # a Hydra whose defaults list takes another override as a value than the memo's rule: that request is
+    # composed by Hydra itself, and no skeleton is kept from it
+    register_plugin_configs()
+    overrides = ["integrator=rk4", "time.end=1", "hydra.run.dir=/tmp/run"]
+    with hydra_for(PACKAGED):
+        loader = GlobalHydra.instance().config_loader()
+        reference = loader.load_configuration(config_name="config", overrides=overrides, run_mode=RunMode.RUN)
+        monkeypatch.setattr(composition, "_classify",
+                            lambda parsed, repo: ((), [o for o in parsed if not o.is_sweep_override()]))
+        with composition.composing_once() as memo:
+            served = loader.load_configuration(config_name="config", overrides=overrides, run_mode=RunMode.RUN)
+    assert memo.compositions == 0 and not memo.skeletons
+    assert OmegaConf.to_yaml(served) == OmegaConf.to_yaml(reference)
+    assert served.hydra.runtime.choices.integrator == "rk4"
