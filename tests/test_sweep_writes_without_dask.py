@@ -1,4 +1,4 @@
-"""Writing run.nc and sweep.nc imports no Dask (gyrolab.output.netcdf_scheduler), and changes nothing written.
+"""Writing run.nc and sweep.nc imports no Dask (gyrolab.output.dask_free_writes), and changes nothing written.
 
 With Dask installed, xarray imported ``dask.array`` and ``distributed`` for the first file a process wrote
 (~0.43 CPU s: a fifth of a 20-job sweep's overhead). The guards answer as xarray and Dask do where the
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from gyrolab.output.netcdf_scheduler import skip_scheduler_question
+from gyrolab.output.dask_free_writes import install_dask_free_writes
 
 pytest.importorskip("dask.array")   # without Dask installed there is nothing to skip
 DASK_MODULES = ("dask", "dask.array", "distributed")
@@ -51,8 +51,8 @@ WRITE = """
 import sys
 from gyrolab import compose_scene
 if {guarded}:
-    from gyrolab.output.netcdf_scheduler import skip_scheduler_question
-    assert skip_scheduler_question()
+    from gyrolab.output.dask_free_writes import install_dask_free_writes
+    assert install_dask_free_writes()
 ds = compose_scene(["time.end=1", "time.n_output=11"]).run()
 for key in [k for k in ds.attrs if "wall" in k or k in ("date_created", "history")]:
     del ds.attrs[key]   # what differs between two runs
@@ -84,7 +84,7 @@ def test_once_dask_is_in_use_each_guard_answers_as_xarray():
     from xarray.backends import netCDF4_, writers
     from xarray.namedarray import pycompat, utils
 
-    assert skip_scheduler_question()
+    assert install_dask_free_writes()
     assert pycompat.array_type("dask") == (da.Array,)
     chunked = xr.Dataset({"x": ("t", da.arange(4.0, chunks=2))})
     plain = xr.Dataset({"x": ("t", np.arange(4.0))})
@@ -102,6 +102,6 @@ def test_once_dask_is_in_use_each_guard_answers_as_xarray():
 def test_installing_twice_guards_once():
     from xarray.backends import writers
 
-    assert skip_scheduler_question() and skip_scheduler_question()
+    assert install_dask_free_writes() and install_dask_free_writes()
     guarded = writers._get_netcdf_autoclose
     assert not hasattr(guarded.__wrapped__, "__wrapped__")

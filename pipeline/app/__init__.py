@@ -56,7 +56,7 @@ from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
 from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
-from gyrolab.output.netcdf_scheduler import skip_scheduler_question
+from gyrolab.output.dask_free_writes import install_dask_free_writes
 from gyrolab.output.written import announce_written
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
@@ -534,7 +534,7 @@ def main() -> None:
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
     show_warnings_in_one_line()
-    skip_scheduler_question()  # run.nc and sweep.nc hold numpy arrays: xarray need not import distributed to write them
+    install_dask_free_writes()  # run.nc and sweep.nc hold numpy arrays: xarray need not import distributed to write them
     with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
         _main(absolute_config_path(sys.argv[1:]))
 

@@ -8,7 +8,7 @@ which write lock to take (``locks.get_write_lock``), which imports ``distributed
 for the first file a process writes (``dask.array`` 0.33 s, ``distributed`` 0.1 s), more than a short
 run itself and a fifth of a 20-job sweep's overhead.
 
-:func:`skip_scheduler_question` puts a guard in front of each of the four that gives Dask's or xarray's
+:func:`install_dask_free_writes` puts a guard in front of each of the four that gives Dask's or xarray's
 own answer without the import where the answer cannot depend on Dask, and asks otherwise:
 
 * ``array_type("dask")`` while ``dask.array`` is not imported: no object can be an instance of its
@@ -32,7 +32,7 @@ from typing import Any
 _GUARD = "_gyrolab_scheduler_guard"
 
 
-def skip_scheduler_question() -> bool:
+def install_dask_free_writes() -> bool:
     """Install the four guards (once per process); whether all four are in place."""
     from xarray.backends import locks, netCDF4_, writers
     from xarray.namedarray import pycompat, utils
