@@ -534,7 +534,7 @@ def main() -> None:
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
     show_warnings_in_one_line()
-    install_dask_free_writes()  # run.nc and sweep.nc hold numpy arrays: xarray need not import distributed to write them
+    install_dask_free_writes()  # run.nc and sweep.nc hold numpy arrays: writing them need not import Dask
     with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
         _main(absolute_config_path(sys.argv[1:]))
 
