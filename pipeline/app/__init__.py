@@ -40,6 +40,7 @@ from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
+from gyrolab.engine.composition import composing_once
 from gyrolab.engine.hydra_private import get_args_parser
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
@@ -55,6 +56,7 @@ from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
 from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
+from gyrolab.output.dask_free_writes import install_dask_free_writes
 from gyrolab.output.written import announce_written
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
@@ -93,7 +95,8 @@ def preflight(argv: Sequence[str]) -> list[str]:
     """Validate the command line before Hydra creates any output directory; the command line Hydra should run.
 
     The config is composed exactly as Hydra will compose it (the same search path,
-    primary config and overrides, from a user's ``--config-dir`` too), checked by
+    primary config and overrides, from a user's ``--config-dir`` too; inside ``main``, Hydra's run is
+    then served from this composition, ``gyrolab.engine.composition``), checked by
     ``gyrolab.engine.safety`` (no config can run code), against the schema (unknown
     keys, types), the budget, and the scene's own validation.
     """
@@ -257,14 +260,14 @@ def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
 
 def validate_scene(scene_cfg: DictConfig) -> None:
     """The checks every run's scene config passes: schema, tolerances, budget, the scene's own validation."""
-    from gyrolab.batch.scheduler import choose_scheduler
+    from gyrolab.batch.scheduler import check_configured
     from gyrolab.experiments import TASKS
 
     plain = check_scene_config(scene_cfg)
     require_finite(plain, "")
     figure_options(plain.get("output"))  # figure formats and dpi, before anything runs
     check_tolerances(plain)
-    choose_scheduler((plain.get("batch") or {}).get("scheduler"))  # an address in a config: refused before any directory
+    check_configured((plain.get("batch") or {}).get("scheduler"))  # an address in a config: refused before any directory
     task = task_of(scene_cfg)
     if task not in ("scene", *TASKS):
         close = difflib.get_close_matches(task, ["scene", *TASKS], n=1)
@@ -531,7 +534,12 @@ def main() -> None:
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
     show_warnings_in_one_line()
-    argv = absolute_config_path(sys.argv[1:])
+    install_dask_free_writes()  # run.nc and sweep.nc hold numpy arrays: writing them need not import Dask
+    with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
+        _main(absolute_config_path(sys.argv[1:]))
+
+
+def _main(argv: list[str]) -> None:
     try:
         from gyrolab.app.parser import split_command
 

@@ -95,11 +95,7 @@ def choose_scheduler(configured: object = None) -> Choice:
 
     ``configured`` is ``batch.scheduler`` from the config: an address there is refused (module docstring).
     """
-    text = "" if configured is None else str(configured).strip()
-    if text not in (*IN_PROCESS, LOCAL):
-        raise ConfigError(f"batch.scheduler={shorten(text)!r} is not read from a config: connecting to a Dask "
-                          f"scheduler lets it run code in this process, so a config file or an experiment may only "
-                          f"say process or local; {WHERE_TO_PUT_IT}")
+    text = check_configured(configured)
     if _command_line is not None:
         return Choice(_command_line or None, f"the command line ({OPTION})")
     if configured is not None and text:
@@ -111,6 +107,18 @@ def choose_scheduler(configured: object = None) -> Choice:
     if address:
         return Choice(address, "Dask's configuration (scheduler-address)")
     return Choice(None, "the default")
+
+
+def check_configured(configured: object) -> str:
+    """``batch.scheduler`` from a config, stripped; ConfigError for an address (module docstring).
+
+    The check alone, without looking up Dask's own setting (which imports Dask): the preflight of every run."""
+    text = "" if configured is None else str(configured).strip()
+    if text not in (*IN_PROCESS, LOCAL):
+        raise ConfigError(f"batch.scheduler={shorten(text)!r} is not read from a config: connecting to a Dask "
+                          f"scheduler lets it run code in this process, so a config file or an experiment may only "
+                          f"say process or local; {WHERE_TO_PUT_IT}")
+    return text
 
 
 def _dask_configured() -> str:
@@ -217,5 +225,5 @@ def _tls_context() -> ssl.SSLContext:
     return context
 
 
-__all__ = ["Choice", "choose_scheduler", "probe", "split_scheduler_option", "take_scheduler_option",
+__all__ = ["Choice", "check_configured", "choose_scheduler", "probe", "split_scheduler_option", "take_scheduler_option",
            "use_command_line_scheduler"]

@@ -398,12 +398,14 @@ def collect(sweep_dir: Path, grid: Grid) -> list[JobResult]:
 
 
 def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: bool | None = None,
-                    launcher: str = "") -> SweepSummary:
+                    launcher: str = "", output: Any | None = None) -> SweepSummary:
     """Write ``sweep_dir/sweep.nc`` (and summary figures) from the sweep's job directories.
 
     ``hydra_cfg`` is the multirun's ``hydra`` config node; without it, it is
     read from ``sweep_dir/multirun.yaml`` (which Hydra writes at the start of
     every sweep). ``figures=None``: as the sweep's callback was configured.
+    ``output``: the multirun's ``output`` section (the figures' formats and dpi); without it, read from
+    ``multirun.yaml`` too.
     """
     sweep_dir = Path(sweep_dir)
     if hydra_cfg is None:
@@ -435,7 +437,12 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
     if figures and grid.dims and summary.finished:
         from gyrolab.sweep.figures import save_sweep_figures  # matplotlib only when figures are drawn
 
-        summary.figures = save_sweep_figures(ds, sweep_dir / "figures")
+        if output is None:
+            summary.figures = save_sweep_figures(ds, sweep_dir / "figures")
+        else:  # the sweep's own config, in memory: no second reading of multirun.yaml (~0.1 s of YAML)
+            from gyrolab.figures.options import figure_options
+
+            summary.figures = save_sweep_figures(ds, sweep_dir / "figures", *figure_options(output))
     return summary
 
 

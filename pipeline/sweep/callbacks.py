@@ -101,7 +101,8 @@ class SweepCallback(Callback):
         sweep_dir = Path(config.hydra.sweep.dir)
         try:
             summary = aggregate_sweep(sweep_dir, hydra_cfg=config.hydra, figures=self.figures,
-                                      launcher=str(config.hydra.launcher.get("_target_", "")).rsplit(".", 1)[-1])
+                                      launcher=str(config.hydra.launcher.get("_target_", "")).rsplit(".", 1)[-1],
+                                      output=config.get("output"))
         except OutputError as error:  # a full disk: one sentence, exit 3, the jobs' results intact
             last_error = f"{error}; the job results are intact: run 'gyrolab --aggregate {sweep_dir}' once " \
                          "the cause is fixed"
