@@ -94,3 +94,14 @@ def test_results_file_records_the_machine(tmp_path, monkeypatch):
     assert record["numbers"] == {"x": 1.5} and record["benchmark"] == "benchmarks/fixture.py"
     for lib in ("gyrolab", "numpy", "numba", "gyrolab_commit"):
         assert lib in record["versions"]
+
+
+def test_the_repositorys_speed_tables_are_the_results_files():
+    # issue 24: the README's and docs' speed tables come from the results files (one command regenerates them):
+    # every generated block of this repository has a results file, and none differs from what it would render
+    tables = _module("tables")
+    root = BENCHMARKS.parent
+    written, missing, changed = tables.regenerate(root, BENCHMARKS / "results", check=True)
+    assert not missing, f"generated blocks with no results file: {sorted(set(missing))}"
+    assert not changed, f"run `python benchmarks/tables.py`: out of date in {[str(p) for p in changed]}"
+    assert "scene_run_verdict" in written and "batch_heyoka" in written  # the README's and the batch's
