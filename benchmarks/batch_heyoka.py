@@ -247,9 +247,19 @@ def main() -> None:
                        f"error ≤ {TARGET:g}; CPU s of the process (all {THREADS} threads), minimum and median of "
                        f"{args.rounds} interleaved rounds; heyoka's batch size is the best of {', '.join(map(str, HEYOKA_LANES))}.",
             "header": ["method", "setting", "CPU s (min)", "CPU s (median)", "max error", "/ heyoka's best batch"],
-            "rows": rows}})
+            "rows": rows}}, summary=batch_summary(winners, cpu))
     print("\nwall times on a shared machine are noisy (other processes use the cores): compare within one run")
     sys.stdout.flush()
+
+
+def batch_summary(winners, cpu):
+    """The README's row: gyrolab's batch Taylor against heyoka's best batch, the cheapest of each reaching TARGET."""
+    ours, peer = winners.get("gyrolab taylor"), winners.get("heyoka batch")
+    if ours is None or peer is None:
+        return None
+    ratio = cpu[ours] / cpu[peer]
+    return [[f"batch Taylor / heyoka's best batch, max error {TARGET:g} over N = 10⁵ (CPU)", f"{ratio:.2f}×", "≤ 0.5×",
+             "PASS" if ratio <= 0.5 else "FAIL"]]
 
 
 if __name__ == "__main__":

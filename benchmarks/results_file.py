@@ -86,14 +86,18 @@ def machine() -> dict[str, Any]:
 
 def write_results(name: str, numbers: dict[str, Any], tables: dict[str, dict[str, Any]] | None = None,
                   clock: str = "time.process_time (CPU time of the process, all its threads)",
-                  command: str | None = None) -> Path:
+                  command: str | None = None, summary: list[list[str]] | None = None) -> Path:
     """Write ``benchmarks/results/<name>.json``; returns its path. ``command``: how the numbers were made, when
-    not ``benchmarks/<name>.py`` without options (a benchmark with several modes names each mode's file)."""
+    not ``benchmarks/<name>.py`` without options (a benchmark with several modes names each mode's file).
+    ``summary``: rows [what, measured, target, verdict] for the README's ``speed_summary`` table, which
+    ``tables.py`` assembles from every results file's rows."""
     RESULTS.mkdir(exist_ok=True)
     path = RESULTS / f"{name}.json"
     record = {"benchmark": command or f"benchmarks/{name}.py",
               "date_utc": f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%dT%H:%MZ}",
               **machine(), "clock": clock, "numbers": numbers, "tables": tables or {}}
+    if summary:
+        record["summary"] = summary
     path.write_text(json.dumps(record, indent=2, default=float) + "\n")
     print(f"written {path}")
     return path

@@ -123,7 +123,9 @@ def default_run() -> None:
                    f"Targets (issue 24) are wall times on an idle 2-core machine.",
         "header": ["command", "wall s", "CPU s", "target wall s", "verdict"], "rows": rows}},
         clock="time.perf_counter (wall) and the children's CPU time (getrusage)",
-        command="benchmarks/startup.py --default-run")
+        command="benchmarks/startup.py --default-run",
+        summary=[[f"the default {row[0]} end to end (wall{', README install' if not dask else ''})", f"{row[1]} s",
+                  f"{row[3]} s", row[4]] for row in rows])
 
 
 def main() -> None:

@@ -87,7 +87,9 @@ def main() -> None:
         "caption": f"`gyrolab -m {' '.join(SWEEP)}` with Hydra's basic launcher: CPU time of the whole sweep "
                    f"(median of {args.repeats} fresh processes) and its overhead per job beyond one `Scene.run()` "
                    f"({run * 1e3:.1f} ms); target ≤ {TARGET} s per job",
-        "header": ["sweep", "sweep CPU (s)", "overhead per job (s)"], "rows": rows}})
+        "header": ["sweep", "sweep CPU (s)", "overhead per job (s)"], "rows": rows}},
+        summary=[[f"a {JOBS}-job sweep's overhead per job, Hydra's basic launcher (CPU)", f"{verdict:.3f} s",
+                  f"≤ {TARGET} s", numbers["verdict"]]])
 
 
 if __name__ == "__main__":

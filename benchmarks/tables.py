@@ -23,16 +23,49 @@ ROOT = Path(__file__).resolve().parent.parent
 BLOCK = re.compile(r"(<!-- generated: (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(<!-- /generated -->)", re.S)
 
 
+#: the table assembled from every results file's ``summary`` rows (the README's)
+SUMMARY = "speed_summary"
+
+
 def load_tables(results: Path) -> dict[str, tuple[dict[str, Any], dict[str, Any]]]:
-    """Every table of every results file: name → (table, the file's record)."""
+    """Every table of every results file: name → (table, the file's record); and ``SUMMARY``, assembled from the
+    files' summary rows."""
     found: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {}
+    records = []
     for path in sorted(results.glob("*.json")):
         record = json.loads(path.read_text())
+        records.append(record)
         for name, table in (record.get("tables") or {}).items():
-            if name in found:
+            if name in found or name == SUMMARY:
                 raise SystemExit(f"table {name!r} is in two results files")
             found[name] = (table, record)
+    summarised = [record for record in records if record.get("summary")]
+    if summarised:
+        found[SUMMARY] = summary_table(summarised)
     return found
+
+
+def summary_table(records: list[dict[str, Any]]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """One row per summary row of each results file, with the command that measured it; its machine line is the
+    records' common CPU (or says they differ), their dates and the largest load among them."""
+    rows = [[*row, f"`{record.get('benchmark', '?')}`"] for record in records for row in record["summary"]]
+    cpus = sorted({str(record.get("cpu_model", "?")) for record in records})
+    dates = sorted(str(record.get("date_utc", "?")) for record in records)
+    first = records[0]
+    merged = {key: first[key] for key in ("host_vector_doubles", "batch_lanes", "cores") if key in first}
+    merged["versions"] = {k: v for k, v in first.get("versions", {}).items() if k != "gyrolab_commit"}
+    merged.update({
+        "cpu_model": cpus[0] if len(cpus) == 1 else f"several CPUs ({'; '.join(cpus)})",
+        "date_utc": dates[0] if dates[0] == dates[-1] else f"{dates[0]} to {dates[-1]}",
+        "load_average_start": [max((record.get("load_average_start") or [float("nan")])[0] for record in records)],
+        "clock": "each row's benchmark says (docs/performance.md)",
+        "benchmark": "benchmarks/<each row's>.py",
+    })
+    merged["load_average_end"] = merged["load_average_start"]
+    table = {"caption": "Issue 24's targets, each from its benchmark's latest results file (the load is the "
+                        "largest at the start of any of them).",
+             "header": ["what", "measured", "target", "verdict", "benchmark"], "rows": rows}
+    return table, merged
 
 
 def machine_line(record: dict[str, Any]) -> str:
