@@ -59,7 +59,7 @@ def summary_table(records: list[dict[str, Any]]) -> tuple[dict[str, Any], dict[s
         "date_utc": dates[0] if dates[0] == dates[-1] else f"{dates[0]} to {dates[-1]}",
         "load_average_start": [max((record.get("load_average_start") or [float("nan")])[0] for record in records)],
         "clock": "each row's benchmark says (docs/performance.md)",
-        "benchmark": "benchmarks/<each row's>.py",
+        "regenerate": "Regenerate: run the row's benchmark (last column), then `python benchmarks/tables.py`.",
     })
     merged["load_average_end"] = merged["load_average_start"]
     table = {"caption": "Issue 24's targets, each from its benchmark's latest results file (the load is the "
@@ -81,7 +81,8 @@ def machine_line(record: dict[str, Any]) -> str:
     return (f"Measured {record.get('date_utc', '?')} on {record.get('cpu_model', '?')}{width}, "
             f"{record.get('cores', '?')} cores, load average {load[0]:.1f} → {load_end[0]:.1f}; "
             f"{libs}{commit}; clock: {record.get('clock', '?')}. "
-            f"Regenerate: `python {record.get('benchmark', 'benchmarks/?.py')}` then `python benchmarks/tables.py`.")
+            + record.get("regenerate", f"Regenerate: `python {record.get('benchmark', 'benchmarks/?.py')}` then "
+                                       f"`python benchmarks/tables.py`."))
 
 
 def render(table: dict[str, Any], record: dict[str, Any]) -> str:

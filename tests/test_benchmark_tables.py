@@ -105,3 +105,20 @@ def test_the_repositorys_speed_tables_are_the_results_files():
     assert not missing, f"generated blocks with no results file: {sorted(set(missing))}"
     assert not changed, f"run `python benchmarks/tables.py`: out of date in {[str(p) for p in changed]}"
     assert "scene_run_verdict" in written and "batch_heyoka" in written  # the README's and the batch's
+
+
+def test_the_summary_table_gathers_every_results_files_rows_with_its_benchmark(tree):
+    tables = _module("tables")
+    results = tree / "benchmarks" / "results"
+    (results / "batch_heyoka.json").write_text(json.dumps({**RECORD, "summary": [["batch / heyoka", "0.45×", "≤ 0.5×",
+                                                                                  "PASS"]]}))
+    (results / "sweep_overhead.json").write_text(json.dumps({
+        **RECORD, "benchmark": "benchmarks/sweep_overhead.py", "date_utc": "2026-11-27T01:00Z", "tables": {},
+        "load_average_start": [0.5, 0, 0], "summary": [["overhead per job", "0.15 s", "≤ 0.2 s", "PASS"]]}))
+    (tree / "README.md").write_text("<!-- generated: speed_summary -->\n<!-- /generated -->\n")
+    tables.main(["--root", str(tree)])
+    text = (tree / "README.md").read_text()
+    assert "| batch / heyoka | 0.45× | ≤ 0.5× | PASS | `benchmarks/batch_heyoka.py` |" in text
+    assert "| overhead per job | 0.15 s | ≤ 0.2 s | PASS | `benchmarks/sweep_overhead.py` |" in text
+    assert "Fixture CPU 9000" in text and "2026-11-26T22:00Z to 2026-11-27T01:00Z" in text
+    assert "load average 3.2" in text  # the largest start load of the files, not the first file's
