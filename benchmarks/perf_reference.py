@@ -338,8 +338,8 @@ def calibration(reference):
         cells = []
         for accuracy in accuracies:
             auto = Auto(accuracy=accuracy)
-            auto.prepare(system)
             try:
+                auto.prepare(system)  # refuses an accuracy below the scene's floor
                 solution = auto.integrate(system.rhs, times, y0, None, built.compiled)
             except Exception as error:  # a refused accuracy (below the round-off floor)
                 cells.append(type(error).__name__)

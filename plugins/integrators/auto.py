@@ -99,6 +99,11 @@ FIRST_RATIO = 1e-3  # first pilot tolerance relative to the accuracy (the typica
 #: the pilot's tight run is at most accuracy/TIGHT_RATIO (final tolerances on the reference scene: accuracy/420 to
 #: accuracy/1300; the tight run is the start of the final one only when at least as accurate)
 TIGHT_RATIO = 3000.0
+#: a pilot whose loose run took fewer steps than this measured nothing about the tolerance (its steps were clipped by the
+#: pilot's end); the error per unit tolerance is then taken as UNMEASURED_PER_TOL, above the final error / tolerance
+#: ratios measured on the reference scene (24–470) and on the short fast scene that showed the case (5.7)
+MIN_PILOT_STEPS = 8
+UNMEASURED_PER_TOL = 1.0 / FIRST_RATIO
 #: a first prediction more than this many times looser than the pilot's τ is measured again at its own tolerance
 #: (one more run over the pilot's span). 20, not 10: over the extremes matrix and the reference scene at four
 #: accuracies per decade (1e-3 to 1e-13) the largest actual / raw predicted final error is 1.09 at every
@@ -214,6 +219,7 @@ class Auto(Integrator):
         amp = amplification(compiled, fun, y0, t_out[0], t_pilot, t_out[-1], self._method(compiled, SHADOW_TOLERANCE))
         loose = None  # the previous round's loose run (tolerance, solution): the next round's tight run
         for _ in range(3):
+            pilot_tau = tau
             per_tol, growth, nfev, measured, (tight_tol, tight), loose = self._pilot(fun, pilot_times, y0, compiled,
                                                                                      tau, loose)
             per_tol = _amplified(per_tol, growth, amp.factor, self.pilot_fraction, CHAOS_MARGIN)
@@ -227,6 +233,15 @@ class Auto(Integrator):
                 tau = chosen
             else:  # at a fixed order, extrapolating to tighter tolerances is safe (the leading term dominates more)
                 break
+        if loose[1].stats.n_steps < MIN_PILOT_STEPS:
+            # The pilot's stretch held a few steps, clipped by its end rather than set by τ: its runs at τ and τ_t
+            # take nearly the same steps, so their difference says nothing of the error's dependence on the
+            # tolerance (initial.r0=32 time.end=0.25: one step each, difference 0, tol 1e-5 chosen for 1e-9, error
+            # 5.7e-5). The whole span is then a few dozen steps: take the prior, cheaply conservative.
+            per_tol = max(per_tol, UNMEASURED_PER_TOL)
+            chosen = min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
+        elif not measured:  # only round-off seen up to pilot_tau: never extrapolate far beyond the loosest τ tried
+            chosen = min(chosen, RECENTRE * pilot_tau)
         # Round-off of the compensated Taylor update grows as a random walk over the steps (see the module's
         # note), that of scipy's plain update by up to an ulp per step: a target below it cannot be met in
         # double precision, whatever the tolerance.
