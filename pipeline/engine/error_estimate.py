@@ -75,32 +75,15 @@ def companion(integrator: Any, has_compiled: bool) -> Companion | None:
     return None
 
 
-def add_error_estimate(ds: xr.Dataset, scene: Any, y: np.ndarray, wall_time: float) -> xr.Dataset:
-    """``ds`` with the error-estimate variables and attributes of a run whose stored states are ``y`` (``measure``
-    then one insertion per variable; ``Scene.run`` passes them to ``build_dataset`` instead, which puts them in
-    while the dataset is assembled: inserting into a built dataset aligns and merges, ~0.4 ms each)."""
-    variables, attrs = measure(scene, y, wall_time, {name: ds[name].variable for name in ds.data_vars})
-    ds.attrs.update(attrs)
-    for key, variable in variables.items():
-        ds[key] = variable
-    return ds
-
-
-def measure(scene: Any, y: np.ndarray, wall_time: float,
-            stored: dict[str, xr.Variable]) -> tuple[dict[str, xr.Variable], dict[str, Any]]:
-    """(variables, attributes) of the error estimate of the scene's run whose stored states are ``y`` and whose
-    dataset variables are ``stored``: ``compare`` then ``Comparison.variables``."""
-    return compare(scene, scene.integrator, y, wall_time).variables(stored)
-
-
 @dataclass(frozen=True)
 class Comparison:
     """A run against its companion: ``difference`` (the estimated error of every stored component at every output
-    time, None when no companion could run) and the attributes saying how (or why not)."""
+    time, None when no companion could run) and the dataset attributes saying how (or why not). ``Scene.run``
+    reads ``max_error`` before the dataset is assembled (rule 11) and passes ``variables`` to ``build_dataset``,
+    which puts them in while assembling: inserting into a built dataset aligns and merges, ~0.4 ms each."""
 
     difference: np.ndarray | None
-    how: str
-    attrs: dict[str, Any]
+    attrs: dict[str, Any]  # error_estimate_method says how (or why not)
     #: the run's stored states (to tell whether a dataset's ω is their first three components)
     y: np.ndarray | None = None
 
@@ -131,7 +114,7 @@ class Comparison:
             key = f"error_estimate_{part}" if part else "error_estimate"
             variables[key] = xr.Variable("time", series, {
                 "units": units, "long_name": f"estimated max-norm error of the stored {what} at each output time",
-                "comment": self.how}, fastpath=True)
+                "comment": attrs["error_estimate_method"]}, fastpath=True)
             attrs[f"error_estimate_max_{part}" if part else "error_estimate_max"] = float(series.max())
         return variables, attrs
 
@@ -148,7 +131,7 @@ def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Com
                   f"not available: integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
                   "compiled model for the Taylor method")
         log.warning("output.error_estimate: %s", reason)
-        return Comparison(None, reason, {"error_estimate_method": reason})
+        return Comparison(None, {"error_estimate_method": reason})
     companion_model = None
     if pick.integrator.supports(COMPILED_MODEL) or pick.integrator.supports(PREFERS_COMPILED_MODEL):
         # the scene's own model is prepared for its integrator (a plugin torque's Taylor kernel compiled); another
@@ -158,14 +141,14 @@ def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Com
         if refusal:
             reason = f"not available: the companion ({pick.how}) {refusal}"
             log.warning("output.error_estimate: %s", reason)
-            return Comparison(None, reason, {"error_estimate_method": reason})
+            return Comparison(None, {"error_estimate_method": reason})
     start = time.perf_counter()
     y0 = scene.system.initial_state()
     other = pick.integrator.integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
     spent = time.perf_counter() - start
     y = np.asarray(y, dtype=float)
     attrs = {"error_estimate_method": pick.how, "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
-    return Comparison(pick.scale * np.abs(y - other), pick.how, attrs, y)
+    return Comparison(pick.scale * np.abs(y - other), attrs, y)
 
 
 def _at_taylor_floor(integrator: Any) -> bool:
