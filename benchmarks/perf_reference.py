@@ -243,7 +243,7 @@ def scene_run_only(reference, rounds):
     interleaved(contestants, 1)
     best = interleaved(contestants, rounds)
     errors = {key: float(np.max(np.abs(np.asarray(result)[:6] - reference))) for key, (_, result) in best.items()}
-    ratios, rows = {}, []
+    ratios, bare_ratios, rows = {}, {}, []
     for eps in EPSILONS:
         peer = min((key for key in best if key[0] == "heyoka" and errors[key] <= eps), key=MEDIANS.get, default=None)
         run_key, bare_key = ("auto Scene.run()", eps), (NO_ESTIMATE, eps)
@@ -255,6 +255,8 @@ def scene_run_only(reference, rounds):
             rows.append([f"{eps:.0e}", f"{MEDIANS[peer] * 1e3:.2f} ({errors[peer]:.1e})",
                          f"{MEDIANS[run_key] * 1e3:.2f} ({errors[run_key]:.1e})", f"{ratios[eps]:.2f}×",
                          f"{MEDIANS[bare_key] * 1e3:.2f}", f"{MEDIANS[bare_key] / MEDIANS[peer]:.2f}×"])
+            # without the estimate auto keeps only its prediction: a run that misses ε has no ratio
+            bare_ratios[eps] = MEDIANS[bare_key] / MEDIANS[peer] if errors[bare_key] <= eps else float("inf")
     print_verdict(ratios)
     if rows:
         write_results("perf_reference_scene_run", {"rounds": rounds, "ratios": {f"{e:.0e}": r for e, r in ratios.items()}},
@@ -271,7 +273,7 @@ def scene_run_only(reference, rounds):
                       command="benchmarks/perf_reference.py --scene-run",
                       summary=[["`auto`'s whole `Scene.run()` / heyoka `propagate_grid`, worst over ε = 1e-6 … 1e-13 "
                                 "(without the error estimate)",
-                                f"{max(ratios.values()):.2f}× ({max(float(r[-1].rstrip('×')) for r in rows):.2f}×)",
+                                f"{max(ratios.values()):.2f}× ({max(bare_ratios.values()):.2f}×)",
                                 f"≤ {TARGET}×", "PASS" if max(ratios.values()) <= TARGET else "FAIL"]])
 
 
