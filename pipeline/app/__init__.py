@@ -53,6 +53,8 @@ from gyrolab.engine.config import (
     use_source,
 )
 from gyrolab.engine.safety import check_config, check_output_dir
+from gyrolab.engine.unread import ACCURACY, given_keys, ignored_attributes, unread_accuracy, warning
+from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
 from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
@@ -139,6 +141,7 @@ def preflight(argv: Sequence[str]) -> list[str]:
     cfg = configs[0]
     for composed in configs:
         check_scene_config(_without_hydra(composed))
+    refuse_unread(configs, [o.input_line for o in overrides])
     run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
@@ -150,6 +153,16 @@ def preflight(argv: Sequence[str]) -> list[str]:
     check_task(task_of(cfg), _without_hydra(cfg), run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
     return argv
+
+
+def refuse_unread(configs: Sequence[DictConfig], overrides: Sequence[str]) -> None:
+    """ConfigError when the command line gives ``accuracy`` and no job's integrator reads it
+    (``gyrolab.engine.unread``). A sweep over integrators (``-m integrator=auto,taylor accuracy=1e-8``) gives the
+    target to the jobs that read it; the others run at their own settings, warn and record it, as for a value
+    from a config file."""
+    sentences = [unread_accuracy(composed) for composed in configs]
+    if ACCURACY in given_keys(overrides) and all(sentences):
+        raise unread_refusal(configs[0], sentences[0])
 
 
 def _output_dir_text(cfg: DictConfig, mode: str) -> str:
@@ -248,7 +261,7 @@ def _is_group(o: Override, cfg: DictConfig) -> bool:
 
 def _compose_job(source: ConfigSource, overrides: list[str], sweeping: bool) -> DictConfig:
     return compose_config(overrides, return_hydra_config=True, from_shell=True, config_name=source.config_name,
-                          run_mode=RunMode.MULTIRUN if sweeping else RunMode.RUN)
+                          run_mode=RunMode.MULTIRUN if sweeping else RunMode.RUN, refuse_unread=False)
 
 
 def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
@@ -384,6 +397,9 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     from gyrolab.output.dataset import write_dataset
 
     task = task_of(cfg)
+    unread = unread_accuracy(cfg) if task in ("scene", "regime") else None  # tasks that run the scene's integrator
+    if unread:  # a config file's accuracy (the preflight refused one the command line gave): said, and recorded
+        log.warning("%s", warning(unread))
     if task != "scene":
         from gyrolab.experiments import run_task
 
@@ -395,6 +411,7 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     ds = scene.run()
     ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
     ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
+    ds.attrs.update(ignored_attributes(cfg) if unread else {})
     path = write_dataset(ds, out_dir / "run.nc")
     announce_written(path)
     if not figures:
