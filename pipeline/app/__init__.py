@@ -53,7 +53,7 @@ from gyrolab.engine.config import (
     use_source,
 )
 from gyrolab.engine.safety import check_config, check_output_dir
-from gyrolab.engine.unread import ACCURACY, given_keys, ignored_attributes, unread_accuracy, warning
+from gyrolab.engine.unread import ACCURACY, ACCURACY_IGNORED_ATTRIBUTE, given_keys, ignored_accuracy, unread_accuracy
 from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
@@ -397,9 +397,11 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     from gyrolab.output.dataset import write_dataset
 
     task = task_of(cfg)
-    unread = unread_accuracy(cfg) if task in ("scene", "regime") else None  # tasks that run the scene's integrator
-    if unread:  # a config file's accuracy (the preflight refused one the command line gave): said, and recorded
-        log.warning("%s", warning(unread))
+    # an accuracy the integrator does not read (the preflight refused one the command line gave to every job): said,
+    # and recorded in run.nc; for the tasks that run the scene's integrator
+    ignored = (ignored_accuracy(cfg, HydraConfig.get().overrides.task) if task in ("scene", "regime") else None)
+    if ignored:
+        log.warning("%s", ignored)
     if task != "scene":
         from gyrolab.experiments import run_task
 
@@ -411,7 +413,8 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     ds = scene.run()
     ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
     ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
-    ds.attrs.update(ignored_attributes(cfg) if unread else {})
+    if ignored:
+        ds.attrs[ACCURACY_IGNORED_ATTRIBUTE] = ignored
     path = write_dataset(ds, out_dir / "run.nc")
     announce_written(path)
     if not figures:

@@ -107,10 +107,16 @@ def _readers() -> list[str]:
     return integrators_with(CHOOSES_METHOD)
 
 
-def warning(value_sentence: str) -> str:
-    """The warning (and the dataset's ``accuracy_ignored``) for an ``accuracy`` a config file set."""
-    return (f"{value_sentence}, so this run does not aim at that accuracy (the value comes from the config files, "
-            f"a default for the integrators that read it)")
+def ignored_accuracy(cfg: DictConfig, overrides: Sequence[str]) -> str | None:
+    """The warning (and the dataset's ``accuracy_ignored``) for an ``accuracy`` a run proceeds without reading: one a
+    config file set, or one a sweep gives to every job while only some jobs' integrators read it; else None."""
+    sentence = unread_accuracy(cfg)
+    if sentence is None:
+        return None
+    source = ("the sweep gives it to every job, and the jobs whose integrator reads it aim at it"
+              if ACCURACY in given_keys(overrides) else "a config file set it, as a default for the integrators "
+              "that read it")
+    return f"{sentence}, so this run does not aim at that accuracy ({source})"
 
 
 def refuse_given_accuracy(cfg: DictConfig, overrides: Sequence[str]) -> None:
@@ -120,12 +126,6 @@ def refuse_given_accuracy(cfg: DictConfig, overrides: Sequence[str]) -> None:
     sentence = unread_accuracy(cfg)
     if sentence is not None:
         raise refusal(cfg, sentence)
-
-
-def ignored_attributes(cfg: DictConfig) -> dict[str, str]:
-    """The dataset attributes recording config values the run did not read (``accuracy_ignored``), else {}."""
-    sentence = unread_accuracy(cfg)
-    return {} if sentence is None else {ACCURACY_IGNORED_ATTRIBUTE: warning(sentence)}
 
 
 def integrator_name(cfg: DictConfig) -> str:

@@ -1,0 +1,111 @@
+"""No config value a run silently ignores (gyrolab.engine.unread; docs/configs.md "Values a run does not read").
+
+A value the user gives and the run does not read is refused in one sentence before anything is written; a value
+a config file set (an experiment's default) lets the run proceed, says so once and is recorded in the dataset.
+"""
+
+import pytest
+import xarray as xr
+
+from gyrolab import compose_scene
+from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, given_keys, reads_accuracy
+from gyrolab.engine.config import compose_config
+from gyrolab.errors import ConfigError
+
+SHORT = ("time.end=1", "output.figures=false")
+
+
+def _one_error_line(done):
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("gyrolab: error: ")
+    return lines[0]
+
+
+# -- accuracy given, not read: refused ----------------------------------------------------------------------------
+
+def test_accuracy_given_to_an_integrator_that_does_not_read_it_is_refused_before_the_run_directory(cli, tmp_path):
+    done = cli("integrator=taylor", "accuracy=1e-8", *SHORT, "hydra.run.dir=out")
+    assert _one_error_line(done) == (
+        "gyrolab: error: accuracy=1e-08 is the target of integrator=auto only; integrator=taylor does not read it and "
+        "runs at its own settings (integrator.tol=1e-16): ask integrator=auto accuracy=1e-08 or set integrator.tol "
+        "instead (and drop accuracy=1e-08)")
+    assert not (tmp_path / "out").exists()
+    assert not list(tmp_path.rglob("run.nc"))
+
+
+@pytest.mark.parametrize("integrator, settings", [
+    ("rk4", "integrator.step=0.01"),
+    ("dop853", "integrator.rtol=1e-10, integrator.atol=1e-10"),
+    ("lie_poisson", "integrator.step=0.01"),
+])
+def test_compose_scene_refuses_a_given_accuracy_naming_the_integrators_own_settings(integrator, settings):
+    with pytest.raises(ConfigError) as refused:
+        compose_scene([f"integrator={integrator}", "accuracy=1e-7", "time.end=1"])
+    text = str(refused.value)
+    assert f"accuracy=1e-07 is the target of integrator=auto only; integrator={integrator} does not read it" in text
+    assert f"({settings})" in text and "ask integrator=auto accuracy=1e-07" in text
+
+
+def test_an_accuracy_an_integrator_reads_is_accepted_whatever_its_name():
+    # auto reads it through its packaged setting; any integrator reads it when a setting refers to it
+    assert compose_scene(["integrator=auto", "accuracy=1e-8", "time.end=1"]).integrator.accuracy == 1e-8
+    scene = compose_scene(["integrator=taylor", "integrator.tol=${accuracy}", "accuracy=1e-10", "time.end=1"])
+    assert scene.integrator.tol == 1e-10
+
+
+def test_an_accuracy_replaced_by_the_integrators_own_setting_is_refused():
+    with pytest.raises(ConfigError, match=r"accuracy=1e-08 is not read: integrator=auto runs at its own settings "
+                                          r"\(integrator.accuracy=1e-06\), which replace it"):
+        compose_scene(["integrator=auto", "integrator.accuracy=1e-6", "accuracy=1e-8", "time.end=1"])
+
+
+def test_a_sweep_whose_jobs_none_read_the_given_accuracy_is_refused(cli, tmp_path):
+    done = cli("-m", "integrator=dop853,taylor", "accuracy=1e-6", *SHORT, "hydra.sweep.dir=sweep")
+    assert "accuracy=1e-06 is the target of integrator=auto only; integrator=dop853" in _one_error_line(done)
+    assert not (tmp_path / "sweep").exists()
+
+
+def test_a_batch_given_an_accuracy_its_integrator_does_not_read_is_refused(cli, tmp_path):
+    done = cli("batch", "integrator=rk4_numba", "accuracy=1e-8", "initial.r0=1,2", "time.end=1", "time.n_output=2",
+               "hydra.sweep.dir=b")
+    assert "integrator=rk4_numba does not read it" in _one_error_line(done)
+    assert not (tmp_path / "b").exists()
+
+
+def test_accuracy_null_and_deleting_it_are_not_values():
+    assert given_keys(["accuracy=1e-8", "+batch.output=final", "~time.n_output", "++x.y=1"]) == {
+        "accuracy", "batch.output", "x.y"}
+    compose_scene(["integrator=taylor", "accuracy=null", "time.end=1"])
+
+
+def test_whether_accuracy_is_read_is_asked_of_the_config_not_the_name():
+    assert reads_accuracy(compose_config(["integrator=auto"]))
+    assert not reads_accuracy(compose_config(["integrator=auto", "integrator.accuracy=1e-6"]))
+    assert not reads_accuracy(compose_config(["integrator=taylor"]))
+    assert reads_accuracy(compose_config(["integrator=taylor", "integrator.tol=${accuracy}", "accuracy=1e-9"]))
+
+
+# -- accuracy from a config file, not read: the run proceeds, says so once, records it ---------------------------
+
+def test_an_experiments_accuracy_the_integrator_does_not_read_is_warned_once_and_recorded(cli, tmp_path):
+    done = cli("experiment=perf_reference", "integrator=taylor", *SHORT, "hydra.run.dir=out")
+    assert done.returncode == 0, done.stderr
+    said = [line for line in done.stderr.splitlines() if "accuracy=1e-08" in line]
+    assert len(said) == 1 and "WARNING" in said[0], done.stderr
+    assert "integrator=taylor does not read it" in said[0] and "a config file set it" in said[0]
+    with xr.open_dataset(tmp_path / "out" / "run.nc") as ds:
+        recorded = ds.attrs[ACCURACY_IGNORED_ATTRIBUTE]
+    assert recorded in said[0]
+
+
+def test_a_sweep_over_integrators_gives_the_accuracy_to_the_jobs_that_read_it_and_records_the_others(cli, tmp_path):
+    done = cli("-m", "integrator=auto,taylor", "accuracy=1e-6", *SHORT, "hydra.sweep.dir=sweep")
+    assert done.returncode == 0, done.stderr
+    with xr.open_dataset(tmp_path / "sweep" / "0" / "run.nc") as auto, \
+            xr.open_dataset(tmp_path / "sweep" / "1" / "run.nc") as taylor:
+        assert auto.attrs["integrator"] != taylor.attrs["integrator"]
+        assert ACCURACY_IGNORED_ATTRIBUTE not in auto.attrs
+        assert "integrator=taylor does not read it" in taylor.attrs[ACCURACY_IGNORED_ATTRIBUTE]
+        assert "the sweep gives it to every job" in taylor.attrs[ACCURACY_IGNORED_ATTRIBUTE]
