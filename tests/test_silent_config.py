@@ -109,3 +109,13 @@ def test_a_sweep_over_integrators_gives_the_accuracy_to_the_jobs_that_read_it_an
         assert ACCURACY_IGNORED_ATTRIBUTE not in auto.attrs
         assert "integrator=taylor does not read it" in taylor.attrs[ACCURACY_IGNORED_ATTRIBUTE]
         assert "the sweep gives it to every job" in taylor.attrs[ACCURACY_IGNORED_ATTRIBUTE]
+
+
+def test_a_batch_from_an_experiment_whose_accuracy_its_integrator_does_not_read_says_so_and_records_it(cli, tmp_path):
+    done = cli("batch", "experiment=perf_reference", "integrator=taylor", "initial.r0=1,2", "time.end=1",
+               "time.n_output=2", "hydra.sweep.dir=b")
+    assert done.returncode == 0, done.stderr
+    said = [line for line in done.stderr.splitlines() if "accuracy=1e-08" in line]
+    assert len(said) == 1 and "WARNING" in said[0] and "integrator=taylor does not read it" in said[0], done.stderr
+    with xr.open_dataset(tmp_path / "b" / "sweep.nc") as ds:
+        assert ds.attrs[ACCURACY_IGNORED_ATTRIBUTE] in said[0]
