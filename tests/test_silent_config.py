@@ -119,3 +119,44 @@ def test_a_batch_from_an_experiment_whose_accuracy_its_integrator_does_not_read_
     assert len(said) == 1 and "WARNING" in said[0] and "integrator=taylor does not read it" in said[0], done.stderr
     with xr.open_dataset(tmp_path / "b" / "sweep.nc") as ds:
         assert ds.attrs[ACCURACY_IGNORED_ATTRIBUTE] in said[0]
+
+
+# -- keys only some runs read, given to a run that does not read them: refused ------------------------------------
+
+@pytest.mark.parametrize("argv, sentence", [
+    (["batch.output=final"], "batch.output=final is read only by task stability_map or gyrolab batch; this run "
+                             "(task scene) does not read it, so it would change nothing: run it with gyrolab batch, "
+                             "or drop it"),
+    (["-m", "batch.decimate=5", "initial.r0=1,2"], "batch.decimate=5 is read only by task stability_map or gyrolab "
+                                                   "batch; this run (task scene)"),
+    (["regime=small_parameter", "output.error_estimate=true"],
+     "output.error_estimate=true is read only by task scene, task work_precision or task yehia2021_precessions; this "
+     "run (task regime) does not read it, so it would change nothing: drop it"),
+    (["experiment=work_precision", "integrator=taylor"],
+     "integrator=taylor is not read by task work_precision, which sets integrator itself (every method of "
+     "work_precision.methods is run); drop it"),
+    (["experiment=work_precision", "accuracy=1e-9"], "accuracy=1e-9 is not read by task work_precision"),
+    (["experiment=work_precision", "time.n_output=50"], "time.n_output=50 is not read by task work_precision"),
+    (["experiment=yehia2021_precessions", "initial.r0=3"], "initial.r0=3 is not read by task yehia2021_precessions, "
+                                                           "which sets initial itself"),
+    (["batch", "output.error_estimate=true", "initial.r0=1,2"],
+     "output.error_estimate=true is read only by task scene, task work_precision or task yehia2021_precessions; this "
+     "run (gyrolab batch) does not read it"),
+])
+def test_a_value_given_to_a_run_that_does_not_read_it_is_one_sentence_and_writes_nothing(argv, sentence, cli, tmp_path):
+    directories = ["hydra.sweep.dir=sweep"] if argv[0] == "batch" else ["hydra.run.dir=out", "hydra.sweep.dir=sweep"]
+    done = cli(*argv, *SHORT, *directories)
+    assert sentence in _one_error_line(done)
+    assert not (tmp_path / "out").exists() and not (tmp_path / "sweep").exists()
+
+
+def test_the_runs_that_read_those_keys_still_take_them():
+    from gyrolab.experiments import refuse_unread
+
+    refuse_unread("task scene", ["output.error_estimate=true"])
+    refuse_unread("gyrolab batch", ["batch.output=final", "batch.decimate=5"])
+    refuse_unread("task stability_map", ["batch.points=100"])
+    refuse_unread("task work_precision", ["time.end=50", "output.error_estimate=false"])
+    refuse_unread("task yehia2021_precessions", ["integrator=taylor", "yehia2021.orbits=2"])
+    # a config file's value is a default for the runs that read it: only overrides are checked
+    refuse_unread("task scene", [])

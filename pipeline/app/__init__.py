@@ -148,8 +148,9 @@ def preflight(argv: Sequence[str]) -> list[str]:
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     validate_scene(_without_hydra(cfg))
-    from gyrolab.experiments import check_task
+    from gyrolab.experiments import check_task, refuse_unread as refuse_unread_by_task
 
+    refuse_unread_by_task(f"task {task_of(cfg)}", [o.input_line for o in overrides])  # batch.* on a plain run, ...
     check_task(task_of(cfg), _without_hydra(cfg), run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
     return argv

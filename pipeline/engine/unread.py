@@ -40,15 +40,25 @@ OWN_SETTINGS = ("accuracy", "tol", "rtol", "atol", "step")
 _PROBES = (1.2345678e-7, 8.7654321e-9)
 
 
-def given_keys(overrides: Sequence[str]) -> set[str]:
-    """The keys an override list gives a value (``accuracy=1e-8``, ``+accuracy=...``, ``++batch.output=final``);
-    a deletion (``~accuracy``) gives none."""
-    keys = set()
+def given_overrides(overrides: Sequence[str]) -> dict[str, str]:
+    """The keys an override list gives a value, each with its override (``accuracy=1e-8``, ``+accuracy=...``,
+    ``++batch.output=final``, ``force=[magnetic]``); a deletion (``~accuracy``) gives none."""
+    given = {}
     for text in overrides:
         key, has_value, _ = str(text).partition("=")
         if has_value and not key.startswith("~"):
-            keys.add(key.lstrip("+").split("@", 1)[0].strip())
-    return keys
+            given[key.lstrip("+").split("@", 1)[0].strip()] = str(text)
+    return given
+
+
+def given_keys(overrides: Sequence[str]) -> set[str]:
+    """The keys an override list gives a value (``given_overrides``' keys)."""
+    return set(given_overrides(overrides))
+
+
+def covers(key: str, given: str) -> bool:
+    """Whether config key ``key`` is ``given`` or a section holding it (``batch`` covers ``batch.output``)."""
+    return given == key or given.startswith(key + ".")
 
 
 def reads_accuracy(cfg: DictConfig) -> bool:

@@ -8,10 +8,13 @@ its own section, and the app hands the composed config to the task's
 from __future__ import annotations
 
 import importlib
+from collections.abc import Sequence
 from pathlib import Path
 
 from omegaconf import DictConfig
 
+from gyrolab.contracts.capabilities import or_list
+from gyrolab.engine.unread import covers, given_overrides
 from gyrolab.errors import ConfigError, choices
 
 TASKS = {
@@ -27,6 +30,44 @@ TASKS = {
     # satellite-gyrostat (Yehia & El-kenani (2021))
     "yehia2021_precessions": "gyrolab.experiments.yehia2021_precessions",
 }
+
+
+#: config keys only some runs read (docs/configs.md, "Values a run does not read") and the runs that read them: the
+#: tasks that run Scene.run read output.error_estimate (it measures the stored trajectory's error); batch.* is read by
+#: gyrolab batch and by the experiments that run one
+BATCH_COMMAND = "gyrolab batch"
+READ_BY = {
+    "batch": ("task stability_map", BATCH_COMMAND),
+    "output.error_estimate": ("task scene", "task work_precision", "task yehia2021_precessions"),
+}
+#: config keys a task sets itself for the scenes it runs, so that a value given for them changes nothing; and why
+REPLACED_BY = {
+    "work_precision": {
+        "integrator": "every method of work_precision.methods is run",
+        "accuracy": "auto's settings are listed in work_precision.methods",
+        "regime": "it compares integrators of the full model",
+        "time.n_output": "it compares final states, with time.n_output=2",
+    },
+    "yehia2021_precessions": {
+        key: "each precession case sets its own body, forces, initial state and span, the span from yehia2021.orbits"
+        for key in ("body", "force", "initial", "time")
+    },
+}
+
+
+def refuse_unread(run: str, overrides: Sequence[str]) -> None:
+    """ConfigError for the first value ``overrides`` give that ``run`` (``task NAME`` or ``gyrolab batch``) does not
+    read: a key only other runs read (READ_BY: ``batch.output=final`` on a plain run), or one the task sets itself
+    (REPLACED_BY). Config files' values are defaults for the runs that read them: only overrides are refused."""
+    for key, text in given_overrides(overrides).items():
+        for optional, readers in READ_BY.items():
+            if covers(optional, key) and run not in readers:
+                way = f"run it with {BATCH_COMMAND}, or drop it" if BATCH_COMMAND in readers else "drop it"
+                raise ConfigError(f"{text} is read only by {or_list(list(readers))}; this run ({run}) does not read "
+                                  f"it, so it would change nothing: {way}")
+        for replaced, why in REPLACED_BY.get(run.removeprefix("task "), {}).items():
+            if covers(replaced, key):
+                raise ConfigError(f"{text} is not read by {run}, which sets {replaced} itself ({why}); drop it")
 
 
 def check_task(name: str, cfg: DictConfig, out_dir: Path) -> None:
