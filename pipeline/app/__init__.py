@@ -161,8 +161,10 @@ def refuse_unread(configs: Sequence[DictConfig], overrides: Sequence[str]) -> No
     (``gyrolab.engine.unread``). A sweep over integrators (``-m integrator=auto,taylor accuracy=1e-8``) gives the
     target to the jobs that read it; the others run at their own settings, warn and record it, as for a value
     from a config file."""
+    if ACCURACY not in given_keys(overrides):
+        return
     sentences = [unread_accuracy(composed) for composed in configs]
-    if ACCURACY in given_keys(overrides) and all(sentences):
+    if all(sentences):
         raise unread_refusal(configs[0], sentences[0])
 
 
