@@ -160,3 +160,12 @@ def test_the_runs_that_read_those_keys_still_take_them():
     refuse_unread("task yehia2021_precessions", ["integrator=taylor", "yehia2021.orbits=2"])
     # a config file's value is a default for the runs that read it: only overrides are checked
     refuse_unread("task scene", [])
+
+
+def test_a_work_precision_method_given_an_accuracy_it_does_not_read_is_refused_before_the_run_directory(cli, tmp_path):
+    done = cli("experiment=work_precision", "work_precision.repeats=1", "~work_precision.methods",
+               "+work_precision.methods={taylor: {accuracy: [1e-8]}}", *SHORT, "hydra.run.dir=out")
+    assert _one_error_line(done).startswith(
+        "gyrolab: error: work_precision.methods.taylor.accuracy: accuracy=1e-08 is the target of integrator=auto only; "
+        "integrator=taylor does not read it")
+    assert not (tmp_path / "out").exists()
