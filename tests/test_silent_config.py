@@ -133,12 +133,17 @@ def test_a_batch_from_an_experiment_whose_accuracy_its_integrator_does_not_read_
      "output.error_estimate=true is read only by task scene, task work_precision or task yehia2021_precessions; this "
      "run (task regime) does not read it, so it would change nothing: drop it"),
     (["experiment=work_precision", "integrator=taylor"],
-     "integrator=taylor is not read by task work_precision, which sets integrator itself (every method of "
-     "work_precision.methods is run); drop it"),
+     "integrator=taylor is not read by task work_precision (it runs every method of work_precision.methods); "
+     "drop it"),
     (["experiment=work_precision", "accuracy=1e-9"], "accuracy=1e-9 is not read by task work_precision"),
     (["experiment=work_precision", "time.n_output=50"], "time.n_output=50 is not read by task work_precision"),
-    (["experiment=yehia2021_precessions", "initial.r0=3"], "initial.r0=3 is not read by task yehia2021_precessions, "
-                                                           "which sets initial itself"),
+    (["experiment=yehia2021_precessions", "initial.r0=3"], "initial.r0=3 is not read by task yehia2021_precessions "
+                                                           "(each precession case sets its own body"),
+    (["experiment=orbit_family", "body.a=3"], "body.a=3 is not read by task orbit_family (each family of "
+                                              "orbit_family.families sets its own body"),
+    (["experiment=ismail2021_tables", "integrator=rk4"], "integrator=rk4 is not read by task ismail2021_tables"),
+    (["experiment=stability_map", "initial.r0=3"], "initial.r0=3 is not read by task stability_map (the map's grid "
+                                                   "sets it"),
     (["batch", "output.error_estimate=true", "initial.r0=1,2"],
      "output.error_estimate=true is read only by task scene, task work_precision or task yehia2021_precessions; this "
      "run (gyrolab batch) does not read it"),
@@ -158,6 +163,7 @@ def test_the_runs_that_read_those_keys_still_take_them():
     refuse_unread("task stability_map", ["batch.points=100"])
     refuse_unread("task work_precision", ["time.end=50", "output.error_estimate=false"])
     refuse_unread("task yehia2021_precessions", ["integrator=taylor", "yehia2021.orbits=2"])
+    refuse_unread("task orbit_family", ["orbit_family.families.x.r0_end=1", "output.figures=false"])
     # a config file's value is a default for the runs that read it: only overrides are checked
     refuse_unread("task scene", [])
 

@@ -40,10 +40,11 @@ READ_BY = {
     "batch": ("task stability_map", BATCH_COMMAND),
     "output.error_estimate": ("task scene", "task work_precision", "task yehia2021_precessions"),
 }
-#: config keys a task sets itself for the scenes it runs, so that a value given for them changes nothing; and why
-REPLACED_BY = {
+#: config keys a task does not read, because it sets them itself for the scenes it runs or runs none: a value given
+#: for them would change nothing; and why (said in the refusal)
+NOT_READ_BY = {
     "work_precision": {
-        "integrator": "every method of work_precision.methods is run",
+        "integrator": "it runs every method of work_precision.methods",
         "accuracy": "auto's settings are listed in work_precision.methods",
         "regime": "it compares integrators of the full model",
         "time.n_output": "it compares final states, with time.n_output=2",
@@ -52,22 +53,35 @@ REPLACED_BY = {
         key: "each precession case sets its own body, forces, initial state and span, the span from yehia2021.orbits"
         for key in ("body", "force", "initial", "time")
     },
+    "stability_map": {
+        key: "the map's grid sets it, from stability_map.theta0, stability_map.r0 and their n_ and _spacing settings"
+        for key in ("initial.theta0", "initial.r0")
+    },
+    "orbit_family": {
+        key: "each family of orbit_family.families sets its own body, Newtonian k and tilt, and the continuation "
+             "its spins and periods"
+        for key in ("system", "body", "force", "initial", "time", "integrator", "accuracy", "regime")
+    },
+    "ismail2021_tables": {
+        key: "it regenerates the paper's two tables from the paper's own parameters"
+        for key in ("system", "body", "force", "initial", "time", "integrator", "accuracy", "regime")
+    },
 }
 
 
 def refuse_unread(run: str, overrides: Sequence[str]) -> None:
     """ConfigError for the first value ``overrides`` give that ``run`` (``task NAME`` or ``gyrolab batch``) does not
-    read: a key only other runs read (READ_BY: ``batch.output=final`` on a plain run), or one the task sets itself
-    (REPLACED_BY). Config files' values are defaults for the runs that read them: only overrides are refused."""
+    read: a key only other runs read (READ_BY: ``batch.output=final`` on a plain run), or one the task does not read
+    (NOT_READ_BY). Config files' values are defaults for the runs that read them: only overrides are refused."""
     for key, text in given_overrides(overrides).items():
         for optional, readers in READ_BY.items():
             if covers(optional, key) and run not in readers:
                 way = f"run it with {BATCH_COMMAND}, or drop it" if BATCH_COMMAND in readers else "drop it"
                 raise ConfigError(f"{text} is read only by {or_list(list(readers))}; this run ({run}) does not read "
                                   f"it, so it would change nothing: {way}")
-        for replaced, why in REPLACED_BY.get(run.removeprefix("task "), {}).items():
-            if covers(replaced, key):
-                raise ConfigError(f"{text} is not read by {run}, which sets {replaced} itself ({why}); drop it")
+        for unread, why in NOT_READ_BY.get(run.removeprefix("task "), {}).items():
+            if covers(unread, key):
+                raise ConfigError(f"{text} is not read by {run} ({why}); drop it")
 
 
 def check_task(name: str, cfg: DictConfig, out_dir: Path) -> None:
