@@ -141,22 +141,22 @@ def preflight(argv: Sequence[str]) -> list[str]:
     cfg = configs[0]
     for composed in configs:
         check_scene_config(_without_hydra(composed))
-    refuse_unread(configs, [o.input_line for o in overrides])
+    refuse_unread_accuracy(configs, [o.input_line for o in overrides])
     run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     validate_scene(_without_hydra(cfg))
-    from gyrolab.experiments import check_task, refuse_unread as refuse_unread_by_task
+    from gyrolab.experiments import check_task, refuse_unread
 
-    refuse_unread_by_task(f"task {task_of(cfg)}", [o.input_line for o in overrides])  # batch.* on a plain run, ...
+    refuse_unread(f"task {task_of(cfg)}", [o.input_line for o in overrides])  # batch.* on a plain run, ...
     check_task(task_of(cfg), _without_hydra(cfg), run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
     return argv
 
 
-def refuse_unread(configs: Sequence[DictConfig], overrides: Sequence[str]) -> None:
+def refuse_unread_accuracy(configs: Sequence[DictConfig], overrides: Sequence[str]) -> None:
     """ConfigError when the command line gives ``accuracy`` and no job's integrator reads it
     (``gyrolab.engine.unread``). A sweep over integrators (``-m integrator=auto,taylor accuracy=1e-8``) gives the
     target to the jobs that read it; the others run at their own settings, warn and record it, as for a value

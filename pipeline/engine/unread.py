@@ -98,7 +98,7 @@ def unread_accuracy(cfg: DictConfig) -> str | None:
         return None  # a broken interpolation: check_scene_config says so
     if value is None or reads_accuracy(cfg):
         return None
-    name, own = integrator_name(cfg), _own_settings(cfg.integrator)
+    name, own = integrator_name(cfg), _own_settings(cfg.get("integrator"))
     settings = f" ({', '.join(f'integrator.{k}={v!r}' for k, v in own)})" if own else ""
     if name in _readers():  # its own accuracy setting was given a value: it replaces the top-level one
         return f"{ACCURACY}={value!r} is not read: integrator={name} runs at its own settings{settings}, which replace it"
@@ -110,7 +110,7 @@ def unread_accuracy(cfg: DictConfig) -> str | None:
 def refusal(cfg: DictConfig, value_sentence: str) -> ConfigError:
     """The one-sentence refusal of an explicitly given ``accuracy`` the integrator does not read, with the ways out."""
     value = OmegaConf.select(cfg, ACCURACY)
-    name, own = integrator_name(cfg), [f"integrator.{k}" for k, _ in _own_settings(cfg.integrator)]
+    name, own = integrator_name(cfg), [f"integrator.{k}" for k, _ in _own_settings(cfg.get("integrator"))]
     readers = _readers()
     if name in readers:
         ways = [f"drop {' and '.join(own)} to aim at {ACCURACY}={value!r}", f"drop {ACCURACY}={value!r}"]
