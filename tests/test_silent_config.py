@@ -128,7 +128,13 @@ def test_a_batch_from_an_experiment_whose_accuracy_its_integrator_does_not_read_
                              "(task scene) does not read it, so it would change nothing: run it with gyrolab batch, "
                              "or drop it"),
     (["-m", "batch.decimate=5", "initial.r0=1,2"], "batch.decimate=5 is read only by task stability_map or gyrolab "
-                                                   "batch; this run (task scene)"),
+                                                   "batch; this run (task scene in a sweep (gyrolab -m)) does not"),
+    (["output.job_figures=true"], "output.job_figures=true is read only by a sweep (gyrolab -m); this run (task scene) "
+                                  "does not read it"),
+    (["experiment=stability_map", "regime=small_parameter"],
+     "regime=small_parameter is read only by task regime or task shaker_omega3; this run (task stability_map)"),
+    (["batch", "regime=small_parameter", "initial.r0=1,2"], "regime=small_parameter is read only by task regime or "
+                                                            "task shaker_omega3; this run (gyrolab batch)"),
     (["regime=small_parameter", "output.error_estimate=true"],
      "output.error_estimate=true is read only by task scene, task work_precision or task yehia2021_precessions; this "
      "run (task regime) does not read it, so it would change nothing: drop it"),
@@ -164,6 +170,9 @@ def test_the_runs_that_read_those_keys_still_take_them():
     refuse_unread("task work_precision", ["time.end=50", "output.error_estimate=false"])
     refuse_unread("task yehia2021_precessions", ["integrator=taylor", "yehia2021.orbits=2"])
     refuse_unread("task orbit_family", ["orbit_family.families.x.r0_end=1", "output.figures=false"])
+    refuse_unread("task shaker_omega3", ["regime.periods=2"])
+    refuse_unread("task scene", ["output.job_figures=true"], sweep=True)
+    refuse_unread("task stability_map", ["regime=null"])   # null unsets: nothing to read
     # a config file's value is a default for the runs that read it: only overrides are checked
     refuse_unread("task scene", [])
 

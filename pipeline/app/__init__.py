@@ -150,7 +150,7 @@ def preflight(argv: Sequence[str]) -> list[str]:
     validate_scene(_without_hydra(cfg))
     from gyrolab.experiments import check_task, refuse_unread
 
-    refuse_unread(f"task {task_of(cfg)}", [o.input_line for o in overrides])  # batch.* on a plain run, ...
+    refuse_unread(f"task {task_of(cfg)}", [o.input_line for o in overrides], sweep=sweeping)  # batch.* on a plain run
     check_task(task_of(cfg), _without_hydra(cfg), run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
     return argv
