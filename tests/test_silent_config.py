@@ -184,3 +184,18 @@ def test_a_work_precision_method_given_an_accuracy_it_does_not_read_is_refused_b
         "gyrolab: error: work_precision.methods.taylor.accuracy: accuracy=1e-08 is the target of integrator=auto only; "
         "integrator=taylor does not read it")
     assert not (tmp_path / "out").exists()
+
+
+def test_a_regime_run_whose_integrator_does_not_read_the_configs_accuracy_records_it(tmp_path):
+    from omegaconf import open_dict
+
+    from gyrolab.experiments import run_task
+
+    cfg = compose_config(["regime=small_parameter", "initial.r0=20", "initial.theta0=1.5", "regime.periods=1",
+                          "regime.samples_per_period=40", "output.figures=false", "integrator=taylor"])
+    with open_dict(cfg):
+        cfg.accuracy = 1e-9   # as an experiment file would set it, for auto
+    run_task("regime", cfg, tmp_path)
+    with xr.open_dataset(tmp_path / "regime.nc") as ds:
+        assert "accuracy=1e-09 is the target of integrator=auto only; integrator=taylor does not read it" in \
+            ds.attrs[ACCURACY_IGNORED_ATTRIBUTE]
