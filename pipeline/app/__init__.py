@@ -53,6 +53,8 @@ from gyrolab.engine.config import (
     use_source,
 )
 from gyrolab.engine.safety import check_config, check_output_dir
+from gyrolab.engine.unread import ACCURACY, ACCURACY_IGNORED_ATTRIBUTE, given_keys, ignored_accuracy, unread_accuracy
+from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
 from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
@@ -139,17 +141,31 @@ def preflight(argv: Sequence[str]) -> list[str]:
     cfg = configs[0]
     for composed in configs:
         check_scene_config(_without_hydra(composed))
+    refuse_unread_accuracy(configs, [o.input_line for o in overrides])
     run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     validate_scene(_without_hydra(cfg))
-    from gyrolab.experiments import check_task
+    from gyrolab.experiments import check_task, refuse_unread
 
+    refuse_unread(f"task {task_of(cfg)}", [o.input_line for o in overrides], sweep=sweeping)  # batch.* on a plain run
     check_task(task_of(cfg), _without_hydra(cfg), run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
     return argv
+
+
+def refuse_unread_accuracy(configs: Sequence[DictConfig], overrides: Sequence[str]) -> None:
+    """ConfigError when the command line gives ``accuracy`` and no job's integrator reads it
+    (``gyrolab.engine.unread``). A sweep over integrators (``-m integrator=auto,taylor accuracy=1e-8``) gives the
+    target to the jobs that read it; the others run at their own settings, warn and record it, as for a value
+    from a config file."""
+    if ACCURACY not in given_keys(overrides):
+        return
+    sentences = [unread_accuracy(composed) for composed in configs]
+    if all(sentences):
+        raise unread_refusal(configs[0], sentences[0])
 
 
 def _output_dir_text(cfg: DictConfig, mode: str) -> str:
@@ -248,7 +264,7 @@ def _is_group(o: Override, cfg: DictConfig) -> bool:
 
 def _compose_job(source: ConfigSource, overrides: list[str], sweeping: bool) -> DictConfig:
     return compose_config(overrides, return_hydra_config=True, from_shell=True, config_name=source.config_name,
-                          run_mode=RunMode.MULTIRUN if sweeping else RunMode.RUN)
+                          run_mode=RunMode.MULTIRUN if sweeping else RunMode.RUN, refuse_unread=False)
 
 
 def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
@@ -384,6 +400,11 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     from gyrolab.output.dataset import write_dataset
 
     task = task_of(cfg)
+    # an accuracy the integrator does not read (the preflight refused one the command line gave to every job): said,
+    # and recorded in run.nc; for the tasks that run the scene's integrator
+    ignored = (ignored_accuracy(cfg, HydraConfig.get().overrides.task) if task in ("scene", "regime") else None)
+    if ignored:
+        log.warning("%s", ignored)
     if task != "scene":
         from gyrolab.experiments import run_task
 
@@ -395,6 +416,8 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     ds = scene.run()
     ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
     ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
+    if ignored:
+        ds.attrs[ACCURACY_IGNORED_ATTRIBUTE] = ignored
     path = write_dataset(ds, out_dir / "run.nc")
     announce_written(path)
     if not figures:

@@ -35,6 +35,7 @@ def batch(args: argparse.Namespace) -> int:
     from gyrolab.batch.sweep import failed_points, run_batch_sweep
     from gyrolab.engine.config import check_scene_config, compose_config
     from gyrolab.engine.budget import check_sweep_size, check_tolerances
+    from gyrolab.experiments import BATCH_COMMAND, refuse_unread
     from gyrolab.engine.safety import check_config, check_output_dir
     from gyrolab.figures.options import figure_options
 
@@ -54,6 +55,7 @@ def batch(args: argparse.Namespace) -> int:
         else:
             scene_overrides.append(override)
     parsed = parse_overrides(scene_overrides)
+    refuse_unread(BATCH_COMMAND, scene_overrides)  # output.error_estimate: a batch measures no error
     check_sweep_size(parsed)  # before anything expands a range(0,1e12,1)
     check_output_dir(str(out_dir), "hydra.sweep.dir")
     first_overrides = _job_overrides(parsed, {})

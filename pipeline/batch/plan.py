@@ -33,6 +33,7 @@ from omegaconf import OmegaConf
 from gyrolab.engine import scene as scene_module
 from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene, build_force, fastest_rate
+from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, GyrolabError, require_finite
 from gyrolab.sweep.grid import Dim, Grid, _refuse_repeats
 from gyrolab.sweep.identity import canonical_config, code_version
@@ -164,9 +165,12 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
     grid, or the explicit list of points of ``batch.zip``/``batch.points_file``."""
     start = time.perf_counter()
     dims = tuple(dims)
+    ignored = None
     if plain is None:
         first = [f"{d.key}={d.labels[0]}" for d in dims]
-        plain = OmegaConf.to_container(compose_config(list(fixed) + first), resolve=True)
+        composed = compose_config(list(fixed) + first)  # refuses an accuracy given and not read
+        ignored = ignored_accuracy(composed, fixed)  # a config file's: said once, and recorded in sweep.nc
+        plain = OmegaConf.to_container(composed, resolve=True)
         plain.pop("hydra", None)
     dims, points = _points(dims, plain)
     if points is None:
@@ -252,9 +256,13 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
         f"a list ({points['kind']}) over {', '.join(d.key for d in dims)}"
     log.info("batch plan: %d points (%s), %d valid, %d combinations of body/force values, %.2f s", n_points,
              layout, int(valid.sum()), len(combo_values), time.perf_counter() - start)
+    attributes = _common_attributes(systems, swept_initial=bool(initial_axes))
+    if ignored:
+        log.warning("%s", ignored)
+        attributes[ACCURACY_IGNORED_ATTRIBUTE] = ignored
     return Plan(dims=dims, names=dim_names(dims), plain=plain, base=base, times=times, y0=y0, combo=combo,
                 combo_values=combo_values, combo_params=combo_params, error=errors.index, messages=errors.messages,
-                attributes=_common_attributes(systems, swept_initial=bool(initial_axes)), points=points,
+                attributes=attributes, points=points,
                 systems={c: built.system for c, built in systems.items()})
 
 

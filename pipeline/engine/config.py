@@ -30,6 +30,7 @@ from omegaconf.errors import OmegaConfBaseException
 from gyrolab.contracts import registry
 from gyrolab.engine.hydra_private import create_automatic_config_search_path
 from gyrolab.errors import ConfigError, choices, shorten
+from gyrolab.engine.unread import refuse_given_accuracy
 from gyrolab.engine.user_yaml import check_user_config_dir
 
 CONFIG_MODULE = "gyrolab.conf"
@@ -180,18 +181,25 @@ def group_options(group: str) -> list[str]:
 
 def compose_config(overrides: Sequence[str], *, return_hydra_config: bool = False,
                    run_mode: RunMode = RunMode.RUN, from_shell: bool = False,
-                   config_name: str | None = None) -> DictConfig:
+                   config_name: str | None = None, refuse_unread: bool = True) -> DictConfig:
     """Compose gyrolab's config with command-line style overrides; ConfigError on any problem.
 
     Inside a running gyrolab app (an experiment composing its scenes) Hydra is already
     initialised on the run's search path, and is reused with the run's primary config.
+    A value the overrides give and the config's integrator does not read (``integrator=taylor accuracy=1e-8``)
+    is refused (``gyrolab.engine.unread``); ``refuse_unread=False`` leaves that to the caller (the app's
+    preflight, which decides over every job of a sweep).
     """
     register_plugin_configs()
     if GlobalHydra.instance().is_initialized():
-        return _compose(overrides, config_name or _running_config_name(), return_hydra_config, run_mode,
-                        from_shell)
-    with hydra_for(_source):
-        return _compose(overrides, _source.config_name, return_hydra_config, run_mode, from_shell)
+        cfg = _compose(overrides, config_name or _running_config_name(), return_hydra_config, run_mode,
+                       from_shell)
+    else:
+        with hydra_for(_source):
+            cfg = _compose(overrides, _source.config_name, return_hydra_config, run_mode, from_shell)
+    if refuse_unread:
+        refuse_given_accuracy(cfg, overrides)
+    return cfg
 
 
 def _running_config_name() -> str:

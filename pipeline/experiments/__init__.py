@@ -8,10 +8,13 @@ its own section, and the app hands the composed config to the task's
 from __future__ import annotations
 
 import importlib
+from collections.abc import Sequence
 from pathlib import Path
 
 from omegaconf import DictConfig
 
+from gyrolab.contracts.capabilities import or_list
+from gyrolab.engine.unread import covers, given_overrides
 from gyrolab.errors import ConfigError, choices
 
 TASKS = {
@@ -27,6 +30,66 @@ TASKS = {
     # satellite-gyrostat (Yehia & El-kenani (2021))
     "yehia2021_precessions": "gyrolab.experiments.yehia2021_precessions",
 }
+
+
+#: config keys only some runs read (docs/configs.md, "Values a run does not read") and the runs that read them: the
+#: tasks that run Scene.run read output.error_estimate (it measures the stored trajectory's error); batch.* is read by
+#: gyrolab batch and by the experiments that run one; a regime by the tasks that compare with it (a plain run given
+#: a regime is task regime); output.job_figures by the jobs of a sweep
+BATCH_COMMAND = "gyrolab batch"
+SWEEP = "a sweep (gyrolab -m)"
+READ_BY = {
+    "batch": ("task stability_map", BATCH_COMMAND),
+    "output.error_estimate": ("task scene", "task work_precision", "task yehia2021_precessions"),
+    "regime": ("task regime", "task shaker_omega3"),
+    "output.job_figures": (SWEEP,),
+}
+#: config keys a task does not read, because it sets them itself for the scenes it runs or runs none: a value given
+#: for them would change nothing; and why (said in the refusal)
+NOT_READ_BY = {
+    "work_precision": {
+        "integrator": "it runs every method of work_precision.methods",
+        "accuracy": "auto's settings are listed in work_precision.methods",
+        "time.n_output": "it compares final states, with time.n_output=2",
+    },
+    "yehia2021_precessions": {
+        key: "each precession case sets its own body, forces, initial state and span, the span from yehia2021.orbits"
+        for key in ("body", "force", "initial", "time")
+    },
+    "stability_map": {
+        key: "the map's grid sets it, from stability_map.theta0, stability_map.r0 and their n_ and _spacing settings"
+        for key in ("initial.theta0", "initial.r0")
+    },
+    "orbit_family": {
+        key: "each family of orbit_family.families sets its own body, Newtonian k and tilt, and the continuation "
+             "its spins and periods"
+        for key in ("system", "body", "force", "initial", "time", "integrator", "accuracy")
+    },
+    "ismail2021_tables": {
+        key: "it regenerates the paper's two tables from the paper's own parameters"
+        for key in ("system", "body", "force", "initial", "time", "integrator", "accuracy")
+    },
+}
+
+
+def refuse_unread(run: str, overrides: Sequence[str], *, sweep: bool = False) -> None:
+    """ConfigError for the first value ``overrides`` give that ``run`` (``task NAME`` or ``gyrolab batch``; ``sweep``:
+    its jobs are a sweep's) does not read: a key only other runs read (READ_BY: ``batch.output=final`` on a plain run),
+    or one the task does not read (NOT_READ_BY). A config file's value is a default for the runs that read it, and
+    null unsets a key: neither is refused."""
+    roles = {run, SWEEP} if sweep else {run}
+    described = f"{run} in {SWEEP}" if sweep else run
+    for key, text in given_overrides(overrides).items():
+        if text.partition("=")[2].strip() == "null":
+            continue
+        for optional, readers in READ_BY.items():
+            if covers(optional, key) and not roles & set(readers):
+                way = f"run it with {BATCH_COMMAND}, or drop it" if BATCH_COMMAND in readers else "drop it"
+                raise ConfigError(f"{text} is read only by {or_list(list(readers))}; this run ({described}) does not "
+                                  f"read it, so it would change nothing: {way}")
+        for unread, why in NOT_READ_BY.get(run.removeprefix("task "), {}).items():
+            if covers(unread, key):
+                raise ConfigError(f"{text} is not read by {run} ({why}); drop it")
 
 
 def check_task(name: str, cfg: DictConfig, out_dir: Path) -> None:

@@ -38,6 +38,7 @@ from gyrolab.physics.attitude import angles_from_states  # noqa: F401  (imported
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
+from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 
 log = logging.getLogger(__name__)
 SOURCES = ("analytic", "full", "orbit")
@@ -239,9 +240,19 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         ds = ds.assign_coords(coords).assign(data)
         ds.attrs.update(attrs)
         log.info("%s: %s", regime.name, ", ".join(f"{k} = {v}" for k, v in attrs.items() if not isinstance(v, list)))
+    ignored = ignored_accuracy(cfg, _task_overrides())  # the app logged it; regime.nc records it
+    if ignored:
+        ds.attrs[ACCURACY_IGNORED_ATTRIBUTE] = ignored
     written = [write_dataset(ds, Path(out_dir) / "regime.nc")]
     written += draw_figures("regime.nc", ds, out_dir, cfg.get("output"))
     return written
+
+
+def _task_overrides() -> list[str]:
+    """The command line's overrides of the running Hydra job (none outside one)."""
+    from hydra.core.hydra_config import HydraConfig
+
+    return list(HydraConfig.get().overrides.task) if HydraConfig.initialized() else []
 
 
 def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any], warnings: list[str]) -> xr.Dataset:

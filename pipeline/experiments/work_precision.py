@@ -41,6 +41,21 @@ TIMING = ("cpu_time: time.process_time() around Scene.run() (CPU time of the who
 SETTING_KEYS = {"rtol": ("rtol", "atol"), "tol": ("tol",), "step": ("step",), "accuracy": ("accuracy",)}
 
 
+def check(cfg: DictConfig, out_dir: Path) -> None:
+    """The refusals before the run directory exists: a method's setting that its integrator does not read
+    (``methods: {taylor: {accuracy: [1e-8]}}`` would run taylor at its own tolerance under the label accuracy=1e-08)."""
+    from gyrolab.engine.config import compose_config
+
+    methods = OmegaConf.to_container(cfg.work_precision, resolve=True).get("methods") or {}
+    for method, settings in methods.items():
+        for key, values in (settings or {}).items():
+            if key == "accuracy" and values:
+                try:
+                    compose_config([f"integrator={method}", f"accuracy={values[0]!r}"])  # refuses a value not read
+                except ConfigError as refused:
+                    raise ConfigError(f"work_precision.methods.{method}.accuracy: {refused}") from None
+
+
 def _scene_for(cfg: DictConfig, method: str, key: str, value: float) -> Scene:
     from gyrolab.engine.config import compose_config
 

@@ -1,0 +1,165 @@
+"""Config values a run would not read: refused when the user gave them, said and recorded when a config file did.
+
+A value that is set but read by nothing is the worst defect a scientific tool can have: the run succeeds and
+the user believes they got what they asked for. ``integrator=taylor accuracy=1e-8`` ran Taylor at its own
+tolerance, exit 0, and nothing said that the 1e-8 target went nowhere.
+
+The top-level ``accuracy`` is read only by an integrator whose settings refer to it (``conf/integrator/auto.yaml``:
+``accuracy: ${accuracy}``; a user's ``integrator.tol='${accuracy}'`` reads it too). Whether it is read is asked
+of the composed config — does the integrator's resolved node change when ``accuracy`` does? — never of the
+integrator's name. What happens when it is not read depends on who set it (docs/configs.md, "Values a run
+does not read"):
+
+* given explicitly (the command line, ``compose_scene``'s overrides, a sweep's value for every job): the
+  user asked for that target and would not get it, so the run is refused before anything is written, in one
+  sentence naming the value, the integrator and the ways out;
+* from a config file (an experiment's default for ``integrator=auto``: ``experiment=perf_reference
+  integrator=taylor`` is a legitimate comparison): the run proceeds, logs one warning and records the same
+  sentence in its dataset (``accuracy_ignored``), so that the dataset cannot be mistaken for a run at that target.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from omegaconf import DictConfig, OmegaConf
+from omegaconf.errors import OmegaConfBaseException
+
+from gyrolab.contracts import registry
+from gyrolab.contracts.capabilities import integrators_with, or_list
+from gyrolab.contracts.integrator import CHOOSES_METHOD
+from gyrolab.errors import ConfigError, GyrolabError
+
+ACCURACY = "accuracy"
+#: the run dataset's global attribute saying that the config's ``accuracy`` was not read, and why
+ACCURACY_IGNORED_ATTRIBUTE = "accuracy_ignored"
+#: an integrator's own accuracy settings, named in the sentences (what the user can set instead)
+OWN_SETTINGS = ("accuracy", "tol", "rtol", "atol", "step")
+#: two values of ``accuracy`` no setting equals by chance: a node that reads ``accuracy`` resolves differently
+_PROBES = (1.2345678e-7, 8.7654321e-9)
+
+
+def given_overrides(overrides: Sequence[str]) -> dict[str, str]:
+    """The keys an override list gives a value, each with its override (``accuracy=1e-8``, ``+accuracy=...``,
+    ``++batch.output=final``, ``force=[magnetic]``); a deletion (``~accuracy``) gives none."""
+    given = {}
+    for text in overrides:
+        key, has_value, _ = str(text).partition("=")
+        if has_value and not key.startswith("~"):
+            given[key.lstrip("+").split("@", 1)[0].strip()] = str(text)
+    return given
+
+
+def given_keys(overrides: Sequence[str]) -> set[str]:
+    """The keys an override list gives a value (``given_overrides``' keys)."""
+    return set(given_overrides(overrides))
+
+
+def covers(key: str, given: str) -> bool:
+    """Whether config key ``key`` is ``given`` or a section holding it (``batch`` covers ``batch.output``)."""
+    return given == key or given.startswith(key + ".")
+
+
+def reads_accuracy(cfg: DictConfig) -> bool:
+    """Whether the selected integrator's settings depend on the top-level ``accuracy``: its node, resolved with two
+    different values of ``accuracy``, differs. A node that cannot be resolved counts as reading it (the schema
+    checks refuse a broken interpolation in their own sentence; this check never refuses on a guess)."""
+    node = cfg.get("integrator")
+    if not isinstance(node, DictConfig):
+        return False
+    integrator = OmegaConf.to_container(node, resolve=False)
+    if "${" not in repr(integrator):
+        return False  # no interpolation: nothing in it can refer to accuracy
+    # the node beside accuracy alone first (~0.1 ms); the whole config when it refers to other keys too (~3 ms)
+    for context in ({}, None):
+        if context is None:
+            context = OmegaConf.to_container(cfg, resolve=False)
+            context.pop("hydra", None)
+        resolved = []
+        for probe in _PROBES:
+            try:
+                resolved.append(OmegaConf.to_container(
+                    OmegaConf.create({**context, ACCURACY: probe, "integrator": integrator}).integrator, resolve=True))
+            except (OmegaConfBaseException, ValueError, TypeError):
+                break
+        else:
+            return resolved[0] != resolved[1]
+    return True
+
+
+def unread_accuracy(cfg: DictConfig) -> str | None:
+    """What is wrong when ``cfg`` sets ``accuracy`` and its integrator does not read it (the core of the refusal
+    and of the warning: "accuracy=1e-08 is the target of integrator=auto only; integrator=taylor does not read
+    it and runs at its own settings (integrator.tol=1e-16)"), else None."""
+    try:
+        value = OmegaConf.select(cfg, ACCURACY, throw_on_missing=False)
+    except OmegaConfBaseException:
+        return None  # a broken interpolation: check_scene_config says so
+    if value is None or reads_accuracy(cfg):
+        return None
+    name, own = integrator_name(cfg), _own_settings(cfg.get("integrator"))
+    settings = f" ({', '.join(f'integrator.{k}={v!r}' for k, v in own)})" if own else ""
+    if name in _readers():  # its own accuracy setting was given a value: it replaces the top-level one
+        return f"{ACCURACY}={value!r} is not read: integrator={name} runs at its own settings{settings}, which replace it"
+    target = (f"the target of integrator={or_list(_readers())} only" if _readers()
+              else "read by no registered integrator's settings")
+    return f"{ACCURACY}={value!r} is {target}; integrator={name} does not read it and runs at its own settings{settings}"
+
+
+def refusal(cfg: DictConfig, value_sentence: str) -> ConfigError:
+    """The one-sentence refusal of an explicitly given ``accuracy`` the integrator does not read, with the ways out."""
+    value = OmegaConf.select(cfg, ACCURACY)
+    name, own = integrator_name(cfg), [f"integrator.{k}" for k, _ in _own_settings(cfg.get("integrator"))]
+    readers = _readers()
+    if name in readers:
+        ways = [f"drop {' and '.join(own)} to aim at {ACCURACY}={value!r}", f"drop {ACCURACY}={value!r}"]
+    else:
+        ways = [f"ask integrator={readers[0]} {ACCURACY}={value!r}"] if readers else []
+        ways.append(f"set {' and '.join(own) or 'the integrator settings'} instead (and drop {ACCURACY}={value!r})")
+    return ConfigError(f"{value_sentence}: {' or '.join(ways)}")
+
+
+def _readers() -> list[str]:
+    """The registered integrators that pick their method for a target accuracy (CHOOSES_METHOD): the ones whose
+    packaged settings read ``accuracy`` (named in the sentences as the way to ask for a target)."""
+    return integrators_with(CHOOSES_METHOD)
+
+
+def ignored_accuracy(cfg: DictConfig, overrides: Sequence[str]) -> str | None:
+    """The warning (and the dataset's ``accuracy_ignored``) for an ``accuracy`` a run proceeds without reading: one a
+    config file set, or one a sweep gives to every job while only some jobs' integrators read it; else None."""
+    sentence = unread_accuracy(cfg)
+    if sentence is None:
+        return None
+    source = ("the sweep gives it to every job, and the jobs whose integrator reads it aim at it"
+              if ACCURACY in given_keys(overrides) else "a config file set it, as a default for the integrators "
+              "that read it")
+    return f"{sentence}, so this run does not aim at that accuracy ({source})"
+
+
+def refuse_given_accuracy(cfg: DictConfig, overrides: Sequence[str]) -> None:
+    """ConfigError when ``overrides`` give ``accuracy`` and the integrator of ``cfg`` does not read it."""
+    if ACCURACY not in given_keys(overrides):
+        return
+    sentence = unread_accuracy(cfg)
+    if sentence is not None:
+        raise refusal(cfg, sentence)
+
+
+def integrator_name(cfg: DictConfig) -> str:
+    """The registered name of the config's integrator (its ``_target_``), or the target itself if not registered."""
+    target = OmegaConf.select(cfg, "integrator._target_", default=None)
+    try:
+        name, _ = registry.resolve_target("integrator", target, "integrator")
+    except GyrolabError:
+        return str(target)
+    return name
+
+
+def _own_settings(node: Any) -> list[tuple[str, Any]]:
+    try:
+        plain = OmegaConf.to_container(node, resolve=True) if isinstance(node, DictConfig) else {}
+    except OmegaConfBaseException:
+        return []
+    return [(key, plain[key]) for key in OWN_SETTINGS if plain.get(key) is not None]
