@@ -100,6 +100,16 @@ def test_an_experiments_accuracy_the_integrator_does_not_read_is_warned_once_and
     assert recorded in said[0]
 
 
+def test_the_python_api_says_and_records_an_experiments_accuracy_the_integrator_does_not_read(caplog):
+    with caplog.at_level("WARNING", logger="gyrolab"):
+        scene = compose_scene(["experiment=perf_reference", "integrator=taylor", "time.end=1"])
+    said = [r.getMessage() for r in caplog.records if "accuracy=1e-08" in r.getMessage()]
+    assert len(said) == 1 and "integrator=taylor does not read it" in said[0]
+    assert scene.run().attrs[ACCURACY_IGNORED_ATTRIBUTE] == said[0]
+    read = compose_scene(["experiment=perf_reference", "time.end=1"])  # auto reads it: nothing to say
+    assert read.accuracy_ignored is None and ACCURACY_IGNORED_ATTRIBUTE not in read.run().attrs
+
+
 def test_a_sweep_over_integrators_gives_the_accuracy_to_the_jobs_that_read_it_and_records_the_others(cli, tmp_path):
     done = cli("-m", "integrator=auto,taylor", "accuracy=1e-6", *SHORT, "hydra.sweep.dir=sweep")
     assert done.returncode == 0, done.stderr

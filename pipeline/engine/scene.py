@@ -26,6 +26,7 @@ from gyrolab.output.dataset import build_dataset, scene_attributes
 from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite, shorten
 from gyrolab.engine.force_guard import GuardedRhs, plugin_forces
 from gyrolab.engine.progress import Progress
+from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 
 log = logging.getLogger(__name__)
 
@@ -67,6 +68,9 @@ class Scene:
     times: np.ndarray
     #: ``time.n_output`` as the config gave it: ``"auto"`` or a number of samples
     n_output_requested: int | str = AUTO
+    #: why the config's ``accuracy`` is not read by this scene's integrator, when a config file set it
+    #: (``gyrolab.engine.unread``; a given one is refused): recorded in every run dataset as ``accuracy_ignored``
+    accuracy_ignored: str | None = None
 
     @classmethod
     def from_config(cls, cfg: DictConfig) -> Scene:
@@ -131,6 +135,8 @@ class Scene:
         computed once per scene as ``config_yaml``; plus ``integrator_nfev_counts``, what the integrator's evaluation
         count counts where that is not right-hand-side calls (its ``evaluation_label``: figures read it)."""
         before, after = scene_attributes(self)
+        if self.accuracy_ignored:
+            before = {**before, ACCURACY_IGNORED_ATTRIBUTE: self.accuracy_ignored}
         label = self.integrator.evaluation_label
         return before, ({**after, NFEV_COUNTS_ATTRIBUTE: label} if label else after)
 
@@ -271,7 +277,13 @@ def compose_scene(overrides: Sequence[str] = ()) -> Scene:
     >>> ds.sizes["time"]
     51
     """
-    return Scene.from_config(compose_config(overrides))
+    cfg = compose_config(overrides)
+    scene = Scene.from_config(cfg)
+    # the gyrolab command says this once per job itself, knowing a sweep's overrides (app._run_locked)
+    scene.accuracy_ignored = ignored_accuracy(cfg, overrides)
+    if scene.accuracy_ignored:
+        log.warning("%s", scene.accuracy_ignored)
+    return scene
 
 
 def run(overrides: Sequence[str] = ()) -> xr.Dataset:
