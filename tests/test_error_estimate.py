@@ -26,6 +26,8 @@ def _actual(ds, overrides):
     ["integrator=dop853", "integrator.rtol=1e-8", "integrator.atol=1e-8", "output.error_estimate=true"],
     ["integrator=rk4", "integrator.step=0.002", "output.error_estimate=true"],
     ["integrator=taylor", "integrator.tol=1e-9", "output.error_estimate=true"],
+    # its half-step companion raised TypeError (refinement.half_step got ``order`` twice) before
+    ["integrator=lie_poisson", "integrator.step=0.01", "output.error_estimate=true"],
 ])
 def test_the_estimate_measures_the_actual_error(integrator):
     overrides = [*SCENE, *integrator]
