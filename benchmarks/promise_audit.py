@@ -65,6 +65,9 @@ INTEGRATORS = {
 PYTHON_STEPPED = {"dop853", "rk45", "rk4", "lsoda", "radau", "bdf"}
 #: a Python-stepped integrator runs only where t_end · (1 + |ω0|) is at most this (its run takes seconds beyond)
 PYTHON_WORK = 300.0
+#: where auto refuses an accuracy as out of double precision's reach, the final error of the Taylor method at this
+#: tolerance (about the best double precision does) says whether the refusal was needed
+BEST_TOL = 1e-15
 
 
 @dataclass
@@ -165,13 +168,22 @@ def estimate_check(ds, truth: np.ndarray, floor: float) -> dict:
     return found
 
 
-def audit_auto(scene: Scene, eps: float, truth: np.ndarray, common: list[str], floor: float) -> dict:
-    overrides = ["integrator=auto", f"accuracy={eps:g}", *common, *scene.overrides]
+def audit_auto(scene: Scene, eps: float, truth: np.ndarray, common: list[str], floor: float,
+               estimate: bool = True) -> dict:
+    """auto at ``eps`` on the scene; ``estimate=False``: with output.error_estimate=false, its prediction alone
+    (no rule-11 rerun to catch a prediction that was wrong)."""
+    off = [] if estimate else ["output.error_estimate=false"]
+    overrides = ["integrator=auto", f"accuracy={eps:g}", *off, *common, *scene.overrides]
     start = time.process_time()
     try:
         ds = compose_scene(overrides).run()
     except ConfigError as error:
-        return {"verdict": "refused", "why": str(error), "cpu": time.process_time() - start, "overrides": overrides}
+        refused = {"verdict": "refused", "why": str(error), "cpu": time.process_time() - start, "overrides": overrides}
+        if estimate and "double precision" in str(error):  # was it needed? double precision's best on this scene
+            best = compose_scene(["integrator=taylor", f"integrator.tol={BEST_TOL:g}", *common, *scene.overrides]).run()
+            refused["best_double"] = float(np.max(np.abs(np.concatenate(
+                [best.omega.values[-1], best.gamma.values[-1], best.alpha.values[-1]]) - truth[-1])))
+        return refused
     except GyrolabError as error:  # a gyrolab error other than a refusal: still one sentence, but not a refusal
         return {"verdict": "BROKEN", "why": f"{type(error).__name__}: {error}", "cpu": time.process_time() - start,
                 "overrides": overrides}
@@ -186,7 +198,8 @@ def audit_auto(scene: Scene, eps: float, truth: np.ndarray, common: list[str], f
             "tolerance": float(ds.attrs.get("auto_tolerance", math.nan)),
             "chaotic": int(ds.attrs.get("auto_chaotic", 0)),
             "rechecked": list(map(float, ds.attrs.get("auto_measured_error_before_recheck", []))),
-            "estimate": estimate_check(ds, truth, floor), "cpu": cpu, "overrides": overrides}
+            "estimate": estimate_check(ds, truth, floor) if estimate else {"available": False, "why": "off"},
+            "cpu": cpu, "overrides": overrides}
 
 
 def audit_integrator(scene: Scene, name: str, settings: list[str], truth: np.ndarray, common: list[str],
@@ -203,6 +216,11 @@ def audit_integrator(scene: Scene, name: str, settings: list[str], truth: np.nda
                "UNDER" if found["under"] else "ok")
     return {"integrator": name, "verdict": verdict, "estimate": found, "overrides": overrides,
             "cpu": time.process_time() - start}
+
+
+def r_eps(row: dict) -> float:
+    """The accuracy a row asked for (read from its overrides: a refused row has no result)."""
+    return float(next(o for o in row["overrides"] if o.startswith("accuracy=")).split("=")[1])
 
 
 def _g(x: float) -> str:
@@ -226,7 +244,7 @@ def main(argv: list[str] | None = None) -> int:
     common = [f"time.n_output={args.n_output}", "output.euler_angles=true"]
     reference = Real128Reference()
     scenes = [random_scene(rng, i) for i in range(args.n)]
-    auto_rows, other_rows, skipped = [], [], []
+    auto_rows, alone_rows, other_rows, skipped = [], [], [], []
     wall = time.perf_counter()
     print("| # | scene | ε | verdict | method | actual | predicted | actual/ε | actual/pred | est/actual | CPU s |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
@@ -242,13 +260,22 @@ def main(argv: list[str] | None = None) -> int:
             row = audit_auto(scene, eps, truth, common, floor)
             row.update(scene=scene.index, kind=scene.kind)
             auto_rows.append(row)
+            alone = audit_auto(scene, eps, truth, common, floor, estimate=False)
+            alone_rows.append({**alone, "scene": scene.index, "kind": scene.kind})
+            if alone["verdict"] == "BROKEN":
+                print(f"| {scene.index} | {label} | {eps:g} | BROKEN with output.error_estimate=false: actual "
+                      f"{_g(alone.get('actual', math.nan))}, predicted {_g(alone.get('predicted', math.nan))} | | | | | | | |")
             if row["verdict"] == "kept" or "actual" in row:
                 est = row["estimate"].get("ratio", math.nan) if row["estimate"]["available"] else math.nan
-                print(f"| {scene.index} | {label} | {eps:g} | {row['verdict']} | {row['method']} | "
+                method = row["method"] + (f" (rechecked after {', '.join(f'{m:.2g}' for m in row['rechecked'])})"
+                                          if row["rechecked"] else "")
+                print(f"| {scene.index} | {label} | {eps:g} | {row['verdict']} | {method} | "
                       f"{_g(row['actual'])} | {_g(row['predicted'])} | {_g(row['actual'] / eps)} | "
                       f"{_g(row['actual'] / row['predicted'])} | {_g(est)} | {row['cpu']:.2f} |", flush=True)
             else:
-                print(f"| {scene.index} | {label} | {eps:g} | {row['verdict']}: {row['why'][:90]}… | | | | | | | "
+                best = (f" (taylor tol {BEST_TOL:g} ends {row['best_double']:.2g} away)" if "best_double" in row
+                        else "")
+                print(f"| {scene.index} | {label} | {eps:g} | {row['verdict']}: {row['why'][:90]}…{best} | | | | | | | "
                       f"{row['cpu']:.2f} |", flush=True)
         if args.integrators_every and scene.index % args.integrators_every == 0:
             for name, choices in INTEGRATORS.items():
@@ -279,6 +306,7 @@ def main(argv: list[str] | None = None) -> int:
     measured = [r for r in auto_rows if "actual" in r]
     worst_eps = max((r["actual"] / r["eps"] for r in measured), default=math.nan)
     worst_pred = max((r["actual"] / r["predicted"] for r in measured), default=math.nan)
+    rechecked = sum(bool(r.get("rechecked")) for r in measured)
     per_integrator: dict[str, dict] = {}
     for row in [*({**r, "integrator": "auto"} for r in measured), *other_rows]:
         e = row.get("estimate") or {}
@@ -296,8 +324,8 @@ def main(argv: list[str] | None = None) -> int:
                 entry["min_ratio_per_time"] = min(entry["min_ratio_per_time"], e["ratio_per_time"])
     under = sum(v["under"] for v in per_integrator.values())
     print(f"\n{len(scenes) - len(skipped)} scenes (seed {args.seed}), {len(auto_rows)} auto runs: {counts['kept']} kept, "
-          f"{counts['refused']} refused, {counts['BROKEN']} BROKEN; worst actual/ε {_g(worst_eps)}, worst "
-          f"actual/predicted {_g(worst_pred)}; {len(other_rows)} other-integrator runs; {under} estimates more than "
+          f"{counts['refused']} refused, {counts['BROKEN']} BROKEN ({rechecked} kept or broken after rule 11's rerun); "
+          f"worst actual/ε {_g(worst_eps)}, worst actual/predicted {_g(worst_pred)}; {len(other_rows)} other-integrator runs; {under} estimates more than "
           f"{ESTIMATE_FACTOR:g}× below the actual error; {wall:.0f} s")
     print("\n| integrator | runs | judged (above round-off) | estimate/actual min | max | worst per-time | "
           "under 1/2 (max) | under 1/2 (per time) |")
@@ -310,13 +338,25 @@ def main(argv: list[str] | None = None) -> int:
                  str(v["under"]), str(v["under_per_time"])]
         table_rows.append(cells)
         print("| " + " | ".join(cells) + " |")
+    alone_counts = {v: sum(r["verdict"] == v for r in alone_rows) for v in ("kept", "refused", "BROKEN")}
+    alone_measured = [r for r in alone_rows if "actual" in r]
+    alone_worst = max((r["actual"] / r["predicted"] for r in alone_measured), default=math.nan)
+    print(f"\nprediction alone (the same runs with output.error_estimate=false, no rule-11 rerun): "
+          f"{alone_counts['kept']} kept, {alone_counts['refused']} refused, {alone_counts['BROKEN']} BROKEN; worst "
+          f"actual/ε {_g(max((r['actual'] / r['eps'] for r in alone_measured), default=math.nan))}, worst "
+          f"actual/predicted {_g(alone_worst)}")
+    needless = [r for r in auto_rows if r.get("best_double", math.inf) < r_eps(r) / 10]
+    print(f"refusals for double precision's reach: {sum('best_double' in r for r in auto_rows)}, of which "
+          f"{len(needless)} where taylor at tol {BEST_TOL:g} ends 10× below ε (a needless refusal, not a broken promise)")
     broken = [r for r in auto_rows if r["verdict"] == "BROKEN"]
+    broken += [{**r, "estimate_off": True} for r in alone_rows if r["verdict"] == "BROKEN"]
     underestimates = [r for r in [*({**r, "integrator": "auto"} for r in measured), *other_rows]
                       if (r.get("estimate") or {}).get("under")]
     for r in broken:
         detail = (f"actual {r['actual']:.3g}, ε {r['eps']:g}, predicted {r['predicted']:.3g}" if "actual" in r
                   else r["why"])
-        print(f"\nBROKEN (scene {r['scene']}): {detail}\n  reproduce: {_command(r['overrides'])}")
+        print(f"\nBROKEN{' with output.error_estimate=false' if r.get('estimate_off') else ''} (scene {r['scene']}): "
+              f"{detail}\n  reproduce: {_command(r['overrides'])}")
     for r in underestimates:
         e = r["estimate"]
         print(f"\nUNDERESTIMATE ({r['integrator']}, scene {r['scene']}): estimate/actual {e['ratio']:.3g} "
@@ -326,12 +366,16 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_write:
         numbers = {"seed": args.seed, "n": args.n, "n_output": args.n_output, "scenes": len(scenes) - len(skipped),
                    "auto_runs": len(auto_rows), **{f"auto_{k}": v for k, v in counts.items()},
-                   "worst_actual_over_eps": worst_eps, "worst_actual_over_predicted": worst_pred,
+                   "worst_actual_over_eps": worst_eps, "worst_actual_over_predicted": worst_pred, "auto_rechecked": rechecked,
+                   **{f"prediction_alone_{k}": v for k, v in alone_counts.items()},
+                   "prediction_alone_worst_actual_over_predicted": alone_worst,
+                   "refused_for_double_precision": sum("best_double" in r for r in auto_rows),
+                   "refused_needlessly": len(needless),
                    "estimates": {k: {**v, "min_ratio": v["min_ratio"] if v["judged"] else None,
                                      "min_ratio_per_time": v["min_ratio_per_time"]
                                      if math.isfinite(v["min_ratio_per_time"]) else None}
                                  for k, v in per_integrator.items()},
-                   "wall_seconds": wall, "auto": auto_rows, "integrators": other_rows, "skipped": skipped}
+                   "wall_seconds": wall, "auto": auto_rows, "auto_prediction_alone": alone_rows, "integrators": other_rows, "skipped": skipped}
         caption = (f"Randomized audit of the accuracy promises (`benchmarks/promise_audit.py --n {args.n} --seed "
                    f"{args.seed}`): {len(scenes) - len(skipped)} scenes, {len(auto_rows)} auto runs, {counts['kept']} "
                    f"kept, {counts['refused']} refused, {counts['BROKEN']} broken (worst actual/ε {_g(worst_eps)}, "
