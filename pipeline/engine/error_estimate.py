@@ -13,8 +13,11 @@ integrator says how (``Integrator.more_accurate``, rule 9 of its contract):
   the compiled Taylor method at tol 1e-15 against the series).
 
 Where the companion cannot be made ``TIGHTER`` times more accurate (a tolerance already at its method's floor), the
-compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model; otherwise the dataset says the
-estimate is not available and why. The estimate costs one more integration (about 1.2–2× the run's time for a
+compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model — and for a run that is itself the
+double-precision Taylor method near that floor (``taylor`` at tol < 1e-14, or ``auto``'s choice of it), the Taylor
+method in double-double, ``TIGHTER`` times tighter, same order: another double run has the same round-off and can
+agree with the run far more closely than either agrees with the truth; otherwise the dataset says the estimate is not
+available and why. The estimate costs one more integration (about 1.2–2× the run's time for a
 tolerance-controlled method, 2× for a fixed step): it is on by default for ``integrator=auto`` only
 (``output.error_estimate: null``), ``true``/``false`` choose it for any integrator.
 
@@ -63,16 +66,29 @@ def wanted(scene: Any) -> bool:
 
 def companion(integrator: Any, has_compiled: bool) -> Companion | None:
     """The more accurate run that measures ``integrator``'s error (its ``more_accurate``, rule 9 of the contract;
-    else the compiled Taylor method at its floor when the scene has a compiled model), or None."""
-    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+    else the compiled Taylor method at its floor when the scene has a compiled model; else, for a run that is itself
+    the double-precision Taylor method near that floor, the Taylor method in double-double), or None."""
+    from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+    from gyrolab.plugins.integrators.compiled_solvers import DOUBLE_DOUBLE, Taylor
 
     finer = integrator.more_accurate(TIGHTER)
     if finer is not None:
         return Companion(*finer)
-    if has_compiled and not _at_taylor_floor(integrator):
+    if not has_compiled:
+        return None
+    taylor = _double_taylor(integrator)
+    if taylor is None or taylor.tol / TIGHTER >= Taylor.TOLERANCE_FLOOR:
         return Companion(Taylor(tol=Taylor.TOLERANCE_FLOOR), 1.0, f"compiled Taylor at tol {Taylor.TOLERANCE_FLOOR:g} "
                          f"({integrator.name} cannot be made {TIGHTER:g}× more accurate)")
-    return None
+    # A double-precision Taylor run near the floor: another double run (the old stand-in, Taylor at tol 1e-16) is no
+    # more accurate. Its error is then mostly round-off, amplified by the motion, and two double runs can agree far
+    # more closely than either agrees with the truth (benchmarks/promise_audit.py: auto at accuracy 1e-12 chose tol
+    # 1.5e-16, the stand-in differed from it by 1.7e-14 where both were 2.1e-12 from the real128 answer, and the
+    # broken prediction went unseen). Double-double has no such round-off.
+    tol = max(taylor.tol / TIGHTER, MIN_TOL)
+    return Companion(Taylor(order=taylor.order, tol=tol, precision=DOUBLE_DOUBLE), 1.0,
+                     f"compiled Taylor in double-double at tol {tol:.3g}, same order ({integrator.name} runs the "
+                     f"Taylor method at double precision's floor)")
 
 
 @dataclass(frozen=True)
@@ -151,7 +167,16 @@ def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Com
     return Comparison(pick.scale * np.abs(y - other), attrs, y)
 
 
+def _double_taylor(integrator: Any) -> Any:
+    """The double-precision Taylor method the run used: the integrator itself, or the method ``auto`` chose; else None."""
+    from gyrolab.plugins.integrators.compiled_solvers import DOUBLE, Taylor
+
+    ran = getattr(integrator, "chosen", None) or integrator
+    return ran if isinstance(ran, Taylor) and ran.precision == DOUBLE else None
+
+
 def _at_taylor_floor(integrator: Any) -> bool:
     from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
-    return isinstance(integrator, Taylor) and integrator.tol / TIGHTER < Taylor.TOLERANCE_FLOOR
+    taylor = _double_taylor(integrator)
+    return taylor is not None and taylor.tol / TIGHTER < Taylor.TOLERANCE_FLOOR
