@@ -14,7 +14,7 @@ integrator says how (``Integrator.more_accurate``, rule 9 of its contract):
 
 Where the companion cannot be made ``TIGHTER`` times more accurate (a tolerance already at its method's floor), the
 compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model — and for a run that is itself the
-double-precision Taylor method near that floor (``taylor`` at tol < 1e-14, or ``auto``'s choice of it), the Taylor
+double-precision Taylor method near that floor (``taylor`` at tol < 1e-13, or ``auto``'s choice of it), the Taylor
 method in double-double, ``TIGHTER`` times tighter, same order: another double run has the same round-off and can
 agree with the run far more closely than either agrees with the truth; otherwise the dataset says the estimate is not
 available and why. The estimate costs one more integration (about 1.2–2× the run's time for a
@@ -46,6 +46,13 @@ log = logging.getLogger(__name__)
 #: tol 1.3e-8) the companion at 100× takes 0.55 ms and ends 176× more accurate, at 1000× 0.68 ms and 1660×; the
 #: per cent an estimate gains is not worth a quarter of the companion's time (AMD EPYC with AVX-512, 2026-11-27)
 TIGHTER = 100.0
+#: a double-precision Taylor run whose companion would run below this tolerance is measured in double-double: a double
+#: companion there has round-off of the run's own size and can agree with it more closely than either agrees with
+#: the truth. benchmarks/promise_audit.py against real128: companions at tol 1.5e-16 and 3.2e-16 (auto at 1e-10 and
+#: 1e-7 on amplifying scenes) measured 0.46× the actual error, one at the floor 0.008×; in double-double, 1.0×. Costs:
+#: the double-double run takes ~10× the double one (16 ms against 1.3 ms on the reference scene), for runs at
+#: tol < 1e-13 only (auto at accuracy ≲ 1e-10)
+DOUBLE_DOUBLE_BELOW = 1e-15
 
 
 @dataclass(frozen=True)
@@ -71,13 +78,13 @@ def companion(integrator: Any, has_compiled: bool) -> Companion | None:
     from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
     from gyrolab.plugins.integrators.compiled_solvers import DOUBLE_DOUBLE, Taylor
 
+    taylor = _double_taylor(integrator) if has_compiled else None
     finer = integrator.more_accurate(TIGHTER)
-    if finer is not None:
+    if finer is not None and (taylor is None or taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW):
         return Companion(*finer)
     if not has_compiled:
         return None
-    taylor = _double_taylor(integrator)
-    if taylor is None or taylor.tol / TIGHTER >= Taylor.TOLERANCE_FLOOR:
+    if taylor is None:
         return Companion(Taylor(tol=Taylor.TOLERANCE_FLOOR), 1.0, f"compiled Taylor at tol {Taylor.TOLERANCE_FLOOR:g} "
                          f"({integrator.name} cannot be made {TIGHTER:g}× more accurate)")
     # A double-precision Taylor run near the floor: another double run (the old stand-in, Taylor at tol 1e-16) is no
@@ -88,7 +95,7 @@ def companion(integrator: Any, has_compiled: bool) -> Companion | None:
     tol = max(taylor.tol / TIGHTER, MIN_TOL)
     return Companion(Taylor(order=taylor.order, tol=tol, precision=DOUBLE_DOUBLE), 1.0,
                      f"compiled Taylor in double-double at tol {tol:.3g}, same order ({integrator.name} runs the "
-                     f"Taylor method at double precision's floor)")
+                     f"Taylor method near double precision's floor)")
 
 
 @dataclass(frozen=True)
