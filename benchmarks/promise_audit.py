@@ -48,8 +48,9 @@ ACCURACIES = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
 ESTIMATE_FACTOR = 2.0
 #: an actual error below this × max(1, |y0|) is round-off: an estimate is not judged against it
 ROUNDOFF = 1e-13
-#: an actual error this large (the attitude's components are at most 1) has left the linear regime in which a companion
-#: run's difference estimates it: a chaotic scene whose trajectory is lost. Such underestimates are labelled
+#: an actual error and an estimate this large (the attitude's components are at most 1) have left the linear regime in
+#: which a companion run's difference estimates the error: a chaotic scene whose trajectory is lost, which an estimate
+#: of this size says. Such runs are counted as "saturated", their factor not judged
 SATURATED = 0.1
 #: the other integrators, each at two settings, audited with output.error_estimate=true on a subset of the scenes.
 #: "python": stepped in Python (scipy or gyrolab's rk4), run only on scenes short enough (``PYTHON_WORK``)
@@ -164,10 +165,13 @@ def estimate_check(ds, truth: np.ndarray, floor: float) -> dict:
                        "ratio_max": stored_max / top if top > floor else math.nan, "ratio_per_time": per_time}
     ratios = [found[p]["ratio_max"] for p in ("omega", "attitude") if not math.isnan(found[p]["ratio_max"])]
     per_time = [found[p]["ratio_per_time"] for p in ("omega", "attitude") if not math.isnan(found[p]["ratio_per_time"])]
+    # an estimate of the size of the state says that the trajectory is lost, which is true: its factor is not judged
+    found["saturated"] = bool(max(found["omega"]["estimate_max"], found["attitude"]["estimate_max"]) >= SATURATED
+                              and max(found["omega"]["actual_max"], found["attitude"]["actual_max"]) >= SATURATED)
     found["ratio"] = min(ratios) if ratios else math.nan
     found["ratio_per_time"] = min(per_time) if per_time else math.nan
-    found["under"] = bool(ratios and min(ratios) < 1.0 / ESTIMATE_FACTOR)
-    found["under_per_time"] = bool(per_time and min(per_time) < 1.0 / ESTIMATE_FACTOR)
+    found["under"] = bool(ratios and min(ratios) < 1.0 / ESTIMATE_FACTOR and not found["saturated"])
+    found["under_per_time"] = bool(per_time and min(per_time) < 1.0 / ESTIMATE_FACTOR and not found["saturated"])
     return found
 
 
@@ -218,7 +222,7 @@ def audit_integrator(scene: Scene, name: str, settings: list[str], truth: np.nda
                 "cpu": time.process_time() - start}
     found = estimate_check(ds, truth, floor)
     verdict = ("n/a" if not found["available"] else "round-off" if math.isnan(found["ratio"]) else
-               "UNDER" if found["under"] else "ok")
+               "saturated" if found["saturated"] else "UNDER" if found["under"] else "ok")
     return {"integrator": name, "verdict": verdict, "estimate": found, "overrides": overrides,
             "cpu": time.process_time() - start}
 
@@ -318,9 +322,10 @@ def main(argv: list[str] | None = None) -> int:
         e = row.get("estimate") or {}
         entry = per_integrator.setdefault(row["integrator"], {"runs": 0, "judged": 0, "under": 0, "under_per_time": 0,
                                                               "min_ratio": math.inf, "max_ratio": 0.0,
-                                                              "min_ratio_per_time": math.inf})
+                                                              "min_ratio_per_time": math.inf, "saturated": 0})
         entry["runs"] += 1
-        if e.get("available") and not math.isnan(e["ratio"]):
+        entry["saturated"] += bool(e.get("saturated"))
+        if e.get("available") and not math.isnan(e["ratio"]) and not e["saturated"]:
             entry["judged"] += 1
             entry["under"] += e["under"]
             entry["under_per_time"] += e["under_per_time"]
@@ -334,12 +339,12 @@ def main(argv: list[str] | None = None) -> int:
           f"worst actual/ε {_g(worst_eps)}, worst actual/predicted {_g(worst_pred)} (largest error over the output "
           f"times / ε, not promised: {_g(worst_over_time)}); {len(other_rows)} other-integrator runs; {under} estimates more than "
           f"{ESTIMATE_FACTOR:g}× below the actual error; {wall:.0f} s")
-    print("\n| integrator | runs | judged (above round-off) | estimate/actual min | max | worst per-time | "
+    print("\n| integrator | runs | judged (above round-off) | saturated | estimate/actual min | max | worst per-time | "
           "under 1/2 (max) | under 1/2 (per time) |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     table_rows = []
     for name, v in per_integrator.items():
-        cells = [name, str(v["runs"]), str(v["judged"]), _g(v["min_ratio"] if v["judged"] else math.nan),
+        cells = [name, str(v["runs"]), str(v["judged"]), str(v["saturated"]), _g(v["min_ratio"] if v["judged"] else math.nan),
                  _g(v["max_ratio"] if v["judged"] else math.nan),
                  _g(v["min_ratio_per_time"] if math.isfinite(v["min_ratio_per_time"]) else math.nan),
                  str(v["under"]), str(v["under_per_time"])]
@@ -366,9 +371,7 @@ def main(argv: list[str] | None = None) -> int:
               f"{detail}\n  reproduce: {_command(r['overrides'])}")
     for r in underestimates:
         e = r["estimate"]
-        saturated = max(e["omega"]["actual_max"], e["attitude"]["actual_max"]) >= SATURATED
-        print(f"\nUNDERESTIMATE ({r['integrator']}, scene {r['scene']}"
-              f"{', saturated: the error is of the size of the state' if saturated else ''}): estimate/actual {e['ratio']:.3g} "
+        print(f"\nUNDERESTIMATE ({r['integrator']}, scene {r['scene']}): estimate/actual {e['ratio']:.3g} "
               f"(ω {e['omega']['estimate_max']:.3g} vs {e['omega']['actual_max']:.3g}, attitude "
               f"{e['attitude']['estimate_max']:.3g} vs {e['attitude']['actual_max']:.3g})\n"
               f"  reproduce: {_command(r['overrides'])}")
@@ -390,7 +393,7 @@ def main(argv: list[str] | None = None) -> int:
                    f"kept, {counts['refused']} refused, {counts['BROKEN']} broken (worst actual/ε {_g(worst_eps)}, "
                    f"actual/predicted {_g(worst_pred)}). The error estimates against the real128 reference:")
         write_results("promise_audit", numbers, {"promise_audit": {
-            "caption": caption, "header": ["integrator", "runs", "judged (above round-off)", "estimate/actual min",
+            "caption": caption, "header": ["integrator", "runs", "judged (above round-off)", "saturated", "estimate/actual min",
                                            "max", "worst per-time", "under 1/2 (max)", "under 1/2 (per time)"],
             "rows": table_rows}}, command=f"benchmarks/promise_audit.py --n {args.n} --seed {args.seed}")
     return 1 if broken or underestimates else 0
