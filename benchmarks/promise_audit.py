@@ -227,6 +227,22 @@ def audit_integrator(scene: Scene, name: str, settings: list[str], truth: np.nda
             "cpu": time.process_time() - start}
 
 
+def compact(row: dict) -> dict:
+    """A run's record for the results file: its numbers, not its overrides (the file lists each scene's once) and,
+    for a refusal, the sentence's first 200 characters."""
+    out = {k: v for k, v in row.items() if k not in ("overrides", "estimate", "why")}
+    settings = [o for o in row["overrides"] if o.startswith(("integrator", "accuracy", "output.error_estimate"))]
+    out["settings"] = " ".join(settings)
+    if "why" in row:
+        out["why"] = row["why"][:200]
+    e = row.get("estimate") or {}
+    if e.get("available"):
+        out["estimate"] = {"ratio": e["ratio"], "ratio_per_time": e["ratio_per_time"], "saturated": e["saturated"],
+                           **{f"{part}_{k}": e[part][k] for part in ("omega", "attitude")
+                              for k in ("actual_max", "estimate_max")}}
+    return out
+
+
 def r_eps(row: dict) -> float:
     """The accuracy a row asked for (read from its overrides: a refused row has no result)."""
     return float(next(o for o in row["overrides"] if o.startswith("accuracy=")).split("=")[1])
@@ -378,7 +394,8 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_write:
         numbers = {"seed": args.seed, "n": args.n, "n_output": args.n_output, "scenes": len(scenes) - len(skipped),
                    "auto_runs": len(auto_rows), **{f"auto_{k}": v for k, v in counts.items()},
-                   "worst_actual_over_eps": worst_eps, "worst_actual_over_predicted": worst_pred, "auto_rechecked": rechecked, "worst_max_over_time_over_eps": worst_over_time,
+                   "worst_actual_over_eps": worst_eps, "worst_actual_over_predicted": worst_pred,
+                   "auto_rechecked": rechecked, "worst_max_over_time_over_eps": worst_over_time,
                    **{f"prediction_alone_{k}": v for k, v in alone_counts.items()},
                    "prediction_alone_worst_actual_over_predicted": alone_worst,
                    "refused_for_double_precision": sum("best_double" in r for r in auto_rows),
@@ -387,7 +404,9 @@ def main(argv: list[str] | None = None) -> int:
                                      "min_ratio_per_time": v["min_ratio_per_time"]
                                      if math.isfinite(v["min_ratio_per_time"]) else None}
                                  for k, v in per_integrator.items()},
-                   "wall_seconds": wall, "auto": auto_rows, "auto_prediction_alone": alone_rows, "integrators": other_rows, "skipped": skipped}
+                   "wall_seconds": wall, "scene_overrides": {s.index: s.overrides for s in scenes},
+                   "auto": [compact(r) for r in auto_rows], "auto_prediction_alone": [compact(r) for r in alone_rows],
+                   "integrators": [compact(r) for r in other_rows], "skipped": skipped}
         caption = (f"Randomized audit of the accuracy promises (`benchmarks/promise_audit.py --n {args.n} --seed "
                    f"{args.seed}`): {len(scenes) - len(skipped)} scenes, {len(auto_rows)} auto runs, {counts['kept']} "
                    f"kept, {counts['refused']} refused, {counts['BROKEN']} broken (worst actual/ε {_g(worst_eps)}, "
