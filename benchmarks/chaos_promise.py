@@ -19,7 +19,7 @@ import numpy as np
 
 from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
-from gyrolab.plugins.compiled import layout
+from real128_reference import reference  # benchmarks/: the script's own directory
 
 #: scenes not used by the tests (tests/test_auto_chaos.py has its own)
 SCENES = {
@@ -37,28 +37,6 @@ SCENES = {
                                         "initial.theta0=1.0", "time.end=300"],
 }
 ACCURACIES = (1e-4, 1e-6, 1e-8, 1e-10)
-
-
-def reference(scene) -> np.ndarray:
-    """The final (ω, γ) in real128 (heyoka, tol 1e-30) on equations written from the papers."""
-    import heyoka as hy
-
-    p = scene.system.compiled_model().params
-    A, B, C = (float(p[layout.INERTIA + k]) for k in range(3))
-    U1, U2, U3 = (float(p[layout.U_Z + k]) for k in range(3))
-    N = float(p[layout.N_Z])
-    w1, w2, w3, g1, g2, g3 = hy.make_vars("w1", "w2", "w3", "g1", "g2", "g3")
-    # 1/I as a real128 constant: heyoka turns a division by a constant into a product by its reciprocal rounded
-    # to double otherwise, which moves this reference by ~5e-8 on the chaotic scenes
-    inv_A, inv_B, inv_C = (hy.expression(hy.real128(1) / hy.real128(x)) for x in (A, B, C))
-    system = [(w1, ((B - C) * w2 * w3 + U2 * g3 - U3 * g2 + N * (C - B) * g2 * g3) * inv_A),
-              (w2, ((C - A) * w3 * w1 + U3 * g1 - U1 * g3 + N * (A - C) * g3 * g1) * inv_B),
-              (w3, ((A - B) * w1 * w2 + U1 * g2 - U2 * g1 + N * (B - A) * g1 * g2) * inv_C),
-              (g1, g2 * w3 - g3 * w2), (g2, g3 * w1 - g1 * w3), (g3, g1 * w2 - g2 * w1)]
-    y0 = np.array(scene.system.initial_state()[:6], dtype=hy.real128)
-    ta = hy.taylor_adaptive(system, y0, tol=hy.real128("1e-30"), fp_type=hy.real128)
-    ta.propagate_until(hy.real128(float(scene.times[-1])))
-    return np.array([float(v) for v in ta.state])
 
 
 def main() -> int:

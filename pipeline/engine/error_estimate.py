@@ -13,8 +13,11 @@ integrator says how (``Integrator.more_accurate``, rule 9 of its contract):
   the compiled Taylor method at tol 1e-15 against the series).
 
 Where the companion cannot be made ``TIGHTER`` times more accurate (a tolerance already at its method's floor), the
-compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model; otherwise the dataset says the
-estimate is not available and why. The estimate costs one more integration (about 1.2–2× the run's time for a
+compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model — and for a run that is itself the
+double-precision Taylor method near that floor (``taylor`` at tol < 1e-12, or ``auto``'s choice of it), the Taylor
+method in double-double, ``TIGHTER`` times tighter, same order: another double run has the same round-off and can
+agree with the run far more closely than either agrees with the truth; otherwise the dataset says the estimate is not
+available and why. The estimate costs one more integration (about 1.2–2× the run's time for a
 tolerance-controlled method, 2× for a fixed step): it is on by default for ``integrator=auto`` only
 (``output.error_estimate: null``), ``true``/``false`` choose it for any integrator.
 
@@ -43,6 +46,15 @@ log = logging.getLogger(__name__)
 #: tol 1.3e-8) the companion at 100× takes 0.55 ms and ends 176× more accurate, at 1000× 0.68 ms and 1660×; the
 #: per cent an estimate gains is not worth a quarter of the companion's time (AMD EPYC with AVX-512, 2026-11-27)
 TIGHTER = 100.0
+#: a double-precision Taylor run whose companion would run below this tolerance is measured in double-double: a double
+#: companion there has round-off of the run's own size and can agree with it more closely than either agrees with
+#: the truth. benchmarks/promise_audit.py's scenes against real128 (120 scenes of seed 5, the Taylor method at a fixed
+#: tol, estimates above round-off and not saturated): with a double companion the smallest estimate / actual error was
+#: 0.0047 at tol 3e-14 (3 of 30 runs below 1/2), 0.16 at 1e-13 (2 of 29), 0.30 at 3e-13 (1 of 54), 0.94 at 1e-12
+#: (74 runs) and 0.95 at 1e-11 (110); with a double-double companion 0.98 at 3e-14 … 1e-13. Cost: the double-double
+#: run takes ~10× the double one (auto's Scene.run on the reference scene at accuracy 1e-10: 84 ms against 65 ms),
+#: for runs at tol < 1e-12 only (auto at accuracy ≲ 1e-9)
+DOUBLE_DOUBLE_BELOW = 1e-14
 
 
 @dataclass(frozen=True)
@@ -63,16 +75,29 @@ def wanted(scene: Any) -> bool:
 
 def companion(integrator: Any, has_compiled: bool) -> Companion | None:
     """The more accurate run that measures ``integrator``'s error (its ``more_accurate``, rule 9 of the contract;
-    else the compiled Taylor method at its floor when the scene has a compiled model), or None."""
-    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+    else the compiled Taylor method at its floor when the scene has a compiled model; else, for a run that is itself
+    the double-precision Taylor method near that floor, the Taylor method in double-double), or None."""
+    from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+    from gyrolab.plugins.integrators.compiled_solvers import DOUBLE_DOUBLE, Taylor
 
+    taylor = _double_taylor(integrator) if has_compiled else None
     finer = integrator.more_accurate(TIGHTER)
-    if finer is not None:
+    if finer is not None and (taylor is None or taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW):
         return Companion(*finer)
-    if has_compiled and not _at_taylor_floor(integrator):
+    if not has_compiled:
+        return None
+    if taylor is None:
         return Companion(Taylor(tol=Taylor.TOLERANCE_FLOOR), 1.0, f"compiled Taylor at tol {Taylor.TOLERANCE_FLOOR:g} "
                          f"({integrator.name} cannot be made {TIGHTER:g}× more accurate)")
-    return None
+    # A double-precision Taylor run near the floor: another double run (the old stand-in, Taylor at tol 1e-16) is no
+    # more accurate. Its error is then mostly round-off, amplified by the motion, and two double runs can agree far
+    # more closely than either agrees with the truth (benchmarks/promise_audit.py: auto at accuracy 1e-12 chose tol
+    # 1.5e-16, the stand-in differed from it by 1.7e-14 where both were 2.1e-12 from the real128 answer, and the
+    # broken prediction went unseen). Double-double has no such round-off.
+    tol = max(taylor.tol / TIGHTER, MIN_TOL)
+    return Companion(Taylor(order=taylor.order, tol=tol, precision=DOUBLE_DOUBLE), 1.0,
+                     f"compiled Taylor in double-double at tol {tol:.3g}, same order ({integrator.name} runs the "
+                     f"Taylor method near double precision's floor)")
 
 
 @dataclass(frozen=True)
@@ -151,7 +176,16 @@ def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Com
     return Comparison(pick.scale * np.abs(y - other), attrs, y)
 
 
+def _double_taylor(integrator: Any) -> Any:
+    """The double-precision Taylor method the run used: the integrator itself, or the method ``auto`` chose; else None."""
+    from gyrolab.plugins.integrators.compiled_solvers import DOUBLE, Taylor
+
+    ran = getattr(integrator, "chosen", None) or integrator
+    return ran if isinstance(ran, Taylor) and ran.precision == DOUBLE else None
+
+
 def _at_taylor_floor(integrator: Any) -> bool:
     from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
-    return isinstance(integrator, Taylor) and integrator.tol / TIGHTER < Taylor.TOLERANCE_FLOOR
+    taylor = _double_taylor(integrator)
+    return taylor is not None and taylor.tol / TIGHTER < Taylor.TOLERANCE_FLOOR
