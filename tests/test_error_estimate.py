@@ -63,6 +63,22 @@ def test_says_why_when_unavailable():
     assert ds.attrs["error_estimate_method"].startswith("not available")
 
 
+def test_near_the_floor_where_truncation_dominates_double_companions_measure_it():
+    # auto at 3e-11 runs Taylor at tol ~3e-13, below the double-double threshold; on this regular scene its error is
+    # truncation, which two double companions (other orders: independent round-off) agree on to far better than it
+    overrides = [*SCENE, "integrator=auto", "accuracy=3e-11"]
+    ds = run(overrides)
+    assert ds.attrs["auto_tolerance"] < 1e-12
+    method = ds.attrs["error_estimate_method"]
+    assert "double-double" not in method and "second double companion" in method
+    actual = _actual(ds, overrides)
+    for part, columns in (("omega", slice(0, 3)), ("attitude", slice(3, 6))):
+        real = actual[:, columns].max(axis=1)
+        resolved = real > 1e-13
+        assert resolved[-1]
+        np.testing.assert_allclose(ds[f"error_estimate_{part}"].values[resolved], real[resolved], rtol=0.5)
+
+
 #: benchmarks/promise_audit.py's scene where round-off dominates (tests/test_promise_audit.py checks it against
 #: heyoka in real128): asked 1e-12, auto chose Taylor at tol 1.5e-16 and ended 2.1e-12 away while the old stand-in
 #: companion (Taylor at tol 1e-16, in double) measured 1.7e-14
@@ -76,6 +92,7 @@ ROUND_OFF_SCENE = ["body.a=0.7046", "body.b=1.4132",
 def test_near_the_taylor_floor_the_estimate_measures_amplified_round_off():
     overrides = ["integrator=taylor", "integrator.tol=1e-16", "output.error_estimate=true", *ROUND_OFF_SCENE]
     ds = run(overrides)
+    assert "double-double" in ds.attrs["error_estimate_method"]  # two double companions saw round-off: escalated
     actual = _actual(ds, overrides).max()
     assert actual > 1e-13  # far above the long-double reference's own error
     estimate = max(ds.attrs["error_estimate_max_omega"], ds.attrs["error_estimate_max_attitude"])

@@ -13,11 +13,13 @@ integrator says how (``Integrator.more_accurate``, rule 9 of its contract):
   the compiled Taylor method at tol 1e-15 against the series).
 
 Where the companion cannot be made ``TIGHTER`` times more accurate (a tolerance already at its method's floor), the
-compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model — and for a run that is itself the
-double-precision Taylor method near that floor (``taylor`` at tol < 1e-12, or ``auto``'s choice of it), the Taylor
-method in double-double, ``TIGHTER`` times tighter, same order: another double run has the same round-off and can
-agree with the run far more closely than either agrees with the truth; otherwise the dataset says the estimate is not
-available and why. The estimate costs one more integration (about 1.2–2× the run's time for a
+compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model; otherwise the dataset says the
+estimate is not available and why. A run that is itself the double-precision Taylor method near that floor (``taylor``
+at tol < 1e-12, or ``auto``'s choice of it) may err mostly by round-off, which another double run shares in size: it
+can agree with the run far more closely than either agrees with the truth. There two double companions run first
+(``TIGHTER`` times tighter, at the run's order and at another: independent round-off); where they disagree by
+``ROUNDOFF_MARGIN`` times less than the error the first measures, that measurement stands, else the Taylor method
+in double-double (``TIGHTER`` times tighter, same order, ~30× a double run's time) measures it. The estimate costs one more integration (about 1.2–2× the run's time for a
 tolerance-controlled method, 2× for a fixed step): it is on by default for ``integrator=auto`` only
 (``output.error_estimate: null``), ``true``/``false`` choose it for any integrator.
 
@@ -51,10 +53,15 @@ TIGHTER = 100.0
 #: the truth. benchmarks/promise_audit.py's scenes against real128 (120 scenes of seed 5, the Taylor method at a fixed
 #: tol, estimates above round-off and not saturated): with a double companion the smallest estimate / actual error was
 #: 0.0047 at tol 3e-14 (3 of 30 runs below 1/2), 0.16 at 1e-13 (2 of 29), 0.30 at 3e-13 (1 of 54), 0.94 at 1e-12
-#: (74 runs) and 0.95 at 1e-11 (110); with a double-double companion 0.98 at 3e-14 … 1e-13. Cost: the double-double
-#: run takes ~10× the double one (auto's Scene.run on the reference scene at accuracy 1e-10: 84 ms against 65 ms),
-#: for runs at tol < 1e-12 only (auto at accuracy ≲ 1e-9)
+#: (74 runs) and 0.95 at 1e-11 (110); with a double-double companion 0.98 at 3e-14 … 1e-13. The double-double run
+#: takes ~30× a double one (reference scene, t = 300: ~17 ms), so it runs only where two double companions show that
+#: round-off is not small against the error measured (``ROUNDOFF_MARGIN``; ``compare``)
 DOUBLE_DOUBLE_BELOW = 1e-14
+
+
+#: near double precision's floor, a double companion is trusted when the round-off two double companions disagree
+#: by is this many times below the error it measures (``compare``); else the double-double companion runs
+ROUNDOFF_MARGIN = 10.0
 
 
 @dataclass(frozen=True)
@@ -62,6 +69,10 @@ class Companion:
     integrator: Any
     scale: float  # error of the stored run ≈ scale · |y − y_companion|
     how: str
+    #: near the Taylor floor: (a double companion ``TIGHTER`` times tighter, a second one at its tolerance and another
+    #: order) tried before ``integrator`` (double-double, ~30× their time): their disagreement measures the round-off
+    #: the double companion shares in size with the run (``compare``)
+    double_first: tuple[Any, Any] | None = None
 
 
 def wanted(scene: Any) -> bool:
@@ -94,10 +105,15 @@ def companion(integrator: Any, has_compiled: bool) -> Companion | None:
     # more closely than either agrees with the truth (benchmarks/promise_audit.py: auto at accuracy 1e-12 chose tol
     # 1.5e-16, the stand-in differed from it by 1.7e-14 where both were 2.1e-12 from the real128 answer, and the
     # broken prediction went unseen). Double-double has no such round-off.
+    from gyrolab.plugins.compiled.taylor import MAX_ORDER
+
     tol = max(taylor.tol / TIGHTER, MIN_TOL)
+    double_tol = max(taylor.tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
+    other_order = taylor.order + 2 if taylor.order + 2 <= MAX_ORDER else taylor.order - 2
     return Companion(Taylor(order=taylor.order, tol=tol, precision=DOUBLE_DOUBLE), 1.0,
                      f"compiled Taylor in double-double at tol {tol:.3g}, same order ({integrator.name} runs the "
-                     f"Taylor method near double precision's floor)")
+                     f"Taylor method near double precision's floor)",
+                     (Taylor(order=taylor.order, tol=double_tol), Taylor(order=other_order, tol=double_tol)))
 
 
 @dataclass(frozen=True)
@@ -169,10 +185,31 @@ def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Com
             return Comparison(None, {"error_estimate_method": reason})
     start = time.perf_counter()
     y0 = scene.system.initial_state()
+    y = np.asarray(y, dtype=float)
+    how = pick.how
+    if pick.double_first is not None:
+        # Near the floor the run's error may be mostly round-off, which a double companion shares in size: it can
+        # agree with the run far more closely than either agrees with the truth. Two double companions (other
+        # orders, other steps: independent round-off) measure that round-off by their disagreement; where it is
+        # ROUNDOFF_MARGIN times below what the first measures, the measurement is truncation error and stands
+        # (the reference scene at accuracy 1e-10: ~1 ms instead of the double-double companion's ~17 ms).
+        first, second = (m.integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
+                         for m in pick.double_first)
+        difference = np.abs(y - first)
+        roundoff = float(np.max(np.abs(first - second)))
+        measured = float(np.max(difference))
+        if ROUNDOFF_MARGIN * roundoff <= measured:
+            spent = time.perf_counter() - start
+            attrs = {"error_estimate_method": f"compiled Taylor at tol {pick.double_first[0].tol:.3g}, same order "
+                                              f"(near double precision's floor: a second double companion at order "
+                                              f"{pick.double_first[1].order} disagrees with it by {roundoff:.2g}, "
+                                              f"≥ {ROUNDOFF_MARGIN:g}× below the error measured)",
+                     "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
+            return Comparison(difference, attrs, y)
+        how = f"{how}: two double companions disagree by {roundoff:.2g}, round-off not small against {measured:.2g}"
     other = pick.integrator.integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
     spent = time.perf_counter() - start
-    y = np.asarray(y, dtype=float)
-    attrs = {"error_estimate_method": pick.how, "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
+    attrs = {"error_estimate_method": how, "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
     return Comparison(pick.scale * np.abs(y - other), attrs, y)
 
 
