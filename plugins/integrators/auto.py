@@ -84,7 +84,8 @@ MAX_GROWTH = 4.0
 PREDICTION_MEANING = ("an upper estimate of the max-norm error of the final state against the exact solution (model "
                       "units): the pilot's measured error extrapolated over the span, raised by the amplification of "
                       "perturbations measured over the whole span (chaotic scenes), times a calibration factor, plus "
-                      "the round-off of double precision (amplified likewise)")
+                      "the round-off of double precision (amplified likewise); checked by output.error_estimate "
+                      "(rule 11: a run that breaks it runs again or is refused), a prediction only without it")
 #: on a chaotic scene the amplification (and the round-off it carries) is taken this many times larger: one tangent
 #: run's growth factor scatters by up to e^2 ≈ 7 between nearby tolerances (``amplification.TANGENT_TOLERANCE``),
 #: and the round-off estimate is an estimate (benchmarks/chaos_promise.py: with no margin, slow_spin at t = 300
