@@ -64,9 +64,9 @@ def test_says_why_when_unavailable():
 
 
 def test_near_the_floor_where_truncation_dominates_double_companions_measure_it():
-    # auto at 3e-11 runs Taylor at tol ~3e-13, below the double-double threshold; on this regular scene its error is
+    # auto at 2e-11 runs Taylor at tol ~1e-13, below the double-double threshold; on this regular scene its error is
     # truncation, which two double companions (other orders: independent round-off) agree on to far better than it
-    overrides = [*SCENE, "integrator=auto", "accuracy=3e-11"]
+    overrides = [*SCENE, "integrator=auto", "accuracy=2e-11"]
     ds = run(overrides)
     assert ds.attrs["auto_tolerance"] < 1e-12
     method = ds.attrs["error_estimate_method"]

@@ -17,7 +17,8 @@ compiled Taylor method at tol 1e-16 stands in when the scene has a compiled mode
 estimate is not available and why. A run that is itself the double-precision Taylor method near that floor (``taylor``
 at tol < 1e-12, or ``auto``'s choice of it) may err mostly by round-off, which another double run shares in size: it
 can agree with the run far more closely than either agrees with the truth. There two double companions run first
-(``TIGHTER`` times tighter, at the run's order and at another: independent round-off); where they disagree by
+(``TIGHTER`` times tighter; one at the run's order, one at another order with 1/I moved by its rounding: what double
+runs share shows as their disagreement); where they disagree by
 ``ROUNDOFF_MARGIN`` times less than the error the first measures, that measurement stands, else the Taylor method
 in double-double (``TIGHTER`` times tighter, ~30× a double run's time) measures it. The estimate costs one more integration (about 1.2–2× the run's time for a
 tolerance-controlled method, 2× for a fixed step): it is on by default for ``integrator=auto`` only
@@ -60,7 +61,11 @@ DOUBLE_DOUBLE_BELOW = 1e-14
 
 
 #: near double precision's floor, a double companion is trusted when the round-off two double companions disagree
-#: by is this many times below the error it measures (``compare``); else the double-double companion runs
+#: by is this many times below the error it measures (``compare``); else the double-double companion runs.
+#: benchmarks/roundoff_margin.py (Taylor at tol 3e-13 … 1.5e-16 on random scenes against heyoka real128): at 10, no
+#: trusted estimate below 1/2 of the actual error in 606 runs of seed 5 (worst 0.56) and one in 1,029 of seed 11
+#: (0.47, where the double-double companion measured it exactly: double runs share an error their disagreement does
+#: not show); at 4, two below 1/2 (worst 0.27); only 50 clears seed 11, trusting 90 runs instead of 296
 ROUNDOFF_MARGIN = 10.0
 
 
@@ -69,9 +74,9 @@ class Companion:
     integrator: Any
     scale: float  # error of the stored run ≈ scale · |y − y_companion|
     how: str
-    #: near the Taylor floor: (a double companion ``TIGHTER`` times tighter, a second one at its tolerance and another
-    #: order) tried before ``integrator`` (double-double, ~30× their time): their disagreement measures the round-off
-    #: the double companion shares in size with the run (``compare``)
+    #: near the Taylor floor: (a double companion ``TIGHTER`` times tighter, a second one at its tolerance, another
+    #: order and 1/I moved by its rounding) tried before ``integrator`` (double-double, ~30× their time): their
+    #: disagreement measures what the double companion shares with the run (``compare``)
     double_first: tuple[Any, Any] | None = None
 
 
@@ -192,12 +197,16 @@ def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Com
     how = pick.how
     if pick.double_first is not None:
         # Near the floor the run's error may be mostly round-off, which a double companion shares in size: it can
-        # agree with the run far more closely than either agrees with the truth. Two double companions (other
-        # orders, other steps: independent round-off) measure that round-off by their disagreement; where it is
-        # ROUNDOFF_MARGIN times below what the first measures, the measurement is truncation error and stands
-        # (the reference scene at accuracy 1e-10: ~1 ms instead of the double-double companion's ~17 ms).
-        first, second = (m.integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
-                         for m in pick.double_first)
+        # agree with the run far more closely than either agrees with the truth. Two double companions measure
+        # what double runs share by their disagreement: another order (other steps: independent round-off) and
+        # the model's one rounded parameter, 1/I, moved by its rounding's size (every double run multiplies by the
+        # same rounded 1/I; a fast top amplifies it: benchmarks/roundoff_margin.py, seed 11, scene 81 at tol 1e-15,
+        # double companions 7.7e-12 apart measured 5.2e-10 where the run was 1.3e-9 from the truth). Where that
+        # is ROUNDOFF_MARGIN times below what the first measures, the measurement stands (the reference scene at
+        # accuracy 1e-10: ~1 ms instead of the double-double companion's ~17 ms).
+        first = pick.double_first[0].integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
+        second = pick.double_first[1].integrate(scene.system.rhs, scene.times, y0, None,
+                                                rounding_moved(companion_model)).y
         difference = np.abs(y - first)
         roundoff = float(np.max(np.abs(first - second)))
         measured = float(np.max(difference))
@@ -214,6 +223,19 @@ def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Com
     spent = time.perf_counter() - start
     attrs = {"error_estimate_method": how, "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
     return Comparison(pick.scale * np.abs(y - other), attrs, y)
+
+
+def rounding_moved(model: Any) -> Any:
+    """``model`` with each parameter the compiled model derives by rounding — 1/I (``layout.INV_INERTIA``) — moved
+    by one unit in the last place (up, down, up): a run with it differs from one with the rounded values as one
+    with the exact values would. Other parameters are the config's own doubles, exact for the reference too."""
+    from gyrolab.contracts.integrator import CompiledModel
+    from gyrolab.plugins.compiled.layout import INV_INERTIA
+
+    params = np.array(model.params, dtype=float)
+    for k, toward in enumerate((np.inf, -np.inf, np.inf)):
+        params[INV_INERTIA + k] = np.nextafter(params[INV_INERTIA + k], toward)
+    return CompiledModel(model.model, params)
 
 
 def _double_taylor(integrator: Any) -> Any:

@@ -1,0 +1,95 @@
+"""Near the Taylor method's floor, when may the error estimate trust a double companion? (``error_estimate``)
+
+A double-precision Taylor run at tol < 1e-12 may err partly by round-off, which a double companion shares in size.
+``gyrolab.engine.error_estimate`` runs two double companions there (``TIGHTER`` times tighter; the run's order, and
+another order with 1/I moved by its rounding) and keeps the first one's measurement E when their disagreement R is
+``ROUNDOFF_MARGIN`` times below it; else a double-double companion measures. This measures that rule against the
+truth: on random scenes (``promise_audit.random_scene``) and tolerances from 3e-13 to 1.5e-16, E, R and the actual
+error (max-norm over every output time and component, against heyoka ``real128``), and for each margin M the
+smallest E / actual among the runs it would trust (R · M ≤ E). The estimate's promise is E / actual ≥ 1/2.
+
+    pip install -e ".[bench]"
+    python benchmarks/roundoff_margin.py --n 120 --seed 5     # ~5 min
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+import numpy as np
+
+from gyrolab import compose_scene
+from gyrolab.engine.error_estimate import ROUNDOFF_MARGIN, TIGHTER, rounding_moved
+from gyrolab.plugins.compiled.taylor import MAX_ORDER
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from promise_audit import SATURATED, random_scene  # noqa: E402  (benchmarks/ is not a package)
+from real128_reference import Real128Reference, covered  # noqa: E402
+
+TOLERANCES = (3e-13, 1e-13, 3e-14, 1e-14, 3e-15, 1e-15, 1.5e-16)
+MARGINS = (2.0, 4.0, 10.0, 20.0, 50.0)
+#: an actual error below this × max(1, |y0|) is at the reference's own level: not judged
+RESOLVED = 1e-15
+
+
+def measure(scene, tol: float) -> tuple[float, float, np.ndarray]:
+    """(E, R, the run's states) of the Taylor method at ``tol`` on ``scene``, as ``error_estimate.compare`` measures
+    them near the floor."""
+    y0 = scene.system.initial_state()
+    run = Taylor(tol=tol)
+    double_tol = max(tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
+    other = run.order + 2 if run.order + 2 <= MAX_ORDER else run.order - 2
+    y, first = (m.integrate(None, scene.times, y0, None, scene.compiled).y
+                for m in (run, Taylor(order=run.order, tol=double_tol)))
+    second = Taylor(order=other, tol=double_tol).integrate(None, scene.times, y0, None,
+                                                           rounding_moved(scene.compiled)).y
+    return float(np.max(np.abs(y - first))), float(np.max(np.abs(first - second))), y
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, default=120)
+    parser.add_argument("--seed", type=int, default=5)
+    args = parser.parse_args()
+    rng = np.random.default_rng(args.seed)
+    reference = Real128Reference()
+    rows = []  # (scene, tol, E, R, actual)
+    for index in range(args.n):
+        spec = random_scene(rng, index)
+        scene = compose_scene(["integrator=taylor", "time.n_output=101", "output.euler_angles=false", *spec.overrides])
+        if not covered(scene):
+            continue
+        truth = reference.states(scene)
+        scale = max(1.0, float(np.max(np.abs(scene.system.initial_state()))))
+        for tol in TOLERANCES:
+            estimate, roundoff, y = measure(scene, tol)
+            actual = float(np.max(np.abs(y - truth)))
+            if RESOLVED * scale < actual < SATURATED:
+                rows.append((index, tol, estimate, roundoff, actual))
+                if estimate >= ROUNDOFF_MARGIN * roundoff and estimate < actual / 2:  # trusted, and more than 2× low
+                    dd = Taylor(tol=max(tol / TIGHTER, 1e-30), precision="double-double")
+                    exact = float(np.max(np.abs(y - dd.integrate(None, scene.times, scene.system.initial_state(),
+                                                                 None, scene.compiled).y)))
+                    print(f"  scene {index} tol {tol:g}: E {estimate:.3g}, R {roundoff:.3g}, actual {actual:.3g}, "
+                          f"double-double companion {exact:.3g}", flush=True)
+        print(f"scene {index}: {len(rows)} runs judged so far", flush=True)
+    rows = np.array(rows)
+    ratio, trust = rows[:, 2] / rows[:, 4], rows[:, 2] / np.maximum(rows[:, 3], 1e-300)
+    print(f"\n{len(rows)} runs (seed {args.seed}, {args.n} scenes, tol {TOLERANCES[0]:g} … {TOLERANCES[-1]:g}); "
+          f"current ROUNDOFF_MARGIN = {ROUNDOFF_MARGIN:g}\n")
+    print("| margin M | runs trusted (R · M ≤ E) | smallest E / actual among them | trusted with E / actual < 1/2 |")
+    print("| --- | --- | --- | --- |")
+    for margin in MARGINS:
+        kept = trust >= margin
+        worst = float(ratio[kept].min()) if kept.any() else float("nan")
+        print(f"| {margin:g} | {int(kept.sum())} of {len(rows)} | {worst:.3g} | {int((ratio[kept] < 0.5).sum())} |")
+    print("\nthe double estimate alone (no margin): smallest E / actual "
+          f"{float(ratio.min()):.3g}, {int((ratio < 0.5).sum())} of {len(rows)} below 1/2")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
