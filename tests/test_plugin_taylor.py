@@ -17,7 +17,7 @@ from scipy.integrate import solve_ivp
 import pytest
 
 from gyrolab.contracts import Force
-from gyrolab.engine.scene import compose_scene
+from gyrolab.engine.scene import compose_scene, run
 from gyrolab.plugins.compiled import fixed_point, models, plugin_taylor, plugin_torque
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from tests.conftest import installed_distribution
@@ -208,6 +208,19 @@ def test_batch_taylor_with_a_plugin_matches_single_runs(centre):
         np.testing.assert_allclose(batch.y[row], alone.y, rtol=0, atol=1e-14)
     auto = compose_scene(["force=[centre]", "integrator=auto", "integrator.accuracy=1e-8", *SHORT])
     assert auto.integrator._method(auto.compiled, 1e-10).name == "taylor"
+
+
+def test_a_plugin_run_near_the_taylor_floor_keeps_its_error_estimate(centre):
+    # the double-double companion evaluates the built-in torques only; near the floor the two double companions
+    # (another order, 1/I moved by its rounding) measure the error where they agree far better than that, instead of
+    # the estimate being "not available" for every plugin torque
+    ds = run(["force=[centre]", "integrator=taylor", "integrator.tol=1e-13", "output.error_estimate=true", *SHORT])
+    assert "second double companion" in ds.attrs["error_estimate_method"]
+    assert 0 < ds.attrs["error_estimate_max_omega"] < 1e-10
+    # where they do not, the dataset says why, naming the plugin the double-double kernel cannot evaluate
+    floor = run(["force=[centre]", "integrator=taylor", "integrator.tol=1e-16", "output.error_estimate=true", *SHORT])
+    method = floor.attrs["error_estimate_method"]
+    assert method.startswith("not available") and "'centre'" in method and "error_estimate_omega" not in floor
 
 
 def test_time_dependent_plugin_torque_under_taylor_against_the_equations_by_hand():

@@ -18,9 +18,9 @@ estimate is not available and why. A run that is itself the double-precision Tay
 at tol < 1e-12, or ``auto``'s choice of it) may err mostly by round-off, which another double run shares in size: it
 can agree with the run far more closely than either agrees with the truth. There two double companions run first
 (``TIGHTER`` times tighter; one at the run's order, one at another order with 1/I moved by its rounding: what double
-runs share shows as their disagreement); where they disagree by
-``ROUNDOFF_MARGIN`` times less than the error the first measures, that measurement stands, else the Taylor method
-in double-double (``TIGHTER`` times tighter, ~30× a double run's time) measures it. The estimate costs one more integration (about 1.2–2× the run's time for a
+runs share shows as their disagreement); where their disagreement is ``ROUNDOFF_MARGIN`` times below the error the
+first measures, that measurement stands, else the Taylor method in double-double (``TIGHTER`` times tighter, ~30× a
+double run's time) measures it. The estimate costs one more integration (about 1.2–2× the run's time for a
 tolerance-controlled method, 2× for a fixed step): it is on by default for ``integrator=auto`` only
 (``output.error_estimate: null``), ``true``/``false`` choose it for any integrator.
 
@@ -175,22 +175,18 @@ def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Com
     pick = companion(integrator, compiled_model is not None)
     name = getattr(integrator, "name", type(integrator).__name__)
     if pick is None:
-        reason = (f"not available: integrator {name!r} already runs at the compiled Taylor method's floor in double "
-                  "precision (nothing more accurate to compare with)" if _at_taylor_floor(integrator) else
-                  f"not available: integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
-                  "compiled model for the Taylor method")
-        log.warning("output.error_estimate: %s", reason)
-        return Comparison(None, {"error_estimate_method": reason})
-    companion_model = None
+        return _unavailable(f"integrator {name!r} already runs at the compiled Taylor method's floor in double "
+                            "precision (nothing more accurate to compare with)" if _at_taylor_floor(integrator) else
+                            f"integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
+                            "compiled model for the Taylor method")
+    companion_model, refusal = None, None
     if pick.integrator.supports(COMPILED_MODEL) or pick.integrator.supports(PREFERS_COMPILED_MODEL):
         # the scene's own model is prepared for its integrator (a plugin torque's Taylor kernel compiled); another
         # one is prepared by the companion's refusal hook, which also says when it cannot run it
         companion_model = scene.compiled if scene.compiled is not None else compiled_model
         refusal = pick.integrator.refusal(companion_model, scene.system) if companion_model is not None else None
-        if refusal:
-            reason = f"not available: the companion ({pick.how}) {refusal}"
-            log.warning("output.error_estimate: %s", reason)
-            return Comparison(None, {"error_estimate_method": reason})
+        if refusal and pick.double_first is None:  # (near the floor the double companions may still suffice)
+            return _unavailable(f"the companion ({pick.how}) {refusal}")
     start = time.perf_counter()
     y0 = scene.system.initial_state()
     y = np.asarray(y, dtype=float)
@@ -219,10 +215,18 @@ def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Com
                      "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
             return Comparison(difference, attrs, y)
         how = f"{how}: two double companions disagree by {roundoff:.2g}, round-off not small against {measured:.2g}"
+        if refusal:  # a plugin torque has no double-double kernel
+            return _unavailable(f"{how}, and the double-double companion {refusal}")
     other = pick.integrator.integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
     spent = time.perf_counter() - start
     attrs = {"error_estimate_method": how, "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
     return Comparison(pick.scale * np.abs(y - other), attrs, y)
+
+
+def _unavailable(why: str) -> Comparison:
+    reason = f"not available: {why}"
+    log.warning("output.error_estimate: %s", reason)
+    return Comparison(None, {"error_estimate_method": reason})
 
 
 def rounding_moved(model: Any) -> Any:
