@@ -53,7 +53,7 @@ from gyrolab.engine.config import (
     use_source,
 )
 from gyrolab.engine.safety import check_config, check_output_dir
-from gyrolab.engine.unread import ACCURACY, ACCURACY_IGNORED_ATTRIBUTE, given_keys, ignored_accuracy, unread_accuracy
+from gyrolab.engine.unread import ACCURACY, given_keys, ignored_accuracy, unread_accuracy
 from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
@@ -413,11 +413,10 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
             announce_written(path)
         return written[0]
     scene = Scene.from_config(cfg)
+    scene.accuracy_ignored = ignored  # in the dataset's attributes, as compose_scene records it
     ds = scene.run()
     ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
     ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
-    if ignored:
-        ds.attrs[ACCURACY_IGNORED_ATTRIBUTE] = ignored
     path = write_dataset(ds, out_dir / "run.nc")
     announce_written(path)
     if not figures:
