@@ -38,8 +38,8 @@ from pathlib import Path
 import numpy as np
 
 from gyrolab import compose_scene
-from gyrolab.plugins.compiled import taylor_dd
-from gyrolab.plugins.compiled.layout import INERTIA, N_Z, U_Z
+from gyrolab.kernels import taylor_dd
+from gyrolab.kernels.layout import INERTIA, N_Z, U_Z
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from results_file import cpu_model  # noqa: E402  (benchmarks/ is not a package; run as a script)
 

@@ -106,7 +106,7 @@ def heyoka_same_work():
         import heyoka as hy
     except ImportError:
         return {}
-    from gyrolab.plugins.compiled.variational import initial_tangent
+    from gyrolab.kernels.variational import initial_tangent
     from gyrolab.plugins.integrators.amplification import TANGENT_TOLERANCE
 
     A, B, C = INERTIA

@@ -11,7 +11,7 @@ under ``dop853_numba``, interleaved, integration time only (best of the repeats)
 under scipy's DOP853 (gyrolab's ``dop853``: the Python right-hand side), at equal error.
 Error = max-norm of the final state's error against the extended-precision reference.
 Targets (issue 12): plugin ≤ 1.3× the built-in's time; ≥ 150× faster than scipy DOP853. Then both
-under ``taylor`` (the plugin's series from the generated kernel of ``plugin_taylor``); target (issue 24,
+under ``taylor`` (the plugin's series from the generated kernel of ``taylor_series``); target (issue 24,
 item 2): plugin ≤ 2× the built-in's time. Last (full run only), the compile time of the plugin's Taylor
 kernel: generated and compiled in a process with an empty kernel cache, then loaded by a second process.
 """
@@ -75,7 +75,7 @@ def rhs_cost(base: list[str], plugin: list[str], compose_scene) -> None:
     """One right-hand-side evaluation, built-in form against the traced plugin (ns; best of 20 loops of 10⁵)."""
     import numba
 
-    from gyrolab.plugins.compiled import models
+    from gyrolab.kernels import models
 
     @numba.njit
     def loop(model, p, y, out, n):
@@ -107,13 +107,13 @@ _KERNEL_TIME = textwrap.dedent('''
     sys.path.insert(0, sys.argv[1])
     from plain_forces import PlainGravity, PlainNewtonian
     from gyrolab import compose_scene
-    from gyrolab.plugins.compiled import plugin_taylor, plugin_torque
+    from gyrolab.kernels import taylor_series, expression
 
     body = compose_scene(["experiment=perf_reference"]).system.body
-    trace = plugin_torque.trace([PlainGravity(body), PlainNewtonian(body, k=0.5)])
-    plugin_torque.compile_trace(trace, ["plain_gravity", "plain_newtonian"])  # (the right-hand side's, as a run does)
+    trace = expression.trace([PlainGravity(body), PlainNewtonian(body, k=0.5)])
+    expression.compile_trace(trace, ["plain_gravity", "plain_newtonian"])  # (the right-hand side's, as a run does)
     start = time.perf_counter()
-    plugin_taylor.compile_taylor(trace, ["plain_gravity", "plain_newtonian"])
+    taylor_series.compile_taylor(trace, ["plain_gravity", "plain_newtonian"])
     print(time.perf_counter() - start)
 ''')
 
@@ -194,7 +194,7 @@ def main() -> None:
         c_time, c_err = min(candidates)
         print(f"{tol:7.0e} {s_time:9.3f} {s_err:9.2e}   {c_time:17.5f} ({c_err:8.2e}) {s_time / c_time:8.0f}×")
 
-    print("\ntaylor (the plugin's series from its generated kernel, plugin_taylor) against the built-in's series:")
+    print("\ntaylor (the plugin's series from its generated kernel, taylor_series) against the built-in's series:")
     print(f"{'tol':>7} {'built-in s':>11} {'error':>9} {'plugin s':>9} {'error':>9} {'ratio':>6}")
     for tol in ((1e-9, 1e-13) if args.quick else (1e-8, 1e-10, 1e-12, 1e-13)):
         runs = {}

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gyrolab.plugins.compiled import layout
+from gyrolab.kernels import layout
 
 TOL = "1e-30"
 
@@ -46,7 +46,7 @@ def reference(scene) -> np.ndarray:
 
 def covered(scene) -> bool:
     """Whether the scene is a fixed-point scene whose torques these equations hold (about the vertical only)."""
-    from gyrolab.plugins.compiled import models
+    from gyrolab.kernels import models
 
     compiled = scene.system.compiled_model()
     if compiled is None or compiled.model != models.FIXED_POINT or layout.torques_on_horizontal_axes(compiled.params):

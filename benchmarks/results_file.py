@@ -24,7 +24,7 @@ LOAD_AT_IMPORT = os.getloadavg()  # the load when the benchmark started
 
 def _lanes_at_import() -> dict[str, int]:
     # read when the benchmark imports this module, with the kernels it runs (not when it writes, minutes later)
-    from gyrolab.plugins.compiled.vector_width import lane_attributes
+    from gyrolab.kernels.vector_width import lane_attributes
 
     return lane_attributes()
 

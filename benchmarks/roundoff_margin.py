@@ -22,7 +22,7 @@ import numpy as np
 
 from gyrolab import compose_scene
 from gyrolab.engine.error_estimate import ROUNDOFF_MARGIN, TIGHTER, rounding_moved
-from gyrolab.plugins.compiled.taylor import MAX_ORDER
+from gyrolab.kernels.taylor import MAX_ORDER
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))

@@ -29,7 +29,7 @@ from perf_reference import GRID, INERTIA, K, R_C, T_END, Y0, heyoka_contestants,
 
 from gyrolab import compose_scene  # noqa: E402
 from gyrolab.physics.reference import fixed_point_reference  # noqa: E402
-from gyrolab.plugins.compiled import fixed_point, taylor  # noqa: E402
+from gyrolab.kernels import fixed_point, taylor  # noqa: E402
 
 ORDERS = (8, 12, 16, 20)
 REPEATS = 20000  # coefficient evaluations per timing

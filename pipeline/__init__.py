@@ -6,14 +6,16 @@ included):
 
 1. ``errors``       the one-sentence errors every layer raises
 2. ``physics``      rigid-body mechanics: no configs, files, plugins or kernels
-3. ``contracts``    what a plugin must do (enforced by the base classes) and the
+3. ``kernels``      the numerical core: a system's equations traced once, the
+                    kernels generated from them, the integrators' inner loops
+4. ``contracts``    what a plugin must do (enforced by the base classes) and the
                     registry that finds plugins by name
-4. ``plugins``      compiled kernels, then forces, systems, integrators
-5. ``analysis``     periodic orbits, continuation, chaos indicators, precessions
+5. ``plugins``      forces, systems, integrators
+6. ``analysis``     periodic orbits, continuation, chaos indicators, precessions
                     (numerical analysis on the plugins), then ``plugins.regimes``
-6. ``output``, ``figures``   the self-describing dataset, provenance, drawing
-7. ``engine``       config → scene → run
-8. ``sweep``, ``batch``, ``experiments``, ``app``   multiruns, batches, the
+7. ``output``, ``figures``   the self-describing dataset, provenance, drawing
+8. ``engine``       config → scene → run
+9. ``sweep``, ``batch``, ``experiments``, ``app``   multiruns, batches, the
                     papers' tables and figures, the command line
 
 ``conf`` holds the Hydra YAML.

@@ -23,7 +23,7 @@ one by one, raising ``AssertionError`` that names the first violation.
 6. every keyword parameter given a nonsense value ("abc") raises gyrolab's one-sentence
    ``ConfigError`` naming the parameter when gyrolab builds the force (parameters whose default
    is None only when ``params`` gives them);
-7. the compiled torque (traced from ``torque``, see ``gyrolab.plugins.compiled.plugin_torque``)
+7. the compiled torque (traced from ``torque``, see ``gyrolab.kernels.expression``)
    equals the Python torque; a torque that cannot be traced is reported as a warning, not a
    failure (it then runs with the Python integrators only).
 """
@@ -213,19 +213,25 @@ def _check_bad_parameters(cls: type, body: Any, where: str, params: dict[str, An
 def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, frames: np.ndarray) -> None:
     if force.compiled_terms() is not None:
         return  # a built-in form; the system's tests compare it with the Python right-hand side
-    from gyrolab.plugins.compiled import plugin_torque
+    from gyrolab.kernels import expression, model
+    from gyrolab.physics.vectors import cross
+
+    def torque(t: Any, y: np.ndarray) -> Any:  # y = (ω, γ, α), as the fixed point lays out its state
+        frame = np.empty((3, 3), dtype=object)
+        frame[0], frame[1], frame[2] = y[6:9], cross(y[3:6], y[6:9]), y[3:6]
+        return _call(force, y[0:3], frame, t)
 
     try:
-        traced = plugin_torque.compile_trace(plugin_torque.trace([force]), [force.name])
-    except plugin_torque.NotCompilable as exc:
+        expression.check_torques([force])
+        compiled = model.compile(model.trace(torque, 9, f"force {force.name}"))
+    except expression.NotCompilable as exc:
         warnings.warn(f"{cls.__name__} runs with the Python integrators only: {exc}", stacklevel=3)
         return
     import ctypes
 
-    kernel = ctypes.CFUNCTYPE(None, ctypes.c_double, *[ctypes.POINTER(ctypes.c_double)] * 3)(traced.address)
-    p = np.zeros(plugin_torque.FIRST_CONSTANT + len(traced.constants))
-    p[plugin_torque.INV_INERTIA:plugin_torque.INV_INERTIA + 3] = 1.0  # read back the torque itself, not I⁻¹ T
-    p[plugin_torque.FIRST_CONSTANT:] = traced.constants
+    address = int(compiled.params[model.TRACED_ADDRESS])
+    kernel = ctypes.CFUNCTYPE(None, ctypes.c_double, *[ctypes.POINTER(ctypes.c_double)] * 3)(address)
+    p = compiled.params
     ptr = ctypes.POINTER(ctypes.c_double)
     for k, (omega, frame) in enumerate(zip(omegas, frames)):
         y = np.concatenate([omega, frame[2], frame[0]])

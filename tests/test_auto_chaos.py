@@ -12,7 +12,7 @@ import pytest
 from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
 from gyrolab.physics.reference import fixed_point_reference
-from gyrolab.plugins.compiled import layout
+from gyrolab.kernels import layout
 
 SLOW_SPIN = ["initial=slow_spin"]
 CHAOTIC_TOP = ["initial.theta0=1", "initial.r0=2", "initial.p0=0.3", "initial.q0=-0.2"]
@@ -86,7 +86,7 @@ def test_the_tangent_growth_kernel_matches_the_variational_equations_integrated_
     # e^1 a growth estimate may be off by.
     from scipy.integrate import solve_ivp
 
-    from gyrolab.plugins.compiled import variational
+    from gyrolab.kernels import variational
 
     built = compose_scene(["integrator=taylor", *scene])
     p = np.array(built.compiled.params, dtype=float)
@@ -121,7 +121,7 @@ def _state_rhs(y, p):
 def test_the_tangent_growth_kernel_takes_the_steps_of_the_indicator_kernel():
     # auto.CHAOS_MARGIN is calibrated on the growth the MEGNO/FLI kernel gives (run_indicators_dop853): on a chaotic
     # scene any change of the steps moves it by up to e^±4, so the lean kernel must reproduce it exactly
-    from gyrolab.plugins.compiled import variational
+    from gyrolab.kernels import variational
 
     built = compose_scene(["integrator=taylor", *SLOW_SPIN, "time.end=300"])
     p = np.array(built.compiled.params, dtype=float)

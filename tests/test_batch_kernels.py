@@ -7,7 +7,7 @@ from scipy.integrate import solve_ivp
 from gyrolab import compose_scene
 from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.plugins.compiled import batch_dop853, batch_taylor
+from gyrolab.kernels import batch_dop853, batch_taylor
 
 SHORT = ["experiment=perf_reference", "time.end=2", "time.n_output=11"]
 SETTINGS = {"dop853_numba": ["integrator.rtol=1e-10", "integrator.atol=1e-10"], "taylor": ["integrator.tol=1e-10"]}
@@ -150,7 +150,7 @@ def test_a_failing_trajectory_is_marked_and_the_others_are_kept(integrator):
 def test_bad_requests_are_one_sentence_config_errors():
     scene = _scene("taylor")
     y0s = _starts(scene, 2)
-    # (taylor refuses only a time-dependent plugin torque: tests/test_plugin_taylor.py)
+    # (taylor refuses only a time-dependent plugin torque: tests/test_taylor_series.py)
     with pytest.raises(ConfigError, match="^times must be a non-empty 1-D array of finite, strictly increasing"):
         integrate_arrays(scene.compiled, scene.integrator, np.array([0.0, 1.0, 1.0]), y0s)
     with pytest.raises(ConfigError, match="^failures='skip' must be 'raise' or 'mark'$"):

@@ -9,8 +9,8 @@ import pytest
 
 from gyrolab import compose_scene
 from gyrolab.batch.integrate import integrate_arrays
-from gyrolab.plugins.compiled import batch_taylor, taylor
-from gyrolab.plugins.compiled.layout import N_Z
+from gyrolab.kernels import batch_taylor, taylor
+from gyrolab.kernels.layout import N_Z
 
 LANES = batch_taylor.LANES
 
@@ -104,7 +104,7 @@ def test_split_form_at_its_admission_bound_is_as_accurate_as_the_direct_form():
     2026-11-27: equal to three digits at 0.9, 9 and 90 × the bound; both errors are the fast spin's, the
     tolerance being relative to |ω|.)"""
     from gyrolab.physics.reference import fixed_point_reference
-    from gyrolab.plugins.compiled.layout import INERTIA, U_Z
+    from gyrolab.kernels.layout import INERTIA, U_Z
 
     scene = _scene(["time.end=0.2"])
     y0s = _starts(scene, LANES, seed=3)

@@ -18,7 +18,7 @@ from gyrolab import compose_scene
 from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.errors import ConfigError
 from gyrolab.analysis.chaos import indicator_outputs, megno_run, poincare_section, section_dataset
-from gyrolab.plugins.compiled import fixed_point, variational
+from gyrolab.kernels import fixed_point, variational
 
 BASE = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=1", "time.n_output=11", "output.euler_angles=false"]
 #: integrable bodies and torques (docs/stability_map.md cites the sources)

@@ -144,7 +144,7 @@ def test_taylor_steps_do_not_depend_on_how_the_run_is_cut_into_kernel_calls():
     """The integrator cuts a run into kernel calls by measured wall time (for progress), so where a call stops
     must not change a single step: one call over all outputs and calls stopping at arbitrary outputs give the
     same bits."""
-    from gyrolab.plugins.compiled import taylor
+    from gyrolab.kernels import taylor
 
     scene = compose_scene(["experiment=perf_reference", "integrator=taylor", "integrator.tol=1e-9", "time.end=20",
                            "time.n_output=201"])
@@ -175,7 +175,7 @@ def test_a_scene_with_a_plugin_traces_every_force_and_its_compiled_rhs_is_the_py
                                                                                           size):
     """A plugin (here magnetic without its built-in form) makes the scene trace all its torques, built-ins too;
     the plugin models' right-hand side (for the states ω, γ and ω, γ, α) must equal the Python one."""
-    from gyrolab.plugins.compiled import models
+    from gyrolab.kernels import models
     from gyrolab.plugins.forces.magnetic import Magnetic
 
     monkeypatch.setattr(Magnetic, "compiled_terms", lambda self: None)
@@ -183,7 +183,7 @@ def test_a_scene_with_a_plugin_traces_every_force_and_its_compiled_rhs_is_the_py
                            "force.magnetic.moment=[0.3,-0.2,0.5]", f"force.magnetic.direction={direction}", "output.euler_angles=false"])
     assert scene.system.initial_state().size == size
     compiled = scene.compiled
-    assert compiled.model == (models.FIXED_POINT_PLUGIN if size == 6 else models.FIXED_POINT_PLUGIN_ALPHA)
+    assert compiled.model == (models.TRACED if size == 6 else models.TRACED)
     assert not compiled.params[3:15].any()  # the packed built-in forms stay empty: their torques are traced
     rng = np.random.default_rng(12)
     for k in range(5):
@@ -198,7 +198,7 @@ def test_taylor_stops_with_one_sentence_when_its_step_cannot_advance_time():
     spacing is 2.2e-16 and the step ~1e-100) used to leave the kernel looping forever; it is a failure now,
     with dop853's status code, and the integrator says so in one sentence."""
     from gyrolab.errors import IntegrationError
-    from gyrolab.plugins.compiled import taylor
+    from gyrolab.kernels import taylor
     from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
     scene = compose_scene(["integrator=taylor", "time.end=2", "time.n_output=3"])

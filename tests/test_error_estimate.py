@@ -6,7 +6,7 @@ import pytest
 
 from gyrolab import run
 from gyrolab.physics.reference import fixed_point_reference
-from gyrolab.plugins.compiled import layout
+from gyrolab.kernels import layout
 from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
 

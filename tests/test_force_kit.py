@@ -174,7 +174,7 @@ def test_scene_turns_plugin_init_errors_and_a_missing_area_flag_into_one_sentenc
 SHORT = ["time.end=3", "time.n_output=31", "output.euler_angles=false"]
 
 
-def test_plugin_torque_runs_compiled_like_the_python_path(kit_forces):
+def test_expression_runs_compiled_like_the_python_path(kit_forces):
     overrides = ["force=[uniform_gravity,tilted,pulsed]", *SHORT]
     scene = compose_scene([*overrides, "integrator=dop853_numba"])
     assert scene.compiled is not None
@@ -227,8 +227,7 @@ def test_first_compile_of_a_form_is_logged_once_then_loaded_from_the_cache(tmp_p
     import logging
 
     from gyrolab.contracts import Force
-    from gyrolab.plugins import compiled
-    from gyrolab.plugins.compiled import plugin_torque
+    from gyrolab.kernels import compiler, expression, model
 
     class Once(Force):
         name = "once_only"
@@ -240,14 +239,17 @@ def test_first_compile_of_a_form_is_logged_once_then_loaded_from_the_cache(tmp_p
         def torque(self, omega, axes):
             return -0.25 * omega * omega[1] / 3.0  # a form no other test traces
 
-    monkeypatch.setattr(compiled, "kernel_cache_dir", lambda: str(tmp_path))
-    monkeypatch.setattr(plugin_torque, "_LOADED", {})
-    with caplog.at_level(logging.INFO, logger=plugin_torque.__name__):
-        first = plugin_torque.compile_trace(plugin_torque.trace([Once(None)]), ["once_only"])
+    def equations(t, y):
+        return Once(None).torque(y[0:3], (None, None, y[3:6]))
+
+    monkeypatch.setattr(compiler, "kernel_cache_dir", lambda: str(tmp_path))
+    monkeypatch.setattr(expression, "_LOADED", {})
+    with caplog.at_level(logging.INFO, logger=expression.__name__):
+        first = model.compile(model.trace(equations, 6, "force once_only"))
         assert "compiling force once_only, once" in caplog.text
         caplog.clear()
-        monkeypatch.setattr(plugin_torque, "_LOADED", {})  # a new process: the module and numba's cache reload
-        again = plugin_torque.compile_trace(plugin_torque.trace([Once(None)]), ["once_only"])
+        monkeypatch.setattr(expression, "_LOADED", {})  # a new process: the module and numba's cache reload
+        again = model.compile(model.trace(equations, 6, "force once_only"))
         assert "compiling" not in caplog.text
-    assert len(list((tmp_path / "forces").glob("gyrolab_force_*.py"))) == 1
-    np.testing.assert_array_equal(first.constants, again.constants)
+    assert len(list((tmp_path / "forces").glob("gyrolab_rhs_*.py"))) == 1
+    np.testing.assert_array_equal(first.params[1:-4], again.params[1:-4])

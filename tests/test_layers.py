@@ -20,8 +20,8 @@ SOURCES = {"pipeline": "gyrolab", "plugins": "gyrolab.plugins"}
 LAYERS = {
     "gyrolab.errors": 0,
     "gyrolab.physics": 1,
-    "gyrolab.contracts": 2,
-    "gyrolab.plugins.compiled": 3,
+    "gyrolab.kernels": 2,
+    "gyrolab.contracts": 3,
     "gyrolab.plugins.forces": 4,
     "gyrolab.plugins.systems": 4,
     "gyrolab.plugins.integrators": 5,
@@ -147,7 +147,7 @@ def test_hydra_private_api_behind_one_module():
 
 
 def test_the_compiled_parameter_array_is_read_by_name():
-    """The fixed-point model's parameter array is laid out in plugins/compiled/layout.py; code reads it by those
+    """The fixed-point model's parameter array is laid out in pipeline/kernels/layout.py; code reads it by those
     names (p[U_Z + 1]), never by bare numbers (p[10]) that silently break when the layout changes."""
     import io
     import re

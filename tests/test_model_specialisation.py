@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from gyrolab.contracts.integrator import CompiledModel
-from gyrolab.plugins.compiled import fixed_point, models
+from gyrolab.kernels import fixed_point, models
 
 INERTIA = np.array([2.0, 1.5, 1.0])
 
@@ -31,7 +31,7 @@ def _params(alpha: bool) -> np.ndarray:
 def test_form_of_each_compiled_model():
     assert models.form(CompiledModel(models.FIXED_POINT, _params(False))).id == models.FIXED_POINT
     assert models.form(CompiledModel(models.FIXED_POINT, _params(True))).id == models.FIXED_POINT_ALPHA
-    for plugin in (models.FIXED_POINT_PLUGIN, models.FIXED_POINT_PLUGIN_ALPHA):
+    for plugin in (models.TRACED, models.TRACED):
         assert models.form(CompiledModel(plugin, np.zeros(30))).id == plugin
     assert numba.typeof(models.FORMS[models.FIXED_POINT]) != numba.typeof(models.FORMS[models.FIXED_POINT_ALPHA])
 
@@ -75,7 +75,7 @@ _CHILD = r'''
 import json, sys
 import numpy as np
 from numba.core import event
-from gyrolab.plugins.compiled import fixed_point, models, plugin_taylor, rk4
+from gyrolab.kernels import fixed_point, models, taylor_series, rk4
 import numba
 
 p = fixed_point.pack(np.array([2.0, 1.5, 1.0]), [], False)
@@ -95,7 +95,7 @@ with event.install_recorder("numba:compile") as rec:
         series(form, p, T, 8, np.zeros((9, 3)))
 compiled = sorted({ev.data["dispatcher"].py_func.__qualname__ for _, ev in rec.buffer if "dispatcher" in ev.data})
 print(json.dumps({"compiled": compiled, "Y": Y.tolist(),
-                  "unused": [len(d.signatures) for d in (plugin_taylor.coefficients, fixed_point.taylor_alpha,
+                  "unused": [len(d.signatures) for d in (taylor_series.coefficients, fixed_point.taylor_alpha,
                                                           fixed_point._cauchy_cross, fixed_point._cauchy_pairs)],
                   "gamma": len(fixed_point.taylor_gamma.signatures)}))
 '''

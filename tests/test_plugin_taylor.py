@@ -1,4 +1,4 @@
-"""``taylor`` on plugin torques: Taylor coefficients propagated through the traced torque (plugin_taylor).
+"""``taylor`` on plugin torques: Taylor coefficients propagated through the traced torque (taylor_series).
 
 Every expected number is independent of the code under test: each operation's series, generated
 for a function of time and summed, must reproduce the function itself evaluated by the math
@@ -18,7 +18,8 @@ import pytest
 
 from gyrolab.contracts import Force
 from gyrolab.engine.scene import compose_scene, run
-from gyrolab.plugins.compiled import fixed_point, models, plugin_taylor, plugin_torque
+from gyrolab.kernels import expression, fixed_point, model as traced, models, taylor_series
+from gyrolab.plugins.systems.fixed_point import traced_model
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from tests.conftest import installed_distribution
 
@@ -44,15 +45,15 @@ class OfTime(Force):
 def series(f, t0, order=ORDER):
     """The generated kernel's coefficients 0..order of the three functions f(t) about t0 (rows).
 
-    The kernel fills the state's series: with the state 0, I = 0 and I⁻¹ = 1 (as parameters), ω's coefficient
-    k + 1 is the torque's coefficient k over k + 1.
+    The kernel fills the state's series: with the functions as ω's rates, ω's coefficient k + 1 is the functions'
+    coefficient k over k + 1.
     """
-    result = plugin_torque.trace([OfTime(f)])
-    address, columns = plugin_taylor.compile_taylor(result, ["of_time"])
+    m = traced.trace(lambda t, y: np.concatenate([OfTime(f).torque(None, None, t), np.zeros(3)]), 6, "of_time")
+    text, columns = taylor_series.source(m)
+    address = expression.load_generated(text, "gyrolab_taylor", "of_time (Taylor)").address
     call = _KERNEL(int(address))
-    p = np.zeros(plugin_torque.FIRST_CONSTANT + len(result.graph.constants))
-    p[plugin_torque.INV_INERTIA:plugin_torque.INV_INERTIA + 3] = 1.0
-    p[plugin_torque.FIRST_CONSTANT:] = result.graph.constants
+    p = np.zeros(traced.TRACED_FIRST_CONSTANT + len(m.constants) + 4)
+    p[traced.TRACED_FIRST_CONSTANT:-4] = m.constants
     Y = np.zeros((order + 2, 6))
     W = np.empty((order + 1) * int(columns))
     call(t0, order + 1, *[a.ctypes.data_as(ctypes.POINTER(ctypes.c_double)) for a in (Y, W, p)])
@@ -159,8 +160,8 @@ def test_drag_under_taylor_and_auto_is_the_exact_decay():
     finally:
         sys.path.pop(0)
     # A = B = C = 1: ω̇ = −c ω, ω(t) = ω0 exp(−c t) (the README's example plugin)
-    model = fixed_point.compiled_model(np.ones(3), [ViscousDrag(None, coefficient=0.3)], False)
-    assert plugin_taylor.ready(model)  # compiles the Taylor kernel (a scene does this when taylor is chosen)
+    model = traced_model(np.ones(3), [ViscousDrag(None, coefficient=0.3)], False)
+    assert taylor_series.ready(model)  # compiles the Taylor kernel (a scene does this when taylor is chosen)
     y0 = np.array([0.1, -0.05, 5.0, 0.0, 0.6, 0.8])
     t = np.linspace(0.0, 5.0, 11)
     y = Taylor(tol=1e-15).integrate(None, t, y0, None, model).y
@@ -188,9 +189,9 @@ def test_plugins_repeating_the_builtin_arithmetic_follow_the_builtin_trajectory(
     beta = next(f for f in system.forces if f.name == "newtonian")
     beta.axis, beta.required_axes = 1, frozenset({1})  # the gradient torque about β = γ × α: every packed form
     builtin = fixed_point.compiled_model(system.inertia, system.forces, system.carries_alpha)
-    plugin = fixed_point.compiled_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
-    assert (builtin.model, plugin.model, system.state_size) == (models.FIXED_POINT, models.FIXED_POINT_PLUGIN_ALPHA, 9)
-    assert plugin_taylor.ready(plugin)
+    plugin = traced_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
+    assert (builtin.model, plugin.model, system.state_size) == (models.FIXED_POINT, models.TRACED, 9)
+    assert taylor_series.ready(plugin)
     y0 = system.initial_state()
     runs = [Taylor(order=20, tol=1e-14).integrate(None, scene.times, y0, None, m).y for m in (builtin, plugin)]
     np.testing.assert_allclose(runs[1], runs[0], rtol=0, atol=1e-12)
@@ -223,7 +224,7 @@ def test_a_plugin_run_near_the_taylor_floor_keeps_its_error_estimate(centre):
     assert method.startswith("not available") and "'centre'" in method and "error_estimate_omega" not in floor
 
 
-def test_time_dependent_plugin_torque_under_taylor_against_the_equations_by_hand():
+def test_time_dependent_expression_under_taylor_against_the_equations_by_hand():
     """A torque that reads time, −0.1 sin(t) ω, under taylor: the series get the step's start time. Reference:
     Euler's equations I ω̇ = Iω × ω + T(t), γ̇ = γ × ω written out here, scipy DOP853 at rtol = atol = 1e-13."""
     class Pulse(Force):
@@ -236,14 +237,14 @@ def test_time_dependent_plugin_torque_under_taylor_against_the_equations_by_hand
             return -0.1 * np.sin(t) * omega
 
     inertia = np.array([1.0, 2.0, 3.0])
-    model = fixed_point.compiled_model(inertia, [Pulse()], False)
-    from gyrolab.plugins.compiled import taylor
+    model = traced_model(inertia, [Pulse()], False)
+    from gyrolab.kernels import taylor
 
     # the kernel called directly before ``ready`` compiled the Taylor kernel: a non-finite status, not a jump to 0
     status, _ = taylor.run(model.model, model.params, 8, 1e-10, np.linspace(0.0, 1.0, 3), np.empty((3, 6)), 1, 3,
                            np.zeros(1), np.ones(6), np.zeros(6), np.zeros(2, dtype=np.int64))
     assert status == taylor.NOT_FINITE
-    assert plugin_taylor.ready(model)
+    assert taylor_series.ready(model)
 
     def by_hand(t, y):
         w, g = y[:3], y[3:]
@@ -290,9 +291,9 @@ def _traced_reference():
     scene = compose_scene(REFERENCE)
     system = scene.system
     builtin = fixed_point.compiled_model(system.inertia, system.forces, system.carries_alpha)
-    plugin = fixed_point.compiled_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
-    assert (builtin.model, plugin.model) == (models.FIXED_POINT, models.FIXED_POINT_PLUGIN)
-    assert plugin_taylor.ready(plugin)
+    plugin = traced_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
+    assert (builtin.model, plugin.model) == (models.FIXED_POINT, models.TRACED)
+    assert taylor_series.ready(plugin)
     return scene, builtin, plugin
 
 
@@ -331,7 +332,8 @@ def test_traced_products_are_shared_as_the_builtin_shares_them():
     need the built-in's twelve Cauchy products per order (ω_y ω_z … for (Iω) × ω, γ_y γ_z … for γ × Iγ, six for
     γ × ω), not the plugin's fourteen as written (I_z γ_z · γ_y and I_y γ_y · γ_z are one product)."""
     scene = compose_scene(REFERENCE)
-    program = plugin_taylor._Program(plugin_torque.trace([Traced(f) for f in scene.system.forces]), 6)
+    plugin = traced_model(scene.system.inertia, [Traced(f) for f in scene.system.forces], False)
+    program = taylor_series._Program(traced.MODELS[int(plugin.params[0])])
     products = {tuple(sorted(program.operands[u].terms[0][0] for u in s.args)) for s in program.series if s.op == "mul"}
     state = {s.extra: i for i, s in enumerate(program.series) if s.op == "y"}
     w, g = [state[m] for m in range(3)], [state[m] for m in range(3, 6)]
@@ -346,12 +348,13 @@ import sys
 import numba
 import numpy as np
 from numba.core.runtime import rtsys
-from gyrolab.plugins.compiled import fixed_point, plugin_taylor
-plugin_taylor._STACK_DOUBLES = 0  # before anything compiles (a fresh kernel cache): W always on the heap
+from gyrolab.kernels import taylor_series
+from gyrolab.plugins.systems.fixed_point import traced_model
+taylor_series._STACK_DOUBLES = 0  # before anything compiles (a fresh kernel cache): W always on the heap
 sys.path.insert(0, sys.argv[1])
 from gyrolab_viscous_drag import ViscousDrag
-model = fixed_point.compiled_model(np.ones(3), [ViscousDrag(None, coefficient=0.3)], False)
-assert plugin_taylor.ready(model)
+model = traced_model(np.ones(3), [ViscousDrag(None, coefficient=0.3)], False)
+assert taylor_series.ready(model)
 
 
 @numba.njit
@@ -359,7 +362,7 @@ def series(p, y, order, times):
     T = np.zeros((order + 1, y.size))
     for _ in range(times):
         T[0] = y
-        plugin_taylor.coefficients(p, T, order, T, 0.0)
+        taylor_series.coefficients(p, T, order, T, 0.0)
     return T
 
 
@@ -380,7 +383,7 @@ print(*calls, float(np.max(np.abs(T[:, :3] - exact))))
 
 
 def test_series_work_array_on_the_heap_gives_the_exact_decay(tmp_path):
-    """Above plugin_taylor._STACK_DOUBLES the kernel's scratch rows live on numba's heap (allocated and freed per
+    """Above taylor_series._STACK_DOUBLES the kernel's scratch rows live on numba's heap (allocated and freed per
     call): forced here for every size (in a fresh kernel cache, so the stack path's cached code is not loaded),
     the series of drag on a spherical body are still those of ω0 exp(−c t), and every allocation is freed."""
     import os
@@ -419,10 +422,10 @@ def test_many_products_of_one_depth_under_taylor_match_scipy():
     the trajectory against scipy's DOP853 on the Python torque."""
     scene = compose_scene(["integrator=taylor", *SHORT])
     system = scene.system
-    model = fixed_point.compiled_model(system.inertia, [ManyProducts()], False)
-    program = plugin_taylor._Program(plugin_torque.trace([ManyProducts()]), 6)
-    assert sum(s.op == "mul" and s.depth == 1 for s in program.series) > 2 * plugin_taylor._GROUP
-    assert plugin_taylor.ready(model)
+    model = traced_model(system.inertia, [ManyProducts()], False)
+    program = taylor_series._Program(traced.MODELS[int(model.params[0])])
+    assert sum(s.op == "mul" and s.depth == 1 for s in program.series) > 2 * taylor_series._GROUP
+    assert taylor_series.ready(model)
     y0 = system.initial_state()
     got = Taylor(tol=1e-15).integrate(None, scene.times, y0, None, model).y
     force, inertia = ManyProducts(), system.inertia

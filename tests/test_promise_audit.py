@@ -9,7 +9,7 @@ import pytest
 
 from gyrolab import compose_scene
 from gyrolab.physics.reference import fixed_point_reference
-from gyrolab.plugins.compiled import layout
+from gyrolab.kernels import layout
 
 hy = pytest.importorskip("heyoka")
 

@@ -244,20 +244,20 @@ def test_first_progress_line_gives_no_estimate_only_a_measured_stretch_does(capl
 def test_compile_notes_reach_the_console_before_logging_is_configured(monkeypatch):
     """Issue 24 item 5: the preflight compiles a force plugin's torque before Hydra configures logging; its note
     "compiling force NAME, once" is shown then (Python would drop the INFO record), and only while unconfigured."""
-    from gyrolab.plugins.compiled import plugin_torque
+    from gyrolab.kernels import expression
 
-    assert plugin_torque.log.name in progress.COMPILE_LOGGERS   # the logger that writes the note
+    assert expression.log.name in progress.COMPILE_LOGGERS   # the logger that writes the note
     monkeypatch.setattr(logging.getLogger(), "handlers", [])     # as before Hydra configures logging
     screen = io.StringIO()
     with progress.compile_notes_on_console(screen):
-        plugin_torque.log.info("compiling %s, once (cached for later runs)", "force spin_damping")
+        expression.log.info("compiling %s, once (cached for later runs)", "force spin_damping")
         logging.getLogger("gyrolab.sweep").info("not a compile note")
-    plugin_torque.log.info("after the preflight: Hydra's handlers")
+    expression.log.info("after the preflight: Hydra's handlers")
     assert screen.getvalue() == "gyrolab: compiling force spin_damping, once (cached for later runs)\n"
-    assert not plugin_torque.log.handlers
+    assert not expression.log.handlers
 
     monkeypatch.setattr(logging.getLogger(), "handlers", [logging.NullHandler()])   # configured: left alone
     configured = io.StringIO()
     with progress.compile_notes_on_console(configured):
-        plugin_torque.log.info("compiling force x, once")
+        expression.log.info("compiling force x, once")
     assert configured.getvalue() == ""

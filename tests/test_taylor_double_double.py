@@ -21,8 +21,8 @@ import pytest
 from gyrolab.contracts import CompiledModel
 from gyrolab.engine.scene import compose_scene
 from gyrolab.errors import ConfigError
-from gyrolab.plugins.compiled import double_double as dd, models, taylor_dd
-from gyrolab.plugins.compiled.layout import (
+from gyrolab.kernels import double_double as dd, models, taylor_dd
+from gyrolab.kernels.layout import (
     CARRIES_ALPHA, GAMMA, GRADIENT, INERTIA, INV_INERTIA, LINEAR, N_PARAMS, N_X, N_Y, N_Z, OMEGA, U_X, U_Y, U_Z,
 )
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
@@ -353,7 +353,7 @@ def test_a_scene_in_double_double_runs_with_alpha_and_every_builtin_force_and_re
     assert ds.gamma_norm.attrs["max_abs_drift"] < 1e-15
 
 
-def test_a_compiled_plugin_torque_is_refused_in_double_double_naming_the_force():
+def test_a_compiled_expression_is_refused_in_double_double_naming_the_force():
     from gyrolab.contracts import Force
 
     class Drag(Force):
@@ -370,7 +370,7 @@ def test_a_compiled_plugin_torque_is_refused_in_double_double_naming_the_force()
         def rhs(self, t, y):
             raise AssertionError("not called")
 
-    model = CompiledModel(models.FIXED_POINT_PLUGIN, np.zeros(N_PARAMS + 4))
+    model = CompiledModel(models.TRACED, np.zeros(N_PARAMS + 4))
     taylor = Taylor(precision="double-double")
     # the scene asks before integrating (contract rule 8, C1) and puts the clause into its one sentence
     assert taylor.refusal(model, System()) == (
@@ -420,12 +420,12 @@ def test_the_one_call_samples_for_auto_equal_the_integrator(chaotic):
     np.testing.assert_array_equal(samples, Taylor(precision="double-double", tol=1e-26).integrate(
         None, t_out, y0, None, model).y)
     with pytest.raises(ConfigError, match="valid choices: integrator.precision=double"):
-        taylor_dd_samples(CompiledModel(models.FIXED_POINT_PLUGIN, p), 1e-26, t_out, y0)
+        taylor_dd_samples(CompiledModel(models.TRACED, p), 1e-26, t_out, y0)
     with pytest.raises(ConfigError, match="at least 1e-32"):
         taylor_dd_samples(model, 1e-33, t_out, y0)
 
 
-def test_the_scene_refuses_a_plugin_torque_in_double_double_before_integrating(tmp_path):
+def test_the_scene_refuses_a_expression_in_double_double_before_integrating(tmp_path):
     from pathlib import Path
 
     from tests.conftest import installed_distribution

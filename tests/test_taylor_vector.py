@@ -6,7 +6,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from gyrolab import compose_scene
-from gyrolab.plugins.compiled import fixed_point, models, taylor
+from gyrolab.kernels import fixed_point, models, taylor
 
 EXTENDED = np.longdouble
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from gyrolab.plugins.compiled import vector_width
+from gyrolab.kernels import vector_width
 
 
 @pytest.mark.parametrize("features, width", [
@@ -40,7 +40,7 @@ def test_host_width_agrees_with_the_kernel_cpu_flags():
 
 
 def test_lane_attributes_name_the_compiled_lanes():
-    from gyrolab.plugins.compiled.batch_taylor import LANES
+    from gyrolab.kernels.batch_taylor import LANES
 
     record = vector_width.lane_attributes()
     assert record["batch_lanes"] == LANES == max(4, vector_width.host_vector_doubles())

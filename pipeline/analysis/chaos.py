@@ -1,7 +1,7 @@
 """Chaos indicators of the heavy body about a fixed point: MEGNO, FLI, nutation deviation, Poincaré sections.
 
 The indicators come from the variational equations integrated with the state in a compiled batch kernel
-(``gyrolab.plugins.compiled.variational``: analytic Jacobian; fixed-step RK4 by blocks of trajectories, or adaptive
+(``gyrolab.kernels.variational``: analytic Jacobian; fixed-step RK4 by blocks of trajectories, or adaptive
 DOP853 one trajectory per thread; parallel over trajectories):
 
 * MEGNO ⟨Y⟩ (Cincotta & Simó 2000, A&AS 147, 205): the time mean of Y(t) = (2/t) ∫₀ᵗ s δ̇·δ/δ·δ ds.
@@ -37,7 +37,7 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
     A state that carries the fixed horizontal axis α (9 components) is accepted when no torque depends on α:
     (ω, γ) is then a closed system and α (the precession angle's axis) does not enter the indicators.
     """
-    from gyrolab.plugins.compiled import fixed_point, layout, models
+    from gyrolab.kernels import fixed_point, layout, models
 
     if compiled is None or compiled.model != models.FIXED_POINT:
         raise ConfigError("chaos indicators need the fixed-point system with built-in torques only "
@@ -89,7 +89,7 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
     ``final_state`` (trajectories, 6) and ``failed`` (trajectories,) True where the trajectory became
     non-finite (its values are then NaN).
     """
-    from gyrolab.plugins.compiled import variational
+    from gyrolab.kernels import variational
     from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
 
     y0, P = _model_arrays(compiled, y0s, params)
@@ -143,7 +143,7 @@ def poincare_section(compiled: Any, y0: np.ndarray, t_end: float, step: float, l
     Crossings are found on the RK4 steps (step ``step``) and located by cubic Hermite interpolation.
     Returns ``t``, ``state`` (crossings, 6), ``phi`` (rad) and ``r`` (ω3).
     """
-    from gyrolab.plugins.compiled import variational
+    from gyrolab.kernels import variational
 
     y, P = _model_arrays(compiled, np.atleast_2d(y0), None if params is None else np.atleast_2d(params))
     if not (np.isfinite(t_end) and t_end > 0 and np.isfinite(step) and step > 0):

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.plugins.compiled import kernel
+from gyrolab.kernels.compiler import kernel
 
 ORDER = 24
 TOL = 1e-17
@@ -146,7 +146,7 @@ class FixedPointModel:
     @classmethod
     def from_system(cls, system) -> FixedPointModel:
         compiled = system.compiled_model()
-        from gyrolab.plugins.compiled import layout, models
+        from gyrolab.kernels import layout, models
 
         if compiled is None or compiled.model != models.FIXED_POINT:  # the built-in torque forms only
             raise ConfigError("periodic orbits need forces with compiled forms; valid forces: uniform_gravity, newtonian")

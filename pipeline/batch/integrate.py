@@ -62,7 +62,7 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
         Shape (trajectories, state size): one initial state per row, finite.
     params : numpy.ndarray, optional
         Shape (trajectories, n): replaces the compiled model's parameters per trajectory (see
-        ``gyrolab.plugins.compiled.fixed_point.pack``); only with a compiled batch kernel.
+        ``gyrolab.kernels.fixed_point.pack``); only with a compiled batch kernel.
 
     Returns
     -------

@@ -128,7 +128,7 @@ def _drifts(system: Any, y: np.ndarray) -> dict[str, tuple[np.ndarray, dict[str,
 
 def _compiled_reductions(compiled: Any, system: Any, size: int) -> bool:
     """The compiled reductions cover the fixed-point model with the packed torque forms only."""
-    from gyrolab.plugins.compiled import fixed_point, models
+    from gyrolab.kernels import fixed_point, models
 
     return compiled.model == models.FIXED_POINT and compiled.params.size == fixed_point.N_PARAMS \
         and size in (6, 9) and hasattr(system, "invariant_values")

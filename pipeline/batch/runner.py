@@ -229,7 +229,7 @@ def lane_record(integrator: type, settings: Settings) -> dict[str, int]:
     """The lane width a vectorised batch kernel was compiled for and the CPU's vector width (empty otherwise)."""
     if settings.output == "indicator" or not integrator.supports(BATCH_KERNEL) or not integrator.supports(VECTOR_LANES):
         return {}
-    from gyrolab.plugins.compiled.vector_width import lane_attributes
+    from gyrolab.kernels.vector_width import lane_attributes
 
     return lane_attributes()
 

@@ -3,28 +3,16 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
+
+from gyrolab.kernels.layout import CompiledTerms
 
 #: Body components of the system's reference-frame axes, indexed 0, 1, 2.
 #: For ``fixed_point`` the frame is the fixed space frame (X, Y, Z = vertical);
 #: an entry is ``None`` when the scene does not carry that axis.
 Axes = tuple[np.ndarray | None, np.ndarray | None, np.ndarray | None]
-
-
-@dataclass
-class CompiledTerms:
-    """A torque written in the two forms compiled kernels evaluate (model units).
-
-    ``linear[i]`` = u adds u × e_i; ``gradient[i]`` = N adds N e_i × I e_i, where e_i
-    is the body-frame image of reference axis i. Uniform gravity, the Newtonian
-    centre and a uniform magnetic field are all of this form.
-    """
-
-    linear: dict[int, np.ndarray] = field(default_factory=dict)
-    gradient: dict[int, float] = field(default_factory=dict)
 
 
 class Force(ABC):

@@ -10,17 +10,10 @@ from typing import Any, ClassVar
 import numpy as np
 
 from gyrolab.contracts.integrator_rules import checked
+from gyrolab.kernels.model import CompiledModel
 
 RightHandSide = Callable[[float, np.ndarray], np.ndarray]
 ProgressCallback = Callable[[float], None]
-
-
-@dataclass(frozen=True)
-class CompiledModel:
-    """A system in the compiled kernels' form: a model id (``gyrolab.plugins.compiled.models``) and its parameters."""
-
-    model: int
-    params: np.ndarray
 
 
 @dataclass

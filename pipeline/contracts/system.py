@@ -37,11 +37,16 @@ class System(ABC):
        (``invariants``), which are exactly those every force preserves.
     5. ``attributes()`` describes the system's parameters and initial state
        for the dataset; ``title()`` names the scene in a few words for figures.
-    6. Optionally, ``compiled_model()`` returns the system (with its forces)
-       in the compiled kernels' form, or None when some part has none; the
-       compiled integrators need it. When it returns None it sets
-       ``compile_error`` to one sentence saying why (the scene and ``--batch``
-       quote it when a compiled integrator is asked for); None: no reason known.
+    6. ``compiled_model()`` returns the system (with its forces) in the
+       compiled kernels' form, which the compiled integrators (``taylor``,
+       ``dop853_numba``, ``rk4_numba``, ``gyrolab batch``) run. The default
+       traces ``rhs`` once on symbols (``gyrolab.kernels.model``): a system
+       whose ``rhs`` is numpy arithmetic without branches on the state gets
+       every compiled kernel without writing one. When it cannot be traced it
+       returns None and sets ``compile_error`` to one sentence saying why (the
+       scene and ``gyrolab batch`` quote it when a compiled integrator is
+       asked for). Override it to return None for a system that must not be
+       compiled.
     7. Optionally, ``invariant_values(y)`` returns each monitored invariant
        (``invariants``) along states of shape (..., state size), vectorised
        over any leading dimensions; ``--batch`` (``gyrolab.batch.outputs``)
@@ -105,8 +110,14 @@ class System(ABC):
         return {}
 
     def compiled_model(self) -> CompiledModel | None:
-        """The system in compiled form, or None (then only Python integrators run it)."""
-        return None
+        """Rule 6: the system compiled from its traced ``rhs``, or None (then only Python integrators run it)."""
+        from gyrolab.kernels import model
+
+        try:
+            return model.compiled_system(self)
+        except model.NotCompilable as exc:
+            self.compile_error = str(exc)
+            return None
 
     def reference_frame(self, y: np.ndarray) -> np.ndarray | None:
         """Rule 9: rows α, β, γ (body components of the reference axes) at state ``y``, or None."""

@@ -93,7 +93,7 @@ def companion(integrator: Any, has_compiled: bool) -> Companion | None:
     """The more accurate run that measures ``integrator``'s error (its ``more_accurate``, rule 9 of the contract;
     else the compiled Taylor method at its floor when the scene has a compiled model; else, for a run that is itself
     the double-precision Taylor method near that floor, the Taylor method in double-double), or None."""
-    from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+    from gyrolab.kernels.taylor_dd import MIN_TOL
     from gyrolab.plugins.integrators.compiled_solvers import DOUBLE_DOUBLE, Taylor
 
     taylor = _double_taylor(integrator) if has_compiled else None
@@ -110,7 +110,7 @@ def companion(integrator: Any, has_compiled: bool) -> Companion | None:
     # more closely than either agrees with the truth (benchmarks/promise_audit.py: auto at accuracy 1e-12 chose tol
     # 1.5e-16, the stand-in differed from it by 1.7e-14 where both were 2.1e-12 from the real128 answer, and the
     # broken prediction went unseen). Double-double has no such round-off.
-    from gyrolab.plugins.compiled.taylor import MAX_ORDER
+    from gyrolab.kernels.taylor import MAX_ORDER
 
     tol = max(taylor.tol / TIGHTER, MIN_TOL)
     double_tol = max(taylor.tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
@@ -230,16 +230,10 @@ def _unavailable(why: str) -> Comparison:
 
 
 def rounding_moved(model: Any) -> Any:
-    """``model`` with each parameter the compiled model derives by rounding — 1/I (``layout.INV_INERTIA``) — moved
-    by one unit in the last place (up, down, up): a run with it differs from one with the rounded values as one
-    with the exact values would. Other parameters are the config's own doubles, exact for the reference too."""
-    from gyrolab.contracts.integrator import CompiledModel
-    from gyrolab.plugins.compiled.layout import INV_INERTIA
+    """``model`` with the numbers it rounded moved by one unit in the last place (``kernels.model.rounding_moved``)."""
+    from gyrolab.kernels.model import rounding_moved as moved
 
-    params = np.array(model.params, dtype=float)
-    for k, toward in enumerate((np.inf, -np.inf, np.inf)):
-        params[INV_INERTIA + k] = np.nextafter(params[INV_INERTIA + k], toward)
-    return CompiledModel(model.model, params)
+    return moved(model)
 
 
 def _double_taylor(integrator: Any) -> Any:

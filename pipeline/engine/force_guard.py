@@ -9,7 +9,7 @@ returns. :class:`GuardedRhs` makes each of these one ``IntegrationError`` senten
 * every call checks that the derivative is finite (one vectorised test, ~1 µs) and turns any
   exception into a sentence; on a failure the state is inspected again to name the force at fault.
 
-The compiled path does not call the Python torque (it runs the traced one, ``plugin_torque``); a
+The compiled path does not call the Python torque (it runs the traced one, ``expression``); a
 torque that cannot be traced runs here.
 """
 

@@ -25,7 +25,7 @@ _bars_allowed = True
 
 
 #: loggers whose INFO notes say that something is being compiled ("compiling force NAME, once")
-COMPILE_LOGGERS = ("gyrolab.plugins.compiled.plugin_torque",)
+COMPILE_LOGGERS = ("gyrolab.kernels.expression",)
 
 
 @contextlib.contextmanager

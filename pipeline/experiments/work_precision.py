@@ -78,7 +78,7 @@ def _final(ds: xr.Dataset) -> np.ndarray:
 def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
     """Final (ω, γ) of the scene from the most accurate reference available, and its name."""
     compiled = scene.system.compiled_model()
-    from gyrolab.plugins.compiled import layout, models
+    from gyrolab.kernels import layout, models
 
     if compiled is None or compiled.model != models.FIXED_POINT:  # the built-in torque forms only
         raise ConfigError("work_precision needs a scene whose forces have compiled forms (for its reference run)")

@@ -12,7 +12,7 @@ aligns with the most expanding one within a few Lyapunov times on a chaotic moti
 
 Two ways to follow δ, the cheapest that applies:
 
-* the variational equations (``plugins/compiled/variational.py``: the analytic Jacobian of the fixed-point model with
+* the variational equations (``pipeline/kernels/variational.py``: the analytic Jacobian of the fixed-point model with
   torques about the vertical, compiled DOP853) — one compiled call over the span;
 * a shadow pair for any other model: the trajectory and a companion started ``SHADOW_OFFSET`` away, integrated
   by the given method chunk by chunk and renormalised after each chunk (Benettin et al. 1980), so the
@@ -88,7 +88,7 @@ def amplification(compiled: Any, fun: Any, y0: np.ndarray, t0: float, t_pilot: f
 def _variational(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float) -> tuple[float, float] | None:
     if compiled is None:
         return None
-    from gyrolab.plugins.compiled import layout, models, variational
+    from gyrolab.kernels import layout, models, variational
 
     if compiled.model != models.FIXED_POINT or layout.torques_on_horizontal_axes(compiled.params):
         return None  # the analytic Jacobian covers the built-in torques about the vertical only

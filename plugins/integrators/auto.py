@@ -181,7 +181,7 @@ class Auto(Integrator):
             from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
 
             if self._taylor is None:
-                from gyrolab.plugins.compiled.plugin_taylor import ready
+                from gyrolab.kernels.taylor_series import ready
 
                 self._taylor = ready(compiled)
             # a compiled model without Taylor coefficients: compiled DOP853 instead
@@ -194,7 +194,7 @@ class Auto(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from gyrolab.plugins.compiled.taylor import order_for
+        from gyrolab.kernels.taylor import order_for
 
         start = time.perf_counter()
         t_out = np.asarray(t_out, dtype=float)
@@ -319,7 +319,7 @@ class Auto(Integrator):
         tolerance); the round-off is double precision's estimate scaled by the ratio of the two unit round-offs."""
         if compiled is None:
             return None
-        from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+        from gyrolab.kernels.taylor_dd import MIN_TOL
         from gyrolab.plugins.integrators.compiled_solvers import DOUBLE_DOUBLE, Taylor, TaylorDoubleDouble
 
         if TaylorDoubleDouble.refusal(compiled, self.system) is not None:
@@ -336,7 +336,7 @@ class Auto(Integrator):
     def _series(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                 start: float) -> Solution | None:
         """The first regime whose analytic series is predicted to meet the accuracy on this scene, or None."""
-        from gyrolab.plugins.compiled.models import FIXED_POINT
+        from gyrolab.kernels.models import FIXED_POINT
 
         if self.system is None or compiled is None or t_out[0] != 0.0 or compiled.model != FIXED_POINT:
             return None  # the regimes' series describe the built-in torques only
@@ -611,7 +611,7 @@ def _fast(function: Any, compiled: CompiledModel | None) -> Any:
     if compiled is None:
         return function
     if function.__name__ not in _COMPILED:
-        from gyrolab.plugins.compiled import kernel
+        from gyrolab.kernels.compiler import kernel
 
         _COMPILED[function.__name__] = kernel(function)
     return _COMPILED[function.__name__]

@@ -6,10 +6,10 @@ The compiled kernels run in parallel over trajectories (``numba.prange``):
   other compiled models one trajectory per thread.
 - DOP853 (``dop853_numba``): adaptive, each trajectory with its own step control (scipy's controller, as the
   single run); fixed-point (ω, γ) states by blocks of lanes vectorised across trajectories
-  (``plugins/compiled/batch_dop853.py``), other models one trajectory per thread.
+  (``pipeline/kernels/batch_dop853.py``), other models one trajectory per thread.
 - Taylor (``taylor``): adaptive, each trajectory with the single run's order and step rule; fixed-point (ω, γ)
   states by lanes of one vector register (8 on AVX-512, 4 on AVX2) vectorised across trajectories
-  (``plugins/compiled/batch_taylor.py``), other models one trajectory per thread.
+  (``pipeline/kernels/batch_taylor.py``), other models one trajectory per thread.
 
 Each function is an integrator's ``integrate_batch``: the arrays come validated from
 ``gyrolab.batch.integrate.integrate_arrays``.
@@ -31,7 +31,7 @@ _REASONS = {1: "its step fell below the spacing of floating-point numbers", 2: "
 def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
               failures: str) -> BatchSolution:
     """Fixed-step RK4 with the fewest equal steps no longer than ``step`` in each output interval."""
-    from gyrolab.plugins.compiled import models, rk4
+    from gyrolab.kernels import models, rk4
     from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
 
     start = time.perf_counter()
@@ -51,10 +51,10 @@ def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.n
 def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
                  failures: str) -> BatchSolution:
     """The Taylor method at ``integrator.order`` and ``integrator.tol`` (``Taylor``'s settings)."""
-    from gyrolab.plugins.compiled import batch_taylor, models, plugin_taylor
+    from gyrolab.kernels import batch_taylor, models, taylor_series
 
     def kernel(out: np.ndarray, steps: np.ndarray, status: np.ndarray) -> None:
-        if not plugin_taylor.ready(compiled, P):
+        if not taylor_series.ready(compiled, P):
             raise ConfigError(f"integrator {integrator.name} has no Taylor coefficients for this compiled model; "
                               f"valid choices for this model: {_batch_alternatives(compiled)}")
         if blockable(compiled, y0s.shape[1]):
@@ -69,7 +69,7 @@ def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
 def dop853_batch(integrator: object, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
                  failures: str) -> BatchSolution:
     """DOP853 with ``integrator.rtol``, ``atol`` and ``max_step`` (scipy's step control)."""
-    from gyrolab.plugins.compiled import batch_dop853, models
+    from gyrolab.kernels import batch_dop853, models
 
     def kernel(out: np.ndarray, steps: np.ndarray, status: np.ndarray) -> None:
         count, size = y0s.shape
@@ -119,6 +119,6 @@ def require_finite_out(out: np.ndarray) -> None:
 
 def blockable(compiled: CompiledModel, size: int) -> bool:
     """The block kernels cover the fixed-point model with state (ω, γ)."""
-    from gyrolab.plugins.compiled import models
+    from gyrolab.kernels import models
 
     return compiled.model == models.FIXED_POINT and size == 6

@@ -150,7 +150,7 @@ class DOP853Numba(Tolerances, Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from gyrolab.plugins.compiled import dop853, models
+        from gyrolab.kernels import dop853, models
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
@@ -199,7 +199,7 @@ class RK4Numba(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from gyrolab.plugins.compiled import models, rk4
+        from gyrolab.kernels import models, rk4
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
@@ -221,7 +221,7 @@ class RK4Numba(Integrator):
 
 
 class Taylor(Integrator):
-    """Taylor series method (``gyrolab.plugins.compiled.taylor``): order and step from the tolerance.
+    """Taylor series method (``gyrolab.kernels.taylor``): order and step from the tolerance.
 
     ``order=None`` (the default) takes Jorba and Zou's optimal order for ``tol``; an explicit order
     overrides it. Calls into the kernel are sized by wall time (``_Chunks``): a run of a few
@@ -236,9 +236,9 @@ class Taylor(Integrator):
 
     @classmethod
     def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
-        from gyrolab.plugins.compiled import plugin_taylor
+        from gyrolab.kernels import taylor_series
 
-        if plugin_taylor.ready(compiled):   # (compiles a traced torque's Taylor kernel, once)
+        if taylor_series.ready(compiled):   # (compiles a traced torque's Taylor kernel, once)
             return None
         named = f"system {system.name!r}'s" if system is not None else "this"
         return f"has no Taylor coefficients for {named} compiled model"
@@ -254,12 +254,12 @@ class Taylor(Integrator):
         return super().__new__(cls)
 
     def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = "double") -> None:
-        from gyrolab.plugins.compiled.taylor import MAX_ORDER, MIN_ORDER, order_for
+        from gyrolab.kernels.taylor import MAX_ORDER, MIN_ORDER, order_for
 
         self.precision = _taylor_precision(precision)
         self.tol = as_number(tol, "integrator.tol", positive=True)
         if self.precision == DOUBLE_DOUBLE:
-            from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+            from gyrolab.kernels.taylor_dd import MIN_TOL
 
             if self.tol < MIN_TOL:
                 raise ConfigError(f"integrator.tol={tol!r} is below double-double's resolution; with "
@@ -273,9 +273,10 @@ class Taylor(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from gyrolab.plugins.compiled import models, taylor
+        from gyrolab.kernels import models, taylor, taylor_series
 
         start = time.perf_counter()
+        taylor_series.ready(compiled)  # a traced model's series kernel, compiled on first need (once: then a test)
         form = models.form(compiled)  # the kernel compiles this model's step only
         t_out, y, out = _outputs(t_out, y0)
         state = np.array([t_out[0]])
@@ -323,20 +324,18 @@ def _taylor_precision(precision: Any) -> str:
 
 class TaylorDoubleDouble(Taylor):
     """``Taylor(precision="double-double")`` (``integrator=taylor integrator.precision=double-double``): the Taylor
-    method in double-double arithmetic (``gyrolab.plugins.compiled.taylor_dd``, ≈ 32 digits), same settings,
-    order rule, chunks and progress as ``Taylor``. Capabilities: the compiled model only — built-in torque forms
-    (a traced plugin torque is refused, naming the force), no time-dependent forces, no batch kernel (``--batch``
-    runs one ``integrate`` per point, each exactly a single run)."""
+    method in double-double arithmetic (``gyrolab.kernels.taylor_dd``, ≈ 32 digits), same settings,
+    order rule, chunks and progress as ``Taylor``. Capabilities: the compiled model only — the fixed point's
+    hand-written kernels and every traced model whose equations are rational in the state (``series_dd``: the
+    orbiting gyrostat, a polynomial plugin torque; a transcendental function of the state is refused, naming it),
+    time-dependent ones too; no batch kernel (``--batch`` runs one ``integrate`` per point, each exactly a single
+    run)."""
 
-    capabilities = frozenset({COMPILED_MODEL})
+    capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT})
 
     @classmethod
     def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
-        from gyrolab.plugins.compiled import models
-
-        if compiled.model == models.FIXED_POINT:
-            return None
-        return _double_double_clause(getattr(system, "forces", None))
+        return _double_double_refusal_clause(compiled, system)
 
     integrate_batch = Integrator.integrate_batch  # no batch kernel
 
@@ -345,7 +344,7 @@ class TaylorDoubleDouble(Taylor):
         return _taylor_double_double(self, fun, t_out, y0, progress, compiled)
 
     def more_accurate(self, factor: float):
-        from gyrolab.plugins.compiled.taylor_dd import MIN_TOL
+        from gyrolab.kernels.taylor_dd import MIN_TOL
 
         tol = self.tol / factor
         if tol < MIN_TOL:
@@ -356,13 +355,12 @@ class TaylorDoubleDouble(Taylor):
 
 def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                           progress: ProgressCallback | None, compiled: CompiledModel) -> Solution:
-    """``Taylor.integrate`` in double-double (``gyrolab.plugins.compiled.taylor_dd``): the state carried in
+    """``Taylor.integrate`` in double-double (``gyrolab.kernels.taylor_dd``): the state carried in
     double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded to
-    double. The initial state is a double, hence exact; a compiled plugin torque is refused."""
-    from gyrolab.plugins.compiled import models, taylor, taylor_dd
+    double. The initial state is a double, hence exact."""
+    from gyrolab.kernels import taylor, taylor_dd
 
-    if compiled.model != models.FIXED_POINT:
-        raise _double_double_refusal(fun)
+    _ready_for_double_double(compiled)
     start = time.perf_counter()
     t_out, y, out = _outputs(t_out, y0)
     low = np.zeros(len(y))  # the state's low parts
@@ -373,7 +371,7 @@ def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray,
     for first, stop in _Chunks(len(t_out)):
         if reached >= stop:
             continue  # a long step already filled this chunk's outputs
-        status, reached = taylor_dd.run(compiled.params, method.order, method.tol, t_out, out, no_low, reached, stop,
+        status, reached = taylor_dd.run(compiled.model, compiled.params, method.order, method.tol, t_out, out, no_low, reached, stop,
                                         state, y, low, stats)
         if status != taylor.OK:
             raise _taylor_failure(status, state[0])
@@ -387,45 +385,49 @@ def taylor_dd_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0
                       order: int | None = None) -> np.ndarray:
     """``taylor_samples`` in double-double: the states at ``t_out`` (rounded to double) of the double-double Taylor
     method at ``tol`` (≥ ``taylor_dd.MIN_TOL``) and ``order`` (None: its optimal order), in one call into the
-    kernel, for a method choosing its setting from short runs (``auto``'s pilot). Built-in torque forms only
-    (a plugin model raises ConfigError); a failed step raises IntegrationError."""
-    from gyrolab.plugins.compiled import models, taylor, taylor_dd
+    kernel, for a method choosing its setting from short runs (``auto``'s pilot). A model double-double cannot run
+    raises ConfigError; a failed step raises IntegrationError."""
+    from gyrolab.kernels import taylor, taylor_dd
 
-    if compiled.model != models.FIXED_POINT:
-        raise _double_double_refusal(None)
+    _ready_for_double_double(compiled)
     if not tol >= taylor_dd.MIN_TOL:
         raise ConfigError(f"tol={tol!r} is below double-double's resolution; it must be at least {taylor_dd.MIN_TOL:g}")
     t_out, y, out = _outputs(t_out, y0)
     state = np.array([t_out[0]])
     order = taylor.order_for(tol) if order is None else order
-    status, _ = taylor_dd.run(compiled.params, order, tol, t_out, out, np.empty((0, len(y))), 1, len(t_out), state,
+    status, _ = taylor_dd.run(compiled.model, compiled.params, order, tol, t_out, out, np.empty((0, len(y))), 1, len(t_out), state,
                               y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
     if status != taylor.OK:
         raise _taylor_failure(status, state[0])
     return out
 
 
-def _double_double_clause(forces: list | None) -> str:
-    """Why double-double cannot run a traced plugin torque, naming the plugin forces among ``forces`` (if known)."""
-    plugins = [force.name for force in forces or [] if force.compiled_terms() is None]
-    what = (f"force {', '.join(repr(name) for name in plugins)} is a compiled plugin torque" if plugins
-            else "this model has a compiled plugin torque")
-    return (f"in double-double precision evaluates the fixed-point model's built-in torque forms only (uniform_gravity, "
-            f"newtonian, magnetic), and {what} (integrator.precision=double runs it)")
+def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -> str | None:
+    """None when double-double can run ``compiled`` (compiling a traced model's series on first need), else why."""
+    from gyrolab.kernels import models, series_dd
+    from gyrolab.kernels.expression import NotCompilable
+
+    if compiled.model == models.FIXED_POINT:
+        return None
+    try:
+        series_dd.ready(compiled)
+    except NotCompilable as exc:
+        named = f"system {system.name!r}" if system is not None else "this model"
+        return f"in double-double precision cannot run {named}: {exc}"
+    return None
 
 
-def _double_double_refusal(fun: RightHandSide | None) -> ConfigError:
-    """The sentence refusing a compiled plugin torque in double-double, naming the force when the right-hand side
-    is a system's bound method (as the scene passes it)."""
-    clause = _double_double_clause(getattr(getattr(fun, "__self__", None), "forces", None))
-    return ConfigError(f"integrator 'taylor' {clause}; valid choices: integrator.precision=double")
+def _ready_for_double_double(compiled: CompiledModel) -> None:
+    clause = _double_double_refusal_clause(compiled)
+    if clause is not None:
+        raise ConfigError(f"integrator 'taylor' {clause}")
 
 
 def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: np.ndarray) -> np.ndarray:
     """The states at ``t_out`` of the Taylor method at ``tol`` (its optimal order), in one call into the kernel:
     for runs over a few periods inside another method (``auto``'s screen), which need neither progress nor
     statistics (``Taylor.integrate``'s chunks and records cost ~10 µs more, a tenth of the screen)."""
-    from gyrolab.plugins.compiled import models, taylor
+    from gyrolab.kernels import models, taylor
 
     t_out, y, out = _outputs(t_out, y0)
     state = np.array([t_out[0]])
@@ -438,7 +440,7 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
 
 def _taylor_failure(status: int, t: float) -> IntegrationError:
     """The one-sentence error for a Taylor kernel's non-OK ``status``, stopped at time ``t``."""
-    from gyrolab.plugins.compiled import taylor
+    from gyrolab.kernels import taylor
 
     if status == taylor.TOO_SMALL_STEP:
         return IntegrationError(f"taylor's step fell below the spacing of floating-point numbers near t={t:.6g} "
@@ -447,7 +449,7 @@ def _taylor_failure(status: int, t: float) -> IntegrationError:
 
 
 class LiePoisson(Integrator):
-    """Structure-preserving splitting of the fixed-point system (see ``gyrolab.plugins.compiled.lie_poisson``)."""
+    """Structure-preserving splitting of the fixed-point system (see ``gyrolab.kernels.lie_poisson``)."""
 
     name = "lie_poisson"
     adaptive = False
@@ -457,7 +459,7 @@ class LiePoisson(Integrator):
 
     @classmethod
     def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
-        from gyrolab.plugins.compiled import models
+        from gyrolab.kernels import models
 
         if compiled.model == models.FIXED_POINT:
             return None
@@ -476,7 +478,7 @@ class LiePoisson(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from gyrolab.plugins.compiled import lie_poisson, models
+        from gyrolab.kernels import lie_poisson, models
 
         if compiled.model != models.FIXED_POINT:
             raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian with the built-in torque "

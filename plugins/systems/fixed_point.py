@@ -100,15 +100,7 @@ class FixedPoint(System):
         return np.array([alpha, np.cross(gamma, alpha), gamma])
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
-        omega = y[0:3]
-        axes = self._axes(y)
-        torque = cross(self.inertia * omega, omega)
-        for force in self.forces:
-            torque = torque + (force.torque(omega, axes, t) if force.time_dependent else force.torque(omega, axes))
-        parts = [torque / self.inertia, cross(axes[2], omega)]
-        if self.carries_alpha:
-            parts.append(cross(axes[0], omega))
-        return np.concatenate(parts)
+        return euler_poisson(t, y, self.inertia, self.forces, self.carries_alpha, self.needs_beta)
 
     # -- invariants ------------------------------------------------------------
     @property
@@ -189,14 +181,10 @@ class FixedPoint(System):
         return attrs
 
     def compiled_model(self) -> CompiledModel | None:
-        """The compiled model, or None when a torque cannot be compiled (``compile_error`` then says why)."""
-        from gyrolab.plugins.compiled import fixed_point, plugin_torque  # numba only when a compiled integrator runs
+        """The hand-written kernels' model for built-in torque forms; otherwise the equations traced (``System``)."""
+        from gyrolab.kernels import fixed_point
 
-        try:
-            return fixed_point.compiled_model(self.inertia, self.forces, self.carries_alpha)
-        except plugin_torque.NotCompilable as exc:
-            self.compile_error = str(exc)
-            return None
+        return fixed_point.compiled_model(self.inertia, self.forces, self.carries_alpha) or super().compiled_model()
 
     def title(self) -> str:
         nd = self.body.nondimensional()
@@ -204,6 +192,38 @@ class FixedPoint(System):
         p, q, r = self.initial.omega
         return (f"body about a fixed point, a={nd['a']:.4g}, b={nd['b']:.4g}; {forces}; "
                 f"ω0=({p:.3g}, {q:.3g}, {r:.3g}) {self.body.rate_label}")
+
+
+def euler_poisson(t: Any, y: np.ndarray, inertia: np.ndarray, forces: Sequence[Force], carries_alpha: bool,
+                  needs_beta: bool) -> np.ndarray:
+    """dy/dt of the Euler–Poisson equations: I ω̇ = (Iω) × ω + Σ torques, γ̇ = γ × ω (α̇ = α × ω), for one state.
+
+    Numbers or symbols (``gyrolab.kernels.model`` traces it into every compiled kernel of a scene with a plugin
+    torque): the equations are written here once.
+    """
+    omega, gamma = y[0:3], y[3:6]
+    alpha = y[6:9] if carries_alpha else None
+    axes = (alpha, cross(gamma, alpha) if needs_beta else None, gamma)
+    torque = cross(inertia * omega, omega)
+    for force in forces:
+        torque = torque + (force.torque(omega, axes, t) if force.time_dependent else force.torque(omega, axes))
+    parts = [torque / inertia, cross(gamma, omega)]
+    if carries_alpha:
+        parts.append(cross(alpha, omega))
+    return np.concatenate(parts)
+
+
+def traced_model(inertia: np.ndarray, forces: Sequence[Force], carries_alpha: bool) -> CompiledModel:
+    """The fixed-point equations with ``forces`` compiled from their trace, whatever forms the forces have (the
+    system itself takes the hand-written kernels when every force has a built-in form). Raises NotCompilable."""
+    from gyrolab.kernels import model
+    from gyrolab.kernels.expression import check_torques
+
+    check_torques(forces)
+    needs_beta = any(1 in f.required_axes for f in forces)
+    names = " + ".join(f.name for f in forces) or "no torque"
+    return model.compile(model.trace(lambda t, y: euler_poisson(t, y, inertia, forces, carries_alpha, needs_beta),
+                                     9 if carries_alpha else 6, f"system fixed_point ({names})"))
 
 
 def _var(dims: str | tuple[str, ...], data: np.ndarray, units: str, long_name: str) -> xr.Variable:

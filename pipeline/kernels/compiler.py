@@ -1,8 +1,6 @@
-"""Compiled (numba) kernels: the fast core under the compiled integrator plugins.
+"""numba, set up once for every kernel: the decorators and the on-disk cache of compiled code.
 
-Kernels take plain float arrays; systems pack their parameters (``pack``), the
-integrator kernels call ``models.rhs(model, ...)``. Compiled code is cached on
-disk between processes. numba only checks the timestamp of the file that
+Compiled code is cached on disk between processes. numba only checks the timestamp of the file that
 defines a kernel, not of the kernels it calls, so the cache lives in a
 directory named after a hash of this package's sources and numba's version: editing any kernel
 starts a fresh cache instead of reusing stale machine code.
@@ -40,7 +38,7 @@ if "NUMBA_CACHE_DIR" not in os.environ:
 
 
 def kernel_cache_dir() -> str:
-    """The directory of compiled kernels (also of the generated force modules, ``plugin_torque``)."""
+    """The directory of compiled kernels (also of the generated force modules, ``expression``)."""
     return numba.config.CACHE_DIR or _cache_dir()
 
 #: Decorator of every kernel: cached on disk; numpy's error model (no zero-division checks

@@ -1,4 +1,4 @@
-"""The fixed-point model's parameter array ``p``, named in one place (``fixed_point.pack`` writes it).
+"""The compiled models' parameter arrays ``p``, named in one place (``fixed_point.pack``, ``model.compile`` write them).
 
 Every kernel and every caller reads ``p`` by these names, never by bare numbers. numba freezes module-level
 integers as compile-time constants, so ``p[U_Z + 1]`` compiles to the same machine code as ``p[10]``.
@@ -11,12 +11,17 @@ integers as compile-time constants, so ``p[U_Z + 1]`` compiles to the same machi
     p[CARRIES_ALPHA]    1.0 when the state carries α (9 components), else 0.0 (state (ω, γ))
     p[INV_INERTIA + k]  1/I_k (the inner loops multiply instead of dividing)
 
-A model with a traced plugin torque appends, after these N_PARAMS entries, the torque kernel's address
-(``ADDRESS``) and its constants (from ``FIRST_CONSTANT``); the Taylor entries end the array, the Taylor
-kernel's address at ``p[p.size - 2]`` and its node count at ``p[p.size - 1]`` (``plugin_taylor``).
+A model compiled from its traced equations (``model``, form ``models.TRACED``) has a layout of its own:
+
+    p[TRACED_ADDRESS]                the right-hand side kernel's address
+    p[TRACED_FIRST_CONSTANT:-TRACED_TAIL]   the equations' numbers, in the order the trace met them
+    p[-4], p[-3]     the Taylor kernel's address and work columns (``taylor_series``; 0 until compiled)
+    p[-2], p[-1]     the double-double Taylor kernel's address and scratch columns (``series_dd``; 0 until compiled)
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -30,10 +35,10 @@ GRADIENT = (N_X, N_Y, N_Z)
 CARRIES_ALPHA = 15
 INV_INERTIA = 16
 N_PARAMS = 19
-#: a model with a traced plugin torque (``plugin_torque``): the compiled torque's address right after the packed
-#: forms, then its constants
-ADDRESS = N_PARAMS
-FIRST_CONSTANT = N_PARAMS + 1
+#: a traced model's parameter array (``model``): the right-hand side kernel's address, then the equations' numbers
+TRACED_ADDRESS = 0
+TRACED_FIRST_CONSTANT = 1
+TRACED_TAIL = 4
 
 #: state components: ω at OMEGA, γ at GAMMA, α at ALPHA (each 3)
 OMEGA, GAMMA, ALPHA = 0, 3, 6
@@ -44,3 +49,16 @@ def torques_on_horizontal_axes(P: np.ndarray) -> bool:
     such a torque needs α, and the (ω, γ)-only analyses (periodic orbits, chaos indicators) refuse it."""
     P = np.asarray(P)
     return bool(np.any(P[..., U_X:U_Z] != 0.0) or np.any(P[..., N_X:N_Z] != 0.0))
+
+
+@dataclass
+class CompiledTerms:
+    """A torque written in the two forms the hand-written fixed-point kernels evaluate (model units).
+
+    ``linear[i]`` = u adds u × e_i; ``gradient[i]`` = N adds N e_i × I e_i, where e_i
+    is the body-frame image of reference axis i. Uniform gravity, the Newtonian
+    centre and a uniform magnetic field are all of this form (``fixed_point.pack`` packs them).
+    """
+
+    linear: dict[int, np.ndarray] = field(default_factory=dict)
+    gradient: dict[int, float] = field(default_factory=dict)

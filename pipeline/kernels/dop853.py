@@ -13,9 +13,9 @@ import math
 
 import numpy as np
 
-from gyrolab.plugins.compiled import dop853_tableau as _c
-from gyrolab.plugins.compiled import kernel
-from gyrolab.plugins.compiled.models import evaluate, rhs
+from gyrolab.kernels import dop853_tableau as _c
+from gyrolab.kernels.compiler import kernel
+from gyrolab.kernels.models import evaluate, rhs
 
 N_STAGES = _c.N_STAGES  # 12
 N_EXTENDED = _c.N_STAGES_EXTENDED  # 16

@@ -28,7 +28,7 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-from gyrolab.plugins.compiled import inline_kernel
+from gyrolab.kernels.compiler import inline_kernel
 
 
 @intrinsic
@@ -150,6 +150,20 @@ def dd_div_d(ah, al, b):
     f += al
     q2 = (s + f) / b
     return quick_two_sum(q1, q2)
+
+
+@inline_kernel
+def dd_div(ah, al, bh, bl):
+    """a / b for double-doubles (QD's sloppy division: two quotient digits, relative error ≤ ~10u²)."""
+    q1 = ah / bh
+    rh, rl = dd_mul_d(bh, bl, q1)
+    sh, sl = dd_add(ah, al, -rh, -rl)
+    q2 = sh / bh
+    rh, rl = dd_mul_d(bh, bl, q2)
+    sh, sl = dd_add(sh, sl, -rh, -rl)
+    q3 = sh / bh
+    q1, q2 = quick_two_sum(q1, q2)
+    return dd_add_d(q1, q2, q3)
 
 
 @inline_kernel

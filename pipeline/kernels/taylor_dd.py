@@ -1,6 +1,7 @@
 """The Taylor series method in double-double arithmetic (≈ 32 digits): "clean numerical simulation" (Liao 2009).
 
-The fixed-point model with its built-in torque forms (``fixed_point``: the gyroscopic torque, U_i × e_i, the
+A traced model's coefficients come from its generated series (``series_dd``, the same rules as below); the
+hand-written ones here serve the fixed-point model with its built-in torque forms (``fixed_point``: the gyroscopic torque, U_i × e_i, the
 gradient terms N_i e_i × I e_i, states (ω, γ) and (ω, γ, α)), the same method as ``taylor.run_scalar``: Taylor
 coefficients from Cauchy products of the quadratic right-hand side, Jorba & Zou's order (``taylor.order_for``)
 and step (``taylor.step_size``, from the last two coefficients' max norms) for a tolerance down to 1e-32,
@@ -26,15 +27,19 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
-from gyrolab.plugins.compiled import inline_kernel, kernel
-from gyrolab.plugins.compiled.double_double import (
+from gyrolab.kernels.compiler import inline_kernel, kernel
+from gyrolab.kernels.double_double import (
     dd_add, dd_div_d, dd_mul, dd_mul_d, dd_norm, dd_sub, dot_add, two_sum,
 )
-from gyrolab.plugins.compiled.layout import (
+from gyrolab.kernels.layout import (
     ALPHA, CARRIES_ALPHA, GAMMA, INERTIA, N_X, N_Y, N_Z, OMEGA, U_X, U_Y, U_Z,
 )
-from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, _norm_inf, step_size
+from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, _norm_inf, step_size
 
 #: the smallest tolerance the double-double kernel takes (its unit round-off is 2^-106 ≈ 1.2e-32)
 MIN_TOL = 1e-32
@@ -171,18 +176,41 @@ def _horner(Th, Tl, order, m, hh, hl):
     return vh, vl
 
 
+@intrinsic
+def _call_generated(typingctx, address, t, order, Th, Tl, S, p):
+    """Call ``void f(double t, int64 order, double* Th, double* Tl, double* S, double* p)`` at ``address``: a traced
+    model's generated double-double series (``series_dd``)."""
+    sig = types.void(types.int64, types.float64, types.int64, Th, Tl, S, p)
+
+    def codegen(context, builder, signature, args):
+        double_ptr = ir.DoubleType().as_pointer()
+        fnty = ir.FunctionType(ir.VoidType(), [ir.DoubleType(), ir.IntType(64)] + [double_ptr] * 4)
+        data = [builder.bitcast(cgutils.create_struct_proxy(ty)(context, builder, value=v).data, double_ptr)
+                for ty, v in zip(signature.args[3:], args[3:])]
+        builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [args[1], args[2], *data])
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
 @kernel
-def run(p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stats):
+def run(model, p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stats):
     """Advance until t_out[i_stop − 1] is filled: ``taylor.run``'s contract (steps clipped at the last output
     time only, every output a step passes filled, state = [t], stats = [coefficient evaluations, steps],
     returns (status, next output index)) with the state in double-double (yh, yl). Y receives the outputs
-    rounded to double; Ylo their low parts when it has Y's shape (else it is not touched)."""
+    rounded to double; Ylo their low parts when it has Y's shape (else it is not touched).
+
+    ``model`` is the compiled model's form id: the hand-written fixed point (0, ``coefficients``) or a traced
+    model (its generated series, ``series_dd``, whose address and scratch columns end ``p``)."""
     n = yh.size
     Th = np.zeros((order + 1, n))
     Tl = np.zeros((order + 1, n))
     Bh = np.zeros((order + 1, 3))
     Bl = np.zeros((order + 1, 3))
-    C = constants(p)
+    traced = model != 0
+    C = np.zeros((2, 6)) if traced else constants(p)
+    S = np.zeros((order + 1) * 2 * int(p[p.size - 1])) if traced else np.zeros(0)
+    address = int(p[p.size - 2]) if traced else 0
     low = Ylo.shape[0] == Y.shape[0]
     t = state[0]
     n_out = t_out.size
@@ -193,7 +221,10 @@ def run(p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stats):
     while i < i_stop:
         for m in range(n):
             Th[0, m], Tl[0, m] = yh[m], yl[m]
-        coefficients(p, C, Th, Tl, order, Bh, Bl)
+        if traced:
+            _call_generated(address, t, order, Th, Tl, S, p)
+        else:
+            coefficients(p, C, Th, Tl, order, Bh, Bl)
         stats[0] += 1
         scale = max(1.0, _norm_inf(yh))
         h = step_size(tol, scale, _norm_inf(Th[order - 1]), _norm_inf(Th[order]), order, safety)
@@ -225,12 +256,12 @@ def run(p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stats):
     return code, i
 
 
-def propagate(p: np.ndarray, tol: float, t_out, y0, order: int | None = None, y0_low=None):
+def propagate(p: np.ndarray, tol: float, t_out, y0, order: int | None = None, y0_low=None, model: int = 0):
     """The states at ``t_out`` from ``y0`` (doubles, or double-doubles with ``y0_low``) in one call into the kernel:
     (high parts, low parts), each (len(t_out), state size), the first row the initial state. For tests, benchmarks
     and callers that want all 32 digits; the integrator plugin (``Taylor(precision="double-double")``) chunks
     its calls for progress instead. Raises RuntimeError on a non-OK status."""
-    from gyrolab.plugins.compiled.taylor import order_for
+    from gyrolab.kernels.taylor import order_for
 
     t_out = np.asarray(t_out, dtype=float)
     yh = np.array(y0, dtype=float)
@@ -241,7 +272,7 @@ def propagate(p: np.ndarray, tol: float, t_out, y0, order: int | None = None, y0
     state = np.array([t_out[0]])
     stats = np.zeros(2, dtype=np.int64)
     order = order_for(tol) if order is None else order
-    status, _ = run(p, order, tol, t_out, Y, Ylo, 1, len(t_out), state, yh, yl, stats)
+    status, _ = run(model, p, order, tol, t_out, Y, Ylo, 1, len(t_out), state, yh, yl, stats)
     if status != OK:
         raise RuntimeError(f"double-double Taylor kernel stopped near t={state[0]:.6g} (status {status})")
     return Y, Ylo

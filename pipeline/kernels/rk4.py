@@ -7,9 +7,9 @@ import math
 import numba
 import numpy as np
 
-from gyrolab.plugins.compiled import kernel
-from gyrolab.plugins.compiled.fixed_point import rhs_block
-from gyrolab.plugins.compiled.models import rhs
+from gyrolab.kernels.compiler import kernel
+from gyrolab.kernels.fixed_point import rhs_block
+from gyrolab.kernels.models import rhs
 
 
 #: Nodes of the four stages, as fractions of the step.

@@ -11,10 +11,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from gyrolab.contracts.force import CompiledTerms
-from gyrolab.plugins.compiled import inline_kernel, kernel
-from gyrolab.plugins.compiled.layout import (  # noqa: F401  (N_PARAMS: fixed_point.N_PARAMS for callers)
-    CARRIES_ALPHA, GRADIENT, INERTIA, INV_INERTIA, LINEAR, N_PARAMS, N_X, N_Y, N_Z, U_X, U_Y, U_Z,
+from gyrolab.kernels.compiler import inline_kernel, kernel
+from gyrolab.kernels.layout import (  # noqa: F401  (N_PARAMS: fixed_point.N_PARAMS for callers)
+    CARRIES_ALPHA, CompiledTerms, GRADIENT, INERTIA, INV_INERTIA, LINEAR, N_PARAMS, N_X, N_Y, N_Z, U_X, U_Y, U_Z,
 )
 
 
@@ -32,24 +31,14 @@ def pack(inertia: np.ndarray, terms: list[CompiledTerms], carries_alpha: bool) -
 
 
 def compiled_model(inertia: np.ndarray, forces: list, carries_alpha: bool):
-    """The fixed-point system's compiled model: built-in torque forms packed, or all torques traced and compiled.
-
-    If every force has ``compiled_terms()``, they fill the packed forms. Otherwise all the torques, the
-    built-ins' too, are traced together into one compiled kernel (``plugin_torque``), whose address and
-    constants extend the parameter array (the plugin models then skip the packed forms: see ``models``).
-    Raises ``plugin_torque.NotCompilable`` naming the construct that prevents compilation.
-    """
-    from gyrolab.contracts.integrator import CompiledModel
-    from gyrolab.plugins.compiled import models, plugin_torque
+    """The hand-written kernels' model (``models.FIXED_POINT``) when every force has ``compiled_terms()``, else None
+    (the system is then compiled from its traced equations, ``model.compiled_system``)."""
+    from gyrolab.kernels.model import CompiledModel
 
     terms = [force.compiled_terms() for force in forces]
-    if all(term is not None for term in terms):
-        return CompiledModel(models.FIXED_POINT, pack(inertia, terms, carries_alpha))
-    plugins = [force.name for force, term in zip(forces, terms) if term is None]
-    compiled = plugin_torque.compile_trace(plugin_torque.trace(forces), plugins)
-    model = models.FIXED_POINT_PLUGIN_ALPHA if carries_alpha else models.FIXED_POINT_PLUGIN
-    return CompiledModel(model, np.concatenate([pack(inertia, [], carries_alpha), [float(compiled.address)],
-                                                compiled.constants]))
+    if any(term is None for term in terms):
+        return None
+    return CompiledModel(0, pack(inertia, terms, carries_alpha))  # models.FIXED_POINT (models imports numba's types)
 
 
 @inline_kernel

@@ -35,10 +35,11 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic, overload
 
-from gyrolab.plugins.compiled.layout import CARRIES_ALPHA, INERTIA, INV_INERTIA, N_Z, U_Z
-from gyrolab.plugins.compiled import inline_kernel, kernel, simd
-from gyrolab.plugins.compiled.models import FIXED_POINT, FormType, taylor_coefficients
-from gyrolab.plugins.compiled.simd import LANES
+from gyrolab.kernels.layout import CARRIES_ALPHA, INERTIA, INV_INERTIA, N_Z, U_Z
+from gyrolab.kernels import simd
+from gyrolab.kernels.compiler import inline_kernel, kernel
+from gyrolab.kernels.models import FIXED_POINT, FormType, taylor_coefficients
+from gyrolab.kernels.simd import LANES
 
 OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2  # dop853's codes
 MIN_ORDER, MAX_ORDER = 4, 60

@@ -23,10 +23,10 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from gyrolab.plugins.compiled import dop853, models
-from gyrolab.plugins.compiled.dop853 import (A, B, D, E3, E5, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, N_EXTENDED,
+from gyrolab.kernels import dop853, models
+from gyrolab.kernels.dop853 import (A, B, D, E3, E5, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, N_EXTENDED,
                                              N_STAGES, NOT_FINITE, OK, SAFETY, TOO_SMALL_STEP)
-from gyrolab.plugins.compiled.fixed_point import rhs_block
+from gyrolab.kernels.fixed_point import rhs_block
 
 LANES = 32  # trajectories advanced in lock step
 TASK = 256  # trajectories per parallel task, at most

@@ -42,16 +42,17 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gyrolab.plugins.compiled.layout import INERTIA, INV_INERTIA, N_Z, U_Z
-from gyrolab.plugins.compiled import kernel, simd, taylor
-from gyrolab.plugins.compiled.vector_width import batch_lanes
+from gyrolab.kernels.layout import INERTIA, INV_INERTIA, N_Z, U_Z
+from gyrolab.kernels import simd, taylor
+from gyrolab.kernels.compiler import kernel
+from gyrolab.kernels.vector_width import batch_lanes
 
 #: trajectories advanced in lock step: one vector register of doubles of the CPU numba compiles for (8 with
 #: AVX-512, 4 with AVX2; never fewer than 4). Fixed when this module is imported, so frozen into the compiled
 #: kernels; numba's cache keys every kernel by the target CPU's name and features (its ``magic_tuple``), from
 #: which the width follows, so a cache written for another width is not loaded.
 LANES = batch_lanes()
-from gyrolab.plugins.compiled.taylor import NOT_FINITE, OK, TOO_SMALL_STEP
+from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP
 
 TASK = 256  # trajectories per parallel task, at most
 STATE = 6  # (ω, γ)

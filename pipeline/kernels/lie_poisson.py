@@ -16,8 +16,8 @@ import math
 
 import numpy as np
 
-from gyrolab.plugins.compiled.layout import CARRIES_ALPHA, INERTIA, INV_INERTIA, N_X, N_Y, N_Z, U_X, U_Y, U_Z
-from gyrolab.plugins.compiled import inline_kernel, kernel
+from gyrolab.kernels.layout import CARRIES_ALPHA, INERTIA, INV_INERTIA, N_X, N_Y, N_Z, U_X, U_Y, U_Z
+from gyrolab.kernels.compiler import inline_kernel, kernel
 
 # Yoshida (1990) triple-jump weights: order 2 -> 4 -> 6
 _W4 = (1.0 / (2.0 - 2.0 ** (1.0 / 3.0)), -(2.0 ** (1.0 / 3.0)) / (2.0 - 2.0 ** (1.0 / 3.0)))

@@ -1,22 +1,20 @@
-"""A force plugin's Python torque, traced into straight-line code and compiled (numba ``cfunc``).
+"""Equations as expressions: numpy code run once on symbols, recorded as a straight-line program.
 
-The plugin's own ``torque(omega, axes[, t])`` runs once on symbolic 3-vectors (numpy object
-arrays of ``Expr``): every arithmetic operation it performs is recorded, and the record is
-written out as scalar code, one local variable per operation, without allocation. Every number
-the torque uses (the plugin's parameters, and constants computed from them) becomes an entry of
-the parameter array instead of a literal, so the generated source — hence the compiled machine
-code, cached on disk under a hash of that source — depends only on the torque's *form*: a
-sweep over a plugin's parameters compiles once.
-
-The compiled kernel has the C signature ``void(double t, double* y, double* p, double* out)``
-and adds I⁻¹ T to out[0:3]; ``models.rhs`` calls it through its address (stored in ``p``),
-so the integrator kernels, cached once, need no recompilation for a new plugin.
+A system's ``rhs(t, y)`` (and the force plugins' ``torque(omega, axes[, t])`` it calls) runs once on
+symbolic values (numpy object arrays of ``Expr``): every arithmetic operation it performs is recorded
+in a ``Graph``, one node per operation. ``gyrolab.kernels.model`` writes the graph out as the
+right-hand side's scalar code and ``gyrolab.kernels.taylor_series`` as its Taylor recurrences: the
+equations are written once, in numpy, and every kernel is generated from them (heyoka's way: the
+system is an expression). Every number the equations use (a body's inertia, a plugin's parameters,
+constants computed from them) becomes an entry of the parameter array instead of a literal, so the
+generated source — hence the compiled machine code, cached on disk under a hash of that source —
+depends only on the equations' *form*: a sweep over parameters compiles once.
 
 What traces: + − × / unary −, powers, sqrt, exp, log, sin, cos, tan, arctan, tanh, abs, on the
-state components, the reference axes the force declares, time, and numbers; numpy's elementwise
-operations, ``cross``, ``dot``, ``sum`` and ``linalg.norm`` on such vectors. What does not: a
-comparison or ``if`` on the state (the compiled code has no branches), converting the state to
-a float (``float()``, ``math.*``), and numpy functions without an object-array form.
+state components, time, and numbers; numpy's elementwise operations, ``cross``, ``dot``, ``sum``,
+``concatenate`` and ``linalg.norm`` on such vectors. What does not: a comparison or ``if`` on the
+state (the compiled code has no branches), converting the state to a float (``float()``,
+``math.*``), and numpy functions without an object-array form.
 """
 
 from __future__ import annotations
@@ -27,16 +25,12 @@ import importlib.util
 import logging
 import math
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 log = logging.getLogger(__name__)
-
-# the generated code reads the fixed-point parameter array by the names of its layout
-from gyrolab.plugins.compiled.layout import ADDRESS, FIRST_CONSTANT, INV_INERTIA  # noqa: E402, F401
 
 _UNARY = {"neg": "-{0}", "sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
           "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})", "arctan": "math.atan({0})",
@@ -160,119 +154,44 @@ class Expr:
     __int__ = __index__ = __complex__ = __float__  # type: ignore[assignment]
 
 
-def _vector(graph: Graph, op: str, first: int) -> np.ndarray:
-    out = np.empty(3, dtype=object)
-    for k in range(3):
-        out[k] = graph.add(op, first + k)
+def symbols(graph: Graph, op: str, count: int, first: int = 0) -> np.ndarray:
+    """``count`` symbolic inputs (``op`` "y": state components ``first``...; "time"), as an object array."""
+    out = np.empty(count, dtype=object)
+    for k in range(count):
+        out[k] = graph.add(op, first + k) if op == "y" else graph.add(op)
     return out
 
 
-@dataclass
-class Trace:
-    """A traced torque: the graph, the output expressions (three per force) and what it reads."""
-
-    graph: Graph
-    outputs: list[Any]
-    needs_beta: bool
-
-    def source(self) -> str:
-        """The cfunc's Python source, with constants read from p (so it depends on the form only)."""
-        lines = []
-        names: dict[int, str] = {}
-        for i, (op, args) in enumerate(self.graph.nodes):
-            names[i] = f"v{i}"
-            if op == "y":
-                expr = f"y[{args[0]}]"
-            elif op == "time":
-                expr = "t"
-            elif op == "const":
-                expr = f"p[{FIRST_CONSTANT + args[0]}]"
-            elif op == "ipow":
-                expr = f"{names[args[0].index]} ** {args[1]}"
-            elif op == "powx":
-                expr = f"{names[args[0].index]} ** {names[args[1].index]}"
-            elif op in _UNARY:
-                expr = _UNARY[op].format(names[args[0].index])
-            else:
-                expr = _BINARY[op].format(names[args[0].index], names[args[1].index])
-            lines.append(f"    v{i} = {expr}")
-        for k in range(3):
-            total = " + ".join(self._term(out[k], names) for out in self.outputs) or "0.0"
-            lines.append(f"    out[{k}] += ({total}) * p[{INV_INERTIA + k}]")
-        return _HEADER + "\n".join(lines) + "\n"
-
-    def _term(self, value: Any, names: dict[int, str]) -> str:
-        return names[value.index] if isinstance(value, Expr) else repr(float(value))
+def cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return np.array([u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]], dtype=object)
 
 
-_HEADER = '''"""Generated by gyrolab from a force plugin's torque (see gyrolab.plugins.compiled.plugin_torque)."""
-import math
+def check_torques(forces: list[Any]) -> None:
+    """Raise NotCompilable naming the first force whose torque cannot be traced, and the construct.
 
-import numba
-from numba import types
-
-SIGNATURE = types.void(types.float64, types.CPointer(types.float64), types.CPointer(types.float64),
-                       types.CPointer(types.float64))
-
-
-@numba.cfunc(SIGNATURE, cache=True, error_model="numpy")
-def kernel(t, y, p, out):
-'''
-
-
-def trace(forces: list[Any]) -> Trace:
-    """Record the torques of ``forces`` (one trace for all); raises NotCompilable naming the construct."""
-    graph = Graph()
-    omega = _vector(graph, "y", 0)
-    gamma = _vector(graph, "y", 3)
-    needed = set().union(*(f.required_axes for f in forces))
-    alpha = _vector(graph, "y", 6) if needed & {0, 1} else None
-    beta = None
-    if 1 in needed:
-        g, a = gamma, alpha
-        beta = np.array([g[1] * a[2] - g[2] * a[1], g[2] * a[0] - g[0] * a[2], g[0] * a[1] - g[1] * a[0]], dtype=object)
-    uses_time = any(getattr(f, "time_dependent", False) for f in forces)
-    t = graph.add("time") if uses_time else None
-    outputs = []
+    A system's equations are traced as a whole (``model.trace``); tracing each force's torque alone first, on
+    symbolic ω, reference axes and time, lets the refusal name the force. Costs microseconds.
+    """
     for force in forces:
-        axes = tuple(v if i in force.required_axes else None for i, v in enumerate((alpha, beta, gamma)))
-        name = force.name
+        graph = Graph()
+        omega, gamma, alpha = (symbols(graph, "y", 3, first) for first in (0, 3, 6))
+        frame = (alpha, cross(gamma, alpha), gamma)
+        axes = tuple(v if i in force.required_axes else None for i, v in enumerate(frame))
         try:
             with np.errstate(all="ignore"):
-                value = force.torque(omega, axes, t) if getattr(force, "time_dependent", False) \
+                value = force.torque(omega, axes, graph.add("time")) if getattr(force, "time_dependent", False) \
                     else force.torque(omega, axes)
         except NotCompilable as exc:
-            raise NotCompilable(f"the torque of force {name!r} cannot be compiled: {exc}") from None
+            raise NotCompilable(f"the torque of force {force.name!r} cannot be compiled: {exc}") from None
         except Exception as exc:  # numpy functions without an object form, undeclared axes (None), ...
-            raise NotCompilable(f"the torque of force {name!r} cannot be compiled: tracing it raised "
+            raise NotCompilable(f"the torque of force {force.name!r} cannot be compiled: tracing it raised "
                                 f"{type(exc).__name__}: {exc}") from None
-        value = np.asarray(value, dtype=object)
-        if value.shape != (3,):
-            raise NotCompilable(f"the torque of force {name!r} has shape {value.shape}, not (3,)")
-        # a component that does not depend on the state is a number: a parameter too, unless exactly 0
-        outputs.append([v if isinstance(v, Expr) or v == 0 else graph.lift(v) for v in value])
-    return Trace(graph, outputs, beta is not None)
-
-
-@dataclass
-class CompiledTorque:
-    """A compiled trace: the cfunc (kept alive here), its address and the trace's constants."""
-
-    kernel: Any
-    address: int
-    constants: np.ndarray
+        shape = np.shape(value)
+        if shape != (3,):
+            raise NotCompilable(f"the torque of force {force.name!r} has shape {shape}, not (3,)")
 
 
 _LOADED: dict[str, Any] = {}
-
-
-def compile_trace(result: Trace, names: list[str]) -> CompiledTorque:
-    """The compiled kernel of a trace: generated once per form, compiled once per machine (cached on disk)."""
-    kernel = load_generated(result.source(), "gyrolab_force", f"force {' + '.join(names)}")
-    from gyrolab.plugins.compiled import plugin_taylor  # the Taylor kernel's entries end the constants
-
-    tail = plugin_taylor.register(int(kernel.address), result, names)
-    return CompiledTorque(kernel, int(kernel.address), np.array(result.graph.constants + tail, dtype=float))
 
 
 def load_generated(source: str, prefix: str, what: str) -> Any:
@@ -282,7 +201,7 @@ def load_generated(source: str, prefix: str, what: str) -> Any:
     digest = hashlib.sha256(source.encode()).hexdigest()[:16]
     module_name = f"{prefix}_{digest}"
     if module_name not in _LOADED:
-        from gyrolab.plugins.compiled import kernel_cache_dir
+        from gyrolab.kernels.compiler import kernel_cache_dir
 
         folder = Path(kernel_cache_dir()) / "forces"
         try:

@@ -2,23 +2,19 @@
 
 numba caches a kernel only if the functions it calls are module globals
 (a function passed as an argument or closed over is recompiled in every
-process), hence one dispatch on ``model`` instead of a callback. A force
-plugin's torque, compiled separately (``plugin_torque``), joins through its
-address, stored in the parameter array: the call is indirect, the kernels that
-make it are compiled and cached once for every plugin.
+process), hence one dispatch on ``model`` instead of a callback.
 
-A scene with a plugin traces all its forces, built-ins included, so the plugin
-models compute only the gyroscopic torque and the kinematics around that call,
-one model per state size. Measured (benchmarks/plugin_speed.py): the
-indirect call itself costs little; what made plugins 1.5–2× slower than the
-built-ins was the built-in form's code (its zero-filled torque terms and the
-run-time branch on α) inlined at every right-hand-side call of the kernels.
+The fixed-point system with built-in torques only has hand-written kernels (``FIXED_POINT``). Every other model (a fixed-point scene with a plugin torque, the orbiting gyrostat, a plugin system) is
+compiled from its traced equations (``model``): one form, ``TRACED``, whose right-hand side is one call of
+the generated kernel through its address (stored in ``p``) and whose Taylor coefficients are one call of the
+generated series kernel (``taylor_series``): the integrator kernels, cached once, serve every such model.
+Measured (benchmarks/plugin_speed.py): the indirect call itself costs little.
 
 A kernel given the model as an int dispatches at run time, so every model's code
 is typed and compiled into it. Given a ``Form`` (``form(compiled)``), the model is
 part of the argument's type: numba compiles a specialisation of the kernel per form,
-containing that form's code only (a built-in (ω, γ) scene compiles neither the plugin
-models nor the α terms), and caches each on disk like any other signature.
+containing that form's code only (a built-in (ω, γ) scene compiles neither the traced
+form nor the α terms), and caches each on disk like any other signature.
 """
 
 from __future__ import annotations
@@ -30,23 +26,22 @@ from numba.core.datamodel.models import OpaqueModel
 from numba.core.imputils import lower_constant
 from numba.extending import NativeValue, intrinsic, overload, register_model, unbox
 
-from gyrolab.plugins.compiled.layout import CARRIES_ALPHA, INERTIA, INV_INERTIA
-from gyrolab.plugins.compiled import fixed_point, inline_kernel, kernel, plugin_taylor
-from gyrolab.plugins.compiled.plugin_torque import ADDRESS
+from gyrolab.kernels.layout import CARRIES_ALPHA, TRACED_ADDRESS
+from gyrolab.kernels import fixed_point, model as _model, taylor_series
+from gyrolab.kernels.compiler import inline_kernel, kernel
 
+#: The fixed-point system with built-in torque forms only (hand-written kernels, ``fixed_point``).
 FIXED_POINT = 0
-#: The fixed-point system (state ω, γ) with all its torques traced and compiled.
-FIXED_POINT_PLUGIN = 1
-#: The same with the state ω, γ, α.
-FIXED_POINT_PLUGIN_ALPHA = 2
+#: A model compiled from its traced equations (``model``).
+TRACED = _model.TRACED
 #: Not a model id (``CompiledModel.model`` is FIXED_POINT): the form of FIXED_POINT with the state ω, γ, α.
 FIXED_POINT_ALPHA = 3
-#: Models whose Taylor coefficients ``taylor_coefficients`` computes (plugin torques: see plugin_taylor.ready).
-TAYLOR_MODELS = (FIXED_POINT, FIXED_POINT_PLUGIN, FIXED_POINT_PLUGIN_ALPHA)
+#: Models whose Taylor coefficients ``taylor_coefficients`` computes (traced ones: see taylor_series.ready).
+TAYLOR_MODELS = (FIXED_POINT, TRACED)
 
 
 @intrinsic
-def _call_torque(typingctx, address, t, y, p, out):
+def _call_rhs(typingctx, address, t, y, p, out):
     """Call ``void f(double t, double* y, double* p, double* out)`` at ``address`` with the arrays' data."""
     sig = types.void(types.int64, types.float64, y, p, out)
 
@@ -61,19 +56,6 @@ def _call_torque(typingctx, address, t, y, p, out):
         return context.get_dummy_value()
 
     return sig, codegen
-
-
-@inline_kernel
-def _free(y, p, out):
-    """The torque-free fixed-point system: I⁻¹ (Iω × ω) and γ̇ = γ × ω (p laid out as fixed_point.pack)."""
-    w0, w1, w2 = y[0], y[1], y[2]
-    g0, g1, g2 = y[3], y[4], y[5]
-    out[0] = (p[INERTIA + 1] - p[INERTIA + 2]) * w1 * w2 * p[INV_INERTIA]
-    out[1] = (p[INERTIA + 2] - p[INERTIA]) * w2 * w0 * p[INV_INERTIA + 1]
-    out[2] = (p[INERTIA] - p[INERTIA + 1]) * w0 * w1 * p[INV_INERTIA + 2]
-    out[3] = g1 * w2 - g2 * w1
-    out[4] = g2 * w0 - g0 * w2
-    out[5] = g0 * w1 - g1 * w0
 
 
 class FormType(types.Type):
@@ -112,7 +94,7 @@ def _constant_form(context, builder, ty, value):
     return context.get_dummy_value()
 
 
-FORMS = {i: Form(i) for i in (FIXED_POINT, FIXED_POINT_PLUGIN, FIXED_POINT_PLUGIN_ALPHA, FIXED_POINT_ALPHA)}
+FORMS = {i: Form(i) for i in (FIXED_POINT, TRACED, FIXED_POINT_ALPHA)}
 
 
 def form(compiled) -> Form:
@@ -123,24 +105,11 @@ def form(compiled) -> Form:
 
 
 @inline_kernel
-def _plugin(t, y, p, out):
-    _free(y, p, out)
-    _call_torque(int(p[ADDRESS]), t, y, p, out)
+def _traced(t, y, p, out):
+    _call_rhs(int(p[TRACED_ADDRESS]), t, y, p, out)
 
 
-@inline_kernel
-def _plugin_alpha(t, y, p, out):
-    _free(y, p, out)
-    w0, w1, w2 = y[0], y[1], y[2]
-    x0, x1, x2 = y[6], y[7], y[8]
-    out[6] = x1 * w2 - x2 * w1
-    out[7] = x2 * w0 - x0 * w2
-    out[8] = x0 * w1 - x1 * w0
-    _call_torque(int(p[ADDRESS]), t, y, p, out)
-
-
-_RHS = {FIXED_POINT: fixed_point.rhs_gamma, FIXED_POINT_ALPHA: fixed_point.rhs_alpha,
-        FIXED_POINT_PLUGIN: _plugin, FIXED_POINT_PLUGIN_ALPHA: _plugin_alpha}
+_RHS = {FIXED_POINT: fixed_point.rhs_gamma, FIXED_POINT_ALPHA: fixed_point.rhs_alpha, TRACED: _traced}
 
 
 def rhs(model, t, y, p, out):
@@ -158,7 +127,7 @@ def _rhs_form(model, t, y, p, out):
 
 
 _GAMMA, _ALPHA = FORMS[FIXED_POINT], FORMS[FIXED_POINT_ALPHA]
-_PLUGIN, _PLUGIN_ALPHA = FORMS[FIXED_POINT_PLUGIN], FORMS[FIXED_POINT_PLUGIN_ALPHA]
+_TRACED = FORMS[TRACED]
 
 
 @inline_kernel
@@ -169,10 +138,8 @@ def _rhs_any(model, t, y, p, out):
             rhs(_ALPHA, t, y, p, out)
         else:
             rhs(_GAMMA, t, y, p, out)
-    elif model == FIXED_POINT_PLUGIN:
-        rhs(_PLUGIN, t, y, p, out)
-    elif model == FIXED_POINT_PLUGIN_ALPHA:
-        rhs(_PLUGIN_ALPHA, t, y, p, out)
+    elif model == TRACED:
+        rhs(_TRACED, t, y, p, out)
 
 
 @overload(rhs, inline="always")
@@ -198,8 +165,8 @@ def evaluate(model, t, y, p, out):
 def _taylor_any(model, p, Y, order, work, t):
     if model == FIXED_POINT:
         fixed_point.taylor_coefficients(p, Y, order, work)
-    elif model == FIXED_POINT_PLUGIN or model == FIXED_POINT_PLUGIN_ALPHA:  # the traced torque's series (plugin_taylor)
-        plugin_taylor.coefficients(p, Y, order, work, t)
+    elif model == TRACED:  # the traced equations' series (taylor_series)
+        taylor_series.coefficients(p, Y, order, work, t)
     else:
         raise ValueError("this compiled model has no Taylor coefficients")
 
@@ -215,17 +182,17 @@ def _taylor_coefficients(model, p, Y, order, work, t=0.0):
         if model.id in (FIXED_POINT, FIXED_POINT_ALPHA):
             f = fixed_point.taylor_gamma if model.id == FIXED_POINT else fixed_point.taylor_alpha
             return lambda model, p, Y, order, work, t=0.0: f(p, Y, order, work)
-        return None  # the plugin forms: below
+        return None  # the traced form: below
     if isinstance(model, types.Integer):
         return lambda model, p, Y, order, work, t=0.0: _taylor_any(model, p, Y, order, work, t)
     return None
 
 
 @overload(taylor_coefficients, inline="always")
-def _taylor_coefficients_plugin(model, p, Y, order, work, t=0.0):
-    """A traced torque's form: one call of its generated series kernel (``plugin_taylor``), inlined into the
+def _taylor_coefficients_traced(model, p, Y, order, work, t=0.0):
+    """The traced form: one call of its generated series kernel (``taylor_series``), inlined into the
     integrator's step (as a call of its own, with the arrays' reference counting, it cost ~30 ns a step:
     a sixth of the step of the reference scene)."""
-    if isinstance(model, FormType) and model.id in (FIXED_POINT_PLUGIN, FIXED_POINT_PLUGIN_ALPHA):
-        return lambda model, p, Y, order, work, t=0.0: plugin_taylor.coefficients(p, Y, order, work, t)
+    if isinstance(model, FormType) and model.id == TRACED:
+        return lambda model, p, Y, order, work, t=0.0: taylor_series.coefficients(p, Y, order, work, t)
     return None

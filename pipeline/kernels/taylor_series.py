@@ -1,19 +1,17 @@
-"""Taylor coefficients of a system with a traced plugin torque, as generated straight-line code.
+"""Taylor coefficients of a traced model (``model``), as generated straight-line code.
 
-The trace of a plugin's torque (``plugin_torque.trace``) is a straight-line program of scalar
-operations on the state, time and constants. Every operation has a recurrence giving the k-th
-Taylor coefficient of its result from the coefficients 0..k of its arguments and 0..k−1 of its
-own (Moore 1966; Jorba & Zou, Exp. Math. 14, 2005, §3; Haro et al. 2016, §2.1). This module
-writes those recurrences, together with the rest of the fixed-point system's right-hand side
-(the gyroscopic torque (Iω) × ω and the kinematics γ̇ = γ × ω, α̇ = α × ω), out as one generated
-``cfunc``
+A model's equations (``model.trace``) are a straight-line program of scalar operations on the
+state, time and constants. Every operation has a recurrence giving the k-th Taylor coefficient of
+its result from the coefficients 0..k of its arguments and 0..k−1 of its own (Moore 1966; Jorba &
+Zou, Exp. Math. 14, 2005, §3; Haro et al. 2016, §2.1). This module writes those recurrences out as
+one generated ``cfunc``
 
     void f(double t, int64 order, double* Y, double* W, double* p)
 
 which fills the state's coefficients Y[1..order] (rows of the state's size) from Y[0], with W
 as scratch (``order`` rows of ``columns`` entries). It is called once per Taylor step: the
 loops over the orders and over the Cauchy sums are inside the generated code, shaped like the
-built-in's (``fixed_point.taylor_coefficients``) and compiled with its fastmath flags (reassociation,
+hand-written fixed-point kernel's (``fixed_point.taylor_coefficients``) and compiled with its fastmath flags (reassociation,
 fused multiply-adds).
 
 The lowering (``_Program``) puts every value in the form const + Σ c_i s_i: a sum of series s_i
@@ -28,12 +26,12 @@ in the order (products of the same depth) are summed in one loop over j, their o
 adjacent columns of W, so that the compiler turns the sums into vector instructions (the built-in's
 ``taylor.run_vector`` does this by hand).
 
-Like the right-hand side's kernel it reads the plugin's numbers from the parameter array, so the
-generated source depends on the torque's form and the state's size only: it is compiled once per
-form (cached on disk under a hash of the source, ``plugin_torque.load_generated``). The source
+Like the right-hand side's kernel it reads the equations' numbers from the parameter array, so the
+generated source depends on the equations' form only: it is compiled once per
+form (cached on disk under a hash of the source, ``expression.load_generated``). The source
 contains only what the lowering writes: local names it makes, indices into the arrays, the
 literals 1.0, −1.0, 0.0 and integer exponents, and the names of ``math`` functions from a fixed
-table — nothing the plugin spells.
+table — nothing a plugin spells.
 
 Recurrences (x, y the arguments, f the result, a sum over j written Σ_j):
   ± and c·x: linear; x·y: Σ_{j=0..k} x_j y_{k−j};
@@ -63,12 +61,10 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gyrolab.plugins.compiled.layout import ALPHA, FIRST_CONSTANT, GAMMA, INERTIA, INV_INERTIA, OMEGA
-from gyrolab.plugins.compiled.plugin_torque import Expr, Trace, load_generated
-
-#: Entries the Taylor kernel adds after the right-hand side's constants; they end the parameter array:
-#: p[-2] = its address, p[-1] = its work columns (both 0 until ``ready`` compiles it).
-TAIL = 2
+from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before the decorators)
+from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
+from gyrolab.kernels.expression import Expr, load_generated
+from gyrolab.kernels.model import MODELS, TRACED, Model
 
 ZERO, ONE, MINUS_ONE = "0.0", "1.0", "-1.0"
 
@@ -303,24 +299,22 @@ def cauchy_sums(typingctx, W, k, columns, base, left, right):
 
 
 class _Program:
-    """A traced torque and the fixed-point system's other terms, lowered to series and their generated code."""
+    """A traced model's equations, lowered to series and their generated code."""
 
-    def __init__(self, result: Trace, size: int) -> None:
+    def __init__(self, model: Model) -> None:
         self.numbers = _Numbers()
         self.series: list[_Series] = []
         self.found: dict[tuple, int] = {}  # a series' key (op and operands) → its id
         self.operands: list[_Lin] = []  # the values series are computed from, one local u<id> each
         self.operand_ids: dict[tuple, int] = {}
         values: dict[int, _Lin] = {}
-        for i, (op, args) in enumerate(result.graph.nodes):
+        for i in sorted(model.live()):  # the program's nodes in order (each after its arguments), dead ones left out
+            op, args = model.graph.nodes[i]
             values[i] = self._node(op, [values[a.index] if isinstance(a, Expr) else a for a in args])
-        torque = [_Lin(), _Lin(), _Lin()]
-        for out in result.outputs:  # per force: three Expr or exact zeros (trace lifts every other number)
-            for m, v in enumerate(out):
-                if isinstance(v, Expr):
-                    torque[m] = self._sum([torque[m], values[v.index]])
-        self.size = size
-        self.rates = self._rates(torque)
+        if len(model.rates) != model.size:
+            raise ValueError(f"{model.what} has {len(model.rates)} rates for {model.size} state components")
+        self.size = model.size
+        self.rates = [values[v.index] if isinstance(v, Expr) else _Lin() for v in model.rates]
 
     # ---- values as linear combinations of series
 
@@ -398,7 +392,7 @@ class _Program:
         if op == "time":
             return self._make("time", (), None, depth=0)
         if op == "const":
-            return _Lin(n.param(FIRST_CONSTANT + a[0]))
+            return _Lin(n.param(TRACED_FIRST_CONSTANT + a[0]))
         if op == "add":
             return self._sum(a)
         if op == "sub":
@@ -437,22 +431,6 @@ class _Program:
                 break
             square = self._mul(square, square)
         return self._function("div", _Lin(ONE), result) if power < 0 else result
-
-    def _rates(self, torque: list[_Lin]) -> list[_Lin]:
-        """The state's rates: I⁻¹ ((Iω) × ω + T) and γ̇ = γ × ω (α̇ = α × ω), as linear combinations."""
-        n = self.numbers
-        inertia = [n.param(INERTIA + m) for m in range(3)]
-        omega = [self._state(OMEGA + m) for m in range(3)]
-
-        def cross(u: list[_Lin], v: list[_Lin]) -> list[_Lin]:
-            return [self._sum([self._mul(u[(m + 1) % 3], v[(m + 2) % 3]), self._mul(u[(m + 2) % 3], v[(m + 1) % 3])],
-                              [1, -1]) for m in range(3)]
-
-        spin = cross([self._scale(w, i) for w, i in zip(omega, inertia)], omega)
-        rates = [self._scale(self._sum([s, t]), n.param(INV_INERTIA + m)) for m, (s, t) in enumerate(zip(spin, torque))]
-        for axis in (GAMMA, ALPHA)[: (self.size - 3) // 3]:
-            rates += cross([self._state(axis + m) for m in range(3)], omega)
-        return rates
 
     # ---- the generated code
 
@@ -551,13 +529,13 @@ class _Program:
         return lines
 
 
-_HEADER = '''"""Generated by gyrolab: Taylor coefficients of a system with a force plugin's torque (gyrolab.plugins.compiled.plugin_taylor)."""
+_HEADER = '''"""Generated by gyrolab: Taylor coefficients of a system's traced equations (gyrolab.kernels.taylor_series)."""
 import math
 
 import numba
 from numba import types
 
-from gyrolab.plugins.compiled.plugin_taylor import cauchy_sums
+from gyrolab.kernels.taylor_series import cauchy_sums
 
 M = {columns}
 N = {size}
@@ -570,52 +548,30 @@ def kernel(t, order, Y, W, p):
 '''
 
 
-def source(result: Trace, size: int = 6) -> tuple[str, int]:
-    """The Taylor cfunc's source for a trace and a state of ``size`` components (6 or 9), and W's columns."""
-    return _Program(result, size).source()
-
-
-#: traces by the address of their right-hand side's kernel: the Taylor kernel compiles when first needed
-_TRACES: dict[int, tuple[Trace, list[str]]] = {}
-
-
-def register(address: int, result: Trace, names: list[str]) -> list[float]:
-    """The parameter array's tail (``TAIL``) for a traced torque whose right-hand side's kernel is at ``address``.
-
-    Nothing compiles here: most runs never use taylor, and a Taylor kernel's first compilation costs
-    0.2–1 s (the reference problem's torque: 0.2 s; one with sqrt, powers, sin and exp: 1.2 s). ``ready``
-    compiles it when an integrator needs it.
-    """
-    _TRACES[address] = (result, names)
-    return [0.0, 0.0]
+def source(model: Model) -> tuple[str, int]:
+    """The Taylor cfunc's source for a traced model, and W's columns."""
+    return _Program(model).source()
 
 
 def ready(compiled: Any, rows: np.ndarray | None = None) -> bool:
-    """Whether ``taylor`` can integrate a compiled model: the built-ins and every traced torque (time-dependent too).
+    """Whether ``taylor`` can integrate a compiled model: the hand-written fixed point and every traced model.
 
-    For a traced torque this compiles (or loads) its Taylor kernel on first need and writes its address
+    For a traced model this compiles (or loads) its Taylor kernel on first need and writes its address
     into ``compiled.params`` (and into every row of ``rows``, a batch's per-trajectory parameters).
+    Nothing compiles before: most runs never use taylor, and a Taylor kernel's first compilation costs
+    0.2–1 s (the reference problem's torque: 0.2 s; one with sqrt, powers, sin and exp: 1.2 s).
     """
-    from gyrolab.plugins.compiled import models
-    from gyrolab.plugins.compiled.plugin_torque import ADDRESS
-
-    if compiled.model not in (models.FIXED_POINT_PLUGIN, models.FIXED_POINT_PLUGIN_ALPHA):
-        return compiled.model in models.TAYLOR_MODELS
+    if compiled.model != TRACED:
+        return compiled.model == 0  # models.FIXED_POINT (not imported: models imports this module)
     p = compiled.params
-    if p[-2] == 0.0:
-        size = 9 if compiled.model == models.FIXED_POINT_PLUGIN_ALPHA else 6
-        p[-2:] = compile_taylor(*_TRACES[int(p[ADDRESS])], size=size)
+    if p[p.size - 4] == 0.0:
+        model = MODELS[int(p[TRACED_ADDRESS])]
+        text, columns = source(model)
+        kernel = load_generated(text, "gyrolab_taylor", f"{model.what} (Taylor)")
+        p[p.size - 4:p.size - 2] = [float(kernel.address), float(columns)]
     if rows is not None:
-        rows[:, -2:] = p[-2:]
+        rows[:, -4:-2] = p[p.size - 4:p.size - 2]
     return True
-
-
-def compile_taylor(result: Trace, names: list[str], size: int = 6) -> list[float]:
-    """[address of the Taylor kernel, its work columns] for a trace and a state of ``size`` (6: ω, γ; 9: with α),
-    compiled once per form (cached on disk)."""
-    text, columns = source(result, size)
-    kernel = load_generated(text, "gyrolab_taylor", f"force {' + '.join(names)} (Taylor)")
-    return [float(kernel.address), float(columns)]
 
 
 #: W (``order`` rows of the kernel's columns) lives on the caller's stack up to this many doubles (128 KiB: a
@@ -667,11 +623,11 @@ def _call(typingctx, address, t, order, size, Y, p):
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def coefficients(p, Y, order, work, t):
-    """Fill Y[1..order] from Y[0] for the fixed-point system with a traced plugin torque (models FIXED_POINT_PLUGIN
-    and FIXED_POINT_PLUGIN_ALPHA): one call of the generated kernel (``source``), whose address ``ready`` wrote
-    at p[-2] and its work columns at p[-1]. ``work`` is unused (the built-in models' β series)."""
-    address = int(p[p.size - 2])
+    """Fill Y[1..order] from Y[0] for a traced model (``models.TRACED``): one call of the generated kernel
+    (``source``), whose address ``ready`` wrote at p[-4] and its work columns at p[-3] (``layout``). ``work`` is
+    unused (the hand-written fixed-point kernels' β series)."""
+    address = int(p[p.size - 4])
     if address == 0:  # the Taylor kernel was not compiled (``ready`` not called): no series, not a crash
         Y[1:] = np.nan
         return
-    _call(address, t, order, order * int(p[p.size - 1]), Y, p)
+    _call(address, t, order, order * int(p[p.size - 3]), Y, p)

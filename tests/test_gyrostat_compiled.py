@@ -1,0 +1,136 @@
+"""The orbiting gyrostat under the compiled integrators: its kernels are generated from its traced equations
+(``gyrolab.kernels.model``), so they are checked against an oracle written separately — the paper's Lagrange
+equations in Euler angles (``physics.gyrostat_euler``: other coordinates, other formulas), integrated by scipy at
+tight tolerance — and against the Jacobi integral, a law of the system."""
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from gyrolab import compose_scene
+from gyrolab.analysis.precession.motion import build_system
+from gyrolab.kernels import model, models
+from gyrolab.physics.attitude import frame_from_angles
+from gyrolab.physics.gyrostat_euler import GyrostatParameters, kinematic_matrix, rhs_euler_angles
+
+# an asymmetric gyrostat with rotors and a tilted magnetic field, tumbling (θ stays away from 0 and π, where the
+# Euler angles are singular)
+PARAMS = GyrostatParameters((1.0, 1.4, 1.9), (0.1, -0.2, 0.4), (0.3, 0.0, 0.9), (0.5, 0.0, -0.6), 1.0)
+ANGLES, RATES = np.array([0.2, 1.1, 0.4]), np.array([0.3, -0.2, 1.2])
+TIMES = np.linspace(0.0, 8.0, 41)
+
+
+def _oracle() -> np.ndarray:
+    """(ω, α, γ) at TIMES from the Euler-angle equations, scipy DOP853 at rtol 1e-13."""
+    sol = solve_ivp(rhs_euler_angles, (TIMES[0], TIMES[-1]), np.concatenate([ANGLES, RATES]), args=(PARAMS,),
+                    method="DOP853", rtol=1e-13, atol=1e-13, t_eval=TIMES)
+    rows = []
+    for psi, theta, phi, *rates in sol.y.T:
+        alpha, _, gamma = (np.asarray(v) for v in frame_from_angles(psi, theta, phi))
+        omega = kinematic_matrix(theta, phi) @ np.asarray(rates) + PARAMS.Omega * gamma
+        rows.append(np.concatenate([omega, alpha, gamma]))
+    return np.array(rows)
+
+
+@pytest.fixture(scope="module")
+def setup():
+    system = build_system(PARAMS)
+    alpha, _, gamma = (np.asarray(v) for v in frame_from_angles(*ANGLES))
+    omega = kinematic_matrix(ANGLES[1], ANGLES[2]) @ RATES + PARAMS.Omega * gamma
+    return system, np.concatenate([omega, alpha, gamma]), _oracle()
+
+
+@pytest.mark.parametrize("integrator, settings, tolerance", [
+    ("taylor", {"tol": 1e-15}, 1e-10),
+    ("dop853_numba", {"rtol": 1e-12, "atol": 1e-12}, 1e-9),
+    ("rk4_numba", {"step": 2e-3}, 1e-8),
+])
+def test_compiled_gyrostat_follows_the_euler_angle_equations(setup, integrator, settings, tolerance):
+    system, y0, expected = setup
+    compiled = system.compiled_model()
+    assert compiled is not None and compiled.model == models.TRACED
+    scene = compose_scene([f"integrator={integrator}", *[f"integrator.{k}={v}" for k, v in settings.items()]])
+    got = scene.integrator.integrate(system.rhs, TIMES, y0, None, compiled).y
+    assert np.max(np.abs(got - expected)) < tolerance
+    jacobi = system.jacobi_integral(got)
+    assert np.max(np.abs(jacobi - jacobi[0])) < tolerance
+
+
+def test_generated_right_hand_side_is_the_python_one_bit_for_bit(setup):
+    """The generated kernel performs the Python right-hand side's operations in the same order: the same doubles."""
+    import ctypes
+
+    system, _, _ = setup
+    compiled = system.compiled_model()
+    kernel = ctypes.CFUNCTYPE(None, ctypes.c_double, *[ctypes.POINTER(ctypes.c_double)] * 3)(
+        int(compiled.params[model.TRACED_ADDRESS]))
+    ptr = ctypes.POINTER(ctypes.c_double)
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        y = rng.normal(size=9)
+        out = np.empty(9)
+        kernel(0.0, y.ctypes.data_as(ptr), compiled.params.ctypes.data_as(ptr), out.ctypes.data_as(ptr))
+        np.testing.assert_array_equal(out, system.rhs(0.0, y))
+
+
+def test_gyrostat_scene_runs_under_taylor_with_its_invariants():
+    ds = compose_scene(["experiment=gyrostat", "integrator=taylor", "time.end=10", "output.figures=false"]).run()
+    assert ds.attrs["integrator"] == "taylor"
+    assert float(ds.frame_error.max()) < 1e-12
+    assert ds.jacobi_integral.attrs["max_abs_drift"] < 1e-12
+
+
+def test_an_untraceable_system_is_refused_in_one_sentence_naming_the_construct():
+    from gyrolab.contracts.system import System
+
+    class Branching(System):
+        name = "branching"
+        body_type = object
+        state_size = 1
+        invariants = ()
+
+        def initial_state(self):
+            return np.ones(1)
+
+        def rhs(self, t, y):
+            return -y if y[0] > 0 else y
+
+        def variables(self, t, y):
+            return {}
+
+    system = Branching(None, [], {}, {})
+    assert system.compiled_model() is None
+    assert "cannot be compiled" in system.compile_error and "compiled code cannot branch" in system.compile_error
+
+
+def test_double_double_gyrostat_keeps_the_jacobi_integral_beyond_double_precision(setup):
+    """The generated double-double series (``series_dd``): the Jacobi integral of the double-double state (high +
+    low parts, evaluated in long double) stays constant far below double precision's 1e-16 — a law of the system,
+    which no double-precision run can show."""
+    from gyrolab.kernels import taylor_dd
+    from gyrolab.plugins.integrators.compiled_solvers import _ready_for_double_double
+
+    system, y0, expected = setup
+    compiled = system.compiled_model()
+    _ready_for_double_double(compiled)
+    hi, lo = taylor_dd.propagate(compiled.params, 1e-30, TIMES, y0, model=compiled.model)
+    assert np.max(np.abs(hi - expected)) < 1e-10  # the same motion as the Euler-angle oracle
+    y = hi.astype(np.longdouble) + lo.astype(np.longdouble)
+    if np.finfo(np.longdouble).eps > 1e-18:
+        pytest.skip("numpy.longdouble is plain double on this platform")
+    inertia, k, omega_rate = (np.asarray(v, dtype=np.longdouble) for v in (system.inertia, system.k, system.Omega))
+    omega, alpha, gamma = y[:, 0:3], y[:, 3:6], y[:, 6:9]
+    potential = system.potential(y.astype(float))  # the potential's own drift is checked on the kinetic part below
+    kinetic = 0.5 * np.sum(omega * inertia * omega, axis=1) - omega_rate * np.sum(gamma * (inertia * omega + k), axis=1)
+    # the magnetic and gradient potentials are polynomial in α, γ: evaluate them in long double too
+    N = 3 * omega_rate ** 2
+    gradient = 0.5 * N * np.sum(alpha * inertia * alpha, axis=1)
+    magnetic = next(f for f in system.forces if f.name == "magnetic")
+    h = np.asarray(-magnetic.field * magnetic.direction, dtype=np.longdouble)  # V = +μ·(h1 α + h2 β + h3 γ)
+    mu = np.asarray(magnetic.moment, dtype=np.longdouble)
+    beta = np.cross(gamma, alpha)
+    field = h[0] * alpha + h[1] * beta + h[2] * gamma
+    jacobi = kinetic + gradient + np.sum(mu * field, axis=1)
+    assert np.allclose(np.asarray(jacobi, dtype=float) - np.asarray(jacobi[0], dtype=float),
+                       potential - potential[0] + (np.asarray(kinetic, dtype=float) - float(kinetic[0])), atol=1e-12)
+    assert np.max(np.abs(jacobi - jacobi[0])) < 1e-18
