@@ -89,14 +89,16 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
     ``final_state`` (trajectories, 6) and ``failed`` (trajectories,) True where the trajectory became
     non-finite (its values are then NaN).
     """
-    from gyrolab.kernels import variational
+    from gyrolab.kernels import models, variational
     from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
 
-    y0, P = _model_arrays(compiled, y0s, params)
     times = np.ascontiguousarray(times, dtype=float)
     if times.ndim != 1 or times.size < 2 or not np.all(np.diff(times) > 0):
         raise ConfigError("times must be at least two increasing output times")
     settings = variational_settings(integrator)
+    if compiled is not None and compiled.model == models.TRACED:
+        return _generated_run(compiled, settings, times, y0s, params, every_time)
+    y0, P = _model_arrays(compiled, y0s, params)
     n = len(y0)
     megno = np.empty((n, times.size if every_time else 1))
     fli, deviation, final = np.empty(n), np.empty(n), np.empty((n, 6))
@@ -111,6 +113,50 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
                                           float(settings.max_step), megno, fli, deviation, final, steps)
     return {"megno": megno, "fli": fli, "max_nutation_deviation": deviation, "final_state": final,
             "failed": ~np.isfinite(megno[:, -1]), "steps": steps}
+
+
+def _generated_run(compiled: Any, settings: Any, times: np.ndarray, y0s: np.ndarray, params: np.ndarray | None,
+                   every_time: bool) -> dict[str, np.ndarray]:
+    """``megno_run`` for a model compiled from its traced equations: its tangent flow generated from them
+    (``kernels.tangent``), run by the compiled batch kernels (RK4 or DOP853 with the integrator's settings). FLI is
+    max ln|δ| over the output times (the hand-written fixed-point kernels take it over every step); the nutation
+    deviation is that of the state's last three components when they are a unit vector γ (θ = arccos γ3: the
+    orbiting gyrostat's orbit normal), else NaN."""
+    from gyrolab.kernels import model, tangent
+    from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, RK4Numba
+
+    if "time" in {model.MODELS[int(compiled.params[0])].graph.nodes[i][0]
+                  for i in model.MODELS[int(compiled.params[0])].live()}:
+        raise ConfigError("chaos indicators of a model compiled from its equations need autonomous equations; a "
+                          "time-dependent force has none here")
+    y0s = np.atleast_2d(np.asarray(y0s, dtype=float))
+    if not np.all(np.isfinite(y0s)):
+        raise ConfigError("initial states contain NaN or inf; every initial state must be finite")
+    augmented = tangent.compiled_megno(compiled)
+    P = tangent.megno_params(augmented, compiled.params if params is None else params)
+    if len(P) == 1 and len(y0s) > 1:
+        P = np.repeat(P, len(y0s), axis=0)
+    t = times - times[0]
+    t[0] = tangent.START
+    method = (RK4Numba(step=float(settings.step)) if settings.fixed_step else
+              DOP853Numba(rtol=float(settings.rtol), atol=float(settings.atol),
+                          max_step=float(settings.max_step) if np.isfinite(settings.max_step) else None))
+    run = method.integrate_batch(augmented, t, tangent.initial_augmented(y0s), P, "mark")
+    n = y0s.shape[1]
+    z = run.y
+    megno = np.zeros((len(y0s), times.size))
+    megno[:, 1:] = z[:, 1:, -1] / (times[1:] - times[0])
+    gamma = z[:, :, n - 3:n]
+    deviation = np.full(len(y0s), np.nan)
+    if np.allclose(np.linalg.norm(y0s[:, n - 3:n], axis=1), 1.0, atol=1e-9):
+        theta = np.arccos(np.clip(gamma[:, :, 2], -1.0, 1.0))
+        deviation = np.max(np.abs(theta - theta[:, :1]), axis=1)
+    failed = np.asarray(run.failed, dtype=bool) | ~np.isfinite(megno[:, -1])
+    megno[failed] = np.nan
+    steps = run.steps if run.steps is not None else np.full(len(y0s), run.n_steps)
+    return {"megno": megno if every_time else megno[:, -1:], "fli": np.where(failed, np.nan, z[:, :, 2 * n].max(axis=1)),
+            "max_nutation_deviation": np.where(failed, np.nan, deviation),
+            "final_state": np.where(failed[:, None], np.nan, z[:, -1, :n]), "failed": failed, "steps": steps}
 
 
 def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray,
