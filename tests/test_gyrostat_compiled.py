@@ -134,3 +134,18 @@ def test_double_double_gyrostat_keeps_the_jacobi_integral_beyond_double_precisio
     assert np.allclose(np.asarray(jacobi, dtype=float) - np.asarray(jacobi[0], dtype=float),
                        potential - potential[0] + (np.asarray(kinetic, dtype=float) - float(kinetic[0])), atol=1e-12)
     assert np.max(np.abs(jacobi - jacobi[0])) < 1e-18
+
+
+@pytest.mark.parametrize("integrator", ["rk4_numba", "rk4", "dop853", "taylor integrator.tol=1e-9"])
+def test_gyrostat_error_estimate_measures_the_actual_error(integrator):
+    """The stored estimate against the actual error (the double-double Taylor run as the reference), within the
+    docs' factor 2 — also when the outputs are closer than half the step (rk4: both runs once took one step per
+    interval, an estimate of 0)."""
+    common = ["experiment=gyrostat", "time.end=6", "time.n_output=1201", "output.figures=false"]
+    ds = compose_scene([*common, *f"integrator={integrator}".split(), "output.error_estimate=true"]).run()
+    reference = compose_scene([*common, "integrator=taylor", "integrator.precision=double-double",
+                               "integrator.tol=1e-24"]).run()
+    actual = float(np.abs(ds.omega - reference.omega).max())
+    estimate = float(ds.attrs["error_estimate_max_omega"])
+    assert actual > 1e-13  # a measurable error (not round-off), so the ratio says something
+    assert 0.5 <= estimate / actual <= 2.0

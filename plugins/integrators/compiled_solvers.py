@@ -30,7 +30,7 @@ from gyrolab.contracts.integrator import (
 )
 from gyrolab.errors import ConfigError, IntegrationError, as_number
 from gyrolab.plugins.integrators import batch_kernels
-from gyrolab.plugins.integrators.refinement import half_step
+from gyrolab.plugins.integrators.refinement import half_step, interval_steps
 from gyrolab.plugins.integrators.tolerances import Tolerances
 from gyrolab.plugins.integrators.step_guard import check_step, compiled_rhs
 
@@ -203,7 +203,7 @@ class RK4Numba(Integrator):
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
-        steps = steps_per_interval(t_out, self.step)
+        steps = interval_steps(self, t_out)
         fun = compiled_rhs(compiled)
         form = models.form(compiled)  # kernels compiled for this model only
         reached = _fixed_step(lambda grid, n, rows, first, stop: rk4.run(form, compiled.params, grid, n,
@@ -485,7 +485,7 @@ class LiePoisson(Integrator):
                               "forms only; valid systems: fixed_point with uniform_gravity, newtonian, magnetic")
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
-        steps = steps_per_interval(t_out, self.step)
+        steps = interval_steps(self, t_out)
         w = lie_poisson.weights(self.order)
         fun = compiled_rhs(compiled)
         reached = _fixed_step(lambda grid, n, rows, first, stop: lie_poisson.run(compiled.params, grid, n, w, y,

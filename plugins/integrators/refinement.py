@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 
 def half_step(method: Any, order: int, /, **kwargs: Any):
     """``more_accurate`` of a fixed-step method of ``order``: the same method at half the step, and Richardson's
@@ -11,5 +13,16 @@ def half_step(method: Any, order: int, /, **kwargs: Any):
     method's other settings; ``method`` and ``order`` are positional-only, so that a method with an ``order`` setting
     of its own (lie_poisson) passes it as ``order=`` (it raised TypeError, a traceback, before)."""
     finer = type(method)(step=method.step / 2, **kwargs)
+    finer.halvings = getattr(method, "halvings", 0) + 1  # every interval's steps doubled (``interval_steps``)
     return finer, 2.0 ** order / (2.0 ** order - 1.0), (f"{method.name} at half the step ({method.step / 2:.3g}), "
                                                          f"Richardson's estimate for order {order}")
+
+
+def interval_steps(method: Any, t_out: np.ndarray) -> np.ndarray:
+    """Equal steps per output interval of a fixed-step method: the fewest no longer than ``method.step``; for a
+    companion made by ``half_step``, exactly twice its coarse method's in every interval. (Halving the step alone
+    left an interval shorter than half the step with one step in both runs: identical runs, an estimate of 0.)"""
+    halvings = getattr(method, "halvings", 0)
+    coarse = method.step * 2 ** halvings
+    return np.maximum(1, np.ceil(np.diff(np.asarray(t_out, dtype=float)) / coarse * (1.0 - 1e-12))).astype(np.int64) \
+        * 2 ** halvings

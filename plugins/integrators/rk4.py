@@ -28,7 +28,7 @@ from gyrolab.contracts.integrator import (
     VariationalSettings,
 )
 from gyrolab.errors import IntegrationError, as_number
-from gyrolab.plugins.integrators.refinement import half_step
+from gyrolab.plugins.integrators.refinement import half_step, interval_steps
 from gyrolab.plugins.integrators.step_guard import check_step
 
 GUARD_CHECKS = 50  # as often as the compiled methods check (once per output chunk)
@@ -72,9 +72,10 @@ class RK4(Integrator):
         """Fill ``out[1:]``; return the number of steps taken."""
         n_steps = 0
         stride = max(1, math.ceil((len(t_out) - 1) / GUARD_CHECKS))
+        steps = interval_steps(self, t_out)
         for i in range(1, len(t_out)):
             t0, interval = t_out[i - 1], t_out[i] - t_out[i - 1]
-            m = max(1, math.ceil(interval / self.step * (1.0 - 1e-12)))
+            m = int(steps[i - 1])
             h = interval / m
             if (i - 1) % stride == 0:  # the guard costs ~9 evaluations: at most GUARD_CHECKS times per run
                 check_step(self.name, fun, t0, y, h)
