@@ -543,7 +543,10 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
        one of them, on dims ``("time",)``;
     6. integrated over [0, ``span``] with scipy's DOP853 at rtol = atol = 1e-12, every invariant stays within
        ``invariant_tolerance`` × max(1, |v0|) of its initial value (an invariant that drifts is no invariant);
-    7. ``attributes()`` is netCDF-safe; ``title()`` a non-empty one-line str.
+    7. ``attributes()`` is netCDF-safe; ``title()`` a non-empty one-line str;
+    8. its compiled model (``compiled_model()``: by default its ``rhs`` traced, ``gyrolab.kernels.model``), if it has
+       one, computes ``rhs`` (to 1e-12) at random states and its Taylor integrator follows the DOP853 trajectory of 6.
+       A system that cannot be traced is warned about (it runs with the Python integrators only), not failed.
     """
     from gyrolab.contracts.system import System
 
@@ -574,6 +577,32 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
     title = system.title()
     if not isinstance(title, str) or not title.strip() or "\n" in title:
         raise _fail(cls, f"title() returned {title!r}; it must name the scene in a few words, on one line")
+    _check_compiled_system(cls, system, t, y)
+
+
+def _check_compiled_system(cls: type, system: Any, t: np.ndarray, y: np.ndarray) -> None:
+    """Rule 8 of ``check_system``: the compiled model against the Python right-hand side and trajectory."""
+    compiled = system.compiled_model()
+    if compiled is None:
+        warnings.warn(f"{cls.__name__} runs with the Python integrators only: {system.compile_error}", stacklevel=3)
+        return
+    from gyrolab.kernels import models
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    rng = np.random.default_rng(11)
+    scale = max(1.0, float(np.max(np.abs(y[0]))))
+    out = np.empty(len(y[0]))
+    for state in [y[0], *(y[0] + 0.1 * scale * rng.normal(size=len(y[0])) for _ in range(10))]:
+        models.evaluate(compiled.model, 0.3, np.ascontiguousarray(state), compiled.params, out)
+        expected = np.asarray(system.rhs(0.3, state.copy()), dtype=float)
+        if not np.allclose(out, expected, rtol=1e-12, atol=1e-12 * max(1.0, float(np.max(np.abs(expected))))):
+            raise _fail(cls, f"the compiled right-hand side {out.tolist()} differs from rhs {expected.tolist()} at "
+                             f"y={state.tolist()}; report this to gyrolab with the system's rhs")
+    got = Taylor(tol=1e-15).integrate(system.rhs, t, y[0], None, compiled).y
+    worst = float(np.max(np.abs(got - y)))
+    if worst > 1e-8 * max(1.0, float(np.max(np.abs(y)))):
+        raise _fail(cls, f"the compiled model under taylor ends {worst:.3g} away from the DOP853 trajectory of rhs; "
+                         "report this to gyrolab with the system's rhs")
 
 
 def _check_state(cls: type, system: Any) -> np.ndarray:

@@ -277,6 +277,20 @@ def test_system_kit_fails_on_a_drifting_invariant():
     check_system(FixedPoint, BODY, INITIAL, forces=[(UniformGravity, {})])  # the unbroken system passes
 
 
+def test_system_kit_fails_on_a_compiled_model_that_is_not_its_rhs():
+    from gyrolab.plugins.forces.uniform_gravity import UniformGravity
+    from gyrolab.plugins.systems.fixed_point import traced_model
+
+    class WrongCompiled(FixedPoint):
+        name = "wrong_compiled"
+
+        def compiled_model(self):  # the equations of another body: what a stale or hand-written model would be
+            return traced_model(self.inertia * 1.01, self.forces, self.carries_alpha)
+
+    with pytest.raises(AssertionError, match=r"^WrongCompiled: the compiled right-hand side .* differs from rhs"):
+        check_system(WrongCompiled, BODY, INITIAL, forces=[(UniformGravity, {})])
+
+
 def test_regime_kit_fails_when_the_solution_does_not_start_at_the_initial_state():
     with pytest.raises(AssertionError, match=r"^OffStart: solution\(system, \[0\]\) = .* differs from initial_state"):
         check_regime(OffStart)
