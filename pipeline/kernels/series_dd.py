@@ -231,8 +231,15 @@ def ready(compiled: Any) -> bool:
 
     p = compiled.params
     if p[p.size - 2] == 0.0:
-        model = MODELS[int(p[TRACED_ADDRESS])]
-        program = _Program(model)
-        kernel = load_generated(program.source(), "gyrolab_taylor_dd", f"{model.what} (double-double Taylor)")
-        p[p.size - 2:] = [float(kernel.address), float(max(program.columns, 1))]
+        address = int(p[TRACED_ADDRESS])
+        if address not in _KERNELS:  # once per form and process
+            model = MODELS[address]
+            program = _Program(model)
+            kernel = load_generated(program.source(), "gyrolab_taylor_dd", f"{model.what} (double-double Taylor)")
+            _KERNELS[address] = (float(kernel.address), float(max(program.columns, 1)))
+        p[p.size - 2:] = _KERNELS[address]
     return True
+
+
+#: the double-double kernel's (address, scratch columns) by the address of its model's right-hand side kernel
+_KERNELS: dict[int, tuple[float, float]] = {}

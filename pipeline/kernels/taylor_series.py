@@ -553,6 +553,10 @@ def source(model: Model) -> tuple[str, int]:
     return _Program(model).source()
 
 
+#: the Taylor kernel's (address, work columns) by the address of its model's right-hand side kernel
+_KERNELS: dict[int, tuple[float, float]] = {}
+
+
 def ready(compiled: Any, rows: np.ndarray | None = None) -> bool:
     """Whether ``taylor`` can integrate a compiled model: the hand-written fixed point and every traced model.
 
@@ -565,10 +569,13 @@ def ready(compiled: Any, rows: np.ndarray | None = None) -> bool:
         return compiled.model == 0  # models.FIXED_POINT (not imported: models imports this module)
     p = compiled.params
     if p[p.size - 4] == 0.0:
-        model = MODELS[int(p[TRACED_ADDRESS])]
-        text, columns = source(model)
-        kernel = load_generated(text, "gyrolab_taylor", f"{model.what} (Taylor)")
-        p[p.size - 4:p.size - 2] = [float(kernel.address), float(columns)]
+        address = int(p[TRACED_ADDRESS])
+        if address not in _KERNELS:  # once per form and process (the rhs kernel's address names the form)
+            model = MODELS[address]
+            text, columns = source(model)
+            kernel = load_generated(text, "gyrolab_taylor", f"{model.what} (Taylor)")
+            _KERNELS[address] = (float(kernel.address), float(columns))
+        p[p.size - 4:p.size - 2] = _KERNELS[address]
     if rows is not None:
         rows[:, -4:-2] = p[p.size - 4:p.size - 2]
     return True

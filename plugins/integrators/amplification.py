@@ -14,7 +14,10 @@ Two ways to follow δ, the cheapest that applies:
 
 * the variational equations (``pipeline/kernels/variational.py``: the analytic Jacobian of the fixed-point model with
   torques about the vertical, compiled DOP853) — one compiled call over the span;
-* a shadow pair for any other model: the trajectory and a companion started ``SHADOW_OFFSET`` away, integrated
+* the tangent flow generated from a traced model's equations (``pipeline/kernels/tangent.py``: the orbiting
+  gyrostat, plugin torques and systems), compiled DOP853 — one compiled call over the span, ln|δ| sampled at
+  ``TANGENT_SAMPLES`` times;
+* a shadow pair for a model with neither (no compiled model): the trajectory and a companion started ``SHADOW_OFFSET`` away, integrated
   by the given method chunk by chunk and renormalised after each chunk (Benettin et al. 1980), so the
   companion's separation stays in the linear regime.
 
@@ -39,6 +42,9 @@ TANGENT_TOLERANCE = 1e-5
 #: the shadow pair's initial separation, relative to the state's size, and its renormalisation chunks
 SHADOW_OFFSET = 1e-7
 SHADOW_CHUNKS = 64
+#: output times of a generated tangent flow's run, where its running maximum of ln|δ| is read (the hand-written
+#: variational run reads it after every step); as many as the shadow pair's renormalisations
+TANGENT_SAMPLES = 64
 
 
 @dataclass(frozen=True)
@@ -80,9 +86,17 @@ def amplification(compiled: Any, fun: Any, y0: np.ndarray, t0: float, t_pilot: f
     span = float(t_end - t0)
     variational = _variational(compiled, y0, t0, t_pilot, t_end)
     if variational is not None:
-        return Amplification(*variational, span, "variational equations (compiled DOP853)")
+        how = ("variational equations (compiled DOP853)" if variational_kind(compiled) == "hand-written" else
+               "tangent flow generated from the equations (compiled DOP853)")
+        return Amplification(*variational, span, how)
     return Amplification(*_shadow_pair(method, fun, compiled, y0, t0, t_pilot, t_end), span,
                          f"shadow pair renormalised {SHADOW_CHUNKS} times ({method.name})")
+
+
+def variational_kind(compiled: Any) -> str:
+    from gyrolab.kernels import models
+
+    return "hand-written" if compiled.model == models.FIXED_POINT else "generated"
 
 
 def _variational(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float) -> tuple[float, float] | None:
@@ -90,6 +104,8 @@ def _variational(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end
         return None
     from gyrolab.kernels import layout, models, variational
 
+    if compiled.model == models.TRACED:
+        return _generated(compiled, y0, t0, t_pilot, t_end)
     if compiled.model != models.FIXED_POINT or layout.torques_on_horizontal_axes(compiled.params):
         return None  # the analytic Jacobian covers the built-in torques about the vertical only
     p = np.array(compiled.params, dtype=float)
@@ -97,6 +113,28 @@ def _variational(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end
     # autonomous: the span from t0 is what counts
     logs = variational.tangent_growths(p, np.asarray(y0, dtype=float), t_pilot - t0, t_end - t0, TANGENT_TOLERANCE)
     return None if not all(np.isfinite(logs)) else logs
+
+
+def _generated(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float) -> tuple[float, float] | None:
+    """(max ln|δ| over [t0, t_pilot], over [t0, t_end]) from the traced model's generated tangent flow."""
+    from gyrolab.kernels import tangent
+    from gyrolab.kernels.model import CompiledModel
+    from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba
+
+    augmented = tangent.compiled_megno(compiled)
+    params = tangent.megno_params(augmented, compiled.params)[0]
+    times = np.unique(np.concatenate([np.linspace(t0, t_end, TANGENT_SAMPLES + 1), [t_pilot]]))
+    if times[0] == 0.0:
+        times[0] = tangent.START  # (the MEGNO quadrature's 2a/t, unused here, is 0/0 at t = 0)
+    method = DOP853Numba(rtol=TANGENT_TOLERANCE, atol=TANGENT_TOLERANCE)
+    try:
+        z = method.integrate(None, times, tangent.initial_augmented(np.asarray(y0, dtype=float)[None, :])[0], None,
+                             CompiledModel(augmented.model, params)).y
+    except Exception:  # noqa: BLE001  (a failed tangent run: the shadow pair measures instead)
+        return None
+    log = np.maximum.accumulate(np.maximum(z[:, 2 * len(y0)], 0.0))
+    pilot = log[np.searchsorted(times, t_pilot)]
+    return (float(pilot), float(log[-1])) if np.all(np.isfinite(log)) else None
 
 
 def _shadow_pair(method: Any, fun: Any, compiled: Any, y0: np.ndarray, t0: float, t_pilot: float,
