@@ -132,14 +132,24 @@ def _animate(args: argparse.Namespace) -> int:
 
 
 def reproduce(args: argparse.Namespace) -> int:
-    """``gyrolab reproduce PATH/run.nc``: the comparison report on stdout; 0 if identical, else 1."""
+    """``gyrolab reproduce PATH/run.nc`` (or a batch's ``sweep.nc``, ``--points``): the comparison report on
+    stdout; 0 if identical, else 1."""
     from gyrolab.app.parser import one_path
-    from gyrolab.sweep.reproduce import report, reproduce as rerun
+    from gyrolab.batch.reproduce import is_batch, reproduce_batch
+    from gyrolab.sweep.reproduce import load_run, report, reproduce as rerun
 
     path = Path(one_path("reproduce", args.paths, "reproduce PATH/run.nc"))
     log_to_stderr()
-    comparison, stored = rerun(path)
-    print("\n".join(report(path, comparison, stored)))
+    stored = load_run(path)
+    if is_batch(stored):
+        comparison, head = reproduce_batch(path, stored, args.points)
+    elif args.points is not None:
+        raise ConfigError(f"--points chooses points of a batch's sweep.nc, and {path} is one run; give it without "
+                          "--points")
+    else:
+        comparison, stored = rerun(path, stored)
+        head = None
+    print("\n".join(report(path, comparison, stored, head)))
     return 0 if comparison.identical else 1
 
 

@@ -133,7 +133,9 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
     reproduce = _Parser(prog="gyrolab reproduce", formatter_class=formatter, epilog=epilog,
                         description=_sentence(COMMANDS["reproduce"]) + ".\nExit status 0: identical; 1: it differs "
                         "(the report on stdout says where).")
-    reproduce.add_argument("paths", nargs="*", metavar="PATH", help="a run.nc or sweep.nc written by gyrolab")
+    reproduce.add_argument("paths", nargs="*", metavar="PATH", help="a run.nc, or a sweep.nc written by gyrolab batch")
+    reproduce.add_argument("--points", metavar="LIST", help="a batch's sweep.nc: rerun only these points, by number "
+                           "(0,5,10-19; point n is grid position numpy.unravel_index(n, shape)); default: all")
     parsers["reproduce"] = reproduce
 
     aggregate = _Parser(prog="gyrolab aggregate", formatter_class=formatter, epilog=epilog,

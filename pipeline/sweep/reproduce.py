@@ -1,5 +1,7 @@
 """``gyrolab --reproduce PATH/run.nc``: rerun a dataset's stored config and say whether the result is identical.
 
+(A batch's ``sweep.nc``: ``gyrolab.batch.reproduce``, with the comparison of this module.)
+
 Identical means every data variable and coordinate is equal bit for bit.
 Otherwise the report names each differing variable with its largest
 absolute difference. Provenance that differs (commit, library versions,
@@ -122,8 +124,9 @@ def _difference(old: xr.DataArray, new: xr.DataArray) -> str:
     return "" if equal.all() else f"{int((~equal).sum())} of {equal.size} values differ"
 
 
-def reproduce(path: Path) -> tuple[Comparison, xr.Dataset]:
-    stored = load_run(path)
+def reproduce(path: Path, stored: xr.Dataset | None = None) -> tuple[Comparison, xr.Dataset]:
+    """Rerun the run.nc at ``path`` (``stored``: its dataset, already loaded) and compare."""
+    stored = load_run(path) if stored is None else stored
     expected = "a run.nc that gyrolab wrote"
     try:
         scene = Scene.from_config(stored_config(stored))
@@ -140,10 +143,11 @@ def reproduce(path: Path) -> tuple[Comparison, xr.Dataset]:
         raise not_gyrolabs(path, error, expected) from None
 
 
-def report(path: Path, comparison: Comparison, stored: xr.Dataset) -> list[str]:
-    head = (f"reproducing {path} ({stored.attrs.get('title', '?')}; {stored.attrs.get('integrator', '?')}, "
-            f"{stored.sizes.get('time', '?')} output times)")
-    lines = [head]
+def report(path: Path, comparison: Comparison, stored: xr.Dataset, head: list[str] | None = None) -> list[str]:
+    """The report's lines: ``head`` (default: the run's title, integrator and output times), then the comparison."""
+    lines = list(head) if head else [
+        f"reproducing {path} ({stored.attrs.get('title', '?')}; {stored.attrs.get('integrator', '?')}, "
+        f"{stored.sizes.get('time', '?')} output times)"]
     lines += [f"  provenance differs: {p}" for p in comparison.provenance]
     if comparison.identical:
         lines.append(f"identical: {len(comparison.same)} variables and coordinates equal bit for bit "
