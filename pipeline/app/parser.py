@@ -34,7 +34,7 @@ ALIASES = {"--batch": "batch", "--plot": "plot", "--reproduce": "reproduce", "--
 #: options whose value is the next word (so that word is not read as a subcommand)
 VALUE_OPTIONS = {"--config-dir", "-cd", "--config-path", "-cp", "--config-name", "-cn", "--cfg", "-c",
                  "--package", "-p", "--scheduler", "--animate", "--format", "--frames", "--fps", "-o", "--output",
-                 "--experimental-rerun", "--shell-completion", "-sc", "--info", "-i"}
+                 "--experimental-rerun", "--shell-completion", "-sc", "--info", "-i", "--points"}
 
 #: where logs and results go, said in every --help
 LOGGING_CONVENTION = ("Log lines and progress go to stderr; results (the paths written, reports) go to stdout, "
