@@ -83,7 +83,8 @@ def _sentence(text: str) -> str:
 def _source_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("where configs come from (as for gyrolab run)")
     group.add_argument("--config-dir", "-cd", metavar="DIR",
-                       help="a folder of your own configs, searched before gyrolab's (conf/ layout)")
+                       help="a folder of your own configs (conf/ layout), searched after gyrolab's: "
+                            "give yours new names (a file named like one of gyrolab's is not read; a warning says so)")
     group.add_argument("--config-path", "-cp", metavar="DIR",
                        help="a folder that replaces gyrolab's primary config folder")
     group.add_argument("--config-name", "-cn", metavar="NAME", help="the primary config (default: config)")
