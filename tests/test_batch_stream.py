@@ -346,4 +346,4 @@ def test_reproduce_reruns_a_batch_sweep_nc_all_points_or_the_chosen_ones(tmp_pat
 
     code, _, err = _reproduce(monkeypatch, capsys, str(path), "--points", "6")
     assert code == 2 and err.strip().splitlines() == [
-        "gyrolab: error: --points '6': 6 is outside the batch's points 0 to 5; e.g. --points 0,5,10-19"]
+        "gyrolab: error: --points '6': 6 is outside the points 0 to 5; e.g. --points 0,5,10-19"]

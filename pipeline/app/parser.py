@@ -134,8 +134,9 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
     reproduce = _Parser(prog="gyrolab reproduce", formatter_class=formatter, epilog=epilog,
                         description=_sentence(COMMANDS["reproduce"]) + ".\nExit status 0: identical; 1: it differs "
                         "(the report on stdout says where).")
-    reproduce.add_argument("paths", nargs="*", metavar="PATH", help="a run.nc, or a sweep.nc written by gyrolab batch")
-    reproduce.add_argument("--points", metavar="LIST", help="a batch's sweep.nc: rerun only these points, by number "
+    reproduce.add_argument("paths", nargs="*", metavar="PATH", help="a run.nc, an experiment's dataset, or a "
+                           "sweep.nc (of gyrolab batch or gyrolab -m) written by gyrolab")
+    reproduce.add_argument("--points", metavar="LIST", help="a sweep.nc: rerun only these points (jobs), by number "
                            "(0,5,10-19; point n is grid position numpy.unravel_index(n, shape)); default: all")
     parsers["reproduce"] = reproduce
 

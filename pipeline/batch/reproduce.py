@@ -29,7 +29,7 @@ from gyrolab.batch.sweep import check_integrator
 from gyrolab.engine.safety import check_stored_config
 from gyrolab.errors import ConfigError, shorten
 from gyrolab.sweep.grid import Grid
-from gyrolab.sweep.reproduce import Comparison, compare
+from gyrolab.sweep.reproduce import Comparison, compare, parse_points
 
 log = logging.getLogger("gyrolab.batch")
 
@@ -37,25 +37,6 @@ log = logging.getLogger("gyrolab.batch")
 def is_batch(stored: xr.Dataset) -> bool:
     """Whether a dataset is a batch's ``sweep.nc`` (``gyrolab batch``)."""
     return stored.attrs.get("sweep_launcher") == "batch" and "batch_grid" in stored.attrs
-
-
-def parse_points(text: str | None, n_points: int) -> list[int] | None:
-    """``--points 0,5,10-19`` as sorted point numbers (None: every point); ConfigError, one sentence, otherwise."""
-    if text is None:
-        return None
-    chosen: set[int] = set()
-    for part in (p.strip() for p in str(text).split(",")):
-        low, dash, high = part.partition("-")
-        try:
-            first, last = int(low), int(high) if dash else int(low)
-        except ValueError:
-            raise ConfigError(f"--points {shorten(repr(text))}: {shorten(repr(part))} is not a point number or a "
-                              f"range; give numbers and ranges from 0 to {n_points - 1}, e.g. --points 0,5,10-19") from None
-        if not 0 <= first <= last < n_points:
-            raise ConfigError(f"--points {shorten(repr(text))}: {part} is outside the batch's points 0 to "
-                              f"{n_points - 1}; e.g. --points 0,5,10-19")
-        chosen.update(range(first, last + 1))
-    return sorted(chosen)
 
 
 def reproduce_batch(path: Path, stored: xr.Dataset, points: str | None = None) -> tuple[Comparison, list[str]]:
