@@ -52,10 +52,17 @@ def test_the_sweeper_is_a_hydra_plugin_by_its_configured_name():
     register_plugin()  # idempotent
     found = {f"{c.__module__}.{c.__name__}": c for c in Plugins.instance().discover(Sweeper)}
     assert target == "hydra_plugins.gyrolab_sweeper.GyrolabSweeper"
-    assert issubclass(found[target], ResumingSweeper)
+    assert isinstance(found[target](max_batch_size=3).sweeper, ResumingSweeper)
     assert "gyrolab.sweep.sweeper.ResumingSweeper" not in found  # only the class Hydra is given by name
     module = sys.modules[found[target].__module__]
     assert Path(module.__file__).parent.name == "gyrolab_sweeper"  # a real module, not a stand-in
+
+
+def test_the_sweeper_plugin_imports_no_gyrolab_until_it_is_used():
+    # Hydra imports every hydra_plugins module whenever any Hydra app starts: an unrelated app must not pay for gyrolab
+    code = "import sys, hydra_plugins.gyrolab_sweeper; print(sorted(m for m in sys.modules if m.startswith('gyrolab')))"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, cwd=REPO.parent)
+    assert done.returncode == 0 and done.stdout.strip() == "[]", done.stderr[-2000:]
 
 
 def test_version_flag_prints_gyrolab_version():
