@@ -64,6 +64,23 @@ def test_identity_follows_the_resolved_config_and_the_code():
     assert job_identity(a, "gyrolab 1; git x") != job_identity(a, "gyrolab 1; git y")
 
 
+def test_gyrolab_code_in_an_identity_is_its_code_trees_not_the_commit(monkeypatch):
+    from gyrolab.output import provenance
+    from gyrolab.sweep import identity
+
+    prov = provenance.provenance()
+    if prov["git_commit"] == "unknown":
+        pytest.skip("not a git checkout of gyrolab")
+    code = identity.code_version()
+    assert f"code {provenance.code_tree()}" in code and prov["git_commit"] not in code
+    # a commit that touches only docs or tests: a new commit, the same trees of pipeline/, plugins/, conf/, ...
+    monkeypatch.setitem(prov, "git_commit", "0" * 40)
+    assert identity.code_version() == code
+    listed = provenance._git("ls-tree", "HEAD", "--", *provenance.CODE_PATHS)
+    assert {line.split()[-1] for line in listed.splitlines()} == {"pipeline", "plugins", "conf", "hydra_plugins",
+                                                                  "pyproject.toml"}
+
+
 def test_identity_covers_the_plugins_a_job_names_not_every_installed_package(tmp_path):
     from tests.conftest import installed_distribution
 
