@@ -2,6 +2,7 @@
 
 import io
 import logging
+import shutil
 import sys
 from pathlib import Path
 
@@ -81,7 +82,7 @@ def test_gyrolab_code_in_an_identity_is_its_code_trees_not_the_commit(monkeypatc
                                                                   "pyproject.toml"}
 
 
-def test_identity_covers_the_plugins_a_job_names_not_every_installed_package(tmp_path):
+def test_identity_covers_the_plugins_a_job_names_not_every_installed_package(tmp_path, monkeypatch):
     from tests.conftest import installed_distribution
 
     from gyrolab.output import provenance
@@ -110,6 +111,18 @@ def test_identity_covers_the_plugins_a_job_names_not_every_installed_package(tmp
         identity._plugin_code.cache_clear()
         assert job_identity(drag) != with_drag
         assert job_identity(plain) == before
+    editable = tmp_path / "checkout"            # an editable install's new commit, its version unchanged
+    shutil.copytree(example, editable)
+    (tmp_path / "site-e").mkdir()
+    with installed_distribution(tmp_path / "site-e", "gyrolab-viscous-drag", "0.1.0",
+                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [editable]):
+        for name in [m for m in sys.modules if m.startswith("gyrolab_viscous_drag")]:
+            monkeypatch.delitem(sys.modules, name)   # a new process: the plugin is imported from the checkout
+        identity._plugin_code.cache_clear()
+        first = job_identity(drag)
+        (editable / "gyrolab_viscous_drag" / "helpers.py").write_text("SCALE = 2.0\n")   # a helper module changed
+        identity._plugin_code.cache_clear()
+        assert job_identity(drag) != first
     provenance.provenance.cache_clear()
     identity._plugin_code.cache_clear()
 

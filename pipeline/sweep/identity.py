@@ -7,8 +7,8 @@ already has a finished result in the sweep directory.
 The code is what the job loads: gyrolab's own (its version, the git trees of its code folders and the digest
 of their uncommitted changes: a commit that changes only documentation or tests leaves it as it is) and the
 third-party plugins the config names (each ``_target_`` outside gyrolab: its distribution's name and version and
-a digest of the module that defines it). Installing, updating or removing a package the job does not use
-leaves every identity as it is.
+a digest of the Python files of the package that defines it). Installing, updating or removing a package the job
+does not use leaves every identity as it is.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ import json
 from functools import cache
 from importlib import metadata
 from importlib.util import find_spec
+from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
@@ -89,7 +90,7 @@ def _targets(node: Any) -> set[str]:
 @cache
 def _plugin_code(target: str) -> str:
     """'' for gyrolab's own classes; else 'distribution==version module@digest' of the plugin's module (the
-    distribution whose entry point names it; the digest: sha256 of the module's file, so that an editable
+    distribution whose entry point names it; the digest: of its package's Python files, so that an editable
     install's new commit counts even when its version stays)."""
     target = _normalise(target)
     module = target.rpartition(".")[0]
@@ -104,9 +105,26 @@ def _plugin_code(target: str) -> str:
         if dist:
             break
     try:
-        spec = find_spec(module)
-        with open(spec.origin, "rb") as source:  # type: ignore[union-attr, arg-type]
-            digest = hashlib.sha256(source.read()).hexdigest()[:12]
+        digest = _source_digest(module)
     except Exception:  # noqa: BLE001 - not importable here: the job refuses it; its name still counts
         digest = "unknown"
     return f"{dist}{module}@{digest}"
+
+
+#: a plugin's package folder larger than this is counted by the module's own file only
+MAX_PACKAGE_FILES = 500
+
+
+def _source_digest(module: str) -> str:
+    """12 hex digits of sha256 over the Python files of the package that holds ``module`` (its folder, with
+    subfolders: the helpers the plugin imports), or of the module's own file when it is not in a package."""
+    spec = find_spec(module)
+    origin = Path(spec.origin)  # type: ignore[union-attr, arg-type]
+    in_package = origin.name == "__init__.py" or "." in module
+    files = sorted(origin.parent.rglob("*.py")) if in_package else [origin]
+    if len(files) > MAX_PACKAGE_FILES:
+        files = [origin]
+    digest = hashlib.sha256()
+    for path in files:
+        digest.update(f"\0{path.relative_to(origin.parent).as_posix()}\0".encode() + path.read_bytes())
+    return digest.hexdigest()[:12]
