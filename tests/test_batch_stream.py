@@ -315,3 +315,35 @@ def test_batch_reports_each_chunk_as_it_starts_and_names_the_kernels_first_load(
     assert [line.split(":")[1].strip() for line in starts] == ["chunk 1", "chunk 2"]
     assert "loads the integration kernels" in starts[0] and "loads" not in starts[1]
     assert any("loading or compiling" in line for line in lines if "in the integration kernels" in line)
+
+
+def _reproduce(monkeypatch, capsys, *args):
+    from gyrolab import app
+
+    monkeypatch.setattr(sys, "argv", ["gyrolab", "reproduce", *args])
+    with pytest.raises(SystemExit) as stop:
+        app.main()
+    captured = capsys.readouterr()
+    return stop.value.code, captured.out, captured.err
+
+
+def test_reproduce_reruns_a_batch_sweep_nc_all_points_or_the_chosen_ones(tmp_path, monkeypatch, capsys):
+    grid = [*FIXED, "batch.chunk=2", "initial.r0=1,2,3", "body.a=1.5,3"]   # a=3: non-physical, failed points
+    path = run_batch_sweep(grid, tmp_path / "b")
+    code, out, _ = _reproduce(monkeypatch, capsys, str(path))
+    assert code == 0, out
+    assert "all 6 of 6 points, in 3 of 3 chunks" in out and "identical:" in out and "NOT" not in out
+
+    tampered = xr.load_dataset(path, decode_times=False, decode_timedelta=False)
+    tampered["omega"].values[2, 0, 1] += 1e-9       # point 4 (r0=3, a=1.5), in the third chunk
+    tampered.to_netcdf(tmp_path / "tampered.nc")
+    code, out, _ = _reproduce(monkeypatch, capsys, str(tmp_path / "tampered.nc"), "--points", "0-3")
+    assert code == 0, out
+    assert "4 of 6 points, in 2 of 3 chunks" in out and "NOT" not in out   # the tampered chunk is not rerun
+    code, out, _ = _reproduce(monkeypatch, capsys, str(tmp_path / "tampered.nc"), "--points", "1,4")
+    assert code == 1, out
+    assert "variable omega: max |Δ|" in out and "1 of 6 values differ" in out and "NOT identical" in out
+
+    code, _, err = _reproduce(monkeypatch, capsys, str(path), "--points", "6")
+    assert code == 2 and err.strip().splitlines() == [
+        "gyrolab: error: --points '6': 6 is outside the points 0 to 5; e.g. --points 0,5,10-19"]

@@ -110,3 +110,26 @@ def test_bash_completes_option_values(scripts, tmp_path, monkeypatch):
     assert _bash(scripts, ["gyrolab", "--cfg", ""]) == {"job", "hydra", "all"}
     assert _bash(scripts, ["gyrolab", "plot", "--format", ""]) == {"gif", "mp4"}
     assert "batch" in _bash(scripts, ["gyrolab", "--config-dir", "myconf", "b"])    # a value is not an override
+
+
+def test_bash_completes_the_experiments_of_the_users_config_dir(scripts, tmp_path, monkeypatch):
+    (tmp_path / "myconf" / "experiment").mkdir(parents=True)
+    (tmp_path / "myconf" / "experiment" / "my_scan.yaml").write_text("# @package _global_\n")
+    monkeypatch.chdir(tmp_path)
+    for words in (["gyrolab", "--config-dir", "myconf", "experiment="], ["gyrolab", "-cd", "myconf", "-m", "experiment="],
+                  ["gyrolab", "--config-dir=myconf", "batch", "experiment=my"]):
+        candidates = _bash(scripts, words)
+        assert "experiment=my_scan" in candidates, (words, candidates)
+    assert "experiment=work_precision" in _bash(scripts, ["gyrolab", "-cd", "myconf", "experiment="])  # gyrolab's too
+    assert "experiment=my_scan" not in _bash(scripts, ["gyrolab", "experiment="])   # only with that --config-dir
+
+
+def test_the_script_offers_installed_plugins(tmp_path):
+    from pathlib import Path
+
+    from tests.conftest import installed_distribution
+
+    example = Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"
+    with installed_distribution(tmp_path, "gyrolab-viscous-drag", "0.1.0",
+                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [example]):
+        assert "force=viscous_drag" in script("bash").split("\n")

@@ -135,3 +135,17 @@ def test_regime_validity_verdict(tmp_path):
     assert np.all(np.diff(e, axis=-1) > 0)
     assert ds.resonance_exponent_max.sel(resonance=2.0).item() == pytest.approx(1.0, abs=0.15)
     assert ds.resonance_omega.attrs["units"] == "1"
+
+
+def test_reproduce_reruns_the_task_that_wrote_a_regime_nc(tmp_path, monkeypatch, capsys):
+    import sys
+
+    from gyrolab import app
+
+    run_task("regime", compose_config([*overrides_000(20.0), "regime.periods=1", "output.figures=false"]), tmp_path)
+    monkeypatch.setattr(sys, "argv", ["gyrolab", "reproduce", str(tmp_path / "regime.nc")])
+    with pytest.raises(SystemExit) as stop:
+        app.main()
+    out = capsys.readouterr().out
+    assert stop.value.code == 0, out
+    assert "task regime run again" in out and "identical:" in out and "NOT" not in out   # not one scene's variables

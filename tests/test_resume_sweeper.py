@@ -82,3 +82,37 @@ def test_remaining_jobs_keep_their_numbers():
     assert launch_runs([0, 1, 2, 9], jobs, 2, merge_gap=0) == [(0, [["x=0"], ["x=1"]]), (2, [["x=2"]]),
                                                                 (9, [["x=9"]])]
     assert launch_runs([], jobs, None) == []
+
+
+def test_a_finished_sweep_and_batch_resume_after_an_unrelated_plugin_is_installed(tmp_path, monkeypatch):
+    from gyrolab.batch.sweep import run_batch_sweep
+    from gyrolab.output import provenance
+    from gyrolab.sweep import identity
+    from tests.conftest import installed_distribution
+
+    monkeypatch.chdir(tmp_path)
+    sweep, two = tmp_path / "sweep", ["body.a=1.5,1.2", "time.end=1", "time.n_output=11", "output.figures=false"]
+    batch = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=1", "time.n_output=11",
+             "output.figures=false", "initial.r0=1,2"]
+    assert gyrolab_in_process(monkeypatch, "-m", *two, f"hydra.sweep.dir={sweep}") in (0, None)
+    run_batch_sweep(batch, tmp_path / "batch")
+    records = {n: json.loads((sweep / str(n) / "job.json").read_text()) for n in range(2)}
+    logs_before = job_logs(sweep)
+    batch_before = (tmp_path / "batch" / "sweep.nc").read_bytes()
+
+    # `pip install gyrolab-viscous-drag` between the run and its resume: a plugin no job names
+    example = Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"
+    site = tmp_path / "site"
+    site.mkdir()
+    with installed_distribution(site, "gyrolab-viscous-drag", "0.1.0",
+                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [example]):
+        provenance.provenance.cache_clear()   # what a new process sees
+        identity._plugin_code.cache_clear()
+        assert "gyrolab-viscous-drag==0.1.0" in provenance.provenance()["plugin_packages"]
+        assert gyrolab_in_process(monkeypatch, "-m", *two, f"hydra.sweep.dir={sweep}") in (0, None)
+        run_batch_sweep(batch, tmp_path / "batch")   # not "holds another batch": the same batch, finished
+    provenance.provenance.cache_clear()
+    assert job_logs(sweep) == logs_before            # no job launched again
+    again = {n: json.loads((sweep / str(n) / "job.json").read_text()) for n in range(2)}
+    assert all(again[n]["skipped"] and again[n]["job_id"] == records[n]["job_id"] for n in range(2))
+    assert (tmp_path / "batch" / "sweep.nc").read_bytes() == batch_before

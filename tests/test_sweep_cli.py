@@ -223,15 +223,32 @@ def test_reproduce_round_trip(basic, tmp_path, monkeypatch, capsys):
     assert "NOT identical: 1 of" in out
 
 
-def test_reproduce_refuses_what_is_not_a_run(basic, monkeypatch, capsys):
+def test_reproduce_a_multirun_sweep_nc_reruns_its_finished_jobs(basic, tmp_path, monkeypatch, capsys):
     from gyrolab import app
 
-    monkeypatch.setattr(sys, "argv", ["gyrolab", "--reproduce", str(basic[0] / "sweep.nc")])
+    # (integrator, a) = (rk4, 1.5), (rk4, 3), (dop853, 1.5), (dop853, 3): a = 3 failed
+    monkeypatch.setattr(sys, "argv", ["gyrolab", "reproduce", str(basic[0] / "sweep.nc")])
     with pytest.raises(SystemExit) as stop:
         app.main()
-    err = capsys.readouterr().err.strip()
-    assert stop.value.code == 2 and len(err.splitlines()) == 1
-    assert err.startswith("gyrolab: error: ") and "sweep.nc" in err and "run.nc" in err
+    out = capsys.readouterr().out
+    assert stop.value.code == 0, out
+    assert "job 1: failed in the sweep; no run.nc to rerun" in out and "job 3: failed in the sweep" in out
+    assert "identical: 2 jobs' datasets equal bit for bit (job 0, job 2)" in out
+
+    # a job's run.nc moved by 1e-9: that job, and only it, differs; --points 2 reruns that job alone
+    sweep_dir = tmp_path / "sweep"
+    shutil.copytree(basic[0], sweep_dir)
+    job = sweep_dir / str(load(sweep_dir / "sweep.nc").job_dir.values.ravel()[2]) / "run.nc"
+    tampered = load(job)
+    tampered["omega"].values[5, 2] += 1e-9
+    tampered.to_netcdf(job)
+    monkeypatch.setattr(sys, "argv", ["gyrolab", "reproduce", str(sweep_dir / "sweep.nc"), "--points", "2"])
+    with pytest.raises(SystemExit) as stop:
+        app.main()
+    out = capsys.readouterr().out
+    assert stop.value.code == 1, out
+    assert "1 of them" in out and "job 0" not in out and "job 2: variable omega: max |Δ|" in out
+    assert "NOT identical: 1 of 1 jobs' datasets differ" in out
 
 
 def test_aggregate_command_rewrites_the_same_sweep_nc(basic, tmp_path):

@@ -2,7 +2,9 @@
 
 import io
 import logging
+import shutil
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,6 +22,7 @@ from gyrolab.sweep.job import run_sweep_job
 from gyrolab.sweep.record import FAILED, read_record
 from gyrolab.sweep.watch import SweepWatcher
 
+REPO = Path(__file__).resolve().parent.parent
 TINY = ["time.end=1", "time.n_output=11", "output.figures=false"]
 
 
@@ -60,6 +63,68 @@ def test_identity_follows_the_resolved_config_and_the_code():
     assert job_identity(a) == job_identity(compose_config(["body.a=2", "initial.r0=3"], return_hydra_config=True))
     assert job_identity(a) != job_identity(compose_config(["body.a=2", "initial.r0=3.5"]))
     assert job_identity(a, "gyrolab 1; git x") != job_identity(a, "gyrolab 1; git y")
+
+
+def test_gyrolab_code_in_an_identity_is_its_code_trees_not_the_commit(monkeypatch):
+    from gyrolab.output import provenance
+    from gyrolab.sweep import identity
+
+    prov = provenance.provenance()
+    if prov["git_commit"] == "unknown":
+        pytest.skip("not a git checkout of gyrolab")
+    code = identity.code_version()
+    assert f"code {provenance.code_tree()}" in code and prov["git_commit"] not in code
+    # a commit that touches only docs or tests: a new commit, the same trees of pipeline/, plugins/, conf/, ...
+    monkeypatch.setitem(prov, "git_commit", "0" * 40)
+    assert identity.code_version() == code
+    listed = provenance._git("ls-tree", "HEAD", "--", *provenance.CODE_PATHS)
+    assert {line.split()[-1] for line in listed.splitlines()} == {"pipeline", "plugins", "conf", "hydra_plugins",
+                                                                  "pyproject.toml"}
+
+
+def test_identity_covers_the_plugins_a_job_names_not_every_installed_package(tmp_path, monkeypatch):
+    from tests.conftest import installed_distribution
+
+    from gyrolab.output import provenance
+    from gyrolab.sweep import identity
+
+    example = REPO / "examples" / "gyrolab-viscous-drag"
+    plain = compose_config(["body.a=2"])
+    before = job_identity(plain)
+
+    def installed(version):
+        site = tmp_path / version
+        site.mkdir()
+        return installed_distribution(site, "gyrolab-viscous-drag", version,
+                                      {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [example])
+
+    with installed("0.1.0"):
+        provenance.provenance.cache_clear()   # as a new process sees it: the plugin is installed
+        identity._plugin_code.cache_clear()
+        assert job_identity(plain) == before  # a plugin the job does not name changes nothing
+        drag = compose_config(["force=[uniform_gravity,viscous_drag]"])
+        code = identity.job_code(drag)
+        assert "plugins gyrolab-viscous-drag==0.1.0 gyrolab_viscous_drag@" in code
+        assert identity.plugins_named(plain) == ""
+        with_drag = job_identity(drag)
+    with installed("0.2.0"):                  # an update of the plugin the job names: another identity
+        identity._plugin_code.cache_clear()
+        assert job_identity(drag) != with_drag
+        assert job_identity(plain) == before
+    editable = tmp_path / "checkout"            # an editable install's new commit, its version unchanged
+    shutil.copytree(example, editable)
+    (tmp_path / "site-e").mkdir()
+    with installed_distribution(tmp_path / "site-e", "gyrolab-viscous-drag", "0.1.0",
+                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [editable]):
+        for name in [m for m in sys.modules if m.startswith("gyrolab_viscous_drag")]:
+            monkeypatch.delitem(sys.modules, name)   # a new process: the plugin is imported from the checkout
+        identity._plugin_code.cache_clear()
+        first = job_identity(drag)
+        (editable / "gyrolab_viscous_drag" / "helpers.py").write_text("SCALE = 2.0\n")   # a helper module changed
+        identity._plugin_code.cache_clear()
+        assert job_identity(drag) != first
+    provenance.provenance.cache_clear()
+    identity._plugin_code.cache_clear()
 
 
 def test_job_records_failures_and_is_skipped_once_settled(tmp_path):

@@ -103,3 +103,21 @@ def test_run_dir_may_use_hydra_resolvers(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     argv = app.preflight(["hydra.run.dir=${hydra:runtime.cwd}/by_cwd", "time.end=1"])
     assert "hydra.run.dir=${hydra:runtime.cwd}/by_cwd" in argv
+
+
+def test_a_user_file_that_a_packaged_one_shadows_is_one_warning_line(myconf, tmp_path, monkeypatch, capsys):
+    from gyrolab.engine import config
+
+    # gyrolab's own body/lagrange_top.yaml is found first (--config-dir goes after it on Hydra's search path)
+    (myconf / "body" / "lagrange_top.yaml").write_text((REPO / "conf" / "body" / "lagrange_top.yaml").read_text()
+                                                       .replace("a: 0.8", "a: 1.7"))
+    config.warn_shadowed.cache_clear()
+    code, err = run_main(["--config-dir=myconf", "body=lagrange_top", *SMALL, "output.figures=false",
+                          "hydra.run.dir=out"], monkeypatch, capsys)
+    assert code == 0, err
+    warned = [line for line in err.splitlines() if line.startswith("gyrolab: warning:")]
+    assert warned == ["gyrolab: warning: myconf/body/lagrange_top.yaml is not read: gyrolab's own body option "
+                      "'lagrange_top' has the same name and is found first (--config-dir is searched after gyrolab's "
+                      "configs); give yours another name and choose it by that name (body=lagrange_top_mine)"]
+    assert "a: 0.8" in stored(tmp_path / "out" / "run.nc")[0]   # what the warning says: gyrolab's file ran
+    config.warn_shadowed.cache_clear()

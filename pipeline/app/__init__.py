@@ -338,9 +338,17 @@ def check_launcher_installed(overrides: Sequence[Override]) -> None:
             continue
         name = str(o.value())
         module = EXTRA_LAUNCHERS.get(name)
-        if module is not None and find_spec(module) is None:
+        if module is not None and not _importable(module, find_spec):
             raise ConfigError(f"hydra/launcher={name} needs the sweep launchers, which are not installed; "
                               'install them with: pip install "gyrolab[cluster]"')
+
+
+def _importable(module: str, find_spec) -> bool:  # noqa: ANN001 - importlib.util.find_spec
+    """Whether ``module`` can be imported (find_spec raises, rather than says None, when a parent package is missing)."""
+    try:
+        return find_spec(module) is not None
+    except (ImportError, ValueError):
+        return False
 
 
 def _without_hydra(cfg: DictConfig) -> DictConfig:

@@ -132,14 +132,35 @@ def _animate(args: argparse.Namespace) -> int:
 
 
 def reproduce(args: argparse.Namespace) -> int:
-    """``gyrolab reproduce PATH/run.nc``: the comparison report on stdout; 0 if identical, else 1."""
+    """``gyrolab reproduce PATH``: a run.nc, an experiment's dataset (the experiment runs again), a sweep.nc of
+    ``gyrolab batch`` or of ``gyrolab -m`` (``--points``: some of its points or jobs); the comparison report on
+    stdout; 0 if identical, else 1."""
     from gyrolab.app.parser import one_path
-    from gyrolab.sweep.reproduce import report, reproduce as rerun
+    from gyrolab.batch.reproduce import is_batch, reproduce_batch
+    from gyrolab.experiments import reproduce_task, task_of_config
+    from gyrolab.sweep.reproduce import checked_config, is_multirun, load_run, report, reproduce_sweep
+    from gyrolab.sweep.reproduce import reproduce as rerun
 
     path = Path(one_path("reproduce", args.paths, "reproduce PATH/run.nc"))
     log_to_stderr()
-    comparison, stored = rerun(path)
-    print("\n".join(report(path, comparison, stored)))
+    stored = load_run(path, sweeps=True)
+    if is_multirun(stored):   # gyrolab -m's sweep.nc: each finished job's run.nc is reproduced
+        comparison, head = reproduce_sweep(path, stored, args.points)
+        print("\n".join(report(path, comparison, stored, head)))
+        return 0 if comparison.identical else 1
+    cfg = checked_config(path, stored)
+    task = task_of_config(cfg)
+    if args.points is not None and (task != "scene" or not is_batch(stored)):
+        raise ConfigError(f"--points chooses points of a sweep.nc, and {path} is "
+                          f"{'one run' if task == 'scene' else f'the dataset of task {task}'}; give it without --points")
+    if task != "scene":    # an experiment's dataset (regime.nc, stability_map.nc, ...): the experiment runs again
+        comparison, head = reproduce_task(path, cfg)
+    elif is_batch(stored):
+        comparison, head = reproduce_batch(path, stored, args.points)
+    else:
+        comparison, stored = rerun(path, stored)
+        head = None
+    print("\n".join(report(path, comparison, stored, head)))
     return 0 if comparison.identical else 1
 
 

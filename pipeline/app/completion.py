@@ -5,7 +5,9 @@ Python start-up): the subcommands, each subcommand's options, the config groups 
 (``integrator=`` then ``integrator=taylor``), the config's keys one level at a time (``time.`` then
 ``time.end=``) and ``true``/``false`` for boolean keys. ``gyrolab --shell-completion install=bash``
 (Hydra's spelling) prints the same script: Hydra's own completion cannot see an installed console script's
-app, nor gyrolab's subcommands. Generate the script again after installing a plugin.
+app, nor gyrolab's subcommands. Generate the script again after installing a plugin. The options of a config
+group in the folder a command line names with ``--config-dir DIR`` (``DIR/experiment/*.yaml``, ...) are read by
+the shell when TAB is pressed, so a user's own experiments are offered without generating anything.
 """
 
 from __future__ import annotations
@@ -34,9 +36,16 @@ def config_words() -> list[str]:
     """Every completion of an override: ``group=``, ``group=option``, ``section.``, ``key=``, ``key=true``."""
     from omegaconf import DictConfig, OmegaConf
 
-    from gyrolab.engine.config import SELECTABLE_GROUPS, compose_config, group_options, hydra_for
+    from gyrolab.engine.config import (
+        SELECTABLE_GROUPS,
+        compose_config,
+        group_options,
+        hydra_for,
+        register_plugin_configs,
+    )
 
     words: list[str] = []
+    register_plugin_configs()   # the installed plugins' options (force=viscous_drag, ...), from the registry
     with hydra_for():
         for group in (*SELECTABLE_GROUPS, *HYDRA_GROUPS):
             words.append(f"{group}=")
@@ -132,10 +141,15 @@ _gyrolab() {
     fi
     set -- ${line% *}
     shift   # the command's own name
-    local value_next=0
+    local value_next=0 option="" confdir=""
     for w in "$@"; do
-        if [[ $value_next -eq 1 ]]; then value_next=0; continue; fi   # the value of --config-dir DIR, ...
-        if [[ " $_gyrolab_value_options " == *" $w "* ]]; then value_next=1; continue; fi
+        if [[ $value_next -eq 1 ]]; then   # the value of --config-dir DIR, ...
+            value_next=0
+            [[ "$option" == --config-dir || "$option" == -cd ]] && confdir="$w"
+            continue
+        fi
+        case "$w" in --config-dir=*|-cd=*) confdir="${w#*=}"; continue;; esac
+        if [[ " $_gyrolab_value_options " == *" $w "* ]]; then value_next=1; option="$w"; continue; fi
         case " $_gyrolab_aliases " in *" ${w%%=*} "*) command="${w#--}"; command="${command%%=*}"; continue;; esac
         if [[ -z "$command" && $overrides -eq 0 && "$w" != -* && " $_gyrolab_commands " == *" $w "* ]]; then
             command="$w"
@@ -160,7 +174,18 @@ _gyrolab() {
         candidates="$(eval "printf '%s' \"\$_gyrolab_options_${command//-/_}\"")"
     else
         case "$command" in
-            run|batch) candidates="$_gyrolab_config";;
+            run|batch)
+                candidates="$_gyrolab_config"
+                if [[ -n "$confdir" && "$cur" == *=* ]]; then   # the options of the user's --config-dir
+                    local group="${cur%%=*}" f
+                    group="${group#+}"
+                    confdir="${confdir/#\~/$HOME}"
+                    for f in "$confdir/$group"/*.yaml; do
+                        [[ -f "$f" ]] || continue
+                        f="${f##*/}"
+                        candidates+=$'\n'"${cur%%=*}=${f%.yaml}"
+                    done
+                fi;;
             plot) candidates="$_gyrolab_plot_config";;
             completion) candidates=$'bash\nzsh';;
             *) candidates="";;

@@ -34,7 +34,7 @@ ALIASES = {"--batch": "batch", "--plot": "plot", "--reproduce": "reproduce", "--
 #: options whose value is the next word (so that word is not read as a subcommand)
 VALUE_OPTIONS = {"--config-dir", "-cd", "--config-path", "-cp", "--config-name", "-cn", "--cfg", "-c",
                  "--package", "-p", "--scheduler", "--animate", "--format", "--frames", "--fps", "-o", "--output",
-                 "--experimental-rerun", "--shell-completion", "-sc", "--info", "-i"}
+                 "--experimental-rerun", "--shell-completion", "-sc", "--info", "-i", "--points"}
 
 #: where logs and results go, said in every --help
 LOGGING_CONVENTION = ("Log lines and progress go to stderr; results (the paths written, reports) go to stdout, "
@@ -83,7 +83,8 @@ def _sentence(text: str) -> str:
 def _source_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("where configs come from (as for gyrolab run)")
     group.add_argument("--config-dir", "-cd", metavar="DIR",
-                       help="a folder of your own configs, searched before gyrolab's (conf/ layout)")
+                       help="a folder of your own configs (conf/ layout), searched after gyrolab's: "
+                            "give yours new names (a file named like one of gyrolab's is not read; a warning says so)")
     group.add_argument("--config-path", "-cp", metavar="DIR",
                        help="a folder that replaces gyrolab's primary config folder")
     group.add_argument("--config-name", "-cn", metavar="NAME", help="the primary config (default: config)")
@@ -133,7 +134,10 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
     reproduce = _Parser(prog="gyrolab reproduce", formatter_class=formatter, epilog=epilog,
                         description=_sentence(COMMANDS["reproduce"]) + ".\nExit status 0: identical; 1: it differs "
                         "(the report on stdout says where).")
-    reproduce.add_argument("paths", nargs="*", metavar="PATH", help="a run.nc or sweep.nc written by gyrolab")
+    reproduce.add_argument("paths", nargs="*", metavar="PATH", help="a run.nc, an experiment's dataset, or a "
+                           "sweep.nc (of gyrolab batch or gyrolab -m) written by gyrolab")
+    reproduce.add_argument("--points", metavar="LIST", help="a sweep.nc: rerun only these points (jobs), by number "
+                           "(0,5,10-19; point n is grid position numpy.unravel_index(n, shape)); default: all")
     parsers["reproduce"] = reproduce
 
     aggregate = _Parser(prog="gyrolab aggregate", formatter_class=formatter, epilog=epilog,

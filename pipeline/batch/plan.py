@@ -36,7 +36,7 @@ from gyrolab.engine.scene import Scene, build_force, fastest_rate
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, GyrolabError, require_finite
 from gyrolab.sweep.grid import Dim, Grid, _refuse_repeats
-from gyrolab.sweep.identity import canonical_config, code_version
+from gyrolab.sweep.identity import canonical_config, job_code
 
 log = logging.getLogger("gyrolab.batch")
 
@@ -44,7 +44,7 @@ VARIABLE_SECTIONS = ("body.", "initial.", "force.")
 PARAM_SECTIONS = ("body.", "force.")
 #: the batch's settings that do not change its result (left out of its identity)
 NOT_IN_IDENTITY = ("scheduler", "progress", "points_file")   # a points file by its contents, not its path
-SCHEME = "gyrolab-batch-1"
+SCHEME = "gyrolab-batch-2"
 #: the stored dimension of an explicit list of points (``batch.points_file``, ``batch.zip``)
 POINT = "point"
 
@@ -119,15 +119,16 @@ class Plan:
         return self.combo_params[self.combo[start:stop]]
 
     def identity(self, chunk: int) -> str:
-        """20 hex digits over the code version, the composed config (without the settings that do not change
-        the result), the grid and the chunk size: the same command gives the same identity."""
+        """20 hex digits over the code it loads (gyrolab's and its plugins': ``job_code``), the composed config
+        (without the settings that do not change the result), the grid and the chunk size: the same command gives
+        the same identity."""
         plain = copy.deepcopy(self.plain)
         for key in NOT_IN_IDENTITY:
             (plain.get("batch") or {}).pop(key, None)
         grid = [[d.key, list(d.labels)] for d in self.dims]
         if self.points is not None:   # a list: its kind, and a points file's contents (SHA-256)
             grid.append(sorted((k, v) for k, v in self.points.items() if k != "points_file"))
-        text = "\n".join((SCHEME, code_version(), canonical_config(plain), json.dumps(grid), str(chunk)))
+        text = "\n".join((SCHEME, job_code(plain), canonical_config(plain), json.dumps(grid), str(chunk)))
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 

@@ -151,9 +151,9 @@ def chunks(shape: tuple[int, ...], size: int) -> list[Chunk]:
     return out
 
 
-def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
+def run_plan(plan: Plan, path: Path, settings: Settings, only: set[int] | None = None) -> RunStats:
     """Integrate every valid point of ``plan``, streaming to ``path`` (resuming a killed run of the same
-    command)."""
+    command); ``only``: just the chunks of these numbers (``gyrolab reproduce --points``: the others stay missing)."""
     size = chunk_size(plan, settings)
     blocks = chunks(plan.shape, size)
     identity = plan.identity(size)
@@ -162,7 +162,7 @@ def run_plan(plan: Plan, path: Path, settings: Settings) -> RunStats:
     if done is None:   # already complete
         return RunStats(path)
     integrator, store.integrator_attributes = batch_integrator(plan, settings)
-    pending = [i for i in range(len(blocks)) if i not in done]
+    pending = [i for i in range(len(blocks)) if i not in done and (only is None or i in only)]
     tasks, empty = [], []
     for i in pending:
         task = chunk_task(plan, blocks[i], i, settings, integrator)

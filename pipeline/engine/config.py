@@ -12,6 +12,7 @@ from __future__ import annotations
 import difflib
 import os
 import re
+import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -29,7 +30,7 @@ from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
 from gyrolab.engine.hydra_private import create_automatic_config_search_path
-from gyrolab.errors import ConfigError, choices, shorten
+from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
 from gyrolab.engine.unread import refuse_given_accuracy
 from gyrolab.engine.user_yaml import check_user_config_dir
 
@@ -61,6 +62,7 @@ class ConfigSource:
                 raise ConfigError(f"--config-dir {config_dir!r} is not a directory; give the folder that holds "
                                   "your YAML files (e.g. --config-dir myconf)")
             check_user_config_dir(config_dir, "--config-dir")
+            warn_shadowed(config_dir, "--config-dir")
         if config_path is not None and not config_path.startswith("pkg://"):
             config_path = os.path.abspath(config_path)
             if not os.path.isdir(config_path):
@@ -94,6 +96,34 @@ _source = ConfigSource()
 def _check_search_dir(directory: str) -> None:
     if os.path.isdir(directory):
         check_user_config_dir(os.path.abspath(directory), "hydra.searchpath")
+        warn_shadowed(os.path.abspath(directory), "hydra.searchpath")
+
+
+class ShadowedConfigWarning(GyrolabWarning):
+    """A file in a user's config folder that is never read: gyrolab's packaged file of the same name wins."""
+
+
+@cache
+def warn_shadowed(directory: str, option: str) -> None:
+    """One warning per file of a user's config folder (``--config-dir``, ``hydra.searchpath``) that has the path of
+    one of gyrolab's packaged configs: Hydra searches gyrolab's configs first (``--config-dir`` goes after them on
+    the search path, as in every Hydra app), so that file is never read."""
+    from importlib.resources import files
+
+    packaged = files(CONFIG_MODULE)
+    for path in sorted(Path(directory).rglob("*.yaml")):
+        relative = path.relative_to(directory)
+        if not packaged.joinpath(*relative.parts).is_file():
+            continue
+        shown = os.path.relpath(path) if not os.path.relpath(path).startswith("..") else str(path)
+        group, name = relative.parent.as_posix(), relative.stem
+        if group == ".":
+            what, instead = f"gyrolab's primary config {relative.name}", "name yours mine.yaml and give --config-name mine"
+        else:
+            what, instead = (f"gyrolab's own {group} option {name!r}",
+                             f"give yours another name and choose it by that name ({group}={name}_mine)")
+        warnings.warn(f"{shown} is not read: {what} has the same name and is found first ({option} is searched after "
+                      f"gyrolab's configs); {instead}", ShadowedConfigWarning, stacklevel=2)
 
 
 def use_source(source: ConfigSource) -> None:

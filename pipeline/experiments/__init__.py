@@ -106,3 +106,40 @@ def run_task(name: str, cfg: DictConfig, out_dir: Path) -> list[Path]:
     if name not in TASKS:
         raise ConfigError(f"unknown task {name!r}; valid choices: {choices(['scene', *TASKS])}")
     return importlib.import_module(TASKS[name]).run(cfg, out_dir)
+
+
+def task_of_config(cfg: DictConfig) -> str:
+    """What a config runs: its task, ``regime`` for a plain run with a regime, else ``scene``."""
+    task = cfg.get("task") or "scene"
+    return "regime" if task == "scene" and cfg.get("regime") else str(task)
+
+
+def reproduce_task(path: Path, cfg: DictConfig) -> tuple[object, list[str]]:
+    """(the comparison, the report's head) of running the experiment a dataset's stored ``cfg`` names again, into a
+    temporary directory, and comparing the dataset of the same name (``gyrolab reproduce PATH/regime.nc``, ...)."""
+    import tempfile
+
+    import xarray as xr
+    from omegaconf import open_dict
+
+    from gyrolab.sweep.reproduce import compare, load_run
+
+    task = task_of_config(cfg)
+    if task not in TASKS:
+        raise ConfigError(f"{path} was written by task {task!r}, which this gyrolab does not have; valid choices: "
+                          f"{choices(['scene', *TASKS])}")
+    cfg = cfg.copy()
+    if isinstance(cfg.get("output"), DictConfig) and "figures" in cfg.output:
+        with open_dict(cfg):
+            cfg.output.figures = False   # the datasets are compared, not the figures
+    with tempfile.TemporaryDirectory(prefix="gyrolab-reproduce-") as tmp:
+        written = [Path(p) for p in run_task(task, cfg, Path(tmp))]
+        same_name = [p for p in written if p.name == Path(path).name and p.suffix == ".nc"]
+        if not same_name:
+            datasets = sorted({p.name for p in written if p.suffix == ".nc"})
+            raise ConfigError(f"{path}: task {task} writes {', '.join(datasets) or 'no dataset'}, not "
+                              f"{Path(path).name}; give the dataset it wrote under its own name")
+        new = xr.load_dataset(same_name[0], decode_times=False, decode_timedelta=False)
+    stored = load_run(path)
+    head = [f"reproducing {path} ({stored.attrs.get('title', '?')}): task {task} run again"]
+    return compare(stored, new), head

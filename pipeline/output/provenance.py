@@ -16,7 +16,7 @@ SOURCE_ROOT = Path(__file__).resolve().parents[2]
 LIBRARIES = ("numpy", "scipy", "xarray", "netCDF4", "hydra-core", "omegaconf", "matplotlib")
 #: entry-point groups whose providers (third-party plugin packages) are part of the code that ran
 #: what can change a result (docs, tests and the README cannot)
-CODE_PATHS = ("pipeline", "plugins", "conf", "pyproject.toml")
+CODE_PATHS = ("pipeline", "plugins", "conf", "hydra_plugins", "pyproject.toml")
 PLUGIN_GROUPS = ("gyrolab.systems", "gyrolab.forces", "gyrolab.integrators", "gyrolab.regimes")
 
 
@@ -47,6 +47,16 @@ def _untracked_code() -> list[str]:
     """New files under CODE_PATHS that git does not track yet (they may be imported all the same)."""
     listed = _git("ls-files", "--others", "--exclude-standard", "--", *CODE_PATHS)
     return sorted(line for line in (listed or "").splitlines() if line)
+
+
+@cache
+def code_tree() -> str:
+    """20 hex digits over the git objects of CODE_PATHS at HEAD ('' outside a git checkout of gyrolab): unlike
+    the commit, it stays the same across commits that change only documentation, tests or benchmarks."""
+    if not _in_own_checkout():
+        return ""
+    listed = _git("ls-tree", "HEAD", "--", *CODE_PATHS)
+    return hashlib.sha256(listed.encode()).hexdigest()[:20] if listed else ""
 
 
 def _diff_digest(untracked: list[str]) -> str:

@@ -3,43 +3,128 @@
 Two jobs with the same identity compute the same result (the integrators are
 deterministic), so a sweep that is run again skips the jobs whose identity
 already has a finished result in the sweep directory.
+
+The code is what the job loads: gyrolab's own (its version, the git trees of its code folders and the digest
+of their uncommitted changes: a commit that changes only documentation or tests leaves it as it is) and the
+third-party plugins the config names (each ``_target_`` outside gyrolab: its distribution's name and version and
+a digest of the Python files of the package that defines it). Installing, updating or removing a package the job
+does not use leaves every identity as it is.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+from functools import cache
+from importlib import metadata
+from importlib.util import find_spec
+from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.output.provenance import provenance
+from gyrolab.contracts.registry import _normalise
+from gyrolab.output.provenance import PLUGIN_GROUPS, code_tree, provenance
 
 #: bump when the meaning of an identity changes (invalidates every stored result)
-SCHEME = "gyrolab-job-1"
+SCHEME = "gyrolab-job-2"
 
 
-def code_version(prov: dict[str, Any] | None = None) -> str:
-    """gyrolab's version, git commit, the digest of uncommitted changes, and third-party plugin packages."""
-    prov = provenance() if prov is None else prov
-    parts = [f"gyrolab {prov['gyrolab_version']}", f"git {prov['git_commit']}"]
+def code_version() -> str:
+    """gyrolab's own code: its version, the git trees of its code (or the commit) and the digest of uncommitted
+    changes to it."""
+    prov = provenance()
+    parts = [f"gyrolab {prov['gyrolab_version']}"]
+    tree = code_tree() if prov["git_commit"] != "unknown" else ""
+    parts.append(f"code {tree}" if tree else f"git {prov['git_commit']}")
     if prov.get("git_dirty") == 1:
         parts.append(f"diff {prov.get('git_diff_sha256', '')[:16] or 'unknown'}")
-    if prov.get("plugin_packages"):
-        parts.append(f"plugins {prov['plugin_packages']}")
     return "; ".join(parts)
+
+
+def plain_config(cfg: DictConfig | dict[str, Any]) -> dict[str, Any]:
+    """The resolved config without Hydra's own node, as plain data."""
+    if isinstance(cfg, DictConfig):
+        return OmegaConf.to_container(OmegaConf.masked_copy(cfg, [k for k in cfg if k != "hydra"]), resolve=True)
+    return {k: v for k, v in cfg.items() if k != "hydra"}
 
 
 def canonical_config(cfg: DictConfig | dict[str, Any]) -> str:
     """The resolved config (without Hydra's own node) as sorted, compact JSON."""
-    if isinstance(cfg, DictConfig):
-        plain = OmegaConf.to_container(OmegaConf.masked_copy(cfg, [k for k in cfg if k != "hydra"]), resolve=True)
-    else:
-        plain = {k: v for k, v in cfg.items() if k != "hydra"}
-    return json.dumps(plain, sort_keys=True, separators=(",", ":"), allow_nan=True)
+    return json.dumps(plain_config(cfg), sort_keys=True, separators=(",", ":"), allow_nan=True)
+
+
+def plugins_named(cfg: DictConfig | dict[str, Any]) -> str:
+    """The third-party plugins a config names (system, forces, integrator, regime: every ``_target_`` outside
+    gyrolab), each as 'distribution==version module@digest', sorted; '' when it names only gyrolab's own."""
+    return " ".join(sorted({_plugin_code(t) for t in _targets(plain_config(cfg))} - {""}))
+
+
+def job_code(cfg: DictConfig | dict[str, Any], code: str | None = None) -> str:
+    """The code a job of config ``cfg`` loads: gyrolab's (``code``, default ``code_version()``) and its plugins'."""
+    plugins = plugins_named(cfg)
+    code = code_version() if code is None else code
+    return f"{code}; plugins {plugins}" if plugins else code
 
 
 def job_identity(cfg: DictConfig | dict[str, Any], code: str | None = None) -> str:
-    """20 hex digits of sha256 over (scheme, code version, canonical config)."""
-    text = "\n".join((SCHEME, code_version() if code is None else code, canonical_config(cfg)))
+    """20 hex digits of sha256 over (scheme, the code the job loads, canonical config); ``code`` is gyrolab's own
+    code version (``code_version()`` when not given), the plugins the config names are added here."""
+    plain = plain_config(cfg)
+    text = "\n".join((SCHEME, job_code(plain, code), canonical_config(plain)))
     return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+def _targets(node: Any) -> set[str]:
+    """Every ``_target_`` string in a plain config."""
+    if isinstance(node, dict):
+        found = {str(node["_target_"])} if isinstance(node.get("_target_"), str) else set()
+        for value in node.values():
+            found |= _targets(value)
+        return found
+    if isinstance(node, list):
+        return set().union(*(_targets(value) for value in node)) if node else set()
+    return set()
+
+
+@cache
+def _plugin_code(target: str) -> str:
+    """'' for gyrolab's own classes; else 'distribution==version module@digest' of the plugin's module (the
+    distribution whose entry point names it; the digest: of its package's Python files, so that an editable
+    install's new commit counts even when its version stays)."""
+    target = _normalise(target)
+    module = target.rpartition(".")[0]
+    if not module or module == "gyrolab" or module.startswith("gyrolab."):
+        return ""
+    dist = ""
+    for group in PLUGIN_GROUPS:
+        for ep in metadata.entry_points(group=group):
+            if _normalise(ep.value) == target and getattr(ep, "dist", None) is not None:
+                dist = f"{ep.dist.metadata['Name']}=={ep.dist.version} "
+                break
+        if dist:
+            break
+    try:
+        digest = _source_digest(module)
+    except Exception:  # noqa: BLE001 - not importable here: the job refuses it; its name still counts
+        digest = "unknown"
+    return f"{dist}{module}@{digest}"
+
+
+#: a plugin's package folder larger than this is counted by the module's own file only
+MAX_PACKAGE_FILES = 500
+
+
+def _source_digest(module: str) -> str:
+    """12 hex digits of sha256 over the Python files of the package that holds ``module`` (its folder, with
+    subfolders: the helpers the plugin imports), or of the module's own file when it is not in a package."""
+    spec = find_spec(module)
+    origin = Path(spec.origin)  # type: ignore[union-attr, arg-type]
+    in_package = origin.name == "__init__.py" or "." in module
+    files = sorted(origin.parent.rglob("*.py")) if in_package else [origin]
+    if len(files) > MAX_PACKAGE_FILES:
+        files = [origin]
+    digest = hashlib.sha256()
+    for path in files:
+        digest.update(f"\0{path.relative_to(origin.parent).as_posix()}\0".encode() + path.read_bytes())
+    return digest.hexdigest()[:12]

@@ -21,7 +21,7 @@ from omegaconf import DictConfig
 
 from gyrolab.errors import GyrolabError, OutputError
 from gyrolab.output.lock import clear_temporaries, owner_of, try_lock, unlock
-from gyrolab.sweep.identity import code_version, job_identity
+from gyrolab.sweep.identity import code_version, job_code, job_identity
 from gyrolab.sweep.orphans import guard_worker
 from gyrolab.sweep.record import (
     ELSEWHERE,
@@ -86,6 +86,7 @@ def _run_locked(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_nu
     code = code_version()
     try:
         job_id = job_identity(cfg, code)
+        code = job_code(cfg, code)  # what the identity covers: gyrolab's code and the plugins the job names
     except Exception as error:  # noqa: BLE001 - e.g. an interpolation that does not resolve: the job fails
         record = _failed(JobRecord(job_id="", status=FAILED, overrides=list(overrides), code_version=code,
                                    job_num=job_num), error, 2, deterministic=False)

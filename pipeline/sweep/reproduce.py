@@ -1,5 +1,9 @@
 """``gyrolab --reproduce PATH/run.nc``: rerun a dataset's stored config and say whether the result is identical.
 
+A multirun's ``sweep.nc``: each finished job's ``run.nc`` (``reproduce_sweep``). A batch's ``sweep.nc``:
+``gyrolab.batch.reproduce``; an experiment's dataset: ``gyrolab.experiments.reproduce_task`` (both with the
+comparison of this module).
+
 Identical means every data variable and coordinate is equal bit for bit.
 Otherwise the report names each differing variable with its largest
 absolute difference. Provenance that differs (commit, library versions,
@@ -17,7 +21,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.engine.budget import check_budget
 from gyrolab.engine.safety import check_stored_config
-from gyrolab.errors import ConfigError, GyrolabError
+from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
@@ -29,6 +33,8 @@ PROVENANCE_KEYS = ("gyrolab_version", "git_commit", "git_dirty", "git_diff_sha25
 
 @dataclass
 class Comparison:
+    #: what ``same`` and ``differ`` count: a run's variables and coordinates, or a sweep's jobs
+    unit: str = "variables and coordinates"
     same: list[str] = field(default_factory=list)
     differ: list[str] = field(default_factory=list)          # one sentence per differing variable
     provenance: list[str] = field(default_factory=list)      # stored vs now, where they differ
@@ -38,15 +44,73 @@ class Comparison:
         return not self.differ
 
 
-def load_run(path: Path) -> xr.Dataset:
+def load_run(path: Path, *, sweeps: bool = False) -> xr.Dataset:
+    """The dataset at ``path``: a run.nc or another dataset with a stored config (``sweeps``: a multirun's
+    sweep.nc too); ConfigError, one sentence, for anything else."""
     path = Path(path)
     ds = load_dataset(path, "a run.nc that gyrolab wrote", decode_times=False, decode_timedelta=False)
+    if sweeps and is_multirun(ds):
+        return ds
     if "config" not in ds.attrs and "job_status" in ds:
         raise ConfigError(f"{str(path)!r} is a sweep dataset, not a run; give one job's run.nc (sweep.nc's "
                           "job_dir variable names each job's directory)")
     if "config" not in ds.attrs:
         raise ConfigError(f"{str(path)!r} has no 'config' attribute; give a run.nc that gyrolab wrote")
     return ds
+
+
+def is_multirun(ds: xr.Dataset) -> bool:
+    """Whether a dataset is a multirun's sweep.nc (``gyrolab -m``): jobs with their directories, no config of its own."""
+    return "config" not in ds.attrs and "job_status" in ds and "job_dir" in ds
+
+
+def parse_points(text: str | None, n_points: int, what: str = "point") -> list[int] | None:
+    """``--points 0,5,10-19`` as sorted numbers below ``n_points`` (None: all); ConfigError, one sentence, otherwise."""
+    if text is None:
+        return None
+    chosen: set[int] = set()
+    for part in (p.strip() for p in str(text).split(",")):
+        low, dash, high = part.partition("-")
+        try:
+            first, last = int(low), int(high) if dash else int(low)
+        except ValueError:
+            raise ConfigError(f"--points {shorten(repr(text))}: {shorten(repr(part))} is not a {what} number or a "
+                              f"range; give numbers and ranges from 0 to {n_points - 1}, e.g. --points 0,5,10-19") from None
+        if not 0 <= first <= last < n_points:
+            raise ConfigError(f"--points {shorten(repr(text))}: {part} is outside the {what}s 0 to {n_points - 1}; "
+                              "e.g. --points 0,5,10-19")
+        chosen.update(range(first, last + 1))
+    return sorted(chosen)
+
+
+def reproduce_sweep(path: Path, stored: xr.Dataset, points: str | None = None) -> tuple[Comparison, list[str]]:
+    """(the comparison, the report's head) of reproducing the finished jobs of a multirun's sweep.nc, each from its
+    own run.nc (``job_dir``, relative to the sweep directory); ``points``: only these jobs (flat numbers over the
+    swept dimensions, C order). A failed job left no run.nc: it is named, not rerun."""
+    path = Path(path)
+    status = np.asarray(stored["job_status"].values).ravel()
+    dirs = [str(d) for d in np.asarray(stored["job_dir"].values).ravel()]
+    chosen = parse_points(points, status.size, "job") if points is not None else list(range(status.size))
+    result, head = Comparison(unit="jobs' datasets"), [f"reproducing {path} (a sweep of {status.size} jobs): "
+                                  f"{'all ' if points is None else ''}{len(chosen)} of them"]
+    top = path.parent.resolve()
+    for n in chosen:
+        if int(status[n]) != 1 or not dirs[n]:
+            head.append(f"  job {n}: {'failed' if int(status[n]) == 2 else 'did not run'} in the sweep; no run.nc to rerun")
+            continue
+        run_path = (top / dirs[n] / "run.nc").resolve()
+        if not run_path.is_relative_to(top):
+            raise ConfigError(f"{path}: job_dir {shorten(repr(dirs[n]))} is outside the sweep directory; give a "
+                              "sweep.nc that gyrolab wrote, in its sweep directory")
+        comparison, _ = reproduce(run_path)
+        head.append(f"  job {n} ({dirs[n]}/run.nc): " + ("identical" if comparison.identical else
+                                                          f"{len(comparison.differ)} variables differ"))
+        if comparison.identical:
+            result.same.append(f"job {n}")
+        else:
+            result.differ.append(f"job {n}: " + "; ".join(comparison.differ))
+        result.provenance = result.provenance or comparison.provenance
+    return result, head
 
 
 def stored_config(stored: xr.Dataset, where: str = "the dataset's config attribute") -> DictConfig:
@@ -122,8 +186,19 @@ def _difference(old: xr.DataArray, new: xr.DataArray) -> str:
     return "" if equal.all() else f"{int((~equal).sum())} of {equal.size} values differ"
 
 
-def reproduce(path: Path) -> tuple[Comparison, xr.Dataset]:
-    stored = load_run(path)
+def checked_config(path: Path, stored: xr.Dataset) -> DictConfig:
+    """``stored_config``, with what a foreign dataset lacks said in one sentence."""
+    try:
+        return stored_config(stored)
+    except GyrolabError:
+        raise
+    except FOREIGN_ERRORS as error:  # a stored config without what gyrolab's runs always have
+        raise not_gyrolabs(path, error, "a run.nc that gyrolab wrote") from None
+
+
+def reproduce(path: Path, stored: xr.Dataset | None = None) -> tuple[Comparison, xr.Dataset]:
+    """Rerun the run.nc at ``path`` (``stored``: its dataset, already loaded) and compare."""
+    stored = load_run(path) if stored is None else stored
     expected = "a run.nc that gyrolab wrote"
     try:
         scene = Scene.from_config(stored_config(stored))
@@ -140,16 +215,17 @@ def reproduce(path: Path) -> tuple[Comparison, xr.Dataset]:
         raise not_gyrolabs(path, error, expected) from None
 
 
-def report(path: Path, comparison: Comparison, stored: xr.Dataset) -> list[str]:
-    head = (f"reproducing {path} ({stored.attrs.get('title', '?')}; {stored.attrs.get('integrator', '?')}, "
-            f"{stored.sizes.get('time', '?')} output times)")
-    lines = [head]
+def report(path: Path, comparison: Comparison, stored: xr.Dataset, head: list[str] | None = None) -> list[str]:
+    """The report's lines: ``head`` (default: the run's title, integrator and output times), then the comparison."""
+    lines = list(head) if head else [
+        f"reproducing {path} ({stored.attrs.get('title', '?')}; {stored.attrs.get('integrator', '?')}, "
+        f"{stored.sizes.get('time', '?')} output times)"]
     lines += [f"  provenance differs: {p}" for p in comparison.provenance]
     if comparison.identical:
-        lines.append(f"identical: {len(comparison.same)} variables and coordinates equal bit for bit "
+        lines.append(f"identical: {len(comparison.same)} {comparison.unit} equal bit for bit "
                      f"({', '.join(comparison.same)})")
     else:
         lines += [f"  {d}" for d in comparison.differ]
         lines.append(f"NOT identical: {len(comparison.differ)} of {len(comparison.differ) + len(comparison.same)} "
-                     "variables and coordinates differ")
+                     f"{comparison.unit} differ")
     return lines

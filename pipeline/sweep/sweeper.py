@@ -262,24 +262,17 @@ def _patched(base: _Base, changed: Sequence[Override]) -> dict[str, Any] | None:
     return plain
 
 
-class GyrolabSweeper(ResumingSweeper):
-    """The sweeper gyrolab's config selects (``hydra/sweeper: gyrolab``)."""
-
-
-#: Hydra instantiates a sweeper only from the ``hydra_plugins`` namespace (it checks the name and imports
-#: it): the class goes by that name there (``register_plugin``) instead of shipping a second top-level package
-GyrolabSweeper.__module__ = "hydra_plugins.gyrolab_sweeper"
-PLUGIN_TARGET = f"{GyrolabSweeper.__module__}.{GyrolabSweeper.__qualname__}"
-
-
 def register_plugin() -> None:
-    """Make gyrolab's sweeper known to Hydra in this process (before Hydra instantiates the sweeper)."""
-    import sys
-    import types
+    """Make sure Hydra knows gyrolab's sweeper (``hydra_plugins.gyrolab_sweeper``) in this process.
 
+    Hydra finds it by scanning the ``hydra_plugins`` namespace package, except in an editable install
+    (``pip install -e .``, the README's): setuptools' editable finder serves the package on import but cannot
+    list it, so Hydra's scan does not see it, and the class is registered here by its real name.
+    """
     from hydra.core.plugins import Plugins
 
-    name = GyrolabSweeper.__module__
-    module = sys.modules.setdefault(name, types.ModuleType(name, "gyrolab's sweeper (gyrolab.sweep.sweeper) for Hydra"))
-    module.GyrolabSweeper = GyrolabSweeper  # type: ignore[attr-defined]  # (also on a stale installed module)
-    Plugins.instance().register(GyrolabSweeper)
+    plugins = Plugins.instance()  # scans first: a scan re-executes the plugin modules it finds
+    from hydra_plugins.gyrolab_sweeper import GyrolabSweeper
+
+    if f"{GyrolabSweeper.__module__}.{GyrolabSweeper.__name__}" not in plugins.class_name_to_class:
+        plugins.register(GyrolabSweeper)
