@@ -191,6 +191,19 @@ def check_torques(forces: list[Any]) -> None:
             raise NotCompilable(f"the torque of force {force.name!r} has shape {shape}, not (3,)")
 
 
+def binary_power(x: Any, n: int, multiply: Any) -> Any:
+    """x^n for an integer n ≥ 1 by binary powering with ``multiply(a, b)``: the generators' series of an integer
+    power, Cauchy products only (no division by x_0, so x_0 = 0 is fine)."""
+    result, square = None, x
+    while True:
+        if n & 1:
+            result = square if result is None else multiply(result, square)
+        n >>= 1
+        if not n:
+            return result
+        square = multiply(square, square)
+
+
 _LOADED: dict[str, Any] = {}
 
 

@@ -27,7 +27,7 @@ from __future__ import annotations
 from typing import Any
 
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before compiling)
-from gyrolab.kernels.expression import Expr, NotCompilable, load_generated
+from gyrolab.kernels.expression import Expr, NotCompilable, binary_power, load_generated
 from gyrolab.kernels.layout import TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import Model
 
@@ -206,14 +206,7 @@ class _Program:
         """x^n by binary powering (Cauchy products), 1/x^|n| for n < 0."""
         if n == 0:
             return ("num", ("1.0", "0.0"))
-        result, square, m = None, x, abs(n)
-        while True:
-            if m & 1:
-                result = square if result is None else self._mul(result, square)
-            m >>= 1
-            if not m:
-                break
-            square = self._mul(square, square)
+        result = binary_power(x, abs(n), self._mul)
         return self._divide(("num", ("1.0", "0.0")), result) if n < 0 else result
 
     def source(self) -> str:

@@ -63,7 +63,7 @@ from numba.extending import intrinsic
 
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before the decorators)
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
-from gyrolab.kernels.expression import Expr, load_generated
+from gyrolab.kernels.expression import Expr, binary_power, load_generated
 from gyrolab.kernels.model import MODELS, TRACED, Model
 
 ZERO, ONE, MINUS_ONE = "0.0", "1.0", "-1.0"
@@ -422,14 +422,7 @@ class _Program:
             return _Lin(ONE)
         if not x.terms:
             return _Lin(self.numbers.call(_NUMBER_FUNCTIONS["ipow"], x.const, int(power)))
-        result, square, m = None, x, abs(power)
-        while True:
-            if m & 1:
-                result = square if result is None else self._mul(result, square)
-            m >>= 1
-            if not m:
-                break
-            square = self._mul(square, square)
+        result = binary_power(x, abs(power), self._mul)
         return self._function("div", _Lin(ONE), result) if power < 0 else result
 
     # ---- the generated code
