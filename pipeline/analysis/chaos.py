@@ -119,7 +119,8 @@ def _generated_run(compiled: Any, settings: Any, times: np.ndarray, y0s: np.ndar
                    every_time: bool) -> dict[str, np.ndarray]:
     """``megno_run`` for a model compiled from its traced equations: its tangent flow generated from them
     (``kernels.tangent``), run by the compiled batch kernels (RK4 or DOP853 with the integrator's settings). FLI is
-    max ln|δ| over the output times (the hand-written fixed-point kernels take it over every step); the nutation
+    max ln|δ| over the output times and ``FLI_SAMPLES`` more (the hand-written fixed-point kernels take it over every
+    step); the nutation
     deviation is that of the state's last three components when they are a unit vector γ (θ = arccos γ3: the
     orbiting gyrostat's orbit normal), else NaN."""
     from gyrolab.kernels import model, tangent
@@ -136,7 +137,10 @@ def _generated_run(compiled: Any, settings: Any, times: np.ndarray, y0s: np.ndar
     P = tangent.megno_params(augmented, compiled.params if params is None else params)
     if len(P) == 1 and len(y0s) > 1:
         P = np.repeat(P, len(y0s), axis=0)
-    t = times - times[0]
+    # the requested times and FLI_SAMPLES more, where max ln|δ| and max |θ − θ0| are read (a map asks for 2 times)
+    grid = np.union1d(times, np.linspace(times[0], times[-1], FLI_SAMPLES + 1))
+    requested = np.searchsorted(grid, times)
+    t = grid - times[0]
     t[0] = tangent.START
     method = (RK4Numba(step=float(settings.step)) if settings.fixed_step else
               DOP853Numba(rtol=float(settings.rtol), atol=float(settings.atol),
@@ -145,7 +149,7 @@ def _generated_run(compiled: Any, settings: Any, times: np.ndarray, y0s: np.ndar
     n = y0s.shape[1]
     z = run.y
     megno = np.zeros((len(y0s), times.size))
-    megno[:, 1:] = z[:, 1:, -1] / (times[1:] - times[0])
+    megno[:, 1:] = z[:, requested[1:], -1] / (times[1:] - times[0])
     gamma = z[:, :, n - 3:n]
     deviation = np.full(len(y0s), np.nan)
     if np.allclose(np.linalg.norm(y0s[:, n - 3:n], axis=1), 1.0, atol=1e-9):
@@ -157,6 +161,11 @@ def _generated_run(compiled: Any, settings: Any, times: np.ndarray, y0s: np.ndar
     return {"megno": megno if every_time else megno[:, -1:], "fli": np.where(failed, np.nan, z[:, :, 2 * n].max(axis=1)),
             "max_nutation_deviation": np.where(failed, np.nan, deviation),
             "final_state": np.where(failed[:, None], np.nan, z[:, -1, :n]), "failed": failed, "steps": steps}
+
+
+#: output times of a generated tangent flow's run (besides the requested ones) where FLI and the nutation deviation
+#: are read: the hand-written kernels read them after every step
+FLI_SAMPLES = 256
 
 
 def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray,
