@@ -353,8 +353,12 @@ def test_a_scene_in_double_double_runs_with_alpha_and_every_builtin_force_and_re
     assert ds.gamma_norm.attrs["max_abs_drift"] < 1e-15
 
 
-def test_a_compiled_expression_is_refused_in_double_double_naming_the_force():
+def test_a_traced_plugin_torque_runs_in_double_double_and_a_transcendental_one_is_refused_naming_it():
+    """The double-double series is generated from the traced equations (``series_dd``): a rational torque runs
+    (same trajectory as double precision, to its accuracy); a function of the state without a double-double series
+    here is refused in one sentence naming it."""
     from gyrolab.contracts import Force
+    from gyrolab.plugins.systems.fixed_point import traced_model
 
     class Drag(Force):
         name = "my_drag"
@@ -362,26 +366,26 @@ def test_a_compiled_expression_is_refused_in_double_double_naming_the_force():
         preserves_area_integral = False
 
         def torque(self, omega, axes):
-            return -0.1 * omega
+            return -0.1 * omega * (1.0 + omega[2] ** 2)
 
-    class System:
-        forces = [Drag()]
+    class Wobble(Drag):
+        name = "my_wobble"
 
-        def rhs(self, t, y):
-            raise AssertionError("not called")
+        def torque(self, omega, axes):
+            return -0.1 * np.sin(omega)
 
-    model = CompiledModel(models.TRACED, np.zeros(N_PARAMS + 4))
-    taylor = Taylor(precision="double-double")
-    # the scene asks before integrating (contract rule 8, C1) and puts the clause into its one sentence
-    assert taylor.refusal(model, System()) == (
-        "in double-double precision evaluates the fixed-point model's built-in torque forms only (uniform_gravity, "
-        "newtonian, magnetic), and force 'my_drag' is a compiled plugin torque (integrator.precision=double runs it)")
-    assert taylor.refusal(CompiledModel(models.FIXED_POINT, np.zeros(N_PARAMS)), System()) is None
-    # called directly, integrate refuses too
-    with pytest.raises(ConfigError, match=r"^integrator 'taylor' in double-double precision .* force 'my_drag' is a "
-                                          r"compiled plugin torque \(integrator.precision=double runs it\); valid "
-                                          r"choices: integrator.precision=double$"):
-        taylor.integrate(System().rhs, np.array([0.0, 1.0]), np.ones(6), None, model)
+    inertia, y0 = np.array([2.0, 1.5, 1.0]), np.array([0.3, -0.2, 2.0, 0.0, 0.6, 0.8])
+    t_out = np.linspace(0.0, 5.0, 11)
+    drag = traced_model(inertia, [Drag()], False)
+    dd = Taylor(precision="double-double", tol=1e-28)
+    assert dd.refusal(drag) is None
+    np.testing.assert_allclose(dd.integrate(None, t_out, y0, None, drag).y,
+                               Taylor(tol=1e-16).integrate(None, t_out, y0, None, drag).y, rtol=0, atol=1e-13)
+    wobble = traced_model(inertia, [Wobble()], False)
+    clause = dd.refusal(wobble)
+    assert clause.startswith("in double-double precision cannot run this model: ") and "'sin'" in clause
+    with pytest.raises(ConfigError, match=r"^integrator 'taylor' in double-double precision cannot run .*'sin'"):
+        dd.integrate(None, t_out, y0, None, wobble)
 
 
 def test_capabilities_batch_points_and_the_error_estimates_companion():
@@ -392,7 +396,7 @@ def test_capabilities_batch_points_and_the_error_estimates_companion():
     taylor = Taylor(precision="double-double", tol=1e-24)
     assert isinstance(taylor, TaylorDoubleDouble) and type(Taylor()) is Taylor and taylor.name == "taylor"
     assert taylor.supports(COMPILED_MODEL) and not taylor.supports(BATCH_KERNEL)
-    assert not taylor.supports(TIME_DEPENDENT) and Taylor().supports(BATCH_KERNEL)
+    assert taylor.supports(TIME_DEPENDENT) and Taylor().supports(BATCH_KERNEL)
     # the error estimate's companion stays in double-double, 1000x tighter, down to the floor
     companion, factor, _ = taylor.more_accurate(1000.0)
     assert (type(companion), companion.order, factor) == (TaylorDoubleDouble, taylor.order, 1.0)
@@ -419,26 +423,34 @@ def test_the_one_call_samples_for_auto_equal_the_integrator(chaotic):
     samples = taylor_dd_samples(model, 1e-26, t_out, y0)
     np.testing.assert_array_equal(samples, Taylor(precision="double-double", tol=1e-26).integrate(
         None, t_out, y0, None, model).y)
-    with pytest.raises(ConfigError, match="valid choices: integrator.precision=double"):
+    with pytest.raises(ConfigError, match="names no traced model"):  # a parameter array that is not a traced model's
         taylor_dd_samples(CompiledModel(models.TRACED, p), 1e-26, t_out, y0)
     with pytest.raises(ConfigError, match="at least 1e-32"):
         taylor_dd_samples(model, 1e-33, t_out, y0)
 
 
-def test_the_scene_refuses_a_expression_in_double_double_before_integrating(tmp_path):
+def test_a_plugin_torque_runs_in_double_double_from_the_scene(tmp_path):
+    """The viscous-drag example (a linear torque) in double-double from a scene: its series generated from the
+    traced equations; the trajectory is the double-precision one to that precision's accuracy, and the energy it
+    dissipates follows dE/dt = −c |ω|² (a law: E(t) − E(0) = −c ∫ |ω|² dt, checked by the trapezoid rule)."""
     from pathlib import Path
 
     from tests.conftest import installed_distribution
 
     example = Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"
+    common = ["force=[uniform_gravity,viscous_drag]", "integrator=taylor", "time.end=5", "time.n_output=2001",
+              "output.figures=false"]
     with installed_distribution(tmp_path, "gyrolab-viscous-drag", "0.1",
                                 {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, paths=[example]):
-        with pytest.raises(ConfigError, match=r"^integrator 'taylor' in double-double precision evaluates the "
-                                              r"fixed-point model's built-in torque forms only .* force 'viscous_drag' "
-                                              r"is a compiled plugin torque \(integrator.precision=double runs it\); "
-                                              r"choose .*taylor"):
-            compose_scene(["force=[uniform_gravity,viscous_drag]", "integrator=taylor",
-                           "integrator.precision=double-double"])
+        dd = compose_scene([*common, "integrator.precision=double-double", "integrator.tol=1e-28"]).run()
+        double = compose_scene(common).run()
+    np.testing.assert_allclose(dd.omega, double.omega, rtol=0, atol=1e-12)
+    scene = compose_scene(["force=[uniform_gravity]"])  # the same body: kinetic + gravity potential
+    energy = scene.system.energy(np.concatenate([dd.omega, dd.gamma, dd.alpha], axis=1))
+    c = float(dd.attrs["force_viscous_drag_coefficient"])
+    power = -c * np.sum(dd.omega.values ** 2, axis=1)
+    dissipated = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(dd.time.values))])
+    np.testing.assert_allclose(energy - energy[0], dissipated, rtol=0, atol=1e-6)
 
 
 def test_the_batch_plan_asks_the_double_double_class_for_capabilities():

@@ -150,6 +150,27 @@ def compile(model: Model) -> CompiledModel:
     return CompiledModel(TRACED, params)
 
 
+def traced_model(compiled: CompiledModel) -> Model:
+    """The model behind a traced compiled model; ValueError when its parameter array names none compiled in this
+    process (a hand-made array, or one from another process: ``bind`` its rows first)."""
+    address = int(compiled.params[TRACED_ADDRESS]) if np.isfinite(compiled.params[TRACED_ADDRESS]) else 0
+    if compiled.model != TRACED or address not in MODELS:
+        raise ValueError("this compiled model's parameter array names no traced model of this process")
+    return MODELS[address]
+
+
+def bind(compiled: CompiledModel, rows: np.ndarray) -> np.ndarray:
+    """Parameter rows (a batch's, possibly built in another process) with the kernel addresses of ``compiled``, this
+    process's compiled form of the same model: an address is only valid in the process that compiled it."""
+    if compiled.model != TRACED:
+        return rows
+    traced_model(compiled)  # (raises for a parameter array that is no traced model's)
+    rows = np.array(rows, dtype=float)
+    rows[:, TRACED_ADDRESS] = compiled.params[TRACED_ADDRESS]
+    rows[:, -TRACED_TAIL:] = compiled.params[-TRACED_TAIL:]
+    return rows
+
+
 def compiled_system(system: Any) -> CompiledModel:
     """A system's compiled model from its own ``rhs(t, y)``: the forces' torques checked one by one first (so that a
     refusal names the force), then the whole right-hand side traced and compiled. Raises NotCompilable."""

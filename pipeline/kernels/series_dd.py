@@ -220,13 +220,13 @@ def ready(compiled: Any) -> bool:
     columns into ``compiled.params`` (``layout``: the last two entries). Raises NotCompilable for a model with a
     transcendental function of the state."""
     from gyrolab.kernels.layout import TRACED_ADDRESS
-    from gyrolab.kernels.model import MODELS
+    from gyrolab.kernels.model import traced_model
 
     p = compiled.params
+    model = traced_model(compiled)  # (ValueError for an array that is no traced model's of this process)
     if p[p.size - 2] == 0.0:
         address = int(p[TRACED_ADDRESS])
         if address not in _KERNELS:  # once per form and process
-            model = MODELS[address]
             program = _Program(model)
             kernel = load_generated(program.source(), "gyrolab_taylor_dd", f"{model.what} (double-double Taylor)")
             _KERNELS[address] = (float(kernel.address), float(max(program.columns, 1)))

@@ -64,7 +64,7 @@ from numba.extending import intrinsic
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before the decorators)
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
 from gyrolab.kernels.expression import Expr, binary_power, load_generated
-from gyrolab.kernels.model import MODELS, TRACED, Model
+from gyrolab.kernels.model import TRACED, Model, traced_model
 
 ZERO, ONE, MINUS_ONE = "0.0", "1.0", "-1.0"
 
@@ -564,7 +564,7 @@ def ready(compiled: Any, rows: np.ndarray | None = None) -> bool:
     if p[p.size - 4] == 0.0:
         address = int(p[TRACED_ADDRESS])
         if address not in _KERNELS:  # once per form and process (the rhs kernel's address names the form)
-            model = MODELS[address]
+            model = traced_model(compiled)
             text, columns = source(model)
             kernel = load_generated(text, "gyrolab_taylor", f"{model.what} (Taylor)")
             _KERNELS[address] = (float(kernel.address), float(columns))

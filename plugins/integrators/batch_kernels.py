@@ -23,6 +23,7 @@ import numpy as np
 
 from gyrolab.contracts.integrator import BatchSolution, CompiledModel
 from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.kernels.model import bind
 
 #: why an adaptive batch kernel stopped a trajectory, by its status code
 _REASONS = {1: "its step fell below the spacing of floating-point numbers", 2: "it became non-finite"}
@@ -35,6 +36,7 @@ def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.n
     from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
 
     start = time.perf_counter()
+    P = bind(compiled, P)
     steps = steps_per_interval(times, step)
     size = y0s.shape[1]
     out = np.empty((len(y0s), len(times), size))
@@ -53,6 +55,8 @@ def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
     """The Taylor method at ``integrator.order`` and ``integrator.tol`` (``Taylor``'s settings)."""
     from gyrolab.kernels import batch_taylor, models, taylor_series
 
+    P = bind(compiled, P)
+
     def kernel(out: np.ndarray, steps: np.ndarray, status: np.ndarray) -> None:
         if not taylor_series.ready(compiled, P):
             raise ConfigError(f"integrator {integrator.name} has no Taylor coefficients for this compiled model; "
@@ -70,6 +74,8 @@ def dop853_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
                  failures: str) -> BatchSolution:
     """DOP853 with ``integrator.rtol``, ``atol`` and ``max_step`` (scipy's step control)."""
     from gyrolab.kernels import batch_dop853, models
+
+    P = bind(compiled, P)
 
     def kernel(out: np.ndarray, steps: np.ndarray, status: np.ndarray) -> None:
         count, size = y0s.shape

@@ -414,6 +414,8 @@ def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -
     except NotCompilable as exc:
         named = f"system {system.name!r}" if system is not None else "this model"
         return f"in double-double precision cannot run {named}: {exc}"
+    except ValueError as exc:
+        return f"in double-double precision cannot run this model: {exc}"
     return None
 
 
