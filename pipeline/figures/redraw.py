@@ -71,7 +71,8 @@ def _drew_figures(path: Path) -> bool:
     try:
         with xr.open_dataset(path) as ds:
             config = ds.attrs.get("config", "")
-        return bool(OmegaConf.select(OmegaConf.create(config), "output.figures", default=True))
+        output = stored_yaml(config, f"the config attribute of {path}").get("output")
+        return bool(output.get("figures", True)) if isinstance(output, dict) else True
     except Exception:  # noqa: BLE001 -- unreadable: leave it alone
         return False
 

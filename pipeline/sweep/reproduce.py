@@ -18,7 +18,7 @@ from omegaconf import DictConfig, OmegaConf
 from gyrolab.engine.budget import check_budget
 from gyrolab.engine.safety import check_stored_config
 from gyrolab.errors import ConfigError, GyrolabError
-from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
+from gyrolab.output.foreign import FOREIGN_ERRORS, load_run, not_gyrolabs
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 
@@ -36,17 +36,6 @@ class Comparison:
     @property
     def identical(self) -> bool:
         return not self.differ
-
-
-def load_run(path: Path) -> xr.Dataset:
-    path = Path(path)
-    ds = load_dataset(path, "a run.nc that gyrolab wrote", decode_times=False, decode_timedelta=False)
-    if "config" not in ds.attrs and "job_status" in ds:
-        raise ConfigError(f"{str(path)!r} is a sweep dataset, not a run; give one job's run.nc (sweep.nc's "
-                          "job_dir variable names each job's directory)")
-    if "config" not in ds.attrs:
-        raise ConfigError(f"{str(path)!r} has no 'config' attribute; give a run.nc that gyrolab wrote")
-    return ds
 
 
 def stored_config(stored: xr.Dataset, where: str = "the dataset's config attribute") -> DictConfig:
