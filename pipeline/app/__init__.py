@@ -145,6 +145,9 @@ def preflight(argv: Sequence[str]) -> list[str]:
     run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
+    from gyrolab.output.trust import check_tree
+
+    check_tree(run_dir, sweep=sweeping)  # a planted link in a directory received from someone else
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     validate_scene(_without_hydra(cfg))

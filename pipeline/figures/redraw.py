@@ -13,8 +13,8 @@ from collections.abc import Iterable
 from pathlib import Path
 
 import xarray as xr
-from omegaconf import OmegaConf
 
+from gyrolab.engine.user_yaml import stored_yaml
 from gyrolab.errors import ConfigError, GyrolabError
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
@@ -69,8 +69,10 @@ def save_kind(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ..
 def _drew_figures(path: Path) -> bool:
     """Whether the run stored at ``path`` drew figures (its stored config's ``output.figures``)."""
     try:
-        with xr.open_dataset(path) as ds:
-            config = ds.attrs.get("config", "")
+        import netCDF4
+
+        with netCDF4.Dataset(path, "r") as nc:  # the header only: no coordinate is read
+            config = nc.getncattr("config") if "config" in nc.ncattrs() else ""
         output = stored_yaml(config, f"the config attribute of {path}").get("output")
         return bool(output.get("figures", True)) if isinstance(output, dict) else True
     except Exception:  # noqa: BLE001 -- unreadable: leave it alone
@@ -96,8 +98,12 @@ def datasets(path: Path) -> list[Path]:
 
 def redraw(path: str | Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int = DEFAULT_DPI) -> list[Path]:
     """Redraw every figure of the datasets under ``path``; returns the files written."""
+    from gyrolab.output.trust import check_tree
+
+    path = Path(path)
+    check_tree(path if path.is_dir() else path.parent, sweep=path.is_dir())
     written = []
-    for dataset in datasets(Path(path)):
+    for dataset in datasets(path):
         written += draw_dataset(dataset, formats, dpi)
     return written
 

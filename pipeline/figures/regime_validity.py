@@ -12,7 +12,6 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
-from omegaconf import OmegaConf
 
 from gyrolab.figures.style import DOUBLE, log_positive, styled, subplots
 

@@ -36,14 +36,17 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
-from omegaconf import OmegaConf
+from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.contracts.integrator import IntegratorStats
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.units import quantity_units
 from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
+from gyrolab.output.foreign import load_dataset
+from gyrolab.output.trust import check_tree
 from gyrolab.output.written import announce_written
+from gyrolab.engine.user_yaml import stored_yaml_file
 from gyrolab.errors import ConfigError
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
@@ -383,9 +386,10 @@ def collect(sweep_dir: Path, grid: Grid) -> list[JobResult]:
                                      exit_code=record.exit_code, **common))
             continue
         try:
-            ds = xr.load_dataset(job_dir / str(record.run), decode_times=False, decode_timedelta=False)
-        except (OSError, ValueError) as error:
-            log.warning("job %s: cannot read its dataset (%s); counted as missing", where, error)
+            ds = load_dataset(job_dir / str(record.run), "a run.nc that gyrolab wrote", decode_times=False,
+                              decode_timedelta=False)
+        except ConfigError as error:
+            log.warning("job %s: %s; counted as missing", where, error)
             results.append(JobResult())
             continue
         if ds.attrs.get("job_id") != record.job_id:
@@ -408,12 +412,16 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
     ``multirun.yaml`` too.
     """
     sweep_dir = Path(sweep_dir)
+    check_tree(sweep_dir, sweep=True)
     if hydra_cfg is None:
         saved = sweep_dir / "multirun.yaml"
         if not saved.is_file():
             raise ConfigError(f"{str(sweep_dir)!r} is not a sweep directory (no multirun.yaml); give the "
                               "directory a 'gyrolab -m ...' run wrote (its hydra.sweep.dir)")
-        hydra_cfg = OmegaConf.load(saved).hydra
+        hydra_cfg = OmegaConf.create(stored_yaml_file(saved)).get("hydra")
+        if not isinstance(hydra_cfg, DictConfig) or "overrides" not in hydra_cfg:
+            raise ConfigError(f"{str(saved)!r} has no hydra.overrides section; give the directory a 'gyrolab -m ...' "
+                              "run wrote (its hydra.sweep.dir)")
         launcher = launcher or _short_target(hydra_cfg.get("launcher", {}).get("_target_", ""))
     if figures is None:
         figures = bool(OmegaConf.select(hydra_cfg, "callbacks.sweep.figures", default=True))

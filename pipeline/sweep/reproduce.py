@@ -17,7 +17,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.engine.budget import check_budget
 from gyrolab.engine.safety import check_stored_config
-from gyrolab.errors import ConfigError, GyrolabError
+from gyrolab.errors import GyrolabError
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_run, not_gyrolabs
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
