@@ -24,6 +24,7 @@ import difflib
 import gc
 import logging
 import os
+import signal
 import sys
 import tempfile
 import warnings
@@ -559,9 +560,52 @@ def main() -> None:
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
     show_warnings_in_one_line()
+    quiet_logging_failures()
     install_dask_free_writes()  # run.nc and sweep.nc hold numpy arrays: writing them need not import Dask
-    with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
-        _main(absolute_config_path(sys.argv[1:]))
+    signal.signal(signal.SIGTERM, _terminated)
+    try:
+        with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
+            _main(absolute_config_path(sys.argv[1:]))
+    except KeyboardInterrupt as interruption:  # Ctrl-C or SIGTERM: every write is whole or absent, locks released
+        from gyrolab.output.lock import release_all
+
+        release_all()
+        print("gyrolab: interrupted; the same command resumes", file=sys.stderr)
+        sys.exit(getattr(interruption, "exit_code", 130))
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, handled as Ctrl-C is (exit 143: 128 + SIGTERM)."""
+
+    exit_code = 128 + signal.SIGTERM
+
+
+def _terminated(signum: int, frame: object) -> None:
+    raise Terminated()
+
+
+def quiet_logging_failures() -> None:
+    """A log line that cannot be written (a full disk under ``gyrolab.log``) is said once, in one line, and that
+    log's further failures are silent: not Python's "--- Logging error ---" and a traceback for every line."""
+    if getattr(logging.Handler.handleError, "gyrolab_quiet", False):
+        return
+
+    def handle_error(self: logging.Handler, record: logging.LogRecord) -> None:
+        if getattr(self, "_gyrolab_failed", False):
+            return
+        self._gyrolab_failed = True  # type: ignore[attr-defined]
+        error = sys.exc_info()[1]
+        from gyrolab.output.atomic import reason
+
+        why = reason(error) if isinstance(error, OSError) else type(error).__name__
+        try:
+            sys.__stderr__.write(f"gyrolab: warning: cannot write the log {getattr(self, 'baseFilename', None) or 'stream'} "
+                                 f"({why}); its further lines are dropped\n")
+        except Exception:  # noqa: BLE001 - stderr itself may be the full device
+            pass
+
+    handle_error.gyrolab_quiet = True  # type: ignore[attr-defined]
+    logging.Handler.handleError = handle_error  # type: ignore[method-assign]
 
 
 def _main(argv: list[str]) -> None:
@@ -589,6 +633,9 @@ def _main(argv: list[str]) -> None:
         register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), before Hydra instantiates it
         with compile_notes_on_console():  # the preflight may compile a force plugin's torque
             sys.argv[1:] = preflight(argv)
+        from gyrolab.output.trust import check_kernel_cache
+
+        check_kernel_cache()
     except GyrolabError as error:
         fail(error)
     from gyrolab.sweep import callbacks

@@ -73,9 +73,10 @@ def batch(args: argparse.Namespace) -> int:
     plain = check_scene_config(first)
     figure_options(plain.get("output"))
     check_tolerances(plain)
-    from gyrolab.output.trust import check_tree
+    from gyrolab.output.trust import check_kernel_cache, check_tree
 
     check_tree(out_dir, sweep=True)
+    check_kernel_cache()
     check_writable(out_dir)
     log_to_stderr()
     if declared:

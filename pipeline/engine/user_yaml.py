@@ -24,6 +24,8 @@ import yaml
 from gyrolab.errors import ConfigError, shorten
 
 MAX_FILE_BYTES = 1024 * 1024
+#: the end of a sentence about a stored config that is not what gyrolab stores
+EDITED = "gyrolab stores plain YAML mappings, so it was edited; give a file gyrolab wrote"
 #: the tags YAML's core schema resolves plain values to; any other (!!python/..., !custom) is refused
 CORE_TAGS = frozenset(f"tag:yaml.org,2002:{t}" for t in
                       ("str", "int", "float", "bool", "null", "map", "seq", "merge", "timestamp", "binary"))
@@ -67,9 +69,10 @@ def _read(path: Path, where: str, *, kind: str = "a config folder holds") -> byt
                           "YAML files") from None
 
 
-def check_yaml_text(data: bytes | str, where: str) -> yaml.Node | None:
+def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> yaml.Node | None:
     """ConfigError (one sentence naming ``where`` and the line) unless ``data`` is a plain YAML mapping within the
-    limits (module docstring); the composed node (None for an empty text)."""
+    limits (module docstring); the composed node (None for an empty text). ``stored``: a config gyrolab stored
+    (the sentences say that it was edited)."""
     if isinstance(data, str):
         data = data.encode("utf-8", "surrogatepass")
     if len(data) > MAX_FILE_BYTES:
@@ -88,16 +91,23 @@ def check_yaml_text(data: bytes | str, where: str) -> yaml.Node | None:
         _check_depth(text, where)  # before composing: PyYAML's composer recurses once per level
         node = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as error:
+        if stored:
+            mark = error.problem_mark or error.context_mark
+            at = f" at line {mark.line + 1}" if mark is not None else ""
+            raise ConfigError(f"{where} is not plain YAML{at} ({shorten(str(error.problem or error.context), 120)}); "
+                              f"{EDITED}") from None
         raise ConfigError(_sentence(where, error)) from None
     except yaml.YAMLError as error:
         raise ConfigError(f"{where} is not valid YAML ({shorten(type(error).__name__)})") from None
     if node is None:
         return None  # an empty file is an empty config
+    _check_nodes(node, where)
     if not isinstance(node, yaml.MappingNode):
         kind = "a list" if isinstance(node, yaml.SequenceNode) else "a single value"
+        if stored:
+            raise ConfigError(f"{where} is {kind}, not a YAML mapping of config sections; {EDITED}")
         raise ConfigError(f"{where}, line {node.start_mark.line + 1}: the file is {kind}, not a mapping of settings "
                           "(key: value lines); every config file is a mapping")
-    _check_nodes(node, where)
     for key, value in node.value:
         if key.value == "defaults" and not isinstance(value, yaml.SequenceNode):
             raise ConfigError(f"{where}, line {value.start_mark.line + 1}: `defaults` must be a list (- group: option "
@@ -111,7 +121,7 @@ def stored_yaml(data: bytes | str, where: str) -> dict:
     untrusted input (anchors, depth, tags, size)."""
     if not isinstance(data, (str, bytes)):
         raise ConfigError(f"{where} is not text; a stored config is a YAML mapping that gyrolab wrote")
-    if check_yaml_text(data, where) is None:
+    if check_yaml_text(data, where, stored=True) is None:
         return {}
     return yaml.safe_load(data)  # checked: plain tags, bounded size and depth
 
@@ -183,7 +193,8 @@ def _check_nodes(root: yaml.Node, where: str) -> None:
         on_path.add(key)
         if node.tag not in CORE_TAGS:
             raise ConfigError(f"{where}, line {node.start_mark.line + 1}: the YAML tag {shorten(node.tag, 60)!r} is not "
-                              "allowed; a config file holds plain values (numbers, strings, lists, mappings)")
+                              "allowed (not plain YAML: gyrolab refuses tags such as !!python/...); a config holds "
+                              "plain values (numbers, strings, lists, mappings)")
         if isinstance(node, yaml.MappingNode):
             seen: dict[object, int] = {}
             for k, _ in node.value:

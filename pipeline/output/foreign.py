@@ -20,7 +20,6 @@ import stat
 import warnings
 from pathlib import Path
 
-import numpy as np
 import xarray as xr
 
 from gyrolab.errors import ConfigError, shorten
@@ -123,8 +122,6 @@ def load_run(path: str | os.PathLike[str]) -> xr.Dataset:
                           "job_dir variable names each job's directory)")
     if "config" not in ds.attrs:
         raise ConfigError(f"{shorten(str(path))!r} has no 'config' attribute; give {RUN}")
-    if "time" not in ds.dims or ds["time"].ndim != 1 or not np.all(np.isfinite(ds["time"].values)):
-        raise not_gyrolabs(path, KeyError("time"), RUN)
     return ds
 
 

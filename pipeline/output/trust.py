@@ -44,6 +44,9 @@ def _where(path: Path) -> str:
 def _refusal(path: Path, mode: int) -> Untrusted:
     if stat.S_ISLNK(mode):
         return Untrusted(f"{_where(path)} is a symbolic link; {REMEDY}")
+    if path.name in OWN_DIRS and not stat.S_ISDIR(mode):
+        return Untrusted(f"{_where(path)} is a file, where gyrolab keeps a folder; remove it or choose another "
+                         "directory")
     kind = "a folder" if stat.S_ISDIR(mode) else "a device, a FIFO or a socket"
     return Untrusted(f"{_where(path)} is {kind}, not a regular file gyrolab writes; remove it or choose another "
                      "directory")
@@ -89,10 +92,7 @@ def own_dir(path: str | os.PathLike[str]) -> Path:
         return path  # the write that follows names the reason (a read-only directory, a full disk)
     mode = os.lstat(path).st_mode
     if not stat.S_ISDIR(mode):
-        if stat.S_ISLNK(mode):
-            raise _refusal(path, mode)
-        raise Untrusted(f"{_where(path)} is a file, where gyrolab keeps a folder; remove it or choose another "
-                        "directory")
+        raise _refusal(path, mode)
     return path
 
 
@@ -152,6 +152,24 @@ def private_dir(path: str | os.PathLike[str], what: str) -> Path:
                         f"gyrolab loads pickles only from a folder only you can write: chmod go-w {shorten(str(path))}"
                         " or remove it")
     return path
+
+
+def check_kernel_cache() -> None:
+    """Untrusted when numba's cache folder (compiled kernels, whose index numba unpickles) or its parent belongs to
+    another user or may be written by anyone (a shared temporary directory another user prepared)."""
+    import sys
+
+    numba = sys.modules.get("numba")
+    folder = getattr(getattr(numba, "config", None), "CACHE_DIR", "") if numba else ""
+    for path in (Path(folder), Path(folder).parent) if folder else ():
+        try:
+            info = os.lstat(path)
+        except OSError:
+            continue
+        if info.st_uid != os.geteuid() or stat.S_ISLNK(info.st_mode) or (
+                info.st_mode & 0o002 and not info.st_mode & stat.S_ISVTX):
+            raise Untrusted(f"numba's cache folder {_where(path)} belongs to another user or may be written by anyone "
+                            "(numba loads pickles from it); set NUMBA_CACHE_DIR to a folder of yours")
 
 
 def umask() -> int:
