@@ -104,6 +104,9 @@ def preflight(argv: Sequence[str]) -> list[str]:
     keys, types), the budget, and the scene's own validation.
     """
     args, _ = get_args_parser().parse_known_args(list(argv))
+    if args.experimental_rerun is not None:  # Hydra unpickles the file: whoever wrote it runs code as you
+        raise ConfigError(f"--experimental-rerun {shorten(args.experimental_rerun)} would load a pickle, which runs "
+                          "whatever code its writer put there; rerun a dataset with gyrolab reproduce PATH/run.nc")
     source = ConfigSource.from_args(args.config_path, args.config_name, args.config_dir)
     use_source(source)
     if args.help or args.hydra_help or args.info or args.shell_completion or args.cfg:

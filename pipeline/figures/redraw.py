@@ -15,7 +15,7 @@ from pathlib import Path
 import xarray as xr
 
 from gyrolab.engine.user_yaml import stored_yaml
-from gyrolab.errors import ConfigError, GyrolabError
+from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 
@@ -67,16 +67,17 @@ def save_kind(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ..
 
 
 def _drew_figures(path: Path) -> bool:
-    """Whether the run stored at ``path`` drew figures (its stored config's ``output.figures``)."""
+    """Whether the run stored at ``path`` drew figures (its stored config's ``output.figures``); ConfigError for a
+    stored config that is not what gyrolab stores (``gyrolab.engine.user_yaml.stored_yaml``)."""
     try:
         import netCDF4
 
         with netCDF4.Dataset(path, "r") as nc:  # the header only: no coordinate is read
             config = nc.getncattr("config") if "config" in nc.ncattrs() else ""
-        output = stored_yaml(config, f"the config attribute of {path}").get("output")
-        return bool(output.get("figures", True)) if isinstance(output, dict) else True
     except Exception:  # noqa: BLE001 -- unreadable: leave it alone
         return False
+    output = stored_yaml(config, f"the config attribute of {shorten(str(path))}").get("output")
+    return bool(output.get("figures", True)) if isinstance(output, dict) else True
 
 
 def datasets(path: Path) -> list[Path]:
