@@ -219,6 +219,27 @@ def test_a_tampered_multirun_yaml_is_refused_by_aggregate(edit, phrase, sweep):
     assert time.perf_counter() - tic < 3
 
 
+def test_a_bomb_in_a_jobs_stored_config_refuses_plot_of_the_sweep(sweep):
+    from gyrolab.figures.redraw import redraw
+
+    with netCDF4.Dataset(sweep / "0" / "run.nc", "a") as nc:
+        nc.config = BOMB
+    tic = time.perf_counter()
+    with pytest.raises(ConfigError, match="expand to more than"):
+        redraw(sweep)
+    assert time.perf_counter() - tic < 3 and not (sweep / "0" / "figures").exists()
+
+
+def test_hydras_experimental_rerun_which_unpickles_is_refused(tmp_path, monkeypatch):
+    from gyrolab.app import preflight
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "config.pickle").write_bytes(b"cos\nsystem\n(S'touch PWNED'\ntR.")
+    with pytest.raises(ConfigError, match="would load a pickle"):
+        preflight(["--experimental-rerun", "config.pickle"])
+    assert not (tmp_path / "PWNED").exists()
+
+
 @pytest.mark.parametrize("content", ["[" * 100_000, '{"run": "../../outside/victim.txt", "job_id": "x", '
                                                     '"status": "finished", "overrides": [], "code_version": ""}'])
 def test_a_hostile_job_record_is_no_record(content, tmp_path):

@@ -43,11 +43,11 @@ from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.units import quantity_units
 from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
-from gyrolab.output.foreign import load_dataset
+from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset
 from gyrolab.output.trust import check_tree
 from gyrolab.output.written import announce_written
 from gyrolab.engine.user_yaml import stored_yaml_file
-from gyrolab.errors import ConfigError
+from gyrolab.errors import ConfigError, shorten
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
 
@@ -432,7 +432,12 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
     try:
         clear_temporaries(sweep_dir)
         results = collect(sweep_dir, grid)
-        ds = assemble(grid, results)
+        try:
+            ds = assemble(grid, results)
+        except FOREIGN_ERRORS as error:  # jobs' datasets that gyrolab did not write as they are
+            raise ConfigError(f"the jobs' datasets in {shorten(str(sweep_dir))!r} do not fit one sweep.nc "
+                              f"({type(error).__name__}); a job's run.nc was edited: remove that job's directory "
+                              "and resume the sweep") from None
         ds.attrs["sweep_launcher"] = launcher
         path = write_dataset(ds, sweep_dir / SWEEP_NAME)
     finally:

@@ -108,6 +108,9 @@ class SweepCallback(Callback):
                          "the cause is fixed"
             last_exit_code = error.exit_code
             return
+        except GyrolabError as error:  # e.g. a link planted in the sweep directory meanwhile: one sentence
+            last_error, last_exit_code = str(error), error.exit_code
+            return
         except Exception as error:  # noqa: BLE001 - the jobs' results are safe; say how to aggregate them later
             last_error = f"could not aggregate the sweep ({type(error).__name__}: {error}); the job results are " \
                          f"intact: run 'gyrolab --aggregate {sweep_dir}' once the cause is fixed"
