@@ -565,7 +565,8 @@ def main() -> None:
     show_warnings_in_one_line()
     quiet_logging_failures()
     install_dask_free_writes()  # run.nc and sweep.nc hold numpy arrays: writing them need not import Dask
-    signal.signal(signal.SIGTERM, _terminated)
+    _main_process.append(os.getpid())
+    previous = signal.signal(signal.SIGTERM, _terminated)
     try:
         with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
             _main(absolute_config_path(sys.argv[1:]))
@@ -575,6 +576,9 @@ def main() -> None:
         release_all()
         print("gyrolab: interrupted; the same command resumes", file=sys.stderr)
         sys.exit(getattr(interruption, "exit_code", 130))
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        _main_process.pop()
 
 
 class Terminated(KeyboardInterrupt):
@@ -583,7 +587,15 @@ class Terminated(KeyboardInterrupt):
     exit_code = 128 + signal.SIGTERM
 
 
+#: the process that runs ``main`` (a forked worker, e.g. of a figure pool, inherits the handler, not the role)
+_main_process: list[int] = []
+
+
 def _terminated(signum: int, frame: object) -> None:
+    if _main_process and os.getpid() != _main_process[-1]:  # a forked worker told to stop: stop as by default
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        os.kill(os.getpid(), signal.SIGTERM)
+        return
     raise Terminated()
 
 
