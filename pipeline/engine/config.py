@@ -31,7 +31,7 @@ from gyrolab.contracts import registry
 from gyrolab.engine.hydra_private import create_automatic_config_search_path
 from gyrolab.errors import ConfigError, choices, shorten
 from gyrolab.engine.unread import refuse_given_accuracy
-from gyrolab.engine.user_yaml import check_user_config_dir
+from gyrolab.output.user_yaml import check_user_config_dir
 
 CONFIG_MODULE = "gyrolab.conf"
 CONFIG_NAME = "config"

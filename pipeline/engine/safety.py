@@ -121,9 +121,9 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
 
 
 def check_stored_config(text: str, where: str) -> DictConfig:
-    """A config stored in a dataset, checked as a user's YAML file is (``gyrolab.engine.user_yaml.stored_yaml``:
+    """A config stored in a dataset, checked as a user's YAML file is (``gyrolab.output.user_yaml.stored_yaml``:
     tags, anchors, depth, size); ConfigError for interpolations."""
-    from gyrolab.engine.user_yaml import stored_yaml
+    from gyrolab.output.user_yaml import stored_yaml
 
     plain = stored_yaml(text, where)
     if not isinstance(plain, dict):

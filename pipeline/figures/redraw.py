@@ -14,7 +14,7 @@ from pathlib import Path
 
 import xarray as xr
 
-from gyrolab.engine.user_yaml import stored_yaml
+from gyrolab.output.user_yaml import stored_yaml
 from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
@@ -68,7 +68,7 @@ def save_kind(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ..
 
 def _drew_figures(path: Path) -> bool:
     """Whether the run stored at ``path`` drew figures (its stored config's ``output.figures``); ConfigError for a
-    stored config that is not what gyrolab stores (``gyrolab.engine.user_yaml.stored_yaml``)."""
+    stored config that is not what gyrolab stores (``gyrolab.output.user_yaml.stored_yaml``)."""
     try:
         import netCDF4
 

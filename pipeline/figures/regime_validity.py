@@ -22,7 +22,7 @@ PARAMETERS = {"mu": "μ", "c/r0": "c/r₀", "c/r0 (as printed)": "μ = c/r₀ (p
 
 def _spec(ds: xr.Dataset) -> dict[str, Any]:
     try:
-        from gyrolab.engine.user_yaml import stored_yaml
+        from gyrolab.output.user_yaml import stored_yaml
 
         return stored_yaml(ds.attrs.get("config", ""), "the dataset's config attribute").get("regime_validity",
                                                                                                {}) or {}

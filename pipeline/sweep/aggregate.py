@@ -46,7 +46,7 @@ from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset
 from gyrolab.output.trust import check_tree
 from gyrolab.output.written import announce_written
-from gyrolab.engine.user_yaml import stored_yaml_file
+from gyrolab.output.user_yaml import stored_yaml_file
 from gyrolab.errors import ConfigError, shorten
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths

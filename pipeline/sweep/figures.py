@@ -11,7 +11,7 @@ from pathlib import Path
 
 import xarray as xr
 
-from gyrolab.engine.user_yaml import stored_yaml_file
+from gyrolab.output.user_yaml import stored_yaml_file
 from gyrolab.figures.options import figure_options
 from gyrolab.figures.sweep import choose_x, final_values  # noqa: F401 -- the sweep's own helpers, re-exported
 

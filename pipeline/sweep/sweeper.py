@@ -40,7 +40,7 @@ from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.engine.hydra_private import ConfigLoaderImpl
-from gyrolab.engine.user_yaml import stored_yaml_file
+from gyrolab.output.user_yaml import stored_yaml_file
 from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.lock import try_lock, unlock
