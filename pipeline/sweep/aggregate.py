@@ -369,6 +369,8 @@ def collect(sweep_dir: Path, grid: Grid) -> list[JobResult]:
     for path in record_paths(sweep_dir):
         record = read_record(path.parent)
         if record is None:
+            log.warning("%s is not a job record gyrolab wrote (too large, too deep, or edited); that job counts as "
+                        "missing and runs again when the sweep is resumed", path)
             continue
         key, mtime = tuple(record.overrides), path.stat().st_mtime
         if key not in found or found[key][0] < mtime:  # a stale copy elsewhere: the newest record wins
