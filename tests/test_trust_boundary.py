@@ -180,6 +180,18 @@ def test_a_sweep_refuses_a_submitit_folder_others_can_write(tmp_path):
     assert not (sweep / "multirun.yaml").exists()
 
 
+def test_numbas_cache_folder_writable_by_anyone_is_refused(tmp_path, monkeypatch):
+    import numba
+
+    folder = tmp_path / "shared" / "numba-cache"
+    folder.mkdir(parents=True)
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(folder))
+    trust.check_kernel_cache()   # the user's own folder
+    folder.parent.chmod(0o777)   # a shared temporary folder without the sticky bit
+    with pytest.raises(ConfigError, match="numba's cache folder .* may be written by anyone"):
+        trust.check_kernel_cache()
+
+
 # ----------------------------------------------------------------------------- 3. stored configs and datasets
 
 BOMB = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(

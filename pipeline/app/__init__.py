@@ -642,15 +642,15 @@ def _main(argv: list[str]) -> None:
             sys.exit(run_subcommand(command, argv))
         if "--shell-completion" in argv or "-sc" in argv:
             sys.exit(shell_completion(argv))
+        from gyrolab.output.trust import check_kernel_cache
+
+        check_kernel_cache()  # before the preflight, which may load a compiled kernel
         register_plugin_configs()
         from gyrolab.sweep.sweeper import register_plugin
 
         register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), before Hydra instantiates it
         with compile_notes_on_console():  # the preflight may compile a force plugin's torque
             sys.argv[1:] = preflight(argv)
-        from gyrolab.output.trust import check_kernel_cache
-
-        check_kernel_cache()
     except GyrolabError as error:
         fail(error)
     from gyrolab.sweep import callbacks

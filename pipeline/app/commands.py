@@ -141,6 +141,9 @@ def reproduce(args: argparse.Namespace) -> int:
     from gyrolab.sweep.reproduce import report, reproduce as rerun
 
     path = Path(one_path("reproduce", args.paths, "reproduce PATH/run.nc"))
+    from gyrolab.output.trust import check_kernel_cache
+
+    check_kernel_cache()
     log_to_stderr()
     comparison, stored = rerun(path)
     print("\n".join(report(path, comparison, stored)))

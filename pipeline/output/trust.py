@@ -161,11 +161,11 @@ def private_dir(path: str | os.PathLike[str], what: str) -> Path:
 
 def check_kernel_cache() -> None:
     """Untrusted when numba's cache folder (compiled kernels, whose index numba unpickles) or its parent belongs to
-    another user or may be written by anyone (a shared temporary directory another user prepared)."""
-    import sys
+    another user or may be written by anyone (a shared temporary directory another user prepared). Called before
+    any kernel is loaded (a command that runs kernels: run, batch, reproduce)."""
+    from gyrolab.plugins.compiled import kernel_cache_dir
 
-    numba = sys.modules.get("numba")
-    folder = getattr(getattr(numba, "config", None), "CACHE_DIR", "") if numba else ""
+    folder = kernel_cache_dir()
     for path in (Path(folder), Path(folder).parent) if folder else ():
         try:
             info = os.lstat(path)
