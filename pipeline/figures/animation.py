@@ -31,7 +31,7 @@ import xarray as xr
 from gyrolab.errors import ConfigError
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.foreign import load_run
-from gyrolab.output.trust import check_output_target, check_tree
+from gyrolab.output.trust import check_output_target
 from gyrolab.figures.labels import unit
 from gyrolab.figures.style import STYLE, unit_sphere
 
@@ -201,8 +201,6 @@ def animate(path: str | os.PathLike[str], output: str | os.PathLike[str] | None 
         raise ConfigError(f"{str(file)!r} has no time axis of finite times to animate; the dataset was edited")
     indices = frame_indices(ds.sizes["time"], int(frames))
     target = Path(output) if output is not None else file.parent / "figures" / f"animation.{fmt}"
-    if output is None:
-        check_tree(file.parent)
     fig, update = motion_figure(ds, indices)
     try:  # written beside the target under a temporary name, renamed when complete (the format is named)
         with atomic_path(target) as tmp, plt.style.context(STYLE):

@@ -102,7 +102,8 @@ def redraw(path: str | Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int 
     from gyrolab.output.trust import check_tree
 
     path = Path(path)
-    check_tree(path if path.is_dir() else path.parent, sweep=path.is_dir())
+    if path.is_dir():  # a job directory that is a link would take its figures outside (a file's: own_dir)
+        check_tree(path, sweep=True)
     written = []
     for dataset in datasets(path):
         written += draw_dataset(dataset, formats, dpi)
