@@ -179,13 +179,16 @@ def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
                     fd = open_own_file(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644)
                     created = True
                 except FileExistsError:
-                    fd = open_own_file(path, os.O_RDWR)
+                    try:
+                        fd = open_own_file(path, os.O_RDWR)
+                    except FileNotFoundError:
+                        continue  # removed between the two opens: again
             else:
                 fd = open_own_file(path, os.O_RDWR)
         except FileNotFoundError:
             if not create:
                 return None
-            continue  # removed between the two opens: again
+            raise
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
         except OSError as error:
