@@ -340,17 +340,36 @@ def test_a_second_different_sweep_is_refused_and_the_first_kept(sweep, cli):
                                                                                     "sweep.nc"]
 
 
+def _claim_after(barrier, sweep: Path, values: str, outcomes) -> None:
+    from omegaconf import OmegaConf
+
+    from gyrolab.sweep.sweeper import claim
+
+    config = OmegaConf.create({"hydra": {"overrides": {"task": [f"initial.r0={values}"]}, "sweeper": {"params": None}}})
+    barrier.wait()
+    try:
+        claim(sweep, config)
+        outcomes.put((values, "claimed"))
+    except ConfigError as error:
+        outcomes.put((values, str(error)))
+
+
 def test_two_different_sweeps_started_at_once_cannot_interleave(tmp_path):
-    command = [sys.executable, "-m", "gyrolab", "-m", "time.end=1", "time.n_output=20", "output.figures=false",
-               "hydra.sweep.dir=sweep"]
-    processes = [subprocess.Popen([*command, f"initial.r0={values}"], cwd=tmp_path, text=True,
-                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for values in ("1,2", "3,4")]
-    outcomes = [(p.wait(timeout=300), p.stderr.read()) for p in processes]
-    assert sorted(code for code, _ in outcomes) == [0, 2], outcomes
-    winner = next(n for n, (code, _) in enumerate(outcomes) if code == 0)
-    assert "holds another sweep" in outcomes[1 - winner][1] and "Traceback" not in outcomes[1 - winner][1]
-    with xr.open_dataset(tmp_path / "sweep" / "sweep.nc") as ds:
-        assert list(ds["r0"].values) == ([1, 2], [3, 4])[winner] and list(ds["job_status"].values) == [1, 1]
+    import multiprocessing
+
+    context = multiprocessing.get_context("fork")
+    barrier, outcomes = context.Barrier(2), context.Queue()
+    workers = [context.Process(target=_claim_after, args=(barrier, tmp_path / "sweep", values, outcomes))
+               for values in ("1,2", "3,4")]
+    for worker in workers:
+        worker.start()
+    results = dict(outcomes.get(timeout=30) for _ in workers)
+    for worker in workers:
+        worker.join(timeout=30)
+    winner = next(values for values, outcome in results.items() if outcome == "claimed")
+    loser = "3,4" if winner == "1,2" else "1,2"
+    assert "holds another sweep" in results[loser]
+    assert f"initial.r0={winner}" in (tmp_path / "sweep" / "multirun.yaml").read_text()
 
 
 def test_the_same_sweep_resumes_and_a_batch_directory_is_refused(sweep, tmp_path):
