@@ -416,14 +416,7 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
     sweep_dir = Path(sweep_dir)
     check_tree(sweep_dir, sweep=True)
     if hydra_cfg is None:
-        saved = sweep_dir / "multirun.yaml"
-        if not saved.is_file():
-            raise ConfigError(f"{str(sweep_dir)!r} is not a sweep directory (no multirun.yaml); give the "
-                              "directory a 'gyrolab -m ...' run wrote (its hydra.sweep.dir)")
-        hydra_cfg = OmegaConf.create(stored_yaml_file(saved)).get("hydra")
-        if not isinstance(hydra_cfg, DictConfig) or "overrides" not in hydra_cfg:
-            raise ConfigError(f"{str(saved)!r} has no hydra.overrides section; give the directory a 'gyrolab -m ...' "
-                              "run wrote (its hydra.sweep.dir)")
+        hydra_cfg = stored_hydra(sweep_dir)
         launcher = launcher or _short_target(hydra_cfg.get("launcher", {}).get("_target_", ""))
     if figures is None:
         figures = bool(OmegaConf.select(hydra_cfg, "callbacks.sweep.figures", default=True))
@@ -459,6 +452,20 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
 
             summary.figures = save_sweep_figures(ds, sweep_dir / "figures", *figure_options(output))
     return summary
+
+
+def stored_hydra(sweep_dir: Path) -> DictConfig:
+    """The ``hydra`` node of the sweep stored in ``sweep_dir/multirun.yaml``, read as untrusted input
+    (``gyrolab.output.user_yaml.stored_yaml_file``); ConfigError when there is none."""
+    saved = Path(sweep_dir) / "multirun.yaml"
+    if not saved.is_file():
+        raise ConfigError(f"{str(sweep_dir)!r} is not a sweep directory (no multirun.yaml); give the "
+                          "directory a 'gyrolab -m ...' run wrote (its hydra.sweep.dir)")
+    hydra_cfg = OmegaConf.create(stored_yaml_file(saved)).get("hydra")
+    if not isinstance(hydra_cfg, DictConfig) or "overrides" not in hydra_cfg:
+        raise ConfigError(f"{str(saved)!r} has no hydra.overrides section; give the directory a 'gyrolab -m ...' "
+                          "run wrote (its hydra.sweep.dir)")
+    return hydra_cfg
 
 
 def wait_for_jobs(sweep_dir: Path) -> None:

@@ -40,12 +40,11 @@ from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.engine.hydra_private import ConfigLoaderImpl
-from gyrolab.output.user_yaml import stored_yaml_file
 from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.lock import try_lock, unlock
 from gyrolab.output.trust import check_tree, private_dir
-from gyrolab.sweep.aggregate import SWEEP_NAME
+from gyrolab.sweep.aggregate import SWEEP_NAME, stored_hydra
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import code_version, job_identity
 from gyrolab.sweep.job import mark_skipped
@@ -142,7 +141,7 @@ def claim(sweep_dir: Path, config: DictConfig) -> None:
             if not saved.exists():
                 raise ConfigError(f"{where!r} holds a {SWEEP_NAME} of a batch or another sweep and no multirun.yaml; "
                                   "choose another hydra.sweep.dir or remove it")
-            theirs = Grid.from_hydra(OmegaConf.create(stored_yaml_file(saved)).get("hydra") or {}).jobs
+            theirs = Grid.from_hydra(stored_hydra(sweep_dir)).jobs
             if theirs != Grid.from_hydra(config.hydra).jobs:
                 raise ConfigError(f"{where!r} holds another sweep ({len(theirs)} jobs, its command line in "
                                   f"{shorten(str(saved))}); choose another hydra.sweep.dir, or run that sweep's "
