@@ -613,9 +613,10 @@ def quiet_logging_failures() -> None:
         from gyrolab.output.atomic import reason
 
         why = reason(error) if isinstance(error, OSError) else type(error).__name__
+        where = getattr(self, "baseFilename", None) or "stream"
         try:
-            sys.__stderr__.write(f"gyrolab: warning: cannot write the log {getattr(self, 'baseFilename', None) or 'stream'} "
-                                 f"({why}); its further lines are dropped\n")
+            print(f"gyrolab: warning: cannot write the log {where} ({why}); its further lines are dropped",
+                  file=sys.stderr)
         except Exception:  # noqa: BLE001 - stderr itself may be the full device
             pass
 
