@@ -50,6 +50,7 @@ MOVED_MODULES = {
     "gyrolab.sweep.batch": "gyrolab.batch.sweep",
     "gyrolab.engine.registry": "gyrolab.contracts.registry",
     "gyrolab.output.figures": "gyrolab.figures.run",
+    "gyrolab.engine.user_yaml": "gyrolab.output.user_yaml",
 }
 
 

@@ -24,6 +24,7 @@ import difflib
 import gc
 import logging
 import os
+import signal
 import sys
 import tempfile
 import warnings
@@ -103,6 +104,9 @@ def preflight(argv: Sequence[str]) -> list[str]:
     keys, types), the budget, and the scene's own validation.
     """
     args, _ = get_args_parser().parse_known_args(list(argv))
+    if args.experimental_rerun is not None:  # Hydra unpickles the file: whoever wrote it runs code as you
+        raise ConfigError(f"--experimental-rerun {shorten(args.experimental_rerun)} would load a pickle, which runs "
+                          "whatever code its writer put there; rerun a dataset with gyrolab reproduce PATH/run.nc")
     source = ConfigSource.from_args(args.config_path, args.config_name, args.config_dir)
     use_source(source)
     if args.help or args.hydra_help or args.info or args.shell_completion or args.cfg:
@@ -145,6 +149,9 @@ def preflight(argv: Sequence[str]) -> list[str]:
     run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
+    from gyrolab.output.trust import check_tree
+
+    check_tree(run_dir, sweep=sweeping)  # a planted link in a directory received from someone else
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     validate_scene(_without_hydra(cfg))
@@ -564,9 +571,65 @@ def main() -> None:
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
     show_warnings_in_one_line()
+    quiet_logging_failures()
     install_dask_free_writes()  # run.nc and sweep.nc hold numpy arrays: writing them need not import Dask
-    with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
-        _main(absolute_config_path(sys.argv[1:]))
+    _main_process.append(os.getpid())
+    previous = signal.signal(signal.SIGTERM, _terminated)
+    try:
+        with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
+            _main(absolute_config_path(sys.argv[1:]))
+    except KeyboardInterrupt as interruption:  # Ctrl-C or SIGTERM: every write is whole or absent, locks released
+        from gyrolab.output.lock import release_all
+
+        release_all()
+        print("gyrolab: interrupted; the same command resumes", file=sys.stderr)
+        sys.exit(getattr(interruption, "exit_code", 130))
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        _main_process.pop()
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, handled as Ctrl-C is (exit 143: 128 + SIGTERM)."""
+
+    exit_code = 128 + signal.SIGTERM
+
+
+#: the process that runs ``main`` (a forked worker, e.g. of a figure pool, inherits the handler, not the role)
+_main_process: list[int] = []
+
+
+def _terminated(signum: int, frame: object) -> None:
+    if _main_process and os.getpid() != _main_process[-1]:  # a forked worker told to stop: stop as by default
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        os.kill(os.getpid(), signal.SIGTERM)
+        return
+    raise Terminated()
+
+
+def quiet_logging_failures() -> None:
+    """A log line that cannot be written (a full disk under ``gyrolab.log``) is said once, in one line, and that
+    log's further failures are silent: not Python's "--- Logging error ---" and a traceback for every line."""
+    if getattr(logging.Handler.handleError, "gyrolab_quiet", False):
+        return
+
+    def handle_error(self: logging.Handler, record: logging.LogRecord) -> None:
+        if getattr(self, "_gyrolab_failed", False):
+            return
+        self._gyrolab_failed = True  # type: ignore[attr-defined]
+        error = sys.exc_info()[1]
+        from gyrolab.output.atomic import reason
+
+        why = reason(error) if isinstance(error, OSError) else type(error).__name__
+        where = getattr(self, "baseFilename", None) or "stream"
+        try:
+            print(f"gyrolab: warning: cannot write the log {where} ({why}); its further lines are dropped",
+                  file=sys.stderr)
+        except Exception:  # noqa: BLE001 - stderr itself may be the full device
+            pass
+
+    handle_error.gyrolab_quiet = True  # type: ignore[attr-defined]
+    logging.Handler.handleError = handle_error  # type: ignore[method-assign]
 
 
 def _main(argv: list[str]) -> None:
@@ -588,6 +651,9 @@ def _main(argv: list[str]) -> None:
             sys.exit(run_subcommand(command, argv))
         if "--shell-completion" in argv or "-sc" in argv:
             sys.exit(shell_completion(argv))
+        from gyrolab.output.trust import check_kernel_cache
+
+        check_kernel_cache()  # before the preflight, which may load a compiled kernel
         register_plugin_configs()
         from gyrolab.sweep.sweeper import register_plugin
 

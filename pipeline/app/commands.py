@@ -73,6 +73,10 @@ def batch(args: argparse.Namespace) -> int:
     plain = check_scene_config(first)
     figure_options(plain.get("output"))
     check_tolerances(plain)
+    from gyrolab.output.trust import check_kernel_cache, check_tree
+
+    check_tree(out_dir, sweep=True)
+    check_kernel_cache()
     check_writable(out_dir)
     log_to_stderr()
     if declared:
@@ -142,6 +146,9 @@ def reproduce(args: argparse.Namespace) -> int:
     from gyrolab.sweep.reproduce import reproduce as rerun
 
     path = Path(one_path("reproduce", args.paths, "reproduce PATH/run.nc"))
+    from gyrolab.output.trust import check_kernel_cache
+
+    check_kernel_cache()
     log_to_stderr()
     stored = load_run(path, sweeps=True)
     if is_multirun(stored):   # gyrolab -m's sweep.nc: each finished job's run.nc is reproduced

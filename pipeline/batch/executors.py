@@ -31,6 +31,7 @@ import errno
 import itertools
 import os
 import uuid
+from pathlib import Path
 from collections.abc import Callable, Iterable
 from importlib.util import find_spec
 from typing import Any, TypeVar
@@ -118,8 +119,15 @@ def _client(kind: str, scheduler: str, source: str) -> Any:
     from distributed import Client, LocalCluster
 
     if kind == "local":
+        import tempfile
+
+        from gyrolab.output.trust import private_dir
+
+        # workers spill pickles to their scratch folder and load them back: one only this user can write
+        scratch = private_dir(Path(tempfile.gettempdir()) / f"gyrolab-dask-{os.geteuid()}", "Dask's scratch folder")
         cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR, env=dict(WORKER_ENV))
+                               dashboard_address=None, silence_logs=logging.ERROR, env=dict(WORKER_ENV),
+                               local_directory=str(scratch))
         return Client(cluster, set_as_default=False)
     scheduler_module.probe(scheduler, source, CONNECT_TIMEOUT)
     try:

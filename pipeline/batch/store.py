@@ -36,6 +36,7 @@ from gyrolab.errors import ConfigError, OutputError
 from gyrolab.output.atomic import TEMP_SUFFIX, _fsync, _fsync_directory, _library_failure, diagnose, reason
 from gyrolab.output.cf import CONVENTIONS, now_iso
 from gyrolab.output.provenance import gyrolab_version, provenance
+from gyrolab.output.trust import check_output_target, no_follow
 from gyrolab.sweep import record
 from gyrolab.sweep.aggregate import STATUS_FLAGS
 
@@ -88,6 +89,7 @@ class Store:
                 _start_journal(self.journal, self.identity)
             else:          # a write that failed mid-line leaves a torn last line: cut it before appending
                 _cut_torn_line(self.journal)
+            check_output_target(self.part)  # netCDF follows links: a planted one is refused first
             self.nc = _open(self.part, "a")
         except OutputError:
             raise
@@ -155,7 +157,7 @@ class Store:
                     self._write(name, chunk, out.data)
         self.nc.sync()
         _fsync(self.part)
-        with open(self.journal, "a", encoding="utf-8") as journal:
+        with open(self.journal, "a", encoding="utf-8", opener=no_follow) as journal:
             journal.write(f"{index}\n")
             journal.flush()
             os.fsync(journal.fileno())
@@ -352,7 +354,7 @@ def _identity_of(path: Path) -> str:
 
 
 def _start_journal(path: Path, identity: str) -> None:
-    with open(path, "w", encoding="utf-8") as journal:
+    with open(path, "w", encoding="utf-8", opener=no_follow) as journal:
         journal.write(f"identity {identity}\n")
         journal.flush()
         os.fsync(journal.fileno())
@@ -375,7 +377,7 @@ def _cut_torn_line(path: Path) -> None:
     """Cut a journal's unterminated last line (a write that failed half-way), so that appending stays exact."""
     data = path.read_bytes()
     if data and not data.endswith(b"\n"):
-        with open(path, "r+b") as journal:
+        with open(path, "r+b", opener=no_follow) as journal:
             journal.truncate(data.rfind(b"\n") + 1)
             journal.flush()
             os.fsync(journal.fileno())

@@ -32,7 +32,7 @@ from gyrolab.contracts import registry
 from gyrolab.engine.hydra_private import create_automatic_config_search_path
 from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
 from gyrolab.engine.unread import refuse_given_accuracy
-from gyrolab.engine.user_yaml import check_user_config_dir
+from gyrolab.output.user_yaml import check_user_config_dir
 
 CONFIG_MODULE = "gyrolab.conf"
 CONFIG_NAME = "config"
@@ -529,8 +529,17 @@ def _example_key(section: str) -> str:
     return {"time": "end", "output": "figures", "body": "a", "initial": "r0"}.get(section, "")
 
 
+#: keys whose packaged default is null, with a value of the type they take otherwise
+NULLABLE = {"output.error_estimate": False}
+
+
 def check_type(where: str, value: Any, default: Any) -> None:
-    """ConfigError unless ``value`` has the type of the packaged default (an int is a valid float)."""
+    """ConfigError unless ``value`` has the type of the packaged default (an int is a valid float; null where the
+    default is null, else the type of ``NULLABLE``'s example)."""
+    if default is None and value is not None and where in NULLABLE:
+        default = NULLABLE[where]
+        if isinstance(default, bool) and not isinstance(value, bool):
+            raise ConfigError(f"{where}={shorten(repr(value))} must be true, false or null")
     if isinstance(default, bool):
         if not isinstance(value, bool):
             raise ConfigError(f"{where}={shorten(repr(value))} must be true or false")

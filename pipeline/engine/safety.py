@@ -121,19 +121,11 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
 
 
 def check_stored_config(text: str, where: str) -> DictConfig:
-    """A config stored in a dataset, parsed with a safe YAML loader; ConfigError for tags or interpolations."""
-    import yaml
+    """A config stored in a dataset, checked as a user's YAML file is (``gyrolab.output.user_yaml.stored_yaml``:
+    tags, anchors, depth, size); ConfigError for interpolations."""
+    from gyrolab.output.user_yaml import stored_yaml
 
-    if not isinstance(text, str):
-        raise ConfigError(f"{where} is not text; give a run.nc that gyrolab wrote")
-    try:
-        plain = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        at = f" at line {mark.line + 1}" if mark is not None else ""
-        problem = getattr(error, "problem", None) or type(error).__name__
-        raise ConfigError(f"{where} is not plain YAML{at} ({shorten(str(problem), 120)}); gyrolab reads stored "
-                          "configs with a safe loader and refuses tags such as !!python/...") from None
+    plain = stored_yaml(text, where)
     if not isinstance(plain, dict):
         raise ConfigError(f"{where} is not a YAML mapping of config sections; give a run.nc that gyrolab wrote")
     for path, value in _leaves(plain):

@@ -21,7 +21,6 @@ from __future__ import annotations
 import logging
 import os
 import shutil
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
@@ -29,7 +28,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from gyrolab.errors import ConfigError, OutputError
+from gyrolab.errors import ConfigError
+from gyrolab.output.atomic import atomic_path
+from gyrolab.output.foreign import load_run
+from gyrolab.output.trust import check_output_target
 from gyrolab.figures.labels import unit
 from gyrolab.figures.style import STYLE, unit_sphere
 
@@ -55,23 +57,40 @@ def attitude(ds: xr.Dataset) -> tuple[np.ndarray, tuple[str, str, str], bool, st
     if "alpha" not in ds or "gamma" not in ds:
         raise ConfigError("this run.nc has no full attitude (no alpha, the fixed X axis in body axes) to animate; "
                           "run it again with output.euler_angles=true")
-    alpha, gamma = ds["alpha"].values, ds["gamma"].values
-    beta = ds["beta"].values if "beta" in ds else np.cross(gamma, alpha)
+    alpha, gamma = _unit_vectors(ds, "alpha"), _unit_vectors(ds, "gamma")
+    beta = _unit_vectors(ds, "beta") if "beta" in ds else np.cross(gamma, alpha)
     rotation = np.stack([alpha, beta, gamma], axis=1)          # rows: the fixed axes in body axes
     if ds.attrs.get("system") == "orbiting_gyrostat":
         return rotation, ("radial", "along-track", "orbit normal"), False, "Gyrostat in the orbital frame"
     return rotation, ("X", "Y", "Z (along the weight)"), True, "Body about the fixed point"
 
 
+def _unit_vectors(ds: xr.Dataset, name: str) -> np.ndarray:
+    """``ds[name]`` as gyrolab writes it, (time, 3) finite numbers, or one sentence naming what is wrong."""
+    values = ds[name]
+    if values.dims[:1] != ("time",) or values.ndim != 2 or values.shape[1] != 3 or values.dtype.kind not in "fiu":
+        raise ConfigError(f"this run.nc's {name} is {values.dtype.name} over {values.dims} {tuple(values.shape)}, "
+                          "not the (time, 3) numbers gyrolab writes; the dataset was edited")
+    data = np.asarray(values.values, dtype=float)
+    if not np.all(np.isfinite(data)):
+        raise ConfigError(f"this run.nc's {name} holds NaN or inf at {int((~np.isfinite(data)).any(1).sum())} output "
+                          "times; a run gyrolab wrote holds finite values (the dataset was edited)")
+    return data
+
+
 def principal_moments(ds: xr.Dataset) -> np.ndarray:
-    """(A, B, C) of the body: SI or gyrostat inertia as stored, else the papers' (a, b, 1) in units of C."""
-    if "body_inertia" in ds.attrs:
-        return np.asarray(ds.attrs["body_inertia"], dtype=float)
-    a = ds.attrs.get("body_nondim_a", ds.attrs.get("body_a"))
-    b = ds.attrs.get("body_nondim_b", ds.attrs.get("body_b"))
-    if a is None or b is None:
+    """(A, B, C) of the body: SI or gyrostat inertia as stored, else the papers' (a, b, 1) in units of C; a sphere
+    when the dataset does not say, or says something else than three positive finite numbers."""
+    try:
+        if "body_inertia" in ds.attrs:
+            moments = np.asarray(ds.attrs["body_inertia"], dtype=float).reshape(3)
+        else:
+            a = ds.attrs.get("body_nondim_a", ds.attrs.get("body_a"))
+            b = ds.attrs.get("body_nondim_b", ds.attrs.get("body_b"))
+            moments = np.array([float(a), float(b), 1.0])
+    except (TypeError, ValueError):
         return np.ones(3)   # unknown: a sphere (the principal axes still show the attitude)
-    return np.array([float(a), float(b), 1.0])
+    return moments if np.all(np.isfinite(moments)) and np.all(moments > 0) else np.ones(3)
 
 
 def ellipsoid_curves(moments: np.ndarray, n: int = 48) -> list[np.ndarray]:
@@ -145,14 +164,12 @@ def _motion_figure(ds: xr.Dataset, indices: np.ndarray) -> tuple[plt.Figure, Cal
 
 
 def _load(path: Path) -> tuple[xr.Dataset, Path]:
+    """The run at ``path`` through the loader every reader uses (``gyrolab.output.foreign.load_run``)."""
     path = Path(path)
     file = path / "run.nc" if path.is_dir() else path
     if not file.is_file():
         raise ConfigError(f"--animate: {str(path)!r} is neither a run.nc nor a run directory holding one")
-    try:
-        return xr.load_dataset(file, decode_times=False), file
-    except (OSError, ValueError) as error:
-        raise OutputError(f"cannot read {str(file)!r}: {error}") from None
+    return load_run(file), file
 
 
 def _check(fmt: str, frames: int, fps: float) -> str:
@@ -177,28 +194,17 @@ def animate(path: str | os.PathLike[str], output: str | os.PathLike[str] | None 
     second. The file appears whole or not at all.
     """
     fmt = _check(fmt, frames, fps)
+    if output is not None:
+        check_output_target(output, "-o")
     ds, file = _load(Path(path))
-    if "time" not in ds.dims:
-        raise ConfigError(f"{str(file)!r} has no time axis to animate")
+    if "time" not in ds.dims or ds["time"].ndim != 1 or not np.all(np.isfinite(ds["time"].values)):
+        raise ConfigError(f"{str(file)!r} has no time axis of finite times to animate; the dataset was edited")
     indices = frame_indices(ds.sizes["time"], int(frames))
     target = Path(output) if output is not None else file.parent / "figures" / f"animation.{fmt}"
-    target.parent.mkdir(parents=True, exist_ok=True)
     fig, update = motion_figure(ds, indices)
-    # written beside the target under a temporary name with the right extension, renamed when complete
-    fd, name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=f".{fmt}", dir=target.parent)
-    os.close(fd)
-    tmp = Path(name)
-    try:
-        with plt.style.context(STYLE):
+    try:  # written beside the target under a temporary name, renamed when complete (the format is named)
+        with atomic_path(target) as tmp, plt.style.context(STYLE):
             (_write_gif if fmt == "gif" else _write_mp4)(fig, update, len(indices), fps, tmp)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, target)
-    except OSError as error:
-        tmp.unlink(missing_ok=True)
-        raise OutputError(f"cannot write {str(target)!r}: {error.strerror or error}") from None
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
     finally:
         plt.close(fig)
     log.info("wrote %s (%d frames)", target, len(indices))

@@ -13,9 +13,9 @@ from collections.abc import Iterable
 from pathlib import Path
 
 import xarray as xr
-from omegaconf import OmegaConf
 
-from gyrolab.errors import ConfigError, GyrolabError
+from gyrolab.output.user_yaml import stored_yaml
+from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 
@@ -67,13 +67,17 @@ def save_kind(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ..
 
 
 def _drew_figures(path: Path) -> bool:
-    """Whether the run stored at ``path`` drew figures (its stored config's ``output.figures``)."""
+    """Whether the run stored at ``path`` drew figures (its stored config's ``output.figures``); ConfigError for a
+    stored config that is not what gyrolab stores (``gyrolab.output.user_yaml.stored_yaml``)."""
     try:
-        with xr.open_dataset(path) as ds:
-            config = ds.attrs.get("config", "")
-        return bool(OmegaConf.select(OmegaConf.create(config), "output.figures", default=True))
+        import netCDF4
+
+        with netCDF4.Dataset(path, "r") as nc:  # the header only: no coordinate is read
+            config = nc.getncattr("config") if "config" in nc.ncattrs() else ""
     except Exception:  # noqa: BLE001 -- unreadable: leave it alone
         return False
+    output = stored_yaml(config, f"the config attribute of {shorten(str(path))}").get("output")
+    return bool(output.get("figures", True)) if isinstance(output, dict) else True
 
 
 def datasets(path: Path) -> list[Path]:
@@ -95,8 +99,13 @@ def datasets(path: Path) -> list[Path]:
 
 def redraw(path: str | Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int = DEFAULT_DPI) -> list[Path]:
     """Redraw every figure of the datasets under ``path``; returns the files written."""
+    from gyrolab.output.trust import check_tree
+
+    path = Path(path)
+    if path.is_dir():  # a job directory that is a link would take its figures outside (a file's: own_dir)
+        check_tree(path, sweep=True)
     written = []
-    for dataset in datasets(Path(path)):
+    for dataset in datasets(path):
         written += draw_dataset(dataset, formats, dpi)
     return written
 

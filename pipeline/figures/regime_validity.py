@@ -12,7 +12,6 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
-from omegaconf import OmegaConf
 
 from gyrolab.figures.style import DOUBLE, log_positive, styled, subplots
 
@@ -23,8 +22,10 @@ PARAMETERS = {"mu": "μ", "c/r0": "c/r₀", "c/r0 (as printed)": "μ = c/r₀ (p
 
 def _spec(ds: xr.Dataset) -> dict[str, Any]:
     try:
-        return OmegaConf.to_container(OmegaConf.create(ds.attrs.get("config", "")), resolve=False).get(
-            "regime_validity", {}) or {}
+        from gyrolab.output.user_yaml import stored_yaml
+
+        return stored_yaml(ds.attrs.get("config", ""), "the dataset's config attribute").get("regime_validity",
+                                                                                               {}) or {}
     except Exception:  # noqa: BLE001 -- a dataset without its config still draws, with generic labels
         return {}
 

@@ -27,6 +27,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from gyrolab.errors import OutputError
+from gyrolab.output.trust import OWN_DIRS, check_output_target, own_dir, umask
 
 #: how a temporary file of ``atomic_path`` is named: prefix "." + final name + ".", suffix
 TEMP_SUFFIX = ".tmp"
@@ -46,12 +47,6 @@ _REASONS = {
 def reason(error: OSError) -> str:
     """A short human reason for an OSError."""
     return _REASONS.get(error.errno, error.strerror or type(error).__name__)
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 #: what netCDF's RuntimeErrors say when the write itself failed (a full disk or a file-size limit is "HDF error")
@@ -74,6 +69,9 @@ def atomic_path(path: str | os.PathLike[str], *, expected_bytes: int | None = No
     the free space.
     """
     path = Path(path)
+    if path.parent.name in OWN_DIRS:
+        own_dir(path.parent)  # figures/, .hydra/: a real folder, not a link out of the run directory
+    check_output_target(path)  # a link or a device there is refused, not replaced
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=TEMP_SUFFIX, dir=path.parent)
@@ -84,7 +82,7 @@ def atomic_path(path: str | os.PathLike[str], *, expected_bytes: int | None = No
     try:
         yield tmp
         _fsync(tmp)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes the file private; results are ordinary files
+        os.chmod(tmp, 0o666 & ~umask())  # mkstemp makes the file private; results are ordinary files
         os.replace(tmp, path)
         _fsync_directory(path.parent)
     except OutputError:

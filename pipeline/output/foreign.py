@@ -1,13 +1,20 @@
-"""Datasets given to ``--plot`` and ``--reproduce`` read as what they claim to be: gyrolab's netCDF files.
+"""Datasets gyrolab reads (``plot``, ``--animate``, ``reproduce``, ``aggregate``) read as what they claim to be:
+gyrolab's netCDF files. Every reader goes through ``load_dataset``.
 
 A path may be anything a user can type: a text file named ``run.nc``, an empty file, a
 directory, a device, a loop of symbolic links, someone else's netCDF file. Each is one
 ConfigError sentence naming the path and what was expected; the file's contents are never
 echoed (a reader's message quotes at most a variable's name).
+
+A dataset is untrusted input: before anything is read into memory, its declared sizes are checked
+against what gyrolab writes (every value it declares is stored, uncompressed: a 6 kB file declaring
+10⁸ time steps was edited) and against the memory available; after reading, every variable along
+``time`` (or a sweep's ``sample``) must hold numbers, as gyrolab writes them.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import stat
 import warnings
@@ -16,6 +23,7 @@ from pathlib import Path
 import xarray as xr
 
 from gyrolab.errors import ConfigError, shorten
+from gyrolab.output.atomic import _size
 
 #: what a figure module or a rerun raises when a dataset lacks what gyrolab's datasets have
 FOREIGN_ERRORS = (LookupError, ValueError, TypeError, AttributeError, ArithmeticError)
@@ -32,15 +40,89 @@ def load_dataset(path: str | os.PathLike[str], expected: str, **options) -> xr.D
         raise ConfigError(f"cannot read {where!r} ({reason}); give {expected}") from None
     if not stat.S_ISREG(mode):
         raise ConfigError(f"{where!r} is not a regular file; give {expected}")
-    if os.stat(path).st_size == 0:
+    size = os.stat(path).st_size
+    if size == 0:
         raise ConfigError(f"{where!r} is empty; give {expected}")
+    unreadable = ConfigError(f"cannot read {where!r} as a netCDF dataset (it is not a netCDF file gyrolab can read); "
+                             f"give {expected}")
+    try:
+        declared = declared_bytes(path)
+    except Exception:  # noqa: BLE001 - any reader failure means the same thing to the user
+        raise unreadable from None
+    check_declared(declared, size, where, expected)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # xarray's "fails while guessing" warnings are the same news
-            return xr.load_dataset(path, **options)
+            ds = xr.load_dataset(path, **options)
     except Exception:  # noqa: BLE001 - any reader failure means the same thing to the user
-        raise ConfigError(f"cannot read {where!r} as a netCDF dataset (it is not a netCDF file gyrolab can read); "
-                          f"give {expected}") from None
+        raise unreadable from None
+    for name, variable in ds.variables.items():
+        if {"time", "sample"} & set(variable.dims) and variable.dtype.kind not in "fiub":
+            raise ConfigError(f"{where!r}: variable {shorten(str(name), 40)!r} holds "
+                              f"{'text' if variable.dtype.kind in 'OSU' else variable.dtype.name} where gyrolab "
+                              f"writes numbers; the dataset was edited; give {expected}")
+    return ds
+
+
+#: a dataset declaring more than this many times its file size (plus MARGIN_BYTES) was edited: gyrolab writes every
+#: value it declares, uncompressed (HDF5 reads values never written as fill values: a small file could make any size)
+SPARSE_FACTOR = 4
+MARGIN_BYTES = 16 * 1024**2
+
+
+def declared_bytes(path: Path) -> int:
+    """The bytes the variables of the netCDF file ``path`` declare, from its header (nothing is read)."""
+    import netCDF4
+
+    total = 0
+    with netCDF4.Dataset(path, "r") as nc:
+        groups = [nc]
+        while groups:
+            group = groups.pop()
+            groups.extend(group.groups.values())
+            for variable in group.variables.values():
+                itemsize = getattr(variable.dtype, "itemsize", 8) or 8   # text (vlen): one pointer per value
+                total += math.prod(variable.shape) * itemsize
+    return total
+
+
+def check_declared(declared: int, size: int, where: str, expected: str) -> None:
+    """ConfigError (naming the limit) when a dataset declares more data than its file holds or memory can take."""
+    if declared > SPARSE_FACTOR * size + MARGIN_BYTES:
+        raise ConfigError(f"{where!r} declares {_size(declared)} of data in a file of {_size(size)}; gyrolab stores "
+                          f"every value it declares (at most {SPARSE_FACTOR}× the file's size), so the dataset was "
+                          f"edited; give {expected}")
+    limit = memory_limit()
+    if declared > limit:
+        raise ConfigError(f"{where!r} declares {_size(declared)} of data, more than the limit of {_size(limit)} "
+                          f"(half the memory available); give {expected}, or read it on a larger machine")
+
+
+def memory_limit() -> int:
+    """Half the memory available now (Linux's MemAvailable), else 4 GiB."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as handle:
+            for line in handle:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024 // 2
+    except (OSError, ValueError, IndexError):
+        pass
+    return 4 * 1024**3
+
+
+RUN = "a run.nc that gyrolab wrote"
+
+
+def load_run(path: str | os.PathLike[str]) -> xr.Dataset:
+    """A run's dataset (``run.nc``) for ``reproduce`` and ``--animate``: one sentence for a sweep's or another file."""
+    path = Path(path)
+    ds = load_dataset(path, RUN, decode_times=False, decode_timedelta=False)
+    if "config" not in ds.attrs and "job_status" in ds:
+        raise ConfigError(f"{shorten(str(path))!r} is a sweep dataset, not a run; give one job's run.nc (sweep.nc's "
+                          "job_dir variable names each job's directory)")
+    if "config" not in ds.attrs:
+        raise ConfigError(f"{shorten(str(path))!r} has no 'config' attribute; give {RUN}")
+    return ds
 
 
 def not_gyrolabs(path: str | os.PathLike[str], error: BaseException, expected: str) -> ConfigError:

@@ -30,6 +30,7 @@ from pathlib import Path
 
 from gyrolab.errors import ConfigError, OutputError
 from gyrolab.output.atomic import reason, remove_stale_temporaries
+from gyrolab.output.trust import open_own_file
 
 log = logging.getLogger("gyrolab")
 
@@ -51,9 +52,12 @@ _held: dict[Path, list[int]] = {}
 def owner_of(directory: Path) -> str:
     """Who holds (or last held) ``directory``'s lock, as its lock file says: 'pid N on HOST', or ''."""
     try:
-        return (Path(directory) / LOCK_NAME).read_text().strip()
-    except OSError:
+        fd = open_own_file(Path(directory) / LOCK_NAME, os.O_RDONLY)
+    except (OSError, ConfigError):
         return ""
+    with os.fdopen(fd, "rb") as handle:
+        text = handle.read(MAX_OWNER_BYTES).decode("utf-8", "replace").strip()
+    return "".join(c for c in text if c.isprintable())[:120]  # a planted file's escape sequences are not echoed
 
 
 def try_lock(directory: str | os.PathLike[str], *, blocking: bool = False) -> bool:
@@ -161,10 +165,26 @@ def wait_for(directory: str | os.PathLike[str]) -> None:
 
 
 def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
-    """An fd holding an exclusive flock on ``path`` (the file now in the directory), or None when busy."""
+    """An fd holding an exclusive flock on ``path`` (the file now in the directory), or None when busy.
+
+    The file is opened without following a link and must be a regular file (``gyrolab.output.trust``): a planted
+    ``.gyrolab.lock`` link is refused, never truncated. The owner's line is written only into a file this call
+    created, or a lock file of gyrolab's (one link, the user's, a line long).
+    """
     while True:
+        created = False
         try:
-            fd = os.open(path, os.O_RDWR | (os.O_CREAT if create else 0), 0o644)
+            if create:
+                try:
+                    fd = open_own_file(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644)
+                    created = True
+                except FileExistsError:
+                    try:
+                        fd = open_own_file(path, os.O_RDWR)
+                    except FileNotFoundError:
+                        continue  # removed between the two opens: again
+            else:
+                fd = open_own_file(path, os.O_RDWR)
         except FileNotFoundError:
             if not create:
                 return None
@@ -178,10 +198,11 @@ def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
             if error.errno in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS):
                 log.warning("the file system of %s has no file locks; two gyrolab runs in this directory "
                             "would not be told apart", path.parent)
-                return os.open(path, os.O_RDWR)
+                return open_own_file(path, os.O_RDWR)
             raise
         try:
-            same = os.fstat(fd).st_ino == os.stat(path).st_ino
+            info = os.fstat(fd)
+            same = info.st_ino == os.lstat(path).st_ino
         except OSError:
             same = False
         if not same:  # the holder released and removed the file between our open and our flock: again
@@ -189,10 +210,15 @@ def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
             if not create:
                 return None
             continue
-        if create:
+        ours = created or (info.st_nlink == 1 and info.st_uid == os.geteuid() and info.st_size <= MAX_OWNER_BYTES)
+        if create and ours:
             try:  # who holds it, for the messages of others; a full disk may refuse this, the lock holds anyway
                 os.ftruncate(fd, 0)
                 os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}\n".encode())
             except OSError:
                 pass
         return fd
+
+
+#: a lock file holds one line; a larger file is not overwritten
+MAX_OWNER_BYTES = 4096

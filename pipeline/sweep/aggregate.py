@@ -36,15 +36,18 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
-from omegaconf import OmegaConf
+from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.contracts.integrator import IntegratorStats
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.units import quantity_units
 from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
+from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset
+from gyrolab.output.trust import check_tree
 from gyrolab.output.written import announce_written
-from gyrolab.errors import ConfigError
+from gyrolab.output.user_yaml import stored_yaml_file
+from gyrolab.errors import ConfigError, shorten
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
 
@@ -366,6 +369,8 @@ def collect(sweep_dir: Path, grid: Grid) -> list[JobResult]:
     for path in record_paths(sweep_dir):
         record = read_record(path.parent)
         if record is None:
+            log.warning("%s is not a job record gyrolab wrote (too large, too deep, or edited); that job counts as "
+                        "missing and runs again when the sweep is resumed", path)
             continue
         key, mtime = tuple(record.overrides), path.stat().st_mtime
         if key not in found or found[key][0] < mtime:  # a stale copy elsewhere: the newest record wins
@@ -383,9 +388,10 @@ def collect(sweep_dir: Path, grid: Grid) -> list[JobResult]:
                                      exit_code=record.exit_code, **common))
             continue
         try:
-            ds = xr.load_dataset(job_dir / str(record.run), decode_times=False, decode_timedelta=False)
-        except (OSError, ValueError) as error:
-            log.warning("job %s: cannot read its dataset (%s); counted as missing", where, error)
+            ds = load_dataset(job_dir / str(record.run), "a run.nc that gyrolab wrote", decode_times=False,
+                              decode_timedelta=False)
+        except ConfigError as error:
+            log.warning("job %s: %s; counted as missing", where, error)
             results.append(JobResult())
             continue
         if ds.attrs.get("job_id") != record.job_id:
@@ -408,12 +414,9 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
     ``multirun.yaml`` too.
     """
     sweep_dir = Path(sweep_dir)
+    check_tree(sweep_dir, sweep=True)
     if hydra_cfg is None:
-        saved = sweep_dir / "multirun.yaml"
-        if not saved.is_file():
-            raise ConfigError(f"{str(sweep_dir)!r} is not a sweep directory (no multirun.yaml); give the "
-                              "directory a 'gyrolab -m ...' run wrote (its hydra.sweep.dir)")
-        hydra_cfg = OmegaConf.load(saved).hydra
+        hydra_cfg = stored_hydra(sweep_dir)
         launcher = launcher or _short_target(hydra_cfg.get("launcher", {}).get("_target_", ""))
     if figures is None:
         figures = bool(OmegaConf.select(hydra_cfg, "callbacks.sweep.figures", default=True))
@@ -424,7 +427,12 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
     try:
         clear_temporaries(sweep_dir)
         results = collect(sweep_dir, grid)
-        ds = assemble(grid, results)
+        try:
+            ds = assemble(grid, results)
+        except FOREIGN_ERRORS as error:  # jobs' datasets that gyrolab did not write as they are
+            raise ConfigError(f"the jobs' datasets in {shorten(str(sweep_dir))!r} do not fit one sweep.nc "
+                              f"({type(error).__name__}); a job's run.nc was edited: remove that job's directory "
+                              "and resume the sweep") from None
         ds.attrs["sweep_launcher"] = launcher
         path = write_dataset(ds, sweep_dir / SWEEP_NAME)
     finally:
@@ -444,6 +452,20 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
 
             summary.figures = save_sweep_figures(ds, sweep_dir / "figures", *figure_options(output))
     return summary
+
+
+def stored_hydra(sweep_dir: Path) -> DictConfig:
+    """The ``hydra`` node of the sweep stored in ``sweep_dir/multirun.yaml``, read as untrusted input
+    (``gyrolab.output.user_yaml.stored_yaml_file``); ConfigError when there is none."""
+    saved = Path(sweep_dir) / "multirun.yaml"
+    if not saved.is_file():
+        raise ConfigError(f"{str(sweep_dir)!r} is not a sweep directory (no multirun.yaml); give the "
+                          "directory a 'gyrolab -m ...' run wrote (its hydra.sweep.dir)")
+    hydra_cfg = OmegaConf.create(stored_yaml_file(saved)).get("hydra")
+    if not isinstance(hydra_cfg, DictConfig) or "overrides" not in hydra_cfg:
+        raise ConfigError(f"{str(saved)!r} has no hydra.overrides section; give the directory a 'gyrolab -m ...' "
+                          "run wrote (its hydra.sweep.dir)")
+    return hydra_cfg
 
 
 def wait_for_jobs(sweep_dir: Path) -> None:

@@ -20,6 +20,7 @@ from omegaconf import DictConfig
 from gyrolab.errors import GyrolabError, OutputError
 from gyrolab.output.atomic import reason
 from gyrolab.output.lock import lock, unlock
+from gyrolab.output.trust import check_output_target, own_dir
 from gyrolab.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.orphans import announce_launcher, forget_launcher
@@ -108,6 +109,9 @@ class SweepCallback(Callback):
                          "the cause is fixed"
             last_exit_code = error.exit_code
             return
+        except GyrolabError as error:  # e.g. a link planted in the sweep directory meanwhile: one sentence
+            last_error, last_exit_code = str(error), error.exit_code
+            return
         except Exception as error:  # noqa: BLE001 - the jobs' results are safe; say how to aggregate them later
             last_error = f"could not aggregate the sweep ({type(error).__name__}: {error}); the job results are " \
                          f"intact: run 'gyrolab --aggregate {sweep_dir}' once the cause is fixed"
@@ -135,6 +139,12 @@ def _tolerate_hydra_record_failures() -> None:
 
     @functools.wraps(save)
     def save_or_warn(cfg: Any, filename: str, output_dir: Path) -> None:
+        try:  # Hydra opens the file following links: a link planted since the preflight's check is not written
+            own_dir(output_dir)
+            check_output_target(Path(output_dir) / filename)
+        except GyrolabError as error:
+            log.warning("%s; the job's config is also stored in its job.json and run.nc", error)
+            return
         try:
             save(cfg, filename, output_dir)
         except OSError as error:

@@ -10,8 +10,8 @@ from collections.abc import Iterable
 from pathlib import Path
 
 import xarray as xr
-from omegaconf import OmegaConf
 
+from gyrolab.output.user_yaml import stored_yaml_file
 from gyrolab.figures.options import figure_options
 from gyrolab.figures.sweep import choose_x, final_values  # noqa: F401 -- the sweep's own helpers, re-exported
 
@@ -25,7 +25,7 @@ def save_sweep_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[
 
     directory = Path(directory)
     saved = directory.parent / "multirun.yaml"
-    output = OmegaConf.load(saved).get("output") if saved.is_file() else None
+    output = stored_yaml_file(saved).get("output") if saved.is_file() else None
     default_formats, default_dpi = figure_options(output)
     return draw(ds, directory, tuple(formats) if formats is not None else default_formats,
                 dpi if dpi is not None else default_dpi)

@@ -18,7 +18,11 @@ import numpy as np
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import OverrideParseException
 
-from gyrolab.errors import ConfigError
+from gyrolab.engine.budget import check_points, sweep_points
+from gyrolab.errors import ConfigError, shorten
+
+#: jobs of a multirun (each its own directory and launch): beyond it, gyrolab batch is the tool
+MAX_JOBS = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -53,14 +57,22 @@ class Grid:
         return tuple(len(d.labels) for d in self.dims)
 
     @classmethod
-    def from_overrides(cls, overrides: Sequence[str], *, repeats: bool = False) -> Grid:
+    def from_overrides(cls, overrides: Sequence[str], *, repeats: bool = False, max_jobs: float | None = None) -> Grid:
         """ConfigError for a malformed override, a non-discrete sweep or a value given twice (unless ``repeats``:
-        a batch's zipped keys may repeat values)."""
+        a batch's zipped keys may repeat values); for more than ``max_jobs`` jobs (the budget's points by default),
+        counted before anything is expanded."""
         parser = OverridesParser.create()
         try:
             parsed = parser.parse_overrides(list(overrides))
         except OverrideParseException as error:
             raise ConfigError(f"malformed sweep override: {str(error).strip().splitlines()[0]}") from None
+        n, named = sweep_points(parsed)
+        allow_large = any(o.key_or_group == "allow_large" and not o.is_sweep_override() and o.value() is True
+                          for o in parsed)
+        if max_jobs is not None and n > max_jobs:
+            raise ConfigError(f"{shorten(named)} makes {n:.3g} jobs, beyond the {max_jobs:.0e} jobs of a multirun "
+                              "(one directory each); the sweep directory was edited, or run it with gyrolab batch")
+        check_points(n, named, allow_large=allow_large)
         choices: dict[str, list[str]] = {}      # key -> job overrides, in first-seen order (as Hydra does)
         typed: dict[str, list[Any]] = {}
         for o in parsed:
@@ -88,10 +100,16 @@ class Grid:
 
     @classmethod
     def from_hydra(cls, hydra_cfg: Mapping[str, Any]) -> Grid:
-        """The grid of a multirun config's ``hydra`` node (sweeper params first, as the basic sweeper does)."""
-        params = hydra_cfg.get("sweeper", {}).get("params") or {}
-        overrides = [f"{k}={v}" for k, v in params.items()] + list(hydra_cfg["overrides"]["task"])
-        return cls.from_overrides(overrides)
+        """The grid of a multirun config's ``hydra`` node (sweeper params first, as the basic sweeper does); a
+        stored one (``multirun.yaml``) is untrusted: plain overrides only, within the budget."""
+        try:
+            params = (hydra_cfg.get("sweeper") or {}).get("params") or {}
+            task = hydra_cfg["overrides"]["task"]
+            overrides = [f"{k}={v}" for k, v in params.items()] + [str(o) for o in task]
+        except Exception:  # noqa: BLE001 - an edited multirun.yaml: any shape but the one Hydra writes
+            raise ConfigError("the sweep's hydra.overrides.task and hydra.sweeper.params are not the lists Hydra "
+                              "writes; multirun.yaml was edited") from None
+        return cls.from_overrides(overrides, max_jobs=MAX_JOBS)
 
 
 def _refuse_repeats(key: str, labels: list[str], values: list[Any]) -> None:

@@ -13,7 +13,12 @@ from collections.abc import Iterator
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
+from gyrolab.errors import ConfigError
 from gyrolab.output.atomic import atomic_open
+from gyrolab.output.trust import open_own_file
+
+#: a job's record is a few hundred bytes; a larger file is not gyrolab's
+MAX_RECORD_BYTES = 1024 * 1024
 
 RECORD_NAME = "job.json"
 FINISHED, FAILED = "finished", "failed"
@@ -53,13 +58,29 @@ def write_record(job_dir: Path, record: JobRecord) -> Path:
 
 
 def read_record(job_dir: Path) -> JobRecord | None:
-    """The record in ``job_dir``, or None when there is none (or it is unreadable: treated as unfinished)."""
+    """The record in ``job_dir``, or None when there is none (or it is unreadable: treated as unfinished).
+
+    A record is untrusted input (a sweep directory may come from someone else): at most MAX_RECORD_BYTES, a JSON
+    mapping whose ``run`` is a file name in the job directory, nested no deeper than Python can parse.
+    """
     try:
-        data = json.loads((Path(job_dir) / RECORD_NAME).read_text())
+        fd = open_own_file(Path(job_dir) / RECORD_NAME, os.O_RDONLY)
+        with os.fdopen(fd, "rb") as handle:
+            text = handle.read(MAX_RECORD_BYTES + 1)
+        if len(text) > MAX_RECORD_BYTES:
+            return None
+        data = json.loads(text)
         known = {f.name for f in fields(JobRecord)}
-        return JobRecord(**{k: v for k, v in data.items() if k in known})
-    except (OSError, ValueError, TypeError):
+        record = JobRecord(**{k: v for k, v in data.items() if k in known})
+    except (OSError, ValueError, TypeError, AttributeError, RecursionError, ConfigError):
         return None
+    run = record.run
+    if run is not None and (not isinstance(run, str) or Path(run).name != run or run in (".", "..")):
+        return None  # a path out of the job directory: not a record gyrolab wrote
+    if not (isinstance(record.overrides, list) and all(isinstance(o, str) for o in record.overrides)
+            and isinstance(record.job_id, str) and isinstance(record.status, str)):
+        return None
+    return record
 
 
 def remove_record(job_dir: Path) -> None:

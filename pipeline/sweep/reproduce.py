@@ -22,7 +22,7 @@ from omegaconf import DictConfig, OmegaConf
 from gyrolab.engine.budget import check_budget
 from gyrolab.engine.safety import check_stored_config
 from gyrolab.errors import ConfigError, GyrolabError, shorten
-from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
+from gyrolab.output.foreign import FOREIGN_ERRORS, RUN, load_dataset, load_run as load_run_only, not_gyrolabs
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 
@@ -47,16 +47,10 @@ class Comparison:
 def load_run(path: Path, *, sweeps: bool = False) -> xr.Dataset:
     """The dataset at ``path``: a run.nc or another dataset with a stored config (``sweeps``: a multirun's
     sweep.nc too); ConfigError, one sentence, for anything else."""
-    path = Path(path)
-    ds = load_dataset(path, "a run.nc that gyrolab wrote", decode_times=False, decode_timedelta=False)
-    if sweeps and is_multirun(ds):
-        return ds
-    if "config" not in ds.attrs and "job_status" in ds:
-        raise ConfigError(f"{str(path)!r} is a sweep dataset, not a run; give one job's run.nc (sweep.nc's "
-                          "job_dir variable names each job's directory)")
-    if "config" not in ds.attrs:
-        raise ConfigError(f"{str(path)!r} has no 'config' attribute; give a run.nc that gyrolab wrote")
-    return ds
+    if not sweeps:
+        return load_run_only(path)
+    ds = load_dataset(Path(path), RUN, decode_times=False, decode_timedelta=False)  # (the trust boundary's loader)
+    return ds if is_multirun(ds) else load_run_only(path)
 
 
 def is_multirun(ds: xr.Dataset) -> bool:

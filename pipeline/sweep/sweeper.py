@@ -23,7 +23,9 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import os
 import re
+import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -38,6 +40,12 @@ from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.engine.hydra_private import ConfigLoaderImpl
+from gyrolab.errors import ConfigError, GyrolabError, shorten
+from gyrolab.output.atomic import atomic_open
+from gyrolab.output.lock import try_lock, unlock
+from gyrolab.output.trust import check_tree, private_dir
+from gyrolab.sweep.aggregate import SWEEP_NAME, stored_hydra
+from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import code_version, job_identity
 from gyrolab.sweep.job import mark_skipped
 from gyrolab.sweep.record import JobRecord, read_record
@@ -84,8 +92,11 @@ class ResumingSweeper(Sweeper):
         overrides = parser.parse_overrides([*params, *arguments])
         jobs = [job for batch in BasicSweeper.split_arguments(overrides, None) for job in batch]
         sweep_dir = Path(self.config.hydra.sweep.dir)
-        sweep_dir.mkdir(parents=True, exist_ok=True)
-        OmegaConf.save(self.config, sweep_dir / "multirun.yaml")
+        try:
+            claim(sweep_dir, self.config)
+        except GyrolabError as error:  # as the sweep callback refuses a directory in use: one sentence
+            print(f"gyrolab: error: {error}", file=sys.stderr)
+            sys.exit(error.exit_code)
 
         tic = time.perf_counter()
         settled, unsure = check_jobs(self.config, self.hydra_context.config_loader, jobs)
@@ -109,6 +120,41 @@ class ResumingSweeper(Sweeper):
             if num not in launched:
                 mark_skipped(job_dir, record, num, jobs[num])
         return returns
+
+
+def claim(sweep_dir: Path, config: DictConfig) -> None:
+    """Make ``sweep_dir`` this sweep's (its ``multirun.yaml``), or refuse it in one sentence (ConfigError).
+
+    One sweep directory, one sweep: a directory holding another sweep (another grid of jobs in its
+    ``multirun.yaml``) or a batch (a ``sweep.nc`` without one) is refused, as ``gyrolab batch`` refuses another
+    batch; the same sweep again resumes. The check and the write of ``multirun.yaml`` happen under the sweep
+    directory's lock, so two sweeps started at once cannot interleave: the later one finds the earlier one's.
+    Nothing already in the directory is followed (``gyrolab.output.trust.check_tree``), and submitit's folder,
+    whose pickles the jobs load, is the user's alone (``private_dir``).
+    """
+    check_tree(sweep_dir, sweep=True)
+    try_lock(sweep_dir, blocking=True)
+    try:
+        saved = sweep_dir / "multirun.yaml"
+        if saved.exists() or (sweep_dir / SWEEP_NAME).exists():
+            where = shorten(str(sweep_dir))
+            if not saved.exists():
+                raise ConfigError(f"{where!r} holds a {SWEEP_NAME} of a batch or another sweep and no multirun.yaml; "
+                                  "choose another hydra.sweep.dir or remove it")
+            theirs = Grid.from_hydra(stored_hydra(sweep_dir)).jobs
+            if theirs != Grid.from_hydra(config.hydra).jobs:
+                raise ConfigError(f"{where!r} holds another sweep ({len(theirs)} jobs, its command line in "
+                                  f"{shorten(str(saved))}); choose another hydra.sweep.dir, or run that sweep's "
+                                  "command again to resume it")
+        folder = OmegaConf.select(config, "hydra.launcher.submitit_folder", default=None)
+        if folder is not None:
+            inside = Path(os.path.relpath(os.path.abspath(str(folder)), os.path.abspath(sweep_dir))).parts
+            if inside and inside[0] not in ("..", "."):
+                private_dir(sweep_dir / inside[0], "submitit's folder")
+        with atomic_open(saved, "w") as stream:
+            stream.write(OmegaConf.to_yaml(config))
+    finally:
+        unlock(sweep_dir)
 
 
 def launch_runs(remaining: Sequence[int], jobs: Sequence[Sequence[str]], max_batch_size: int | None,

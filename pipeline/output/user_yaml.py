@@ -1,4 +1,6 @@
-"""A user's YAML files (``--config-dir``, ``--config-path``) read as what they claim to be, before Hydra reads them.
+"""A user's YAML files (``--config-dir``, ``--config-path``), and every config gyrolab stored (a dataset's
+``config`` attribute, ``multirun.yaml``, ``.hydra/*.yaml``), read as what they claim to be before anything else
+reads them (``stored_yaml``: a directory or a dataset received from someone else is untrusted input).
 
 Hydra turns a YAML problem into a 65–104-line traceback, and expands anchors and aliases without
 bound (a "billion laughs" file hangs it). Each file is checked here first with PyYAML's safe
@@ -22,6 +24,8 @@ import yaml
 from gyrolab.errors import ConfigError, shorten
 
 MAX_FILE_BYTES = 1024 * 1024
+#: the end of a sentence about a stored config that is not what gyrolab stores
+EDITED = "gyrolab stores plain YAML mappings, so it was edited; give a file gyrolab wrote"
 #: the tags YAML's core schema resolves plain values to; any other (!!python/..., !custom) is refused
 CORE_TAGS = frozenset(f"tag:yaml.org,2002:{t}" for t in
                       ("str", "int", "float", "bool", "null", "map", "seq", "merge", "timestamp", "binary"))
@@ -48,17 +52,32 @@ def check_user_config_dir(directory: str, option: str) -> None:
 
 
 def check_user_yaml(path: Path) -> None:
-    where = _display(path)
+    check_yaml_text(_read(path, _display(path)), _display(path))
+
+
+def _read(path: Path, where: str, *, kind: str = "a config folder holds") -> bytes:
+    """The bytes of the regular file ``path`` (at most MAX_FILE_BYTES), read without following a FIFO or a device."""
     try:
         if not stat.S_ISREG(path.stat().st_mode):  # a FIFO or a link to /dev/zero would block the read forever
-            raise ConfigError(f"{where} is not a regular file; a config folder holds YAML files")
+            raise ConfigError(f"{where} is not a regular file; {kind} YAML files")
         if path.stat().st_size > MAX_FILE_BYTES:
             raise ConfigError(f"{where} is larger than {MAX_FILE_BYTES // 1024} KiB; a config file is a short "
                               "YAML mapping of settings")
-        data = path.read_bytes()
+        return path.read_bytes()
     except OSError as error:
-        raise ConfigError(f"{where} cannot be read ({error.strerror or error}); a config folder holds readable "
+        raise ConfigError(f"{where} cannot be read ({error.strerror or error}); {kind} readable "
                           "YAML files") from None
+
+
+def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> yaml.Node | None:
+    """ConfigError (one sentence naming ``where`` and the line) unless ``data`` is a plain YAML mapping within the
+    limits (module docstring); the composed node (None for an empty text). ``stored``: a config gyrolab stored
+    (the sentences say that it was edited)."""
+    if isinstance(data, str):
+        data = data.encode("utf-8", "surrogatepass")
+    if len(data) > MAX_FILE_BYTES:
+        raise ConfigError(f"{where} is larger than {MAX_FILE_BYTES // 1024} KiB; a config is a short YAML mapping "
+                          "of settings")
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
@@ -69,22 +88,62 @@ def check_user_yaml(path: Path) -> None:
         raise ConfigError(f"{where}, line {text.count(chr(10), 0, bad) + 1}: a control character (code "
                           f"{ord(text[bad])}) that YAML does not allow; a config file is plain text")
     try:
+        _check_depth(text, where)  # before composing: PyYAML's composer recurses once per level
         node = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as error:
+        if stored:
+            mark = error.problem_mark or error.context_mark
+            at = f" at line {mark.line + 1}" if mark is not None else ""
+            raise ConfigError(f"{where} is not plain YAML{at} ({shorten(str(error.problem or error.context), 120)}); "
+                              f"{EDITED}") from None
         raise ConfigError(_sentence(where, error)) from None
     except yaml.YAMLError as error:
         raise ConfigError(f"{where} is not valid YAML ({shorten(type(error).__name__)})") from None
     if node is None:
-        return  # an empty file is an empty config
+        return None  # an empty file is an empty config
+    _check_nodes(node, where)
     if not isinstance(node, yaml.MappingNode):
         kind = "a list" if isinstance(node, yaml.SequenceNode) else "a single value"
+        if stored:
+            raise ConfigError(f"{where} is {kind}, not a YAML mapping of config sections; {EDITED}")
         raise ConfigError(f"{where}, line {node.start_mark.line + 1}: the file is {kind}, not a mapping of settings "
                           "(key: value lines); every config file is a mapping")
-    _check_nodes(node, where)
     for key, value in node.value:
         if key.value == "defaults" and not isinstance(value, yaml.SequenceNode):
             raise ConfigError(f"{where}, line {value.start_mark.line + 1}: `defaults` must be a list (- group: option "
                               "lines), as in Hydra's defaults list")
+    return node
+
+
+def stored_yaml(data: bytes | str, where: str) -> dict:
+    """A config gyrolab stored (a dataset's ``config`` attribute, ``multirun.yaml``, ``.hydra/config.yaml``) as
+    plain data, after the checks of a user's file: a directory or a dataset received from someone else is
+    untrusted input (anchors, depth, tags, size)."""
+    if not isinstance(data, (str, bytes)):
+        raise ConfigError(f"{where} is not text; a stored config is a YAML mapping that gyrolab wrote")
+    if check_yaml_text(data, where, stored=True) is None:
+        return {}
+    return yaml.safe_load(data)  # checked: plain tags, bounded size and depth
+
+
+def stored_yaml_file(path: Path, where: str | None = None) -> dict:
+    """``stored_yaml`` of the file ``path`` (a regular file of at most MAX_FILE_BYTES)."""
+    where = where or _display(path)
+    return stored_yaml(_read(Path(path), where, kind="a stored config is"), where)
+
+
+def _check_depth(text: str, where: str) -> None:
+    """ConfigError when lists and mappings nest deeper than MAX_DEPTH (PyYAML's parser is iterative; its composer
+    is not, and Python's recursion would end near 1000 levels)."""
+    depth = 0
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise ConfigError(f"{where}, line {event.start_mark.line + 1}: lists and mappings nested more than "
+                                  f"{MAX_DEPTH} deep; a config file is a short mapping of settings")
+        elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
+            depth -= 1
 
 
 def _display(path: Path) -> str:
@@ -134,7 +193,8 @@ def _check_nodes(root: yaml.Node, where: str) -> None:
         on_path.add(key)
         if node.tag not in CORE_TAGS:
             raise ConfigError(f"{where}, line {node.start_mark.line + 1}: the YAML tag {shorten(node.tag, 60)!r} is not "
-                              "allowed; a config file holds plain values (numbers, strings, lists, mappings)")
+                              "allowed (not plain YAML: gyrolab refuses tags such as !!python/...); a config holds "
+                              "plain values (numbers, strings, lists, mappings)")
         if isinstance(node, yaml.MappingNode):
             seen: dict[object, int] = {}
             for k, _ in node.value:
