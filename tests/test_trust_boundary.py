@@ -183,7 +183,7 @@ def test_a_sweep_refuses_a_submitit_folder_others_can_write(tmp_path):
 def test_numbas_cache_folder_writable_by_anyone_is_refused(tmp_path, monkeypatch):
     import numba
 
-    import gyrolab.plugins.compiled  # noqa: F401 - sets numba's cache folder on import
+    import gyrolab.kernels.compiler  # noqa: F401 - sets numba's cache folder on import
 
     folder = tmp_path / "shared" / "numba-cache"
     folder.mkdir(parents=True)

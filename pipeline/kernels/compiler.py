@@ -23,12 +23,28 @@ def _cache_dir() -> str:
     name = f"numba-{digest.hexdigest()[:16]}"
     root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "gyrolab"
     try:
-        (root / name).mkdir(parents=True, exist_ok=True)
-    except OSError:  # a read-only home (some cluster nodes): cache per machine in the temporary directory
-        import tempfile
-
-        root = Path(tempfile.gettempdir()) / "gyrolab"
+        _private(root)
+        (root / name).mkdir(mode=0o700, exist_ok=True)
+    except OSError:  # a read-only home (some cluster nodes): a folder of this user's in the temporary directory
+        root = private_temporary()
     return str(root / name)
+
+
+def _private(folder: Path) -> None:
+    """Make ``folder`` (and missing parents) owner-only: numba unpickles its cache index, and the generated kernels
+    (``expression.load_generated``) are imported from it, so no one else may write there."""
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    folder.mkdir(mode=0o700, exist_ok=True)
+
+
+def private_temporary() -> Path:
+    """This user's folder for gyrolab in the temporary directory (``gyrolab-UID``, owner-only): a shared
+    ``/tmp/gyrolab`` that another user created first could hold code or pickles gyrolab would load."""
+    import tempfile
+
+    folder = Path(tempfile.gettempdir()) / f"gyrolab-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
+    _private(folder)
+    return folder
 
 
 import numba  # noqa: E402

@@ -218,12 +218,12 @@ def load_generated(source: str, prefix: str, what: str) -> Any:
 
         folder = Path(kernel_cache_dir()) / "forces"
         try:
-            folder.mkdir(parents=True, exist_ok=True)
-        except OSError:  # a read-only cache (some cluster nodes): this machine's temporary directory
-            import tempfile
+            folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+        except OSError:  # a read-only cache (some cluster nodes): this user's private temporary folder
+            from gyrolab.kernels.compiler import private_temporary
 
-            folder = Path(tempfile.gettempdir()) / "gyrolab" / "forces"
-            folder.mkdir(parents=True, exist_ok=True)
+            folder = private_temporary() / "forces"
+            folder.mkdir(mode=0o700, exist_ok=True)
         path = folder / f"{module_name}.py"
         marker = path.with_suffix(".compiled")
         if not path.exists() or path.read_text() != source:

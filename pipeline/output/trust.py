@@ -163,7 +163,7 @@ def check_kernel_cache() -> None:
     """Untrusted when numba's cache folder (compiled kernels, whose index numba unpickles) or its parent belongs to
     another user or may be written by anyone (a shared temporary directory another user prepared). Called before
     any kernel is loaded (a command that runs kernels: run, batch, reproduce)."""
-    from gyrolab.plugins.compiled import kernel_cache_dir
+    from gyrolab.kernels.compiler import kernel_cache_dir
 
     folder = kernel_cache_dir()
     for path in (Path(folder), Path(folder).parent) if folder else ():
