@@ -20,8 +20,9 @@ orbital frame (a third of them in the radial–normal plane, the paper's h2 = 0)
 benchmarks/gyrostat_reference.py (equations written from the model's vector form and checked against gyrolab's
 numpy right-hand side at random states for every scene; heyoka, real128, tol 1e-30) at every output time.
 
-    nice -n 5 python benchmarks/promise_audit_gyrostat.py --n 40      # ~10-15 min on a loaded 2-core machine
+    nice -n 5 python benchmarks/promise_audit_gyrostat.py --n 40      # ~3 min (2 of them compiling) on 2 loaded cores
     python benchmarks/promise_audit_gyrostat.py --n 3 --no-write      # a quick look
+    python benchmarks/promise_audit_gyrostat.py --n 100 --seed 5 --t-max 200 --spin-max 30 --no-write  # harsher
 """
 
 from __future__ import annotations
@@ -61,7 +62,7 @@ def _vector(v) -> str:
     return "[" + ",".join(repr(float(x)) for x in v) + "]"
 
 
-def random_scene(rng: np.random.Generator, index: int) -> Scene:
+def random_scene(rng: np.random.Generator, index: int, t_max: float = 25.0, spin_max: float = 10.0) -> Scene:
     kind = str(rng.choice(["asymmetric", "asymmetric", "asymmetric", "A=B", "B=C"]))
     while True:
         A, B, C = np.round(np.exp(rng.uniform(np.log(0.5), np.log(2.5), size=3)), 4)
@@ -83,9 +84,9 @@ def random_scene(rng: np.random.Generator, index: int) -> Scene:
         direction = _unit(rng)
     moment = np.round(rng.normal(size=3), 4)
     theta0 = float(rng.uniform(0.2, math.pi - 0.2))
-    spin = math.exp(rng.uniform(math.log(0.1), math.log(10.0))) * rng.choice([-1.0, 1.0])
+    spin = math.exp(rng.uniform(math.log(0.1), math.log(spin_max))) * rng.choice([-1.0, 1.0])
     rates = [float(rng.uniform(-1, 1)), float(rng.uniform(-0.5, 0.5)), spin]
-    t_end = math.exp(rng.uniform(math.log(3.0), math.log(25.0)))
+    t_end = math.exp(rng.uniform(math.log(3.0), math.log(t_max)))
     overrides = ["experiment=gyrostat", "body=gyrostat_asymmetric", f"body.inertia={_vector([A, B, C])}",
                  f"body.gyrostatic_momentum={_vector(k)}", f"body.orbit_rate={Omega}", "force=[newtonian,magnetic]",
                  "force.newtonian.k=null", f"force.magnetic.field={field:.6g}",
@@ -131,13 +132,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--integrators-every", type=int, default=4,
                         help="audit taylor / dop853_numba / rk4_numba estimates on every k-th scene (0: never)")
     parser.add_argument("--n-output", type=int, default=101, help="output times per run (time.n_output)")
+    parser.add_argument("--t-max", type=float, default=25.0, help="longest span drawn (default 25)")
+    parser.add_argument("--spin-max", type=float, default=10.0, help="fastest spin φ̇0 drawn (default 10)")
     parser.add_argument("--no-write", action="store_true",
                         help="do not write benchmarks/results/promise_audit_gyrostat.json")
     args = parser.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     common = [f"time.n_output={args.n_output}", "output.figures=false"]
     reference = gr.Real128Gyrostat()
-    scenes = [random_scene(rng, i) for i in range(args.n)]
+    scenes = [random_scene(rng, i, args.t_max, args.spin_max) for i in range(args.n)]
     auto_rows, other_rows, checks = [], [], []
     wall = time.perf_counter()
     print("| # | scene | ε | verdict | method | final error | max over times | predicted | final/ε | max/ε | "
@@ -250,7 +253,8 @@ def main(argv: list[str] | None = None) -> int:
             if r.get("promise") == "BROKEN" or (r.get("estimate") or {}).get("under"):
                 out["reproduce"] = _command(r["overrides"])
             return out
-        numbers = {"seed": args.seed, "n": args.n, "n_output": args.n_output, "auto_runs": len(auto_rows),
+        numbers = {"seed": args.seed, "n": args.n, "n_output": args.n_output, "t_max": args.t_max,
+                   "spin_max": args.spin_max, "auto_runs": len(auto_rows),
                    **{f"auto_{k}": v for k, v in counts.items()}, "worst_final_over_eps": worst_final,
                    "worst_max_over_time_over_eps": worst_all, "worst_actual_over_predicted": worst_pred,
                    "runs_above_prediction": above_predicted, "reference_rhs_check_max": max(checks),
