@@ -22,7 +22,8 @@ numpy right-hand side at random states for every scene; heyoka, real128, tol 1e-
 
     nice -n 5 python benchmarks/promise_audit_gyrostat.py --n 40      # ~3 min (2 of them compiling) on 2 loaded cores
     python benchmarks/promise_audit_gyrostat.py --n 3 --no-write      # a quick look
-    python benchmarks/promise_audit_gyrostat.py --n 100 --seed 5 --t-max 200 --spin-max 30 --no-write  # harsher
+    python benchmarks/promise_audit_gyrostat.py --n 100 --seed 5 --t-max 200 --spin-max 30 \
+        --name promise_audit_gyrostat_long                            # harsher: longer spans, faster spins
 """
 
 from __future__ import annotations
@@ -40,8 +41,8 @@ from gyrolab.errors import GyrolabError
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gyrostat_reference as gr  # noqa: E402  (benchmarks/ is not a package)
-from promise_audit import (ACCURACIES, ESTIMATE_FACTOR, ROUNDOFF, Scene, _command, _g, audit_auto,  # noqa: E402
-                           compact, estimate_check)
+from promise_audit import (ACCURACIES, BEST_TOL, ESTIMATE_FACTOR, ROUNDOFF, Scene, _command, _g,  # noqa: E402
+                           audit_auto, compact, estimate_check, r_eps)
 from results_file import write_results  # noqa: E402
 
 #: (integrator, settings) audited with output.error_estimate=true on every k-th scene
@@ -136,6 +137,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--spin-max", type=float, default=10.0, help="fastest spin φ̇0 drawn (default 10)")
     parser.add_argument("--no-write", action="store_true",
                         help="do not write benchmarks/results/promise_audit_gyrostat.json")
+    parser.add_argument("--name", default="promise_audit_gyrostat",
+                        help="results file (benchmarks/results/NAME.json) and its table's name")
     args = parser.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     common = [f"time.n_output={args.n_output}", "output.figures=false"]
@@ -166,8 +169,10 @@ def main(argv: list[str] | None = None) -> int:
                       f"{_g(row['predicted'])} | {_g(row['actual'] / eps)} | {_g(row['actual_max_over_time'] / eps)} | "
                       f"{_g(est)} | {row['cpu']:.2f} |", flush=True)
             else:
-                print(f"| {scene.index} | {label} | {eps:g} | {row['promise']}: {row['why'][:100]} | | | | | | | | "
-                      f"{row['cpu']:.2f} |", flush=True)
+                best = (f" (taylor tol {BEST_TOL:g} ends {row['best_double']:.2g} away)" if "best_double" in row
+                        else "")
+                print(f"| {scene.index} | {label} | {eps:g} | {row['promise']}: {row['why'][:100]}…{best} | | | | | | | "
+                      f"| {row['cpu']:.2f} |", flush=True)
         if args.integrators_every and scene.index % args.integrators_every == 0:
             for name, settings in INTEGRATORS:
                 other_rows.append({**audit_integrator(scene, name, settings, truth, common, floor),
@@ -230,6 +235,12 @@ def main(argv: list[str] | None = None) -> int:
                  str(v["under"]), str(v["under_per_time"])]
         table_rows.append(cells)
         print("| " + " | ".join(cells) + " |")
+    needless = [r for r in auto_rows if r.get("best_double", math.inf) < r_eps(r) / 10]
+    print(f"\nrefusals for double precision's reach: {sum('best_double' in r for r in auto_rows)}, of which "
+          f"{len(needless)} where taylor at tol {BEST_TOL:g} ends 10× below ε (a needless refusal, not a broken promise)")
+    for r in needless:
+        print(f"  needless refusal (scene {r['scene']}, ε {r_eps(r):g}): taylor tol {BEST_TOL:g} ends "
+              f"{r['best_double']:.2g} away; reproduce: {_command(r['overrides'])}")
     broken = [r for r in auto_rows if r["promise"] == "BROKEN"]
     underestimates = [r for r in [*({**r, "integrator": "auto"} for r in measured), *other_rows]
                       if (r.get("estimate") or {}).get("under")]
@@ -257,23 +268,29 @@ def main(argv: list[str] | None = None) -> int:
                    "spin_max": args.spin_max, "auto_runs": len(auto_rows),
                    **{f"auto_{k}": v for k, v in counts.items()}, "worst_final_over_eps": worst_final,
                    "worst_max_over_time_over_eps": worst_all, "worst_actual_over_predicted": worst_pred,
-                   "runs_above_prediction": above_predicted, "reference_rhs_check_max": max(checks),
+                   "runs_above_prediction": above_predicted,
+                   "refused_for_double_precision": sum("best_double" in r for r in auto_rows),
+                   "refused_needlessly": len(needless), "reference_rhs_check_max": max(checks),
                    "estimates": {k: {**v, "min_ratio": v["min_ratio"] if v["judged"] else None,
                                      "min_ratio_per_time": v["min_ratio_per_time"]
                                      if math.isfinite(v["min_ratio_per_time"]) else None}
                                  for k, v in per_integrator.items()},
                    "wall_seconds": wall, "scene_overrides": {s.index: s.overrides for s in scenes},
                    "auto": [record(r) for r in auto_rows], "integrators": [record(r) for r in other_rows]}
+        options = ("" if (args.t_max, args.spin_max) == (25.0, 10.0) else
+                   f" --t-max {args.t_max:g} --spin-max {args.spin_max:g}")
         caption = (f"Randomized audit on orbiting-gyrostat scenes (`benchmarks/promise_audit_gyrostat.py --n {args.n} "
-                   f"--seed {args.seed}`): {len(scenes)} scenes, {len(auto_rows)} auto runs, {counts['kept']} kept, "
+                   f"--seed {args.seed}{options}`, spans up to {args.t_max:g}, spins up to {args.spin_max:g}): "
+                   f"{len(scenes)} scenes, {len(auto_rows)} auto runs, {counts['kept']} kept, "
                    f"{counts['refused']} refused, {counts['BROKEN']} broken (final and every output time ≤ ε; worst "
                    f"final/ε {_g(worst_final)}, max over times/ε {_g(worst_all)}). The error estimates against "
                    f"the real128 reference:")
-        write_results("promise_audit_gyrostat", numbers, {"promise_audit_gyrostat": {
+        write_results(args.name, numbers, {args.name: {
             "caption": caption, "header": ["integrator", "runs", "judged (above round-off)", "saturated",
                                            "no estimate", "estimate/actual min", "max", "worst per-time",
                                            "under 1/2 (max)", "under 1/2 (per time)"],
-            "rows": table_rows}}, command=f"benchmarks/promise_audit_gyrostat.py --n {args.n} --seed {args.seed}")
+            "rows": table_rows}}, command=f"benchmarks/promise_audit_gyrostat.py --n {args.n} --seed {args.seed}{options}"
+                      + ("" if args.name == "promise_audit_gyrostat" else f" --name {args.name}"))
     return 1 if broken or underestimates else 0
 
 
