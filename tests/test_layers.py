@@ -11,7 +11,6 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 SOURCES = {"pipeline": "gyrolab", "plugins": "gyrolab.plugins"}
@@ -118,19 +117,14 @@ def test_the_checker_sees_a_function_level_import(tmp_path):
     assert LAYERS[_unit("gyrolab.engine.scene")] > LAYERS[_unit("gyrolab.physics.body")]
 
 
-@pytest.mark.parametrize("old, new", [
-    ("gyrolab.physics.chaos", "gyrolab.analysis.chaos"),
-    ("gyrolab.physics.periodic", "gyrolab.analysis.periodic"),
-    ("gyrolab.physics.precession.cases", "gyrolab.analysis.precession.cases"),
-    ("gyrolab.engine.batch", "gyrolab.batch.integrate"),
-    ("gyrolab.sweep.batch", "gyrolab.batch.sweep"),
-    ("gyrolab.engine.registry", "gyrolab.contracts.registry"),
-    ("gyrolab.plugins.systems.gyrostat_euler", "gyrolab.physics.gyrostat_euler"),
-])
-def test_moved_modules_keep_their_old_names(old, new):
-    import importlib
+def test_no_moved_module_aliases():
+    """A 0.1.0 package keeps one name per module: no import hook mapping old module paths to new ones."""
+    import sys
 
-    assert importlib.import_module(old) is importlib.import_module(new)
+    import gyrolab
+
+    assert not hasattr(gyrolab, "MOVED_MODULES")
+    assert not any(type(finder).__module__.startswith("gyrolab") for finder in sys.meta_path)
 
 
 def test_hydra_private_api_behind_one_module():
