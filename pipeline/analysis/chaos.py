@@ -126,8 +126,7 @@ def _generated_run(compiled: Any, settings: Any, times: np.ndarray, y0s: np.ndar
     from gyrolab.kernels import model, tangent
     from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, RK4Numba
 
-    if "time" in {model.MODELS[int(compiled.params[0])].graph.nodes[i][0]
-                  for i in model.MODELS[int(compiled.params[0])].live()}:
+    if model.traced_model(compiled).time_dependent:
         raise ConfigError("chaos indicators of a model compiled from its equations need autonomous equations; a "
                           "time-dependent force has none here")
     y0s = np.atleast_2d(np.asarray(y0s, dtype=float))

@@ -84,6 +84,11 @@ class Model:
         return seen
 
     @property
+    def time_dependent(self) -> bool:
+        """Whether the rates read time (a time-dependent force): not autonomous."""
+        return any(self.graph.nodes[i][0] == "time" for i in self.live())
+
+    @property
     def constants(self) -> list[float]:
         return self.graph.constants
 
