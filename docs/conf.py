@@ -3,7 +3,9 @@
 Sphinx rather than MkDocs: the API reference is rendered from numpydoc docstrings, the format scipy,
 xarray and heyoka.py use, and myst-parser lets the existing Markdown pages stay Markdown.
 """
+import os
 import re
+import shutil
 import sys
 from pathlib import Path
 
@@ -22,27 +24,68 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
+    "sphinx_copybutton",  # a copy button on every code block, the prompts ($, >>>) left out of the copy
     "gyrolab_figure",  # docs/_ext: runs a gyrolab command at build time and shows its figure
 ]
+
+# Links into numpy, scipy, xarray and Hydra (a docstring's :class:`xarray.Dataset` becomes a link). Intersphinx
+# downloads each project's objects.inv when the build starts, and a download that fails is a warning, which -W
+# turns into a failed build: on a machine without network (CI's, the developers') the build must not depend on
+# it, and no package on PyPI ships these inventories to read locally. So the links are made only when
+# GYROLAB_DOCS_INTERSPHINX=1 (a build for publishing, with network); without it the same references render as
+# plain code. gyrolab's own inventory (docs/_build/html/objects.inv) is written either way.
+intersphinx_mapping = {
+    "python": ("https://docs.python.org/3", None),
+    "numpy": ("https://numpy.org/doc/stable", None),
+    "scipy": ("https://docs.scipy.org/doc/scipy", None),
+    "xarray": ("https://docs.xarray.dev/en/stable", None),
+    "hydra": ("https://hydra.cc/api", None),
+}
+if os.environ.get("GYROLAB_DOCS_INTERSPHINX") == "1":
+    extensions.append("sphinx.ext.intersphinx")
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 root_doc = "index"
 # Derivation scripts and their notes are records beside the pages, not pages of their own; _build is output.
-exclude_patterns = ["_build", "_generated", "derivations/scripts", "Thumbs.db", ".DS_Store"]
+exclude_patterns = ["_build", "_generated", "_templates", "derivations/scripts", "Thumbs.db", ".DS_Store"]
+templates_path = ["_templates"]
 
 # Headings get anchors so that pages may link to `page.md#a-section` (myst's GitHub-style slugs).
 myst_heading_anchors = 4
 myst_enable_extensions = ["dollarmath", "deflist", "colon_fence"]
 
-autosummary_generate = False
+# One page per public object: api.md lists the names in autosummary tables (:toctree: api), whose stub pages
+# (docs/api/, git-ignored) are written at every build from _templates/autosummary.
+autosummary_generate = True
+autosummary_generate_overwrite = True
 autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": True}
 autodoc_typehints = "none"  # numpydoc's Parameters sections carry the types
 numpydoc_show_class_members = False
 numpydoc_validation_checks: set[str] = set()
 
-html_theme = "alabaster"
+# pydata-sphinx-theme, the theme of numpy, scipy and xarray: the sections in the header, the section's pages on
+# the left, the page's own table of contents on the right, a light and a dark mode.
+html_theme = "pydata_sphinx_theme"
 html_title = f"gyrolab {release}"
-html_static_path: list[str] = []
+html_static_path = ["_static"]
+html_css_files = ["gyrolab.css"]
+html_theme_options = {
+    "navbar_align": "left",
+    "header_links_before_dropdown": 6,
+    "secondary_sidebar_items": ["page-toc", "sourcelink"],
+    "show_toc_level": 2,
+    "navigation_with_keys": False,
+    "footer_start": ["copyright"],
+    "footer_end": ["sphinx-version"],
+}
+# a page without sub-pages has no left-hand sidebar: its width goes to the text
+html_sidebars = {page: [] for page in ("index", "getting-started", "tutorial", "gallery")}
+html_show_sourcelink = False
+
+# sphinx-copybutton: copy the command, not the prompt ("$ " in the gallery's console blocks, ">>> " in doctests)
+copybutton_prompt_text = r"\$ |>>> |\.\.\. "
+copybutton_prompt_is_regexp = True
+copybutton_only_copy_prompt_lines = False
 
 # gyrolab's docstrings write absolute values and norms as |x| (they are read in terminals first), which
 # reStructuredText would take for substitutions. Escape a bar outside ``literals`` and literal blocks; a line
@@ -65,16 +108,27 @@ def _escape_bars(app, what, name, obj, options, lines):
         lines[i] = "".join(p if p.startswith("``") else p.replace("|", r"\|") for p in pieces)
 
 
-# A page added to docs/ (docs/cli.md, docs/datasets.md, ...) joins the user guide without editing index.md:
-# the UNLISTED-PAGES line of its user-guide toctree becomes every top-level page index.md does not name.
+# A page added to docs/ (docs/cli.md, docs/datasets.md, ...) joins the user guide without editing a toctree:
+# the UNLISTED-PAGES line of user-guide.md's toctree becomes every top-level page that no section page names.
+SECTION_PAGES = ("index", "user-guide", "papers", "api")
+
+
 def _unlisted_pages(app, docname, source):
-    if docname != "index":
+    if docname != "user-guide":
         return
-    listed = set(re.findall(r"(?m)^([\w-]+)$", source[0]))
-    pages = sorted(path.stem for path in Path(app.srcdir).glob("*.md") if path.stem not in listed | {"index"})
+    listed = set(SECTION_PAGES)
+    for page in SECTION_PAGES:
+        listed |= set(re.findall(r"(?m)^(?:[^<\n]*<)?([\w-]+)>?$", (Path(app.srcdir) / f"{page}.md").read_text()))
+    pages = sorted(path.stem for path in Path(app.srcdir).glob("*.md") if path.stem not in listed)
     source[0] = source[0].replace("UNLISTED-PAGES\n", "".join(f"{page}\n" for page in pages))
+
+
+# autosummary rewrites the stubs of the names api.md lists; a stub of a name no longer listed would stay a page
+def _remove_stale_stubs(app, config):
+    shutil.rmtree(Path(app.srcdir) / "api", ignore_errors=True)
 
 
 def setup(app):
     app.connect("autodoc-process-docstring", _escape_bars)
     app.connect("source-read", _unlisted_pages)
+    app.connect("config-inited", _remove_stale_stubs, priority=100)
