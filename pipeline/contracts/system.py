@@ -40,13 +40,13 @@ class System(ABC):
     6. Optionally, ``compiled_model()`` returns the system (with its forces)
        in the compiled kernels' form, or None when some part has none; the
        compiled integrators need it. When it returns None it sets
-       ``compile_error`` to one sentence saying why (the scene and ``--batch``
+       ``compile_error`` to one sentence saying why (the scene and ``gyrolab batch``
        quote it when a compiled integrator is asked for); None: no reason known.
     7. Optionally, ``invariant_values(y)`` returns each monitored invariant
        (``invariants``) along states of shape (..., state size), vectorised
-       over any leading dimensions; ``--batch`` (``gyrolab.batch.outputs``)
+       over any leading dimensions; ``gyrolab batch`` (``gyrolab.batch.outputs``)
        uses it for the drifts of many trajectories at once. None (the
-       default): ``--batch`` computes them from ``variables``, one trajectory
+       default): ``gyrolab batch`` computes them from ``variables``, one trajectory
        at a time.
     8. Optionally, ``initial_states(initial, columns)`` returns
        ``initial_state()`` for many points at once (``gyrolab.batch.plan``):
