@@ -81,6 +81,8 @@ html_theme_options = {
 # a page without sub-pages has no left-hand sidebar: its width goes to the text
 html_sidebars = {page: [] for page in ("index", "getting-started", "tutorial", "gallery")}
 html_show_sourcelink = False
+# the in-page contents of an API page list its members by their own names (run, not Scene.run)
+toc_object_entries_show_parents = "hide"
 
 # sphinx-copybutton: copy the command, not the prompt ("$ " in the gallery's console blocks, ">>> " in doctests)
 copybutton_prompt_text = r"\$ |>>> |\.\.\. "
