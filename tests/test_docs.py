@@ -4,6 +4,7 @@ the link check finds a broken link. (The build itself, warnings as errors, and t
 site run in .ci/run.)"""
 import importlib
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -132,3 +133,16 @@ def test_the_link_check_finds_a_broken_link_and_a_missing_anchor(tmp_path):
     (tmp_path / "_images" / "a.png").write_bytes(b"")
     (tmp_path / "page.html").write_text('<html><body><section id="there">x</section></body></html>')
     assert subprocess.run([sys.executable, str(DOCS / "_ext" / "check_links.py"), str(tmp_path)]).returncode == 0
+
+
+@pytest.mark.skipif(not any(shutil.which(b) for b in ("chromium", "chromium-browser", "google-chrome")),
+                    reason="no Chromium (apt-get install chromium)")
+def test_the_layout_check_finds_a_table_wider_than_the_column(tmp_path):
+    column = '<div class="bd-article" style="width: 600px">{}</div>'
+    (tmp_path / "wide.html").write_text("<html><body>" + column.format(
+        '<table style="width: 900px"><tr><td>a</td></tr></table>') + "</body></html>")
+    (tmp_path / "narrow.html").write_text("<html><body>" + column.format("<p>fits</p>") + "</body></html>")
+    check = [sys.executable, str(DOCS / "_ext" / "check_layout.py"), str(tmp_path)]
+    wide = subprocess.run([*check, "wide.html"], capture_output=True, text=True, timeout=300)
+    assert wide.returncode == 1 and "wide.html: text column: table" in wide.stdout, wide.stdout + wide.stderr
+    assert subprocess.run([*check, "narrow.html"], capture_output=True, timeout=300).returncode == 0
