@@ -28,18 +28,20 @@ extensions = [
     "gyrolab_figure",  # docs/_ext: runs a gyrolab command at build time and shows its figure
 ]
 
-# Links into numpy, scipy, xarray and Hydra (a docstring's :class:`xarray.Dataset` becomes a link). Intersphinx
-# downloads each project's objects.inv when the build starts, and a download that fails is a warning, which -W
-# turns into a failed build: on a machine without network (CI's, the developers') the build must not depend on
-# it, and no package on PyPI ships these inventories to read locally. So the links are made only when
-# GYROLAB_DOCS_INTERSPHINX=1 (a build for publishing, with network); without it the same references render as
-# plain code. gyrolab's own inventory (docs/_build/html/objects.inv) is written either way.
+# Links into numpy, scipy, xarray and Hydra's config library (a docstring's :class:`xarray.Dataset` becomes a
+# link). Intersphinx downloads each project's objects.inv when the build starts, and a download that fails is a
+# warning, which -W turns into a failed build: on a machine without network (CI's, the developers') the build
+# must not depend on it, and no package on PyPI ships these inventories to read locally. So the links are made
+# only when GYROLAB_DOCS_INTERSPHINX=1 (a build for publishing, with network); without it the same references
+# render as plain code. gyrolab's own inventory (docs/_build/html/objects.inv) is written either way.
+# Hydra's own site (hydra.cc) is not a Sphinx site and publishes no inventory; the config types gyrolab's
+# docstrings name (DictConfig) are OmegaConf's, whose documentation is.
 intersphinx_mapping = {
     "python": ("https://docs.python.org/3", None),
     "numpy": ("https://numpy.org/doc/stable", None),
     "scipy": ("https://docs.scipy.org/doc/scipy", None),
     "xarray": ("https://docs.xarray.dev/en/stable", None),
-    "hydra": ("https://hydra.cc/api", None),
+    "omegaconf": ("https://omegaconf.readthedocs.io/en/latest", None),
 }
 if os.environ.get("GYROLAB_DOCS_INTERSPHINX") == "1":
     extensions.append("sphinx.ext.intersphinx")
@@ -72,7 +74,7 @@ html_css_files = ["gyrolab.css"]
 html_theme_options = {
     "navbar_align": "left",
     "header_links_before_dropdown": 6,
-    "secondary_sidebar_items": ["page-toc", "sourcelink"],
+    "secondary_sidebar_items": ["page-toc"],
     "show_toc_level": 2,
     "navigation_with_keys": False,
     "footer_start": ["copyright"],
@@ -84,10 +86,10 @@ html_show_sourcelink = False
 # the in-page contents of an API page list its members by their own names (run, not Scene.run)
 toc_object_entries_show_parents = "hide"
 
-# sphinx-copybutton: copy the command, not the prompt ("$ " in the gallery's console blocks, ">>> " in doctests)
+# sphinx-copybutton: copy the command, not the prompt ("$ " in the gallery's console blocks, ">>> " in doctests),
+# and of a block with prompts only the prompted lines (not a doctest's output); a block without prompts whole
 copybutton_prompt_text = r"\$ |>>> |\.\.\. "
 copybutton_prompt_is_regexp = True
-copybutton_only_copy_prompt_lines = False
 
 # gyrolab's docstrings write absolute values and norms as |x| (they are read in terminals first), which
 # reStructuredText would take for substitutions. Escape a bar outside ``literals`` and literal blocks; a line
