@@ -60,7 +60,9 @@ myst_enable_extensions = ["dollarmath", "deflist", "colon_fence"]
 # (docs/api/, git-ignored) are written at every build from _templates/autosummary.
 autosummary_generate = True
 autosummary_generate_overwrite = True
-autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": True}
+# every member of a documented class is indexed (a link target), documented or not; Sphinx 9 took the former
+# "undoc-members": False as on all the same, so the setting now says what the build does
+autodoc_default_options = {"members": True, "undoc-members": True, "show-inheritance": True}
 autodoc_typehints = "none"  # numpydoc's Parameters sections carry the types
 numpydoc_show_class_members = False
 numpydoc_validation_checks: set[str] = set()
@@ -112,6 +114,45 @@ def _escape_bars(app, what, name, obj, options, lines):
         lines[i] = "".join(p if p.startswith("``") else p.replace("|", r"\|") for p in pieces)
 
 
+# Every member gets an entry (undoc-members), so that it is indexed and can be linked to. A dataclass field
+# (Scene.config, Body.g, ...) has no docstring of its own, so its entry would be empty: its description is in its
+# class's numpydoc "Attributes" or "Parameters" section, and the entry gets it, with its type.
+_DOUBLE_BACKTICKS = re.compile(r"``(.+?)``")
+
+
+def _describe_bare_fields(app, domain, objtype, contentnode):
+    if domain != "py" or objtype != "attribute" or contentnode.astext().strip():
+        return
+    import importlib
+    import inspect
+
+    from docutils import nodes
+    from numpydoc.docscrape import NumpyDocString
+
+    signature = contentnode.parent[0]
+    module, path = signature.get("module"), signature.get("fullname", "").split(".")
+    if not module or len(path) < 2:
+        return
+    try:
+        owner = importlib.import_module(module)
+        for part in path[:-1]:
+            owner = getattr(owner, part)
+        sections = NumpyDocString(inspect.getdoc(owner) or "")
+        documented = [*sections["Attributes"], *sections["Parameters"]]
+    except Exception:  # noqa: BLE001 - nothing importable or parseable: the entry stays as autodoc made it
+        return
+    for entry in documented:
+        if entry.name == path[-1] and entry.desc:
+            paragraph = nodes.paragraph()
+            if entry.type:
+                paragraph += nodes.emphasis(text=entry.type)
+                paragraph += nodes.Text(": ")
+            for i, piece in enumerate(_DOUBLE_BACKTICKS.split(" ".join(entry.desc))):
+                paragraph += nodes.literal(text=piece) if i % 2 else nodes.Text(piece.replace("`", ""))
+            contentnode += paragraph
+            return
+
+
 # A page added to docs/ (docs/cli.md, docs/datasets.md, ...) joins the user guide without editing a toctree:
 # the UNLISTED-PAGES line of user-guide.md's toctree becomes every top-level page that no section page names.
 SECTION_PAGES = ("index", "user-guide", "papers", "api")
@@ -133,6 +174,7 @@ def _remove_stale_stubs(app, config):
 
 
 def setup(app):
+    app.connect("object-description-transform", _describe_bare_fields)
     app.connect("autodoc-process-docstring", _escape_bars)
     app.connect("source-read", _unlisted_pages)
     app.connect("config-inited", _remove_stale_stubs, priority=100)
