@@ -318,7 +318,7 @@ def scene_run_only(reference, rounds):
     if rows:
         write_results("perf_reference_scene_run", {"rounds": rounds, "ratios": {f"{e:.0e}": r for e, r in ratios.items()}},
                       {"scene_run_verdict": {
-                          "caption": f"Issue 24's verdict: `auto`'s whole `Scene.run()` (dataset and default error "
+                          "caption": f"The verdict: `auto`'s whole `Scene.run()` (dataset and default error "
                                      f"estimate included; beside it with `output.error_estimate=false`) against "
                                      f"heyoka's `propagate_grid` at its cheapest tolerance reaching ε, on the reference "
                                      f"scene's 3,001 output times; CPU ms, medians of {rounds} interleaved rounds "

@@ -120,7 +120,7 @@ def default_run() -> None:
     write_results("startup_default_run", {"rows": rows, "dask_installed": dask}, {"default_run": {
         "caption": f"The default `gyrolab` end to end in a fresh process (best of 3; Dask "
                    f"{'installed: the test extras' if dask else 'not installed: the README install'}). "
-                   f"Targets (issue 24) are wall times on an idle 2-core machine.",
+                   f"The targets are wall times on an idle 2-core machine.",
         "header": ["command", "wall s", "CPU s", "target wall s", "verdict"], "rows": rows}},
         clock="time.perf_counter (wall) and the children's CPU time (getrusage)",
         command="benchmarks/startup.py --default-run",

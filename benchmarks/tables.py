@@ -62,7 +62,7 @@ def summary_table(records: list[dict[str, Any]]) -> tuple[dict[str, Any], dict[s
         "regenerate": "Regenerate: run the row's benchmark (last column), then `python benchmarks/tables.py`.",
     })
     merged["load_average_end"] = merged["load_average_start"]
-    table = {"caption": "Issue 24's targets, each from its benchmark's latest results file (the load is the "
+    table = {"caption": "gyrolab's speed targets, each from its benchmark's latest results file (the load is the "
                         "largest at the start of any of them).",
              "header": ["what", "measured", "target", "verdict", "benchmark"], "rows": rows}
     return table, merged

@@ -49,7 +49,7 @@ class Force(ABC):
        for one state (vectors of shape (3,)). Write it as arithmetic on the
        vectors (numpy operations, ``gyrolab.physics.vectors`` helpers, np.sqrt,
        np.exp, np.sin, ...): gyrolab traces it once into compiled code, so it runs
-       under the compiled integrators, ``--batch`` and ``auto`` at machine speed.
+       under the compiled integrators, ``gyrolab batch`` and ``auto`` at machine speed.
        A torque that branches on the state (``if``, comparisons, ``max``) or
        converts it to a float (``float()``, ``math.*``) runs with the Python
        integrators only; the log and any compiled integrator say which construct.
@@ -75,7 +75,7 @@ class Force(ABC):
        the built-in forms every compiled integrator (Taylor and Lie–Poisson too)
        evaluates; a traced torque (rule 3) runs with ``dop853_numba``,
        ``rk4_numba``, ``taylor`` (its Taylor coefficients propagated through the
-       trace; not with ``integrator.precision=double-double``), ``--batch`` and
+       trace; not with ``integrator.precision=double-double``), ``gyrolab batch`` and
        ``auto``, but not with ``lie_poisson``, which takes the built-in forms only.
 
     What gyrolab enforces on a third-party force (gyrolab's own are trusted),

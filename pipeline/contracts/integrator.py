@@ -161,8 +161,8 @@ class Integrator(ABC):
        C3. ``TIME_DEPENDENT``: it passes the true time to ``fun`` (and to a compiled model), so the scene
            lets it integrate time-dependent forces; others are refused for them.
        C4. ``BATCH_KERNEL``: ``integrate_batch(compiled, times, y0s, params, failures)`` integrates many
-           trajectories of a compiled model in one call; ``--batch`` and
-           ``gyrolab.batch.integrate.integrate_arrays`` call it. Without it ``--batch`` still runs the
+           trajectories of a compiled model in one call; ``gyrolab batch`` and
+           ``gyrolab.batch.integrate.integrate_arrays`` call it. Without it ``gyrolab batch`` still runs the
            integrator, with one ``integrate`` call per point.
        C5. ``VECTOR_LANES``: its batch kernel advances trajectories together in SIMD lanes (a batch
            dataset's ``batch_path`` attribute says so).
@@ -170,7 +170,7 @@ class Integrator(ABC):
            equations run with its method (fixed-step RK4 or adaptive DOP853, and with which step or
            tolerances); the indicators are refused for other integrators.
        C7. ``CHOOSES_METHOD``: it chooses a method and tolerance itself: per scene in ``integrate``, per
-           batch in ``choose_batch_method(compiled, times, y0s, params)``, which ``--batch`` calls once
+           batch in ``choose_batch_method(compiled, times, y0s, params)``, which ``gyrolab batch`` calls once
            before the chunks; its evaluation counts include that choice's pilot runs.
 
        ``evaluation_label``, when set, says what its evaluation count ``nfev`` counts where that is not

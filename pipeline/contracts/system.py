@@ -49,9 +49,9 @@ class System(ABC):
        compiled.
     7. Optionally, ``invariant_values(y)`` returns each monitored invariant
        (``invariants``) along states of shape (..., state size), vectorised
-       over any leading dimensions; ``--batch`` (``gyrolab.batch.outputs``)
+       over any leading dimensions; ``gyrolab batch`` (``gyrolab.batch.outputs``)
        uses it for the drifts of many trajectories at once. None (the
-       default): ``--batch`` computes them from ``variables``, one trajectory
+       default): ``gyrolab batch`` computes them from ``variables``, one trajectory
        at a time.
     8. Optionally, ``initial_states(initial, columns)`` returns
        ``initial_state()`` for many points at once (``gyrolab.batch.plan``):
