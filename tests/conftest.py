@@ -29,7 +29,8 @@ def installed_distribution(site, name, version, plugins=None, paths=(), group="g
     ...; or ``plugins`` as a dict group -> {name: "module:Class"} for several groups), ``site`` and ``paths`` on
     sys.path, gyrolab's plugin registry refreshed on entry and on exit. ``forces=`` is the older name of
     ``plugins``."""
-    from gyrolab.engine import config, registry
+    from gyrolab.contracts import registry
+    from gyrolab.engine import config
 
     plugins = forces if plugins is None else plugins
     groups = plugins if plugins and all(isinstance(v, dict) for v in plugins.values()) else {group: plugins}

@@ -173,8 +173,8 @@ def test_taylor_steps_do_not_depend_on_how_the_run_is_cut_into_kernel_calls():
 @pytest.mark.parametrize("direction, size", [("[0.0,0.0,1.0]", 6), ("[0.6,0.0,0.8]", 9)])  # (α: fixed X needed)
 def test_a_scene_with_a_plugin_traces_every_force_and_its_compiled_rhs_is_the_python_rhs(monkeypatch, direction,
                                                                                           size):
-    """A plugin (here magnetic without its built-in form) makes the scene trace all its torques, built-ins too;
-    the plugin models' right-hand side (for the states ω, γ and ω, γ, α) must equal the Python one."""
+    """A plugin (here magnetic without its built-in form) makes the scene trace its whole right-hand side, built-in
+    torques too; the traced model's right-hand side (for the states ω, γ and ω, γ, α) must equal the Python one."""
     from gyrolab.kernels import models
     from gyrolab.plugins.forces.magnetic import Magnetic
 
@@ -183,8 +183,7 @@ def test_a_scene_with_a_plugin_traces_every_force_and_its_compiled_rhs_is_the_py
                            "force.magnetic.moment=[0.3,-0.2,0.5]", f"force.magnetic.direction={direction}", "output.euler_angles=false"])
     assert scene.system.initial_state().size == size
     compiled = scene.compiled
-    assert compiled.model == (models.TRACED if size == 6 else models.TRACED)
-    assert not compiled.params[3:15].any()  # the packed built-in forms stay empty: their torques are traced
+    assert compiled.model == models.TRACED
     rng = np.random.default_rng(12)
     for k in range(5):
         y = scene.system.initial_state() + 0.3 * rng.standard_normal(size)

@@ -413,6 +413,9 @@ def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -
         series_dd.ready(compiled)
     except NotCompilable as exc:
         named = f"system {system.name!r}" if system is not None else "this model"
+        plugins = [f"{f.name!r}" for f in getattr(system, "forces", []) if f.compiled_terms() is None]
+        if plugins:
+            named += f" with force {', '.join(plugins)}"
         return f"in double-double precision cannot run {named}: {exc}"
     except ValueError as exc:
         return f"in double-double precision cannot run this model: {exc}"
