@@ -38,7 +38,11 @@ class Untrusted(ConfigError):
 
 
 def _where(path: Path) -> str:
-    return repr(shorten(str(path)))
+    """The path for a sentence: a long folder shortened, the entry's own name always whole (it is what to remove)."""
+    text = str(path)
+    if len(text) <= 80:
+        return repr(text)
+    return repr(f"{shorten(str(path.parent), 60)}/{shorten(path.name, 40)}")
 
 
 def _refusal(path: Path, mode: int) -> Untrusted:
