@@ -66,8 +66,8 @@ def _diff_digest(untracked: list[str]) -> str:
                               capture_output=True, timeout=30)
     except (OSError, subprocess.TimeoutExpired):
         return ""
-    if done.returncode != 0:
-        return ""
+    if done.returncode != 0 or not (done.stdout or untracked):
+        return ""  # the code is as committed (documentation or tests may differ): nothing to tell apart
     digest = hashlib.sha256(done.stdout)
     for name in untracked:
         try:
@@ -112,7 +112,8 @@ def provenance() -> dict[str, Any]:
     code files (under ``CODE_PATHS``) are not committed yet, 0 when clean, -1
     when unknown (not a git checkout of gyrolab, or git unavailable);
     ``git_diff_sha256`` is the sha256 of the uncommitted code changes, new
-    files included, so that two dirty trees can be told apart.
+    files included, so that two dirty trees can be told apart ("" when only
+    documentation or tests differ: a job's identity, which reads it, stays).
     """
     commit = _git("rev-parse", "HEAD") if _in_own_checkout() else None
     status = _git("status", "--porcelain", "--untracked-files=no") if commit else None
