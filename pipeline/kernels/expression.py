@@ -220,7 +220,7 @@ def load_generated(source: str, prefix: str, what: str) -> Any:
         try:
             folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         except OSError:  # a read-only cache (some cluster nodes): this user's private temporary folder
-            from gyrolab.kernels.compiler import private_temporary
+            from gyrolab.kernels.cache import private_temporary
 
             folder = private_temporary() / "forces"
             folder.mkdir(mode=0o700, exist_ok=True)

@@ -167,9 +167,15 @@ def check_kernel_cache() -> None:
     """Untrusted when numba's cache folder (compiled kernels, whose index numba unpickles) or its parent belongs to
     another user or may be written by anyone (a shared temporary directory another user prepared). Called before
     any kernel is loaded (a command that runs kernels: run, batch, reproduce)."""
-    from gyrolab.kernels.compiler import kernel_cache_dir
+    import sys
 
-    folder = kernel_cache_dir()
+    from gyrolab.kernels.cache import cache_dir
+
+    # the folder numba uses once it is set up in this process, else the one it will use (found without importing
+    # numba, which a run of scipy's integrators never needs)
+    numba = sys.modules.get("numba")
+    folder = (numba.config.CACHE_DIR if numba is not None and "gyrolab.kernels.compiler" in sys.modules else None) \
+        or cache_dir()
     for path in (Path(folder), Path(folder).parent) if folder else ():
         try:
             info = os.lstat(path)
