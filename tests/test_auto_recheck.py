@@ -81,4 +81,7 @@ def test_a_promise_the_reruns_cannot_keep_is_one_sentence(monkeypatch):
         compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", *CHAOTIC_TOP, "time.end=110"]).run()
     message = str(refused.value)
     assert message.startswith("accuracy=1e-06 is not met on this scene") and "\n" not in message
-    assert "integrator.extended_precision=true" in message
+    assert "a shorter time.end" in message and "extended_precision" not in message  # (the climb is the default)
+    with pytest.raises(ConfigError, match="or integrator.extended_precision=true$"):  # advice that changes something
+        compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", "integrator.extended_precision=false",
+                       *CHAOTIC_TOP, "time.end=110"]).run()

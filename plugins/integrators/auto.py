@@ -141,7 +141,7 @@ class Auto(Integrator):
     evaluation_label = "pilot and chosen method's evaluations"
 
     def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 1.0,
-                 extended_precision: bool = False) -> None:
+                 extended_precision: bool = True) -> None:
         if accuracy is None:
             raise ConfigError("integrator=auto needs a target: set accuracy=... (max-norm error of the final state)")
         self.accuracy = as_number(accuracy, "accuracy", positive=True)
@@ -495,14 +495,16 @@ class Auto(Integrator):
         method = self.chosen if self.chosen is not None else None
         factor = RECHECK_MARGIN * measured_error / self.accuracy
         finer = method.more_accurate(factor) if method is not None else None
+        if finer is None and method is not None:
+            finer = self._climb(method, factor)
         what = (f"the error estimate measures {measured_error:.2g} where auto predicted {predicted:.2g} "
                 f"({self.choice.get('auto_method')})")
         if len(self.measured_before) >= MAX_RECHECKS or (method is not None and finer is None):
             reason = (f"after {MAX_RECHECKS} runs made more accurate {what}" if len(self.measured_before) >= MAX_RECHECKS
                       else f"{what}, and {method.name} cannot be made {factor:.2g}× more accurate")
+            climb = "" if self.extended_precision else " or integrator.extended_precision=true"
             raise ConfigError(f"accuracy={self.accuracy:g} is not met on this scene: {reason}; ask for "
-                              f"accuracy ≥ {RECHECK_MARGIN * measured_error:.1g}, a shorter time.end or "
-                              f"integrator.extended_precision=true")
+                              f"accuracy ≥ {RECHECK_MARGIN * measured_error:.1g} or a shorter time.end{climb}")
         again = type(self)(accuracy=self.accuracy, pilot_fraction=self.pilot_fraction, safety=self.safety,
                            extended_precision=self.extended_precision)
         again.measured_before = (*self.measured_before, measured_error)
@@ -511,6 +513,18 @@ class Auto(Integrator):
         else:
             again._recheck = (finer[0], dict(self.choice))
         return again
+
+    def _climb(self, method: Any, factor: float) -> tuple[Any, float, str] | None:
+        """The next rung of the precision ladder for a recheck (``tightened_for``): a double Taylor run at its floor
+        goes on in double-double (``extended_precision``, the default), ``factor`` times more accurate; else None."""
+        from gyrolab.kernels.taylor_dd import MIN_TOL
+        from gyrolab.plugins.integrators.compiled_solvers import DOUBLE, DOUBLE_DOUBLE, Taylor
+
+        if not (self.extended_precision and isinstance(method, Taylor) and method.precision == DOUBLE):
+            return None
+        tol = max(method.tol / factor, MIN_TOL)
+        return (Taylor(tol=tol, precision=DOUBLE_DOUBLE), 1.0,
+                f"taylor double-double at tol {tol:.3g}: double precision's floor reached")
 
     def _run_recheck(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None,
                      compiled: CompiledModel | None, start: float) -> Solution:
