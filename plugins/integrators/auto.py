@@ -141,7 +141,7 @@ class Auto(Integrator):
     evaluation_label = "pilot and chosen method's evaluations"
 
     def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 1.0,
-                 extended_precision: bool = True) -> None:
+                 extended_precision: bool | None = None) -> None:
         if accuracy is None:
             raise ConfigError("integrator=auto needs a target: set accuracy=... (max-norm error of the final state)")
         self.accuracy = as_number(accuracy, "accuracy", positive=True)
@@ -149,11 +149,15 @@ class Auto(Integrator):
         if self.pilot_fraction >= 1:
             raise ConfigError(f"integrator.pilot_fraction={pilot_fraction} must be below 1")
         self.safety = as_number(safety, "integrator.safety", positive=True)
-        if not isinstance(extended_precision, (bool, np.bool_)):
-            raise ConfigError(f"integrator.extended_precision={extended_precision!r} must be true or false")
+        if extended_precision is not None and not isinstance(extended_precision, (bool, np.bool_)):
+            raise ConfigError(f"integrator.extended_precision={extended_precision!r} must be true, false or null")
         #: whether a target double precision cannot reach may be met in double-double (integrator=taylor
-        #: integrator.precision=double-double) instead of being refused
-        self.extended_precision = bool(extended_precision)
+        #: integrator.precision=double-double) instead of being refused: yes unless forbidden (false)
+        self.extended_precision = extended_precision is not False
+        #: asked for explicitly (true): a batch then runs one choice per trajectory, each free to climb; by default
+        #: (null) a batch chooses once, in double precision, for its vectorised kernel (one run per trajectory in
+        #: Python costs ~23× the CPU)
+        self.per_trajectory = extended_precision is True
         #: the measured errors of the earlier runs that broke their prediction (``tightened_for``)
         self.measured_before: tuple[float, ...] = ()
         #: a run again after a failed check (``tightened_for``): (the method, made more accurate by the factor the
@@ -506,7 +510,7 @@ class Auto(Integrator):
             raise ConfigError(f"accuracy={self.accuracy:g} is not met on this scene: {reason}; ask for "
                               f"accuracy ≥ {RECHECK_MARGIN * measured_error:.1g} or a shorter time.end{climb}")
         again = type(self)(accuracy=self.accuracy, pilot_fraction=self.pilot_fraction, safety=self.safety,
-                           extended_precision=self.extended_precision)
+                           extended_precision=self.extended_precision and (self.per_trajectory or None))
         again.measured_before = (*self.measured_before, measured_error)
         if finer is None:  # an analytic series: integrate instead
             again._no_series = True
@@ -576,7 +580,8 @@ class Auto(Integrator):
         sample = list(dict.fromkeys([0, int(np.argmax(np.abs(y0s).max(axis=1))), int(np.argmax(spread))]))[:AUTO_SAMPLE]
         choices = []
         for j in sample:
-            single = type(self)(accuracy=self.accuracy, pilot_fraction=self.pilot_fraction, safety=self.safety)
+            single = type(self)(accuracy=self.accuracy, pilot_fraction=self.pilot_fraction, safety=self.safety,
+                                extended_precision=False)  # the vectorised kernels run in double precision
             model = CompiledModel(compiled.model, P[j])
             single.integrate(compiled_rhs(model), times, y0s[j], None, model)
             choices.append(single.choice)
