@@ -149,3 +149,20 @@ def test_gyrostat_error_estimate_measures_the_actual_error(integrator):
     estimate = float(ds.attrs["error_estimate_max_omega"])
     assert actual > 1e-13  # a measurable error (not round-off), so the ratio says something
     assert 0.5 <= estimate / actual <= 2.0
+
+
+def test_a_gyrostat_stability_map_runs_from_its_generated_tangent_flow(cli, tmp_path):
+    """``experiment=stability_map`` on the orbiting gyrostat: MEGNO from the generated tangent flow, no Poincaré
+    sections (the heavy body's), the figure drawn without the heavy body's regimes and with the gyrostat's rate
+    unit."""
+    import xarray as xr
+
+    done = cli("experiment=stability_map", "system=orbiting_gyrostat", "body=gyrostat_symmetric",
+               "initial=gyrostat_precession", "force=[newtonian,magnetic]", "force.newtonian.k=null",
+               "initial.euler_rates0=null", "initial.p0=0", "initial.q0=0", "stability_map.n_theta0=3",
+               "stability_map.n_r0=3", "stability_map.r0=[0.5,3]", "time.end=30", "hydra.run.dir=map")
+    assert done.returncode == 0, done.stderr
+    with xr.open_dataset(tmp_path / "map" / "stability_map.nc") as ds:
+        assert np.all(np.isfinite(ds.indicator.values)) and "section_phi" not in ds
+        assert np.all(ds.indicator.values > 0.5)  # MEGNO of these motions: regular (≈ 2) or above
+    assert (tmp_path / "map" / "figures" / "stability_map.png").stat().st_size > 10_000

@@ -76,7 +76,7 @@ def check(cfg: DictConfig, out_dir: Path) -> None:
     the grid (its size against the budget) and the map's file name (inside the run directory)."""
     grid(cfg)
     confined_output_path(out_dir, cfg.stability_map.get("file"), "stability_map.file")
-    sections = cfg.stability_map.get("sections") or []
+    sections = _sections(cfg)
     if sections:
         t_end = as_number(cfg.stability_map.get("section_time"), "stability_map.section_time")
         if not t_end > 0:
@@ -88,6 +88,17 @@ def check(cfg: DictConfig, out_dir: Path) -> None:
                 as_number(v, f"stability_map.sections[{n}]")
 
 
+def _sections(cfg: DictConfig) -> list:
+    """The Poincaré sections to draw: the config's, for the heavy body about a fixed point only (the section
+    γ3 = const and its coordinates φ, r are that system's; another system's map has none, said once in the log)."""
+    sections = list(cfg.stability_map.get("sections") or [])
+    if sections and not str((cfg.get("system") or {}).get("_target_", "")).endswith(".FixedPoint"):
+        log.info("stability map: Poincaré sections (γ3 = const) are drawn for the body about a fixed point only; "
+                 "none for this system")
+        return []
+    return sections
+
+
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     from gyrolab.batch.sweep import run_batch
 
@@ -95,7 +106,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     plain.pop("hydra", None)
     path = confined_output_path(out_dir, cfg.stability_map.file, "stability_map.file")
     run_batch([], grid(cfg), path, plain=plain, lock=False)   # the app holds the run directory's lock
-    sections = cfg.stability_map.get("sections") or []
+    sections = _sections(cfg)
     if sections:
         try:
             _add_sections(path, plain, sections,

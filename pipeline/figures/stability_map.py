@@ -72,6 +72,32 @@ def _body_omega(ds: xr.Dataset) -> float | None:
     return math.sqrt(w2) if w2 > 0 else None
 
 
+def _stored_system(ds: xr.Dataset) -> tuple[str, dict]:
+    """(the system's class name, the body section) of the map's stored config (checked as untrusted input); ("", {})
+    when the dataset holds none: the fixed point's annotations are then drawn as before."""
+    from gyrolab.errors import ConfigError
+    from gyrolab.output.user_yaml import stored_yaml
+
+    try:
+        config = stored_yaml(ds.attrs.get("config", ""), "the map's stored config") if "config" in ds.attrs else {}
+    except ConfigError:
+        return "", {}
+    config = config if isinstance(config, dict) else {}
+    target = str((config.get("system") or {}).get("_target_", ""))
+    return target.rpartition(".")[2], dict(config.get("body") or {})
+
+
+def _rate_unit(ds: xr.Dataset) -> str:
+    """The r0 axis's unit: the coordinate's CF units, or the nondimensional rate unit of the map's system."""
+    units = str(ds["r0"].attrs.get("units", "1"))
+    if units not in ("1", ""):
+        return units
+    system, body = _stored_system(ds)
+    if system == "OrbitingGyrostat":
+        return "units of Ω" if float(body.get("orbit_rate", 1.0) or 1.0) == 1.0 else "model rate"
+    return "units of c"
+
+
 def _com_on_z(ds: xr.Dataset) -> bool:
     """Whether the map's body has its centre of mass on the body +z axis (the large-parameter regime's domain)."""
     com = ds.attrs.get("body_nondim_com_direction")
@@ -151,20 +177,22 @@ def draw_stability_map(ds: xr.Dataset) -> plt.Figure:
     if np.isnan(indicator).any():
         panel_note(map_ax, f"grey: {int(np.isnan(indicator).sum())} failed points")
     r_lo, r_hi, t_lo, t_hi = r_edges[0], r_edges[-1], t_edges[0], t_edges[-1]
-    _mark_regimes(map_ax, ds, r_lo, r_hi)
-    _mark_examples(map_ax, ds, t_lo, t_hi, r_lo, r_hi)
+    system = _stored_system(ds)[0]
+    if system in ("", "FixedPoint"):  # the papers' regimes and example scenes are the heavy body's
+        _mark_regimes(map_ax, ds, r_lo, r_hi)
+        _mark_examples(map_ax, ds, t_lo, t_hi, r_lo, r_hi)
     if "max_nutation_deviation" in ds:
         dev = dev_ax.pcolormesh(r_edges, t_edges, np.ma.masked_invalid(_values(ds, "max_nutation_deviation")),
                                 cmap="viridis", shading="flat", rasterized=True)
         fig.colorbar(dev, ax=dev_ax, pad=0.02).set_label("max |θ − θ0| (rad)", fontsize=7)
     else:
         dev_ax.set_axis_off()
-    r_unit = str(ds["r0"].attrs.get("units", "1"))
+    r_unit = _rate_unit(ds)
     for ax in (map_ax, dev_ax):
         ax.set_xscale("log" if log_r else "linear")
         ax.set_xlim(r_lo, r_hi)
         ax.set_ylim(t_lo, t_hi)
-        ax.set_xlabel("initial spin r0 " + ("(units of c)" if r_unit in ("1", "") else f"({r_unit})"))
+        ax.set_xlabel(f"initial spin r0 ({r_unit})")
         ax.set_ylabel("initial nutation θ0 (rad)")
         ax.grid(False)
     if n_sections:
