@@ -132,12 +132,18 @@ def test_compiled_integrator_refuses_a_force_without_compiled_form(monkeypatch):
         compose_scene(["integrator=taylor"])
 
 
-def test_auto_refuses_an_accuracy_beyond_double_precision():
+def test_auto_refuses_an_accuracy_beyond_double_precision_when_it_may_not_climb():
+    no_climb = "integrator.extended_precision=false"
     with pytest.raises(ConfigError, match="accuracy=1e-15 is below"):
-        run(["integrator=auto", "accuracy=1e-15", "time.end=1", "time.n_output=3"])
+        run(["integrator=auto", "accuracy=1e-15", "time.end=1", "time.n_output=3", no_climb])
     # 300 time units at spin 5: ~3000 steps; compensated round-off ~eps·|y|·√steps = 6e-14 (measured: 2e-14)
     with pytest.raises(ConfigError, match="below the round-off"):
-        run(["experiment=perf_reference", "time.n_output=2", "accuracy=1e-14"])
+        run(["experiment=perf_reference", "time.n_output=2", "accuracy=1e-14", no_climb])
+    # by default it climbs: the same target in double-double (32 digits), and a 1e-31 target is below even that
+    ds = run(["integrator=auto", "accuracy=1e-15", "time.end=1", "time.n_output=3"])
+    assert ds.attrs["auto_precision"] == "double-double"
+    with pytest.raises(ConfigError, match="accuracy=1e-31 is below what double-double reaches"):
+        run(["integrator=auto", "accuracy=1e-31", "time.end=1", "time.n_output=3"])
 
 
 def test_taylor_steps_do_not_depend_on_how_the_run_is_cut_into_kernel_calls():

@@ -94,6 +94,8 @@ CHAOS_MARGIN = 10.0
 #: tolerance of the shadow pair that measures the amplification where the variational equations do not apply
 SHADOW_TOLERANCE = 1e-9
 FLOOR = 1e-15  # relative to the state's size: nothing in double precision reaches below this
+#: the same for double-double (its Taylor method's smallest tolerance is 1e-32; its round-off ~1e-31 per step)
+DOUBLE_DOUBLE_FLOOR = 1e-30
 MIN_TOLERANCE = 1e-13  # first pilot: tighter tolerances differ from τ/100 by round-off only on O(1) states
 MAX_TOLERANCE = 1e-5  # looser per-step tolerances take steps near the Taylor series' radius of convergence
 FIRST_RATIO = 1e-3  # first pilot tolerance relative to the accuracy (the typical error/tolerance ratio is 10–500)
@@ -175,10 +177,17 @@ class Auto(Integrator):
     def prepare(self, system: Any) -> None:
         self.system = system
         # the floor of integrate(), checked when the scene is built: a refusal before the run directory exists
-        scale = max(1.0, *map(abs, system.initial_state()))
-        if self.accuracy < FLOOR * scale:
-            raise ConfigError(f"accuracy={self.accuracy:g} is below what double precision reaches on this scene "
-                              f"(about {FLOOR * scale:.1g} for states of size {scale:.3g}); ask for more")
+        self._check_floor(max(1.0, *map(abs, system.initial_state())))
+
+    def _check_floor(self, scale: float) -> None:
+        """One sentence for an accuracy below what the highest precision allowed reaches on states of size ``scale``
+        (double-double unless ``extended_precision`` is false; whether the model has a double-double form is
+        asked when it is needed)."""
+        floor, what = (DOUBLE_DOUBLE_FLOOR, "double-double") if self.extended_precision else (FLOOR, "double precision")
+        if self.accuracy < floor * scale:
+            advice = "" if self.extended_precision else " or allow integrator.extended_precision"
+            raise ConfigError(f"accuracy={self.accuracy:g} is below what {what} reaches on this scene "
+                              f"(about {floor * scale:.1g} for states of size {scale:.3g}); ask for more{advice}")
 
     def _method(self, compiled: CompiledModel | None, tol: float) -> Integrator:
         if compiled is not None:
@@ -204,9 +213,7 @@ class Auto(Integrator):
         t_out = np.asarray(t_out, dtype=float)
         self._taylor = None
         scale = max(1.0, *map(abs, y0))  # a few components: Python's max is several times faster than numpy's
-        if self.accuracy < FLOOR * scale:
-            raise ConfigError(f"accuracy={self.accuracy:g} is below what double precision reaches on this scene "
-                              f"(about {FLOOR * scale:.1g} for states of size {scale:.3g}); ask for more")
+        self._check_floor(scale)
         if self._recheck is not None:
             return self._run_recheck(fun, t_out, y0, progress, compiled, start)
         series = None if self._no_series else self._series(fun, t_out, y0, compiled, start)
