@@ -256,6 +256,23 @@ def _command(overrides: list[str]) -> str:
     return "gyrolab " + " ".join(f"'{o}'" if any(c in o for c in "[],") else o for o in overrides)
 
 
+def print_estimate_table(rows: list[dict]) -> None:
+    """The integrators' estimate table (Markdown): one row per audited integrator run."""
+    print("\n| # | integrator | settings | verdict | actual ω | est ω | actual att. | est att. | est/actual (max) | "
+          "est/actual (worst time) | CPU s |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    for row in rows:
+        e = row.get("estimate") or {}
+        if e.get("available"):
+            print(f"| {row['scene']} | {row['integrator']} | {row['settings']} | {row['verdict']} | "
+                  f"{_g(e['omega']['actual_max'])} | {_g(e['omega']['estimate_max'])} | "
+                  f"{_g(e['attitude']['actual_max'])} | {_g(e['attitude']['estimate_max'])} | {_g(e['ratio'])} | "
+                  f"{_g(e['ratio_per_time'])} | {row['cpu']:.2f} |")
+        else:
+            print(f"| {row['scene']} | {row['integrator']} | {row['settings']} | {row['verdict']}: "
+                  f"{(row.get('why') or e.get('why', ''))[:80]} | | | | | | | {row['cpu']:.2f} |")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--n", type=int, default=100, help="random scenes (default 100: ~5 min on one core)")
@@ -311,20 +328,7 @@ def main(argv: list[str] | None = None) -> int:
                                        "scene": scene.index, "settings": " ".join(settings)})
     wall = time.perf_counter() - wall
 
-    # the integrators' estimate table
-    print("\n| # | integrator | settings | verdict | actual ω | est ω | actual att. | est att. | est/actual (max) | "
-          "est/actual (worst time) | CPU s |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    for row in other_rows:
-        e = row.get("estimate") or {}
-        if e.get("available"):
-            print(f"| {row['scene']} | {row['integrator']} | {row['settings']} | {row['verdict']} | "
-                  f"{_g(e['omega']['actual_max'])} | {_g(e['omega']['estimate_max'])} | "
-                  f"{_g(e['attitude']['actual_max'])} | {_g(e['attitude']['estimate_max'])} | {_g(e['ratio'])} | "
-                  f"{_g(e['ratio_per_time'])} | {row['cpu']:.2f} |")
-        else:
-            print(f"| {row['scene']} | {row['integrator']} | {row['settings']} | {row['verdict']}: "
-                  f"{(row.get('why') or e.get('why', ''))[:80]} | | | | | | | {row['cpu']:.2f} |")
+    print_estimate_table(other_rows)
 
     # summary
     counts = {v: sum(r["verdict"] == v for r in auto_rows) for v in ("kept", "refused", "BROKEN")}

@@ -42,7 +42,7 @@ from gyrolab.errors import GyrolabError
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gyrostat_reference as gr  # noqa: E402  (benchmarks/ is not a package)
 from promise_audit import (ACCURACIES, BEST_TOL, ESTIMATE_FACTOR, ROUNDOFF, Scene, _command, _g,  # noqa: E402
-                           audit_auto, compact, estimate_check, r_eps)
+                           audit_auto, compact, estimate_check, print_estimate_table, r_eps)
 from results_file import write_results  # noqa: E402
 
 #: (integrator, settings) audited with output.error_estimate=true on every k-th scene
@@ -179,19 +179,7 @@ def main(argv: list[str] | None = None) -> int:
                                    "scene": scene.index, "settings": " ".join(settings)})
     wall = time.perf_counter() - wall
 
-    print("\n| # | integrator | settings | verdict | actual ω | est ω | actual att. | est att. | est/actual (max) | "
-          "est/actual (worst time) | CPU s |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    for row in other_rows:
-        e = row.get("estimate") or {}
-        if e.get("available"):
-            print(f"| {row['scene']} | {row['integrator']} | {row['settings']} | {row['verdict']} | "
-                  f"{_g(e['omega']['actual_max'])} | {_g(e['omega']['estimate_max'])} | "
-                  f"{_g(e['attitude']['actual_max'])} | {_g(e['attitude']['estimate_max'])} | {_g(e['ratio'])} | "
-                  f"{_g(e['ratio_per_time'])} | {row['cpu']:.2f} |")
-        else:
-            print(f"| {row['scene']} | {row['integrator']} | {row['settings']} | {row['verdict']}: "
-                  f"{(row.get('why') or e.get('why', ''))[:80]} | | | | | | | {row['cpu']:.2f} |")
+    print_estimate_table(other_rows)
 
     counts = {v: sum(r["promise"] == v for r in auto_rows) for v in ("kept", "refused", "BROKEN")}
     measured = [r for r in auto_rows if "actual" in r]
