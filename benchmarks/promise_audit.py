@@ -256,6 +256,30 @@ def _command(overrides: list[str]) -> str:
     return "gyrolab " + " ".join(f"'{o}'" if any(c in o for c in "[],") else o for o in overrides)
 
 
+def estimates_by_integrator(rows: list[dict]) -> dict[str, dict]:
+    """Per integrator: runs, runs judged (an estimate above round-off), estimates more than ESTIMATE_FACTOR× low
+    (final and per output time), estimate/actual extremes, saturated runs and runs without an estimate."""
+    per_integrator: dict[str, dict] = {}
+    for row in rows:
+        e = row.get("estimate") or {}
+        entry = per_integrator.setdefault(row["integrator"], {"runs": 0, "judged": 0, "under": 0, "under_per_time": 0,
+                                                              "min_ratio": math.inf, "max_ratio": 0.0,
+                                                              "min_ratio_per_time": math.inf, "saturated": 0,
+                                                              "unavailable": 0})
+        entry["runs"] += 1
+        entry["unavailable"] += not e.get("available", False)
+        entry["saturated"] += bool(e.get("saturated"))
+        if e.get("available") and not math.isnan(e["ratio"]) and not e["saturated"]:
+            entry["judged"] += 1
+            entry["under"] += e["under"]
+            entry["under_per_time"] += e["under_per_time"]
+            entry["min_ratio"] = min(entry["min_ratio"], e["ratio"])
+            entry["max_ratio"] = max(entry["max_ratio"], e["ratio"])
+            if not math.isnan(e["ratio_per_time"]):
+                entry["min_ratio_per_time"] = min(entry["min_ratio_per_time"], e["ratio_per_time"])
+    return per_integrator
+
+
 def print_estimate_table(rows: list[dict]) -> None:
     """The integrators' estimate table (Markdown): one row per audited integrator run."""
     print("\n| # | integrator | settings | verdict | actual ω | est ω | actual att. | est att. | est/actual (max) | "
@@ -337,22 +361,7 @@ def main(argv: list[str] | None = None) -> int:
     worst_pred = max((r["actual"] / r["predicted"] for r in measured), default=math.nan)
     rechecked = sum(bool(r.get("rechecked")) for r in measured)
     worst_over_time = max((r["actual_max_over_time"] / r["eps"] for r in measured), default=math.nan)
-    per_integrator: dict[str, dict] = {}
-    for row in [*({**r, "integrator": "auto"} for r in measured), *other_rows]:
-        e = row.get("estimate") or {}
-        entry = per_integrator.setdefault(row["integrator"], {"runs": 0, "judged": 0, "under": 0, "under_per_time": 0,
-                                                              "min_ratio": math.inf, "max_ratio": 0.0,
-                                                              "min_ratio_per_time": math.inf, "saturated": 0})
-        entry["runs"] += 1
-        entry["saturated"] += bool(e.get("saturated"))
-        if e.get("available") and not math.isnan(e["ratio"]) and not e["saturated"]:
-            entry["judged"] += 1
-            entry["under"] += e["under"]
-            entry["under_per_time"] += e["under_per_time"]
-            entry["min_ratio"] = min(entry["min_ratio"], e["ratio"])
-            entry["max_ratio"] = max(entry["max_ratio"], e["ratio"])
-            if not math.isnan(e["ratio_per_time"]):
-                entry["min_ratio_per_time"] = min(entry["min_ratio_per_time"], e["ratio_per_time"])
+    per_integrator = estimates_by_integrator([*({**r, "integrator": "auto"} for r in measured), *other_rows])
     under = sum(v["under"] for v in per_integrator.values())
     print(f"\n{len(scenes) - len(skipped)} scenes (seed {args.seed}), {len(auto_rows)} auto runs: {counts['kept']} kept, "
           f"{counts['refused']} refused, {counts['BROKEN']} BROKEN ({rechecked} kept or broken after rule 11's rerun); "

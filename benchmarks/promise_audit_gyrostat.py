@@ -42,7 +42,8 @@ from gyrolab.errors import GyrolabError
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gyrostat_reference as gr  # noqa: E402  (benchmarks/ is not a package)
 from promise_audit import (ACCURACIES, BEST_TOL, ESTIMATE_FACTOR, ROUNDOFF, Scene, _command, _g,  # noqa: E402
-                           audit_auto, compact, estimate_check, print_estimate_table, r_eps)
+                           audit_auto, compact, estimate_check, estimates_by_integrator,
+                           print_estimate_table, r_eps)
 from results_file import write_results  # noqa: E402
 
 #: (integrator, settings) audited with output.error_estimate=true on every k-th scene
@@ -187,24 +188,7 @@ def main(argv: list[str] | None = None) -> int:
     worst_all = max((r["actual_max_over_time"] / r["eps"] for r in measured), default=math.nan)
     worst_pred = max((r["actual"] / r["predicted"] for r in measured), default=math.nan)
     above_predicted = sum(not r["below_predicted"] for r in measured)
-    per_integrator: dict[str, dict] = {}
-    for row in [*({**r, "integrator": "auto"} for r in measured), *other_rows]:
-        e = row.get("estimate") or {}
-        entry = per_integrator.setdefault(row["integrator"], {"runs": 0, "judged": 0, "under": 0, "under_per_time": 0,
-                                                              "min_ratio": math.inf, "max_ratio": 0.0,
-                                                              "min_ratio_per_time": math.inf, "saturated": 0,
-                                                              "unavailable": 0})
-        entry["runs"] += 1
-        entry["unavailable"] += not e.get("available", False)
-        entry["saturated"] += bool(e.get("saturated"))
-        if e.get("available") and not math.isnan(e["ratio"]) and not e["saturated"]:
-            entry["judged"] += 1
-            entry["under"] += e["under"]
-            entry["under_per_time"] += e["under_per_time"]
-            entry["min_ratio"] = min(entry["min_ratio"], e["ratio"])
-            entry["max_ratio"] = max(entry["max_ratio"], e["ratio"])
-            if not math.isnan(e["ratio_per_time"]):
-                entry["min_ratio_per_time"] = min(entry["min_ratio_per_time"], e["ratio_per_time"])
+    per_integrator = estimates_by_integrator([*({**r, "integrator": "auto"} for r in measured), *other_rows])
     under = sum(v["under"] for v in per_integrator.values())
     print(f"\n{len(scenes)} gyrostat scenes (seed {args.seed}), {len(auto_rows)} auto runs: {counts['kept']} kept, "
           f"{counts['refused']} refused, {counts['BROKEN']} BROKEN (final and every output time ≤ ε); worst final/ε "

@@ -22,7 +22,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from gyrolab.kernels.expression import Expr, Graph, NotCompilable, load_generated, symbols
+from gyrolab.kernels.expression import Expr, Graph, NotCompilable, check_torques, load_generated, symbols
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT, TRACED_TAIL
 
 #: form id of a model compiled from its traced equations (``models.TRACED``; here to avoid importing numba's models)
@@ -179,8 +179,6 @@ def bind(compiled: CompiledModel, rows: np.ndarray) -> np.ndarray:
 def compiled_system(system: Any) -> CompiledModel:
     """A system's compiled model from its own ``rhs(t, y)``: the forces' torques checked one by one first (so that a
     refusal names the force), then the whole right-hand side traced and compiled. Raises NotCompilable."""
-    from gyrolab.kernels.expression import check_torques
-
     check_torques(getattr(system, "forces", []))
     forces = " + ".join(f.name for f in getattr(system, "forces", [])) or "no torque"
     return compile(trace(system.rhs, system.state_size, f"system {system.name} ({forces})"))

@@ -190,15 +190,6 @@ def run_indicators_dop853(P, t_out, Y0, D0, rtol, atol, max_step, megno, fli, de
                            steps, j)
 
 
-def tangent_growth(p: np.ndarray, y0: np.ndarray, t_end: float, tol: float) -> float:
-    """max ln|δ(t)| over [0, t_end] of the unit tangent vector ``initial_tangent`` of the (ω, γ) state ``y0`` (the
-    fast Lyapunov indicator), by DOP853 at rtol = atol = ``tol`` in this thread; ``p`` with CARRIES_ALPHA = 0.
-    NaN when the integration fails. (One run of ``tangent_growths``.)"""
-    y = np.ascontiguousarray(y0[:6], dtype=float)
-    return float(_tangent_run(np.ascontiguousarray(p, dtype=float), y, initial_tangent(y[None, :])[0], float(t_end),
-                              float(tol)))
-
-
 def tangent_growths(p: np.ndarray, y0: np.ndarray, t_pilot: float, t_end: float, tol: float) -> tuple[float, float]:
     """(max ln|δ(t)| over [0, t_pilot], over [0, t_end]) of the unit tangent vector ``initial_tangent`` of the (ω, γ)
     state ``y0``, by DOP853 at rtol = atol = ``tol`` in this thread (no thread pool: one trajectory). ``p`` with
