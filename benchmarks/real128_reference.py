@@ -26,7 +26,7 @@ def reference(scene) -> np.ndarray:
     """The final (ω, γ) in real128 (heyoka, tol 1e-30) on equations written from the papers."""
     import heyoka as hy
 
-    p = scene.system.compiled_model().params
+    p = scene.system.compiled_model().built_in
     A, B, C = (float(p[layout.INERTIA + k]) for k in range(3))
     U1, U2, U3 = (float(p[layout.U_Z + k]) for k in range(3))
     N = float(p[layout.N_Z])
@@ -46,12 +46,9 @@ def reference(scene) -> np.ndarray:
 
 def covered(scene) -> bool:
     """Whether the scene is a fixed-point scene whose torques these equations hold (about the vertical only)."""
-    from gyrolab.kernels import models
-
-    compiled = scene.system.compiled_model()
-    if compiled is None or compiled.model != models.FIXED_POINT or layout.torques_on_horizontal_axes(compiled.params):
-        return False
-    return len(compiled.params) == layout.N_PARAMS  # no traced plugin torque
+    compiled = scene.system.compiled_model()  # (built_in: every torque a built-in form, with α carried or not)
+    return compiled is not None and compiled.built_in is not None \
+        and not layout.torques_on_horizontal_axes(compiled.built_in)
 
 
 class Real128Reference:
@@ -76,7 +73,7 @@ class Real128Reference:
         hy = self.hy
         if not covered(scene):
             raise ValueError("the real128 reference covers fixed-point scenes with torques about the vertical only")
-        p = scene.system.compiled_model().params
+        p = scene.system.compiled_model().built_in
         moments = [hy.real128(float(p[layout.INERTIA + k])) for k in range(3)]
         pars = [*moments, *(hy.real128(1) / m for m in moments),
                 *(hy.real128(float(p[layout.U_Z + k])) for k in range(3)), hy.real128(float(p[layout.N_Z]))]

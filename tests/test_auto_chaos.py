@@ -20,7 +20,7 @@ CHAOTIC_TOP = ["initial.theta0=1", "initial.r0=2", "initial.p0=0.3", "initial.q0
 
 def _reference(overrides):
     scene = compose_scene(["integrator=taylor", "time.n_output=2", *overrides])
-    p = scene.system.compiled_model().params
+    p = scene.system.compiled_model().built_in
     return fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3], p[layout.N_Z],
                                  scene.system.initial_state()[:6], scene.times[[0, -1]])[-1].astype(float)
 
@@ -92,7 +92,7 @@ def test_the_tangent_growth_kernel_matches_the_variational_equations_integrated_
     from gyrolab.kernels import variational
 
     built = compose_scene(["integrator=taylor", *scene])
-    p = np.array(built.compiled.params, dtype=float)
+    p = np.array(built.compiled.built_in, dtype=float)
     p[layout.CARRIES_ALPHA] = 0.0
     y0 = built.system.initial_state()[:6]
     t_end = float(built.times[-1])
@@ -127,7 +127,7 @@ def test_the_tangent_growth_kernel_takes_the_steps_of_the_indicator_kernel():
     from gyrolab.kernels import variational
 
     built = compose_scene(["integrator=taylor", *SLOW_SPIN, "time.end=300"])
-    p = np.array(built.compiled.params, dtype=float)
+    p = np.array(built.compiled.built_in, dtype=float)
     p[layout.CARRIES_ALPHA] = 0.0
     y0 = built.system.initial_state()[:6]
     expected = []

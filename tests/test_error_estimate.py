@@ -15,7 +15,7 @@ SCENE = ["experiment=perf_reference", "time.end=60", "time.n_output=31", "output
 
 def _actual(ds, overrides):
     scene = compose_scene(overrides)
-    p = scene.system.compiled_model().params
+    p = scene.system.compiled_model().built_in
     truth = fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3], p[layout.N_Z],
                                   scene.system.initial_state()[:6], scene.times).astype(float)
     states = np.concatenate([ds.omega.values, ds.gamma.values], axis=1)

@@ -1,4 +1,4 @@
-"""Kernels compiled per model form (``models.Form``): a built-in scene compiles no plugin and no α code.
+"""Kernels compiled per model form (``models.Form``): a built-in scene compiles no plugin code.
 
 Issue 12, item 6 (first compile). The expected values are the run-time dispatch's (an int model), which
 the forms must reproduce bit for bit, and which code numba did or did not compile.
@@ -21,31 +21,27 @@ from gyrolab.kernels import fixed_point, models
 INERTIA = np.array([2.0, 1.5, 1.0])
 
 
-def _params(alpha: bool) -> np.ndarray:
-    p = fixed_point.pack(INERTIA, [], alpha)
-    p[3:12] = [0.02, -0.01, 0.03, 0.05, 0.01, -0.02, 0.3, 0.2, 0.9]  # U_0, U_1, U_2
-    p[12:15] = [0.4, 0.3, 0.5]  # N_0, N_1, N_2
+def _params() -> np.ndarray:
+    p = fixed_point.pack(INERTIA, [], False)
+    p[9:12] = [0.3, 0.2, 0.9]  # U_2
+    p[14] = 0.5  # N_2
     return p
 
 
 def test_form_of_each_compiled_model():
-    assert models.form(CompiledModel(models.FIXED_POINT, _params(False))).id == models.FIXED_POINT
-    assert models.form(CompiledModel(models.FIXED_POINT, _params(True))).id == models.FIXED_POINT_ALPHA
-    for plugin in (models.TRACED, models.TRACED):
-        assert models.form(CompiledModel(plugin, np.zeros(30))).id == plugin
-    assert numba.typeof(models.FORMS[models.FIXED_POINT]) != numba.typeof(models.FORMS[models.FIXED_POINT_ALPHA])
+    assert models.form(CompiledModel(models.FIXED_POINT, _params())).id == models.FIXED_POINT
+    assert models.form(CompiledModel(models.TRACED, np.zeros(30))).id == models.TRACED
+    assert numba.typeof(models.FORMS[models.FIXED_POINT]) != numba.typeof(models.FORMS[models.TRACED])
 
 
-@pytest.mark.parametrize("alpha", [False, True])
-def test_forms_match_run_time_dispatch_bit_for_bit(alpha):
-    p = _params(alpha)
-    n = 9 if alpha else 6
-    y = np.array([0.3, -1.1, 2.2, 0.48, 0.6, 0.64, 0.8, 0.0, -0.6])[:n]
-    by_int, by_form = np.empty(n), np.empty(n)
+def test_form_matches_run_time_dispatch_bit_for_bit():
+    p = _params()
+    y = np.array([0.3, -1.1, 2.2, 0.48, 0.6, 0.64])
+    by_int, by_form = np.empty(6), np.empty(6)
     models.evaluate(models.FIXED_POINT, 0.0, y, p, by_int)
     models.evaluate(models.form(CompiledModel(models.FIXED_POINT, p)), 0.0, y, p, by_form)
     assert np.array_equal(by_int, by_form)
-    assert np.all(by_form != 0.0)  # every component computed (α's too)
+    assert np.all(by_form != 0.0)  # every component computed
 
 
 @numba.njit
@@ -53,22 +49,20 @@ def _probe(model, y, p, out):
     models.rhs(model, 0.0, y, p, out)
 
 
-def _compiled_ir(model, alpha: bool) -> str:
+def _compiled_ir(model) -> str:
     """The LLVM IR of ``_probe`` for one model argument, with every function it calls linked in."""
-    y = np.ones(9 if alpha else 6)
-    _probe(model, y, _params(alpha), np.empty_like(y))
+    y = np.ones(6)
+    _probe(model, y, _params(), np.empty_like(y))
     return _probe.inspect_llvm(_probe.signatures[-1])
 
 
-def test_builtin_form_compiles_no_plugin_and_no_alpha_code():
-    """The run-time dispatch contains the plugin models' indirect call (``inttoptr``) and the α terms; the
-    (ω, γ) form neither, the α form no plugin call and more arithmetic than the (ω, γ) form."""
-    dispatch = _compiled_ir(models.FIXED_POINT, True)
-    gamma = _compiled_ir(models.FORMS[models.FIXED_POINT], False)
-    alpha = _compiled_ir(models.FORMS[models.FIXED_POINT_ALPHA], True)
+def test_builtin_form_compiles_no_plugin_code():
+    """The run-time dispatch contains the traced models' indirect call (``inttoptr``); the built-in form does not."""
+    dispatch = _compiled_ir(models.FIXED_POINT)
+    built_in = _compiled_ir(models.FORMS[models.FIXED_POINT])
     assert "inttoptr" in dispatch
-    assert "inttoptr" not in gamma and "inttoptr" not in alpha
-    assert gamma.count("fmul") < alpha.count("fmul") < dispatch.count("fmul")
+    assert "inttoptr" not in built_in
+    assert built_in.count("fmul") <= dispatch.count("fmul")
 
 
 _CHILD = r'''
@@ -95,15 +89,13 @@ with event.install_recorder("numba:compile") as rec:
         series(form, p, T, 8, np.zeros((9, 3)))
 compiled = sorted({ev.data["dispatcher"].py_func.__qualname__ for _, ev in rec.buffer if "dispatcher" in ev.data})
 print(json.dumps({"compiled": compiled, "Y": Y.tolist(),
-                  "unused": [len(d.signatures) for d in (taylor_series.coefficients, fixed_point.taylor_alpha,
-                                                          fixed_point._cauchy_cross, fixed_point._cauchy_pairs)],
-                  "gamma": len(fixed_point.taylor_gamma.signatures)}))
+                  "unused": [len(taylor_series.coefficients.signatures)],
+                  "gamma": len(fixed_point.taylor_coefficients.signatures)}))
 '''
 
 
 def test_fresh_cache_compiles_the_form_only_and_a_second_process_loads_it(tmp_path):
-    """In a fresh kernel cache the (ω, γ) form compiles neither the plugins' Taylor code nor the α terms' Cauchy
-    sums; a second process on that cache compiles nothing (numba loads every kernel from disk)."""
+    """In a fresh kernel cache the (ω, γ) form does not compile the traced models' Taylor code; a second process on that cache compiles nothing (numba loads every kernel from disk)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
 
     def child(which: str) -> dict:
@@ -113,7 +105,7 @@ def test_fresh_cache_compiles_the_form_only_and_a_second_process_loads_it(tmp_pa
 
     first = child("first")
     assert "run" in first["compiled"] and first["gamma"] == 1
-    assert first["unused"] == [0, 0, 0, 0]
+    assert first["unused"] == [0]
     second = child("second")
     assert second["compiled"] == []
     assert second["Y"] == first["Y"]

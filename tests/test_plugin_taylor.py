@@ -188,9 +188,10 @@ def test_plugins_repeating_the_builtin_arithmetic_follow_the_builtin_trajectory(
     system = scene.system
     beta = next(f for f in system.forces if f.name == "newtonian")
     beta.axis, beta.required_axes = 1, frozenset({1})  # the gradient torque about β = γ × α: every packed form
-    builtin = fixed_point.compiled_model(system.inertia, system.forces, system.carries_alpha)
+    builtin = system.compiled_model()  # with α: the built-in forms' numpy equations, traced
     plugin = traced_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
-    assert (builtin.model, plugin.model, system.state_size) == (models.FIXED_POINT, models.TRACED, 9)
+    assert (builtin.model, plugin.model, system.state_size) == (models.TRACED, models.TRACED, 9)
+    assert builtin.built_in is not None and plugin.built_in is None
     assert taylor_series.ready(plugin)
     y0 = system.initial_state()
     runs = [Taylor(order=20, tol=1e-14).integrate(None, scene.times, y0, None, m).y for m in (builtin, plugin)]
@@ -290,7 +291,7 @@ def _traced_reference():
     """The reference problem's built-in model and the same torques traced as a plugin's (state ω, γ)."""
     scene = compose_scene(REFERENCE)
     system = scene.system
-    builtin = fixed_point.compiled_model(system.inertia, system.forces, system.carries_alpha)
+    builtin = system.compiled_model()
     plugin = traced_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
     assert (builtin.model, plugin.model) == (models.FIXED_POINT, models.TRACED)
     assert taylor_series.ready(plugin)
@@ -299,7 +300,7 @@ def _traced_reference():
 
 def test_traced_reference_torques_give_the_builtin_series_and_trajectory():
     """Gravity + Newtonian centre traced (the generated series kernel) against the built-ins' hand-written
-    Cauchy sums (fixed_point.taylor_gamma): every coefficient to rounding, and the trajectory to round-off;
+    Cauchy sums (fixed_point.taylor_coefficients): every coefficient to rounding, and the trajectory to round-off;
     both against the extended-precision reference at the end."""
     import numba
 

@@ -37,7 +37,7 @@ def test_the_real128_reference_agrees_with_the_long_double_one(reference):
     numpy long-double Taylor method) agree to long double's accuracy on a scene with both torques."""
     scene = compose_scene(["integrator=taylor", "force=[uniform_gravity,newtonian]", "initial.theta0=0.7",
                            "initial.r0=3", "time.end=20", "time.n_output=11"])
-    p = scene.system.compiled_model().params
+    p = scene.system.compiled_model().built_in
     long_double = fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3],
                                         p[layout.N_Z], scene.system.initial_state()[:6], scene.times).astype(float)
     real128 = reference.states(scene)

@@ -348,7 +348,7 @@ def test_vertical_magnetic_field_adds_to_the_weight():
     assert [s.x0, s.y0, s.z0] == pytest.approx(U / np.linalg.norm(U))
     orbit = exact_orbit(scene, regime)
     t = np.linspace(0.0, orbit.period, 9)
-    y = integrate(scene, orbit.y0, t, taylor=True)[:, :6]
+    y = integrate(scene, with_alpha(scene, regime, orbit.y0), t, taylor=True)[:, :6]
     error = np.abs(regime.solution(scene.system, t) - y) / np.array([s.c, s.c, s.c * s.r0, 1, 1, 1])
     assert np.max(error) < 5 * (1 / s.r0) ** 7  # 6.6e-10 = 1.6 ε⁷ at ε = c/r0 = 0.0456; 2.4e-2 without the field
     with pytest.raises(ConfigError, match="vertical magnetic field"):

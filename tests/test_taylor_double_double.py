@@ -264,6 +264,29 @@ def test_double_double_taylor_matches_a_50_digit_reference_where_double_precisio
     assert 1e-28 < coarse[-1] < 1e-21
 
 
+def _traced_packed_equations(p):
+    """The equations ``decimal_reference`` integrates, written in numpy from the packed parameters p and compiled
+    from their trace (a state with α runs the traced form: ``series_dd``)."""
+    from gyrolab.kernels import model, series_dd
+    from gyrolab.physics.vectors import cross
+
+    inertia = p[INERTIA:INERTIA + 3]
+    U = [p[LINEAR[i]:LINEAR[i] + 3] for i in range(3)]
+    N = [p[GRADIENT[i]] for i in range(3)]
+
+    def equations(t, y):
+        w, g, a = y[0:3], y[3:6], y[6:9]
+        b = cross(g, a)
+        torque = cross(inertia * w, w)
+        for e, u, n in zip((a, b, g), U, N):
+            torque = torque + cross(u, e) + n * cross(e, inertia * e)
+        return np.concatenate([torque / inertia, cross(g, w), cross(a, w)])
+
+    compiled = model.compile(model.trace(equations, 9, "the packed fixed-point equations with α"))
+    assert series_dd.ready(compiled)
+    return compiled
+
+
 def test_the_form_with_alpha_and_every_torque_term_matches_the_decimal_reference():
     p = np.zeros(N_PARAMS)
     p[INERTIA:INERTIA + 3] = (2.0, 1.5, 1.0)
@@ -277,9 +300,10 @@ def test_the_form_with_alpha_and_every_torque_term_matches_the_decimal_reference
     alpha = np.array([math.cos(1.0), 0.0, -math.sin(1.0)])
     y0 = np.concatenate([[0.3, -0.2, 1.1], gamma, alpha])
     t_out = np.array([0.0, 1.5, 3.0])
-    hi, lo = taylor_dd.propagate(p, 1e-30, t_out, y0)
+    traced = _traced_packed_equations(p)
+    hi, lo = taylor_dd.propagate(traced.params, 1e-30, t_out, y0, model=models.TRACED)
     errors = _errors(hi, lo, decimal_reference(p, y0, t_out, order=40, tol=Decimal("1e-40")))
-    assert max(errors) < 1e-30, errors  # measured 2e-32
+    assert max(errors) < 1e-30, errors  # measured 2e-32 (hand-written α form), 4e-32 (traced)
 
 
 # --- physics: first integrals over a long run -------------------------------------------------------------------
@@ -344,7 +368,9 @@ def test_a_scene_in_double_double_runs_with_alpha_and_every_builtin_force_and_re
     assert seen and seen[-1] == 30.0 and solution.y.dtype == np.float64
     # the reference for the α form: the same kernel's all digits agree with the stored doubles, and the double
     # kernel agrees to its own round-off
-    hi, lo = taylor_dd.propagate(dd_scene.compiled.params, 1e-28, dd_scene.times, dd_scene.system.initial_state())
+    assert dd_scene.compiled.model == models.TRACED  # a state with α runs the traced equations
+    hi, lo = taylor_dd.propagate(dd_scene.compiled.params, 1e-28, dd_scene.times, dd_scene.system.initial_state(),
+                                 model=models.TRACED)
     np.testing.assert_array_equal(solution.y, hi)
     double = compose_scene([*overrides, "integrator.tol=1e-16"])
     np.testing.assert_allclose(double.run().omega.values, solution.y[:, :3], rtol=0, atol=1e-12)

@@ -81,7 +81,7 @@ def _run(kernel, compiled, order, tol, t_out, y0, **kwargs):
 
 def test_run_takes_the_vector_step_for_the_fixed_point_model_without_alpha_only():
     """``taylor.run`` dispatches: the reference scene (fixed point, (ω, γ)) bit for bit as ``run_vector``; the
-    same scene carrying α (Euler angles on) bit for bit as ``run_scalar``."""
+    same scene carrying α (Euler angles on: its traced equations) bit for bit as ``run_scalar``."""
     scene = _reference_scene(1e-10, end=20.0, n_output=201)
     assert scene.compiled.model == models.FIXED_POINT and scene.compiled.params[15] == 0.0
     y0 = scene.system.initial_state()
@@ -94,7 +94,10 @@ def test_run_takes_the_vector_step_for_the_fixed_point_model_without_alpha_only(
                 np.testing.assert_array_equal(a, b)
     with_alpha = compose_scene(["experiment=perf_reference", "integrator=taylor", "integrator.tol=1e-10",
                                 "time.end=20", "time.n_output=201", "output.euler_angles=true"])
-    assert with_alpha.compiled.params[15] == 1.0
+    assert with_alpha.compiled.model == models.TRACED  # α: the traced equations, the scalar step
+    from gyrolab.kernels import taylor_series
+
+    assert taylor_series.ready(with_alpha.compiled)
     y0 = with_alpha.system.initial_state()
     a, b = (_run(kernel, with_alpha.compiled, 13, 1e-10, with_alpha.times, y0)
             for kernel in (taylor.run, taylor.run_scalar))

@@ -37,9 +37,9 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
     A state that carries the fixed horizontal axis α (9 components) is accepted when no torque depends on α:
     (ω, γ) is then a closed system and α (the precession angle's axis) does not enter the indicators.
     """
-    from gyrolab.kernels import fixed_point, layout, models
+    from gyrolab.kernels import fixed_point, layout
 
-    if compiled is None or compiled.model != models.FIXED_POINT:
+    if compiled is None or compiled.built_in is None:
         raise ConfigError("chaos indicators need the fixed-point system with built-in torques only "
                           "(uniform_gravity, newtonian); a force plugin's torque has no variational equations here")
     y0s = np.ascontiguousarray(y0s, dtype=float)
@@ -47,7 +47,7 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
         raise ConfigError(f"initial states have shape {y0s.shape}; chaos indicators need (trajectories, 6) or (trajectories, 9)")
     if not np.all(np.isfinite(y0s)):
         raise ConfigError("initial states contain NaN or inf; every initial state must be finite")
-    P = np.tile(compiled.params, (len(y0s), 1)) if params is None else np.ascontiguousarray(params, dtype=float)
+    P = np.tile(compiled.built_in, (len(y0s), 1)) if params is None else np.ascontiguousarray(params, dtype=float)
     if P.shape != (len(y0s), fixed_point.N_PARAMS):
         raise ConfigError(f"params has shape {P.shape}; it must be ({len(y0s)}, {fixed_point.N_PARAMS})")
     if layout.torques_on_horizontal_axes(P):
@@ -96,7 +96,9 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
     if times.ndim != 1 or times.size < 2 or not np.all(np.diff(times) > 0):
         raise ConfigError("times must be at least two increasing output times")
     settings = variational_settings(integrator)
-    if compiled is not None and compiled.model == models.TRACED:
+    if compiled is not None and compiled.model == models.TRACED and (compiled.built_in is None or params is not None):
+        # traced equations: their generated tangent flow (a fixed point carrying α with built-in torques alone takes
+        # the hand-written (ω, γ) flow below, unless its rows are given in the traced layout)
         return _generated_run(compiled, settings, times, y0s, params, every_time)
     y0, P = _model_arrays(compiled, y0s, params)
     n = len(y0)

@@ -146,11 +146,11 @@ class FixedPointModel:
     @classmethod
     def from_system(cls, system) -> FixedPointModel:
         compiled = system.compiled_model()
-        from gyrolab.kernels import layout, models
+        from gyrolab.kernels import layout
 
-        if compiled is None or compiled.model != models.FIXED_POINT:  # the built-in torque forms only
+        if compiled is None or compiled.built_in is None:  # the built-in torque forms only
             raise ConfigError("periodic orbits need forces with compiled forms; valid forces: uniform_gravity, newtonian")
-        p = compiled.params
+        p = compiled.built_in
         if layout.torques_on_horizontal_axes(p):
             raise ConfigError("periodic orbits are computed for fields symmetric about the vertical only; "
                               "valid forces: uniform_gravity, newtonian")

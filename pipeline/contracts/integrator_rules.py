@@ -29,6 +29,9 @@ def checked(integrate: Callable[..., Any]) -> Callable[..., Any]:
     def wrapper(self: Any, fun: Any, t_out: Any, y0: Any, *args: Any, **kwargs: Any) -> Any:
         name = _name(self)
         t_out, y0 = check_inputs(name, t_out, y0)
+        compiled = args[1] if len(args) > 1 else kwargs.get("compiled")
+        if compiled is not None:
+            _check_compiled_size(name, compiled, y0)
         try:
             solution = integrate(self, fun, t_out, y0, *args, **kwargs)
         except GyrolabError:
@@ -41,6 +44,17 @@ def checked(integrate: Callable[..., Any]) -> Callable[..., Any]:
 
     setattr(wrapper, _CHECKED, True)
     return wrapper
+
+
+def _check_compiled_size(name: str, compiled: Any, y0: np.ndarray) -> None:
+    """A compiled model's kernels index the state by its own size, unchecked: a state of another size would make them
+    read and write past the arrays (a crash, or silently wrong numbers), so it is refused here."""
+    from gyrolab.kernels.model import state_size
+
+    size = state_size(compiled)
+    if size is not None and size != len(y0):
+        raise IntegrationError(f"integrator {name!r} was given an initial state of {len(y0)} components for a "
+                               f"compiled model of {size}; pass the system's own state (System.initial_state())")
 
 
 def _name(integrator: Any) -> str:

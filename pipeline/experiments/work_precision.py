@@ -78,11 +78,11 @@ def _final(ds: xr.Dataset) -> np.ndarray:
 def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
     """Final (ω, γ) of the scene from the most accurate reference available, and its name."""
     compiled = scene.system.compiled_model()
-    from gyrolab.kernels import layout, models
+    from gyrolab.kernels import layout
 
-    if compiled is None or compiled.model != models.FIXED_POINT:  # the built-in torque forms only
+    if compiled is None or compiled.built_in is None:  # the built-in torque forms only
         raise ConfigError("work_precision needs a scene whose forces have compiled forms (for its reference run)")
-    p = compiled.params
+    p = compiled.built_in
     y0 = scene.system.initial_state()[:6]
     if not layout.torques_on_horizontal_axes(p):
         ref = fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3],

@@ -11,8 +11,9 @@
 The compiled model (``CompiledModel``) is the form id ``models.TRACED`` and the parameter array, laid out
 as ``layout`` says for it: the right-hand side kernel's address, the program's numbers (the only thing that
 changes between two scenes of the same form), and the Taylor kernel's address and work columns.
-The fixed-point model with only built-in torques has a hand-written form of its own (``models.FIXED_POINT``,
-``fixed_point.pack``); every other system, a plugin system included, is compiled from its equations here.
+The fixed-point model (ω, γ) with only built-in torques has a hand-written form of its own (``models.FIXED_POINT``,
+``fixed_point.pack``); every other system, a plugin system and the fixed point carrying α included, is compiled
+from its equations here.
 """
 
 from __future__ import annotations
@@ -35,6 +36,15 @@ class CompiledModel:
 
     model: int
     params: np.ndarray
+    #: the fixed point's packed parameters (``fixed_point.pack``) when every torque has a built-in form, whatever
+    #: the form that runs it (a state with α runs the traced equations): what the Lie–Poisson splitting, the
+    #: analytic Jacobian and the regimes' series read; None for every other model (the hand-written form's own
+    #: parameters when not given)
+    built_in: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.model == 0 and self.built_in is None:  # models.FIXED_POINT: its parameters are the packed ones
+            object.__setattr__(self, "built_in", self.params)
 
 
 _UNARY = {"neg": "-{0}", "sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
@@ -162,6 +172,17 @@ def traced_model(compiled: CompiledModel) -> Model:
     if compiled.model != TRACED or address not in MODELS:
         raise ValueError("this compiled model's parameter array names no traced model of this process")
     return MODELS[address]
+
+
+def state_size(compiled: CompiledModel) -> int | None:
+    """The state size a compiled model's kernels read and write: 6 for the hand-written fixed point (ω, γ), the traced
+    program's size otherwise; None for a parameter array that names no traced model of this process."""
+    if compiled.model != TRACED:
+        return 6
+    try:
+        return traced_model(compiled).size
+    except ValueError:
+        return None
 
 
 def bind(compiled: CompiledModel, rows: np.ndarray) -> np.ndarray:

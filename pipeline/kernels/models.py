@@ -26,7 +26,7 @@ from numba.core.datamodel.models import OpaqueModel
 from numba.core.imputils import lower_constant
 from numba.extending import NativeValue, intrinsic, overload, register_model, unbox
 
-from gyrolab.kernels.layout import CARRIES_ALPHA, TRACED_ADDRESS
+from gyrolab.kernels.layout import TRACED_ADDRESS
 from gyrolab.kernels import fixed_point, model as _model, taylor_series
 from gyrolab.kernels.compiler import inline_kernel, kernel
 
@@ -34,8 +34,6 @@ from gyrolab.kernels.compiler import inline_kernel, kernel
 FIXED_POINT = 0
 #: A model compiled from its traced equations (``model``).
 TRACED = _model.TRACED
-#: Not a model id (``CompiledModel.model`` is FIXED_POINT): the form of FIXED_POINT with the state ω, γ, α.
-FIXED_POINT_ALPHA = 3
 #: Models whose Taylor coefficients ``taylor_coefficients`` computes (traced ones: see taylor_series.ready).
 TAYLOR_MODELS = (FIXED_POINT, TRACED)
 
@@ -94,13 +92,11 @@ def _constant_form(context, builder, ty, value):
     return context.get_dummy_value()
 
 
-FORMS = {i: Form(i) for i in (FIXED_POINT, TRACED, FIXED_POINT_ALPHA)}
+FORMS = {i: Form(i) for i in (FIXED_POINT, TRACED)}
 
 
 def form(compiled) -> Form:
     """The kernels' model argument for a ``CompiledModel``: compiles and runs its form's code only."""
-    if compiled.model == FIXED_POINT and compiled.params[CARRIES_ALPHA] != 0.0:
-        return FORMS[FIXED_POINT_ALPHA]
     return FORMS[compiled.model]
 
 
@@ -109,7 +105,7 @@ def _traced(t, y, p, out):
     _call_rhs(int(p[TRACED_ADDRESS]), t, y, p, out)
 
 
-_RHS = {FIXED_POINT: fixed_point.rhs_gamma, FIXED_POINT_ALPHA: fixed_point.rhs_alpha, TRACED: _traced}
+_RHS = {FIXED_POINT: fixed_point.rhs, TRACED: _traced}
 
 
 def rhs(model, t, y, p, out):
@@ -126,7 +122,7 @@ def _rhs_form(model, t, y, p, out):
     return None
 
 
-_GAMMA, _ALPHA = FORMS[FIXED_POINT], FORMS[FIXED_POINT_ALPHA]
+_FIXED_POINT = FORMS[FIXED_POINT]
 _TRACED = FORMS[TRACED]
 
 
@@ -134,10 +130,7 @@ _TRACED = FORMS[TRACED]
 def _rhs_any(model, t, y, p, out):
     """The run-time dispatch: a branch per form, each the form's plain call."""
     if model == FIXED_POINT:
-        if p[CARRIES_ALPHA] != 0.0:
-            rhs(_ALPHA, t, y, p, out)
-        else:
-            rhs(_GAMMA, t, y, p, out)
+        rhs(_FIXED_POINT, t, y, p, out)
     elif model == TRACED:
         rhs(_TRACED, t, y, p, out)
 
@@ -179,9 +172,8 @@ def taylor_coefficients(model, p, Y, order, work, t=0.0):
 @overload(taylor_coefficients, inline="never", jit_options={"error_model": "numpy"})
 def _taylor_coefficients(model, p, Y, order, work, t=0.0):
     if isinstance(model, FormType):
-        if model.id in (FIXED_POINT, FIXED_POINT_ALPHA):
-            f = fixed_point.taylor_gamma if model.id == FIXED_POINT else fixed_point.taylor_alpha
-            return lambda model, p, Y, order, work, t=0.0: f(p, Y, order, work)
+        if model.id == FIXED_POINT:
+            return lambda model, p, Y, order, work, t=0.0: fixed_point.taylor_coefficients(p, Y, order, work)
         return None  # the traced form: below
     if isinstance(model, types.Integer):
         return lambda model, p, Y, order, work, t=0.0: _taylor_any(model, p, Y, order, work, t)

@@ -35,7 +35,7 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic, overload
 
-from gyrolab.kernels.layout import CARRIES_ALPHA, INERTIA, INV_INERTIA, N_Z, U_Z
+from gyrolab.kernels.layout import INERTIA, INV_INERTIA, N_Z, U_Z
 from gyrolab.kernels import simd
 from gyrolab.kernels.compiler import inline_kernel, kernel
 from gyrolab.kernels.models import FIXED_POINT, FormType, taylor_coefficients
@@ -105,7 +105,7 @@ def _route_by_model(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, ca
         return scalar
     if isinstance(model, types.Integer):
         def either(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
-            if model == FIXED_POINT and p[CARRIES_ALPHA] == 0.0:
+            if model == FIXED_POINT:
                 return run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
             return run_scalar(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats)
         return either
@@ -336,7 +336,7 @@ def series(p, y, order):
 
 @kernel
 def run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
-    """``run`` for the fixed-point model without α (p[CARRIES_ALPHA] = 0, y = (ω, γ)), the step vectorised across the
+    """``run`` for the fixed-point model (y = (ω, γ)), the step vectorised across the
     components: ``_coefficients``, the dense output (``_dense``) and the compensated update (``_update``) in
     ``<4 x double>``. Same order, step rule, dense output (strict arithmetic), compensated update, status
     codes, stats and chunking contract as ``run_scalar``; the coefficients and the update's Horner sums fuse

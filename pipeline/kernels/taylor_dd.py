@@ -2,13 +2,13 @@
 
 A traced model's coefficients come from its generated series (``series_dd``, the same rules as below); the
 hand-written ones here serve the fixed-point model with its built-in torque forms (``fixed_point``: the gyroscopic torque, U_i × e_i, the
-gradient terms N_i e_i × I e_i, states (ω, γ) and (ω, γ, α)), the same method as ``taylor.run_scalar``: Taylor
+gradient term N_2 γ × I γ, the state (ω, γ)), the same method as ``taylor.run_scalar``: Taylor
 coefficients from Cauchy products of the quadratic right-hand side, Jorba & Zou's order (``taylor.order_for``)
 and step (``taylor.step_size``, from the last two coefficients' max norms) for a tolerance down to 1e-32,
 the series as the dense output. Every number that enters the state is a double-double
 (``double_double``):
 
-* the state (ω, γ[, α]) is carried in double-double between steps (``yh``, ``yl``: high and low parts);
+* the state is carried in double-double between steps (``yh``, ``yl``: high and low parts);
 * the Cauchy sums are compensated dot products (``double_double.dot_add``: error ≤ ~k·u²·Σ|terms| for the
   k-th coefficient, u² = 2^-106), the scalings in double-double;
 * the parameters are doubles, hence exact as double-doubles, but the derived constants are not: 1/I_k is
@@ -37,7 +37,7 @@ from gyrolab.kernels.double_double import (
     dd_add, dd_div_d, dd_mul, dd_mul_d, dd_norm, dd_sub, dot_add, two_sum,
 )
 from gyrolab.kernels.layout import (
-    ALPHA, CARRIES_ALPHA, GAMMA, INERTIA, N_X, N_Y, N_Z, OMEGA, U_X, U_Y, U_Z,
+    GAMMA, INERTIA, N_Z, OMEGA, U_Z,
 )
 from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, _norm_inf, step_size
 
@@ -112,16 +112,14 @@ def _u_cross(u0, u1, u2, h0, l0, h1, l1, h2, l2):
 
 
 @kernel
-def coefficients(p, C, Th, Tl, order, Bh, Bl):
+def coefficients(p, C, Th, Tl, order):
     """Fill rows 1..order of the Taylor coefficients (Th, Tl: high and low parts, (order+1, state size)) from row 0.
 
-    Y_{k+1} = F_k / (k + 1), F_k the k-th coefficient of the right-hand side: I ω̇ = Iω × ω + U_2 × γ + N_2 γ × Iγ
-    (+ U_0 × α + U_1 × β + N_0 α × Iα + N_1 β × Iβ with β = γ × α), γ̇ = γ × ω, α̇ = α × ω; the gyroscopic and
-    gradient torques in their component form ((Iω) × ω)_x = (I_y − I_z) ω_y ω_z. ``C`` is ``constants(p)``;
-    Bh, Bl (order+1, 3) receive β's coefficients in the form with α.
+    Y_{k+1} = F_k / (k + 1), F_k the k-th coefficient of the right-hand side: I ω̇ = Iω × ω + U_2 × γ + N_2 γ × Iγ,
+    γ̇ = γ × ω; the gyroscopic and gradient torques in their component form ((Iω) × ω)_x = (I_y − I_z) ω_y ω_z.
+    ``C`` is ``constants(p)``.
     """
-    has_alpha = p[CARRIES_ALPHA] != 0.0
-    n_z, n_x, n_y = p[N_Z], p[N_X], p[N_Y]
+    n_z = p[N_Z]
     acc = np.empty((2, 3))
     for k in range(order):
         w = _pairs(Th, Tl, OMEGA, Th, Tl, OMEGA, k)
@@ -135,31 +133,6 @@ def coefficients(p, C, Th, Tl, order, Bh, Bl):
             sh, sl = dd_sub(w[2 * c], w[2 * c + 1], qh, ql)
             qh, ql = dd_mul(C[0, DIFF + c], C[1, DIFF + c], sh, sl)
             acc[0, c], acc[1, c] = dd_add(qh, ql, u[2 * c], u[2 * c + 1])
-        if has_alpha:
-            beta = _cross(Th, Tl, GAMMA, Th, Tl, ALPHA, k)
-            for c in range(3):
-                Bh[k, c], Bl[k, c] = beta[2 * c], beta[2 * c + 1]
-            ua = _u_cross(p[U_X], p[U_X + 1], p[U_X + 2], Th[k, ALPHA], Tl[k, ALPHA], Th[k, ALPHA + 1],
-                          Tl[k, ALPHA + 1], Th[k, ALPHA + 2], Tl[k, ALPHA + 2])
-            ub = _u_cross(p[U_Y], p[U_Y + 1], p[U_Y + 2], beta[0], beta[1], beta[2], beta[3], beta[4], beta[5])
-            for c in range(3):
-                sh, sl = dd_add(ua[2 * c], ua[2 * c + 1], ub[2 * c], ub[2 * c + 1])
-                acc[0, c], acc[1, c] = dd_add(acc[0, c], acc[1, c], sh, sl)
-            if n_x != 0.0:
-                a = _pairs(Th, Tl, ALPHA, Th, Tl, ALPHA, k)
-                for c in range(3):
-                    qh, ql = dd_mul_d(a[2 * c], a[2 * c + 1], n_x)
-                    sh, sl = dd_mul(C[0, DIFF + c], C[1, DIFF + c], qh, ql)
-                    acc[0, c], acc[1, c] = dd_sub(acc[0, c], acc[1, c], sh, sl)
-            if n_y != 0.0:
-                b = _pairs(Bh, Bl, 0, Bh, Bl, 0, k)
-                for c in range(3):
-                    qh, ql = dd_mul_d(b[2 * c], b[2 * c + 1], n_y)
-                    sh, sl = dd_mul(C[0, DIFF + c], C[1, DIFF + c], qh, ql)
-                    acc[0, c], acc[1, c] = dd_sub(acc[0, c], acc[1, c], sh, sl)
-            aw = _cross(Th, Tl, ALPHA, Th, Tl, OMEGA, k)
-            for c in range(3):
-                Th[k + 1, ALPHA + c], Tl[k + 1, ALPHA + c] = dd_div_d(aw[2 * c], aw[2 * c + 1], k + 1.0)
         for c in range(3):
             sh, sl = dd_mul(acc[0, c], acc[1, c], C[0, INV + c], C[1, INV + c])
             Th[k + 1, OMEGA + c], Tl[k + 1, OMEGA + c] = dd_div_d(sh, sl, k + 1.0)
@@ -205,8 +178,6 @@ def run(model, p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stat
     n = yh.size
     Th = np.zeros((order + 1, n))
     Tl = np.zeros((order + 1, n))
-    Bh = np.zeros((order + 1, 3))
-    Bl = np.zeros((order + 1, 3))
     traced = model != 0
     C = np.zeros((2, 6)) if traced else constants(p)
     S = np.zeros((order + 1) * 2 * int(p[p.size - 1])) if traced else np.zeros(0)
@@ -224,7 +195,7 @@ def run(model, p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stat
         if traced:
             _call_generated(address, t, order, Th, Tl, S, p)
         else:
-            coefficients(p, C, Th, Tl, order, Bh, Bl)
+            coefficients(p, C, Th, Tl, order)
         stats[0] += 1
         scale = max(1.0, _norm_inf(yh))
         h = step_size(tol, scale, _norm_inf(Th[order - 1]), _norm_inf(Th[order]), order, safety)
@@ -261,8 +232,12 @@ def propagate(p: np.ndarray, tol: float, t_out, y0, order: int | None = None, y0
     (high parts, low parts), each (len(t_out), state size), the first row the initial state. For tests, benchmarks
     and callers that want all 32 digits; the integrator plugin (``Taylor(precision="double-double")``) chunks
     its calls for progress instead. Raises RuntimeError on a non-OK status."""
+    from gyrolab.kernels.layout import N_PARAMS
     from gyrolab.kernels.taylor import order_for
 
+    if model == 0 and (len(p) != N_PARAMS or len(y0) != 6):  # (the hand-written kernel would read past them)
+        raise ValueError("model 0 is the hand-written fixed point: packed parameters (fixed_point.pack) and a state "
+                         "(ω, γ); pass model=1 for a traced model's parameters")
     t_out = np.asarray(t_out, dtype=float)
     yh = np.array(y0, dtype=float)
     yl = np.zeros_like(yh) if y0_low is None else np.array(y0_low, dtype=float)

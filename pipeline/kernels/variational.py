@@ -32,7 +32,7 @@ from gyrolab.kernels.layout import INERTIA, INV_INERTIA, N_Z, U_Z
 from gyrolab.kernels import dop853
 from gyrolab.kernels.compiler import inline_kernel, kernel
 from gyrolab.kernels.fixed_point import rhs_block
-from gyrolab.kernels.fixed_point import rhs_gamma as rhs  # (ω, γ) states only
+from gyrolab.kernels.fixed_point import rhs  # (ω, γ) states
 
 #: unknowns of the augmented system: x (6), δ (6), the MEGNO quadratures a and b
 AUGMENTED = 14

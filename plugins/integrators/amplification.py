@@ -96,23 +96,32 @@ def amplification(compiled: Any, fun: Any, y0: np.ndarray, t0: float, t_pilot: f
 def variational_kind(compiled: Any) -> str:
     from gyrolab.kernels import models
 
-    return "hand-written" if compiled.model == models.FIXED_POINT else "generated"
+    return "hand-written" if _closed_built_in(compiled) is not None else "generated"
 
 
 def _variational(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float) -> tuple[float, float] | None:
     if compiled is None:
         return None
-    from gyrolab.kernels import layout, models, variational
+    from gyrolab.kernels import variational
 
-    if compiled.model == models.TRACED:
+    p = _closed_built_in(compiled)
+    if p is None:
         return _generated(compiled, y0, t0, t_pilot, t_end)
-    if compiled.model != models.FIXED_POINT or layout.torques_on_horizontal_axes(compiled.params):
-        return None  # the analytic Jacobian covers the built-in torques about the vertical only
-    p = np.array(compiled.params, dtype=float)
-    p[layout.CARRIES_ALPHA] = 0.0  # (ω, γ) is closed without α when no torque reads it
     # autonomous: the span from t0 is what counts
     logs = variational.tangent_growths(p, np.asarray(y0, dtype=float), t_pilot - t0, t_end - t0, TANGENT_TOLERANCE)
     return None if not all(np.isfinite(logs)) else logs
+
+
+def _closed_built_in(compiled: Any) -> np.ndarray | None:
+    """The built-in fixed point's parameters for the state (ω, γ) alone, when no torque reads α (then (ω, γ) is a
+    closed system and the analytic Jacobian covers it); None otherwise (the generated tangent flow runs)."""
+    from gyrolab.kernels import layout
+
+    if compiled.built_in is None or layout.torques_on_horizontal_axes(compiled.built_in):
+        return None
+    p = np.array(compiled.built_in, dtype=float)
+    p[layout.CARRIES_ALPHA] = 0.0
+    return p
 
 
 def _generated(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float) -> tuple[float, float] | None:

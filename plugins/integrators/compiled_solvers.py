@@ -432,8 +432,9 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
     """The states at ``t_out`` of the Taylor method at ``tol`` (its optimal order), in one call into the kernel:
     for runs over a few periods inside another method (``auto``'s screen), which need neither progress nor
     statistics (``Taylor.integrate``'s chunks and records cost ~10 µs more, a tenth of the screen)."""
-    from gyrolab.kernels import models, taylor
+    from gyrolab.kernels import models, taylor, taylor_series
 
+    taylor_series.ready(compiled)  # a traced model's series kernel (a scene carrying α is one)
     t_out, y, out = _outputs(t_out, y0)
     state = np.array([t_out[0]])
     status, _ = taylor.run(models.form(compiled), compiled.params, taylor.order_for(tol), tol, t_out, out, 1,
@@ -464,9 +465,7 @@ class LiePoisson(Integrator):
 
     @classmethod
     def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
-        from gyrolab.kernels import models
-
-        if compiled.model == models.FIXED_POINT:
+        if compiled.built_in is not None:
             return None
         traced = ", ".join(f.name for f in system.forces if f.compiled_terms() is None) if system is not None else ""
         return ("evaluates the built-in torque forms only, and "
@@ -483,9 +482,9 @@ class LiePoisson(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        from gyrolab.kernels import lie_poisson, models
+        from gyrolab.kernels import lie_poisson
 
-        if compiled.model != models.FIXED_POINT:
+        if compiled.built_in is None:
             raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian with the built-in torque "
                               "forms only; valid systems: fixed_point with uniform_gravity, newtonian, magnetic")
         start = time.perf_counter()
@@ -493,7 +492,7 @@ class LiePoisson(Integrator):
         steps = interval_steps(self, t_out)
         w = lie_poisson.weights(self.order)
         fun = compiled_rhs(compiled)
-        reached = _fixed_step(lambda grid, n, rows, first, stop: lie_poisson.run(compiled.params, grid, n, w, y,
+        reached = _fixed_step(lambda grid, n, rows, first, stop: lie_poisson.run(compiled.built_in, grid, n, w, y,
                                                                                  rows, first, stop),
                               self.name, fun, t_out, steps, y, out, progress)
         if reached != len(t_out):

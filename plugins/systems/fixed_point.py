@@ -13,6 +13,7 @@ force acting along a non-vertical direction. β = γ × α is never stored.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -181,10 +182,15 @@ class FixedPoint(System):
         return attrs
 
     def compiled_model(self) -> CompiledModel | None:
-        """The hand-written kernels' model for built-in torque forms; otherwise the equations traced (``System``)."""
+        """The hand-written kernels' model for the state (ω, γ) with built-in torque forms; otherwise the equations
+        traced (``System``), carrying the built-in forms' parameters when every torque has one (``built_in``)."""
         from gyrolab.kernels import fixed_point
 
-        return fixed_point.compiled_model(self.inertia, self.forces, self.carries_alpha) or super().compiled_model()
+        packed = fixed_point.built_in(self.inertia, self.forces, self.carries_alpha)
+        if packed is not None and not self.carries_alpha:
+            return CompiledModel(0, packed, built_in=packed)  # models.FIXED_POINT
+        compiled = super().compiled_model()
+        return compiled if compiled is None or packed is None else replace(compiled, built_in=packed)
 
     def title(self) -> str:
         nd = self.body.nondimensional()
