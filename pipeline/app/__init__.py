@@ -41,8 +41,7 @@ from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
-from gyrolab.engine.composition import composing_once
-from gyrolab.engine.hydra_private import get_args_parser
+from gyrolab.compat import composing_once, get_args_parser, install_dask_free_writes
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
     ConfigSource,
@@ -59,7 +58,6 @@ from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
 from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
-from gyrolab.output.dask_free_writes import install_dask_free_writes
 from gyrolab.output.written import announce_written
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid

@@ -1,36 +1,48 @@
-"""One composition per command: Hydra's config composition, remembered for the rest of the command.
+"""The one place where gyrolab reaches into Hydra's and xarray's internals, each use checked against the library
+version it was written for, with the library's own public path otherwise.
 
-Without it, one ``gyrolab`` run composed its config three times (the preflight, Hydra's ``get_mode``
-and Hydra's run), and a sweep of N jobs N + 4 times, each composition reading every YAML file of the
-defaults list again (~60 ms). Inside :func:`composing_once` Hydra's ``ConfigLoaderImpl`` splits its
-composition in two, as its own code does:
+Kept because their measured gain is large (``gyrolab`` with and without each, best of 3 CPU s, Hydra 1.3.8,
+xarray 2026.9, Dask installed; ``docs/performance.md``):
 
-1. the *skeleton*: the defaults list and the config merged from it, which depend only on the primary
-   config, the search path and the overrides that choose config-group options (``integrator=rk4``,
-   ``hydra/launcher=joblib``, ``+experiment=x``, ``~regime``); composed once per distinct set of
-   those, exactly as Hydra composes it (the same functions, in the same order);
-2. the rest, for every request: a copy of the skeleton, the value overrides applied with Hydra's own
-   function, and the ``hydra`` node filled in (overrides, choices, override_dirname, cwd, ...), by a
-   copy of the tail of Hydra's ``_load_configuration_impl`` (Hydra is pinned to 1.3.x for it; the
-   tests compare both paths' configs key by key).
+* **One composition per command** (:func:`composing_once`, Hydra ``1.3.x``): a plain run composed its
+  config three times (the preflight, Hydra's ``get_mode`` and Hydra's run), a sweep of N jobs N + 4 times,
+  each composition reading every YAML file of the defaults list again. Inside the block Hydra's
+  ``ConfigLoaderImpl._load_configuration_impl`` composes the *skeleton* (the defaults list and the config
+  merged from it, which depend only on the primary config, the search path and the overrides that choose
+  config-group options) once per distinct set of those, with Hydra's own functions in Hydra's order, and
+  serves every request from a copy of it: the value overrides applied with Hydra's function and the
+  ``hydra`` node filled in by a copy of the tail of Hydra 1.3's ``_load_configuration_impl``. Gain: 0.16 s
+  of a 1.9 s default run, 0.85 s of a 10-job sweep (~85 ms a job). Which overrides shape the defaults list
+  follows Hydra 1.3's rule (``defaults_list.Overrides``); a request Hydra's defaults list classifies
+  otherwise is composed by Hydra itself. ``tests/test_sweep_composition.py`` compares both paths' configs
+  for every job of a set of sweeps.
+* **Writes without Dask** (:func:`install_dask_free_writes`, xarray ``XARRAY_SUPPORTED``): with Dask installed
+  (the ``cluster`` and ``test`` extras) ``to_netcdf`` imports ``dask.array`` and ``distributed`` for any
+  dataset, only to learn that nothing in it is Dask's. Gain: 0.45 CPU s of every run and sweep (none on
+  the bare install, which has no Dask).
 
-So the preflight's composition is the one Hydra's run uses, and the jobs of a value sweep share one
-skeleton; every job still gets the config Hydra would compose for it. Which overrides shape the
-defaults list follows Hydra 1.3's own rule (``defaults_list.Overrides``: the name of a config group,
-not given a mapping); when Hydra's defaults list takes other overrides as values on a first
-composition, that request is composed by Hydra itself. ``tests/test_sweep_composition.py`` compares
-both paths' configs for every job of a set of sweeps, which is what a new Hydra is checked by.
+Dropped for a small gain: ``xr.Dataset._construct_direct`` for the run dataset (~1 ms of a 25 ms run).
+
+Also here, with no fallback (``pyproject.toml`` pins ``hydra-core>=1.3,<1.4`` for them): the private Hydra
+functions the preflight needs to compose exactly what ``@hydra.main`` will run (the search path, Hydra's
+argument parser, ``_run_hydra``) and those gyrolab's sweeper applies job overrides with.
 """
 
 from __future__ import annotations
 
 import copy
 import os
+import sys
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
+import hydra
+from hydra import version as hydra_version
+from hydra._internal.config_loader_impl import ConfigLoaderImpl, get_overrides_dirname
+from hydra._internal.defaults_list import create_defaults_list
+from hydra._internal.utils import _run_hydra, create_automatic_config_search_path, get_args_parser
 from hydra.conf import ConfigSourceInfo
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override
@@ -38,8 +50,48 @@ from hydra.core.utils import JobRuntime
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from gyrolab.engine.hydra_private import ConfigLoaderImpl, create_defaults_list, get_overrides_dirname
+__all__ = ["ConfigLoaderImpl", "composing_once", "create_automatic_config_search_path", "get_args_parser",
+           "install_dask_free_writes", "run_hydra"]
 
+#: the versions each kept patch was written for: (first, first not supported), by (major, minor)
+HYDRA_SUPPORTED = ((1, 3), (1, 4))
+XARRAY_SUPPORTED = ((2024, 1), (2027, 1))
+
+
+def supported(version: str, window: tuple[tuple[int, int], tuple[int, int]]) -> bool:
+    """Whether ``version`` ("1.3.8", "2026.9.0", "2025.1.2.dev3") lies in ``window``."""
+    try:
+        major, minor = (int(part) for part in version.split(".")[:2])
+    except ValueError:
+        return False
+    return window[0] <= (major, minor) < window[1]
+
+
+def hydra_supported() -> bool:
+    return supported(hydra.__version__, HYDRA_SUPPORTED)
+
+
+def __getattr__(name: str) -> Any:
+    # the two heavier classes are imported when first asked for (Hydra's run and gyrolab's sweeper)
+    if name == "Hydra":
+        from hydra._internal.hydra import Hydra
+
+        return Hydra
+    if name == "BasicSweeper":
+        from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
+
+        return BasicSweeper
+    raise AttributeError(name)
+
+
+def run_hydra(args: Any, task_function: Any, config_path: str, config_name: str) -> None:
+    """What ``@hydra.main(config_path, config_name)``'s function does with the command line, given it parsed
+    (``args``: Hydra's own parser's namespace) rather than read from ``sys.argv``."""
+    _run_hydra(args=args, args_parser=get_args_parser(), task_function=task_function, config_path=config_path,
+               config_name=config_name)
+
+
+# --- one composition per command (Hydra 1.3) ---
 
 @dataclass
 class Skeleton:
@@ -67,8 +119,6 @@ class CompositionMemo:
         if config_name is None:
             return _ORIGINAL(loader, config_name=config_name, overrides=overrides, run_mode=run_mode,
                              from_shell=from_shell, validate_sweep_overrides=validate_sweep_overrides)
-        from hydra import __version__, version
-
         self.requests += 1
         loader.ensure_main_config_source_available()
         parsed = OverridesParser.create().parse_overrides(overrides=overrides)
@@ -100,8 +150,8 @@ class CompositionMemo:
             cfg.hydra.runtime.choices.update(skeleton.known_choices)
             for key in cfg.hydra.job.env_copy:
                 cfg.hydra.job.env_set[key] = os.environ[key]
-        cfg.hydra.runtime.version = __version__
-        cfg.hydra.runtime.version_base = version.getbase()
+        cfg.hydra.runtime.version = hydra.__version__
+        cfg.hydra.runtime.version_base = hydra_version.getbase()
         cfg.hydra.runtime.cwd = os.getcwd()
         cfg.hydra.runtime.config_sources = [ConfigSourceInfo(path=x.path, schema=x.scheme(), provider=x.provider)
                                             for x in skeleton.sources]
@@ -198,7 +248,11 @@ def composing_once() -> Iterator[CompositionMemo]:
     if active is not None:  # nested (a command run from a command): the outer memo serves
         yield active
         return
-    memo = active = CompositionMemo()
+    memo = CompositionMemo()
+    if not hydra_supported():  # a Hydra this copy was not written for: every composition is Hydra's own
+        yield memo
+        return
+    active = memo
 
     def load(self: ConfigLoaderImpl, config_name: str | None, overrides: list[str], run_mode: RunMode,
              from_shell: bool = True, validate_sweep_overrides: bool = True) -> DictConfig:
@@ -210,3 +264,108 @@ def composing_once() -> Iterator[CompositionMemo]:
     finally:
         ConfigLoaderImpl._load_configuration_impl = _ORIGINAL
         active = None
+
+
+# --- writes without Dask (xarray) ---
+#
+# xarray's string coder asks whether a char array is a Dask array (``pycompat.array_type("dask")``, which imports
+# ``dask.array``, and ``utils.is_dask_collection``, which imports ``dask.base``), and asks Dask's scheduler whether
+# to close the file after every write (``writers._get_netcdf_autoclose``) and which write lock to take
+# (``locks.get_write_lock``, which imports ``distributed``). A guard in front of each gives Dask's or xarray's own
+# answer without the import where the answer cannot depend on Dask, and asks otherwise:
+#
+# * ``array_type("dask")`` while ``dask.array`` is not imported: no object can be an instance of its ``Array``
+#   class, so there is no type to test against (``()``, xarray's answer without Dask);
+# * ``is_dask_collection(x)`` for an ``x`` without a ``__dask_graph__`` method: False (Dask's first test);
+# * autoclose for a dataset without chunks: False (xarray: ``have_chunks and ...``);
+# * the write lock while ``distributed`` is not imported (so no Dask client exists) and Dask's config names no
+#   scheduler: xarray's threaded lock (what it takes without Dask and under Dask's default).
+#
+# Once Dask is in use (a batch on a Dask scheduler, a chunked dataset), xarray decides as before. An xarray
+# without one of these functions keeps it unguarded.
+
+_GUARD = "_gyrolab_scheduler_guard"
+
+
+def install_dask_free_writes() -> bool:
+    """Install the four guards (once per process); whether all four are in place. False, and nothing
+    installed, under an xarray outside ``XARRAY_SUPPORTED``: xarray's own path, which imports Dask."""
+    import xarray
+
+    if not supported(xarray.__version__, XARRAY_SUPPORTED):
+        return False
+    from xarray.backends import locks, netCDF4_, writers
+    from xarray.namedarray import pycompat, utils
+
+    return all([
+        _guard(pycompat, "_get_cached_duck_array_module", _no_dask_arrays_before_dask),
+        _guard(utils, "is_dask_collection", _no_graph_no_collection),
+        _guard(writers, "_get_netcdf_autoclose", _unchunked_autoclose),
+        _guard(netCDF4_, "get_write_lock", lambda original: _lock_without_dask(original, locks)),
+    ])
+
+
+def _guard(module: Any, name: str, make: Any) -> bool:
+    original = getattr(module, name, None)
+    if original is None:
+        return False
+    if not getattr(original, _GUARD, False):
+        guarded = make(original)
+        setattr(guarded, _GUARD, True)
+        guarded.__wrapped__ = original
+        setattr(module, name, guarded)
+    return True
+
+
+class _DaskNotImported:
+    """xarray's record of the ``dask`` duck-array module, asked before ``dask.array`` is imported: no type yet
+    (nothing can be an instance of a class not loaded); anything else is xarray's own answer."""
+
+    type: tuple = ()
+
+    def __init__(self, original: Any) -> None:
+        self._original = original
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._original("dask"), name)
+
+
+def _no_dask_arrays_before_dask(original: Any) -> Any:
+    def cached_duck_array_module(mod: Any) -> Any:
+        if mod == "dask" and "dask.array" not in sys.modules:
+            return _DaskNotImported(original)  # not cached: once dask.array is imported, xarray's record
+        return original(mod)
+    return cached_duck_array_module
+
+
+def _no_graph_no_collection(original: Any) -> Any:
+    def is_dask_collection(x: object) -> bool:
+        if "dask" not in sys.modules and not callable(getattr(x, "__dask_graph__", None)):
+            return False  # dask.base.is_dask_collection's answer for an object without a graph method
+        return original(x)
+    return is_dask_collection
+
+
+def _unchunked_autoclose(original: Any) -> Any:
+    def autoclose(dataset: Any, engine: Any) -> bool:
+        if all(variable.chunks is None for variable in dataset.variables.values()):
+            return False  # xarray's answer without chunks
+        return original(dataset, engine)
+    return autoclose
+
+
+def _lock_without_dask(original: Any, locks: Any) -> Any:
+    lock_maker = getattr(locks, "_get_lock_maker", None)
+
+    def get_write_lock(key: str) -> Any:
+        if lock_maker is None or "distributed" in sys.modules or _configured_scheduler():
+            return original(key)
+        return lock_maker(None)(key)  # xarray's lock without a Dask scheduler (= under Dask's default)
+    return get_write_lock
+
+
+def _configured_scheduler() -> bool:
+    """Whether Dask, if imported, is configured with a scheduler (then xarray's lock follows it)."""
+    dask = sys.modules.get("dask")
+    config = getattr(dask, "config", None)
+    return config is not None and bool(config.get("scheduler", None) or config.get("get", None))
