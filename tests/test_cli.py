@@ -268,3 +268,46 @@ def test_logs_go_to_stderr_and_results_to_stdout(cli, tmp_path):
     assert aggregate.returncode == 0, aggregate.stderr
     assert aggregate.stdout.splitlines() == ["wrote sweep/sweep.nc"]
     assert "[INFO]" in aggregate.stderr
+
+
+# ---- one run, one scene -------------------------------------------------------------------------------------------
+
+def test_a_plain_run_builds_one_scene_and_checks_its_config_once(monkeypatch, tmp_path):
+    """The preflight's scene is the one the run integrates: one composition's config checked once against the
+    schema, one question whether the integrator reads ``accuracy``, one ``Scene``."""
+    from gyrolab import app
+    from gyrolab.engine.scene import Scene
+
+    calls = {"scene": 0, "check": 0, "accuracy": 0}
+
+    def counting(name, function):
+        def counted(*args, **kwargs):
+            calls[name] += 1
+            return function(*args, **kwargs)
+        return counted
+
+    built = Scene.from_config.__func__
+    monkeypatch.setattr(Scene, "from_config", classmethod(counting("scene", built)))
+    monkeypatch.setattr(app, "check_scene_config", counting("check", app.check_scene_config))
+    monkeypatch.setattr(app, "ignored_accuracy", counting("accuracy", app.ignored_accuracy))
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", ["gyrolab", "time.end=1", "time.n_output=11", "output.figures=false",
+                                      f"hydra.run.dir={tmp_path}/run"])
+    app.main()
+    assert calls == {"scene": 1, "check": 1, "accuracy": 1}
+    with xr.open_dataset(tmp_path / "run" / "run.nc") as ds:
+        assert ds.sizes["time"] == 11
+
+
+def test_the_run_builds_its_own_scene_when_its_config_is_not_the_preflights(monkeypatch):
+    from gyrolab import app
+    from omegaconf import OmegaConf
+
+    cfg = OmegaConf.create({"time": {"end": 1}})
+    app._prepared[:] = [app.Prepared({"time": {"end": 2}}, object(), None)]
+    assert app.take_prepared(cfg) is None and not app._prepared
+    app._prepared[:] = [app.Prepared({"time": {"end": "${now:%H}"}}, object(), None)]  # may resolve otherwise
+    assert app.take_prepared(OmegaConf.create({"time": {"end": "${now:%H}"}})) is None
+    prepared = app.Prepared({"time": {"end": 1}}, object(), "note")
+    app._prepared[:] = [prepared]
+    assert app.take_prepared(cfg) is prepared

@@ -141,9 +141,9 @@ def preflight(argv: Sequence[str]) -> list[str]:
                 values = list(o.sweep_string_iterator())[(1 if o in overrides else 0):]  # the first: composed
                 configs += [_compose_job(source, _job_overrides(swept, {id(o): value}), sweeping) for value in values]
     cfg = configs[0]
-    for composed in configs:
-        check_scene_config(_without_hydra(composed))
-    refuse_unread_accuracy(configs, [o.input_line for o in overrides])
+    scene_cfgs = [_without_hydra(composed) for composed in configs]
+    plains = [check_scene_config(scene_cfg) for scene_cfg in scene_cfgs]
+    notes = accuracy_notes(configs, [o.input_line for o in overrides])
     run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
@@ -152,25 +152,51 @@ def preflight(argv: Sequence[str]) -> list[str]:
     check_tree(run_dir, sweep=sweeping)  # a planted link in a directory received from someone else
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
-    validate_scene(_without_hydra(cfg))
+    scene = validate_scene(scene_cfgs[0], plains[0])
     from gyrolab.experiments import check_task, refuse_unread
 
     refuse_unread(f"task {task_of(cfg)}", [o.input_line for o in overrides], sweep=sweeping)  # batch.* on a plain run
-    check_task(task_of(cfg), _without_hydra(cfg), run_dir)  # an experiment's own refusals, before its directory
+    check_task(task_of(cfg), scene_cfgs[0], run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
+    if not sweeping:  # the run takes the preflight's scene and its accuracy note (_run_locked)
+        _prepared[:] = [Prepared(OmegaConf.to_container(scene_cfgs[0], resolve=False), scene, notes[0])]
     return argv
 
 
-def refuse_unread_accuracy(configs: Sequence[DictConfig], overrides: Sequence[str]) -> None:
-    """ConfigError when the command line gives ``accuracy`` and no job's integrator reads it
-    (``gyrolab.engine.unread``). A sweep over integrators (``-m integrator=auto,taylor accuracy=1e-8``) gives the
-    target to the jobs that read it; the others run at their own settings, warn and record it, as for a value
-    from a config file."""
-    if ACCURACY not in given_keys(overrides):
-        return
-    sentences = [unread_accuracy(composed) for composed in configs]
-    if all(sentences):
-        raise unread_refusal(configs[0], sentences[0])
+@dataclasses.dataclass
+class Prepared:
+    """What the preflight of a plain run built, for the run to use rather than build again."""
+
+    #: the scene config it was built from, unresolved (the run's must be the same)
+    config: dict
+    #: the scene, built once (None: the task builds its own)
+    scene: Scene | None
+    #: why the config's ``accuracy`` goes unread (``gyrolab.engine.unread.ignored_accuracy``), or None
+    accuracy_ignored: str | None
+
+
+#: the preflight's work for the run of this command (at most one)
+_prepared: list[Prepared] = []
+
+
+def take_prepared(cfg: DictConfig) -> Prepared | None:
+    """The preflight's work, if it was done for ``cfg``: the same config, with no resolver whose value could
+    differ between the preflight and the run (``${now:...}``, ``${oc.env:...}``, ``${hydra:...}``)."""
+    prepared = _prepared.pop() if _prepared else None
+    if prepared is None or "${" in repr(prepared.config):
+        return None
+    return prepared if OmegaConf.to_container(cfg, resolve=False) == prepared.config else None
+
+
+def accuracy_notes(configs: Sequence[DictConfig], overrides: Sequence[str]) -> list[str | None]:
+    """Each config's note on an ``accuracy`` its integrator does not read (``gyrolab.engine.unread``), or None; a
+    ConfigError when the command line gives ``accuracy`` and no job's integrator reads it. A sweep over integrators
+    (``-m integrator=auto,taylor accuracy=1e-8``) gives the target to the jobs that read it; the others run at their
+    own settings, warn and record it, as for a value from a config file."""
+    notes = [ignored_accuracy(composed, overrides) for composed in configs]
+    if ACCURACY in given_keys(overrides) and all(notes):
+        raise unread_refusal(configs[0], unread_accuracy(configs[0]))
+    return notes
 
 
 def _output_dir_text(cfg: DictConfig, mode: str) -> str:
@@ -279,12 +305,12 @@ def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
                               "sweep, so give a single value")
 
 
-def validate_scene(scene_cfg: DictConfig) -> None:
-    """The checks every run's scene config passes: schema, tolerances, budget, the scene's own validation."""
+def validate_scene(scene_cfg: DictConfig, plain: dict) -> Scene | None:
+    """The checks every run's scene config passes beyond its schema (``plain``: ``check_scene_config``'s answer):
+    tolerances, budget, the scene's own validation; the scene, built once, for a task that runs it."""
     from gyrolab.batch.scheduler import check_configured
     from gyrolab.experiments import TASKS
 
-    plain = check_scene_config(scene_cfg)
     require_finite(plain, "")
     figure_options(plain.get("output"))  # figure formats and dpi, before anything runs
     check_tolerances(plain)
@@ -295,17 +321,18 @@ def validate_scene(scene_cfg: DictConfig) -> None:
         hint = f"did you mean task={close[0]}? " if close else ""
         raise ConfigError(f"unknown task {shorten(repr(task))}; {hint}valid choices: {choices(['scene', *TASKS])}")
     if task not in ("scene", "regime"):
-        return  # an experiment validates the scenes it composes
-    probe = scene_cfg.copy()
-    with open_dict(probe):
-        probe.time.n_output = 2  # the state's size, before allocating n_output samples
-    check_budget(plain, Scene.from_config(probe).system.initial_state().size)
-    if task_of(scene_cfg) == "regime":  # the regime's domain is checked before anything is written
+        return None  # an experiment validates the scenes it composes
+    if task == "regime":  # the regime's domain is checked before anything is written
         from gyrolab.experiments.regime_run import prepare
 
+        probe = scene_cfg.copy()
+        with open_dict(probe):
+            probe.time.n_output = 2  # the state's size, before allocating n_output samples
+        check_budget(plain, Scene.from_config(probe).system.initial_state().size)
         prepare(scene_cfg, report=False)   # the run reports the domain warnings (once)
-    else:
-        Scene.from_config(scene_cfg)
+        return None
+    # the budget as soon as the state's size is known, before n_output samples are allocated
+    return Scene.from_config(scene_cfg, check=lambda system: check_budget(plain, system.initial_state().size))
 
 
 def check_plugin_names(overrides: Sequence[Override]) -> None:
@@ -413,9 +440,11 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     from gyrolab.output.dataset import write_dataset
 
     task = task_of(cfg)
+    prepared = take_prepared(cfg) if job_id is None else None  # a plain run: the preflight's scene and note
     # an accuracy the integrator does not read (the preflight refused one the command line gave to every job): said,
     # and recorded in run.nc; for the tasks that run the scene's integrator
-    ignored = (ignored_accuracy(cfg, HydraConfig.get().overrides.task) if task in ("scene", "regime") else None)
+    ignored = None if task not in ("scene", "regime") else prepared.accuracy_ignored if prepared else \
+        ignored_accuracy(cfg, HydraConfig.get().overrides.task)
     if ignored:
         log.warning("%s", ignored)
     if task != "scene":
@@ -425,7 +454,7 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
         for path in written:
             announce_written(path)
         return written[0]
-    scene = Scene.from_config(cfg)
+    scene = prepared.scene if prepared and prepared.scene else Scene.from_config(cfg)
     scene.accuracy_ignored = ignored  # in the dataset's attributes, as compose_scene records it
     ds = scene.run()
     ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
@@ -631,6 +660,7 @@ def quiet_logging_failures() -> None:
 
 
 def _main(argv: list[str]) -> None:
+    _prepared.clear()  # nothing from an earlier command of this process
     try:
         from gyrolab.app.parser import split_command
 

@@ -73,7 +73,9 @@ class Scene:
     accuracy_ignored: str | None = None
 
     @classmethod
-    def from_config(cls, cfg: DictConfig) -> Scene:
+    def from_config(cls, cfg: DictConfig, check: Callable[[System], None] | None = None) -> Scene:
+        """The scene of a composed config; ``check`` (the preflight's budget) is given the system as soon as it is
+        built, before the output times are allocated or the integrator built."""
         plain = OmegaConf.to_container(cfg, resolve=True)
         require_finite(plain, "")
         system_cls = _plugin_class("system", cfg.system, "system")
@@ -83,6 +85,8 @@ class Scene:
             for name, node in (cfg.get("force") or {}).items()
         ]
         system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
+        if check is not None:
+            check(system)
         check_force_claims(system, float(plain["time"].get("start", 0.0) or 0.0))
         timed = [f.name for f in forces if f.time_dependent]
         if timed and system.name != "fixed_point":
