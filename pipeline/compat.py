@@ -23,13 +23,18 @@ xarray 2026.9, Dask installed; ``docs/performance.md``):
 
 Dropped for a small gain: ``xr.Dataset._construct_direct`` for the run dataset (~1 ms of a 25 ms run).
 
+* **Hydra's run of a parsed command line** (:func:`run_hydra`, Hydra ``1.3.x``): ``_run_hydra``, what
+  ``@hydra.main`` calls with the namespace its parser read from ``sys.argv``, called with the namespace of
+  gyrolab's one command-line parser; otherwise ``hydra.main`` on ``sys.argv`` rebuilt from that namespace.
+
 Also here, with no fallback (``pyproject.toml`` pins ``hydra-core>=1.3,<1.4`` for them): the private Hydra
-functions the preflight needs to compose exactly what ``@hydra.main`` will run (the search path, Hydra's
-argument parser, ``_run_hydra``) and those gyrolab's sweeper applies job overrides with.
+functions the preflight needs to compose exactly what Hydra will run (the search path, Hydra's argument
+parser) and those gyrolab's sweeper applies job overrides with.
 """
 
 from __future__ import annotations
 
+import argparse
 import copy
 import os
 import sys
@@ -42,7 +47,7 @@ import hydra
 from hydra import version as hydra_version
 from hydra._internal.config_loader_impl import ConfigLoaderImpl, get_overrides_dirname
 from hydra._internal.defaults_list import create_defaults_list
-from hydra._internal.utils import _run_hydra, create_automatic_config_search_path, get_args_parser
+from hydra._internal.utils import create_automatic_config_search_path, get_args_parser
 from hydra.conf import ConfigSourceInfo
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override
@@ -84,11 +89,34 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(name)
 
 
-def run_hydra(args: Any, task_function: Any, config_path: str, config_name: str) -> None:
-    """What ``@hydra.main(config_path, config_name)``'s function does with the command line, given it parsed
-    (``args``: Hydra's own parser's namespace) rather than read from ``sys.argv``."""
-    _run_hydra(args=args, args_parser=get_args_parser(), task_function=task_function, config_path=config_path,
-               config_name=config_name)
+def run_hydra(args: argparse.Namespace, parser: argparse.ArgumentParser, task_function: Any, config_path: str,
+              config_name: str) -> None:
+    """What ``@hydra.main(config_path, config_name, version_base="1.3")`` does with a command line, given it parsed
+    (``args``, by ``parser``: Hydra's options and gyrolab's) rather than read from ``sys.argv``. Under a Hydra
+    outside ``HYDRA_SUPPORTED``: ``hydra.main`` itself, on a ``sys.argv`` rebuilt from ``args`` (``hydra_argv``)."""
+    hydra_version.setbase("1.3")
+    if hydra_supported():
+        from hydra._internal.utils import _run_hydra
+
+        _run_hydra(args=args, args_parser=parser, task_function=task_function, config_path=config_path,
+                   config_name=config_name)
+        return
+    saved = sys.argv[1:]
+    sys.argv[1:] = hydra_argv(args)
+    try:
+        hydra.main(config_path=config_path, config_name=config_name, version_base="1.3")(task_function)()
+    finally:
+        sys.argv[1:] = saved
+
+
+def hydra_argv(args: argparse.Namespace) -> list[str]:
+    """The command line Hydra's own parser reads as ``args``: its options, then the overrides."""
+    words: list[str] = []
+    for action in get_args_parser()._actions:
+        value = getattr(args, action.dest, None)
+        if action.option_strings and value not in (None, False) and action.dest != "version":
+            words += action.option_strings[:1] if action.nargs == 0 else [action.option_strings[0], str(value)]
+    return [*words, *args.overrides]
 
 
 # --- one composition per command (Hydra 1.3) ---

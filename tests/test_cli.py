@@ -86,8 +86,12 @@ def test_every_experiment_runs_from_the_command_line(selector, cli, tmp_path):
 
 # ---- the command line's grammar: subcommands, old spellings, options anywhere ------------------------------------
 
-from gyrolab.app.parser import ALIASES, COMMANDS, build_parsers, split_command  # noqa: E402
+from gyrolab.app.parser import (ALIASES, COMMANDS, build_parsers, parse_command_line, run_parser,  # noqa: E402
+                                 split_command, value_options)
 from gyrolab.errors import ConfigError  # noqa: E402
+
+#: the options that take a value, read from every subcommand's parser
+OPTIONS = value_options({"run": run_parser(), **build_parsers()})
 
 
 @pytest.mark.parametrize("argv, command, rest", [
@@ -110,12 +114,48 @@ from gyrolab.errors import ConfigError  # noqa: E402
     (["time.end=1", "plot"], "run", ["time.end=1", "plot"]),                  # after an override, a word is a value
 ])
 def test_the_subcommand_is_found_wherever_it_is_spelled(argv, command, rest):
-    assert split_command(argv) == (command, rest)
+    assert split_command(argv, OPTIONS) == (command, rest)
 
 
 def test_an_unknown_subcommand_is_one_sentence_with_the_choices():
     with pytest.raises(ConfigError, match="unknown subcommand 'bach'.*did you mean gyrolab batch\\?.*aggregate"):
-        split_command(["bach", "initial.r0=1,2"])
+        split_command(["bach", "initial.r0=1,2"], OPTIONS)
+
+
+def test_the_options_that_take_a_value_are_read_from_the_parsers():
+    # typed here, not read from the parsers under test: each takes the next word as its value
+    for option in ("--config-dir", "-cd", "--config-path", "-cp", "--config-name", "-cn", "--cfg", "-c", "--package",
+                   "--scheduler", "--animate", "--format", "--frames", "--fps", "-o", "--output", "--points",
+                   "--experimental-rerun", "--info"):
+        assert option in OPTIONS, option
+    assert not {"-m", "--multirun", "--help", "--resolve", "--version", "-V"} & OPTIONS
+    assert split_command(["--points", "plot", "reproduce", "sweep.nc"], OPTIONS) == (
+        "reproduce", ["--points", "plot", "sweep.nc"])
+
+
+@pytest.mark.parametrize("argv, command, expected", [
+    (["time.end=1", "-m", "--config-dir", "conf", "initial.r0=1,2"], "run",
+     {"multirun": True, "config_dir": "conf", "overrides": ["time.end=1", "initial.r0=1,2"], "scheduler": None}),
+    (["--scheduler", "local", "experiment=x", "-V"], "run",
+     {"scheduler": "local", "version": True, "overrides": ["experiment=x"]}),
+    (["reproduce", "sweep.nc", "--points", "0-3"], "reproduce", {"paths": ["sweep.nc"], "points": "0-3"}),
+    (["--batch", "a=1,2", "-cd", "conf"], "batch", {"overrides": ["a=1,2"], "config_dir": "conf"}),
+])
+def test_one_parser_per_subcommand_reads_options_in_any_position(argv, command, expected):
+    found, args = parse_command_line(argv)
+    assert found == command
+    assert {key: getattr(args, key) for key in expected} == expected
+
+
+def test_a_run_leaves_sys_argv_as_it_was(monkeypatch, tmp_path):
+    from gyrolab import app
+
+    argv = ["gyrolab", "--config-dir", str(tmp_path), "time.end=1", "time.n_output=11", "output.figures=false",
+            f"hydra.run.dir={tmp_path}/run"]
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", list(argv))
+    app.main()
+    assert sys.argv == argv and (tmp_path / "run" / "run.nc").is_file()
 
 
 def test_every_old_spelling_names_a_subcommand():

@@ -17,6 +17,7 @@ and ``completion`` (the bash and zsh script). Logs go to stderr, results to stdo
 
 from __future__ import annotations
 
+import argparse
 import atexit
 import copy
 import dataclasses
@@ -32,7 +33,6 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import hydra
 from hydra.core.hydra_config import HydraConfig
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override
@@ -41,7 +41,7 @@ from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
-from gyrolab.compat import composing_once, get_args_parser, install_dask_free_writes
+from gyrolab.compat import composing_once, install_dask_free_writes, run_hydra
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
     ConfigSource,
@@ -92,16 +92,17 @@ def show_warnings_in_one_line() -> None:
     warnings.showwarning = show
 
 
-def preflight(argv: Sequence[str]) -> list[str]:
-    """Validate the command line before Hydra creates any output directory; the command line Hydra should run.
+def preflight(args: argparse.Namespace) -> argparse.Namespace:
+    """Validate the command line (``args``: ``gyrolab run``'s options, ``gyrolab.app.parser.run_parser``) before
+    Hydra creates any output directory; the options Hydra should run (``+group=x`` may become ``group=x``).
 
     The config is composed exactly as Hydra will compose it (the same search path,
     primary config and overrides, from a user's ``--config-dir`` too; inside ``main``, Hydra's run is
-    then served from this composition, ``gyrolab.engine.composition``), checked by
+    then served from this composition, ``gyrolab.compat.composing_once``), checked by
     ``gyrolab.engine.safety`` (no config can run code), against the schema (unknown
-    keys, types), the budget, and the scene's own validation.
+    keys, types), the budget, and the scene's own validation. For a plain run the scene it builds is the one
+    the run integrates (``take_prepared``).
     """
-    args, _ = get_args_parser().parse_known_args(list(argv))
     if args.experimental_rerun is not None:  # Hydra unpickles the file: whoever wrote it runs code as you
         raise ConfigError(f"--experimental-rerun {shorten(args.experimental_rerun)} would load a pickle, which runs "
                           "whatever code its writer put there; rerun a dataset with gyrolab reproduce PATH/run.nc")
@@ -112,12 +113,11 @@ def preflight(argv: Sequence[str]) -> list[str]:
         with hydra_for(source):
             cfg = _compose_job(source, list(args.overrides), False)
         check_config(cfg, Path(str(cfg.hydra.run.dir)), command_line=args.overrides)
-        return list(argv)
+        return args
     overrides = parse_overrides(args.overrides)
-    rewritten = _plus_group_as_override(source, list(argv), overrides)
-    if rewritten != list(argv):
-        argv = rewritten
-        args, _ = get_args_parser().parse_known_args(argv)
+    rewritten = _plus_group_as_override(source, list(args.overrides), overrides)
+    if rewritten != list(args.overrides):
+        args = argparse.Namespace(**{**vars(args), "overrides": rewritten})
         overrides = parse_overrides(args.overrides)
     sweeps = [o for o in overrides if o.is_sweep_override()]
     if sweeps and not args.multirun:
@@ -160,7 +160,7 @@ def preflight(argv: Sequence[str]) -> list[str]:
     check_writable(run_dir)
     if not sweeping:  # the run takes the preflight's scene and its accuracy note (_run_locked)
         _prepared[:] = [Prepared(OmegaConf.to_container(scene_cfgs[0], resolve=False), scene, notes[0])]
-    return argv
+    return args
 
 
 @dataclasses.dataclass
@@ -219,11 +219,11 @@ def _output_dir_text(cfg: DictConfig, mode: str) -> str:
 
 
 def _plus_group_as_override(source: ConfigSource, argv: list[str], overrides: Sequence[Override]) -> list[str]:
-    """``+experiment=mine`` as ``experiment=mine`` when the primary config already lists the group.
+    """The overrides ``argv`` with ``+experiment=mine`` as ``experiment=mine`` when the primary config already lists
+    the group.
 
     Hydra refuses to add a group its defaults list has (``experiment: null`` in gyrolab's
-    config.yaml); both spellings are common, so both select the option. The command line
-    Hydra runs is rewritten the same way.
+    config.yaml); both spellings are common, so both select the option.
     """
     adds = [o for o in overrides if o.is_add() and o.key_or_group in SELECTABLE_GROUPS and o.package is None]
     if not adds:
@@ -405,8 +405,8 @@ def check_writable(directory: Path) -> None:
                           "choose a writable hydra.run.dir (or hydra.sweep.dir)") from None
 
 
-@hydra.main(config_path="pkg://gyrolab.conf", config_name="config", version_base="1.3")
 def _task(cfg: DictConfig) -> None:
+    """Hydra's task: one run, or one job of a multirun (``gyrolab.compat.run_hydra`` calls it as ``@hydra.main`` does)."""
     hydra_cfg = HydraConfig.get()
     out_dir = Path(hydra_cfg.runtime.output_dir)
     if hydra_cfg.mode == RunMode.MULTIRUN:
@@ -489,68 +489,31 @@ def run_command(argv: Sequence[str]) -> int | None:
     """The subcommand ``argv`` names (``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``,
     ``completion``, or an old spelling ``--batch``, ...; options in any position): its exit status, or None for
     ``run`` (Hydra's app, the default)."""
-    from gyrolab.app.parser import split_command
+    from gyrolab.app.parser import parse_command_line
 
-    command, rest = split_command(argv)
-    return None if command == "run" else run_subcommand(command, rest)
+    command, args = parse_command_line(argv)
+    return None if command == "run" else run_subcommand(command, args)
 
 
-def run_subcommand(command: str, argv: Sequence[str]) -> int:
-    """Parse ``argv`` with ``command``'s parser (``gyrolab.app.parser``) and run it (``gyrolab.app.commands``)."""
+def run_subcommand(command: str, args: argparse.Namespace) -> int:
+    """Run ``command`` (not ``run``) with its parsed options (``gyrolab.app.commands``)."""
     from gyrolab.app.commands import RUNNERS
-    from gyrolab.app.parser import parse
 
-    args = parse(command, argv)
     if hasattr(args, "config_dir"):
         use_source(ConfigSource.from_args(args.config_path, args.config_name, args.config_dir))
     return RUNNERS[command](args)
 
 
-#: Hydra's options that choose where configs come from, long and short
-SOURCE_OPTIONS = {"--config-dir": "config_dir", "-cd": "config_dir", "--config-path": "config_path",
-                  "-cp": "config_path", "--config-name": "config_name", "-cn": "config_name"}
-
-
-def split_source_options(argv: Sequence[str]) -> tuple[ConfigSource, list[str]]:
-    """(the config source named by leading ``--config-dir``/``--config-path``/``--config-name``, the rest)."""
-    given: dict[str, str] = {}
-    rest = list(argv)
-    while rest and rest[0].split("=", 1)[0] in SOURCE_OPTIONS:
-        option, has_value, value = rest.pop(0).partition("=")
-        if not has_value:
-            if not rest:
-                raise ConfigError(f"{option} needs a value, e.g. {option} myconf")
-            value = rest.pop(0)
-        given[SOURCE_OPTIONS[option]] = value
-    source = ConfigSource.from_args(given.get("config_path"), given.get("config_name"), given.get("config_dir"))
-    return source, rest
-
-
-def absolute_config_path(argv: Sequence[str]) -> list[str]:
-    """``argv`` with a relative ``--config-path`` made absolute from the working directory.
+def absolute_config_path(args: argparse.Namespace) -> argparse.Namespace:
+    """``args`` with a relative ``--config-path`` made absolute from the working directory.
 
     Hydra reads a relative --config-path against the folder of the app's source file,
     which is inside the installed package; a user means the working directory.
     """
-    out = list(argv)
-    for i, arg in enumerate(out):
-        option, has_value, value = arg.partition("=")
-        if option in ("--config-path", "-cp"):
-            if has_value and value and not value.startswith("pkg://"):
-                out[i] = f"{option}={os.path.abspath(value)}"
-            elif not has_value and i + 1 < len(out) and not out[i + 1].startswith("pkg://"):
-                out[i + 1] = os.path.abspath(out[i + 1])
-    return out
-
-
-def _plot(argv: Sequence[str]) -> int:
-    """``--plot PATH ...`` (kept for callers of the old function): ``gyrolab plot``."""
-    return run_subcommand("plot", [a for a in (argv[0].partition("=")[2], *argv[1:]) if a])
-
-
-def _batch(overrides: Sequence[str]) -> int:
-    """``--batch OVERRIDES`` (kept for callers of the old function): ``gyrolab batch``."""
-    return run_subcommand("batch", list(overrides))
+    path = args.config_path
+    if path and not path.startswith("pkg://"):
+        args.config_path = os.path.abspath(path)
+    return args
 
 
 def _sweep_status(summary: SweepSummary | None = None) -> int:
@@ -574,12 +537,11 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
     return 1
 
 
-def shell_completion(argv: Sequence[str]) -> int:
+def shell_completion(args: argparse.Namespace) -> int:
     """Hydra's ``--shell-completion install=bash`` (or ``zsh``, ``uninstall=...``): gyrolab's own completion
     script (``gyrolab.app.completion``), which knows the subcommands; Hydra's cannot see an installed app."""
     from gyrolab.app.completion import SHELLS, script
 
-    args, _ = get_args_parser().parse_known_args(list(argv))
     args_list = list(args.overrides)
     action, _, shell = (args_list[0] if len(args_list) == 1 else "").partition("=")
     if action not in ("install", "uninstall") or shell not in SHELLS:
@@ -604,7 +566,7 @@ def main() -> None:
     previous = signal.signal(signal.SIGTERM, _terminated)
     try:
         with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
-            _main(absolute_config_path(sys.argv[1:]))
+            _main(sys.argv[1:])
     except KeyboardInterrupt as interruption:  # Ctrl-C or SIGTERM: every write is whole or absent, locks released
         from gyrolab.output.lock import release_all
 
@@ -662,23 +624,24 @@ def quiet_logging_failures() -> None:
 def _main(argv: list[str]) -> None:
     _prepared.clear()  # nothing from an earlier command of this process
     try:
-        from gyrolab.app.parser import split_command
+        from gyrolab.app.parser import parse_command_line, run_parser
 
-        command, argv = split_command(argv)
-        if command == "run":  # --scheduler ADDRESS: the only config-free way to Dask, for experiments run by Hydra too
-            from gyrolab.batch.scheduler import take_scheduler_option
-
-            argv = take_scheduler_option(argv)
-        sys.argv[1:] = argv
-        if command == "run" and ("--version" in argv or "-V" in argv):
+        command, args = parse_command_line(argv)
+        if command != "run":
+            sys.exit(run_subcommand(command, args))
+        if args.version:
             from gyrolab.output.provenance import gyrolab_version
 
             print(f"gyrolab {gyrolab_version()}")
             sys.exit(0)
-        if command != "run":
-            sys.exit(run_subcommand(command, argv))
-        if "--shell-completion" in argv or "-sc" in argv:
-            sys.exit(shell_completion(argv))
+        from gyrolab.batch.scheduler import use_command_line_scheduler
+
+        # --scheduler ADDRESS: the only config-free way to Dask, for experiments run by Hydra too; None when not
+        # given, so no value is left from an earlier command
+        use_command_line_scheduler(args.scheduler)
+        if args.shell_completion:
+            sys.exit(shell_completion(args))
+        args = absolute_config_path(args)
         from gyrolab.output.trust import check_kernel_cache
 
         check_kernel_cache()  # before the preflight, which may load a compiled kernel
@@ -687,7 +650,7 @@ def _main(argv: list[str]) -> None:
 
         register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), before Hydra instantiates it
         with compile_notes_on_console():  # the preflight may compile a force plugin's torque
-            sys.argv[1:] = preflight(argv)
+            args = preflight(args)
     except GyrolabError as error:
         fail(error)
     from gyrolab.sweep import callbacks
@@ -700,7 +663,7 @@ def _main(argv: list[str]) -> None:
     from gyrolab.output.lock import release_all
 
     try:
-        _task()
+        run_hydra(args, run_parser(), _task, config_path="pkg://gyrolab.conf", config_name="config")
     finally:
         release_all()  # a failed run's lock too (Hydra skips the callback's on_run_end when the job exits)
     status = _sweep_status()
