@@ -1,5 +1,6 @@
 """The gyrolab command: default scene, figures, multirun; subcommands, help, batch's sweep, the logging convention."""
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -351,3 +352,41 @@ def test_the_run_builds_its_own_scene_when_its_config_is_not_the_preflights(monk
     prepared = app.Prepared({"time": {"end": 1}}, object(), "note")
     app._prepared[:] = [prepared]
     assert app.take_prepared(cfg) is prepared
+
+
+@pytest.mark.parametrize("argv", [
+    ["-m", "time.end=1", "--config-dir", "conf", "initial.r0=1,2", "--info", "config"],
+    ["--cfg", "job", "--resolve", "-p", "time", "-cn", "config", "body.a=2"],
+    ["--help", "--scheduler", "local", "-V"],
+])
+def test_the_command_line_rebuilt_for_hydra_reads_as_the_parsed_one(argv):
+    from gyrolab.compat import get_args_parser, hydra_argv
+
+    ours = vars(run_parser().parse_intermixed_args(argv))
+    hydras = vars(get_args_parser().parse_args(hydra_argv(argparse.Namespace(**ours))))
+    assert hydras == {key: ours[key] for key in hydras} and len(hydras) == len(ours) - 2  # not --version, --scheduler
+
+
+def test_under_a_hydra_it_was_not_written_for_the_run_is_hydra_mains(monkeypatch, tmp_path):
+    # outside Hydra 1.3.x: no composition memo, and hydra.main reads the command line from sys.argv (restored after)
+    import hydra
+
+    from gyrolab import app, compat
+
+    argv = ["gyrolab", "time.end=1", "time.n_output=11", "output.figures=false", f"hydra.run.dir={tmp_path}/run"]
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", list(argv))
+    monkeypatch.setattr(hydra, "__version__", "1.4.0")
+    seen = []
+    main = hydra.main
+
+    def watched(*args, **kwargs):
+        seen.append((list(sys.argv), compat.active))
+        return main(*args, **kwargs)
+
+    monkeypatch.setattr(hydra, "main", watched)
+    app.main()
+    assert seen == [(["gyrolab", *argv[1:]], None)]
+    assert sys.argv == argv
+    with xr.open_dataset(tmp_path / "run" / "run.nc") as ds:
+        assert ds.sizes["time"] == 11
