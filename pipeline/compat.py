@@ -1,35 +1,27 @@
-"""The one place where gyrolab reaches into Hydra's and xarray's internals, each use checked against the library
-version it was written for, with the library's own public path otherwise.
+"""The one place where gyrolab reaches into Hydra's and xarray's internals: each use is checked against the
+library version it was written for and takes the library's own public path otherwise.
 
-Kept because their measured gain is large (``gyrolab`` with and without each, best of 3 CPU s, Hydra 1.3.8,
-xarray 2026.9, Dask installed; ``docs/performance.md``):
+Kept for their measured gain (``gyrolab`` with and without each, best of 3, CPU s; Hydra 1.3.8, xarray 2026.9):
 
-* **One composition per command** (:func:`composing_once`, Hydra ``1.3.x``): a plain run composed its
-  config three times (the preflight, Hydra's ``get_mode`` and Hydra's run), a sweep of N jobs N + 4 times,
-  each composition reading every YAML file of the defaults list again. Inside the block Hydra's
+* :func:`composing_once` (Hydra 1.3.x): one composition per command. A plain run composed its config three
+  times (the preflight, Hydra's ``get_mode`` and its run), a sweep of N jobs N + 4 times. Inside the block
   ``ConfigLoaderImpl._load_configuration_impl`` composes the *skeleton* (the defaults list and the config
-  merged from it, which depend only on the primary config, the search path and the overrides that choose
-  config-group options) once per distinct set of those, with Hydra's own functions in Hydra's order, and
-  serves every request from a copy of it: the value overrides applied with Hydra's function and the
-  ``hydra`` node filled in by a copy of the tail of Hydra 1.3's ``_load_configuration_impl``. Gain: 0.16 s
-  of a 1.9 s default run, 0.85 s of a 10-job sweep (~85 ms a job). Which overrides shape the defaults list
-  follows Hydra 1.3's rule (``defaults_list.Overrides``); a request Hydra's defaults list classifies
-  otherwise is composed by Hydra itself. ``tests/test_sweep_composition.py`` compares both paths' configs
-  for every job of a set of sweeps.
-* **Writes without Dask** (:func:`install_dask_free_writes`, xarray ``XARRAY_SUPPORTED``): with Dask installed
-  (the ``cluster`` and ``test`` extras) ``to_netcdf`` imports ``dask.array`` and ``distributed`` for any
-  dataset, only to learn that nothing in it is Dask's. Gain: 0.45 CPU s of every run and sweep (none on
-  the bare install, which has no Dask).
+  merged from it, shaped only by the primary config, the search path and the group choices) once per set of
+  group choices, with Hydra's functions in Hydra's order, and serves each request from a copy: the value
+  overrides applied with Hydra's function, the ``hydra`` node filled by a copy of the tail of Hydra 1.3's
+  ``_load_configuration_impl``; a request Hydra classifies otherwise is Hydra's own. Gain: 0.16 s of a 1.9 s
+  run, ~85 ms a sweep job. ``tests/test_sweep_composition.py`` compares both paths for every job of sweeps.
+* :func:`install_dask_free_writes` (xarray ``XARRAY_SUPPORTED``): with Dask installed, ``to_netcdf`` imports
+  ``dask.array`` and ``distributed`` for any dataset only to learn that nothing in it is Dask's. Gain: 0.45 s
+  of every run and sweep with the ``test`` or ``cluster`` extra (none on the bare install).
+* :func:`run_hydra` (Hydra 1.3.x): ``_run_hydra``, which ``@hydra.main`` calls with the namespace it parsed
+  from ``sys.argv``, given the namespace of gyrolab's own parser; otherwise ``hydra.main`` on ``sys.argv``
+  rebuilt from it.
 
-Dropped for a small gain: ``xr.Dataset._construct_direct`` for the run dataset (~1 ms of a 25 ms run).
-
-* **Hydra's run of a parsed command line** (:func:`run_hydra`, Hydra ``1.3.x``): ``_run_hydra``, what
-  ``@hydra.main`` calls with the namespace its parser read from ``sys.argv``, called with the namespace of
-  gyrolab's one command-line parser; otherwise ``hydra.main`` on ``sys.argv`` rebuilt from that namespace.
-
-Also here, with no fallback (``pyproject.toml`` pins ``hydra-core>=1.3,<1.4`` for them): the private Hydra
-functions the preflight needs to compose exactly what Hydra will run (the search path, Hydra's argument
-parser) and those gyrolab's sweeper applies job overrides with.
+Dropped: ``xr.Dataset._construct_direct`` for the run dataset (~1 ms of a 25 ms run). Also here, with no
+fallback (``pyproject.toml`` pins ``hydra-core>=1.3,<1.4``): the private functions the preflight composes
+with exactly as Hydra will (the search path, Hydra's argument parser), and those gyrolab's sweeper applies
+job overrides with.
 """
 
 from __future__ import annotations
@@ -47,16 +39,13 @@ import hydra
 from hydra import version as hydra_version
 from hydra._internal.config_loader_impl import ConfigLoaderImpl, get_overrides_dirname
 from hydra._internal.defaults_list import create_defaults_list
-from hydra._internal.utils import create_automatic_config_search_path, get_args_parser
+from hydra._internal.utils import create_automatic_config_search_path, get_args_parser  # noqa: F401 - re-exported
 from hydra.conf import ConfigSourceInfo
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override
 from hydra.core.utils import JobRuntime
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
-
-__all__ = ["ConfigLoaderImpl", "composing_once", "create_automatic_config_search_path", "get_args_parser",
-           "install_dask_free_writes", "run_hydra"]
 
 #: the versions each kept patch was written for: (first, first not supported), by (major, minor)
 HYDRA_SUPPORTED = ((1, 3), (1, 4))
