@@ -454,7 +454,11 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
         for path in written:
             announce_written(path)
         return written[0]
-    scene = prepared.scene if prepared and prepared.scene else Scene.from_config(cfg)
+    if prepared and prepared.scene:
+        scene = prepared.scene
+        scene.log_notes()  # into the run's log, as a scene built here says them
+    else:
+        scene = Scene.from_config(cfg)
     scene.accuracy_ignored = ignored  # in the dataset's attributes, as compose_scene records it
     ds = scene.run()
     ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)

@@ -119,14 +119,17 @@ class Scene:
                 valid = _choices_with(accept=lambda c: (c.supports(COMPILED_MODEL) or c.supports(PREFERS_COMPILED_MODEL))
                                       and c is not type(integrator) and c.refusal(compiled, system) is None)
                 raise ConfigError(f"integrator {integrator.name!r} {refusal}; choose {valid}")
-        elif integrator.supports(PREFERS_COMPILED_MODEL):
-            reason = system.compile_error
-            if reason:
-                log.info("%s; %s runs scipy's integrators", reason, integrator.name)
-        warning = scene.sampling_warning()
+        scene.log_notes()
+        return scene
+
+    def log_notes(self) -> None:
+        """Log what the scene's user should know: output times that undersample its motion (a warning), scipy's
+        integrators running where a compiled model could not be built (info)."""
+        if self.compiled is None and self.integrator.supports(PREFERS_COMPILED_MODEL) and self.system.compile_error:
+            log.info("%s; %s runs scipy's integrators", self.system.compile_error, self.integrator.name)
+        warning = self.sampling_warning()
         if warning:
             log.warning("%s", warning)
-        return scene
 
     @cached_property
     def config_yaml(self) -> str:
