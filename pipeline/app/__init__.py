@@ -114,32 +114,9 @@ def preflight(args: argparse.Namespace) -> argparse.Namespace:
             cfg = _compose_job(source, list(args.overrides), False)
         check_config(cfg, Path(str(cfg.hydra.run.dir)), command_line=args.overrides)
         return args
-    overrides = parse_overrides(args.overrides)
-    rewritten = _plus_group_as_override(source, list(args.overrides), overrides)
-    if rewritten != list(args.overrides):
-        args = argparse.Namespace(**{**vars(args), "overrides": rewritten})
-        overrides = parse_overrides(args.overrides)
-    sweeps = [o for o in overrides if o.is_sweep_override()]
-    if sweeps and not args.multirun:
-        raise ConfigError(f"{shorten(sweeps[0].input_line)!r} is a sweep; run it with -m (gyrolab -m "
-                          f"{shorten(sweeps[0].input_line)} ...), or give one value")
+    args, overrides = _checked_overrides(source, args)
     sweeping = bool(args.multirun)
-    check_launcher_installed(overrides)
-    if sweeping:
-        _refuse_swept_hydra_settings(overrides)
-        check_sweep_size(overrides)  # before anything expands a range(0,1e12,1)
-        Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
-    with hydra_for(source):
-        # One job composed and validated: the first value of every sweep (each group choice checked for safety).
-        first = _compose_job(source, _job_overrides(overrides, {}), sweeping)
-    with hydra_for(dataclasses.replace(source, searchpath=tuple(first.hydra.searchpath or ()))):
-        check_plugin_names(overrides)  # every value of every swept group
-        configs = [first]
-        swept = [*overrides, *(_sweeper_params(configs[0]) if sweeping else [])]
-        for o in swept:
-            if o.is_sweep_override() and _is_group(o, configs[0]):
-                values = list(o.sweep_string_iterator())[(1 if o in overrides else 0):]  # the first: composed
-                configs += [_compose_job(source, _job_overrides(swept, {id(o): value}), sweeping) for value in values]
+    configs = _compose_jobs(source, overrides, sweeping)
     cfg = configs[0]
     scene_cfgs = [_without_hydra(composed) for composed in configs]
     plains = [check_scene_config(scene_cfg) for scene_cfg in scene_cfgs]
@@ -161,6 +138,42 @@ def preflight(args: argparse.Namespace) -> argparse.Namespace:
     if not sweeping:  # the run takes the preflight's scene and its accuracy note (_run_locked)
         _prepared[:] = [Prepared(OmegaConf.to_container(scene_cfgs[0], resolve=False), scene, notes[0])]
     return args
+
+
+def _checked_overrides(source: ConfigSource, args: argparse.Namespace) -> tuple[argparse.Namespace, list[Override]]:
+    """(``args`` with ``+group=x`` as ``group=x`` where the group is listed, its overrides parsed), or one sentence:
+    a malformed override, a sweep without -m, a launcher not installed, a sweep Hydra cannot run."""
+    overrides = parse_overrides(args.overrides)
+    rewritten = _plus_group_as_override(source, list(args.overrides), overrides)
+    if rewritten != list(args.overrides):
+        args = argparse.Namespace(**{**vars(args), "overrides": rewritten})
+        overrides = parse_overrides(args.overrides)
+    sweeps = [o for o in overrides if o.is_sweep_override()]
+    if sweeps and not args.multirun:
+        raise ConfigError(f"{shorten(sweeps[0].input_line)!r} is a sweep; run it with -m (gyrolab -m "
+                          f"{shorten(sweeps[0].input_line)} ...), or give one value")
+    check_launcher_installed(overrides)
+    if args.multirun:
+        _refuse_swept_hydra_settings(overrides)
+        check_sweep_size(overrides)  # before anything expands a range(0,1e12,1)
+        Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
+    return args, overrides
+
+
+def _compose_jobs(source: ConfigSource, overrides: list[Override], sweeping: bool) -> list[DictConfig]:
+    """The configs to validate: the first job (the first value of every sweep), then one per other value of each
+    swept config group (from the command line or the config's ``hydra.sweeper.params``), each option composed."""
+    with hydra_for(source):
+        first = _compose_job(source, _job_overrides(overrides, {}), sweeping)
+    with hydra_for(dataclasses.replace(source, searchpath=tuple(first.hydra.searchpath or ()))):
+        check_plugin_names(overrides)  # every value of every swept group
+        configs = [first]
+        swept = [*overrides, *(_sweeper_params(first) if sweeping else [])]
+        for o in swept:
+            if o.is_sweep_override() and _is_group(o, first):
+                values = list(o.sweep_string_iterator())[(1 if o in overrides else 0):]  # the first: composed
+                configs += [_compose_job(source, _job_overrides(swept, {id(o): value}), sweeping) for value in values]
+    return configs
 
 
 @dataclasses.dataclass
