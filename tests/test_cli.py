@@ -1,5 +1,6 @@
 """The gyrolab command: default scene, figures, multirun; subcommands, help, batch's sweep, the logging convention."""
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -86,8 +87,12 @@ def test_every_experiment_runs_from_the_command_line(selector, cli, tmp_path):
 
 # ---- the command line's grammar: subcommands, old spellings, options anywhere ------------------------------------
 
-from gyrolab.app.parser import ALIASES, COMMANDS, build_parsers, split_command  # noqa: E402
+from gyrolab.app.parser import (ALIASES, COMMANDS, build_parsers, parse_command_line, run_parser,  # noqa: E402
+                                 split_command, value_options)
 from gyrolab.errors import ConfigError  # noqa: E402
+
+#: the options that take a value, read from every subcommand's parser
+OPTIONS = value_options({"run": run_parser(), **build_parsers()})
 
 
 @pytest.mark.parametrize("argv, command, rest", [
@@ -110,12 +115,48 @@ from gyrolab.errors import ConfigError  # noqa: E402
     (["time.end=1", "plot"], "run", ["time.end=1", "plot"]),                  # after an override, a word is a value
 ])
 def test_the_subcommand_is_found_wherever_it_is_spelled(argv, command, rest):
-    assert split_command(argv) == (command, rest)
+    assert split_command(argv, OPTIONS) == (command, rest)
 
 
 def test_an_unknown_subcommand_is_one_sentence_with_the_choices():
     with pytest.raises(ConfigError, match="unknown subcommand 'bach'.*did you mean gyrolab batch\\?.*aggregate"):
-        split_command(["bach", "initial.r0=1,2"])
+        split_command(["bach", "initial.r0=1,2"], OPTIONS)
+
+
+def test_the_options_that_take_a_value_are_read_from_the_parsers():
+    # typed here, not read from the parsers under test: each takes the next word as its value
+    for option in ("--config-dir", "-cd", "--config-path", "-cp", "--config-name", "-cn", "--cfg", "-c", "--package",
+                   "--scheduler", "--animate", "--format", "--frames", "--fps", "-o", "--output", "--points",
+                   "--experimental-rerun", "--info"):
+        assert option in OPTIONS, option
+    assert not {"-m", "--multirun", "--help", "--resolve", "--version", "-V"} & OPTIONS
+    assert split_command(["--points", "plot", "reproduce", "sweep.nc"], OPTIONS) == (
+        "reproduce", ["--points", "plot", "sweep.nc"])
+
+
+@pytest.mark.parametrize("argv, command, expected", [
+    (["time.end=1", "-m", "--config-dir", "conf", "initial.r0=1,2"], "run",
+     {"multirun": True, "config_dir": "conf", "overrides": ["time.end=1", "initial.r0=1,2"], "scheduler": None}),
+    (["--scheduler", "local", "experiment=x", "-V"], "run",
+     {"scheduler": "local", "version": True, "overrides": ["experiment=x"]}),
+    (["reproduce", "sweep.nc", "--points", "0-3"], "reproduce", {"paths": ["sweep.nc"], "points": "0-3"}),
+    (["--batch", "a=1,2", "-cd", "conf"], "batch", {"overrides": ["a=1,2"], "config_dir": "conf"}),
+])
+def test_one_parser_per_subcommand_reads_options_in_any_position(argv, command, expected):
+    found, args = parse_command_line(argv)
+    assert found == command
+    assert {key: getattr(args, key) for key in expected} == expected
+
+
+def test_a_run_leaves_sys_argv_as_it_was(monkeypatch, tmp_path):
+    from gyrolab import app
+
+    argv = ["gyrolab", "--config-dir", str(tmp_path), "time.end=1", "time.n_output=11", "output.figures=false",
+            f"hydra.run.dir={tmp_path}/run"]
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", list(argv))
+    app.main()
+    assert sys.argv == argv and (tmp_path / "run" / "run.nc").is_file()
 
 
 def test_every_old_spelling_names_a_subcommand():
@@ -268,3 +309,84 @@ def test_logs_go_to_stderr_and_results_to_stdout(cli, tmp_path):
     assert aggregate.returncode == 0, aggregate.stderr
     assert aggregate.stdout.splitlines() == ["wrote sweep/sweep.nc"]
     assert "[INFO]" in aggregate.stderr
+
+
+# ---- one run, one scene -------------------------------------------------------------------------------------------
+
+def test_a_plain_run_builds_one_scene_and_checks_its_config_once(monkeypatch, tmp_path):
+    """The preflight's scene is the one the run integrates: one composition's config checked once against the
+    schema, one question whether the integrator reads ``accuracy``, one ``Scene``."""
+    from gyrolab import app
+    from gyrolab.engine.scene import Scene
+
+    calls = {"scene": 0, "check": 0, "accuracy": 0}
+
+    def counting(name, function):
+        def counted(*args, **kwargs):
+            calls[name] += 1
+            return function(*args, **kwargs)
+        return counted
+
+    built = Scene.from_config.__func__
+    monkeypatch.setattr(Scene, "from_config", classmethod(counting("scene", built)))
+    monkeypatch.setattr(app, "check_scene_config", counting("check", app.check_scene_config))
+    monkeypatch.setattr(app, "ignored_accuracy", counting("accuracy", app.ignored_accuracy))
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", ["gyrolab", "time.end=1", "time.n_output=11", "output.figures=false",
+                                      f"hydra.run.dir={tmp_path}/run"])
+    app.main()
+    assert calls == {"scene": 1, "check": 1, "accuracy": 1}
+    with xr.open_dataset(tmp_path / "run" / "run.nc") as ds:
+        assert ds.sizes["time"] == 11
+
+
+def test_the_run_builds_its_own_scene_when_its_config_is_not_the_preflights(monkeypatch):
+    from gyrolab import app
+    from omegaconf import OmegaConf
+
+    cfg = OmegaConf.create({"time": {"end": 1}})
+    app._prepared[:] = [app.Prepared({"time": {"end": 2}}, object(), None)]
+    assert app.take_prepared(cfg) is None and not app._prepared
+    app._prepared[:] = [app.Prepared({"time": {"end": "${now:%H}"}}, object(), None)]  # may resolve otherwise
+    assert app.take_prepared(OmegaConf.create({"time": {"end": "${now:%H}"}})) is None
+    prepared = app.Prepared({"time": {"end": 1}}, object(), "note")
+    app._prepared[:] = [prepared]
+    assert app.take_prepared(cfg) is prepared
+
+
+@pytest.mark.parametrize("argv", [
+    ["-m", "time.end=1", "--config-dir", "conf", "initial.r0=1,2", "--info", "config"],
+    ["--cfg", "job", "--resolve", "-p", "time", "-cn", "config", "body.a=2"],
+    ["--help", "--scheduler", "local", "-V"],
+])
+def test_the_command_line_rebuilt_for_hydra_reads_as_the_parsed_one(argv):
+    from gyrolab.compat import get_args_parser, hydra_argv
+
+    ours = vars(run_parser().parse_intermixed_args(argv))
+    hydras = vars(get_args_parser().parse_args(hydra_argv(argparse.Namespace(**ours))))
+    assert hydras == {key: ours[key] for key in hydras} and len(hydras) == len(ours) - 2  # not --version, --scheduler
+
+
+def test_under_a_hydra_it_was_not_written_for_the_run_is_hydra_mains(monkeypatch, tmp_path):
+    # outside Hydra 1.3.x: no composition memo, and hydra.main reads the command line from sys.argv (restored after)
+    import hydra
+
+    from gyrolab import app, compat
+
+    argv = ["gyrolab", "time.end=1", "time.n_output=11", "output.figures=false", f"hydra.run.dir={tmp_path}/run"]
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", list(argv))
+    monkeypatch.setattr(hydra, "__version__", "1.4.0")
+    seen = []
+    main = hydra.main
+
+    def watched(*args, **kwargs):
+        seen.append((list(sys.argv), compat.active))
+        return main(*args, **kwargs)
+
+    monkeypatch.setattr(hydra, "main", watched)
+    app.main()
+    assert seen == [(["gyrolab", *argv[1:]], None)]
+    assert sys.argv == argv
+    with xr.open_dataset(tmp_path / "run" / "run.nc") as ds:
+        assert ds.sizes["time"] == 11

@@ -9,6 +9,7 @@ import xarray as xr
 from PIL import Image
 
 from gyrolab.app import preflight, run_command
+from gyrolab.app.parser import parse_run
 from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError
@@ -72,7 +73,7 @@ def test_bad_figure_settings_are_one_sentence(output, words):
 
 def test_bad_format_is_refused_before_anything_runs(tmp_path):
     with pytest.raises(ConfigError, match="valid: pdf, png, svg"):
-        preflight(["output.figure_formats=[png,eps]", f"hydra.run.dir={tmp_path / 'out'}"])
+        preflight(parse_run(["output.figure_formats=[png,eps]", f"hydra.run.dir={tmp_path / 'out'}"]))
     assert not (tmp_path / "out").exists()
 
 

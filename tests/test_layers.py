@@ -18,6 +18,7 @@ SOURCES = {"pipeline": "gyrolab", "plugins": "gyrolab.plugins"}
 #: sub-package -> layer; an import must go to a strictly lower layer or stay inside its own sub-package
 LAYERS = {
     "gyrolab.errors": 0,
+    "gyrolab.compat": 0,
     "gyrolab.physics": 1,
     "gyrolab.kernels": 2,
     "gyrolab.contracts": 3,
@@ -127,17 +128,24 @@ def test_no_moved_module_aliases():
     assert not any(type(finder).__module__.startswith("gyrolab") for finder in sys.meta_path)
 
 
-def test_hydra_private_api_behind_one_module():
+#: what only gyrolab.compat may import or call: Hydra's private API, xarray's internals
+PRIVATE = ("hydra._internal", "xarray.backends", "xarray.namedarray", "xarray.core")
+
+
+def test_library_internals_behind_one_module():
     for folder in SOURCES:
         for path in sorted((ROOT / folder).rglob("*.py")):
-            if path.name == "hydra_private.py":
+            if path.name == "compat.py":
                 continue
             tree = ast.parse(path.read_text())
             for node in ast.walk(tree):
                 names = [node.module or ""] if isinstance(node, ast.ImportFrom) else \
                     [a.name for a in node.names] if isinstance(node, ast.Import) else []
-                assert not any(n.startswith("hydra._internal") for n in names), \
-                    f"{path.relative_to(ROOT)}:{node.lineno} imports Hydra's private API; use gyrolab.engine.hydra_private"
+                assert not any(n.startswith(PRIVATE) for n in names), \
+                    f"{path.relative_to(ROOT)}:{node.lineno} imports a library's internals; use gyrolab.compat"
+                if isinstance(node, ast.Attribute):
+                    assert node.attr not in ("_construct_direct", "_load_configuration_impl"), \
+                        f"{path.relative_to(ROOT)}:{node.lineno} uses a library's private attribute; use gyrolab.compat"
 
 
 def test_the_compiled_parameter_array_is_read_by_name():

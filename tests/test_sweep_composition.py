@@ -1,4 +1,4 @@
-"""One composition per command (gyrolab.engine.composition) gives every job the config Hydra composes for it.
+"""One composition per command (gyrolab.compat.composing_once) gives every job the config Hydra composes for it.
 
 The reference is Hydra's own ``ConfigLoaderImpl`` outside ``composing_once``: the master config of a
 multirun, then each job's config as Hydra's basic launcher builds it (``load_sweep_config``, then
@@ -23,9 +23,9 @@ from hydra.errors import ConfigCompositionException
 from hydra.types import RunMode
 from omegaconf import OmegaConf, open_dict
 
-from gyrolab.engine import composition
+from gyrolab import compat as composition
 from gyrolab.engine.config import ConfigSource, hydra_for, register_plugin_configs
-from gyrolab.engine.hydra_private import BasicSweeper, ConfigLoaderImpl
+from gyrolab.compat import BasicSweeper, ConfigLoaderImpl
 
 
 def jobs_of(arguments):
@@ -227,3 +227,24 @@ def test_a_first_composition_that_hydra_splits_otherwise_is_hydras(monkeypatch):
     assert memo.compositions == 0 and not memo.skeletons
     assert OmegaConf.to_yaml(served) == OmegaConf.to_yaml(reference)
     assert served.hydra.runtime.choices.integrator == "rk4"
+
+
+@pytest.mark.parametrize("version, served", [("1.3.0", True), ("1.3.8", True), ("1.2.0", False), ("1.4.0", False),
+                                             ("2.0.0.dev1", False)])
+def test_only_the_hydra_it_was_written_for_is_served_from_the_memo(monkeypatch, version, served):
+    # a Hydra outside 1.3.x: nothing is replaced, every composition is Hydra's own, and the configs are the same
+    import hydra
+
+    arguments = ["time.end=1", "initial.r0=1,2", "hydra.sweep.dir=/tmp/sweep"]
+    register_plugin_configs()
+    with hydra_for(PACKAGED):
+        reference = launch_configs("config", arguments)
+        monkeypatch.setattr(hydra, "__version__", version)
+        with composition.composing_once() as memo:
+            monkeypatch.undo()  # the version is checked on entry; the configs record the real one
+            replaced = ConfigLoaderImpl._load_configuration_impl is not composition._ORIGINAL
+            configs = launch_configs("config", arguments)
+    assert replaced is served and (memo.requests > 0) is served
+    assert ConfigLoaderImpl._load_configuration_impl is composition._ORIGINAL
+    assert described(configs[0], False) == described(reference[0], False)
+    assert [described(c) for c in configs[1]] == [described(c) for c in reference[1]]

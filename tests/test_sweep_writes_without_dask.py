@@ -1,4 +1,4 @@
-"""Writing run.nc and sweep.nc imports no Dask (gyrolab.output.dask_free_writes), and changes nothing written.
+"""Writing run.nc and sweep.nc imports no Dask (gyrolab.compat), and changes nothing written.
 
 With Dask installed, xarray imported ``dask.array`` and ``distributed`` for the first file a process wrote
 (~0.43 CPU s: a fifth of a 20-job sweep's overhead). The guards answer as xarray and Dask do where the
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from gyrolab.output.dask_free_writes import install_dask_free_writes
+from gyrolab.compat import install_dask_free_writes
 
 pytest.importorskip("dask.array")   # without Dask installed there is nothing to skip
 DASK_MODULES = ("dask", "dask.array", "distributed")
@@ -49,10 +49,12 @@ def test_a_sweep_imports_no_dask(tmp_path):
 
 WRITE = """
 import sys
+import xarray
+if not {guarded}:  # an xarray the guards were not written for: xarray's own path
+    xarray.__version__ = "2099.1.0"
 from gyrolab import compose_scene
-if {guarded}:
-    from gyrolab.output.dask_free_writes import install_dask_free_writes
-    assert install_dask_free_writes()
+from gyrolab.compat import install_dask_free_writes
+assert install_dask_free_writes() is {guarded}
 ds = compose_scene(["time.end=1", "time.n_output=11"]).run()
 for key in [k for k in ds.attrs if "wall" in k or k in ("date_created", "history")]:
     del ds.attrs[key]   # what differs between two runs
@@ -62,7 +64,17 @@ print("DASK", [m for m in {modules!r} if m in sys.modules])
 """
 
 
+@pytest.mark.parametrize("version, installed", [("2023.12.0", False), ("2024.1.0", True), ("2026.9.0", True),
+                                                 ("2027.1.0", False), ("not.a.version", False)])
+def test_the_guards_are_installed_for_the_xarray_versions_they_were_written_for(version, installed):
+    from gyrolab.compat import XARRAY_SUPPORTED, supported
+
+    assert supported(version, XARRAY_SUPPORTED) is installed
+
+
 def test_the_written_file_is_the_file_xarray_writes(tmp_path):
+    """Under a supported xarray (the guards installed, no Dask imported) and an unsupported one (xarray's own
+    path, which imports Dask): the same file."""
     printed = {}
     for guarded in (True, False):
         path = str(tmp_path / f"{guarded}.nc")

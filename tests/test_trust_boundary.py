@@ -246,11 +246,12 @@ def test_a_bomb_in_a_jobs_stored_config_refuses_plot_of_the_sweep(sweep):
 
 def test_hydras_experimental_rerun_which_unpickles_is_refused(tmp_path, monkeypatch):
     from gyrolab.app import preflight
+    from gyrolab.app.parser import parse_run
 
     monkeypatch.chdir(tmp_path)
     (tmp_path / "config.pickle").write_bytes(b"cos\nsystem\n(S'touch PWNED'\ntR.")
     with pytest.raises(ConfigError, match="would load a pickle"):
-        preflight(["--experimental-rerun", "config.pickle"])
+        preflight(parse_run(["--experimental-rerun", "config.pickle"]))
     assert not (tmp_path / "PWNED").exists()
 
 

@@ -53,15 +53,14 @@ def test_user_primary_config_runs(myconf, tmp_path, monkeypatch, capsys):
 ])
 def test_the_preflight_composes_the_users_config(argv, expected, myconf, monkeypatch):
     """Each form passes the preflight, which composes from the user's folder (the runs above: Hydra agrees)."""
-    from hydra._internal.utils import get_args_parser
-
     from gyrolab import app
+    from gyrolab.app.parser import parse_run
     from gyrolab.engine.config import ConfigSource, compose_config, current_source, use_source
 
-    argv = app.absolute_config_path([a.format(conf=myconf) for a in argv])
+    args = app.absolute_config_path(parse_run([a.format(conf=myconf) for a in argv]))
     try:
-        app.preflight([*argv, "hydra.run.dir=out"])
-        overrides = get_args_parser().parse_known_args(argv)[0].overrides
+        app.preflight(parse_run([*[a.format(conf=myconf) for a in argv], "hydra.run.dir=out"]))
+        overrides = args.overrides
         cfg = compose_config(overrides, config_name=current_source().config_name)
     finally:
         use_source(ConfigSource())
@@ -99,10 +98,11 @@ def test_the_preflight_validates_the_users_config(myconf, tmp_path, monkeypatch,
 def test_run_dir_may_use_hydra_resolvers(tmp_path, monkeypatch):
     # ${hydra:...} in the run directory is Hydra's own idiom: the preflight resolves it as the run will
     from gyrolab import app
+    from gyrolab.app.parser import parse_run
 
     monkeypatch.chdir(tmp_path)
-    argv = app.preflight(["hydra.run.dir=${hydra:runtime.cwd}/by_cwd", "time.end=1"])
-    assert "hydra.run.dir=${hydra:runtime.cwd}/by_cwd" in argv
+    args = app.preflight(parse_run(["hydra.run.dir=${hydra:runtime.cwd}/by_cwd", "time.end=1"]))
+    assert "hydra.run.dir=${hydra:runtime.cwd}/by_cwd" in args.overrides
 
 
 def test_a_user_file_that_a_packaged_one_shadows_is_one_warning_line(myconf, tmp_path, monkeypatch, capsys):

@@ -17,6 +17,7 @@ and ``completion`` (the bash and zsh script). Logs go to stderr, results to stdo
 
 from __future__ import annotations
 
+import argparse
 import atexit
 import copy
 import dataclasses
@@ -32,7 +33,6 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import hydra
 from hydra.core.hydra_config import HydraConfig
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override
@@ -41,8 +41,7 @@ from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
-from gyrolab.engine.composition import composing_once
-from gyrolab.engine.hydra_private import get_args_parser
+from gyrolab.compat import composing_once, install_dask_free_writes, run_hydra
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
     ConfigSource,
@@ -59,7 +58,6 @@ from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.figures.options import figure_options
 from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
-from gyrolab.output.dask_free_writes import install_dask_free_writes
 from gyrolab.output.written import announce_written
 from gyrolab.engine.scene import Scene
 from gyrolab.sweep.grid import Grid
@@ -94,16 +92,17 @@ def show_warnings_in_one_line() -> None:
     warnings.showwarning = show
 
 
-def preflight(argv: Sequence[str]) -> list[str]:
-    """Validate the command line before Hydra creates any output directory; the command line Hydra should run.
+def preflight(args: argparse.Namespace) -> argparse.Namespace:
+    """Validate the command line (``args``: ``gyrolab run``'s options, ``gyrolab.app.parser.run_parser``) before
+    Hydra creates any output directory; the options Hydra should run (``+group=x`` may become ``group=x``).
 
     The config is composed exactly as Hydra will compose it (the same search path,
     primary config and overrides, from a user's ``--config-dir`` too; inside ``main``, Hydra's run is
-    then served from this composition, ``gyrolab.engine.composition``), checked by
+    then served from this composition, ``gyrolab.compat.composing_once``), checked by
     ``gyrolab.engine.safety`` (no config can run code), against the schema (unknown
-    keys, types), the budget, and the scene's own validation.
+    keys, types), the budget, and the scene's own validation. For a plain run the scene it builds is the one
+    the run integrates (``take_prepared``).
     """
-    args, _ = get_args_parser().parse_known_args(list(argv))
     if args.experimental_rerun is not None:  # Hydra unpickles the file: whoever wrote it runs code as you
         raise ConfigError(f"--experimental-rerun {shorten(args.experimental_rerun)} would load a pickle, which runs "
                           "whatever code its writer put there; rerun a dataset with gyrolab reproduce PATH/run.nc")
@@ -114,38 +113,14 @@ def preflight(argv: Sequence[str]) -> list[str]:
         with hydra_for(source):
             cfg = _compose_job(source, list(args.overrides), False)
         check_config(cfg, Path(str(cfg.hydra.run.dir)), command_line=args.overrides)
-        return list(argv)
-    overrides = parse_overrides(args.overrides)
-    rewritten = _plus_group_as_override(source, list(argv), overrides)
-    if rewritten != list(argv):
-        argv = rewritten
-        args, _ = get_args_parser().parse_known_args(argv)
-        overrides = parse_overrides(args.overrides)
-    sweeps = [o for o in overrides if o.is_sweep_override()]
-    if sweeps and not args.multirun:
-        raise ConfigError(f"{shorten(sweeps[0].input_line)!r} is a sweep; run it with -m (gyrolab -m "
-                          f"{shorten(sweeps[0].input_line)} ...), or give one value")
+        return args
+    args, overrides = _checked_overrides(source, args)
     sweeping = bool(args.multirun)
-    check_launcher_installed(overrides)
-    if sweeping:
-        _refuse_swept_hydra_settings(overrides)
-        check_sweep_size(overrides)  # before anything expands a range(0,1e12,1)
-        Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
-    with hydra_for(source):
-        # One job composed and validated: the first value of every sweep (each group choice checked for safety).
-        first = _compose_job(source, _job_overrides(overrides, {}), sweeping)
-    with hydra_for(dataclasses.replace(source, searchpath=tuple(first.hydra.searchpath or ()))):
-        check_plugin_names(overrides)  # every value of every swept group
-        configs = [first]
-        swept = [*overrides, *(_sweeper_params(configs[0]) if sweeping else [])]
-        for o in swept:
-            if o.is_sweep_override() and _is_group(o, configs[0]):
-                values = list(o.sweep_string_iterator())[(1 if o in overrides else 0):]  # the first: composed
-                configs += [_compose_job(source, _job_overrides(swept, {id(o): value}), sweeping) for value in values]
+    configs = _compose_jobs(source, overrides, sweeping)
     cfg = configs[0]
-    for composed in configs:
-        check_scene_config(_without_hydra(composed))
-    refuse_unread_accuracy(configs, [o.input_line for o in overrides])
+    scene_cfgs = [_without_hydra(composed) for composed in configs]
+    plains = [check_scene_config(scene_cfg) for scene_cfg in scene_cfgs]
+    notes = accuracy_notes(configs, [o.input_line for o in overrides])
     run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
@@ -154,25 +129,87 @@ def preflight(argv: Sequence[str]) -> list[str]:
     check_tree(run_dir, sweep=sweeping)  # a planted link in a directory received from someone else
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
-    validate_scene(_without_hydra(cfg))
+    scene = validate_scene(scene_cfgs[0], plains[0])
     from gyrolab.experiments import check_task, refuse_unread
 
     refuse_unread(f"task {task_of(cfg)}", [o.input_line for o in overrides], sweep=sweeping)  # batch.* on a plain run
-    check_task(task_of(cfg), _without_hydra(cfg), run_dir)  # an experiment's own refusals, before its directory
+    check_task(task_of(cfg), scene_cfgs[0], run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
-    return argv
+    if not sweeping:  # the run takes the preflight's scene and its accuracy note (_run_locked)
+        _prepared[:] = [Prepared(OmegaConf.to_container(scene_cfgs[0], resolve=False), scene, notes[0])]
+    return args
 
 
-def refuse_unread_accuracy(configs: Sequence[DictConfig], overrides: Sequence[str]) -> None:
-    """ConfigError when the command line gives ``accuracy`` and no job's integrator reads it
-    (``gyrolab.engine.unread``). A sweep over integrators (``-m integrator=auto,taylor accuracy=1e-8``) gives the
-    target to the jobs that read it; the others run at their own settings, warn and record it, as for a value
-    from a config file."""
-    if ACCURACY not in given_keys(overrides):
-        return
-    sentences = [unread_accuracy(composed) for composed in configs]
-    if all(sentences):
-        raise unread_refusal(configs[0], sentences[0])
+def _checked_overrides(source: ConfigSource, args: argparse.Namespace) -> tuple[argparse.Namespace, list[Override]]:
+    """(``args`` with ``+group=x`` as ``group=x`` where the group is listed, its overrides parsed), or one sentence:
+    a malformed override, a sweep without -m, a launcher not installed, a sweep Hydra cannot run."""
+    overrides = parse_overrides(args.overrides)
+    rewritten = _plus_group_as_override(source, list(args.overrides), overrides)
+    if rewritten != list(args.overrides):
+        args = argparse.Namespace(**{**vars(args), "overrides": rewritten})
+        overrides = parse_overrides(args.overrides)
+    sweeps = [o for o in overrides if o.is_sweep_override()]
+    if sweeps and not args.multirun:
+        raise ConfigError(f"{shorten(sweeps[0].input_line)!r} is a sweep; run it with -m (gyrolab -m "
+                          f"{shorten(sweeps[0].input_line)} ...), or give one value")
+    check_launcher_installed(overrides)
+    if args.multirun:
+        _refuse_swept_hydra_settings(overrides)
+        check_sweep_size(overrides)  # before anything expands a range(0,1e12,1)
+        Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
+    return args, overrides
+
+
+def _compose_jobs(source: ConfigSource, overrides: list[Override], sweeping: bool) -> list[DictConfig]:
+    """The configs to validate: the first job (the first value of every sweep), then one per other value of each
+    swept config group (from the command line or the config's ``hydra.sweeper.params``), each option composed."""
+    with hydra_for(source):
+        first = _compose_job(source, _job_overrides(overrides, {}), sweeping)
+    with hydra_for(dataclasses.replace(source, searchpath=tuple(first.hydra.searchpath or ()))):
+        check_plugin_names(overrides)  # every value of every swept group
+        configs = [first]
+        swept = [*overrides, *(_sweeper_params(first) if sweeping else [])]
+        for o in swept:
+            if o.is_sweep_override() and _is_group(o, first):
+                values = list(o.sweep_string_iterator())[(1 if o in overrides else 0):]  # the first: composed
+                configs += [_compose_job(source, _job_overrides(swept, {id(o): value}), sweeping) for value in values]
+    return configs
+
+
+@dataclasses.dataclass
+class Prepared:
+    """What the preflight of a plain run built, for the run to use rather than build again."""
+
+    #: the scene config it was built from, unresolved (the run's must be the same)
+    config: dict
+    #: the scene, built once (None: the task builds its own)
+    scene: Scene | None
+    #: why the config's ``accuracy`` goes unread (``gyrolab.engine.unread.ignored_accuracy``), or None
+    accuracy_ignored: str | None
+
+
+#: the preflight's work for the run of this command (at most one)
+_prepared: list[Prepared] = []
+
+
+def take_prepared(cfg: DictConfig) -> Prepared | None:
+    """The preflight's work, if it was done for ``cfg``: the same config, with no resolver whose value could
+    differ between the preflight and the run (``${now:...}``, ``${oc.env:...}``, ``${hydra:...}``)."""
+    prepared = _prepared.pop() if _prepared else None
+    if prepared is None or "${" in repr(prepared.config):
+        return None
+    return prepared if OmegaConf.to_container(cfg, resolve=False) == prepared.config else None
+
+
+def accuracy_notes(configs: Sequence[DictConfig], overrides: Sequence[str]) -> list[str | None]:
+    """Each config's note on an ``accuracy`` its integrator does not read (``gyrolab.engine.unread``), or None; a
+    ConfigError when the command line gives ``accuracy`` and no job's integrator reads it. A sweep over integrators
+    (``-m integrator=auto,taylor accuracy=1e-8``) gives the target to the jobs that read it; the others run at their
+    own settings, warn and record it, as for a value from a config file."""
+    notes = [ignored_accuracy(composed, overrides) for composed in configs]
+    if ACCURACY in given_keys(overrides) and all(notes):
+        raise unread_refusal(configs[0], unread_accuracy(configs[0]))
+    return notes
 
 
 def _output_dir_text(cfg: DictConfig, mode: str) -> str:
@@ -195,11 +232,11 @@ def _output_dir_text(cfg: DictConfig, mode: str) -> str:
 
 
 def _plus_group_as_override(source: ConfigSource, argv: list[str], overrides: Sequence[Override]) -> list[str]:
-    """``+experiment=mine`` as ``experiment=mine`` when the primary config already lists the group.
+    """The overrides ``argv`` with ``+experiment=mine`` as ``experiment=mine`` when the primary config already lists
+    the group.
 
     Hydra refuses to add a group its defaults list has (``experiment: null`` in gyrolab's
-    config.yaml); both spellings are common, so both select the option. The command line
-    Hydra runs is rewritten the same way.
+    config.yaml); both spellings are common, so both select the option.
     """
     adds = [o for o in overrides if o.is_add() and o.key_or_group in SELECTABLE_GROUPS and o.package is None]
     if not adds:
@@ -281,12 +318,12 @@ def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
                               "sweep, so give a single value")
 
 
-def validate_scene(scene_cfg: DictConfig) -> None:
-    """The checks every run's scene config passes: schema, tolerances, budget, the scene's own validation."""
+def validate_scene(scene_cfg: DictConfig, plain: dict) -> Scene | None:
+    """The checks every run's scene config passes beyond its schema (``plain``: ``check_scene_config``'s answer):
+    tolerances, budget, the scene's own validation; the scene, built once, for a task that runs it."""
     from gyrolab.batch.scheduler import check_configured
     from gyrolab.experiments import TASKS
 
-    plain = check_scene_config(scene_cfg)
     require_finite(plain, "")
     figure_options(plain.get("output"))  # figure formats and dpi, before anything runs
     check_tolerances(plain)
@@ -297,17 +334,18 @@ def validate_scene(scene_cfg: DictConfig) -> None:
         hint = f"did you mean task={close[0]}? " if close else ""
         raise ConfigError(f"unknown task {shorten(repr(task))}; {hint}valid choices: {choices(['scene', *TASKS])}")
     if task not in ("scene", "regime"):
-        return  # an experiment validates the scenes it composes
-    probe = scene_cfg.copy()
-    with open_dict(probe):
-        probe.time.n_output = 2  # the state's size, before allocating n_output samples
-    check_budget(plain, Scene.from_config(probe).system.initial_state().size)
-    if task_of(scene_cfg) == "regime":  # the regime's domain is checked before anything is written
+        return None  # an experiment validates the scenes it composes
+    if task == "regime":  # the regime's domain is checked before anything is written
         from gyrolab.experiments.regime_run import prepare
 
+        probe = scene_cfg.copy()
+        with open_dict(probe):
+            probe.time.n_output = 2  # the state's size, before allocating n_output samples
+        check_budget(plain, Scene.from_config(probe).system.initial_state().size)
         prepare(scene_cfg, report=False)   # the run reports the domain warnings (once)
-    else:
-        Scene.from_config(scene_cfg)
+        return None
+    # the budget as soon as the state's size is known, before n_output samples are allocated
+    return Scene.from_config(scene_cfg, check=lambda system: check_budget(plain, system.initial_state().size))
 
 
 def check_plugin_names(overrides: Sequence[Override]) -> None:
@@ -380,8 +418,8 @@ def check_writable(directory: Path) -> None:
                           "choose a writable hydra.run.dir (or hydra.sweep.dir)") from None
 
 
-@hydra.main(config_path="pkg://gyrolab.conf", config_name="config", version_base="1.3")
 def _task(cfg: DictConfig) -> None:
+    """Hydra's task: one run, or one job of a multirun (``gyrolab.compat.run_hydra`` calls it as ``@hydra.main`` does)."""
     hydra_cfg = HydraConfig.get()
     out_dir = Path(hydra_cfg.runtime.output_dir)
     if hydra_cfg.mode == RunMode.MULTIRUN:
@@ -415,9 +453,11 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     from gyrolab.output.dataset import write_dataset
 
     task = task_of(cfg)
+    prepared = take_prepared(cfg) if job_id is None else None  # a plain run: the preflight's scene and note
     # an accuracy the integrator does not read (the preflight refused one the command line gave to every job): said,
     # and recorded in run.nc; for the tasks that run the scene's integrator
-    ignored = (ignored_accuracy(cfg, HydraConfig.get().overrides.task) if task in ("scene", "regime") else None)
+    ignored = None if task not in ("scene", "regime") else prepared.accuracy_ignored if prepared else \
+        ignored_accuracy(cfg, HydraConfig.get().overrides.task)
     if ignored:
         log.warning("%s", ignored)
     if task != "scene":
@@ -427,7 +467,11 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
         for path in written:
             announce_written(path)
         return written[0]
-    scene = Scene.from_config(cfg)
+    if prepared and prepared.scene:
+        scene = prepared.scene
+        scene.log_notes()  # into the run's log, as a scene built here says them
+    else:
+        scene = Scene.from_config(cfg)
     scene.accuracy_ignored = ignored  # in the dataset's attributes, as compose_scene records it
     ds = scene.run()
     ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
@@ -462,68 +506,31 @@ def run_command(argv: Sequence[str]) -> int | None:
     """The subcommand ``argv`` names (``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``,
     ``completion``, or an old spelling ``--batch``, ...; options in any position): its exit status, or None for
     ``run`` (Hydra's app, the default)."""
-    from gyrolab.app.parser import split_command
+    from gyrolab.app.parser import parse_command_line
 
-    command, rest = split_command(argv)
-    return None if command == "run" else run_subcommand(command, rest)
+    command, args = parse_command_line(argv)
+    return None if command == "run" else run_subcommand(command, args)
 
 
-def run_subcommand(command: str, argv: Sequence[str]) -> int:
-    """Parse ``argv`` with ``command``'s parser (``gyrolab.app.parser``) and run it (``gyrolab.app.commands``)."""
+def run_subcommand(command: str, args: argparse.Namespace) -> int:
+    """Run ``command`` (not ``run``) with its parsed options (``gyrolab.app.commands``)."""
     from gyrolab.app.commands import RUNNERS
-    from gyrolab.app.parser import parse
 
-    args = parse(command, argv)
     if hasattr(args, "config_dir"):
         use_source(ConfigSource.from_args(args.config_path, args.config_name, args.config_dir))
     return RUNNERS[command](args)
 
 
-#: Hydra's options that choose where configs come from, long and short
-SOURCE_OPTIONS = {"--config-dir": "config_dir", "-cd": "config_dir", "--config-path": "config_path",
-                  "-cp": "config_path", "--config-name": "config_name", "-cn": "config_name"}
-
-
-def split_source_options(argv: Sequence[str]) -> tuple[ConfigSource, list[str]]:
-    """(the config source named by leading ``--config-dir``/``--config-path``/``--config-name``, the rest)."""
-    given: dict[str, str] = {}
-    rest = list(argv)
-    while rest and rest[0].split("=", 1)[0] in SOURCE_OPTIONS:
-        option, has_value, value = rest.pop(0).partition("=")
-        if not has_value:
-            if not rest:
-                raise ConfigError(f"{option} needs a value, e.g. {option} myconf")
-            value = rest.pop(0)
-        given[SOURCE_OPTIONS[option]] = value
-    source = ConfigSource.from_args(given.get("config_path"), given.get("config_name"), given.get("config_dir"))
-    return source, rest
-
-
-def absolute_config_path(argv: Sequence[str]) -> list[str]:
-    """``argv`` with a relative ``--config-path`` made absolute from the working directory.
+def absolute_config_path(args: argparse.Namespace) -> argparse.Namespace:
+    """``args`` with a relative ``--config-path`` made absolute from the working directory.
 
     Hydra reads a relative --config-path against the folder of the app's source file,
     which is inside the installed package; a user means the working directory.
     """
-    out = list(argv)
-    for i, arg in enumerate(out):
-        option, has_value, value = arg.partition("=")
-        if option in ("--config-path", "-cp"):
-            if has_value and value and not value.startswith("pkg://"):
-                out[i] = f"{option}={os.path.abspath(value)}"
-            elif not has_value and i + 1 < len(out) and not out[i + 1].startswith("pkg://"):
-                out[i + 1] = os.path.abspath(out[i + 1])
-    return out
-
-
-def _plot(argv: Sequence[str]) -> int:
-    """``--plot PATH ...`` (kept for callers of the old function): ``gyrolab plot``."""
-    return run_subcommand("plot", [a for a in (argv[0].partition("=")[2], *argv[1:]) if a])
-
-
-def _batch(overrides: Sequence[str]) -> int:
-    """``--batch OVERRIDES`` (kept for callers of the old function): ``gyrolab batch``."""
-    return run_subcommand("batch", list(overrides))
+    path = args.config_path
+    if path and not path.startswith("pkg://"):
+        args.config_path = os.path.abspath(path)
+    return args
 
 
 def _sweep_status(summary: SweepSummary | None = None) -> int:
@@ -547,12 +554,11 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
     return 1
 
 
-def shell_completion(argv: Sequence[str]) -> int:
+def shell_completion(args: argparse.Namespace) -> int:
     """Hydra's ``--shell-completion install=bash`` (or ``zsh``, ``uninstall=...``): gyrolab's own completion
     script (``gyrolab.app.completion``), which knows the subcommands; Hydra's cannot see an installed app."""
     from gyrolab.app.completion import SHELLS, script
 
-    args, _ = get_args_parser().parse_known_args(list(argv))
     args_list = list(args.overrides)
     action, _, shell = (args_list[0] if len(args_list) == 1 else "").partition("=")
     if action not in ("install", "uninstall") or shell not in SHELLS:
@@ -577,7 +583,7 @@ def main() -> None:
     previous = signal.signal(signal.SIGTERM, _terminated)
     try:
         with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
-            _main(absolute_config_path(sys.argv[1:]))
+            _main(sys.argv[1:])
     except KeyboardInterrupt as interruption:  # Ctrl-C or SIGTERM: every write is whole or absent, locks released
         from gyrolab.output.lock import release_all
 
@@ -633,24 +639,26 @@ def quiet_logging_failures() -> None:
 
 
 def _main(argv: list[str]) -> None:
+    _prepared.clear()  # nothing from an earlier command of this process
     try:
-        from gyrolab.app.parser import split_command
+        from gyrolab.app.parser import parse_command_line, run_parser
 
-        command, argv = split_command(argv)
-        if command == "run":  # --scheduler ADDRESS: the only config-free way to Dask, for experiments run by Hydra too
-            from gyrolab.batch.scheduler import take_scheduler_option
-
-            argv = take_scheduler_option(argv)
-        sys.argv[1:] = argv
-        if command == "run" and ("--version" in argv or "-V" in argv):
+        command, args = parse_command_line(argv)
+        if command != "run":
+            sys.exit(run_subcommand(command, args))
+        if args.version:
             from gyrolab.output.provenance import gyrolab_version
 
             print(f"gyrolab {gyrolab_version()}")
             sys.exit(0)
-        if command != "run":
-            sys.exit(run_subcommand(command, argv))
-        if "--shell-completion" in argv or "-sc" in argv:
-            sys.exit(shell_completion(argv))
+        from gyrolab.batch.scheduler import use_command_line_scheduler
+
+        # --scheduler ADDRESS: the only config-free way to Dask, for experiments run by Hydra too; None when not
+        # given, so no value is left from an earlier command
+        use_command_line_scheduler(args.scheduler)
+        if args.shell_completion:
+            sys.exit(shell_completion(args))
+        args = absolute_config_path(args)
         from gyrolab.output.trust import check_kernel_cache
 
         check_kernel_cache()  # before the preflight, which may load a compiled kernel
@@ -659,7 +667,7 @@ def _main(argv: list[str]) -> None:
 
         register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), before Hydra instantiates it
         with compile_notes_on_console():  # the preflight may compile a force plugin's torque
-            sys.argv[1:] = preflight(argv)
+            args = preflight(args)
     except GyrolabError as error:
         fail(error)
     from gyrolab.sweep import callbacks
@@ -672,7 +680,7 @@ def _main(argv: list[str]) -> None:
     from gyrolab.output.lock import release_all
 
     try:
-        _task()
+        run_hydra(args, run_parser(), _task, config_path="pkg://gyrolab.conf", config_name="config")
     finally:
         release_all()  # a failed run's lock too (Hydra skips the callback's on_run_end when the job exits)
     status = _sweep_status()

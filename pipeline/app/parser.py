@@ -1,7 +1,9 @@
 """The command line's grammar: which subcommand a command line names, and one argparse parser per subcommand.
 
 ``gyrolab run`` (the default: ``gyrolab``, ``gyrolab -m ...``, ``gyrolab experiment=x``) is Hydra's own
-app, so its options are Hydra's and are parsed by Hydra; the other subcommands are parsed here. The old
+app: its parser is Hydra's (``get_args_parser``, the options Hydra documents) with gyrolab's ``--scheduler`` and
+``--version``, and its namespace goes to Hydra as it is (``gyrolab.compat.run_hydra``). Every subcommand is
+parsed here, options in any position. The old
 spellings (``--batch``, ``--plot``, ``--reproduce``, ``--new-force``, ``--aggregate``) name the same
 subcommands, anywhere on the line, as do the words (``gyrolab batch ...``); options go in any position
 (``gyrolab --batch --config-dir usercfg experiment=r0_scan`` and ``gyrolab batch experiment=r0_scan -cd usercfg``
@@ -31,18 +33,40 @@ COMMANDS = {
 ALIASES = {"--batch": "batch", "--plot": "plot", "--reproduce": "reproduce", "--aggregate": "aggregate",
            "--new-force": "new-force"}
 
-#: options whose value is the next word (so that word is not read as a subcommand)
-VALUE_OPTIONS = {"--config-dir", "-cd", "--config-path", "-cp", "--config-name", "-cn", "--cfg", "-c",
-                 "--package", "-p", "--scheduler", "--animate", "--format", "--frames", "--fps", "-o", "--output",
-                 "--experimental-rerun", "--shell-completion", "-sc", "--info", "-i", "--points"}
-
 #: where logs and results go, said in every --help
 LOGGING_CONVENTION = ("Log lines and progress go to stderr; results (the paths written, reports) go to stdout, "
                       "so `gyrolab ... > written.txt` keeps a list of the files.")
 
-def split_command(argv: Sequence[str]) -> tuple[str, list[str]]:
+
+def parse_command_line(argv: Sequence[str]) -> tuple[str, argparse.Namespace]:
+    """(the subcommand ``argv`` names, its options parsed by that subcommand's parser, in any order); ``--help``
+    of a subcommand other than ``run`` prints and exits 0 (``run``'s is Hydra's, from its config)."""
+    parsers = {"run": run_parser(), **build_parsers()}
+    command, rest = split_command(argv, value_options(parsers))
+    return command, parsers[command].parse_intermixed_args(rest)
+
+
+def parse_run(argv: Sequence[str]) -> argparse.Namespace:
+    """``gyrolab run``'s options (``argv`` without the word ``run``)."""
+    return run_parser().parse_intermixed_args(list(argv))
+
+
+def value_options(parsers: dict[str, argparse.ArgumentParser]) -> set[str]:
+    """The options of any subcommand that take a value (the next word is then a value, not a subcommand)."""
+    return {option for parser in parsers.values() for action in parser._actions if action.nargs != 0
+            for option in action.option_strings}
+
+
+def __getattr__(name: str) -> set[str]:
+    if name == "VALUE_OPTIONS":  # the completion script's list, read from the parsers
+        return value_options({"run": run_parser(), **build_parsers()})
+    raise AttributeError(name)
+
+
+def split_command(argv: Sequence[str], value_options: set[str]) -> tuple[str, list[str]]:
     """(the subcommand ``argv`` names, the rest of ``argv``): a subcommand word before the first override,
-    or an old ``--batch``-style spelling anywhere (``--plot=PATH`` keeps PATH); ``run`` when none is named."""
+    or an old ``--batch``-style spelling anywhere (``--plot=PATH`` keeps PATH); ``run`` when none is named.
+    ``value_options``: the options whose value is the next word."""
     argv = list(argv)
     takes_value = False
     bare_words_allowed = True
@@ -53,7 +77,7 @@ def split_command(argv: Sequence[str]) -> tuple[str, list[str]]:
         name, has_value, value = arg.partition("=")
         if name in ALIASES:
             return ALIASES[name], argv[:i] + ([value] if has_value else []) + argv[i + 1:]
-        if arg in VALUE_OPTIONS:
+        if arg in value_options:
             takes_value = True
         elif arg.startswith("-"):
             continue
@@ -94,8 +118,21 @@ def _overrides(parser: argparse.ArgumentParser, what: str) -> None:
     parser.add_argument("overrides", nargs="*", metavar="KEY=VALUE", help=what)
 
 
+def run_parser() -> argparse.ArgumentParser:
+    """``gyrolab run``'s parser: Hydra's own (``--help`` is Hydra's app help, from the config), with gyrolab's
+    ``--version`` for Hydra's and ``--scheduler``."""
+    from gyrolab.compat import get_args_parser
+
+    parser = _Parser(prog="gyrolab", parents=[get_args_parser()], add_help=False, conflict_handler="resolve",
+                     description=_sentence(COMMANDS["run"]))
+    parser.add_argument("--version", "-V", action="store_true", help="print gyrolab's version and exit")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="where an experiment's batch runs: process, local or tcp://HOST:PORT (as gyrolab batch)")
+    return parser
+
+
 def build_parsers() -> dict[str, argparse.ArgumentParser]:
-    """One parser per subcommand except ``run`` (Hydra's); each one's ``--help`` lists its options."""
+    """One parser per subcommand except ``run`` (``run_parser``); each one's ``--help`` lists its options."""
     epilog = LOGGING_CONVENTION
     formatter = argparse.RawDescriptionHelpFormatter
     parsers: dict[str, argparse.ArgumentParser] = {}
@@ -159,12 +196,6 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
     _source_options(completion)
     parsers["completion"] = completion
     return parsers
-
-
-def parse(command: str, argv: Sequence[str]) -> argparse.Namespace:
-    """The options of ``command`` (not ``run``), in any order; ``--help`` prints and exits 0."""
-    parser = build_parsers()[command]
-    return parser.parse_intermixed_args(list(argv))
 
 
 def one_path(command: str, paths: Sequence[str], usage: str) -> str:

@@ -29,7 +29,7 @@ from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
-from gyrolab.engine.hydra_private import create_automatic_config_search_path
+from gyrolab.compat import create_automatic_config_search_path
 from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
 from gyrolab.engine.unread import refuse_given_accuracy
 from gyrolab.output.user_yaml import check_user_config_dir
@@ -139,7 +139,7 @@ def current_source() -> ConfigSource:
 @contextmanager
 def hydra_for(source: ConfigSource | None = None) -> Iterator[None]:
     """A Hydra initialised on ``source`` (default: the current one) for the duration of the block."""
-    from gyrolab.engine.hydra_private import Hydra
+    from gyrolab.compat import Hydra
 
     GlobalHydra.instance().clear()
     Hydra.create_main_hydra2(task_name="app", config_search_path=(source or _source).search_path())

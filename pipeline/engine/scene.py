@@ -73,7 +73,9 @@ class Scene:
     accuracy_ignored: str | None = None
 
     @classmethod
-    def from_config(cls, cfg: DictConfig) -> Scene:
+    def from_config(cls, cfg: DictConfig, check: Callable[[System], None] | None = None) -> Scene:
+        """The scene of a composed config; ``check`` (the preflight's budget) is given the system as soon as it is
+        built, before the output times are allocated or the integrator built."""
         plain = OmegaConf.to_container(cfg, resolve=True)
         require_finite(plain, "")
         system_cls = _plugin_class("system", cfg.system, "system")
@@ -83,16 +85,13 @@ class Scene:
             for name, node in (cfg.get("force") or {}).items()
         ]
         system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
+        if check is not None:
+            check(system)
         check_force_claims(system, float(plain["time"].get("start", 0.0) or 0.0))
         timed = [f.name for f in forces if f.time_dependent]
-        if timed and system.name != "fixed_point":
-            raise ConfigError(f"force {timed[0]!r} is time-dependent, which system {system.name!r} does not support; "
-                              "valid systems: fixed_point")
+        _check_time_dependent(timed, system)
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
-        if timed and not integrator.supports(TIME_DEPENDENT):
-            raise ConfigError(f"integrator {integrator.name!r} does not integrate time-dependent forces (capability "
-                              f"{TIME_DEPENDENT}) and force {timed[0]!r} is one; valid choices: "
-                              f"{_choices_with(TIME_DEPENDENT)}")
+        _check_time_dependent(timed, system, integrator)
         requested = plain["time"].get("n_output", AUTO)
         times = _output_times(plain["time"], fastest_rate(system))
         try:
@@ -102,27 +101,34 @@ class Scene:
         except Exception as exc:  # noqa: BLE001 - a third-party integrator's prepare: one sentence naming it
             raise init_failure(type(integrator), "integrator", exc) from exc
         scene = cls(config=cfg, system=system, integrator=integrator, times=times, n_output_requested=requested)
-        if integrator.supports(COMPILED_MODEL) and scene.compiled is None:
+        scene._check_compiled_model()
+        scene.log_notes()
+        return scene
+
+    def _check_compiled_model(self) -> None:
+        """ConfigError when the integrator runs compiled models only and the system has none, or refuses the
+        system's compiled model; each sentence names the integrators that would run it."""
+        integrator, system, compiled = self.integrator, self.system, self.compiled
+        if integrator.supports(COMPILED_MODEL) and compiled is None:
             reason = system.compile_error or f"system {system.name!r} has no compiled form"
             raise ConfigError(
                 f"integrator {integrator.name!r} runs compiled models only, and {reason}; "
                 f"choose {_choices_with(accept=lambda c: not c.supports(COMPILED_MODEL))}"
             )
-        if scene.compiled is not None:
-            refusal = integrator.refusal(scene.compiled, system)
-            if refusal:
-                compiled = scene.compiled
-                valid = _choices_with(accept=lambda c: (c.supports(COMPILED_MODEL) or c.supports(PREFERS_COMPILED_MODEL))
-                                      and c is not type(integrator) and c.refusal(compiled, system) is None)
-                raise ConfigError(f"integrator {integrator.name!r} {refusal}; choose {valid}")
-        elif integrator.supports(PREFERS_COMPILED_MODEL):
-            reason = system.compile_error
-            if reason:
-                log.info("%s; %s runs scipy's integrators", reason, integrator.name)
-        warning = scene.sampling_warning()
+        refusal = integrator.refusal(compiled, system) if compiled is not None else None
+        if refusal:
+            valid = _choices_with(accept=lambda c: (c.supports(COMPILED_MODEL) or c.supports(PREFERS_COMPILED_MODEL))
+                                  and c is not type(integrator) and c.refusal(compiled, system) is None)
+            raise ConfigError(f"integrator {integrator.name!r} {refusal}; choose {valid}")
+
+    def log_notes(self) -> None:
+        """Log what the scene's user should know: output times that undersample its motion (a warning), scipy's
+        integrators running where a compiled model could not be built (info)."""
+        if self.compiled is None and self.integrator.supports(PREFERS_COMPILED_MODEL) and self.system.compile_error:
+            log.info("%s; %s runs scipy's integrators", self.system.compile_error, self.integrator.name)
+        warning = self.sampling_warning()
         if warning:
             log.warning("%s", warning)
-        return scene
 
     @cached_property
     def config_yaml(self) -> str:
@@ -300,6 +306,18 @@ def run(overrides: Sequence[str] = ()) -> xr.Dataset:
         The run's dataset (what ``run.nc`` holds); nothing is written to disk.
     """
     return compose_scene(overrides).run()
+
+
+def _check_time_dependent(timed: Sequence[str], system: System, integrator: Integrator | None = None) -> None:
+    """ConfigError when time-dependent forces (``timed``) act in a system, or (given) an integrator, that does not
+    support them."""
+    if timed and system.name != "fixed_point":
+        raise ConfigError(f"force {timed[0]!r} is time-dependent, which system {system.name!r} does not support; "
+                          "valid systems: fixed_point")
+    if timed and integrator is not None and not integrator.supports(TIME_DEPENDENT):
+        raise ConfigError(f"integrator {integrator.name!r} does not integrate time-dependent forces (capability "
+                          f"{TIME_DEPENDENT}) and force {timed[0]!r} is one; valid choices: "
+                          f"{_choices_with(TIME_DEPENDENT)}")
 
 
 def _choices_with(*capabilities: str, accept: Any = None) -> str:

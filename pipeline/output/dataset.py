@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 import xarray as xr
 
+from gyrolab.compat import install_dask_free_writes
 from gyrolab.contracts.integrator import Integrator, Solution
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.cf import conform, unit_attributes
@@ -26,21 +27,18 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
+# a run dataset holds numpy arrays: building and writing it need not import Dask (~0.4 s when it is installed)
+install_dask_free_writes()
+
 #: labels of the ``frame_axis`` dimension (the orbiting gyrostat's orbital and inertial frames)
 FRAME_AXES = ("x_radial", "y_along_track", "z_normal")
-
-
-#: label coordinates (``axis``, ``frame_axis``) of at most this length get one shared pandas index per process
-#: (xarray treats indexes as immutable and shares them between copies of a dataset itself)
-SMALL_COORDINATE = 16
-_LABEL_INDEXES: dict[tuple[Any, ...], Any] = {}
 
 
 def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.Variable]], tuple[
         dict[str, xr.Variable], dict[str, Any]]] | None = None, integrator: Integrator | None = None) -> xr.Dataset:
     """The run dataset of ``scene`` from ``solution``; ``add`` (given the trajectory's variables) returns more
     variables and attributes to put in while it is assembled (``Scene.run``'s error estimate): inserting a
-    variable into a built dataset aligns and merges (~0.4 ms each, more than the whole assembly). ``integrator``:
+    variable into a built dataset aligns and merges again (~0.4 ms each). ``integrator``:
     the one that ran, when not the scene's own (``auto`` run again aimed tighter, rule 11 of its contract)."""
     system, integrator = scene.system, integrator or scene.integrator
     body = system.body
@@ -62,7 +60,7 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
         coords["frame_axis"] = ("frame_axis", np.array(FRAME_AXES), {
             "units": "1", "long_name": "frame axis: orbital (radial, along-track, orbit normal) or inertial (X, Y, Z: "
                                        "the orbital axes at t = 0)"})
-    ds = assemble(variables, coords)
+    ds = xr.Dataset(variables, coords=coords)
     before, after = scene.dataset_attributes  # the scene's own, once per scene
     ds.attrs.update(before)
     ds.attrs.update(integrator.attributes())
@@ -116,56 +114,6 @@ def scene_attributes(scene: Scene) -> tuple[dict[str, Any], dict[str, Any]]:
                 part[key] = value = value.copy()  # not the system's own array (its initial state, say)
                 value.flags.writeable = False
     return before, after
-
-
-def assemble(variables: dict[str, xr.Variable], coords: dict[str, tuple[str, np.ndarray, dict[str, Any]]]) -> xr.Dataset:
-    """``xr.Dataset(variables, coords=coords)`` without xarray's merge, for data variables and 1-d dimension
-    coordinates whose sizes agree (anything else goes through ``xr.Dataset``, which validates and raises).
-
-    The public constructor aligns and merges every variable and builds each pandas index through a chain of
-    copies and checks (~1 ms of a ~3 ms ``Scene.run()`` on the reference scene); here each coordinate gets
-    its index directly and the dataset is put together from the variables as they are. The result is the
-    same dataset, variable order included (tests/test_runspeed.py compares the two).
-    """
-    construct = getattr(xr.Dataset, "_construct_direct", None)
-    sizes: dict[str, int] = {}
-    consistent = construct is not None and all(
-        isinstance(v, xr.Variable) and name not in coords for name, v in variables.items())
-    if consistent:
-        for name, (dim, data, _) in coords.items():
-            consistent = consistent and name == dim and np.ndim(data) == 1 and sizes.setdefault(dim, len(data)) == len(data)
-        for v in variables.values():
-            consistent = consistent and all(sizes.get(d) == n for d, n in zip(v.dims, v.shape))
-    if not consistent:
-        return xr.Dataset(variables, coords=coords)
-    all_variables, indexes = dict(variables), {}
-    for name, (dim, data, attrs) in coords.items():
-        data = np.asarray(data)
-        if len(data) <= SMALL_COORDINATE and data.dtype.kind == "U":  # the axis labels: the same index every run
-            key = (name, data.dtype.str, tuple(data.tolist()))
-            if key not in _LABEL_INDEXES:
-                _LABEL_INDEXES[key] = _index(data, name, dim)
-            indexes[name] = _LABEL_INDEXES[key]
-        else:
-            indexes[name] = _index(data, name, dim)
-        # fastpath: data is an ndarray, so xarray need not probe it for duck arrays (the first probe imports
-        # dask.array, ~0.4 s of a process's first run, when dask is installed)
-        variable = xr.Variable(dim, data, attrs, fastpath=True)
-        all_variables.update(indexes[name].create_variables({name: variable}))
-    try:
-        return construct(all_variables, set(coords), sizes, None, indexes)
-    except TypeError:  # a future xarray changed its private constructor: the public one still works
-        return xr.Dataset(variables, coords=coords)
-
-
-def _index(data: np.ndarray, name: str, dim: str) -> Any:
-    """xarray's index of a coordinate, built from a pandas index already named ``name``: given an array, PandasIndex
-    copies the index it makes to name it (half of its ~60 µs), and first probes the array for chunked duck arrays,
-    which imports dask.array (~0.4 s of a process's first run) when dask is installed."""
-    import pandas as pd
-    from xarray.indexes import PandasIndex
-
-    return PandasIndex(pd.Index(data, name=name, copy=False), dim, coord_dtype=data.dtype)
 
 
 def time_attributes(body: ModelUnits) -> dict[str, str]:

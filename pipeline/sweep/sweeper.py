@@ -39,7 +39,7 @@ from hydra.plugins.sweeper import Sweeper
 from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.engine.hydra_private import ConfigLoaderImpl
+from gyrolab.compat import ConfigLoaderImpl
 from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.lock import try_lock, unlock
@@ -85,7 +85,7 @@ class ResumingSweeper(Sweeper):
 
     def sweep(self, arguments: list[str]) -> Any:
         assert self.config is not None and self.launcher is not None and self.hydra_context is not None
-        from gyrolab.engine.hydra_private import BasicSweeper
+        from gyrolab.compat import BasicSweeper
 
         parser = OverridesParser.create(config_loader=self.hydra_context.config_loader)
         params = [f"{key}={value}" for key, value in self.params.items()]  # as the basic sweeper: params first
