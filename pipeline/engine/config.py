@@ -26,19 +26,25 @@ from hydra.core.global_hydra import GlobalHydra
 from hydra.errors import HydraException, MissingConfigException, OverrideParseException
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf
-from omegaconf.errors import OmegaConfBaseException
+from omegaconf.errors import ConfigKeyError, OmegaConfBaseException, ValidationError
 
 from gyrolab.contracts import registry
 from gyrolab.engine.hydra_private import create_automatic_config_search_path
 from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
+from gyrolab.engine.schemas import (
+    SELECTABLE_GROUPS,
+    missing_section,
+    required_sections,
+    unknown_key_sentence,
+    validate,
+)
+from gyrolab.engine.schemas import sentence as schema_sentence
 from gyrolab.engine.unread import refuse_given_accuracy
 from gyrolab.output.user_yaml import check_user_config_dir
 
 CONFIG_MODULE = "gyrolab.conf"
 CONFIG_NAME = "config"
 PACKAGED_PATH = f"pkg://{CONFIG_MODULE}"
-#: groups whose options are chosen by name on the command line
-SELECTABLE_GROUPS = ("system", "body", "initial", "force", "integrator", "regime", "experiment")
 #: the file of ``@hydra.main``: Hydra resolves a relative ``--config-path`` against its folder
 _APP_FILE = str(Path(__file__).resolve().parent.parent / "app" / "__init__.py")
 
@@ -191,18 +197,6 @@ def plugin_default_body(group: str, cls: type) -> dict[str, Any] | None:
     return dict(body)
 
 
-def plugin_body_keys() -> set[str]:
-    """The body keys third-party systems' ``default_body`` sections use (valid in ``body`` besides the packaged ones)."""
-    keys: set[str] = set()
-    for name in registry.external("system"):
-        try:
-            cls = registry.load("system", name)
-        except ConfigError:
-            continue  # an unusable plugin: register_plugin_configs warned, and a scene naming it is refused
-        keys |= set(plugin_default_body("system", cls) or {})
-    return keys
-
-
 def group_options(group: str) -> list[str]:
     """Names selectable in a config group (needs an initialised Hydra)."""
     loader = GlobalHydra.instance().config_loader()
@@ -296,6 +290,8 @@ def friendly_composition_error(error: Exception, overrides: Sequence[str], confi
     """One sentence for Hydra's "Could not override 'KEY'" and friends, with the closest valid name."""
     text = _first_line(error)
     cause = error.__cause__ or error.__context__
+    if isinstance(cause, (ValidationError, ConfigKeyError)) and getattr(cause, "full_key", None):
+        return schema_sentence(cause)  # a schema's refusal: the key, the value, what is expected
     if text.startswith("Could not append to config. An item is already at '"):
         key = text.split("'")[1]
         return ConfigError(f"+{shorten(key)}=... adds a key, but `{shorten(key)}` exists already; change it with "
@@ -315,21 +311,6 @@ def friendly_composition_error(error: Exception, overrides: Sequence[str], confi
     if "Could not delete from config" in text or "Could not find" in text:
         return ConfigError(f"{shorten(text, 200)}; ~KEY deletes only a key or group the config has")
     return ConfigError(shorten(text, 300))
-
-
-def unknown_key_sentence(key: str, known: Sequence[str], override: str = "", cause: str = "") -> str:
-    """"`time.ennd` is not a key of `time`; did you mean `time.end`?" (with the valid keys if none is close)."""
-    parent, _, leaf = key.rpartition(".")
-    where = f"`{parent}`" if parent else "the config"
-    close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
-    if "ValidationError" in cause or "ConfigTypeError" in cause:
-        return (f"{shorten(override or key)!s}: `{shorten(key)}` is a section, not a value; set one of its keys "
-                f"(e.g. {next((k for k in known if k.startswith(key + '.')), key + '.KEY')}=...)")
-    if close:
-        return f"`{shorten(key)}` is not a key of {where}; did you mean `{close[0]}`?"
-    siblings = sorted({k.rpartition(".")[2] for k in known if k.rpartition(".")[0] == parent})  # a key once
-    return (f"`{shorten(key)}` is not a key of {where}; valid keys: "
-            f"{shorten(', '.join(siblings) or '(none)', 300)}")
 
 
 def _known_names(overrides: Sequence[str], key: str, config_name: str) -> list[str]:
@@ -368,101 +349,22 @@ def _first_line(error: Exception) -> str:
     return line.split(" See https://")[0]
 
 
-# ---- the scene config's schema: closed sections, value types ------------------------------------------------
-
-#: sections whose keys are fixed: their valid keys and value types are read from the packaged config
-_CLOSED_SECTIONS = ("time", "output")
-#: sections whose valid keys are the union over the packaged options of their group
-_OPTION_SECTIONS = ("body", "initial")
-
-
-@cache
-def packaged_reference() -> dict[str, Any]:
-    """The packaged config's plain defaults and, per section, the keys any packaged option uses."""
-    from importlib.resources import files
-
-    conf = files(CONFIG_MODULE)
-    main = OmegaConf.to_container(OmegaConf.load(str(conf / "config.yaml")), resolve=False)
-    top = set(main) - {"defaults", "hydra"}
-    for option in (conf / "experiment").iterdir():
-        if option.name.endswith(".yaml"):
-            top |= set(OmegaConf.load(str(option))) - {"defaults", "hydra"}
-    sections: dict[str, set[str]] = {}
-    for group in (*_OPTION_SECTIONS, "integrator", "system", "regime"):
-        keys: set[str] = set()
-        for option in (conf / group).iterdir():
-            if option.name.endswith(".yaml"):
-                text = option.read_text()
-                node = OmegaConf.create(text) if text.strip() else OmegaConf.create({})
-                if "@package _global_" in text.split("\n", 1)[0]:
-                    node = node.get(group) or {}
-                keys |= set(node) - {"defaults"}
-        sections[group] = keys
-    return {"top": top | set(SELECTABLE_GROUPS), "defaults": main, "sections": sections}
-
+# ---- the scene config: its schemas (gyrolab.engine.schemas), then what a type cannot say ----------------------
 
 def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
-    """The scene config resolved to plain values; ConfigError for an unknown key, a wrong type, a bad reference.
+    """The scene config resolved to plain values; ConfigError for a missing section, an unknown key, a wrong type,
+    a bad reference, a number too large to compute with or a torque that silently vanishes.
 
-    Unknown keys are refused with the closest valid one (``+time.ennd=5``, a typo in
-    a user's experiment file); values of ``time`` and ``output`` must have the type of
-    the packaged default; an interpolation must point at a key that exists.
+    Keys and types are the schemas' (:func:`gyrolab.engine.schemas.validate`: a user's primary config or a stored
+    one that does not name them is checked against them too).
     """
-    ref = packaged_reference()
-    for key in cfg.keys():
-        if key not in ref["top"]:
-            raise ConfigError(unknown_key_sentence(str(key), sorted(ref["top"])))
-    for section in ("time", "output", "body", "initial", "system", "integrator"):
-        if section not in cfg or cfg[section] is None:
-            how = (f"set its keys instead (e.g. {section}.{_example_key(section)}=...)" if _example_key(section)
-                   else f"choose one ({section}=NAME)")
-            raise ConfigError(f"the config has no `{section}` section (deleted with ~{section}?); every run needs "
-                              f"it: {how}")
-    plain = resolve_plain(cfg)
-    for section in ("time", "output", "body", "initial"):
-        if not isinstance(plain[section], dict):
-            raise ConfigError(f"{section}={shorten(repr(plain[section]))}: `{section}` is a section, not a value; "
-                              f"set one of its keys (e.g. {section}.{_example_key(section)}=...)")
-        valid = (ref["defaults"][section] if section in _CLOSED_SECTIONS else ref["sections"][section])
-        if section == "body":
-            valid = valid | plugin_body_keys()  # a third-party system's body keys (register_plugin_configs)
-        for key, value in plain[section].items():
-            if key not in valid:
-                raise ConfigError(unknown_key_sentence(f"{section}.{key}", [f"{section}.{k}" for k in valid]))
-            if section in _CLOSED_SECTIONS:
-                check_type(f"{section}.{key}", value, ref["defaults"][section][key])
-    for group in ("integrator", "system", "regime", "force", "batch"):
-        if plain.get(group) is not None and not isinstance(plain[group], dict):
-            raise ConfigError(f"{group}={shorten(repr(plain[group]))}: `{group}` is a section (a mapping), not a "
-                              f"value; choose an option ({group}=NAME) or set its keys ({group}.KEY=...)")
-    for group in ("integrator", "system", "regime"):
-        node = plain.get(group)
-        if isinstance(node, dict) and "_target_" in node and _plugin_keys(group, node["_target_"]):
-            valid = _plugin_keys(group, node["_target_"]) | ref["sections"][group]
-            for key in node:
-                if key not in valid:
-                    raise ConfigError(unknown_key_sentence(f"{group}.{key}", [f"{group}.{k}" for k in valid]))
-    for name, node in (plain.get("force") or {}).items():
-        valid = _plugin_keys("force", node["_target_"]) if isinstance(node, dict) and "_target_" in node else set()
-        if valid:
-            for key in node:
-                if key not in valid:
-                    raise ConfigError(unknown_key_sentence(f"force.{name}.{key}",
-                                                           [f"force.{name}.{k}" for k in valid]))
-    for key in ("task",):
-        if key in plain and not isinstance(plain[key], str):
-            raise ConfigError(f"{key}={shorten(repr(plain[key]))} must be a task name (a string)")
-    n_output = plain["time"].get("n_output")
-    if n_output != "auto" and (isinstance(n_output, bool) or not isinstance(n_output, int)):
-        raise ConfigError(f"time.n_output={shorten(repr(n_output))} must be an integer (the samples stored) or auto")
+    for section in required_sections():
+        if section not in cfg or OmegaConf.is_missing(cfg, section) or cfg[section] is None:
+            raise ConfigError(missing_section(section))
+    plain = resolve_plain(validate(cfg))
     for section, node in plain.items():
         _check_magnitudes(str(section), node)
     _check_degenerate_vectors(plain)
-    accuracy = plain.get("accuracy")
-    if accuracy is not None:
-        check_type("accuracy", accuracy, 0.0)
-    if "allow_large" in plain:
-        check_type("allow_large", plain["allow_large"], False)
     return plain
 
 
@@ -515,40 +417,6 @@ def _check_magnitudes(where: str, node: Any) -> None:
         if large:
             raise ConfigError(f"{where}={shorten(repr(node), 40)} is too large; gyrolab takes numbers up to "
                               f"{MAX_MAGNITUDE:.0e} in magnitude (use nondimensional or scaled units)")
-
-
-def _plugin_keys(group: str, target: Any) -> set[str]:
-    try:
-        _, cls = registry.resolve_target(group, target, group)
-    except ConfigError:
-        return set()  # Scene.from_config says which targets are valid
-    return {"_target_", *registry.default_params(cls)}
-
-
-def _example_key(section: str) -> str:
-    return {"time": "end", "output": "figures", "body": "a", "initial": "r0"}.get(section, "")
-
-
-#: keys whose packaged default is null, with a value of the type they take otherwise
-NULLABLE = {"output.error_estimate": False}
-
-
-def check_type(where: str, value: Any, default: Any) -> None:
-    """ConfigError unless ``value`` has the type of the packaged default (an int is a valid float; null where the
-    default is null, else the type of ``NULLABLE``'s example)."""
-    if default is None and value is not None and where in NULLABLE:
-        default = NULLABLE[where]
-        if isinstance(default, bool) and not isinstance(value, bool):
-            raise ConfigError(f"{where}={shorten(repr(value))} must be true, false or null")
-    if isinstance(default, bool):
-        if not isinstance(value, bool):
-            raise ConfigError(f"{where}={shorten(repr(value))} must be true or false")
-    elif isinstance(default, int):
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"{where}={shorten(repr(value))} must be an integer")
-    elif isinstance(default, float):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(f"{where}={shorten(repr(value))} must be a number")
 
 
 def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
