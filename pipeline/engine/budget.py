@@ -38,7 +38,7 @@ def check_tolerances(plain: dict[str, Any]) -> None:
         if value is None or isinstance(value, bool) or not isinstance(value, (int, float)):
             continue
         if not 0 < value < 1:
-            raise ConfigError(f"{where}={value!r} is outside (0, 1); a tolerance must be positive and below 1, "
+            raise ConfigError(f"{where}={value:g} is outside (0, 1); a tolerance must be positive and below 1, "
                               "e.g. 1e-10")
 
 

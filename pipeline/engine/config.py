@@ -36,8 +36,10 @@ from gyrolab.engine.schemas import (
     missing_section,
     required_sections,
     unknown_key_sentence,
+    resolve_plain,
     validate,
 )
+from gyrolab.engine.schemas import first_line as _first_line
 from gyrolab.engine.schemas import sentence as schema_sentence
 from gyrolab.engine.unread import refuse_given_accuracy
 from gyrolab.output.user_yaml import check_user_config_dir
@@ -246,6 +248,9 @@ def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bo
         raise ConfigError(f"malformed override: {_first_line(error)}") from None
     except (HydraException, OmegaConfBaseException) as error:
         raise friendly_composition_error(error, overrides, config_name) from None
+    except OverflowError:  # an integer of hundreds of digits given for a number
+        raise ConfigError(f"{shorten(' '.join(overrides), 120)}: a number is too large; gyrolab takes numbers up to "
+                          f"{MAX_MAGNITUDE:.0e} in magnitude (use nondimensional or scaled units)") from None
     except (ValueError, TypeError) as error:  # Hydra's defaults list on a malformed group override
         raise ConfigError(f"cannot compose the config with {shorten(' '.join(overrides), 120)} "
                           f"({shorten(_first_line(error), 120)})") from None
@@ -290,7 +295,8 @@ def friendly_composition_error(error: Exception, overrides: Sequence[str], confi
     """One sentence for Hydra's "Could not override 'KEY'" and friends, with the closest valid name."""
     text = _first_line(error)
     cause = error.__cause__ or error.__context__
-    if isinstance(cause, (ValidationError, ConfigKeyError)) and getattr(cause, "full_key", None):
+    if isinstance(cause, (ValidationError, ConfigKeyError)) and (getattr(cause, "full_key", None)
+                                                                 or "Merge error" in str(cause)):
         return schema_sentence(cause)  # a schema's refusal: the key, the value, what is expected
     if text.startswith("Could not append to config. An item is already at '"):
         key = text.split("'")[1]
@@ -337,18 +343,6 @@ def key_paths(node: Any, prefix: str = "") -> Iterator[str]:
                 yield from key_paths(child, path)
 
 
-def _first_line(error: Exception) -> str:
-    """The first line of a Hydra/OmegaConf message, without its pointer to the online docs."""
-    lines = [line.strip() for line in str(error).strip().splitlines() if line.strip()]
-    line = lines[0] if lines else type(error).__name__
-    if line.endswith(":") and len(lines) > 1:  # "In 'experiment/x': ConfigTypeError raised while composing config:"
-        line = f"{line} {lines[1]}"
-    for merge in ("Cannot merge DictConfig with ListConfig", "Cannot merge ListConfig with DictConfig"):
-        line = line.replace(merge, "a list and a section (a mapping) do not match: one is given where the config "
-                                   "has the other")
-    return line.split(" See https://")[0]
-
-
 # ---- the scene config: its schemas (gyrolab.engine.schemas), then what a type cannot say ----------------------
 
 def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
@@ -361,7 +355,7 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
     for section in required_sections():
         if section not in cfg or OmegaConf.is_missing(cfg, section) or cfg[section] is None:
             raise ConfigError(missing_section(section))
-    plain = resolve_plain(validate(cfg))
+    plain = validate(cfg)
     for section, node in plain.items():
         _check_magnitudes(str(section), node)
     _check_degenerate_vectors(plain)
@@ -417,26 +411,3 @@ def _check_magnitudes(where: str, node: Any) -> None:
         if large:
             raise ConfigError(f"{where}={shorten(repr(node), 40)} is too large; gyrolab takes numbers up to "
                               f"{MAX_MAGNITUDE:.0e} in magnitude (use nondimensional or scaled units)")
-
-
-def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
-    """``OmegaConf.to_container(cfg, resolve=True)`` with a one-sentence error for a broken interpolation."""
-    try:
-        return OmegaConf.to_container(cfg, resolve=True, throw_on_missing=True)
-    except OmegaConfBaseException as error:
-        key = getattr(error, "full_key", None) or "?"
-        raw = _raw_value(cfg, key)
-        reason = _first_line(error).split(" full_key:")[0]
-        return_hint = "refer to an existing key, e.g. ${time.end}, or give a plain value"
-        raise ConfigError(f"{shorten(key)}={shorten(str(raw))} cannot be resolved ({shorten(reason, 160)}); "
-                          f"{return_hint}") from None
-
-
-def _raw_value(cfg: DictConfig, key: str) -> Any:
-    node: Any = cfg
-    try:
-        for part in key.split("."):
-            node = node._get_node(part)
-        return node._value()
-    except Exception:  # noqa: BLE001 - only for the message
-        return "?"

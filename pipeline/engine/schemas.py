@@ -19,8 +19,10 @@ sets; ``gyrolab.experiments`` derives its tables from the declarations.
 
 from __future__ import annotations
 
+import ast
 import dataclasses
 import difflib
+import re
 import inspect
 import typing
 from dataclasses import dataclass, field
@@ -316,9 +318,9 @@ def body_schema(fields: dict[str, Any]) -> type:
 
 # ---- validation ---------------------------------------------------------------------------------------------
 
-def validate(cfg: DictConfig) -> DictConfig:
-    """``cfg`` merged into its schemas (the primary config's, then each group's by its ``_target_``), ConfigError in
-    one sentence for an unknown key, a value of the wrong type or a missing section."""
+def validate(cfg: DictConfig) -> dict[str, Any]:
+    """``cfg`` merged into its schemas (the primary config's, then each group's by its ``_target_``) and resolved to
+    plain values; ConfigError in one sentence for an unknown key, a value of the wrong type, a bad reference."""
     for group in GROUP_SECTIONS:
         node = cfg.get(group) if group in cfg and not OmegaConf.is_missing(cfg, group) else None
         if node is not None and not isinstance(node, DictConfig):
@@ -335,10 +337,11 @@ def validate(cfg: DictConfig) -> DictConfig:
                 except OmegaConfBaseException as error:
                     raise sentence(error, prefix=f"{key}.") from None
                 OmegaConf.update(merged, key, typed, merge=False)
-        _check_metadata(merged, Gyrolab, "")
     except OmegaConfBaseException as error:
         raise sentence(error) from None
-    return merged
+    plain = resolve_plain(merged)
+    _check_metadata(plain, Gyrolab, "")
+    return plain
 
 
 def _group_schemas(cfg: DictConfig) -> list[tuple[str, type]]:
@@ -381,15 +384,16 @@ def _schema_of(group: str, target: Any) -> tuple[str | None, type | None]:
 
 def _check_metadata(node: Any, schema: type, prefix: str) -> None:
     """The checks a type cannot say: a value of an ``Any`` field with ``type`` (and ``alt``), recursively."""
+    hints = typing.get_type_hints(schema)
     for f in dataclasses.fields(schema):
-        value = node.get(f.name) if isinstance(node, DictConfig) else None
+        value = node.get(f.name)
         key = f"{prefix}{f.name}"
         expected = f.metadata.get("type")
         if expected is not None and value != f.metadata.get("alt", object()):
             if isinstance(value, bool) or not isinstance(value, expected):
                 raise ConfigError(_type_sentence(key, value, expected, f.metadata.get("alt")))
-        if isinstance(value, DictConfig) and dataclasses.is_dataclass(OmegaConf.get_type(value)):
-            _check_metadata(value, OmegaConf.get_type(value), key + ".")
+        if isinstance(value, dict) and dataclasses.is_dataclass(_strip_optional(hints[f.name])):
+            _check_metadata(value, _strip_optional(hints[f.name]), key + ".")
 
 
 def sentence(error: OmegaConfBaseException, prefix: str = "") -> ConfigError:
@@ -402,19 +406,10 @@ def sentence(error: OmegaConfBaseException, prefix: str = "") -> ConfigError:
         parent = key.rpartition(".")[0]
         known = [f"{parent}.{f.name}" if parent else f.name for f in dataclasses.fields(schema)]
         return ConfigError(unknown_key_sentence(key, known + ([] if parent else list(SELECTABLE_GROUPS))))
-    if isinstance(error, ValidationError) and key:
-        hint = _field_type(schema, key.rpartition(".")[2].split("[")[0])
-        value = getattr(error, "value", None)
-        value = OmegaConf.to_container(value) if isinstance(value, (DictConfig, ListConfig)) else value
-        if isinstance(value, (dict, list)) and (dataclasses.is_dataclass(hint) or _is_list(hint)):
-            return ConfigError(f"{key}={shorten(repr(value))}: a list and a section (a mapping) do not match; "
-                               f"{key} must be {_words(hint)}")
-        if dataclasses.is_dataclass(hint):
-            example = required_sections().get(key) or _example(hint)
-            return ConfigError(f"{key}={shorten(repr(value))}: `{key}` is a section, not a value; set one of its "
-                               f"keys (e.g. {key}.{example}=...)")
-        if hint is not None:
-            return ConfigError(_type_sentence(key, value, hint))
+    if isinstance(error, ValidationError):
+        key, hint, value = _validation_subject(error, key, schema)
+        if key and hint is not None:
+            return ConfigError(_mismatch_sentence(key, value, hint))
     reason = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
     return ConfigError(f"{key or 'the config'} is not valid ({shorten(reason, 160)})")
 
@@ -433,6 +428,39 @@ def unknown_key_sentence(key: str, known: Sequence[str], override: str = "", cau
     return (f"`{shorten(key)}` is not a key of {where}; valid keys: "
             f"{shorten(', '.join(siblings) or '(none)', 300)}")
 
+
+
+def _validation_subject(error: ValidationError, key: str, schema: Any) -> tuple[str, Any, Any]:
+    """(key, expected type, value) of a ValidationError; a merge error names only the schema ("Merge error: list is
+    not a subclass of Time. value: [1, 2]"): its key is the config's section of that type."""
+    merge = re.search(r"Merge error: \w+ is not a subclass of (\w+)\. value: (.*)", str(error))
+    if key or merge is None:
+        value = getattr(error, "value", None)
+        value = OmegaConf.to_container(value) if isinstance(value, (DictConfig, ListConfig)) else value
+        return key, _field_type(schema, key.rpartition(".")[2].split("[")[0]), value
+    parent = getattr(error, "parent_node", None)
+    for name in (parent.keys() if isinstance(parent, DictConfig) else ()):
+        node = parent._get_node(name)
+        if isinstance(node, DictConfig) and OmegaConf.get_type(node).__name__ == merge.group(1):
+            try:
+                value = ast.literal_eval(merge.group(2))
+            except (ValueError, SyntaxError):
+                value = merge.group(2)
+            return str(name), OmegaConf.get_type(node), value
+    return key, None, None
+
+
+def _mismatch_sentence(key: str, value: Any, hint: Any) -> str:
+    """A value of the wrong kind: a list for a section or the reverse, a value for a section, a wrong type."""
+    section = dataclasses.is_dataclass(_strip_optional(hint)) or typing.get_origin(_strip_optional(hint)) is dict
+    if (section and isinstance(value, list)) or (_is_list(hint) and isinstance(value, dict)):
+        return f"{key}={shorten(repr(value))}: a list and a section (a mapping) do not match; {key} must be {_words(hint)}"
+    if section:
+        base = _strip_optional(hint)
+        example = required_sections().get(key) or (_example(base) if dataclasses.is_dataclass(base) else "NAME")
+        return (f"{key}={shorten(repr(value))}: `{key}` is a section, not a value; set one of its keys "
+                f"(e.g. {key}.{example}=...)")
+    return _type_sentence(key, value, hint)
 
 
 def _field_type(schema: Any, name: str) -> Any:
@@ -535,3 +563,38 @@ def signature_keys(cls: type) -> set[str]:
     """The keyword parameters of a plugin's ``__init__`` (for the test that the built-in schemas match them)."""
     return {p.name for p in inspect.signature(cls.__init__).parameters.values()
             if p.kind is p.KEYWORD_ONLY or (p.default is not p.empty and p.name != "self")}
+
+
+def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
+    """``OmegaConf.to_container(cfg, resolve=True)`` with a one-sentence error for a broken interpolation."""
+    try:
+        return OmegaConf.to_container(cfg, resolve=True, throw_on_missing=True)
+    except OmegaConfBaseException as error:
+        key = getattr(error, "full_key", None) or "?"
+        raw = _raw_value(cfg, key)
+        reason = first_line(error).split(" full_key:")[0]
+        return_hint = "refer to an existing key, e.g. ${time.end}, or give a plain value"
+        raise ConfigError(f"{shorten(key)}={shorten(str(raw))} cannot be resolved ({shorten(reason, 160)}); "
+                          f"{return_hint}") from None
+
+
+def _raw_value(cfg: DictConfig, key: str) -> Any:
+    node: Any = cfg
+    try:
+        for part in key.split("."):
+            node = node._get_node(part)
+        return node._value()
+    except Exception:  # noqa: BLE001 - only for the message
+        return "?"
+
+
+def first_line(error: Exception) -> str:
+    """The first line of a Hydra/OmegaConf message, without its pointer to the online docs."""
+    lines = [line.strip() for line in str(error).strip().splitlines() if line.strip()]
+    line = lines[0] if lines else type(error).__name__
+    if line.endswith(":") and len(lines) > 1:  # "In 'experiment/x': ConfigTypeError raised while composing config:"
+        line = f"{line} {lines[1]}"
+    for merge in ("Cannot merge DictConfig with ListConfig", "Cannot merge ListConfig with DictConfig"):
+        line = line.replace(merge, "a list and a section (a mapping) do not match: one is given where the config "
+                                   "has the other")
+    return line.split(" See https://")[0]
