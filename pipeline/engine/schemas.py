@@ -509,6 +509,10 @@ def required_sections() -> dict[str, str]:
     return {f.name: f.metadata["example"] for f in dataclasses.fields(Gyrolab) if "example" in f.metadata}
 
 
+#: sections every run needs, with a key to show in the sentences (``gyrolab.app`` refuses ``~time``)
+REQUIRED_SECTIONS = required_sections()
+
+
 def missing_section(section: str) -> str:
     example = required_sections()[section]
     how = f"choose one ({section}=NAME)" if example == "_target_" else f"set its keys instead (e.g. {section}.{example}=...)"
