@@ -34,6 +34,7 @@ from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
 from gyrolab.engine.schemas import (
     SELECTABLE_GROUPS,
     missing_section,
+    plugin_schema,
     required_sections,
     unknown_key_sentence,
     resolve_plain,
@@ -159,7 +160,8 @@ def hydra_for(source: ConfigSource | None = None) -> Iterator[None]:
 
 @cache
 def register_plugin_configs() -> None:
-    """Give every third-party plugin a config node built from its ``__init__`` keyword defaults.
+    """Give every third-party plugin a config node: its schema (its class's ``schema`` dataclass, else one made from
+    its ``__init__`` keyword defaults: ``gyrolab.engine.schemas.plugin_schema``) with its ``_target_``.
 
     Built-in plugins have YAML files in ``conf/``; a plugin package only
     registers an entry point, and this makes ``force=[..., its_name]`` work.
@@ -175,11 +177,10 @@ def register_plugin_configs() -> None:
         for name, target in registry.external(group).items():
             try:
                 cls = registry.load(group, name)
-                params = registry.default_params(cls)
+                node: Any = OmegaConf.merge(OmegaConf.structured(plugin_schema(cls)), {"_target_": target})
             except ConfigError as error:
                 registry.unusable_warning(group, name, error)
-                cls, params = None, {}
-            node = {"_target_": target, **params}
+                cls, node = None, {"_target_": target}
             # A force option nests under its own name so that several can be selected at once.
             store.store(group=group, name=name, node={name: node} if group == "force" else node)
             body = plugin_default_body(group, cls) if cls is not None else None
