@@ -37,7 +37,6 @@ from gyrolab.engine.schemas import (
     plugin_schema,
     required_sections,
     unknown_key_sentence,
-    resolve_plain,
     validate,
 )
 from gyrolab.engine.schemas import first_line as _first_line
@@ -260,7 +259,13 @@ def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bo
 
         with open_dict(cfg):
             del cfg["hydra"]
-    return cfg
+    # checked by the schemas, used as any mapping (an experiment sets whole sections); Hydra's own node stays typed
+    plain = OmegaConf.create(OmegaConf.to_container(OmegaConf.masked_copy(cfg, [k for k in cfg if k != "hydra"]),
+                                                    resolve=False))
+    if "hydra" in cfg:
+        plain.hydra = cfg.hydra
+    OmegaConf.set_struct(plain, True)
+    return plain
 
 
 def _unknown_option(text: str) -> ConfigError | None:

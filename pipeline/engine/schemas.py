@@ -23,11 +23,11 @@ import ast
 import dataclasses
 import difflib
 import re
-import inspect
+import types
 import typing
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cache
-from collections.abc import Sequence
 from typing import Any, Dict, List, Optional
 
 from hydra.core.config_store import ConfigStore
@@ -277,7 +277,7 @@ SYSTEM_SECTIONS = {"fixed_point": (RigidBody, Attitude), "orbiting_gyrostat": (G
 def register() -> None:
     """Store the schemas: ``gyrolab_schema`` (the primary config's) and ``schema/<group>/<name>``."""
     store = ConfigStore.instance()
-    store.store(name="gyrolab_schema", node=Gyrolab)
+    store.store(name="gyrolab_schema", node=_while_composing(Gyrolab))
     for group, schemas in BUILTIN.items():
         for schema in set(schemas.values()):
             store.store(group=f"schema/{group}", name=schema.__name__.lower(), node=schema)
@@ -286,7 +286,18 @@ def register() -> None:
         store.store(group="schema/initial", name=initial.__name__.lower(), node=initial)
 
 
-register()
+def _while_composing(schema: type) -> type:
+    """The primary config's schema while Hydra composes: its keys and top-level values typed, its sections any
+    mapping, so that ``~output.dpi`` and ``~work_precision.methods`` delete as in any Hydra app (the sections are
+    typed by :func:`validate` after composing)."""
+    hints, fields = typing.get_type_hints(schema), []
+    for f in dataclasses.fields(schema):
+        base = _strip_optional(hints[f.name])
+        if dataclasses.is_dataclass(base) or typing.get_origin(base) is dict:
+            fields.append((f.name, Any, field(default=MISSING if "example" in f.metadata else None)))
+        else:
+            fields.append((f.name, hints[f.name], field(default=f.default, metadata=f.metadata)))
+    return dataclasses.make_dataclass(f"{schema.__name__}WhileComposing", fields)
 
 
 def plugin_schema(cls: type) -> type:
@@ -475,8 +486,7 @@ def _is_list(hint: Any) -> bool:
 
 def _strip_optional(hint: Any) -> Any:
     args = [a for a in typing.get_args(hint) if a is not type(None)]
-    return args[0] if typing.get_origin(hint) in (typing.Union, getattr(__import__("types"), "UnionType", None)) \
-        and len(args) == 1 else hint
+    return args[0] if typing.get_origin(hint) in (typing.Union, types.UnionType) and len(args) == 1 else hint
 
 
 def _example(schema: type) -> str:
@@ -563,12 +573,6 @@ class Task:
         return dataclasses.replace(self, sets={**self.sets, **dict.fromkeys(keys, why)})
 
 
-def signature_keys(cls: type) -> set[str]:
-    """The keyword parameters of a plugin's ``__init__`` (for the test that the built-in schemas match them)."""
-    return {p.name for p in inspect.signature(cls.__init__).parameters.values()
-            if p.kind is p.KEYWORD_ONLY or (p.default is not p.empty and p.name != "self")}
-
-
 def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
     """``OmegaConf.to_container(cfg, resolve=True)`` with a one-sentence error for a broken interpolation."""
     try:
@@ -602,3 +606,6 @@ def first_line(error: Exception) -> str:
         line = line.replace(merge, "a list and a section (a mapping) do not match: one is given where the config "
                                    "has the other")
     return line.split(" See https://")[0]
+
+
+register()  # at import, as Hydra's structured-config examples do: before any composition
