@@ -277,7 +277,9 @@ SYSTEM_SECTIONS = {"fixed_point": (RigidBody, Attitude), "orbiting_gyrostat": (G
 def register() -> None:
     """Store the schemas: ``gyrolab_schema`` (the primary config's) and ``schema/<group>/<name>``."""
     store = ConfigStore.instance()
-    store.store(name="gyrolab_schema", node=_while_composing(Gyrolab))
+    primary = OmegaConf.structured(_while_composing(Gyrolab))
+    OmegaConf.set_struct(primary, False)  # a user's own group (+notes=lab) composes; validate refuses it for a run
+    store.store(name="gyrolab_schema", node=primary)
     for group, schemas in BUILTIN.items():
         for schema in set(schemas.values()):
             store.store(group=f"schema/{group}", name=schema.__name__.lower(), node=schema)
