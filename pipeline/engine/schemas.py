@@ -302,6 +302,7 @@ def _while_composing(schema: type) -> type:
     return dataclasses.make_dataclass(f"{schema.__name__}WhileComposing", fields)
 
 
+@cache
 def plugin_schema(cls: type) -> type:
     """A third-party plugin's schema: its ``schema`` dataclass, else one made from its ``__init__`` keywords
     (their annotations where OmegaConf can check them, else ``Any``)."""
@@ -324,9 +325,10 @@ def plugin_schema(cls: type) -> type:
     return dataclasses.make_dataclass(f"{cls.__name__}Schema", fields)
 
 
-def body_schema(fields: dict[str, Any]) -> type:
+@cache
+def body_schema(keys: tuple[str, ...]) -> type:
     """The body schema of a third-party system's ``default_body``: its keys, any value."""
-    return dataclasses.make_dataclass("PluginBody", [(k, Any, None) for k in fields])
+    return dataclasses.make_dataclass("PluginBody", [(k, Any, None) for k in keys])
 
 
 # ---- validation ---------------------------------------------------------------------------------------------
@@ -341,12 +343,12 @@ def validate(cfg: DictConfig) -> dict[str, Any]:
                               f"choose an option ({group}=NAME) or set its keys ({group}.KEY=...)")
     try:
         # a plain copy: a key Hydra's ``+key=`` added to a composed structured config is refused here too
-        merged = OmegaConf.merge(OmegaConf.structured(Gyrolab), OmegaConf.to_container(cfg, resolve=False))
+        merged = OmegaConf.merge(_structured(Gyrolab), OmegaConf.to_container(cfg, resolve=False))
         for key, schema in _group_schemas(merged):
             node = OmegaConf.select(merged, key)
             if isinstance(node, DictConfig) and OmegaConf.get_type(node) is dict:
                 try:
-                    typed = OmegaConf.merge(OmegaConf.structured(schema), node)
+                    typed = OmegaConf.merge(_structured(schema), node)
                 except OmegaConfBaseException as error:
                     raise sentence(error, prefix=f"{key}.") from None
                 OmegaConf.update(merged, key, typed, merge=False)
@@ -355,6 +357,12 @@ def validate(cfg: DictConfig) -> dict[str, Any]:
     plain = resolve_plain(merged)
     _check_metadata(plain, Gyrolab, "")
     return plain
+
+
+@cache
+def _structured(schema: type) -> DictConfig:
+    """A schema's config, made once (OmegaConf.merge copies it)."""
+    return OmegaConf.structured(schema)
 
 
 def _group_schemas(cfg: DictConfig) -> list[tuple[str, type]]:
@@ -375,7 +383,7 @@ def _group_schemas(cfg: DictConfig) -> list[tuple[str, type]]:
     if system and system not in SYSTEM_SECTIONS:  # a third-party system: its default_body's keys, else a rigid body
         cls = registry.load("system", system)
         default = getattr(cls, "default_body", None)
-        body = body_schema(default) if isinstance(default, dict) else RigidBody
+        body = body_schema(tuple(default)) if isinstance(default, dict) else RigidBody
         initial = GyrostatInitial
     return found + [(k, s) for k, s in (("body", body), ("initial", initial)) if s is not None]
 
