@@ -62,11 +62,6 @@ def read_by() -> dict[str, tuple[str, ...]]:
     return {key: tuple(name for name, task in runs.items() if key in task.reads) for key in only_declared_keys()}
 
 
-def not_read_by() -> dict[str, dict[str, str]]:
-    """Task -> the keys it sets itself for the scenes it runs (a value given for them would change nothing) and why."""
-    return {name: declaration(f"task {name}").sets for name in TASKS if declaration(f"task {name}").sets}
-
-
 def refuse_unread(run: str, overrides: Sequence[str], *, sweep: bool = False) -> None:
     """ConfigError for the first value ``overrides`` give that ``run`` (``task NAME`` or ``gyrolab batch``; ``sweep``:
     its jobs are a sweep's) does not read: a key only other runs read (``batch.output=final`` on a plain run), or one
