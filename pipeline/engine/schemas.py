@@ -130,7 +130,7 @@ class Gyrolab:
     system: Any = _required("_target_")
     body: Any = _required("a")
     initial: Any = _required("r0")
-    force: Dict[str, Any] = field(default_factory=dict)
+    force: Optional[Dict[str, Any]] = field(default_factory=dict)
     integrator: Any = _required("rtol")
     regime: Any = field(default=None, metadata=ONLY_DECLARED)
     work_precision: Optional[WorkPrecision] = None
