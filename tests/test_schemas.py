@@ -21,10 +21,10 @@ from gyrolab.engine.config import check_scene_config, compose_config
 from gyrolab.errors import ConfigError
 
 
-@pytest.mark.parametrize("group, name", [(g, n) for g, names in schemas.BUILTIN.items() for n in names])
+@pytest.mark.parametrize("group, name", [(g, n) for g, names in registry.BUILTINS.items() for n in names])
 def test_a_builtin_schema_has_the_keys_and_defaults_of_its_plugin(group, name):
     cls = registry.load(group, name)
-    schema = {f.name: f for f in dataclasses.fields(schemas.BUILTIN[group][name])}
+    schema = {f.name: f for f in dataclasses.fields(schemas.BUILTIN[group][cls.__name__])}
     params = registry.default_params(cls)
     assert set(schema) == {"_target_", *params}, (group, name)
     for key, default in params.items():

@@ -263,14 +263,13 @@ class ResonantOmega3(Regime):
     phase_deg: float = 45.0
 
 
-#: group -> built-in plugin name -> its schema (the YAML option of the same name extends it)
+#: group -> built-in plugin class name -> its schema (the YAML option of that plugin extends it)
 BUILTIN = {
-    "system": {"fixed_point": System, "orbiting_gyrostat": System},
-    "force": {"uniform_gravity": UniformGravity, "newtonian": Newtonian, "magnetic": Magnetic},
-    "integrator": {"rk4": FixedStep, "rk4_numba": FixedStep, "lie_poisson": LiePoisson, "taylor": Taylor,
-                   "auto": Auto, **dict.fromkeys(("rk45", "dop853", "dop853_numba", "lsoda", "radau", "bdf"),
-                                                 Tolerances)},
-    "regime": {"small_parameter": SmallParameter, "large_parameter": Regime, "resonant_omega3": ResonantOmega3},
+    "system": {"FixedPoint": System, "OrbitingGyrostat": System},
+    "force": {"UniformGravity": UniformGravity, "Newtonian": Newtonian, "Magnetic": Magnetic},
+    "integrator": {"RK4": FixedStep, "RK4Numba": FixedStep, "LiePoisson": LiePoisson, "Taylor": Taylor, "Auto": Auto,
+                   **dict.fromkeys(("RK45", "DOP853", "DOP853Numba", "LSODA", "Radau", "BDF"), Tolerances)},
+    "regime": {"SmallParameter": SmallParameter, "LargeParameter": Regime, "ResonantOmega3": ResonantOmega3},
 }
 #: a system's body and initial sections (a third-party system: RigidBody, or its ``default_body``'s keys)
 SYSTEM_SECTIONS = {"fixed_point": (RigidBody, Attitude), "orbiting_gyrostat": (GyrostatBody, GyrostatInitial)}
@@ -397,8 +396,9 @@ def _schema_of(group: str, target: Any) -> tuple[str | None, type | None]:
     name = by_target.get(registry._normalise(target))
     if name is None:
         return None, None  # not registered: Scene.from_config and the trust boundary say so
-    if name in BUILTIN[group]:
-        return name, BUILTIN[group][name]
+    builtin = BUILTIN[group].get(registry.targets(group)[name].rpartition(":")[2])
+    if builtin is not None and name in registry.BUILTINS[group]:
+        return name, builtin
     try:
         return name, plugin_schema(registry.load(group, name))
     except ConfigError:
