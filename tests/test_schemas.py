@@ -45,7 +45,9 @@ def _hydra_composes(overrides):
                                                            run_mode=RunMode.RUN)
 
 
-@pytest.mark.parametrize("group", ["system", "body", "initial", "force", "integrator", "regime"])
+# initial's options name no schema: a batch sweeps initial.r0=abc,5 and reports the bad point in its own sentence
+# (tests/test_batch_stream.py); validate types them after composing
+@pytest.mark.parametrize("group", ["system", "body", "force", "integrator", "regime"])
 def test_every_packaged_option_extends_a_schema(group):
     for option in sorted(p.name[:-5] for p in (files("gyrolab.conf") / group).iterdir() if p.name.endswith(".yaml")):
         cfg = _hydra_composes([f"{group}=[{option}]" if group == "force" else f"{group}={option}"])
