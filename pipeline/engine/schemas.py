@@ -352,6 +352,9 @@ def validate(cfg: DictConfig) -> dict[str, Any]:
                     typed = OmegaConf.merge(_structured(schema), node)
                 except OmegaConfBaseException as error:
                     raise sentence(error, prefix=f"{key}.") from None
+                except OverflowError:  # an integer of hundreds of digits for a number
+                    raise ConfigError(f"{key}: a number is too large; gyrolab takes numbers up to 1e+100 in "
+                                      "magnitude (use nondimensional or scaled units)") from None
                 OmegaConf.update(merged, key, typed, merge=False)
     except OmegaConfBaseException as error:
         raise sentence(error) from None
