@@ -53,12 +53,21 @@ parameters, `preserves_area_integral` and the tests' exact solution (gyrolab's d
 
 TEMPLATES['gyrolab_viscous_drag/__init__.py'] = r'''"""Linear viscous drag on the body: torque −c ω (a gyrolab force plugin)."""
 
+from dataclasses import dataclass
+
 from gyrolab.contracts import Force
 from gyrolab.errors import as_number
 
 
+@dataclass
+class ViscousDragConfig:                  # the config's schema (force.viscous_drag): its keys and their types,
+    _target_: str = "gyrolab_viscous_drag:ViscousDrag"   # checked by Hydra while composing (gyrolab.engine.schemas)
+    coefficient: float = 0.1
+
+
 class ViscousDrag(Force):
     name = "viscous_drag"
+    schema = ViscousDragConfig
     required_axes = frozenset()           # reference axes the torque reads: none (2 would be the vertical γ)
     preserves_area_integral = False       # −c ω has a component along γ: Iω·γ decays, it is no invariant
 

@@ -428,11 +428,11 @@ def test_a_log_that_cannot_be_written_is_said_once(capfd):
 
 
 def test_a_null_default_is_type_checked():
-    from gyrolab.engine.config import check_type
+    from gyrolab.engine.config import check_scene_config, compose_config
 
     with pytest.raises(ConfigError, match="output.error_estimate='maybe' must be true, false or null"):
-        check_type("output.error_estimate", "maybe", None)
-    check_type("output.error_estimate", True, None)
+        check_scene_config(compose_config(["output.error_estimate=maybe"]))
+    assert check_scene_config(compose_config(["output.error_estimate=true"]))["output"]["error_estimate"] is True
 
 
 def test_the_umask_is_read_without_changing_it(monkeypatch):

@@ -281,8 +281,7 @@ OVERRIDE_FORMS = "key=value (time.end=50), group=option (integrator=rk4), +key=v
 MAX_OVERRIDE_CHARS = 10_000
 MAX_KEY_CHARS = 200
 #: sections every run needs, with a key to show in the message
-REQUIRED_SECTIONS = {"time": "end", "output": "figures", "body": "a", "initial": "r0", "system": "_target_",
-                     "integrator": "rtol"}
+from gyrolab.engine.schemas import REQUIRED_SECTIONS  # noqa: E402  (derived from the schemas)
 
 
 def _job_overrides(overrides: Sequence[Override], chosen: dict[int, str]) -> list[str]:

@@ -18,15 +18,33 @@ from gyrolab.errors import ConfigError
 
 SHELLS = ("bash", "zsh")
 
-#: Hydra's keys worth completing (the rest of ``hydra.`` is rarely typed)
-HYDRA_KEYS = ("hydra.run.dir", "hydra.sweep.dir", "hydra.sweep.subdir", "hydra.job.name", "hydra.verbose")
 HYDRA_GROUPS = ("hydra/launcher", "hydra/sweeper")
+#: nodes of gyrolab's ``hydra`` section that are not settings one types (help texts, logging, callbacks)
+_HYDRA_NODES_NOT_TYPED = ("help", "job_logging", "hydra_logging", "callbacks")
 
-#: the options of ``gyrolab run`` (Hydra's, gyrolab's old subcommand spellings, --version)
-RUN_OPTIONS = ("--help", "-h", "--hydra-help", "--version", "-V", "--cfg", "-c", "--resolve", "--package", "-p",
-               "--run", "-r", "--multirun", "-m", "--shell-completion", "-sc", "--config-path", "-cp",
-               "--config-name", "-cn", "--config-dir", "-cd", "--info", "-i", "--experimental-rerun",
-               "--batch", "--plot", "--reproduce", "--aggregate", "--new-force")
+
+def hydra_keys() -> list[str]:
+    """Hydra's keys worth completing: the settings gyrolab's primary config gives (``hydra.run.dir``,
+    ``hydra.sweep.dir``, ``hydra.sweep.subdir``, ``hydra.job.name``) and Hydra's ``hydra.verbose``."""
+    from importlib.resources import files
+
+    from omegaconf import OmegaConf
+
+    from gyrolab.engine.config import CONFIG_MODULE
+
+    hydra = OmegaConf.to_container(OmegaConf.load(str(files(CONFIG_MODULE) / "config.yaml")).hydra)
+    keys = [f"hydra.{key}" for key, _ in _leaves(hydra) if key.split(".")[0] not in _HYDRA_NODES_NOT_TYPED]
+    return [*keys, "hydra.verbose"]
+
+
+def run_options() -> list[str]:
+    """The options of ``gyrolab run``: Hydra's own (its argument parser's), gyrolab's ``-V`` (short for --version)
+    and the old spellings of the subcommands."""
+    from gyrolab.app.parser import ALIASES
+    from gyrolab.engine.hydra_private import get_args_parser
+
+    return [*(s for action in get_args_parser()._actions for s in action.option_strings), "-V", *ALIASES]
+
 
 #: subcommands whose arguments are paths (the shell's file completion joins in)
 PATH_COMMANDS = ("plot", "reproduce", "aggregate")
@@ -57,7 +75,7 @@ def config_words() -> list[str]:
         words.append(f"{key}=")
         if isinstance(value, bool):
             words += [f"{key}=true", f"{key}=false"]
-    for key in HYDRA_KEYS:
+    for key in hydra_keys():
         words += [*_prefixes(key, ()), f"{key}="]
     return list(dict.fromkeys(words))
 
@@ -66,7 +84,7 @@ def _leaves(node: object, prefix: str = "") -> Iterator[tuple[str, object]]:
     if isinstance(node, dict) and node:
         for key, value in node.items():
             yield from _leaves(value, f"{prefix}{key}.")
-    elif prefix and not prefix.rstrip(".").startswith("hydra"):
+    elif prefix and not prefix.startswith("hydra."):
         yield prefix.rstrip("."), node
 
 
@@ -81,7 +99,7 @@ def option_words() -> dict[str, list[str]]:
     """Each subcommand's options (``run``: Hydra's and the old spellings)."""
     from gyrolab.app.parser import build_parsers
 
-    options = {"run": list(RUN_OPTIONS)}
+    options = {"run": run_options()}
     for name, parser in build_parsers().items():
         options[name] = [s for action in parser._actions for s in action.option_strings]
     return options

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from gyrolab.engine.schemas import keys_with
 from gyrolab.errors import ConfigError
 
 MAX_STATE_BYTES = 2 * 1024**3
@@ -25,8 +26,8 @@ MAX_STEPS = 1_000_000_000
 #: an optimistic cost of one step (fast compiled kernels), used to say how long a request would take
 SECONDS_PER_STEP = 1e-6
 RADIANS_PER_STEP = 2.0
-#: tolerance-like parameters, relative to the state's scale: each must lie in (0, 1)
-TOLERANCES = ("rtol", "atol", "tol", "accuracy")
+#: tolerance-like parameters, relative to the state's scale: each must lie in (0, 1) (the schemas' TOLERANCE fields)
+TOLERANCES = keys_with("tolerance")
 ESCAPE = "set allow_large=true to run it anyway"
 
 
@@ -38,7 +39,7 @@ def check_tolerances(plain: dict[str, Any]) -> None:
         if value is None or isinstance(value, bool) or not isinstance(value, (int, float)):
             continue
         if not 0 < value < 1:
-            raise ConfigError(f"{where}={value!r} is outside (0, 1); a tolerance must be positive and below 1, "
+            raise ConfigError(f"{where}={value:g} is outside (0, 1); a tolerance must be positive and below 1, "
                               "e.g. 1e-10")
 
 

@@ -26,19 +26,27 @@ from hydra.core.global_hydra import GlobalHydra
 from hydra.errors import HydraException, MissingConfigException, OverrideParseException
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf
-from omegaconf.errors import OmegaConfBaseException
+from omegaconf.errors import ConfigKeyError, OmegaConfBaseException, ValidationError
 
 from gyrolab.contracts import registry
 from gyrolab.compat import create_automatic_config_search_path
 from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
+from gyrolab.engine.schemas import (
+    SELECTABLE_GROUPS,
+    missing_section,
+    plugin_schema,
+    required_sections,
+    unknown_key_sentence,
+    validate,
+)
+from gyrolab.engine.schemas import first_line as _first_line
+from gyrolab.engine.schemas import sentence as schema_sentence
 from gyrolab.engine.unread import refuse_given_accuracy
 from gyrolab.output.user_yaml import check_user_config_dir
 
 CONFIG_MODULE = "gyrolab.conf"
 CONFIG_NAME = "config"
 PACKAGED_PATH = f"pkg://{CONFIG_MODULE}"
-#: groups whose options are chosen by name on the command line
-SELECTABLE_GROUPS = ("system", "body", "initial", "force", "integrator", "regime", "experiment")
 #: the file of ``@hydra.main``: Hydra resolves a relative ``--config-path`` against its folder
 _APP_FILE = str(Path(__file__).resolve().parent.parent / "app" / "__init__.py")
 
@@ -151,7 +159,8 @@ def hydra_for(source: ConfigSource | None = None) -> Iterator[None]:
 
 @cache
 def register_plugin_configs() -> None:
-    """Give every third-party plugin a config node built from its ``__init__`` keyword defaults.
+    """Give every third-party plugin a config node: its schema (its class's ``schema`` dataclass, else one made from
+    its ``__init__`` keyword defaults: ``gyrolab.engine.schemas.plugin_schema``) with its ``_target_``.
 
     Built-in plugins have YAML files in ``conf/``; a plugin package only
     registers an entry point, and this makes ``force=[..., its_name]`` work.
@@ -167,11 +176,10 @@ def register_plugin_configs() -> None:
         for name, target in registry.external(group).items():
             try:
                 cls = registry.load(group, name)
-                params = registry.default_params(cls)
+                node: Any = OmegaConf.merge(OmegaConf.structured(plugin_schema(cls)), {"_target_": target})
             except ConfigError as error:
                 registry.unusable_warning(group, name, error)
-                cls, params = None, {}
-            node = {"_target_": target, **params}
+                cls, node = None, {"_target_": target}
             # A force option nests under its own name so that several can be selected at once.
             store.store(group=group, name=name, node={name: node} if group == "force" else node)
             body = plugin_default_body(group, cls) if cls is not None else None
@@ -189,18 +197,6 @@ def plugin_default_body(group: str, cls: type) -> dict[str, Any] | None:
         raise ConfigError(f"system plugin {cls.__name__}.default_body={shorten(repr(body))} must be a dict of "
                           "body keys to values (its body section); fix the plugin package")
     return dict(body)
-
-
-def plugin_body_keys() -> set[str]:
-    """The body keys third-party systems' ``default_body`` sections use (valid in ``body`` besides the packaged ones)."""
-    keys: set[str] = set()
-    for name in registry.external("system"):
-        try:
-            cls = registry.load("system", name)
-        except ConfigError:
-            continue  # an unusable plugin: register_plugin_configs warned, and a scene naming it is refused
-        keys |= set(plugin_default_body("system", cls) or {})
-    return keys
 
 
 def group_options(group: str) -> list[str]:
@@ -252,6 +248,9 @@ def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bo
         raise ConfigError(f"malformed override: {_first_line(error)}") from None
     except (HydraException, OmegaConfBaseException) as error:
         raise friendly_composition_error(error, overrides, config_name) from None
+    except OverflowError:  # an integer of hundreds of digits given for a number
+        raise ConfigError(f"{shorten(' '.join(overrides), 120)}: a number is too large; gyrolab takes numbers up to "
+                          f"{MAX_MAGNITUDE:.0e} in magnitude (use nondimensional or scaled units)") from None
     except (ValueError, TypeError) as error:  # Hydra's defaults list on a malformed group override
         raise ConfigError(f"cannot compose the config with {shorten(' '.join(overrides), 120)} "
                           f"({shorten(_first_line(error), 120)})") from None
@@ -260,7 +259,13 @@ def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bo
 
         with open_dict(cfg):
             del cfg["hydra"]
-    return cfg
+    # checked by the schemas, used as any mapping (an experiment sets whole sections); Hydra's own node stays typed
+    plain = OmegaConf.create(OmegaConf.to_container(OmegaConf.masked_copy(cfg, [k for k in cfg if k != "hydra"]),
+                                                    resolve=False))
+    if "hydra" in cfg:
+        plain.hydra = cfg.hydra
+    OmegaConf.set_struct(plain, True)
+    return plain
 
 
 def _unknown_option(text: str) -> ConfigError | None:
@@ -296,6 +301,9 @@ def friendly_composition_error(error: Exception, overrides: Sequence[str], confi
     """One sentence for Hydra's "Could not override 'KEY'" and friends, with the closest valid name."""
     text = _first_line(error)
     cause = error.__cause__ or error.__context__
+    if isinstance(cause, (ValidationError, ConfigKeyError)) and (getattr(cause, "full_key", None)
+                                                                 or "Merge error" in str(cause)):
+        return schema_sentence(cause)  # a schema's refusal: the key, the value, what is expected
     if text.startswith("Could not append to config. An item is already at '"):
         key = text.split("'")[1]
         return ConfigError(f"+{shorten(key)}=... adds a key, but `{shorten(key)}` exists already; change it with "
@@ -315,21 +323,6 @@ def friendly_composition_error(error: Exception, overrides: Sequence[str], confi
     if "Could not delete from config" in text or "Could not find" in text:
         return ConfigError(f"{shorten(text, 200)}; ~KEY deletes only a key or group the config has")
     return ConfigError(shorten(text, 300))
-
-
-def unknown_key_sentence(key: str, known: Sequence[str], override: str = "", cause: str = "") -> str:
-    """"`time.ennd` is not a key of `time`; did you mean `time.end`?" (with the valid keys if none is close)."""
-    parent, _, leaf = key.rpartition(".")
-    where = f"`{parent}`" if parent else "the config"
-    close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
-    if "ValidationError" in cause or "ConfigTypeError" in cause:
-        return (f"{shorten(override or key)!s}: `{shorten(key)}` is a section, not a value; set one of its keys "
-                f"(e.g. {next((k for k in known if k.startswith(key + '.')), key + '.KEY')}=...)")
-    if close:
-        return f"`{shorten(key)}` is not a key of {where}; did you mean `{close[0]}`?"
-    siblings = sorted({k.rpartition(".")[2] for k in known if k.rpartition(".")[0] == parent})  # a key once
-    return (f"`{shorten(key)}` is not a key of {where}; valid keys: "
-            f"{shorten(', '.join(siblings) or '(none)', 300)}")
 
 
 def _known_names(overrides: Sequence[str], key: str, config_name: str) -> list[str]:
@@ -356,113 +349,22 @@ def key_paths(node: Any, prefix: str = "") -> Iterator[str]:
                 yield from key_paths(child, path)
 
 
-def _first_line(error: Exception) -> str:
-    """The first line of a Hydra/OmegaConf message, without its pointer to the online docs."""
-    lines = [line.strip() for line in str(error).strip().splitlines() if line.strip()]
-    line = lines[0] if lines else type(error).__name__
-    if line.endswith(":") and len(lines) > 1:  # "In 'experiment/x': ConfigTypeError raised while composing config:"
-        line = f"{line} {lines[1]}"
-    for merge in ("Cannot merge DictConfig with ListConfig", "Cannot merge ListConfig with DictConfig"):
-        line = line.replace(merge, "a list and a section (a mapping) do not match: one is given where the config "
-                                   "has the other")
-    return line.split(" See https://")[0]
-
-
-# ---- the scene config's schema: closed sections, value types ------------------------------------------------
-
-#: sections whose keys are fixed: their valid keys and value types are read from the packaged config
-_CLOSED_SECTIONS = ("time", "output")
-#: sections whose valid keys are the union over the packaged options of their group
-_OPTION_SECTIONS = ("body", "initial")
-
-
-@cache
-def packaged_reference() -> dict[str, Any]:
-    """The packaged config's plain defaults and, per section, the keys any packaged option uses."""
-    from importlib.resources import files
-
-    conf = files(CONFIG_MODULE)
-    main = OmegaConf.to_container(OmegaConf.load(str(conf / "config.yaml")), resolve=False)
-    top = set(main) - {"defaults", "hydra"}
-    for option in (conf / "experiment").iterdir():
-        if option.name.endswith(".yaml"):
-            top |= set(OmegaConf.load(str(option))) - {"defaults", "hydra"}
-    sections: dict[str, set[str]] = {}
-    for group in (*_OPTION_SECTIONS, "integrator", "system", "regime"):
-        keys: set[str] = set()
-        for option in (conf / group).iterdir():
-            if option.name.endswith(".yaml"):
-                text = option.read_text()
-                node = OmegaConf.create(text) if text.strip() else OmegaConf.create({})
-                if "@package _global_" in text.split("\n", 1)[0]:
-                    node = node.get(group) or {}
-                keys |= set(node) - {"defaults"}
-        sections[group] = keys
-    return {"top": top | set(SELECTABLE_GROUPS), "defaults": main, "sections": sections}
-
+# ---- the scene config: its schemas (gyrolab.engine.schemas), then what a type cannot say ----------------------
 
 def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
-    """The scene config resolved to plain values; ConfigError for an unknown key, a wrong type, a bad reference.
+    """The scene config resolved to plain values; ConfigError for a missing section, an unknown key, a wrong type,
+    a bad reference, a number too large to compute with or a torque that silently vanishes.
 
-    Unknown keys are refused with the closest valid one (``+time.ennd=5``, a typo in
-    a user's experiment file); values of ``time`` and ``output`` must have the type of
-    the packaged default; an interpolation must point at a key that exists.
+    Keys and types are the schemas' (:func:`gyrolab.engine.schemas.validate`: a user's primary config or a stored
+    one that does not name them is checked against them too).
     """
-    ref = packaged_reference()
-    for key in cfg.keys():
-        if key not in ref["top"]:
-            raise ConfigError(unknown_key_sentence(str(key), sorted(ref["top"])))
-    for section in ("time", "output", "body", "initial", "system", "integrator"):
-        if section not in cfg or cfg[section] is None:
-            how = (f"set its keys instead (e.g. {section}.{_example_key(section)}=...)" if _example_key(section)
-                   else f"choose one ({section}=NAME)")
-            raise ConfigError(f"the config has no `{section}` section (deleted with ~{section}?); every run needs "
-                              f"it: {how}")
-    plain = resolve_plain(cfg)
-    for section in ("time", "output", "body", "initial"):
-        if not isinstance(plain[section], dict):
-            raise ConfigError(f"{section}={shorten(repr(plain[section]))}: `{section}` is a section, not a value; "
-                              f"set one of its keys (e.g. {section}.{_example_key(section)}=...)")
-        valid = (ref["defaults"][section] if section in _CLOSED_SECTIONS else ref["sections"][section])
-        if section == "body":
-            valid = valid | plugin_body_keys()  # a third-party system's body keys (register_plugin_configs)
-        for key, value in plain[section].items():
-            if key not in valid:
-                raise ConfigError(unknown_key_sentence(f"{section}.{key}", [f"{section}.{k}" for k in valid]))
-            if section in _CLOSED_SECTIONS:
-                check_type(f"{section}.{key}", value, ref["defaults"][section][key])
-    for group in ("integrator", "system", "regime", "force", "batch"):
-        if plain.get(group) is not None and not isinstance(plain[group], dict):
-            raise ConfigError(f"{group}={shorten(repr(plain[group]))}: `{group}` is a section (a mapping), not a "
-                              f"value; choose an option ({group}=NAME) or set its keys ({group}.KEY=...)")
-    for group in ("integrator", "system", "regime"):
-        node = plain.get(group)
-        if isinstance(node, dict) and "_target_" in node and _plugin_keys(group, node["_target_"]):
-            valid = _plugin_keys(group, node["_target_"]) | ref["sections"][group]
-            for key in node:
-                if key not in valid:
-                    raise ConfigError(unknown_key_sentence(f"{group}.{key}", [f"{group}.{k}" for k in valid]))
-    for name, node in (plain.get("force") or {}).items():
-        valid = _plugin_keys("force", node["_target_"]) if isinstance(node, dict) and "_target_" in node else set()
-        if valid:
-            for key in node:
-                if key not in valid:
-                    raise ConfigError(unknown_key_sentence(f"force.{name}.{key}",
-                                                           [f"force.{name}.{k}" for k in valid]))
-    for key in ("task",):
-        if key in plain and not isinstance(plain[key], str):
-            raise ConfigError(f"{key}={shorten(repr(plain[key]))} must be a task name (a string)")
-    n_output = plain["time"].get("n_output")
-    if n_output != "auto" and (isinstance(n_output, bool) or not isinstance(n_output, int)):
-        raise ConfigError(f"time.n_output={shorten(repr(n_output))} must be an integer (the samples stored) or auto")
+    for section in required_sections():
+        if section not in cfg or OmegaConf.is_missing(cfg, section) or cfg[section] is None:
+            raise ConfigError(missing_section(section))
+    plain = validate(cfg)
     for section, node in plain.items():
         _check_magnitudes(str(section), node)
     _check_degenerate_vectors(plain)
-    accuracy = plain.get("accuracy")
-    if accuracy is not None:
-        check_type("accuracy", accuracy, 0.0)
-    if "allow_large" in plain:
-        check_type("allow_large", plain["allow_large"], False)
     return plain
 
 
@@ -515,60 +417,3 @@ def _check_magnitudes(where: str, node: Any) -> None:
         if large:
             raise ConfigError(f"{where}={shorten(repr(node), 40)} is too large; gyrolab takes numbers up to "
                               f"{MAX_MAGNITUDE:.0e} in magnitude (use nondimensional or scaled units)")
-
-
-def _plugin_keys(group: str, target: Any) -> set[str]:
-    try:
-        _, cls = registry.resolve_target(group, target, group)
-    except ConfigError:
-        return set()  # Scene.from_config says which targets are valid
-    return {"_target_", *registry.default_params(cls)}
-
-
-def _example_key(section: str) -> str:
-    return {"time": "end", "output": "figures", "body": "a", "initial": "r0"}.get(section, "")
-
-
-#: keys whose packaged default is null, with a value of the type they take otherwise
-NULLABLE = {"output.error_estimate": False}
-
-
-def check_type(where: str, value: Any, default: Any) -> None:
-    """ConfigError unless ``value`` has the type of the packaged default (an int is a valid float; null where the
-    default is null, else the type of ``NULLABLE``'s example)."""
-    if default is None and value is not None and where in NULLABLE:
-        default = NULLABLE[where]
-        if isinstance(default, bool) and not isinstance(value, bool):
-            raise ConfigError(f"{where}={shorten(repr(value))} must be true, false or null")
-    if isinstance(default, bool):
-        if not isinstance(value, bool):
-            raise ConfigError(f"{where}={shorten(repr(value))} must be true or false")
-    elif isinstance(default, int):
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"{where}={shorten(repr(value))} must be an integer")
-    elif isinstance(default, float):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(f"{where}={shorten(repr(value))} must be a number")
-
-
-def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
-    """``OmegaConf.to_container(cfg, resolve=True)`` with a one-sentence error for a broken interpolation."""
-    try:
-        return OmegaConf.to_container(cfg, resolve=True, throw_on_missing=True)
-    except OmegaConfBaseException as error:
-        key = getattr(error, "full_key", None) or "?"
-        raw = _raw_value(cfg, key)
-        reason = _first_line(error).split(" full_key:")[0]
-        return_hint = "refer to an existing key, e.g. ${time.end}, or give a plain value"
-        raise ConfigError(f"{shorten(key)}={shorten(str(raw))} cannot be resolved ({shorten(reason, 160)}); "
-                          f"{return_hint}") from None
-
-
-def _raw_value(cfg: DictConfig, key: str) -> Any:
-    node: Any = cfg
-    try:
-        for part in key.split("."):
-            node = node._get_node(part)
-        return node._value()
-    except Exception:  # noqa: BLE001 - only for the message
-        return "?"

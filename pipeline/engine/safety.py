@@ -41,6 +41,7 @@ from omegaconf import DictConfig, ListConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
+from gyrolab.engine.schemas import resolve_plain
 from gyrolab.errors import ConfigError, shorten
 
 #: ``_target_`` values allowed under ``hydra`` besides the installed launchers and sweepers
@@ -213,8 +214,6 @@ def _protected_dirs() -> tuple[Path, ...]:
 # ---- helpers ----------------------------------------------------------------------------------------------
 
 def _plain(cfg: DictConfig, skip: str) -> dict[str, Any]:
-    from gyrolab.engine.config import resolve_plain
-
     keys = [k for k in cfg.keys() if k != skip]
     return resolve_plain(OmegaConf.masked_copy(cfg, keys)) if keys else {}
 

@@ -5,9 +5,9 @@ the user believes they got what they asked for. ``integrator=taylor accuracy=1e-
 tolerance, exit 0, and nothing said that the 1e-8 target went nowhere.
 
 The top-level ``accuracy`` is read only by an integrator whose settings refer to it (``conf/integrator/auto.yaml``:
-``accuracy: ${accuracy}``; a user's ``integrator.tol='${accuracy}'`` reads it too). Whether it is read is asked
-of the composed config — does the integrator's resolved node change when ``accuracy`` does? — never of the
-integrator's name. What happens when it is not read depends on who set it (docs/configs.md, "Values a run
+``accuracy: ${accuracy}``; a user's ``integrator.tol='${accuracy}'`` reads it too). Whether it is read is read
+off the composed config — does a value of the integrator's node refer to ``accuracy``, directly or through other
+keys? — never off the integrator's name. What happens when it is not read depends on who set it (docs/configs.md, "Values a run
 does not read"):
 
 * given explicitly (the command line, ``compose_scene``'s overrides, a sweep's value for every job): the
@@ -20,6 +20,7 @@ does not read"):
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from typing import Any
 
@@ -27,6 +28,7 @@ from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
+from gyrolab.engine.schemas import keys_with
 from gyrolab.contracts.capabilities import integrators_with, or_list
 from gyrolab.contracts.integrator import CHOOSES_METHOD
 from gyrolab.errors import ConfigError, GyrolabError
@@ -34,10 +36,12 @@ from gyrolab.errors import ConfigError, GyrolabError
 ACCURACY = "accuracy"
 #: the run dataset's global attribute saying that the config's ``accuracy`` was not read, and why
 ACCURACY_IGNORED_ATTRIBUTE = "accuracy_ignored"
-#: an integrator's own accuracy settings, named in the sentences (what the user can set instead)
-OWN_SETTINGS = ("accuracy", "tol", "rtol", "atol", "step")
-#: two values of ``accuracy`` no setting equals by chance: a node that reads ``accuracy`` resolves differently
-_PROBES = (1.2345678e-7, 8.7654321e-9)
+#: an integrator's own accuracy settings, named in the sentences (what the user can set instead): the schemas'
+#: tolerances and steps (``gyrolab.engine.schemas``)
+OWN_SETTINGS = keys_with("own")
+#: an interpolation's references: ``${key}``, ``${..key}``, ``${oc.select:key,default}`` (a resolver's name is
+#: captured too, and found in no config)
+_REFERENCE = re.compile(r"\$\{\s*(?:oc\.select:)?\s*(\.*[A-Za-z_][\w.]*)")
 
 
 def given_overrides(overrides: Sequence[str]) -> dict[str, str]:
@@ -62,30 +66,42 @@ def covers(key: str, given: str) -> bool:
 
 
 def reads_accuracy(cfg: DictConfig) -> bool:
-    """Whether the selected integrator's settings depend on the top-level ``accuracy``: its node, resolved with two
-    different values of ``accuracy``, differs. A node that cannot be resolved counts as reading it (the schema
-    checks refuse a broken interpolation in their own sentence; this check never refuses on a guess)."""
+    """Whether the selected integrator's settings refer to the top-level ``accuracy``, directly (``${accuracy}``,
+    ``${..accuracy}``) or through other keys of the config (``${my.target}`` with ``my.target: ${accuracy}``)."""
     node = cfg.get("integrator")
     if not isinstance(node, DictConfig):
         return False
-    integrator = OmegaConf.to_container(node, resolve=False)
-    if "${" not in repr(integrator):
-        return False  # no interpolation: nothing in it can refer to accuracy
-    # the node beside accuracy alone first (~0.1 ms); the whole config when it refers to other keys too (~3 ms)
-    for context in ({}, None):
-        if context is None:
-            context = OmegaConf.to_container(cfg, resolve=False)
-            context.pop("hydra", None)
-        resolved = []
-        for probe in _PROBES:
-            try:
-                resolved.append(OmegaConf.to_container(
-                    OmegaConf.create({**context, ACCURACY: probe, "integrator": integrator}).integrator, resolve=True))
-            except (OmegaConfBaseException, ValueError, TypeError):
-                break
-        else:
-            return resolved[0] != resolved[1]
-    return True
+    return _refers_to(cfg, OmegaConf.to_container(node, resolve=False), "integrator", set())
+
+
+def _refers_to(cfg: DictConfig, value: Any, where: str, seen: set[str]) -> bool:
+    """Whether the unresolved ``value`` of key ``where`` refers to ``accuracy``, following the keys it refers to."""
+    if isinstance(value, dict):
+        return any(_refers_to(cfg, v, f"{where}.{k}", seen) for k, v in value.items())
+    if isinstance(value, list):
+        return any(_refers_to(cfg, v, where, seen) for v in value)
+    if not isinstance(value, str):
+        return False
+    for reference in _REFERENCE.findall(value):
+        dots = len(reference) - len(reference.lstrip("."))
+        key = reference if not dots else ".".join([*where.split(".")[:-dots], reference.lstrip(".")])
+        if key == ACCURACY:
+            return True
+        if key not in seen:
+            seen.add(key)
+            if _refers_to(cfg, _raw(cfg, key), key, seen):
+                return True
+    return False
+
+
+def _raw(cfg: DictConfig, key: str) -> Any:
+    """The unresolved value of ``key`` (None when the config has no such key)."""
+    node: Any = cfg
+    for part in key.split("."):
+        if not isinstance(node, DictConfig) or part not in node:
+            return None
+        node = node._get_node(part)
+    return OmegaConf.to_container(node, resolve=False) if isinstance(node, DictConfig) else node._value()
 
 
 def unread_accuracy(cfg: DictConfig) -> str | None:

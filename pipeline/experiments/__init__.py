@@ -8,86 +8,77 @@ its own section, and the app hands the composed config to the task's
 from __future__ import annotations
 
 import importlib
+import pkgutil
+import re
 from collections.abc import Sequence
+from functools import cache
 from pathlib import Path
 
 from omegaconf import DictConfig
 
 from gyrolab.contracts.capabilities import or_list
+from gyrolab.engine.schemas import Task, only_declared_keys
 from gyrolab.engine.unread import covers, given_overrides
 from gyrolab.errors import ConfigError, choices
 
-TASKS = {
-    "work_precision": "gyrolab.experiments.work_precision",
-    # expansion regimes (Ismail (2021), Shaker et al.)
-    "regime": "gyrolab.experiments.regime_run",
-    "regime_validity": "gyrolab.experiments.regime_validity",
-    "ismail2021_tables": "gyrolab.experiments.ismail2021_tables",
-    "shaker_omega3": "gyrolab.experiments.shaker_omega3",
-    "orbit_family": "gyrolab.experiments.orbit_family",
-    # issue 14: a chaos indicator over a grid of initial conditions, as one resumable batch
-    "stability_map": "gyrolab.experiments.stability_map",
-    # satellite-gyrostat (Yehia & El-kenani (2021))
-    "yehia2021_precessions": "gyrolab.experiments.yehia2021_precessions",
-}
+#: a declaration ``TASK = Task("NAME", ...)`` in a module of this package names the task that module runs
+_DECLARATION = re.compile(r'^TASK = Task\(\s*"(\w+)"', re.MULTILINE)
 
 
-#: config keys only some runs read (docs/configs.md, "Values a run does not read") and the runs that read them: the
-#: tasks that run Scene.run read output.error_estimate (it measures the stored trajectory's error); batch.* is read by
-#: gyrolab batch and by the experiments that run one; a regime by the tasks that compare with it (a plain run given
-#: a regime is task regime); output.job_figures by the jobs of a sweep
+def _task_modules() -> dict[str, str]:
+    """Task name -> module, read from the declarations' text (importing every experiment would cost ~0.6 s)."""
+    found = {}
+    for module in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+        source = Path(__path__[0], f"{module.name}.py")
+        declared = _DECLARATION.search(source.read_text(encoding="utf-8")) if source.is_file() else None
+        if declared:
+            found[declared.group(1)] = f"{__name__}.{module.name}"
+    return found
+
+
+#: task name -> the module whose ``run(cfg, out_dir)`` runs it (and whose ``TASK`` says what it reads and sets)
+TASKS = _task_modules()
+#: a plain run (Scene.run: it measures the stored trajectory's error), gyrolab batch, the jobs of a sweep
+SCENE = Task("scene", reads=("output.error_estimate",))
 BATCH_COMMAND = "gyrolab batch"
 SWEEP = "a sweep (gyrolab -m)"
-READ_BY = {
-    "batch": ("task stability_map", BATCH_COMMAND),
-    "output.error_estimate": ("task scene", "task work_precision", "task yehia2021_precessions"),
-    "regime": ("task regime", "task shaker_omega3"),
-    "output.job_figures": (SWEEP,),
-}
-#: config keys a task does not read, because it sets them itself for the scenes it runs or runs none: a value given
-#: for them would change nothing; and why (said in the refusal)
-NOT_READ_BY = {
-    "work_precision": {
-        "integrator": "it runs every method of work_precision.methods",
-        "accuracy": "auto's settings are listed in work_precision.methods",
-        "time.n_output": "it compares final states, with time.n_output=2",
-    },
-    "yehia2021_precessions": {
-        key: "each precession case sets its own body, forces, initial state and span, the span from yehia2021.orbits"
-        for key in ("body", "force", "initial", "time")
-    },
-    "stability_map": {
-        key: "the map's grid sets it, from stability_map.theta0, stability_map.r0 and their n_ and _spacing settings"
-        for key in ("initial.theta0", "initial.r0")
-    },
-    "orbit_family": {
-        key: "each family of orbit_family.families sets its own body, Newtonian k and tilt, and the continuation "
-             "its spins and periods"
-        for key in ("system", "body", "force", "initial", "time", "integrator", "accuracy")
-    },
-    "ismail2021_tables": {
-        key: "it regenerates the paper's two tables from the paper's own parameters"
-        for key in ("system", "body", "force", "initial", "time", "integrator", "accuracy")
-    },
-}
+_RUNS = {BATCH_COMMAND: Task(BATCH_COMMAND, reads=("batch",)), SWEEP: Task(SWEEP, reads=("output.job_figures",))}
+
+
+def declaration(run: str) -> Task:
+    """What ``run`` (``task NAME``, ``gyrolab batch``, a sweep) declares it reads and sets (imports its module)."""
+    name = run.removeprefix("task ")
+    if name in TASKS:
+        return importlib.import_module(TASKS[name]).TASK
+    if run in _RUNS:
+        return _RUNS[run]
+    return SCENE if name == "scene" else Task(name)  # an unknown task: run_task refuses it in its own sentence
+
+
+@cache
+def read_by() -> dict[str, tuple[str, ...]]:
+    """Each key only some runs read (``gyrolab.engine.schemas.only_declared_keys``) -> the runs that declare it."""
+    runs = {"task scene": SCENE, **{f"task {n}": declaration(f"task {n}") for n in TASKS}, **_RUNS}
+    return {key: tuple(name for name, task in runs.items() if key in task.reads) for key in only_declared_keys()}
 
 
 def refuse_unread(run: str, overrides: Sequence[str], *, sweep: bool = False) -> None:
     """ConfigError for the first value ``overrides`` give that ``run`` (``task NAME`` or ``gyrolab batch``; ``sweep``:
-    its jobs are a sweep's) does not read: a key only other runs read (READ_BY: ``batch.output=final`` on a plain run),
-    or one the task does not read (NOT_READ_BY). A config file's value is a default for the runs that read it, and
-    null unsets a key: neither is refused."""
-    roles = {run, SWEEP} if sweep else {run}
+    its jobs are a sweep's) does not read: a key only other runs read (``batch.output=final`` on a plain run), or one
+    the task sets itself (its declaration's ``sets``). A config file's value is a default for the runs that read it,
+    and null unsets a key: neither is refused."""
+    roles = [declaration(run), *([_RUNS[SWEEP]] if sweep else [])]
     described = f"{run} in {SWEEP}" if sweep else run
     for key, text in given_overrides(overrides).items():
         if text.partition("=")[2].strip() == "null":
             continue
-        for optional, readers in READ_BY.items():
-            if covers(optional, key) and not roles & set(readers):
+        for optional in only_declared_keys():
+            if covers(optional, key) and not any(optional in role.reads for role in roles):
+                readers = read_by()[optional]
                 way = f"run it with {BATCH_COMMAND}, or drop it" if BATCH_COMMAND in readers else "drop it"
                 raise ConfigError(f"{text} is read only by {or_list(list(readers))}; this run ({described}) does not "
                                   f"read it, so it would change nothing: {way}")
-        for unread, why in NOT_READ_BY.get(run.removeprefix("task "), {}).items():
+        for unread, why in roles[0].sets.items():
             if covers(unread, key):
                 raise ConfigError(f"{text} is not read by {run} ({why}); drop it")
 

@@ -30,6 +30,7 @@ from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
+from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
 COLUMNS = ("p2", "gamma2", "dp2", "dgamma2")
@@ -103,6 +104,12 @@ def table2() -> np.ndarray:
     p = rk4_oscillator(W_P2, A, STEP, n)[::every]
     g = rk4_oscillator(1.0, 1.0, STEP, n)[::every]
     return np.column_stack([p[:, 0], g[:, 0], p[:, 1], g[:, 1]])
+
+
+#: what the task reads and sets (gyrolab.experiments derives its tables from it)
+TASK = Task("ismail2021_tables").sets_all(
+    ("system", "body", "force", "initial", "time", "integrator", "accuracy"),
+    "it regenerates the paper's two tables from the paper's own parameters")
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:

@@ -32,6 +32,8 @@ from gyrolab.analysis.periodic import FixedPointModel
 from gyrolab.plugins.regimes import large_parameter as slow
 from gyrolab.plugins.regimes.base import NondimensionalScene
 from gyrolab.plugins.regimes.small_parameter import SmallParameter
+from gyrolab.engine import schemas
+from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
 COMPONENTS = ("p", "q", "r", "gamma_x", "gamma_y", "gamma_z")
@@ -134,6 +136,13 @@ def bands(r0: np.ndarray, error: np.ndarray, tol: float) -> str:
     if not ok.any():
         return "nowhere"
     return f"r0/c {r0[ok].min():.3g}–{r0[ok].max():.3g}"
+
+
+#: what the task reads and sets (gyrolab.experiments derives its tables from it)
+TASK = Task("orbit_family", section="orbit_family", settings=schemas.OrbitFamily).sets_all(
+    ("system", "body", "force", "initial", "time", "integrator", "accuracy"),
+    "each family of orbit_family.families sets its own body, Newtonian k and tilt, and the continuation its spins "
+    "and periods")
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:

@@ -39,6 +39,7 @@ from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
+from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
 SOURCES = ("analytic", "full", "orbit")
@@ -204,6 +205,10 @@ def errors(result: dict[str, Any], against: str = "orbit") -> dict[str, float]:
     if against == "orbit":
         out["period"] = abs(result["period_analytic"] - result["orbit"].period)
     return out
+
+
+#: what the task reads and sets (gyrolab.experiments derives its tables from it)
+TASK = Task("regime", reads=("regime",))
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:

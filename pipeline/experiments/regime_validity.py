@@ -29,6 +29,7 @@ from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.experiments.regime_run import compute, errors, prepare
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
+from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
 
@@ -89,6 +90,10 @@ def _r0_for(regime: str, value: float, cfg: DictConfig) -> float:
         theta0 = float(cfg.regime_validity[regime].scene["initial.theta0"])
         return float(np.sqrt(np.cos(theta0)) / value)
     return 1.0 / value  # c/r0 in units of c
+
+
+#: what the task reads and sets (gyrolab.experiments derives its tables from it)
+TASK = Task("regime_validity", section="regime_validity")
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:

@@ -20,8 +20,13 @@ from gyrolab.output.dataset import time_attributes, write_dataset
 from gyrolab.experiments.regime_run import compute, prepare
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
+from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
+
+
+#: what the task reads and sets (gyrolab.experiments derives its tables from it)
+TASK = Task("shaker_omega3", reads=("regime",))
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:

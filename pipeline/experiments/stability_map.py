@@ -34,6 +34,8 @@ SECTION_DIMENSIONS = {
 }
 from gyrolab.output.dataset import write_dataset
 from gyrolab.sweep.grid import Dim
+from gyrolab.engine import schemas
+from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
 
@@ -69,6 +71,12 @@ def grid(cfg: DictConfig) -> list[Dim]:
         values = spaced(first, last, n) if n > 1 else np.array([first])
         dims.append(Dim(f"initial.{key}", tuple(repr(float(v)) for v in values), tuple(float(v) for v in values)))
     return dims
+
+
+#: what the task reads and sets (gyrolab.experiments derives its tables from it)
+TASK = Task("stability_map", reads=("batch",), section="stability_map", settings=schemas.StabilityMap).sets_all(
+    ("initial.theta0", "initial.r0"),
+    "the map's grid sets it, from stability_map.theta0, stability_map.r0 and their n_ and _spacing settings")
 
 
 def check(cfg: DictConfig, out_dir: Path) -> None:

@@ -32,6 +32,8 @@ from gyrolab.output.provenance import provenance
 from gyrolab.physics.reference import fixed_point_reference
 from gyrolab.engine.scene import Scene
 from gyrolab.figures.redraw import draw_figures
+from gyrolab.engine import schemas
+from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
 #: how cpu_time was measured (the dataset's ``timing`` attribute)
@@ -39,6 +41,14 @@ TIMING = ("cpu_time: time.process_time() around Scene.run() (CPU time of the who
           "minimum over {} repeats after one untimed run that compiles or loads the kernels; "
           "wall_time: time.perf_counter(), minimum over the same repeats")
 SETTING_KEYS = {"rtol": ("rtol", "atol"), "tol": ("tol",), "step": ("step",), "accuracy": ("accuracy",)}
+
+
+#: what the task reads and sets (gyrolab.experiments derives its tables from it)
+TASK = Task("work_precision", reads=("output.error_estimate",), section="work_precision",
+            settings=schemas.WorkPrecision, sets={
+                "integrator": "it runs every method of work_precision.methods",
+                "accuracy": "auto's settings are listed in work_precision.methods",
+                "time.n_output": "it compares final states, with time.n_output=2"})
 
 
 def check(cfg: DictConfig, out_dir: Path) -> None:

@@ -35,6 +35,8 @@ from gyrolab.analysis.precession.stability import Floquet, floquet
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
+from gyrolab.engine import schemas
+from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
 #: what ``stable`` asserts, said in the data (the multipliers decide spectral stability only)
@@ -105,6 +107,13 @@ def stability_of(system, case: Case, verdict: str, residual: float) -> tuple[Flo
     why = (f"not a solution (vector residual {residual:.1e}): stability of a non-solution is undefined"
            if verdict == "fails" else f"residual {residual:.1e} neither ~0 nor large: not analysed")
     return Floquet("not a solution" if verdict == "fails" else "unclear", float("nan"), np.array([])), why
+
+
+#: what the task reads and sets (gyrolab.experiments derives its tables from it)
+TASK = Task("yehia2021_precessions", reads=("output.error_estimate",), section="yehia2021",
+            settings=schemas.Yehia2021).sets_all(
+    ("body", "force", "initial", "time"),
+    "each precession case sets its own body, forces, initial state and span, the span from yehia2021.orbits")
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
