@@ -1,7 +1,7 @@
 """Near the Taylor method's floor, when may the error estimate trust a double companion? (``error_estimate``)
 
 A double-precision Taylor run at tol < 1e-12 may err partly by round-off, which a double companion shares in size.
-``gyrolab.engine.error_estimate`` runs two double companions there (``TIGHTER`` times tighter; the run's order, and
+``gyrolab.accuracy.estimate`` runs two double companions there (``TIGHTER`` times tighter; the run's order, and
 another order with 1/I moved by its rounding) and keeps the first one's measurement E when their disagreement R is
 ``ROUNDOFF_MARGIN`` times below it; else a double-double companion measures. This measures that rule against the
 truth: on random scenes (``promise_audit.random_scene``) and tolerances from 3e-13 to 1.5e-16, E, R and the actual
@@ -21,7 +21,8 @@ import sys
 import numpy as np
 
 from gyrolab import compose_scene
-from gyrolab.engine.error_estimate import ROUNDOFF_MARGIN, TIGHTER, rounding_moved
+from gyrolab.accuracy.calibration import ROUNDOFF_MARGIN, TIGHTER
+from gyrolab.accuracy.estimate import rounding_moved
 from gyrolab.kernels.taylor import MAX_ORDER
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 

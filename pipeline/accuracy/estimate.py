@@ -40,34 +40,10 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL
+from gyrolab.accuracy.calibration import DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
+from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL
 
 log = logging.getLogger(__name__)
-
-#: the companion is this many times more accurate than the run (tolerances this many times smaller): the estimate is
-#: then within ~1 % of the companion-free truth. 100, not 1000: on the reference scene (auto at 1e-6: Taylor order 12,
-#: tol 1.3e-8) the companion at 100× takes 0.55 ms and ends 176× more accurate, at 1000× 0.68 ms and 1660×; the
-#: per cent an estimate gains is not worth a quarter of the companion's time (AMD EPYC with AVX-512, 2026-11-27)
-TIGHTER = 100.0
-#: a double-precision Taylor run whose companion would run below this tolerance is measured in double-double: a double
-#: companion there has round-off of the run's own size and can agree with it more closely than either agrees with
-#: the truth. benchmarks/promise_audit.py's scenes against real128 (120 scenes of seed 5, the Taylor method at a fixed
-#: tol, estimates above round-off and not saturated): with a double companion the smallest estimate / actual error was
-#: 0.0047 at tol 3e-14 (3 of 30 runs below 1/2), 0.16 at 1e-13 (2 of 29), 0.30 at 3e-13 (1 of 54), 0.94 at 1e-12
-#: (74 runs) and 0.95 at 1e-11 (110); with a double-double companion 0.98 at 3e-14 … 1e-13. The double-double run
-#: takes ~30× a double one (reference scene, t = 300: ~17 ms), so it runs only where two double companions show that
-#: round-off is not small against the error measured (``ROUNDOFF_MARGIN``; ``compare``)
-DOUBLE_DOUBLE_BELOW = 1e-14
-
-
-#: near double precision's floor, a double companion is trusted when the round-off two double companions disagree
-#: by is this many times below the error it measures (``compare``); else the double-double companion runs.
-#: benchmarks/roundoff_margin.py (Taylor at tol 3e-13 … 1.5e-16 on random scenes against heyoka real128): at 10, no
-#: trusted estimate below 1/2 of the actual error in 606 runs of seed 5 (worst 0.56) and one in 1,029 of seed 11
-#: (0.47, where the double-double companion measured it exactly: double runs share an error their disagreement does
-#: not show); at 4, two below 1/2 (worst 0.27); only 50 clears seed 11, trusting 90 runs instead of 296
-ROUNDOFF_MARGIN = 10.0
-
 
 @dataclass(frozen=True)
 class Companion:
@@ -89,38 +65,36 @@ def wanted(scene: Any) -> bool:
     return bool(choice)
 
 
-def companion(integrator: Any, has_compiled: bool) -> Companion | None:
-    """The more accurate run that measures ``integrator``'s error (its ``more_accurate``, rule 9 of the contract;
+def companion(method: Any, has_compiled: bool) -> Companion | None:
+    """The more accurate run that measures the run of ``method`` (its ``more_accurate``, rule 9 of the contract;
     else the compiled Taylor method at its floor when the scene has a compiled model; else, for a run that is itself
-    the double-precision Taylor method near that floor, the Taylor method in double-double), or None."""
-    from gyrolab.kernels.taylor_dd import MIN_TOL
-    from gyrolab.plugins.integrators.compiled_solvers import DOUBLE_DOUBLE, Taylor
+    the double-precision Taylor method near that floor, the method one rung up the precision ladder), or None."""
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
-    taylor = _double_taylor(integrator) if has_compiled else None
-    finer = integrator.more_accurate(TIGHTER)
+    taylor = _double_taylor(method) if has_compiled else None
+    finer = method.more_accurate(TIGHTER)
     if finer is not None and (taylor is None or taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW):
         return Companion(*finer)
     if not has_compiled:
         return None
     if taylor is None:
         return Companion(Taylor(tol=Taylor.TOLERANCE_FLOOR), 1.0, f"compiled Taylor at tol {Taylor.TOLERANCE_FLOOR:g} "
-                         f"({integrator.name} cannot be made {TIGHTER:g}× more accurate)")
+                         f"({method.name} cannot be made {TIGHTER:g}× more accurate)")
     # A double-precision Taylor run near the floor: another double run (the old stand-in, Taylor at tol 1e-16) is no
     # more accurate. Its error is then mostly round-off, amplified by the motion, and two double runs can agree far
     # more closely than either agrees with the truth (benchmarks/promise_audit.py: auto at accuracy 1e-12 chose tol
     # 1.5e-16, the stand-in differed from it by 1.7e-14 where both were 2.1e-12 from the real128 answer, and the
-    # broken prediction went unseen). Double-double has no such round-off.
+    # broken prediction went unseen). The next rung up, double-double, has no such round-off.
     from gyrolab.kernels.taylor import MAX_ORDER
 
-    tol = max(taylor.tol / TIGHTER, MIN_TOL)
+    up, _, _ = taylor.climbed(TIGHTER)
     double_tol = max(taylor.tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
     other_order = taylor.order + 2 if taylor.order + 2 <= MAX_ORDER else taylor.order - 2
     # the order for its own tolerance, not the run's: a companion need only be more accurate, and a low order is slow
     # there (reference scene, t = 300, tol 1e-18: order 16 25 ms, order 22 20 ms; auto's runs near the floor already
     # take ~19–21)
-    return Companion(Taylor(tol=tol, precision=DOUBLE_DOUBLE), 1.0,
-                     f"compiled Taylor in double-double at tol {tol:.3g} ({integrator.name} runs the "
-                     f"Taylor method near double precision's floor)",
+    return Companion(up, 1.0, f"compiled Taylor in double-double at tol {up.tol:.3g} ({method.name} runs the "
+                              f"Taylor method near double precision's floor)",
                      (Taylor(order=taylor.order, tol=double_tol), Taylor(order=other_order, tol=double_tol)))
 
 
@@ -168,15 +142,17 @@ class Comparison:
         return variables, attrs
 
 
-def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Comparison:
-    """Run the companion of ``integrator``'s run of ``scene`` (stored states ``y``, integration time ``wall_time``)
-    and compare: the measured error estimate, or why none is available."""
+def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any = None) -> Comparison:
+    """Run the companion of ``method``'s run of ``scene`` (stored states ``y``, integration time ``wall_time``; with
+    ``check``, a run that is no integration, measured against ``check``) and compare: the measured error estimate,
+    or why none is available."""
     compiled_model = scene.system.compiled_model()
-    pick = companion(integrator, compiled_model is not None)
-    name = getattr(integrator, "name", type(integrator).__name__)
+    pick = Companion(check, 1.0, f"{check.name} ({_settings(check)}) against the analytic series") if check else \
+        companion(method, compiled_model is not None)
+    name = getattr(method, "name", type(method).__name__)
     if pick is None:
         return _unavailable(f"integrator {name!r} already runs at the compiled Taylor method's floor in double "
-                            "precision (nothing more accurate to compare with)" if _at_taylor_floor(integrator) else
+                            "precision (nothing more accurate to compare with)" if _double_taylor(method) else
                             f"integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
                             "compiled model for the Taylor method")
     companion_model, refusal = None, None
@@ -236,16 +212,12 @@ def rounding_moved(model: Any) -> Any:
     return moved(model)
 
 
-def _double_taylor(integrator: Any) -> Any:
-    """The double-precision Taylor method the run used: the integrator itself, or the method ``auto`` chose; else None."""
-    from gyrolab.plugins.integrators.compiled_solvers import DOUBLE, Taylor
-
-    ran = getattr(integrator, "chosen", None) or integrator
-    return ran if isinstance(ran, Taylor) and ran.precision == DOUBLE else None
+def _double_taylor(method: Any) -> Any:
+    """``method`` when it is the double-precision Taylor method (a method with a rung above it, ``climbed``), whose
+    error near its floor is mostly round-off; else None."""
+    return method if method.precision == PRECISIONS[0] and method.climbed(1.0) is not None else None
 
 
-def _at_taylor_floor(integrator: Any) -> bool:
-    from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
-    taylor = _double_taylor(integrator)
-    return taylor is not None and taylor.tol / TIGHTER < Taylor.TOLERANCE_FLOOR
+def _settings(method: Any) -> str:
+    return ", ".join(f"{k.removeprefix('integrator_')} {v:g}" if isinstance(v, float) else
+                     f"{k.removeprefix('integrator_')} {v}" for k, v in method.attributes().items())
