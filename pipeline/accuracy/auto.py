@@ -152,7 +152,8 @@ class Auto(Integrator):
         if self.accuracy < floor * scale:
             advice = "" if self.extended_precision else ", or integrator.extended_precision=true"
             raise ConfigError(f"accuracy={self.accuracy:g} is below what {what} reaches on this scene "
-                              f"(about {floor * scale:.1g} for states of size {scale:.3g}); ask for accuracy ≥ "
+                              f"(about {floor * scale:.1g} for states of size {scale:.3g}, stored as doubles); ask "
+                              f"for accuracy ≥ "
                               f"{at_least(10 * floor * scale)}{advice}")
 
     def attributes(self) -> dict[str, Any]:
@@ -285,27 +286,39 @@ class Auto(Integrator):
         up = make(tol).climbed(1.0)  # the next rung's method at tol, when the chosen method has one
         if up is not None and (compiled is None or type(up[0]).refusal(compiled, self.system) is not None):
             up = None  # (a model without a double-double form)
-        chaos = (f"λ ≈ {amp.lyapunov:.2g}: perturbations grow ~{amp.factor:.1g}× after the pilot, so " if
-                 amp.factor > (1.0 / self.pilot_fraction) ** MAX_GROWTH else "")
+        chaotic = amp.factor > (1.0 / self.pilot_fraction) ** MAX_GROWTH
         if up is not None and self.extended_precision:
             if best_dd < self.accuracy:
                 return up[0], tol, roundoff_dd, (
                     f"double precision's round-off on this scene (about {roundoff:.1g} over ~{steps:.0f} steps) is "
                     f"above accuracy={self.accuracy:g}; double-double's is about {roundoff_dd:.1g}")
-            horizon = amp.horizon(self.accuracy, roundoff_dd / math.exp(min(max(amp.log_span, 0.0), 700.0)))
-            raise ConfigError(
-                f"accuracy={self.accuracy:g} cannot be reached even in double-double on this scene ({chaos}"
-                f"double-double keeps {self.accuracy:g} only to t ≈ {t_out[0] + min(horizon, t_out[-1] - t_out[0]):.4g} of "
-                f"{t_out[-1]:.4g}: error about {best_dd:.1g}); ask for accuracy ≥ {at_least(3 * best_dd)} or a "
-                f"shorter time.end")
-        horizon = amp.horizon(self.accuracy, roundoff / math.exp(min(max(amp.log_span, 0.0), 700.0)))
+            raise self._refusal("double-double", best_dd, chaotic, amp, t_out, "")
         climb = ", or integrator.extended_precision=true (auto then climbs to double-double)" if (
             up is not None and best_dd < self.accuracy) else ""
-        raise ConfigError(
-            f"accuracy={self.accuracy:g} cannot be reached in double precision on this scene ({chaos}round-off "
-            f"about {roundoff:.1g} over ~{steps:.0f} steps, so double precision keeps {self.accuracy:g} only to t ≈ "
-            f"{t_out[0] + min(horizon, t_out[-1] - t_out[0]):.4g} of {t_out[-1]:.4g}); ask for accuracy ≥ "
-            f"{at_least(3 * roundoff)} or a shorter time.end{climb}")
+        raise self._refusal("double precision", roundoff, chaotic, amp, t_out, climb)
+
+    def _refusal(self, rung: str, error: float, chaotic: bool, amp: Any, t_out: np.ndarray,
+                 climb: str) -> ConfigError:
+        """One sentence: ``rung``'s error on this scene (``error``) is above the accuracy, naming λ and the horizon
+        (how long ``rung`` keeps the accuracy: e^{λt} growth on a chaotic scene, a random walk ∝ √t otherwise); its
+        advice is a target 3× above the error (when below the state's size) or a time.end inside the horizon."""
+        span, scale = t_out[-1] - t_out[0], max(1.0, *map(abs, self.system.initial_state())) if self.system else 1.0
+        if chaotic:
+            horizon = amp.horizon(self.accuracy, error / math.exp(min(max(amp.log_span, 0.0), 700.0)))
+            growth = f"λ ≈ {amp.lyapunov:.2g}, perturbations grow ~{amp.factor:.1g}× after the pilot: "
+        else:
+            horizon, growth = span * (self.accuracy / error) ** 2, ""
+        horizon = min(horizon, span)
+        asks = [f"accuracy ≥ {at_least(3 * error)}"] if 3 * error < 0.1 * scale else []
+        if horizon > 0.01 * span:
+            end = t_out[0] + 0.8 * horizon
+            digits = 10.0 ** (math.floor(math.log10(abs(end))) - 2) if end else 1.0
+            asks.append(f"time.end ≤ {math.floor(end / digits) * digits:.4g}")
+        word = "" if rung == "double precision" else " even"
+        return ConfigError(
+            f"accuracy={self.accuracy:g} cannot be reached{word} in {rung} on this scene ({growth}error about "
+            f"{error:.1g}, so {rung} keeps {self.accuracy:g} only to t ≈ {t_out[0] + horizon:.4g} of "
+            f"{t_out[-1]:.4g}); ask for {' or '.join(asks) or 'a shorter time.end'}{climb}")
 
     def _series(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                 start: float) -> Solution | None:

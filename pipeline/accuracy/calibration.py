@@ -83,8 +83,9 @@ MISS_MARGIN = _constant("MISS_MARGIN", 1000.0, PERF, "a series' predicted error 
 SCREEN_POINTS = _constant("SCREEN_POINTS", 512, PERF, "grid of the screen before the series check (~0.25 ms)")
 SCREEN_TOLERANCE = _constant("SCREEN_TOLERANCE", 1e-9, PERF, "tolerance of the screen's Taylor run")
 FLOOR = _constant("FLOOR", 1e-15, PROMISE, "relative to the state's size: no double run reaches below")
-DOUBLE_DOUBLE_FLOOR = _constant("DOUBLE_DOUBLE_FLOOR", 1e-30, PROMISE, (
-    "the same for double-double (its Taylor method's smallest tolerance is 1e-32; round-off ~1e-31 per step)"))
+DOUBLE_DOUBLE_FLOOR = _constant("DOUBLE_DOUBLE_FLOOR", 1e-16, PROMISE, (
+    "the same for double-double: it integrates to ~1e-31 but stores its states as doubles, each rounded by up to half "
+    "an ulp (≤ 1.1e-16 × the state's size); asked 5e-29 at time.end=1, the error estimate measured 1.1e-16"))
 AUTO_SAMPLE = _constant("AUTO_SAMPLE", 3, PROMISE, "trajectories of a batch on which auto runs its pilot")
 # ---- the recheck (``gyrolab.accuracy.promise``) ----------------------------------------------------------------------
 RECHECK_MARGIN = _constant("RECHECK_MARGIN", 3.0, PROMISE, (
