@@ -85,3 +85,29 @@ def test_a_promise_the_reruns_cannot_keep_is_one_sentence(monkeypatch):
     with pytest.raises(ConfigError, match=r"integrator.extended_precision=true \(auto then climbs to double-double\)$"):
         compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", "integrator.extended_precision=false",
                        *CHAOTIC_TOP, "time.end=110"]).run()
+
+
+def test_the_recheck_compares_every_output_time(monkeypatch):
+    # the promise covers the trajectory, not the final state alone: with the measured error of the final state hidden
+    # (set to 0), what the estimate measures at the output times before it (t = 109, 108, …) still breaks the prediction
+    # and sends the run again; the answer is then within ε at every output time against the double-double reference
+    import gyrolab.accuracy.promise as promise
+
+    _no_growth(monkeypatch)
+    compare = promise.estimate.compare
+
+    def final_hidden(*args, **kwargs):
+        comparison = compare(*args, **kwargs)
+        if comparison.difference is not None:
+            comparison.difference[-1] = 0.0
+        return comparison
+
+    monkeypatch.setattr(promise.estimate, "compare", final_hidden)
+    overrides = [*CHAOTIC_TOP, "time.end=110", "time.n_output=111"]
+    ds = compose_scene(["integrator=auto", "accuracy=1e-6", *overrides]).run()
+    assert ds.attrs["auto_measured_error_before_recheck"][0] > 1e-6  # measured before the end
+    assert "auto_recheck" in ds.attrs
+    truth = compose_scene(["integrator=taylor", "integrator.precision=double-double", "integrator.tol=1e-28",
+                           *overrides]).run()
+    error = max(float(np.max(np.abs(ds[v].values - truth[v].values))) for v in ("omega", "gamma"))
+    assert error <= 1e-6 and error <= ds.attrs["auto_predicted_error"], error
