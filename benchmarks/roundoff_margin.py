@@ -22,7 +22,7 @@ import numpy as np
 
 from gyrolab import compose_scene
 from gyrolab.accuracy.calibration import ROUNDOFF_MARGIN, TIGHTER
-from gyrolab.accuracy.estimate import rounding_moved
+from gyrolab.kernels.model import rounding_moved
 from gyrolab.kernels.taylor import MAX_ORDER
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 

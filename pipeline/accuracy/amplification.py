@@ -71,20 +71,16 @@ def amplification(compiled: Any, fun: Any, y0: np.ndarray, t0: float, t_pilot: f
     ``method`` is an integrator instance for the shadow pair (``auto``'s loose method) when the variational
     equations do not apply to ``compiled``.
     """
+    from gyrolab.kernels import models
+
     span = float(t_end - t0)
     variational = _variational(compiled, y0, t0, t_pilot, t_end)
     if variational is not None:
-        how = ("variational equations (compiled DOP853)" if variational_kind(compiled) == "hand-written" else
+        how = ("variational equations (compiled DOP853)" if compiled.model != models.TRACED else
                "tangent flow generated from the equations (compiled DOP853)")
         return Amplification(*variational, span, how)
     return Amplification(*_shadow_pair(method, fun, compiled, y0, t0, t_pilot, t_end), span,
                          f"shadow pair renormalised {SHADOW_CHUNKS} times ({method.name})")
-
-
-def variational_kind(compiled: Any) -> str:
-    from gyrolab.kernels import models
-
-    return "hand-written" if compiled.model == models.FIXED_POINT else "generated"
 
 
 def _variational(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float) -> tuple[float, float] | None:

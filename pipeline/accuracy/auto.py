@@ -1,53 +1,33 @@
 """Accuracy-targeted choice: the cheapest integrator and setting predicted to reach ``accuracy``.
 
-A tolerance is not an accuracy: how the final error depends on it varies
-with the scene (on the reference scene the final error of the Taylor method
-is 24 to 470 times its per-step tolerance depending on the order; on the
-extremes matrix the ratio spans four decades), and no per-step error control
-predicts how local errors grow into the global one. So ``auto`` measures
-that dependence on the scene itself with a short pilot: two runs over the
-first ``pilot_fraction`` of the time span, at tolerances τ and τ_t ≤ τ/10 and the
-same order, give the error of the τ run along the pilot (hence a growth
-exponent q, error ∝ t^q). At a fixed order the error is proportional to the
-tolerance (checked in the tests), so the full span at tolerance τ' is
-predicted to end with error err(τ) · (τ'/τ) · (T/T_pilot)^q, with q ≥ 2: a
-non-symplectic method drifts in energy linearly on a near-integrable motion,
-so its phase error grows quadratically (measured on the reference problem:
-the error of Taylor at tol 1e-10 grows ×100 from t = 30 to t = 300).
-``auto`` picks τ' to meet ``accuracy`` with a safety factor and records the
-prediction multiplied by ``CALIBRATION`` (``tests/test_extremes.py`` and
-``tests/test_compiled.py`` check that the recorded prediction bounds the actual
-error on the extremes matrix and the reference scene). The pilot is not wasted:
-its tight run is at least as accurate as the final one, so it is the first
-``pilot_fraction`` of the trajectory and the final run continues from its end.
-A pilot round that re-centres τ (the first prediction asked for a tolerance
-more than ``RECENTRE`` = 20× looser) or loosens it (only round-off seen) reuses the previous
-round's τ run as its tight run, so each later round costs one run, not two.
+A tolerance is not an accuracy: how the final error depends on it varies with the scene (on the reference scene the
+final error of the Taylor method is 24 to 470 times its per-step tolerance depending on the order; on the extremes
+matrix the ratio spans four decades), and no per-step error control predicts how local errors grow into the global
+one. So ``auto`` measures that dependence on the scene itself with a short pilot: two runs over the first
+``pilot_fraction`` of the time span, at tolerances τ and τ_t ≤ τ/10 and the same order, give the error of the τ run
+along the pilot (hence a growth exponent q, error ∝ t^q). At a fixed order the error is proportional to the tolerance
+(checked in the tests), so the full span at tolerance τ' is predicted to end with error err(τ) · (τ'/τ) ·
+(T/T_pilot)^q, with q ≥ 2: a non-symplectic method drifts in energy linearly on a near-integrable motion, so its phase
+error grows quadratically. ``auto`` picks τ' to meet ``accuracy`` with a safety factor and records the prediction
+multiplied by ``CALIBRATION`` (``calibration.TABLE``: the measurement behind it and the benchmark that checks it).
+The pilot is not wasted: its tight run is at least as accurate as the final one, so it is the first
+``pilot_fraction`` of the trajectory and the final run continues from its end. A pilot round that re-centres τ (the
+first prediction asked for a tolerance more than ``RECENTRE`` times looser) or loosens it (only round-off seen) reuses
+the previous round's τ run as its tight run, so each later round costs one run, not two.
 
-Calibration, measured 2026-11-24 with ``python benchmarks/perf_reference.py
---calibration`` (the pilot as it is now: re-centred rounds reuse their previous
-run, tight runs down to accuracy/3000): the largest ratio of the actual final
-error to the raw prediction (before CALIBRATION and round-off) over the
-extremes matrix and the reference scene at accuracies 1e-3 to 1e-13, counting
-only errors at least 100 times above the references' disagreement, is 0.94
-(reference scene, accuracy 1e-5); on the extremes scenes it is at most 0.19.
-The previous pilot gave 0.86 there. CALIBRATION = 3 leaves a factor 3.2.
+Candidates, fastest first: an expansion regime's analytic series (no integration at all), when the scene lies in the
+regime's domain, starts on the periodic orbit the series describes, and the series' error — measured over one period
+against a tight Taylor run and extrapolated linearly in time, as a phase drift — meets the target; then the compiled
+Taylor method when the scene has a compiled model; otherwise scipy's DOP853. Before any series is built, a regime that
+declares ``period_spread`` is ruled out when the scene's own motion never comes back near its start over the orbit's
+period range (``Auto._misses_orbits``: a necessary condition of the series check, ~0.25 ms; building and checking the
+series costs ~2 ms, 0.4 s on a process's first call).
 
-Candidates, fastest first: an expansion regime's analytic series (no
-integration at all), when the scene lies in the regime's domain, starts on the
-periodic orbit the series describes, and the series' error — measured over one
-period against a tight Taylor run and extrapolated linearly in time, as a
-phase drift — meets the target; then the compiled Taylor method when the
-scene has a compiled model; otherwise scipy's DOP853. Before any series is
-built, a regime that declares ``period_spread`` is ruled out when the scene's
-own motion never comes back near its start over the orbit's period range
-(``Auto._misses_orbits``: a necessary condition of the series check, ~0.25 ms;
-building and checking the series costs ~2 ms, 0.4 s on a process's first call).
-
-Round-off: the Taylor state update is compensated (Kahan), so round-off no
-longer grows by an ulp per step but as a random walk, about eps·|y|·√steps
-(measured floor on the reference scene: 9e-15 over 2,700 steps, where this
-estimate gives 6e-14); targets below that estimate are refused.
+Round-off: the Taylor state update is compensated (Kahan), so round-off grows as a random walk, about eps·|y|·√steps
+(measured on the reference scene: 9e-15 over 2,700 steps, where this estimate gives 6e-14), amplified on a chaotic
+scene by the growth of perturbations. Where it is above the target, ``auto`` climbs the precision ladder (the method's
+``climbed``: the Taylor method in double-double) unless ``extended_precision`` is false, and refuses only what the
+highest rung allowed cannot reach (``Auto._refusal``).
 """
 
 from __future__ import annotations
@@ -59,53 +39,21 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.contracts.integrator import (
-    BATCH_KERNEL,
-    CHOOSES_METHOD,
-    PRECISIONS,
-    Choice,
-    PREFERS_COMPILED_MODEL,
-    TIME_DEPENDENT,
-    VECTOR_LANES,
-    BatchSolution,
-    CompiledModel,
-    Integrator,
-    IntegratorStats,
-    ProgressCallback,
-    RightHandSide,
-    Solution,
-)
-from gyrolab.errors import ConfigError, GyrolabError, as_number
 from gyrolab.accuracy.amplification import amplification
-from gyrolab.accuracy.calibration import (
-    AUTO_SAMPLE,
-    CALIBRATION,
-    CHAOS_MARGIN,
-    DOUBLE_DOUBLE_FLOOR,
-    FIRST_RATIO,
-    FLOOR,
-    MAX_GROWTH,
-    MAX_TOLERANCE,
-    MIN_GROWTH,
-    MIN_PILOT_STEPS,
-    MIN_TOLERANCE,
-    MISS_MARGIN,
-    PILOT_POINTS,
-    RECENTRE,
-    SCREEN_POINTS,
-    SCREEN_TOLERANCE,
-    SHADOW_TOLERANCE,
-    TIGHT_RATIO,
-    UNMEASURED_PER_TOL,
-)
+from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_FLOOR, FIRST_RATIO,
+                                          FLOOR, MAX_GROWTH, MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE,
+                                          MISS_MARGIN, PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
+                                          SHADOW_TOLERANCE, TIGHT_RATIO, UNMEASURED_PER_TOL)
+from gyrolab.contracts.integrator import (BATCH_KERNEL, CHOOSES_METHOD, PRECISIONS, PREFERS_COMPILED_MODEL,
+                                          TIME_DEPENDENT, VECTOR_LANES, BatchSolution, Choice, CompiledModel,
+                                          Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution)
+from gyrolab.errors import ConfigError, GyrolabError, as_number
 
 #: what ``auto_predicted_error`` is, stored beside it in every run
-PREDICTION_MEANING = ("an upper estimate of the max-norm error of the stored state at every output time against the "
-                      "exact solution (model units): the pilot's measured error extrapolated over the span, raised by "
-                      "the amplification of perturbations measured over the whole span (chaotic scenes), times a "
-                      "calibration factor, plus the round-off of the precision that ran (amplified likewise); checked "
-                      "at every output time by output.error_estimate (a run that breaks it runs again or is refused: "
-                      "gyrolab.accuracy.promise), a prediction only without it")
+PREDICTION_MEANING = ("an upper estimate of the max-norm error of the stored state at every output time (model units): "
+                      "the pilot's error extrapolated over the span, raised by the measured growth of perturbations, "
+                      "times a calibration factor, plus the round-off of the precision that ran; checked at every "
+                      "output time by output.error_estimate (gyrolab.accuracy.promise), a prediction only without it")
 EPS = float(np.finfo(float).eps)
 #: the unit round-off of double-double arithmetic (a 106-bit significand), for auto's extended-precision choice
 DOUBLE_DOUBLE_EPS = 2.0 ** -104
@@ -159,14 +107,10 @@ class Auto(Integrator):
     def attributes(self) -> dict[str, Any]:
         return {"accuracy": self.accuracy}
 
-    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
-                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        """The cheapest method predicted to meet the accuracy, run; what it chose and promises is the solution's
-        ``choice`` (nothing is kept on the integrator)."""
-        return self._integrate(fun, np.asarray(t_out, dtype=float), y0, progress, compiled, series=True)
-
-    def _integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None,
-                   compiled: CompiledModel | None, series: bool) -> Solution:
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None = None,
+                  compiled: CompiledModel | None = None, series: bool = True) -> Solution:
+        """The cheapest method predicted to meet the accuracy (``series``: a regime's analytic series among the
+        candidates), run; what it chose and promises is the solution's ``choice`` (nothing is kept on ``self``)."""
         from gyrolab.kernels.taylor import order_for
         from gyrolab.kernels.taylor_series import ready
 
@@ -176,7 +120,7 @@ class Auto(Integrator):
         if series:
             solution = self._series(fun, t_out, y0, compiled, start)
             if solution is not None:
-                solution.choice.instead = lambda: self._integrate(fun, t_out, y0, progress, compiled, series=False)
+                solution.choice.instead = lambda: self.integrate(fun, t_out, y0, progress, compiled, series=False)
                 return solution
         span = t_out[-1] - t_out[0]
         t_pilot = t_out[0] + span * self.pilot_fraction
@@ -463,7 +407,6 @@ class Auto(Integrator):
         run; the batch then runs the chosen method at the smallest tolerance chosen. A trajectory harder
         than every sampled one may miss the accuracy: sample it (pass it first) when you know it.
         """
-        from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
         from gyrolab.plugins.integrators.step_guard import compiled_rhs
 
         P = params
@@ -474,15 +417,10 @@ class Auto(Integrator):
             single = type(self)(accuracy=self.accuracy, pilot_fraction=self.pilot_fraction, safety=self.safety,
                                 extended_precision=False)  # the vectorised kernels run in double precision
             model = CompiledModel(compiled.model, P[j])
-            choices.append(single.integrate(compiled_rhs(model), times, y0s[j], None, model).choice.attributes)
-        choice = min(choices, key=lambda c: c["auto_tolerance"])
-        tol = float(choice["auto_tolerance"])
-        method = Taylor(order=choice["auto_order"], tol=tol) if choice["auto_method"] == Taylor.name \
-            else DOP853Numba(rtol=tol, atol=tol)
-        settings = {"accuracy": self.accuracy,
-                    **{k: v.item() if isinstance(v, np.generic) else v for k, v in choice.items()},
-                    "auto_sampled_trajectories": len(sample)}
-        return method, settings
+            choices.append(single.integrate(compiled_rhs(model), times, y0s[j], None, model, series=False).choice)
+        choice = min(choices, key=lambda c: c.attributes["auto_tolerance"])  # the chosen method (Taylor or DOP853)
+        return choice.method, {"accuracy": self.accuracy, "auto_sampled_trajectories": len(sample),
+                               **{k: v.item() if isinstance(v, np.generic) else v for k, v in choice.attributes.items()}}
 
     def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
                         failures: str) -> BatchSolution:

@@ -35,63 +35,52 @@ def _constant(name: str, value: float, benchmark: str, basis: str) -> float:
     return value
 
 
-# ---- the error estimate (``gyrolab.accuracy.estimate``) -------------------------------------------------------------
-TIGHTER = _constant("TIGHTER", 100.0, PERF, (
-    "the companion is this many times more accurate than the run: within ~1 % of the truth; on the reference scene "
-    "(auto at 1e-6) the companion at 100× takes 0.55 ms and ends 176× more accurate, at 1000× 0.68 ms and 1660×"))
-DOUBLE_DOUBLE_BELOW = _constant("DOUBLE_DOUBLE_BELOW", 1e-14, PROMISE, (
-    "a double Taylor run whose companion would run below this tol is measured in double-double: with a double "
-    "companion the smallest estimate / actual error was 0.0047 at tol 3e-14, 0.94 at 1e-12; double-double 0.98"))
-ROUNDOFF_MARGIN = _constant("ROUNDOFF_MARGIN", 10.0, ROUNDOFF, (
-    "a double companion near the floor is trusted when two double companions disagree by this many times less than "
-    "the error it measures: at 10 no trusted estimate below 1/2 of the actual error in 606 runs (seed 5)"))
-# ---- the growth of perturbations (``gyrolab.accuracy.amplification``) ------------------------------------------------
-TANGENT_TOLERANCE = _constant("TANGENT_TOLERANCE", 1e-5, CHAOS, (
-    "tolerance of the tangent run: slow_spin over t = 300 grows e^19.3 at 1e-5, e^17.4 at 1e-4, e^23.3 at 1e-3"))
-SHADOW_OFFSET = _constant("SHADOW_OFFSET", 1e-7, CHAOS, "the shadow pair's separation relative to the state's size")
-SHADOW_CHUNKS = _constant("SHADOW_CHUNKS", 64, CHAOS, "the shadow pair's renormalisations over the span")
-TANGENT_SAMPLES = _constant("TANGENT_SAMPLES", 64, CHAOS, "times a generated tangent run reads max ln|δ| at")
-CHAOS_MARGIN = _constant("CHAOS_MARGIN", 10.0, CHAOS, (
-    "a chaotic scene's amplification is taken this many times larger: one tangent run's growth scatters by up to "
-    "e^2 between nearby tolerances; with no margin slow_spin at t = 300 was accepted at 1e-6 and ended at 1.4e-6"))
-SHADOW_TOLERANCE = _constant("SHADOW_TOLERANCE", 1e-9, CHAOS, "tolerance of the shadow pair's runs")
-# ---- auto's pilot and choice (``gyrolab.accuracy.auto``) -------------------------------------------------------------
-PILOT_POINTS = _constant("PILOT_POINTS", 65, CALIBRATE, "samples of the pilot's error growth")
-MIN_GROWTH = _constant("MIN_GROWTH", 2.0, CALIBRATE, (
-    "the pilot's power law t^q is at least quadratic: a non-symplectic method's phase error on a near-integrable "
-    "motion; Taylor at tol 1e-10 on the reference scene grows ×100 from t = 30 to t = 300"))
-MAX_GROWTH = _constant("MAX_GROWTH", 4.0, CALIBRATE, (
-    "the largest power law the pilot fits; an amplification beyond (1/pilot_fraction)^MAX_GROWTH is chaos"))
-FIRST_RATIO = _constant("FIRST_RATIO", 1e-3, CALIBRATE, (
-    "first pilot tolerance relative to the accuracy (final error / tolerance is 24–470 on the reference scene)"))
-MIN_TOLERANCE = _constant("MIN_TOLERANCE", 1e-13, CALIBRATE, "the first pilot's tightest tolerance")
-MAX_TOLERANCE = _constant("MAX_TOLERANCE", 1e-5, CALIBRATE, (
-    "looser per-step tolerances take steps near the Taylor series' radius of convergence"))
-TIGHT_RATIO = _constant("TIGHT_RATIO", 3000.0, CALIBRATE, (
-    "the pilot's tight run is at most accuracy/TIGHT_RATIO (final tolerances are accuracy/420 … accuracy/1300)"))
-MIN_PILOT_STEPS = _constant("MIN_PILOT_STEPS", 8, PROMISE, (
-    "a pilot whose loose run took fewer steps measured nothing (r0 = 32 over t = 0.25 at 1e-9 ended 5.7e-5 away)"))
-UNMEASURED_PER_TOL = _constant("UNMEASURED_PER_TOL", 1e3, CALIBRATE, (
-    "the error per unit tolerance taken when the pilot measured nothing: above the 24–470 measured"))
-RECENTRE = _constant("RECENTRE", 20.0, CALIBRATE, (
-    "a first prediction this many times looser than the pilot's τ is measured again: the largest actual / raw "
-    "prediction is 1.09 at every threshold from 10 to 100; at 20 the pilot re-measures in 267 of 369 runs"))
-CALIBRATION = _constant("CALIBRATION", 3.0, CALIBRATE, (
-    "the recorded prediction is the raw one times this: the largest actual / raw predicted final error on the "
-    "extremes matrix and the reference scene at 1e-3 … 1e-13 is 0.94"))
-MISS_MARGIN = _constant("MISS_MARGIN", 1000.0, PERF, "a series' predicted error is trusted to this factor")
-SCREEN_POINTS = _constant("SCREEN_POINTS", 512, PERF, "grid of the screen before the series check (~0.25 ms)")
-SCREEN_TOLERANCE = _constant("SCREEN_TOLERANCE", 1e-9, PERF, "tolerance of the screen's Taylor run")
-FLOOR = _constant("FLOOR", 1e-15, PROMISE, "relative to the state's size: no double run reaches below")
-DOUBLE_DOUBLE_FLOOR = _constant("DOUBLE_DOUBLE_FLOOR", 1e-16, PROMISE, (
-    "the same for double-double: it integrates to ~1e-31 but stores its states as doubles, each rounded by up to half "
-    "an ulp (≤ 1.1e-16 × the state's size); asked 5e-29 at time.end=1, the error estimate measured 1.1e-16"))
-AUTO_SAMPLE = _constant("AUTO_SAMPLE", 3, PROMISE, "trajectories of a batch on which auto runs its pilot")
-# ---- the recheck (``gyrolab.accuracy.promise``) ----------------------------------------------------------------------
-RECHECK_MARGIN = _constant("RECHECK_MARGIN", 3.0, PROMISE, (
-    "a run that broke its promise runs again aimed this many times below what would have met it; over the extremes "
-    "matrix and the reference scene the measured error is at most 0.47× the prediction"))
-MAX_RECHECKS = _constant("MAX_RECHECKS", 2, PROMISE, "runs made more accurate before the recheck refuses")
+_c = _constant
+# the error estimate (``estimate``)
+TIGHTER = _c("TIGHTER", 100.0, PERF, "companion this many times more accurate: reference scene at 1e-6, 0.55 ms and "
+             "176× more accurate (1000×: 0.68 ms, 1660×)")
+DOUBLE_DOUBLE_BELOW = _c("DOUBLE_DOUBLE_BELOW", 1e-14, PROMISE, "a double Taylor run whose companion tol is below this "
+                         "is measured in double-double: double companions' estimate / actual 0.0047 at 3e-14, 0.94 at "
+                         "1e-12; double-double 0.98")
+ROUNDOFF_MARGIN = _c("ROUNDOFF_MARGIN", 10.0, ROUNDOFF, "a double companion near the floor is trusted when two disagree "
+                     "this many times below what it measures: no estimate below 1/2 of the error in 606 runs (seed 5)")
+# the growth of perturbations (``amplification``)
+TANGENT_TOLERANCE = _c("TANGENT_TOLERANCE", 1e-5, CHAOS, "tangent run's tolerance: slow_spin over t = 300 grows e^19.3 "
+                       "at 1e-5, e^17.4 at 1e-4, e^23.3 at 1e-3")
+SHADOW_OFFSET = _c("SHADOW_OFFSET", 1e-7, CHAOS, "the shadow pair's separation relative to the state's size")
+SHADOW_CHUNKS = _c("SHADOW_CHUNKS", 64, CHAOS, "the shadow pair's renormalisations over the span")
+TANGENT_SAMPLES = _c("TANGENT_SAMPLES", 64, CHAOS, "times a generated tangent run reads max ln|δ| at")
+CHAOS_MARGIN = _c("CHAOS_MARGIN", 10.0, CHAOS, "a chaotic scene's amplification taken this many times larger (one "
+                  "tangent run scatters by e^2); with none slow_spin at t = 300 was accepted at 1e-6, ended at 1.4e-6")
+SHADOW_TOLERANCE = _c("SHADOW_TOLERANCE", 1e-9, CHAOS, "tolerance of the shadow pair's runs")
+# auto's pilot and choice (``auto``)
+PILOT_POINTS = _c("PILOT_POINTS", 65, CALIBRATE, "samples of the pilot's error growth")
+MIN_GROWTH = _c("MIN_GROWTH", 2.0, CALIBRATE, "the pilot's power law t^q is at least quadratic (phase drift): Taylor "
+                "at tol 1e-10 on the reference scene grows ×100 from t = 30 to t = 300")
+MAX_GROWTH = _c("MAX_GROWTH", 4.0, CALIBRATE, "the pilot's largest power law; growth beyond (1/pilot_fraction)^4 is chaos")
+FIRST_RATIO = _c("FIRST_RATIO", 1e-3, CALIBRATE, "first pilot tolerance / accuracy (final error / tol: 24–470)")
+MIN_TOLERANCE = _c("MIN_TOLERANCE", 1e-13, CALIBRATE, "the first pilot's tightest tolerance")
+MAX_TOLERANCE = _c("MAX_TOLERANCE", 1e-5, CALIBRATE, "looser tolerances step near the Taylor series' radius")
+TIGHT_RATIO = _c("TIGHT_RATIO", 3000.0, CALIBRATE, "pilot's tight run ≤ accuracy / this (final tols: accuracy/420 … /1300)")
+MIN_PILOT_STEPS = _c("MIN_PILOT_STEPS", 8, PROMISE, "a pilot of fewer steps measured nothing (r0 = 32 over t = 0.25 at "
+                     "1e-9 ended 5.7e-5 away)")
+UNMEASURED_PER_TOL = _c("UNMEASURED_PER_TOL", 1e3, CALIBRATE, "error per unit tol taken when the pilot measured nothing "
+                        "(measured: 24–470)")
+RECENTRE = _c("RECENTRE", 20.0, CALIBRATE, "a first prediction this many times looser than τ is measured again: actual "
+              "/ raw prediction ≤ 1.09 at every threshold 10–100; at 20, 267 of 369 runs re-measure")
+CALIBRATION = _c("CALIBRATION", 3.0, CALIBRATE, "recorded prediction = raw × this: the largest actual / raw final error "
+                 "on the extremes matrix and the reference scene at 1e-3 … 1e-13 is 0.94")
+MISS_MARGIN = _c("MISS_MARGIN", 1000.0, PERF, "a series' predicted error is trusted to this factor")
+SCREEN_POINTS = _c("SCREEN_POINTS", 512, PERF, "grid of the screen before the series check (~0.25 ms)")
+SCREEN_TOLERANCE = _c("SCREEN_TOLERANCE", 1e-9, PERF, "tolerance of the screen's Taylor run")
+FLOOR = _c("FLOOR", 1e-15, PROMISE, "relative to the state's size: no double run reaches below")
+DOUBLE_DOUBLE_FLOOR = _c("DOUBLE_DOUBLE_FLOOR", 1e-16, PROMISE, "double-double stores its states as doubles, rounded "
+                         "by ≤ 1.1e-16 × their size: asked 5e-29 at time.end=1, the estimate measured 1.1e-16")
+AUTO_SAMPLE = _c("AUTO_SAMPLE", 3, PROMISE, "trajectories of a batch on which auto runs its pilot")
+# the recheck (``promise``)
+RECHECK_MARGIN = _c("RECHECK_MARGIN", 3.0, PROMISE, "a broken promise reruns aimed this many times below what would "
+                    "have met it; extremes matrix and reference scene: measured ≤ 0.47× the prediction")
+MAX_RECHECKS = _c("MAX_RECHECKS", 2, PROMISE, "runs made more accurate before the recheck refuses")
 
 
 def report(benchmark: str, measured: dict[str, tuple[bool, str]]) -> bool:

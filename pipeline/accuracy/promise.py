@@ -37,19 +37,12 @@ class Ran:
     choice: Choice | None = None
     measured_before: list[float] = field(default_factory=list)
 
-    @property
-    def name(self) -> str:
-        return self.integrator.name
-
-    @property
-    def adaptive(self) -> bool:
-        return self.integrator.adaptive
+    def __post_init__(self) -> None:
+        self.name, self.adaptive = self.integrator.name, self.integrator.adaptive
 
     def attributes(self) -> dict[str, Any]:
-        attrs = {**self.integrator.attributes(), **(self.choice.attributes if self.choice else {})}
-        if self.measured_before:
-            attrs["auto_measured_error_before_recheck"] = list(self.measured_before)
-        return attrs
+        before = {"auto_measured_error_before_recheck": self.measured_before} if self.measured_before else {}
+        return {**self.integrator.attributes(), **(self.choice.attributes if self.choice else {}), **before}
 
 
 def measured_run(scene: Any, y0: np.ndarray, progress: Any, compiled: Any) -> tuple[Solution, Ran, Any]:
@@ -92,21 +85,18 @@ def _again(scene: Any, y0: np.ndarray, progress: Any, compiled: Any, choice: Cho
     """The run again, made more accurate by the factor ``measured`` asks for, or one ConfigError sentence."""
     what = (f"the error estimate measures {measured:.2g} where {scene.integrator.name} predicted {choice.promised:.2g} "
             f"({choice.attributes.get('auto_method')})")
+    if rechecks > MAX_RECHECKS:
+        raise _refusal(choice, f"after {MAX_RECHECKS} runs made more accurate {what}", measured)
     if choice.method is None:  # an analytic series: integrate instead
-        if rechecks > MAX_RECHECKS:
-            raise _refusal(choice, f"after {MAX_RECHECKS} runs made more accurate {what}", measured)
         solution = choice.instead()
         solution.choice.attributes["auto_recheck"] = f"{what}: integrated instead"
         return solution
     factor = RECHECK_MARGIN * measured / choice.target
-    finer = choice.method.more_accurate(factor)
-    how = "more accurate"
+    finer, how = choice.method.more_accurate(factor), "more accurate"
     if finer is None and choice.may_climb:
         finer, how = choice.method.climbed(factor), "one rung up the precision ladder"
-    if rechecks > MAX_RECHECKS or finer is None:
-        reason = (f"after {MAX_RECHECKS} runs made more accurate {what}" if rechecks > MAX_RECHECKS
-                  else f"{what}, and {choice.method.name} cannot be made {factor:.2g}× more accurate")
-        raise _refusal(choice, reason, measured)
+    if finer is None:
+        raise _refusal(choice, f"{what}, and {choice.method.name} cannot be made {factor:.2g}× more accurate", measured)
     method = finer[0]
     try:
         solution = method.integrate(scene.rhs, scene.times, y0, progress, compiled)
@@ -116,15 +106,13 @@ def _again(scene: Any, y0: np.ndarray, progress: Any, compiled: Any, choice: Cho
     settings = {f"auto_{k.removeprefix('integrator_')}": v for k, v in method.attributes().items()}
     attributes = {**choice.attributes, **settings, "auto_method": method.name,
                   "auto_tolerance": settings.get("auto_tol", settings.get("auto_rtol")),
-                  # error ∝ tolerance at a fixed order: the earlier measurement scaled down, checked again by the
-                  # measurement of this run
+                  # error ∝ tolerance at a fixed order: the measurement scaled down to the target, measured again
                   "auto_predicted_error": choice.target, "auto_precision": method.precision,
                   "auto_recheck": f"{what}: {finer[2]} ({how})"}
     if method.precision != choice.method.precision:
         attributes["auto_precision_reason"] = (f"the error estimate measured {measured:.2g} where accuracy="
                                                f"{choice.target:g} was asked, and {choice.method.name} had reached "
                                                f"{choice.method.precision} precision's floor")
-    attributes.pop("auto_predicted_error_raised_by", None)
     solution.choice = replace(choice, method=method, attributes=attributes, promised=choice.target)
     return solution
 

@@ -287,7 +287,7 @@ class Integrator(ABC):
         turns the two runs' difference into this run's error estimate, a few words saying how), or None when it
         cannot be made so (a tolerance already at its floor, or nothing to tighten). A method with tolerances
         divides them by ``factor`` (the number is 1); a fixed-step method of order p halves its step (the number is
-        Richardson's 2^p / (2^p − 1)); a method that chooses (CHOOSES_METHOD) answers for the method it ran."""
+        Richardson's 2^p / (2^p − 1)); a method that chooses (CHOOSES_METHOD) returns the method it ran instead."""
         return None
 
     #: rule 11: its rung on the precision ladder (``PRECISIONS``)
