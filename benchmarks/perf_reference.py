@@ -529,6 +529,24 @@ def main() -> None:
     print(f"cold `gyrolab` default run, end to end: {cold[1]:.2f} s with warm kernel cache "
           f"(first process {cold[0]:.2f} s; goal 3 s)")
     print(f"\nload average {os.getloadavg()[0]:.1f} at the end (a loaded machine slows every contestant alike)")
+    from gyrolab.accuracy import calibration as table
+
+    table.report(table.PERF, tighter_check(reference))
+
+
+def tighter_check(reference):
+    """The companion's gain on the reference scene (``calibration.TIGHTER``): Taylor as auto runs it at 1e-6 (order
+    12, tol 1.3e-8) and at tol / TIGHTER, final errors against the extended-precision reference."""
+    from gyrolab.accuracy import calibration as table
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    scene = compose_scene(["experiment=perf_reference", "time.n_output=2"])
+    y0 = scene.system.initial_state()
+    errors = [float(np.max(np.abs(Taylor(order=12, tol=tol).integrate(None, scene.times, y0, None, scene.compiled)
+                                  .y[-1][:6] - reference[:6]))) for tol in (1.3e-8, 1.3e-8 / table.TIGHTER)]
+    gain = errors[0] / errors[1]
+    return {"TIGHTER": (gain >= table.TIGHTER / 3, f"the companion at tol / {table.TIGHTER:g} ends {gain:.0f}× more "
+                                                   "accurate on the reference scene (supported from TIGHTER / 3)")}
 
 
 if __name__ == "__main__":

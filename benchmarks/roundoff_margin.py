@@ -89,7 +89,13 @@ def main() -> int:
         print(f"| {margin:g} | {int(kept.sum())} of {len(rows)} | {worst:.3g} | {int((ratio[kept] < 0.5).sum())} |")
     print("\nthe double estimate alone (no margin): smallest E / actual "
           f"{float(ratio.min()):.3g}, {int((ratio < 0.5).sum())} of {len(rows)} below 1/2")
-    return 0
+    from gyrolab.accuracy import calibration as table
+
+    trusted = trust >= ROUNDOFF_MARGIN
+    low = int((ratio[trusted] < 0.5).sum())
+    supported = table.report(table.ROUNDOFF, {"ROUNDOFF_MARGIN": (
+        low <= max(1, len(rows) // 1000), f"{low} of {int(trusted.sum())} trusted estimates below 1/2 of the error")})
+    return 0 if supported else 1
 
 
 if __name__ == "__main__":
