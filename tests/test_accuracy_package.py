@@ -1,13 +1,16 @@
-"""The calibration constants of ``gyrolab.accuracy`` sit in one table, each naming the benchmark that regenerates it,
-and that benchmark reads the table and reports whether its measurement still supports each value."""
+"""``gyrolab.accuracy`` owns accuracy: the engine imports no concrete integrator, ``auto`` keeps nothing of a call,
+and the calibration constants sit in one table, each naming the benchmark that regenerates it, which reads the table
+and reports whether its measurement still supports each value."""
 
 from __future__ import annotations
 
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from gyrolab import compose_scene
 from gyrolab.accuracy import calibration as table
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -38,3 +41,22 @@ def test_the_report_says_when_a_measurement_contradicts_a_value(capsys):
     assert "ROUNDOFF_MARGIN = 10: NOT SUPPORTED by another" in capsys.readouterr().out
     with pytest.raises(KeyError, match="CALIBRATION"):  # a benchmark may not judge another benchmark's constant
         table.report(table.ROUNDOFF, {"CALIBRATION": (True, "")})
+
+
+def test_the_engine_imports_no_concrete_integrator():
+    for path in (ROOT / "pipeline" / "engine").glob("*.py"):
+        text = path.read_text()
+        assert "plugins.integrators" not in text and "accuracy.auto" not in text, path.name
+
+
+def test_auto_keeps_nothing_of_a_call():
+    # what a run chose comes back with its solution (Solution.choice); the integrator is as it was before the call
+    scene = compose_scene(["experiment=perf_reference", "time.n_output=2", "accuracy=1e-8"])
+    auto = scene.integrator
+    before = dict(vars(auto))
+    solution = auto.integrate(scene.rhs, scene.times, scene.system.initial_state(), None, scene.compiled)
+    assert vars(auto) == before
+    assert solution.choice.method.name == "taylor" and solution.choice.promised <= 1e-8
+    assert solution.choice.attributes["auto_precision"] == "double"
+    again = auto.integrate(scene.rhs, scene.times, scene.system.initial_state(), None, scene.compiled)
+    np.testing.assert_array_equal(again.y, solution.y)
