@@ -107,7 +107,7 @@ def heyoka_same_work():
     except ImportError:
         return {}
     from gyrolab.kernels.variational import initial_tangent
-    from gyrolab.plugins.integrators.amplification import TANGENT_TOLERANCE
+    from gyrolab.accuracy.calibration import TANGENT_TOLERANCE
 
     A, B, C = INERTIA
     x0, y0, z0 = R_C
@@ -169,7 +169,7 @@ def final_state(ds):
 
 def peer_table(reference, rounds, quick):
     """Time to reach each ε: heyoka propagate_grid against gyrolab taylor/auto (integration and Scene.run)."""
-    from gyrolab.plugins.integrators.auto import Auto
+    from gyrolab.accuracy.auto import Auto
     from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
     scene = compose_scene(["experiment=perf_reference"])
@@ -280,7 +280,7 @@ def print_verdict(run_ratios):
 
 
 def tangent_tolerance():
-    from gyrolab.plugins.integrators.amplification import TANGENT_TOLERANCE
+    from gyrolab.accuracy.calibration import TANGENT_TOLERANCE
 
     return TANGENT_TOLERANCE
 
@@ -345,7 +345,7 @@ def run_breakdown(rounds, quick):
     """Where ``Scene.run()`` with ``integrator=auto`` spends its time: the regimes' series check, the pilot and
     final Taylor runs (auto without the series check), the dataset, interleaved like the peer table."""
     from gyrolab.output.dataset import build_dataset
-    from gyrolab.plugins.integrators.auto import Auto
+    from gyrolab.accuracy.auto import Auto
 
     contestants = {}
     for eps in EPSILONS[::3] if quick else EPSILONS[::2]:
@@ -375,15 +375,15 @@ def run_breakdown(rounds, quick):
 
 
 def calibration(reference):
-    """Actual / raw predicted final error of ``integrator=auto`` (``Auto.raw_predicted_error``: before CALIBRATION
+    """Actual / raw predicted final error of ``integrator=auto`` (``auto_raw_predicted_error``: before CALIBRATION
     and round-off) over the extremes matrix of ``tests/test_extremes.py`` and the reference scene, accuracies 1e-3 to
-    1e-13: the measurement behind ``gyrolab.plugins.integrators.auto.CALIBRATION``. Extremes scenes are judged
+    1e-13: the measurement behind ``gyrolab.accuracy.calibration.CALIBRATION``, reported against the table. Extremes scenes are judged
     against Taylor at tol 1e-17 (ratios marked * are within 100× of its disagreement with compiled DOP853 at 1e-13,
     i.e. not measured); the reference scene against the extended-precision reference."""
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "tests"))
     from test_extremes import SCENES
 
-    from gyrolab.plugins.integrators.auto import Auto
+    from gyrolab.accuracy.auto import Auto
     from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
 
     cases = [(name, [*overrides, "time.n_output=51"]) for name, overrides in SCENES.items()]
@@ -391,7 +391,7 @@ def calibration(reference):
     accuracies = [10.0 ** -k for k in range(3, 14)]
     print("\n`auto` calibration: actual / raw predicted final error (* not measurable: near the reference's own "
           f"error)\n\n| scene | {' | '.join(f'{a:.0e}' for a in accuracies)} |\n| --- |{' --- |' * len(accuracies)}")
-    worst = (0.0, "")
+    worst, exceeded = (0.0, ""), 0
     for name, overrides in cases:
         built = compose_scene([*overrides, "integrator=auto", "accuracy=1e-9"])
         system, times, y0 = built.system, built.times, built.system.initial_state()
@@ -411,20 +411,27 @@ def calibration(reference):
                 cells.append(type(error).__name__)
                 continue
             actual = float(np.max(np.abs(solution.y[-1][:len(truth)] - truth)))
-            ratio = actual / auto.raw_predicted_error
+            ratio = actual / solution.choice.attributes["auto_raw_predicted_error"]
             measured = actual > 100 * floor
             if measured and ratio > worst[0]:
                 worst = (ratio, f"{name}, accuracy {accuracy:.0e}")
-            bound = "" if actual <= auto.choice["auto_predicted_error"] else " (prediction exceeded)"
+            exceeded += actual > solution.choice.promised
+            bound = "" if actual <= solution.choice.promised else " (prediction exceeded)"
             cells.append(f"{ratio:.2f}{'' if measured else '*'}{bound}")
         print(f"| {name} | {' | '.join(cells)} |")
     print(f"\nlargest measured ratio: {worst[0]:.2f} ({worst[1]})")
+    from gyrolab.accuracy import calibration as table
+
+    return table.report(table.CALIBRATE, {"CALIBRATION": (
+        worst[0] * 1.5 <= table.CALIBRATION and not exceeded,
+        f"the largest actual / raw prediction {worst[0]:.2f} (the value must leave a factor 1.5 above it), "
+        f"{exceeded} recorded predictions exceeded")})
 
 
 FIRST_CHECK = """
 import time, numpy as np
 from gyrolab import compose_scene
-from gyrolab.plugins.integrators.auto import Auto
+from gyrolab.accuracy.auto import Auto
 scene = compose_scene(["experiment=perf_reference", "accuracy=1e-8"])
 grid, y0, compiled = np.linspace(0.0, 300.0, 3001), scene.system.initial_state(), scene.compiled
 Auto(accuracy=1e-8).integrate(None, grid, y0, None, compiled)  # kernels loaded: what follows is the check alone
@@ -502,8 +509,7 @@ def main() -> None:
     reference = fixed_point_reference(INERTIA, R_C, K, Y0, [0.0, T_END])[-1].astype(float)
     print(f"# reference: extended-precision Taylor, {time.perf_counter() - start:.1f} s")
     if args.calibration:
-        calibration(reference)
-        return
+        sys.exit(0 if calibration(reference) else 1)
     if args.scene_run:
         scene_run_only(reference, rounds)
         return
@@ -523,6 +529,24 @@ def main() -> None:
     print(f"cold `gyrolab` default run, end to end: {cold[1]:.2f} s with warm kernel cache "
           f"(first process {cold[0]:.2f} s; goal 3 s)")
     print(f"\nload average {os.getloadavg()[0]:.1f} at the end (a loaded machine slows every contestant alike)")
+    from gyrolab.accuracy import calibration as table
+
+    table.report(table.PERF, tighter_check(reference))
+
+
+def tighter_check(reference):
+    """The companion's gain on the reference scene (``calibration.TIGHTER``): Taylor as auto runs it at 1e-6 (order
+    12, tol 1.3e-8) and at tol / TIGHTER, final errors against the extended-precision reference."""
+    from gyrolab.accuracy import calibration as table
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    scene = compose_scene(["experiment=perf_reference", "time.n_output=2"])
+    y0 = scene.system.initial_state()
+    errors = [float(np.max(np.abs(Taylor(order=12, tol=tol).integrate(None, scene.times, y0, None, scene.compiled)
+                                  .y[-1][:6] - reference[:6]))) for tol in (1.3e-8, 1.3e-8 / table.TIGHTER)]
+    gain = errors[0] / errors[1]
+    return {"TIGHTER": (gain >= table.TIGHTER / 3, f"the companion at tol / {table.TIGHTER:g} ends {gain:.0f}× more "
+                                                   "accurate on the reference scene (supported from TIGHTER / 3)")}
 
 
 if __name__ == "__main__":

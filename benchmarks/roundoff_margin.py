@@ -1,7 +1,7 @@
 """Near the Taylor method's floor, when may the error estimate trust a double companion? (``error_estimate``)
 
 A double-precision Taylor run at tol < 1e-12 may err partly by round-off, which a double companion shares in size.
-``gyrolab.engine.error_estimate`` runs two double companions there (``TIGHTER`` times tighter; the run's order, and
+``gyrolab.accuracy.estimate`` runs two double companions there (``TIGHTER`` times tighter; the run's order, and
 another order with 1/I moved by its rounding) and keeps the first one's measurement E when their disagreement R is
 ``ROUNDOFF_MARGIN`` times below it; else a double-double companion measures. This measures that rule against the
 truth: on random scenes (``promise_audit.random_scene``) and tolerances from 3e-13 to 1.5e-16, E, R and the actual
@@ -21,7 +21,8 @@ import sys
 import numpy as np
 
 from gyrolab import compose_scene
-from gyrolab.engine.error_estimate import ROUNDOFF_MARGIN, TIGHTER, rounding_moved
+from gyrolab.accuracy.calibration import ROUNDOFF_MARGIN, TIGHTER
+from gyrolab.kernels.model import rounding_moved
 from gyrolab.kernels.taylor import MAX_ORDER
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
@@ -88,7 +89,13 @@ def main() -> int:
         print(f"| {margin:g} | {int(kept.sum())} of {len(rows)} | {worst:.3g} | {int((ratio[kept] < 0.5).sum())} |")
     print("\nthe double estimate alone (no margin): smallest E / actual "
           f"{float(ratio.min()):.3g}, {int((ratio < 0.5).sum())} of {len(rows)} below 1/2")
-    return 0
+    from gyrolab.accuracy import calibration as table
+
+    trusted = trust >= ROUNDOFF_MARGIN
+    low = int((ratio[trusted] < 0.5).sum())
+    supported = table.report(table.ROUNDOFF, {"ROUNDOFF_MARGIN": (
+        low <= max(1, len(rows) // 1000), f"{low} of {int(trusted.sum())} trusted estimates below 1/2 of the error")})
+    return 0 if supported else 1
 
 
 if __name__ == "__main__":

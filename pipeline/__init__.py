@@ -10,7 +10,8 @@ included):
                     kernels generated from them, the integrators' inner loops
 4. ``contracts``    what a plugin must do (enforced by the base classes) and the
                     registry that finds plugins by name
-5. ``plugins``      forces, systems, integrators
+5. ``plugins``      forces, systems, integrators, then ``accuracy``: the target
+                    (``auto``), the error's measurement and the recheck
 6. ``analysis``     periodic orbits, continuation, chaos indicators, precessions
                     (numerical analysis on the plugins), then ``plugins.regimes``
 7. ``output``, ``figures``   the self-describing dataset, provenance, drawing

@@ -61,7 +61,7 @@ def test_a_regular_scene_is_not_called_chaotic_and_records_its_growth():
     assert ds.attrs["auto_chaotic"] == 0
     assert 0 < ds.attrs["auto_lyapunov_exponent"] < 0.03  # ln(growth)/t of a shear: small, and shrinking with t
     assert "auto_precision_horizon" not in ds.attrs
-    assert "max-norm error of the final state" in ds.attrs["auto_predicted_error_bounds"]
+    assert "at every output time" in ds.attrs["auto_predicted_error_bounds"]
 
 
 def test_extended_precision_meets_what_double_precision_refuses():

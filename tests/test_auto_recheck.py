@@ -35,8 +35,8 @@ def test_a_pilot_of_a_few_clipped_steps_no_longer_breaks_the_promise(accuracy, e
 def _no_growth(monkeypatch):
     """auto's amplification measured as none: its prediction then misses the chaos (as a tangent run whose growth
     scatters low would make it miss)."""
-    import gyrolab.plugins.integrators.auto as auto_module
-    from gyrolab.plugins.integrators.amplification import Amplification
+    import gyrolab.accuracy.auto as auto_module
+    from gyrolab.accuracy.amplification import Amplification
 
     monkeypatch.setattr(auto_module, "amplification",
                         lambda compiled, fun, y0, t0, t_pilot, t_end, method: Amplification(0.0, 0.0, t_end - t0,
@@ -73,15 +73,41 @@ def test_without_the_error_estimate_nothing_catches_a_prediction_that_misses(mon
 
 
 def test_a_promise_the_reruns_cannot_keep_is_one_sentence(monkeypatch):
-    import gyrolab.plugins.integrators.auto as auto_module
+    import gyrolab.accuracy.promise as promise_module
 
     _no_growth(monkeypatch)
-    monkeypatch.setattr(auto_module, "MAX_RECHECKS", 0)
+    monkeypatch.setattr(promise_module, "MAX_RECHECKS", 0)
     with pytest.raises(ConfigError) as refused:
         compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", *CHAOTIC_TOP, "time.end=110"]).run()
     message = str(refused.value)
     assert message.startswith("accuracy=1e-06 is not met on this scene") and "\n" not in message
     assert "a shorter time.end" in message and "extended_precision" not in message  # (the climb is the default)
-    with pytest.raises(ConfigError, match="or integrator.extended_precision=true$"):  # advice that changes something
+    with pytest.raises(ConfigError, match=r"integrator.extended_precision=true \(auto then climbs to double-double\)$"):
         compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", "integrator.extended_precision=false",
                        *CHAOTIC_TOP, "time.end=110"]).run()
+
+
+def test_the_recheck_compares_every_output_time(monkeypatch):
+    # the promise covers the trajectory, not the final state alone: with the measured error of the final state hidden
+    # (set to 0), what the estimate measures at the output times before it (t = 109, 108, …) still breaks the prediction
+    # and sends the run again; the answer is then within ε at every output time against the double-double reference
+    import gyrolab.accuracy.promise as promise
+
+    _no_growth(monkeypatch)
+    compare = promise.estimate.compare
+
+    def final_hidden(*args, **kwargs):
+        comparison = compare(*args, **kwargs)
+        if comparison.difference is not None:
+            comparison.difference[-1] = 0.0
+        return comparison
+
+    monkeypatch.setattr(promise.estimate, "compare", final_hidden)
+    overrides = [*CHAOTIC_TOP, "time.end=110", "time.n_output=111"]
+    ds = compose_scene(["integrator=auto", "accuracy=1e-6", *overrides]).run()
+    assert ds.attrs["auto_measured_error_before_recheck"][0] > 1e-6  # measured before the end
+    assert "auto_recheck" in ds.attrs
+    truth = compose_scene(["integrator=taylor", "integrator.precision=double-double", "integrator.tol=1e-28",
+                           *overrides]).run()
+    error = max(float(np.max(np.abs(ds[v].values - truth[v].values))) for v in ("omega", "gamma"))
+    assert error <= 1e-6 and error <= ds.attrs["auto_predicted_error"], error

@@ -5,7 +5,7 @@ pilot measures again (``RECENTRE``), its recorded prediction still bounds the er
 import numpy as np
 import pytest
 
-from gyrolab.plugins.integrators.auto import _comes_back, _error_growth, _fast
+from gyrolab.accuracy.auto import _comes_back, _error_growth, _fast
 
 TIMES = np.linspace(0.0, 30.0, 361)
 
@@ -71,7 +71,8 @@ SHORT_SWING = ["initial.r0=1e-3", "initial.p0=0", "initial.q0=0", "time.end=5", 
 ], ids=["re-measured", "extrapolated"])
 def test_a_prediction_far_looser_than_the_pilot_is_measured_again(monkeypatch, overrides, accuracy, rounds):
     from gyrolab import compose_scene
-    from gyrolab.plugins.integrators import auto
+    from gyrolab.accuracy import auto
+    from gyrolab.accuracy import calibration as auto_calibration
     from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
     taus, pilot = [], auto.Auto._pilot
@@ -83,8 +84,8 @@ def test_a_prediction_far_looser_than_the_pilot_is_measured_again(monkeypatch, o
     solution = method.integrate(scene.system.rhs, scene.times, y0, None, scene.compiled)
     assert len(taus) == rounds
     if rounds == 2:
-        assert taus[1] > auto.RECENTRE * taus[0]
+        assert taus[1] > auto_calibration.RECENTRE * taus[0]
     # either way the recorded prediction bounds the actual error (truth: Taylor at tol 1e-17, error ~1e-14)
     truth = Taylor(tol=1e-17).integrate(scene.system.rhs, scene.times[[0, -1]], y0, None, scene.compiled).y[-1]
     error = float(np.max(np.abs(solution.y[-1] - truth)))
-    assert error <= method.choice["auto_predicted_error"] <= accuracy
+    assert error <= solution.choice.promised <= accuracy

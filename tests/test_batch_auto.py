@@ -8,7 +8,7 @@ from scipy.integrate import solve_ivp
 
 from gyrolab import compose_scene
 from gyrolab.batch.integrate import integrate_batch
-from gyrolab.plugins.integrators.auto import Auto
+from gyrolab.accuracy.auto import Auto
 from gyrolab.plugins.integrators.step_guard import compiled_rhs
 
 ACCURACY = 1e-8

@@ -77,7 +77,7 @@ def test_auto_predicted_error_bounds_the_actual_error(scene):
     # issue 13: the recorded prediction was once 35× optimistic. Reference: compiled DOP853 at tolerance
     # 1e-13 (another method, and the right-hand-side kernel rather than the Taylor-coefficient one; it
     # agrees with the extended-precision reference to ≤ 3e-11 on these scenes).
-    from gyrolab.plugins.integrators.auto import Auto
+    from gyrolab.accuracy.auto import Auto
     from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba
 
     built = compose_scene([*SCENES[scene], "integrator=auto", "accuracy=1e-9", "time.n_output=51"])
@@ -88,4 +88,4 @@ def test_auto_predicted_error_bounds_the_actual_error(scene):
         auto.prepare(system)
         solution = auto.integrate(system.rhs, times, y0, None, built.compiled)
         actual = np.max(np.abs(solution.y[-1] - reference.y[-1]))
-        assert actual <= auto.attributes()["auto_predicted_error"] <= accuracy, accuracy
+        assert actual <= solution.choice.promised <= accuracy, accuracy

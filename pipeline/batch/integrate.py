@@ -19,7 +19,7 @@ from gyrolab.contracts import CompiledModel, Integrator
 from gyrolab.contracts.integrator import BATCH_KERNEL, CHOOSES_METHOD, BatchSolution, RightHandSide
 from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.plugins.integrators.auto import AUTO_SAMPLE  # auto's pilot sample of a batch (importable here, as before)
+from gyrolab.accuracy.calibration import AUTO_SAMPLE  # auto's pilot sample of a batch (importable here, as before)
 
 # BATCH_INTEGRATORS (like FAST_PATH, ADAPTIVE) is computed from the registry's capabilities by __getattr__ below
 __all__ = ["AUTO_SAMPLE", "BATCH_INTEGRATORS", "BatchSolution",  # noqa: F822 "auto_choice", "batch_kernel_integrators",

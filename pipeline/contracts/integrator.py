@@ -35,12 +35,34 @@ class IntegratorStats:
 
 
 @dataclass
+class Choice:
+    """C7: what an integrator that chooses its method ran in one ``integrate`` call, returned with the ``Solution``
+    (nothing of a call is kept on the integrator). ``gyrolab.accuracy`` measures ``method``'s run and rechecks
+    ``promised`` against the measurement; the dataset stores ``attributes``."""
+
+    #: the method that ran (None: no integration, an analytic series, measured against ``check``)
+    method: Integrator | None
+    #: dataset attributes saying what was chosen and why (``auto_method``, ``auto_precision``, ...)
+    attributes: dict[str, Any]
+    #: the target asked for (``accuracy``) and the max-norm error promised at every output time (None: no promise)
+    target: float | None = None
+    promised: float | None = None
+    #: whether the run may climb the precision ladder (``Integrator.climbed``) when it must be made more accurate
+    may_climb: bool = False
+    #: with ``method`` None: the more accurate run that measures it, and the run to take instead when it breaks
+    check: Integrator | None = None
+    instead: Callable[[], Solution] | None = None
+
+
+@dataclass
 class Solution:
     """Samples of the state at the requested output times."""
 
     t: np.ndarray  # (n,)
     y: np.ndarray  # (n, state size)
     stats: IntegratorStats
+    #: C7: what was chosen and ran (None for an integrator that does not choose)
+    choice: Choice | None = None
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -65,6 +87,8 @@ CHOOSES_METHOD = "chooses_method"
 #: every capability, in the order the documentation lists them
 CAPABILITIES = (COMPILED_MODEL, PREFERS_COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL,
                 CHOOSES_METHOD)
+#: the precision ladder, lowest rung first: an integrator's ``precision`` names its rung, ``climbed`` goes up one
+PRECISIONS = ("double", "double-double")
 #: the run dataset's attribute holding the integrator's ``evaluation_label`` (what ``integrator_nfev`` counts)
 NFEV_COUNTS_ATTRIBUTE = "integrator_nfev_counts"
 #: the boolean class attributes of older integrators that declare a capability (third-party code may set them)
@@ -179,10 +203,12 @@ class Integrator(ABC):
        ``output.error_estimate`` compares with this one to measure the stored trajectory's error.
     10. ``prepare(system)`` is called once by the scene before integrating
         (default: nothing); ``auto`` uses it to consult the system's regimes.
-    11. ``tightened_for(measured_error)``, optional (CHOOSES_METHOD): when ``output.error_estimate``
-        measured the last run's error above what the integrator promised, the same integrator aimed
-        tighter, which the scene runs instead (a promise resting on a measurement, not only on a
-        prediction); None when the promise holds (the default).
+    11. ``precision`` names its rung on the precision ladder (``PRECISIONS``); ``climbed(factor)``, optional:
+        the same method one rung up, ``factor`` times more accurate (the double Taylor method in
+        double-double), which ``gyrolab.accuracy`` runs where ``more_accurate`` has reached its floor.
+        A CHOOSES_METHOD integrator returns what it chose with its solution (``Solution.choice``, a ``Choice``:
+        the method that ran and the error it promises at every output time); ``gyrolab.accuracy`` measures the
+        run and, while the measurement breaks the promise, runs that method made more accurate instead.
 
     What gyrolab enforces (``gyrolab.contracts.integrator_rules``): every
     subclass's ``integrate`` — built-in or third-party, under its own name —
@@ -261,12 +287,15 @@ class Integrator(ABC):
         turns the two runs' difference into this run's error estimate, a few words saying how), or None when it
         cannot be made so (a tolerance already at its floor, or nothing to tighten). A method with tolerances
         divides them by ``factor`` (the number is 1); a fixed-step method of order p halves its step (the number is
-        Richardson's 2^p / (2^p − 1)); a method that chooses (CHOOSES_METHOD) answers for the method it ran."""
+        Richardson's 2^p / (2^p − 1)); a method that chooses (CHOOSES_METHOD) returns the method it ran instead."""
         return None
 
-    def tightened_for(self, measured_error: float) -> Integrator | None:
-        """Rule 11 (CHOOSES_METHOD): the same integrator aimed tighter when ``measured_error`` (the largest error
-        ``output.error_estimate`` measured on its last run's stored states) breaks what it promised, else None."""
+    #: rule 11: its rung on the precision ladder (``PRECISIONS``)
+    precision: str = PRECISIONS[0]
+
+    def climbed(self, factor: float) -> tuple[Integrator, float, str] | None:
+        """Rule 11: (the same method one rung up the precision ladder, ``factor`` times more accurate, the number
+        and words of ``more_accurate``), or None: no higher rung."""
         return None
 
     def choose_batch_method(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray,

@@ -54,7 +54,7 @@ BUILTINS: dict[str, dict[str, str]] = {
         "dop853_numba": "gyrolab.plugins.integrators.compiled_solvers:DOP853Numba",
         "rk4_numba": "gyrolab.plugins.integrators.compiled_solvers:RK4Numba",
         "taylor": "gyrolab.plugins.integrators.compiled_solvers:Taylor",
-        "auto": "gyrolab.plugins.integrators.auto:Auto",
+        "auto": "gyrolab.accuracy.auto:Auto",
         "lie_poisson": "gyrolab.plugins.integrators.compiled_solvers:LiePoisson",
     },
     "regime": {

@@ -13,7 +13,7 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.contracts import registry
-from gyrolab.engine import error_estimate
+from gyrolab import accuracy
 from gyrolab.engine.config import compose_config
 from gyrolab.contracts import CompiledModel, Integrator, System
 from gyrolab.contracts.integrator import (
@@ -217,44 +217,9 @@ class Scene:
             # the compiled path runs a plugin's traced torque, unguarded: one Python evaluation first names the
             # force whose torque is already at fault at the start (the usual case: NaN or inf in its formula)
             self.rhs.inspect(float(self.times[0]), y0)
-        integrator = self.integrator
-        solution = integrator.integrate(self.rhs, self.times, y0, progress, compiled)
-        self._log_stats(integrator, solution)
-        add = None
-        if error_estimate.wanted(self):  # a companion run measures the stored trajectory's error
-            comparison = error_estimate.compare(self, integrator, solution.y, solution.stats.wall_time)
-            integrator, solution, comparison = self._keep_promise(integrator, solution, comparison, y0, progress,
-                                                                  compiled)
-            add = comparison.variables
-        return build_dataset(self, solution, add, integrator)
-
-    def _keep_promise(self, integrator: Integrator, solution: Any, comparison: Any, y0: np.ndarray, progress: Any,
-                      compiled: CompiledModel | None) -> tuple[Integrator, Any, Any]:
-        """Rule 11 of the integrator contract: while the measured error breaks what the integrator promised, run the
-        tightened integrator it names instead (it raises, in one sentence, when it gives up)."""
-        while comparison.max_error is not None:
-            again = integrator.tightened_for(comparison.max_error)
-            if again is None:
-                break
-            log.warning("%s: the error estimate measured %.2g, above the run's recorded prediction: running again, "
-                        "more accurately", integrator.name, comparison.max_error)
-            try:
-                again.prepare(self.system)
-                solution = again.integrate(self.rhs, self.times, y0, progress, compiled)
-            except ConfigError as refused:  # it names its tighter aim; say why it was aimed there
-                raise ConfigError(f"{integrator.name}'s run measured an error of {comparison.max_error:.2g} "
-                                  f"(output.error_estimate), above what it promised, and the more accurate run is "
-                                  f"refused: {refused}") from None
-            self._log_stats(again, solution)
-            integrator = again
-            comparison = error_estimate.compare(self, integrator, solution.y, solution.stats.wall_time)
-        return integrator, solution, comparison
-
-    @staticmethod
-    def _log_stats(integrator: Integrator, solution: Any) -> None:
-        stats = solution.stats
-        log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", integrator.name, stats.n_steps,
-                 "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)
+        # the run, its error measured and its promise kept (gyrolab.accuracy)
+        solution, ran, add = accuracy.measured_run(self, y0, progress, compiled)
+        return build_dataset(self, solution, add, ran)
 
 
 def compose_scene(overrides: Sequence[str] = ()) -> Scene:

@@ -305,6 +305,14 @@ class Taylor(Integrator):
             return None
         return Taylor(order=self.order, tol=tol), 1.0, f"taylor at tol {tol:.3g} ({factor:g}× tighter), same order"
 
+    def climbed(self, factor: float):
+        """Rule 11: the double-double rung, ``factor`` times more accurate (None: already on it)."""
+        from gyrolab.kernels.taylor_dd import MIN_TOL
+
+        tol = max(self.tol / factor, MIN_TOL)
+        return None if self.precision != DOUBLE else (Taylor(tol=tol, precision=DOUBLE_DOUBLE), 1.0, (
+            f"taylor double-double at tol {tol:.3g}: double precision's floor reached"))
+
     def attributes(self) -> dict[str, Any]:
         return {"integrator_order": self.order, "integrator_tol": self.tol, "integrator_precision": self.precision}
 

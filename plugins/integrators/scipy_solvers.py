@@ -111,7 +111,7 @@ class LSODA(ScipySolver):
 #: ``newton_tol``), which loosens as rtol shrinks below (10 ε)^(2/3) ≈ 1.7e-10: a tighter run is then not reliably
 #: more accurate (benchmarks/promise_audit.py: Radau on a fast top, r0 = 26, t = 5.3, stayed at 2–4e-9 from rtol 1e-10
 #: to 1e-12, and its companion at rtol/100 estimated 0.08× the actual error). Below it their error estimate takes the
-#: compiled Taylor method's stand-in (``gyrolab.engine.error_estimate``).
+#: compiled Taylor method's stand-in (``gyrolab.accuracy.estimate``).
 IMPLICIT_NEWTON_FLOOR = (10 * float(np.finfo(float).eps)) ** (2.0 / 3.0)
 
 

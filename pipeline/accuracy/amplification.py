@@ -33,19 +33,7 @@ from typing import Any
 
 import numpy as np
 
-#: tolerance of the tangent run: the growth factor is needed to within a factor of a few (a bound with a safety
-#: factor). On the reference scene (regular, t = 300) the growth after the pilot is e^2.28 at 1e-5 and e^2.26 at
-#: 1e-4, for 0.69 and 0.56 ms (both runs); but on chaotic scenes a looser run follows another chaotic trajectory
-#: sooner and its estimate scatters more: on slow_spin over t = 300, e^19.3 at 1e-5, e^17.4 at 1e-4, e^23.3 at 1e-3
-#: (AMD EPYC with AVX-512, 2026-11-26)
-TANGENT_TOLERANCE = 1e-5
-#: the shadow pair's initial separation, relative to the state's size, and its renormalisation chunks
-SHADOW_OFFSET = 1e-7
-SHADOW_CHUNKS = 64
-#: output times of a generated tangent flow's run, where its running maximum of ln|δ| is read (the hand-written
-#: variational run reads it after every step); as many as the shadow pair's renormalisations
-TANGENT_SAMPLES = 64
-
+from gyrolab.accuracy.calibration import SHADOW_CHUNKS, SHADOW_OFFSET, TANGENT_SAMPLES, TANGENT_TOLERANCE
 
 @dataclass(frozen=True)
 class Amplification:
@@ -83,20 +71,16 @@ def amplification(compiled: Any, fun: Any, y0: np.ndarray, t0: float, t_pilot: f
     ``method`` is an integrator instance for the shadow pair (``auto``'s loose method) when the variational
     equations do not apply to ``compiled``.
     """
+    from gyrolab.kernels import models
+
     span = float(t_end - t0)
     variational = _variational(compiled, y0, t0, t_pilot, t_end)
     if variational is not None:
-        how = ("variational equations (compiled DOP853)" if variational_kind(compiled) == "hand-written" else
+        how = ("variational equations (compiled DOP853)" if compiled.model != models.TRACED else
                "tangent flow generated from the equations (compiled DOP853)")
         return Amplification(*variational, span, how)
     return Amplification(*_shadow_pair(method, fun, compiled, y0, t0, t_pilot, t_end), span,
                          f"shadow pair renormalised {SHADOW_CHUNKS} times ({method.name})")
-
-
-def variational_kind(compiled: Any) -> str:
-    from gyrolab.kernels import models
-
-    return "hand-written" if _closed_built_in(compiled) is not None else "generated"
 
 
 def _variational(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float) -> tuple[float, float] | None:

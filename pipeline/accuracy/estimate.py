@@ -1,32 +1,21 @@
 """A measured error for the stored trajectory (``output.error_estimate``): a companion run on the same output times.
 
 A tolerance is not an error, and a recorded prediction is only a prediction; what a user can check is a measurement.
-The companion integrates the same scene with the same method, made more accurate by a known factor; each
-integrator says how (``Integrator.more_accurate``, rule 9 of its contract):
+The companion integrates the same scene with the method that ran made more accurate by a known factor, as the method
+itself says (``Integrator.more_accurate``, rule 9): tolerances ``TIGHTER`` times smaller (|y − y_companion| then
+estimates the run's error to within ~1/``TIGHTER``), or for a fixed-step method of order p half the step and
+Richardson's factor 2^p / (2^p − 1); an analytic series (``auto``) is measured against the compiled Taylor method at
+tol 1e-15. Where the method is at its floor, the compiled Taylor method at tol 1e-16 stands in when the scene has a
+compiled model. A double-precision Taylor run near that floor may err mostly by round-off, which another double run
+shares in size: two double companions run first (one at another order with 1/I moved by its rounding: what double runs
+share shows as their disagreement); where they disagree ``ROUNDOFF_MARGIN`` times below the error the first measures,
+that measurement stands, else the method one rung up the precision ladder (``climbed``: double-double, ~30× a double
+run's time) measures it. The estimate costs one more integration: it is on by default for the integrators that choose
+their method (``output.error_estimate: null``), ``true``/``false`` choose it for any integrator.
 
-* a method with tolerances (``rtol``/``atol``, or the Taylor method's ``tol``): the same method at tolerances
-  ``TIGHTER`` times smaller; its error is then ~``TIGHTER`` times smaller, so |y − y_companion| estimates the
-  stored run's error to within ~1/``TIGHTER``;
-* a fixed-step method of order p (RK4: 4): the same method at half the step, and Richardson's estimate of the
-  coarse run's error, |y_h − y_{h/2}| · 2^p / (2^p − 1);
-* ``auto``: the method it chose, made more accurate the same way (or, when it took a regime's analytic series,
-  the compiled Taylor method at tol 1e-15 against the series).
-
-Where the companion cannot be made ``TIGHTER`` times more accurate (a tolerance already at its method's floor), the
-compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model; otherwise the dataset says the
-estimate is not available and why. A run that is itself the double-precision Taylor method near that floor (``taylor``
-at tol < 1e-12, or ``auto``'s choice of it) may err mostly by round-off, which another double run shares in size: it
-can agree with the run far more closely than either agrees with the truth. There two double companions run first
-(``TIGHTER`` times tighter; one at the run's order, one at another order with 1/I moved by its rounding: what double
-runs share shows as their disagreement); where their disagreement is ``ROUNDOFF_MARGIN`` times below the error the
-first measures, that measurement stands, else the Taylor method in double-double (``TIGHTER`` times tighter, ~30× a
-double run's time) measures it. The estimate costs one more integration (about 1.2–2× the run's time for a
-tolerance-controlled method, 2× for a fixed step): it is on by default for ``integrator=auto`` only
-(``output.error_estimate: null``), ``true``/``false`` choose it for any integrator.
-
-The estimate is stored as ``error_estimate_omega`` (the angular velocity's max-norm error at each output time, in
-ω's units) and ``error_estimate_attitude`` (the direction cosines' max-norm error, dimensionless) for systems whose
-state starts with ω; as ``error_estimate`` (the whole state's max-norm error) for other systems.
+It is stored as ``error_estimate_omega`` (ω's max-norm error at each output time, in ω's units) and
+``error_estimate_attitude`` (the direction cosines', dimensionless) for systems whose state starts with ω; as
+``error_estimate`` (the whole state's) for other systems.
 """
 
 from __future__ import annotations
@@ -40,34 +29,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL
+from gyrolab.accuracy.calibration import DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
+from gyrolab.kernels.model import rounding_moved
+from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL
 
 log = logging.getLogger(__name__)
-
-#: the companion is this many times more accurate than the run (tolerances this many times smaller): the estimate is
-#: then within ~1 % of the companion-free truth. 100, not 1000: on the reference scene (auto at 1e-6: Taylor order 12,
-#: tol 1.3e-8) the companion at 100× takes 0.55 ms and ends 176× more accurate, at 1000× 0.68 ms and 1660×; the
-#: per cent an estimate gains is not worth a quarter of the companion's time (AMD EPYC with AVX-512, 2026-11-27)
-TIGHTER = 100.0
-#: a double-precision Taylor run whose companion would run below this tolerance is measured in double-double: a double
-#: companion there has round-off of the run's own size and can agree with it more closely than either agrees with
-#: the truth. benchmarks/promise_audit.py's scenes against real128 (120 scenes of seed 5, the Taylor method at a fixed
-#: tol, estimates above round-off and not saturated): with a double companion the smallest estimate / actual error was
-#: 0.0047 at tol 3e-14 (3 of 30 runs below 1/2), 0.16 at 1e-13 (2 of 29), 0.30 at 3e-13 (1 of 54), 0.94 at 1e-12
-#: (74 runs) and 0.95 at 1e-11 (110); with a double-double companion 0.98 at 3e-14 … 1e-13. The double-double run
-#: takes ~30× a double one (reference scene, t = 300: ~17 ms), so it runs only where two double companions show that
-#: round-off is not small against the error measured (``ROUNDOFF_MARGIN``; ``compare``)
-DOUBLE_DOUBLE_BELOW = 1e-14
-
-
-#: near double precision's floor, a double companion is trusted when the round-off two double companions disagree
-#: by is this many times below the error it measures (``compare``); else the double-double companion runs.
-#: benchmarks/roundoff_margin.py (Taylor at tol 3e-13 … 1.5e-16 on random scenes against heyoka real128): at 10, no
-#: trusted estimate below 1/2 of the actual error in 606 runs of seed 5 (worst 0.56) and one in 1,029 of seed 11
-#: (0.47, where the double-double companion measured it exactly: double runs share an error their disagreement does
-#: not show); at 4, two below 1/2 (worst 0.27); only 50 clears seed 11, trusting 90 runs instead of 296
-ROUNDOFF_MARGIN = 10.0
-
 
 @dataclass(frozen=True)
 class Companion:
@@ -89,38 +55,31 @@ def wanted(scene: Any) -> bool:
     return bool(choice)
 
 
-def companion(integrator: Any, has_compiled: bool) -> Companion | None:
-    """The more accurate run that measures ``integrator``'s error (its ``more_accurate``, rule 9 of the contract;
+def companion(method: Any, has_compiled: bool) -> Companion | None:
+    """The more accurate run that measures the run of ``method`` (its ``more_accurate``, rule 9 of the contract;
     else the compiled Taylor method at its floor when the scene has a compiled model; else, for a run that is itself
-    the double-precision Taylor method near that floor, the Taylor method in double-double), or None."""
-    from gyrolab.kernels.taylor_dd import MIN_TOL
-    from gyrolab.plugins.integrators.compiled_solvers import DOUBLE_DOUBLE, Taylor
+    the double-precision Taylor method near that floor, the method one rung up the precision ladder), or None."""
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
-    taylor = _double_taylor(integrator) if has_compiled else None
-    finer = integrator.more_accurate(TIGHTER)
+    taylor = _double_taylor(method) if has_compiled else None
+    finer = method.more_accurate(TIGHTER)
     if finer is not None and (taylor is None or taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW):
         return Companion(*finer)
     if not has_compiled:
         return None
     if taylor is None:
         return Companion(Taylor(tol=Taylor.TOLERANCE_FLOOR), 1.0, f"compiled Taylor at tol {Taylor.TOLERANCE_FLOOR:g} "
-                         f"({integrator.name} cannot be made {TIGHTER:g}× more accurate)")
-    # A double-precision Taylor run near the floor: another double run (the old stand-in, Taylor at tol 1e-16) is no
-    # more accurate. Its error is then mostly round-off, amplified by the motion, and two double runs can agree far
-    # more closely than either agrees with the truth (benchmarks/promise_audit.py: auto at accuracy 1e-12 chose tol
-    # 1.5e-16, the stand-in differed from it by 1.7e-14 where both were 2.1e-12 from the real128 answer, and the
-    # broken prediction went unseen). Double-double has no such round-off.
+                         f"({method.name} cannot be made {TIGHTER:g}× more accurate)")
+    # A double Taylor run near the floor errs mostly by round-off, which another double run shares (promise_audit: auto
+    # at 1e-12 chose tol 1.5e-16; the stand-in differed by 1.7e-14 where both were 2.1e-12 off): double-double has none
     from gyrolab.kernels.taylor import MAX_ORDER
 
-    tol = max(taylor.tol / TIGHTER, MIN_TOL)
+    up, _, _ = taylor.climbed(TIGHTER)
     double_tol = max(taylor.tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
     other_order = taylor.order + 2 if taylor.order + 2 <= MAX_ORDER else taylor.order - 2
-    # the order for its own tolerance, not the run's: a companion need only be more accurate, and a low order is slow
-    # there (reference scene, t = 300, tol 1e-18: order 16 25 ms, order 22 20 ms; auto's runs near the floor already
-    # take ~19–21)
-    return Companion(Taylor(tol=tol, precision=DOUBLE_DOUBLE), 1.0,
-                     f"compiled Taylor in double-double at tol {tol:.3g} ({integrator.name} runs the "
-                     f"Taylor method near double precision's floor)",
+    # (double-double at the order for its own tolerance: reference scene, t = 300, tol 1e-18: order 16 25 ms, 22 20 ms)
+    return Companion(up, 1.0, f"compiled Taylor in double-double at tol {up.tol:.3g} ({method.name} runs the "
+                              f"Taylor method near double precision's floor)",
                      (Taylor(order=taylor.order, tol=double_tol), Taylor(order=other_order, tol=double_tol)))
 
 
@@ -168,15 +127,17 @@ class Comparison:
         return variables, attrs
 
 
-def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Comparison:
-    """Run the companion of ``integrator``'s run of ``scene`` (stored states ``y``, integration time ``wall_time``)
-    and compare: the measured error estimate, or why none is available."""
+def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any = None) -> Comparison:
+    """Run the companion of ``method``'s run of ``scene`` (stored states ``y``, integration time ``wall_time``; with
+    ``check``, a run that is no integration, measured against ``check``) and compare: the measured error estimate,
+    or why none is available."""
     compiled_model = scene.system.compiled_model()
-    pick = companion(integrator, compiled_model is not None)
-    name = getattr(integrator, "name", type(integrator).__name__)
+    pick = companion(method, compiled_model is not None) if check is None else Companion(check, 1.0, (
+        f"{check.name} ({', '.join(f'{k} {v}' for k, v in check.attributes().items())}) against the analytic series"))
+    name = getattr(method, "name", type(method).__name__)
     if pick is None:
         return _unavailable(f"integrator {name!r} already runs at the compiled Taylor method's floor in double "
-                            "precision (nothing more accurate to compare with)" if _at_taylor_floor(integrator) else
+                            "precision (nothing more accurate to compare with)" if _double_taylor(method) else
                             f"integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
                             "compiled model for the Taylor method")
     companion_model, refusal = None, None
@@ -202,7 +163,7 @@ def compare(scene: Any, integrator: Any, y: np.ndarray, wall_time: float) -> Com
         # accuracy 1e-10: ~1 ms instead of the double-double companion's ~17 ms).
         first = pick.double_first[0].integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
         second = pick.double_first[1].integrate(scene.system.rhs, scene.times, y0, None,
-                                                rounding_moved(companion_model)).y
+                                                rounding_moved(companion_model)).y  # (kernels.model's)
         difference = np.abs(y - first)
         roundoff = float(np.max(np.abs(first - second)))
         measured = float(np.max(difference))
@@ -229,23 +190,7 @@ def _unavailable(why: str) -> Comparison:
     return Comparison(None, {"error_estimate_method": reason})
 
 
-def rounding_moved(model: Any) -> Any:
-    """``model`` with the numbers it rounded moved by one unit in the last place (``kernels.model.rounding_moved``)."""
-    from gyrolab.kernels.model import rounding_moved as moved
-
-    return moved(model)
-
-
-def _double_taylor(integrator: Any) -> Any:
-    """The double-precision Taylor method the run used: the integrator itself, or the method ``auto`` chose; else None."""
-    from gyrolab.plugins.integrators.compiled_solvers import DOUBLE, Taylor
-
-    ran = getattr(integrator, "chosen", None) or integrator
-    return ran if isinstance(ran, Taylor) and ran.precision == DOUBLE else None
-
-
-def _at_taylor_floor(integrator: Any) -> bool:
-    from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
-    taylor = _double_taylor(integrator)
-    return taylor is not None and taylor.tol / TIGHTER < Taylor.TOLERANCE_FLOOR
+def _double_taylor(method: Any) -> Any:
+    """``method`` when it is the double-precision Taylor method (a method with a rung above it, ``climbed``), whose
+    error near its floor is mostly round-off; else None."""
+    return method if method.precision == PRECISIONS[0] and method.climbed(1.0) is not None else None

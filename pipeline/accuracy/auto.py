@@ -1,137 +1,62 @@
 """Accuracy-targeted choice: the cheapest integrator and setting predicted to reach ``accuracy``.
 
-A tolerance is not an accuracy: how the final error depends on it varies
-with the scene (on the reference scene the final error of the Taylor method
-is 24 to 470 times its per-step tolerance depending on the order; on the
-extremes matrix the ratio spans four decades), and no per-step error control
-predicts how local errors grow into the global one. So ``auto`` measures
-that dependence on the scene itself with a short pilot: two runs over the
-first ``pilot_fraction`` of the time span, at tolerances τ and τ_t ≤ τ/10 and the
-same order, give the error of the τ run along the pilot (hence a growth
-exponent q, error ∝ t^q). At a fixed order the error is proportional to the
-tolerance (checked in the tests), so the full span at tolerance τ' is
-predicted to end with error err(τ) · (τ'/τ) · (T/T_pilot)^q, with q ≥ 2: a
-non-symplectic method drifts in energy linearly on a near-integrable motion,
-so its phase error grows quadratically (measured on the reference problem:
-the error of Taylor at tol 1e-10 grows ×100 from t = 30 to t = 300).
-``auto`` picks τ' to meet ``accuracy`` with a safety factor and records the
-prediction multiplied by ``CALIBRATION`` (``tests/test_extremes.py`` and
-``tests/test_compiled.py`` check that the recorded prediction bounds the actual
-error on the extremes matrix and the reference scene). The pilot is not wasted:
-its tight run is at least as accurate as the final one, so it is the first
-``pilot_fraction`` of the trajectory and the final run continues from its end.
-A pilot round that re-centres τ (the first prediction asked for a tolerance
-more than ``RECENTRE`` = 20× looser) or loosens it (only round-off seen) reuses the previous
-round's τ run as its tight run, so each later round costs one run, not two.
+A tolerance is not an accuracy: how the final error depends on it varies with the scene (on the reference scene the
+final error of the Taylor method is 24 to 470 times its per-step tolerance depending on the order; on the extremes
+matrix the ratio spans four decades), and no per-step error control predicts how local errors grow into the global
+one. So ``auto`` measures that dependence on the scene itself with a short pilot: two runs over the first
+``pilot_fraction`` of the time span, at tolerances τ and τ_t ≤ τ/10 and the same order, give the error of the τ run
+along the pilot (hence a growth exponent q, error ∝ t^q). At a fixed order the error is proportional to the tolerance
+(checked in the tests), so the full span at tolerance τ' is predicted to end with error err(τ) · (τ'/τ) ·
+(T/T_pilot)^q, with q ≥ 2: a non-symplectic method drifts in energy linearly on a near-integrable motion, so its phase
+error grows quadratically. ``auto`` picks τ' to meet ``accuracy`` with a safety factor and records the prediction
+multiplied by ``CALIBRATION`` (``calibration.TABLE``: the measurement behind it and the benchmark that checks it).
+The pilot is not wasted: its tight run is at least as accurate as the final one, so it is the first
+``pilot_fraction`` of the trajectory and the final run continues from its end. A pilot round that re-centres τ (the
+first prediction asked for a tolerance more than ``RECENTRE`` times looser) or loosens it (only round-off seen) reuses
+the previous round's τ run as its tight run, so each later round costs one run, not two.
 
-Calibration, measured 2026-11-24 with ``python benchmarks/perf_reference.py
---calibration`` (the pilot as it is now: re-centred rounds reuse their previous
-run, tight runs down to accuracy/3000): the largest ratio of the actual final
-error to the raw prediction (before CALIBRATION and round-off) over the
-extremes matrix and the reference scene at accuracies 1e-3 to 1e-13, counting
-only errors at least 100 times above the references' disagreement, is 0.94
-(reference scene, accuracy 1e-5); on the extremes scenes it is at most 0.19.
-The previous pilot gave 0.86 there. CALIBRATION = 3 leaves a factor 3.2.
+Candidates, fastest first: an expansion regime's analytic series (no integration at all), when the scene lies in the
+regime's domain, starts on the periodic orbit the series describes, and the series' error — measured over one period
+against a tight Taylor run and extrapolated linearly in time, as a phase drift — meets the target; then the compiled
+Taylor method when the scene has a compiled model; otherwise scipy's DOP853. Before any series is built, a regime that
+declares ``period_spread`` is ruled out when the scene's own motion never comes back near its start over the orbit's
+period range (``Auto._misses_orbits``: a necessary condition of the series check, ~0.25 ms; building and checking the
+series costs ~2 ms, 0.4 s on a process's first call).
 
-Candidates, fastest first: an expansion regime's analytic series (no
-integration at all), when the scene lies in the regime's domain, starts on the
-periodic orbit the series describes, and the series' error — measured over one
-period against a tight Taylor run and extrapolated linearly in time, as a
-phase drift — meets the target; then the compiled Taylor method when the
-scene has a compiled model; otherwise scipy's DOP853. Before any series is
-built, a regime that declares ``period_spread`` is ruled out when the scene's
-own motion never comes back near its start over the orbit's period range
-(``Auto._misses_orbits``: a necessary condition of the series check, ~0.25 ms;
-building and checking the series costs ~2 ms, 0.4 s on a process's first call).
-
-Round-off: the Taylor state update is compensated (Kahan), so round-off no
-longer grows by an ulp per step but as a random walk, about eps·|y|·√steps
-(measured floor on the reference scene: 9e-15 over 2,700 steps, where this
-estimate gives 6e-14); targets below that estimate are refused.
+Round-off: the Taylor state update is compensated (Kahan), so round-off grows as a random walk, about eps·|y|·√steps
+(measured on the reference scene: 9e-15 over 2,700 steps, where this estimate gives 6e-14), amplified on a chaotic
+scene by the growth of perturbations. Where it is above the target, ``auto`` climbs the precision ladder (the method's
+``climbed``: the Taylor method in double-double) unless ``extended_precision`` is false, and refuses only what the
+highest rung allowed cannot reach (``Auto._refusal``).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from typing import Any
 
 import numpy as np
 
-from gyrolab.contracts.integrator import (
-    BATCH_KERNEL,
-    CHOOSES_METHOD,
-    PREFERS_COMPILED_MODEL,
-    TIME_DEPENDENT,
-    VECTOR_LANES,
-    BatchSolution,
-    CompiledModel,
-    Integrator,
-    IntegratorStats,
-    ProgressCallback,
-    RightHandSide,
-    Solution,
-)
+from gyrolab.accuracy.amplification import amplification
+from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_FLOOR, FIRST_RATIO,
+                                          FLOOR, MAX_GROWTH, MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE,
+                                          MISS_MARGIN, PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
+                                          SHADOW_TOLERANCE, TIGHT_RATIO, UNMEASURED_PER_TOL)
+from gyrolab.contracts.integrator import (BATCH_KERNEL, CHOOSES_METHOD, PRECISIONS, PREFERS_COMPILED_MODEL,
+                                          TIME_DEPENDENT, VECTOR_LANES, BatchSolution, Choice, CompiledModel,
+                                          Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution)
 from gyrolab.errors import ConfigError, GyrolabError, as_number
-from gyrolab.plugins.integrators.amplification import amplification
 
-PILOT_POINTS = 65
-MIN_GROWTH = 2.0
-#: the pilot's power law t^q is capped at this q; an amplification beyond (1/pilot_fraction)^MAX_GROWTH after the
-#: pilot is exponential growth: a chaotic scene
-MAX_GROWTH = 4.0
 #: what ``auto_predicted_error`` is, stored beside it in every run
-PREDICTION_MEANING = ("an upper estimate of the max-norm error of the final state against the exact solution (model "
-                      "units): the pilot's measured error extrapolated over the span, raised by the amplification of "
-                      "perturbations measured over the whole span (chaotic scenes), times a calibration factor, plus "
-                      "the round-off of double precision (amplified likewise); checked by output.error_estimate "
-                      "(rule 11: a run that breaks it runs again or is refused), a prediction only without it")
-#: on a chaotic scene the amplification (and the round-off it carries) is taken this many times larger: one tangent
-#: run's growth factor scatters by up to e^2 ≈ 7 between nearby tolerances (``amplification.TANGENT_TOLERANCE``),
-#: and the round-off estimate is an estimate (benchmarks/chaos_promise.py: with no margin, slow_spin at t = 300
-#: was accepted at 1e-6 and ended at 1.4e-6)
-CHAOS_MARGIN = 10.0
-#: tolerance of the shadow pair that measures the amplification where the variational equations do not apply
-SHADOW_TOLERANCE = 1e-9
-FLOOR = 1e-15  # relative to the state's size: nothing in double precision reaches below this
-#: the same for double-double (its Taylor method's smallest tolerance is 1e-32; its round-off ~1e-31 per step)
-DOUBLE_DOUBLE_FLOOR = 1e-30
-MIN_TOLERANCE = 1e-13  # first pilot: tighter tolerances differ from τ/100 by round-off only on O(1) states
-MAX_TOLERANCE = 1e-5  # looser per-step tolerances take steps near the Taylor series' radius of convergence
-FIRST_RATIO = 1e-3  # first pilot tolerance relative to the accuracy (the typical error/tolerance ratio is 10–500)
-#: the pilot's tight run is at most accuracy/TIGHT_RATIO (final tolerances on the reference scene: accuracy/420 to
-#: accuracy/1300; the tight run is the start of the final one only when at least as accurate)
-TIGHT_RATIO = 3000.0
-#: a pilot whose loose run took fewer steps than this measured nothing about the tolerance (its steps were clipped by the
-#: pilot's end); the error per unit tolerance is then taken as UNMEASURED_PER_TOL, above the final error / tolerance
-#: ratios measured on the reference scene (24–470) and on the short fast scene that showed the case (5.7)
-MIN_PILOT_STEPS = 8
-UNMEASURED_PER_TOL = 1.0 / FIRST_RATIO
-#: a first prediction more than this many times looser than the pilot's τ is measured again at its own tolerance
-#: (one more run over the pilot's span). 20, not 10: over the extremes matrix and the reference scene at four
-#: accuracies per decade (1e-3 to 1e-13) the largest actual / raw predicted final error is 1.09 at every
-#: threshold from 10 to 100 and no recorded prediction is exceeded; at 20 the pilot re-measures in 267 of the
-#: 369 runs instead of 295 (docs/performance.md)
-RECENTRE = 20.0
-#: the recorded prediction is the raw one times this: the largest actual / raw predicted final error measured on the
-#: extremes matrix and the reference scene (accuracies 1e-3 to 1e-13) is 0.94 (module docstring)
-CALIBRATION = 3.0
-#: a series' predicted error (its first omitted term) is an estimate: trusted to within this factor when ruling
-#: out the other orders of a regime whose orbit the scene misses
-MISS_MARGIN = 1000.0
-#: the screen before the series check (``Auto._misses_orbits``): its grid over the period range and the tolerance
-#: of its Taylor run (whose error, far below 1e3 × this on the one to four periods it covers, is added to its margin)
-SCREEN_POINTS = 512
-SCREEN_TOLERANCE = 1e-9
+PREDICTION_MEANING = ("an upper estimate of the max-norm error of the stored state at every output time (model units): "
+                      "the pilot's error extrapolated over the span, raised by the measured growth of perturbations, "
+                      "times a calibration factor, plus the round-off of the precision that ran; checked at every "
+                      "output time by output.error_estimate (gyrolab.accuracy.promise), a prediction only without it")
 EPS = float(np.finfo(float).eps)
 #: the unit round-off of double-double arithmetic (a 106-bit significand), for auto's extended-precision choice
 DOUBLE_DOUBLE_EPS = 2.0 ** -104
-#: a run whose measured error (``output.error_estimate``) exceeds its recorded prediction is run again aimed this many
-#: times below the target that would have met it, at most ``MAX_RECHECKS`` times (``Auto.tightened_for``)
-RECHECK_MARGIN = 3.0
-MAX_RECHECKS = 2
-#: trajectories of a batch on which ``auto`` runs its pilot (the first, the largest state, the most unusual parameters)
-AUTO_SAMPLE = 3
 _PILOT_GRID = np.linspace(0.0, 1.0, PILOT_POINTS)
 
 
@@ -145,7 +70,7 @@ class Auto(Integrator):
     def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 1.0,
                  extended_precision: bool | None = None) -> None:
         if accuracy is None:
-            raise ConfigError("integrator=auto needs a target: set accuracy=... (max-norm error of the final state)")
+            raise ConfigError("integrator=auto needs a target: set accuracy=... (max-norm error of the stored states)")
         self.accuracy = as_number(accuracy, "accuracy", positive=True)
         self.pilot_fraction = as_number(pilot_fraction, "integrator.pilot_fraction", positive=True)
         if self.pilot_fraction >= 1:
@@ -160,19 +85,7 @@ class Auto(Integrator):
         #: (null) a batch chooses once, in double precision, for its vectorised kernel (one run per trajectory in
         #: Python costs ~23× the CPU)
         self.per_trajectory = extended_precision is True
-        #: the measured errors of the earlier runs that broke their prediction (``tightened_for``)
-        self.measured_before: tuple[float, ...] = ()
-        #: a run again after a failed check (``tightened_for``): (the method, made more accurate by the factor the
-        #: measurement asked for; the earlier run's choice); None: choose as usual
-        self._recheck: tuple[Integrator, dict[str, Any]] | None = None
-        self._no_series = False  # a series whose measured error broke its prediction is not taken again
-        self.choice: dict[str, Any] = {}
-        self.chaos: dict[str, Any] = {}  # the amplification measured over the span (auto_lyapunov_exponent, ...)
-        self.chosen: Integrator | None = None  # the method the last integrate ran (None: an analytic series)
-        self.system: Any = None
-        self._pilot_steps = 0
-        self._order: int | None = None
-        self._taylor: bool | None = None  # whether the compiled model has Taylor coefficients (asked once per run)
+        self.system: Any = None  # the scene's system (``prepare``): its regimes' series are candidates
 
     def prepare(self, system: Any) -> None:
         self.system = system
@@ -185,40 +98,30 @@ class Auto(Integrator):
         asked when it is needed)."""
         floor, what = (DOUBLE_DOUBLE_FLOOR, "double-double") if self.extended_precision else (FLOOR, "double precision")
         if self.accuracy < floor * scale:
-            advice = "" if self.extended_precision else " or allow integrator.extended_precision"
+            advice = "" if self.extended_precision else ", or integrator.extended_precision=true"
             raise ConfigError(f"accuracy={self.accuracy:g} is below what {what} reaches on this scene "
-                              f"(about {floor * scale:.1g} for states of size {scale:.3g}); ask for more{advice}")
+                              f"(about {floor * scale:.1g} for states of size {scale:.3g}, stored as doubles); ask "
+                              f"for accuracy ≥ "
+                              f"{at_least(10 * floor * scale)}{advice}")
 
-    def _method(self, compiled: CompiledModel | None, tol: float) -> Integrator:
-        if compiled is not None:
-            from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
+    def attributes(self) -> dict[str, Any]:
+        return {"accuracy": self.accuracy}
 
-            if self._taylor is None:
-                from gyrolab.kernels.taylor_series import ready
-
-                self._taylor = ready(compiled)
-            # a compiled model without Taylor coefficients: compiled DOP853 instead
-            if self._taylor:
-                return Taylor(order=self._order, tol=tol)
-            return DOP853Numba(rtol=tol, atol=tol)
-        from gyrolab.plugins.integrators.scipy_solvers import DOP853
-
-        return DOP853(rtol=tol, atol=tol)
-
-    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
-                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+    def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None = None,
+                  compiled: CompiledModel | None = None, series: bool = True) -> Solution:
+        """The cheapest method predicted to meet the accuracy (``series``: a regime's analytic series among the
+        candidates), run; what it chose and promises is the solution's ``choice`` (nothing is kept on ``self``)."""
         from gyrolab.kernels.taylor import order_for
+        from gyrolab.kernels.taylor_series import ready
 
         start = time.perf_counter()
-        t_out = np.asarray(t_out, dtype=float)
-        self._taylor = None
         scale = max(1.0, *map(abs, y0))  # a few components: Python's max is several times faster than numpy's
         self._check_floor(scale)
-        if self._recheck is not None:
-            return self._run_recheck(fun, t_out, y0, progress, compiled, start)
-        series = None if self._no_series else self._series(fun, t_out, y0, compiled, start)
-        if series is not None:
-            return series
+        if series:
+            solution = self._series(fun, t_out, y0, compiled, start)
+            if solution is not None:
+                solution.choice.instead = lambda: self.integrate(fun, t_out, y0, progress, compiled, series=False)
+                return solution
         span = t_out[-1] - t_out[0]
         t_pilot = t_out[0] + span * self.pilot_fraction
         # the pilot's grid holds the output times it covers: its tight run is the start of the trajectory
@@ -226,14 +129,16 @@ class Auto(Integrator):
         pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * _PILOT_GRID, inside)
         tau, pilot_nfev = min(max(self.accuracy * FIRST_RATIO, MIN_TOLERANCE), MAX_TOLERANCE / 10), 0
         # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance
-        self._order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
+        order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
+        taylor = compiled is not None and ready(compiled)  # whether the compiled model has Taylor coefficients
+        make = functools.partial(_method, compiled, order if taylor else None)
         # how much the motion amplifies an error present at the pilot's end by the end of the span (chaos: e^{λt})
-        amp = amplification(compiled, fun, y0, t_out[0], t_pilot, t_out[-1], self._method(compiled, SHADOW_TOLERANCE))
+        amp = amplification(compiled, fun, y0, t_out[0], t_pilot, t_out[-1], make(SHADOW_TOLERANCE))
         loose = None  # the previous round's loose run (tolerance, solution): the next round's tight run
         for _ in range(3):
             pilot_tau = tau
             per_tol, growth, nfev, measured, (tight_tol, tight), loose = self._pilot(fun, pilot_times, y0, compiled,
-                                                                                     tau, loose)
+                                                                                     tau, loose, make)
             per_tol = _amplified(per_tol, growth, amp.factor, self.pilot_fraction, CHAOS_MARGIN)
             pilot_nfev += nfev
             # per_tol bounds the truncation error even when the pilot saw only round-off
@@ -257,44 +162,25 @@ class Auto(Integrator):
         # Round-off of the compensated Taylor update grows as a random walk over the steps (see the module's
         # note), that of scipy's plain update by up to an ulp per step: a target below it cannot be met in
         # double precision, whatever the tolerance.
-        steps = self._pilot_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / self._order))
-        compensated = bool(self._taylor)  # Taylor's update is compensated (None: no compiled model, scipy's DOP853)
-        roundoff = EPS * scale * (math.sqrt(steps) if compensated else steps)
+        steps = tight.stats.n_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / order))
+        roundoff = EPS * scale * (math.sqrt(steps) if taylor else steps)
         chaotic = amp.factor > (1.0 / self.pilot_fraction) ** MAX_GROWTH  # faster than any power law the pilot fits
         if chaotic:  # round-off committed early grows with the perturbations: up to e^{max ln|δ|}
             roundoff *= CHAOS_MARGIN * math.exp(min(max(amp.log_span, 0.0), 700.0))
-        self.chaos = {"auto_lyapunov_exponent": amp.lyapunov, "auto_amplification": amp.factor,
-                      "auto_amplification_method": amp.how, "auto_chaotic": int(chaotic)}
+        chaos = {"auto_lyapunov_exponent": amp.lyapunov, "auto_amplification": amp.factor,
+                 "auto_amplification_method": amp.how, "auto_chaotic": int(chaotic)}
         if chaotic:
-            self.chaos["auto_precision_horizon"] = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
-        extended = None
-        if roundoff > self.accuracy and self.extended_precision:
-            extended = self._extended(compiled, per_tol, roundoff)
-        if roundoff > self.accuracy and extended is None:
-            roundoff_dd = roundoff * DOUBLE_DOUBLE_EPS / EPS
-            if self.extended_precision and compiled is not None and roundoff_dd > self.accuracy:
-                raise ConfigError(
-                    f"accuracy={self.accuracy:g} cannot be reached even in double-double on this scene (λ ≈ "
-                    f"{amp.lyapunov:.2g}, perturbations grow ~{amp.factor:.1g}× after the pilot: round-off about "
-                    f"{roundoff_dd:.1g}); ask for accuracy ≥ {roundoff_dd:.1g} or a shorter time.end")
-            if chaotic:
-                horizon = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
-                raise ConfigError(
-                    f"accuracy={self.accuracy:g} cannot be reached in double precision on this chaotic scene: "
-                    f"λ ≈ {amp.lyapunov:.2g}, so round-off grows ~{amp.factor:.1g}× after the pilot and double "
-                    f"precision keeps {self.accuracy:g} only to t ≈ {t_out[0] + horizon:.4g} of {t_out[-1]:.4g}; ask "
-                    f"for accuracy ≥ {roundoff:.1g}, a shorter time.end, integrator.extended_precision=true (auto then "
-                    f"runs double-double where it can) or integrator=taylor integrator.precision=double-double")
-            raise ConfigError(f"accuracy={self.accuracy:g} is below the round-off that double precision accumulates "
-                              f"on this scene (about {roundoff:.1g} over ~{steps:.0f} steps); ask for at least that")
-        if extended is not None:  # double-double: its own round-off, its own tolerance, from the start
-            method, chosen, roundoff = extended
+            chaos["auto_precision_horizon"] = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
+        climbed = roundoff > self.accuracy
+        method, why = None, (f"double precision's round-off on this scene (about {roundoff:.1g} over ~{steps:.0f} "
+                             f"steps) is below accuracy={self.accuracy:g}")
+        if climbed:
+            method, chosen, roundoff, why = self._climb(compiled, make, per_tol, roundoff, steps, amp, t_out)
         elif CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
-        if extended is None:
-            method = self._method(compiled, chosen)
-        self.chosen = method  # what ran: more_accurate answers for it
-        if tight_tol <= chosen and extended is None:  # the pilot's tight run is as accurate: continue from its end
+        if method is None:
+            method = make(chosen)
+        if tight_tol <= chosen and not climbed:  # the pilot's tight run is as accurate: continue from its end
             head = np.searchsorted(pilot_times, inside)  # the outputs inside the pilot
             rest = t_out[t_out >= t_pilot]
             tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest,
@@ -305,44 +191,78 @@ class Auto(Integrator):
         else:
             solution = method.integrate(fun, t_out, y0, progress, compiled)
             y, final_stats, n_steps = solution.y, solution.stats, solution.stats.n_steps
-        self.raw_predicted_error = per_tol * chosen  # before CALIBRATION and round-off: what the calibration measures
-        self.choice = {
+        promised = CALIBRATION * per_tol * chosen + roundoff
+        choice = {
             "auto_method": method.name,
             "auto_tolerance": chosen,
-            "auto_predicted_error": CALIBRATION * per_tol * chosen + roundoff,
+            "auto_predicted_error": promised,
             "auto_predicted_error_bounds": PREDICTION_MEANING,
+            # before CALIBRATION and round-off: what benchmarks/perf_reference.py --calibration measures
+            "auto_raw_predicted_error": per_tol * chosen,
             "auto_error_growth_exponent": growth,
             "auto_pilot_nfev": pilot_nfev,
-            **self.chaos,
+            **chaos,
             **{f"auto_{k.removeprefix('integrator_')}": v for k, v in method.attributes().items()},
+            "auto_precision": method.precision,
+            "auto_precision_reason": why,
         }
         return Solution(t_out, y, IntegratorStats(
             nfev=final_stats.nfev + pilot_nfev, n_steps=n_steps, n_rejected=final_stats.n_rejected,
-            wall_time=time.perf_counter() - start, njev=final_stats.njev, nlu=final_stats.nlu))
+            wall_time=time.perf_counter() - start, njev=final_stats.njev, nlu=final_stats.nlu),
+            Choice(method, choice, self.accuracy, promised, self.extended_precision))
 
-    def _extended(self, compiled: CompiledModel | None, per_tol: float,
-                  roundoff: float) -> tuple[Integrator, float, float] | None:
-        """(the double-double Taylor method, its tolerance, its round-off) that meets the accuracy where double
-        precision cannot, or None when the model has no double-double kernel or even it cannot.
+    def _climb(self, compiled: CompiledModel | None, make: Any, per_tol: float, roundoff: float, steps: float,
+               amp: Any, t_out: np.ndarray) -> tuple[Integrator, float, float, str]:
+        """(the method one rung up the precision ladder, its tolerance, its round-off, why) where double precision's
+        round-off on this scene (``roundoff``) is above the accuracy; else one ConfigError sentence naming λ and
+        the horizon, whose advice is a target the scene reaches (``at_least``: rounded up, with room for the
+        truncation error).
 
         The truncation error per unit tolerance is the pilot's (measured at its order; the double-double run takes
         the optimal, higher order for its tolerance, hence fewer and larger steps: no more error per unit
         tolerance); the round-off is double precision's estimate scaled by the ratio of the two unit round-offs."""
-        if compiled is None:
-            return None
         from gyrolab.kernels.taylor_dd import MIN_TOL
-        from gyrolab.plugins.integrators.compiled_solvers import DOUBLE_DOUBLE, Taylor, TaylorDoubleDouble
 
-        if TaylorDoubleDouble.refusal(compiled, self.system) is not None:
-            return None
         roundoff_dd = roundoff * DOUBLE_DOUBLE_EPS / EPS
-        if roundoff_dd > self.accuracy:
-            return None
+        best_dd = roundoff_dd + self.safety * CALIBRATION * per_tol * MIN_TOL  # the best double-double does here
         tol = (self.accuracy - roundoff_dd) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         tol = min(max(tol, MIN_TOL), MAX_TOLERANCE)
-        if CALIBRATION * per_tol * tol + roundoff_dd > self.accuracy:
-            return None
-        return Taylor(tol=tol, precision=DOUBLE_DOUBLE), tol, roundoff_dd
+        up = make(tol).climbed(1.0)  # the next rung's method at tol, when the chosen method has one
+        if up is not None and (compiled is None or type(up[0]).refusal(compiled, self.system) is not None):
+            up = None  # (a model without a double-double form)
+        chaotic = amp.factor > (1.0 / self.pilot_fraction) ** MAX_GROWTH
+        if up is not None and self.extended_precision:
+            if best_dd < self.accuracy:
+                return up[0], tol, roundoff_dd, (
+                    f"double precision's round-off on this scene (about {roundoff:.1g} over ~{steps:.0f} steps) is "
+                    f"above accuracy={self.accuracy:g}; double-double's is about {roundoff_dd:.1g}")
+            raise self._refusal("double-double", best_dd, chaotic, amp, t_out, "")
+        climb = ", or integrator.extended_precision=true (auto then climbs to double-double)" if (
+            up is not None and best_dd < self.accuracy) else ""
+        raise self._refusal("double precision", roundoff, chaotic, amp, t_out, climb)
+
+    def _refusal(self, rung: str, error: float, chaotic: bool, amp: Any, t_out: np.ndarray,
+                 climb: str) -> ConfigError:
+        """One sentence: ``rung``'s error on this scene (``error``) is above the accuracy, naming λ and the horizon
+        (how long ``rung`` keeps the accuracy: e^{λt} growth on a chaotic scene, a random walk ∝ √t otherwise); its
+        advice is a target 3× above the error (when below the state's size) or a time.end inside the horizon."""
+        span, scale = t_out[-1] - t_out[0], max(1.0, *map(abs, self.system.initial_state())) if self.system else 1.0
+        if chaotic:
+            horizon = amp.horizon(self.accuracy, error / math.exp(min(max(amp.log_span, 0.0), 700.0)))
+            growth = f"λ ≈ {amp.lyapunov:.2g}, perturbations grow ~{amp.factor:.1g}× after the pilot: "
+        else:
+            horizon, growth = span * (self.accuracy / error) ** 2, ""
+        horizon = min(horizon, span)
+        asks = [f"accuracy ≥ {at_least(3 * error)}"] if 3 * error < 0.1 * scale else []
+        if horizon > 0.01 * span:
+            end = t_out[0] + 0.8 * horizon
+            digits = 10.0 ** (math.floor(math.log10(abs(end))) - 2) if end else 1.0
+            asks.append(f"time.end ≤ {math.floor(end / digits) * digits:.4g}")
+        word = "" if rung == "double precision" else " even"
+        return ConfigError(
+            f"accuracy={self.accuracy:g} cannot be reached{word} in {rung} on this scene ({growth}error about "
+            f"{error:.1g}, so {rung} keeps {self.accuracy:g} only to t ≈ {t_out[0] + horizon:.4g} of "
+            f"{t_out[-1]:.4g}); ask for {' or '.join(asks) or 'a shorter time.end'}{climb}")
 
     def _series(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
                 start: float) -> Solution | None:
@@ -403,12 +323,15 @@ class Auto(Integrator):
                 alpha = np.stack([frame_from_angles(a, b, c)[0] for a, b, c in
                                   zip(angles["psi"], angles["theta"], angles["phi"])])
                 y = np.concatenate([y, alpha], axis=1)
-            self.chosen = None  # an analytic series: more_accurate is the full model by a tight Taylor run
-            self.choice = {"auto_method": f"regime {name}", "auto_predicted_error": predicted,
-                           "auto_series_error_one_period": measured, "auto_check_nfev": truth.stats.nfev,
-                           **regime.attributes()}
+            attributes = {"auto_method": f"regime {name}", "auto_predicted_error": predicted,
+                          "auto_series_error_one_period": measured, "auto_check_nfev": truth.stats.nfev,
+                          "auto_precision": PRECISIONS[0], "auto_precision_reason": "an analytic series, evaluated "
+                          "in double precision: no integration", **regime.attributes()}
+            # measured against the full model by the compiled Taylor method at tol 1e-15 (the series' check run)
             return Solution(t_out, y, IntegratorStats(nfev=truth.stats.nfev, n_steps=0, n_rejected=0,
-                                                      wall_time=time.perf_counter() - start))
+                                                      wall_time=time.perf_counter() - start),
+                            Choice(None, attributes, self.accuracy, predicted, self.extended_precision,
+                                   check=Taylor(tol=1e-15)))
         return None
 
     def _misses_orbits(self, base: Any, fun: RightHandSide, y0: np.ndarray, compiled: CompiledModel,
@@ -448,13 +371,13 @@ class Auto(Integrator):
         return not _fast(_comes_back, compiled)(y, y0, margin)
 
     def _pilot(self, fun: RightHandSide, times: np.ndarray, y0: np.ndarray, compiled: CompiledModel | None,
-               tau: float, previous: tuple[float, Solution] | None
+               tau: float, previous: tuple[float, Solution] | None, make: Any
                ) -> tuple[float, float, int, bool, tuple[float, Solution], tuple[float, Solution]]:
         """(raw predicted final error per unit tolerance, growth exponent q, evaluations, whether the pilot
         measured an error above round-off, the tight run and the loose run as (tolerance, solution)) from runs
         at τ and a tighter τ_t: the previous round's loose run when τ_t ≤ τ/10 (a re-centred or loosened round
         reuses it), else a new run at min(τ/100, accuracy/TIGHT_RATIO). The error at τ is then the runs' difference × τ/(τ − τ_t)."""
-        loose = self._method(compiled, tau).integrate(fun, times, y0, None, compiled)
+        loose = make(tau).integrate(fun, times, y0, None, compiled)
         if previous is not None and previous[0] <= tau / 10:
             tight_tol, tight = previous
             tight_nfev = 0
@@ -462,7 +385,7 @@ class Auto(Integrator):
             # τ/100, or tighter where τ is held at MIN_TOLERANCE far above the final tolerance (~accuracy/1000): the
             # tight run must be at least as accurate as the final one to be its start
             tight_tol = min(tau * 1e-2, self.accuracy / TIGHT_RATIO)
-            tight = self._method(compiled, tight_tol).integrate(fun, times, y0, None, compiled)
+            tight = make(tight_tol).integrate(fun, times, y0, None, compiled)
             tight_nfev = tight.stats.nfev
         final, slope = _fast(_error_growth, compiled)(loose.y, tight.y, times)
         # differences within a few hundred ulps are round-off, not a measurement of the truncation error
@@ -471,102 +394,7 @@ class Auto(Integrator):
         # quadratically: assume q = 2 unless the pilot shows faster growth (its early error is a plateau).
         growth = MIN_GROWTH if math.isnan(slope) else min(max(slope, MIN_GROWTH), MAX_GROWTH)
         per_tol = final / (tau - tight_tol) * (1.0 / self.pilot_fraction) ** growth
-        self._pilot_steps = tight.stats.n_steps
         return per_tol, growth, loose.stats.nfev + tight_nfev, measured, (tight_tol, tight), (tau, loose)
-
-    def attributes(self) -> dict[str, Any]:
-        checked = {"auto_measured_error_before_recheck": list(self.measured_before)} if self.measured_before else {}
-        return {"accuracy": self.accuracy, **self.choice, **checked}
-
-    def tightened_for(self, measured_error: float) -> Auto | None:
-        """Rule 11: when the measured error of the last run (``output.error_estimate``, on by default for auto)
-        exceeds its recorded prediction, auto again with the method it ran made more accurate by the factor the
-        measurement asks for (``RECHECK_MARGIN`` × measured / accuracy: at a fixed order the error is proportional
-        to the tolerance), at most ``MAX_RECHECKS`` times, then one ConfigError sentence; else None. A measured
-        error above the prediction but ``RECHECK_MARGIN`` times below the accuracy asked for keeps the run, and
-        the recorded prediction is raised to ``RECHECK_MARGIN`` × the measurement. A regime's series whose
-        measured error breaks its prediction is replaced by auto's integration.
-
-        The prediction rests on the pilot (which sees only round-off when the pilot's stretch is shorter than a
-        step: r0 = 32 over t = 0.25 at 1e-9 chose tol 1e-5 and predicted 2e-14 where the error was 5.7e-5) and on
-        the amplification of one tangent run, whose growth on a chaotic scene scatters by up to e^±4 with any
-        change of its steps (docs/performance.md); the measurement is the companion run's difference, within ~1 %
-        of the error where truncation dominates. Over the extremes matrix and the reference scene at 1e-4 … 1e-13
-        the measured error is at most 0.47× the prediction, so a scene that keeps its promise runs once."""
-        predicted = self.choice.get("auto_predicted_error")
-        if predicted is None or not measured_error > predicted:
-            return None
-        if RECHECK_MARGIN * measured_error <= self.accuracy:
-            # the target is met by a margin, but not the recorded prediction: the measurement bounds the error now
-            self.choice["auto_predicted_error"] = RECHECK_MARGIN * measured_error
-            self.choice["auto_predicted_error_raised_by"] = "output.error_estimate: the measured error, times 3"
-            return None
-        method = self.chosen if self.chosen is not None else None
-        factor = RECHECK_MARGIN * measured_error / self.accuracy
-        finer = method.more_accurate(factor) if method is not None else None
-        if finer is None and method is not None:
-            finer = self._climb(method, factor)
-        what = (f"the error estimate measures {measured_error:.2g} where auto predicted {predicted:.2g} "
-                f"({self.choice.get('auto_method')})")
-        if len(self.measured_before) >= MAX_RECHECKS or (method is not None and finer is None):
-            reason = (f"after {MAX_RECHECKS} runs made more accurate {what}" if len(self.measured_before) >= MAX_RECHECKS
-                      else f"{what}, and {method.name} cannot be made {factor:.2g}× more accurate")
-            climb = "" if self.extended_precision else " or integrator.extended_precision=true"
-            raise ConfigError(f"accuracy={self.accuracy:g} is not met on this scene: {reason}; ask for "
-                              f"accuracy ≥ {RECHECK_MARGIN * measured_error:.1g} or a shorter time.end{climb}")
-        again = type(self)(accuracy=self.accuracy, pilot_fraction=self.pilot_fraction, safety=self.safety,
-                           extended_precision=self.extended_precision and (self.per_trajectory or None))
-        again.measured_before = (*self.measured_before, measured_error)
-        if finer is None:  # an analytic series: integrate instead
-            again._no_series = True
-        else:
-            again._recheck = (finer[0], dict(self.choice))
-        return again
-
-    def _climb(self, method: Any, factor: float) -> tuple[Any, float, str] | None:
-        """The next rung of the precision ladder for a recheck (``tightened_for``): a double Taylor run at its floor
-        goes on in double-double (``extended_precision``, the default), ``factor`` times more accurate; else None."""
-        from gyrolab.kernels.taylor_dd import MIN_TOL
-        from gyrolab.plugins.integrators.compiled_solvers import DOUBLE, DOUBLE_DOUBLE, Taylor
-
-        if not (self.extended_precision and isinstance(method, Taylor) and method.precision == DOUBLE):
-            return None
-        tol = max(method.tol / factor, MIN_TOL)
-        return (Taylor(tol=tol, precision=DOUBLE_DOUBLE), 1.0,
-                f"taylor double-double at tol {tol:.3g}: double precision's floor reached")
-
-    def _run_recheck(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None,
-                     compiled: CompiledModel | None, start: float) -> Solution:
-        """The earlier run's method made as much more accurate as its measured error asked (``tightened_for``)."""
-        method, earlier = self._recheck
-        solution = method.integrate(fun, t_out, y0, progress, compiled)
-        self.chosen = method
-        settings = {f"auto_{k.removeprefix('integrator_')}": v for k, v in method.attributes().items()}
-        self.choice = {**earlier, **settings, "auto_method": method.name,
-                       "auto_tolerance": settings.get("auto_tol", settings.get("auto_rtol", earlier.get("auto_tolerance"))),
-                       # error ∝ tolerance at a fixed order: the earlier measurement scaled down, checked again by
-                       # the measurement of this run
-                       "auto_predicted_error": self.accuracy,
-                       "auto_measured_error_before_recheck": list(self.measured_before)}
-        self.choice.pop("auto_predicted_error_raised_by", None)
-        stats = solution.stats
-        return Solution(t_out, solution.y, IntegratorStats(
-            nfev=stats.nfev, n_steps=stats.n_steps, n_rejected=stats.n_rejected,
-            wall_time=time.perf_counter() - start, njev=stats.njev, nlu=stats.nlu))
-
-    def more_accurate(self, factor: float):
-        """Rule 9 for the method it ran (after ``integrate``): that method ``factor`` times more accurate; for an
-        analytic series, the full model by the compiled Taylor method at tol 1e-15 (the series' check run)."""
-        if not self.choice:
-            return None
-        if self.chosen is None:
-            from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
-            return Taylor(tol=1e-15), 1.0, f"compiled Taylor at tol 1e-15 against auto's {self.choice['auto_method']}"
-        finer = self.chosen.more_accurate(factor)
-        if finer is None:
-            return None
-        return finer[0], finer[1], f"auto's choice, {finer[2]}"
 
     def choose_batch_method(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray,
                             params: np.ndarray) -> tuple[Integrator, dict[str, Any]]:
@@ -577,7 +405,6 @@ class Auto(Integrator):
         run; the batch then runs the chosen method at the smallest tolerance chosen. A trajectory harder
         than every sampled one may miss the accuracy: sample it (pass it first) when you know it.
         """
-        from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
         from gyrolab.plugins.integrators.step_guard import compiled_rhs
 
         P = params
@@ -588,17 +415,10 @@ class Auto(Integrator):
             single = type(self)(accuracy=self.accuracy, pilot_fraction=self.pilot_fraction, safety=self.safety,
                                 extended_precision=False)  # the vectorised kernels run in double precision
             model = CompiledModel(compiled.model, P[j])
-            single.integrate(compiled_rhs(model), times, y0s[j], None, model)
-            choices.append(single.choice)
-        choice = min(choices, key=lambda c: c["auto_tolerance"])
-        tol = float(choice["auto_tolerance"])
-        method = Taylor(order=choice["auto_order"], tol=tol) if choice["auto_method"] == Taylor.name \
-            else DOP853Numba(rtol=tol, atol=tol)
-        settings = {"accuracy": self.accuracy,
-                    **{k: v.item() if isinstance(v, np.generic) else v for k, v in choice.items()},
-                    "auto_sampled_trajectories": len(sample)}
-        self.choice = {k: v for k, v in settings.items() if k != "accuracy"}
-        return method, settings
+            choices.append(single.integrate(compiled_rhs(model), times, y0s[j], None, model, series=False).choice)
+        choice = min(choices, key=lambda c: c.attributes["auto_tolerance"])  # the chosen method (Taylor or DOP853)
+        return choice.method, {"accuracy": self.accuracy, "auto_sampled_trajectories": len(sample),
+                               **{k: v.item() if isinstance(v, np.generic) else v for k, v in choice.attributes.items()}}
 
     def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
                         failures: str) -> BatchSolution:
@@ -609,6 +429,26 @@ class Auto(Integrator):
         solution.wall_time = time.perf_counter() - start
         solution.settings = settings
         return solution
+
+
+def _method(compiled: CompiledModel | None, order: int | None, tol: float) -> Integrator:
+    """The method auto runs at ``tol``: the compiled Taylor method at ``order`` (None: a compiled model without
+    Taylor coefficients, compiled DOP853 instead); scipy's DOP853 without a compiled model."""
+    if compiled is not None:
+        from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
+
+        return Taylor(order=order, tol=tol) if order is not None else DOP853Numba(rtol=tol, atol=tol)
+    from gyrolab.plugins.integrators.scipy_solvers import DOP853
+
+    return DOP853(rtol=tol, atol=tol)
+
+
+def at_least(value: float) -> str:
+    """``value`` rounded up to one significant digit, as a refusal's advice writes it (rounding to nearest may go
+    below what the scene needs: "ask for accuracy ≥ 1e-10" for 1.4e-10 was refused again)."""
+    exponent = math.floor(math.log10(value))
+    digit = math.ceil(value / 10.0 ** exponent * (1 - 1e-12))
+    return f"{digit}e{exponent}" if digit < 10 else f"1e{exponent + 1}"
 
 
 def _amplified(per_tol: float, growth: float, factor: float, fraction: float, margin: float) -> float:

@@ -1,0 +1,103 @@
+"""Every tuned number behind ``auto``'s choice, the error estimate and the recheck, in one table.
+
+Each entry names the benchmark that regenerates it (``TABLE[name].benchmark``). That benchmark reads the table and
+reports, for each entry naming it, whether its measurement still supports the value (``report``); an entry it did
+not measure in that run is listed as unchecked, never as supported. Measurements quoted below were made on an AMD
+EPYC with AVX-512 (2026-11-24 … 27) unless a benchmark's results file says otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+PROMISE = "benchmarks/promise_audit.py"
+PERF = "benchmarks/perf_reference.py"
+CALIBRATE = "benchmarks/perf_reference.py --calibration"
+CHAOS = "benchmarks/chaos_promise.py"
+ROUNDOFF = "benchmarks/roundoff_margin.py"
+
+
+@dataclass(frozen=True)
+class Constant:
+    name: str
+    value: float
+    benchmark: str
+    #: what the benchmark measured that the value rests on
+    basis: str
+
+
+#: name -> Constant, in the order below
+TABLE: dict[str, Constant] = {}
+
+
+def _constant(name: str, value: float, benchmark: str, basis: str) -> float:
+    TABLE[name] = Constant(name, value, benchmark, basis)
+    return value
+
+
+_c = _constant
+# the error estimate (``estimate``)
+TIGHTER = _c("TIGHTER", 100.0, PERF, "companion this many times more accurate: reference scene at 1e-6, 0.55 ms and "
+             "176× more accurate (1000×: 0.68 ms, 1660×)")
+DOUBLE_DOUBLE_BELOW = _c("DOUBLE_DOUBLE_BELOW", 1e-14, PROMISE, "a double Taylor run whose companion tol is below this "
+                         "is measured in double-double: double companions' estimate / actual 0.0047 at 3e-14, 0.94 at "
+                         "1e-12; double-double 0.98")
+ROUNDOFF_MARGIN = _c("ROUNDOFF_MARGIN", 10.0, ROUNDOFF, "a double companion near the floor is trusted when two disagree "
+                     "this many times below what it measures: no estimate below 1/2 of the error in 606 runs (seed 5)")
+# the growth of perturbations (``amplification``)
+TANGENT_TOLERANCE = _c("TANGENT_TOLERANCE", 1e-5, CHAOS, "tangent run's tolerance: slow_spin over t = 300 grows e^19.3 "
+                       "at 1e-5, e^17.4 at 1e-4, e^23.3 at 1e-3")
+SHADOW_OFFSET = _c("SHADOW_OFFSET", 1e-7, CHAOS, "the shadow pair's separation relative to the state's size")
+SHADOW_CHUNKS = _c("SHADOW_CHUNKS", 64, CHAOS, "the shadow pair's renormalisations over the span")
+TANGENT_SAMPLES = _c("TANGENT_SAMPLES", 64, CHAOS, "times a generated tangent run reads max ln|δ| at")
+CHAOS_MARGIN = _c("CHAOS_MARGIN", 10.0, CHAOS, "a chaotic scene's amplification taken this many times larger (one "
+                  "tangent run scatters by e^2); with none slow_spin at t = 300 was accepted at 1e-6, ended at 1.4e-6")
+SHADOW_TOLERANCE = _c("SHADOW_TOLERANCE", 1e-9, CHAOS, "tolerance of the shadow pair's runs")
+# auto's pilot and choice (``auto``)
+PILOT_POINTS = _c("PILOT_POINTS", 65, CALIBRATE, "samples of the pilot's error growth")
+MIN_GROWTH = _c("MIN_GROWTH", 2.0, CALIBRATE, "the pilot's power law t^q is at least quadratic (phase drift): Taylor "
+                "at tol 1e-10 on the reference scene grows ×100 from t = 30 to t = 300")
+MAX_GROWTH = _c("MAX_GROWTH", 4.0, CALIBRATE, "the pilot's largest power law; growth beyond (1/pilot_fraction)^4 is chaos")
+FIRST_RATIO = _c("FIRST_RATIO", 1e-3, CALIBRATE, "first pilot tolerance / accuracy (final error / tol: 24–470)")
+MIN_TOLERANCE = _c("MIN_TOLERANCE", 1e-13, CALIBRATE, "the first pilot's tightest tolerance")
+MAX_TOLERANCE = _c("MAX_TOLERANCE", 1e-5, CALIBRATE, "looser tolerances step near the Taylor series' radius")
+TIGHT_RATIO = _c("TIGHT_RATIO", 3000.0, CALIBRATE, "pilot's tight run ≤ accuracy / this (final tols: accuracy/420 … /1300)")
+MIN_PILOT_STEPS = _c("MIN_PILOT_STEPS", 8, PROMISE, "a pilot of fewer steps measured nothing (r0 = 32 over t = 0.25 at "
+                     "1e-9 ended 5.7e-5 away)")
+UNMEASURED_PER_TOL = _c("UNMEASURED_PER_TOL", 1e3, CALIBRATE, "error per unit tol taken when the pilot measured nothing "
+                        "(measured: 24–470)")
+RECENTRE = _c("RECENTRE", 20.0, CALIBRATE, "a first prediction this many times looser than τ is measured again: actual "
+              "/ raw prediction ≤ 1.09 at every threshold 10–100; at 20, 267 of 369 runs re-measure")
+CALIBRATION = _c("CALIBRATION", 3.0, CALIBRATE, "recorded prediction = raw × this: the largest actual / raw final error "
+                 "on the extremes matrix and the reference scene at 1e-3 … 1e-13 is 0.94")
+MISS_MARGIN = _c("MISS_MARGIN", 1000.0, PERF, "a series' predicted error is trusted to this factor")
+SCREEN_POINTS = _c("SCREEN_POINTS", 512, PERF, "grid of the screen before the series check (~0.25 ms)")
+SCREEN_TOLERANCE = _c("SCREEN_TOLERANCE", 1e-9, PERF, "tolerance of the screen's Taylor run")
+FLOOR = _c("FLOOR", 1e-15, PROMISE, "relative to the state's size: no double run reaches below")
+DOUBLE_DOUBLE_FLOOR = _c("DOUBLE_DOUBLE_FLOOR", 1e-16, PROMISE, "double-double stores its states as doubles, rounded "
+                         "by ≤ 1.1e-16 × their size: asked 5e-29 at time.end=1, the estimate measured 1.1e-16")
+AUTO_SAMPLE = _c("AUTO_SAMPLE", 3, PROMISE, "trajectories of a batch on which auto runs its pilot")
+# the recheck (``promise``)
+RECHECK_MARGIN = _c("RECHECK_MARGIN", 3.0, PROMISE, "a broken promise reruns aimed this many times below what would "
+                    "have met it; extremes matrix and reference scene: measured ≤ 0.47× the prediction")
+MAX_RECHECKS = _c("MAX_RECHECKS", 2, PROMISE, "runs made more accurate before the recheck refuses")
+
+
+def report(benchmark: str, measured: dict[str, tuple[bool, str]]) -> bool:
+    """Print, for every constant of the table that ``benchmark`` regenerates, whether this run's measurement
+    (``measured[name]``: (supports the value, what was measured)) supports it; return False if one is contradicted.
+    A constant the run did not measure is printed as unchecked."""
+    mine = [c for c in TABLE.values() if c.benchmark == benchmark]
+    print(f"\ncalibration constants regenerated by {benchmark} (gyrolab.accuracy.calibration):")
+    ok = True
+    for c in mine:
+        if c.name in measured:
+            supported, what = measured[c.name]
+            ok &= supported
+            print(f"  {c.name} = {c.value:g}: {'supported' if supported else 'NOT SUPPORTED'} by {what}")
+        else:
+            print(f"  {c.name} = {c.value:g}: unchecked by this run")
+    unknown = sorted(set(measured) - {c.name for c in mine})
+    if unknown:
+        raise KeyError(f"{benchmark} measured constants the table does not attribute to it: {', '.join(unknown)}")
+    return ok

@@ -1,0 +1,129 @@
+"""The recheck: a run's promise held against the measurement of its error, at every output time.
+
+A run that chose its method (``Solution.choice``) promises a max-norm error at every stored output time
+(``Choice.promised``, ``auto_predicted_error``). The error estimate (``estimate.compare``) measures the error at
+every output time; while its largest value breaks the promise, the method that ran is run again made as much more
+accurate as the measurement asks (``RECHECK_MARGIN`` × measured / target: at a fixed order the error is proportional
+to the tolerance; ``more_accurate``, else one rung up the precision ladder, ``climbed``), at most ``MAX_RECHECKS``
+times, then one ConfigError sentence whose advice is a target the measurement shows reachable. A measured error above
+the prediction but ``RECHECK_MARGIN`` times below the target keeps the run, the recorded prediction raised to
+``RECHECK_MARGIN`` × the measurement. An analytic series whose measured error breaks its prediction is replaced by
+the integration (``Choice.instead``).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from gyrolab.accuracy import estimate
+from gyrolab.accuracy.auto import at_least
+from gyrolab.accuracy.calibration import MAX_RECHECKS, RECHECK_MARGIN
+from gyrolab.contracts.integrator import Choice, Integrator, Solution
+from gyrolab.errors import ConfigError
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class Ran:
+    """What ran, as the run dataset describes it (``build_dataset`` reads ``name``, ``adaptive``, ``attributes()``):
+    the scene's integrator's settings and, for one that chooses, its final choice and the rechecks before it."""
+
+    integrator: Integrator
+    choice: Choice | None = None
+    measured_before: list[float] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.name, self.adaptive = self.integrator.name, self.integrator.adaptive
+
+    def attributes(self) -> dict[str, Any]:
+        before = {"auto_measured_error_before_recheck": self.measured_before} if self.measured_before else {}
+        return {**self.integrator.attributes(), **(self.choice.attributes if self.choice else {}), **before}
+
+
+def measured_run(scene: Any, y0: np.ndarray, progress: Any, compiled: Any) -> tuple[Solution, Ran, Any]:
+    """``scene``'s run, its error measured where wanted (``estimate.wanted``) and its promise kept: (the solution,
+    what ran for the dataset, the estimate's ``variables`` for ``build_dataset`` or None)."""
+    integrator = scene.integrator
+    solution = integrator.integrate(scene.rhs, scene.times, y0, progress, compiled)
+    _log_stats(integrator.name, solution)
+    ran = Ran(integrator, solution.choice)
+    if not estimate.wanted(scene):
+        return solution, ran, None
+    comparison = _compare(scene, solution)
+    while comparison.max_error is not None and ran.choice is not None and ran.choice.promised is not None \
+            and comparison.max_error > ran.choice.promised:
+        measured, choice = comparison.max_error, ran.choice
+        if RECHECK_MARGIN * measured <= choice.target:
+            # the target is met by a margin, but not the recorded prediction: the measurement bounds the error now
+            ran.choice = replace(choice, promised=RECHECK_MARGIN * measured, attributes={
+                **choice.attributes, "auto_predicted_error": RECHECK_MARGIN * measured,
+                "auto_predicted_error_raised_by": f"output.error_estimate: the measured error, times {RECHECK_MARGIN:g}"})
+            break
+        log.warning("%s: the error estimate measured %.2g, above the run's recorded prediction: running again, "
+                    "more accurately", integrator.name, measured)
+        ran.measured_before.append(measured)
+        solution = _again(scene, y0, progress, compiled, choice, measured, len(ran.measured_before))
+        _log_stats(integrator.name, solution)
+        ran.choice = solution.choice
+        comparison = _compare(scene, solution)
+    return solution, ran, comparison.variables
+
+
+def _compare(scene: Any, solution: Solution) -> estimate.Comparison:
+    choice = solution.choice
+    method = scene.integrator if choice is None else choice.method
+    return estimate.compare(scene, method, solution.y, solution.stats.wall_time, None if choice is None else choice.check)
+
+
+def _again(scene: Any, y0: np.ndarray, progress: Any, compiled: Any, choice: Choice, measured: float,
+           rechecks: int) -> Solution:
+    """The run again, made more accurate by the factor ``measured`` asks for, or one ConfigError sentence."""
+    what = (f"the error estimate measures {measured:.2g} where {scene.integrator.name} predicted {choice.promised:.2g} "
+            f"({choice.attributes.get('auto_method')})")
+    if rechecks > MAX_RECHECKS:
+        raise _refusal(choice, f"after {MAX_RECHECKS} runs made more accurate {what}", measured)
+    if choice.method is None:  # an analytic series: integrate instead
+        solution = choice.instead()
+        solution.choice.attributes["auto_recheck"] = f"{what}: integrated instead"
+        return solution
+    factor = RECHECK_MARGIN * measured / choice.target
+    finer, how = choice.method.more_accurate(factor), "more accurate"
+    if finer is None and choice.may_climb:
+        finer, how = choice.method.climbed(factor), "one rung up the precision ladder"
+    if finer is None:
+        raise _refusal(choice, f"{what}, and {choice.method.name} cannot be made {factor:.2g}× more accurate", measured)
+    method = finer[0]
+    try:
+        solution = method.integrate(scene.rhs, scene.times, y0, progress, compiled)
+    except ConfigError as refused:  # (a model the higher rung cannot run)
+        raise ConfigError(f"{scene.integrator.name}'s run measured an error of {measured:.2g} (output.error_estimate), "
+                          f"above what it promised, and the more accurate run is refused: {refused}") from None
+    settings = {f"auto_{k.removeprefix('integrator_')}": v for k, v in method.attributes().items()}
+    attributes = {**choice.attributes, **settings, "auto_method": method.name,
+                  "auto_tolerance": settings.get("auto_tol", settings.get("auto_rtol")),
+                  # error ∝ tolerance at a fixed order: the measurement scaled down to the target, measured again
+                  "auto_predicted_error": choice.target, "auto_precision": method.precision,
+                  "auto_recheck": f"{what}: {finer[2]} ({how})"}
+    if method.precision != choice.method.precision:
+        attributes["auto_precision_reason"] = (f"the error estimate measured {measured:.2g} where accuracy="
+                                               f"{choice.target:g} was asked, and {choice.method.name} had reached "
+                                               f"{choice.method.precision} precision's floor")
+    solution.choice = replace(choice, method=method, attributes=attributes, promised=choice.target)
+    return solution
+
+
+def _refusal(choice: Choice, reason: str, measured: float) -> ConfigError:
+    climb = "" if choice.may_climb else ", or integrator.extended_precision=true (auto then climbs to double-double)"
+    return ConfigError(f"accuracy={choice.target:g} is not met on this scene: {reason}; ask for accuracy ≥ "
+                       f"{at_least(RECHECK_MARGIN * measured)} or a shorter time.end{climb}")
+
+
+def _log_stats(name: str, solution: Solution) -> None:
+    stats = solution.stats
+    log.info("%s: %d steps (%s rejected), %d evaluations, %.3f s", name, stats.n_steps,
+             "?" if stats.n_rejected is None else stats.n_rejected, stats.nfev, stats.wall_time)
