@@ -201,6 +201,9 @@ def test_the_hand_kept_tables_are_gone():
         assert not hasattr(experiments, name)
     for name in ("RUN_OPTIONS", "HYDRA_KEYS"):
         assert not hasattr(completion, name)
+    from gyrolab.app import parser
+
+    assert not hasattr(parser, "VALUE_OPTIONS")  # read from the parsers (parser.value_options)
     assert {"--multirun", "--config-dir", "--batch", "-V"} <= set(completion.run_options())
     assert "hydra.run.dir" in completion.hydra_keys()
 

@@ -41,7 +41,7 @@ def run_options() -> list[str]:
     """The options of ``gyrolab run``: Hydra's own (its argument parser's), gyrolab's ``-V`` (short for --version)
     and the old spellings of the subcommands."""
     from gyrolab.app.parser import ALIASES
-    from gyrolab.engine.hydra_private import get_args_parser
+    from gyrolab.compat import get_args_parser
 
     return [*(s for action in get_args_parser()._actions for s in action.option_strings), "-V", *ALIASES]
 
@@ -107,7 +107,7 @@ def option_words() -> dict[str, list[str]]:
 
 def script(shell: str) -> str:
     """The completion script for ``shell`` (bash, or zsh through its bash compatibility)."""
-    from gyrolab.app.parser import ALIASES, COMMANDS, VALUE_OPTIONS
+    from gyrolab.app.parser import ALIASES, COMMANDS, build_parsers, run_parser, value_options
 
     if shell not in SHELLS:
         raise ConfigError(f"no completion for shell {shell!r}; valid choices: {', '.join(SHELLS)}")
@@ -127,7 +127,7 @@ def script(shell: str) -> str:
         f"_gyrolab_config={_quote(chr(10).join(config))}",
         f"_gyrolab_plot_config={_quote(chr(10).join(plot_words))}",
         f"_gyrolab_path_commands={_quote(' '.join(PATH_COMMANDS))}",
-        f"_gyrolab_value_options={_quote(' '.join(sorted(VALUE_OPTIONS)))}",
+        f"_gyrolab_value_options={_quote(' '.join(sorted(value_options({'run': run_parser(), **build_parsers()}))))}",
     ]
     for name, words in options.items():
         lines.append(f"_gyrolab_options_{name.replace('-', '_')}={_quote(chr(10).join(words))}")

@@ -57,12 +57,6 @@ def value_options(parsers: dict[str, argparse.ArgumentParser]) -> set[str]:
             for option in action.option_strings}
 
 
-def __getattr__(name: str) -> set[str]:
-    if name == "VALUE_OPTIONS":  # the completion script's list, read from the parsers
-        return value_options({"run": run_parser(), **build_parsers()})
-    raise AttributeError(name)
-
-
 def split_command(argv: Sequence[str], value_options: set[str]) -> tuple[str, list[str]]:
     """(the subcommand ``argv`` names, the rest of ``argv``): a subcommand word before the first override,
     or an old ``--batch``-style spelling anywhere (``--plot=PATH`` keeps PATH); ``run`` when none is named.
