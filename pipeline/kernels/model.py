@@ -208,7 +208,7 @@ def compiled_system(system: Any) -> CompiledModel:
 def rounding_moved(compiled: CompiledModel) -> CompiledModel:
     """The same model with the numbers it holds rounded moved by one unit in the last place: a run with it differs
     from one with the rounded values as one with the exact values would (an error estimate's companion run,
-    ``engine.error_estimate``, so has round-off independent of the run it measures).
+    ``accuracy.estimate``, so has round-off independent of the run it measures).
 
     The hand-written fixed point: 1/I (``layout.INV_INERTIA``; up, down, up), the one parameter it derives by
     rounding (the others are the config's own doubles, exact for a reference too). A traced model: every number of
