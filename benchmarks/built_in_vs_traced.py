@@ -33,7 +33,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=7)
     args = parser.parse_args()
-    print(f"| state | integrator | setting | hand-written (ms) | traced (ms) | traced / hand |")
+    print("| state | integrator | setting | hand-written (ms) | traced (ms) | traced / hand |")
     print("| --- | --- | --- | --- | --- | --- |")
     for alpha in (False, True):
         scene = compose_scene(["experiment=perf_reference", f"output.euler_angles={str(alpha).lower()}"])

@@ -13,7 +13,6 @@ import sys
 
 import numba
 import numpy as np
-import pytest
 
 from gyrolab.contracts.integrator import CompiledModel
 from gyrolab.kernels import fixed_point, models

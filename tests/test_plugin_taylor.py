@@ -18,7 +18,7 @@ import pytest
 
 from gyrolab.contracts import Force
 from gyrolab.engine.scene import compose_scene, run
-from gyrolab.kernels import expression, fixed_point, model as traced, models, taylor_series
+from gyrolab.kernels import expression, model as traced, models, taylor_series
 from gyrolab.plugins.systems.fixed_point import traced_model
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from tests.conftest import installed_distribution
