@@ -436,11 +436,14 @@ def test_an_alias_bomb_in_a_config_dir_does_not_hang(cli, tmp_path):
 
 
 def test_a_failed_run_leaves_no_lock(cli, tmp_path):
-    # a step too long for the spin is found when the integration starts, after the run directory exists
+    # a step too long for the spin is found when the integration starts, after the run directory exists; a folder
+    # Hydra made for the run goes with it (tests/test_cli.py), one the user gave stays, without the lock
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "notes.txt").write_text("the user's")
     done = cli("integrator=rk4", "integrator.step=5", "initial.r0=50", "time.end=2000", "output.figures=false",
                "hydra.run.dir=out")
     assert done.returncode != 0 and done.stderr.strip().splitlines()[-1].startswith("gyrolab: error: ")
-    assert (tmp_path / "out").is_dir()
+    assert (tmp_path / "out" / "notes.txt").exists()
     assert not (tmp_path / "out" / ".gyrolab.lock").exists()
     assert not list((tmp_path / "out").rglob("*.part")) and not (tmp_path / "out" / "run.nc").exists()
 

@@ -23,6 +23,22 @@ def test_default_run_writes_dataset_and_figures(cli, tmp_path):
     assert figures == FIGURES
 
 
+def test_a_run_refused_while_integrating_leaves_no_run_folder(cli, tmp_path):
+    """auto's pilot finds the docs' chaotic top beyond double-double at 1e-12 over t = 3000 (λ ≈ 0.11): one sentence,
+    a non-zero exit and no folder of a run that never was; a folder the user gave, with files of their own, stays."""
+    chaotic = ["integrator=auto", "accuracy=1e-12", "initial.p0=0.3", "initial.q0=-0.2", "initial.r0=2",
+               "time.end=3000", "output.figures=false"]
+    done = cli(*chaotic, "hydra.run.dir=out")
+    assert done.returncode != 0 and "double-double" in done.stderr, done.stderr
+    assert done.stderr.count("gyrolab: error:") == 1
+    assert not (tmp_path / "out").exists()
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("kept")
+    done = cli(*chaotic, "hydra.run.dir=mine")
+    assert done.returncode != 0
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "kept" and not (tmp_path / "mine" / "run.nc").exists()
+
+
 def test_multirun_writes_one_dataset_per_job(cli, tmp_path):
     done = cli("-m", "integrator=rk4,dop853", "time.end=1", "time.n_output=11", "output.figures=false",
                "hydra.sweep.dir=sweep")

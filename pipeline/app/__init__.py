@@ -25,6 +25,7 @@ import difflib
 import gc
 import logging
 import os
+import shutil
 import signal
 import sys
 import tempfile
@@ -428,10 +429,23 @@ def _task(cfg: DictConfig) -> None:
         run_sweep_job(cfg, out_dir, list(hydra_cfg.overrides.task), hydra_cfg.job.num,
                       lambda job_id: _run_one(cfg, out_dir, job_id, figures=job_figures))
         return
+    fresh = _only_hydras_files(out_dir)  # Hydra made it for this run (else: a folder the user pointed at)
     try:
         _run_one(cfg, out_dir)
     except GyrolabError as error:
+        if fresh and _only_hydras_files(out_dir):
+            # a run refused once integrating (auto's pilot, a failed step) leaves no folder of a run that never was;
+            # the sentence below says what its log would
+            shutil.rmtree(out_dir, ignore_errors=True)
         fail(error)
+
+
+def _only_hydras_files(out_dir: Path) -> bool:
+    """Whether ``out_dir`` holds only what is there before the task starts: Hydra's configs, the job's log and the
+    folder's lock (taken from the preflight on)."""
+    from gyrolab.output.lock import LOCK_NAME
+
+    return out_dir.is_dir() and {p.name for p in out_dir.iterdir()} <= {".hydra", "gyrolab.log", LOCK_NAME}
 
 
 def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None, figures: bool = True) -> Path:
