@@ -178,8 +178,14 @@ def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] =
     jobs = [(name, ds, directory, formats, dpi) for name in FIGURES]
     if workers > 1 and "fork" in multiprocessing.get_all_start_methods() and not multiprocessing.current_process().daemon:
         # forked after matplotlib is imported: a worker costs milliseconds, not an import
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
+        pool = multiprocessing.get_context("fork").Pool(workers)
+        try:
             results = pool.starmap(_draw, jobs)
+        finally:
+            # close and join, not the context manager's terminate(): terminate kills the workers, and one killed while
+            # it held the task queue's lock left another blocked on that lock and the run waiting for it (a hung run)
+            pool.close()
+            pool.join()
     else:
         results = [_draw(*job) for job in jobs]
     return [path for paths in results for path in paths]
