@@ -1,5 +1,6 @@
-"""The batch Taylor kernel's vector parts against independent scalar code: the step rule, the split form of the
-Cauchy sums, the outputs of a step over several output times, and where the split form is admitted."""
+"""The batch Taylor kernel's vector parts against independent code: the generated series against an
+extended-precision reference, the step rule against the scalar one, the outputs of a step over several output
+times against the single-trajectory kernel, and a lane's independence from its neighbours."""
 
 import math
 
@@ -22,7 +23,7 @@ def _both_rules(T, order, tol, vector, scalar, flags):
     K = np.empty((4, LANES))
     K[0], K[1], K[2], K[3] = tol, safety, 1.0 / (order - 1), 1.0 / order
     S = np.zeros((2, LANES))
-    batch_taylor._step_sizes(T, order, K, S)
+    batch_taylor._step_sizes(T, order, T.shape[1], K, S)
     for lane in range(LANES):
         vector[lane], flags[lane] = S[0, lane], S[1, lane]
         scale, n1, n2 = 1.0, 0.0, 0.0
@@ -71,77 +72,29 @@ def _starts(scene, count, seed, scale=0.1):
     return y0s
 
 
-def _run(P, order, tol, times, y0s, split):
-    out = np.empty((len(y0s), len(times), 6))
-    out[:, 0] = y0s
-    steps, status = np.zeros(len(y0s), dtype=np.int64), np.zeros(len(y0s), dtype=np.int64)
-    batch_taylor.run_blocks(P, order, tol, times, y0s, out, steps, status, batch_taylor.task_size(len(y0s)), split)
-    assert not status.any()
-    return out, steps
-
-
-def test_split_form_agrees_with_the_direct_form():
-    """The split form (six sums of ω ± √N₂ γ from order SPLIT on) against the direct form (twelve sums of ω and
-    γ) at tol 1e-15, order 18, t ∈ [0, 2], with spins up to four times the reference and N₂ from 0.05 to 2:
-    the same steps, and states within 1e-13 (rounding, a hundred times below the tolerance of any setting
-    the benchmark asks for)."""
-    scene = _scene()
-    y0s = _starts(scene, 3 * LANES, seed=11)
-    y0s[::3, 0:3] *= 4.0
-    P = np.tile(scene.compiled.params, (len(y0s), 1))
-    P[:, N_Z] = np.linspace(0.05, 2.0, len(y0s))
-    assert batch_taylor.split_ready(P, y0s).all()
-    direct, direct_steps = _run(P, 18, 1e-15, scene.times, y0s, 18)
-    split, split_steps = _run(P, 18, 1e-15, scene.times, y0s, batch_taylor.SPLIT)
-    np.testing.assert_array_equal(split_steps, direct_steps)
-    np.testing.assert_allclose(split, direct, rtol=0, atol=1e-13)
-
-
-def test_split_form_at_its_admission_bound_is_as_accurate_as_the_direct_form():
-    """At |ω| / (√N₂ |γ|) ≈ 0.9 × SPLIT_RATIO, the edge of what ``split_ready`` admits, both forms against an
-    extended-precision reference (``physics.reference``: the equations summed in long double, not these kernels):
-    the same steps, and the split form's γ error within 1 % (+ a few ulps) of the direct form's. (Measured on
-    2026-11-27: equal to three digits at 0.9, 9 and 90 × the bound; both errors are the fast spin's, the
-    tolerance being relative to |ω|.)"""
+def test_lanes_follow_the_extended_precision_reference():
+    """The generated lanes (the fixed point's equations traced over its packed parameters) against an independent
+    oracle, ``physics.reference`` (the Euler–Poisson equations' own Taylor series summed in long double, not
+    these kernels): spins up to four times the reference's and N₂ from 0 to 2, tol 1e-15 at order 18 on
+    t ∈ [0, 2]: every output within 1e-12."""
     from gyrolab.physics.reference import fixed_point_reference
     from gyrolab.kernels.layout import INERTIA, U_Z
 
-    scene = _scene(["time.end=0.2"])
-    y0s = _starts(scene, LANES, seed=3)
-    P = np.tile(scene.compiled.params, (LANES, 1))
-    P[:, N_Z] = 0.5
-    gamma = np.linalg.norm(y0s[:, 3:6], axis=1)
-    direction = y0s[:, 0:3] / np.linalg.norm(y0s[:, 0:3], axis=1)[:, None]
-    y0s[:, 0:3] = direction * (0.9 * batch_taylor.SPLIT_RATIO * np.sqrt(0.5) * gamma)[:, None]
-    assert batch_taylor.split_ready(P, y0s).all()
-    direct, direct_steps = _run(P, 18, 1e-15, scene.times, y0s, 18)
-    split, split_steps = _run(P, 18, 1e-15, scene.times, y0s, batch_taylor.SPLIT)
-    np.testing.assert_array_equal(split_steps, direct_steps)
-    for j in range(2):
+    scene = _scene(["integrator.tol=1e-15", "integrator.order=18"])
+    y0s = _starts(scene, LANES + 3, seed=11)
+    y0s[::3, 0:3] *= 4.0
+    P = np.tile(scene.compiled.params, (len(y0s), 1))
+    P[:, N_Z] = np.linspace(0.0, 2.0, len(y0s))
+    batch = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s, P)
+    for j in range(len(y0s)):
         reference = fixed_point_reference(P[j, INERTIA:INERTIA + 3], P[j, U_Z:U_Z + 3], P[j, N_Z], y0s[j],
                                           scene.times).astype(float)
-        direct_error = np.max(np.abs(direct[j, :, 3:6] - reference[:, 3:6]))
-        split_error = np.max(np.abs(split[j, :, 3:6] - reference[:, 3:6]))
-        assert split_error <= 1.01 * direct_error + 4 * np.finfo(float).eps
-
-
-def test_split_form_is_admitted_only_where_its_rounding_stays_small():
-    scene = _scene()
-    y0s = _starts(scene, 4, seed=12)
-    P = np.tile(scene.compiled.params, (4, 1))
-    assert batch_taylor.split_ready(P, y0s).all()  # the reference body: |ω| ≈ 5, √N₂ |γ| ≈ 0.7
-    P[1, N_Z] = 0.0  # no Newtonian centre: a = 0
-    P[2, N_Z] = -0.5  # a repelling one: no real a
-    y0s[3, 0:3] = (0.0, 0.0, 2000.0)  # |ω| / (√N₂ |γ|) ≈ 2800 > 1024
-    assert batch_taylor.split_ready(P, y0s).tolist() == [True, False, False, False]
-    released = y0s[:1].copy()
-    released[0, 0:3] = 0.0  # released at rest: energy bounds |ω| by the potential's range
-    assert batch_taylor.split_ready(P[:1], released).all()
+        assert np.max(np.abs(batch.y[j] - reference)) < 1e-12
 
 
 def test_a_trajectory_in_a_mixed_batch_is_computed_as_alone():
-    """A batch mixing trajectories with and without the split form (N₂ = 0 for some): each result, bit for bit,
-    the one it has alone (its form follows from its own parameters and state, never from its neighbours)."""
+    """A batch mixing parameters (N₂ = 0 for some): each result, bit for bit, the one it has alone (its arithmetic
+    follows from its own parameters and state, never from its neighbours)."""
     scene = _scene()
     y0s = _starts(scene, 2 * LANES + 3, seed=13)
     P = np.tile(scene.compiled.params, (len(y0s), 1))
@@ -174,7 +127,7 @@ def test_steps_over_several_output_times_agree_with_the_single_kernel(n_output):
 @numba.njit
 def _row_addresses(order):
     T = batch_taylor._rows(order + 1, 6)
-    Q = batch_taylor._rows(1, batch_taylor.CONSTANTS)[0]
+    Q = batch_taylor._rows(1, 11)[0]
     return T.ctypes.data % 64, Q.ctypes.data % 64
 
 

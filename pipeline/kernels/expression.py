@@ -208,7 +208,12 @@ _LOADED: dict[str, Any] = {}
 
 
 def load_generated(source: str, prefix: str, what: str) -> Any:
-    """The ``kernel`` of a generated module: written to PREFIX_<hash of source>.py in the kernel cache, imported
+    """The ``kernel`` of a generated module (``generated_module``)."""
+    return generated_module(source, prefix, what).kernel
+
+
+def generated_module(source: str, prefix: str, what: str) -> Any:
+    """A generated module of numba ``cfunc``s: written to PREFIX_<hash of source>.py in the kernel cache, imported
     (numba compiles it, or loads its cache) once per process; the first compilation on a machine logs
     "compiling WHAT, once"."""
     digest = hashlib.sha256(source.encode()).hexdigest()[:16]
@@ -238,6 +243,6 @@ def load_generated(source: str, prefix: str, what: str) -> Any:
         module = importlib.util.module_from_spec(spec)
         sys.modules[module_name] = module
         spec.loader.exec_module(module)
-        _LOADED[module_name] = module.kernel  # the cfunc compiled (or loaded its cache) on import
+        _LOADED[module_name] = module  # its cfuncs compiled (or loaded their cache) on import
         marker.touch()
     return _LOADED[module_name]

@@ -8,10 +8,14 @@ e_2 = γ (vertical).
 
 from __future__ import annotations
 
+import functools
+
 import numba
 import numpy as np
 
 from gyrolab.kernels.compiler import inline_kernel, kernel
+from gyrolab.kernels.expression import Graph, cross, symbols
+from gyrolab.kernels.model import Model
 from gyrolab.kernels.layout import (  # noqa: F401  (N_PARAMS: fixed_point.N_PARAMS for callers)
     CARRIES_ALPHA, CompiledTerms, GRADIENT, INERTIA, INV_INERTIA, LINEAR, N_PARAMS, N_Z, U_Z,
 )
@@ -41,6 +45,21 @@ def built_in(inertia: np.ndarray, forces: list, carries_alpha: bool) -> np.ndarr
     if any(term is None for term in terms):
         return None
     return pack(inertia, terms, carries_alpha)
+
+
+@functools.cache
+def packed_model() -> Model:
+    """The (ω, γ) equations of ``rhs`` traced with the packed parameters as the trace's numbers (p[i] is number i):
+    the same model, in the form the generated kernels take (``batch_taylor``'s lanes read ``pack``'s rows as
+    they are)."""
+    graph = Graph()
+    y = symbols(graph, "y", 6)
+    p = [graph.lift(0.0) for _ in range(N_PARAMS)]  # numbers 0..N_PARAMS−1: the kernels read them from p
+    inertia, inv = np.array(p[INERTIA:INERTIA + 3]), np.array(p[INV_INERTIA:INV_INERTIA + 3])
+    omega, gamma = y[0:3], y[3:6]
+    torque = cross(inertia * omega, omega) + cross(np.array(p[U_Z:U_Z + 3]), gamma) \
+        + p[N_Z] * cross(gamma, inertia * gamma)
+    return Model(graph, [*(torque * inv), *cross(gamma, omega)], 6, "the fixed point (ω, γ), built-in torques")
 
 
 @inline_kernel

@@ -289,7 +289,7 @@ _update = simd.update(ROWS, 2)
 
 @kernel
 def _constants(p, Q):
-    """``_coefficients``' constants from the parameters (``fixed_point.pack``), as batch_taylor._load forms them."""
+    """``_coefficients``' constants from the parameters (``fixed_point.pack``), in the order the batch lanes read them."""
     I0, I1, I2 = p[INERTIA], p[INERTIA + 1], p[INERTIA + 2]
     u0, u1, u2 = p[U_Z], p[U_Z + 1], p[U_Z + 2]
     Q[0, 0], Q[0, 1], Q[0, 2] = (I1 - I2) * p[INV_INERTIA], (I2 - I0) * p[INV_INERTIA + 1], (I0 - I1) * p[INV_INERTIA + 2]

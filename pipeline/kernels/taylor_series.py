@@ -301,7 +301,8 @@ def cauchy_sums(typingctx, W, k, columns, base, left, right):
 class _Program:
     """A traced model's equations, lowered to series and their generated code."""
 
-    def __init__(self, model: Model) -> None:
+    def __init__(self, model: Model, first_constant: int = TRACED_FIRST_CONSTANT) -> None:
+        self.first_constant = first_constant  # p's index of the trace's first number (0: a packed layout's own)
         self.numbers = _Numbers()
         self.series: list[_Series] = []
         self.found: dict[tuple, int] = {}  # a series' key (op and operands) → its id
@@ -392,7 +393,7 @@ class _Program:
         if op == "time":
             return self._make("time", (), None, depth=0)
         if op == "const":
-            return _Lin(n.param(TRACED_FIRST_CONSTANT + a[0]))
+            return _Lin(n.param(self.first_constant + a[0]))
         if op == "add":
             return self._sum(a)
         if op == "sub":

@@ -7,9 +7,10 @@ The compiled kernels run in parallel over trajectories (``numba.prange``):
 - DOP853 (``dop853_numba``): adaptive, each trajectory with its own step control (scipy's controller, as the
   single run); fixed-point (ω, γ) states by blocks of lanes vectorised across trajectories
   (``pipeline/kernels/batch_dop853.py``), other models one trajectory per thread.
-- Taylor (``taylor``): adaptive, each trajectory with the single run's order and step rule; fixed-point (ω, γ)
-  states by lanes of one vector register (8 on AVX-512, 4 on AVX2) vectorised across trajectories
-  (``pipeline/kernels/batch_taylor.py``), other models one trajectory per thread.
+- Taylor (``taylor``): adaptive, each trajectory with the single run's order and step rule; every model whose
+  equations are polynomial (the fixed point, the orbiting gyrostat, polynomial plugin torques) by lanes of one
+  vector register (8 on AVX-512, 4 on AVX2) vectorised across trajectories, the series generated from the
+  equations (``pipeline/kernels/batch_taylor.py``); other models one trajectory per thread.
 
 Each function is an integrator's ``integrate_batch``: the arrays come validated from
 ``gyrolab.batch.integrate.integrate_arrays``.
@@ -61,9 +62,7 @@ def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
         if not taylor_series.ready(compiled, P):
             raise ConfigError(f"integrator {integrator.name} has no Taylor coefficients for this compiled model; "
                               f"valid choices for this model: {_batch_alternatives(compiled)}")
-        if blockable(compiled, y0s.shape[1]):
-            batch_taylor.run_lanes(P, integrator.order, integrator.tol, times, y0s, out, steps, status)
-        else:
+        if not batch_taylor.run_lanes(compiled, P, integrator.order, integrator.tol, times, y0s, out, steps, status):
             batch_taylor.run_each(models.form(compiled), P, integrator.order, integrator.tol, times, y0s, out, steps,
                                   status)
 
