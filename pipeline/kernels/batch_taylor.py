@@ -469,16 +469,17 @@ def _horner(v, b, p, size, components, chains):
 
 
 @intrinsic
-def _advance(typingctx, T, order, n, H, carry, D, O):
+def _advance(typingctx, T, order, n, H, carry, D, O, F):
     """Every lane's output at its own t + dt and its step: O[c] = T[0, c] + (Σ_{k≥1} T[k, c] dt^k − carry[c])
     with dt = D[0] (Horner in strict arithmetic, ``_dense``'s), then the state T[0] += Σ_{k≥1} T[k] h^k with
     h = H[0] (Horner, multiply and add may fuse), a compensated (Kahan, strict) sum with ``carry``
     (``simd.update``'s arithmetic). The output's and the step's Horner chains share their loads of T and
-    interleave. Idle lanes have h = 0; a lane without an output ignores O."""
-    if not (simd.vector_arrays([T, H, carry, D, O]) and T.ndim == 3 and isinstance(order, types.Integer)
+    interleave. Idle lanes have h = 0; a lane without an output ignores O. F[0] receives 0 in every lane whose new
+    state is finite (NaN in the others: the sum of its components times 0)."""
+    if not (simd.vector_arrays([T, H, carry, D, O, F]) and T.ndim == 3 and isinstance(order, types.Integer)
             and isinstance(n, types.Integer)):
         return None
-    sig = types.void(T, order, n, H, carry, D, O)
+    sig = types.void(T, order, n, H, carry, D, O, F)
 
     def codegen(context, builder, signature, args):
         v = simd.Lanes(context, builder, signature, args, LANES)
@@ -486,6 +487,7 @@ def _advance(typingctx, T, order, n, H, carry, D, O):
         p = context.cast(builder, args[1], signature.args[1], types.intp)
         size = context.cast(builder, args[2], signature.args[2], types.intp)
         h, dt = v.load(3, 0), v.load(5, 0)
+        probe = cgutils.alloca_once_value(b, v.constant(0.0))
 
         def emit(components):
             sums = _horner(v, b, p, size, components, ((h, simd.FUSE), (dt, ())))
@@ -496,8 +498,10 @@ def _advance(typingctx, T, order, n, H, carry, D, O):
                 total = b.fadd(y, inc)
                 v.store(b.fsub(b.fsub(total, y), inc), 4, c)
                 v.store(total, 0, c)
+                b.store(b.fadd(b.load(probe), b.fmul(total, v.constant(0.0))), probe)
 
         _components(b, size, emit)
+        v.store(b.load(probe), 7, 0)
         return context.get_dummy_value()
 
     return sig, codegen
@@ -594,6 +598,7 @@ def _task(series, constants, numbers, columns, Params, order, tol, t_out, Y0, Y,
     S = _rows(1, 2)[0]  # each lane's step from _step_sizes, and where the scalar rule must take over
     D = _rows(1, 1)[0]  # each lane's time from its step's start to its next output time (_dense)
     O = _rows(1, n)[0]  # the lanes' states there
+    F = _rows(1, 1)[0]  # 0 where a lane's new state is finite (``_advance``)
     due = np.zeros(LANES, dtype=np.bool_)  # the lanes with an output in this step
     following = first
     for lane in range(LANES):
@@ -628,7 +633,7 @@ def _task(series, constants, numbers, columns, Params, order, tol, t_out, Y0, Y,
             _outputs(T, order, t_out, t, t_next, traj, index, carry, D, O, Y)
             due[:] = False
             D[0, :] = 0.0
-        _advance(T, order, n, H, carry, D, O)
+        _advance(T, order, n, H, carry, D, O, F)
         for lane in range(LANES):
             if due[lane]:
                 for c in range(n):
@@ -638,9 +643,7 @@ def _task(series, constants, numbers, columns, Params, order, tol, t_out, Y0, Y,
             j = traj[lane]
             if j < 0:
                 continue
-            finite = True
-            for c in range(n):
-                finite = finite and math.isfinite(T[0, c, lane])
+            finite = F[0, lane] == 0.0
             if finite and t_next[lane] > t[0, lane]:
                 steps[j] += 1
                 t[0, lane] = t_next[lane]
