@@ -1,8 +1,9 @@
 """DOP853 (``dop853``) for many trajectories at once: per-trajectory step control, vectorised across them.
 
-``run_blocks`` (fixed-point (ω, γ) states) advances LANES trajectories in lock
-step, stored column-wise as in ``rk4.run_batch_blocks``: every stage is one
-``rhs_block`` call and one stage sum over all lanes, so the arithmetic
+``run_blocks`` advances LANES trajectories of any compiled model in lock step,
+stored column-wise as in ``rk4.run_batch_blocks``: every stage is one call of
+the model's right-hand side by columns (generated from its equations,
+``models.block_rhs``) and one stage sum over all lanes, so the arithmetic
 vectorises across trajectories. Each lane keeps its own time, step, derivative,
 output index and accept/reject state, with the single-trajectory kernel's
 controller (scipy's: same initial step, error norm, step factors, minimum
@@ -13,9 +14,6 @@ time takes the next trajectory of its task (TASK trajectories; tasks run in
 parallel with ``prange``): easy and hard trajectories in one task cost no idle
 lanes until the task's last trajectories. Outputs come from the 7th-order
 dense output (three extra stages, computed on the steps that cover an output).
-
-``run_each`` serves every other compiled model, one trajectory per thread, with
-the single-trajectory kernel itself.
 """
 
 from __future__ import annotations
@@ -24,14 +22,13 @@ import numba
 import numpy as np
 
 from gyrolab.kernels import dop853, models
-from gyrolab.kernels.dop853 import (A, B, D, E3, E5, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, N_EXTENDED,
+from gyrolab.kernels.dop853 import (A, B, C, D, E3, E5, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, N_EXTENDED,
                                              N_STAGES, NOT_FINITE, OK, SAFETY, TOO_SMALL_STEP)
-from gyrolab.kernels.fixed_point import rhs_block
+from gyrolab.kernels.models import call_block
 
 LANES = 32  # trajectories advanced in lock step
 TASK = 256  # trajectories per parallel task, at most
 RUNNING = -1  # status of a trajectory not finished yet
-_FIXED_POINT = models.FORMS[models.FIXED_POINT]  # the (ω, γ) form only (models.Form)
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -51,15 +48,22 @@ def _stage(K, s, a_row, y, h, ytmp, acc):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _load(lane, traj, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs, index, Y, nfev):
+def _stage_times(t, c, h, ts):
+    """ts = t + c h in every lane (the single kernel's stage time)."""
+    for j in range(t.size):
+        ts[j] = t[j] + c * h[j]
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _load(model, lane, traj, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs, index, Y, nfev):
     """Put trajectory ``traj`` into ``lane``: state, parameters, derivative, scipy's initial step."""
     n = Y0.shape[1]
     y0 = Y0[traj].copy()
     p = Params[traj].copy()
     f0 = np.empty(n)
-    models.rhs(_FIXED_POINT, t0, y0, p, f0)
+    models.rhs(model, t0, y0, p, f0)
     stats = np.zeros(3, dtype=np.int64)
-    h_abs[lane] = dop853.initial_step(_FIXED_POINT, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats)
+    h_abs[lane] = dop853.initial_step(model, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats)
     nfev[traj] = 1 + stats[0]
     for c in range(n):
         y[c, lane] = y0[c]
@@ -72,8 +76,10 @@ def _load(lane, traj, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t,
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def run_blocks(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status, task_size):
-    """Every trajectory j (initial state Y0[j], parameters Params[j]) over t_out into Y[j].
+def run_blocks(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status,
+               task_size):
+    """Every trajectory j (initial state Y0[j], parameters Params[j]) over t_out into Y[j]: the stages by the
+    model's right-hand side by columns at ``block`` (``models.block_rhs``), the rest by ``model`` (a Form).
 
     steps/rejected_steps/nfev[j] receive its counts, status[j] OK, TOO_SMALL_STEP or NOT_FINITE
     (its outputs from the failed step on are NaN). t_out has at least two times. Tasks of
@@ -82,7 +88,7 @@ def run_blocks(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps
     count = Y0.shape[0]
     n_tasks = (count + task_size - 1) // task_size
     for task in numba.prange(n_tasks):  # the loop stays small: numba's parallel pass compiles slowly on big bodies
-        _task(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status,
+        _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status,
               task * task_size, min(task * task_size + task_size, count))
 
 
@@ -93,7 +99,7 @@ def task_size(count: int) -> int:
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _task(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status, first, stop):
+def _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status, first, stop):
     """``run_blocks`` for the trajectories first..stop−1, LANES at a time."""
     n = Y0.shape[1]
     n_out = t_out.size
@@ -105,6 +111,7 @@ def _task(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfe
     y_new = np.zeros((n, LANES))
     P = np.zeros((Params.shape[1], LANES))
     t = np.zeros(LANES)
+    ts = np.zeros(LANES)  # each lane's stage time
     sums = np.zeros(LANES)
     h = np.zeros(LANES)  # the trial step of each lane (0 in idle and failed lanes)
     t_next = np.zeros(LANES)  # the trial step's end (kept: t + (t_next − t) need not round to t_next)
@@ -120,8 +127,8 @@ def _task(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfe
         if following < stop:
             traj[lane] = following
             active[lane] = True
-            _load(lane, following, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs, index, Y,
-                  nfev)
+            _load(model, lane, following, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs, index,
+                  Y, nfev)
             following += 1
         else:  # an idle lane computes on a finite copy of lane 0 and is never read
             for c in range(n):
@@ -156,9 +163,11 @@ def _task(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfe
                 K[0, c, lane] = f[c, lane]
         for s in range(1, N_STAGES):
             _stage(K, s, A[s], y, h, ytmp, sums)
-            rhs_block(ytmp, P, K[s], LANES)
+            _stage_times(t, C[s], h, ts)
+            call_block(block, ts, ytmp, P, K[s], LANES)
         _stage(K, N_STAGES, B, y, h, y_new, sums)
-        rhs_block(y_new, P, K[N_STAGES], LANES)
+        _stage_times(t, C[N_STAGES], h, ts)
+        call_block(block, ts, y_new, P, K[N_STAGES], LANES)
         # each lane's error norm, acceptance and next step
         need_dense = False
         for lane in range(LANES):
@@ -208,7 +217,8 @@ def _task(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfe
         if need_dense:  # the three extra stages of the dense output, for the lanes that need them
             for s in range(N_STAGES + 1, N_EXTENDED):
                 _stage(K, s, A[s], y, h, ytmp, sums)
-                rhs_block(ytmp, P, K[s], LANES)
+                _stage_times(t, C[s], h, ts)
+                call_block(block, ts, ytmp, P, K[s], LANES)
         for lane in range(LANES):
             j = traj[lane]
             if j < 0:
@@ -258,8 +268,8 @@ def _task(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfe
                 traj[lane] = following
                 active[lane] = True
                 retry[lane] = False
-                _load(lane, following, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs, index,
-                      Y, nfev)
+                _load(model, lane, following, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs,
+                      index, Y, nfev)
                 following += 1
             else:  # idle from now on: a finite state, no step
                 traj[lane] = -1
@@ -269,31 +279,3 @@ def _task(Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfe
                 for c in range(n):
                     y[c, lane] = 0.0
                     f[c, lane] = 0.0
-
-
-@numba.njit(cache=True, parallel=True, error_model="numpy")
-def run_each(model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status):
-    """``run_blocks`` for any compiled model: one trajectory per thread, the single-trajectory kernel."""
-    for j in numba.prange(Y0.shape[0]):
-        _one(model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status, j)
-
-
-@numba.njit(cache=True, error_model="numpy")
-def _one(model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status, j):
-    n = Y0.shape[1]
-    t_bound = t_out[t_out.size - 1]
-    y = Y0[j].copy()
-    Y[j, 0] = y
-    p = Params[j]
-    f = np.empty(n)
-    models.rhs(model, t_out[0], y, p, f)
-    stats = np.zeros(3, dtype=np.int64)
-    stats[0] = 1
-    h0 = dop853.initial_step(model, p, t_out[0], y, f, t_bound, max_step, rtol, atol, stats)
-    state = np.array([t_out[0], h0])
-    code, reached = dop853.run(model, p, t_out, Y[j], 1, t_out.size, state, y, f, t_bound, rtol, atol, max_step, stats)
-    nfev[j], steps[j], rejected_steps[j] = stats[0], stats[1], stats[2]
-    status[j] = code
-    if code != OK:
-        for r in range(reached, t_out.size):
-            Y[j, r] = np.nan

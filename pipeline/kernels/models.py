@@ -95,6 +95,32 @@ def _constant_form(context, builder, ty, value):
 FORMS = {i: Form(i) for i in (FIXED_POINT, TRACED)}
 
 
+def block_rhs(compiled) -> int:
+    """The address of a compiled model's right-hand side by columns (``model.block_kernel``): the batch kernels'
+    stages, for every model (the built-in fixed point as its equations traced over its packed parameters)."""
+    if compiled.model == TRACED:
+        return _model.block_kernel(_model.traced_model(compiled))
+    return _model.block_kernel(fixed_point.packed_model(), 0)
+
+
+@intrinsic
+def call_block(typingctx, address, t, Y, P, out, count):
+    """Call ``void f(double* t, double* Y, double* P, double* out, int64 count, int64 stride)`` at ``address`` with
+    the arrays' data (``block_rhs``); the stride is Y's row length."""
+    sig = types.void(types.int64, t, Y, P, out, types.int64)
+
+    def codegen(context, builder, signature, args):
+        double_ptr, i64 = ir.DoubleType().as_pointer(), ir.IntType(64)
+        fnty = ir.FunctionType(ir.VoidType(), [double_ptr] * 4 + [i64, i64])
+        arrays = [context.make_array(ty)(context, builder, v) for ty, v in zip(signature.args[1:5], args[1:5])]
+        stride = cgutils.unpack_tuple(builder, arrays[1].shape)[1]
+        data = [builder.bitcast(a.data, double_ptr) for a in arrays]
+        builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [*data, args[5], stride])
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
 def form(compiled) -> Form:
     """The kernels' model argument for a ``CompiledModel``: compiles and runs its form's code only."""
     return FORMS[compiled.model]

@@ -8,8 +8,7 @@ import numba
 import numpy as np
 
 from gyrolab.kernels.compiler import kernel
-from gyrolab.kernels.fixed_point import rhs_block
-from gyrolab.kernels.models import rhs
+from gyrolab.kernels.models import call_block, rhs
 
 
 #: Nodes of the four stages, as fractions of the step.
@@ -54,25 +53,14 @@ def run(model, p, t_out, steps_per_interval, y, Y, i_next, i_stop):
     return i_stop
 
 
-@numba.njit(cache=True, parallel=True, error_model="numpy")
-def run_batch(model, P, t_out, steps_per_interval, Y0, Y):
-    """Many trajectories at once: P[j] parameters and Y0[j] initial state of trajectory j; Y[j, i] the outputs."""
-    count, n = Y0.shape
-    for j in numba.prange(count):
-        y = Y0[j].copy()
-        K, tmp = np.empty((4, n)), np.empty(n)
-        Y[j, 0] = y
-        for i in range(1, t_out.size):
-            _advance(model, P[j], t_out[i - 1], y, t_out[i] - t_out[i - 1], steps_per_interval[i - 1], K, tmp)
-            Y[j, i] = y
-
-
 BLOCK = 64
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def run_batch_blocks(P, t_out, steps_per_interval, Y0, Y):
-    """``run_batch`` for fixed-point (ω, γ) states, by blocks of trajectories stored column-wise.
+def run_batch_blocks(block, P, t_out, steps_per_interval, Y0, Y):
+    """Every trajectory j (initial state Y0[j], parameters P[j]) over t_out into Y[j] with ``run``'s steps, by
+    blocks of trajectories stored column-wise, the stages by the model's right-hand side by columns at ``block``
+    (``models.block_rhs``).
 
     Each block advances BLOCK trajectories in lock step, so every loop runs across
     trajectories and vectorises; blocks run in parallel.
@@ -90,23 +78,29 @@ def run_batch_blocks(P, t_out, steps_per_interval, Y0, Y):
             Y[j0 + j, 0] = Y0[j0 + j]
         k1, k2, k3 = np.empty((n, BLOCK)), np.empty((n, BLOCK)), np.empty((n, BLOCK))
         k4, tmp = np.empty((n, BLOCK)), np.empty((n, BLOCK))
+        ts = np.empty(BLOCK)  # the stage's time (``run``'s), in every lane
         for i in range(1, t_out.size):
             steps = steps_per_interval[i - 1]
             h = (t_out[i] - t_out[i - 1]) / steps
-            for _ in range(steps):
-                rhs_block(y, p, k1, m)
+            for step in range(steps):
+                t = t_out[i - 1] + step * h
+                ts[:] = t + NODES[0] * h
+                call_block(block, ts, y, p, k1, m)
                 for c in range(n):
                     for j in range(m):
                         tmp[c, j] = y[c, j] + 0.5 * h * k1[c, j]
-                rhs_block(tmp, p, k2, m)
+                ts[:] = t + NODES[1] * h
+                call_block(block, ts, tmp, p, k2, m)
                 for c in range(n):
                     for j in range(m):
                         tmp[c, j] = y[c, j] + 0.5 * h * k2[c, j]
-                rhs_block(tmp, p, k3, m)
+                ts[:] = t + NODES[2] * h
+                call_block(block, ts, tmp, p, k3, m)
                 for c in range(n):
                     for j in range(m):
                         tmp[c, j] = y[c, j] + h * k3[c, j]
-                rhs_block(tmp, p, k4, m)
+                ts[:] = t + NODES[3] * h
+                call_block(block, ts, tmp, p, k4, m)
                 for c in range(n):
                     for j in range(m):
                         y[c, j] += (h / 6.0) * (k1[c, j] + 2.0 * k2[c, j] + 2.0 * k3[c, j] + k4[c, j])

@@ -1,12 +1,12 @@
 """The built-in integrators' batch kernels (capability BATCH_KERNEL): many trajectories of one compiled model per call.
 
 The compiled kernels run in parallel over trajectories (``numba.prange``):
-- RK4 (``rk4``, ``rk4_numba``): fixed step; fixed-point (ω, γ) states go by blocks of trajectories stored
-  column-wise, so the arithmetic vectorises across trajectories (7× faster than one trajectory per thread);
-  other compiled models one trajectory per thread.
+- RK4 (``rk4``, ``rk4_numba``): fixed step, by blocks of trajectories stored column-wise, so the arithmetic
+  vectorises across trajectories (7× faster than one trajectory per thread); every model's stages are its
+  right-hand side by columns, generated from its equations (``models.block_rhs``).
 - DOP853 (``dop853_numba``): adaptive, each trajectory with its own step control (scipy's controller, as the
-  single run); fixed-point (ω, γ) states by blocks of lanes vectorised across trajectories
-  (``pipeline/kernels/batch_dop853.py``), other models one trajectory per thread.
+  single run), by lanes vectorised across trajectories (``pipeline/kernels/batch_dop853.py``), the stages by the
+  same generated right-hand side by columns.
 - Taylor (``taylor``): adaptive, each trajectory with the single run's order and step rule; every model whose
   equations are polynomial (the fixed point, the orbiting gyrostat, polynomial plugin torques) by lanes of one
   vector register (8 on AVX-512, 4 on AVX2) vectorised across trajectories, the series generated from the
@@ -39,12 +39,8 @@ def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.n
     start = time.perf_counter()
     P = bind(compiled, P)
     steps = steps_per_interval(times, step)
-    size = y0s.shape[1]
-    out = np.empty((len(y0s), len(times), size))
-    if blockable(compiled, size):
-        rk4.run_batch_blocks(P, times, steps, y0s, out)
-    else:
-        rk4.run_batch(models.form(compiled), P, times, steps, y0s, out)
+    out = np.empty((len(y0s), len(times), y0s.shape[1]))
+    rk4.run_batch_blocks(models.block_rhs(compiled), P, times, steps, y0s, out)
     failed = ~np.all(np.isfinite(out), axis=(1, 2))
     if failures == "raise":
         require_finite_out(out)
@@ -77,13 +73,11 @@ def dop853_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
     P = bind(compiled, P)
 
     def kernel(out: np.ndarray, steps: np.ndarray, status: np.ndarray) -> None:
-        count, size = y0s.shape
+        count = y0s.shape[0]
         rejected, nfev = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
         args = (times, y0s, out, integrator.rtol, integrator.atol, integrator.max_step, steps, rejected, nfev, status)
-        if blockable(compiled, size):
-            batch_dop853.run_blocks(P, *args, batch_dop853.task_size(count))
-        else:
-            batch_dop853.run_each(models.form(compiled), P, *args)
+        batch_dop853.run_blocks(models.block_rhs(compiled), models.form(compiled), P, *args,
+                                batch_dop853.task_size(count))
 
     return _adaptive(integrator, kernel, times, y0s, failures)
 
@@ -120,10 +114,3 @@ def require_finite_out(out: np.ndarray) -> None:
     if not np.all(np.isfinite(out)):
         bad = int(np.argmax(~np.all(np.isfinite(out), axis=(1, 2))))
         raise IntegrationError(f"trajectory {bad} of the batch became non-finite; reduce integrator.step")
-
-
-def blockable(compiled: CompiledModel, size: int) -> bool:
-    """The block kernels cover the fixed-point model with state (ω, γ)."""
-    from gyrolab.kernels import models
-
-    return compiled.model == models.FIXED_POINT and size == 6
