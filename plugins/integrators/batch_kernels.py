@@ -7,10 +7,9 @@ The compiled kernels run in parallel over trajectories (``numba.prange``):
 - DOP853 (``dop853_numba``): adaptive, each trajectory with its own step control (scipy's controller, as the
   single run), by lanes vectorised across trajectories (``pipeline/kernels/batch_dop853.py``), the stages by the
   same generated right-hand side by columns.
-- Taylor (``taylor``): adaptive, each trajectory with the single run's order and step rule; every model whose
-  equations are polynomial (the fixed point, the orbiting gyrostat, polynomial plugin torques) by lanes of one
+- Taylor (``taylor``): adaptive, each trajectory with the single run's order and step rule, by lanes of one
   vector register (8 on AVX-512, 4 on AVX2) vectorised across trajectories, the series generated from the
-  equations (``pipeline/kernels/batch_taylor.py``); other models one trajectory per thread.
+  model's equations (``pipeline/kernels/batch_taylor.py``).
 
 Each function is an integrator's ``integrate_batch``: the arrays come validated from
 ``gyrolab.batch.integrate.integrate_arrays``.
@@ -50,7 +49,7 @@ def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.n
 def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
                  failures: str) -> BatchSolution:
     """The Taylor method at ``integrator.order`` and ``integrator.tol`` (``Taylor``'s settings)."""
-    from gyrolab.kernels import batch_taylor, models, taylor_series
+    from gyrolab.kernels import batch_taylor, taylor_series
 
     P = bind(compiled, P)
 
@@ -58,9 +57,7 @@ def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
         if not taylor_series.ready(compiled, P):
             raise ConfigError(f"integrator {integrator.name} has no Taylor coefficients for this compiled model; "
                               f"valid choices for this model: {_batch_alternatives(compiled)}")
-        if not batch_taylor.run_lanes(compiled, P, integrator.order, integrator.tol, times, y0s, out, steps, status):
-            batch_taylor.run_each(models.form(compiled), P, integrator.order, integrator.tol, times, y0s, out, steps,
-                                  status)
+        batch_taylor.run_lanes(compiled, P, integrator.order, integrator.tol, times, y0s, out, steps, status)
 
     return _adaptive(integrator, kernel, times, y0s, failures)
 
