@@ -6,6 +6,7 @@ import pytest
 
 from gyrolab import app
 from gyrolab.errors import ConfigError
+from tests.helpers import files_under, run_main
 
 CASES = {
     "unknown integrator": (["integrator=foo"], ["'foo'", "dop853", "rk4"]),
@@ -91,21 +92,6 @@ def test_regime_outside_its_domain_writes_nothing(tmp_path, monkeypatch, capsys)
 
 
 # ---- the corpus: every bad input is one sentence, a non-zero exit, nothing created -------------------------
-
-def run_main(argv, monkeypatch, capsys):
-    """``gyrolab ARGV`` in this process: (exit code, stderr)."""
-    from gyrolab.engine.config import ConfigSource, use_source
-
-    monkeypatch.setattr(sys, "argv", ["gyrolab", *argv])
-    try:
-        app.main()
-        code = 0
-    except SystemExit as stop:
-        code = stop.code
-    finally:
-        use_source(ConfigSource())
-    return code, capsys.readouterr().err
-
 
 LONG = "x" * 100_000
 DIGITS = "1" * 400
@@ -307,17 +293,13 @@ FOREIGN = [
 ]
 
 
-def _created(root):
-    return {p for p in root.rglob("*")}
-
-
 def _one_sentence(argv, files, phrase, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     for name, content in files.items():
         path = tmp_path / name
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(content) if isinstance(content, bytes) else path.write_text(content)
-    before = _created(tmp_path)
+    before = files_under(tmp_path)
     extra = [] if argv[0] in ("--batch", "--plot", "--reproduce") or "hydra.run.dir" in " ".join(argv) else \
         ["hydra.run.dir=out"]
     code, err = run_main([*argv, *extra], monkeypatch, capsys)
@@ -327,7 +309,7 @@ def _one_sentence(argv, files, phrase, tmp_path, monkeypatch, capsys):
     assert len(lines) == 1 and lines[0].startswith("gyrolab: error: "), err
     assert phrase in lines[0], (phrase, lines[0])
     assert "secret" not in lines[0].lower() and "PRIVATE" not in lines[0], lines[0]
-    assert _created(tmp_path) == before
+    assert files_under(tmp_path) == before
 
 
 @pytest.mark.parametrize("argv, files, phrase", FILE_CORPUS, ids=[f"{i}-{p[:40]}" for i, (_, _, p) in

@@ -9,7 +9,7 @@ import subprocess
 import pytest
 
 from gyrolab.app.completion import script
-from tests.helpers import REPO
+from tests.helpers import VISCOUS_DRAG
 
 #: (words before the cursor, the word under it) -> candidates that must be offered, candidates that must not
 CASES = [
@@ -129,7 +129,6 @@ def test_the_script_offers_installed_plugins(tmp_path):
 
     from tests.conftest import installed_distribution
 
-    example = REPO / "examples" / "gyrolab-viscous-drag"
     with installed_distribution(tmp_path, "gyrolab-viscous-drag", "0.1.0",
-                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [example]):
+                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [VISCOUS_DRAG]):
         assert "force=viscous_drag" in script("bash").split("\n")

@@ -11,24 +11,21 @@ import os
 import resource
 import signal
 import socket
-import subprocess
-import sys
 import threading
-from pathlib import Path
 
 import numpy as np
 import pytest
-from tests.conftest import mounted_tmpfs
 import xarray as xr
 
 from gyrolab.batch import executors, scheduler, store
 from gyrolab.batch.runner import Settings, run_chunk
 from gyrolab.batch.sweep import run_batch_sweep
 from gyrolab.errors import ConfigError, OutputError
+from tests.conftest import mounted_tmpfs
+from tests.helpers import files_under, gyrolab, one_error_line
 
 pytestmark = pytest.mark.slow  # subprocesses under file-size limits, silent peers with their 10 s deadline
 
-GYROLAB = [sys.executable, "-m", "gyrolab"]
 SMALL = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=2", "time.n_output=41", "output.euler_angles=false",
          "output.figures=false"]
 GRID = [*SMALL, "batch.output=trajectory", "batch.chunk=10", "initial.theta0=0.3,0.5,0.7,0.9",
@@ -40,21 +37,8 @@ def cli(args, cwd, limit=None, env=None):
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, resource.RLIM_INFINITY))
 
-    return subprocess.run([*GYROLAB, *args], cwd=cwd, capture_output=True, text=True, timeout=600,
-                          preexec_fn=limited if limit else None, env={**os.environ, **(env or {})})
-
-
-def one_sentence(done, code, *fragments):
-    errors = [line for line in done.stderr.splitlines() if line.startswith("gyrolab: error:")]
-    assert done.returncode == code, done.stderr[-2000:]
-    assert len(errors) == 1 and "Traceback" not in done.stderr, done.stderr[-2000:]
-    for fragment in fragments:
-        assert fragment in errors[0], errors[0]
-    return errors[0]
-
-
-def files(root):
-    return sorted(str(p.relative_to(root)) for p in Path(root).rglob("*"))
+    return gyrolab(*args, cwd=cwd, timeout=600, preexec_fn=limited if limit else None,
+                   env={**os.environ, **(env or {})})
 
 
 def data_of(path):
@@ -137,8 +121,8 @@ def test_a_malformed_option_is_one_sentence(argv):
 def test_a_config_with_an_address_is_refused_on_the_command_line_before_anything_is_written(tmp_path):
     done = cli(["--batch", *SMALL, "batch.scheduler=tcp://127.0.0.1:8786", "initial.r0=2,3", "hydra.sweep.dir=out"],
                tmp_path)
-    one_sentence(done, 2, "batch.scheduler=", "--scheduler")
-    assert files(tmp_path) == []
+    one_error_line(done, "batch.scheduler=", "--scheduler", code=2)
+    assert files_under(tmp_path) == []
 
 
 class FakePeer:
@@ -201,17 +185,17 @@ def test_the_command_line_names_a_bad_peer_in_one_line_and_writes_nothing(peer, 
     finally:
         if fake:
             fake.close()
-    line = one_sentence(done, 2, address, "the command line (--scheduler)")
+    line = one_error_line(done, address, "the command line (--scheduler)", code=2)
     assert peer != "silent" or "sent nothing within 10 s" in line   # the timeout the sentence promises
-    assert files(tmp_path) == []   # refused before the sweep directory is made
+    assert files_under(tmp_path) == []   # refused before the sweep directory is made
 
 
 def test_the_environment_is_a_source_too(tmp_path):
     address = f"tcp://127.0.0.1:{free_port()}"
     done = cli(["--batch", *SMALL, "initial.r0=2,3", "hydra.sweep.dir=out"], tmp_path,
                env={"DASK_SCHEDULER_ADDRESS": address})
-    one_sentence(done, 2, address, "the environment (DASK_SCHEDULER_ADDRESS)")
-    assert files(tmp_path) == []
+    one_error_line(done, address, "the environment (DASK_SCHEDULER_ADDRESS)", code=2)
+    assert files_under(tmp_path) == []
 
 
 # ----------------------------------------------------------------------------- item 3: a full disk
@@ -228,7 +212,7 @@ def uninterrupted(tmp_path_factory):
 def test_a_file_size_limit_in_a_batch_is_one_sentence_exit_3_and_the_rerun_completes_identically(tmp_path,
                                                                                                   uninterrupted):
     done = cli(["--batch", *GRID, "hydra.sweep.dir=out"], tmp_path, limit=60_000)
-    one_sentence(done, 3, "sweep.nc.part", "file-size limit", "rerun the same command")
+    one_error_line(done, "sweep.nc.part", "file-size limit", "rerun the same command", code=3)
     again = cli(["--batch", *GRID, "hydra.sweep.dir=out"], tmp_path)
     assert again.returncode == 0, again.stderr[-2000:]
     assert_same_data(data_of(tmp_path / "out" / "sweep.nc"), uninterrupted)
@@ -285,7 +269,7 @@ def test_a_stability_map_under_a_file_size_limit_is_one_sentence_and_resumes_ide
     whole = cli([*args[:-1], "hydra.run.dir=whole"], tmp_path)
     assert whole.returncode == 0, whole.stderr[-2000:]
     done = cli(args, tmp_path, limit=12_000)
-    one_sentence(done, 3, "stability_map.nc.part", "file-size limit")
+    one_error_line(done, "stability_map.nc.part", "file-size limit", code=3)
     again = cli(args, tmp_path)
     assert again.returncode == 0, again.stderr[-2000:]
     a, b = data_of(tmp_path / "whole" / "stability_map.nc"), data_of(tmp_path / "map" / "stability_map.nc")
@@ -313,7 +297,7 @@ def test_a_multirun_whose_job_results_cannot_be_written_exits_3_and_the_rerun_co
     whole = cli([*sweep, "hydra.sweep.dir=whole"], tmp_path)
     assert whole.returncode == 0, whole.stderr[-2000:]
     done = cli([*sweep, "hydra.sweep.dir=full"], tmp_path, limit=150_000)   # above Hydra's files, below run.nc
-    one_sentence(done, 3, "2 of 2 jobs failed", "could not be written", "rerun the same command")
+    one_error_line(done, "2 of 2 jobs failed", "could not be written", "rerun the same command", code=3)
     again = cli([*sweep, "hydra.sweep.dir=full"], tmp_path)
     assert again.returncode == 0, again.stderr[-2000:]
     a, b = data_of(tmp_path / "whole" / "sweep.nc"), data_of(tmp_path / "full" / "sweep.nc")
@@ -334,10 +318,10 @@ def test_a_really_full_disk_in_a_batch_is_one_sentence_and_the_rerun_with_room_c
     free = stats.f_bavail * stats.f_frsize
     filler = small_tmpfs / "filler"
     filler.write_bytes(bytes(max(0, free - 64 * 1024)))   # 64 KiB left: the batch's file needs ~170 KiB
-    before = files(small_tmpfs)
+    before = files_under(small_tmpfs)
     done = cli(["--batch", *GRID, f"hydra.sweep.dir={small_tmpfs}"], tmp_path)
-    one_sentence(done, 3, "sweep.nc.part", "no space left on device", "rerun the same command")
-    assert [f for f in files(small_tmpfs) if f not in before and f != ".gyrolab.lock"] == []
+    one_error_line(done, "sweep.nc.part", "no space left on device", "rerun the same command", code=3)
+    assert [f for f in files_under(small_tmpfs) if f not in before and f != ".gyrolab.lock"] == []
     filler.unlink()   # room again
     again = cli(["--batch", *GRID, f"hydra.sweep.dir={small_tmpfs}"], tmp_path)
     assert again.returncode == 0, again.stderr[-2000:]
@@ -346,15 +330,15 @@ def test_a_really_full_disk_in_a_batch_is_one_sentence_and_the_rerun_with_room_c
 
 def test_an_experiment_with_an_address_is_refused_before_its_run_directory_exists(tmp_path):
     done = cli(["experiment=stability_map", "batch.scheduler=tcp://127.0.0.1:8786", "hydra.run.dir=map"], tmp_path)
-    one_sentence(done, 2, "batch.scheduler=", "run code", "--scheduler")
-    assert files(tmp_path) == []
+    one_error_line(done, "batch.scheduler=", "run code", "--scheduler", code=2)
+    assert files_under(tmp_path) == []
 
 
 def test_the_option_reaches_an_experiment_run_by_hydra(tmp_path):
     address = f"tcp://127.0.0.1:{free_port()}"
     done = cli(["--scheduler", address, "experiment=stability_map", "stability_map.n_theta0=2",
                 "stability_map.n_r0=2", "time.end=1", "output.figures=false", "hydra.run.dir=map"], tmp_path)
-    one_sentence(done, 2, address, "the command line (--scheduler)", "no Dask scheduler answers")
+    one_error_line(done, address, "the command line (--scheduler)", "no Dask scheduler answers", code=2)
 
 
 # ----------------------------------------------------------------------------- follow-ups (harden-batch2)
@@ -411,7 +395,7 @@ def test_a_stability_map_whose_sections_cannot_be_added_keeps_the_map_and_resume
     assert whole.returncode == 0, whole.stderr[-2000:]
     final = tmp_path / "whole" / "stability_map.nc"
     done = cli(args, tmp_path, limit=int(0.7 * final.stat().st_size))
-    one_sentence(done, 3, "stability_map.nc", "file-size limit", "the map itself is kept")
+    one_error_line(done, "stability_map.nc", "file-size limit", "the map itself is kept", code=3)
     again = cli(args, tmp_path)
     assert again.returncode == 0, again.stderr[-2000:]
     a, b = data_of(final), data_of(tmp_path / "map" / "stability_map.nc")

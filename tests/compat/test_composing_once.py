@@ -12,7 +12,6 @@ override Hydra refuses (the same error).
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
 
 import pytest
@@ -26,6 +25,7 @@ from omegaconf import OmegaConf, open_dict
 from gyrolab import compat as composition
 from gyrolab.engine.config import ConfigSource, hydra_for, register_plugin_configs
 from gyrolab.compat import BasicSweeper, ConfigLoaderImpl
+from tests.helpers import gyrolab_in_process
 
 
 def jobs_of(arguments):
@@ -145,17 +145,6 @@ def test_a_job_hydra_refuses_fails_the_same_way():
                 if memo is not None:
                     memo.__exit__(None, None, None)
     assert errors[0] == errors[1]
-
-
-def gyrolab_in_process(monkeypatch, *args):
-    from gyrolab import app
-
-    monkeypatch.setattr(sys, "argv", ["gyrolab", *args])
-    try:
-        app.main()
-    except SystemExit as stop:
-        return stop.code
-    return 0
 
 
 def counted_compositions(monkeypatch):

@@ -9,16 +9,15 @@ API and, for a few, through the real command line: the exit code, exactly one ``
 on stderr, no traceback and no ``run.nc``.
 """
 
-import sys
 import textwrap
 
 import numpy as np
 import pytest
 
-from gyrolab import app
 from gyrolab.engine.scene import compose_scene
 from gyrolab.errors import ConfigError, IntegrationError
 from tests.conftest import installed_distribution
+from tests.helpers import run_main
 
 PLUGINS = textwrap.dedent('''
     import time
@@ -425,21 +424,6 @@ def test_integrate_refuses_bad_inputs():
 
 # ---- the command line: exit code, one line, no traceback, no run.nc ------------------------------------------
 
-def run_main(argv, tmp_path, monkeypatch, capsys):
-    from gyrolab.engine.config import ConfigSource, use_source
-
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(sys, "argv", ["gyrolab", *argv, "hydra.run.dir=out"])
-    try:
-        app.main()
-        code = 0
-    except SystemExit as stop:
-        code = stop.code
-    finally:
-        use_source(ConfigSource())
-    return code, capsys.readouterr().err
-
-
 @pytest.mark.parametrize("argv, code, needle", [
     (["force=[uniform_gravity,raising]"], 3, "torque of force 'raising' raised RuntimeError"),
     (["force=[returns_none]"], 3, "torque of force 'returns_none' returned NoneType"),
@@ -450,7 +434,8 @@ def run_main(argv, tmp_path, monkeypatch, capsys):
     (["force=[init_fails]", "force.init_fails.kind=ImportError"], 2, "failed to build: ImportError"),
 ])
 def test_command_line_failures_are_one_line(plugins, tmp_path, monkeypatch, capsys, argv, code, needle):
-    status, err = run_main([*argv, *SHORT], tmp_path, monkeypatch, capsys)
+    monkeypatch.chdir(tmp_path)
+    status, err = run_main([*argv, *SHORT, "hydra.run.dir=out"], monkeypatch, capsys)
     errors = [line for line in err.splitlines() if line.startswith("gyrolab: error:")]
     assert status == code, err
     assert len(errors) == 1 and needle in errors[0], err

@@ -15,23 +15,19 @@ import xarray as xr
 from gyrolab.engine.config import compose_config
 from gyrolab.engine.safety import check_config
 from gyrolab.errors import ConfigError
-from tests.app.test_bad_input import run_main
-
-
-def files(root: Path) -> set[Path]:
-    return {p for p in root.rglob("*")}
+from tests.helpers import files_under, run_main
 
 
 def refused(argv, tmp_path, monkeypatch, capsys, key):
     """Run gyrolab in this process; assert a one-sentence refusal naming ``key`` and no new file."""
     monkeypatch.chdir(tmp_path)
-    before = files(tmp_path)
+    before = files_under(tmp_path)
     code, err = run_main([*argv, "hydra.run.dir=out", "hydra.sweep.dir=sweep"], monkeypatch, capsys)
     assert code == 2, err
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("gyrolab: error: ") and "Traceback" not in err, err
     assert key in lines[0], (key, lines[0])
-    assert files(tmp_path) == before
+    assert files_under(tmp_path) == before
     return lines[0]
 
 

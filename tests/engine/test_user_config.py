@@ -10,8 +10,7 @@ import pytest
 import xarray as xr
 
 from gyrolab.sweep.aggregate import FINISHED, STATUS_FLAGS
-from tests.helpers import REPO
-from tests.app.test_bad_input import run_main
+from tests.helpers import REPO, run_main
 
 SMALL = ["time.end=1", "time.n_output=11"]
 

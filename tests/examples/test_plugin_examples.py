@@ -6,7 +6,6 @@ integrator and the system from the command line), and its own tests (gyrolab's c
 run here. The kits themselves are tested below on deliberately broken plugins: a kit that cannot fail checks nothing.
 """
 
-import importlib.util
 import inspect
 import tomllib
 
@@ -22,7 +21,7 @@ from gyrolab.plugins.regimes.small_parameter import SmallParameter
 from gyrolab.plugins.systems.fixed_point import FixedPoint
 from gyrolab.testing import check_integrator, check_regime, check_system
 from tests.conftest import installed_distribution
-from tests.helpers import REPO
+from tests.helpers import REPO, example_tests
 
 EXAMPLES = {  # folder -> (entry-point group, plugin name, the example's own test file)
     "gyrolab-scipy-rk23": ("gyrolab.integrators", "scipy_rk23", "test_scipy_rk23.py"),
@@ -49,15 +48,6 @@ def installed(tmp_path_factory):
         yield paths
 
 
-def _example_tests(folder):
-    _, _, test_file = EXAMPLES[folder]
-    spec = importlib.util.spec_from_file_location(f"example_tests_{folder.replace('-', '_')}",
-                                                  REPO / "examples" / folder / "tests" / test_file)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def _run_all(module):
     """Every test function of an example's test module, each parametrization included (no fixtures are used)."""
     ran = 0
@@ -82,7 +72,7 @@ def test_example_is_found_through_its_entry_point(installed, folder):
 
 @pytest.mark.parametrize("folder", sorted(EXAMPLES))
 def test_example_package_passes_its_own_tests(installed, folder):
-    assert _run_all(_example_tests(folder)) >= 3
+    assert _run_all(example_tests(folder, EXAMPLES[folder][2])) >= 3
 
 
 def test_integrator_runs_from_the_api(installed):

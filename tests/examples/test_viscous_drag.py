@@ -6,7 +6,6 @@ The plugin page's (docs/writing-a-force.md) example is its literal content; ``gy
 tests (gyrolab's contract kit and the exact solution of drag) run here.
 """
 
-import importlib.util
 import re
 import tomllib
 
@@ -16,25 +15,17 @@ from gyrolab.engine.scene import compose_scene
 from gyrolab.errors import ConfigError
 from gyrolab.scaffold import new_force_package, render
 from tests.conftest import installed_distribution
-from tests.helpers import REPO
+from tests.helpers import REPO, VISCOUS_DRAG, example_tests
 
-EXAMPLE = REPO / "examples" / "gyrolab-viscous-drag"
 
 
 @pytest.fixture(scope="module")
 def installed_plugin(tmp_path_factory):
     """The example's package on the path, plus a .dist-info carrying its pyproject's entry points."""
-    project = tomllib.loads((EXAMPLE / "pyproject.toml").read_text())["project"]
+    project = tomllib.loads((VISCOUS_DRAG / "pyproject.toml").read_text())["project"]
     with installed_distribution(tmp_path_factory.mktemp("site"), project["name"], project["version"],
-                                project["entry-points"]["gyrolab.forces"], [EXAMPLE]) as site:
+                                project["entry-points"]["gyrolab.forces"], [VISCOUS_DRAG]) as site:
         yield site
-
-
-def _example_tests():
-    spec = importlib.util.spec_from_file_location("example_tests", EXAMPLE / "tests" / "test_viscous_drag.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def test_plugin_page_is_the_example_package():
@@ -44,12 +35,12 @@ def test_plugin_page_is_the_example_package():
     assert {path for path, _ in blocks} >= {"gyrolab_viscous_drag/__init__.py", "pyproject.toml",
                                            "tests/test_viscous_drag.py"}
     for path, text in blocks:
-        assert text == (EXAMPLE / path).read_text(), f"README's block for {path} differs from the example's file"
+        assert text == (VISCOUS_DRAG / path).read_text(), f"README's block for {path} differs from the example's file"
 
 
 def test_new_force_scaffold_reproduces_the_example(tmp_path):
-    assert render("viscous_drag") == {p.relative_to(EXAMPLE).as_posix(): p.read_text()
-                                      for p in EXAMPLE.rglob("*") if p.is_file() and "__pycache__" not in p.parts}
+    assert render("viscous_drag") == {p.relative_to(VISCOUS_DRAG).as_posix(): p.read_text()
+                                      for p in VISCOUS_DRAG.rglob("*") if p.is_file() and "__pycache__" not in p.parts}
     root = new_force_package("tidal_lock", tmp_path)
     assert (root / "gyrolab_tidal_lock" / "__init__.py").read_text().count("class TidalLock(Force):") == 1
     assert 'tidal_lock = "gyrolab_tidal_lock:TidalLock"' in (root / "pyproject.toml").read_text()
@@ -60,7 +51,7 @@ def test_new_force_scaffold_reproduces_the_example(tmp_path):
 
 
 def test_example_package_passes_its_own_tests(installed_plugin):
-    tests = _example_tests()
+    tests = example_tests("gyrolab-viscous-drag", "test_viscous_drag.py")
     tests.test_contract()  # gyrolab.testing.check_force
     tests.test_bad_coefficient_is_one_sentence()
     for integrator in ("dop853", "dop853_numba"):  # exact solution ω0 exp(−c t), Python and compiled
@@ -75,7 +66,7 @@ def test_bad_parameter_is_one_config_error(installed_plugin):
 def test_external_force_runs_from_the_command_line(installed_plugin, cli, tmp_path):
     done = cli("force=[uniform_gravity,viscous_drag]", "force.viscous_drag.coefficient=0.2", "time.end=1",
                "time.n_output=11", "output.figures=false", "hydra.run.dir=out",
-               env_extra={"PYTHONPATH": f"{installed_plugin}:{EXAMPLE}"})
+               env_extra={"PYTHONPATH": f"{installed_plugin}:{VISCOUS_DRAG}"})
     assert done.returncode == 0, done.stderr
     import xarray as xr
 

@@ -8,7 +8,7 @@ from gyrolab.engine.config import compose_config
 from gyrolab.errors import ConfigError
 from gyrolab.experiments import run_task
 from gyrolab.experiments.regime_run import angles_from_states
-from tests.helpers import B1, overrides_000, overrides_001, run_case
+from tests.helpers.regimes import B1, overrides_000, overrides_001, run_case
 
 
 def test_regime_run_writes_a_self_describing_dataset_and_figure(tmp_path):

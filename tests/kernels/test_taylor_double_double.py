@@ -26,7 +26,7 @@ from gyrolab.kernels.layout import (
     CARRIES_ALPHA, GAMMA, GRADIENT, INERTIA, INV_INERTIA, LINEAR, N_PARAMS, N_X, N_Y, N_Z, OMEGA, U_X, U_Y, U_Z,
 )
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
-from tests.helpers import REPO
+from tests.helpers import VISCOUS_DRAG
 
 U2 = Fraction(1, 2 ** 104)  # "a unit of 2^-104": double-double's unit round-off is 2^-106
 RNG = np.random.default_rng(20261126)
@@ -463,11 +463,10 @@ def test_a_plugin_torque_runs_in_double_double_from_the_scene(tmp_path):
 
     from tests.conftest import installed_distribution
 
-    example = REPO / "examples" / "gyrolab-viscous-drag"
     common = ["force=[uniform_gravity,viscous_drag]", "integrator=taylor", "time.end=5", "time.n_output=2001",
               "output.figures=false"]
     with installed_distribution(tmp_path, "gyrolab-viscous-drag", "0.1",
-                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, paths=[example]):
+                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, paths=[VISCOUS_DRAG]):
         dd = compose_scene([*common, "integrator.precision=double-double", "integrator.tol=1e-28"]).run()
         double = compose_scene(common).run()
     np.testing.assert_allclose(dd.omega, double.omega, rtol=0, atol=1e-12)

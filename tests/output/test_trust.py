@@ -27,15 +27,9 @@ from gyrolab.output import trust
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.foreign import load_dataset, load_run
 from gyrolab.output.lock import LOCK_NAME, directory_lock, try_lock, unlock
+from tests.helpers import one_error_line
 
 SECRET = "the user's own file\n"
-
-
-def _one_sentence(done: subprocess.CompletedProcess, phrase: str) -> None:
-    assert done.returncode not in (0, None), done.stderr
-    assert "Traceback" not in done.stderr
-    errors = [line for line in done.stderr.splitlines() if line.startswith("gyrolab: error: ")]
-    assert len(errors) == 1 and phrase in errors[0], done.stderr
 
 
 @pytest.fixture(scope="module")
@@ -129,7 +123,7 @@ def test_an_atomic_write_never_replaces_a_device_or_a_link(tmp_path, victim):
 
 def test_aggregate_refuses_a_planted_lock_link_in_one_sentence(sweep, victim, cli):
     (sweep / LOCK_NAME).symlink_to(victim)
-    _one_sentence(cli("aggregate", str(sweep)), "is a symbolic link")
+    one_error_line(cli("aggregate", str(sweep)), "is a symbolic link")
     assert victim.read_text() == SECRET
 
 
@@ -137,7 +131,7 @@ def test_a_run_into_a_directory_with_a_linked_log_is_refused_before_anything(tmp
     run = tmp_path / "run"
     run.mkdir()
     (run / "gyrolab.log").symlink_to(victim)
-    _one_sentence(cli("time.end=1", f"hydra.run.dir={run}"), "gyrolab.log' is a symbolic link")
+    one_error_line(cli("time.end=1", f"hydra.run.dir={run}"), "gyrolab.log' is a symbolic link")
     assert victim.read_text() == SECRET
     assert sorted(p.name for p in run.iterdir()) == ["gyrolab.log"]
 
@@ -335,7 +329,7 @@ def test_a_second_different_sweep_is_refused_and_the_first_kept(sweep, cli):
     before = (sweep / "sweep.nc").read_bytes()
     done = cli("-m", "initial.r0=1,3", "time.end=1", "time.n_output=20", "output.figures=false",
                f"hydra.sweep.dir={sweep}")
-    _one_sentence(done, "holds another sweep")
+    one_error_line(done, "holds another sweep")
     assert (sweep / "sweep.nc").read_bytes() == before
     assert sorted(p.name for p in sweep.iterdir() if not p.name.startswith(".")) == ["0", "1", "multirun.yaml",
                                                                                     "sweep.nc"]

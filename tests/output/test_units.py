@@ -1,8 +1,8 @@
 """Every numeric variable and coordinate of every dataset kind has ``units`` and ``long_name`` (issue 25, item 4).
 
-The dataset kinds are the ones tests/output/test_cf.py builds (run.nc of both systems, multirun and --batch
-sweep.nc, regime.nc, every experiment's dataset, the stability map), small and fast, plus the orbiting
-gyrostat's experiment. Units follow CF: a UDUNITS string, ``"1"`` for a dimensionless number (counts, ratios,
+The dataset kinds are the ones tests/output/test_cf.py checks (tests/helpers/datasets.py: run.nc of both systems,
+multirun and --batch sweep.nc, regime.nc, every experiment's dataset, the stability map), small and fast, plus the
+orbiting gyrostat's experiment. Units follow CF: a UDUNITS string, ``"1"`` for a dimensionless number (counts, ratios,
 the nondimensional model quantities). Text variables carry a long_name only. A dimension without a
 coordinate must be explained by some variable along it (its long_name says what the index counts)
 or a global attribute ``<dim>_description``.
@@ -12,9 +12,7 @@ from __future__ import annotations
 
 import pytest
 
-pytest.importorskip("compliance_checker", reason="compliance-checker is not installed (pip install -e '.[test]')")
-
-from tests.output.test_cf import KINDS, _run  # noqa: E402
+from tests.helpers.datasets import KINDS, assembled_sweep, run_dataset
 
 
 
@@ -32,7 +30,7 @@ def _batch_output(output):
 
 
 #: the gyrostat experiment is a scene: its dataset is a run.nc of the orbiting gyrostat with its own options
-ALL_KINDS = {**KINDS, "gyrostat": _run(["experiment=gyrostat"]),
+ALL_KINDS = {**KINDS, "gyrostat": run_dataset(["experiment=gyrostat"]),
              **{f"sweep_batch_{output}": _batch_output(output) for output in ("decimated", "final")}}
 
 
@@ -60,17 +58,7 @@ SI_TOP = ["body.units=si", "body.a=null", "body.b=null", "body.com_direction=nul
 
 
 def _sweep_of(overrides, tail=("time.end=0.5", "time.n_output=5")):
-    from gyrolab import run
-    from gyrolab.sweep.aggregate import FINISHED, JobResult, assemble
-    from gyrolab.sweep.grid import Grid
-
-    grid = Grid.from_overrides([*overrides, "output.euler_angles=false", *tail, "output.figures=false"])
-    results = []
-    for n, job in enumerate(grid.jobs):
-        ds = run(list(job))
-        ds.attrs.update(hydra_overrides=" ".join(job), job_id=f"job{n}")
-        results.append(JobResult(FINISHED, ds, job_id=f"job{n}", job_dir=str(n)))
-    return assemble(grid, results)
+    return assembled_sweep([*overrides, "output.euler_angles=false", *tail, "output.figures=false"])
 
 
 def test_sweep_of_an_si_top_gives_swept_keys_and_per_job_attributes_their_physical_units():

@@ -1,8 +1,8 @@
 """The numeric Poincaré–Lindstedt series (gyrolab.physics.lindstedt) against independent truths.
 
 Truths: the corrected closed forms of seed 000 (report docs/derivations/seed000_large_parameter.md §5, derived by
-hand and checked against exact orbits in tests/plugins/regimes/test_small_parameter.py), the exact periodic orbits of the
-full model (Newton shooting, gyrolab.analysis.periodic), and the Lagrange top's steady precession, whose frequency
+hand and checked against exact orbits in tests/plugins/regimes/test_small_parameter.py), the exact periodic orbits of
+the full model (Newton shooting, gyrolab.analysis.periodic), and the Lagrange top's steady precession, whose frequency
 is known in closed form: aγ0''ψ̇² ∓ r0ψ̇ + 1 = 0 (c = 1), so Ω(ε) has its branch point at ε = 1/(2√(aγ0'')).
 """
 
@@ -13,18 +13,11 @@ from gyrolab.analysis.lindstedt_check import error_ladder, exact_orbit, series_e
 from gyrolab.physics.lindstedt import Body, series
 from gyrolab.plugins.regimes import ismail2021 as paper
 
-from tests.helpers import slope
+from tests.helpers.regimes import slope, taylor_coefficients
 
 Z0 = float(np.sqrt(1 - 0.34))
 BODY_I = Body(a=2.0, b=1.5, x0=0.5, y0=0.3, z0=Z0, k=0.3)  # report 000's body I
 GAMMA = 0.5  # seed 000's scaling γ0'' = Γε (eq. 28), Γ of report 000
-
-
-def _taylor(f, k_max, radius=0.05, points=32):
-    """Taylor coefficients 0..k_max in ε of f(ε) (arrays) by the Cauchy integral on |ε| = radius."""
-    theta = 2 * np.pi * np.arange(points) / points
-    values = np.array([f(radius * np.exp(1j * t)) for t in theta])
-    return [np.mean(values * np.exp(-1j * k * theta)[:, None, None], axis=0) / radius**k for k in range(k_max + 1)]
 
 
 def test_orders_three_and_four_reproduce_the_corrected_closed_forms():
@@ -39,8 +32,8 @@ def test_orders_three_and_four_reproduce_the_corrected_closed_forms():
         S = paper.scaled(tau, P)
         return np.stack([S[k] for k in ("p1", "q1", "r1", "g1", "g2", "g3")], axis=-1)
 
-    ours = _taylor(lambda e: sol.scaled(e, tau, 4), 3)
-    theirs = _taylor(closed, 3)
+    ours = taylor_coefficients(lambda e: sol.scaled(e, tau, 4), 4)
+    theirs = taylor_coefficients(closed, 4)
     for k in range(4):
         columns = slice(0, 6) if k < 3 else slice(2, 6)
         assert np.max(np.abs(ours[k][:, columns] - theirs[k][:, columns])) < 1e-10, k

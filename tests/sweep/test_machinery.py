@@ -20,7 +20,7 @@ from gyrolab.sweep.identity import job_identity
 from gyrolab.sweep.job import run_sweep_job
 from gyrolab.sweep.record import FAILED, read_record
 from gyrolab.sweep.watch import SweepWatcher
-from tests.helpers import REPO
+from tests.helpers import VISCOUS_DRAG
 
 TINY = ["time.end=1", "time.n_output=11", "output.figures=false"]
 
@@ -87,7 +87,6 @@ def test_identity_covers_the_plugins_a_job_names_not_every_installed_package(tmp
     from gyrolab.output import provenance
     from gyrolab.sweep import identity
 
-    example = REPO / "examples" / "gyrolab-viscous-drag"
     plain = compose_config(["body.a=2"])
     before = job_identity(plain)
 
@@ -95,7 +94,7 @@ def test_identity_covers_the_plugins_a_job_names_not_every_installed_package(tmp
         site = tmp_path / version
         site.mkdir()
         return installed_distribution(site, "gyrolab-viscous-drag", version,
-                                      {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [example])
+                                      {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [VISCOUS_DRAG])
 
     with installed("0.1.0"):
         provenance.provenance.cache_clear()   # as a new process sees it: the plugin is installed
@@ -111,7 +110,7 @@ def test_identity_covers_the_plugins_a_job_names_not_every_installed_package(tmp
         assert job_identity(drag) != with_drag
         assert job_identity(plain) == before
     editable = tmp_path / "checkout"            # an editable install's new commit, its version unchanged
-    shutil.copytree(example, editable)
+    shutil.copytree(VISCOUS_DRAG, editable)
     (tmp_path / "site-e").mkdir()
     with installed_distribution(tmp_path / "site-e", "gyrolab-viscous-drag", "0.1.0",
                                 {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [editable]):

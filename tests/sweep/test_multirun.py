@@ -19,25 +19,17 @@ import pytest
 import xarray as xr
 import yaml
 
+from tests.helpers import (
+    CODE_DEPENDENT_ATTRS,
+    CODE_DEPENDENT_VARIABLES,
+    VOLATILE_ATTRS,
+    VOLATILE_VARIABLES,
+    gyrolab,
+    load,
+)
+
 # A 2 × 2 sweep of tiny scenes; a = 3 breaks the triangle inequality (3 > 1.5 + 1), so 2 jobs fail.
 SWEEP = ["integrator=rk4,dop853", "body.a=1.5,3", "time.end=1", "time.n_output=11", "output.figures=false"]
-# What legitimately differs between two runs of the same sweep: the time things took, when the file
-# was written and which launcher ran the jobs. Nothing else may differ.
-VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
-VOLATILE_VARIABLES = ("integrator_wall_time",)
-# ... unless someone edits the source tree between the two runs (other people work in this tree):
-# then the code version, and with it every job id, differs too, and correctly so.
-CODE_DEPENDENT_ATTRS = ("git_commit", "git_dirty", "git_diff_sha256")
-CODE_DEPENDENT_VARIABLES = ("job_id",)
-
-
-def gyrolab(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "gyrolab", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=300)
-
-
-def load(path):
-    return xr.load_dataset(path, decode_times=False, decode_timedelta=False)
 
 
 def code_versions(sweep_dir):

@@ -25,7 +25,15 @@ import pytest
 import xarray as xr
 
 from gyrolab.sweep import slurm_local
-from tests.helpers import REPO
+from tests.helpers import (
+    CODE_DEPENDENT_ATTRS,
+    CODE_DEPENDENT_VARIABLES,
+    REPO,
+    VOLATILE_ATTRS,
+    VOLATILE_VARIABLES,
+    gyrolab,
+    load,
+)
 
 pytestmark = [pytest.mark.slurm, pytest.mark.slow]  # a real cluster: end to end, seconds per test
 
@@ -33,11 +41,6 @@ pytestmark = [pytest.mark.slurm, pytest.mark.slow]  # a real cluster: end to end
 DOCS = REPO / "docs" / "cluster.md"
 # set (to anything but 0) where the SLURM tests must run, e.g. in CI: then a cluster that cannot start fails them
 REQUIRED = "GYROLAB_REQUIRE_SLURM"
-# What legitimately differs between two runs of the same command: when, how long, which launcher.
-VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
-VOLATILE_VARIABLES = ("integrator_wall_time",)
-# ... and what follows the source tree (attributes, or variables when a sweep's jobs ran under several versions)
-CODE_DEPENDENT = ("git_commit", "git_dirty", "git_diff_sha256", "job_id")
 
 
 @pytest.fixture(scope="module")
@@ -76,11 +79,10 @@ def commands(name):
     return [shlex.split(line) for line in recipe(name).splitlines() if line.strip()]
 
 
-def gyrolab(command, cwd):
+def run_line(command, cwd):
     """A recipe line ``gyrolab ...``, run with this Python (this venv's gyrolab)."""
     assert command[0] == "gyrolab", command
-    return subprocess.run([sys.executable, "-m", "gyrolab", *command[1:]], cwd=cwd, capture_output=True,
-                          text=True, timeout=300)
+    return gyrolab(*command[1:], cwd=cwd)
 
 
 @contextlib.contextmanager
@@ -106,8 +108,8 @@ def assert_same_dataset(ran, expected):
     """The dataset at ``ran`` equals the one at ``expected`` exactly (values, coordinates, attributes), except
     for what says when and how long, and the code's provenance (git_*, job_id) where it differs: the working
     tree changed between the two runs (someone editing it meanwhile)."""
-    a, b = (xr.load_dataset(p, decode_times=False, decode_timedelta=False) for p in (ran, expected))
-    provenance = [k for k in CODE_DEPENDENT if a.attrs.get(k) != b.attrs.get(k)
+    a, b = (load(p) for p in (ran, expected))
+    provenance = [k for k in (*CODE_DEPENDENT_ATTRS, *CODE_DEPENDENT_VARIABLES) if a.attrs.get(k) != b.attrs.get(k)
                   or (k in a.variables and k in b.variables and not a[k].equals(b[k]))]
     for ds in (a, b):
         ds.attrs = {k: v for k, v in ds.attrs.items() if k not in VOLATILE_ATTRS and k not in provenance}
@@ -125,10 +127,10 @@ def test_the_cluster_runs_a_job(slurm):
 def test_submitit_launcher_sweep_equals_the_local_sweep(slurm, tmp_path):
     local, on_slurm = commands("sweep")
     assert "hydra/launcher=slurm" in on_slurm and f"hydra.launcher.partition={slurm.partition}" in on_slurm
-    done = gyrolab(local, tmp_path)
+    done = run_line(local, tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
     began = time.monotonic()
-    done = gyrolab(on_slurm, tmp_path)
+    done = run_line(on_slurm, tmp_path)
     print(f"slurm: the sweep through submitit took {time.monotonic() - began:.1f} s")
     assert done.returncode == 0, done.stderr[-3000:] + slurm.logs()
     sweep = tmp_path / "slurm"
@@ -141,7 +143,7 @@ def test_submitit_launcher_sweep_equals_the_local_sweep(slurm, tmp_path):
 def test_dask_jobqueue_batch_equals_the_local_batch(slurm, tmp_path, monkeypatch):
     local, on_slurm = commands("batch")
     assert on_slurm[:2] == ["python", "slurm_batch.py"]
-    done = gyrolab(local, tmp_path)
+    done = run_line(local, tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
     # python slurm_batch.py ..., in this process, so that the test can ask its Dask scheduler what ran
     monkeypatch.chdir(tmp_path)   # SLURM writes the workers' slurm-JOBID.out here

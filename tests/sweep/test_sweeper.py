@@ -7,31 +7,19 @@ every job Hydra launches in that directory), the run.nc files and job records th
 
 import json
 import shutil
-import sys
 from pathlib import Path
 
 import xarray as xr
 
 from gyrolab.sweep.sweeper import launch_runs
-from tests.helpers import REPO
+from tests.helpers import VISCOUS_DRAG, gyrolab_in_process, load
 
 # 2 × 2 tiny scenes: a config-group dimension (integrator) and a value dimension (body.a); all finish.
 SWEEP = ["integrator=rk4,dop853", "body.a=1.5,1.2", "time.end=1", "time.n_output=11", "output.figures=false"]
 
 
-def gyrolab_in_process(monkeypatch, *args):
-    from gyrolab import app
-
-    monkeypatch.setattr(sys, "argv", ["gyrolab", *args])
-    try:
-        app.main()
-    except SystemExit as stop:
-        return stop.code
-    return 0
-
-
 def comparable(path):
-    ds = xr.load_dataset(path, decode_times=False, decode_timedelta=False)
+    ds = load(path)
     for key in ("date_created", "history"):
         ds.attrs.pop(key, None)
     return ds.drop_vars(["integrator_wall_time"])
@@ -102,11 +90,10 @@ def test_a_finished_sweep_and_batch_resume_after_an_unrelated_plugin_is_installe
     batch_before = (tmp_path / "batch" / "sweep.nc").read_bytes()
 
     # `pip install gyrolab-viscous-drag` between the run and its resume: a plugin no job names
-    example = REPO / "examples" / "gyrolab-viscous-drag"
     site = tmp_path / "site"
     site.mkdir()
     with installed_distribution(site, "gyrolab-viscous-drag", "0.1.0",
-                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [example]):
+                                {"viscous_drag": "gyrolab_viscous_drag:ViscousDrag"}, [VISCOUS_DRAG]):
         provenance.provenance.cache_clear()   # what a new process sees
         identity._plugin_code.cache_clear()
         assert "gyrolab-viscous-drag==0.1.0" in provenance.provenance()["plugin_packages"]

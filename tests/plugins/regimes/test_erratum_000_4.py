@@ -12,17 +12,10 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from gyrolab.plugins.regimes import ismail2021 as paper
-from tests.helpers import GAMMA_000, slope
+from tests.helpers.regimes import GAMMA_000, slope, taylor_coefficients
 
 BODY_I = paper.Params(a=2.0, b=1.5, x0=0.5, y0=0.3, z0=0.8124, k=0.3, mu=1.0, g0=0.37)  # A > B > C
 BODY_II = paper.Params(a=0.65, b=0.85, x0=-0.4, y0=0.6, z0=0.6928, k=0.8, mu=1.0, g0=0.55)  # A < B < C
-
-
-def _taylor(fun, n=4, rho=0.05, m=32):
-    """Taylor coefficients 0..n−1 of an analytic fun(ε) by the Cauchy integral on |ε| = ρ (trapezoid rule)."""
-    th = 2 * np.pi * np.arange(m) / m
-    vals = np.array([fun(rho * np.exp(1j * t)) for t in th])
-    return [(np.mean(vals * np.exp(-1j * k * th)[:, None], axis=0) / rho**k).real for k in range(n)]
 
 
 def _full_model_coefficients(body, Z, Z0):
@@ -34,7 +27,7 @@ def _full_model_coefficients(body, Z, Z0):
         p2dd = (dd[0] - eps * P.chi1 * dd[3]) / (1 - eps**2 * P.chi1 * P.a * P.g0)  # (9) inverted
         return np.array([p2dd + P.omega2 * Z[0], dd[3] - eps * P.a * P.g0 * p2dd + Z[2]])
 
-    return _taylor(residual)
+    return taylor_coefficients(residual, 4, real=True)
 
 
 @pytest.mark.parametrize("body", [BODY_I, BODY_II], ids=["body_I", "body_II"])

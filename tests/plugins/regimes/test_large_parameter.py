@@ -19,7 +19,7 @@ from gyrolab.analysis.periodic import FixedPointModel
 from gyrolab.plugins.regimes import ismail2021 as paper
 from gyrolab.plugins.regimes.base import nondimensional_scene
 from gyrolab.plugins.regimes.large_parameter import _sample, printed_reading_state, series_for
-from tests.helpers import BODY_000, GAMMA_000
+from tests.helpers.regimes import BODY_000, GAMMA_000
 
 # Seed 000's body I inertia (a = 2, b = 1.5, k = 0.3) with the centre of mass moved onto the z axis, swing 1 rad.
 PENDULUM = ["regime=large_parameter", "body.com_direction=[0,0,1]", "force.newtonian.k=0.3",

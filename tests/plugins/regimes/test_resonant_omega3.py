@@ -12,7 +12,7 @@ from gyrolab.engine.config import compose_config
 from gyrolab.errors import ConfigError
 from gyrolab.experiments.regime_run import errors, prepare
 from gyrolab.plugins.regimes import shaker_omega3 as paper
-from tests.helpers import B1, B2, overrides_001, run_case, slope
+from tests.helpers.regimes import B1, B2, overrides_001, run_case, slope
 
 MUS = (0.05, 0.035, 0.025)
 

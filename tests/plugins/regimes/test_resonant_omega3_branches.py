@@ -17,7 +17,7 @@ from gyrolab.experiments.regime_run import errors
 from gyrolab.analysis.periodic import FixedPointModel, shoot
 from gyrolab.plugins.regimes import shaker_omega3 as paper
 from gyrolab.plugins.regimes.resonant_omega3 import ResonantOmega3
-from tests.helpers import B1, overrides_001, run_case, slope
+from tests.helpers.regimes import B1, overrides_001, run_case, slope
 
 B3 = dict(a=0.4, b=1 / 7, rc=(0.48, 0.36, -0.8), k=2.0, theta0=np.pi / 3)
 MODEL = FixedPointModel(np.array([B3["a"], B3["b"], 1.0]), np.array(B3["rc"]), B3["k"])

@@ -14,12 +14,13 @@ from gyrolab.errors import ConfigError
 from gyrolab.experiments.regime_run import errors, exact_orbit, integrate, prepare, with_alpha
 from gyrolab.plugins.regimes import ismail2021 as paper
 
-from tests.helpers import (
+from tests.helpers.regimes import (
     BODY_000,
     GAMMA_000,
     overrides_000,
     run_case,
     slope,
+    taylor_coefficients,
 )
 
 MUS = (16.0, 32.0, 64.0)
@@ -133,13 +134,6 @@ from scipy.integrate import solve_ivp  # noqa: E402
 BODY_I = paper.Params(a=2.0, b=1.5, x0=0.5, y0=0.3, z0=0.8124, k=0.3, mu=1.0, g0=0.37)
 
 
-def _taylor(fun, n=4, rho=0.05, m=32):
-    """Taylor coefficients 0..n−1 of an analytic fun(ε) by the Cauchy integral on |ε| = ρ (trapezoid rule)."""
-    th = 2 * np.pi * np.arange(m) / m
-    vals = np.array([fun(rho * np.exp(1j * t)) for t in th])
-    return [(np.mean(vals * np.exp(-1j * k * th)[:, None], axis=0) / rho**k).real for k in range(n)]
-
-
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_erratum_000_2_eq7_k_term_sign(seed):
     # γ̈ + γ of the full model (eq. 1 = the full equations rescaled, differentiated along the flow) expanded in ε:
@@ -151,7 +145,7 @@ def test_erratum_000_2_eq7_k_term_sign(seed):
         Y = paper.state_from_integrals(p1, q1, g1, g2, s2, s3, P)
         return np.array([paper.flow_derivative(Y, P)[1][3] + Y[3]])
 
-    c = [float(v[0]) for v in _taylor(residual)]
+    c = [float(v[0]) for v in taylor_coefficients(residual, 4, real=True)]
     assert abs(c[0]) < 1e-12 and c[1] == pytest.approx(BODY_I.g0 * p1 * (1 + BODY_I.B1), abs=1e-10)
     corrected = paper.eq7_gamma_mu2(p1, q1, g1, g2, s2, s3, BODY_I)
     printed = paper.eq7_gamma_mu2(p1, q1, g1, g2, s2, s3, BODY_I, printed=True)
@@ -174,7 +168,7 @@ def test_erratum_000_3_eq14_phi2(seed):
         back = paper.reduced_from_scaled(Y, P) - Z  # the change of variables round-trips exactly
         return np.array([p2dd + P.omega2 * Z[0], dd[3] - eps * P.a * P.g0 * p2dd + Z[2], *back])
 
-    c = _taylor(residual)
+    c = taylor_coefficients(residual, 4, real=True)
     assert np.max(np.abs(np.array(c[:2])[:, :2])) < 1e-12
     assert np.max(np.abs(np.array(c)[:, 2:])) < 1e-11
     F2, Phi2 = paper.eq14_F2_Phi2(Z, Z0, BODY_I)
@@ -213,7 +207,7 @@ def test_reduced_system_14_truncated_after_mu2_against_the_full_model():
 
 
 def test_reduced_rhs_is_exposed_on_the_plugin():
-    from tests.helpers import run_case
+    from tests.helpers.regimes import run_case
 
     scene, regime, t, result = run_case(overrides_000(32.0))
     rhs, Z0, to_model = regime.reduced_rhs(scene.system)

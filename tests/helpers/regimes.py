@@ -1,20 +1,14 @@
-"""Helpers shared by several test modules (fixtures and the context managers tests enter like fixtures are in
-conftest.py).
+"""Shared set-up of the regime tests: the research's test bodies, error fits against exact orbits, and Taylor
+coefficients in ε by the Cauchy integral.
 
-The regime set-ups below are the research's test bodies and error fits against exact orbits: every expected number
-comes from the papers, from physics (the exact periodic orbit of the full model, found by shooting) or from the
-independent verification reports in docs/derivations/, never from the regime code under test.
+Every expected number comes from the papers, from physics (the exact periodic orbit of the full model, found by
+shooting) or from the independent verification reports in docs/derivations/, never from the regime code under test.
 """
-
-from pathlib import Path
 
 import numpy as np
 
 from gyrolab.engine.config import compose_config
 from gyrolab.experiments.regime_run import compute, prepare
-
-#: the checkout: pyproject.toml, conf/, docs/, examples/, benchmarks/
-REPO = Path(__file__).resolve().parent.parent
 
 # Seed 000 report, body I: a = 2, b = 1.5, r_c = (0.5, 0.3, 0.8124), k = 0.3, Γ = μγ0'' = 0.5.
 BODY_000 = ["body.a=2.0", "body.b=1.5", f"body.com_direction=[0.5,0.3,{float(np.sqrt(1 - 0.34))!r}]",
@@ -48,3 +42,13 @@ def run_case(overrides, samples=240, full=False):
 
 def slope(x, y):
     return float(np.polyfit(np.log(x), np.log(y), 1)[0])
+
+
+def taylor_coefficients(f, count, radius=0.05, points=32, real=False):
+    """Taylor coefficients 0..count−1 in ε of an analytic f(ε) (an array of any shape) by the Cauchy integral on
+    |ε| = radius (trapezoid rule); their real parts when ``real``."""
+    theta = 2 * np.pi * np.arange(points) / points
+    values = np.array([f(radius * np.exp(1j * t)) for t in theta])
+    along = (-1,) + (1,) * (values.ndim - 1)   # the weights along the points, broadcast over f's shape
+    coefficients = [np.mean(values * np.exp(-1j * k * theta).reshape(along), axis=0) / radius**k for k in range(count)]
+    return [c.real for c in coefficients] if real else coefficients
