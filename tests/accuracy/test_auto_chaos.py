@@ -11,19 +11,8 @@ import pytest
 
 from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
-from gyrolab.physics.reference import fixed_point_reference
 from gyrolab.kernels import layout
-
-SLOW_SPIN = ["initial=slow_spin"]
-CHAOTIC_TOP = ["initial.theta0=1", "initial.r0=2", "initial.p0=0.3", "initial.q0=-0.2"]
-
-
-def _reference(overrides):
-    scene = compose_scene(["integrator=taylor", "time.n_output=2", *overrides])
-    p = scene.system.compiled_model().built_in
-    return fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3], p[layout.N_Z],
-                                 scene.system.initial_state()[:6], scene.times[[0, -1]])[-1].astype(float)
-
+from tests.helpers.accuracy import CHAOTIC_TOP, SLOW_SPIN, long_double_final
 
 @pytest.mark.parametrize("scene, end, accuracy", [
     (SLOW_SPIN, 150.0, 1e-6), (SLOW_SPIN, 150.0, 1e-9), (CHAOTIC_TOP, 110.0, 1e-7), (CHAOTIC_TOP, 110.0, 1e-9),
@@ -32,7 +21,7 @@ def test_auto_on_a_chaotic_scene_keeps_its_promise_or_refuses(scene, end, accura
     """With its default (``integrator.extended_precision=true``) auto climbs to double-double where double precision
     cannot keep ε; it refuses only what double-double cannot reach either."""
     overrides = [*scene, f"time.end={end}"]
-    truth = _reference(overrides)
+    truth = long_double_final(overrides)
     try:
         ds = compose_scene(["integrator=auto", f"accuracy={accuracy}", "time.n_output=2", *overrides]).run()
     except ConfigError as error:
@@ -69,7 +58,7 @@ def test_extended_precision_meets_what_double_precision_refuses():
     # allow it); by default auto runs the double-double Taylor method and ends below ε and its bound (long-double
     # reference: error ~1e-12 here)
     overrides = [*CHAOTIC_TOP, "time.end=110"]
-    truth = _reference(overrides)
+    truth = long_double_final(overrides)
     with pytest.raises(ConfigError, match="integrator.extended_precision=true"):
         compose_scene(["integrator=auto", "accuracy=1e-9", "integrator.extended_precision=false", "time.n_output=2",
                        *overrides]).run()

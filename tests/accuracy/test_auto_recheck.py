@@ -10,7 +10,7 @@ import pytest
 
 from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
-from tests.accuracy.test_auto_chaos import CHAOTIC_TOP, _reference
+from tests.helpers.accuracy import CHAOTIC_TOP, long_double_final, no_growth
 
 
 @pytest.mark.parametrize("estimate", ["true", "false"])
@@ -23,7 +23,7 @@ def test_a_pilot_of_a_few_clipped_steps_no_longer_breaks_the_promise(accuracy, e
     theta0 = float(np.arccos(0.5 / 32.0))
     overrides = ["body.a=2.0", "body.b=1.5", "force.newtonian.k=0.3", "initial.r0=32.0", f"initial.theta0={theta0!r}",
                  "initial.p0=0.3", "initial.q0=0.0", "time.end=0.25", "time.n_output=6"]
-    truth = _reference(overrides)
+    truth = long_double_final(overrides)
     ds = compose_scene(["integrator=auto", f"accuracy={accuracy}", f"output.error_estimate={estimate}",
                         *overrides]).run()
     final = np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
@@ -32,24 +32,13 @@ def test_a_pilot_of_a_few_clipped_steps_no_longer_breaks_the_promise(accuracy, e
     assert "auto_measured_error_before_recheck" not in ds.attrs  # the first run kept it
 
 
-def _no_growth(monkeypatch):
-    """auto's amplification measured as none: its prediction then misses the chaos (as a tangent run whose growth
-    scatters low would make it miss)."""
-    import gyrolab.accuracy.auto as auto_module
-    from gyrolab.accuracy.amplification import Amplification
-
-    monkeypatch.setattr(auto_module, "amplification",
-                        lambda compiled, fun, y0, t0, t_pilot, t_end, method: Amplification(0.0, 0.0, t_end - t0,
-                                                                                           "none (test)"))
-
-
 def test_a_run_whose_measured_error_breaks_the_prediction_is_run_again_more_accurately(monkeypatch):
     # rule 11: with no amplification the chaotic top at t = 110 ends with 2e-6 where 1e-6 is asked and predicted;
     # the error estimate measures it and auto runs its method again, more accurately, keeping the promise against
     # the long-double reference
-    _no_growth(monkeypatch)
+    no_growth(monkeypatch)
     overrides = [*CHAOTIC_TOP, "time.end=110"]
-    truth = _reference(overrides)
+    truth = long_double_final(overrides)
     ds = compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", *overrides]).run()
     final = np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
     actual = float(np.max(np.abs(final - truth)))
@@ -62,9 +51,9 @@ def test_a_run_whose_measured_error_breaks_the_prediction_is_run_again_more_accu
 def test_without_the_error_estimate_nothing_catches_a_prediction_that_misses(monkeypatch):
     # the same scene with output.error_estimate=false: the safety net above is the measurement, so the broken
     # prediction stands (what this test shows is why the estimate is on by default for auto)
-    _no_growth(monkeypatch)
+    no_growth(monkeypatch)
     overrides = [*CHAOTIC_TOP, "time.end=110"]
-    truth = _reference(overrides)
+    truth = long_double_final(overrides)
     ds = compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", "output.error_estimate=false",
                         *overrides]).run()
     final = np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
@@ -75,7 +64,7 @@ def test_without_the_error_estimate_nothing_catches_a_prediction_that_misses(mon
 def test_a_promise_the_reruns_cannot_keep_is_one_sentence(monkeypatch):
     import gyrolab.accuracy.promise as promise_module
 
-    _no_growth(monkeypatch)
+    no_growth(monkeypatch)
     monkeypatch.setattr(promise_module, "MAX_RECHECKS", 0)
     with pytest.raises(ConfigError) as refused:
         compose_scene(["integrator=auto", "accuracy=1e-6", "time.n_output=2", *CHAOTIC_TOP, "time.end=110"]).run()
@@ -93,7 +82,7 @@ def test_the_recheck_compares_every_output_time(monkeypatch):
     # and sends the run again; the answer is then within ε at every output time against the double-double reference
     import gyrolab.accuracy.promise as promise
 
-    _no_growth(monkeypatch)
+    no_growth(monkeypatch)
     compare = promise.estimate.compare
 
     def final_hidden(*args, **kwargs):

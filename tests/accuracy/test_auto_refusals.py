@@ -16,8 +16,7 @@ import pytest
 
 from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
-from tests.accuracy.test_auto_chaos import CHAOTIC_TOP, SLOW_SPIN
-from tests.accuracy.test_auto_recheck import _no_growth
+from tests.helpers.accuracy import CHAOTIC_TOP, SLOW_SPIN, no_growth
 
 NO_CLIMB = "integrator.extended_precision=false"
 #: (scene overrides, the refusal's kind as the sentence says it, the advice it must give)
@@ -78,7 +77,7 @@ def test_a_recheck_refusal_gives_advice_that_works(monkeypatch):
     # target the measurement shows reachable, and the same scene (its prediction still missing the chaos) meets it
     import gyrolab.accuracy.promise as promise
 
-    _no_growth(monkeypatch)
+    no_growth(monkeypatch)
     overrides = [*CHAOTIC_TOP, "accuracy=1e-6", "time.end=110", "time.n_output=12"]
     with monkeypatch.context() as no_rerun:
         no_rerun.setattr(promise, "MAX_RECHECKS", 0)

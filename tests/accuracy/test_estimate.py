@@ -5,19 +5,16 @@ import numpy as np
 import pytest
 
 from gyrolab import run
-from gyrolab.physics.reference import fixed_point_reference
-from gyrolab.kernels import layout
 from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
+from tests.helpers.accuracy import ROUND_OFF, long_double_states
 
 SCENE = ["experiment=perf_reference", "time.end=60", "time.n_output=31", "output.euler_angles=false"]
 
 
 def _actual(ds, overrides):
     scene = compose_scene(overrides)
-    p = scene.system.compiled_model().built_in
-    truth = fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3], p[layout.N_Z],
-                                  scene.system.initial_state()[:6], scene.times).astype(float)
+    truth = long_double_states(scene, scene.times)
     states = np.concatenate([ds.omega.values, ds.gamma.values], axis=1)
     return np.abs(states - truth)
 
@@ -87,11 +84,7 @@ def test_near_the_floor_where_truncation_dominates_double_companions_measure_it(
 #: benchmarks/promise_audit.py's scene where round-off dominates (tests/accuracy/test_promise_audit.py checks it against
 #: heyoka in real128): asked 1e-12, auto chose Taylor at tol 1.5e-16 and ended 2.1e-12 away while the old stand-in
 #: companion (Taylor at tol 1e-16, in double) measured 1.7e-14
-ROUND_OFF_SCENE = ["body.a=0.7046", "body.b=1.4132",
-                   "body.com_direction=[-0.8673026531207482,-0.4887282266173314,-0.09450306025304023]",
-                   "force=[uniform_gravity]", "initial.theta0=2.67839", "initial.phi0=1.08408", "initial.psi0=2.71915",
-                   "initial.r0=0.171348", "initial.p0=-0.2898", "initial.q0=0.08809", "time.end=54.48",
-                   "time.n_output=51", "output.euler_angles=false"]
+ROUND_OFF_SCENE = [*ROUND_OFF, "time.n_output=51", "output.euler_angles=false"]
 
 
 def test_near_the_taylor_floor_the_estimate_measures_amplified_round_off():

@@ -7,9 +7,8 @@ import numpy as np
 import pytest
 
 from gyrolab import compose_scene
-from gyrolab.physics.reference import fixed_point_reference
-from gyrolab.kernels import layout
 from tests.helpers import REPO
+from tests.helpers.accuracy import ROUND_OFF, long_double_states
 
 hy = pytest.importorskip("heyoka")
 
@@ -38,9 +37,7 @@ def test_the_real128_reference_agrees_with_the_long_double_one(reference):
     numpy long-double Taylor method) agree to long double's accuracy on a scene with both torques."""
     scene = compose_scene(["integrator=taylor", "force=[uniform_gravity,newtonian]", "initial.theta0=0.7",
                            "initial.r0=3", "time.end=20", "time.n_output=11"])
-    p = scene.system.compiled_model().built_in
-    long_double = fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3],
-                                        p[layout.N_Z], scene.system.initial_state()[:6], scene.times).astype(float)
+    long_double = long_double_states(scene, scene.times)
     real128 = reference.states(scene)
     assert real128.shape == (11, 9)  # ω, γ and the fixed horizontal axis α (output.euler_angles)
     np.testing.assert_allclose(real128[:, :6], long_double, rtol=0, atol=1e-13)
@@ -65,11 +62,7 @@ def test_auto_keeps_its_promise_on_the_audit_scene(reference, accuracy):
 #: predicted 1e-12; the motion amplifies perturbations ~2,700× after the pilot (below auto's chaos threshold, so its
 #: round-off estimate was not amplified) and the run ended 2.1e-12 from the real128 answer. The error estimate's
 #: stand-in companion, Taylor at tol 1e-16 in double, differed from the run by 1.7e-14: the broken promise went unseen
-ROUND_OFF_SCENE = ["body.a=0.7046", "body.b=1.4132",
-                   "body.com_direction=[-0.8673026531207482,-0.4887282266173314,-0.09450306025304023]",
-                   "force=[uniform_gravity]", "initial.theta0=2.67839", "initial.phi0=1.08408", "initial.psi0=2.71915",
-                   "initial.r0=0.171348", "initial.p0=-0.2898", "initial.q0=0.08809", "time.end=54.48",
-                   "time.n_output=101"]
+ROUND_OFF_SCENE = [*ROUND_OFF, "time.n_output=101"]
 
 
 def _error(ds, truth):
