@@ -1,23 +1,16 @@
 import contextlib
 import os
-import sys
-from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parent.parent
+from tests.helpers import gyrolab
 
 
 @pytest.fixture
 def cli(tmp_path):
     """Run the real ``gyrolab`` command in a subprocess (cwd = tmp_path)."""
-    import subprocess
-
     def _run(*args, env_extra=None):
-        env = dict(os.environ)
-        env.update(env_extra or {})
-        return subprocess.run([sys.executable, "-m", "gyrolab", *args], cwd=tmp_path, env=env,
-                              capture_output=True, text=True, timeout=300)
+        return gyrolab(*args, cwd=tmp_path, env={**os.environ, **(env_extra or {})})
 
     return _run
 
