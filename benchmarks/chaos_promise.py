@@ -21,7 +21,7 @@ from gyrolab import compose_scene
 from gyrolab.errors import ConfigError
 from real128_reference import reference  # benchmarks/: the script's own directory
 
-#: scenes not used by the tests (tests/test_auto_chaos.py has its own)
+#: scenes not used by the tests (tests/accuracy/test_auto_chaos.py has its own)
 SCENES = {
     "slow_spin t=300 (issue 22)": ["initial=slow_spin", "time.end=300"],
     "chaotic top t=200 (stability map)": ["initial.theta0=1", "initial.r0=2", "initial.p0=0.3", "initial.q0=-0.2",

@@ -376,7 +376,7 @@ def run_breakdown(rounds, quick):
 
 def calibration(reference):
     """Actual / raw predicted final error of ``integrator=auto`` (``auto_raw_predicted_error``: before CALIBRATION
-    and round-off) over the extremes matrix of ``tests/test_extremes.py`` and the reference scene, accuracies 1e-3 to
+    and round-off) over the extremes matrix of ``tests/accuracy/test_extremes.py`` and the reference scene, accuracies 1e-3 to
     1e-13: the measurement behind ``gyrolab.accuracy.calibration.CALIBRATION``, reported against the table. Extremes scenes are judged
     against Taylor at tol 1e-17 (ratios marked * are within 100× of its disagreement with compiled DOP853 at 1e-13,
     i.e. not measured); the reference scene against the extended-precision reference."""

@@ -1,7 +1,7 @@
 """gyrolab: reproducible experiments on rigid-body and satellite attitude dynamics.
 
 The package's folders are its architecture, in layers: each imports only the
-layers below it (``tests/test_layers.py`` checks it, function-level imports
+layers below it (``tests/package/test_layers.py`` checks it, function-level imports
 included):
 
 1. ``errors``       the one-sentence errors every layer raises

@@ -10,7 +10,7 @@ Kept for their measured gain (``gyrolab`` with and without each, best of 3, CPU 
   group choices, with Hydra's functions in Hydra's order, and serves each request from a copy: the value
   overrides applied with Hydra's function, the ``hydra`` node filled by a copy of the tail of Hydra 1.3's
   ``_load_configuration_impl``; a request Hydra classifies otherwise is Hydra's own. Gain: 0.16 s of a 1.9 s
-  run, ~85 ms a sweep job. ``tests/test_sweep_composition.py`` compares both paths for every job of sweeps.
+  run, ~85 ms a sweep job. ``tests/compat/test_composing_once.py`` compares both paths for every job of sweeps.
 * :func:`install_dask_free_writes` (xarray ``XARRAY_SUPPORTED``): with Dask installed, ``to_netcdf`` imports
   ``dask.array`` and ``distributed`` for any dataset only to learn that nothing in it is Dask's. Gain: 0.45 s
   of every run and sweep with the ``test`` or ``cluster`` extra (none on the bare install).

@@ -21,7 +21,7 @@ experiments). It makes the netCDF file a CF-1.8 file without changing what the d
   be false, so it stays (docs/datasets.md);
 * every variable and coordinate has a ``long_name`` (CF §3.3 wants one where there is no
   ``standard_name``): one a builder forgot (a third-party system's variable, say) becomes the
-  variable's name, logged; gyrolab's own builders give real ones (tests/test_cf_compliance.py).
+  variable's name, logged; gyrolab's own builders give real ones (tests/output/test_cf.py).
 
 ``unit_attributes(body)`` gives the machine-readable scales of a body's model units (global
 attributes ``time_unit``, ``energy_unit``, ``rate_unit`` and, for an SI fixed-point body, the

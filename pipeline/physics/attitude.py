@@ -127,7 +127,7 @@ def unwrap_with_pole_combination(psi: np.ndarray, phi: np.ndarray, upper: np.nda
 def angles_from_states(t: np.ndarray, y: np.ndarray, psi0: float) -> dict[str, np.ndarray]:
     """Euler angles of sampled (ω, γ) states: θ and φ from γ, ψ by quadrature of ψ̇ = (pγ + qγ')/(1 − γ''²)
     (Shaker et al. eq. 29) with a cubic spline through the samples (error ~ h⁴: 7e-11 rad at 200 samples per
-    period against ψ from α, tests/test_regime_experiments.py) — for states that come without the fixed axis α."""
+    period against ψ from α, tests/experiments/test_regime_experiments.py) — for states that come without the fixed axis α."""
     from scipy.interpolate import CubicSpline  # scipy.interpolate: imported when used, not with attitude
 
     theta, phi = nutation_and_spin(y[:, 3:6])

@@ -11,7 +11,7 @@ paper has h2 = 0 and the sign +μ·H), E_q = d/dt ∂L/∂q̇ − ∂L/∂q is
 derived with sympy in ``docs/derivations/scripts/seed002/derive_euler_lagrange.py``
 (notation there: D = A − B, a = A sin²φ + B cos²φ, P = ψ̇ + Ω, κc = k1 sin φ + k2 cos φ,
 κs = k1 cos φ − k2 sin φ). On any motion E = Jᵀ R, with R the residual of the vector
-Euler equations (tests/test_gyrostat_model.py checks this on random states); det J = −sin θ,
+Euler equations (tests/analysis/test_precession.py checks this on random states); det J = −sin θ,
 so at θ ∈ {0, π} the Euler-angle form loses one direction of R.
 """
 

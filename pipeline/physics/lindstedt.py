@@ -107,7 +107,7 @@ class LindstedtSeries:
         the same with ‖Y_k‖); ``pade``: the smallest |pole| of the diagonal Padé approximant of Ω (in ε², when Ω is
         even in ε as at a fixed tilt). On the Lagrange top, whose Ω(ε) is known in closed form (steady precession,
         branch point ε = 1/(2√(aγ0''))), ``domb_sykes`` is within 0.5 % at order 32, ``root`` within 3 % below
-        (tests/test_lindstedt.py).
+        (tests/physics/test_lindstedt.py).
         """
         n = self.norms()
         ks = np.arange(len(n))

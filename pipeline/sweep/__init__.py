@@ -16,5 +16,5 @@ Modules, one job each:
 * ``callbacks`` -- the Hydra callback that aggregates at the end of a multirun
 * ``reproduce`` -- rerun a ``run.nc`` from its stored config and compare bit for bit
 * ``slurm_local`` -- a one-node SLURM on this machine to try the SLURM launcher on
-  (``python -m gyrolab.sweep.slurm_local start|status|stop``; tests/test_slurm.py's cluster)
+  (``python -m gyrolab.sweep.slurm_local start|status|stop``; tests/sweep/test_slurm.py's cluster)
 """

@@ -6,8 +6,8 @@
     python -m gyrolab.sweep.slurm_local stop      # cancel their jobs, stop their daemons, remove their files
 
 ``start`` needs root (the daemons run as root) and Debian's packages ``slurm-wlm`` and ``munge``, which it
-installs with ``apt-get`` when missing. tests/test_slurm.py starts its cluster with the same code
-(``start()`` below, through tests/slurm_cluster.py).
+installs with ``apt-get`` when missing. tests/sweep/test_slurm.py starts its cluster with the same code
+(``start()`` below).
 
 ``start()`` installs the packages when they are missing (``apt-get install``, root only), writes a
 munge key and a minimal ``slurm.conf`` for this host into a fresh state directory, starts ``munged``,

@@ -53,7 +53,7 @@ class SlowSpinSeries:
     y(s T(ε); ε) = y_P(s T0) + ε Φ(s T0) ∂y0/∂ε + Σ_{j=2..7} ε^j y_j(s),  T(ε) = T0 + T2 ε² + T4 ε⁴ + T6 ε⁶,
     s ∈ [0, 1) the phase. y_P, T0: the pendulum swing (exact); the first-order term: the variational equations
     along it (exact). At fixed phase q, γ, γ'' and T are even in ε and p, r, γ' odd (the orbit at −ε is the
-    one at ε with p, r, γ' reversed: tests/test_regime_large_parameter.py checks it to rounding), so y_j, T_j
+    one at ε with p, r, γ' reversed: tests/plugins/regimes/test_large_parameter.py checks it to rounding), so y_j, T_j
     (j ≥ 2) are, per phase point, the least-squares fit in (ε², ε⁴, ε⁶) or (ε³, ε⁵, ε⁷) of the remainder
     y − y_P − ε y1 of the exact orbits at ε = FIT_SPINS; stored as Fourier coefficients (``HARMONICS`` phase
     points). The top coefficient absorbs the truncation: the defended orders are those measured (docs/regimes.md).

@@ -15,7 +15,7 @@ reading only, ``ii`` (M2 = ``sign``·√(a2/a1)) and ``iv`` (phase ``phase_deg``
 amplitude circle). Corrected, (ii) and (iv) are refused: the resonant forcing
 M3³L310 ≠ 0 locks the p-mode phase to branch (iii) (erratum 001-6). Branch (iii)
 orders: p, q 1 (the O(μ) amplitude correction is not derived), r, γ's, period 2
-(``shaker_omega3`` module docstring; tests/test_regime_branches.py).
+(``shaker_omega3`` module docstring; tests/plugins/regimes/test_resonant_omega3_branches.py).
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ Branches of (23) (the generating p-mode p2 = M1 cos 3τ + M2 sin 3τ, E² = M1²
 only the amplitude; the solution here is the case-(i) series with the p-mode amplitude
 μℓ1 replaced by M1 (exact in every term linear in the p-mode, i.e. to O(μ) in γ, γ', γ'';
 the O(μ) amplitude correction β1 and the M1² terms of r and the period are not derived),
-so p, q are O(μ) and the rest O(μ²) (measured: tests/test_regime_branches.py).
+so p, q are O(μ) and the rest O(μ²) (measured: tests/plugins/regimes/test_resonant_omega3_branches.py).
 (ii) M1 = 0 and (iv) 0 < |M2| < E are not periodic solutions unless L310 = 0 (erratum
 001-6): the resonant forcing M3³L310 locks the p-mode phase to ε = 0, π. They exist
 only as the printed reading, as the generating solution (16).
@@ -177,7 +177,7 @@ def scaled_rhs(tau: float, Y: np.ndarray, mu: float, C: Constants) -> np.ndarray
         ṙ1 = μ²(−C1p1q1 + x0'γ1' − y0'γ1 + kC1γ1γ1'),
         γ̇1 = r1γ1' − μq1γ1'',  γ̇1' = μp1γ1'' − r1γ1,  γ̇1'' = μ(q1γ1 − p1γ1').
 
-    Exact: it is the full model rescaled (tests/test_regime_resonant_omega3.py).
+    Exact: it is the full model rescaled (tests/plugins/regimes/test_resonant_omega3.py).
     """
     a, b, x, y, z, k, A1, B1, C1 = C.a, C.b, C.x0, C.y0, C.z0, C.k, C.A1, C.B1, C.C1
     p, q, r, g1, g2, g3 = Y

@@ -80,7 +80,7 @@ def finite_tilt_frequency(P: paper.Params) -> float:
     The ε² coefficient is −[x0'√(1 − γ0''²) − z0'γ0'' + (k/4)(b − a − γ0''²(a + 3b − 4))]: (36) with the finite
     tilt kept — its O(γ0''²) terms are O(ε⁴) in Ismail's (2021) scaling γ0'' = Γε, so (36) agrees with it there.
     Found from the numeric series' ε² coefficient (exact in γ0'') and checked against exact orbits'
-    periods (tests/test_regime_small_parameter.py).
+    periods (tests/plugins/regimes/test_small_parameter.py).
     """
     g = P.g0
     return 1 - (P.x0 * np.sqrt(1 - g * g) - P.z0 * g
@@ -231,7 +231,7 @@ class SmallParameter(FixedPointRegime):
         ``to_model(Z, Z0)`` maps a (4, n) solution back to (n, 6) model-unit states (p, q, r, γ, γ', γ'')
         at t = τ/(c r0). ``formula=printed`` uses the printed Φ2, F3, Φ3 (errata 000-3, 000-4). Error against the
         full model over a period: O(μ⁻⁴) from a generic state, p, q O(μ⁻⁵) on the periodic orbit
-        (tests/test_erratum_000_4.py).
+        (tests/plugins/regimes/test_erratum_000_4.py).
         """
         s = self.scene(system)
         P = self.params(s)

@@ -66,8 +66,8 @@ def slurm():
 
 
 def recipe(name):
-    """The fenced block of docs/cluster.md after ``<!-- tests/test_slurm.py runs the next block: NAME -->``."""
-    marker = f"<!-- tests/test_slurm.py runs the next block: {name} -->"
+    """The fenced block of docs/cluster.md after ``<!-- tests/sweep/test_slurm.py runs the next block: NAME -->``."""
+    marker = f"<!-- tests/sweep/test_slurm.py runs the next block: {name} -->"
     text = DOCS.read_text()
     assert marker in text, f"docs/cluster.md has no block {name!r}"
     block = text.split(marker, 1)[1].split("```", 2)[1]

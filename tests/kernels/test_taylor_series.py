@@ -22,6 +22,7 @@ from gyrolab.kernels import expression, model as traced, models, taylor_series
 from gyrolab.plugins.systems.fixed_point import traced_model
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from tests.conftest import installed_distribution
+from tests.helpers import VISCOUS_DRAG
 
 ORDER = 24
 _KERNEL = ctypes.CFUNCTYPE(None, ctypes.c_double, ctypes.c_int64, *[ctypes.POINTER(ctypes.c_double)] * 3)
@@ -152,9 +153,8 @@ def test_off_axis_centre_under_taylor_matches_scipy(centre):
 
 def test_drag_under_taylor_and_auto_is_the_exact_decay():
     import sys
-    from pathlib import Path
 
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"))
+    sys.path.insert(0, str(VISCOUS_DRAG))
     try:
         from gyrolab_viscous_drag import ViscousDrag
     finally:
@@ -263,11 +263,10 @@ def test_time_dependent_expression_under_taylor_against_the_equations_by_hand():
 def test_batch_sweep_of_a_plugin_parameter_under_taylor_is_the_exact_decay(cli, tmp_path, tmp_path_factory):
     """``gyrolab --batch`` over the README's drag plugin: ω(t) = ω0 exp(−c t) on a spherical body, for every c."""
     import tomllib
-    from pathlib import Path
 
     import xarray as xr
 
-    example = Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"
+    example = VISCOUS_DRAG
     project = tomllib.loads((example / "pyproject.toml").read_text())["project"]
     with installed_distribution(tmp_path_factory.mktemp("site"), project["name"], project["version"],
                                 project["entry-points"]["gyrolab.forces"], [example]) as site:
@@ -390,9 +389,8 @@ def test_series_work_array_on_the_heap_gives_the_exact_decay(tmp_path):
     import os
     import subprocess
     import sys
-    from pathlib import Path
 
-    example = Path(__file__).resolve().parent.parent / "examples" / "gyrolab-viscous-drag"
+    example = VISCOUS_DRAG
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), NUMBA_NRT_STATS="1")
     done = subprocess.run([sys.executable, "-c", _HEAP_CHILD, str(example)], env=env, capture_output=True, text=True,
                           timeout=900)
