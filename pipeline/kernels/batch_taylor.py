@@ -27,9 +27,6 @@ lines costs two.
 Why LLVM IR: written as numba loops over lanes, the Cauchy sums are reductions whose accumulators LLVM keeps in
 memory (numba does not run LLVM's SLP vectoriser); such a kernel was 1.2–2× slower than one trajectory per
 thread. The IR works on ``<LANES x double>`` values, the accumulators in registers.
-
-``run_each`` runs one trajectory per thread with the single-trajectory kernel itself: the tests' reference for
-the lanes.
 """
 
 from __future__ import annotations
@@ -856,29 +853,3 @@ def _outputs(T, order, t_out, t, t_next, traj, index, carry, D, O, Y):
                 for c in range(n):
                     Y[j, index[lane], c] = O[c, lane]
                 index[lane] += 1
-
-
-@numba.njit(cache=True, parallel=True, error_model="numpy")
-def run_each(model, Params, order, tol, t_out, Y0, Y, steps, status):
-    """Every trajectory j (initial state Y0[j], parameters Params[j]) over t_out into Y[j], one per thread.
-
-    steps[j] receives its number of steps, status[j] OK, NOT_FINITE or TOO_SMALL_STEP (its outputs from the
-    failed step on are NaN). t_out has at least two times.
-    """
-    for j in numba.prange(Y0.shape[0]):  # the loop stays small: numba's parallel pass compiles slowly on big bodies
-        _one(model, Params, order, tol, t_out, Y0, Y, steps, status, j)
-
-
-@kernel
-def _one(model, Params, order, tol, t_out, Y0, Y, steps, status, j):
-    y = Y0[j].copy()
-    Y[j, 0] = y
-    state = np.array([t_out[0]])
-    carry = np.zeros(y.size)
-    stats = np.zeros(2, dtype=np.int64)
-    code, reached = taylor.run(model, Params[j], order, tol, t_out, Y[j], 1, t_out.size, state, y, carry, stats)
-    steps[j] = stats[1]
-    status[j] = code
-    if code != OK:
-        for r in range(reached, t_out.size):
-            Y[j, r] = np.nan

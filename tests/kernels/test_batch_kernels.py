@@ -8,6 +8,7 @@ from gyrolab import compose_scene
 from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.kernels import batch_dop853, batch_taylor
+from tests.helpers.taylor import single_kernel_runs
 
 SHORT = ["experiment=perf_reference", "time.end=2", "time.n_output=11"]
 SETTINGS = {"dop853_numba": ["integrator.rtol=1e-10", "integrator.atol=1e-10"], "taylor": ["integrator.tol=1e-10"]}
@@ -68,7 +69,7 @@ def test_a_lane_does_not_depend_on_its_neighbours(integrator):
 
 
 def test_taylor_lanes_take_the_steps_of_the_single_trajectory_kernel():
-    """The lane kernel against ``taylor.run`` on each trajectory (one per thread, ``run_each``), easy and hard
+    """The lane kernel against ``taylor.run`` on each trajectory alone (``single_kernel_runs``), easy and hard
     trajectories mixed, each with its own A and Newtonian coefficient: the same number of steps, and the same
     outputs to rounding (its vector sums fuse multiply and add in another order; 1e-13 is a thousand
     tolerances below the 1e-10 asked)."""
@@ -80,12 +81,8 @@ def test_taylor_lanes_take_the_steps_of_the_single_trajectory_kernel():
     P[:, 16] = 1.0 / P[:, 0]
     P[:, 14] *= np.linspace(0.0, 2.0, len(y0s))  # N_2
     batch = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s, P)
-    out = np.empty_like(batch.y)
-    out[:, 0] = y0s
-    steps, status = np.zeros(len(y0s), dtype=np.int64), np.zeros(len(y0s), dtype=np.int64)
-    batch_taylor.run_each(scene.compiled.model, P, scene.integrator.order, scene.integrator.tol, scene.times, y0s,
-                          out, steps, status)
-    assert not status.any() and steps.min() < steps.max() / 2  # the mix: some take twice the steps of others
+    out, steps = single_kernel_runs(scene.compiled, P, scene.integrator, scene.times, y0s)
+    assert steps.min() < steps.max() / 2  # the mix: some take twice the steps of others
     np.testing.assert_array_equal(batch.steps, steps)
     np.testing.assert_allclose(batch.y, out, rtol=0, atol=1e-13)
 

@@ -12,6 +12,7 @@ from gyrolab import compose_scene
 from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.kernels import batch_taylor, taylor
 from gyrolab.kernels.layout import N_Z
+from tests.helpers.taylor import single_kernel_runs
 
 LANES = batch_taylor.LANES
 
@@ -109,17 +110,13 @@ def test_a_trajectory_in_a_mixed_batch_is_computed_as_alone():
 @pytest.mark.parametrize("n_output", [201, 2001])  # steps of ~0.17 over outputs 0.01 and 0.001 apart
 def test_steps_over_several_output_times_agree_with_the_single_kernel(n_output):
     """Output times closer than a step (several outputs per step: the separate output path) against the
-    single-trajectory kernel (``run_each``, scalar Horner per output): the same steps, outputs within 1e-13."""
+    single-trajectory kernel (``taylor.run``, scalar Horner per output): the same steps, outputs within 1e-13."""
     scene = _scene([f"time.n_output={n_output}", "integrator.tol=1e-12"])
     y0s = _starts(scene, LANES + 3, seed=14)
     P = np.tile(scene.compiled.params, (len(y0s), 1))
     batch = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s, P)
-    out = np.empty_like(batch.y)
-    out[:, 0] = y0s
-    steps, status = np.zeros(len(y0s), dtype=np.int64), np.zeros(len(y0s), dtype=np.int64)
-    batch_taylor.run_each(scene.compiled.model, P, scene.integrator.order, scene.integrator.tol, scene.times, y0s,
-                          out, steps, status)
-    assert not status.any() and batch.steps.max() < n_output / 2
+    out, steps = single_kernel_runs(scene.compiled, P, scene.integrator, scene.times, y0s)
+    assert batch.steps.max() < n_output / 2
     np.testing.assert_array_equal(batch.steps, steps)
     np.testing.assert_allclose(batch.y, out, rtol=0, atol=1e-13)
 
@@ -151,7 +148,7 @@ def test_lanes_of_every_function_follow_scipy_and_the_single_kernel():
     1e-13."""
     from scipy.integrate import solve_ivp
 
-    from gyrolab.kernels import model, models, taylor_series
+    from gyrolab.kernels import model
     from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
     compiled = model.compile(model.trace(_every_function, 3, "every function"))
@@ -163,12 +160,6 @@ def test_lanes_of_every_function_follow_scipy_and_the_single_kernel():
         reference = solve_ivp(lambda t, y: _every_function(t, y).astype(float), (0.0, 3.0), y0s[j], method="DOP853",
                               rtol=1e-13, atol=1e-13, t_eval=times).y.T
         assert np.max(np.abs(batch.y[j] - reference)) < 1e-11
-    P = model.bind(compiled, np.tile(compiled.params, (len(y0s), 1)))
-    assert taylor_series.ready(compiled, P)
-    out = np.empty_like(batch.y)
-    out[:, 0] = y0s
-    steps, status = np.zeros(len(y0s), dtype=np.int64), np.zeros(len(y0s), dtype=np.int64)
-    batch_taylor.run_each(models.form(compiled), P, integrator.order, integrator.tol, times, y0s, out, steps, status)
-    assert not status.any()
+    out, steps = single_kernel_runs(compiled, np.tile(compiled.params, (len(y0s), 1)), integrator, times, y0s)
     np.testing.assert_array_equal(batch.steps, steps)
     np.testing.assert_allclose(batch.y, out, rtol=0, atol=1e-13)

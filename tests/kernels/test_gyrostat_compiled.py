@@ -12,6 +12,7 @@ from gyrolab.analysis.precession.motion import build_system
 from gyrolab.kernels import model, models
 from gyrolab.physics.attitude import frame_from_angles
 from gyrolab.physics.gyrostat_euler import GyrostatParameters, kinematic_matrix, rhs_euler_angles
+from tests.helpers.taylor import single_kernel_runs
 
 # an asymmetric gyrostat with rotors and a tilted magnetic field, tumbling (θ stays away from 0 and π, where the
 # Euler angles are singular)
@@ -185,15 +186,6 @@ def test_gyrostat_batch_runs_by_vector_lanes_against_the_euler_angle_equations(s
     y0s = np.tile(y0, (count, 1))
     y0s[:, 0:3] += rng.normal(scale=0.1, size=(count, 3))
     batch = integrate_arrays(compiled, scene.integrator, TIMES, y0s)
-    P = model.bind(compiled, np.tile(compiled.params, (count, 1)))
-    out = np.empty_like(batch.y)
-    out[:, 0] = y0s
-    steps, status = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
-    from gyrolab.kernels import taylor_series
-
-    assert taylor_series.ready(compiled, P)
-    batch_taylor.run_each(models.form(compiled), P, scene.integrator.order, scene.integrator.tol, TIMES, y0s, out,
-                          steps, status)
-    assert not status.any()
+    out, steps = single_kernel_runs(compiled, np.tile(compiled.params, (count, 1)), scene.integrator, TIMES, y0s)
     np.testing.assert_array_equal(batch.steps, steps)
     np.testing.assert_allclose(batch.y, out, rtol=0, atol=1e-13)
