@@ -4,6 +4,7 @@
     python benchmarks/perf_reference.py            # full tables (a few minutes)
     python benchmarks/perf_reference.py --quick    # fewer tolerances, fewer rounds
     python benchmarks/perf_reference.py --calibration  # only the measurement behind auto's CALIBRATION
+    python benchmarks/perf_reference.py --breakdown --quick  # where auto's Scene.run() spends its time
 
 Reference problem (issue 5, ``experiment=perf_reference``): nondimensional
 Euler–Poisson, A, B, C = 2, 1.5, 1, r_c = (0.3, 0.2, 0.9327…), k = 0.5,
@@ -343,12 +344,16 @@ def scene_run_only(reference, rounds):
 
 def run_breakdown(rounds, quick):
     """Where ``Scene.run()`` with ``integrator=auto`` spends its time: the regimes' series check, the pilot and
-    final Taylor runs (auto without the series check), the dataset, interleaved like the peer table."""
+    final Taylor runs (auto without the series check; the chaos measure's tangent run included, and beside it
+    alone), the error estimate (its companion runs, ``estimate.compare``), the dataset, interleaved like the peer
+    table."""
     from gyrolab.output.dataset import build_dataset
+    from gyrolab.accuracy import estimate
+    from gyrolab.accuracy.amplification import amplification
     from gyrolab.accuracy.auto import Auto
 
     contestants = {}
-    for eps in EPSILONS[::3] if quick else EPSILONS[::2]:
+    for eps in EPSILONS[::3] if quick else EPSILONS:
         scene = compose_scene(["experiment=perf_reference", f"accuracy={eps}"])
         compiled, y0 = scene.compiled, scene.system.initial_state()
 
@@ -363,6 +368,10 @@ def run_breakdown(rounds, quick):
         solution = integration()
         contestants[("series check", eps)] = series
         contestants[("pilot + Taylor", eps)] = integration
+        contestants[("(of which tangent run)", eps)] = lambda compiled=compiled, y0=y0: amplification(
+            compiled, None, y0, 0.0, 0.1 * T_END, T_END, None)
+        contestants[("error estimate", eps)] = lambda scene=scene, solution=solution: estimate.compare(
+            scene, solution.choice.method, solution.y, solution.stats.wall_time)
         contestants[("dataset", eps)] = lambda scene=scene, solution=solution: build_dataset(scene, solution)
         contestants[("Scene.run()", eps)] = scene.run
     interleaved(contestants, 1)
@@ -497,6 +506,9 @@ def main() -> None:
                         help="only the measurement behind auto's CALIBRATION (about 30 s)")
     parser.add_argument("--scene-run", action="store_true",
                         help="only heyoka against auto's Scene.run() per ε, with the PASS/FAIL verdict (issue 24)")
+    parser.add_argument("--breakdown", action="store_true",
+                        help="only where auto's Scene.run() spends its time (series check, pilot and run, tangent "
+                             "run, error estimate, dataset)")
     args = parser.parse_args()
     global WALL
     WALL = args.wall
@@ -512,6 +524,9 @@ def main() -> None:
         sys.exit(0 if calibration(reference) else 1)
     if args.scene_run:
         scene_run_only(reference, rounds)
+        return
+    if args.breakdown:
+        run_breakdown(rounds, args.quick)
         return
     peer_table(reference, rounds, args.quick)
     run_breakdown(rounds, args.quick)
