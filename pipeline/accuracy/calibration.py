@@ -41,11 +41,12 @@ TIGHTER = _c("TIGHTER", 100.0, PERF, "companion this many times more accurate: r
              "176× more accurate (1000×: 0.68 ms, 1660×)")
 DOUBLE_DOUBLE_BELOW = _c("DOUBLE_DOUBLE_BELOW", 3e-15, ROUNDOFF, "a double Taylor run whose companion tol is below "
                          "this is measured by two double companions (then double-double): one alone measured every "
-                         "run at tol 3e-13 within 0.68–1.16× of the actual error (152 runs, seeds 5 and 11), at 1e-13 "
-                         "up to 4.2× (2 of 153 above 2×)")
+                         "run at tol 3e-13 within 0.68–1.92× of the actual error (227 runs, seeds 5 and 11, 120 scenes "
+                         "each; Intel Xeon, 2026-11-29), at 1e-13 0.20–4.2× (2 of 228 outside 1/2 … 2×)")
 ROUNDOFF_MARGIN = _c("ROUNDOFF_MARGIN", 6.0, ROUNDOFF, "a double companion near the floor is trusted when two disagree "
-                     "this many times below what it measures: seeds 5 and 11 (809 runs), trusted at 6: 312, "
-                     "E / actual 0.47–2.64, the same two outside 1/2 … 2× as at 10 (251 trusted); at 4: 5 outside")
+                     "this many times below what it measures: seeds 5 and 11 (1,217 runs), trusted at 6: 448, one "
+                     "below 1/2 of the error (0.47), as at 10 (354 trusted); at 4: 550, two (worst 0.27); Intel Xeon, "
+                     "2026-11-29")
 # the growth of perturbations (``amplification``)
 TANGENT_TOLERANCE = _c("TANGENT_TOLERANCE", 1e-5, CHAOS, "tangent run's tolerance: slow_spin over t = 300 grows e^19.3 "
                        "at 1e-5, e^17.4 at 1e-4, e^23.3 at 1e-3")
