@@ -7,6 +7,8 @@ another order with 1/I moved by its rounding) and keeps the first one's measurem
 truth: on random scenes (``promise_audit.random_scene``) and tolerances from 3e-13 to 1.5e-16, E, R and the actual
 error (max-norm over every output time and component, against heyoka ``real128``), and for each margin M the
 smallest E / actual among the runs it would trust (R · M ≤ E). The estimate's promise is E / actual ≥ 1/2.
+It also measures the single double companion (E alone) at each tolerance: the runs whose companion tol is at least
+``DOUBLE_DOUBLE_BELOW`` are measured by it alone, without the second companion.
 
     pip install -e ".[bench]"
     python benchmarks/roundoff_margin.py --n 120 --seed 5     # ~5 min
@@ -21,7 +23,7 @@ import sys
 import numpy as np
 
 from gyrolab import compose_scene
-from gyrolab.accuracy.calibration import ROUNDOFF_MARGIN, TIGHTER
+from gyrolab.accuracy.calibration import DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
 from gyrolab.kernels.model import rounding_moved
 from gyrolab.kernels.taylor import MAX_ORDER
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
@@ -31,7 +33,7 @@ from promise_audit import SATURATED, random_scene  # noqa: E402  (benchmarks/ is
 from real128_reference import Real128Reference, covered  # noqa: E402
 
 TOLERANCES = (3e-13, 1e-13, 3e-14, 1e-14, 3e-15, 1e-15, 1.5e-16)
-MARGINS = (2.0, 4.0, 10.0, 20.0, 50.0)
+MARGINS = (2.0, 4.0, 6.0, 10.0, 20.0, 50.0)
 #: an actual error below this × max(1, |y0|) is at the reference's own level: not judged
 RESOLVED = 1e-15
 
@@ -89,12 +91,24 @@ def main() -> int:
         print(f"| {margin:g} | {int(kept.sum())} of {len(rows)} | {worst:.3g} | {int((ratio[kept] < 0.5).sum())} |")
     print("\nthe double estimate alone (no margin): smallest E / actual "
           f"{float(ratio.min()):.3g}, {int((ratio < 0.5).sum())} of {len(rows)} below 1/2")
+    print("\n| run tol | runs | E / actual min | max | below 1/2 | above 2 |\n| --- | --- | --- | --- | --- | --- |")
+    for tol in TOLERANCES:
+        at = ratio[rows[:, 1] == tol]
+        if at.size:
+            print(f"| {tol:g} | {at.size} | {at.min():.3g} | {at.max():.3g} | {int((at < 0.5).sum())} | "
+                  f"{int((at > 2).sum())} |")
     from gyrolab.accuracy import calibration as table
 
     trusted = trust >= ROUNDOFF_MARGIN
     low = int((ratio[trusted] < 0.5).sum())
-    supported = table.report(table.ROUNDOFF, {"ROUNDOFF_MARGIN": (
-        low <= max(1, len(rows) // 1000), f"{low} of {int(trusted.sum())} trusted estimates below 1/2 of the error")})
+    alone = ratio[rows[:, 1] / TIGHTER >= DOUBLE_DOUBLE_BELOW]
+    off = int(((alone < 0.5) | (alone > 2)).sum())
+    supported = table.report(table.ROUNDOFF, {
+        "ROUNDOFF_MARGIN": (low <= max(1, len(rows) // 1000),
+                            f"{low} of {int(trusted.sum())} trusted estimates below 1/2 of the error"),
+        "DOUBLE_DOUBLE_BELOW": (off == 0, f"{off} of {alone.size} runs whose companion tol is ≥ {DOUBLE_DOUBLE_BELOW:g} "
+                                          f"measured outside 1/2 … 2× by it alone (E / actual {alone.min():.3g} … "
+                                          f"{alone.max():.3g})" if alone.size else "no run that tolerance")})
     return 0 if supported else 1
 
 

@@ -37,7 +37,7 @@ def test_no_accuracy_module_keeps_a_constant_of_the_table_for_itself():
 def test_the_report_says_when_a_measurement_contradicts_a_value(capsys):
     assert table.report(table.ROUNDOFF, {"ROUNDOFF_MARGIN": (True, "a measurement")})
     assert not table.report(table.ROUNDOFF, {"ROUNDOFF_MARGIN": (False, "another")})
-    assert "ROUNDOFF_MARGIN = 10: NOT SUPPORTED by another" in capsys.readouterr().out
+    assert f"ROUNDOFF_MARGIN = {table.ROUNDOFF_MARGIN:g}: NOT SUPPORTED by another" in capsys.readouterr().out
     with pytest.raises(KeyError, match="CALIBRATION"):  # a benchmark may not judge another benchmark's constant
         table.report(table.ROUNDOFF, {"CALIBRATION": (True, "")})
 
