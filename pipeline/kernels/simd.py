@@ -3,10 +3,10 @@
 Arrays of doubles are seen as rows of vectors: in ``batch_taylor`` a row holds one component of LANES
 trajectories (8 on AVX-512, 4 on AVX2), in ``taylor`` one 3-vector of one trajectory (and a zero) in a
 ``<4 x double>``. ``taylor`` forms the fixed-point right-hand side's coefficient from its Cauchy sums with
-``Lanes.fixed_point_rate`` and updates the state with ``update`` (Horner, then Kahan); ``batch_taylor`` uses
-the same arithmetic in its own intrinsics, with its sums in another order (by pairs, and from order 6 on in a
-split form), so a trajectory in a lane and alone agree to rounding, not bit for bit. ``Lanes.log2`` and
-``Lanes.exp2`` are vector powers for the lanes' step rule.
+``Lanes.fixed_point_rate`` and updates the state with ``update`` (Horner, then Kahan); ``batch_taylor`` emits
+the recurrences generated from a model's equations, its sums in another order (by pairs), so a trajectory in a
+lane and alone agree to rounding, not bit for bit. ``Lanes.log2`` and ``Lanes.exp2`` are vector powers for the
+lanes' step rule.
 
 Why intrinsics: numba does not run LLVM's SLP vectoriser, and the Cauchy sums
 written as numba loops keep their accumulators in memory (``batch_taylor``'s

@@ -203,7 +203,7 @@ def _coefficients(v, p, row):
 
     Q is (4, LANES): q = (I_y − I_z)/I_x (and cyclically), N_2 in every lane, and the torque U_2 × γ's
     constants qa = (U_y/I_x, U_z/I_y, U_x/I_z), qb = (U_z/I_x, U_x/I_y, U_y/I_z) (``_constants``); the
-    fourth lane of each is 0. The rate is ``simd.Lanes.fixed_point_rate``, batch_taylor's expression. The
+    fourth lane of each is 0. The rate is ``simd.Lanes.fixed_point_rate``. The
     cross product's sum runs in two accumulators (its plus and minus products), so that no chain of
     dependent fused multiply-adds is longer than one per term; the terms that involve the newest
     coefficient k come last (see the loop). Both orders differ from the scalar kernel's and the batch
@@ -283,7 +283,7 @@ def _dense(typingctx, T, order, dt, carry, out):
     return sig, codegen
 
 
-#: The state rows T[0, W], T[0, G] += Σ_{k≥1} T[k] h^k, compensated (``simd.update``: batch_taylor's update).
+#: The state rows T[0, W], T[0, G] += Σ_{k≥1} T[k] h^k, compensated (``simd.update``, the batch lanes' arithmetic).
 _update = simd.update(ROWS, 2)
 
 
@@ -340,7 +340,7 @@ def run_vector(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     components: ``_coefficients``, the dense output (``_dense``) and the compensated update (``_update``) in
     ``<4 x double>``. Same order, step rule, dense output (strict arithmetic), compensated update, status
     codes, stats and chunking contract as ``run_scalar``; the coefficients and the update's Horner sums fuse
-    multiply and add (as batch_taylor's lanes do), so the results agree with ``run_scalar``'s to rounding."""
+    multiply and add (as the batch lanes do), so the results agree with ``run_scalar``'s to rounding."""
     T = np.zeros((order + 1, ROWS, LANES))
     Q = np.zeros((4, LANES))
     C = np.zeros((2, LANES))  # the Kahan compensation, rows W and G
