@@ -42,7 +42,17 @@ import numpy as np
 from gyrolab.contracts.claims import _rotation, axes_of as _axes, random_states, rotation_torque  # noqa: F401
 from gyrolab.contracts.force import Force
 from gyrolab.contracts.integrator_rules import unchecked
-from gyrolab.errors import ConfigError
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.physics.body import Body
+from gyrolab.engine.scene import build_force, compose_scene
+from gyrolab.kernels import expression, model, models
+from gyrolab.physics.vectors import cross
+from gyrolab.plugins.systems.fixed_point import FixedPoint
+from gyrolab.contracts.integrator import Integrator, IntegratorStats, Solution
+from gyrolab.contracts.system import System
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
+import xarray as xr
+from gyrolab.contracts.regime import Regime
 
 __all__ = ["check_force", "check_integrator", "check_regime", "check_system", "random_states", "rotation_torque"]
 
@@ -54,8 +64,6 @@ _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
 def _test_body():
-    from gyrolab.physics.body import Body
-
     return Body.from_config({"units": "nondimensional", "a": 0.7, "b": 0.9, "com_direction": [0.3, 0.4, 0.866025403784]})
 
 
@@ -88,8 +96,6 @@ def check_force(cls: type, body: Any = None, *, n_states: int = 20, **params: An
     AssertionError
         Naming the first rule the plugin breaks.
     """
-    from gyrolab.engine.scene import build_force
-
     if not (isinstance(cls, type) and issubclass(cls, Force)):
         raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Force")
     body = _test_body() if body is None else body
@@ -188,8 +194,6 @@ def _check_attributes(cls: type, force: Force) -> None:
 
 
 def _check_bad_parameters(cls: type, body: Any, where: str, params: dict[str, Any]) -> None:
-    from gyrolab.engine.scene import build_force
-
     for key, param in inspect.signature(cls.__init__).parameters.items():
         if param.kind is not inspect.Parameter.KEYWORD_ONLY or (param.default is None and key not in params):
             continue  # a parameter off by default is checked when the caller gives it
@@ -213,9 +217,6 @@ def _check_bad_parameters(cls: type, body: Any, where: str, params: dict[str, An
 def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, frames: np.ndarray) -> None:
     if force.compiled_terms() is not None:
         return  # a built-in form; the system's tests compare it with the Python right-hand side
-    from gyrolab.kernels import expression, model
-    from gyrolab.physics.vectors import cross
-
     def torque(t: Any, y: np.ndarray) -> Any:  # y = (ω, γ, α), as the fixed point lays out its state
         frame = np.empty((3, 3), dtype=object)
         frame[0], frame[1], frame[2] = y[6:9], cross(y[3:6], y[6:9]), y[3:6]
@@ -227,7 +228,7 @@ def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, fram
     except expression.NotCompilable as exc:
         warnings.warn(f"{cls.__name__} runs with the Python integrators only: {exc}", stacklevel=3)
         return
-    import ctypes
+    import ctypes  # start-up: only for this check
 
     address = int(compiled.params[model.TRACED_ADDRESS])
     kernel = ctypes.CFUNCTYPE(None, ctypes.c_double, *[ctypes.POINTER(ctypes.c_double)] * 3)(address)
@@ -292,9 +293,6 @@ FREE_TOP_A, FREE_TOP_OMEGA0 = 0.8, (0.1, -0.05, 5.0)
 def free_top_problem() -> ExactProblem:
     """The torque-free symmetric top as gyrolab's fixed-point system, with its compiled model: I ω̇ = (Iω) × ω with
     A = B gives r constant and (p, q) turning at λ = (C − A) r / A (ṗ = −λ q, q̇ = λ p)."""
-    from gyrolab.physics.body import Body
-    from gyrolab.plugins.systems.fixed_point import FixedPoint
-
     body = Body.from_config({"units": "nondimensional", "a": FREE_TOP_A, "b": FREE_TOP_A,
                              "com_direction": [0.0, 0.0, 0.0]})
     p0, q0, r0 = FREE_TOP_OMEGA0
@@ -352,8 +350,6 @@ def check_integrator(cls: type, **params: Any) -> None:
     and no torque, whose ω turns at a constant rate), ``nfev`` > 0 only, and rule 7 is skipped (a blow-up has no
     compiled model).
     """
-    from gyrolab.contracts.integrator import Integrator
-
     if not (isinstance(cls, type) and issubclass(cls, Integrator)):
         raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Integrator")
     name = getattr(cls, "name", None)
@@ -386,8 +382,6 @@ def _build_plugin(cls: type, params: dict[str, Any], *args: Any) -> Any:
 
 def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> Any:
     """Rules 3–6 of ``check_integrator`` on one problem with a known solution; returns the run's stats."""
-    from gyrolab.contracts.integrator import IntegratorStats, Solution
-
     calls = [0]
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
@@ -440,8 +434,6 @@ def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> A
 
 
 def _check_blow_up(cls: type, integrator: Any) -> None:
-    from gyrolab.errors import IntegrationError
-
     try:
         with np.errstate(over="ignore", invalid="ignore"):
             solution = unchecked(integrator)(_blow_up, BLOW_UP_TIMES.copy(), np.array([1.0]), None, None)
@@ -548,8 +540,6 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
        one, computes ``rhs`` (to 1e-12) at random states and its Taylor integrator follows the DOP853 trajectory of 6.
        A system that cannot be traced is warned about (it runs with the Python integrators only), not failed.
     """
-    from gyrolab.contracts.system import System
-
     if not (isinstance(cls, type) and issubclass(cls, System)):
         raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.System")
     name = getattr(cls, "name", None)
@@ -562,8 +552,6 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
         built_body = body_type.from_config(dict(body))
     except ConfigError as exc:
         raise _fail(cls, f"body_type.from_config({body}) raised ConfigError: {exc}") from None
-    from gyrolab.engine.scene import build_force
-
     built_forces = [build_force(force_cls, dict(force_params), f"force.{force_cls.name}", built_body)
                     for force_cls, force_params in forces]
     output = {"euler_angles": True} if output is None else dict(output)
@@ -586,9 +574,6 @@ def _check_compiled_system(cls: type, system: Any, t: np.ndarray, y: np.ndarray)
     if compiled is None:
         warnings.warn(f"{cls.__name__} runs with the Python integrators only: {system.compile_error}", stacklevel=3)
         return
-    from gyrolab.kernels import models
-    from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
     rng = np.random.default_rng(11)
     scale = max(1.0, float(np.max(np.abs(y[0]))))
     out = np.empty(len(y[0]))
@@ -626,7 +611,7 @@ def _check_state(cls: type, system: Any) -> np.ndarray:
 
 
 def _integrate_tightly(cls: type, system: Any, y0: np.ndarray, span: float) -> tuple[np.ndarray, np.ndarray]:
-    from scipy.integrate import solve_ivp
+    from scipy.integrate import solve_ivp  # start-up: scipy.integrate only for this check
 
     t = np.linspace(0.0, span, 41)
     done = solve_ivp(system.rhs, (0.0, span), y0, method="DOP853", t_eval=t, rtol=SYSTEM_RTOL, atol=SYSTEM_RTOL)
@@ -637,8 +622,6 @@ def _integrate_tightly(cls: type, system: Any, y0: np.ndarray, span: float) -> t
 
 
 def _check_variables(cls: type, system: Any, t: np.ndarray, y: np.ndarray) -> None:
-    import xarray as xr
-
     invariants = system.invariants
     if not isinstance(invariants, tuple) or not all(isinstance(n, str) for n in invariants):
         raise _fail(cls, f"invariants={invariants!r} must be a tuple of dataset variable names (str)")
@@ -716,9 +699,6 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     7. ``euler_angles(system, t)`` has exactly the keys psi, theta, phi, each a finite array of shape (n,);
     8. ``attributes()`` is netCDF-safe.
     """
-    from gyrolab.contracts.regime import Regime
-    from gyrolab.contracts.system import System
-
     if not (isinstance(cls, type) and issubclass(cls, Regime)):
         raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Regime")
     _check_regime_declarations(cls)
@@ -728,8 +708,6 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     if isinstance(scene, System):
         system = scene
     else:
-        from gyrolab.engine.scene import compose_scene
-
         system = compose_scene(list(scene)).system
     if system.name not in cls.systems:
         raise _fail(cls, f"the kit's scene has system {system.name!r}, not one of systems={cls.systems}; give a "

@@ -43,6 +43,11 @@ from omegaconf.errors import OmegaConfBaseException
 from gyrolab.contracts import registry
 from gyrolab.engine.schemas import resolve_plain
 from gyrolab.errors import ConfigError, shorten
+from hydra.core.plugins import Plugins
+from hydra.plugins.launcher import Launcher
+from hydra.plugins.sweeper import Sweeper
+from gyrolab.output.user_yaml import stored_yaml
+from importlib.resources import files
 
 #: ``_target_`` values allowed under ``hydra`` besides the installed launchers and sweepers
 #: (gyrolab's sweep callback and sweeper are named, not imported: the engine sits below gyrolab.sweep)
@@ -64,10 +69,6 @@ LAUNCHER_SHELL_KEYS = ("setup", "srun_args", "additional_parameters")
 @cache
 def hydra_targets() -> frozenset[str]:
     """gyrolab's callback and sweeper and every installed Hydra launcher and sweeper class."""
-    from hydra.core.plugins import Plugins
-    from hydra.plugins.launcher import Launcher
-    from hydra.plugins.sweeper import Sweeper
-
     found = {f"{cls.__module__}.{cls.__qualname__}" for kind in (Launcher, Sweeper)
              for cls in Plugins.instance().discover(kind)}
     return HYDRA_TARGETS | found
@@ -124,8 +125,6 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
 def check_stored_config(text: str, where: str) -> DictConfig:
     """A config stored in a dataset, checked as a user's YAML file is (``gyrolab.output.user_yaml.stored_yaml``:
     tags, anchors, depth, size); ConfigError for interpolations."""
-    from gyrolab.output.user_yaml import stored_yaml
-
     plain = stored_yaml(text, where)
     if not isinstance(plain, dict):
         raise ConfigError(f"{where} is not a YAML mapping of config sections; give a run.nc that gyrolab wrote")
@@ -327,8 +326,6 @@ def _check_paths(hydra: dict[str, Any], run_dir: Path) -> None:
 
 @cache
 def _packaged_launcher_shell() -> dict[str, Any]:
-    from importlib.resources import files
-
     found: dict[str, Any] = {}
     for option in (files("gyrolab.conf") / "hydra" / "launcher").iterdir():
         if option.name.endswith(".yaml"):

@@ -27,6 +27,9 @@ from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite,
 from gyrolab.engine.force_guard import GuardedRhs, plugin_forces
 from gyrolab.engine.progress import Progress
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
+from gyrolab.contracts.capabilities import integrators_with, or_list
+from gyrolab.contracts.force import check_declared
+from gyrolab.contracts.claims import check_claims, claim_states
 
 log = logging.getLogger(__name__)
 
@@ -287,8 +290,6 @@ def _check_time_dependent(timed: Sequence[str], system: System, integrator: Inte
 
 def _choices_with(*capabilities: str, accept: Any = None) -> str:
     """The registered integrators with ``capabilities`` (and passing ``accept``), as "a, b or c"."""
-    from gyrolab.contracts.capabilities import integrators_with, or_list
-
     return or_list(integrators_with(*capabilities, accept=accept))
 
 
@@ -342,8 +343,6 @@ def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
     naming the plugin (``init_failure``); the force must declare its area-integral flag.
     An AttributeError (the force reads something the system's body does not have) is one ConfigError too.
     """
-    from gyrolab.contracts.force import check_declared
-
     if not isinstance(node, DictConfig):
         node = OmegaConf.create(dict(node))
     params = _params(cls, node, where)
@@ -380,8 +379,6 @@ def check_force_claims(system: System, t0: float = 0.0) -> None:
     plugins = plugin_forces(system.forces)
     if not plugins:
         return
-    from gyrolab.contracts.claims import check_claims, claim_states
-
     y0 = np.asarray(system.initial_state(), dtype=float)
     frame0 = system.reference_frame(y0)
     omegas, frames = claim_states(y0[:3], frame0)

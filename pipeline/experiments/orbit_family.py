@@ -34,6 +34,7 @@ from gyrolab.plugins.regimes.base import NondimensionalScene
 from gyrolab.plugins.regimes.small_parameter import SmallParameter
 from gyrolab.engine import schemas
 from gyrolab.engine.schemas import Task
+from gyrolab.figures.redraw import draw_figures
 
 log = logging.getLogger(__name__)
 COMPONENTS = ("p", "q", "r", "gamma_x", "gamma_y", "gamma_z")
@@ -153,8 +154,6 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     traces = [trace(name, _family_spec(name, f)) for name, f in families.items()]
     ds = dataset(traces, cfg)
     out_dir = Path(out_dir)
-    from gyrolab.figures.redraw import draw_figures
-
     return [write_dataset(ds, out_dir / "orbit_family.nc"), *draw_figures("orbit_family.nc", ds, out_dir, cfg.get("output"))]
 
 

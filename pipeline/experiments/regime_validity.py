@@ -26,10 +26,16 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.experiments.regime_run import compute, errors, prepare
+from gyrolab.experiments.regime_run import compute, errors, prepare, build_regime
 from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.schemas import Task
+from gyrolab.engine.config import compose_config
+from gyrolab.engine.scene import Scene
+from gyrolab.contracts import registry
+from gyrolab.plugins.regimes.base import nondimensional_scene
+from gyrolab.plugins.regimes.large_parameter import printed_reading_state
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
 log = logging.getLogger(__name__)
 
@@ -55,8 +61,6 @@ def _group(cfg: DictConfig, entry: str) -> str:
 
 
 def _cfg_for(cfg: DictConfig, regime: str, r0: float) -> DictConfig:
-    from gyrolab.engine.config import compose_config
-
     base = OmegaConf.to_container(cfg, resolve=True)
     new = compose_config([f"regime={_group(cfg, regime)}", "regime.periods=1"])
     with open_dict(new):
@@ -201,9 +205,6 @@ def resonance_point(cfg: DictConfig, omega: float, *, check: bool = True) -> tup
         if check:
             scene, regime, _ = _prepare(sub, f"resonance sweep at ω = {float(omega):g}")
         else:
-            from gyrolab.experiments.regime_run import build_regime
-            from gyrolab.engine.scene import Scene
-
             scene, regime = Scene.from_config(sub), build_regime(sub)
     except ConfigError as error:
         return f"refused: {error}", nan
@@ -302,17 +303,11 @@ def _resonance_dataset(sweep: dict) -> xr.Dataset:
 
 
 def _regime_class(name: str):
-    from gyrolab.contracts import registry
-
     return registry.load("regime", name)
 
 
 def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:
     """Printed (35) under μ = c/r0 against the full model: γ'' error over one τ period (Ismail (2021) report §3)."""
-    from gyrolab.engine.scene import Scene
-    from gyrolab.plugins.regimes.base import nondimensional_scene
-    from gyrolab.plugins.regimes.large_parameter import printed_reading_state
-
     errs = []
     mus = [float(v) for v in cfg.regime_validity.large_parameter["values"]]
     for mu in mus:
@@ -325,8 +320,6 @@ def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:
         approx = printed_reading_state(t, s)
         y0 = approx[0].copy()
         y0[3:6] /= np.linalg.norm(y0[3:6])
-        from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
         model = scene.system.compiled_model()
         y0 = np.concatenate([y0, scene.system.initial_state()[6:]])[: scene.system.state_size]
         exact = Taylor(order=24, tol=1e-16).integrate(scene.system.rhs, t, y0, None, model).y

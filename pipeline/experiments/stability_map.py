@@ -36,6 +36,8 @@ from gyrolab.output.dataset import write_dataset
 from gyrolab.sweep.grid import Dim
 from gyrolab.engine import schemas
 from gyrolab.engine.schemas import Task
+from gyrolab.batch.sweep import run_batch
+from gyrolab.analysis.chaos import section_dataset
 
 log = logging.getLogger(__name__)
 
@@ -108,8 +110,6 @@ def _sections(cfg: DictConfig) -> list:
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
-    from gyrolab.batch.sweep import run_batch
-
     plain = OmegaConf.to_container(cfg, resolve=True)
     plain.pop("hydra", None)
     path = confined_output_path(out_dir, cfg.stability_map.file, "stability_map.file")
@@ -129,8 +129,6 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
 def _add_sections(path: Path, plain: dict, points: Sequence[Sequence[float]], t_end: float) -> None:
     """Poincaré sections of the chosen (θ0, r0) points, integrated by the chaos kernel with the map's step, added to
     the map's file (rewritten atomically; a rerun replaces them)."""
-    from gyrolab.analysis.chaos import section_dataset
-
     if not t_end > 0:
         raise ConfigError(f"stability_map.section_time={t_end!r} must be a positive time")
     scenes = []

@@ -14,6 +14,7 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.figures.style import DOUBLE, log_positive, styled, subplots
+from gyrolab.output.user_yaml import stored_yaml
 
 #: error key -> (legend, marker); one color per key in every panel
 KEYS = {"pq": ("p, q", "o"), "r": ("r", "s"), "gamma": ("γ₁, γ₂", "D"), "gamma3": ("γ₃", "^"), "period": ("period", "v")}
@@ -22,8 +23,6 @@ PARAMETERS = {"mu": "μ", "c/r0": "c/r₀", "c/r0 (as printed)": "μ = c/r₀ (p
 
 def _spec(ds: xr.Dataset) -> dict[str, Any]:
     try:
-        from gyrolab.output.user_yaml import stored_yaml
-
         return stored_yaml(ds.attrs.get("config", ""), "the dataset's config attribute").get("regime_validity",
                                                                                                {}) or {}
     except Exception:  # noqa: BLE001 -- a dataset without its config still draws, with generic labels

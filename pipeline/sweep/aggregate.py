@@ -50,6 +50,7 @@ from gyrolab.output.user_yaml import stored_yaml_file
 from gyrolab.errors import ConfigError, shorten
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
+from gyrolab.figures.options import figure_options
 
 log = logging.getLogger("gyrolab.sweep")
 
@@ -448,8 +449,6 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
         if output is None:
             summary.figures = save_sweep_figures(ds, sweep_dir / "figures")
         else:  # the sweep's own config, in memory: no second reading of multirun.yaml (~0.1 s of YAML)
-            from gyrolab.figures.options import figure_options
-
             summary.figures = save_sweep_figures(ds, sweep_dir / "figures", *figure_options(output))
     return summary
 

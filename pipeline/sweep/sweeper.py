@@ -39,7 +39,7 @@ from hydra.plugins.sweeper import Sweeper
 from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.compat import ConfigLoaderImpl
+from gyrolab.compat import ConfigLoaderImpl, BasicSweeper
 from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.lock import try_lock, unlock
@@ -49,6 +49,7 @@ from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import code_version, job_identity
 from gyrolab.sweep.job import mark_skipped
 from gyrolab.sweep.record import JobRecord, read_record
+from hydra.core.plugins import Plugins
 
 log = logging.getLogger("gyrolab.sweep")
 
@@ -77,16 +78,12 @@ class ResumingSweeper(Sweeper):
         self.launcher: Launcher | None = None
 
     def setup(self, *, hydra_context: HydraContext, task_function: TaskFunction, config: DictConfig) -> None:
-        from hydra.core.plugins import Plugins
-
         self.hydra_context, self.config = hydra_context, config
         self.launcher = Plugins.instance().instantiate_launcher(hydra_context=hydra_context,
                                                                 task_function=task_function, config=config)
 
     def sweep(self, arguments: list[str]) -> Any:
         assert self.config is not None and self.launcher is not None and self.hydra_context is not None
-        from gyrolab.compat import BasicSweeper
-
         parser = OverridesParser.create(config_loader=self.hydra_context.config_loader)
         params = [f"{key}={value}" for key, value in self.params.items()]  # as the basic sweeper: params first
         overrides = parser.parse_overrides([*params, *arguments])
@@ -315,10 +312,8 @@ def register_plugin() -> None:
     (``pip install -e .``, the README's): setuptools' editable finder serves the package on import but cannot
     list it, so Hydra's scan does not see it, and the class is registered here by its real name.
     """
-    from hydra.core.plugins import Plugins
-
     plugins = Plugins.instance()  # scans first: a scan re-executes the plugin modules it finds
-    from hydra_plugins.gyrolab_sweeper import GyrolabSweeper
+    from hydra_plugins.gyrolab_sweeper import GyrolabSweeper  # after the scan above, which re-executes it
 
     if f"{GyrolabSweeper.__module__}.{GyrolabSweeper.__name__}" not in plugins.class_name_to_class:
         plugins.register(GyrolabSweeper)

@@ -35,6 +35,7 @@ from gyrolab.analysis.periodic import FixedPointModel
 from gyrolab.physics.attitude import angles_from_states
 from gyrolab.plugins.regimes import ismail2021 as paper
 from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
+from gyrolab.physics import pendulum
 
 MAX_SPIN = 0.2        # refused above: the series' radius of convergence is ≈ 0.29 (docs/regimes.md)
 WARN_SPIN = 0.1
@@ -206,8 +207,6 @@ class LargeParameter(FixedPointRegime):
         if not MIN_TILT <= s.theta0 <= MAX_TILT:
             raise ConfigError(f"regime large_parameter needs a swing amplitude {MIN_TILT:g} ≤ θ0 ≤ {MAX_TILT:g}, got "
                               f"θ0={s.theta0:.4g}")
-        from gyrolab.physics import pendulum
-
         kap = pendulum.kappa(s.a, s.k)
         if not 1 + kap * np.cos(s.theta0) > 0 or not 1 + kap > 0:
             raise ConfigError(f"regime large_parameter needs a swing about the lowest position, 1 + κ cos θ > 0 with "

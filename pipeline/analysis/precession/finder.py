@@ -109,7 +109,7 @@ def find_normal_rests(params: GyrostatParameters, theta0: float, *, grid: int = 
     A γ-component that vanishes for every χ (A = B with h1 μ·β ≡ 0) is a one-parameter family: one
     representative χ = 0 with ``family_dimension`` 1. Each solution is re-checked by the vector residual.
     """
-    from scipy.optimize import brentq, minimize_scalar
+    from scipy.optimize import brentq, minimize_scalar  # start-up: scipy.optimize only for a search
 
     sigma = 1.0 if np.cos(theta0) > 0 else -1.0
     theta0 = 0.0 if sigma > 0 else np.pi
