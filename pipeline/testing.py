@@ -396,6 +396,19 @@ def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> A
         raise _fail(cls, f"integrate returned {type(solution).__name__}, not gyrolab.contracts.Solution")
     if not np.array_equal(y0, problem.y0) or not np.array_equal(t_out, OSCILLATOR_TIMES):
         raise _fail(cls, "integrate modified its input y0 or t_out in place; work on copies")
+    _check_samples(cls, solution, t_out, y0, on)
+    _check_accuracy(cls, integrator, problem, np.asarray(solution.y), t_out, on)
+    stats = _checked_stats(cls, solution, problem, calls[0])
+    if not reported:
+        raise _fail(cls, "integrate never called progress(t); call it every few steps when it is given")
+    outside = [r for r in reported if not t_out[0] <= float(r) <= t_out[-1]]
+    if outside:
+        raise _fail(cls, f"progress was called with t={outside[0]!r}, outside the interval [{t_out[0]}, {t_out[-1]}]")
+    return stats
+
+
+def _check_samples(cls: type, solution: Solution, t_out: np.ndarray, y0: np.ndarray, on: str) -> None:
+    """Rule 3: the solution is sampled at exactly ``t_out``, finite, with the state size, starting at ``y0``."""
     t, y = np.asarray(solution.t), np.asarray(solution.y)
     if t.shape != t_out.shape or not np.array_equal(t, t_out):
         raise _fail(cls, f"Solution.t is {np.round(t, 12).tolist()}, not the requested t_out "
@@ -406,6 +419,11 @@ def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> A
         raise _fail(cls, f"Solution.y has non-finite values {on}; raise IntegrationError instead")
     if np.max(np.abs(y[0] - y0)) > 1e-14 * max(1.0, float(np.max(np.abs(y0)))):
         raise _fail(cls, f"Solution.y[0] = {y[0].tolist()} is not y0 = {y0.tolist()} at t_out[0], the initial time")
+
+
+def _check_accuracy(cls: type, integrator: Any, problem: ExactProblem, y: np.ndarray, t_out: np.ndarray,
+                    on: str) -> None:
+    """Rule 4: the error against the exact solution is within the integrator's own tolerance."""
     error = float(np.max(np.abs(y[:, problem.compared] - problem.exact(t_out))))
     rtol, atol = getattr(integrator, "rtol", None), getattr(integrator, "atol", None)
     if cls.adaptive and rtol is not None and atol is not None:
@@ -415,21 +433,21 @@ def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> A
     if not error <= allowed:
         raise _fail(cls, f"its error {on} is {error:.3g}, above {allowed:.3g} ({why}); it does not integrate to its "
                          "own tolerance")
+
+
+def _checked_stats(cls: type, solution: Solution, problem: ExactProblem, calls: int) -> IntegratorStats:
+    """Rule 5: the run's stats count the evaluations made (at most ``calls`` for a Python right-hand side) and
+    the steps taken."""
     stats = solution.stats
     if not isinstance(stats, IntegratorStats):
         raise _fail(cls, f"Solution.stats is {type(stats).__name__}, not gyrolab.contracts.IntegratorStats")
     if not isinstance(stats.nfev, (int, np.integer)) or stats.nfev <= 0:
         raise _fail(cls, f"stats.nfev={stats.nfev!r} must count the right-hand-side evaluations (an integer > 0)")
-    if problem.compiled is None and stats.nfev > calls[0]:
-        raise _fail(cls, f"stats.nfev={stats.nfev}, but the right-hand side was called {calls[0]} times; count the "
+    if problem.compiled is None and stats.nfev > calls:
+        raise _fail(cls, f"stats.nfev={stats.nfev}, but the right-hand side was called {calls} times; count the "
                          "evaluations made, no more")
     if not isinstance(stats.n_steps, (int, np.integer)) or stats.n_steps < 1:
         raise _fail(cls, f"stats.n_steps={stats.n_steps!r} must be the number of steps taken (an integer ≥ 1)")
-    if not reported:
-        raise _fail(cls, "integrate never called progress(t); call it every few steps when it is given")
-    outside = [r for r in reported if not t_out[0] <= float(r) <= t_out[-1]]
-    if outside:
-        raise _fail(cls, f"progress was called with t={outside[0]!r}, outside the interval [{t_out[0]}, {t_out[-1]}]")
     return stats
 
 

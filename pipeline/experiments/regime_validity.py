@@ -107,52 +107,9 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     for regime_name in spec.regimes:
         values = [float(v) for v in spec[regime_name]["values"]]
         fit_below = float(spec[regime_name]["fit_below"])
-        errs = {against: {k: [] for k in KEYS} for against in ("orbit", "full")}
-        status = []
-        theory = getattr(_regime_class(_group(cfg, regime_name)), "order", {})
-        for value in values:
-            sub = _cfg_for(cfg, regime_name, _r0_for(regime_name, value, cfg))
-            try:
-                scene, regime, _ = _prepare(sub, f"{regime_name} at {spec[regime_name]['parameter']} = {value:g}")
-            except ConfigError as error:
-                status.append(f"refused: {error}")
-                _append_missing(errs)
-                continue
-            theory = regime.order  # the instance's: a branch may have other orders than the class default
-            T = regime.period(scene.system)
-            t = np.linspace(0, T, 241)
-            try:
-                result = compute(scene, regime, t)
-            except IntegrationError as error:  # no exact orbit near the series (far outside its domain)
-                status.append(f"failed: {error}")
-                _append_missing(errs)
-                continue
-            status.append("ok")
-            sc = _scales(regime, scene.system)
-            for against in errs:
-                e = errors(result, against)
-                for k in KEYS:
-                    errs[against][k].append(e.get(k, np.nan) / sc[k] if k in e else np.nan)
-        orders = {}
-        for k in KEYS:
-            x, y = np.array(values), np.array(errs["orbit"][k])
-            ok = (x <= fit_below) & np.isfinite(y) & (y > 0)
-            orders[k] = float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0]) if ok.sum() >= 2 else np.nan
-        # an order is consistent within 0.2 of the theory's; a faster decay is consistent too (the theory's
-        # O(μⁿ) is a bound: a small coefficient shows as a higher fitted slope) but is named in the verdict
-        checked = [k for k in KEYS if k in theory and np.isfinite(orders[k])]
-        good = all(orders[k] >= theory[k] - 0.2 for k in checked)
-        faster = [LONG[k] for k in checked if orders[k] > theory[k] + 0.2]
-        refused = [v for v, s in zip(values, status) if s.startswith("refused")]
-        failed = [v for v, s in zip(values, status) if s.startswith("failed")]
-        verdict = (f"{regime_name}: fitted orders (parameter ≤ {fit_below:g}) "
-                   + ", ".join(f"{LONG[k]} {orders[k]:.2f} (theory {theory.get(k, float('nan')):g})" for k in KEYS)
-                   + f"; {'consistent with' if good else 'NOT consistent with'} the theory"
-                   + (f" ({', '.join(faster)} faster than its bound)" if faster else "") + "; "
-                   + (f"refused outside the domain at {spec[regime_name]['parameter']} = "
-                      + ", ".join(f'{v:g}' for v in refused) if refused else "no refused point")
-                   + (f"; no exact orbit found near the series at {spec[regime_name]['parameter']} = "
-                      + ", ".join(f"{v:g}" for v in failed) if failed else ""))
+        errs, status, theory = _regime_errors(cfg, regime_name, values)
+        orders = _fitted_orders(values, errs["orbit"], fit_below)
+        verdict = _verdict(regime_name, spec[regime_name]["parameter"], fit_below, values, status, orders, theory)
         log.info("%s", verdict)
         verdicts.append(verdict)
         rows.append((regime_name, values, errs, orders, status))
@@ -175,6 +132,71 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                     "regime's domain or with non-physical bodies); their text is in %s (attribute expected_warnings)",
                     len(_expected), written[0])
     return written
+
+
+def _regime_errors(cfg: DictConfig, regime_name: str, values: list[float]) -> tuple[dict, list[str], dict]:
+    """(errors against the exact orbit and the full equations per key, each point's status, the theory's orders)
+    of a regime's series at each value of its parameter."""
+    errs: dict[str, dict[str, list]] = {against: {k: [] for k in KEYS} for against in ("orbit", "full")}
+    status = []
+    theory = getattr(_regime_class(_group(cfg, regime_name)), "order", {})
+    for value in values:
+        sub = _cfg_for(cfg, regime_name, _r0_for(regime_name, value, cfg))
+        try:
+            scene, regime, _ = _prepare(sub, f"{regime_name} at {cfg.regime_validity[regime_name]['parameter']} = "
+                                             f"{value:g}")
+        except ConfigError as error:
+            status.append(f"refused: {error}")
+            _append_missing(errs)
+            continue
+        theory = regime.order  # the instance's: a branch may have other orders than the class default
+        t = np.linspace(0, regime.period(scene.system), 241)
+        try:
+            result = compute(scene, regime, t)
+        except IntegrationError as error:  # no exact orbit near the series (far outside its domain)
+            status.append(f"failed: {error}")
+            _append_missing(errs)
+            continue
+        status.append("ok")
+        sc = _scales(regime, scene.system)
+        for against in errs:
+            e = errors(result, against)
+            for k in KEYS:
+                errs[against][k].append(e.get(k, np.nan) / sc[k] if k in e else np.nan)
+    return errs, status, theory
+
+
+def _fitted_orders(values: list[float], errs: dict[str, list], fit_below: float) -> dict[str, float]:
+    """Per key, the slope of log error against log parameter over the points at or below ``fit_below``."""
+    orders = {}
+    for k in KEYS:
+        x, y = np.array(values), np.array(errs[k])
+        ok = (x <= fit_below) & np.isfinite(y) & (y > 0)
+        orders[k] = float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0]) if ok.sum() >= 2 else np.nan
+    return orders
+
+
+def _verdict(regime_name: str, parameter: str, fit_below: float, values: list[float], status: list[str],
+             orders: dict[str, float], theory: dict) -> str:
+    """The regime's fitted orders against the theory's, and where it was refused or found no exact orbit."""
+    # an order is consistent within 0.2 of the theory's; a faster decay is consistent too (the theory's
+    # O(μⁿ) is a bound: a small coefficient shows as a higher fitted slope) but is named in the verdict
+    checked = [k for k in KEYS if k in theory and np.isfinite(orders[k])]
+    good = all(orders[k] >= theory[k] - 0.2 for k in checked)
+    faster = [LONG[k] for k in checked if orders[k] > theory[k] + 0.2]
+    return (f"{regime_name}: fitted orders (parameter ≤ {fit_below:g}) "
+            + ", ".join(f"{LONG[k]} {orders[k]:.2f} (theory {theory.get(k, float('nan')):g})" for k in KEYS)
+            + f"; {'consistent with' if good else 'NOT consistent with'} the theory"
+            + (f" ({', '.join(faster)} faster than its bound)" if faster else "") + "; "
+            + _missing_points(parameter, values, status))
+
+
+def _missing_points(parameter: str, values: list[float], status: list[str]) -> str:
+    """Where a regime was refused outside its domain, and where no exact orbit was found near its series."""
+    refused = ", ".join(f"{v:g}" for v, s in zip(values, status) if s.startswith("refused"))
+    failed = ", ".join(f"{v:g}" for v, s in zip(values, status) if s.startswith("failed"))
+    return ((f"refused outside the domain at {parameter} = {refused}" if refused else "no refused point")
+            + (f"; no exact orbit found near the series at {parameter} = {failed}" if failed else ""))
 
 
 def a_for_omega(omega: float, b: float) -> float:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+from typing import Any
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -60,19 +61,25 @@ def grid(cfg: DictConfig) -> list[Dim]:
         if points is None and key == "r0":
             check_points(float(n_theta) * n_r, f"stability_map.n_theta0={n_theta} × n_r0={n_r}",
                          allow_large=cfg.get("allow_large") is True)
-        if len(span) != 2:
-            raise ConfigError(f"stability_map.{key}={list(span)!r} must be [first, last]")
-        first, last = (as_number(v, f"stability_map.{key}") for v in span)
-        if n > 1 and first == last:
-            raise ConfigError(f"stability_map.{key}={list(span)!r} is one value, but n_{key}={n} points are asked; "
-                              f"give [first, last] with first ≠ last, or n_{key}=1")
-        spacing = settings.get(f"{key}_spacing", "linear")
-        if spacing not in ("linear", "log") or (spacing == "log" and not 0 < first < last):
-            raise ConfigError(f"stability_map.{key}_spacing={spacing!r} must be linear or log (log: 0 < first < last)")
-        spaced = np.geomspace if spacing == "log" else np.linspace
-        values = spaced(first, last, n) if n > 1 else np.array([first])
+        values = _axis_values(settings, key, span, n)
         dims.append(Dim(f"initial.{key}", tuple(repr(float(v)) for v in values), tuple(float(v) for v in values)))
     return dims
+
+
+def _axis_values(settings: DictConfig, key: str, span: Any, n: int) -> np.ndarray:
+    """The ``n`` values of axis ``key`` from ``span`` = [first, last], linear or log spaced; ConfigError if a
+    setting is wrong."""
+    if len(span) != 2:
+        raise ConfigError(f"stability_map.{key}={list(span)!r} must be [first, last]")
+    first, last = (as_number(v, f"stability_map.{key}") for v in span)
+    if n > 1 and first == last:
+        raise ConfigError(f"stability_map.{key}={list(span)!r} is one value, but n_{key}={n} points are asked; "
+                          f"give [first, last] with first ≠ last, or n_{key}=1")
+    spacing = settings.get(f"{key}_spacing", "linear")
+    if spacing not in ("linear", "log") or (spacing == "log" and not 0 < first < last):
+        raise ConfigError(f"stability_map.{key}_spacing={spacing!r} must be linear or log (log: 0 < first < last)")
+    spaced = np.geomspace if spacing == "log" else np.linspace
+    return spaced(first, last, n) if n > 1 else np.array([first])
 
 
 #: what the task reads and sets (gyrolab.experiments derives its tables from it)

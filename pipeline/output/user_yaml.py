@@ -73,6 +73,16 @@ def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> y
     """ConfigError (one sentence naming ``where`` and the line) unless ``data`` is a plain YAML mapping within the
     limits (module docstring); the composed node (None for an empty text). ``stored``: a config gyrolab stored
     (the sentences say that it was edited)."""
+    node = _composed(_decoded(data, where), where, stored)
+    if node is None:
+        return None  # an empty file is an empty config
+    _check_nodes(node, where)
+    _check_top_level(node, where, stored)
+    return node
+
+
+def _decoded(data: bytes | str, where: str) -> str:
+    """The text of ``data``: within the size limit, UTF-8, no control character YAML refuses."""
     if isinstance(data, str):
         data = data.encode("utf-8", "surrogatepass")
     if len(data) > MAX_FILE_BYTES:
@@ -87,9 +97,14 @@ def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> y
     if bad is not None:
         raise ConfigError(f"{where}, line {text.count(chr(10), 0, bad) + 1}: a control character (code "
                           f"{ord(text[bad])}) that YAML does not allow; a config file is plain text")
+    return text
+
+
+def _composed(text: str, where: str, stored: bool) -> yaml.Node | None:
+    """The YAML node of ``text`` (not deeper than the limit), or one sentence saying where it is not YAML."""
     try:
         _check_depth(text, where)  # before composing: PyYAML's composer recurses once per level
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        return yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as error:
         if stored:
             mark = error.problem_mark or error.context_mark
@@ -99,9 +114,10 @@ def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> y
         raise ConfigError(_sentence(where, error)) from None
     except yaml.YAMLError as error:
         raise ConfigError(f"{where} is not valid YAML ({shorten(type(error).__name__)})") from None
-    if node is None:
-        return None  # an empty file is an empty config
-    _check_nodes(node, where)
+
+
+def _check_top_level(node: yaml.Node, where: str, stored: bool) -> None:
+    """ConfigError unless the file is a mapping whose ``defaults``, if any, is a list."""
     if not isinstance(node, yaml.MappingNode):
         kind = "a list" if isinstance(node, yaml.SequenceNode) else "a single value"
         if stored:
@@ -112,7 +128,6 @@ def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> y
         if key.value == "defaults" and not isinstance(value, yaml.SequenceNode):
             raise ConfigError(f"{where}, line {value.start_mark.line + 1}: `defaults` must be a list (- group: option "
                               "lines), as in Hydra's defaults list")
-    return node
 
 
 def stored_yaml(data: bytes | str, where: str) -> dict:

@@ -238,22 +238,32 @@ class IdentityPredictor:
 
     def identity(self, overrides: Sequence[str]) -> str | None:
         parsed = [self._parse(text) for text in overrides]
-        choices = tuple(o.input_line for o in parsed if self._is_group(o))
         # Hydra's own settings are the same for every job of a sweep and are not part of an identity
         values = [o for o in parsed if not self._is_group(o) and not o.key_or_group.startswith("hydra.")]
+        base = self._base(tuple(o.input_line for o in parsed if self._is_group(o)), overrides, values)
+        if base is None or not all(o.key_or_group in base.applied for o in values):
+            return None
+        changed = [o for o in values if base.applied[o.key_or_group].input_line != o.input_line]
+        if any(o.is_delete() for o in changed):
+            return None
+        plain = self._resolved_with(base, changed)
+        return None if plain is None else job_identity(plain, self.code)
+
+    def _base(self, choices: tuple[str, ...], overrides: Sequence[str], values: list) -> _Base | None:
+        """The composed config of the jobs choosing ``choices`` (composed once), or None where a resolver could
+        give each job its own value."""
         if choices not in self._bases:
             composed = self.loader.load_sweep_config(self.master, list(overrides))
             scene = OmegaConf.masked_copy(composed, [k for k in composed if k != "hydra"])
             unresolved = OmegaConf.to_container(scene, resolve=False)
             self._bases[choices] = None if _RESOLVER.search(repr(unresolved)) else _Base(
                 scene, {o.key_or_group: o for o in values}, None if "${" in repr(unresolved) else unresolved)
-        base = self._bases[choices]
-        if base is None:
-            return None
-        changed = [o for o in values if base.applied[o.key_or_group].input_line != o.input_line] \
-            if all(o.key_or_group in base.applied for o in values) else None
-        if changed is None or any(o.is_delete() for o in changed):
-            return None
+        return self._bases[choices]
+
+    @staticmethod
+    def _resolved_with(base: _Base, changed: list) -> dict | None:
+        """The base config with the ``changed`` overrides applied, resolved (None: it does not resolve); the base
+        is left as it was."""
         try:
             try:
                 for o in changed:
@@ -262,14 +272,12 @@ class IdentityPredictor:
                 raise OverridesDoNotApply(str(error)) from error
             try:
                 plain = _patched(base, changed)
-                if plain is None:
-                    plain = OmegaConf.to_container(base.scene, resolve=True)
+                return plain if plain is not None else OmegaConf.to_container(base.scene, resolve=True)
             except Exception:  # noqa: BLE001 - e.g. an interpolation that does not resolve: the job records it
                 return None
         finally:
             for o in changed:  # back to the composed job's values
                 ConfigLoaderImpl._apply_overrides_to_config([_as_change(base.applied[o.key_or_group])], base.scene)
-        return job_identity(plain, self.code)
 
     def _parse(self, text: str) -> Override:
         if text not in self._parsed:
