@@ -104,6 +104,14 @@ class ResumingSweeper(Sweeper):
         # As the basic sweeper, refuse a sweep with a job Hydra cannot compose before launching any job: every
         # job's overrides were applied above; the jobs where that failed are composed in full (Hydra's error).
         self.validate_batch_is_legal([jobs[num] for num in unsure if num not in settled])
+        returns, launched = self._launch(jobs, remaining)
+        for num, (job_dir, record) in settled.items():  # as a job that skips itself records it
+            if num not in launched:
+                mark_skipped(job_dir, record, num, jobs[num])
+        return returns
+
+    def _launch(self, jobs: list, remaining: list[int]) -> tuple[list, set[int]]:
+        """Launch the ``remaining`` jobs in batches: (the launcher's results, the job numbers launched)."""
         # A sequential launcher gains nothing from launching settled jobs between remaining ones.
         gap = 0 if type(self.launcher).__name__ == "BasicLauncher" else MERGE_GAP
         returns, launched = [], set()
@@ -113,10 +121,7 @@ class ResumingSweeper(Sweeper):
             for r in results:
                 _ = r.return_value  # re-raises a job's exception, as the basic sweeper does
             returns.append(results)
-        for num, (job_dir, record) in settled.items():  # as a job that skips itself records it
-            if num not in launched:
-                mark_skipped(job_dir, record, num, jobs[num])
-        return returns
+        return returns, launched
 
 
 def claim(sweep_dir: Path, config: DictConfig) -> None:
