@@ -647,22 +647,27 @@ def _check_variables(cls: type, system: Any, t: np.ndarray, y: np.ndarray) -> No
     if not isinstance(variables, dict):
         raise _fail(cls, f"variables(t, y) returned {type(variables).__name__}, not a dict of xarray.Variable")
     for key, variable in variables.items():
-        if not isinstance(variable, xr.Variable):
-            raise _fail(cls, f"variables(t, y)[{key!r}] is {type(variable).__name__}, not an xarray.Variable")
-        if not variable.dims or variable.dims[0] != "time" or variable.shape[0] != len(t):
-            raise _fail(cls, f"variable {key!r} has dims {variable.dims} and shape {variable.shape}; its first "
-                             f"dimension must be time, of length {len(t)}")
-        for attr in ("units", "long_name"):
-            value = variable.attrs.get(attr)
-            if not isinstance(value, str) or not value.strip():
-                raise _fail(cls, f"variable {key!r} has no CF {attr} (got {value!r}); give every variable units "
-                                 "and long_name")
+        _check_variable(cls, key, variable, len(t))
     for name in invariants:
         if name not in variables:
             raise _fail(cls, f"invariant {name!r} is not among variables(t, y) ({', '.join(variables)}); every "
                              "monitored invariant must be a dataset variable")
         if variables[name].dims != ("time",):
             raise _fail(cls, f"invariant {name!r} has dims {variables[name].dims}, not ('time',)")
+
+
+def _check_variable(cls: type, key: str, variable: Any, n_times: int) -> None:
+    """A system's dataset variable: an xarray.Variable over time first, with CF units and long_name."""
+    if not isinstance(variable, xr.Variable):
+        raise _fail(cls, f"variables(t, y)[{key!r}] is {type(variable).__name__}, not an xarray.Variable")
+    if not variable.dims or variable.dims[0] != "time" or variable.shape[0] != n_times:
+        raise _fail(cls, f"variable {key!r} has dims {variable.dims} and shape {variable.shape}; its first "
+                         f"dimension must be time, of length {n_times}")
+    for attr in ("units", "long_name"):
+        value = variable.attrs.get(attr)
+        if not isinstance(value, str) or not value.strip():
+            raise _fail(cls, f"variable {key!r} has no CF {attr} (got {value!r}); give every variable units "
+                             "and long_name")
 
 
 def _check_invariants_conserved(cls: type, system: Any, t: np.ndarray, y: np.ndarray, tolerance: float) -> None:
@@ -734,6 +739,15 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     if not isinstance(warnings_, list) or not all(isinstance(w, str) and "\n" not in w.strip() for w in warnings_):
         raise _fail(cls, f"check_domain returned {warnings_!r}; it must return a list of one-line warnings (str) "
                          "and raise ConfigError outside the domain")
+    _check_regime_numbers(cls, regime, system)
+    t = np.linspace(0.0, float(regime.period(system)), 9)
+    _check_euler_angles(cls, regime, system, t)
+    _check_mapping(cls, regime.attributes(), "attributes()")
+
+
+def _check_regime_numbers(cls: type, regime: Any, system: Any) -> None:
+    """Rules 4–6: a finite parameter value, a start state matching the solution at 0, a finite positive period
+    over which the solution is finite, of shape (n, 6)."""
     value = regime.parameter_value(system)
     if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) or not math.isfinite(float(value)):
         raise _fail(cls, f"parameter_value(system) returned {value!r}, not a finite number")
@@ -746,8 +760,6 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     if y.shape != (len(t), 6) or not np.all(np.isfinite(y)):
         raise _fail(cls, f"solution(system, t) for {len(t)} times returned shape {y.shape}"
                          f"{'' if np.all(np.isfinite(y)) else ' with non-finite values'}; it must be finite, (n, 6)")
-    _check_euler_angles(cls, regime, system, t)
-    _check_mapping(cls, regime.attributes(), "attributes()")
 
 
 def _check_regime_declarations(cls: type) -> None:
