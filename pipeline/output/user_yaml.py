@@ -211,19 +211,24 @@ def _check_nodes(root: yaml.Node, where: str) -> None:
                               "allowed (not plain YAML: gyrolab refuses tags such as !!python/...); a config holds "
                               "plain values (numbers, strings, lists, mappings)")
         if isinstance(node, yaml.MappingNode):
-            seen: dict[object, int] = {}
-            for k, _ in node.value:
-                if not isinstance(k, yaml.ScalarNode):
-                    raise ConfigError(f"{where}, line {k.start_mark.line + 1}: a key is a list or a mapping; keys of a "
-                                      "config are plain names")
-                if isinstance(k, yaml.ScalarNode):
-                    if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
-                        raise ConfigError(f"{where}, line {k.start_mark.line + 1}: the key {shorten(k.value, 60)!r} "
-                                          f"is given twice in one mapping (first on line {seen[k.value]}); "
-                                          "give each key once")
-                    seen[k.value] = k.start_mark.line + 1
+            _check_keys(node, where)
         stack.append((node, True, depth))
         stack.extend((c, False, depth + 1) for c in _children(node) if id(c) not in sizes)
+
+
+def _check_keys(node: yaml.MappingNode, where: str) -> None:
+    """ConfigError for a key that is not a plain name, or given twice in one mapping."""
+    seen: dict[object, int] = {}
+    for k, _ in node.value:
+        if not isinstance(k, yaml.ScalarNode):
+            raise ConfigError(f"{where}, line {k.start_mark.line + 1}: a key is a list or a mapping; keys of a "
+                              "config are plain names")
+        if isinstance(k, yaml.ScalarNode):
+            if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
+                raise ConfigError(f"{where}, line {k.start_mark.line + 1}: the key {shorten(k.value, 60)!r} "
+                                  f"is given twice in one mapping (first on line {seen[k.value]}); "
+                                  "give each key once")
+            seen[k.value] = k.start_mark.line + 1
 
 
 def _children(node: yaml.Node) -> list[yaml.Node]:
