@@ -265,40 +265,63 @@ def resonance_sweep(cfg: DictConfig) -> dict:
                 err["max"][i, j, m] = max(e.values()) if status[i, j, m] == "ok" else np.nan
         small = np.abs(n * n - omega[i] ** 2)
         for k in exponents:
-            y = err[k][i]
-            ok = (distances[None, :] <= fit_within) & np.isfinite(y) & (y > 0)
-            if ok.sum() >= 3:
-                exponents[k][i] = -float(np.polyfit(np.log(small[ok]), np.log(y[ok]), 1)[0])
-        # per distance, the worst point over both sides: +inf where shooting failed, NaN where refused
-        failed_at = np.vectorize(lambda x: str(x).startswith("failed"))(status[i])
-        refused_at = np.vectorize(lambda x: str(x).startswith("refused"))(status[i])
-        worst = np.where(failed_at, np.inf, err["max"][i])
-        computed = ~np.all(refused_at, axis=0)
-        worst = np.array([np.nanmax(worst[:, m]) if computed[m] else np.nan for m in range(len(distances))])
-        # holds: the smallest swept distance from which every computed point on both sides has error ≤ tol
-        for m in np.argsort(distances)[::-1]:
-            if not computed[m]:
-                continue
-            if not worst[m] <= tol:
-                break
-            holds[i] = distances[m]
-        refused = [f"{d:g}" for d in sorted(distances[np.any(refused_at, axis=0)])]
-        failed = [f"{w:.4g}" for w in omega[i][failed_at]]
-        ref = distances.max()
-        far = worst[np.argmax(distances)]
-        edge = worst[computed][np.argmin(distances[computed])] if computed.any() else np.nan
-        verdicts.append(
-            f"{spec.regime} near the resonance ω = {n:g} (c/r0 = {1 / float(spec.r0):g}, b = {float(spec.b):g}, ω set "
-            f"through a): max relative error against the exact orbit grows as |{n:g}² − ω²|^−s with s = "
-            f"{exponents['max'][i]:.2f} (p, q {exponents['pq'][i]:.2f}, γ, γ' {exponents['gamma'][i]:.2f}, "
-            f"γ'' {exponents['gamma3'][i]:.2f}; fitted for |ω − {n:g}| ≤ {fit_within:g}); {far:.2g} at |ω − {n:g}| = "
-            f"{ref:g}, {edge:.2g} at the closest accepted point; the regime holds (error ≤ {tol:g}) for |ω − {n:g}| ≥ "
-            f"{holds[i]:g}; " + (f"refused at |ω − {n:g}| = {', '.join(refused)}" if refused else "no refused point")
-            + (f"; shooting failed at ω = {', '.join(failed)}" if failed else ""))
+            exponents[k][i] = _growth_exponent(err[k][i], small, distances, fit_within)
+        worst, computed, failed_at, refused_at = _worst_over_sides(status[i], err["max"][i])
+        holds[i] = _holds_from(distances, worst, computed, tol)
+        verdicts.append(_resonance_verdict(spec, n, {k: v[i] for k, v in exponents.items()}, holds[i], distances,
+                                           worst, computed, sorted(distances[np.any(refused_at, axis=0)]),
+                                           omega[i][failed_at]))
         log.info("%s", verdicts[-1])
     return {"resonances": resonances, "distances": distances, "sides": sides, "omega": omega, "errors": err,
             "status": status, "exponents": exponents, "holds": holds, "verdicts": verdicts,
             "fit_within": fit_within, "tolerance": tol, "epsilon": 1 / float(spec.r0)}
+
+
+def _growth_exponent(y: np.ndarray, small: np.ndarray, distances: np.ndarray, fit_within: float) -> float:
+    """s of error ∝ |n² − ω²|^−s, fitted over the points within ``fit_within`` of the resonance (NaN: too few)."""
+    ok = (distances[None, :] <= fit_within) & np.isfinite(y) & (y > 0)
+    return -float(np.polyfit(np.log(small[ok]), np.log(y[ok]), 1)[0]) if ok.sum() >= 3 else np.nan
+
+
+def _worst_over_sides(status: np.ndarray, max_error: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Per distance, the worst point over both sides (+inf where shooting failed, NaN where refused on both),
+    whether any point was computed there, and where points failed or were refused."""
+    failed_at = np.vectorize(lambda x: str(x).startswith("failed"))(status)
+    refused_at = np.vectorize(lambda x: str(x).startswith("refused"))(status)
+    worst = np.where(failed_at, np.inf, max_error)
+    computed = ~np.all(refused_at, axis=0)
+    worst = np.array([np.nanmax(worst[:, m]) if computed[m] else np.nan for m in range(worst.shape[1])])
+    return worst, computed, failed_at, refused_at
+
+
+def _holds_from(distances: np.ndarray, worst: np.ndarray, computed: np.ndarray, tol: float) -> float:
+    """The smallest swept distance from which every computed point on both sides has error ≤ ``tol``."""
+    holds = np.nan
+    for m in np.argsort(distances)[::-1]:
+        if not computed[m]:
+            continue
+        if not worst[m] <= tol:
+            break
+        holds = distances[m]
+    return holds
+
+
+def _resonance_verdict(spec: DictConfig, n: float, exponents: dict[str, float], holds: float, distances: np.ndarray,
+                       worst: np.ndarray, computed: np.ndarray, refused_distances: list, failed_omegas: np.ndarray) -> str:
+    """How the error grows towards the resonance ω = n, and from which distance the regime holds."""
+    refused = [f"{d:g}" for d in refused_distances]
+    failed = [f"{w:.4g}" for w in failed_omegas]
+    fit_within, tol = float(spec.fit_within), float(spec.tolerance)
+    far = worst[np.argmax(distances)]
+    edge = worst[computed][np.argmin(distances[computed])] if computed.any() else np.nan
+    return (f"{spec.regime} near the resonance ω = {n:g} (c/r0 = {1 / float(spec.r0):g}, b = {float(spec.b):g}, ω set "
+            f"through a): max relative error against the exact orbit grows as |{n:g}² − ω²|^−s with s = "
+            f"{exponents['max']:.2f} (p, q {exponents['pq']:.2f}, γ, γ' {exponents['gamma']:.2f}, "
+            f"γ'' {exponents['gamma3']:.2f}; fitted for |ω − {n:g}| ≤ {fit_within:g}); {far:.2g} at |ω − {n:g}| = "
+            f"{distances.max():g}, {edge:.2g} at the closest accepted point; the regime holds (error ≤ {tol:g}) for "
+            f"|ω − {n:g}| ≥ {holds:g}; " + (f"refused at |ω − {n:g}| = {', '.join(refused)}" if refused else
+                                            "no refused point")
+            + (f"; shooting failed at ω = {', '.join(failed)}" if failed else ""))
 
 
 def _resonance_dataset(sweep: dict) -> xr.Dataset:
