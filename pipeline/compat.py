@@ -36,6 +36,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import hydra
+import xarray
 from hydra import version as hydra_version
 from hydra._internal.config_loader_impl import ConfigLoaderImpl, get_overrides_dirname
 from hydra._internal.defaults_list import create_defaults_list
@@ -46,7 +47,6 @@ from hydra.core.override_parser.types import Override
 from hydra.core.utils import JobRuntime
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
-import xarray
 from xarray.backends import locks, netCDF4_, writers
 from xarray.namedarray import pycompat, utils
 

@@ -38,21 +38,22 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-
-from gyrolab.contracts.claims import _rotation, axes_of as _axes, random_states, rotation_torque  # noqa: F401
-from gyrolab.contracts.force import Force
-from gyrolab.contracts.integrator_rules import unchecked
-from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.physics.body import Body
-from gyrolab.engine.scene import build_force, compose_scene
-from gyrolab.kernels import expression, model, models
-from gyrolab.physics.vectors import cross
-from gyrolab.plugins.systems.fixed_point import FixedPoint
-from gyrolab.contracts.integrator import Integrator, IntegratorStats, Solution
-from gyrolab.contracts.system import System
-from gyrolab.plugins.integrators.compiled_solvers import Taylor
 import xarray as xr
+
+from gyrolab.contracts.claims import _rotation, random_states, rotation_torque  # noqa: F401
+from gyrolab.contracts.claims import axes_of as _axes
+from gyrolab.contracts.force import Force
+from gyrolab.contracts.integrator import Integrator, IntegratorStats, Solution
+from gyrolab.contracts.integrator_rules import unchecked
 from gyrolab.contracts.regime import Regime
+from gyrolab.contracts.system import System
+from gyrolab.engine.scene import build_force, compose_scene
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.kernels import expression, model, models
+from gyrolab.physics.body import Body
+from gyrolab.physics.vectors import cross
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
+from gyrolab.plugins.systems.fixed_point import FixedPoint
 
 __all__ = ["check_force", "check_integrator", "check_regime", "check_system", "random_states", "rotation_torque"]
 

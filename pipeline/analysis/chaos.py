@@ -21,11 +21,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.kernels import fixed_point, layout, models, variational, model, tangent
-from gyrolab.contracts.integrator import VARIATIONAL
 from gyrolab.contracts.capabilities import integrators_with, or_list
-from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval, DOP853Numba, RK4Numba
+from gyrolab.contracts.integrator import VARIATIONAL
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.kernels import fixed_point, layout, model, models, tangent, variational
+from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, RK4Numba, steps_per_interval
 
 INDICATOR_NAME = "MEGNO"
 INDICATOR_DEFINITION = ("MEGNO <Y>(t_end) (Cincotta & Simo 2000): time mean of Y(t) = (2/t) int_0^t s d'.d/d.d ds "

@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.kernels.compiler import kernel
 from gyrolab.kernels import layout
+from gyrolab.kernels.compiler import kernel
 
 ORDER = 24
 TOL = 1e-17

@@ -31,6 +31,7 @@ import sys
 import tempfile
 import warnings
 from collections.abc import Sequence
+from importlib.util import find_spec
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -40,9 +41,13 @@ from hydra.core.override_parser.types import Override
 from hydra.errors import OverrideParseException
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
+from omegaconf.errors import OmegaConfBaseException
 
-from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
+from gyrolab.app.completion import SHELLS, script
+from gyrolab.app.parser import parse_command_line, run_parser
+from gyrolab.batch.scheduler import check_configured, use_command_line_scheduler
 from gyrolab.compat import composing_once, install_dask_free_writes, run_hydra
+from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
     ConfigSource,
@@ -53,29 +58,24 @@ from gyrolab.engine.config import (
     register_plugin_configs,
     use_source,
 )
+from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
 from gyrolab.engine.safety import check_config, check_output_dir
+from gyrolab.engine.scene import Scene
 from gyrolab.engine.unread import ACCURACY, given_keys, ignored_accuracy, unread_accuracy
 from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
+from gyrolab.experiments import TASKS, check_task, refuse_unread, run_task
 from gyrolab.figures.options import figure_options
-from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
+from gyrolab.output.atomic import reason
+from gyrolab.output.dataset import write_dataset
+from gyrolab.output.lock import LOCK_NAME, release_all, writing_in
+from gyrolab.output.provenance import gyrolab_version
+from gyrolab.output.trust import check_kernel_cache, check_tree
 from gyrolab.output.written import announce_written
-from gyrolab.engine.scene import Scene
+from gyrolab.sweep import callbacks
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
 from gyrolab.sweep.job import draws_job_figures, run_sweep_job
-from gyrolab.output.trust import check_tree, check_kernel_cache
-from gyrolab.experiments import check_task, refuse_unread, TASKS, run_task
-from omegaconf.errors import OmegaConfBaseException
-from gyrolab.batch.scheduler import check_configured, use_command_line_scheduler
-from importlib.util import find_spec
-from gyrolab.output.lock import LOCK_NAME, writing_in, release_all
-from gyrolab.output.dataset import write_dataset
-from gyrolab.app.parser import parse_command_line, run_parser
-from gyrolab.sweep import callbacks
-from gyrolab.app.completion import SHELLS, script
-from gyrolab.output.atomic import reason
-from gyrolab.output.provenance import gyrolab_version
 from gyrolab.sweep.sweeper import register_plugin
 
 if TYPE_CHECKING:

@@ -10,27 +10,28 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from datetime import datetime
 from pathlib import Path
 
-from gyrolab.errors import ConfigError, shorten
-from gyrolab.output.written import announce_written
-from datetime import datetime
-from gyrolab.app import _job_overrides, _sweeper_params, check_writable, parse_overrides, _sweep_status
+from gyrolab.app import _job_overrides, _sweep_status, _sweeper_params, check_writable, parse_overrides
+from gyrolab.app.completion import script
+from gyrolab.app.parser import one_path
+from gyrolab.batch.reproduce import is_batch, reproduce_batch
 from gyrolab.batch.scheduler import use_command_line_scheduler
 from gyrolab.batch.sweep import failed_points, run_batch_sweep
-from gyrolab.engine.config import check_scene_config, compose_config
 from gyrolab.engine.budget import check_sweep_size, check_tolerances
-from gyrolab.experiments import BATCH_COMMAND, refuse_unread, reproduce_task, task_of_config
+from gyrolab.engine.config import check_scene_config, compose_config
 from gyrolab.engine.safety import check_config, check_output_dir
+from gyrolab.errors import ConfigError, shorten
+from gyrolab.experiments import BATCH_COMMAND, refuse_unread, reproduce_task, task_of_config
 from gyrolab.figures.options import figure_options
-from gyrolab.output.trust import check_kernel_cache, check_tree
-from gyrolab.app.parser import one_path
 from gyrolab.figures.redraw import redraw
-from gyrolab.batch.reproduce import is_batch, reproduce_batch
-from gyrolab.sweep.reproduce import checked_config, is_multirun, load_run, report, reproduce_sweep, reproduce as rerun
-from gyrolab.sweep.aggregate import aggregate_sweep, log_summary
+from gyrolab.output.trust import check_kernel_cache, check_tree
+from gyrolab.output.written import announce_written
 from gyrolab.scaffold import new_force_package
-from gyrolab.app.completion import script
+from gyrolab.sweep.aggregate import aggregate_sweep, log_summary
+from gyrolab.sweep.reproduce import checked_config, is_multirun, load_run, report, reproduce_sweep
+from gyrolab.sweep.reproduce import reproduce as rerun
 
 log = logging.getLogger("gyrolab")
 

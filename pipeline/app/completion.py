@@ -13,14 +13,21 @@ the shell when TAB is pressed, so a user's own experiments are offered without g
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
-
-from gyrolab.errors import ConfigError
 from importlib.resources import files
-from omegaconf import OmegaConf, DictConfig
-from gyrolab.engine.config import (CONFIG_MODULE, SELECTABLE_GROUPS, compose_config, group_options, hydra_for,
-                                   register_plugin_configs)
-from gyrolab.app.parser import ALIASES, build_parsers, COMMANDS, run_parser, value_options
+
+from omegaconf import DictConfig, OmegaConf
+
+from gyrolab.app.parser import ALIASES, COMMANDS, build_parsers, run_parser, value_options
 from gyrolab.compat import get_args_parser
+from gyrolab.engine.config import (
+    CONFIG_MODULE,
+    SELECTABLE_GROUPS,
+    compose_config,
+    group_options,
+    hydra_for,
+    register_plugin_configs,
+)
+from gyrolab.errors import ConfigError
 
 SHELLS = ("bash", "zsh")
 

@@ -16,8 +16,8 @@ import argparse
 import difflib
 from collections.abc import Sequence
 
-from gyrolab.errors import ConfigError, shorten
 from gyrolab.compat import get_args_parser
+from gyrolab.errors import ConfigError, shorten
 
 #: subcommand -> one line saying what it does (the order of ``gyrolab --help``)
 COMMANDS = {

@@ -7,8 +7,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from gyrolab.kernels.layout import CompiledTerms
 from gyrolab.errors import ConfigError
+from gyrolab.kernels.layout import CompiledTerms
 
 #: Body components of the system's reference-frame axes, indexed 0, 1, 2.
 #: For ``fixed_point`` the frame is the fixed space frame (X, Y, Z = vertical);

@@ -18,10 +18,11 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from hydra.core.override_parser.types import ChoiceSweep, RangeSweep
+
+from gyrolab.engine.scene import AUTO, AUTO_MAX_SAMPLES
 from gyrolab.engine.schemas import keys_with
 from gyrolab.errors import ConfigError
-from gyrolab.engine.scene import AUTO, AUTO_MAX_SAMPLES
-from hydra.core.override_parser.types import ChoiceSweep, RangeSweep
 
 MAX_STATE_BYTES = 2 * 1024**3
 MAX_STEPS = 1_000_000_000

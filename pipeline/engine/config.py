@@ -17,20 +17,21 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cache
+from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
 from hydra.core.config_search_path import ConfigSearchPath, SearchPathQuery
 from hydra.core.config_store import ConfigStore
 from hydra.core.global_hydra import GlobalHydra
+from hydra.core.hydra_config import HydraConfig
 from hydra.errors import HydraException, MissingConfigException, OverrideParseException
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
 from omegaconf.errors import ConfigKeyError, OmegaConfBaseException, ValidationError
 
+from gyrolab.compat import Hydra, create_automatic_config_search_path
 from gyrolab.contracts import registry
-from gyrolab.compat import create_automatic_config_search_path, Hydra
-from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
 from gyrolab.engine.schemas import (
     SELECTABLE_GROUPS,
     missing_section,
@@ -42,9 +43,8 @@ from gyrolab.engine.schemas import (
 from gyrolab.engine.schemas import first_line as _first_line
 from gyrolab.engine.schemas import sentence as schema_sentence
 from gyrolab.engine.unread import refuse_given_accuracy
+from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
 from gyrolab.output.user_yaml import check_user_config_dir
-from importlib.resources import files
-from hydra.core.hydra_config import HydraConfig
 
 CONFIG_MODULE = "gyrolab.conf"
 CONFIG_NAME = "config"

@@ -34,20 +34,20 @@ import site
 import sysconfig
 from collections.abc import Iterator, Sequence
 from functools import cache
+from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
+from hydra.core.plugins import Plugins
+from hydra.plugins.launcher import Launcher
+from hydra.plugins.sweeper import Sweeper
 from omegaconf import DictConfig, ListConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
 from gyrolab.engine.schemas import resolve_plain
 from gyrolab.errors import ConfigError, shorten
-from hydra.core.plugins import Plugins
-from hydra.plugins.launcher import Launcher
-from hydra.plugins.sweeper import Sweeper
 from gyrolab.output.user_yaml import stored_yaml
-from importlib.resources import files
 
 #: ``_target_`` values allowed under ``hydra`` besides the installed launchers and sweepers
 #: (gyrolab's sweep callback and sweeper are named, not imported: the engine sits below gyrolab.sweep)

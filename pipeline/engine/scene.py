@@ -12,24 +12,23 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.contracts import registry
 from gyrolab import accuracy
-from gyrolab.engine.config import compose_config
-from gyrolab.contracts import CompiledModel, Integrator, System
+from gyrolab.contracts import CompiledModel, Integrator, System, registry
+from gyrolab.contracts.capabilities import integrators_with, or_list
+from gyrolab.contracts.claims import check_claims, claim_states
+from gyrolab.contracts.force import check_declared
 from gyrolab.contracts.integrator import (
     COMPILED_MODEL,
     NFEV_COUNTS_ATTRIBUTE,
     PREFERS_COMPILED_MODEL,
     TIME_DEPENDENT,
 )
-from gyrolab.output.dataset import build_dataset, scene_attributes
-from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite, shorten
+from gyrolab.engine.config import compose_config
 from gyrolab.engine.force_guard import GuardedRhs, plugin_forces
 from gyrolab.engine.progress import Progress
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
-from gyrolab.contracts.capabilities import integrators_with, or_list
-from gyrolab.contracts.force import check_declared
-from gyrolab.contracts.claims import check_claims, claim_states
+from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite, shorten
+from gyrolab.output.dataset import build_dataset, scene_attributes
 
 log = logging.getLogger(__name__)
 

@@ -10,18 +10,18 @@ from __future__ import annotations
 import importlib
 import pkgutil
 import re
+import tempfile
 from collections.abc import Sequence
 from functools import cache
 from pathlib import Path
 
+import xarray as xr
 from omegaconf import DictConfig, open_dict
 
 from gyrolab.contracts.capabilities import or_list
 from gyrolab.engine.schemas import Task, only_declared_keys
 from gyrolab.engine.unread import covers, given_overrides
 from gyrolab.errors import ConfigError, choices
-import tempfile
-import xarray as xr
 from gyrolab.sweep.reproduce import compare, load_run
 
 #: a declaration ``TASK = Task("NAME", ...)`` in a module of this package names the task that module runs

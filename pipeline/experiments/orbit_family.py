@@ -22,19 +22,26 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
+from gyrolab.analysis.continuation import (
+    FamilyPoint,
+    Section,
+    bifurcations,
+    continue_family,
+    locate_events,
+    shoot_section,
+)
+from gyrolab.analysis.periodic import FixedPointModel
+from gyrolab.engine import schemas
+from gyrolab.engine.schemas import Task
 from gyrolab.errors import ConfigError, IntegrationError, as_number
+from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
 from gyrolab.physics import pendulum
-from gyrolab.analysis.continuation import FamilyPoint, Section, bifurcations, continue_family, locate_events, shoot_section
-from gyrolab.analysis.periodic import FixedPointModel
 from gyrolab.plugins.regimes import large_parameter as slow
 from gyrolab.plugins.regimes.base import NondimensionalScene
 from gyrolab.plugins.regimes.small_parameter import SmallParameter
-from gyrolab.engine import schemas
-from gyrolab.engine.schemas import Task
-from gyrolab.figures.redraw import draw_figures
 
 log = logging.getLogger(__name__)
 COMPONENTS = ("p", "q", "r", "gamma_x", "gamma_y", "gamma_z")

@@ -25,25 +25,27 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
+from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig, OmegaConf
 
+from gyrolab.analysis.periodic import FixedPointModel, PeriodicOrbit, shoot
 from gyrolab.contracts import registry
-from gyrolab.contracts.regime import Regime
 from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL
+from gyrolab.contracts.regime import Regime
+from gyrolab.engine.scene import Scene
+from gyrolab.engine.schemas import Task
+from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.cf import conform, unit_attributes
 from gyrolab.output.dataset import time_attributes, write_dataset
-from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.analysis.periodic import FixedPointModel, PeriodicOrbit, shoot
-from gyrolab.physics.attitude import angles_from_states  # noqa: F401  (imported from here by earlier code)
-from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
-from gyrolab.engine.scene import Scene
-from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
-from gyrolab.engine.schemas import Task
+from gyrolab.physics.attitude import (
+    angles_from_states,  # noqa: F401  (imported from here by earlier code)
+    frame_from_angles,
+)
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
-from gyrolab.physics.attitude import frame_from_angles
 from gyrolab.plugins.integrators.scipy_solvers import DOP853
-from hydra.core.hydra_config import HydraConfig
 
 log = logging.getLogger(__name__)
 SOURCES = ("analytic", "full", "orbit")

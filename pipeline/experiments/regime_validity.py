@@ -23,19 +23,19 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
-from gyrolab.output.cf import conform
-from gyrolab.output.dataset import write_dataset
-from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.experiments.regime_run import compute, errors, prepare, build_regime
-from gyrolab.figures.redraw import draw_figures
-from gyrolab.output.provenance import provenance
-from gyrolab.engine.schemas import Task
+from gyrolab.contracts import registry
 from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene
-from gyrolab.contracts import registry
+from gyrolab.engine.schemas import Task
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.experiments.regime_run import build_regime, compute, errors, prepare
+from gyrolab.figures.redraw import draw_figures
+from gyrolab.output.cf import conform
+from gyrolab.output.dataset import write_dataset
+from gyrolab.output.provenance import provenance
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from gyrolab.plugins.regimes.base import nondimensional_scene
 from gyrolab.plugins.regimes.large_parameter import printed_reading_state
-from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
 log = logging.getLogger(__name__)
 

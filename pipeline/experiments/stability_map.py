@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Any
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -33,12 +33,12 @@ SECTION_DIMENSIONS = {
     "crossing_description": "dimension crossing: the upward crossings of the section by that point's trajectory, "
                             "in time order (NaN past its last crossing)",
 }
-from gyrolab.output.dataset import write_dataset
-from gyrolab.sweep.grid import Dim
+from gyrolab.analysis.chaos import section_dataset
+from gyrolab.batch.sweep import run_batch
 from gyrolab.engine import schemas
 from gyrolab.engine.schemas import Task
-from gyrolab.batch.sweep import run_batch
-from gyrolab.analysis.chaos import section_dataset
+from gyrolab.output.dataset import write_dataset
+from gyrolab.sweep.grid import Dim
 
 log = logging.getLogger(__name__)
 

@@ -25,17 +25,17 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.contracts.integrator import NFEV_COUNTS_ATTRIBUTE
+from gyrolab.engine import schemas
+from gyrolab.engine.config import compose_config
+from gyrolab.engine.scene import Scene
+from gyrolab.engine.schemas import Task
+from gyrolab.errors import ConfigError
+from gyrolab.figures.redraw import draw_figures
+from gyrolab.kernels import layout
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
-from gyrolab.errors import ConfigError
 from gyrolab.output.provenance import provenance
 from gyrolab.physics.reference import fixed_point_reference
-from gyrolab.engine.scene import Scene
-from gyrolab.figures.redraw import draw_figures
-from gyrolab.engine import schemas
-from gyrolab.engine.schemas import Task
-from gyrolab.engine.config import compose_config
-from gyrolab.kernels import layout
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
 log = logging.getLogger(__name__)

@@ -29,11 +29,11 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.errors import ConfigError
+from gyrolab.figures.labels import unit
+from gyrolab.figures.style import STYLE, unit_sphere
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.foreign import load_run
 from gyrolab.output.trust import check_output_target
-from gyrolab.figures.labels import unit
-from gyrolab.figures.style import STYLE, unit_sphere
 
 log = logging.getLogger(__name__)
 

@@ -13,8 +13,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.contracts.integrator import CHOOSES_METHOD, NFEV_COUNTS_ATTRIBUTE
 from gyrolab.contracts import registry
+from gyrolab.contracts.integrator import CHOOSES_METHOD, NFEV_COUNTS_ATTRIBUTE
 from gyrolab.errors import GyrolabError
 
 

@@ -14,11 +14,11 @@ from pathlib import Path
 
 import xarray as xr
 
-from gyrolab.output.user_yaml import stored_yaml
 from gyrolab.errors import ConfigError, GyrolabError, shorten
-from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS, figure_options
+from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.output.trust import check_tree
+from gyrolab.output.user_yaml import stored_yaml
 
 #: dataset file name -> the gyrolab.figures module that draws its figures
 KINDS = {

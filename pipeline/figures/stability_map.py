@@ -19,11 +19,11 @@ import numpy as np
 import xarray as xr
 from matplotlib.colors import Normalize
 
-from gyrolab.errors import OutputError, ConfigError
+from gyrolab.errors import ConfigError, OutputError
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
+from gyrolab.figures.save import save_all
 from gyrolab.figures.style import DOUBLE, panel_note, styled
 from gyrolab.output.user_yaml import stored_yaml
-from gyrolab.figures.save import save_all
 
 #: colour scale of MEGNO: 0 (stable periodic) … 2 (quasi-periodic) … CLIP and beyond (chaotic)
 CLIP = 8.0

@@ -21,10 +21,10 @@ from __future__ import annotations
 import errno
 import os
 import stat
+import sys
 from pathlib import Path
 
 from gyrolab.errors import ConfigError, shorten
-import sys
 from gyrolab.kernels.cache import cache_dir
 
 #: gyrolab's folders inside a run or sweep directory

@@ -32,6 +32,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+
 from gyrolab.errors import ConfigError
 
 

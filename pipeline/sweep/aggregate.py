@@ -39,18 +39,18 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.contracts.integrator import IntegratorStats
+from gyrolab.errors import ConfigError, shorten
+from gyrolab.figures.options import figure_options
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
-from gyrolab.output.units import quantity_units
-from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset
+from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
 from gyrolab.output.trust import check_tree
-from gyrolab.output.written import announce_written
+from gyrolab.output.units import quantity_units
 from gyrolab.output.user_yaml import stored_yaml_file
-from gyrolab.errors import ConfigError, shorten
+from gyrolab.output.written import announce_written
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
-from gyrolab.figures.options import figure_options
 
 log = logging.getLogger("gyrolab.sweep")
 

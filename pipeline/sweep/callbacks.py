@@ -9,11 +9,13 @@ summary figures. The jobs themselves record their outcome (``job.json``) in
 
 from __future__ import annotations
 
+import functools
 import logging
 import sys
 from pathlib import Path
 from typing import Any
 
+from hydra.core import utils as hydra_utils
 from hydra.experimental.callback import Callback
 from omegaconf import DictConfig
 
@@ -24,10 +26,8 @@ from gyrolab.output.trust import check_output_target, own_dir
 from gyrolab.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.orphans import announce_launcher, forget_launcher
-from gyrolab.sweep.watch import SweepWatcher
 from gyrolab.sweep.sweeper import register_plugin
-import functools
-from hydra.core import utils as hydra_utils
+from gyrolab.sweep.watch import SweepWatcher
 
 log = logging.getLogger("gyrolab.sweep")
 

@@ -34,12 +34,13 @@ from typing import Any
 
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override, OverrideType
+from hydra.core.plugins import Plugins
 from hydra.plugins.launcher import Launcher
 from hydra.plugins.sweeper import Sweeper
 from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.compat import ConfigLoaderImpl, BasicSweeper
+from gyrolab.compat import BasicSweeper, ConfigLoaderImpl
 from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.lock import try_lock, unlock
@@ -49,7 +50,6 @@ from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import code_version, job_identity
 from gyrolab.sweep.job import mark_skipped
 from gyrolab.sweep.record import JobRecord, read_record
-from hydra.core.plugins import Plugins
 
 log = logging.getLogger("gyrolab.sweep")
 

@@ -29,13 +29,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.analysis.continuation import Section, _evaluate, shoot_section
 from gyrolab.analysis.periodic import FixedPointModel
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.physics import pendulum
 from gyrolab.physics.attitude import angles_from_states
 from gyrolab.plugins.regimes import ismail2021 as paper
 from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
-from gyrolab.physics import pendulum
 
 MAX_SPIN = 0.2        # refused above: the series' radius of convergence is ≈ 0.29 (docs/regimes.md)
 WARN_SPIN = 0.1

@@ -19,15 +19,15 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.physics.attitude import euler_angles, frame_from_angles, nutation_and_spin
-from gyrolab.physics.body import Body
 from gyrolab.contracts.force import Force
 from gyrolab.contracts.integrator import CompiledModel
 from gyrolab.contracts.system import System
-from gyrolab.physics.initial import InitialAttitude
-from gyrolab.physics.vectors import cross, dot, norm
 from gyrolab.kernels import model
 from gyrolab.kernels.expression import check_torques
+from gyrolab.physics.attitude import euler_angles, frame_from_angles, nutation_and_spin
+from gyrolab.physics.body import Body
+from gyrolab.physics.initial import InitialAttitude
+from gyrolab.physics.vectors import cross, dot, norm
 
 
 class FixedPoint(System):

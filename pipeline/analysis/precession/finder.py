@@ -19,8 +19,8 @@ import numpy as np
 from scipy.optimize import brentq, least_squares, minimize_scalar
 from scipy.stats import qmc
 
-from gyrolab.errors import ConfigError
 from gyrolab.analysis.precession.motion import Precession, build_system, states, vector_residual
+from gyrolab.errors import ConfigError
 from gyrolab.physics.gyrostat_euler import GyrostatParameters
 
 MOTION = ("n", "m", "theta0", "psi0")
