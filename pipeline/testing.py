@@ -30,6 +30,7 @@ one by one, raising ``AssertionError`` that names the first violation.
 
 from __future__ import annotations
 
+import ctypes
 import inspect
 import math
 import re
@@ -229,8 +230,6 @@ def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, fram
     except expression.NotCompilable as exc:
         warnings.warn(f"{cls.__name__} runs with the Python integrators only: {exc}", stacklevel=3)
         return
-    import ctypes  # start-up: only for this check
-
     address = int(compiled.params[model.TRACED_ADDRESS])
     kernel = ctypes.CFUNCTYPE(None, ctypes.c_double, *[ctypes.POINTER(ctypes.c_double)] * 3)(address)
     p = compiled.params

@@ -94,11 +94,6 @@ def batch(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
-def _quoted(value: str) -> str:
-    """A value as a quoted Hydra override value (an address's ``:`` and ``/`` are not plain override text)."""
-    return f"'{value}'" if "'" not in value else f'"{value}"'
-
-
 def plot(args: argparse.Namespace) -> int:
     """``gyrolab plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]``: redraw every figure of the
     datasets under PATH (``gyrolab.figures.redraw``) with the current style, formats and dpi; nothing is
