@@ -38,8 +38,10 @@ from typing import Any
 import hydra
 import xarray
 from hydra import version as hydra_version
+from hydra._internal.core_plugins.basic_sweeper import BasicSweeper  # noqa: F401 - re-exported
 from hydra._internal.config_loader_impl import ConfigLoaderImpl, get_overrides_dirname
 from hydra._internal.defaults_list import create_defaults_list
+from hydra._internal.hydra import Hydra  # noqa: F401 - re-exported
 from hydra._internal.utils import _run_hydra, create_automatic_config_search_path, get_args_parser  # noqa: F401
 from hydra.conf import ConfigSourceInfo
 from hydra.core.override_parser.overrides_parser import OverridesParser
@@ -66,19 +68,6 @@ def supported(version: str, window: tuple[tuple[int, int], tuple[int, int]]) -> 
 
 def hydra_supported() -> bool:
     return supported(hydra.__version__, HYDRA_SUPPORTED)
-
-
-def __getattr__(name: str) -> Any:
-    # the two heavier classes are imported when first asked for (Hydra's run and gyrolab's sweeper)
-    if name == "Hydra":
-        from hydra._internal.hydra import Hydra  # start-up: only for Hydra's run
-
-        return Hydra
-    if name == "BasicSweeper":
-        from hydra._internal.core_plugins.basic_sweeper import BasicSweeper  # start-up: only for a sweep
-
-        return BasicSweeper
-    raise AttributeError(name)
 
 
 def run_hydra(args: argparse.Namespace, parser: argparse.ArgumentParser, task_function: Any, config_path: str,
