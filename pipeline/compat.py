@@ -36,16 +36,21 @@ from dataclasses import dataclass
 from typing import Any
 
 import hydra
+import xarray
 from hydra import version as hydra_version
+from hydra._internal.core_plugins.basic_sweeper import BasicSweeper  # noqa: F401 - re-exported
 from hydra._internal.config_loader_impl import ConfigLoaderImpl, get_overrides_dirname
 from hydra._internal.defaults_list import create_defaults_list
-from hydra._internal.utils import create_automatic_config_search_path, get_args_parser  # noqa: F401 - re-exported
+from hydra._internal.hydra import Hydra  # noqa: F401 - re-exported
+from hydra._internal.utils import _run_hydra, create_automatic_config_search_path, get_args_parser  # noqa: F401
 from hydra.conf import ConfigSourceInfo
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override
 from hydra.core.utils import JobRuntime
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
+from xarray.backends import locks, netCDF4_, writers
+from xarray.namedarray import pycompat, utils
 
 #: the versions each kept patch was written for: (first, first not supported), by (major, minor)
 HYDRA_SUPPORTED = ((1, 3), (1, 4))
@@ -65,19 +70,6 @@ def hydra_supported() -> bool:
     return supported(hydra.__version__, HYDRA_SUPPORTED)
 
 
-def __getattr__(name: str) -> Any:
-    # the two heavier classes are imported when first asked for (Hydra's run and gyrolab's sweeper)
-    if name == "Hydra":
-        from hydra._internal.hydra import Hydra
-
-        return Hydra
-    if name == "BasicSweeper":
-        from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
-
-        return BasicSweeper
-    raise AttributeError(name)
-
-
 def run_hydra(args: argparse.Namespace, parser: argparse.ArgumentParser, task_function: Any, config_path: str,
               config_name: str) -> None:
     """What ``@hydra.main(config_path, config_name, version_base="1.3")`` does with a command line, given it parsed
@@ -85,8 +77,6 @@ def run_hydra(args: argparse.Namespace, parser: argparse.ArgumentParser, task_fu
     outside ``HYDRA_SUPPORTED``: ``hydra.main`` itself, on a ``sys.argv`` rebuilt from ``args`` (``hydra_argv``)."""
     hydra_version.setbase("1.3")
     if hydra_supported():
-        from hydra._internal.utils import _run_hydra
-
         _run_hydra(args=args, args_parser=parser, task_function=task_function, config_path=config_path,
                    config_name=config_name)
         return
@@ -307,13 +297,8 @@ _GUARD = "_gyrolab_scheduler_guard"
 def install_dask_free_writes() -> bool:
     """Install the four guards (once per process); whether all four are in place. False, and nothing
     installed, under an xarray outside ``XARRAY_SUPPORTED``: xarray's own path, which imports Dask."""
-    import xarray
-
     if not supported(xarray.__version__, XARRAY_SUPPORTED):
         return False
-    from xarray.backends import locks, netCDF4_, writers
-    from xarray.namedarray import pycompat, utils
-
     return all([
         _guard(pycompat, "_get_cached_duck_array_module", _no_dask_arrays_before_dask),
         _guard(utils, "is_dask_collection", _no_graph_no_collection),

@@ -13,6 +13,7 @@ import re
 from pathlib import Path
 
 from gyrolab.errors import ConfigError
+from gyrolab.output.atomic import atomic_path
 
 EXAMPLE = "viscous_drag"
 
@@ -140,8 +141,6 @@ def render(name: str) -> dict[str, str]:
 
 def new_force_package(name: str, parent: Path = Path(".")) -> Path:
     """Write ``gyrolab-NAME/`` under ``parent`` (refusing to overwrite) and return its path."""
-    from gyrolab.output.atomic import atomic_path
-
     files = render(name)
     root = Path(parent) / f"gyrolab-{name.replace('_', '-')}"
     if root.exists():

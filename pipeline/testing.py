@@ -30,6 +30,7 @@ one by one, raising ``AssertionError`` that names the first violation.
 
 from __future__ import annotations
 
+import ctypes
 import inspect
 import math
 import re
@@ -38,11 +39,22 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import xarray as xr
 
-from gyrolab.contracts.claims import _rotation, axes_of as _axes, random_states, rotation_torque  # noqa: F401
+from gyrolab.contracts.claims import _rotation, random_states, rotation_torque  # noqa: F401
+from gyrolab.contracts.claims import axes_of as _axes
 from gyrolab.contracts.force import Force
+from gyrolab.contracts.integrator import Integrator, IntegratorStats, Solution
 from gyrolab.contracts.integrator_rules import unchecked
-from gyrolab.errors import ConfigError
+from gyrolab.contracts.regime import Regime
+from gyrolab.contracts.system import System
+from gyrolab.engine.scene import build_force, compose_scene
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.kernels import expression, model, models
+from gyrolab.physics.body import Body
+from gyrolab.physics.vectors import cross
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
+from gyrolab.plugins.systems.fixed_point import FixedPoint
 
 __all__ = ["check_force", "check_integrator", "check_regime", "check_system", "random_states", "rotation_torque"]
 
@@ -54,8 +66,6 @@ _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
 def _test_body():
-    from gyrolab.physics.body import Body
-
     return Body.from_config({"units": "nondimensional", "a": 0.7, "b": 0.9, "com_direction": [0.3, 0.4, 0.866025403784]})
 
 
@@ -88,8 +98,6 @@ def check_force(cls: type, body: Any = None, *, n_states: int = 20, **params: An
     AssertionError
         Naming the first rule the plugin breaks.
     """
-    from gyrolab.engine.scene import build_force
-
     if not (isinstance(cls, type) and issubclass(cls, Force)):
         raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Force")
     body = _test_body() if body is None else body
@@ -188,8 +196,6 @@ def _check_attributes(cls: type, force: Force) -> None:
 
 
 def _check_bad_parameters(cls: type, body: Any, where: str, params: dict[str, Any]) -> None:
-    from gyrolab.engine.scene import build_force
-
     for key, param in inspect.signature(cls.__init__).parameters.items():
         if param.kind is not inspect.Parameter.KEYWORD_ONLY or (param.default is None and key not in params):
             continue  # a parameter off by default is checked when the caller gives it
@@ -213,9 +219,6 @@ def _check_bad_parameters(cls: type, body: Any, where: str, params: dict[str, An
 def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, frames: np.ndarray) -> None:
     if force.compiled_terms() is not None:
         return  # a built-in form; the system's tests compare it with the Python right-hand side
-    from gyrolab.kernels import expression, model
-    from gyrolab.physics.vectors import cross
-
     def torque(t: Any, y: np.ndarray) -> Any:  # y = (ω, γ, α), as the fixed point lays out its state
         frame = np.empty((3, 3), dtype=object)
         frame[0], frame[1], frame[2] = y[6:9], cross(y[3:6], y[6:9]), y[3:6]
@@ -227,8 +230,6 @@ def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, fram
     except expression.NotCompilable as exc:
         warnings.warn(f"{cls.__name__} runs with the Python integrators only: {exc}", stacklevel=3)
         return
-    import ctypes
-
     address = int(compiled.params[model.TRACED_ADDRESS])
     kernel = ctypes.CFUNCTYPE(None, ctypes.c_double, *[ctypes.POINTER(ctypes.c_double)] * 3)(address)
     p = compiled.params
@@ -292,9 +293,6 @@ FREE_TOP_A, FREE_TOP_OMEGA0 = 0.8, (0.1, -0.05, 5.0)
 def free_top_problem() -> ExactProblem:
     """The torque-free symmetric top as gyrolab's fixed-point system, with its compiled model: I ω̇ = (Iω) × ω with
     A = B gives r constant and (p, q) turning at λ = (C − A) r / A (ṗ = −λ q, q̇ = λ p)."""
-    from gyrolab.physics.body import Body
-    from gyrolab.plugins.systems.fixed_point import FixedPoint
-
     body = Body.from_config({"units": "nondimensional", "a": FREE_TOP_A, "b": FREE_TOP_A,
                              "com_direction": [0.0, 0.0, 0.0]})
     p0, q0, r0 = FREE_TOP_OMEGA0
@@ -352,8 +350,6 @@ def check_integrator(cls: type, **params: Any) -> None:
     and no torque, whose ω turns at a constant rate), ``nfev`` > 0 only, and rule 7 is skipped (a blow-up has no
     compiled model).
     """
-    from gyrolab.contracts.integrator import Integrator
-
     if not (isinstance(cls, type) and issubclass(cls, Integrator)):
         raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Integrator")
     name = getattr(cls, "name", None)
@@ -386,8 +382,6 @@ def _build_plugin(cls: type, params: dict[str, Any], *args: Any) -> Any:
 
 def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> Any:
     """Rules 3–6 of ``check_integrator`` on one problem with a known solution; returns the run's stats."""
-    from gyrolab.contracts.integrator import IntegratorStats, Solution
-
     calls = [0]
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
@@ -402,6 +396,19 @@ def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> A
         raise _fail(cls, f"integrate returned {type(solution).__name__}, not gyrolab.contracts.Solution")
     if not np.array_equal(y0, problem.y0) or not np.array_equal(t_out, OSCILLATOR_TIMES):
         raise _fail(cls, "integrate modified its input y0 or t_out in place; work on copies")
+    _check_samples(cls, solution, t_out, y0, on)
+    _check_accuracy(cls, integrator, problem, np.asarray(solution.y), t_out, on)
+    stats = _checked_stats(cls, solution, problem, calls[0])
+    if not reported:
+        raise _fail(cls, "integrate never called progress(t); call it every few steps when it is given")
+    outside = [r for r in reported if not t_out[0] <= float(r) <= t_out[-1]]
+    if outside:
+        raise _fail(cls, f"progress was called with t={outside[0]!r}, outside the interval [{t_out[0]}, {t_out[-1]}]")
+    return stats
+
+
+def _check_samples(cls: type, solution: Solution, t_out: np.ndarray, y0: np.ndarray, on: str) -> None:
+    """Rule 3: the solution is sampled at exactly ``t_out``, finite, with the state size, starting at ``y0``."""
     t, y = np.asarray(solution.t), np.asarray(solution.y)
     if t.shape != t_out.shape or not np.array_equal(t, t_out):
         raise _fail(cls, f"Solution.t is {np.round(t, 12).tolist()}, not the requested t_out "
@@ -412,6 +419,11 @@ def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> A
         raise _fail(cls, f"Solution.y has non-finite values {on}; raise IntegrationError instead")
     if np.max(np.abs(y[0] - y0)) > 1e-14 * max(1.0, float(np.max(np.abs(y0)))):
         raise _fail(cls, f"Solution.y[0] = {y[0].tolist()} is not y0 = {y0.tolist()} at t_out[0], the initial time")
+
+
+def _check_accuracy(cls: type, integrator: Any, problem: ExactProblem, y: np.ndarray, t_out: np.ndarray,
+                    on: str) -> None:
+    """Rule 4: the error against the exact solution is within the integrator's own tolerance."""
     error = float(np.max(np.abs(y[:, problem.compared] - problem.exact(t_out))))
     rtol, atol = getattr(integrator, "rtol", None), getattr(integrator, "atol", None)
     if cls.adaptive and rtol is not None and atol is not None:
@@ -421,27 +433,25 @@ def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> A
     if not error <= allowed:
         raise _fail(cls, f"its error {on} is {error:.3g}, above {allowed:.3g} ({why}); it does not integrate to its "
                          "own tolerance")
+
+
+def _checked_stats(cls: type, solution: Solution, problem: ExactProblem, calls: int) -> IntegratorStats:
+    """Rule 5: the run's stats count the evaluations made (at most ``calls`` for a Python right-hand side) and
+    the steps taken."""
     stats = solution.stats
     if not isinstance(stats, IntegratorStats):
         raise _fail(cls, f"Solution.stats is {type(stats).__name__}, not gyrolab.contracts.IntegratorStats")
     if not isinstance(stats.nfev, (int, np.integer)) or stats.nfev <= 0:
         raise _fail(cls, f"stats.nfev={stats.nfev!r} must count the right-hand-side evaluations (an integer > 0)")
-    if problem.compiled is None and stats.nfev > calls[0]:
-        raise _fail(cls, f"stats.nfev={stats.nfev}, but the right-hand side was called {calls[0]} times; count the "
+    if problem.compiled is None and stats.nfev > calls:
+        raise _fail(cls, f"stats.nfev={stats.nfev}, but the right-hand side was called {calls} times; count the "
                          "evaluations made, no more")
     if not isinstance(stats.n_steps, (int, np.integer)) or stats.n_steps < 1:
         raise _fail(cls, f"stats.n_steps={stats.n_steps!r} must be the number of steps taken (an integer ≥ 1)")
-    if not reported:
-        raise _fail(cls, "integrate never called progress(t); call it every few steps when it is given")
-    outside = [r for r in reported if not t_out[0] <= float(r) <= t_out[-1]]
-    if outside:
-        raise _fail(cls, f"progress was called with t={outside[0]!r}, outside the interval [{t_out[0]}, {t_out[-1]}]")
     return stats
 
 
 def _check_blow_up(cls: type, integrator: Any) -> None:
-    from gyrolab.errors import IntegrationError
-
     try:
         with np.errstate(over="ignore", invalid="ignore"):
             solution = unchecked(integrator)(_blow_up, BLOW_UP_TIMES.copy(), np.array([1.0]), None, None)
@@ -548,8 +558,6 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
        one, computes ``rhs`` (to 1e-12) at random states and its Taylor integrator follows the DOP853 trajectory of 6.
        A system that cannot be traced is warned about (it runs with the Python integrators only), not failed.
     """
-    from gyrolab.contracts.system import System
-
     if not (isinstance(cls, type) and issubclass(cls, System)):
         raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.System")
     name = getattr(cls, "name", None)
@@ -562,8 +570,6 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
         built_body = body_type.from_config(dict(body))
     except ConfigError as exc:
         raise _fail(cls, f"body_type.from_config({body}) raised ConfigError: {exc}") from None
-    from gyrolab.engine.scene import build_force
-
     built_forces = [build_force(force_cls, dict(force_params), f"force.{force_cls.name}", built_body)
                     for force_cls, force_params in forces]
     output = {"euler_angles": True} if output is None else dict(output)
@@ -586,9 +592,6 @@ def _check_compiled_system(cls: type, system: Any, t: np.ndarray, y: np.ndarray)
     if compiled is None:
         warnings.warn(f"{cls.__name__} runs with the Python integrators only: {system.compile_error}", stacklevel=3)
         return
-    from gyrolab.kernels import models
-    from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
     rng = np.random.default_rng(11)
     scale = max(1.0, float(np.max(np.abs(y[0]))))
     out = np.empty(len(y[0]))
@@ -626,7 +629,7 @@ def _check_state(cls: type, system: Any) -> np.ndarray:
 
 
 def _integrate_tightly(cls: type, system: Any, y0: np.ndarray, span: float) -> tuple[np.ndarray, np.ndarray]:
-    from scipy.integrate import solve_ivp
+    from scipy.integrate import solve_ivp  # start-up: scipy.integrate only for this check
 
     t = np.linspace(0.0, span, 41)
     done = solve_ivp(system.rhs, (0.0, span), y0, method="DOP853", t_eval=t, rtol=SYSTEM_RTOL, atol=SYSTEM_RTOL)
@@ -637,8 +640,6 @@ def _integrate_tightly(cls: type, system: Any, y0: np.ndarray, span: float) -> t
 
 
 def _check_variables(cls: type, system: Any, t: np.ndarray, y: np.ndarray) -> None:
-    import xarray as xr
-
     invariants = system.invariants
     if not isinstance(invariants, tuple) or not all(isinstance(n, str) for n in invariants):
         raise _fail(cls, f"invariants={invariants!r} must be a tuple of dataset variable names (str)")
@@ -646,22 +647,27 @@ def _check_variables(cls: type, system: Any, t: np.ndarray, y: np.ndarray) -> No
     if not isinstance(variables, dict):
         raise _fail(cls, f"variables(t, y) returned {type(variables).__name__}, not a dict of xarray.Variable")
     for key, variable in variables.items():
-        if not isinstance(variable, xr.Variable):
-            raise _fail(cls, f"variables(t, y)[{key!r}] is {type(variable).__name__}, not an xarray.Variable")
-        if not variable.dims or variable.dims[0] != "time" or variable.shape[0] != len(t):
-            raise _fail(cls, f"variable {key!r} has dims {variable.dims} and shape {variable.shape}; its first "
-                             f"dimension must be time, of length {len(t)}")
-        for attr in ("units", "long_name"):
-            value = variable.attrs.get(attr)
-            if not isinstance(value, str) or not value.strip():
-                raise _fail(cls, f"variable {key!r} has no CF {attr} (got {value!r}); give every variable units "
-                                 "and long_name")
+        _check_variable(cls, key, variable, len(t))
     for name in invariants:
         if name not in variables:
             raise _fail(cls, f"invariant {name!r} is not among variables(t, y) ({', '.join(variables)}); every "
                              "monitored invariant must be a dataset variable")
         if variables[name].dims != ("time",):
             raise _fail(cls, f"invariant {name!r} has dims {variables[name].dims}, not ('time',)")
+
+
+def _check_variable(cls: type, key: str, variable: Any, n_times: int) -> None:
+    """A system's dataset variable: an xarray.Variable over time first, with CF units and long_name."""
+    if not isinstance(variable, xr.Variable):
+        raise _fail(cls, f"variables(t, y)[{key!r}] is {type(variable).__name__}, not an xarray.Variable")
+    if not variable.dims or variable.dims[0] != "time" or variable.shape[0] != n_times:
+        raise _fail(cls, f"variable {key!r} has dims {variable.dims} and shape {variable.shape}; its first "
+                         f"dimension must be time, of length {n_times}")
+    for attr in ("units", "long_name"):
+        value = variable.attrs.get(attr)
+        if not isinstance(value, str) or not value.strip():
+            raise _fail(cls, f"variable {key!r} has no CF {attr} (got {value!r}); give every variable units "
+                             "and long_name")
 
 
 def _check_invariants_conserved(cls: type, system: Any, t: np.ndarray, y: np.ndarray, tolerance: float) -> None:
@@ -716,9 +722,6 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     7. ``euler_angles(system, t)`` has exactly the keys psi, theta, phi, each a finite array of shape (n,);
     8. ``attributes()`` is netCDF-safe.
     """
-    from gyrolab.contracts.regime import Regime
-    from gyrolab.contracts.system import System
-
     if not (isinstance(cls, type) and issubclass(cls, Regime)):
         raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Regime")
     _check_regime_declarations(cls)
@@ -728,8 +731,6 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     if isinstance(scene, System):
         system = scene
     else:
-        from gyrolab.engine.scene import compose_scene
-
         system = compose_scene(list(scene)).system
     if system.name not in cls.systems:
         raise _fail(cls, f"the kit's scene has system {system.name!r}, not one of systems={cls.systems}; give a "
@@ -738,6 +739,15 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     if not isinstance(warnings_, list) or not all(isinstance(w, str) and "\n" not in w.strip() for w in warnings_):
         raise _fail(cls, f"check_domain returned {warnings_!r}; it must return a list of one-line warnings (str) "
                          "and raise ConfigError outside the domain")
+    _check_regime_numbers(cls, regime, system)
+    t = np.linspace(0.0, float(regime.period(system)), 9)
+    _check_euler_angles(cls, regime, system, t)
+    _check_mapping(cls, regime.attributes(), "attributes()")
+
+
+def _check_regime_numbers(cls: type, regime: Any, system: Any) -> None:
+    """Rules 4–6: a finite parameter value, a start state matching the solution at 0, a finite positive period
+    over which the solution is finite, of shape (n, 6)."""
     value = regime.parameter_value(system)
     if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) or not math.isfinite(float(value)):
         raise _fail(cls, f"parameter_value(system) returned {value!r}, not a finite number")
@@ -750,8 +760,6 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     if y.shape != (len(t), 6) or not np.all(np.isfinite(y)):
         raise _fail(cls, f"solution(system, t) for {len(t)} times returned shape {y.shape}"
                          f"{'' if np.all(np.isfinite(y)) else ' with non-finite values'}; it must be finite, (n, 6)")
-    _check_euler_angles(cls, regime, system, t)
-    _check_mapping(cls, regime.attributes(), "attributes()")
 
 
 def _check_regime_declarations(cls: type) -> None:

@@ -21,7 +21,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from gyrolab.contracts.capabilities import integrators_with, or_list
+from gyrolab.contracts.integrator import VARIATIONAL
 from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.kernels import fixed_point, layout, model, models, tangent, variational
+from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, RK4Numba, steps_per_interval
 
 INDICATOR_NAME = "MEGNO"
 INDICATOR_DEFINITION = ("MEGNO <Y>(t_end) (Cincotta & Simo 2000): time mean of Y(t) = (2/t) int_0^t s d'.d/d.d ds "
@@ -37,8 +41,6 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
     A state that carries the fixed horizontal axis α (9 components) is accepted when no torque depends on α:
     (ω, γ) is then a closed system and α (the precession angle's axis) does not enter the indicators.
     """
-    from gyrolab.kernels import fixed_point, layout
-
     if compiled is None or compiled.built_in is None:
         raise ConfigError("chaos indicators need the fixed-point system with built-in torques only "
                           "(uniform_gravity, newtonian); a force plugin's torque has no variational equations here")
@@ -64,12 +66,8 @@ def _model_arrays(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> 
 def variational_settings(integrator: Any) -> Any:
     """How the variational kernels run with ``integrator`` (its ``variational_settings()``); one ConfigError naming it,
     the capability and the registered integrators that have it when it does not declare VARIATIONAL."""
-    from gyrolab.contracts.integrator import VARIATIONAL
-
     supports = getattr(integrator, "supports", None)
     if supports is None or not supports(VARIATIONAL):
-        from gyrolab.contracts.capabilities import integrators_with, or_list
-
         name = getattr(integrator, "name", None) or integrator
         raise ConfigError(f"integrator {name!r} has no variational equations (capability {VARIATIONAL}), which the "
                           f"chaos indicators need; valid choices: {or_list(integrators_with(VARIATIONAL))}")
@@ -89,9 +87,6 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
     ``final_state`` (trajectories, 6) and ``failed`` (trajectories,) True where the trajectory became
     non-finite (its values are then NaN).
     """
-    from gyrolab.kernels import models, variational
-    from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
-
     times = np.ascontiguousarray(times, dtype=float)
     if times.ndim != 1 or times.size < 2 or not np.all(np.diff(times) > 0):
         raise ConfigError("times must be at least two increasing output times")
@@ -125,9 +120,6 @@ def _generated_run(compiled: Any, settings: Any, times: np.ndarray, y0s: np.ndar
     step); the nutation
     deviation is that of the state's last three components when they are a unit vector γ (θ = arccos γ3: the
     orbiting gyrostat's orbit normal), else NaN."""
-    from gyrolab.kernels import model, tangent
-    from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, RK4Numba
-
     if model.traced_model(compiled).time_dependent:
         raise ConfigError("chaos indicators of a model compiled from its equations need autonomous equations; a "
                           "time-dependent force has none here")
@@ -199,8 +191,6 @@ def poincare_section(compiled: Any, y0: np.ndarray, t_end: float, step: float, l
     Crossings are found on the RK4 steps (step ``step``) and located by cubic Hermite interpolation.
     Returns ``t``, ``state`` (crossings, 6), ``phi`` (rad) and ``r`` (ω3).
     """
-    from gyrolab.kernels import variational
-
     y, P = _model_arrays(compiled, np.atleast_2d(y0), None if params is None else np.atleast_2d(params))
     if not (np.isfinite(t_end) and t_end > 0 and np.isfinite(step) and step > 0):
         raise ConfigError(f"a Poincaré section needs t_end > 0 and step > 0, not t_end={t_end}, step={step}")

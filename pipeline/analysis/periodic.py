@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.kernels import layout
 from gyrolab.kernels.compiler import kernel
 
 ORDER = 24
@@ -146,8 +147,6 @@ class FixedPointModel:
     @classmethod
     def from_system(cls, system) -> FixedPointModel:
         compiled = system.compiled_model()
-        from gyrolab.kernels import layout
-
         if compiled is None or compiled.built_in is None:  # the built-in torque forms only
             raise ConfigError("periodic orbits need forces with compiled forms; valid forces: uniform_gravity, newtonian")
         p = compiled.built_in

@@ -31,6 +31,7 @@ import sys
 import tempfile
 import warnings
 from collections.abc import Sequence
+from importlib.util import find_spec
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -40,9 +41,13 @@ from hydra.core.override_parser.types import Override
 from hydra.errors import OverrideParseException
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf, open_dict
+from omegaconf.errors import OmegaConfBaseException
 
-from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
+from gyrolab.app.completion import SHELLS, script
+from gyrolab.app.parser import parse_command_line, run_parser
+from gyrolab.batch.scheduler import check_configured, use_command_line_scheduler
 from gyrolab.compat import composing_once, install_dask_free_writes, run_hydra
+from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
 from gyrolab.engine.config import (
     SELECTABLE_GROUPS,
     ConfigSource,
@@ -53,17 +58,25 @@ from gyrolab.engine.config import (
     register_plugin_configs,
     use_source,
 )
+from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
 from gyrolab.engine.safety import check_config, check_output_dir
+from gyrolab.engine.scene import Scene
 from gyrolab.engine.unread import ACCURACY, given_keys, ignored_accuracy, unread_accuracy
 from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
+from gyrolab.experiments import TASKS, check_task, refuse_unread, run_task
 from gyrolab.figures.options import figure_options
-from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
+from gyrolab.output.atomic import reason
+from gyrolab.output.dataset import write_dataset
+from gyrolab.output.lock import LOCK_NAME, release_all, writing_in
+from gyrolab.output.provenance import gyrolab_version
+from gyrolab.output.trust import check_kernel_cache, check_tree
 from gyrolab.output.written import announce_written
-from gyrolab.engine.scene import Scene
+from gyrolab.sweep import callbacks
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
 from gyrolab.sweep.job import draws_job_figures, run_sweep_job
+from gyrolab.sweep.sweeper import register_plugin
 
 if TYPE_CHECKING:
     from gyrolab.sweep.aggregate import SweepSummary
@@ -125,14 +138,10 @@ def preflight(args: argparse.Namespace) -> argparse.Namespace:
     run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
-    from gyrolab.output.trust import check_tree
-
     check_tree(run_dir, sweep=sweeping)  # a planted link in a directory received from someone else
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     scene = validate_scene(scene_cfgs[0], plains[0])
-    from gyrolab.experiments import check_task, refuse_unread
-
     refuse_unread(f"task {task_of(cfg)}", [o.input_line for o in overrides], sweep=sweeping)  # batch.* on a plain run
     check_task(task_of(cfg), scene_cfgs[0], run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
@@ -219,8 +228,6 @@ def _output_dir_text(cfg: DictConfig, mode: str) -> str:
     ``${hydra:...}`` needs the Hydra config registered, as it is inside the run; a key that only
     exists once the job runs (``hydra.runtime.*``) cannot name the directory before it exists.
     """
-    from omegaconf.errors import OmegaConfBaseException
-
     key = f"hydra.{mode}.dir"
     try:
         HydraConfig.instance().set_config(copy.deepcopy(cfg))  # set_config marks its argument read-only
@@ -321,9 +328,6 @@ def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
 def validate_scene(scene_cfg: DictConfig, plain: dict) -> Scene | None:
     """The checks every run's scene config passes beyond its schema (``plain``: ``check_scene_config``'s answer):
     tolerances, budget, the scene's own validation; the scene, built once, for a task that runs it."""
-    from gyrolab.batch.scheduler import check_configured
-    from gyrolab.experiments import TASKS
-
     require_finite(plain, "")
     figure_options(plain.get("output"))  # figure formats and dpi, before anything runs
     check_tolerances(plain)
@@ -336,7 +340,7 @@ def validate_scene(scene_cfg: DictConfig, plain: dict) -> Scene | None:
     if task not in ("scene", "regime"):
         return None  # an experiment validates the scenes it composes
     if task == "regime":  # the regime's domain is checked before anything is written
-        from gyrolab.experiments.regime_run import prepare
+        from gyrolab.experiments.regime_run import prepare  # start-up: a regime run's only (numba)
 
         probe = scene_cfg.copy()
         with open_dict(probe):
@@ -376,8 +380,6 @@ EXTRA_LAUNCHERS = {
 
 def check_launcher_installed(overrides: Sequence[Override]) -> None:
     """A launcher of the ``cluster`` extra, chosen without the extra installed, is one sentence."""
-    from importlib.util import find_spec
-
     for o in overrides:
         if o.key_or_group != "hydra/launcher" or o.is_delete():
             continue
@@ -443,8 +445,6 @@ def _task(cfg: DictConfig) -> None:
 def _only_hydras_files(out_dir: Path) -> bool:
     """Whether ``out_dir`` holds only what is there before the task starts: Hydra's configs, the job's log and the
     folder's lock (taken from the preflight on)."""
-    from gyrolab.output.lock import LOCK_NAME
-
     return out_dir.is_dir() and {p.name for p in out_dir.iterdir()} <= {".hydra", "gyrolab.log", LOCK_NAME}
 
 
@@ -456,15 +456,11 @@ def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None, figures:
     ``out_dir`` is locked meanwhile (a second run into it is refused in one sentence) and cleared of
     the temporary files that killed writes left there (``gyrolab.output.lock.writing_in``).
     """
-    from gyrolab.output.lock import writing_in
-
     with writing_in(out_dir):
         return _run_locked(cfg, out_dir, job_id, figures)
 
 
 def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: bool) -> Path:
-    from gyrolab.output.dataset import write_dataset
-
     task = task_of(cfg)
     prepared = take_prepared(cfg) if job_id is None else None  # a plain run: the preflight's scene and note
     # an accuracy the integrator does not read (the preflight refused one the command line gave to every job): said,
@@ -474,8 +470,6 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     if ignored:
         log.warning("%s", ignored)
     if task != "scene":
-        from gyrolab.experiments import run_task
-
         written = run_task(task, cfg, out_dir)
         for path in written:
             announce_written(path)
@@ -519,15 +513,13 @@ def run_command(argv: Sequence[str]) -> int | None:
     """The subcommand ``argv`` names (``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``,
     ``completion``, or an old spelling ``--batch``, ...; options in any position): its exit status, or None for
     ``run`` (Hydra's app, the default)."""
-    from gyrolab.app.parser import parse_command_line
-
     command, args = parse_command_line(argv)
     return None if command == "run" else run_subcommand(command, args)
 
 
 def run_subcommand(command: str, args: argparse.Namespace) -> int:
     """Run ``command`` (not ``run``) with its parsed options (``gyrolab.app.commands``)."""
-    from gyrolab.app.commands import RUNNERS
+    from gyrolab.app.commands import RUNNERS  # import cycle: commands imports gyrolab.app
 
     if hasattr(args, "config_dir"):
         use_source(ConfigSource.from_args(args.config_path, args.config_name, args.config_dir))
@@ -548,8 +540,6 @@ def absolute_config_path(args: argparse.Namespace) -> argparse.Namespace:
 
 def _sweep_status(summary: SweepSummary | None = None) -> int:
     """0 if every job of the last sweep finished, else 1 (with one line saying where the errors are)."""
-    from gyrolab.sweep import callbacks
-
     if callbacks.last_error:
         print(f"gyrolab: error: {callbacks.last_error}", file=sys.stderr)
         return callbacks.last_exit_code
@@ -570,8 +560,6 @@ def _sweep_status(summary: SweepSummary | None = None) -> int:
 def shell_completion(args: argparse.Namespace) -> int:
     """Hydra's ``--shell-completion install=bash`` (or ``zsh``, ``uninstall=...``): gyrolab's own completion
     script (``gyrolab.app.completion``), which knows the subcommands; Hydra's cannot see an installed app."""
-    from gyrolab.app.completion import SHELLS, script
-
     args_list = list(args.overrides)
     action, _, shell = (args_list[0] if len(args_list) == 1 else "").partition("=")
     if action not in ("install", "uninstall") or shell not in SHELLS:
@@ -598,8 +586,6 @@ def main() -> None:
         with composing_once():  # the preflight's composition is the one Hydra runs (and a sweep's jobs start from)
             _main(sys.argv[1:])
     except KeyboardInterrupt as interruption:  # Ctrl-C or SIGTERM: every write is whole or absent, locks released
-        from gyrolab.output.lock import release_all
-
         release_all()
         print("gyrolab: interrupted; the same command resumes", file=sys.stderr)
         sys.exit(getattr(interruption, "exit_code", 130))
@@ -637,8 +623,6 @@ def quiet_logging_failures() -> None:
             return
         self._gyrolab_failed = True  # type: ignore[attr-defined]
         error = sys.exc_info()[1]
-        from gyrolab.output.atomic import reason
-
         why = reason(error) if isinstance(error, OSError) else type(error).__name__
         where = getattr(self, "baseFilename", None) or "stream"
         try:
@@ -654,44 +638,30 @@ def quiet_logging_failures() -> None:
 def _main(argv: list[str]) -> None:
     _prepared.clear()  # nothing from an earlier command of this process
     try:
-        from gyrolab.app.parser import parse_command_line, run_parser
-
         command, args = parse_command_line(argv)
         if command != "run":
             sys.exit(run_subcommand(command, args))
         if args.version:
-            from gyrolab.output.provenance import gyrolab_version
-
             print(f"gyrolab {gyrolab_version()}")
             sys.exit(0)
-        from gyrolab.batch.scheduler import use_command_line_scheduler
-
         # --scheduler ADDRESS: the only config-free way to Dask, for experiments run by Hydra too; None when not
         # given, so no value is left from an earlier command
         use_command_line_scheduler(args.scheduler)
         if args.shell_completion:
             sys.exit(shell_completion(args))
         args = absolute_config_path(args)
-        from gyrolab.output.trust import check_kernel_cache
-
         check_kernel_cache()  # before the preflight, which may load a compiled kernel
         register_plugin_configs()
-        from gyrolab.sweep.sweeper import register_plugin
-
         register_plugin()  # gyrolab's own sweeper (conf/hydra/sweeper/gyrolab.yaml), before Hydra instantiates it
         with compile_notes_on_console():  # the preflight may compile a force plugin's torque
             args = preflight(args)
     except GyrolabError as error:
         fail(error)
-    from gyrolab.sweep import callbacks
-
     # each command starts clean (tests and notebooks run several in one process): no outcome of an earlier
     # sweep (a sweep without gyrolab's callback, from a user's primary config, would not clear it) and bars
     # allowed again (a multirun job turns them off)
     callbacks.reset()
     allow_bars(True)
-    from gyrolab.output.lock import release_all
-
     try:
         run_hydra(args, run_parser(), _task, config_path="pkg://gyrolab.conf", config_name="config")
     finally:

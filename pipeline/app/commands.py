@@ -10,10 +10,28 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from datetime import datetime
 from pathlib import Path
 
+from gyrolab.app import _job_overrides, _sweep_status, _sweeper_params, check_writable, parse_overrides
+from gyrolab.app.completion import script
+from gyrolab.app.parser import one_path
+from gyrolab.batch.reproduce import is_batch, reproduce_batch
+from gyrolab.batch.scheduler import use_command_line_scheduler
+from gyrolab.batch.sweep import failed_points, run_batch_sweep
+from gyrolab.engine.budget import check_sweep_size, check_tolerances
+from gyrolab.engine.config import check_scene_config, compose_config
+from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.errors import ConfigError, shorten
+from gyrolab.experiments import BATCH_COMMAND, refuse_unread, reproduce_task, task_of_config
+from gyrolab.figures.options import figure_options
+from gyrolab.figures.redraw import redraw
+from gyrolab.output.trust import check_kernel_cache, check_tree
 from gyrolab.output.written import announce_written
+from gyrolab.scaffold import new_force_package
+from gyrolab.sweep.aggregate import aggregate_sweep, log_summary
+from gyrolab.sweep.reproduce import checked_config, is_multirun, load_run, report, reproduce_sweep
+from gyrolab.sweep.reproduce import reproduce as rerun
 
 log = logging.getLogger("gyrolab")
 
@@ -28,17 +46,6 @@ def log_to_stderr() -> None:
 def batch(args: argparse.Namespace) -> int:
     """``gyrolab batch KEY=V1,V2 ... [hydra.sweep.dir=DIR] [--scheduler ADDRESS]``: the grid in one batch, one
     sweep.nc (resumable). The sweep is the command line's plus the config's ``hydra.sweeper.params``, as for -m."""
-    from datetime import datetime
-
-    from gyrolab.app import (_job_overrides, _sweeper_params, check_writable, parse_overrides)
-    from gyrolab.batch.scheduler import use_command_line_scheduler
-    from gyrolab.batch.sweep import failed_points, run_batch_sweep
-    from gyrolab.engine.config import check_scene_config, compose_config
-    from gyrolab.engine.budget import check_sweep_size, check_tolerances
-    from gyrolab.experiments import BATCH_COMMAND, refuse_unread
-    from gyrolab.engine.safety import check_config, check_output_dir
-    from gyrolab.figures.options import figure_options
-
     overrides = list(args.overrides)
     # the command line's own route to a Dask scheduler (issue 23: trusted only here and in the environment);
     # None when not given, so no value is left from an earlier command
@@ -73,8 +80,6 @@ def batch(args: argparse.Namespace) -> int:
     plain = check_scene_config(first)
     figure_options(plain.get("output"))
     check_tolerances(plain)
-    from gyrolab.output.trust import check_kernel_cache, check_tree
-
     check_tree(out_dir, sweep=True)
     check_kernel_cache()
     check_writable(out_dir)
@@ -89,19 +94,10 @@ def batch(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
-def _quoted(value: str) -> str:
-    """A value as a quoted Hydra override value (an address's ``:`` and ``/`` are not plain override text)."""
-    return f"'{value}'" if "'" not in value else f'"{value}"'
-
-
 def plot(args: argparse.Namespace) -> int:
     """``gyrolab plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]``: redraw every figure of the
     datasets under PATH (``gyrolab.figures.redraw``) with the current style, formats and dpi; nothing is
     integrated. ``--animate RUN`` animates a run instead (``gyrolab.figures.animation``)."""
-    from gyrolab.app.parser import one_path
-    from gyrolab.engine.config import compose_config
-    from gyrolab.figures.options import figure_options
-
     paths = [a for a in args.arguments if "=" not in a]
     overrides = [a for a in args.arguments if "=" in a]
     foreign = [o for o in overrides if not o.startswith("output.")]
@@ -117,8 +113,6 @@ def plot(args: argparse.Namespace) -> int:
         raise ConfigError(f"plot --{animation_options[0]} is an option of --animate; usage: gyrolab plot "
                           f"--animate RUN --{animation_options[0]} ...")
     path = one_path("plot", paths, "plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]")
-    from gyrolab.figures.redraw import redraw
-
     log_to_stderr()
     formats, dpi = figure_options(compose_config(overrides).output)
     for written in redraw(Path(path), formats, dpi):
@@ -139,15 +133,7 @@ def reproduce(args: argparse.Namespace) -> int:
     """``gyrolab reproduce PATH``: a run.nc, an experiment's dataset (the experiment runs again), a sweep.nc of
     ``gyrolab batch`` or of ``gyrolab -m`` (``--points``: some of its points or jobs); the comparison report on
     stdout; 0 if identical, else 1."""
-    from gyrolab.app.parser import one_path
-    from gyrolab.batch.reproduce import is_batch, reproduce_batch
-    from gyrolab.experiments import reproduce_task, task_of_config
-    from gyrolab.sweep.reproduce import checked_config, is_multirun, load_run, report, reproduce_sweep
-    from gyrolab.sweep.reproduce import reproduce as rerun
-
     path = Path(one_path("reproduce", args.paths, "reproduce PATH/run.nc"))
-    from gyrolab.output.trust import check_kernel_cache
-
     check_kernel_cache()
     log_to_stderr()
     stored = load_run(path, sweeps=True)
@@ -173,10 +159,6 @@ def reproduce(args: argparse.Namespace) -> int:
 
 def aggregate(args: argparse.Namespace) -> int:
     """``gyrolab aggregate SWEEP_DIR``: (re)write SWEEP_DIR/sweep.nc; 0 if every job finished, else 1."""
-    from gyrolab.app import _sweep_status
-    from gyrolab.app.parser import one_path
-    from gyrolab.sweep.aggregate import aggregate_sweep, log_summary
-
     path = Path(one_path("aggregate", args.paths, "aggregate SWEEP_DIR"))
     log_to_stderr()
     summary = aggregate_sweep(path)
@@ -186,8 +168,6 @@ def aggregate(args: argparse.Namespace) -> int:
 
 def new_force(args: argparse.Namespace) -> int:
     """``gyrolab new-force NAME``: a force plugin package to start from, with its tests."""
-    from gyrolab.scaffold import new_force_package
-
     if len(args.names) != 1:
         raise ConfigError("new-force takes one name; usage: gyrolab new-force NAME")
     root = new_force_package(args.names[0])
@@ -198,8 +178,6 @@ def new_force(args: argparse.Namespace) -> int:
 
 def completion(args: argparse.Namespace) -> int:
     """``gyrolab completion bash|zsh``: the completion script on stdout (eval it in the shell's rc file)."""
-    from gyrolab.app.completion import script
-
     print(script(args.shell))
     return 0
 

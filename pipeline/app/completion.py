@@ -13,7 +13,20 @@ the shell when TAB is pressed, so a user's own experiments are offered without g
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
+from importlib.resources import files
 
+from omegaconf import DictConfig, OmegaConf
+
+from gyrolab.app.parser import ALIASES, COMMANDS, build_parsers, run_parser, value_options
+from gyrolab.compat import get_args_parser
+from gyrolab.engine.config import (
+    CONFIG_MODULE,
+    SELECTABLE_GROUPS,
+    compose_config,
+    group_options,
+    hydra_for,
+    register_plugin_configs,
+)
 from gyrolab.errors import ConfigError
 
 SHELLS = ("bash", "zsh")
@@ -26,12 +39,6 @@ _HYDRA_NODES_NOT_TYPED = ("help", "job_logging", "hydra_logging", "callbacks")
 def hydra_keys() -> list[str]:
     """Hydra's keys worth completing: the settings gyrolab's primary config gives (``hydra.run.dir``,
     ``hydra.sweep.dir``, ``hydra.sweep.subdir``, ``hydra.job.name``) and Hydra's ``hydra.verbose``."""
-    from importlib.resources import files
-
-    from omegaconf import OmegaConf
-
-    from gyrolab.engine.config import CONFIG_MODULE
-
     hydra = OmegaConf.to_container(OmegaConf.load(str(files(CONFIG_MODULE) / "config.yaml")).hydra)
     keys = [f"hydra.{key}" for key, _ in _leaves(hydra) if key.split(".")[0] not in _HYDRA_NODES_NOT_TYPED]
     return [*keys, "hydra.verbose"]
@@ -40,9 +47,6 @@ def hydra_keys() -> list[str]:
 def run_options() -> list[str]:
     """The options of ``gyrolab run``: Hydra's own (its argument parser's), gyrolab's ``-V`` (short for --version)
     and the old spellings of the subcommands."""
-    from gyrolab.app.parser import ALIASES
-    from gyrolab.compat import get_args_parser
-
     return [*(s for action in get_args_parser()._actions for s in action.option_strings), "-V", *ALIASES]
 
 
@@ -52,16 +56,6 @@ PATH_COMMANDS = ("plot", "reproduce", "aggregate")
 
 def config_words() -> list[str]:
     """Every completion of an override: ``group=``, ``group=option``, ``section.``, ``key=``, ``key=true``."""
-    from omegaconf import DictConfig, OmegaConf
-
-    from gyrolab.engine.config import (
-        SELECTABLE_GROUPS,
-        compose_config,
-        group_options,
-        hydra_for,
-        register_plugin_configs,
-    )
-
     words: list[str] = []
     register_plugin_configs()   # the installed plugins' options (force=viscous_drag, ...), from the registry
     with hydra_for():
@@ -97,8 +91,6 @@ def _prefixes(key: str, groups: Sequence[str]) -> list[str]:
 
 def option_words() -> dict[str, list[str]]:
     """Each subcommand's options (``run``: Hydra's and the old spellings)."""
-    from gyrolab.app.parser import build_parsers
-
     options = {"run": run_options()}
     for name, parser in build_parsers().items():
         options[name] = [s for action in parser._actions for s in action.option_strings]
@@ -107,8 +99,6 @@ def option_words() -> dict[str, list[str]]:
 
 def script(shell: str) -> str:
     """The completion script for ``shell`` (bash, or zsh through its bash compatibility)."""
-    from gyrolab.app.parser import ALIASES, COMMANDS, build_parsers, run_parser, value_options
-
     if shell not in SHELLS:
         raise ConfigError(f"no completion for shell {shell!r}; valid choices: {', '.join(SHELLS)}")
     options = option_words()

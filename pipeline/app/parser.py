@@ -16,6 +16,7 @@ import argparse
 import difflib
 from collections.abc import Sequence
 
+from gyrolab.compat import get_args_parser
 from gyrolab.errors import ConfigError, shorten
 
 #: subcommand -> one line saying what it does (the order of ``gyrolab --help``)
@@ -115,8 +116,6 @@ def _overrides(parser: argparse.ArgumentParser, what: str) -> None:
 def run_parser() -> argparse.ArgumentParser:
     """``gyrolab run``'s parser: Hydra's own (``--help`` is Hydra's app help, from the config), with gyrolab's
     ``--version`` for Hydra's and ``--scheduler``."""
-    from gyrolab.compat import get_args_parser
-
     parser = _Parser(prog="gyrolab", parents=[get_args_parser()], add_help=False, conflict_handler="resolve",
                      description=_sentence(COMMANDS["run"]))
     parser.add_argument("--version", "-V", action="store_true", help="print gyrolab's version and exit")

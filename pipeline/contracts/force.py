@@ -7,6 +7,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from gyrolab.errors import ConfigError
 from gyrolab.kernels.layout import CompiledTerms
 
 #: Body components of the system's reference-frame axes, indexed 0, 1, 2.
@@ -119,8 +120,6 @@ class Force(ABC):
 
 def check_declared(force: Force, where: str) -> None:
     """ConfigError unless the force declares ``preserves_area_integral`` as a bool (rule 6)."""
-    from gyrolab.errors import ConfigError
-
     flag = getattr(force, "preserves_area_integral", None)
     if not isinstance(flag, (bool, np.bool_)):
         raise ConfigError(

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from gyrolab.errors import GyrolabError, IntegrationError, shorten
+from gyrolab.kernels.model import state_size
 
 #: marks a wrapped ``integrate`` so that it is never wrapped twice
 _CHECKED = "__gyrolab_checked__"
@@ -49,8 +50,6 @@ def checked(integrate: Callable[..., Any]) -> Callable[..., Any]:
 def _check_compiled_size(name: str, compiled: Any, y0: np.ndarray) -> None:
     """A compiled model's kernels index the state by its own size, unchecked: a state of another size would make them
     read and write past the arrays (a crash, or silently wrong numbers), so it is refused here."""
-    from gyrolab.kernels.model import state_size
-
     size = state_size(compiled)
     if size is not None and size != len(y0):
         raise IntegrationError(f"integrator {name!r} was given an initial state of {len(y0)} components for a "
@@ -78,6 +77,7 @@ def check_inputs(name: str, t_out: Any, y0: Any) -> tuple[np.ndarray, np.ndarray
 def check_solution(name: str, solution: Any, t_out: np.ndarray, size: int) -> None:
     """IntegrationError (one sentence naming the integrator and what is wrong) unless ``solution`` keeps the
     contract: a ``Solution`` with ``t`` of len(t_out), ``y`` of shape (len(t_out), size), all finite, and stats."""
+    # import cycle: contracts.integrator imports this module
     from gyrolab.contracts.integrator import IntegratorStats, Solution
 
     rule = "(gyrolab.contracts.Integrator, rules 2–4)"

@@ -11,6 +11,7 @@ import xarray as xr
 
 from gyrolab.contracts.force import Force
 from gyrolab.contracts.integrator import CompiledModel
+from gyrolab.kernels import model
 
 
 class System(ABC):
@@ -111,8 +112,6 @@ class System(ABC):
 
     def compiled_model(self) -> CompiledModel | None:
         """Rule 6: the system compiled from its traced ``rhs``, or None (then only Python integrators run it)."""
-        from gyrolab.kernels import model
-
         try:
             return model.compiled_system(self)
         except model.NotCompilable as exc:

@@ -18,6 +18,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from hydra.core.override_parser.types import ChoiceSweep, RangeSweep
+
+from gyrolab.engine.scene import AUTO, AUTO_MAX_SAMPLES
 from gyrolab.engine.schemas import keys_with
 from gyrolab.errors import ConfigError
 
@@ -85,8 +88,6 @@ def estimated_steps(plain: dict[str, Any]) -> tuple[float, str]:
 
 def _n_output(time: dict[str, Any]) -> int:
     """The stored samples, or for ``auto`` their cap (the count itself needs the built scene)."""
-    from gyrolab.engine.scene import AUTO, AUTO_MAX_SAMPLES
-
     return AUTO_MAX_SAMPLES if time.get("n_output", AUTO) == AUTO else int(time["n_output"])
 
 
@@ -131,8 +132,6 @@ def sweep_points(overrides: Any) -> tuple[float, str]:
 
 
 def _sweep_length(o: Any) -> float:
-    from hydra.core.override_parser.types import ChoiceSweep, RangeSweep
-
     value = o.value()
     if isinstance(value, RangeSweep):
         start, stop, step = (float(v) if v is not None else None for v in (value.start, value.stop, value.step))

@@ -17,20 +17,21 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cache
+from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
 from hydra.core.config_search_path import ConfigSearchPath, SearchPathQuery
 from hydra.core.config_store import ConfigStore
 from hydra.core.global_hydra import GlobalHydra
+from hydra.core.hydra_config import HydraConfig
 from hydra.errors import HydraException, MissingConfigException, OverrideParseException
 from hydra.types import RunMode
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig, OmegaConf, open_dict
 from omegaconf.errors import ConfigKeyError, OmegaConfBaseException, ValidationError
 
+from gyrolab.compat import Hydra, create_automatic_config_search_path
 from gyrolab.contracts import registry
-from gyrolab.compat import create_automatic_config_search_path
-from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
 from gyrolab.engine.schemas import (
     SELECTABLE_GROUPS,
     missing_section,
@@ -42,6 +43,7 @@ from gyrolab.engine.schemas import (
 from gyrolab.engine.schemas import first_line as _first_line
 from gyrolab.engine.schemas import sentence as schema_sentence
 from gyrolab.engine.unread import refuse_given_accuracy
+from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
 from gyrolab.output.user_yaml import check_user_config_dir
 
 CONFIG_MODULE = "gyrolab.conf"
@@ -116,8 +118,6 @@ def warn_shadowed(directory: str, option: str) -> None:
     """One warning per file of a user's config folder (``--config-dir``, ``hydra.searchpath``) that has the path of
     one of gyrolab's packaged configs: Hydra searches gyrolab's configs first (``--config-dir`` goes after them on
     the search path, as in every Hydra app), so that file is never read."""
-    from importlib.resources import files
-
     packaged = files(CONFIG_MODULE)
     for path in sorted(Path(directory).rglob("*.yaml")):
         relative = path.relative_to(directory)
@@ -147,8 +147,6 @@ def current_source() -> ConfigSource:
 @contextmanager
 def hydra_for(source: ConfigSource | None = None) -> Iterator[None]:
     """A Hydra initialised on ``source`` (default: the current one) for the duration of the block."""
-    from gyrolab.compat import Hydra
-
     GlobalHydra.instance().clear()
     Hydra.create_main_hydra2(task_name="app", config_search_path=(source or _source).search_path())
     try:
@@ -229,8 +227,6 @@ def compose_config(overrides: Sequence[str], *, return_hydra_config: bool = Fals
 
 
 def _running_config_name() -> str:
-    from hydra.core.hydra_config import HydraConfig
-
     if HydraConfig.initialized():
         return HydraConfig.get().job.config_name or _source.config_name
     return _source.config_name
@@ -255,8 +251,6 @@ def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bo
         raise ConfigError(f"cannot compose the config with {shorten(' '.join(overrides), 120)} "
                           f"({shorten(_first_line(error), 120)})") from None
     if not return_hydra_config and "hydra" in cfg:
-        from omegaconf import open_dict
-
         with open_dict(cfg):
             del cfg["hydra"]
     # checked by the schemas, used as any mapping (an experiment sets whole sections); Hydra's own node stays typed

@@ -95,7 +95,7 @@ class Progress:
         self._bar = self._make_bar(stream) if _bars_allowed and on_terminal(stream) else None
 
     def _make_bar(self, stream: TextIO) -> Any:
-        from tqdm import tqdm
+        from tqdm import tqdm  # start-up: tqdm only for a bar on a terminal
 
         return tqdm(total=self.t_end - self.t_start, desc=self.label, file=stream, delay=BAR_DELAY, leave=False,
                     mininterval=0.25, bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.4g} of {total:.4g} "

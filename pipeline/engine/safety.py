@@ -34,15 +34,20 @@ import site
 import sysconfig
 from collections.abc import Iterator, Sequence
 from functools import cache
+from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
+from hydra.core.plugins import Plugins
+from hydra.plugins.launcher import Launcher
+from hydra.plugins.sweeper import Sweeper
 from omegaconf import DictConfig, ListConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
 from gyrolab.engine.schemas import resolve_plain
 from gyrolab.errors import ConfigError, shorten
+from gyrolab.output.user_yaml import stored_yaml
 
 #: ``_target_`` values allowed under ``hydra`` besides the installed launchers and sweepers
 #: (gyrolab's sweep callback and sweeper are named, not imported: the engine sits below gyrolab.sweep)
@@ -64,10 +69,6 @@ LAUNCHER_SHELL_KEYS = ("setup", "srun_args", "additional_parameters")
 @cache
 def hydra_targets() -> frozenset[str]:
     """gyrolab's callback and sweeper and every installed Hydra launcher and sweeper class."""
-    from hydra.core.plugins import Plugins
-    from hydra.plugins.launcher import Launcher
-    from hydra.plugins.sweeper import Sweeper
-
     found = {f"{cls.__module__}.{cls.__qualname__}" for kind in (Launcher, Sweeper)
              for cls in Plugins.instance().discover(kind)}
     return HYDRA_TARGETS | found
@@ -90,22 +91,10 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
     scene = _plain(cfg, skip="hydra")
     hydra = cfg.get("hydra") if "hydra" in cfg else None
     plain_hydra = _resolved_hydra(cfg, run_dir, job_subdir) if hydra is not None and run_dir is not None else {}
-    allowed_plugins = plugin_targets()
-    for path, value in _targets(scene):
-        if registry._normalise(str(value)) not in allowed_plugins:
-            group = path.split(".", 1)[0]
-            valid = (f"choose one by name ({group}=NAME), valid names: {', '.join(registry.names(group))}"
-                     if group in registry.GROUPS else "a config may name only registered gyrolab plugins")
-            raise ConfigError(f"{path}={shorten(repr(value))} is not a registered gyrolab plugin and cannot be "
-                              f"called; {valid}")
+    _check_plugin_targets(scene)
     if not plain_hydra:
         return
-    allowed = hydra_targets()
-    for path, value in _targets(plain_hydra, "hydra"):
-        if str(value) not in allowed:
-            raise ConfigError(f"{path}={shorten(repr(value))} is not allowed; under hydra a config may name only "
-                              f"gyrolab's sweep callback and the installed launchers and sweepers "
-                              f"({', '.join(sorted(t.rsplit('.', 1)[1] for t in allowed))})")
+    _check_hydra_targets(plain_hydra)
     mode = str(plain_hydra.get("mode") or "")
     if mode.endswith("MULTIRUN") != job_subdir and mode not in ("", "None"):
         raise ConfigError(f"hydra.mode={mode.rsplit('.', 1)[-1]} disagrees with the command line; start a sweep "
@@ -114,18 +103,44 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
     out = _output_dir(run_dir, plain_hydra, job_subdir)
     for name in ("job_logging", "hydra_logging"):
         _check_logging(plain_hydra.get(name), f"hydra.{name}", out)
-    for key in (plain_hydra.get("job") or {}).get("env_set") or {}:
+    _check_env_set((plain_hydra.get("job") or {}).get("env_set") or {})
+    _check_launcher_shell(plain_hydra.get("launcher") or {}, command_line)
+
+
+def _check_plugin_targets(scene: dict) -> None:
+    """ConfigError unless every ``_target_`` of the scene names a registered gyrolab plugin."""
+    allowed_plugins = plugin_targets()
+    for path, value in _targets(scene):
+        if registry._normalise(str(value)) not in allowed_plugins:
+            group = path.split(".", 1)[0]
+            valid = (f"choose one by name ({group}=NAME), valid names: {', '.join(registry.names(group))}"
+                     if group in registry.GROUPS else "a config may name only registered gyrolab plugins")
+            raise ConfigError(f"{path}={shorten(repr(value))} is not a registered gyrolab plugin and cannot be "
+                              f"called; {valid}")
+
+
+def _check_hydra_targets(plain_hydra: dict) -> None:
+    """ConfigError unless every ``_target_`` under hydra is gyrolab's sweep callback or an installed launcher or
+    sweeper."""
+    allowed = hydra_targets()
+    for path, value in _targets(plain_hydra, "hydra"):
+        if str(value) not in allowed:
+            raise ConfigError(f"{path}={shorten(repr(value))} is not allowed; under hydra a config may name only "
+                              f"gyrolab's sweep callback and the installed launchers and sweepers "
+                              f"({', '.join(sorted(t.rsplit('.', 1)[1] for t in allowed))})")
+
+
+def _check_env_set(env_set: Any) -> None:
+    """ConfigError unless ``hydra.job.env_set`` sets thread counts only."""
+    for key in env_set:
         if not ENV_ALLOWED.match(str(key)):
             raise ConfigError(f"hydra.job.env_set.{shorten(str(key))} is not allowed; a config may set thread counts "
                               "only (OMP_NUM_THREADS, MKL_NUM_THREADS, ...); set other variables in your shell")
-    _check_launcher_shell(plain_hydra.get("launcher") or {}, command_line)
 
 
 def check_stored_config(text: str, where: str) -> DictConfig:
     """A config stored in a dataset, checked as a user's YAML file is (``gyrolab.output.user_yaml.stored_yaml``:
     tags, anchors, depth, size); ConfigError for interpolations."""
-    from gyrolab.output.user_yaml import stored_yaml
-
     plain = stored_yaml(text, where)
     if not isinstance(plain, dict):
         raise ConfigError(f"{where} is not a YAML mapping of config sections; give a run.nc that gyrolab wrote")
@@ -161,6 +176,12 @@ def check_output_dir(text: str, key: str) -> None:
         raise ConfigError(f"{key}={shorten(text)} cannot be resolved (a loop of symbolic links?); give a directory "
                           f"for the results, e.g. {key}=outputs/run1") from None
     _refuse_link_loop(resolved, key, text)
+    _refuse_code_dirs(resolved, real, key, text)
+
+
+def _refuse_code_dirs(resolved: Path, real: Path, key: str, text: str) -> None:
+    """ConfigError for an output directory (as given, and where its links point) in a system directory, a
+    site-packages folder or a folder Python loads code from."""
     for candidate in (resolved, real):
         if _is_system_dir(candidate):
             raise ConfigError(f"{key}={shorten(text)} is inside a system directory ({candidate.parts[1]}); give a "
@@ -327,8 +348,6 @@ def _check_paths(hydra: dict[str, Any], run_dir: Path) -> None:
 
 @cache
 def _packaged_launcher_shell() -> dict[str, Any]:
-    from importlib.resources import files
-
     found: dict[str, Any] = {}
     for option in (files("gyrolab.conf") / "hydra" / "launcher").iterdir():
         if option.name.endswith(".yaml"):

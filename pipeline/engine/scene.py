@@ -12,21 +12,23 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.contracts import registry
 from gyrolab import accuracy
-from gyrolab.engine.config import compose_config
-from gyrolab.contracts import CompiledModel, Integrator, System
+from gyrolab.contracts import CompiledModel, Integrator, System, registry
+from gyrolab.contracts.capabilities import integrators_with, or_list
+from gyrolab.contracts.claims import check_claims, claim_states
+from gyrolab.contracts.force import check_declared
 from gyrolab.contracts.integrator import (
     COMPILED_MODEL,
     NFEV_COUNTS_ATTRIBUTE,
     PREFERS_COMPILED_MODEL,
     TIME_DEPENDENT,
 )
-from gyrolab.output.dataset import build_dataset, scene_attributes
-from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite, shorten
+from gyrolab.engine.config import compose_config
 from gyrolab.engine.force_guard import GuardedRhs, plugin_forces
 from gyrolab.engine.progress import Progress
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
+from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite, shorten
+from gyrolab.output.dataset import build_dataset, scene_attributes
 
 log = logging.getLogger(__name__)
 
@@ -287,8 +289,6 @@ def _check_time_dependent(timed: Sequence[str], system: System, integrator: Inte
 
 def _choices_with(*capabilities: str, accept: Any = None) -> str:
     """The registered integrators with ``capabilities`` (and passing ``accept``), as "a, b or c"."""
-    from gyrolab.contracts.capabilities import integrators_with, or_list
-
     return or_list(integrators_with(*capabilities, accept=accept))
 
 
@@ -342,8 +342,6 @@ def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
     naming the plugin (``init_failure``); the force must declare its area-integral flag.
     An AttributeError (the force reads something the system's body does not have) is one ConfigError too.
     """
-    from gyrolab.contracts.force import check_declared
-
     if not isinstance(node, DictConfig):
         node = OmegaConf.create(dict(node))
     params = _params(cls, node, where)
@@ -380,8 +378,6 @@ def check_force_claims(system: System, t0: float = 0.0) -> None:
     plugins = plugin_forces(system.forces)
     if not plugins:
         return
-    from gyrolab.contracts.claims import check_claims, claim_states
-
     y0 = np.asarray(system.initial_state(), dtype=float)
     frame0 = system.reference_frame(y0)
     omegas, frames = claim_states(y0[:3], frame0)

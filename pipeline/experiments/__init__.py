@@ -10,16 +10,19 @@ from __future__ import annotations
 import importlib
 import pkgutil
 import re
+import tempfile
 from collections.abc import Sequence
 from functools import cache
 from pathlib import Path
 
-from omegaconf import DictConfig
+import xarray as xr
+from omegaconf import DictConfig, open_dict
 
 from gyrolab.contracts.capabilities import or_list
 from gyrolab.engine.schemas import Task, only_declared_keys
 from gyrolab.engine.unread import covers, given_overrides
 from gyrolab.errors import ConfigError, choices
+from gyrolab.sweep.reproduce import compare, load_run
 
 #: a declaration ``TASK = Task("NAME", ...)`` in a module of this package names the task that module runs
 _DECLARATION = re.compile(r'^TASK = Task\(\s*"(\w+)"', re.MULTILINE)
@@ -108,13 +111,6 @@ def task_of_config(cfg: DictConfig) -> str:
 def reproduce_task(path: Path, cfg: DictConfig) -> tuple[object, list[str]]:
     """(the comparison, the report's head) of running the experiment a dataset's stored ``cfg`` names again, into a
     temporary directory, and comparing the dataset of the same name (``gyrolab reproduce PATH/regime.nc``, ...)."""
-    import tempfile
-
-    import xarray as xr
-    from omegaconf import open_dict
-
-    from gyrolab.sweep.reproduce import compare, load_run
-
     task = task_of_config(cfg)
     if task not in TASKS:
         raise ConfigError(f"{path} was written by task {task!r}, which this gyrolab does not have; valid choices: "

@@ -22,18 +22,26 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
+from gyrolab.analysis.continuation import (
+    FamilyPoint,
+    Section,
+    bifurcations,
+    continue_family,
+    locate_events,
+    shoot_section,
+)
+from gyrolab.analysis.periodic import FixedPointModel
+from gyrolab.engine import schemas
+from gyrolab.engine.schemas import Task
 from gyrolab.errors import ConfigError, IntegrationError, as_number
+from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
 from gyrolab.physics import pendulum
-from gyrolab.analysis.continuation import FamilyPoint, Section, bifurcations, continue_family, locate_events, shoot_section
-from gyrolab.analysis.periodic import FixedPointModel
 from gyrolab.plugins.regimes import large_parameter as slow
 from gyrolab.plugins.regimes.base import NondimensionalScene
 from gyrolab.plugins.regimes.small_parameter import SmallParameter
-from gyrolab.engine import schemas
-from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
 COMPONENTS = ("p", "q", "r", "gamma_x", "gamma_y", "gamma_z")
@@ -153,22 +161,41 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     traces = [trace(name, _family_spec(name, f)) for name, f in families.items()]
     ds = dataset(traces, cfg)
     out_dir = Path(out_dir)
-    from gyrolab.figures.redraw import draw_figures
-
     return [write_dataset(ds, out_dir / "orbit_family.nc"), *draw_figures("orbit_family.nc", ds, out_dir, cfg.get("output"))]
 
 
 def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
+    """The families' points, the series' errors along them and the located bifurcations, in one dataset."""
     points = [p for tr in traces for p in tr["points"]]
-    family = np.array([tr["name"] for tr in traces for _ in tr["points"]])
-    labels = {i: "" for i in range(len(points))}
-    offset = 0
+    data = {**_point_variables(traces, points), **_error_variables(traces), **_event_variables(traces)}
+    coords = {"point": ("point", np.arange(len(points)), {"units": "1", "long_name": "point along the families"}),
+              "component": ("component", np.array(COMPONENTS), {"units": "1", "long_name": "state component"}),
+              "multiplier": ("multiplier", np.arange(6), {"units": "1", "long_name": "Floquet multiplier index"}),
+              "event": ("event", np.arange(len(data["event_kind"][1])), {"units": "1",
+                                                                         "long_name": "located bifurcation index"})}
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update({"title": "exact periodic-orbit families of the heavy body, fast to slow spin",
+                     "summary": _summary(traces),
+                     "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
+    return conform(ds, source="orbit_family experiment")
+
+
+def _bifurcation_labels(traces: list[dict]) -> list[str]:
+    """Per point along the families: the bifurcations detected between the previous point and it."""
+    labels: list[str] = []
     for tr in traces:
+        here = [""] * len(tr["points"])
         for i, label in tr["events"]:
-            labels[offset + i] = (labels[offset + i] + ", " if labels[offset + i] else "") + label
-        offset += len(tr["points"])
+            here[i] = f"{here[i]}, {label}" if here[i] else label
+        labels += here
+    return labels
+
+
+def _point_variables(traces: list[dict], points: list) -> dict[str, Any]:
+    """The variables along dimension ``point``: each family point, its stability and its bifurcation label."""
+    family = np.array([tr["name"] for tr in traces for _ in tr["points"]])
     multipliers = np.array([p.multipliers for p in points])
-    data: dict[str, Any] = {
+    return {
         "r0_over_c": ("point", np.array([p.r0 for p in points]), {"units": "1", "long_name": "spin r0 in units of c = √(Mgℓ/C)"}),
         "period": ("point", np.array([p.period for p in points]), {"units": "1", "long_name": "period of the body-frame motion (units of 1/c)"}),
         "initial_state": (("point", "component"), np.array([p.y0 for p in points]),
@@ -184,9 +211,14 @@ def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
         "family": ("point", family, {"units": "1", "long_name": "family name (orbit_family.families)"}),
         "family_label": ("point", np.array([tr["label"] for tr in traces for _ in tr["points"]]),
                          {"units": "1", "long_name": "family description (body, tilt, where it starts)"}),
-        "bifurcation": ("point", np.array([labels[i] for i in range(len(points))]),
+        "bifurcation": ("point", np.array(_bifurcation_labels(traces)),
                         {"units": "1", "long_name": "bifurcation detected between the previous point and this one"}),
     }
+
+
+def _error_variables(traces: list[dict]) -> dict[str, Any]:
+    """The relative error of each series along the families."""
+    data = {}
     for key in traces[0]["errors"]:
         name = "fast_spin" if key.startswith("order") else "slow_spin"
         what = (f"fast-spin series (small_parameter, {key.replace('_', ' ')})" if name == "fast_spin"
@@ -194,13 +226,15 @@ def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
         data[f"error_{name}_{key}" if name == "fast_spin" else "error_slow_spin_series"] = (
             "point", np.concatenate([tr["errors"][key] for tr in traces]),
             {"units": "1", "long_name": f"relative error of the {what} against the exact orbit (NaN: outside its domain)"})
-    coords = {"point": ("point", np.arange(len(points)), {"units": "1", "long_name": "point along the families"}),
-              "component": ("component", np.array(COMPONENTS), {"units": "1", "long_name": "state component"}),
-              "multiplier": ("multiplier", np.arange(6), {"units": "1", "long_name": "Floquet multiplier index"})}
+    return data
+
+
+def _event_variables(traces: list[dict]) -> dict[str, Any]:
+    """The variables along dimension ``event``: each located bifurcation."""
     starts = np.cumsum([0] + [len(tr["points"]) for tr in traces])
     located = [(tr["name"], e) for tr in traces for e in tr["located"]]
     after = [int(start + e.index) for start, tr in zip(starts, traces) for e in tr["located"]]
-    data.update({
+    return {
         "event_point": ("event", np.array(after, dtype=np.int64), {
             "units": "1", "long_name": "index along point of the family point right after the bifurcation"}),
         "event_family": ("event", np.array([n for n, _ in located], dtype=str), {
@@ -218,9 +252,11 @@ def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
                                        "(NaN for a fold, located by interpolation)"}),
         "event_method": ("event", np.array([e.located for _, e in located], dtype=str), {
             "units": "1", "long_name": "how the bifurcation was located"}),
-    })
-    coords["event"] = ("event", np.arange(len(located)), {"units": "1", "long_name": "located bifurcation index"})
-    ds = xr.Dataset(data, coords=coords)
+    }
+
+
+def _summary(traces: list[dict]) -> str:
+    """One line per family: how it ended, its first bifurcations, where each series is within each band."""
     summary = []
     for tr in traces:
         r0 = np.array([p.r0 for p in tr["points"]])
@@ -229,7 +265,4 @@ def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
         for key, errs in tr["errors"].items():
             parts.append(f"{key} series within " + ", ".join(f"{tol:g}: {bands(r0, np.array(errs), tol)}" for tol in BANDS))
         summary.append("; ".join(parts))
-    ds.attrs.update({"title": "exact periodic-orbit families of the heavy body, fast to slow spin",
-                     "summary": " | ".join(summary),
-                     "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    return conform(ds, source="orbit_family experiment")
+    return " | ".join(summary)

@@ -25,21 +25,27 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
+from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig, OmegaConf
 
+from gyrolab.analysis.periodic import FixedPointModel, PeriodicOrbit, shoot
 from gyrolab.contracts import registry
-from gyrolab.contracts.regime import Regime
 from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL
+from gyrolab.contracts.regime import Regime
+from gyrolab.engine.scene import Scene
+from gyrolab.engine.schemas import Task
+from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.cf import conform, unit_attributes
 from gyrolab.output.dataset import time_attributes, write_dataset
-from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.analysis.periodic import FixedPointModel, PeriodicOrbit, shoot
-from gyrolab.physics.attitude import angles_from_states  # noqa: F401  (imported from here by earlier code)
-from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
-from gyrolab.engine.scene import Scene
-from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
-from gyrolab.engine.schemas import Task
+from gyrolab.physics.attitude import (
+    angles_from_states,  # noqa: F401  (imported from here by earlier code)
+    frame_from_angles,
+)
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
+from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
 log = logging.getLogger(__name__)
 SOURCES = ("analytic", "full", "orbit")
@@ -98,8 +104,6 @@ def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = Fal
     """The full model from y0 (the system's layout) at times t: the scene's integrator or compiled Taylor."""
     system = scene.system
     if taylor:
-        from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
         return Taylor(order=24, tol=1e-16).integrate(system.rhs, t, y0, None, system.compiled_model()).y
     integrator = scene.integrator
     wants = integrator.supports(COMPILED_MODEL) or integrator.supports(PREFERS_COMPILED_MODEL)
@@ -108,8 +112,6 @@ def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = Fal
 
 def with_alpha(scene: Scene, regime: Regime, y6: np.ndarray) -> np.ndarray:
     """A 6-state in the system's layout (α from ψ0 and the state's θ, φ)."""
-    from gyrolab.physics.attitude import frame_from_angles
-
     if scene.system.state_size == 6:
         return y6
     psi0 = float(regime.euler_angles(scene.system, np.array([0.0]))["psi"][0])
@@ -171,8 +173,6 @@ def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[np.nd
     label = integrator.name
     # a compiled-only integrator has no model of the reduced system; one that chooses its method chose for the full one
     if integrator.supports(COMPILED_MODEL) or integrator.supports(CHOOSES_METHOD):
-        from gyrolab.plugins.integrators.scipy_solvers import DOP853
-
         settings = {k: getattr(integrator, k, 1e-12) for k in ("rtol", "atol")}
         integrator = DOP853(**settings)
         label = (f"{DOP853.name} rtol={settings['rtol']:g} atol={settings['atol']:g} (standing in for the scene's "
@@ -255,8 +255,6 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
 
 def _task_overrides() -> list[str]:
     """The command line's overrides of the running Hydra job (none outside one)."""
-    from hydra.core.hydra_config import HydraConfig
-
     return list(HydraConfig.get().overrides.task) if HydraConfig.initialized() else []
 
 

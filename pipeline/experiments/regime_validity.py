@@ -23,13 +23,19 @@ import numpy as np
 import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
+from gyrolab.contracts import registry
+from gyrolab.engine.config import compose_config
+from gyrolab.engine.scene import Scene
+from gyrolab.engine.schemas import Task
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.experiments.regime_run import build_regime, compute, errors, prepare
+from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
-from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.experiments.regime_run import compute, errors, prepare
-from gyrolab.figures.redraw import draw_figures
 from gyrolab.output.provenance import provenance
-from gyrolab.engine.schemas import Task
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
+from gyrolab.plugins.regimes.base import nondimensional_scene
+from gyrolab.plugins.regimes.large_parameter import printed_reading_state
 
 log = logging.getLogger(__name__)
 
@@ -55,8 +61,6 @@ def _group(cfg: DictConfig, entry: str) -> str:
 
 
 def _cfg_for(cfg: DictConfig, regime: str, r0: float) -> DictConfig:
-    from gyrolab.engine.config import compose_config
-
     base = OmegaConf.to_container(cfg, resolve=True)
     new = compose_config([f"regime={_group(cfg, regime)}", "regime.periods=1"])
     with open_dict(new):
@@ -103,52 +107,9 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     for regime_name in spec.regimes:
         values = [float(v) for v in spec[regime_name]["values"]]
         fit_below = float(spec[regime_name]["fit_below"])
-        errs = {against: {k: [] for k in KEYS} for against in ("orbit", "full")}
-        status = []
-        theory = getattr(_regime_class(_group(cfg, regime_name)), "order", {})
-        for value in values:
-            sub = _cfg_for(cfg, regime_name, _r0_for(regime_name, value, cfg))
-            try:
-                scene, regime, _ = _prepare(sub, f"{regime_name} at {spec[regime_name]['parameter']} = {value:g}")
-            except ConfigError as error:
-                status.append(f"refused: {error}")
-                _append_missing(errs)
-                continue
-            theory = regime.order  # the instance's: a branch may have other orders than the class default
-            T = regime.period(scene.system)
-            t = np.linspace(0, T, 241)
-            try:
-                result = compute(scene, regime, t)
-            except IntegrationError as error:  # no exact orbit near the series (far outside its domain)
-                status.append(f"failed: {error}")
-                _append_missing(errs)
-                continue
-            status.append("ok")
-            sc = _scales(regime, scene.system)
-            for against in errs:
-                e = errors(result, against)
-                for k in KEYS:
-                    errs[against][k].append(e.get(k, np.nan) / sc[k] if k in e else np.nan)
-        orders = {}
-        for k in KEYS:
-            x, y = np.array(values), np.array(errs["orbit"][k])
-            ok = (x <= fit_below) & np.isfinite(y) & (y > 0)
-            orders[k] = float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0]) if ok.sum() >= 2 else np.nan
-        # an order is consistent within 0.2 of the theory's; a faster decay is consistent too (the theory's
-        # O(μⁿ) is a bound: a small coefficient shows as a higher fitted slope) but is named in the verdict
-        checked = [k for k in KEYS if k in theory and np.isfinite(orders[k])]
-        good = all(orders[k] >= theory[k] - 0.2 for k in checked)
-        faster = [LONG[k] for k in checked if orders[k] > theory[k] + 0.2]
-        refused = [v for v, s in zip(values, status) if s.startswith("refused")]
-        failed = [v for v, s in zip(values, status) if s.startswith("failed")]
-        verdict = (f"{regime_name}: fitted orders (parameter ≤ {fit_below:g}) "
-                   + ", ".join(f"{LONG[k]} {orders[k]:.2f} (theory {theory.get(k, float('nan')):g})" for k in KEYS)
-                   + f"; {'consistent with' if good else 'NOT consistent with'} the theory"
-                   + (f" ({', '.join(faster)} faster than its bound)" if faster else "") + "; "
-                   + (f"refused outside the domain at {spec[regime_name]['parameter']} = "
-                      + ", ".join(f'{v:g}' for v in refused) if refused else "no refused point")
-                   + (f"; no exact orbit found near the series at {spec[regime_name]['parameter']} = "
-                      + ", ".join(f"{v:g}" for v in failed) if failed else ""))
+        errs, status, theory = _regime_errors(cfg, regime_name, values)
+        orders = _fitted_orders(values, errs["orbit"], fit_below)
+        verdict = _verdict(regime_name, spec[regime_name]["parameter"], fit_below, values, status, orders, theory)
         log.info("%s", verdict)
         verdicts.append(verdict)
         rows.append((regime_name, values, errs, orders, status))
@@ -171,6 +132,71 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                     "regime's domain or with non-physical bodies); their text is in %s (attribute expected_warnings)",
                     len(_expected), written[0])
     return written
+
+
+def _regime_errors(cfg: DictConfig, regime_name: str, values: list[float]) -> tuple[dict, list[str], dict]:
+    """(errors against the exact orbit and the full equations per key, each point's status, the theory's orders)
+    of a regime's series at each value of its parameter."""
+    errs: dict[str, dict[str, list]] = {against: {k: [] for k in KEYS} for against in ("orbit", "full")}
+    status = []
+    theory = getattr(_regime_class(_group(cfg, regime_name)), "order", {})
+    for value in values:
+        sub = _cfg_for(cfg, regime_name, _r0_for(regime_name, value, cfg))
+        try:
+            scene, regime, _ = _prepare(sub, f"{regime_name} at {cfg.regime_validity[regime_name]['parameter']} = "
+                                             f"{value:g}")
+        except ConfigError as error:
+            status.append(f"refused: {error}")
+            _append_missing(errs)
+            continue
+        theory = regime.order  # the instance's: a branch may have other orders than the class default
+        t = np.linspace(0, regime.period(scene.system), 241)
+        try:
+            result = compute(scene, regime, t)
+        except IntegrationError as error:  # no exact orbit near the series (far outside its domain)
+            status.append(f"failed: {error}")
+            _append_missing(errs)
+            continue
+        status.append("ok")
+        sc = _scales(regime, scene.system)
+        for against in errs:
+            e = errors(result, against)
+            for k in KEYS:
+                errs[against][k].append(e.get(k, np.nan) / sc[k] if k in e else np.nan)
+    return errs, status, theory
+
+
+def _fitted_orders(values: list[float], errs: dict[str, list], fit_below: float) -> dict[str, float]:
+    """Per key, the slope of log error against log parameter over the points at or below ``fit_below``."""
+    orders = {}
+    for k in KEYS:
+        x, y = np.array(values), np.array(errs[k])
+        ok = (x <= fit_below) & np.isfinite(y) & (y > 0)
+        orders[k] = float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0]) if ok.sum() >= 2 else np.nan
+    return orders
+
+
+def _verdict(regime_name: str, parameter: str, fit_below: float, values: list[float], status: list[str],
+             orders: dict[str, float], theory: dict) -> str:
+    """The regime's fitted orders against the theory's, and where it was refused or found no exact orbit."""
+    # an order is consistent within 0.2 of the theory's; a faster decay is consistent too (the theory's
+    # O(μⁿ) is a bound: a small coefficient shows as a higher fitted slope) but is named in the verdict
+    checked = [k for k in KEYS if k in theory and np.isfinite(orders[k])]
+    good = all(orders[k] >= theory[k] - 0.2 for k in checked)
+    faster = [LONG[k] for k in checked if orders[k] > theory[k] + 0.2]
+    return (f"{regime_name}: fitted orders (parameter ≤ {fit_below:g}) "
+            + ", ".join(f"{LONG[k]} {orders[k]:.2f} (theory {theory.get(k, float('nan')):g})" for k in KEYS)
+            + f"; {'consistent with' if good else 'NOT consistent with'} the theory"
+            + (f" ({', '.join(faster)} faster than its bound)" if faster else "") + "; "
+            + _missing_points(parameter, values, status))
+
+
+def _missing_points(parameter: str, values: list[float], status: list[str]) -> str:
+    """Where a regime was refused outside its domain, and where no exact orbit was found near its series."""
+    refused = ", ".join(f"{v:g}" for v, s in zip(values, status) if s.startswith("refused"))
+    failed = ", ".join(f"{v:g}" for v, s in zip(values, status) if s.startswith("failed"))
+    return ((f"refused outside the domain at {parameter} = {refused}" if refused else "no refused point")
+            + (f"; no exact orbit found near the series at {parameter} = {failed}" if failed else ""))
 
 
 def a_for_omega(omega: float, b: float) -> float:
@@ -201,9 +227,6 @@ def resonance_point(cfg: DictConfig, omega: float, *, check: bool = True) -> tup
         if check:
             scene, regime, _ = _prepare(sub, f"resonance sweep at ω = {float(omega):g}")
         else:
-            from gyrolab.experiments.regime_run import build_regime
-            from gyrolab.engine.scene import Scene
-
             scene, regime = Scene.from_config(sub), build_regime(sub)
     except ConfigError as error:
         return f"refused: {error}", nan
@@ -242,40 +265,63 @@ def resonance_sweep(cfg: DictConfig) -> dict:
                 err["max"][i, j, m] = max(e.values()) if status[i, j, m] == "ok" else np.nan
         small = np.abs(n * n - omega[i] ** 2)
         for k in exponents:
-            y = err[k][i]
-            ok = (distances[None, :] <= fit_within) & np.isfinite(y) & (y > 0)
-            if ok.sum() >= 3:
-                exponents[k][i] = -float(np.polyfit(np.log(small[ok]), np.log(y[ok]), 1)[0])
-        # per distance, the worst point over both sides: +inf where shooting failed, NaN where refused
-        failed_at = np.vectorize(lambda x: str(x).startswith("failed"))(status[i])
-        refused_at = np.vectorize(lambda x: str(x).startswith("refused"))(status[i])
-        worst = np.where(failed_at, np.inf, err["max"][i])
-        computed = ~np.all(refused_at, axis=0)
-        worst = np.array([np.nanmax(worst[:, m]) if computed[m] else np.nan for m in range(len(distances))])
-        # holds: the smallest swept distance from which every computed point on both sides has error ≤ tol
-        for m in np.argsort(distances)[::-1]:
-            if not computed[m]:
-                continue
-            if not worst[m] <= tol:
-                break
-            holds[i] = distances[m]
-        refused = [f"{d:g}" for d in sorted(distances[np.any(refused_at, axis=0)])]
-        failed = [f"{w:.4g}" for w in omega[i][failed_at]]
-        ref = distances.max()
-        far = worst[np.argmax(distances)]
-        edge = worst[computed][np.argmin(distances[computed])] if computed.any() else np.nan
-        verdicts.append(
-            f"{spec.regime} near the resonance ω = {n:g} (c/r0 = {1 / float(spec.r0):g}, b = {float(spec.b):g}, ω set "
-            f"through a): max relative error against the exact orbit grows as |{n:g}² − ω²|^−s with s = "
-            f"{exponents['max'][i]:.2f} (p, q {exponents['pq'][i]:.2f}, γ, γ' {exponents['gamma'][i]:.2f}, "
-            f"γ'' {exponents['gamma3'][i]:.2f}; fitted for |ω − {n:g}| ≤ {fit_within:g}); {far:.2g} at |ω − {n:g}| = "
-            f"{ref:g}, {edge:.2g} at the closest accepted point; the regime holds (error ≤ {tol:g}) for |ω − {n:g}| ≥ "
-            f"{holds[i]:g}; " + (f"refused at |ω − {n:g}| = {', '.join(refused)}" if refused else "no refused point")
-            + (f"; shooting failed at ω = {', '.join(failed)}" if failed else ""))
+            exponents[k][i] = _growth_exponent(err[k][i], small, distances, fit_within)
+        worst, computed, failed_at, refused_at = _worst_over_sides(status[i], err["max"][i])
+        holds[i] = _holds_from(distances, worst, computed, tol)
+        verdicts.append(_resonance_verdict(spec, n, {k: v[i] for k, v in exponents.items()}, holds[i], distances,
+                                           worst, computed, sorted(distances[np.any(refused_at, axis=0)]),
+                                           omega[i][failed_at]))
         log.info("%s", verdicts[-1])
     return {"resonances": resonances, "distances": distances, "sides": sides, "omega": omega, "errors": err,
             "status": status, "exponents": exponents, "holds": holds, "verdicts": verdicts,
             "fit_within": fit_within, "tolerance": tol, "epsilon": 1 / float(spec.r0)}
+
+
+def _growth_exponent(y: np.ndarray, small: np.ndarray, distances: np.ndarray, fit_within: float) -> float:
+    """s of error ∝ |n² − ω²|^−s, fitted over the points within ``fit_within`` of the resonance (NaN: too few)."""
+    ok = (distances[None, :] <= fit_within) & np.isfinite(y) & (y > 0)
+    return -float(np.polyfit(np.log(small[ok]), np.log(y[ok]), 1)[0]) if ok.sum() >= 3 else np.nan
+
+
+def _worst_over_sides(status: np.ndarray, max_error: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Per distance, the worst point over both sides (+inf where shooting failed, NaN where refused on both),
+    whether any point was computed there, and where points failed or were refused."""
+    failed_at = np.vectorize(lambda x: str(x).startswith("failed"))(status)
+    refused_at = np.vectorize(lambda x: str(x).startswith("refused"))(status)
+    worst = np.where(failed_at, np.inf, max_error)
+    computed = ~np.all(refused_at, axis=0)
+    worst = np.array([np.nanmax(worst[:, m]) if computed[m] else np.nan for m in range(worst.shape[1])])
+    return worst, computed, failed_at, refused_at
+
+
+def _holds_from(distances: np.ndarray, worst: np.ndarray, computed: np.ndarray, tol: float) -> float:
+    """The smallest swept distance from which every computed point on both sides has error ≤ ``tol``."""
+    holds = np.nan
+    for m in np.argsort(distances)[::-1]:
+        if not computed[m]:
+            continue
+        if not worst[m] <= tol:
+            break
+        holds = distances[m]
+    return holds
+
+
+def _resonance_verdict(spec: DictConfig, n: float, exponents: dict[str, float], holds: float, distances: np.ndarray,
+                       worst: np.ndarray, computed: np.ndarray, refused_distances: list, failed_omegas: np.ndarray) -> str:
+    """How the error grows towards the resonance ω = n, and from which distance the regime holds."""
+    refused = [f"{d:g}" for d in refused_distances]
+    failed = [f"{w:.4g}" for w in failed_omegas]
+    fit_within, tol = float(spec.fit_within), float(spec.tolerance)
+    far = worst[np.argmax(distances)]
+    edge = worst[computed][np.argmin(distances[computed])] if computed.any() else np.nan
+    return (f"{spec.regime} near the resonance ω = {n:g} (c/r0 = {1 / float(spec.r0):g}, b = {float(spec.b):g}, ω set "
+            f"through a): max relative error against the exact orbit grows as |{n:g}² − ω²|^−s with s = "
+            f"{exponents['max']:.2f} (p, q {exponents['pq']:.2f}, γ, γ' {exponents['gamma']:.2f}, "
+            f"γ'' {exponents['gamma3']:.2f}; fitted for |ω − {n:g}| ≤ {fit_within:g}); {far:.2g} at |ω − {n:g}| = "
+            f"{distances.max():g}, {edge:.2g} at the closest accepted point; the regime holds (error ≤ {tol:g}) for "
+            f"|ω − {n:g}| ≥ {holds:g}; " + (f"refused at |ω − {n:g}| = {', '.join(refused)}" if refused else
+                                            "no refused point")
+            + (f"; shooting failed at ω = {', '.join(failed)}" if failed else ""))
 
 
 def _resonance_dataset(sweep: dict) -> xr.Dataset:
@@ -302,17 +348,11 @@ def _resonance_dataset(sweep: dict) -> xr.Dataset:
 
 
 def _regime_class(name: str):
-    from gyrolab.contracts import registry
-
     return registry.load("regime", name)
 
 
 def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:
     """Printed (35) under μ = c/r0 against the full model: γ'' error over one τ period (Ismail (2021) report §3)."""
-    from gyrolab.engine.scene import Scene
-    from gyrolab.plugins.regimes.base import nondimensional_scene
-    from gyrolab.plugins.regimes.large_parameter import printed_reading_state
-
     errs = []
     mus = [float(v) for v in cfg.regime_validity.large_parameter["values"]]
     for mu in mus:
@@ -325,8 +365,6 @@ def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:
         approx = printed_reading_state(t, s)
         y0 = approx[0].copy()
         y0[3:6] /= np.linalg.norm(y0[3:6])
-        from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
         model = scene.system.compiled_model()
         y0 = np.concatenate([y0, scene.system.initial_state()[6:]])[: scene.system.state_size]
         exact = Taylor(order=24, tol=1e-16).integrate(scene.system.rhs, t, y0, None, model).y

@@ -13,6 +13,7 @@ import logging
 import math
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -32,10 +33,12 @@ SECTION_DIMENSIONS = {
     "crossing_description": "dimension crossing: the upward crossings of the section by that point's trajectory, "
                             "in time order (NaN past its last crossing)",
 }
-from gyrolab.output.dataset import write_dataset
-from gyrolab.sweep.grid import Dim
+from gyrolab.analysis.chaos import section_dataset
+from gyrolab.batch.sweep import run_batch
 from gyrolab.engine import schemas
 from gyrolab.engine.schemas import Task
+from gyrolab.output.dataset import write_dataset
+from gyrolab.sweep.grid import Dim
 
 log = logging.getLogger(__name__)
 
@@ -58,19 +61,25 @@ def grid(cfg: DictConfig) -> list[Dim]:
         if points is None and key == "r0":
             check_points(float(n_theta) * n_r, f"stability_map.n_theta0={n_theta} × n_r0={n_r}",
                          allow_large=cfg.get("allow_large") is True)
-        if len(span) != 2:
-            raise ConfigError(f"stability_map.{key}={list(span)!r} must be [first, last]")
-        first, last = (as_number(v, f"stability_map.{key}") for v in span)
-        if n > 1 and first == last:
-            raise ConfigError(f"stability_map.{key}={list(span)!r} is one value, but n_{key}={n} points are asked; "
-                              f"give [first, last] with first ≠ last, or n_{key}=1")
-        spacing = settings.get(f"{key}_spacing", "linear")
-        if spacing not in ("linear", "log") or (spacing == "log" and not 0 < first < last):
-            raise ConfigError(f"stability_map.{key}_spacing={spacing!r} must be linear or log (log: 0 < first < last)")
-        spaced = np.geomspace if spacing == "log" else np.linspace
-        values = spaced(first, last, n) if n > 1 else np.array([first])
+        values = _axis_values(settings, key, span, n)
         dims.append(Dim(f"initial.{key}", tuple(repr(float(v)) for v in values), tuple(float(v) for v in values)))
     return dims
+
+
+def _axis_values(settings: DictConfig, key: str, span: Any, n: int) -> np.ndarray:
+    """The ``n`` values of axis ``key`` from ``span`` = [first, last], linear or log spaced; ConfigError if a
+    setting is wrong."""
+    if len(span) != 2:
+        raise ConfigError(f"stability_map.{key}={list(span)!r} must be [first, last]")
+    first, last = (as_number(v, f"stability_map.{key}") for v in span)
+    if n > 1 and first == last:
+        raise ConfigError(f"stability_map.{key}={list(span)!r} is one value, but n_{key}={n} points are asked; "
+                          f"give [first, last] with first ≠ last, or n_{key}=1")
+    spacing = settings.get(f"{key}_spacing", "linear")
+    if spacing not in ("linear", "log") or (spacing == "log" and not 0 < first < last):
+        raise ConfigError(f"stability_map.{key}_spacing={spacing!r} must be linear or log (log: 0 < first < last)")
+    spaced = np.geomspace if spacing == "log" else np.linspace
+    return spaced(first, last, n) if n > 1 else np.array([first])
 
 
 #: what the task reads and sets (gyrolab.experiments derives its tables from it)
@@ -108,8 +117,6 @@ def _sections(cfg: DictConfig) -> list:
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
-    from gyrolab.batch.sweep import run_batch
-
     plain = OmegaConf.to_container(cfg, resolve=True)
     plain.pop("hydra", None)
     path = confined_output_path(out_dir, cfg.stability_map.file, "stability_map.file")
@@ -129,8 +136,6 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
 def _add_sections(path: Path, plain: dict, points: Sequence[Sequence[float]], t_end: float) -> None:
     """Poincaré sections of the chosen (θ0, r0) points, integrated by the chaos kernel with the map's step, added to
     the map's file (rewritten atomically; a rerun replaces them)."""
-    from gyrolab.analysis.chaos import section_dataset
-
     if not t_end > 0:
         raise ConfigError(f"stability_map.section_time={t_end!r} must be a positive time")
     scenes = []

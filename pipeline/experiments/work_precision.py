@@ -25,15 +25,18 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.contracts.integrator import NFEV_COUNTS_ATTRIBUTE
+from gyrolab.engine import schemas
+from gyrolab.engine.config import compose_config
+from gyrolab.engine.scene import Scene
+from gyrolab.engine.schemas import Task
+from gyrolab.errors import ConfigError
+from gyrolab.figures.redraw import draw_figures
+from gyrolab.kernels import layout
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
-from gyrolab.errors import ConfigError
 from gyrolab.output.provenance import provenance
 from gyrolab.physics.reference import fixed_point_reference
-from gyrolab.engine.scene import Scene
-from gyrolab.figures.redraw import draw_figures
-from gyrolab.engine import schemas
-from gyrolab.engine.schemas import Task
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
 log = logging.getLogger(__name__)
 #: how cpu_time was measured (the dataset's ``timing`` attribute)
@@ -54,8 +57,6 @@ TASK = Task("work_precision", reads=("output.error_estimate",), section="work_pr
 def check(cfg: DictConfig, out_dir: Path) -> None:
     """The refusals before the run directory exists: a method's setting that its integrator does not read
     (``methods: {taylor: {accuracy: [1e-8]}}`` would run taylor at its own tolerance under the label accuracy=1e-08)."""
-    from gyrolab.engine.config import compose_config
-
     methods = OmegaConf.to_container(cfg.work_precision, resolve=True).get("methods") or {}
     for method, settings in methods.items():
         for key, values in (settings or {}).items():
@@ -67,8 +68,6 @@ def check(cfg: DictConfig, out_dir: Path) -> None:
 
 
 def _scene_for(cfg: DictConfig, method: str, key: str, value: float) -> Scene:
-    from gyrolab.engine.config import compose_config
-
     overrides = [f"integrator={method}"]
     overrides += [f"accuracy={value!r}"] if key == "accuracy" else [f"integrator.{k}={value!r}" for k in SETTING_KEYS[key]]
     base = OmegaConf.to_container(cfg, resolve=True)
@@ -88,8 +87,6 @@ def _final(ds: xr.Dataset) -> np.ndarray:
 def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
     """Final (ω, γ) of the scene from the most accurate reference available, and its name."""
     compiled = scene.system.compiled_model()
-    from gyrolab.kernels import layout
-
     if compiled is None or compiled.built_in is None:  # the built-in torque forms only
         raise ConfigError("work_precision needs a scene whose forces have compiled forms (for its reference run)")
     p = compiled.built_in
@@ -98,8 +95,6 @@ def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
         ref = fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3],
                                     p[layout.N_Z], y0, scene.times[[0, -1]])
         return ref[-1].astype(float), "extended-precision Taylor (gyrolab.physics.reference)"
-    from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
     sol = Taylor(order=24, tol=1e-18).integrate(scene.system.rhs, scene.times, scene.system.initial_state(), None,
                                                 compiled)
     return sol.y[-1, :6], "compiled Taylor, order 24, tol 1e-18 (double precision)"

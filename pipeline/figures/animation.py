@@ -29,11 +29,11 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.errors import ConfigError
+from gyrolab.figures.labels import unit
+from gyrolab.figures.style import STYLE, unit_sphere
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.foreign import load_run
 from gyrolab.output.trust import check_output_target
-from gyrolab.figures.labels import unit
-from gyrolab.figures.style import STYLE, unit_sphere
 
 log = logging.getLogger(__name__)
 
@@ -212,7 +212,7 @@ def animate(path: str | os.PathLike[str], output: str | os.PathLike[str] | None 
 
 
 def _write_gif(fig: plt.Figure, update: Callable[[int], None], n: int, fps: float, path: Path) -> None:
-    from PIL import Image
+    from PIL import Image  # start-up: PIL only for a GIF
 
     fig.set_dpi(GIF_DPI)
     images = []
@@ -225,7 +225,7 @@ def _write_gif(fig: plt.Figure, update: Callable[[int], None], n: int, fps: floa
 
 
 def _write_mp4(fig: plt.Figure, update: Callable[[int], None], n: int, fps: float, path: Path) -> None:
-    from matplotlib.animation import FFMpegWriter
+    from matplotlib.animation import FFMpegWriter  # start-up: only for an MP4
 
     writer = FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p", "-f", "mp4"])
     with writer.saving(fig, str(path), MP4_DPI):

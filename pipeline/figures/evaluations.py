@@ -13,14 +13,13 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from gyrolab.contracts import registry
 from gyrolab.contracts.integrator import CHOOSES_METHOD, NFEV_COUNTS_ATTRIBUTE
+from gyrolab.errors import GyrolabError
 
 
 def integrator_class(name: str) -> Any:
     """The registered integrator class called ``name``, or None (unknown, or its package fails to import)."""
-    from gyrolab.contracts import registry
-    from gyrolab.errors import GyrolabError
-
     try:
         return registry.load("integrator", name)
     except (GyrolabError, ImportError, AttributeError):

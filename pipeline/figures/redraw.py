@@ -14,10 +14,11 @@ from pathlib import Path
 
 import xarray as xr
 
-from gyrolab.output.user_yaml import stored_yaml
 from gyrolab.errors import ConfigError, GyrolabError, shorten
+from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS, figure_options
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
-from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
+from gyrolab.output.trust import check_tree
+from gyrolab.output.user_yaml import stored_yaml
 
 #: dataset file name -> the gyrolab.figures module that draws its figures
 KINDS = {
@@ -61,7 +62,7 @@ def save_kind(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ..
     module = importlib.import_module(f"gyrolab.figures.{KINDS[name]}")
     if hasattr(module, "save_figures"):
         return module.save_figures(ds, directory, formats, dpi)
-    from gyrolab.figures.save import save_all
+    from gyrolab.figures.save import save_all  # start-up: matplotlib only when figures are drawn
 
     return save_all({stem: draw(ds) for stem, draw in module.FIGURES.items()}, directory, ds, formats, dpi)
 
@@ -70,7 +71,7 @@ def _drew_figures(path: Path) -> bool:
     """Whether the run stored at ``path`` drew figures (its stored config's ``output.figures``); ConfigError for a
     stored config that is not what gyrolab stores (``gyrolab.output.user_yaml.stored_yaml``)."""
     try:
-        import netCDF4
+        import netCDF4  # start-up: netCDF4 only when a header is read
 
         with netCDF4.Dataset(path, "r") as nc:  # the header only: no coordinate is read
             config = nc.getncattr("config") if "config" in nc.ncattrs() else ""
@@ -99,8 +100,6 @@ def datasets(path: Path) -> list[Path]:
 
 def redraw(path: str | Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int = DEFAULT_DPI) -> list[Path]:
     """Redraw every figure of the datasets under ``path``; returns the files written."""
-    from gyrolab.output.trust import check_tree
-
     path = Path(path)
     if path.is_dir():  # a job directory that is a link would take its figures outside (a file's: own_dir)
         check_tree(path, sweep=True)
@@ -113,8 +112,6 @@ def redraw(path: str | Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int 
 def draw_figures(name: str, ds: xr.Dataset, out_dir: str | Path, output: object | None) -> list[Path]:
     """The figures of dataset ``name`` (a key of ``KINDS``) drawn from ``ds`` into ``out_dir/figures``, in the
     formats and dpi of the ``output`` config section; none when ``output.figures`` is false."""
-    from gyrolab.figures.options import figure_options
-
     output = output if output is not None else {}
     if not output.get("figures", True):
         return []

@@ -19,9 +19,11 @@ import numpy as np
 import xarray as xr
 from matplotlib.colors import Normalize
 
-from gyrolab.errors import OutputError
+from gyrolab.errors import ConfigError, OutputError
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
+from gyrolab.figures.save import save_all
 from gyrolab.figures.style import DOUBLE, panel_note, styled
+from gyrolab.output.user_yaml import stored_yaml
 
 #: colour scale of MEGNO: 0 (stable periodic) … 2 (quasi-periodic) … CLIP and beyond (chaotic)
 CLIP = 8.0
@@ -75,9 +77,6 @@ def _body_omega(ds: xr.Dataset) -> float | None:
 def _stored_system(ds: xr.Dataset) -> tuple[str, dict]:
     """(the system's class name, the body section) of the map's stored config (checked as untrusted input); ("", {})
     when the dataset holds none: the fixed point's annotations are then drawn as before."""
-    from gyrolab.errors import ConfigError
-    from gyrolab.output.user_yaml import stored_yaml
-
     try:
         config = stored_yaml(ds.attrs.get("config", ""), "the map's stored config") if "config" in ds.attrs else {}
     except ConfigError:
@@ -227,6 +226,4 @@ FIGURES = {"stability_map": draw_stability_map}
 def draw(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
          dpi: int = DEFAULT_DPI) -> list[Path]:
     """Write ``stability_map.<format>`` drawn from ``ds`` into ``directory``; returns the paths."""
-    from gyrolab.figures.save import save_all
-
     return save_all({"stability_map": draw_stability_map(ds)}, directory, ds, tuple(formats), dpi)

@@ -172,11 +172,6 @@ def _fsync_directory(directory: Path) -> None:
         os.close(fd)
 
 
-def is_temporary(path: Path) -> bool:
-    """Whether ``path`` is named like a temporary file of ``atomic_path``."""
-    return path.name.startswith(".") and path.name.endswith(TEMP_SUFFIX)
-
-
 def remove_stale_temporaries(directory: str | os.PathLike[str]) -> list[Path]:
     """Remove temporary files that killed writes left in ``directory`` (not recursive).
 

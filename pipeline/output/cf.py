@@ -59,24 +59,7 @@ def conform(ds: xr.Dataset, title: str | None = None, source: str = "") -> xr.Da
     ``title`` is used only when ``ds`` has none; ``source`` says what made the file (``history``).
     """
     for name in list(ds.variables):
-        variable = ds.variables[name]
-        if variable.dtype.kind in "iu" and variable.dtype.itemsize > 4:
-            values = variable.values
-            fits = not values.size or (values.min() >= _INT32.min and values.max() <= _INT32.max)
-            ds[name] = variable.astype(np.int32 if fits else np.float64)
-            variable = ds.variables[name]
-        attrs = variable.attrs
-        if attrs.get("standard_name") == "time" and not _SINCE.match(str(attrs.get("units", ""))):
-            del attrs["standard_name"]
-        if not attrs.get("long_name") and not attrs.get("standard_name"):
-            log.info("dataset variable %r has no long_name; its name stands in", name)
-            attrs["long_name"] = str(name)
-        if name in ds.coords:
-            if name == "time":  # elapsed model time is the T axis (no calendar claimed: see the docstring)
-                attrs.setdefault("axis", "T")
-            variable.encoding["_FillValue"] = None
-            if _is_text(variable):
-                variable.encoding["dtype"] = "S1"
+        _conform_variable(ds, name)
     created = now_iso()
     what = f": {source}" if source else ""
     ds.attrs["Conventions"] = CONVENTIONS
@@ -84,6 +67,29 @@ def conform(ds: xr.Dataset, title: str | None = None, source: str = "") -> xr.Da
     ds.attrs["date_created"] = created
     ds.attrs["history"] = f"{created} written by gyrolab {gyrolab_version()}{what}"
     return ds
+
+
+def _conform_variable(ds: xr.Dataset, name: Any) -> None:
+    """One variable made CF: 64-bit integers narrowed (netCDF3-safe), a time standard_name only with a "since"
+    unit, a long_name always, coordinates without fill values (text as characters)."""
+    variable = ds.variables[name]
+    if variable.dtype.kind in "iu" and variable.dtype.itemsize > 4:
+        values = variable.values
+        fits = not values.size or (values.min() >= _INT32.min and values.max() <= _INT32.max)
+        ds[name] = variable.astype(np.int32 if fits else np.float64)
+        variable = ds.variables[name]
+    attrs = variable.attrs
+    if attrs.get("standard_name") == "time" and not _SINCE.match(str(attrs.get("units", ""))):
+        del attrs["standard_name"]
+    if not attrs.get("long_name") and not attrs.get("standard_name"):
+        log.info("dataset variable %r has no long_name; its name stands in", name)
+        attrs["long_name"] = str(name)
+    if name in ds.coords:
+        if name == "time":  # elapsed model time is the T axis (no calendar claimed: see the docstring)
+            attrs.setdefault("axis", "T")
+        variable.encoding["_FillValue"] = None
+        if _is_text(variable):
+            variable.encoding["dtype"] = "S1"
 
 
 def _is_text(variable: xr.Variable) -> bool:

@@ -72,7 +72,7 @@ MARGIN_BYTES = 16 * 1024**2
 
 def declared_bytes(path: Path) -> int:
     """The bytes the variables of the netCDF file ``path`` declare, from its header (nothing is read)."""
-    import netCDF4
+    import netCDF4  # start-up: netCDF4 only when a file is read
 
     total = 0
     with netCDF4.Dataset(path, "r") as nc:

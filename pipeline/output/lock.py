@@ -172,23 +172,9 @@ def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
     created, or a lock file of gyrolab's (one link, the user's, a line long).
     """
     while True:
-        created = False
-        try:
-            if create:
-                try:
-                    fd = open_own_file(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644)
-                    created = True
-                except FileExistsError:
-                    try:
-                        fd = open_own_file(path, os.O_RDWR)
-                    except FileNotFoundError:
-                        continue  # removed between the two opens: again
-            else:
-                fd = open_own_file(path, os.O_RDWR)
-        except FileNotFoundError:
-            if not create:
-                return None
-            raise
+        fd, created = _open_lock_file(path, create)
+        if fd is None:
+            return None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
         except OSError as error:
@@ -210,14 +196,40 @@ def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
             if not create:
                 return None
             continue
-        ours = created or (info.st_nlink == 1 and info.st_uid == os.geteuid() and info.st_size <= MAX_OWNER_BYTES)
-        if create and ours:
-            try:  # who holds it, for the messages of others; a full disk may refuse this, the lock holds anyway
-                os.ftruncate(fd, 0)
-                os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}\n".encode())
-            except OSError:
-                pass
+        if create:
+            _write_owner(fd, created, info)
         return fd
+
+
+def _open_lock_file(path: Path, create: bool) -> tuple[int | None, bool]:
+    """(an fd on ``path``, whether this call created the file); (None, False) when it is gone and not to be
+    created."""
+    while True:
+        try:
+            if not create:
+                return open_own_file(path, os.O_RDWR), False
+            try:
+                return open_own_file(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644), True
+            except FileExistsError:
+                try:
+                    return open_own_file(path, os.O_RDWR), False
+                except FileNotFoundError:
+                    continue  # removed between the two opens: again
+        except FileNotFoundError:
+            if not create:
+                return None, False
+            raise
+
+
+def _write_owner(fd: int, created: bool, info: os.stat_result) -> None:
+    """Who holds the lock, for the messages of others: into a file this call created, or a lock file of gyrolab's
+    (one link, the user's, a line long)."""
+    if created or (info.st_nlink == 1 and info.st_uid == os.geteuid() and info.st_size <= MAX_OWNER_BYTES):
+        try:  # a full disk may refuse this, the lock holds anyway
+            os.ftruncate(fd, 0)
+            os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}\n".encode())
+        except OSError:
+            pass
 
 
 #: a lock file holds one line; a larger file is not overwritten

@@ -21,9 +21,11 @@ from __future__ import annotations
 import errno
 import os
 import stat
+import sys
 from pathlib import Path
 
 from gyrolab.errors import ConfigError, shorten
+from gyrolab.kernels.cache import cache_dir
 
 #: gyrolab's folders inside a run or sweep directory
 OWN_DIRS = frozenset({"figures", ".hydra", ".submitit"})
@@ -167,10 +169,6 @@ def check_kernel_cache() -> None:
     """Untrusted when numba's cache folder (compiled kernels, whose index numba unpickles) or its parent belongs to
     another user or may be written by anyone (a shared temporary directory another user prepared). Called before
     any kernel is loaded (a command that runs kernels: run, batch, reproduce)."""
-    import sys
-
-    from gyrolab.kernels.cache import cache_dir
-
     # the folder numba uses once it is set up in this process, else the one it will use (found without importing
     # numba, which a run of scipy's integrators never needs)
     numba = sys.modules.get("numba")

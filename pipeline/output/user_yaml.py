@@ -73,6 +73,16 @@ def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> y
     """ConfigError (one sentence naming ``where`` and the line) unless ``data`` is a plain YAML mapping within the
     limits (module docstring); the composed node (None for an empty text). ``stored``: a config gyrolab stored
     (the sentences say that it was edited)."""
+    node = _composed(_decoded(data, where), where, stored)
+    if node is None:
+        return None  # an empty file is an empty config
+    _check_nodes(node, where)
+    _check_top_level(node, where, stored)
+    return node
+
+
+def _decoded(data: bytes | str, where: str) -> str:
+    """The text of ``data``: within the size limit, UTF-8, no control character YAML refuses."""
     if isinstance(data, str):
         data = data.encode("utf-8", "surrogatepass")
     if len(data) > MAX_FILE_BYTES:
@@ -87,9 +97,14 @@ def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> y
     if bad is not None:
         raise ConfigError(f"{where}, line {text.count(chr(10), 0, bad) + 1}: a control character (code "
                           f"{ord(text[bad])}) that YAML does not allow; a config file is plain text")
+    return text
+
+
+def _composed(text: str, where: str, stored: bool) -> yaml.Node | None:
+    """The YAML node of ``text`` (not deeper than the limit), or one sentence saying where it is not YAML."""
     try:
         _check_depth(text, where)  # before composing: PyYAML's composer recurses once per level
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        return yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as error:
         if stored:
             mark = error.problem_mark or error.context_mark
@@ -99,9 +114,10 @@ def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> y
         raise ConfigError(_sentence(where, error)) from None
     except yaml.YAMLError as error:
         raise ConfigError(f"{where} is not valid YAML ({shorten(type(error).__name__)})") from None
-    if node is None:
-        return None  # an empty file is an empty config
-    _check_nodes(node, where)
+
+
+def _check_top_level(node: yaml.Node, where: str, stored: bool) -> None:
+    """ConfigError unless the file is a mapping whose ``defaults``, if any, is a list."""
     if not isinstance(node, yaml.MappingNode):
         kind = "a list" if isinstance(node, yaml.SequenceNode) else "a single value"
         if stored:
@@ -112,7 +128,6 @@ def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> y
         if key.value == "defaults" and not isinstance(value, yaml.SequenceNode):
             raise ConfigError(f"{where}, line {value.start_mark.line + 1}: `defaults` must be a list (- group: option "
                               "lines), as in Hydra's defaults list")
-    return node
 
 
 def stored_yaml(data: bytes | str, where: str) -> dict:
@@ -196,19 +211,24 @@ def _check_nodes(root: yaml.Node, where: str) -> None:
                               "allowed (not plain YAML: gyrolab refuses tags such as !!python/...); a config holds "
                               "plain values (numbers, strings, lists, mappings)")
         if isinstance(node, yaml.MappingNode):
-            seen: dict[object, int] = {}
-            for k, _ in node.value:
-                if not isinstance(k, yaml.ScalarNode):
-                    raise ConfigError(f"{where}, line {k.start_mark.line + 1}: a key is a list or a mapping; keys of a "
-                                      "config are plain names")
-                if isinstance(k, yaml.ScalarNode):
-                    if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
-                        raise ConfigError(f"{where}, line {k.start_mark.line + 1}: the key {shorten(k.value, 60)!r} "
-                                          f"is given twice in one mapping (first on line {seen[k.value]}); "
-                                          "give each key once")
-                    seen[k.value] = k.start_mark.line + 1
+            _check_keys(node, where)
         stack.append((node, True, depth))
         stack.extend((c, False, depth + 1) for c in _children(node) if id(c) not in sizes)
+
+
+def _check_keys(node: yaml.MappingNode, where: str) -> None:
+    """ConfigError for a key that is not a plain name, or given twice in one mapping."""
+    seen: dict[object, int] = {}
+    for k, _ in node.value:
+        if not isinstance(k, yaml.ScalarNode):
+            raise ConfigError(f"{where}, line {k.start_mark.line + 1}: a key is a list or a mapping; keys of a "
+                              "config are plain names")
+        if isinstance(k, yaml.ScalarNode):
+            if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
+                raise ConfigError(f"{where}, line {k.start_mark.line + 1}: the key {shorten(k.value, 60)!r} "
+                                  f"is given twice in one mapping (first on line {seen[k.value]}); "
+                                  "give each key once")
+            seen[k.value] = k.start_mark.line + 1
 
 
 def _children(node: yaml.Node) -> list[yaml.Node]:

@@ -32,6 +32,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+
 from gyrolab.errors import ConfigError
 
 
@@ -124,7 +125,7 @@ class LindstedtSeries:
         coeffs, power = (w[::2], 2) if even else (w, 1)
         m = (len(coeffs) - 1) // 2
         if m >= 1:
-            from scipy.interpolate import pade as pade_fit
+            from scipy.interpolate import pade as pade_fit  # start-up: scipy.interpolate only for a Padé fit
 
             try:
                 with warnings.catch_warnings():  # an ill-conditioned Padé system is expected near resonances

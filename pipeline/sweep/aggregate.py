@@ -39,15 +39,16 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.contracts.integrator import IntegratorStats
+from gyrolab.errors import ConfigError, shorten
+from gyrolab.figures.options import figure_options
 from gyrolab.output.cf import conform
 from gyrolab.output.dataset import write_dataset
-from gyrolab.output.units import quantity_units
-from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset
+from gyrolab.output.lock import LOCK_NAME, clear_temporaries, owner_of, try_lock, unlock, wait_for
 from gyrolab.output.trust import check_tree
-from gyrolab.output.written import announce_written
+from gyrolab.output.units import quantity_units
 from gyrolab.output.user_yaml import stored_yaml_file
-from gyrolab.errors import ConfigError, shorten
+from gyrolab.output.written import announce_written
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
 
@@ -128,31 +129,68 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
                               **_units(values, quantity_units(dim.key, body_units))})
         for name, dim in zip(names, grid.dims) for values in [dim.coordinate()]
     }
-    data_vars: dict[str, Any] = {}
-
     sample = _sample_dim([ds for _, ds in done])
-    if done:
-        first = done[0][1]
-        for name, coord in first.coords.items():
-            if name == "time" and sample == "sample":
-                continue
-            for _, ds in done[1:]:
-                if name not in ds.coords or not np.array_equal(ds[name].values, coord.values):
-                    raise ConfigError(f"jobs of this sweep disagree on coordinate {name!r}; they cannot share "
-                                      "one sweep.nc")
-            coords[name] = (coord.dims, coord.values, _common_attrs([ds[name] for _, ds in done]))
-            for attr, variable in _per_job_attrs(done, name, shape, grid_dims, body_units).items():
-                data_vars[f"{name}_{attr}"] = variable
-                _index_coordinate(coords, variable, f"{name}_{attr}")
-        if sample == "sample":
-            data_vars["time"] = _stack(done, "time", shape, grid_dims, sample)
-            data_vars["time"][2].pop("axis", None)   # a variable over the jobs now, not the T coordinate (CF §4)
-        for name in _union([list(ds.data_vars) for _, ds in done]):
-            data_vars[name] = _stack(done, name, shape, grid_dims, sample)
-            for attr, variable in _per_job_attrs(done, name, shape, grid_dims, body_units).items():
-                data_vars[f"{name}_{attr}"] = variable
-                _index_coordinate(coords, variable, f"{name}_{attr}")
+    data_vars = _stacked_variables(done, coords, shape, grid_dims, sample, body_units) if done else {}
+    common = _run_attributes(done, coords, data_vars, shape, grid_dims, body_units)
+    data_vars.update(_job_table(grid, results, grid_dims))
+    ds = xr.Dataset(data_vars, coords=coords)
+    ds.attrs.update({**common, **_sweep_attributes(grid, results, grid_dims, sample)})
+    return conform(ds, source=f"sweep of {len(results)} jobs over {' × '.join(grid_dims) or 'no parameter'}")
 
+
+def _sweep_attributes(grid: Grid, results: Sequence[JobResult], grid_dims: tuple[str, ...],
+                      sample: str) -> dict[str, Any]:
+    """What the sweep was (its title, dimensions, keys) and how its jobs ended."""
+    counts = {status: sum(r.status == status for r in results) for status in STATUS_FLAGS}
+    return {
+        "failed_job_description": "dimension failed_job: one entry per failed job, in job order (the failed_job_* "
+                                  "variables are its table)",
+        **({"sample_description": "dimension sample: each job's output times in order (the jobs' output times "
+                                  "differ: the variable time holds each job's own)"} if sample == "sample" else {}),
+        "title": f"gyrolab sweep over {' × '.join(grid_dims) or 'no parameter'} ({len(results)} jobs)",
+        "sweep_dims": " ".join(grid_dims),
+        "sweep_keys": " ".join(d.key for d in grid.dims),
+        "n_jobs": len(results),
+        "n_finished": counts[FINISHED],
+        "n_failed": counts[FAILED],
+        "n_missing": counts[MISSING],
+    }
+
+
+def _stacked_variables(done: list[tuple[tuple, xr.Dataset]], coords: dict[str, Any], shape: tuple[int, ...],
+                       grid_dims: tuple[str, ...], sample: str, body_units: str) -> dict[str, Any]:
+    """The finished jobs' variables stacked over the grid, with their per-job attributes; the jobs' shared
+    coordinates go into ``coords`` (ConfigError if the jobs disagree on one)."""
+    data_vars: dict[str, Any] = {}
+    first = done[0][1]
+    for name, coord in first.coords.items():
+        if name == "time" and sample == "sample":
+            continue
+        for _, ds in done[1:]:
+            if name not in ds.coords or not np.array_equal(ds[name].values, coord.values):
+                raise ConfigError(f"jobs of this sweep disagree on coordinate {name!r}; they cannot share "
+                                  "one sweep.nc")
+        coords[name] = (coord.dims, coord.values, _common_attrs([ds[name] for _, ds in done]))
+        _add_per_job_attrs(data_vars, coords, done, name, shape, grid_dims, body_units)
+    if sample == "sample":
+        data_vars["time"] = _stack(done, "time", shape, grid_dims, sample)
+        data_vars["time"][2].pop("axis", None)   # a variable over the jobs now, not the T coordinate (CF §4)
+    for name in _union([list(ds.data_vars) for _, ds in done]):
+        data_vars[name] = _stack(done, name, shape, grid_dims, sample)
+        _add_per_job_attrs(data_vars, coords, done, name, shape, grid_dims, body_units)
+    return data_vars
+
+
+def _add_per_job_attrs(data_vars: dict[str, Any], coords: dict[str, Any], done: list, name: str,
+                       shape: tuple[int, ...], grid_dims: tuple[str, ...], body_units: str) -> None:
+    for attr, variable in _per_job_attrs(done, name, shape, grid_dims, body_units).items():
+        data_vars[f"{name}_{attr}"] = variable
+        _index_coordinate(coords, variable, f"{name}_{attr}")
+
+
+def _run_attributes(done: list[tuple[tuple, xr.Dataset]], coords: dict[str, Any], data_vars: dict[str, Any],
+                    shape: tuple[int, ...], grid_dims: tuple[str, ...], body_units: str) -> dict[str, Any]:
+    """The run attributes every finished job shares (returned); the others become per-job variables."""
     taken = set(coords) | set(data_vars) | set(grid_dims) | {"sample", "failed_job", "job_status", "job_dir",
                                                               "job_id", "title", "Conventions"}
     common: dict[str, Any] = {}
@@ -170,38 +208,24 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
                                                                     units or quantity_units(key, body_units))})
         taken.add(name)
         _index_coordinate(coords, data_vars[name], key)
+    return common
 
-    statuses = np.zeros(shape, dtype=np.int8)
-    job_ids = np.full(shape, "", dtype=object)
-    job_dirs = np.full(shape, "", dtype=object)
+
+def _job_table(grid: Grid, results: Sequence[JobResult], grid_dims: tuple[str, ...]) -> dict[str, Any]:
+    """Every job's status, id and directory over the grid, and the failed jobs' table."""
+    statuses = np.zeros(grid.shape, dtype=np.int8)
+    job_ids = np.full(grid.shape, "", dtype=object)
+    job_dirs = np.full(grid.shape, "", dtype=object)
     for n, result in enumerate(results):
         statuses[grid.index[n]] = STATUS_FLAGS[result.status]
         job_ids[grid.index[n]] = result.job_id
         job_dirs[grid.index[n]] = result.job_dir
-    data_vars["job_status"] = (grid_dims, statuses, {
-        "long_name": "how the job ended", "units": "1", "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8),
-        "flag_meanings": " ".join(STATUS_FLAGS)})
-    data_vars["job_id"] = (grid_dims, job_ids, {"long_name": "hash of the job's resolved config and code version"})
-    data_vars["job_dir"] = (grid_dims, job_dirs, {"long_name": "job directory, relative to the sweep directory"})
-    data_vars.update(_failure_table(grid, results))
-
-    ds = xr.Dataset(data_vars, coords=coords)
-    counts = {status: sum(r.status == status for r in results) for status in STATUS_FLAGS}
-    ds.attrs.update(common)
-    ds.attrs.update({
-        "failed_job_description": "dimension failed_job: one entry per failed job, in job order (the failed_job_* "
-                                  "variables are its table)",
-        **({"sample_description": "dimension sample: each job's output times in order (the jobs' output times "
-                                  "differ: the variable time holds each job's own)"} if sample == "sample" else {}),
-        "title": f"gyrolab sweep over {' × '.join(grid_dims) or 'no parameter'} ({len(results)} jobs)",
-        "sweep_dims": " ".join(grid_dims),
-        "sweep_keys": " ".join(d.key for d in grid.dims),
-        "n_jobs": len(results),
-        "n_finished": counts[FINISHED],
-        "n_failed": counts[FAILED],
-        "n_missing": counts[MISSING],
-    })
-    return conform(ds, source=f"sweep of {len(results)} jobs over {' × '.join(grid_dims) or 'no parameter'}")
+    return {"job_status": (grid_dims, statuses, {
+                "long_name": "how the job ended", "units": "1",
+                "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8), "flag_meanings": " ".join(STATUS_FLAGS)}),
+            "job_id": (grid_dims, job_ids, {"long_name": "hash of the job's resolved config and code version"}),
+            "job_dir": (grid_dims, job_dirs, {"long_name": "job directory, relative to the sweep directory"}),
+            **_failure_table(grid, results)}
 
 
 def _dim_names(grid: Grid, datasets: Sequence[xr.Dataset]) -> list[str]:
@@ -448,8 +472,6 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
         if output is None:
             summary.figures = save_sweep_figures(ds, sweep_dir / "figures")
         else:  # the sweep's own config, in memory: no second reading of multirun.yaml (~0.1 s of YAML)
-            from gyrolab.figures.options import figure_options
-
             summary.figures = save_sweep_figures(ds, sweep_dir / "figures", *figure_options(output))
     return summary
 

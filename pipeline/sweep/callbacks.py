@@ -9,11 +9,13 @@ summary figures. The jobs themselves record their outcome (``job.json``) in
 
 from __future__ import annotations
 
+import functools
 import logging
 import sys
 from pathlib import Path
 from typing import Any
 
+from hydra.core import utils as hydra_utils
 from hydra.experimental.callback import Callback
 from omegaconf import DictConfig
 
@@ -24,6 +26,7 @@ from gyrolab.output.trust import check_output_target, own_dir
 from gyrolab.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.orphans import announce_launcher, forget_launcher
+from gyrolab.sweep.sweeper import register_plugin
 from gyrolab.sweep.watch import SweepWatcher
 
 log = logging.getLogger("gyrolab.sweep")
@@ -75,8 +78,6 @@ class SweepCallback(Callback):
             unlock(locked)
 
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
-        from gyrolab.sweep.sweeper import register_plugin
-
         register_plugin()  # Hydra instantiates the sweeper next (already done by the preflight; kept idempotent)
         reset()
         self._announced = announce_launcher()  # worker processes of this sweep die with this process
@@ -129,10 +130,6 @@ def _tolerate_hydra_record_failures() -> None:
     and ``run.nc``, so the copy is dropped (no partial file is left) and the job goes on: a job
     that then cannot write its results fails alone, in one sentence, like any other write failure.
     """
-    import functools
-
-    from hydra.core import utils as hydra_utils
-
     save = hydra_utils._save_config
     if getattr(save, "_gyrolab_tolerant", False):
         return

@@ -66,29 +66,8 @@ class Grid:
             parsed = parser.parse_overrides(list(overrides))
         except OverrideParseException as error:
             raise ConfigError(f"malformed sweep override: {str(error).strip().splitlines()[0]}") from None
-        n, named = sweep_points(parsed)
-        allow_large = any(o.key_or_group == "allow_large" and not o.is_sweep_override() and o.value() is True
-                          for o in parsed)
-        if max_jobs is not None and n > max_jobs:
-            raise ConfigError(f"{shorten(named)} makes {n:.3g} jobs, beyond the {max_jobs:.0e} jobs of a multirun "
-                              "(one directory each); the sweep directory was edited, or run it with gyrolab batch")
-        check_points(n, named, allow_large=allow_large)
-        choices: dict[str, list[str]] = {}      # key -> job overrides, in first-seen order (as Hydra does)
-        typed: dict[str, list[Any]] = {}
-        for o in parsed:
-            key = o.get_key_element()
-            if o.is_sweep_override():
-                if not o.is_discrete_sweep():
-                    raise ConfigError(f"{o.input_line!r} is not a list of values; the basic sweeper runs "
-                                      "discrete sweeps only (a,b,c or range(...) or choice(...))")
-                labels = list(o.sweep_string_iterator())
-                choices[key] = [f"{key}={label}" for label in labels]
-                typed[key] = list(o.sweep_iterator())
-                if not repeats:
-                    _refuse_repeats(key, labels, typed[key])
-            else:
-                choices[key] = [f"{key}={o.get_value_element_as_str()}"]
-                typed.pop(key, None)
+        _check_budget(parsed, max_jobs)
+        choices, typed = _choices(parsed, repeats)
         dims = tuple(Dim(key, tuple(c.split("=", 1)[1] for c in choices[key]), tuple(typed[key]))
                      for key in choices if key in typed)
         lists = list(choices.values())
@@ -97,6 +76,7 @@ class Grid:
         index = tuple(tuple(position[i] for i in swept)
                       for position in itertools.product(*(range(len(values)) for values in lists)))
         return cls(dims=dims, jobs=jobs, index=index)
+
 
     @classmethod
     def from_hydra(cls, hydra_cfg: Mapping[str, Any]) -> Grid:
@@ -111,6 +91,38 @@ class Grid:
                               "writes; multirun.yaml was edited") from None
         return cls.from_overrides(overrides, max_jobs=MAX_JOBS)
 
+
+def _choices(parsed: Sequence[Any], repeats: bool) -> tuple[dict[str, list[str]], dict[str, list[Any]]]:
+    """(key -> its job overrides in first-seen order, as Hydra does; swept key -> its typed values); ConfigError
+    for a sweep that is not discrete or, unless ``repeats``, gives a value twice."""
+    choices: dict[str, list[str]] = {}
+    typed: dict[str, list[Any]] = {}
+    for o in parsed:
+        key = o.get_key_element()
+        if not o.is_sweep_override():
+            choices[key] = [f"{key}={o.get_value_element_as_str()}"]
+            typed.pop(key, None)
+            continue
+        if not o.is_discrete_sweep():
+            raise ConfigError(f"{o.input_line!r} is not a list of values; the basic sweeper runs "
+                              "discrete sweeps only (a,b,c or range(...) or choice(...))")
+        labels = list(o.sweep_string_iterator())
+        choices[key] = [f"{key}={label}" for label in labels]
+        typed[key] = list(o.sweep_iterator())
+        if not repeats:
+            _refuse_repeats(key, labels, typed[key])
+    return choices, typed
+
+
+def _check_budget(parsed: Sequence[Any], max_jobs: float | None) -> None:
+    """ConfigError for more than ``max_jobs`` jobs, or more points than the budget allows, counted unexpanded."""
+    n, named = sweep_points(parsed)
+    allow_large = any(o.key_or_group == "allow_large" and not o.is_sweep_override() and o.value() is True
+                      for o in parsed)
+    if max_jobs is not None and n > max_jobs:
+        raise ConfigError(f"{shorten(named)} makes {n:.3g} jobs, beyond the {max_jobs:.0e} jobs of a multirun "
+                          "(one directory each); the sweep directory was edited, or run it with gyrolab batch")
+    check_points(n, named, allow_large=allow_large)
 
 def _refuse_repeats(key: str, labels: list[str], values: list[Any]) -> None:
     seen: dict[str, str] = {}

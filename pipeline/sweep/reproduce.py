@@ -158,26 +158,30 @@ def _difference(old: xr.DataArray, new: xr.DataArray) -> str:
     if old.dims != new.dims or a.shape != b.shape:
         return f"shape {dict(zip(old.dims, a.shape))} in the dataset, {dict(zip(new.dims, b.shape))} in the rerun"
     if a.dtype.kind in "fc" and b.dtype.kind in "fc":
-        a, b = a.astype(np.float64), b.astype(np.float64)
-        if a.tobytes() == b.tobytes():  # the bits in C order, whatever either array's memory layout
-            return ""
-        nan_a, nan_b = np.isnan(a), np.isnan(b)
-        if (nan_a != nan_b).any():
-            return f"NaN at {int((nan_a != nan_b).sum())} places where the other has a number"
-        delta = np.abs(a - b)
-        delta[nan_a] = 0.0
-        scale = float(np.max(np.abs(a))) or 1.0
-        worst = np.unravel_index(int(np.argmax(delta)), delta.shape)
-        where = ", ".join(f"{d}={old[d].values[i]}" if d in old.coords else f"{d}[{i}]"
-                          for d, i in zip(old.dims, worst))
-        return (f"max |Δ| = {float(delta[worst]):.3g} (relative to max |value| {float(delta[worst]) / scale:.3g}) "
-                f"at {where or 'the only value'}; {int((delta > 0).sum())} of {delta.size} values differ")
+        return _float_difference(old, a.astype(np.float64), b.astype(np.float64))
     if a.dtype == b.dtype and np.array_equal(a, b):
         return ""
     if a.dtype.kind in "iub" and b.dtype.kind in "iub":
         return f"max |Δ| = {int(np.max(np.abs(a.astype(np.int64) - b.astype(np.int64))))}"
     equal = np.asarray(a.astype(str) == b.astype(str))
     return "" if equal.all() else f"{int((~equal).sum())} of {equal.size} values differ"
+
+
+def _float_difference(old: xr.DataArray, a: np.ndarray, b: np.ndarray) -> str:
+    """'' if the floats ``a`` and ``b`` are bit-for-bit equal, else where NaNs differ or the largest difference."""
+    if a.tobytes() == b.tobytes():  # the bits in C order, whatever either array's memory layout
+        return ""
+    nan_a, nan_b = np.isnan(a), np.isnan(b)
+    if (nan_a != nan_b).any():
+        return f"NaN at {int((nan_a != nan_b).sum())} places where the other has a number"
+    delta = np.abs(a - b)
+    delta[nan_a] = 0.0
+    scale = float(np.max(np.abs(a))) or 1.0
+    worst = np.unravel_index(int(np.argmax(delta)), delta.shape)
+    where = ", ".join(f"{d}={old[d].values[i]}" if d in old.coords else f"{d}[{i}]"
+                      for d, i in zip(old.dims, worst))
+    return (f"max |Δ| = {float(delta[worst]):.3g} (relative to max |value| {float(delta[worst]) / scale:.3g}) "
+            f"at {where or 'the only value'}; {int((delta > 0).sum())} of {delta.size} values differ")
 
 
 def checked_config(path: Path, stored: xr.Dataset) -> DictConfig:

@@ -34,12 +34,13 @@ from typing import Any
 
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.core.override_parser.types import Override, OverrideType
+from hydra.core.plugins import Plugins
 from hydra.plugins.launcher import Launcher
 from hydra.plugins.sweeper import Sweeper
 from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.compat import ConfigLoaderImpl
+from gyrolab.compat import BasicSweeper, ConfigLoaderImpl
 from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.lock import try_lock, unlock
@@ -77,16 +78,12 @@ class ResumingSweeper(Sweeper):
         self.launcher: Launcher | None = None
 
     def setup(self, *, hydra_context: HydraContext, task_function: TaskFunction, config: DictConfig) -> None:
-        from hydra.core.plugins import Plugins
-
         self.hydra_context, self.config = hydra_context, config
         self.launcher = Plugins.instance().instantiate_launcher(hydra_context=hydra_context,
                                                                 task_function=task_function, config=config)
 
     def sweep(self, arguments: list[str]) -> Any:
         assert self.config is not None and self.launcher is not None and self.hydra_context is not None
-        from gyrolab.compat import BasicSweeper
-
         parser = OverridesParser.create(config_loader=self.hydra_context.config_loader)
         params = [f"{key}={value}" for key, value in self.params.items()]  # as the basic sweeper: params first
         overrides = parser.parse_overrides([*params, *arguments])
@@ -107,6 +104,14 @@ class ResumingSweeper(Sweeper):
         # As the basic sweeper, refuse a sweep with a job Hydra cannot compose before launching any job: every
         # job's overrides were applied above; the jobs where that failed are composed in full (Hydra's error).
         self.validate_batch_is_legal([jobs[num] for num in unsure if num not in settled])
+        returns, launched = self._launch(jobs, remaining)
+        for num, (job_dir, record) in settled.items():  # as a job that skips itself records it
+            if num not in launched:
+                mark_skipped(job_dir, record, num, jobs[num])
+        return returns
+
+    def _launch(self, jobs: list, remaining: list[int]) -> tuple[list, set[int]]:
+        """Launch the ``remaining`` jobs in batches: (the launcher's results, the job numbers launched)."""
         # A sequential launcher gains nothing from launching settled jobs between remaining ones.
         gap = 0 if type(self.launcher).__name__ == "BasicLauncher" else MERGE_GAP
         returns, launched = [], set()
@@ -116,10 +121,7 @@ class ResumingSweeper(Sweeper):
             for r in results:
                 _ = r.return_value  # re-raises a job's exception, as the basic sweeper does
             returns.append(results)
-        for num, (job_dir, record) in settled.items():  # as a job that skips itself records it
-            if num not in launched:
-                mark_skipped(job_dir, record, num, jobs[num])
-        return returns
+        return returns, launched
 
 
 def claim(sweep_dir: Path, config: DictConfig) -> None:
@@ -241,22 +243,32 @@ class IdentityPredictor:
 
     def identity(self, overrides: Sequence[str]) -> str | None:
         parsed = [self._parse(text) for text in overrides]
-        choices = tuple(o.input_line for o in parsed if self._is_group(o))
         # Hydra's own settings are the same for every job of a sweep and are not part of an identity
         values = [o for o in parsed if not self._is_group(o) and not o.key_or_group.startswith("hydra.")]
+        base = self._base(tuple(o.input_line for o in parsed if self._is_group(o)), overrides, values)
+        if base is None or not all(o.key_or_group in base.applied for o in values):
+            return None
+        changed = [o for o in values if base.applied[o.key_or_group].input_line != o.input_line]
+        if any(o.is_delete() for o in changed):
+            return None
+        plain = self._resolved_with(base, changed)
+        return None if plain is None else job_identity(plain, self.code)
+
+    def _base(self, choices: tuple[str, ...], overrides: Sequence[str], values: list) -> _Base | None:
+        """The composed config of the jobs choosing ``choices`` (composed once), or None where a resolver could
+        give each job its own value."""
         if choices not in self._bases:
             composed = self.loader.load_sweep_config(self.master, list(overrides))
             scene = OmegaConf.masked_copy(composed, [k for k in composed if k != "hydra"])
             unresolved = OmegaConf.to_container(scene, resolve=False)
             self._bases[choices] = None if _RESOLVER.search(repr(unresolved)) else _Base(
                 scene, {o.key_or_group: o for o in values}, None if "${" in repr(unresolved) else unresolved)
-        base = self._bases[choices]
-        if base is None:
-            return None
-        changed = [o for o in values if base.applied[o.key_or_group].input_line != o.input_line] \
-            if all(o.key_or_group in base.applied for o in values) else None
-        if changed is None or any(o.is_delete() for o in changed):
-            return None
+        return self._bases[choices]
+
+    @staticmethod
+    def _resolved_with(base: _Base, changed: list) -> dict | None:
+        """The base config with the ``changed`` overrides applied, resolved (None: it does not resolve); the base
+        is left as it was."""
         try:
             try:
                 for o in changed:
@@ -265,14 +277,12 @@ class IdentityPredictor:
                 raise OverridesDoNotApply(str(error)) from error
             try:
                 plain = _patched(base, changed)
-                if plain is None:
-                    plain = OmegaConf.to_container(base.scene, resolve=True)
+                return plain if plain is not None else OmegaConf.to_container(base.scene, resolve=True)
             except Exception:  # noqa: BLE001 - e.g. an interpolation that does not resolve: the job records it
                 return None
         finally:
             for o in changed:  # back to the composed job's values
                 ConfigLoaderImpl._apply_overrides_to_config([_as_change(base.applied[o.key_or_group])], base.scene)
-        return job_identity(plain, self.code)
 
     def _parse(self, text: str) -> Override:
         if text not in self._parsed:
@@ -315,10 +325,8 @@ def register_plugin() -> None:
     (``pip install -e .``, the README's): setuptools' editable finder serves the package on import but cannot
     list it, so Hydra's scan does not see it, and the class is registered here by its real name.
     """
-    from hydra.core.plugins import Plugins
-
     plugins = Plugins.instance()  # scans first: a scan re-executes the plugin modules it finds
-    from hydra_plugins.gyrolab_sweeper import GyrolabSweeper
+    from hydra_plugins.gyrolab_sweeper import GyrolabSweeper  # after the scan above, which re-executes it
 
     if f"{GyrolabSweeper.__module__}.{GyrolabSweeper.__name__}" not in plugins.class_name_to_class:
         plugins.register(GyrolabSweeper)

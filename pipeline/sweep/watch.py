@@ -37,7 +37,7 @@ class SweepWatcher:
         self._before = self._snapshot()
         self._began = time.monotonic()
         if on_terminal(sys.stderr):
-            from tqdm import tqdm
+            from tqdm import tqdm  # start-up: tqdm only for a bar on a terminal
 
             self._streams = (sys.stdout, sys.stderr)
             self._bar = tqdm(total=self.total, desc="sweep", unit="job", file=sys.stderr, dynamic_ncols=True)

@@ -65,19 +65,7 @@ def _nondimensional_scene(system: System, regime: str) -> NondimensionalScene:
         raise ConfigError(f"regime {regime} is derived for force=[uniform_gravity] or [uniform_gravity,newtonian] "
                           f"(a vertical magnetic field may add to or replace gravity), got force={names}")
     body = system.body
-    nd = body.nondimensional()
-    # The torque U × γ: the weight's moment plus m·B of a vertical uniform field (the same form, Ismail (2021) eq. 1)
-    U = np.array(body.weight_moment, dtype=float) if "uniform_gravity" in names else np.zeros(3)
-    for force in system.forces:
-        if force.name == "magnetic":
-            if np.any(force.direction[:2] != 0):
-                raise ConfigError(f"regime {regime} needs a vertical magnetic field, force.magnetic.direction="
-                                  f"[0,0,±1], got {force.direction.tolist()}")
-            U = U + force.field * force.direction[2] * force.moment
-    if np.linalg.norm(U - np.asarray(body.weight_moment)) > 0:
-        moment = float(np.linalg.norm(U))
-        nd = {**nd, "c2": moment / float(body.inertia[2]),
-              "com_direction": (U / moment).tolist() if moment > 0 else [0.0, 0.0, 0.0]}
+    nd = _with_magnetic_moment(system, regime, body.nondimensional(), names)
     c2 = nd.get("c2", 1.0)
     if c2 <= 0:
         raise ConfigError(f"regime {regime} needs a heavy body (c² = |U|/C > 0 with U = Mg r_c [+ m·B]), got c²={c2:g}")
@@ -95,6 +83,24 @@ def _nondimensional_scene(system: System, regime: str) -> NondimensionalScene:
     x0, y0, z0 = nd["com_direction"]
     return NondimensionalScene(a=nd["a"], b=nd["b"], x0=x0, y0=y0, z0=z0, k=k, c=c, r0=float(omega0[2]) / c,
                                theta0=theta0, psi0=psi0, nonphysical=bool(body.nonphysical))
+
+
+def _with_magnetic_moment(system: System, regime: str, nd: dict, names: list[str]) -> dict:
+    """The body's nondimensional data with c² and the centre-of-mass direction of the torque U × γ: the weight's
+    moment plus m·B of a vertical uniform field (the same form, Ismail (2021) eq. 1)."""
+    body = system.body
+    U = np.array(body.weight_moment, dtype=float) if "uniform_gravity" in names else np.zeros(3)
+    for force in system.forces:
+        if force.name == "magnetic":
+            if np.any(force.direction[:2] != 0):
+                raise ConfigError(f"regime {regime} needs a vertical magnetic field, force.magnetic.direction="
+                                  f"[0,0,±1], got {force.direction.tolist()}")
+            U = U + force.field * force.direction[2] * force.moment
+    if np.linalg.norm(U - np.asarray(body.weight_moment)) > 0:
+        moment = float(np.linalg.norm(U))
+        nd = {**nd, "c2": moment / float(body.inertia[2]),
+              "com_direction": (U / moment).tolist() if moment > 0 else [0.0, 0.0, 0.0]}
+    return nd
 
 
 class FixedPointRegime(Regime):

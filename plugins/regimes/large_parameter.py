@@ -29,9 +29,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.analysis.continuation import Section, _evaluate, shoot_section
 from gyrolab.analysis.periodic import FixedPointModel
+from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.physics import pendulum
 from gyrolab.physics.attitude import angles_from_states
 from gyrolab.plugins.regimes import ismail2021 as paper
 from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
@@ -206,8 +207,6 @@ class LargeParameter(FixedPointRegime):
         if not MIN_TILT <= s.theta0 <= MAX_TILT:
             raise ConfigError(f"regime large_parameter needs a swing amplitude {MIN_TILT:g} ≤ θ0 ≤ {MAX_TILT:g}, got "
                               f"θ0={s.theta0:.4g}")
-        from gyrolab.physics import pendulum
-
         kap = pendulum.kappa(s.a, s.k)
         if not 1 + kap * np.cos(s.theta0) > 0 or not 1 + kap > 0:
             raise ConfigError(f"regime large_parameter needs a swing about the lowest position, 1 + κ cos θ > 0 with "

@@ -183,37 +183,12 @@ class SmallParameter(FixedPointRegime):
         if not 0 < eps < 1:
             raise ConfigError(f"regime small_parameter needs fast spin, 0 < c/r0 < 1, but initial.r0 gives "
                               f"c/r0={eps:.4g}; choose r0 > c (r0 ≥ 5c for errors below ~1e-3)")
-        w2 = s.omega2
-        w = np.sqrt(w2) if w2 > 0 else 0.0
-        for n in RESONANCES:
-            if w2 > 0 and abs(n * n - w2) < divisor_threshold(n, eps):
-                raise ConfigError(f"regime small_parameter excludes the resonance ω = {n:g}: the body has "
-                                  f"ω = {w:.5g} (ω² = (C−A)(C−B)/(AB)), |{n:g}² − ω²| = {abs(n * n - w2):.3g} < "
-                                  f"{divisor_threshold(n, eps):.3g} at c/r0 = {eps:.3g}; choose a, b with |ω − {n:g}| ≥ "
-                                  f"{refusal_distance(n, eps):.3g} or spin faster"
-                                  + (" (or regime=resonant_omega3)" if n == 3 else ""))
-        warnings = []
-        for n in RESONANCES:
-            if w2 > 0 and abs(w - n) < WARN_DISTANCE:
-                warnings.append(f"ω = {w:.4g} is within {WARN_DISTANCE:g} of the excluded resonance ω = {n:g}: "
-                                f"terms ∝ 1/({n:g}² − ω²) = {1 / (n * n - w2):.3g} amplify the error")
-        if w2 <= 0:
-            warnings.append(f"ω² = {w2:.4g} ≤ 0 (A, B on both sides of C): the generating p-mode is not an "
-                            "oscillation; the expansion is untested there")
+        warnings = _resonance_warnings(s.omega2, eps)
         if eps > 0.2 and self.series_order is None:  # the order-N series warns at half its radius instead
             warnings.append(f"c/r0 = {eps:.3g} > 0.2: near the edge of the fast-spin domain, expect errors of "
                             f"order (c/r0)² ≈ {eps**2:.2g}")
         if self.series_order is not None:
-            self.check_series_domain(s)
-            R = self.series(system).radius_of_convergence()
-            if not eps < R:
-                raise ConfigError(f"regime small_parameter with order={self.series_order} needs c/r0 below the "
-                                  f"series' radius of convergence {R:.3g} (estimated from its coefficients), but "
-                                  f"c/r0={eps:.4g}; choose r0/c > {1 / R:.3g}")
-            if eps > 0.5 * R:
-                warnings.append(f"c/r0 = {eps:.3g} is beyond half the series' radius of convergence {R:.3g}: "
-                                f"the error falls only like ({eps / R:.2f})^(N+1) with the order N")
-            return warnings + self.reseat_warnings(system)
+            return warnings + self._series_warnings(system, s, eps) + self.reseat_warnings(system)
         gamma = s.gamma0pp / eps
         if abs(gamma) > 3:
             warnings.append(f"Γ = cos θ0 · r0/c = {gamma:.3g}: the closed forms assume cos θ0 = O(c/r0) "
@@ -222,6 +197,19 @@ class SmallParameter(FixedPointRegime):
         if abs(s.a + s.b - 1) < 0.05:
             warnings.append(f"a + b − 1 = {s.a + s.b - 1:.3g}: the z0'/(a + b − 1) terms of (35) are large")
         return warnings + self.reseat_warnings(system)
+
+    def _series_warnings(self, system, s, eps: float) -> list[str]:
+        """The order-N series' domain: ConfigError beyond its radius of convergence, a warning beyond half of it."""
+        self.check_series_domain(s)
+        R = self.series(system).radius_of_convergence()
+        if not eps < R:
+            raise ConfigError(f"regime small_parameter with order={self.series_order} needs c/r0 below the "
+                              f"series' radius of convergence {R:.3g} (estimated from its coefficients), but "
+                              f"c/r0={eps:.4g}; choose r0/c > {1 / R:.3g}")
+        if eps > 0.5 * R:
+            return [f"c/r0 = {eps:.3g} is beyond half the series' radius of convergence {R:.3g}: "
+                    f"the error falls only like ({eps / R:.2f})^(N+1) with the order N"]
+        return []
 
     def reduced_rhs(self, system):
         """The reduced quasilinear system (000 eq. 14 through the μ⁻³ terms, corrected F3, Φ3) for this scene.
@@ -347,3 +335,24 @@ def series_diagnostics(regime: SmallParameter, system) -> tuple[dict[str, Any], 
         "series_consistency_max": float(np.max(sol.consistency)),
     }
     return data, coords, attrs
+
+
+def _resonance_warnings(w2: float, eps: float) -> list[str]:
+    """ConfigError at a resonance ω = n the series excludes; warnings near one, and for ω² ≤ 0."""
+    w = np.sqrt(w2) if w2 > 0 else 0.0
+    for n in RESONANCES:
+        if w2 > 0 and abs(n * n - w2) < divisor_threshold(n, eps):
+            raise ConfigError(f"regime small_parameter excludes the resonance ω = {n:g}: the body has "
+                              f"ω = {w:.5g} (ω² = (C−A)(C−B)/(AB)), |{n:g}² − ω²| = {abs(n * n - w2):.3g} < "
+                              f"{divisor_threshold(n, eps):.3g} at c/r0 = {eps:.3g}; choose a, b with |ω − {n:g}| ≥ "
+                              f"{refusal_distance(n, eps):.3g} or spin faster"
+                              + (" (or regime=resonant_omega3)" if n == 3 else ""))
+    warnings = []
+    for n in RESONANCES:
+        if w2 > 0 and abs(w - n) < WARN_DISTANCE:
+            warnings.append(f"ω = {w:.4g} is within {WARN_DISTANCE:g} of the excluded resonance ω = {n:g}: "
+                            f"terms ∝ 1/({n:g}² − ω²) = {1 / (n * n - w2):.3g} amplify the error")
+    if w2 <= 0:
+        warnings.append(f"ω² = {w2:.4g} ≤ 0 (A, B on both sides of C): the generating p-mode is not an "
+                        "oscillation; the expansion is untested there")
+    return warnings

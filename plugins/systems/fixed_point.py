@@ -19,11 +19,13 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.physics.attitude import euler_angles, frame_from_angles, nutation_and_spin
-from gyrolab.physics.body import Body
 from gyrolab.contracts.force import Force
 from gyrolab.contracts.integrator import CompiledModel
 from gyrolab.contracts.system import System
+from gyrolab.kernels import model
+from gyrolab.kernels.expression import check_torques
+from gyrolab.physics.attitude import euler_angles, frame_from_angles, nutation_and_spin
+from gyrolab.physics.body import Body
 from gyrolab.physics.initial import InitialAttitude
 from gyrolab.physics.vectors import cross, dot, norm
 
@@ -184,7 +186,7 @@ class FixedPoint(System):
     def compiled_model(self) -> CompiledModel | None:
         """The hand-written kernels' model for the state (ω, γ) with built-in torque forms; otherwise the equations
         traced (``System``), carrying the built-in forms' parameters when every torque has one (``built_in``)."""
-        from gyrolab.kernels import fixed_point
+        from gyrolab.kernels import fixed_point  # start-up: the compiled kernels import numba
 
         packed = fixed_point.built_in(self.inertia, self.forces, self.carries_alpha)
         if packed is not None and not self.carries_alpha:
@@ -222,9 +224,6 @@ def euler_poisson(t: Any, y: np.ndarray, inertia: np.ndarray, forces: Sequence[F
 def traced_model(inertia: np.ndarray, forces: Sequence[Force], carries_alpha: bool) -> CompiledModel:
     """The fixed-point equations with ``forces`` compiled from their trace, whatever forms the forces have (the
     system itself takes the hand-written kernels when every force has a built-in form). Raises NotCompilable."""
-    from gyrolab.kernels import model
-    from gyrolab.kernels.expression import check_torques
-
     check_torques(forces)
     needs_beta = any(1 in f.required_axes for f in forces)
     names = " + ".join(f.name for f in forces) or "no torque"

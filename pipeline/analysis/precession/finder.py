@@ -12,14 +12,15 @@ it (the null space of the residual's Jacobian): 0 = isolated, d > 0 = a d-parame
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import brentq, least_squares, minimize_scalar
 from scipy.stats import qmc
 
-from gyrolab.errors import ConfigError
 from gyrolab.analysis.precession.motion import Precession, build_system, states, vector_residual
+from gyrolab.errors import ConfigError
 from gyrolab.physics.gyrostat_euler import GyrostatParameters
 
 MOTION = ("n", "m", "theta0", "psi0")
@@ -109,8 +110,6 @@ def find_normal_rests(params: GyrostatParameters, theta0: float, *, grid: int = 
     A γ-component that vanishes for every χ (A = B with h1 μ·β ≡ 0) is a one-parameter family: one
     representative χ = 0 with ``family_dimension`` 1. Each solution is re-checked by the vector residual.
     """
-    from scipy.optimize import brentq, minimize_scalar
-
     sigma = 1.0 if np.cos(theta0) > 0 else -1.0
     theta0 = 0.0 if sigma > 0 else np.pi
     chis = np.linspace(0.0, 2 * np.pi, grid + 1)
@@ -119,21 +118,8 @@ def find_normal_rests(params: GyrostatParameters, theta0: float, *, grid: int = 
     if np.max(np.abs(g)) < accept * scale:
         roots, dimension = [0.0], 1
     else:
-        dimension, roots = 0, []
-        gamma_torque = lambda x: sigma * _rest_torque(params, theta0, x)[2]  # noqa: E731
-        for i in range(grid):
-            a, b = chis[i], chis[i + 1]
-            if g[i] == 0.0:
-                roots.append(a)
-            elif g[i] * g[i + 1] < 0:
-                roots.append(brentq(gamma_torque, a, b, xtol=1e-15, rtol=1e-15))
-            elif 0 < i and abs(g[i]) < abs(g[i - 1]) and abs(g[i]) < abs(g[i + 1]):
-                polish = minimize_scalar(lambda x: abs(gamma_torque(x)), bounds=(chis[i - 1], b), method="bounded",
-                                         options={"xatol": 1e-14})
-                if abs(polish.fun) < accept * scale:
-                    roots.append(float(polish.x))
-        roots = [r % (2 * np.pi) for r in roots]
-        roots = [r for j, r in enumerate(roots) if all(abs(np.angle(np.exp(1j * (r - q)))) > 1e-9 for q in roots[:j])]
+        roots, dimension = _torque_zeros(lambda x: sigma * _rest_torque(params, theta0, x)[2], chis, g,
+                                         accept * scale), 0
     found = []
     for chi in roots:
         base = _rest_torque(params.replace(k1=0.0, k2=0.0), theta0, chi)
@@ -148,3 +134,24 @@ def find_normal_rests(params: GyrostatParameters, theta0: float, *, grid: int = 
             found.append(Solution(motion, p, {"n": 0.0, "m": 0.0, "psi0": float(chi), "theta0": theta0,
                                               "k1": float(k12[0]), "k2": float(k12[1])}, residual, dimension))
     return found
+
+
+def _torque_zeros(gamma_torque: Callable[[float], float], chis: np.ndarray, g: np.ndarray,
+                  tolerance: float) -> list[float]:
+    """The distinct zeros in [0, 2π) of ``gamma_torque``, sampled as ``g`` on the grid ``chis``: sign changes
+    (Brent), and grazing minima polished to within ``tolerance``."""
+    roots = []
+    for i in range(len(chis) - 1):
+        a, b = chis[i], chis[i + 1]
+        if g[i] == 0.0:
+            roots.append(a)
+        elif g[i] * g[i + 1] < 0:
+            roots.append(brentq(gamma_torque, a, b, xtol=1e-15, rtol=1e-15))
+        elif 0 < i and abs(g[i]) < abs(g[i - 1]) and abs(g[i]) < abs(g[i + 1]):
+            polish = minimize_scalar(lambda x: abs(gamma_torque(x)), bounds=(chis[i - 1], b), method="bounded",
+                                     options={"xatol": 1e-14})
+            if abs(polish.fun) < tolerance:
+                roots.append(float(polish.x))
+    roots = [r % (2 * np.pi) for r in roots]
+    roots = [r for j, r in enumerate(roots) if all(abs(np.angle(np.exp(1j * (r - q)))) > 1e-9 for q in roots[:j])]
+    return roots

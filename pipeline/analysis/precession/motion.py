@@ -16,7 +16,7 @@ import numpy as np
 
 from gyrolab.physics.attitude import frame_from_angles, nutation_and_spin
 from gyrolab.contracts.integrator import Integrator
-from gyrolab.errors import ConfigError, as_number
+from gyrolab.errors import as_number
 from gyrolab.plugins.forces.magnetic import Magnetic
 from gyrolab.plugins.forces.newtonian import Newtonian
 from gyrolab.physics.gyrostat_body import GyrostatBody
@@ -116,8 +116,3 @@ def theta_deviation(system: OrbitingGyrostat, motion: Precession, integrator: In
     first = t <= 2 * np.pi / system.Omega * (1 + 1e-12)
     return {"max_theta_deviation": float(deviation.max()), "max_theta_deviation_orbit1": float(deviation[first].max()),
             "jacobi_drift": float(np.max(np.abs(jacobi - jacobi[0])))}
-
-
-def require_orbit(params: GyrostatParameters) -> None:
-    if not params.Omega > 0:
-        raise ConfigError(f"orbit rate Ω={params.Omega:g} must be positive")
