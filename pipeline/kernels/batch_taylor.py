@@ -1,28 +1,27 @@
 """The Taylor method (``taylor``) for many trajectories at once: per-trajectory steps, vectorised across them.
 
-``run_lanes`` advances LANES trajectories of any compiled model in lock step, one vector register of doubles (8
-on AVX-512, 4 on AVX2). The Taylor coefficients are stored [order, component, lane], lane innermost, and every part of a step runs over all
-lanes at once in vector registers: the series, the step sizes, the outputs and the state update. Each lane keeps
-its own time, step, Kahan carry and output index, with the single-trajectory kernel's step rule and dense output
-(``taylor.run``: same order, same Jorba–Zou step from the last two coefficients, Horner evaluation at the output
-times, compensated update), so a lane takes the steps the single kernel takes on its trajectory, to rounding (the
-vector sums add in another order than the scalar ones; the step rule's powers go through a vector log2/exp2 a few
-ulps from libm's). A lane reads and writes only its own column, and its arithmetic follows from its own
-parameters and state, so its result does not depend on its neighbours. Taylor rejects no step: every busy lane
-advances at every step. A lane whose trajectory has reached the last output time (or failed) takes the next
-trajectory of its task (``task_size`` trajectories; tasks run in parallel with ``prange``).
+``run_lanes`` advances LANES trajectories of any compiled model in lock step, one vector register of doubles (8 on
+AVX-512, 4 on AVX2). The Taylor coefficients are stored [order, component, lane], lane innermost, and every part of
+a step runs over all lanes at once in vector registers: the series, the step sizes, the outputs and the state
+update. Each lane keeps its own time, step, Kahan carry and output index, with the single-trajectory kernel's step
+rule and dense output (``taylor.run``: same order, same Jorba–Zou step from the last two coefficients, Horner
+evaluation at the output times, compensated update), so a lane takes the steps the single kernel takes on its
+trajectory, to rounding (the vector sums add in another order than the scalar ones; the step rule's powers go
+through a vector log2/exp2 a few ulps from libm's). A lane reads and writes only its own column, and its arithmetic
+follows from its own parameters and state, so its result does not depend on its neighbours. Taylor rejects no step:
+every busy lane advances at every step. A lane whose trajectory has reached the last output time (or failed) takes
+the next trajectory of its task (``task_size`` trajectories; tasks run in parallel with ``prange``).
 
-The series is generated from the model's equations, as the single-trajectory kernel's is (``taylor_series``
-lowers them to Cauchy products of linear combinations of series and functions of series; ``_emit_series``
-writes that program's recurrences as LLVM IR over ``<LANES x double>``, ``_Functions`` those of the functions
-and divisions): one generated ``cfunc`` per form (cached on disk), with the
-numbers of the equations per lane in Q (``constants``, run when a lane takes a trajectory). The hand-written
-fixed point ``models.FIXED_POINT`` is the same model traced over its packed parameters (``fixed_point.
-packed_model``), so a batch's ``pack`` rows are read as they are. Every product's Cauchy sum runs over pairs
-(j, k − j): the operands' rows at j and k − j, loaded once, serve two fused multiply-adds of every product that
-reads them, the pair with the newest coefficient last (the next order's older terms overlap its computation).
-The work arrays start on 64-byte boundaries (``_rows``): numba aligns to 32, and a 512-bit load across two cache
-lines costs two.
+The series is generated from the model's equations, as the single-trajectory kernel's is (``taylor_series`` lowers
+them to Cauchy products of linear combinations of series and functions of series; ``_emit_series`` writes that
+program's recurrences as LLVM IR over ``<LANES x double>``, ``_Functions`` those of the functions and divisions):
+one generated ``cfunc`` per form (cached on disk), with the numbers of the equations per lane in Q (``constants``,
+run when a lane takes a trajectory). The hand-written fixed point ``models.FIXED_POINT`` is the same model traced
+over its packed parameters (``fixed_point.packed_model``), so a batch's ``pack`` rows are read as they are. Every
+product's Cauchy sum runs over pairs (j, k − j): the operands' rows at j and k − j, loaded once, serve two fused
+multiply-adds of every product that reads them, the pair with the newest coefficient last (the next order's older
+terms overlap its computation). The work arrays start on 64-byte boundaries (``_rows``): numba aligns to 32, and a
+512-bit load across two cache lines costs two.
 
 Why LLVM IR: written as numba loops over lanes, the Cauchy sums are reductions whose accumulators LLVM keeps in
 memory (numba does not run LLVM's SLP vectoriser); such a kernel was 1.2–2× slower than one trajectory per
