@@ -180,17 +180,9 @@ class Auto(Integrator):
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         if method is None:
             method = make(chosen)
-        if tight_tol <= chosen and not climbed:  # the pilot's tight run is as accurate: continue from its end
-            head = np.searchsorted(pilot_times, inside)  # the outputs inside the pilot
-            rest = t_out[t_out >= t_pilot]
-            tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest,
-                                    tight.y[-1], progress, compiled)
-            y = np.concatenate([tight.y[head], tail.y[-len(rest):]])
-            final_stats = tail.stats
-            n_steps = tail.stats.n_steps + tight.stats.n_steps
-        else:
-            solution = method.integrate(fun, t_out, y0, progress, compiled)
-            y, final_stats, n_steps = solution.y, solution.stats, solution.stats.n_steps
+        # the pilot's tight run is as accurate when its tolerance is: the run continues from its end
+        resumed = (tight, pilot_times, inside, t_pilot) if tight_tol <= chosen and not climbed else None
+        y, final_stats, n_steps = _final_run(method, fun, t_out, y0, progress, compiled, resumed)
         promised = CALIBRATION * per_tol * chosen + roundoff
         choice = {
             "auto_method": method.name,
@@ -533,3 +525,20 @@ def _comes_back(y: np.ndarray, y0: np.ndarray, margin: float) -> bool:
         if near:
             return True
     return False
+
+
+def _final_run(method: Integrator, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
+               progress: ProgressCallback | None, compiled: CompiledModel | None,
+               resumed: tuple | None) -> tuple[np.ndarray, IntegratorStats, int]:
+    """(outputs, the run's stats, steps) of ``auto``'s chosen ``method`` over ``t_out``: from y0, or, with ``resumed``
+    = (the pilot's tight run, its times, the output times inside the pilot, the pilot's end), from the end of the
+    pilot's tight run, whose outputs inside the pilot are kept."""
+    if resumed is None:
+        solution = method.integrate(fun, t_out, y0, progress, compiled)
+        return solution.y, solution.stats, solution.stats.n_steps
+    tight, pilot_times, inside, t_pilot = resumed
+    head = np.searchsorted(pilot_times, inside)  # the outputs inside the pilot
+    rest = t_out[t_out >= t_pilot]
+    tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest, tight.y[-1],
+                            progress, compiled)
+    return np.concatenate([tight.y[head], tail.y[-len(rest):]]), tail.stats, tail.stats.n_steps + tight.stats.n_steps

@@ -161,6 +161,16 @@ def dim_names(dims: Sequence[Dim]) -> tuple[str, ...]:
     return tuple(s if short.count(s) == 1 else d.key.lstrip("+~").replace(".", "_") for s, d in zip(short, dims))
 
 
+def _not_finite_points(axes: list, n_points: int) -> np.ndarray:
+    """The points with a swept value that is not a finite number: the single run's checks decide them (rare)."""
+    suspect = np.zeros(n_points, dtype=bool)
+    for values, codes in axes:
+        odd = np.array([not _finite_number(v) for v in values], dtype=bool)
+        if odd.any():
+            suspect |= odd[codes]
+    return suspect
+
+
 def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any] | None = None) -> Plan:
     """The plan of the swept keys ``dims`` over the config composed from ``fixed`` (or given as ``plain``): their
     grid, or the explicit list of points of ``batch.zip``/``batch.points_file``."""
@@ -189,12 +199,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
     def values_of(n: int) -> dict[str, Any]:
         return {d.key: values[codes[n]] for d, (values, codes) in zip(dims, axes)}
 
-    # points with a value that is not a finite number: the single run's checks decide (rare)
-    suspect = np.zeros(n_points, dtype=bool)
-    for values, codes in axes:
-        odd = np.array([not _finite_number(v) for v in values], dtype=bool)
-        if odd.any():
-            suspect |= odd[codes]
+    suspect = _not_finite_points(axes, n_points)
 
     # body and forces once per combination of their swept values
     combo, combo_values = _combos([dims[i] for i in param_axes], [axes[i] for i in param_axes], n_points)
