@@ -71,6 +71,7 @@ def amplification(compiled: Any, fun: Any, y0: np.ndarray, t0: float, t_pilot: f
     ``method`` is an integrator instance for the shadow pair (``auto``'s loose method) when the variational
     equations do not apply to ``compiled``.
     """
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import models
 
     span = float(t_end - t0)
@@ -86,6 +87,7 @@ def amplification(compiled: Any, fun: Any, y0: np.ndarray, t0: float, t_pilot: f
 def _variational(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float) -> tuple[float, float] | None:
     if compiled is None:
         return None
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import variational
 
     p = _closed_built_in(compiled)

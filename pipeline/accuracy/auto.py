@@ -111,6 +111,7 @@ class Auto(Integrator):
                   compiled: CompiledModel | None = None, series: bool = True) -> Solution:
         """The cheapest method predicted to meet the accuracy (``series``: a regime's analytic series among the
         candidates), run; what it chose and promises is the solution's ``choice`` (nothing is kept on ``self``)."""
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.taylor import order_for
         from gyrolab.kernels.taylor_series import ready
 
@@ -213,6 +214,7 @@ class Auto(Integrator):
         The truncation error per unit tolerance is the pilot's (measured at its order; the double-double run takes
         the optimal, higher order for its tolerance, hence fewer and larger steps: no more error per unit
         tolerance); the round-off is double precision's estimate scaled by the ratio of the two unit round-offs."""
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.taylor_dd import MIN_TOL
 
         roundoff_dd = roundoff * DOUBLE_DOUBLE_EPS / EPS
@@ -467,6 +469,7 @@ def _fast(function: Any, compiled: CompiledModel | None) -> Any:
     if compiled is None:
         return function
     if function.__name__ not in _COMPILED:
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.compiler import kernel
 
         _COMPILED[function.__name__] = kernel(function)

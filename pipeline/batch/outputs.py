@@ -128,6 +128,7 @@ def _drifts(system: Any, y: np.ndarray) -> dict[str, tuple[np.ndarray, dict[str,
 
 def _compiled_reductions(compiled: Any, system: Any, size: int) -> bool:
     """The compiled reductions cover the fixed-point model with the packed torque forms only."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import fixed_point, models
 
     return compiled.model == models.FIXED_POINT and compiled.params.size == fixed_point.N_PARAMS \
@@ -223,6 +224,7 @@ def _place(outputs: dict[str, Output], part: Mapping[str, tuple], index: np.ndar
 def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray,
                       params: np.ndarray) -> dict[str, Output]:
     """The chaos indicator's outputs (``gyrolab.analysis.chaos.indicator_outputs``, imported here only)."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.analysis.chaos import indicator_outputs as compute
 
     out = {}

@@ -45,8 +45,10 @@ from numba.extending import intrinsic
 from gyrolab.kernels import simd, taylor
 from gyrolab.kernels.compiler import kernel
 from gyrolab.kernels.expression import generated_module
+from gyrolab.kernels.fixed_point import packed_model
 from gyrolab.kernels.layout import TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import TRACED, CompiledModel, traced_model
+from gyrolab.kernels.taylor_series import _Program
 from gyrolab.kernels.vector_width import batch_lanes
 
 #: trajectories advanced in lock step: one vector register of doubles of the CPU numba compiles for (8 with
@@ -76,8 +78,6 @@ def plan(model: Any, first_constant: int) -> dict:
     (constant, ((series, coefficient), ...)); series as (op, operands, extra, depth), extra the state index of
     "y" and the exponent's number of "pow".
     """
-    from gyrolab.kernels.taylor_series import _Program
-
     program = _Program(model, first_constant)
     rows: dict[str, int] = {}
 
@@ -467,8 +467,6 @@ def lanes_kernel(compiled: CompiledModel) -> tuple[int, int, int, int]:
     if compiled.model == TRACED:
         model, first = traced_model(compiled), TRACED_FIRST_CONSTANT
     else:  # models.FIXED_POINT: the same equations over its packed parameters
-        from gyrolab.kernels.fixed_point import packed_model
-
         model, first = packed_model(), 0
     key = (id(model), first)
     if key not in _KERNELS:

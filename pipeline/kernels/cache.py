@@ -19,7 +19,7 @@ def cache_dir() -> str:
     """NUMBA_CACHE_DIR when set, else gyrolab's folder for this package's sources and numba's version."""
     if os.environ.get("NUMBA_CACHE_DIR"):
         return os.environ["NUMBA_CACHE_DIR"]
-    from importlib.metadata import version
+    from importlib.metadata import version  # start-up: only where NUMBA_CACHE_DIR is unset
 
     digest = hashlib.sha256(f"numba {version('numba')} {platform.machine()}".encode())
     for source in sorted(Path(__file__).parent.glob("*.py")):
@@ -44,7 +44,7 @@ def _private(folder: Path) -> None:
 def private_temporary() -> Path:
     """This user's folder for gyrolab in the temporary directory (``gyrolab-UID``, owner-only): a shared
     ``/tmp/gyrolab`` that another user created first could hold code or pickles gyrolab would load."""
-    import tempfile
+    import tempfile  # (rare: only for a read-only cache)
 
     folder = Path(tempfile.gettempdir()) / f"gyrolab-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
     _private(folder)

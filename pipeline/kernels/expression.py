@@ -219,13 +219,13 @@ def generated_module(source: str, prefix: str, what: str) -> Any:
     digest = hashlib.sha256(source.encode()).hexdigest()[:16]
     module_name = f"{prefix}_{digest}"
     if module_name not in _LOADED:
-        from gyrolab.kernels.compiler import kernel_cache_dir
+        from gyrolab.kernels.compiler import kernel_cache_dir  # start-up: imports numba, needed only to compile
 
         folder = Path(kernel_cache_dir()) / "forces"
         try:
             folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         except OSError:  # a read-only cache (some cluster nodes): this user's private temporary folder
-            from gyrolab.kernels.cache import private_temporary
+            from gyrolab.kernels.cache import private_temporary  # (rare: a read-only cache)
 
             folder = private_temporary() / "forces"
             folder.mkdir(mode=0o700, exist_ok=True)

@@ -24,7 +24,7 @@ from typing import Any, Callable
 import numpy as np
 
 from gyrolab.kernels.expression import Expr, Graph, NotCompilable, check_torques, load_generated, symbols
-from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT, TRACED_TAIL
+from gyrolab.kernels.layout import INV_INERTIA, TRACED_ADDRESS, TRACED_FIRST_CONSTANT, TRACED_TAIL
 
 #: form id of a model compiled from its traced equations (``models.TRACED``; here to avoid importing numba's models)
 TRACED = 1
@@ -253,8 +253,6 @@ def rounding_moved(compiled: CompiledModel) -> CompiledModel:
     rounding (the others are the config's own doubles, exact for a reference too). A traced model: every number of
     its equations (up and down alternately), since the trace cannot tell a config's double from a derived one.
     """
-    from gyrolab.kernels.layout import INV_INERTIA
-
     params = np.array(compiled.params, dtype=float)
     if compiled.model == TRACED:
         numbers = params[TRACED_FIRST_CONSTANT:params.size - TRACED_TAIL]

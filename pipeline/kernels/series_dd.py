@@ -28,8 +28,8 @@ from typing import Any
 
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before compiling)
 from gyrolab.kernels.expression import Expr, NotCompilable, binary_power, load_generated
-from gyrolab.kernels.layout import TRACED_FIRST_CONSTANT
-from gyrolab.kernels.model import Model
+from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
+from gyrolab.kernels.model import Model, traced_model
 
 _NUMBER_FUNCTIONS = {"sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
                      "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})",
@@ -219,9 +219,6 @@ def ready(compiled: Any) -> bool:
     """Compile (or load) a traced model's double-double series kernel on first need; write its address and scratch
     columns into ``compiled.params`` (``layout``: the last two entries). Raises NotCompilable for a model with a
     transcendental function of the state."""
-    from gyrolab.kernels.layout import TRACED_ADDRESS
-    from gyrolab.kernels.model import traced_model
-
     p = compiled.params
     model = traced_model(compiled)  # (ValueError for an array that is no traced model's of this process)
     if p[p.size - 2] == 0.0:

@@ -37,9 +37,9 @@ from gyrolab.kernels.double_double import (
     dd_add, dd_div_d, dd_mul, dd_mul_d, dd_norm, dd_sub, dot_add, two_sum,
 )
 from gyrolab.kernels.layout import (
-    GAMMA, INERTIA, N_Z, OMEGA, U_Z,
+    GAMMA, INERTIA, N_PARAMS, N_Z, OMEGA, U_Z,
 )
-from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, _norm_inf, step_size
+from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, _norm_inf, order_for, step_size
 
 #: the smallest tolerance the double-double kernel takes (its unit round-off is 2^-106 ≈ 1.2e-32)
 MIN_TOL = 1e-32
@@ -232,9 +232,6 @@ def propagate(p: np.ndarray, tol: float, t_out, y0, order: int | None = None, y0
     (high parts, low parts), each (len(t_out), state size), the first row the initial state. For tests, benchmarks
     and callers that want all 32 digits; the integrator plugin (``Taylor(precision="double-double")``) chunks
     its calls for progress instead. Raises RuntimeError on a non-OK status."""
-    from gyrolab.kernels.layout import N_PARAMS
-    from gyrolab.kernels.taylor import order_for
-
     if model == 0 and (len(p) != N_PARAMS or len(y0) != 6):  # (the hand-written kernel would read past them)
         raise ValueError("model 0 is the hand-written fixed point: packed parameters (fixed_point.pack) and a state "
                          "(ω, γ); pass model=1 for a traced model's parameters")

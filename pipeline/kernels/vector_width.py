@@ -32,7 +32,7 @@ def host_features() -> frozenset[str]:
     if override:
         return frozenset(f[1:] for f in override.split(",") if f.startswith("+"))
     try:
-        from llvmlite import binding
+        from llvmlite import binding  # start-up: LLVM's binding loads only when the lanes' width is asked
 
         found = binding.get_host_cpu_features()
     except (ImportError, RuntimeError):

@@ -32,6 +32,7 @@ _REASONS = {1: "its step fell below the spacing of floating-point numbers", 2: "
 def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
               failures: str) -> BatchSolution:
     """Fixed-step RK4 with the fewest equal steps no longer than ``step`` in each output interval."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import models, rk4
     from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
 
@@ -49,6 +50,7 @@ def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.n
 def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
                  failures: str) -> BatchSolution:
     """The Taylor method at ``integrator.order`` and ``integrator.tol`` (``Taylor``'s settings)."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import batch_taylor, taylor_series
 
     P = bind(compiled, P)
@@ -65,6 +67,7 @@ def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
 def dop853_batch(integrator: object, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
                  failures: str) -> BatchSolution:
     """DOP853 with ``integrator.rtol``, ``atol`` and ``max_step`` (scipy's step control)."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import batch_dop853, models
 
     P = bind(compiled, P)

@@ -150,6 +150,7 @@ class DOP853Numba(Tolerances, Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels import dop853, models
 
         start = time.perf_counter()
@@ -199,6 +200,7 @@ class RK4Numba(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels import models, rk4
 
         start = time.perf_counter()
@@ -236,6 +238,7 @@ class Taylor(Integrator):
 
     @classmethod
     def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels import taylor_series
 
         if taylor_series.ready(compiled):   # (compiles a traced torque's Taylor kernel, once)
@@ -254,11 +257,13 @@ class Taylor(Integrator):
         return super().__new__(cls)
 
     def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = "double") -> None:
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.taylor import MAX_ORDER, MIN_ORDER, order_for
 
         self.precision = _taylor_precision(precision)
         self.tol = as_number(tol, "integrator.tol", positive=True)
         if self.precision == DOUBLE_DOUBLE:
+            # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
             from gyrolab.kernels.taylor_dd import MIN_TOL
 
             if self.tol < MIN_TOL:
@@ -273,6 +278,7 @@ class Taylor(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels import models, taylor, taylor_series
 
         start = time.perf_counter()
@@ -307,6 +313,7 @@ class Taylor(Integrator):
 
     def climbed(self, factor: float):
         """Rule 11: the double-double rung, ``factor`` times more accurate (None: already on it)."""
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.taylor_dd import MIN_TOL
 
         tol = max(self.tol / factor, MIN_TOL)
@@ -352,6 +359,7 @@ class TaylorDoubleDouble(Taylor):
         return _taylor_double_double(self, fun, t_out, y0, progress, compiled)
 
     def more_accurate(self, factor: float):
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.taylor_dd import MIN_TOL
 
         tol = self.tol / factor
@@ -366,6 +374,7 @@ def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray,
     """``Taylor.integrate`` in double-double (``gyrolab.kernels.taylor_dd``): the state carried in
     double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded to
     double. The initial state is a double, hence exact."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import taylor, taylor_dd
 
     _ready_for_double_double(compiled)
@@ -395,6 +404,7 @@ def taylor_dd_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0
     method at ``tol`` (≥ ``taylor_dd.MIN_TOL``) and ``order`` (None: its optimal order), in one call into the
     kernel, for a method choosing its setting from short runs (``auto``'s pilot). A model double-double cannot run
     raises ConfigError; a failed step raises IntegrationError."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import taylor, taylor_dd
 
     _ready_for_double_double(compiled)
@@ -412,6 +422,7 @@ def taylor_dd_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0
 
 def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -> str | None:
     """None when double-double can run ``compiled`` (compiling a traced model's series on first need), else why."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import models, series_dd
     from gyrolab.kernels.expression import NotCompilable
 
@@ -440,6 +451,7 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
     """The states at ``t_out`` of the Taylor method at ``tol`` (its optimal order), in one call into the kernel:
     for runs over a few periods inside another method (``auto``'s screen), which need neither progress nor
     statistics (``Taylor.integrate``'s chunks and records cost ~10 µs more, a tenth of the screen)."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import models, taylor, taylor_series
 
     taylor_series.ready(compiled)  # a traced model's series kernel (a scene carrying α is one)
@@ -454,6 +466,7 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
 
 def _taylor_failure(status: int, t: float) -> IntegrationError:
     """The one-sentence error for a Taylor kernel's non-OK ``status``, stopped at time ``t``."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import taylor
 
     if status == taylor.TOO_SMALL_STEP:
@@ -490,6 +503,7 @@ class LiePoisson(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels import lie_poisson
 
         if compiled.built_in is None:

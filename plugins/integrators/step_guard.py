@@ -47,6 +47,7 @@ def jacobian_norm(fun: Callable[[float, np.ndarray], np.ndarray], t: float, y: n
 
 def compiled_rhs(compiled) -> Callable[[float, np.ndarray], np.ndarray]:
     """The compiled model's right-hand side as a Python callable (for occasional checks only)."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import models
 
     form = models.form(compiled)
