@@ -148,15 +148,6 @@ def test_compensated_dot_product_errs_by_u_squared_times_the_sum_of_the_terms():
         assert abs(_exact(hi, lo) - sum(terms)) <= n * U2 * sum(abs(t) for t in terms)
 
 
-def test_the_inertias_reciprocal_is_computed_to_double_double():
-    p = np.zeros(N_PARAMS)
-    p[INERTIA:INERTIA + 3] = (3.0, 1.7, 0.1)
-    C = taylor_dd.constants(p)
-    for k, inertia in enumerate((3.0, 1.7, 0.1)):
-        assert abs(_exact(C[0, taylor_dd.INV + k], C[1, taylor_dd.INV + k]) * Fraction(inertia) - 1) < U2
-    assert _exact(C[0, taylor_dd.DIFF], C[1, taylor_dd.DIFF]) == Fraction(1.7) - Fraction(0.1)
-
-
 # --- an independent reference: Taylor series in decimal arithmetic ---------------------------------------------
 
 DIGITS = 50
@@ -229,16 +220,19 @@ def decimal_reference(p, y0, t_out, *, order=44, tol=Decimal("1e-42")):
 @pytest.fixture(scope="module")
 def chaotic():
     """The chaotic top (the default body and forces, initial=slow_spin), state (ω, γ)."""
+    from gyrolab.kernels import series_dd
+
     scene = compose_scene(["initial=slow_spin", "output.euler_angles=false", "integrator=taylor",
                            "integrator.precision=double-double"])
-    return scene.compiled.params, scene.system.initial_state()
+    series_dd.ready(scene.compiled)
+    return scene.compiled, scene.system.initial_state()
 
 
 @pytest.fixture(scope="module")
 def reference(chaotic):
-    p, y0 = chaotic
+    compiled, y0 = chaotic
     t_out = np.array([0.0, 20.0, 40.0, 60.0])
-    return t_out, decimal_reference(p, y0, t_out)
+    return t_out, decimal_reference(compiled.built_in, y0, t_out)
 
 
 def _errors(hi, lo, exact):
@@ -248,20 +242,20 @@ def _errors(hi, lo, exact):
 
 
 def test_double_double_taylor_matches_a_50_digit_reference_where_double_precision_cannot(chaotic, reference):
-    p, y0 = chaotic
+    compiled, y0 = chaotic
     t_out, exact = reference
-    hi, lo = taylor_dd.propagate(p, 1e-30, t_out, y0)
+    hi, lo = taylor_dd.propagate(compiled.params, 1e-30, t_out, y0)
     errors = _errors(hi, lo, exact)
     assert max(errors) < 1e-29, errors  # measured 6e-31 at t = 60
     # the dataset's doubles: the double-double state rounded, within half an ulp of the truth (and a little)
     stored = _errors(hi, np.zeros_like(lo), exact)
     assert max(stored) < 2e-16
     # double precision on the same scene: its error has grown orders of magnitude above round-off
-    double = Taylor(tol=1e-16).integrate(None, t_out, y0, None, CompiledModel(models.FIXED_POINT, p)).y
+    double = Taylor(tol=1e-16).integrate(None, t_out, y0, None, compiled).y
     double_errors = _errors(double, np.zeros_like(double), exact)
     assert double_errors[-1] > 1e12 * errors[-1]  # measured 2e-15
     # and double-double's error follows its tolerance (Jorba & Zou's step: error ∝ tol)
-    coarse = _errors(*taylor_dd.propagate(p, 1e-24, t_out, y0), exact)
+    coarse = _errors(*taylor_dd.propagate(compiled.params, 1e-24, t_out, y0), exact)
     assert 1e-28 < coarse[-1] < 1e-21
 
 
@@ -328,16 +322,17 @@ def _invariants(p, hi, lo):
 
 
 def test_energy_area_integral_and_gamma_norm_are_conserved_to_1e_28_over_a_long_run(chaotic):
-    p, y0 = chaotic
+    compiled, y0 = chaotic
+    p = compiled.built_in
     t_out = np.linspace(0.0, 1000.0, 41)
-    hi, lo = taylor_dd.propagate(p, 1e-30, t_out, y0)
+    hi, lo = taylor_dd.propagate(compiled.params, 1e-30, t_out, y0)
     rows = _invariants(p, hi, lo)
     energy0, area0, norm0, scale = rows[0]
     drift = [(abs(e - energy0) / scale, abs(a - area0), abs(g - norm0)) for e, a, g, _ in rows]
     worst = [float(max(d[i] for d in drift)) for i in range(3)]
     assert max(worst) < 1e-28, worst  # measured ~2e-31 over t = 1000 (~3,000 steps)
     # in double precision the same run drifts by round-off: ~1e-16 … 1e-15
-    double = Taylor(tol=1e-16).integrate(None, t_out, y0, None, CompiledModel(models.FIXED_POINT, p)).y
+    double = Taylor(tol=1e-16).integrate(None, t_out, y0, None, compiled).y
     e_double = [float(abs(e - energy0) / scale) for e, *_ in _invariants(p, double, np.zeros_like(double))]
     assert max(e_double) > 1e10 * worst[0]
 
@@ -445,8 +440,8 @@ def test_capabilities_batch_points_and_the_error_estimates_companion():
 def test_the_one_call_samples_for_auto_equal_the_integrator(chaotic):
     from gyrolab.plugins.integrators.compiled_solvers import taylor_dd_samples
 
-    p, y0 = chaotic
-    model, t_out = CompiledModel(models.FIXED_POINT, p), np.linspace(0.0, 20.0, 41)
+    model, y0 = chaotic
+    p, t_out = model.built_in, np.linspace(0.0, 20.0, 41)
     samples = taylor_dd_samples(model, 1e-26, t_out, y0)
     np.testing.assert_array_equal(samples, Taylor(precision="double-double", tol=1e-26).integrate(
         None, t_out, y0, None, model).y)
