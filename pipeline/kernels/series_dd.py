@@ -43,7 +43,7 @@ import math
 import numba
 from numba import types
 
-from gyrolab.kernels.double_double import dd_add, dd_div, dd_div_d, dd_mul, dd_norm, dot_add
+from gyrolab.kernels.double_double import dd_add, dd_div, dd_div_d, dd_mul, dd_norm, dot_add, sum_add
 
 M = {columns}
 N = {size}
@@ -56,29 +56,43 @@ def kernel(t, order, Th, Tl, S, p):
 '''
 
 
+ONE = ("1.0", "0.0")
+
+
+def _negative(c: tuple[str, str]) -> tuple[str, str]:
+    return tuple(x[1:] if x.startswith("-") else f"-{x}" for x in c)  # type: ignore[return-value]
+
+
 class _Program:
-    """The generated statements: numbers once per call, then every series' coefficient k inside ``for k``."""
+    """The generated statements: numbers once per call, then every series' coefficient k inside ``for k``.
+
+    A value is a number ``("num", (hi, lo))`` or a pending sum ``("sum", {term: coefficient})`` of terms
+    ``("s", where)`` (a series), ``("p", a, b)`` (the Cauchy product of the series a and b, a ≤ b) and ``("1",)``
+    (the number 1 at k = 0), each coefficient a number. Sums of products are kept open, equal terms merged (their
+    coefficients added once per call: (I_1 − I_2) ω_1 ω_2 for I_1 ω_1 ω_2 − I_2 ω_2 ω_1), numbers factored out
+    of products, and a sum is written out (``_series``: a scratch column) only where a product, a division or a
+    power needs its coefficients; the products a sum needs are one loop of compensated dot products, each
+    product once per k however many sums use it.
+    """
 
     def __init__(self, model: Model) -> None:
         self.model = model
         self.numbers: list[str] = []
         self.body: list[str] = []
         self.columns = 0
-        self.values: dict[int, tuple[str, Any]] = {}  # node → ("num", (hi, lo) names) | ("series", where)
+        self.written: dict[Any, Any] = {}  # a sum's terms → its column; a product → its k-th coefficient's names
+        self.values: dict[int, tuple[str, Any]] = {}
         for i in sorted(model.live()):
             op, args = model.graph.nodes[i]
             self.values[i] = self._node(i, op, [self.values[a.index] if isinstance(a, Expr) else a for a in args])
         for m, rate in enumerate(model.rates):
             target = f"Th[(k + 1) * N + {m}], Tl[(k + 1) * N + {m}]"
-            if not isinstance(rate, Expr):
-                self.body.append(f"{target} = 0.0, 0.0")
-                continue
-            kind, where = self.values[rate.index]
-            if kind == "num":
-                self.body.append(f"{target} = ({where[0]}, {where[1]}) if k == 0 else (0.0, 0.0)")
+            value = self.values[rate.index] if isinstance(rate, Expr) else ("num", ("0.0", "0.0"))
+            if value[0] == "num":
+                self.body.append(f"{target} = ({value[1][0]}, {value[1][1]}) if k == 0 else (0.0, 0.0)")
             else:
-                h, lo = self._at(where, "k")
-                self.body.append(f"{target} = dd_div_d({h}, {lo}, k + 1.0)")
+                self.body.append(f"rh, rl = {self._combination(value[1])}")
+                self.body.append(f"{target} = dd_div_d(rh, rl, k + 1.0)")
 
     # ---- places
 
@@ -89,53 +103,105 @@ class _Program:
         column = where[1]
         return f"S[(({j}) * M + {column}) * 2]", f"S[(({j}) * M + {column}) * 2 + 1]"
 
-    def _column(self) -> tuple[str, int]:
-        self.columns += 1
-        return ("S", self.columns - 1)
-
-    def _store(self, where: Any, value: str) -> None:
-        h, lo = self._at(where, "k")
-        self.body.append(f"{h}, {lo} = {value}")
-
-    def _number(self, i: int, value: str) -> tuple[str, Any]:
-        names = (f"c{i}h", f"c{i}l")
+    def _number(self, value: str) -> tuple[str, str]:
+        names = (f"c{len(self.numbers)}h", f"c{len(self.numbers)}l")
         self.numbers.append(f"{names[0]}, {names[1]} = {value}")
-        return ("num", names)
+        return names
+
+    def _times(self, c: tuple[str, str], d: tuple[str, str]) -> tuple[str, str]:
+        for a, b in ((c, d), (d, c)):
+            if a in (ONE, _negative(ONE)):
+                return b if a == ONE else _negative(b)
+        return self._number(f"dd_mul({c[0]}, {c[1]}, {d[0]}, {d[1]})")
+
+    @staticmethod
+    def _sum(where: Any) -> tuple[str, Any]:
+        return ("sum", {("s", where): ONE})
+
+    def _series(self, value: tuple[str, Any]) -> Any:
+        """Where a sum's coefficients are: the series itself, or a scratch column written here once."""
+        terms = value[1]
+        if len(terms) == 1 and next(iter(terms.values())) == ONE and next(iter(terms))[0] == "s":
+            return next(iter(terms))[1]
+        key = tuple(terms.items())
+        if key not in self.written:
+            self.columns += 1
+            self.written[key] = where = ("S", self.columns - 1)
+            h, lo = self._at(where, "k")
+            self.body.append(f"{h}, {lo} = {self._combination(terms)}")
+        return self.written[key]
+
+    def _combination(self, terms: dict[Any, tuple[str, str]]) -> str:
+        """Statements for the k-th coefficient of Σ c·term; returns its (hi, lo) expression."""
+        new = [term for term in terms if term[0] == "p" and term not in self.written]
+        if new:
+            names = [(f"q{len(self.written) + n}h", f"q{len(self.written) + n}l") for n in range(len(new))]
+            self.body.append(" = ".join(f"{h} = {lo}" for h, lo in names) + " = 0.0")
+            self.body.append("for j in range(k + 1):")
+            for (h, lo), (_, a, b) in zip(names, new):
+                ah, al = self._at(a, "j")
+                bh, bl = self._at(b, "k - j")
+                self.body.append(f"    {h}, {lo} = dot_add({h}, {lo}, {ah}, {al}, {bh}, {bl})")
+            for (h, lo), term in zip(names, new):
+                self.body.append(f"{h}, {lo} = dd_norm({h}, {lo})")
+                self.written[term] = (h, lo)
+        parts = []
+        for term, c in terms.items():
+            if term[0] == "1":
+                parts.append((("(1.0 if k == 0 else 0.0)", "0.0"), c))
+            else:
+                parts.append((self.written[term] if term[0] == "p" else self._at(term[1], "k"), c))
+        if len(parts) == 1:
+            (th, tl), c = parts[0]
+            if c in (ONE, _negative(ONE)):
+                return f"{th}, {tl}" if c == ONE else f"-{th}, -{tl}"
+            return f"dd_mul({c[0]}, {c[1]}, {th}, {tl})"
+        self.body.append("sh = sl = 0.0")
+        for (th, tl), c in parts:
+            if c in (ONE, _negative(ONE)):
+                sign = "" if c == ONE else "-"
+                self.body.append(f"sh, sl = sum_add(sh, sl, {sign}{th}, {sign}{tl})")
+            else:
+                self.body.append(f"sh, sl = dot_add(sh, sl, {c[0]}, {c[1]}, {th}, {tl})")
+        return "dd_norm(sh, sl)"
 
     # ---- operations
 
     def _node(self, i: int, op: str, a: list[Any]) -> tuple[str, Any]:
         if op == "y":
-            return ("series", ("y", a[0]))
+            return self._sum(("y", a[0]))
         if op == "const":
-            return self._number(i, f"p[{TRACED_FIRST_CONSTANT + a[0]}], 0.0")
+            return ("num", self._number(f"p[{TRACED_FIRST_CONSTANT + a[0]}], 0.0"))
         if op == "time":
-            where = self._column()
-            self._store(where, "(t, 0.0) if k == 0 else ((1.0, 0.0) if k == 1 else (0.0, 0.0))")
-            return ("series", where)
-        series = [v for v in a if isinstance(v, tuple) and v[0] == "series"]
+            self.columns += 1
+            where = ("S", self.columns - 1)
+            h, lo = self._at(where, "k")
+            self.body.append(f"{h}, {lo} = (t, 0.0) if k == 0 else ((1.0, 0.0) if k == 1 else (0.0, 0.0))")
+            return self._sum(where)
+        series = [v for v in a if isinstance(v, tuple) and v[0] == "sum"]
         if not series and op == "ipow":  # a number's integer power: repeated products, once per call
-            h, lo = f"c{i}h", f"c{i}l"
-            self.numbers.append(f"{h}, {lo} = 1.0, 0.0")
+            h, lo = self._number("1.0, 0.0")
             self.numbers += [f"{h}, {lo} = dd_mul({h}, {lo}, {a[0][1][0]}, {a[0][1][1]})"] * abs(int(a[1]))
             if int(a[1]) < 0:
                 self.numbers.append(f"{h}, {lo} = dd_div(1.0, 0.0, {h}, {lo})")
             return ("num", (h, lo))
         if not series:  # numbers only
-            return self._number(i, self._numbers_op(op, a))
+            return ("num", self._number(self._numbers_op(op, a)))
         if op in ("add", "sub"):
-            return self._sum(op, a[0], a[1])
+            x, y = (v if v[0] == "sum" else ("sum", {("1",): v[1]}) for v in a)
+            terms = dict(x[1])
+            for term, c in y[1].items():
+                c = _negative(c) if op == "sub" else c
+                terms[term] = self._number(f"dd_add({terms[term][0]}, {terms[term][1]}, {c[0]}, {c[1]})") \
+                    if term in terms else c
+            return ("sum", terms)
         if op == "neg":
-            where = self._column()
-            h, lo = self._at(a[0][1], "k")
-            self._store(where, f"-{h}, -{lo}")
-            return ("series", where)
+            return ("sum", {term: _negative(c) for term, c in a[0][1].items()})
         if op == "mul":
             return self._mul(a[0], a[1])
         if op == "div":
             if a[1][0] == "num":  # a series over a number: times its reciprocal, computed once
-                reciprocal = self._number(i, f"dd_div(1.0, 0.0, {a[1][1][0]}, {a[1][1][1]})")
-                return self._mul(a[0], reciprocal)
+                return self._mul(a[0], ("num", self._number(f"dd_div(1.0, 0.0, {a[1][1][0]}, {a[1][1][1]})")))
             return self._divide(a[0], a[1])
         if op == "ipow":
             return self._power(a[0], a[1])
@@ -157,57 +223,43 @@ class _Program:
         args = [v[1][0] if isinstance(v, tuple) else v for v in a]
         return f"{_NUMBER_FUNCTIONS[op].format(*args)}, 0.0"
 
-    def _sum(self, op: str, x: Any, y: Any) -> tuple[str, Any]:
-        where = self._column()
-        sign = "-" if op == "sub" else ""
-        if x[0] == "series" and y[0] == "series":
-            xh, xl = self._at(x[1], "k")
-            yh, yl = self._at(y[1], "k")
-            self._store(where, f"dd_add({xh}, {xl}, {sign}{yh}, {sign}{yl})")
-            return ("series", where)
-        s, n = (x, y) if x[0] == "series" else (y, x)
-        sh, sl = self._at(s[1], "k")
-        s_sign = sign if s is y else ""
-        n_sign = sign if n is y else ""
-        self._store(where, f"dd_add({s_sign}{sh}, {s_sign}{sl}, {n_sign}{n[1][0]}, {n_sign}{n[1][1]}) if k == 0 "
-                           f"else ({s_sign}{sh}, {s_sign}{sl})")
-        return ("series", where)
+    def _single(self, value: tuple[str, Any]) -> tuple[tuple[str, str], Any]:
+        """(c, where) with value = c·series: a one-series sum keeps its coefficient, any other is written out."""
+        terms = value[1]
+        if len(terms) == 1 and next(iter(terms))[0] == "s":
+            (_, where), c = next(iter(terms.items()))
+            return c, where
+        return ONE, self._series(value)
 
-    def _mul(self, x: Any, y: Any) -> tuple[str, Any]:
-        where = self._column()
+    def _mul(self, x: tuple[str, Any], y: tuple[str, Any]) -> tuple[str, Any]:
         if x[0] == "num" or y[0] == "num":
             n, s = (x, y) if x[0] == "num" else (y, x)
-            sh, sl = self._at(s[1], "k")
-            self._store(where, f"dd_mul({n[1][0]}, {n[1][1]}, {sh}, {sl})")
-            return ("series", where)
-        xh, xl = self._at(x[1], "j")
-        yh, yl = self._at(y[1], "k - j")
-        self.body += ["sh = 0.0", "sl = 0.0", "for j in range(k + 1):", f"    sh, sl = dot_add(sh, sl, {xh}, {xl}, {yh}, {yl})"]
-        self._store(where, "dd_norm(sh, sl)")
-        return ("series", where)
+            return ("sum", {term: self._times(n[1], c) for term, c in s[1].items()})
+        (c, a), (d, b) = self._single(x), self._single(y)
+        return ("sum", {("p", *sorted((a, b))): self._times(c, d)})
 
-    def _divide(self, x: Any, y: Any) -> tuple[str, Any]:
+    def _divide(self, x: tuple[str, Any], y: tuple[str, Any]) -> tuple[str, Any]:
         """f = x / y for a series y: f_k = (x_k − Σ_{j<k} f_j y_{k−j}) / y_0."""
-        where = self._column()
-        fh, fl = self._at(where, "j")
-        yh, yl = self._at(y[1], "k - j")
-        y0h, y0l = self._at(y[1], "0")
+        self.columns += 1
+        where = ("S", self.columns - 1)
         if x[0] == "num":
             self.body.append(f"sh, sl = ({x[1][0]}, {x[1][1]}) if k == 0 else (0.0, 0.0)")
         else:
-            xh, xl = self._at(x[1], "k")
-            self.body.append(f"sh, sl = {xh}, {xl}")
-        self.body += ["for j in range(k):", f"    ph, pl = dd_mul({fh}, {fl}, {yh}, {yl})",
-                      "    sh, sl = dd_add(sh, sl, -ph, -pl)"]
-        self._store(where, f"dd_div(sh, sl, {y0h}, {y0l})")
-        return ("series", where)
+            self.body.append(f"sh, sl = {self._combination(x[1])}")
+        fh, fl = self._at(where, "j")
+        yh, yl = self._at(self._series(y), "k - j")
+        y0h, y0l = self._at(self._series(y), "0")
+        self.body += ["for j in range(k):", f"    sh, sl = dot_add(sh, sl, -{fh}, -{fl}, {yh}, {yl})"]
+        h, lo = self._at(where, "k")
+        self.body += ["sh, sl = dd_norm(sh, sl)", f"{h}, {lo} = dd_div(sh, sl, {y0h}, {y0l})"]
+        return self._sum(where)
 
-    def _power(self, x: Any, n: int) -> tuple[str, Any]:
+    def _power(self, x: tuple[str, Any], n: int) -> tuple[str, Any]:
         """x^n by binary powering (Cauchy products), 1/x^|n| for n < 0."""
         if n == 0:
-            return ("num", ("1.0", "0.0"))
+            return ("num", ONE)
         result = binary_power(x, abs(n), self._mul)
-        return self._divide(("num", ("1.0", "0.0")), result) if n < 0 else result
+        return self._divide(("num", ONE), result) if n < 0 else result
 
     def source(self) -> str:
         lines = [*self.numbers, "for k in range(order):", *[f"    {line}" for line in self.body]]
