@@ -57,6 +57,8 @@ def kernel(t, order, Th, Tl, S, p):
 
 
 ONE = ("1.0", "0.0")
+#: Cauchy products side by side in one loop at most (their accumulators stay in registers)
+_LOOP = 6
 
 
 def _negative(c: tuple[str, str]) -> tuple[str, str]:
@@ -78,7 +80,8 @@ class _Program:
     def __init__(self, model: Model) -> None:
         self.model = model
         self.numbers: list[str] = []
-        self.body: list[str] = []
+        self.body: list[Any] = []  # statements, and product loops: lists of (names, a, b), ``_loop``
+        self.ready: dict[Any, int] = {}  # a scratch column → the index in ``body`` from which it is written
         self.columns = 0
         self.written: dict[Any, Any] = {}  # a sum's terms → its column; a product → its k-th coefficient's names
         self.values: dict[int, tuple[str, Any]] = {}
@@ -129,22 +132,19 @@ class _Program:
             self.written[key] = where = ("S", self.columns - 1)
             h, lo = self._at(where, "k")
             self.body.append(f"{h}, {lo} = {self._combination(terms)}")
+            self.ready[where] = len(self.body)
         return self.written[key]
 
     def _combination(self, terms: dict[Any, tuple[str, str]]) -> str:
         """Statements for the k-th coefficient of Σ c·term; returns its (hi, lo) expression."""
-        new = [term for term in terms if term[0] == "p" and term not in self.written]
-        if new:
-            names = [(f"q{len(self.written) + n}h", f"q{len(self.written) + n}l") for n in range(len(new))]
-            self.body.append(" = ".join(f"{h} = {lo}" for h, lo in names) + " = 0.0")
-            self.body.append("for j in range(k + 1):")
-            for (h, lo), (_, a, b) in zip(names, new):
-                ah, al = self._at(a, "j")
-                bh, bl = self._at(b, "k - j")
-                self.body.append(f"    {h}, {lo} = dot_add({h}, {lo}, {ah}, {al}, {bh}, {bl})")
-            for (h, lo), term in zip(names, new):
-                self.body.append(f"{h}, {lo} = dd_norm({h}, {lo})")
-                self.written[term] = (h, lo)
+        for term in terms:
+            if term[0] == "p" and term not in self.written:
+                self.written[term] = names = (f"q{len(self.written)}h", f"q{len(self.written)}l")
+                after = max(self.ready.get(term[1], 0), self.ready.get(term[2], 0))
+                loop = next((item for item in self.body[after:] if isinstance(item, list) and len(item) < _LOOP), None)
+                if loop is None:
+                    self.body.append(loop := [])
+                loop.append((names, term[1], term[2]))
         parts = []
         for term, c in terms.items():
             if term[0] == "1":
@@ -177,6 +177,7 @@ class _Program:
             where = ("S", self.columns - 1)
             h, lo = self._at(where, "k")
             self.body.append(f"{h}, {lo} = (t, 0.0) if k == 0 else ((1.0, 0.0) if k == 1 else (0.0, 0.0))")
+            self.ready[where] = len(self.body)
             return self._sum(where)
         series = [v for v in a if isinstance(v, tuple) and v[0] == "sum"]
         if not series and op == "ipow":  # a number's integer power: repeated products, once per call
@@ -252,6 +253,7 @@ class _Program:
         self.body += ["for j in range(k):", f"    sh, sl = dot_add(sh, sl, -{fh}, -{fl}, {yh}, {yl})"]
         h, lo = self._at(where, "k")
         self.body += ["sh, sl = dd_norm(sh, sl)", f"{h}, {lo} = dd_div(sh, sl, {y0h}, {y0l})"]
+        self.ready[where] = len(self.body)
         return self._sum(where)
 
     def _power(self, x: tuple[str, Any], n: int) -> tuple[str, Any]:
@@ -261,8 +263,19 @@ class _Program:
         result = binary_power(x, abs(n), self._mul)
         return self._divide(("num", ONE), result) if n < 0 else result
 
+    def _loop(self, products: list[Any]) -> list[str]:
+        """The statements of a product loop: the k-th coefficients of its Cauchy products, one compensated dot
+        product each, side by side in one ``for j``."""
+        lines = [" = ".join(f"{h} = {lo}" for (h, lo), _, _ in products) + " = 0.0", "for j in range(k + 1):"]
+        for (h, lo), a, b in products:
+            ah, al = self._at(a, "j")
+            bh, bl = self._at(b, "k - j")
+            lines.append(f"    {h}, {lo} = dot_add({h}, {lo}, {ah}, {al}, {bh}, {bl})")
+        return lines + [f"{h}, {lo} = dd_norm({h}, {lo})" for (h, lo), _, _ in products]
+
     def source(self) -> str:
-        lines = [*self.numbers, "for k in range(order):", *[f"    {line}" for line in self.body]]
+        body = [line for item in self.body for line in (self._loop(item) if isinstance(item, list) else [item])]
+        lines = [*self.numbers, "for k in range(order):", *[f"    {line}" for line in body]]
         text = _HEADER.format(columns=max(self.columns, 1), size=self.model.size)
         return text + "".join(f"    {line}\n" for line in lines)
 
