@@ -175,10 +175,3 @@ def dot_add(sh, sl, ah, al, bh, bl):
     e = fma(al, bh, e)
     s, t = two_sum(sh, p)
     return s, sl + (t + e)
-
-
-@inline_kernel
-def sum_add(sh, sl, ah, al):
-    """(sh, sl) + a for a compensated sum (``dot_add`` with b = 1): finish with ``dd_norm``."""
-    s, t = two_sum(sh, ah)
-    return s, sl + (t + al)

@@ -43,7 +43,7 @@ import math
 import numba
 from numba import types
 
-from gyrolab.kernels.double_double import dd_add, dd_div, dd_div_d, dd_mul, dd_norm, dot_add, sum_add
+from gyrolab.kernels.double_double import dd_add, dd_div, dd_div_d, dd_mul, dd_norm, dot_add
 
 M = {columns}
 N = {size}
@@ -63,6 +63,11 @@ _LOOP = 6
 
 def _negative(c: tuple[str, str]) -> tuple[str, str]:
     return tuple(x[1:] if x.startswith("-") else f"-{x}" for x in c)  # type: ignore[return-value]
+
+
+def _terms(value: tuple[str, Any]) -> dict[Any, tuple[str, str]]:
+    """A value's terms: a number c is c·1."""
+    return value[1] if value[0] == "sum" else {("1",): value[1]}
 
 
 class _Program:
@@ -89,13 +94,9 @@ class _Program:
             op, args = model.graph.nodes[i]
             self.values[i] = self._node(i, op, [self.values[a.index] if isinstance(a, Expr) else a for a in args])
         for m, rate in enumerate(model.rates):
-            target = f"Th[(k + 1) * N + {m}], Tl[(k + 1) * N + {m}]"
             value = self.values[rate.index] if isinstance(rate, Expr) else ("num", ("0.0", "0.0"))
-            if value[0] == "num":
-                self.body.append(f"{target} = ({value[1][0]}, {value[1][1]}) if k == 0 else (0.0, 0.0)")
-            else:
-                self.body.append(f"rh, rl = {self._combination(value[1])}")
-                self.body.append(f"{target} = dd_div_d(rh, rl, k + 1.0)")
+            self.body += [f"rh, rl = {self._combination(_terms(value))}",
+                          f"Th[(k + 1) * N + {m}], Tl[(k + 1) * N + {m}] = dd_div_d(rh, rl, k + 1.0)"]
 
     # ---- places
 
@@ -117,8 +118,14 @@ class _Program:
                 return b if a == ONE else _negative(b)
         return self._number(f"dd_mul({c[0]}, {c[1]}, {d[0]}, {d[1]})")
 
-    @staticmethod
-    def _sum(where: Any) -> tuple[str, Any]:
+    def _column(self) -> Any:
+        self.columns += 1
+        return ("S", self.columns - 1)
+
+    def _written(self, where: Any, *lines: str) -> tuple[str, Any]:
+        """The series in column ``where``, written by ``lines`` (appended here: products of it come after)."""
+        self.body += lines
+        self.ready[where] = len(self.body)
         return ("sum", {("s", where): ONE})
 
     def _series(self, value: tuple[str, Any]) -> Any:
@@ -128,11 +135,8 @@ class _Program:
             return next(iter(terms))[1]
         key = tuple(terms.items())
         if key not in self.written:
-            self.columns += 1
-            self.written[key] = where = ("S", self.columns - 1)
-            h, lo = self._at(where, "k")
-            self.body.append(f"{h}, {lo} = {self._combination(terms)}")
-            self.ready[where] = len(self.body)
+            self.written[key] = where = self._column()
+            self._written(where, "{}, {} = ".format(*self._at(where, "k")) + self._combination(terms))
         return self.written[key]
 
     def _combination(self, terms: dict[Any, tuple[str, str]]) -> str:
@@ -145,40 +149,25 @@ class _Program:
                 if loop is None:
                     self.body.append(loop := [])
                 loop.append((names, term[1], term[2]))
-        parts = []
-        for term, c in terms.items():
-            if term[0] == "1":
-                parts.append((("(1.0 if k == 0 else 0.0)", "0.0"), c))
-            else:
-                parts.append((self.written[term] if term[0] == "p" else self._at(term[1], "k"), c))
-        if len(parts) == 1:
-            (th, tl), c = parts[0]
-            if c in (ONE, _negative(ONE)):
-                return f"{th}, {tl}" if c == ONE else f"-{th}, -{tl}"
-            return f"dd_mul({c[0]}, {c[1]}, {th}, {tl})"
+        parts = [(self.written[term] if term[0] == "p" else self._at(term[1], "k") if term[0] == "s"
+                  else ("(1.0 if k == 0 else 0.0)", "0.0"), c) for term, c in terms.items()]
+        if len(parts) == 1 and parts[0][1] == ONE:
+            return ", ".join(parts[0][0])
         self.body.append("sh = sl = 0.0")
-        for (th, tl), c in parts:
-            if c in (ONE, _negative(ONE)):
-                sign = "" if c == ONE else "-"
-                self.body.append(f"sh, sl = sum_add(sh, sl, {sign}{th}, {sign}{tl})")
-            else:
-                self.body.append(f"sh, sl = dot_add(sh, sl, {c[0]}, {c[1]}, {th}, {tl})")
+        self.body += [f"sh, sl = dot_add(sh, sl, {c[0]}, {c[1]}, {th}, {tl})" for (th, tl), c in parts]
         return "dd_norm(sh, sl)"
 
     # ---- operations
 
     def _node(self, i: int, op: str, a: list[Any]) -> tuple[str, Any]:
         if op == "y":
-            return self._sum(("y", a[0]))
+            return ("sum", {("s", ("y", a[0])): ONE})
         if op == "const":
             return ("num", self._number(f"p[{TRACED_FIRST_CONSTANT + a[0]}], 0.0"))
         if op == "time":
-            self.columns += 1
-            where = ("S", self.columns - 1)
-            h, lo = self._at(where, "k")
-            self.body.append(f"{h}, {lo} = (t, 0.0) if k == 0 else ((1.0, 0.0) if k == 1 else (0.0, 0.0))")
-            self.ready[where] = len(self.body)
-            return self._sum(where)
+            where = self._column()
+            return self._written(where, "{}, {} = (t, 0.0) if k == 0 else ((1.0, 0.0) if k == 1 else (0.0, 0.0))"
+                                 .format(*self._at(where, "k")))
         series = [v for v in a if isinstance(v, tuple) and v[0] == "sum"]
         if not series and op == "ipow":  # a number's integer power: repeated products, once per call
             h, lo = self._number("1.0, 0.0")
@@ -189,15 +178,9 @@ class _Program:
         if not series:  # numbers only
             return ("num", self._number(self._numbers_op(op, a)))
         if op in ("add", "sub"):
-            x, y = (v if v[0] == "sum" else ("sum", {("1",): v[1]}) for v in a)
-            terms = dict(x[1])
-            for term, c in y[1].items():
-                c = _negative(c) if op == "sub" else c
-                terms[term] = self._number(f"dd_add({terms[term][0]}, {terms[term][1]}, {c[0]}, {c[1]})") \
-                    if term in terms else c
-            return ("sum", terms)
+            return self._plus(a[0], self._mul(("num", _negative(ONE)), a[1]) if op == "sub" else a[1])
         if op == "neg":
-            return ("sum", {term: _negative(c) for term, c in a[0][1].items()})
+            return self._mul(("num", _negative(ONE)), a[0])
         if op == "mul":
             return self._mul(a[0], a[1])
         if op == "div":
@@ -224,37 +207,39 @@ class _Program:
         args = [v[1][0] if isinstance(v, tuple) else v for v in a]
         return f"{_NUMBER_FUNCTIONS[op].format(*args)}, 0.0"
 
-    def _single(self, value: tuple[str, Any]) -> tuple[tuple[str, str], Any]:
-        """(c, where) with value = c·series: a one-series sum keeps its coefficient, any other is written out."""
-        terms = value[1]
-        if len(terms) == 1 and next(iter(terms))[0] == "s":
-            (_, where), c = next(iter(terms.items()))
-            return c, where
-        return ONE, self._series(value)
+    def _plus(self, *values: tuple[str, Any]) -> tuple[str, Any]:
+        terms: dict[Any, tuple[str, str]] = {}
+        for value in values:
+            for term, c in _terms(value).items():
+                terms[term] = self._number(f"dd_add({terms[term][0]}, {terms[term][1]}, {c[0]}, {c[1]})") \
+                    if term in terms else c
+        return ("sum", terms)
+
+    def _factor(self, value: tuple[str, Any]) -> tuple[tuple[str, str], Any, Any]:
+        """(c, a, d) with value = c·a + d for a series a and a number d (None for 0): a sum of one series and a
+        number keeps them, any other is written out."""
+        terms = dict(value[1])
+        d = terms.pop(("1",), None)
+        ((term, c),) = terms.items() if len(terms) == 1 else ((("",), ONE),)
+        return (c, term[1], d) if term[0] == "s" else (ONE, self._series(value), None)
 
     def _mul(self, x: tuple[str, Any], y: tuple[str, Any]) -> tuple[str, Any]:
         if x[0] == "num" or y[0] == "num":
             n, s = (x, y) if x[0] == "num" else (y, x)
-            return ("sum", {term: self._times(n[1], c) for term, c in s[1].items()})
-        (c, a), (d, b) = self._single(x), self._single(y)
-        return ("sum", {("p", *sorted((a, b))): self._times(c, d)})
+            return ("sum", {term: self._times(n[1], c) for term, c in _terms(s).items()})
+        (c, a, d), (e, b, f) = self._factor(x), self._factor(y)  # (c·a + d)(e·b + f) = c·e·ab + c·f·a + d·e·b + d·f
+        values = [("sum", {("p", *sorted((a, b))): self._times(c, e)})]
+        values += [("sum", {("s", s): self._times(g, h)}) for s, g, h in ((a, c, f), (b, e, d)) if h]
+        return self._plus(*values, *([("num", self._times(d, f))] if d and f else []))
 
     def _divide(self, x: tuple[str, Any], y: tuple[str, Any]) -> tuple[str, Any]:
         """f = x / y for a series y: f_k = (x_k − Σ_{j<k} f_j y_{k−j}) / y_0."""
-        self.columns += 1
-        where = ("S", self.columns - 1)
-        if x[0] == "num":
-            self.body.append(f"sh, sl = ({x[1][0]}, {x[1][1]}) if k == 0 else (0.0, 0.0)")
-        else:
-            self.body.append(f"sh, sl = {self._combination(x[1])}")
-        fh, fl = self._at(where, "j")
-        yh, yl = self._at(self._series(y), "k - j")
-        y0h, y0l = self._at(self._series(y), "0")
-        self.body += ["for j in range(k):", f"    sh, sl = dot_add(sh, sl, -{fh}, -{fl}, {yh}, {yl})"]
-        h, lo = self._at(where, "k")
-        self.body += ["sh, sl = dd_norm(sh, sl)", f"{h}, {lo} = dd_div(sh, sl, {y0h}, {y0l})"]
-        self.ready[where] = len(self.body)
-        return self._sum(where)
+        (yh, yl), (y0h, y0l) = self._at(self._series(y), "k - j"), self._at(self._series(y), "0")
+        where = self._column()
+        (fh, fl), (h, lo) = self._at(where, "j"), self._at(where, "k")
+        return self._written(where, f"sh, sl = {self._combination(_terms(x))}", "for j in range(k):",
+                             f"    sh, sl = dot_add(sh, sl, -{fh}, -{fl}, {yh}, {yl})", "sh, sl = dd_norm(sh, sl)",
+                             f"{h}, {lo} = dd_div(sh, sl, {y0h}, {y0l})")
 
     def _power(self, x: tuple[str, Any], n: int) -> tuple[str, Any]:
         """x^n by binary powering (Cauchy products), 1/x^|n| for n < 0."""
