@@ -96,7 +96,7 @@ class _Program:
         for m, rate in enumerate(model.rates):
             value = self.values[rate.index] if isinstance(rate, Expr) else ("num", ("0.0", "0.0"))
             self.body += [f"rh, rl = {self._combination(_terms(value))}",
-                          f"Th[(k + 1) * N + {m}], Tl[(k + 1) * N + {m}] = dd_div_d(rh, rl, k + 1.0)"]
+                          f"Th[(k + 1) * N + {m}], Tl[(k + 1) * N + {m}] = dd_mul(rh, rl, ih, il)"]
 
     # ---- places
 
@@ -260,6 +260,7 @@ class _Program:
 
     def source(self) -> str:
         body = [line for item in self.body for line in (self._loop(item) if isinstance(item, list) else [item])]
+        body = ["ih, il = dd_div_d(1.0, 0.0, k + 1.0)", *body]  # 1/(k + 1), once for every rate
         lines = [*self.numbers, "for k in range(order):", *[f"    {line}" for line in body]]
         text = _HEADER.format(columns=max(self.columns, 1), size=self.model.size)
         return text + "".join(f"    {line}\n" for line in lines)
