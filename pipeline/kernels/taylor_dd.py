@@ -35,13 +35,16 @@ MIN_TOL = 1e-32
 
 
 @inline_kernel
-def _horner(Th, Tl, order, m, hh, hl):
-    """Σ_{k=0}^{order} T[k, m] h^k in double-double, for a double-double h."""
-    vh, vl = Th[order, m], Tl[order, m]
+def _horner(Th, Tl, order, hh, hl, vh, vl):
+    """v[m] = Σ_{k=0}^{order} T[k, m] h^k in double-double for a double-double h, every component m side by side
+    (independent chains: one Horner sum alone waits on its own latency)."""
+    n = vh.size
+    for m in range(n):
+        vh[m], vl[m] = Th[order, m], Tl[order, m]
     for k in range(order - 1, -1, -1):
-        ph, pl = dd_mul(vh, vl, hh, hl)
-        vh, vl = dd_add(ph, pl, Th[k, m], Tl[k, m])
-    return vh, vl
+        for m in range(n):
+            ph, pl = dd_mul(vh[m], vl[m], hh, hl)
+            vh[m], vl[m] = dd_add(ph, pl, Th[k, m], Tl[k, m])
 
 
 @intrinsic
@@ -73,6 +76,7 @@ def run(model, p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stat
     n = yh.size
     Th = np.zeros((order + 1, n))
     Tl = np.zeros((order + 1, n))
+    vh, vl = np.empty(n), np.empty(n)
     S = np.zeros((order + 1) * 2 * int(p[p.size - 1]))
     address = int(p[p.size - 2])
     low = Ylo.shape[0] == Y.shape[0]
@@ -97,16 +101,16 @@ def run(model, p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stat
             break
         while i < n_out and t_out[i] <= t_new:
             dh, dl = two_sum(t_out[i], -t)  # the offset, exact
+            _horner(Th, Tl, order, dh, dl, vh, vl)
             for m in range(n):
-                vh, vl = _horner(Th, Tl, order, m, dh, dl)
-                Y[i, m] = vh
+                Y[i, m] = vh[m]
                 if low:
-                    Ylo[i, m] = vl
+                    Ylo[i, m] = vl[m]
             i += 1
         hh, hl = two_sum(t_new, -t)  # the step taken, exact
+        _horner(Th, Tl, order, hh, hl, yh, yl)
         finite = True
         for m in range(n):
-            yh[m], yl[m] = _horner(Th, Tl, order, m, hh, hl)
             finite = finite and math.isfinite(yh[m]) and math.isfinite(yl[m])
         if not finite:
             code = NOT_FINITE
