@@ -65,17 +65,9 @@ BUILTINS: dict[str, dict[str, str]] = {
 }
 
 
-#: import paths of gyrolab 0.1 (top-level ``plugins``), still found in configs stored in older datasets
-_LEGACY_PREFIXES = {"plugins.": "gyrolab.plugins."}
-
-
 def _normalise(target: str) -> str:
-    """'pkg.mod:Cls' and 'pkg.mod.Cls' name the same class; a 0.1 path names its class of today."""
-    target = target.replace(":", ".")
-    for old, new in _LEGACY_PREFIXES.items():
-        if target.startswith(old):
-            return new + target[len(old):]
-    return target
+    """'pkg.mod:Cls' and 'pkg.mod.Cls' name the same class."""
+    return target.replace(":", ".")
 
 
 class PluginLoadWarning(GyrolabWarning):
