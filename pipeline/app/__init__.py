@@ -64,7 +64,7 @@ from gyrolab.engine.scene import Scene
 from gyrolab.engine.unread import ACCURACY, given_keys, ignored_accuracy, unread_accuracy
 from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
-from gyrolab.experiments import TASKS, check_task, refuse_unread, run_task
+from gyrolab.experiments import TASKS, check_task, refuse_unread, run_task, task_of
 from gyrolab.figures.options import figure_options
 from gyrolab.output.atomic import reason
 from gyrolab.output.dataset import write_dataset
@@ -492,12 +492,6 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     for figure in draw_figures("run.nc", ds, out_dir, cfg.output):
         announce_written(figure)
     return path
-
-
-def task_of(cfg: DictConfig) -> str:
-    """What a run does: an experiment's task, a regime comparison when a regime is chosen, else the scene."""
-    task = cfg.get("task") or "scene"
-    return "regime" if task == "scene" and cfg.get("regime") else task
 
 
 def _quiet_console() -> None:
