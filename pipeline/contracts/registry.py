@@ -95,6 +95,13 @@ def external(group: str) -> dict[str, str]:
     return {name: ep.value for name, ep in found.items()}
 
 
+def plugin_entry_points() -> list[Any]:
+    """The entry point of every registered third-party plugin, of every group (read once, by ``external``)."""
+    for group in GROUPS:
+        external(group)
+    return [ep for group in GROUPS for ep in _ENTRY_POINTS[group].values()]
+
+
 def origin(group: str, name: str) -> str:
     """Where a registered plugin comes from, for error sentences: "distribution 'x' (entry point a = m:C)"."""
     external(group)  # (re)reads the entry points when the cache was cleared
