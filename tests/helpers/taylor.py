@@ -32,3 +32,14 @@ def single_kernel_runs(compiled, P, integrator, times, y0s):
           np.ascontiguousarray(y0s, dtype=float), out, steps, status)
     assert not status.any()
     return out, steps
+
+
+def fixed_point_rows(overrides, a_values, k_values):
+    """Per-trajectory parameter rows of the fixed point with A/C = a_values[j] and the Newtonian k = k_values[j]
+    (each row a scene of its own, composed from ``overrides``): (the compiled models' rows, their packed built-in
+    parameters for the references)."""
+    from gyrolab import compose_scene
+
+    scenes = [compose_scene([*overrides, f"body.a={a}", f"force.newtonian.k={k}"])
+              for a, k in zip(a_values, k_values)]
+    return (np.array([s.compiled.params for s in scenes]), np.array([s.compiled.built_in for s in scenes]))

@@ -8,7 +8,7 @@ from gyrolab import compose_scene
 from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.kernels import batch_dop853, batch_taylor
-from tests.helpers.taylor import single_kernel_runs
+from tests.helpers.taylor import fixed_point_rows, single_kernel_runs
 
 SHORT = ["experiment=perf_reference", "time.end=2", "time.n_output=11"]
 SETTINGS = {"dop853_numba": ["integrator.rtol=1e-10", "integrator.atol=1e-10"], "taylor": ["integrator.tol=1e-10"]}
@@ -76,10 +76,8 @@ def test_taylor_lanes_take_the_steps_of_the_single_trajectory_kernel():
     scene = _scene("taylor")
     y0s = _starts(scene, 11, seed=7)
     y0s[::3, 0:3] *= 4.0
-    P = np.tile(scene.compiled.params, (len(y0s), 1))
-    P[:, 0] *= np.linspace(0.9, 1.1, len(y0s))  # A (and 1/A: parameters as fixed_point.pack lays them out)
-    P[:, 16] = 1.0 / P[:, 0]
-    P[:, 14] *= np.linspace(0.0, 2.0, len(y0s))  # N_2
+    P, _ = fixed_point_rows([*SHORT, "integrator=taylor", *SETTINGS["taylor"], "output.euler_angles=false"],
+                            2.0 * np.linspace(0.9, 1.1, len(y0s)), 0.5 * np.linspace(0.0, 2.0, len(y0s)))
     batch = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s, P)
     out, steps = single_kernel_runs(scene.compiled, P, scene.integrator, scene.times, y0s)
     assert steps.min() < steps.max() / 2  # the mix: some take twice the steps of others

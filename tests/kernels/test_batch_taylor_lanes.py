@@ -12,7 +12,7 @@ from gyrolab import compose_scene
 from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.kernels import batch_taylor, taylor
 from gyrolab.kernels.layout import N_Z
-from tests.helpers.taylor import single_kernel_runs
+from tests.helpers.taylor import fixed_point_rows, single_kernel_runs
 
 LANES = batch_taylor.LANES
 
@@ -61,9 +61,11 @@ def test_vector_step_sizes_are_the_scalar_rule_to_rounding():
         np.testing.assert_allclose(vector[kept], scalar[kept], rtol=1e-13, atol=0)
 
 
+SCENE = ["experiment=perf_reference", "time.end=2", "time.n_output=11", "integrator=taylor"]
+
+
 def _scene(extra=()):
-    return compose_scene(["experiment=perf_reference", "time.end=2", "time.n_output=11", "integrator=taylor",
-                          *extra])
+    return compose_scene([*SCENE, *extra])
 
 
 def _starts(scene, count, seed, scale=0.1):
@@ -74,22 +76,22 @@ def _starts(scene, count, seed, scale=0.1):
 
 
 def test_lanes_follow_the_extended_precision_reference():
-    """The generated lanes (the fixed point's equations traced over its packed parameters) against an independent
-    oracle, ``physics.reference`` (the Euler–Poisson equations' own Taylor series summed in long double, not
-    these kernels): spins up to four times the reference's and N₂ from 0 to 2, tol 1e-15 at order 18 on
-    t ∈ [0, 2]: every output within 1e-12."""
+    """The generated lanes (the fixed point's traced equations) against an independent oracle,
+    ``physics.reference`` (the Euler–Poisson equations' own Taylor series summed in long double, not these
+    kernels): spins up to four times the reference's and N₂ from 0 to 2, tol 1e-15 at order 18 on t ∈ [0, 2]:
+    every output within 1e-12."""
     from gyrolab.physics.reference import fixed_point_reference
     from gyrolab.kernels.layout import INERTIA, U_Z
 
-    scene = _scene(["integrator.tol=1e-15", "integrator.order=18"])
+    extra = ["integrator.tol=1e-15", "integrator.order=18"]
+    scene = _scene(extra)
     y0s = _starts(scene, LANES + 3, seed=11)
     y0s[::3, 0:3] *= 4.0
-    P = np.tile(scene.compiled.params, (len(y0s), 1))
-    P[:, N_Z] = np.linspace(0.0, 2.0, len(y0s))
+    P, packed = fixed_point_rows(SCENE + extra, np.full(len(y0s), 2.0), np.linspace(0.0, 2.0, len(y0s)))
     batch = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s, P)
     for j in range(len(y0s)):
-        reference = fixed_point_reference(P[j, INERTIA:INERTIA + 3], P[j, U_Z:U_Z + 3], P[j, N_Z], y0s[j],
-                                          scene.times).astype(float)
+        reference = fixed_point_reference(packed[j, INERTIA:INERTIA + 3], packed[j, U_Z:U_Z + 3], packed[j, N_Z],
+                                          y0s[j], scene.times).astype(float)
         assert np.max(np.abs(batch.y[j] - reference)) < 1e-12
 
 
@@ -98,8 +100,7 @@ def test_a_trajectory_in_a_mixed_batch_is_computed_as_alone():
     follows from its own parameters and state, never from its neighbours)."""
     scene = _scene()
     y0s = _starts(scene, 2 * LANES + 3, seed=13)
-    P = np.tile(scene.compiled.params, (len(y0s), 1))
-    P[::3, N_Z] = 0.0
+    P, _ = fixed_point_rows(SCENE, np.full(len(y0s), 2.0), np.where(np.arange(len(y0s)) % 3 == 0, 0.0, 0.5))
     mixed = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s, P)
     for j in (0, 1, 3, len(y0s) - 1):
         alone = integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s[j:j + 1], P[j:j + 1])
