@@ -287,51 +287,17 @@ def test_batch_sweep_of_a_plugin_parameter_under_taylor_is_the_exact_decay(cli, 
 REFERENCE = ["experiment=perf_reference", "integrator=taylor", "time.end=30", "time.n_output=31"]
 
 
-def _cauchy_series(inertia, u, n, y0, order):
-    """The Euler–Poisson Taylor coefficients of (ω, γ) by Cauchy products in numpy, written here independently of the
-    generated kernels: I ω' = (Iω) × ω + U × γ + N γ × Iγ, γ' = γ × ω, coefficient k + 1 = (that of the rate) / (k + 1)."""
-    w, g = [np.array(y0[:3], dtype=float)], [np.array(y0[3:], dtype=float)]
-
-    def cauchy_cross(a, b, k):
-        return sum(np.cross(a[j], b[k - j]) for j in range(k + 1))
-
-    for k in range(order):
-        rate_w = (cauchy_cross([inertia * x for x in w], w, k) + np.cross(u, g[k])
-                  + n * cauchy_cross(g, [inertia * x for x in g], k)) / inertia
-        w.append(rate_w / (k + 1))
-        g.append(cauchy_cross(g, w, k) / (k + 1))
-    return np.hstack([np.array(w), np.array(g)])
-
-
-def test_the_fixed_points_generated_series_and_trajectory_against_independent_references():
-    """Gravity + Newtonian centre (the built-in torques, their equations traced into the generated series kernel):
-    every coefficient against Cauchy products written in numpy here (to rounding), the same torques traced as a
-    plugin's give the same trajectory, and the run ends on the extended-precision reference."""
-    import numba
-
-    from gyrolab.kernels import layout
+def test_the_fixed_points_traced_torques_give_the_same_trajectory_as_a_plugins_and_the_reference():
+    """Gravity + Newtonian centre (the built-in torques traced into the generated kernels) and the same torques traced
+    as a plugin's: the same trajectory to round-off, ending on the extended-precision reference (the coefficients
+    against extended-precision Cauchy products: tests/kernels/test_taylor_step.py)."""
     from gyrolab.physics.reference import fixed_point_reference
 
     scene = compose_scene(REFERENCE)
     system = scene.system
     builtin = system.compiled_model()
     plugin = traced_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
-    assert taylor_series.ready(builtin) and taylor_series.ready(plugin)
     y0 = system.initial_state()
-    packed = builtin.built_in
-
-    @numba.njit
-    def series(model, p, y, order):
-        T = np.zeros((order + 1, y.size))
-        T[0] = y
-        models.taylor_coefficients(model, p, T, order, np.zeros((order + 1, 3)))
-        return T
-
-    for order in (1, 2, 3, 16, 30):  # the Cauchy loops' edge cases (no middle rows, one, an odd count) and beyond
-        ours = series(models.form(builtin), builtin.params, y0, order)
-        theirs = _cauchy_series(system.inertia, packed[layout.U_Z:layout.U_Z + 3], packed[layout.N_Z], y0, order)
-        for k in range(order + 1):
-            np.testing.assert_allclose(ours[k], theirs[k], rtol=0, atol=1e-14 * np.abs(theirs[k]).max(), err_msg=k)
     runs = [Taylor(tol=1e-14).integrate(None, scene.times, y0, None, m).y for m in (builtin, plugin)]
     np.testing.assert_allclose(runs[1], runs[0], rtol=0, atol=1e-12)
     exact = fixed_point_reference(system.inertia, system.body.weight_moment, 0.5, y0, [0.0, 30.0])[-1].astype(float)
