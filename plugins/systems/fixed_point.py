@@ -189,8 +189,6 @@ class FixedPoint(System):
         from gyrolab.kernels import fixed_point  # start-up: the compiled kernels import numba
 
         packed = fixed_point.built_in(self.inertia, self.forces, self.carries_alpha)
-        if packed is not None and not self.carries_alpha:
-            return CompiledModel(0, packed, built_in=packed)  # models.FIXED_POINT
         compiled = super().compiled_model()
         return compiled if compiled is None or packed is None else replace(compiled, built_in=packed)
 
