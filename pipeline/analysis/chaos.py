@@ -37,10 +37,10 @@ FLI_DEFINITION = ("fast Lyapunov indicator (Froeschle, Lega & Gonczi 1997): max 
 #: an adaptive run reads max ln|δ| and max |θ − θ0| at the requested times and this many more, evenly spread (its
 #: dense output: no extra step); a fixed-step run reads them after every step
 FLI_SAMPLES = 256
-#: a fixed-step run's outputs per call of the batch kernel (it runs on from the last one): the memory of reading
-#: every step stays bounded (trajectories × WINDOW × (2n + 3) doubles)
-WINDOW = 512
-
+#: bytes of samples one call of a batch kernel may hold (trajectories × samples × (2n + 3) doubles, ``batch.memory``'s
+#: default): a fixed-step run goes on from its last sample in windows of time (the same steps: bit for bit the
+#: result of one call), an adaptive run takes the trajectories in groups (each its own steps: independent)
+MEMORY = 64 * 2**20
 
 def _traced(compiled: Any) -> Any:
     """The traced model behind ``compiled``; one ConfigError when there is none (no compiled model)."""
@@ -118,36 +118,41 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
     sphere = slice(n - 3, n)
     on_sphere = np.allclose(np.linalg.norm(y0s[:, sphere], axis=1), 1.0, atol=1e-9)
     z0 = tangent.initial_augmented(y0s, tangent.direction(y0s, sphere if on_sphere else None))
-    if settings.fixed_step:  # every step an output: the grid of the steps, in windows
+    width = z0.shape[1]
+    if settings.fixed_step:  # every step an output: the grid of the steps, in windows of time
         steps = steps_per_interval(times, float(settings.step))
         grid = np.concatenate([times[:1]] + [np.linspace(a, b, k + 1)[1:] for a, b, k in
                                              zip(times[:-1], times[1:], steps)])
         method = RK4Numba(step=float(settings.step))
-        windows = range(0, grid.size - 1, WINDOW)
+        window = max(64, MEMORY // (len(y0s) * width * 8))
+        parts = [(slice(None), first, min(first + window, grid.size - 1)) for first in range(0, grid.size - 1, window)]
     else:
         grid = np.union1d(times, np.linspace(times[0], times[-1], FLI_SAMPLES + 1))
         method = DOP853Numba(rtol=float(settings.rtol), atol=float(settings.atol),
                              max_step=float(settings.max_step) if np.isfinite(settings.max_step) else None)
-        windows = range(0, 1)
+        group = max(256, MEMORY // (grid.size * width * 8))
+        parts = [(slice(r, r + group), 0, grid.size - 1) for r in range(0, len(y0s), group)]
     requested = np.searchsorted(grid, times)
     b = np.zeros((len(y0s), times.size))  # the quadrature b at the requested times
     fli, low, high = np.zeros(len(y0s)), z0[:, n - 1].copy(), z0[:, n - 1].copy()  # max ℓ; min, max of γ3
     failed = np.zeros(len(y0s), dtype=bool)
     taken = np.zeros(len(y0s), dtype=np.int64)
-    z = z0[:, None, :]
-    for first in windows:
-        stop = grid.size - 1 if not settings.fixed_step else min(first + WINDOW, grid.size - 1)
+    last = z0.copy()
+    for rows, first, stop in parts:
         t = grid[first:stop + 1] - times[0]
         if first == 0:
             t[0] = tangent.START
-        run = method.integrate_batch(augmented, t, np.ascontiguousarray(z[:, -1]), P, "mark")
+        run = method.integrate_batch(augmented, t, np.ascontiguousarray(last[rows]), np.ascontiguousarray(P[rows]),
+                                     "mark")
         z = run.y
-        failed |= np.asarray(run.failed, dtype=bool)
-        taken += run.steps if run.steps is not None else run.n_steps
-        fli = np.maximum(fli, z[:, :, 2 * n].max(axis=1))
-        low, high = np.minimum(low, z[:, :, n - 1].min(axis=1)), np.maximum(high, z[:, :, n - 1].max(axis=1))
-        inside = (requested >= first) & (requested <= stop)
-        b[:, inside] = z[:, requested[inside] - first, 2 * n + 2]
+        last[rows] = z[:, -1]
+        failed[rows] |= np.asarray(run.failed, dtype=bool)
+        taken[rows] += run.steps if run.steps is not None else run.n_steps
+        fli[rows] = np.maximum(fli[rows], z[:, :, 2 * n].max(axis=1))
+        low[rows] = np.minimum(low[rows], z[:, :, n - 1].min(axis=1))
+        high[rows] = np.maximum(high[rows], z[:, :, n - 1].max(axis=1))
+        inside = np.flatnonzero((requested >= first) & (requested <= stop))
+        b[rows, inside] = z[:, requested[inside] - first, 2 * n + 2]
     megno = np.zeros((len(y0s), times.size))
     megno[:, 1:] = b[:, 1:] / (times[1:] - times[0])
     failed |= ~np.isfinite(megno[:, -1])
@@ -156,7 +161,7 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
     megno[failed] = np.nan
     return {"megno": megno if every_time else megno[:, -1:], "fli": np.where(failed, np.nan, fli),
             "max_nutation_deviation": np.where(failed | (not on_sphere), np.nan, deviation),
-            "final_state": np.where(failed[:, None], np.nan, z[:, -1, :n]), "failed": failed, "steps": taken}
+            "final_state": np.where(failed[:, None], np.nan, last[:, :n]), "failed": failed, "steps": taken}
 
 
 def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray,
