@@ -206,6 +206,23 @@ def test_trajectories_are_independent_across_blocks_and_a_failure_stays_local():
             np.testing.assert_array_equal(alone[key][0], batch[key][j])
 
 
+def test_reading_every_step_in_windows_or_the_trajectories_in_groups_changes_nothing(monkeypatch):
+    """A fixed-step run goes on from its last step in windows of time, an adaptive run takes the trajectories in
+    groups, both when the samples would exceed chaos.MEMORY: bit for bit the results of one call."""
+    from gyrolab.analysis import chaos
+
+    scene = _scene(*CHAOTIC)
+    y0 = _states(scene, np.linspace(0.2, 2.8, 300), np.linspace(0.2, 4.0, 300))
+    compiled, times = scene.system.compiled_model(), np.array([0.0, 1.0, 3.0])
+    dop = compose_scene(["integrator=dop853_numba", "integrator.rtol=1e-8", "integrator.atol=1e-8"]).integrator
+    whole = [megno_run(compiled, integrator, times, y0) for integrator in (scene.integrator, dop)]
+    monkeypatch.setattr(chaos, "MEMORY", 1)  # windows of 64 steps (300 steps: 5), groups of 256 trajectories (2)
+    for integrator, expected in zip((scene.integrator, dop), whole):
+        parts = megno_run(compiled, integrator, times, y0)
+        for key in ("megno", "fli", "max_nutation_deviation", "final_state", "steps"):
+            np.testing.assert_array_equal(parts[key], expected[key])
+
+
 def test_a_state_carrying_alpha_gives_the_same_indicators():
     with_alpha = _scene(*CHAOTIC[:2], "output.euler_angles=true")
     without = _scene(*CHAOTIC[:2])
