@@ -138,21 +138,21 @@ def megno_run(compiled: Any, integrator: Any, times: np.ndarray, y0s: np.ndarray
     failed = np.zeros(len(y0s), dtype=bool)
     taken = np.zeros(len(y0s), dtype=np.int64)
     last = z0.copy()
-    for rows, first, stop in parts:
+    for which, first, stop in parts:
         t = grid[first:stop + 1] - times[0]
         if first == 0:
             t[0] = tangent.START
-        run = method.integrate_batch(augmented, t, np.ascontiguousarray(last[rows]), np.ascontiguousarray(P[rows]),
+        run = method.integrate_batch(augmented, t, np.ascontiguousarray(last[which]), np.ascontiguousarray(P[which]),
                                      "mark")
         z = run.y
-        last[rows] = z[:, -1]
-        failed[rows] |= np.asarray(run.failed, dtype=bool)
-        taken[rows] += run.steps if run.steps is not None else run.n_steps
-        fli[rows] = np.maximum(fli[rows], z[:, :, 2 * n].max(axis=1))
-        low[rows] = np.minimum(low[rows], z[:, :, n - 1].min(axis=1))
-        high[rows] = np.maximum(high[rows], z[:, :, n - 1].max(axis=1))
+        last[which] = z[:, -1]
+        failed[which] |= np.asarray(run.failed, dtype=bool)
+        taken[which] += run.steps if run.steps is not None else run.n_steps
+        fli[which] = np.maximum(fli[which], z[:, :, 2 * n].max(axis=1))
+        low[which] = np.minimum(low[which], z[:, :, n - 1].min(axis=1))
+        high[which] = np.maximum(high[which], z[:, :, n - 1].max(axis=1))
         inside = np.flatnonzero((requested >= first) & (requested <= stop))
-        b[rows, inside] = z[:, requested[inside] - first, 2 * n + 2]
+        b[which, inside] = z[:, requested[inside] - first, 2 * n + 2]
     megno = np.zeros((len(y0s), times.size))
     megno[:, 1:] = b[:, 1:] / (times[1:] - times[0])
     failed |= ~np.isfinite(megno[:, -1])
