@@ -44,7 +44,7 @@ import xarray as xr
 from gyrolab.contracts.claims import _rotation, random_states, rotation_torque  # noqa: F401
 from gyrolab.contracts.claims import axes_of as _axes
 from gyrolab.contracts.force import Force
-from gyrolab.contracts.integrator import Integrator, IntegratorStats, Solution
+from gyrolab.contracts.integrator import COMPILED_MODEL, Integrator, IntegratorStats, Solution
 from gyrolab.contracts.integrator_rules import unchecked
 from gyrolab.contracts.regime import Regime
 from gyrolab.contracts.system import System
@@ -345,7 +345,7 @@ def check_integrator(cls: type, **params: Any) -> None:
        returns non-finite values, and never returns a finite "solution" past the blow-up;
     8. ``attributes()`` and ``stats.attributes()`` are netCDF-safe.
 
-    A compiled integrator (``needs_compiled_model``) integrates the compiled model it is given, not ``fun``: rules
+    A compiled integrator (``COMPILED_MODEL``) integrates the compiled model it is given, not ``fun``: rules
     3–6 are then checked on the free symmetric top (``free_top_problem``: gyrolab's fixed-point system with A = B
     and no torque, whose ω turns at a constant rate), ``nfev`` > 0 only, and rule 7 is skipped (a blow-up has no
     compiled model).
@@ -363,7 +363,7 @@ def check_integrator(cls: type, **params: Any) -> None:
     params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
     integrator = _build_plugin(cls, params)
     _check_bad_plugin_parameters(cls, params, "integrator")
-    if cls.needs_compiled_model:
+    if cls.supports(COMPILED_MODEL):
         stats = _check_exact_problem(cls, integrator, free_top_problem())
     else:
         stats = _check_exact_problem(cls, integrator, oscillator_problem())

@@ -64,7 +64,7 @@ from gyrolab.engine.scene import Scene
 from gyrolab.engine.unread import ACCURACY, given_keys, ignored_accuracy, unread_accuracy
 from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
-from gyrolab.experiments import TASKS, check_task, refuse_unread, run_task
+from gyrolab.experiments import TASKS, check_task, refuse_unread, run_task, task_of
 from gyrolab.figures.options import figure_options
 from gyrolab.output.atomic import reason
 from gyrolab.output.dataset import write_dataset
@@ -494,12 +494,6 @@ def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: boo
     return path
 
 
-def task_of(cfg: DictConfig) -> str:
-    """What a run does: an experiment's task, a regime comparison when a regime is chosen, else the scene."""
-    task = cfg.get("task") or "scene"
-    return "regime" if task == "scene" and cfg.get("regime") else task
-
-
 def _quiet_console() -> None:
     """On a terminal, a sweep job logs warnings only to the console (all of it goes to its log file)."""
     if not on_terminal(sys.stderr):
@@ -577,6 +571,9 @@ def main() -> None:
     # ~1 s of every command's wall time (0.1 s after a freeze, measured). Files are closed explicitly, so
     # nothing needs that collection's finalisers.
     atexit.register(gc.freeze)
+    # What the imports built lives until exit, so no collection during the command need walk it again (−0.07 CPU s
+    # of the default run, measured).
+    gc.freeze()
     show_warnings_in_one_line()
     quiet_logging_failures()
     install_dask_free_writes()  # run.nc and sweep.nc hold numpy arrays: writing them need not import Dask

@@ -23,7 +23,7 @@ from gyrolab.engine.budget import check_sweep_size, check_tolerances
 from gyrolab.engine.config import check_scene_config, compose_config
 from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.errors import ConfigError, shorten
-from gyrolab.experiments import BATCH_COMMAND, refuse_unread, reproduce_task, task_of_config
+from gyrolab.experiments import BATCH_COMMAND, refuse_unread, reproduce_task, task_of
 from gyrolab.figures.options import figure_options
 from gyrolab.figures.redraw import redraw
 from gyrolab.output.trust import check_kernel_cache, check_tree
@@ -142,7 +142,7 @@ def reproduce(args: argparse.Namespace) -> int:
         print("\n".join(report(path, comparison, stored, head)))
         return 0 if comparison.identical else 1
     cfg = checked_config(path, stored)
-    task = task_of_config(cfg)
+    task = task_of(cfg)
     if args.points is not None and (task != "scene" or not is_batch(stored)):
         raise ConfigError(f"--points chooses points of a sweep.nc, and {path} is "
                           f"{'one run' if task == 'scene' else f'the dataset of task {task}'}; give it without --points")

@@ -18,7 +18,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import numba
 import numpy as np
 
 from gyrolab.physics.attitude import nutation_and_spin
@@ -48,21 +47,13 @@ def output_times(times: np.ndarray, mode: str, decimate: int) -> np.ndarray:
 
 
 def state_outputs(mode: str, decimate: int, times: np.ndarray, y: np.ndarray,
-                  groups: Sequence[tuple[Any, np.ndarray]], compiled: Any = None, params: np.ndarray | None = None
-                  ) -> dict[str, Output]:
+                  groups: Sequence[tuple[Any, np.ndarray]]) -> dict[str, Output]:
     """The outputs of ``mode`` (not ``indicator``) for trajectories ``y`` (points × times × state).
 
     ``groups`` are (system, rows): the rows of ``y`` to compute with each system — the system built with
-    those points' body and forces (energy and units depend on them); other rows stay NaN. With the
-    fixed-point system's compiled model (``compiled``, ``params`` per row of ``y``) the reductions run
-    compiled, in one pass over the trajectories.
+    those points' body and forces (energy and units depend on them); other rows stay NaN.
     """
     outputs: dict[str, Output] = {}
-    reduced = None   # the compiled reductions of every row at once (one kernel call for all groups)
-    if mode == "reductions" and compiled is not None and y.size \
-            and all(_compiled_reductions(compiled, system, y.shape[2]) for system, _ in groups):
-        reduced = np.empty((len(y), 5))
-        _reduce_fixed_point(np.ascontiguousarray(y), np.ascontiguousarray(params), reduced)
     for system, index in groups:
         index = np.asarray(index)
         if not index.size:
@@ -80,9 +71,7 @@ def state_outputs(mode: str, decimate: int, times: np.ndarray, y: np.ndarray,
             continue
         finals = _final_variables(system, times, y[index, -1])
         _place(outputs, finals, index, len(y))
-        if reduced is not None:
-            _place(outputs, _fixed_point_reductions(system, reduced[index]), index, len(y))
-        elif mode == "reductions":   # by blocks of points that fit in the cache (numpy streams each operation)
+        if mode == "reductions":   # by blocks of points that fit in the cache (numpy streams each operation)
             for lo in range(0, len(index), REDUCTION_BLOCK):
                 rows = index[lo:lo + REDUCTION_BLOCK]
                 block = y[rows]
@@ -124,77 +113,6 @@ def _drifts(system: Any, y: np.ndarray) -> dict[str, tuple[np.ndarray, dict[str,
         drift = np.max(np.abs(series - series[:, :1]), axis=1)
         out[name + DRIFT_SUFFIX] = (drift, _drift_attrs(name, units))
     return out
-
-
-def _compiled_reductions(compiled: Any, system: Any, size: int) -> bool:
-    """The compiled reductions cover the fixed-point model with the packed torque forms only."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import fixed_point, models
-
-    return compiled.model == models.FIXED_POINT and compiled.params.size == fixed_point.N_PARAMS \
-        and size in (6, 9) and hasattr(system, "invariant_values")
-
-
-def _fixed_point_reductions(system: Any, out: np.ndarray) -> dict[str, tuple]:
-    """The outputs of ``_reduce_fixed_point``'s rows ``out`` for points of ``system`` (its invariants, units)."""
-    units = _units(system)
-    part = {}
-    for k, name in enumerate(("energy", "area_integral", "gamma_norm", "frame_error")):
-        if name in system.invariants:
-            part[name + DRIFT_SUFFIX] = ((), out[:, k], _drift_attrs(name, units))
-    part[NUTATION] = ((), out[:, 4], dict(NUTATION_ATTRS))
-    return part
-
-
-@numba.njit(cache=True, parallel=True, error_model="numpy")
-def _reduce_fixed_point(y, p, out):
-    """Per trajectory of y (points × times × state (ω, γ[, α])) with packed parameters p (``fixed_point.pack``):
-    max |I(t) − I(0)| of the energy ½ω·Iω − Σ U_i·e_i + Σ ½ N_i e_i·I e_i (the potentials of the packed
-    torques U_i × e_i and N_i e_i × I e_i), of the area integral Iω·γ, of |γ| and of the frame error
-    max(| |α| − 1 |, |α·γ|); and max |θ(t) − θ(0)|, θ = atan2(|γ_xy|, γ_z).
-
-    θ decreases monotonically with cos θ = γ_z/|γ|, so the samples of the largest and smallest θ are those of
-    the smallest and largest γ_z/|γ|: θ (atan2) is evaluated at those two samples only, not at every one."""
-    n_points, n_times, size = y.shape
-    for j in numba.prange(n_points):
-        I0, I1, I2 = p[j, 0], p[j, 1], p[j, 2]
-        e0 = a0 = n0 = f0 = 0.0
-        de = da = dn = fmax = 0.0
-        c_lo, c_hi, i_lo, i_hi = np.inf, -np.inf, 0, 0
-        for i in range(n_times):
-            w0, w1, w2 = y[j, i, 0], y[j, i, 1], y[j, i, 2]
-            g0, g1, g2 = y[j, i, 3], y[j, i, 4], y[j, i, 5]
-            energy = 0.5 * (I0 * w0 * w0 + I1 * w1 * w1 + I2 * w2 * w2) \
-                - (p[j, 9] * g0 + p[j, 10] * g1 + p[j, 11] * g2) \
-                + 0.5 * p[j, 14] * (I0 * g0 * g0 + I1 * g1 * g1 + I2 * g2 * g2)
-            frame = 0.0
-            if size == 9:
-                x0, x1, x2 = y[j, i, 6], y[j, i, 7], y[j, i, 8]
-                b0, b1, b2 = g1 * x2 - g2 * x1, g2 * x0 - g0 * x2, g0 * x1 - g1 * x0
-                energy += -(p[j, 3] * x0 + p[j, 4] * x1 + p[j, 5] * x2) - (p[j, 6] * b0 + p[j, 7] * b1 + p[j, 8] * b2) \
-                    + 0.5 * p[j, 12] * (I0 * x0 * x0 + I1 * x1 * x1 + I2 * x2 * x2) \
-                    + 0.5 * p[j, 13] * (I0 * b0 * b0 + I1 * b1 * b1 + I2 * b2 * b2)
-                frame = max(abs(np.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - 1.0), abs(x0 * g0 + x1 * g1 + x2 * g2))
-            area = I0 * w0 * g0 + I1 * w1 * g1 + I2 * w2 * g2
-            gnorm = np.sqrt(g0 * g0 + g1 * g1 + g2 * g2)
-            cosine = g2 / gnorm
-            if cosine < c_lo:
-                c_lo, i_lo = cosine, i
-            if cosine > c_hi:
-                c_hi, i_hi = cosine, i
-            if i == 0:
-                e0, a0, n0, f0 = energy, area, gnorm, frame
-            de = max(de, abs(energy - e0))
-            da = max(da, abs(area - a0))
-            dn = max(dn, abs(gnorm - n0))
-            fmax = max(fmax, abs(frame - f0))
-        th0 = np.arctan2(np.hypot(y[j, 0, 3], y[j, 0, 4]), y[j, 0, 5])
-        th_hi = np.arctan2(np.hypot(y[j, i_lo, 3], y[j, i_lo, 4]), y[j, i_lo, 5])
-        th_lo = np.arctan2(np.hypot(y[j, i_hi, 3], y[j, i_hi, 4]), y[j, i_hi, 5])
-        dth = max(abs(th_hi - th0), abs(th_lo - th0))
-        if not (c_lo <= c_hi):   # a non-finite γ: NaN, as the per-sample maximum gave
-            dth = np.nan
-        out[j, 0], out[j, 1], out[j, 2], out[j, 3], out[j, 4] = de, da, dn, fmax, dth
 
 
 def _drift_attrs(name: str, units: Mapping[str, str]) -> dict[str, str]:

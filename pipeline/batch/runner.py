@@ -346,8 +346,8 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
         failed = np.asarray(solution.failed, dtype=bool)
         settings = solution.settings
         with np.errstate(invalid="ignore"):   # every row, so that a chunk whose points all failed still has its
-            outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, groups, compiled,
-                                    task.params)   # variables (the store is created from the first chunk's)
+            # (every variable: the store is created from the first chunk's)
+            outputs = state_outputs(task.output, task.decimate, solution.t, solution.y, groups)
         for out in outputs.values():
             out.data[failed] = np.nan
     all_failed = np.zeros(task.n_rows, dtype=bool)

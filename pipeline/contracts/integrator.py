@@ -70,9 +70,9 @@ class Solution:
 # tests an integrator's name). Each is a rule of the contract (C1-C7 in ``Integrator``'s docstring); docs/plugins.md,
 # "Integrator capabilities", says what the engine does with each and which built-ins have it.
 
-#: C1: integrates the system's compiled model (``compiled``) instead of calling ``fun`` (alias: ``needs_compiled_model``)
+#: C1: integrates the system's compiled model (``compiled``) instead of calling ``fun``
 COMPILED_MODEL = "compiled_model"
-#: C2: integrates the compiled model when the system has one, ``fun`` otherwise (alias: ``prefers_compiled_model``)
+#: C2: integrates the compiled model when the system has one, ``fun`` otherwise
 PREFERS_COMPILED_MODEL = "prefers_compiled_model"
 #: C3: passes the true time to the right-hand side, so it integrates time-dependent forces
 TIME_DEPENDENT = "time_dependent"
@@ -91,19 +91,6 @@ CAPABILITIES = (COMPILED_MODEL, PREFERS_COMPILED_MODEL, TIME_DEPENDENT, BATCH_KE
 PRECISIONS = ("double", "double-double")
 #: the run dataset's attribute holding the integrator's ``evaluation_label`` (what ``integrator_nfev`` counts)
 NFEV_COUNTS_ATTRIBUTE = "integrator_nfev_counts"
-#: the boolean class attributes of older integrators that declare a capability (third-party code may set them)
-_ALIASES = {COMPILED_MODEL: "needs_compiled_model", PREFERS_COMPILED_MODEL: "prefers_compiled_model"}
-
-
-class _CapabilityFlag:
-    """A boolean alias of a capability: reads True when the class declares the capability. A subclass that sets the
-    attribute itself (``needs_compiled_model = True``, the older way) declares the capability that way."""
-
-    def __init__(self, capability: str) -> None:
-        self.capability = capability
-
-    def __get__(self, instance: Any, owner: type) -> bool:
-        return self.capability in getattr(owner, "capabilities", ())
 
 
 @dataclass
@@ -169,7 +156,7 @@ class Integrator(ABC):
        with one sentence saying when and why.
     5. It calls ``progress(t)``, when given, every few steps (cheap; the
        callback decides whether to report).
-    6. A compiled integrator sets ``needs_compiled_model`` and integrates the
+    6. A compiled integrator declares ``COMPILED_MODEL`` (rule 8) and integrates the
        ``compiled`` model it is given (the system's ``compiled_model()``)
        instead of calling ``fun``; the scene refuses it, before integrating,
        for a system or force that has no compiled form.
@@ -177,11 +164,10 @@ class Integrator(ABC):
     8. It declares what it can do in ``capabilities`` (a frozenset of the module's capability constants)
        and the engine asks ``supports(capability)``, never for an integrator's name:
 
-       C1. ``COMPILED_MODEL``: it integrates the ``compiled`` model it is given (rule 6; the older
-           ``needs_compiled_model = True`` declares it too). The scene refuses it for a system without
-           a compiled form, and asks ``refusal(compiled, system)`` whether it can run the one it has.
+       C1. ``COMPILED_MODEL``: it integrates the ``compiled`` model it is given (rule 6). The scene refuses
+           it for a system without a compiled form, and asks ``refusal(compiled, system)`` whether it can run the one it has.
        C2. ``PREFERS_COMPILED_MODEL``: it takes the compiled model when the system has one, else calls
-           ``fun`` (``prefers_compiled_model = True`` declares it too).
+           ``fun``.
        C3. ``TIME_DEPENDENT``: it passes the true time to ``fun`` (and to a compiled model), so the scene
            lets it integrate time-dependent forces; others are refused for them.
        C4. ``BATCH_KERNEL``: ``integrate_batch(compiled, times, y0s, params, failures)`` integrates many
@@ -227,8 +213,6 @@ class Integrator(ABC):
 
     name: ClassVar[str]
     adaptive: ClassVar[bool]
-    needs_compiled_model: ClassVar[bool] = _CapabilityFlag(COMPILED_MODEL)
-    prefers_compiled_model: ClassVar[bool] = _CapabilityFlag(PREFERS_COMPILED_MODEL)
 
     @abstractmethod
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
@@ -252,16 +236,10 @@ class Integrator(ABC):
 
     @classmethod
     def supports(cls, capability: str) -> bool:
-        """Whether the integrator declares ``capability`` (in ``capabilities``, or through a boolean alias)."""
+        """Whether the integrator declares ``capability`` in ``capabilities``."""
         if capability not in CAPABILITIES:
             raise ValueError(f"capability {capability!r} is not one of gyrolab's; valid: {', '.join(CAPABILITIES)}")
-        alias = _ALIASES.get(capability)
-        return capability in cls.capabilities or (alias is not None and getattr(cls, alias) is True)
-
-    @classmethod
-    def declared_capabilities(cls) -> frozenset[str]:
-        """Every capability the integrator declares, aliases included."""
-        return frozenset(c for c in CAPABILITIES if cls.supports(c))
+        return capability in cls.capabilities
 
     @classmethod
     def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:

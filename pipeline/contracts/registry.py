@@ -65,17 +65,9 @@ BUILTINS: dict[str, dict[str, str]] = {
 }
 
 
-#: import paths of gyrolab 0.1 (top-level ``plugins``), still found in configs stored in older datasets
-_LEGACY_PREFIXES = {"plugins.": "gyrolab.plugins."}
-
-
 def _normalise(target: str) -> str:
-    """'pkg.mod:Cls' and 'pkg.mod.Cls' name the same class; a 0.1 path names its class of today."""
-    target = target.replace(":", ".")
-    for old, new in _LEGACY_PREFIXES.items():
-        if target.startswith(old):
-            return new + target[len(old):]
-    return target
+    """'pkg.mod:Cls' and 'pkg.mod.Cls' name the same class."""
+    return target.replace(":", ".")
 
 
 class PluginLoadWarning(GyrolabWarning):
@@ -101,6 +93,13 @@ def external(group: str) -> dict[str, str]:
         found[ep.name] = ep
     _ENTRY_POINTS[group] = found
     return {name: ep.value for name, ep in found.items()}
+
+
+def plugin_entry_points() -> list[Any]:
+    """The entry point of every registered third-party plugin, of every group (read once, by ``external``)."""
+    for group in GROUPS:
+        external(group)
+    return [ep for group in GROUPS for ep in _ENTRY_POINTS[group].values()]
 
 
 def origin(group: str, name: str) -> str:

@@ -1,29 +1,12 @@
 """No config and no dataset can run code: the one place where gyrolab decides what a config may name.
 
-Threat model: a YAML file (an experiment, a primary config, a whole ``--config-dir``)
-or a ``run.nc`` that someone else wrote. Reading it must not run code that is not
-gyrolab's or an installed, registered plugin's, and must not write outside the run
-directory. Installed packages are trusted (they could run code anyway); text is not.
-
-:func:`check_config` is applied by the preflight to every composed config (each group
-choice of a sweep too) before Hydra creates a directory, instantiates a callback or
-configures logging, and by ``--reproduce`` and ``--batch`` to the configs they build:
-
-- every ``_target_`` anywhere must be on an allowlist: under ``hydra`` gyrolab's sweep
-  callback and the installed Hydra launchers and sweepers; elsewhere a registered
-  gyrolab plugin (``gyrolab.contracts.registry``);
-- Hydra's logging configs (``hydra.job_logging``, ``hydra.hydra_logging``) may name only
-  the standard logging handler, formatter and filter classes (``()`` and ``class`` keys),
-  no ``.`` attribute setters, no ``ext://`` object other than ``sys.stdout``/``sys.stderr``,
-  and log files only inside the run directory, ending in ``.log``;
-- Hydra's own paths (``output_subdir``, ``sweep.subdir``, the submitit folder) stay inside
-  the run directory, which may not be empty, the working directory or one of its parents,
-  or inside an installation of Python packages;
-- ``hydra.job.env_set`` may set thread counts only; the shell lines of a cluster launcher
-  (``setup``, ``srun_args``, ``additional_parameters``) must be the packaged ones or typed
-  on the command line.
-
-Each refusal is one ConfigError sentence naming the key.
+Threat model: a YAML file (an experiment, a primary config, a whole ``--config-dir``) or a ``run.nc`` that someone
+else wrote; installed packages are trusted (they could run code anyway), text is not. :func:`check_config` is
+applied by the preflight to every composed config (each group choice of a sweep too) before Hydra creates a
+directory, instantiates a callback or configures logging, and by ``reproduce`` and ``batch`` to the configs they
+build. The rules (allowlisted ``_target_``s, Hydra's logging configs, paths inside the run directory, thread
+counts only in ``env_set``, the launchers' shell lines) are listed in docs/safety.md, "Safety and failures"; each
+refusal is one ConfigError sentence naming the key.
 """
 
 from __future__ import annotations

@@ -102,7 +102,7 @@ def run_task(name: str, cfg: DictConfig, out_dir: Path) -> list[Path]:
     return importlib.import_module(TASKS[name]).run(cfg, out_dir)
 
 
-def task_of_config(cfg: DictConfig) -> str:
+def task_of(cfg: DictConfig) -> str:
     """What a config runs: its task, ``regime`` for a plain run with a regime, else ``scene``."""
     task = cfg.get("task") or "scene"
     return "regime" if task == "scene" and cfg.get("regime") else str(task)
@@ -111,7 +111,7 @@ def task_of_config(cfg: DictConfig) -> str:
 def reproduce_task(path: Path, cfg: DictConfig) -> tuple[object, list[str]]:
     """(the comparison, the report's head) of running the experiment a dataset's stored ``cfg`` names again, into a
     temporary directory, and comparing the dataset of the same name (``gyrolab reproduce PATH/regime.nc``, ...)."""
-    task = task_of_config(cfg)
+    task = task_of(cfg)
     if task not in TASKS:
         raise ConfigError(f"{path} was written by task {task!r}, which this gyrolab does not have; valid choices: "
                           f"{choices(['scene', *TASKS])}")

@@ -20,6 +20,9 @@ from gyrolab.output.atomic import atomic_path
 
 logging.getLogger("fontTools").setLevel(logging.WARNING)  # PDF font subsetting logs every table at INFO
 
+#: zlib level 3 rather than PIL's 6: the same pixels, a 9 % larger file, a third less time to encode (the default
+#: run's four PNGs: −0.06 CPU s)
+_LIGHTER = {"png": {"pil_kwargs": {"compress_level": 3}}}
 #: dataset attributes copied into every figure's metadata
 PROVENANCE_KEYS = ("gyrolab_version", "git_commit", "git_dirty", "git_diff_sha256", "job_id", "hydra_overrides")
 
@@ -57,7 +60,7 @@ def save(fig: plt.Figure, stem: str | Path, formats: Iterable[str] = DEFAULT_FOR
         for fmt in formats:
             path = stem.parent / f"{stem.name}.{fmt}"
             with atomic_path(path) as tmp:
-                fig.savefig(tmp, format=fmt, dpi=dpi, metadata=_for_format(fmt, metadata or {}))
+                fig.savefig(tmp, format=fmt, dpi=dpi, metadata=_for_format(fmt, metadata or {}), **_LIGHTER.get(fmt, {}))
             written.append(path)
     if close:
         plt.close(fig)

@@ -16,8 +16,7 @@ The series is generated from the model's equations, as the single-trajectory ker
 them to Cauchy products of linear combinations of series and functions of series; ``_emit_series`` writes that
 program's recurrences as LLVM IR over ``<LANES x double>``, ``_Functions`` those of the functions and divisions):
 one generated ``cfunc`` per form (cached on disk), with the numbers of the equations per lane in Q (``constants``,
-run when a lane takes a trajectory). The hand-written fixed point ``models.FIXED_POINT`` is the same model traced
-over its packed parameters (``fixed_point.packed_model``), so a batch's ``pack`` rows are read as they are. Every
+run when a lane takes a trajectory). Every
 product's Cauchy sum runs over pairs (j, k − j): the operands' rows at j and k − j, loaded once, serve two fused
 multiply-adds of every product that reads them, the pair with the newest coefficient last (the next order's older
 terms overlap its computation). The work arrays start on 64-byte boundaries (``_rows``): numba aligns to 32, and a
@@ -45,10 +44,10 @@ from numba.extending import intrinsic
 from gyrolab.kernels import simd, taylor
 from gyrolab.kernels.compiler import kernel
 from gyrolab.kernels.expression import generated_module
-from gyrolab.kernels.fixed_point import packed_model
 from gyrolab.kernels.layout import TRACED_FIRST_CONSTANT
-from gyrolab.kernels.model import TRACED, CompiledModel, traced_model
-from gyrolab.kernels.taylor_series import _Program
+from gyrolab.kernels.model import CompiledModel, traced_model
+from gyrolab.kernels.recurrences import AUXILIARY, Functions, splat_int
+from gyrolab.kernels.taylor_series import plan
 from gyrolab.kernels.vector_width import batch_lanes
 
 #: trajectories advanced in lock step: one vector register of doubles of the CPU numba compiles for (8 with
@@ -65,40 +64,12 @@ GROUP = 16
 #: fewer products than this in a group: two accumulators each (``_cauchy``)
 TWIN = 8
 #: the generated series' source names this module's own hash: an emitter change compiles the series anew
-_EMITTER = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:12]
+_EMITTER = hashlib.sha256(b"".join(Path(__file__).with_name(name).read_bytes()
+                                   for name in ("batch_taylor.py", "recurrences.py"))).hexdigest()[:12]
 _P = types.CPointer(types.float64)
 
 
 # ---- the generated series
-
-def plan(model: Any, first_constant: int) -> dict:
-    """The lanes' program of a model (``taylor_series``' lowering).
-
-    Numbers are given as Q rows (ints) or the literals "0.0", "1.0", "-1.0"; a linear combination as
-    (constant, ((series, coefficient), ...)); series as (op, operands, extra, depth), extra the state index of
-    "y" and the exponent's number of "pow".
-    """
-    program = _Program(model, first_constant)
-    rows: dict[str, int] = {}
-
-    def number(name: str) -> Any:
-        return name if name in ("0.0", "1.0", "-1.0") else rows.setdefault(name, len(rows))
-
-    def combination(value: Any) -> tuple:
-        return number(value.const), tuple((i, number(c)) for i, c in value.terms)
-
-    series = [(s.op, s.args, number(s.extra) if s.op == "pow" else s.extra, s.depth) for s in program.series]
-    operands = [combination(u) for u in program.operands]
-    rates = [combination(r) for r in program.rates]
-    lines = [*program.numbers.lines, *(f"q[{row} * LANES + lane] = {name}" for name, row in rows.items())]
-    return {"size": program.size, "series": series, "operands": operands, "rates": rates, "numbers": len(rows),
-            "lines": lines}
-
-
-#: functions whose recurrence needs an auxiliary series (``taylor_series``): tan, tanh: 1 ± f²; arctan: 1 + x²;
-#: arctan2: x² + y²
-_AUXILIARY = ("tan", "tanh", "arctan", "arctan2")
-
 
 def _layout(series: list) -> dict[tuple, int]:
     """W's columns: ("u", operand) for every operand of a product or a function, ("f", series, 0) for a function's
@@ -111,7 +82,7 @@ def _layout(series: list) -> dict[tuple, int]:
             column.setdefault(("u", u), len(column))
         if op != "mul":
             column[("f", i, 0)] = len(column)
-            if op == "sin" or op in _AUXILIARY:
+            if op == "sin" or op in AUXILIARY:
                 column[("f", i, 1)] = len(column)
     return column
 
@@ -119,7 +90,8 @@ def _layout(series: list) -> dict[tuple, int]:
 def source(program: dict) -> str:
     """The generated module: ``constants`` (a lane's numbers from its parameter row) and ``kernel`` (the series)."""
     shape = {k: program[k] for k in ("size", "series", "operands", "rates")}
-    body = "".join(f"    {line}\n" for line in program["lines"]) or "    pass\n"
+    lines = [*program["lines"], *(f"q[{row} * LANES + lane] = {name}" for row, name in enumerate(program["names"]))]
+    body = "".join(f"    {line}\n" for line in lines) or "    pass\n"
     return _HEADER.format(emitter=_EMITTER, lanes=LANES, plan=repr(shape)) + body
 
 
@@ -237,7 +209,7 @@ def _emit_series(b: ir.IRBuilder, program: dict, lanes: int, order, T, W, Q, t) 
                 later = b.select(b.icmp_signed("==", k, const(1)), splat(1.0), splat(0.0))
                 values[i] = b.select(first, load(t, zero), later)
         depth = max((s[3] for s in series), default=0)
-        emit = _Functions(b, lanes, k, first, lambda row, key: load(W, at(row, width, column[key])),
+        emit = Functions(b, lanes, k, first, lambda row, key: load(W, at(row, width, column[key])),
                           lambda value, row, key: store(value, W, at(row, width, column[key])), number)
         for d in range(1, depth + 1):
             here = [(i, s) for i, s in enumerate(series) if s[3] == d and s[0] != "cos"]
@@ -254,157 +226,12 @@ def _emit_series(b: ir.IRBuilder, program: dict, lanes: int, order, T, W, Q, t) 
             for i, (op, args, extra, _) in here:
                 if op != "mul":
                     values.update(emit(op, i, args, extra, rows))
-        inv = b.fdiv(splat(1.0), _splat_int(b, vec, lanes, b.add(k, const(1))))
+        inv = b.fdiv(splat(1.0), splat_int(b, vec, lanes, b.add(k, const(1))))
         rates = [b.fmul(combination(rate, values), inv, flags=simd.FUSE) for rate in program["rates"]]
         k1 = b.add(k, const(1))
         for m, value in enumerate(rates):
             store(value, T, at(k1, size, m))
             b.store(value, newest[m])
-
-
-class _Functions:
-    """The order-k coefficient of a function of a series (``taylor_series``' recurrences, in every lane): at order 0
-    its value (libm's, lane by lane, as the scalar kernel's; sqrt and division exact), at order k ≥ 1 its
-    recurrence from the W rows of its operands (0..k) and of itself (0..k−1). Returns {series: value}, the sine's
-    cosine as series + 1; stores its rows in W."""
-
-    def __init__(self, b, lanes, k, first, load, store, number):
-        self.b, self.lanes, self.k, self.first = b, lanes, k, first
-        self.load, self.store, self.number = load, store, number
-        self.vec = ir.VectorType(ir.DoubleType(), lanes)
-        self.kf = _splat_int(b, self.vec, lanes, k)
-
-    def splat(self, x):
-        return ir.Constant(self.vec, [float(x)] * self.lanes)
-
-    def libm(self, name, *xs):
-        """The C library's ``name`` lane by lane."""
-        b, double = self.b, ir.DoubleType()
-        fn = cgutils.get_or_insert_function(b.module, ir.FunctionType(double, [double] * len(xs)), name)
-        out = ir.Constant(self.vec, ir.Undefined)
-        for lane in range(self.lanes):
-            i = ir.Constant(ir.IntType(32), lane)
-            out = b.insert_element(out, b.call(fn, [b.extract_element(x, i) for x in xs]), i)
-        return out
-
-    def total(self, lo, hi, term):
-        """Σ_{j=lo}^{hi−1} term(j) (LLVM integers lo, hi; term returns a vector)."""
-        b = self.b
-        acc = cgutils.alloca_once_value(b, self.splat(0.0))
-        with cgutils.for_range(b, b.sub(hi, lo)) as loop:
-            j = b.add(lo, loop.index)
-            b.store(b.fadd(b.load(acc), term(j), flags=simd.FUSE), acc)
-        return b.load(acc)
-
-    def __call__(self, op, i, args, extra, rows):
-        b, k = self.b, self.k
-        i64 = k.type
-        zero, one = ir.Constant(i64, 0), ir.Constant(i64, 1)
-        x = (lambda row: self.load(row, ("u", args[0])))
-        y = (lambda row: self.load(row, ("u", args[1]))) if len(args) > 1 else None
-        f = (lambda row: self.load(row, ("f", i, 0)))
-        g = (lambda row: self.load(row, ("f", i, 1)))  # the cosine or the auxiliary series
-        jf = (lambda j: _splat_int(b, self.vec, self.lanes, j))
-        mul = (lambda p, q: b.fmul(p, q, flags=simd.FUSE))
-        xk, x0 = rows[args[0]], x(zero)
-        slots = [cgutils.alloca_once(b, self.vec) for _ in range(2)]
-        with b.if_else(self.first) as (start, later):
-            with start:
-                for slot, value in zip(slots, self._start(op, rows, args, extra)):
-                    b.store(value, slot)
-            with later:
-                if op == "div":
-                    s = b.fsub(xk, self.total(zero, k, lambda j: mul(f(j), y(b.sub(k, j)))))
-                    values = [b.fdiv(s, y(zero))]
-                elif op == "sqrt":
-                    s = b.fsub(xk, self.total(one, k, lambda j: mul(f(j), f(b.sub(k, j)))))
-                    values = [b.fdiv(s, mul(self.splat(2.0), f(zero)))]
-                elif op == "exp":
-                    values = [b.fdiv(self.total(one, b.add(k, one), lambda j: mul(mul(jf(j), x(j)), f(b.sub(k, j)))),
-                                     self.kf)]
-                elif op == "log":
-                    s = b.fdiv(self.total(one, k, lambda j: mul(mul(jf(j), f(j)), x(b.sub(k, j)))), self.kf)
-                    values = [b.fdiv(b.fsub(xk, s), x0)]
-                elif op == "sin":  # (sine, cosine)
-                    values = [b.fdiv(self.total(one, b.add(k, one), lambda j: mul(mul(jf(j), x(j)), g(b.sub(k, j)))),
-                                     self.kf),
-                              b.fneg(b.fdiv(self.total(one, b.add(k, one),
-                                                       lambda j: mul(mul(jf(j), x(j)), f(b.sub(k, j)))), self.kf))]
-                elif op in ("tan", "tanh"):  # f' = d x', d = 1 ± f²
-                    fk = b.fdiv(self.total(one, b.add(k, one), lambda j: mul(mul(jf(j), x(j)), g(b.sub(k, j)))),
-                                self.kf)
-                    d = b.fadd(self.total(one, k, lambda j: mul(f(j), f(b.sub(k, j)))), mul(self.splat(2.0),
-                                                                                            mul(f(zero), fk)))
-                    values = [fk, d if op == "tan" else b.fneg(d)]
-                elif op == "arctan":  # f' d = x', d = 1 + x²
-                    d = self.total(zero, b.add(k, one), lambda j: mul(x(j), x(b.sub(k, j))))
-                    s = b.fsub(mul(self.kf, xk), self.total(one, k, lambda j: mul(mul(jf(j), f(j)), g(b.sub(k, j)))))
-                    values = [b.fdiv(s, mul(self.kf, g(zero))), d]
-                elif op == "arctan2":  # f = atan2(x, y), d = x² + y², f' d = y x' − x y'
-                    d = self.total(zero, b.add(k, one),
-                                   lambda j: b.fadd(mul(x(j), x(b.sub(k, j))), mul(y(j), y(b.sub(k, j)))))
-                    s = self.total(zero, k, lambda j: mul(jf(b.sub(k, j)), b.fsub(mul(y(j), x(b.sub(k, j))),
-                                                                                  mul(x(j), y(b.sub(k, j))))))
-                    s = b.fsub(s, self.total(one, k, lambda j: mul(mul(jf(j), f(j)), g(b.sub(k, j)))))
-                    values = [b.fdiv(s, mul(self.kf, g(zero))), d]
-                elif op == "pow":  # x f' = e f x'
-                    e = self.number(extra)
-                    s = self.total(zero, k, lambda j: mul(mul(b.fsub(mul(e, jf(b.sub(k, j))), jf(j)), x(b.sub(k, j))),
-                                                          f(j)))
-                    values = [b.fdiv(s, mul(self.kf, x0))]
-                elif op == "abs":
-                    sign = b.select(b.fcmp_ordered(">", x0, self.splat(0.0)), self.splat(1.0),
-                                    b.select(b.fcmp_ordered("<", x0, self.splat(0.0)), self.splat(-1.0),
-                                             self.splat(0.0)))
-                    values = [mul(sign, xk)]
-                else:
-                    raise ValueError(f"the Taylor lanes have no recurrence for {op!r}")
-                for slot, value in zip(slots, values):
-                    b.store(value, slot)
-        out = [b.load(slot) for slot in slots]
-        self.store(out[0], k, ("f", i, 0))
-        if op == "sin" or op in _AUXILIARY:
-            self.store(out[1], k, ("f", i, 1))
-        return {i: out[0], i + 1: out[1]} if op == "sin" else {i: out[0]}
-
-    def _start(self, op, rows, args, extra):
-        """A function's order-0 value (and its cosine or auxiliary series)."""
-        b = self.b
-        x = rows[args[0]]
-        square = (lambda v: b.fmul(v, v))
-        if op == "div":
-            return [b.fdiv(x, rows[args[1]])]
-        if op == "sqrt":
-            return [simd_call(b, self.vec, "sqrt", x)]
-        if op == "sin":
-            return [self.libm("sin", x), self.libm("cos", x)]
-        if op in ("tan", "tanh"):
-            value = self.libm(op, x)
-            return [value, (b.fadd if op == "tan" else b.fsub)(self.splat(1.0), square(value))]
-        if op == "arctan":
-            return [self.libm("atan", x), b.fadd(self.splat(1.0), square(x))]
-        if op == "arctan2":
-            return [self.libm("atan2", x, rows[args[1]]), b.fadd(square(x), square(rows[args[1]]))]
-        if op == "pow":
-            return [self.libm("pow", x, self.number(extra))]
-        if op == "abs":
-            return [simd_call(b, self.vec, "fabs", x)]
-        return [self.libm(op, x)]  # exp, log
-
-
-def simd_call(b, vec, name, *args):
-    """The LLVM vector intrinsic ``llvm.NAME`` on ``args``."""
-    fn = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * len(args)),
-                                        f"llvm.{name}.v{vec.count}f64")
-    return b.call(fn, list(args))
-
-
-def _splat_int(b, vec, lanes, n):
-    """<lanes x double> of the LLVM integer n."""
-    x = b.sitofp(n, ir.DoubleType())
-    one = b.insert_element(ir.Constant(vec, ir.Undefined), x, ir.Constant(ir.IntType(32), 0))
-    return b.shuffle_vector(one, ir.Constant(vec, ir.Undefined),
-                            ir.Constant(ir.VectorType(ir.IntType(32), lanes), [0] * lanes))
 
 
 def _cauchy(b, products, k, rows, load_row, zero, first):
@@ -464,15 +291,12 @@ _KERNELS: dict[tuple[int, int], tuple[int, int, int, int] | None] = {}
 def lanes_kernel(compiled: CompiledModel) -> tuple[int, int, int, int]:
     """The generated lanes of a compiled model: (series address, constants address, numbers, W's columns), compiled
     (or loaded from the disk cache) on first need."""
-    if compiled.model == TRACED:
-        model, first = traced_model(compiled), TRACED_FIRST_CONSTANT
-    else:  # models.FIXED_POINT: the same equations over its packed parameters
-        model, first = packed_model(), 0
+    model, first = traced_model(compiled), TRACED_FIRST_CONSTANT
     key = (id(model), first)
     if key not in _KERNELS:
         program = plan(model, first)
         module = generated_module(source(program), "gyrolab_lanes", f"{model.what} (Taylor lanes)")
-        _KERNELS[key] = (int(module.kernel.address), int(module.constants.address), max(program["numbers"], 1),
+        _KERNELS[key] = (int(module.kernel.address), int(module.constants.address), max(len(program["names"]), 1),
                          _columns(program))
     return _KERNELS[key]
 

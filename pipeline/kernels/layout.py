@@ -53,7 +53,7 @@ def torques_on_horizontal_axes(P: np.ndarray) -> bool:
 
 @dataclass
 class CompiledTerms:
-    """A torque written in the two forms the hand-written fixed-point kernels evaluate (model units).
+    """A torque written in the two built-in forms the packed parameters hold (model units).
 
     ``linear[i]`` = u adds u × e_i; ``gradient[i]`` = N adds N e_i × I e_i, where e_i
     is the body-frame image of reference axis i. Uniform gravity, the Newtonian

@@ -11,9 +11,7 @@
 The compiled model (``CompiledModel``) is the form id ``models.TRACED`` and the parameter array, laid out
 as ``layout`` says for it: the right-hand side kernel's address, the program's numbers (the only thing that
 changes between two scenes of the same form), and the Taylor kernel's address and work columns.
-The fixed-point model (ω, γ) with only built-in torques has a hand-written form of its own (``models.FIXED_POINT``,
-``fixed_point.pack``); every other system, a plugin system and the fixed point carrying α included, is compiled
-from its equations here.
+Every system, the fixed point with its built-in torques included, is compiled from its equations here.
 """
 
 from __future__ import annotations
@@ -24,7 +22,7 @@ from typing import Any, Callable
 import numpy as np
 
 from gyrolab.kernels.expression import Expr, Graph, NotCompilable, check_torques, load_generated, symbols
-from gyrolab.kernels.layout import INV_INERTIA, TRACED_ADDRESS, TRACED_FIRST_CONSTANT, TRACED_TAIL
+from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT, TRACED_TAIL
 
 #: form id of a model compiled from its traced equations (``models.TRACED``; here to avoid importing numba's models)
 TRACED = 1
@@ -36,15 +34,9 @@ class CompiledModel:
 
     model: int
     params: np.ndarray
-    #: the fixed point's packed parameters (``fixed_point.pack``) when every torque has a built-in form, whatever
-    #: the form that runs it (a state with α runs the traced equations): what the Lie–Poisson splitting, the
-    #: analytic Jacobian and the regimes' series read; None for every other model (the hand-written form's own
-    #: parameters when not given)
+    #: the fixed point's packed parameters (``fixed_point.pack``) when every torque has a built-in form: what the
+    #: Lie–Poisson splitting and the regimes' series read; None for every other model
     built_in: np.ndarray | None = None
-
-    def __post_init__(self) -> None:
-        if self.model == 0 and self.built_in is None:  # models.FIXED_POINT: its parameters are the packed ones
-            object.__setattr__(self, "built_in", self.params)
 
 
 _UNARY = {"neg": "-{0}", "sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
@@ -214,10 +206,8 @@ def traced_model(compiled: CompiledModel) -> Model:
 
 
 def state_size(compiled: CompiledModel) -> int | None:
-    """The state size a compiled model's kernels read and write: 6 for the hand-written fixed point (ω, γ), the traced
-    program's size otherwise; None for a parameter array that names no traced model of this process."""
-    if compiled.model != TRACED:
-        return 6
+    """The state size a compiled model's kernels read and write: the traced program's; None for a parameter array
+    that names no traced model of this process."""
     try:
         return traced_model(compiled).size
     except ValueError:
@@ -247,20 +237,13 @@ def compiled_system(system: Any) -> CompiledModel:
 def rounding_moved(compiled: CompiledModel) -> CompiledModel:
     """The same model with the numbers it holds rounded moved by one unit in the last place: a run with it differs
     from one with the rounded values as one with the exact values would (an error estimate's companion run,
-    ``accuracy.estimate``, so has round-off independent of the run it measures).
-
-    The hand-written fixed point: 1/I (``layout.INV_INERTIA``; up, down, up), the one parameter it derives by
-    rounding (the others are the config's own doubles, exact for a reference too). A traced model: every number of
-    its equations (up and down alternately), since the trace cannot tell a config's double from a derived one.
+    ``accuracy.estimate``, so has round-off independent of the run it measures). Every number of the equations
+    moves (up and down alternately), since the trace cannot tell a config's double from a derived one.
     """
     params = np.array(compiled.params, dtype=float)
-    if compiled.model == TRACED:
-        numbers = params[TRACED_FIRST_CONSTANT:params.size - TRACED_TAIL]
-        toward = np.where(np.arange(numbers.size) % 2 == 0, np.inf, -np.inf)
-        params[TRACED_FIRST_CONSTANT:params.size - TRACED_TAIL] = np.nextafter(numbers, toward)
-    else:
-        for k, toward in enumerate((np.inf, -np.inf, np.inf)):
-            params[INV_INERTIA + k] = np.nextafter(params[INV_INERTIA + k], toward)
+    numbers = params[TRACED_FIRST_CONSTANT:params.size - TRACED_TAIL]
+    toward = np.where(np.arange(numbers.size) % 2 == 0, np.inf, -np.inf)
+    params[TRACED_FIRST_CONSTANT:params.size - TRACED_TAIL] = np.nextafter(numbers, toward)
     return CompiledModel(compiled.model, params)
 
 

@@ -1,20 +1,19 @@
-"""The compiled models integrator kernels can call, selected by an integer id.
+"""The compiled models integrator kernels can call.
 
 numba caches a kernel only if the functions it calls are module globals
 (a function passed as an argument or closed over is recompiled in every
-process), hence one dispatch on ``model`` instead of a callback.
+process), hence calls through addresses instead of callbacks.
 
-The fixed-point system with built-in torques only has hand-written kernels (``FIXED_POINT``). Every other model (a fixed-point scene with a plugin torque, the orbiting gyrostat, a plugin system) is
+Every model (the fixed point with its built-in or plugin torques, the orbiting gyrostat, a plugin system) is
 compiled from its traced equations (``model``): one form, ``TRACED``, whose right-hand side is one call of
 the generated kernel through its address (stored in ``p``) and whose Taylor coefficients are one call of the
-generated series kernel (``taylor_series``): the integrator kernels, cached once, serve every such model.
+generated series kernel (``taylor_series``): the integrator kernels, cached once, serve every model.
 Measured (benchmarks/plugin_speed.py): the indirect call itself costs little.
 
 A kernel given the model as an int dispatches at run time, so every model's code
 is typed and compiled into it. Given a ``Form`` (``form(compiled)``), the model is
 part of the argument's type: numba compiles a specialisation of the kernel per form,
-containing that form's code only (a built-in (ω, γ) scene compiles neither the traced
-form nor the α terms), and caches each on disk like any other signature.
+containing that form's code only, and caches each on disk like any other signature.
 """
 
 from __future__ import annotations
@@ -27,15 +26,11 @@ from numba.core.imputils import lower_constant
 from numba.extending import NativeValue, intrinsic, overload, register_model, unbox
 
 from gyrolab.kernels.layout import TRACED_ADDRESS
-from gyrolab.kernels import fixed_point, model as _model, taylor_series
+from gyrolab.kernels import model as _model, taylor_series
 from gyrolab.kernels.compiler import inline_kernel, kernel
 
-#: The fixed-point system with built-in torque forms only (hand-written kernels, ``fixed_point``).
-FIXED_POINT = 0
-#: A model compiled from its traced equations (``model``).
+#: A model compiled from its traced equations (``model``): every model.
 TRACED = _model.TRACED
-#: Models whose Taylor coefficients ``taylor_coefficients`` computes (traced ones: see taylor_series.ready).
-TAYLOR_MODELS = (FIXED_POINT, TRACED)
 
 
 @intrinsic
@@ -92,15 +87,13 @@ def _constant_form(context, builder, ty, value):
     return context.get_dummy_value()
 
 
-FORMS = {i: Form(i) for i in (FIXED_POINT, TRACED)}
+FORMS = {TRACED: Form(TRACED)}
 
 
 def block_rhs(compiled) -> int:
     """The address of a compiled model's right-hand side by columns (``model.block_kernel``): the batch kernels'
-    stages, for every model (the built-in fixed point as its equations traced over its packed parameters)."""
-    if compiled.model == TRACED:
-        return _model.block_kernel(_model.traced_model(compiled))
-    return _model.block_kernel(fixed_point.packed_model(), 0)
+    stages, for every model."""
+    return _model.block_kernel(_model.traced_model(compiled))
 
 
 @intrinsic
@@ -131,7 +124,7 @@ def _traced(t, y, p, out):
     _call_rhs(int(p[TRACED_ADDRESS]), t, y, p, out)
 
 
-_RHS = {FIXED_POINT: fixed_point.rhs, TRACED: _traced}
+_RHS = {TRACED: _traced}
 
 
 def rhs(model, t, y, p, out):
@@ -148,16 +141,13 @@ def _rhs_form(model, t, y, p, out):
     return None
 
 
-_FIXED_POINT = FORMS[FIXED_POINT]
 _TRACED = FORMS[TRACED]
 
 
 @inline_kernel
 def _rhs_any(model, t, y, p, out):
     """The run-time dispatch: a branch per form, each the form's plain call."""
-    if model == FIXED_POINT:
-        rhs(_FIXED_POINT, t, y, p, out)
-    elif model == TRACED:
+    if model == TRACED:
         rhs(_TRACED, t, y, p, out)
 
 
@@ -182,9 +172,7 @@ def evaluate(model, t, y, p, out):
 
 @inline_kernel
 def _taylor_any(model, p, Y, order, work, t):
-    if model == FIXED_POINT:
-        fixed_point.taylor_coefficients(p, Y, order, work)
-    elif model == TRACED:  # the traced equations' series (taylor_series)
+    if model == TRACED:  # the traced equations' series (taylor_series)
         taylor_series.coefficients(p, Y, order, work, t)
     else:
         raise ValueError("this compiled model has no Taylor coefficients")
@@ -197,10 +185,6 @@ def taylor_coefficients(model, p, Y, order, work, t=0.0):
 
 @overload(taylor_coefficients, inline="never", jit_options={"error_model": "numpy"})
 def _taylor_coefficients(model, p, Y, order, work, t=0.0):
-    if isinstance(model, FormType):
-        if model.id == FIXED_POINT:
-            return lambda model, p, Y, order, work, t=0.0: fixed_point.taylor_coefficients(p, Y, order, work)
-        return None  # the traced form: below
     if isinstance(model, types.Integer):
         return lambda model, p, Y, order, work, t=0.0: _taylor_any(model, p, Y, order, work, t)
     return None

@@ -1,57 +1,47 @@
-"""Taylor coefficients of a traced model (``model``), as generated straight-line code.
+"""Taylor coefficients of a traced model (``model``), as generated code: one trajectory, its series in vector lanes.
 
-A model's equations (``model.trace``) are a straight-line program of scalar operations on the
-state, time and constants. Every operation has a recurrence giving the k-th Taylor coefficient of
-its result from the coefficients 0..k of its arguments and 0..k−1 of its own (Moore 1966; Jorba &
-Zou, Exp. Math. 14, 2005, §3; Haro et al. 2016, §2.1). This module writes those recurrences out as
-one generated ``cfunc``
+A model's equations (``model.trace``) are a straight-line program of scalar operations on the state, time and
+constants. Every operation has a recurrence giving the k-th Taylor coefficient of its result from the coefficients
+0..k of its arguments and 0..k−1 of its own (Moore 1966; Jorba & Zou, Exp. Math. 14, 2005, §3; Haro et al. 2016,
+§2.1; the functions' in ``recurrences``). This module writes those recurrences out as one generated ``cfunc``
 
     void f(double t, int64 order, double* Y, double* W, double* p)
 
-which fills the state's coefficients Y[1..order] (rows of the state's size) from Y[0], with W
-as scratch (``order`` rows of ``columns`` entries). It is called once per Taylor step: the
-loops over the orders and over the Cauchy sums are inside the generated code, shaped like the
-hand-written fixed-point kernel's (``fixed_point.taylor_coefficients``) and compiled with its fastmath flags (reassociation,
-fused multiply-adds).
+which fills the state's coefficients Y[1..order] (rows of the state's size) from Y[0], with W as scratch (``order``
+rows of ``columns`` entries). It is called once per Taylor step: the loop over the orders and the Cauchy sums are
+inside the generated code.
 
-The lowering (``_Program``) puts every value in the form const + Σ c_i s_i: a sum of series s_i
-(state components, time, products, results of nonlinear functions) with coefficients c_i that do
-not depend on the state (the plugin's numbers, the inertia, and what is computed from them only,
-once per call). So sums, differences and multiplications by numbers cost no series of their
-own, a product of two state-dependent values is one Cauchy product of the values with their
-numeric factors pulled out, and equal products are one series: the plugin's I_2 γ_1 γ_2 and
-I_1 γ_2 γ_1 share the product γ_1 γ_2 (and the built-in (Iω) × ω's ω_1 ω_2 its terms), as the
-built-in's code shares them. The Cauchy products that only depend on series computed earlier
-in the order (products of the same depth) are summed in one loop over j, their operands in
-adjacent columns of W, so that the compiler turns the sums into vector instructions (the built-in's
-``taylor.run_vector`` does this by hand).
+The lowering (``_Program``) puts every value in the form const + Σ c_i s_i: a sum of series s_i (state components,
+time, products, results of nonlinear functions) with coefficients c_i that do not depend on the state (the
+equations' numbers, the inertia, and what is computed from them only, once per call). So sums, differences and
+multiplications by numbers cost no series of their own, a product of two state-dependent values is one Cauchy
+product of the values with their numeric factors pulled out, and equal products are one series: the fixed point's
+I_2 ω_1 ω_2 and I_1 ω_2 ω_1 share the product ω_1 ω_2.
 
-Like the right-hand side's kernel it reads the equations' numbers from the parameter array, so the
-generated source depends on the equations' form only: it is compiled once per
-form (cached on disk under a hash of the source, ``expression.load_generated``). The source
-contains only what the lowering writes: local names it makes, indices into the arrays, the
-literals 1.0, −1.0, 0.0 and integer exponents, and the names of ``math`` functions from a fixed
-table — nothing a plugin spells.
+The emitter (``_emit``) writes LLVM IR whose vector lanes are the program's series: the state's components in one
+vector (padded to a power of two: the fixed point's six in one ``<8 x double>``), the products of one depth in
+others (``pieces``), so an order's work is a few vector operations: the products' operands gathered from the
+state's and the products' lanes by shuffles (``gather``), their Cauchy sums Σ_j L_j ⊙ R_{k−j} by pairs (j, k − j)
+in fused multiply-adds, and the rates' linear combinations as sums of shuffled lanes times coefficient vectors, the
+1/(k + 1) folded into the coefficients (off the chain of dependent operations from one order to the next).
+Functions of series (sin, sqrt, division, ...) run their recurrences in a lane of their own
+(``recurrences.Functions``). The same recurrences as the hand-written fixed-point kernel this replaced, whose
+vectorised form (ω, γ and their cyclic permutations in ``<4 x double>``) it generalises; measured against it in
+docs/performance.md.
 
-Recurrences (x, y the arguments, f the result, a sum over j written Σ_j):
-  ± and c·x: linear; x·y: Σ_{j=0..k} x_j y_{k−j};
-  x/y: f_k = (x_k − Σ_{j<k} f_j y_{k−j}) / y_0;  √x: f_k = (x_k − Σ_{j=1..k−1} f_j f_{k−j}) / (2 f_0);
-  exp: f_k = (1/k) Σ_{j=1..k} j x_j f_{k−j};  log: f_k = (x_k − (1/k) Σ_{j=1..k−1} j f_j x_{k−j}) / x_0;
-  sin, cos as a pair: s_k = (1/k) Σ j x_j c_{k−j},  c_k = −(1/k) Σ j x_j s_{k−j};
-  tan, tanh: f' = g x' with g = 1 ± f² (an auxiliary series);  arctan: f' (1 + x²) = x';
-  arctan2(y, x): f' (x² + y²) = x y' − y x';  x^a (a constant): x f' = a f x', i.e.
-  f_k = Σ_{j<k} (a(k−j) − j) x_{k−j} f_j / (k x_0);  x^y (y on the state): exp(y log x);
-  x^n (integer n): repeated Cauchy products (no division, so x_0 = 0 is fine), 1/x^|n| for n < 0;
-  |x|: sign(x_0) x_k, exact wherever x_0 ≠ 0 (at x_0 = 0, |x| has no Taylor series);
-  time: t_0 = t, t_1 = 1.
-The divisions make x/y, √x, log x, x^a (a not an integer), x^y and arctan2 (at x = y = 0) singular
-where their argument's value is 0 (as the functions themselves, or their derivatives, are): there
-the coefficients are inf/NaN and ``taylor`` stops with its one-sentence non-finite error.
-The Taylor kernel compiles when a run first needs it (``ready``), not with the right-hand side's.
+Like the right-hand side's kernel it reads the equations' numbers from the parameter array, so the generated source
+depends on the equations' form only: it is compiled once per form (cached on disk under a hash of the source, which
+names this emitter's own hash, ``expression.generated_module``). The source contains only what the lowering writes:
+local names it makes, indices into the arrays, the literals 1.0, −1.0, 0.0 and integer exponents, and the names of
+``math`` functions from a fixed table — nothing a plugin spells. Time's series: t_0 = t, t_1 = 1. x^n (an integer
+n) is repeated Cauchy products (no division, so x_0 = 0 is fine), 1/x^|n| for n < 0; x^y (y on the state) is
+exp(y log x). The Taylor kernel compiles when a run first needs it (``ready``), not with the right-hand side's.
 """
 
 from __future__ import annotations
 
+import hashlib
+from pathlib import Path
 from typing import Any
 
 import numba
@@ -61,12 +51,29 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from gyrolab.kernels import simd
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before the decorators)
+from gyrolab.kernels.expression import Expr, binary_power, generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
-from gyrolab.kernels.expression import Expr, binary_power, load_generated
 from gyrolab.kernels.model import TRACED, Model, traced_model
+from gyrolab.kernels.recurrences import AUXILIARY, Functions
 
 ZERO, ONE, MINUS_ONE = "0.0", "1.0", "-1.0"
+#: lanes of the widest vector the series uses (AVX-512's; an AVX2 CPU runs each as two)
+VECTOR = 8
+#: products whose Cauchy sums share one loop (their accumulators and operands stay in the vector registers)
+GROUP = 32
+#: the rates' aligned layout of the products (``_aligned``) is taken while it needs at most this many times the lanes
+#: of the compact one (the fixed point: 16 lanes for 12 products, aligned: 8 % faster a step than compact)
+ALIGNED_COST = 1.4
+#: lanes up to which a Cauchy sum runs in two accumulators (two chains of dependent additions, half as long); with
+#: more, the registers are better spent on the operands' loads
+TWIN = 16
+#: the generated series' source names the emitters' hash: an emitter change compiles the series anew
+_EMITTER = hashlib.sha256(b"".join(Path(__file__).with_name(name).read_bytes()
+                                   for name in ("taylor_series.py", "recurrences.py"))).hexdigest()[:12]
+_P = types.CPointer(types.float64)
+_PAD = object()  # a gathered lane that may hold any value (a padding lane)
 
 
 class _Numbers:
@@ -135,16 +142,6 @@ class _Lin:
     def key(self) -> tuple:
         return (self.const, self.terms)
 
-    def expression(self, first: bool) -> str:
-        """The value at order 0 (``first``: with the constant) or at order k ≥ 1 (the constant's coefficients vanish)."""
-        parts = [self.const] if first and self.const != ZERO else []
-        for i, c in self.terms:
-            parts.append(f"s{i}" if c == ONE else f"-s{i}" if c == MINUS_ONE else f"{c} * s{i}")
-        while len(parts) > 2:  # summed as a balanced tree: dependent additions log2(terms) deep, not terms deep
-            parts = [f"({parts[i]} + {parts[i + 1]})" if i + 1 < len(parts) else parts[i]
-                     for i in range(0, len(parts), 2)]
-        return " + ".join(parts) or ZERO
-
 
 class _Series:
     """A series the generated code computes order by order: a state component, time, a product or a function."""
@@ -159,143 +156,12 @@ class _Series:
         self.columns: list[int] = []  # its own columns of W (functions: the series and auxiliaries)
 
 
-# order-0 values of the functions of a series (x, y: operand locals, e: a number)
-_VALUES = {"sqrt": "math.sqrt({x})", "exp": "math.exp({x})", "log": "math.log({x})", "sin": "math.sin({x})",
-           "cos": "math.cos({x})", "tan": "math.tan({x})", "tanh": "math.tanh({x})", "arctan": "math.atan({x})",
-           "abs": "abs({x})", "div": "{x} / {y}", "arctan2": "math.atan2({x}, {y})", "pow": "{x} ** {e}"}
 # the same of numbers (folded into ``_Numbers``)
 _NUMBER_FUNCTIONS = {"sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
                      "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})",
                      "tanh": "math.tanh({0})", "arctan": "math.atan({0})", "abs": "abs({0})",
                      "arctan2": "math.atan2({0}, {1})", "pow": "{0} ** {1}", "ipow": "{0} ** {1}"}
 
-# order-k recurrences (k ≥ 1, r = k·M the row's start): {x}, {y} the operands' columns, {c} the result's,
-# {d} an auxiliary's, {co} the cosine's (the sine's is {c}), {e} the exponent's local; rows 0..k of the operands
-# and 0..k−1 of the result are in W
-_STEPS = {
-    "div": "s = W[r + {x}]\nfor j in range(k):\n    s -= W[j * M + {c}] * W[(k - j) * M + {y}]\nW[r + {c}] = s / W[{y}]",
-    "sqrt": "s = W[r + {x}]\nfor j in range(1, k):\n    s -= W[j * M + {c}] * W[(k - j) * M + {c}]\n"
-            "W[r + {c}] = s / (2.0 * W[{c}])",
-    "exp": "s = 0.0\nfor j in range(1, k + 1):\n    s += j * W[j * M + {x}] * W[(k - j) * M + {c}]\nW[r + {c}] = s / k",
-    "log": "s = 0.0\nfor j in range(1, k):\n    s += j * W[j * M + {c}] * W[(k - j) * M + {x}]\n"
-           "W[r + {c}] = (W[r + {x}] - s / k) / W[{x}]",
-    "sin": "s = 0.0\nq = 0.0\nfor j in range(1, k + 1):\n    s += j * W[j * M + {x}] * W[(k - j) * M + {co}]\n"
-           "    q += j * W[j * M + {x}] * W[(k - j) * M + {c}]\nW[r + {c}] = s / k\nW[r + {co}] = -q / k",
-    "tan": "s = 0.0\nfor j in range(1, k + 1):\n    s += j * W[j * M + {x}] * W[(k - j) * M + {d}]\nW[r + {c}] = s / k\n"
-           "s = 0.0\nfor j in range(k + 1):\n    s += W[j * M + {c}] * W[(k - j) * M + {c}]\nW[r + {d}] = {sign}s",
-    "arctan": "s = 0.0\nfor j in range(k + 1):\n    s += W[j * M + {x}] * W[(k - j) * M + {x}]\nW[r + {d}] = s\n"
-              "s = k * W[r + {x}]\nfor j in range(1, k):\n    s -= j * W[j * M + {c}] * W[(k - j) * M + {d}]\n"
-              "W[r + {c}] = s / (k * W[{d}])",
-    # f = atan2(x, y): d = x² + y², f' d = y x' − x y'
-    "arctan2": "s = 0.0\nfor j in range(k + 1):\n"
-               "    s += W[j * M + {x}] * W[(k - j) * M + {x}] + W[j * M + {y}] * W[(k - j) * M + {y}]\n"
-               "W[r + {d}] = s\ns = 0.0\nfor j in range(k):\n"
-               "    s += (k - j) * (W[j * M + {y}] * W[(k - j) * M + {x}] - W[j * M + {x}] * W[(k - j) * M + {y}])\n"
-               "for j in range(1, k):\n    s -= j * W[j * M + {c}] * W[(k - j) * M + {d}]\n"
-               "W[r + {c}] = s / (k * W[{d}])",
-    "pow": "s = 0.0\nfor j in range(k):\n    s += ({e} * (k - j) - j) * W[(k - j) * M + {x}] * W[j * M + {c}]\n"
-           "W[r + {c}] = s / (k * W[{x}])",
-    "abs": "W[r + {c}] = (1.0 if W[{x}] > 0.0 else -1.0 if W[{x}] < 0.0 else 0.0) * W[r + {x}]",
-}
-_STEPS["tanh"] = _STEPS["tan"]
-# auxiliary series at order 0 ({c}: the result's column)
-_AUXILIARY = {"tan": "1.0 + W[{c}] * W[{c}]", "tanh": "1.0 - W[{c}] * W[{c}]", "arctan": "1.0 + W[{x}] * W[{x}]",
-              "arctan2": "W[{x}] * W[{x}] + W[{y}] * W[{y}]"}
-
-
-_FUSE = ("contract",)  # a product and its sum may fuse (as the built-in's fastmath)
-
-#: ``cauchy_sums``' vectors: at most _LANES lanes each (a power of two: the compiler splits other lengths into
-#: pairs of lanes), at most _GROUP lanes summed in one loop (the accumulators stay in registers)
-_LANES = 8
-_GROUP = 64
-
-
-def _chunks(start: int, n: int) -> list[tuple[int, int]]:
-    """(first lane, lanes) of the vectors covering lanes start..start+n−1: powers of two, largest first."""
-    out = []
-    while n:
-        size = min(_LANES, 1 << (n.bit_length() - 1))
-        out.append((start, size))
-        start, n = start + size, n - size
-    return out
-
-
-@intrinsic
-def cauchy_sums(typingctx, W, k, columns, base, left, right):
-    """The k-th coefficients of n products at once: Σ_{j=0..k} L_j ⊙ R_{k−j}, as an n-tuple.
-
-    The products' first operands' coefficients sit side by side in W's rows (``columns`` wide) from column
-    ``base``, their second operands' after them (from base + n); rows 0..k−1 are filled, row k is given as the
-    n-tuples ``left`` and ``right`` and stored here, as vectors (a vector load of what scalar stores wrote
-    would wait for them to reach the cache). The sums run in vectors, so the compiler emits packed fused
-    multiply-adds (the built-in's ``taylor.run_vector`` does the same by hand): the terms of rows 1..k−1 first,
-    alternately into two accumulators (two chains of dependent additions, half as long), then those with
-    row k (j = 0 and j = k) from the registers it was packed in.
-    """
-    if not (isinstance(columns, types.IntegerLiteral) and isinstance(base, types.IntegerLiteral)):
-        return None
-    if not (isinstance(left, types.UniTuple) and isinstance(right, types.UniTuple) and left.count == right.count
-            and isinstance(k, types.Integer)):
-        return None
-    n, stride, first = left.count, columns.literal_value, base.literal_value
-    sig = types.UniTuple(types.float64, n)(W, k, columns, base, types.UniTuple(types.float64, n),
-                                           types.UniTuple(types.float64, n))
-
-    def codegen(context, builder, signature, args):
-        b = builder
-        i64, i32 = ir.IntType(64), ir.IntType(32)
-        k_ = context.cast(b, args[1], signature.args[1], types.int64)
-        one, two = ir.Constant(i64, 1), ir.Constant(i64, 2)
-        newest = [[b.extract_value(args[a], i) for i in range(n)] for a in (4, 5)]
-
-        def at(row, column, size):
-            """The address of ``size`` lanes of row ``row`` (an i64 value) from ``column`` (an int)."""
-            index = b.add(b.mul(row, ir.Constant(i64, stride)), ir.Constant(i64, column))
-            return b.bitcast(b.gep(args[0], [index]), ir.VectorType(ir.DoubleType(), size).as_pointer())
-
-        sums = []
-        for group in range(0, n, _GROUP):
-            chunks = _chunks(group, min(_GROUP, n - group))
-            acc = {}
-            newest_vectors = ({}, {})
-            for lane, size in chunks:
-                vec = ir.VectorType(ir.DoubleType(), size)
-                for operand, column in ((0, first + lane), (1, first + n + lane)):  # row k, stored as vectors
-                    v = ir.Constant(vec, ir.Undefined)
-                    for i in range(size):
-                        v = b.insert_element(v, newest[operand][lane + i], ir.Constant(i32, i))
-                    b.store(v, at(k_, column, size), align=8)
-                    newest_vectors[operand][lane] = v
-                acc[lane] = [cgutils.alloca_once_value(b, ir.Constant(vec, [0.0] * size)) for _ in range(2)]
-
-            def terms(j, which):
-                for lane, size in chunks:
-                    product = b.fmul(b.load(at(j, first + lane, size), align=8),
-                                     b.load(at(b.sub(k_, j), first + n + lane, size), align=8), flags=_FUSE)
-                    b.store(b.fadd(b.load(acc[lane][which]), product, flags=_FUSE), acc[lane][which])
-
-            zero = ir.Constant(i64, 0)
-            middle = b.sub(k_, one)  # rows 1..k−1, two at a time (none at k = 0)
-            middle = b.select(b.icmp_signed(">", middle, zero), middle, zero)
-            with cgutils.for_range(b, b.sdiv(middle, two)) as loop:
-                j = b.add(b.mul(loop.index, two), one)
-                terms(j, 0)
-                terms(b.add(j, one), 1)
-            with b.if_then(b.icmp_signed("!=", b.srem(middle, two), ir.Constant(i64, 0))):
-                terms(middle, 0)
-            for lane, size in chunks:
-                a0 = b.fadd(b.load(acc[lane][0]), b.fmul(b.load(at(zero, first + lane, size), align=8),
-                                                         newest_vectors[1][lane], flags=_FUSE), flags=_FUSE)
-                a1 = b.fadd(b.load(acc[lane][1]), b.fmul(newest_vectors[0][lane],
-                                                         b.load(at(zero, first + n + lane, size), align=8),
-                                                         flags=_FUSE), flags=_FUSE)
-                # (at k = 0, row 0 is row k: a0 = a1 = the one term L_0 R_0)
-                total = b.select(b.icmp_signed("==", k_, zero), a0, b.fadd(a0, a1, flags=_FUSE))
-                sums += [b.extract_element(total, ir.Constant(i32, i)) for i in range(size)]
-        return context.make_tuple(b, signature.return_type, sums)
-
-    return sig, codegen
 
 
 class _Program:
@@ -426,101 +292,117 @@ class _Program:
         result = binary_power(x, abs(power), self._mul)
         return self._function("div", _Lin(ONE), result) if power < 0 else result
 
-    # ---- the generated code
 
-    def source(self) -> tuple[str, int]:
-        """The cfunc's source and the number of columns of W."""
-        depth = max((s.depth for s in self.series), default=0)
-        columns = 0
-        slots: dict[int, list[tuple[int, int]]] = {}  # a depth's products: (series, first operand's column)
-        operand_column: dict[int, int] = {}  # operands of functions: their series' columns
-        for d in range(1, depth + 1):
-            products = [i for i, s in enumerate(self.series) if s.depth == d and s.op == "mul"]
-            slots[d] = [(i, columns + k) for k, i in enumerate(products)]
-            columns += 2 * len(products)  # the first operands side by side, then the second
-        for i, s in enumerate(self.series):
-            if s.op in ("y", "time", "mul", "cos"):
-                continue
-            for u in s.args:
-                if u not in operand_column:
-                    operand_column[u] = columns
-                    columns += 1
-            s.columns = [columns]
-            columns += 1
-            if s.op == "sin":  # the cosine's column
-                self.series[i + 1].columns = [columns]
-                columns += 1
-            elif s.op in _AUXILIARY:
-                s.columns.append(columns)
-                columns += 1
-        self.columns = max(columns, 1)
-        lines = [*self.numbers.lines, "# order 0"]
-        lines += self._order(True, depth, slots, operand_column)
-        lines += ["for k in range(1, order):", "    r = k * M", "    inv = 1.0 / (k + 1)"]
-        lines += [f"    {line}" for line in self._order(False, depth, slots, operand_column)]
-        text = _HEADER.format(columns=self.columns, size=self.size) + "".join(f"    {x}\n" for x in lines)
-        return text, self.columns
+def plan(model: Any, first_constant: int = TRACED_FIRST_CONSTANT) -> dict:
+    """A model's lowered program (``_Program``) as plain data, for the emitters (this module's and the batch lanes').
 
-    def _order(self, first: bool, depth: int, slots: dict[int, list[tuple[int, int]]],
-               operand_column: dict[int, int]) -> list[str]:
-        """The statements of order 0 (``first``) or of order k ≥ 1 (inside the loop over k)."""
-        lines = []
-        row = "" if first else "r + "
-        known: set[int] = set()
+    Numbers are given as indices into ``names`` (the locals the ``lines`` compute from the parameter array p) or the
+    literals "0.0", "1.0", "-1.0"; a linear combination as (constant, ((series, coefficient), ...)); series as
+    (op, operands, extra, depth), extra the state index of "y" and the exponent's number of "pow".
+    """
+    program = _Program(model, first_constant)
+    rows: dict[str, int] = {}
 
-        def operand(u: int) -> str:
-            if u not in known:
-                known.add(u)
-                lines.append(f"u{u} = {self.operands[u].expression(first)}")
-            return f"u{u}"
+    def number(name: str) -> Any:
+        return name if name in (ZERO, ONE, MINUS_ONE) else rows.setdefault(name, len(rows))
 
-        for i, s in enumerate(self.series):
-            if s.op == "y" and first:  # (at order k ≥ 1, the previous order left them in s<i>)
-                lines.append(f"s{i} = Y[{s.extra}]")
-            elif s.op == "time":
-                lines.append(f"s{i} = t" if first else f"s{i} = 1.0 if k == 1 else 0.0")
-        for d in range(1, depth + 1):
-            products = slots[d]
-            pairs = [self.series[i].args for i, _ in products]
-            left, right = [operand(x) for x, _ in pairs], [operand(y) for _, y in pairs]
-            if products:  # the depth's Cauchy sums at once, in vectors (``cauchy_sums`` stores row k's operands)
-                names = ", ".join(f"s{i}" for i, _ in products)
-                lines.append(f"{names}, = cauchy_sums(W, {0 if first else 'k'}, {self.columns}, {products[0][1]}, "
-                             f"({', '.join(left)},), ({', '.join(right)},))")
-            for i, s in enumerate(self.series):
-                if s.depth != d or s.op in ("mul", "cos"):
-                    continue
-                cols = {"c": s.columns[0]}
-                for name, u in zip("xy", s.args):
-                    lines.append(f"W[{row}{operand_column[u]}] = {operand(u)}")
-                    cols[name] = operand_column[u]
-                if s.op == "sin":
-                    cols["co"] = self.series[i + 1].columns[0]
-                elif len(s.columns) > 1:
-                    cols["d"] = s.columns[1]
-                if first:
-                    value = _VALUES[s.op].format(**{k: f"u{s.args[n]}" for n, k in enumerate("xy") if n < len(s.args)},
-                                                 e=s.extra)
-                    lines.append(f"W[{cols['c']}] = {value}")
-                    if s.op == "sin":
-                        lines.append(f"W[{cols['co']}] = math.cos(u{s.args[0]})")
-                    elif s.op in _AUXILIARY:
-                        lines.append(f"W[{cols['d']}] = {_AUXILIARY[s.op].format(**cols)}")
-                else:
-                    sign = "" if s.op == "tan" else "-"
-                    lines += _STEPS[s.op].format(**cols, e=s.extra, sign=sign).split("\n")
-                lines.append(f"s{i} = W[{row}{cols['c']}]")
-                if s.op == "sin":
-                    lines.append(f"s{i + 1} = W[{row}{cols['co']}]")
-        state = {s.extra: i for i, s in enumerate(self.series) if s.op == "y"}
-        for m, rate in enumerate(self.rates):  # the state's next coefficients
-            value = rate.expression(first)
-            lines.append(f"n{m} = {value}" if first else f"n{m} = ({value}) * inv")
-        for m in range(len(self.rates)):  # stored, and kept for the next order (no reload)
-            lines.append(f"Y[N + {m}] = n{m}" if first else f"Y[(k + 1) * N + {m}] = n{m}")
-            if m in state:
-                lines.append(f"s{state[m]} = n{m}")
-        return lines
+    def combination(value: _Lin) -> tuple:
+        return number(value.const), tuple((i, number(c)) for i, c in value.terms)
+
+    series = [(s.op, s.args, number(s.extra) if s.op == "pow" else s.extra, s.depth) for s in program.series]
+    operands = [combination(u) for u in program.operands]
+    rates = [combination(r) for r in program.rates]
+    return {"size": program.size, "series": series, "operands": operands, "rates": rates, "names": list(rows),
+            "lines": program.numbers.lines}
+
+
+def pieces(n: int) -> list[tuple[int, int]]:
+    """(first lane, lanes) of the vectors holding n lanes: VECTOR lanes each, the last rounded up to a power of two
+    (its top lanes padding, never stored where another row starts): one vector where an exact split takes two. A
+    vector of another length is split by the compiler into scalars."""
+    out, lo = [], 0
+    while lo < n:
+        width = min(VECTOR, 1 << (n - lo - 1).bit_length())
+        out.append((lo, width))
+        lo += width
+    return out
+
+
+def _padded(n: int) -> int:
+    return sum(width for _, width in pieces(n))
+
+
+def _groups(program: dict) -> dict[int, list[list[int | None]]]:
+    """Each depth's products in groups (a group's vector lane l is its product l; None: a padding lane).
+
+    Where it costs few lanes, depth 1 is laid out aligned with the rates (``_aligned``); otherwise each depth's
+    products side by side, at most GROUP a group."""
+    series = program["series"]
+    depth = max((s[3] for s in series), default=0)
+    out = {}
+    for d in range(1, depth + 1):
+        products = [i for i, s in enumerate(series) if s[3] == d and s[0] == "mul"]
+        compact = [products[g:g + GROUP] for g in range(0, len(products), GROUP)]
+        aligned = _aligned(program, products) if d == 1 else None
+        lanes = (lambda groups: sum(_padded(len(g)) for g in groups))
+        out[d] = aligned if aligned is not None and lanes(aligned) <= ALIGNED_COST * lanes(compact) else compact
+    return out
+
+
+def _aligned(program: dict, products: list[int]) -> list[list[int | None]] | None:
+    """Groups whose lane m holds a product the rate of state component m reads (its t-th product term in group
+    t), then the products no rate reads, side by side: the rates' sums then add whole vectors, with no shuffle
+    between the Cauchy sums and the next order (the hand-written fixed-point kernel's layout, found for any
+    model). None when a rate reads a product twice or more than GROUP lanes would be needed."""
+    size, placed, groups = program["size"], set(), []
+    reads = [[i for i, _ in terms if i in products] for _, terms in program["rates"]]
+    for t in range(max((len(r) for r in reads), default=0)):
+        group = []
+        for m in range(size):
+            i = reads[m][t] if t < len(reads[m]) else None
+            if i in placed:
+                return None
+            group.append(i)
+            placed.add(i)
+        groups.append(group)
+    rest = [i for i in products if i not in placed]
+    groups += [rest[g:g + GROUP] for g in range(0, len(rest), GROUP)]
+    return groups if all(_padded(len(g)) <= GROUP for g in groups) else None
+
+
+def layout(program: dict) -> tuple[dict[tuple, int], int]:
+    """W's columns and their number: each group of products' first operands ("L", depth, group) and second operands
+    ("R", ...) side by side (padded to whole vectors); then the functions' operands ("u", operand), results ("f",
+    series, 0) and cosines or auxiliary series ("f", series, 1)."""
+    column: dict[tuple, int] = {}
+    width = 0
+    for d, groups in _groups(program).items():
+        for g, products in enumerate(groups):
+            column[("L", d, g)] = width
+            column[("R", d, g)] = width + _padded(len(products))
+            width += 2 * _padded(len(products))
+    for i, (op, args, _, _) in enumerate(program["series"]):
+        if op in ("y", "time", "cos", "mul"):
+            continue
+        for u in args:
+            if ("u", u) not in column:
+                column[("u", u)] = width
+                width += 1
+        column[("f", i, 0)] = width
+        width += 1
+        if op == "sin" or op in AUXILIARY:
+            column[("f", i, 1)] = width
+            width += 1
+    return column, max(width, 1)
+
+
+def source(program: dict) -> str:
+    """The generated module: ``kernel``, the numbers computed from p once per call, then the series."""
+    shape = {k: program[k] for k in ("size", "series", "operands", "rates")}
+    shape["numbers"] = len(program["names"])
+    body = "".join(f"    {line}\n" for line in program["lines"])
+    names = ", ".join(program["names"]) or "0.0"
+    return _HEADER.format(emitter=_EMITTER, plan=repr(shape)) + body + f"    _series(t, order, Y, W, ({names},))\n"
 
 
 _HEADER = '''"""Generated by gyrolab: Taylor coefficients of a system's traced equations (gyrolab.kernels.taylor_series)."""
@@ -529,22 +411,276 @@ import math
 import numba
 from numba import types
 
-from gyrolab.kernels.taylor_series import cauchy_sums
+from gyrolab.kernels.taylor_series import series_intrinsic
 
-M = {columns}
-N = {size}
+EMITTER = "{emitter}"
+PLAN = {plan}
 _P = types.CPointer(types.float64)
-SIGNATURE = types.void(types.float64, types.int64, _P, _P, _P)
+_series = series_intrinsic(PLAN)
 
 
-@numba.cfunc(SIGNATURE, cache=True, error_model="numpy", fastmath={{"reassoc", "contract", "nsz"}})
+@numba.cfunc(types.void(types.float64, types.int64, _P, _P, _P), cache=True, error_model="numpy")
 def kernel(t, order, Y, W, p):
 '''
 
 
-def source(model: Model) -> tuple[str, int]:
-    """The Taylor cfunc's source for a traced model, and W's columns."""
-    return _Program(model).source()
+def series_intrinsic(program: dict) -> Any:
+    """The intrinsic ``(t, order, Y, W, numbers)`` (numbers: the tuple of ``names``' values) that fills Y[1..order]
+    from Y[0] (``_emit``)."""
+
+    @intrinsic
+    def _series(typingctx, t, order, Y, W, numbers):
+        sig = types.void(types.float64, types.int64, _P, _P, numbers)
+
+        def codegen(context, builder, signature, args):
+            _Emitter(builder, program, args[4]).series(*args[:4])
+            return context.get_dummy_value()
+
+        return sig, codegen
+
+    return _series
+
+
+class _Emitter:
+    """The series' IR (see the module's docstring). A value at the current order is a list of vectors (``pieces``);
+    ``where`` maps a series to its (vector, lane)."""
+
+    def __init__(self, b: ir.IRBuilder, program: dict, numbers: Any) -> None:
+        self.b, self.program = b, program
+        self.column, self.width = layout(program)
+        self.numbers = [b.extract_value(numbers, i) for i in range(program["numbers"])]
+        self.i32, self.i64 = ir.IntType(32), ir.IntType(64)
+
+    # ---- small pieces of IR
+
+    @staticmethod
+    def vec(n: int) -> ir.VectorType:
+        return ir.VectorType(ir.DoubleType(), n)
+
+    def int(self, x: int) -> ir.Constant:
+        return ir.Constant(self.i64, x)
+
+    def number(self, ref: Any) -> Any:
+        return ir.Constant(ir.DoubleType(), float(ref)) if isinstance(ref, str) else self.numbers[ref]
+
+    def splat(self, scalar_vector: Any, n: int) -> Any:
+        """n lanes of a <1 x double>'s value."""
+        return self.b.shuffle_vector(scalar_vector, ir.Constant(scalar_vector.type, ir.Undefined),
+                                     ir.Constant(ir.VectorType(self.i32, n), [0] * n))
+
+    def address(self, base: Any, index: Any, n: int) -> Any:
+        return self.b.bitcast(self.b.gep(base, [index]), self.vec(n).as_pointer())
+
+    def at(self, row: Any, column: int) -> Any:
+        return self.b.add(self.b.mul(row, self.int(self.width)), self.int(column))
+
+    def load(self, base: Any, index: Any, n: int) -> list:
+        return [self.b.load(self.address(base, self.b.add(index, self.int(lo)), w), align=8) for lo, w in pieces(n)]
+
+    def store(self, value: list, base: Any, index: Any, n: int) -> None:
+        """The first n lanes of ``value`` (padding lanes are not stored: rows of Y are n wide), in vectors whose
+        lengths are powers of two."""
+        b = self.b
+        for (lo, w), v in zip(pieces(n), value):
+            used, sub = min(w, n - lo), 0
+            while sub < used:
+                size = 1 << (used - sub).bit_length() - 1
+                part = v if size == w else b.shuffle_vector(v, ir.Constant(v.type, ir.Undefined), ir.Constant(
+                    ir.VectorType(self.i32, size), list(range(sub, sub + size))))
+                b.store(part, self.address(base, b.add(index, self.int(lo + sub)), size), align=8)
+                sub += size
+
+    @staticmethod
+    def locate(value: list, lane: int) -> tuple:
+        for v in value:
+            if lane < v.type.count:
+                return v, lane
+            lane -= v.type.count
+        raise IndexError(lane)
+
+    # ---- gathers and linear combinations
+
+    def gather(self, sources: list) -> list:
+        """A value whose lane l is sources[l] ((vector, lane), None for 0, or _PAD for any value)."""
+        return [self._gather(sources[lo:lo + w], w) for lo, w in pieces(len(sources))]
+
+    def _gather(self, sources: list, n: int) -> Any:
+        """One vector of n lanes: a shuffle per source vector (none where a vector's lanes are already in place),
+        merged by pairs (a balanced tree: the merges of three sources are two deep, not three); zeros by a blend.
+        Lanes beyond ``sources`` are padding (any value)."""
+        b = self.b
+        by_vector: dict[int, tuple[Any, list]] = {}
+        zeros = []
+        for lane, source in enumerate(sources):
+            if source is None:
+                zeros.append(lane)
+            elif source is not _PAD:
+                by_vector.setdefault(id(source[0]), (source[0], []))[1].append((lane, source[1]))
+        mask = ir.VectorType(self.i32, n)
+        parts = []  # (vector of n lanes, the lanes it holds)
+        for v, lanes in by_vector.values():
+            pick = list(range(n)) if v.type.count == n else [0] * n
+            for lane, source_lane in lanes:
+                pick[lane] = source_lane
+            same = v.type.count == n and pick == list(range(n))
+            parts.append((v if same else b.shuffle_vector(v, ir.Constant(v.type, ir.Undefined),
+                                                           ir.Constant(mask, pick)), {lane for lane, _ in lanes}))
+        while len(parts) > 1:
+            merged = [(b.shuffle_vector(x, y, ir.Constant(mask, [n + lane if lane in ys else lane for lane in range(n)])),
+                       xs | ys) for (x, xs), (y, ys) in zip(parts[0::2], parts[1::2])]
+            parts = merged + parts[len(merged) * 2:]
+        zero = ir.Constant(self.vec(n), [0.0] * n)
+        if not parts:
+            return zero
+        if not zeros:
+            return parts[0][0]
+        keep = ir.Constant(ir.VectorType(ir.IntType(1), n), [int(lane not in zeros) for lane in range(n)])
+        return b.select(keep, parts[0][0], zero)
+
+    def constants(self, refs: list, scale: Any = None) -> list:
+        """The value whose lanes are the numbers ``refs`` (times ``scale``, a <1 x double>, if given). Loop-invariant
+        but for the scale: the compiler hoists them out of the loop over orders."""
+        out = []
+        for lo, w in pieces(len(refs)):
+            v = ir.Constant(self.vec(w), [0.0] * w)
+            for lane, ref in enumerate(refs[lo:lo + w]):
+                v = self.b.insert_element(v, self.number(ref), ir.Constant(self.i32, lane))
+            out.append(v if scale is None else self.b.fmul(v, self.splat(scale, w)))
+        return out
+
+    def combinations(self, values: list, where: dict, only_first: Any, scale: Any = None) -> list:
+        """The value whose lane m is the linear combination values[m] = (constant, ((series, coefficient), ...)) at
+        this order (its constant at order 0 only; None: a padding lane), times ``scale`` (a <1 x double>, applied to
+        the coefficients: off the chain of dependent operations from one order to the next).
+
+        The terms are summed by slots: a slot takes from one source vector (the state, a group of products, a
+        function's lane) one term of every lane that reads it, so a slot is one gathered vector — no shuffle at all
+        where the lanes are aligned (``_aligned``) — times one coefficient vector; the slots are summed as a
+        balanced tree."""
+        b, n = self.b, len(values)
+        slots: dict[tuple, list] = {}
+        for lane, value in enumerate(values):
+            seen: dict[int, int] = {}
+            for i, ref in (value or (ZERO, ()))[1]:
+                source = where[i]
+                count = seen[id(source[0])] = seen.get(id(source[0]), -1) + 1
+                slots.setdefault((id(source[0]), count), []).append((lane, source, ref))
+        filler = [_PAD if value is None else None for value in values]
+        parts = []
+        for entries in slots.values():
+            sources, refs = list(filler), [ZERO] * n
+            for lane, source, ref in entries:
+                sources[lane], refs[lane] = source, ref
+            x = self.gather(sources)
+            if scale is None and set(refs) <= {ONE, ZERO}:
+                parts.append(x)
+            elif scale is None and set(refs) <= {MINUS_ONE, ZERO}:
+                parts.append([b.fneg(v) for v in x])
+            else:
+                parts.append([b.fmul(c, v, flags=simd.FUSE) for c, v in zip(self.constants(refs, scale), x)])
+        consts = [ZERO if value is None else value[0] for value in values]
+        if any(c != ZERO for c in consts):
+            parts.append([b.fmul(c, self.splat(only_first, c.type.count), flags=simd.FUSE)
+                          for c in self.constants(consts, scale)])
+        while len(parts) > 1:
+            parts = [[b.fadd(x, y, flags=simd.FUSE) for x, y in zip(parts[i], parts[i + 1])]
+                     if i + 1 < len(parts) else parts[i] for i in range(0, len(parts), 2)]
+        return parts[0] if parts else [ir.Constant(self.vec(w), [0.0] * w) for _, w in pieces(n)]
+
+    # ---- the series
+
+    def series(self, t: Any, order: Any, Y: Any, W: Any) -> None:
+        """For k = 0 … order − 1: each depth's products (operands gathered and stored in W, Cauchy sums) and
+        functions, then Y[k + 1] = (the rates' combinations) / (k + 1)."""
+        b, program, column = self.b, self.program, self.column
+        double = ir.DoubleType()
+        size, series, operands = program["size"], program["series"], program["operands"]
+        Y, W = (b.bitcast(x, double.as_pointer()) for x in (Y, W))
+        newest = []  # the state's coefficients of the current order, in registers from one order to the next
+        for lo, w in pieces(size):
+            v = ir.Constant(self.vec(w), [0.0] * w)
+            for m in range(lo, min(lo + w, size)):
+                v = b.insert_element(v, b.load(b.gep(Y, [self.int(m)])), ir.Constant(self.i32, m - lo))
+            newest.append(cgutils.alloca_once_value(b, v))
+        one = ir.Constant(self.vec(1), [1.0])
+        with cgutils.for_range(b, order) as loop:
+            k = loop.index
+            first = b.icmp_signed("==", k, self.int(0))
+            only_first = b.select(first, one, ir.Constant(self.vec(1), [0.0]))
+            state = [b.load(x) for x in newest]
+            where: dict[int, tuple] = {}
+            for i, (op, _, extra, _) in enumerate(series):
+                if op == "y":
+                    where[i] = self.locate(state, extra)
+                elif op == "time":
+                    later = b.select(b.icmp_signed("==", k, self.int(1)), one, ir.Constant(self.vec(1), [0.0]))
+                    where[i] = (b.select(first, b.insert_element(one, t, ir.Constant(self.i32, 0)), later), 0)
+            functions = Functions(
+                b, 1, k, first, lambda row, key: b.load(self.address(W, self.at(row, column[key]), 1), align=8),
+                lambda value, row, key: b.store(value, self.address(W, self.at(row, column[key]), 1), align=8),
+                lambda ref: self.constants([ref])[0])
+            for d, groups in _groups(program).items():
+                for g, products in enumerate(groups):
+                    self._products(d, g, products, k, first, where, only_first, W)
+                rows = {}
+                for i, (op, args, extra, depth) in enumerate(series):
+                    if depth != d or op in ("mul", "cos"):
+                        continue
+                    for u in args:
+                        if u not in rows:
+                            rows[u] = self.combinations([operands[u]], where, only_first)[0]
+                            b.store(rows[u], self.address(W, self.at(k, column[("u", u)]), 1), align=8)
+                    for j, value in functions(op, i, args, extra, rows).items():
+                        where[j] = (value, 0)
+            inv = b.fdiv(one, b.insert_element(one, b.sitofp(b.add(k, self.int(1)), double), ir.Constant(self.i32, 0)))
+            rate = self.combinations(program["rates"], where, only_first, inv)
+            self.store(rate, Y, b.mul(b.add(k, self.int(1)), self.int(size)), size)
+            for x, v in zip(newest, rate):
+                b.store(v, x)
+
+    def _products(self, d: int, g: int, products: list, k: Any, first: Any, where: dict, only_first: Any,
+                  W: Any) -> None:
+        """A group's order-k coefficients Σ_{j=0..k} L_j ⊙ R_{k−j}: the operands' row k gathered and stored in W,
+        the pairs (j, k − j) into two accumulators (or one, ``TWIN``), the middle term when k is even, then the
+        newest row's terms (in registers) against row 0."""
+        b, operands, series = self.b, self.program["operands"], self.program["series"]
+        n = len(products)
+        left_column, right_column = self.column[("L", d, g)], self.column[("R", d, g)]
+        left, right = (self.combinations([None if i is None else operands[series[i][1][side]] for i in products], where,
+                                         only_first) for side in (0, 1))
+        for value, column in ((left, left_column), (right, right_column)):
+            for (lo, w), v in zip(pieces(n), value):
+                b.store(v, self.address(W, self.at(k, column + lo), w), align=8)
+
+        def rows(row):
+            return self.load(W, self.at(row, left_column), n), self.load(W, self.at(row, right_column), n)
+
+        zero = [ir.Constant(v.type, [0.0] * v.type.count) for v in left]
+        acc0 = [cgutils.alloca_once_value(b, z) for z in zero]
+        acc1 = [cgutils.alloca_once_value(b, z) for z in zero] if _padded(n) <= TWIN else acc0
+
+        def add(acc, xs, ys):
+            for slot, x, y in zip(acc, xs, ys):
+                b.store(b.fadd(b.load(slot), b.fmul(x, y, flags=simd.FUSE), flags=simd.FUSE), slot)
+
+        one, two = self.int(1), self.int(2)
+        pairs = b.sdiv(b.sub(k, one), two)  # (k − 1) // 2 for k ≥ 1; 0 at k = 0 (sdiv rounds toward zero)
+        with cgutils.for_range(b, pairs) as loop:
+            j = b.sub(pairs, loop.index)  # from the middle outwards: the pair nearest the newest row last
+            (lj, rj), (lk, rk) = rows(j), rows(b.sub(k, j))
+            add(acc0, lj, rk)
+            add(acc1, lk, rj)
+        even = b.icmp_signed("==", b.and_(k, one), self.int(0))
+        with b.if_then(b.and_(even, b.icmp_signed(">", k, self.int(0)))):
+            add(acc0, *rows(b.lshr(k, one)))
+        total = []
+        for slot0, slot1, l0, r0, lk, rk in zip(acc0, acc1, *rows(self.int(0)), left, right):
+            a0 = b.fadd(b.load(slot0), b.fmul(l0, rk, flags=simd.FUSE), flags=simd.FUSE)
+            a1 = b.fadd(b.load(slot1) if acc1 is not acc0 else a0, b.fmul(lk, r0, flags=simd.FUSE), flags=simd.FUSE)
+            total.append(b.select(first, a0, a1 if acc1 is acc0 else b.fadd(a0, a1, flags=simd.FUSE)))
+        for lane, i in enumerate(products):
+            if i is not None:
+                where[i] = self.locate(total, lane)
 
 
 #: the Taylor kernel's (address, work columns) by the address of its model's right-hand side kernel
@@ -552,23 +688,22 @@ _KERNELS: dict[int, tuple[float, float]] = {}
 
 
 def ready(compiled: Any, rows: np.ndarray | None = None) -> bool:
-    """Whether ``taylor`` can integrate a compiled model: the hand-written fixed point and every traced model.
+    """Whether ``taylor`` can integrate a compiled model: every traced model can.
 
-    For a traced model this compiles (or loads) its Taylor kernel on first need and writes its address
-    into ``compiled.params`` (and into every row of ``rows``, a batch's per-trajectory parameters).
-    Nothing compiles before: most runs never use taylor, and a Taylor kernel's first compilation costs
-    0.2–1 s (the reference problem's torque: 0.2 s; one with sqrt, powers, sin and exp: 1.2 s).
+    This compiles (or loads) its Taylor kernel on first need and writes its address and work columns into
+    ``compiled.params`` (and into every row of ``rows``, a batch's per-trajectory parameters). Nothing compiles
+    before: most runs never use taylor, and a Taylor kernel's first compilation costs 0.2–1 s.
     """
     if compiled.model != TRACED:
-        return compiled.model == 0  # models.FIXED_POINT (not imported: models imports this module)
+        return False
     p = compiled.params
     if p[p.size - 4] == 0.0:
         address = int(p[TRACED_ADDRESS])
         if address not in _KERNELS:  # once per form and process (the rhs kernel's address names the form)
             model = traced_model(compiled)
-            text, columns = source(model)
-            kernel = load_generated(text, "gyrolab_taylor", f"{model.what} (Taylor)")
-            _KERNELS[address] = (float(kernel.address), float(columns))
+            program = plan(model)
+            module = generated_module(source(program), "gyrolab_taylor", f"{model.what} (Taylor)")
+            _KERNELS[address] = (float(module.kernel.address), float(layout(program)[1]))
         p[p.size - 4:p.size - 2] = _KERNELS[address]
     if rows is not None:
         rows[:, -4:-2] = p[p.size - 4:p.size - 2]
@@ -626,7 +761,7 @@ def _call(typingctx, address, t, order, size, Y, p):
 def coefficients(p, Y, order, work, t):
     """Fill Y[1..order] from Y[0] for a traced model (``models.TRACED``): one call of the generated kernel
     (``source``), whose address ``ready`` wrote at p[-4] and its work columns at p[-3] (``layout``). ``work`` is
-    unused (the hand-written fixed-point kernels' β series)."""
+    unused (the signature of ``models.taylor_coefficients``)."""
     address = int(p[p.size - 4])
     if address == 0:  # the Taylor kernel was not compiled (``ready`` not called): no series, not a crash
         Y[1:] = np.nan

@@ -11,13 +11,13 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+from gyrolab.contracts import registry
+
 SOURCE_ROOT = Path(__file__).resolve().parents[2]
 #: always recorded (when installed), on top of gyrolab's declared dependencies
 LIBRARIES = ("numpy", "scipy", "xarray", "netCDF4", "hydra-core", "omegaconf", "matplotlib")
-#: entry-point groups whose providers (third-party plugin packages) are part of the code that ran
 #: what can change a result (docs, tests and the README cannot)
 CODE_PATHS = ("pipeline", "plugins", "conf", "hydra_plugins", "pyproject.toml")
-PLUGIN_GROUPS = ("gyrolab.systems", "gyrolab.forces", "gyrolab.integrators", "gyrolab.regimes")
 
 
 @cache
@@ -96,11 +96,10 @@ def _libraries() -> list[str]:
 def plugin_packages() -> str:
     """'name==version' of every installed distribution that registers gyrolab plugins, sorted."""
     found = set()
-    for group in PLUGIN_GROUPS:
-        for ep in metadata.entry_points(group=group):
-            dist = getattr(ep, "dist", None)
-            if dist is not None and dist.metadata["Name"] and dist.metadata["Name"].lower() != "gyrolab":
-                found.add(f"{dist.metadata['Name']}=={dist.version}")
+    for ep in registry.plugin_entry_points():
+        dist = getattr(ep, "dist", None)
+        if dist is not None and dist.metadata["Name"] and dist.metadata["Name"].lower() != "gyrolab":
+            found.add(f"{dist.metadata['Name']}=={dist.version}")
     return " ".join(sorted(found))
 
 

@@ -12,8 +12,10 @@ import numpy as np
 def cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """u × v along the last axis."""
     if u.ndim == 1 and v.ndim == 1:
-        u0, u1, u2 = u
-        v0, v1, v2 = v
+        # Python floats: the same products and differences, bit for bit, at a third of the cost of numpy scalars
+        # (the default run's right-hand side crosses ~100k pairs)
+        u0, u1, u2 = u.tolist()
+        v0, v1, v2 = v.tolist()
         return np.array((u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0))
     return np.cross(u, v)
 

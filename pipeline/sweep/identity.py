@@ -16,15 +16,14 @@ from __future__ import annotations
 import hashlib
 import json
 from functools import cache
-from importlib import metadata
 from importlib.util import find_spec
 from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.contracts.registry import _normalise
-from gyrolab.output.provenance import PLUGIN_GROUPS, code_tree, provenance
+from gyrolab.contracts.registry import _normalise, plugin_entry_points
+from gyrolab.output.provenance import code_tree, provenance
 
 #: bump when the meaning of an identity changes (invalidates every stored result)
 SCHEME = "gyrolab-job-2"
@@ -96,14 +95,8 @@ def _plugin_code(target: str) -> str:
     module = target.rpartition(".")[0]
     if not module or module == "gyrolab" or module.startswith("gyrolab."):
         return ""
-    dist = ""
-    for group in PLUGIN_GROUPS:
-        for ep in metadata.entry_points(group=group):
-            if _normalise(ep.value) == target and getattr(ep, "dist", None) is not None:
-                dist = f"{ep.dist.metadata['Name']}=={ep.dist.version} "
-                break
-        if dist:
-            break
+    dist = next((f"{ep.dist.metadata['Name']}=={ep.dist.version} " for ep in plugin_entry_points()
+                 if _normalise(ep.value) == target and getattr(ep, "dist", None) is not None), "")
     try:
         digest = _source_digest(module)
     except Exception:  # noqa: BLE001 - not importable here: the job refuses it; its name still counts

@@ -5,20 +5,10 @@
     python -m gyrolab.sweep.slurm_local status    # the clusters it started that are running
     python -m gyrolab.sweep.slurm_local stop      # cancel their jobs, stop their daemons, remove their files
 
-``start`` needs root (the daemons run as root) and Debian's packages ``slurm-wlm`` and ``munge``, which it
-installs with ``apt-get`` when missing. tests/sweep/test_slurm.py starts its cluster with the same code
-(``start()`` below).
-
-``start()`` installs the packages when they are missing (``apt-get install``, root only), writes a
-munge key and a minimal ``slurm.conf`` for this host into a fresh state directory, starts ``munged``,
-``slurmctld`` and ``slurmd`` in the foreground as children of this process, and waits until ``sinfo``
-shows the node idle. ``Cluster.stop()`` cancels the jobs and ends every process that belongs to the
-cluster. Nothing outside the state directory is configured: clients find the cluster through the
-``SLURM_CONF`` environment variable (``start()`` sets it in ``os.environ``, so ``sbatch`` run by
-submitit or dask-jobqueue from this process or its children finds it), the daemons through the
-ports written in that file, and munge through the socket named in ``AuthInfo``, so a system munge or
-SLURM (default socket, ports 6817/6818) is left alone. The command line's ``start`` runs ``start()`` in a
-small background process that holds the cluster until ``stop`` (or SIGTERM) ends it.
+What ``start`` installs, writes and starts, and how clients find the cluster through ``SLURM_CONF`` without
+touching a system SLURM or munge: docs/cluster.md, "A SLURM on your own machine". ``start()`` returns the running
+cluster (tests/sweep/test_slurm.py starts its own with it); the command line's ``start`` runs it in a small
+background process that holds the cluster until ``stop`` (or SIGTERM) ends it.
 
 A process killed before its ``stop()`` leaves daemons behind: every state directory records the
 pid of the process that started it (``owner``), and the next ``start()`` ends the processes of every

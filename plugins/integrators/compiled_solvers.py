@@ -340,9 +340,9 @@ def _taylor_precision(precision: Any) -> str:
 class TaylorDoubleDouble(Taylor):
     """``Taylor(precision="double-double")`` (``integrator=taylor integrator.precision=double-double``): the Taylor
     method in double-double arithmetic (``gyrolab.kernels.taylor_dd``, ≈ 32 digits), same settings,
-    order rule, chunks and progress as ``Taylor``. Capabilities: the compiled model only — the fixed point's
-    hand-written kernels and every traced model whose equations are rational in the state (``series_dd``: the
-    orbiting gyrostat, a polynomial plugin torque; a transcendental function of the state is refused, naming it),
+    order rule, chunks and progress as ``Taylor``. Capabilities: the compiled model only — every traced model
+    whose equations are rational in the state (``series_dd``: the fixed point, the orbiting gyrostat, a polynomial
+    plugin torque; a transcendental function of the state is refused, naming it),
     time-dependent ones too; no batch kernel (``--batch`` runs one ``integrate`` per point, each exactly a single
     run)."""
 
@@ -423,11 +423,9 @@ def taylor_dd_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0
 def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -> str | None:
     """None when double-double can run ``compiled`` (compiling a traced model's series on first need), else why."""
     # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import models, series_dd
+    from gyrolab.kernels import series_dd
     from gyrolab.kernels.expression import NotCompilable
 
-    if compiled.model == models.FIXED_POINT:
-        return None
     try:
         series_dd.ready(compiled)
     except NotCompilable as exc:

@@ -179,15 +179,3 @@ class FixedPointRegime(Regime):
 
     def attributes(self) -> dict[str, Any]:
         return {**super().attributes(), "regime_parameter_long_name": self.parameter_long_name}
-
-    def diagnostics(self, system: System) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
-        """Extra evidence for a regime run's dataset: (data variables, coordinates, attributes); none by default."""
-        return {}, {}, {}
-
-    def series_candidates(self, system: System, accuracy: float) -> list[tuple[Regime, float]]:
-        """Variants of this regime (lowest order first) with their predicted max error, for ``integrator=auto``.
-
-        The default is the regime itself with no prediction (auto measures it); a regime with a series of
-        selectable order lists the orders predicted to meet ``accuracy``.
-        """
-        return [(self, float("nan"))]

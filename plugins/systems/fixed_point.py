@@ -184,8 +184,8 @@ class FixedPoint(System):
         return attrs
 
     def compiled_model(self) -> CompiledModel | None:
-        """The hand-written kernels' model for the state (ω, γ) with built-in torque forms; otherwise the equations
-        traced (``System``), carrying the built-in forms' parameters when every torque has one (``built_in``)."""
+        """The equations traced (``System``), carrying the built-in forms' parameters when every torque has one
+        (``built_in``: what the Lie–Poisson splitting and the regimes read)."""
         from gyrolab.kernels import fixed_point  # start-up: the compiled kernels import numba
 
         packed = fixed_point.built_in(self.inertia, self.forces, self.carries_alpha)
@@ -211,7 +211,9 @@ def euler_poisson(t: Any, y: np.ndarray, inertia: np.ndarray, forces: Sequence[F
     alpha = y[6:9] if carries_alpha else None
     axes = (alpha, cross(gamma, alpha) if needs_beta else None, gamma)
     torque = cross(inertia * omega, omega)
-    for force in forces:
+    # summed in the order of the forces' names, not the config's: a dataset's stored config (its keys sorted by the
+    # YAML writer) reproduces the run bit for bit
+    for force in sorted(forces, key=lambda f: f.name):
         torque = torque + (force.torque(omega, axes, t) if force.time_dependent else force.torque(omega, axes))
     parts = [torque / inertia, cross(gamma, omega)]
     if carries_alpha:
@@ -220,8 +222,8 @@ def euler_poisson(t: Any, y: np.ndarray, inertia: np.ndarray, forces: Sequence[F
 
 
 def traced_model(inertia: np.ndarray, forces: Sequence[Force], carries_alpha: bool) -> CompiledModel:
-    """The fixed-point equations with ``forces`` compiled from their trace, whatever forms the forces have (the
-    system itself takes the hand-written kernels when every force has a built-in form). Raises NotCompilable."""
+    """The fixed-point equations with ``forces`` compiled from their trace, whatever forms the forces have.
+    Raises NotCompilable."""
     check_torques(forces)
     needs_beta = any(1 in f.required_axes for f in forces)
     names = " + ".join(f.name for f in forces) or "no torque"

@@ -227,22 +227,9 @@ def test_a_batch_kernel_hook_runs_through_integrate_arrays():
         integrate_arrays(scene.compiled, Marker(), scene.times, y0s)
 
 
-def test_capabilities_and_their_boolean_aliases():
-    class Old(Integrator):   # the older declaration: a boolean class attribute
-        name, adaptive, needs_compiled_model = "old", True, True
-
-        def integrate(self, fun, t_out, y0, progress=None, compiled=None):
-            raise NotImplementedError
-
-    class New(Old):
-        needs_compiled_model = Integrator.needs_compiled_model   # back to the capability-driven alias
-        capabilities = frozenset({PREFERS_COMPILED_MODEL, BATCH_KERNEL})
-
-    assert Old.supports(COMPILED_MODEL) and Old.declared_capabilities() == {COMPILED_MODEL}
-    assert not New.needs_compiled_model and New.prefers_compiled_model and New().prefers_compiled_model
-    assert New.declared_capabilities() == {PREFERS_COMPILED_MODEL, BATCH_KERNEL}
+def test_an_unknown_capability_is_refused():
     with pytest.raises(ValueError, match="valid: compiled_model"):
-        New.supports("batch")
+        Integrator.supports("batch")
 
 
 BUILTIN_CAPABILITIES = {
@@ -262,7 +249,7 @@ def test_the_built_ins_declare_what_docs_plugins_md_lists():
     names stay importable, derived from the capabilities."""
     from gyrolab.batch import integrate
 
-    assert {n: set(registry.load("integrator", n).declared_capabilities()) for n in BUILTIN_CAPABILITIES} == \
+    assert {n: set(registry.load("integrator", n).capabilities) for n in BUILTIN_CAPABILITIES} == \
         BUILTIN_CAPABILITIES
     assert integrate.BATCH_INTEGRATORS == ("rk4", "rk4_numba", "dop853_numba", "taylor", "auto")
     assert integrate.FAST_PATH == ("rk4", "rk4_numba")

@@ -25,7 +25,7 @@ from gyrolab.kernels import double_double as dd, models, taylor_dd
 from gyrolab.kernels.layout import (
     CARRIES_ALPHA, GAMMA, GRADIENT, INERTIA, INV_INERTIA, LINEAR, N_PARAMS, N_X, N_Y, N_Z, OMEGA, U_X, U_Y, U_Z,
 )
-from gyrolab.plugins.integrators.compiled_solvers import Taylor
+from gyrolab.plugins.integrators.compiled_solvers import Taylor, _ready_for_double_double
 from tests.helpers import VISCOUS_DRAG
 
 U2 = Fraction(1, 2 ** 104)  # "a unit of 2^-104": double-double's unit round-off is 2^-106
@@ -148,15 +148,6 @@ def test_compensated_dot_product_errs_by_u_squared_times_the_sum_of_the_terms():
         assert abs(_exact(hi, lo) - sum(terms)) <= n * U2 * sum(abs(t) for t in terms)
 
 
-def test_the_inertias_reciprocal_is_computed_to_double_double():
-    p = np.zeros(N_PARAMS)
-    p[INERTIA:INERTIA + 3] = (3.0, 1.7, 0.1)
-    C = taylor_dd.constants(p)
-    for k, inertia in enumerate((3.0, 1.7, 0.1)):
-        assert abs(_exact(C[0, taylor_dd.INV + k], C[1, taylor_dd.INV + k]) * Fraction(inertia) - 1) < U2
-    assert _exact(C[0, taylor_dd.DIFF], C[1, taylor_dd.DIFF]) == Fraction(1.7) - Fraction(0.1)
-
-
 # --- an independent reference: Taylor series in decimal arithmetic ---------------------------------------------
 
 DIGITS = 50
@@ -229,16 +220,19 @@ def decimal_reference(p, y0, t_out, *, order=44, tol=Decimal("1e-42")):
 @pytest.fixture(scope="module")
 def chaotic():
     """The chaotic top (the default body and forces, initial=slow_spin), state (ω, γ)."""
+    from gyrolab.kernels import series_dd
+
     scene = compose_scene(["initial=slow_spin", "output.euler_angles=false", "integrator=taylor",
                            "integrator.precision=double-double"])
-    return scene.compiled.params, scene.system.initial_state()
+    series_dd.ready(scene.compiled)
+    return scene.compiled, scene.system.initial_state()
 
 
 @pytest.fixture(scope="module")
 def reference(chaotic):
-    p, y0 = chaotic
+    compiled, y0 = chaotic
     t_out = np.array([0.0, 20.0, 40.0, 60.0])
-    return t_out, decimal_reference(p, y0, t_out)
+    return t_out, decimal_reference(compiled.built_in, y0, t_out)
 
 
 def _errors(hi, lo, exact):
@@ -248,21 +242,35 @@ def _errors(hi, lo, exact):
 
 
 def test_double_double_taylor_matches_a_50_digit_reference_where_double_precision_cannot(chaotic, reference):
-    p, y0 = chaotic
+    compiled, y0 = chaotic
     t_out, exact = reference
-    hi, lo = taylor_dd.propagate(p, 1e-30, t_out, y0)
+    hi, lo = taylor_dd.propagate(compiled.params, 1e-30, t_out, y0)
     errors = _errors(hi, lo, exact)
     assert max(errors) < 1e-29, errors  # measured 6e-31 at t = 60
     # the dataset's doubles: the double-double state rounded, within half an ulp of the truth (and a little)
     stored = _errors(hi, np.zeros_like(lo), exact)
     assert max(stored) < 2e-16
     # double precision on the same scene: its error has grown orders of magnitude above round-off
-    double = Taylor(tol=1e-16).integrate(None, t_out, y0, None, CompiledModel(models.FIXED_POINT, p)).y
+    double = Taylor(tol=1e-16).integrate(None, t_out, y0, None, compiled).y
     double_errors = _errors(double, np.zeros_like(double), exact)
     assert double_errors[-1] > 1e12 * errors[-1]  # measured 2e-15
     # and double-double's error follows its tolerance (Jorba & Zou's step: error ∝ tol)
-    coarse = _errors(*taylor_dd.propagate(p, 1e-24, t_out, y0), exact)
+    coarse = _errors(*taylor_dd.propagate(compiled.params, 1e-24, t_out, y0), exact)
     assert 1e-28 < coarse[-1] < 1e-21
+
+
+def test_the_traced_equations_match_the_50_digit_reference_too(reference):
+    """The same scene's equations traced from the system's numpy ``euler_poisson`` run the generated series
+    (``series_dd``: products merged, numbers factored out of them) to the same accuracy."""
+    from gyrolab.plugins.systems.fixed_point import traced_model
+
+    system = compose_scene(["initial=slow_spin", "output.euler_angles=false"]).system
+    traced = traced_model(system.inertia, system.forces, False)
+    _ready_for_double_double(traced)
+    t_out, exact = reference
+    errors = _errors(*taylor_dd.propagate(traced.params, 1e-30, t_out, system.initial_state(), model=traced.model),
+                     exact)
+    assert max(errors) < 1e-29, errors  # measured 3.5e-31 at t = 60
 
 
 def _traced_packed_equations(p):
@@ -304,7 +312,7 @@ def test_the_form_with_alpha_and_every_torque_term_matches_the_decimal_reference
     traced = _traced_packed_equations(p)
     hi, lo = taylor_dd.propagate(traced.params, 1e-30, t_out, y0, model=models.TRACED)
     errors = _errors(hi, lo, decimal_reference(p, y0, t_out, order=40, tol=Decimal("1e-40")))
-    assert max(errors) < 1e-30, errors  # measured 2e-32 (hand-written α form), 4e-32 (traced)
+    assert max(errors) < 1e-30, errors  # measured 2e-32 (hand-written α form), 2.7e-32 (traced)
 
 
 # --- physics: first integrals over a long run -------------------------------------------------------------------
@@ -328,16 +336,17 @@ def _invariants(p, hi, lo):
 
 
 def test_energy_area_integral_and_gamma_norm_are_conserved_to_1e_28_over_a_long_run(chaotic):
-    p, y0 = chaotic
+    compiled, y0 = chaotic
+    p = compiled.built_in
     t_out = np.linspace(0.0, 1000.0, 41)
-    hi, lo = taylor_dd.propagate(p, 1e-30, t_out, y0)
+    hi, lo = taylor_dd.propagate(compiled.params, 1e-30, t_out, y0)
     rows = _invariants(p, hi, lo)
     energy0, area0, norm0, scale = rows[0]
     drift = [(abs(e - energy0) / scale, abs(a - area0), abs(g - norm0)) for e, a, g, _ in rows]
     worst = [float(max(d[i] for d in drift)) for i in range(3)]
     assert max(worst) < 1e-28, worst  # measured ~2e-31 over t = 1000 (~3,000 steps)
     # in double precision the same run drifts by round-off: ~1e-16 … 1e-15
-    double = Taylor(tol=1e-16).integrate(None, t_out, y0, None, CompiledModel(models.FIXED_POINT, p)).y
+    double = Taylor(tol=1e-16).integrate(None, t_out, y0, None, compiled).y
     e_double = [float(abs(e - energy0) / scale) for e, *_ in _invariants(p, double, np.zeros_like(double))]
     assert max(e_double) > 1e10 * worst[0]
 
@@ -378,6 +387,43 @@ def test_a_scene_in_double_double_runs_with_alpha_and_every_builtin_force_and_re
     ds = dd_scene.run()
     assert ds.attrs["integrator_precision"] == "double-double" and ds.omega.dtype == np.float64
     assert ds.gamma_norm.attrs["max_abs_drift"] < 1e-15
+
+
+@numba.njit
+def _generated_series(address, t, order, Th, Tl, S, p):
+    taylor_dd._call_generated(address, t, order, Th, Tl, S, p)
+
+
+def test_the_generated_series_of_products_quotients_powers_and_time_are_exact_to_double_double():
+    """``series_dd``'s operations against exact rational series (``Fraction``) at t0 = 1/2: y0' = y0² (a product of
+    a series with itself: y0 = a/(1 − a s), s = t − t0), y1' = 1/y1 (a quotient of series: y1 = √(9/4 + 2s)), and
+    y2' = 1/(2 − t) + (1 + t)⁻² − 3(2 + t)t + (3t + 7)t (numbers over and times series, a negative power, equal
+    products merged: the last two terms are t)."""
+    from gyrolab.kernels import model, series_dd
+
+    def equations(t, y):
+        return np.array([y[0] * y[0], 1.0 / y[1],
+                         1.0 / (2.0 - t) + (1.0 + t) ** -2 - 3.0 * (2.0 + t) * t + (t * 3.0 + 7.0) * t])
+
+    compiled = model.compile(model.trace(equations, 3, "rational functions of time and state"))
+    assert series_dd.ready(compiled)
+    order, a = 24, 0.3
+    p = compiled.params
+    Th, Tl = np.zeros((order + 1, 3)), np.zeros((order + 1, 3))
+    Th[0] = (a, 1.5, 0.0)
+    _generated_series(int(p[-2]), 0.5, order, Th, Tl, np.zeros((order + 1) * 2 * int(p[-1])), p)
+    half = Fraction(1, 2)
+    binomial = [Fraction(1)]
+    for k in range(1, order + 1):
+        binomial.append(binomial[-1] * (half - k + 1) / k)
+    c = Fraction(3, 2)
+    rate = [1 / c ** (k + 1) + (k + 1) * (-1) ** k / c ** (k + 2) + (half if k == 0 else 1 if k == 1 else 0)
+            for k in range(order)]
+    exact = [[Fraction(a) ** (k + 1), c * binomial[k] * (Fraction(8, 9)) ** k, rate[k - 1] / k if k else 0]
+             for k in range(order + 1)]
+    errors = [abs(Fraction(float(Th[k, m])) + Fraction(float(Tl[k, m])) - exact[k][m]) / abs(exact[k][m])
+              for k in range(1, order + 1) for m in range(3)]
+    assert max(errors) < 1e-30, float(max(errors))  # measured 1.7e-31
 
 
 def test_a_traced_plugin_torque_runs_in_double_double_and_a_transcendental_one_is_refused_naming_it():
@@ -445,8 +491,8 @@ def test_capabilities_batch_points_and_the_error_estimates_companion():
 def test_the_one_call_samples_for_auto_equal_the_integrator(chaotic):
     from gyrolab.plugins.integrators.compiled_solvers import taylor_dd_samples
 
-    p, y0 = chaotic
-    model, t_out = CompiledModel(models.FIXED_POINT, p), np.linspace(0.0, 20.0, 41)
+    model, y0 = chaotic
+    p, t_out = model.built_in, np.linspace(0.0, 20.0, 41)
     samples = taylor_dd_samples(model, 1e-26, t_out, y0)
     np.testing.assert_array_equal(samples, Taylor(precision="double-double", tol=1e-26).integrate(
         None, t_out, y0, None, model).y)

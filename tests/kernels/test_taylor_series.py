@@ -50,8 +50,9 @@ def series(f, t0, order=ORDER):
     coefficient k over k + 1.
     """
     m = traced.trace(lambda t, y: np.concatenate([OfTime(f).torque(None, None, t), np.zeros(3)]), 6, "of_time")
-    text, columns = taylor_series.source(m)
-    address = expression.load_generated(text, "gyrolab_taylor", "of_time (Taylor)").address
+    program = taylor_series.plan(m)
+    columns = taylor_series.layout(program)[1]
+    address = expression.load_generated(taylor_series.source(program), "gyrolab_taylor", "of_time (Taylor)").address
     call = _KERNEL(int(address))
     p = np.zeros(traced.TRACED_FIRST_CONSTANT + len(m.constants) + 4)
     p[traced.TRACED_FIRST_CONSTANT:-4] = m.constants
@@ -286,27 +287,38 @@ def test_batch_sweep_of_a_plugin_parameter_under_taylor_is_the_exact_decay(cli, 
 REFERENCE = ["experiment=perf_reference", "integrator=taylor", "time.end=30", "time.n_output=31"]
 
 
-def _traced_reference():
-    """The reference problem's built-in model and the same torques traced as a plugin's (state ω, γ)."""
+def _cauchy_series(inertia, u, n, y0, order):
+    """The Euler–Poisson Taylor coefficients of (ω, γ) by Cauchy products in numpy, written here independently of the
+    generated kernels: I ω' = (Iω) × ω + U × γ + N γ × Iγ, γ' = γ × ω, coefficient k + 1 = (that of the rate) / (k + 1)."""
+    w, g = [np.array(y0[:3], dtype=float)], [np.array(y0[3:], dtype=float)]
+
+    def cauchy_cross(a, b, k):
+        return sum(np.cross(a[j], b[k - j]) for j in range(k + 1))
+
+    for k in range(order):
+        rate_w = (cauchy_cross([inertia * x for x in w], w, k) + np.cross(u, g[k])
+                  + n * cauchy_cross(g, [inertia * x for x in g], k)) / inertia
+        w.append(rate_w / (k + 1))
+        g.append(cauchy_cross(g, w, k) / (k + 1))
+    return np.hstack([np.array(w), np.array(g)])
+
+
+def test_the_fixed_points_generated_series_and_trajectory_against_independent_references():
+    """Gravity + Newtonian centre (the built-in torques, their equations traced into the generated series kernel):
+    every coefficient against Cauchy products written in numpy here (to rounding), the same torques traced as a
+    plugin's give the same trajectory, and the run ends on the extended-precision reference."""
+    import numba
+
+    from gyrolab.kernels import layout
+    from gyrolab.physics.reference import fixed_point_reference
+
     scene = compose_scene(REFERENCE)
     system = scene.system
     builtin = system.compiled_model()
     plugin = traced_model(system.inertia, [Traced(f) for f in system.forces], system.carries_alpha)
-    assert (builtin.model, plugin.model) == (models.FIXED_POINT, models.TRACED)
-    assert taylor_series.ready(plugin)
-    return scene, builtin, plugin
-
-
-def test_traced_reference_torques_give_the_builtin_series_and_trajectory():
-    """Gravity + Newtonian centre traced (the generated series kernel) against the built-ins' hand-written
-    Cauchy sums (fixed_point.taylor_coefficients): every coefficient to rounding, and the trajectory to round-off;
-    both against the extended-precision reference at the end."""
-    import numba
-
-    from gyrolab.physics.reference import fixed_point_reference
-
-    scene, builtin, plugin = _traced_reference()
-    y0 = scene.system.initial_state()
+    assert taylor_series.ready(builtin) and taylor_series.ready(plugin)
+    y0 = system.initial_state()
+    packed = builtin.built_in
 
     @numba.njit
     def series(model, p, y, order):
@@ -315,16 +327,15 @@ def test_traced_reference_torques_give_the_builtin_series_and_trajectory():
         models.taylor_coefficients(model, p, T, order, np.zeros((order + 1, 3)))
         return T
 
-    for order in (1, 2, 3, 16, 30):  # the vector sums' edge cases (no middle rows, one, an odd count) and beyond
-        ours = series(models.form(plugin), plugin.params, y0, order)
-        theirs = series(models.form(builtin), builtin.params, y0, order)
+    for order in (1, 2, 3, 16, 30):  # the Cauchy loops' edge cases (no middle rows, one, an odd count) and beyond
+        ours = series(models.form(builtin), builtin.params, y0, order)
+        theirs = _cauchy_series(system.inertia, packed[layout.U_Z:layout.U_Z + 3], packed[layout.N_Z], y0, order)
         for k in range(order + 1):
             np.testing.assert_allclose(ours[k], theirs[k], rtol=0, atol=1e-14 * np.abs(theirs[k]).max(), err_msg=k)
     runs = [Taylor(tol=1e-14).integrate(None, scene.times, y0, None, m).y for m in (builtin, plugin)]
     np.testing.assert_allclose(runs[1], runs[0], rtol=0, atol=1e-12)
-    system = scene.system
     exact = fixed_point_reference(system.inertia, system.body.weight_moment, 0.5, y0, [0.0, 30.0])[-1].astype(float)
-    np.testing.assert_allclose(runs[1][-1], exact, rtol=0, atol=1e-11)
+    np.testing.assert_allclose(runs[0][-1], exact, rtol=0, atol=1e-11)
 
 
 def test_traced_products_are_shared_as_the_builtin_shares_them():
@@ -401,7 +412,7 @@ def test_series_work_array_on_the_heap_gives_the_exact_decay(tmp_path):
 
 
 class ManyProducts(Force):
-    """Σ_i a_i (ω + b_i γ) × γ: 150 distinct Cauchy products of one depth (three vector groups in cauchy_sums)."""
+    """Σ_i a_i (ω + b_i γ) × γ: 150 distinct Cauchy products of one depth (several groups of the Cauchy sums' loops)."""
 
     name = "many_products"
     required_axes = frozenset({2})
@@ -417,13 +428,13 @@ class ManyProducts(Force):
 
 
 def test_many_products_of_one_depth_under_taylor_match_scipy():
-    """More products than one loop of cauchy_sums takes (_GROUP) and vector lengths that are not powers of two:
+    """More products than one loop of the Cauchy sums takes (GROUP) and vector lengths that are not powers of two:
     the trajectory against scipy's DOP853 on the Python torque."""
     scene = compose_scene(["integrator=taylor", *SHORT])
     system = scene.system
     model = traced_model(system.inertia, [ManyProducts()], False)
     program = taylor_series._Program(traced.MODELS[int(model.params[0])])
-    assert sum(s.op == "mul" and s.depth == 1 for s in program.series) > 2 * taylor_series._GROUP
+    assert sum(s.op == "mul" and s.depth == 1 for s in program.series) > 2 * taylor_series.GROUP
     assert taylor_series.ready(model)
     y0 = system.initial_state()
     got = Taylor(tol=1e-15).integrate(None, scene.times, y0, None, model).y

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import pytest
 
-from gyrolab.contracts import registry
 from gyrolab.errors import ConfigError
 from tests.helpers import REPO
 
@@ -69,12 +68,6 @@ def test_version_flag_prints_gyrolab_version():
     done = subprocess.run([sys.executable, "-m", "gyrolab", "--version"], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0
     assert done.stdout.strip() == f"gyrolab {metadata.version('gyrolab')}"
-
-
-def test_targets_of_version_0_1_still_name_their_plugins():
-    # configs stored in datasets written before the package was named gyrolab
-    name, cls = registry.resolve_target("force", "plugins.forces.newtonian.Newtonian", "force.newtonian")
-    assert name == "newtonian" and cls.__module__ == "gyrolab.plugins.forces.newtonian"
 
 
 def test_a_launcher_of_the_cluster_extra_missing_is_one_sentence(monkeypatch):
