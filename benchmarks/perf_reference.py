@@ -107,7 +107,7 @@ def heyoka_same_work():
         import heyoka as hy
     except ImportError:
         return {}
-    from gyrolab.kernels.variational import initial_tangent
+    from gyrolab.kernels.tangent import direction
     from gyrolab.accuracy.calibration import TANGENT_TOLERANCE
 
     A, B, C = INERTIA
@@ -121,7 +121,7 @@ def heyoka_same_work():
            g2 * r - g3 * q, g3 * p - g1 * r, g1 * q - g2 * p]
     variational = list(zip(state, rhs)) + [
         (d, hy.sum([hy.diff(f, x) * dx for x, dx in zip(state, tangent)])) for d, f in zip(tangent, rhs)]
-    start = np.concatenate([Y0, initial_tangent(Y0[None, :])[0]])
+    start = np.concatenate([Y0, direction(Y0[None, :], slice(3, 6))[0]])
     chaos = hy.taylor_adaptive(variational, start, tol=TANGENT_TOLERANCE)
     runs = {tol: hy.taylor_adaptive(list(zip(state, rhs)), Y0, tol=tol) for tol in
             [10.0 ** -k for k in range(6, 16)] + [np.finfo(float).eps]}

@@ -12,12 +12,11 @@ aligns with the most expanding one within a few Lyapunov times on a chaotic moti
 
 Two ways to follow δ, the cheapest that applies:
 
-* the variational equations (``pipeline/kernels/variational.py``: the analytic Jacobian of the fixed-point model with
-  torques about the vertical, compiled DOP853) — one compiled call over the span;
-* the tangent flow generated from a traced model's equations (``pipeline/kernels/tangent.py``: the orbiting
-  gyrostat, plugin torques and systems), compiled DOP853 — one compiled call over the span, ln|δ| sampled at
-  ``TANGENT_SAMPLES`` times;
-* a shadow pair for a model with neither (no compiled model): the trajectory and a companion started ``SHADOW_OFFSET`` away, integrated
+* the tangent flow generated from a traced model's equations (``pipeline/kernels/tangent.py``: the fixed point in
+  (ω, γ) when no torque reads α, the orbiting gyrostat, plugin torques and systems; state, unit tangent vector and
+  ln|δ|, without the MEGNO quadratures), compiled DOP853 — one compiled call over the span, ln|δ| sampled at
+  ``TANGENT_SAMPLES`` times and the pilot's end (its dense output: the steps of a run to the span's end);
+* a shadow pair for a model with none (no compiled model): the trajectory and a companion started ``SHADOW_OFFSET`` away, integrated
   by the given method chunk by chunk and renormalised after each chunk (Benettin et al. 1980), so the
   companion's separation stays in the linear regime.
 
@@ -34,6 +33,8 @@ from typing import Any
 import numpy as np
 
 from gyrolab.accuracy.calibration import SHADOW_CHUNKS, SHADOW_OFFSET, TANGENT_SAMPLES, TANGENT_TOLERANCE
+from gyrolab.kernels.model import TRACED, CompiledModel
+
 
 @dataclass(frozen=True)
 class Amplification:
@@ -68,66 +69,38 @@ def amplification(compiled: Any, fun: Any, y0: np.ndarray, t0: float, t_pilot: f
                   method: Any) -> Amplification:
     """The growth of a unit perturbation over [t0, t_pilot] and [t0, t_end] (``Amplification``).
 
-    ``method`` is an integrator instance for the shadow pair (``auto``'s loose method) when the variational
-    equations do not apply to ``compiled``.
+    ``method`` is an integrator instance for the shadow pair (``auto``'s loose method) when no tangent flow can be
+    generated for ``compiled``.
     """
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import models
-
     span = float(t_end - t0)
-    variational = _variational(compiled, y0, t0, t_pilot, t_end)
-    if variational is not None:
-        how = ("variational equations (compiled DOP853)" if compiled.model != models.TRACED else
-               "tangent flow generated from the equations (compiled DOP853)")
-        return Amplification(*variational, span, how)
+    growth = None if compiled is None or compiled.model != TRACED else _generated(compiled, y0, t0, t_pilot, t_end)
+    if growth is not None:
+        return Amplification(*growth, span, "tangent flow generated from the equations (compiled DOP853)")
     return Amplification(*_shadow_pair(method, fun, compiled, y0, t0, t_pilot, t_end), span,
                          f"shadow pair renormalised {SHADOW_CHUNKS} times ({method.name})")
 
 
-def _variational(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float) -> tuple[float, float] | None:
-    if compiled is None:
-        return None
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import variational
-
-    p = _closed_built_in(compiled)
-    if p is None:
-        return _generated(compiled, y0, t0, t_pilot, t_end)
-    # autonomous: the span from t0 is what counts
-    logs = variational.tangent_growths(p, np.asarray(y0, dtype=float), t_pilot - t0, t_end - t0, TANGENT_TOLERANCE)
-    return None if not all(np.isfinite(logs)) else logs
-
-
-def _closed_built_in(compiled: Any) -> np.ndarray | None:
-    """The built-in fixed point's parameters for the state (ω, γ) alone, when no torque reads α (then (ω, γ) is a
-    closed system and the analytic Jacobian covers it); None otherwise (the generated tangent flow runs)."""
-    from gyrolab.kernels import layout
-
-    if compiled.built_in is None or layout.torques_on_horizontal_axes(compiled.built_in):
-        return None
-    p = np.array(compiled.built_in, dtype=float)
-    p[layout.CARRIES_ALPHA] = 0.0
-    return p
-
-
 def _generated(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float) -> tuple[float, float] | None:
-    """(max ln|δ| over [t0, t_pilot], over [t0, t_end]) from the traced model's generated tangent flow."""
-    from gyrolab.kernels import tangent
-    from gyrolab.kernels.model import CompiledModel
+    """(max ln|δ| over [t0, t_pilot], over [t0, t_end]) from the traced model's generated tangent flow; None when the
+    run fails. The fixed point's tangent vector starts tangent to |γ| = 1 (``tangent.direction``)."""
+    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
+    from gyrolab.kernels import layout, tangent
     from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba
 
-    augmented = tangent.compiled_megno(compiled)
+    augmented = tangent.compiled_megno(compiled, quadratures=False)
     params = tangent.megno_params(augmented, compiled.params)[0]
     times = np.unique(np.concatenate([np.linspace(t0, t_end, TANGENT_SAMPLES + 1), [t_pilot]]))
     if times[0] == 0.0:
-        times[0] = tangent.START  # (the MEGNO quadrature's 2a/t, unused here, is 0/0 at t = 0)
+        times[0] = tangent.START  # (the generated flow starts there; its ℓ' = u·Ju is finite at t = 0 anyway)
+    x0 = np.asarray(y0, dtype=float)[None, :tangent.flow_size(compiled)]
+    sphere = slice(layout.GAMMA, layout.GAMMA + 3) if compiled.built_in is not None else None
     method = DOP853Numba(rtol=TANGENT_TOLERANCE, atol=TANGENT_TOLERANCE)
     try:
-        z = method.integrate(None, times, tangent.initial_augmented(np.asarray(y0, dtype=float)[None, :])[0], None,
-                             CompiledModel(augmented.model, params)).y
+        z = method.integrate(None, times, tangent.initial_augmented(x0, tangent.direction(x0, sphere), False)[0],
+                             None, CompiledModel(augmented.model, params)).y
     except Exception:  # noqa: BLE001  (a failed tangent run: the shadow pair measures instead)
         return None
-    log = np.maximum.accumulate(np.maximum(z[:, 2 * len(y0)], 0.0))
+    log = np.maximum.accumulate(np.maximum(z[:, -1], 0.0))
     pilot = log[np.searchsorted(times, t_pilot)]
     return (float(pilot), float(log[-1])) if np.all(np.isfinite(log)) else None
 

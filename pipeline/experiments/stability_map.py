@@ -150,8 +150,8 @@ def _add_sections(path: Path, plain: dict, points: Sequence[Sequence[float]], t_
     theta0, r0 = (np.array([float(p[k]) for p in points]) for k in (0, 1))
     with xr.open_dataset(path) as stored:
         ds = stored.drop_vars([v for v in stored.variables if str(v).startswith("section_")]).load()
-    sections = section_dataset(compiled, np.stack([s.system.initial_state()[:6] for s in scenes]), theta0, r0, t_end,
-                               step, np.stack([s.system.compiled_model().built_in for s in scenes]),
+    sections = section_dataset(compiled, np.stack([s.system.initial_state() for s in scenes]), theta0, r0, t_end,
+                               step, np.stack([s.system.compiled_model().params for s in scenes]),
                                rate_units=ds.r0.attrs.get("units", "1"))
     # conform: the rewrite must stay CF-1.8 like the store's file (no _FillValue on the coordinates, history)
     merged = ds.merge(sections, combine_attrs="drop_conflicts")

@@ -8,7 +8,8 @@ inner loops. Plain float arrays in, plain float arrays out: units, configs and f
   Lie–Poisson splitting, the regimes and the chaos kernels read).
 - ``models``: the calls from a compiled model to its right-hand side and Taylor coefficients.
 - the integrators' kernels: ``dop853``, ``rk4``, ``taylor`` (and ``taylor_dd`` in double-double,
-  ``batch_*`` for many trajectories, ``variational``, ``lie_poisson``).
+  ``batch_*`` for many trajectories, ``lie_poisson``); ``tangent`` generates a model's tangent flow (the
+  variational equations of the chaos indicators and ``auto``'s growth of perturbations).
 - ``compiler``: numba's set-up (the decorators, the on-disk cache). Importing this package does not import
   numba: ``model`` traces equations with numpy alone.
 """

@@ -70,61 +70,41 @@ def test_extended_precision_meets_what_double_precision_refuses():
 
 
 @pytest.mark.parametrize("scene", [["experiment=perf_reference"], CHAOTIC_TOP, ["body=lagrange_top", "initial=upright"]])
-def test_the_tangent_growth_kernel_matches_the_variational_equations_integrated_by_scipy(scene):
-    # amplification's one compiled run (state and tangent, DOP853 at 1e-5) against scipy's DOP853 at 1e-11 on the
-    # variational equations written from the numpy Jacobian (variational.jacobian): max ln|δ| over [0, t_pilot]
-    # and over the span. The kernel's maximum is over its step ends, scipy's over a dense grid (on the upright top
-    # |δ| oscillates within a step: 0.284 against 0.306 at t_pilot): they agree within 0.05, far below the factor
-    # e^1 a growth estimate may be off by.
+def test_the_tangent_growth_matches_the_variational_equations_integrated_by_scipy(scene):
+    # amplification's one compiled run of the generated tangent flow (DOP853 at TANGENT_TOLERANCE) against scipy's
+    # DOP853 at 1e-11 on the variational equations δ' = J δ written here: f from the equations (``_state_rhs``) and
+    # J δ by the complex step, Im f(x + i h δ) / h (exact to rounding). Both read max ln|δ| at the run's sample times
+    # (the span's TANGENT_SAMPLES + 1 and the pilot's end) from the same unit δ(0): over [0, t_pilot] and the span.
     from scipy.integrate import solve_ivp
 
-    from gyrolab.kernels import variational
+    from gyrolab.accuracy.amplification import amplification
+    from gyrolab.accuracy.calibration import TANGENT_SAMPLES
+    from gyrolab.kernels import tangent
 
     built = compose_scene(["integrator=taylor", *scene])
     p = np.array(built.compiled.built_in, dtype=float)
-    p[layout.CARRIES_ALPHA] = 0.0
-    y0 = built.system.initial_state()[:6]
+    y0 = built.system.initial_state()
     t_end = float(built.times[-1])
     t_pilot = 0.1 * t_end
 
     def augmented(t, z):
-        return np.concatenate([_state_rhs(z[:6], p),
-                               variational.jacobian(z[:6], p) @ z[6:]])
+        return np.concatenate([_state_rhs(z[:6], p), _state_rhs(z[:6] + 1e-30j * z[6:], p).imag / 1e-30])
 
-    d0 = variational.initial_tangent(y0[None, :])[0]
-    grid = np.linspace(0.0, t_end, 20001)
-    z = solve_ivp(augmented, (0.0, t_end), np.concatenate([y0, d0]), method="DOP853", rtol=1e-11, atol=1e-11,
+    d0 = tangent.direction(y0[None, :6], slice(3, 6))[0]
+    grid = np.unique(np.concatenate([np.linspace(0.0, t_end, TANGENT_SAMPLES + 1), [t_pilot]]))
+    z = solve_ivp(augmented, (0.0, t_end), np.concatenate([y0[:6], d0]), method="DOP853", rtol=1e-11, atol=1e-11,
                   t_eval=grid).y
     log_norm = np.maximum.accumulate(np.maximum(np.log(np.linalg.norm(z[6:], axis=0)), 0.0))
     expected = (log_norm[grid <= t_pilot][-1], log_norm[-1])
-    measured = variational.tangent_growths(p, y0, t_pilot, t_end, 1e-5)
-    assert np.allclose(measured, expected, atol=0.05), (measured, expected)
+    growth = amplification(built.compiled, None, y0, 0.0, t_pilot, t_end, None)
+    assert growth.how.startswith("tangent flow generated")
+    assert np.allclose((growth.log_pilot, growth.log_span), expected, atol=0.05), (growth, expected)
 
 
 def _state_rhs(y, p):
-    """The Euler–Poisson right-hand side written from the equations (variational module docstring), in numpy."""
+    """The Euler–Poisson right-hand side written from the equations (docs/stability_map.md), in numpy (complex too)."""
     inertia = p[layout.INERTIA:layout.INERTIA + 3]
     u, n = p[layout.U_Z:layout.U_Z + 3], p[layout.N_Z]
     omega, gamma = y[:3], y[3:6]
     torque = np.cross(inertia * omega, omega) + np.cross(u, gamma) + n * np.cross(gamma, inertia * gamma)
     return np.concatenate([torque / inertia, np.cross(gamma, omega)])
-
-
-def test_the_tangent_growth_kernel_takes_the_steps_of_the_indicator_kernel():
-    # auto.CHAOS_MARGIN is calibrated on the growth the MEGNO/FLI kernel gives (run_indicators_dop853): on a chaotic
-    # scene any change of the steps moves it by up to e^±4, so the lean kernel must reproduce it exactly
-    from gyrolab.kernels import variational
-
-    built = compose_scene(["integrator=taylor", *SLOW_SPIN, "time.end=300"])
-    p = np.array(built.compiled.built_in, dtype=float)
-    p[layout.CARRIES_ALPHA] = 0.0
-    y0 = built.system.initial_state()[:6]
-    expected = []
-    for end in (30.0, 300.0):
-        megno, fli, deviation, final = np.empty((1, 1)), np.empty(1), np.empty(1), np.empty((1, 6))
-        variational.run_indicators_dop853(p[None, :], np.array([0.0, end]), y0[None, :],
-                                          variational.initial_tangent(y0[None, :]), 1e-5, 1e-5, np.inf, megno, fli,
-                                          deviation, final, np.zeros(1, dtype=np.int64))
-        expected.append(float(fli[0]))
-    assert variational.tangent_growths(p, y0, 30.0, 300.0, 1e-5) == tuple(expected)
-

@@ -1,7 +1,7 @@
 """Chaos indicators (gyrolab.analysis.chaos): the variational equations, MEGNO and FLI on scenes whose answer is known.
 
 Known answers, none taken from the kernel under test:
-* the Jacobian: central finite differences of the compiled right-hand side;
+* the generated tangent flow's J u: central finite differences of the compiled right-hand side;
 * integrable cases — Euler–Poinsot (no torque), Lagrange (A = B, centre of mass on the symmetry axis),
   Kovalevskaya (A = B = 2C, centre of mass in the equatorial plane) — are regular for every initial
   condition, so MEGNO ⟨Y⟩ → 2 (quasi-periodic) or 0 (periodic) and stops growing (Cincotta & Simó 2000);
@@ -18,7 +18,7 @@ from gyrolab import compose_scene
 from gyrolab.batch.integrate import integrate_arrays
 from gyrolab.errors import ConfigError
 from gyrolab.analysis.chaos import indicator_outputs, megno_run, poincare_section, section_dataset
-from gyrolab.kernels import fixed_point, variational
+from gyrolab.kernels import models, rk4, tangent
 
 BASE = ["integrator=rk4_numba", "integrator.step=0.01", "time.end=1", "time.n_output=11", "output.euler_angles=false"]
 #: integrable bodies and torques (docs/stability_map.md cites the sources)
@@ -47,40 +47,43 @@ def _states(scene, theta0s, r0s):
     return np.array(rows)
 
 
-def test_jacobian_matches_finite_differences_of_the_compiled_rhs():
+def test_generated_tangent_flow_matches_finite_differences_of_the_compiled_rhs():
     rng = np.random.default_rng(1)
     for overrides in ([], ["body=lagrange_top"], ["force=[newtonian]"]):
         compiled = _scene(*overrides).system.compiled_model()
         p = compiled.params
+        augmented = tangent.compiled_megno(compiled)
+        q = tangent.megno_params(augmented, p)[0]
+
+        def f(form, t, y, params):
+            out = np.empty(len(y))
+            models.evaluate(form, t, np.ascontiguousarray(y), params, out)
+            return out
+        rhs = lambda y: f(models.form(compiled), 0.0, y, p)  # noqa: E731
         for _ in range(4):
             y = np.concatenate([rng.normal(size=3), rng.normal(size=3)])
             y[3:6] /= np.linalg.norm(y[3:6])
             h = 1e-6
-            fd = np.empty((6, 6))
-            for k in range(6):
-                plus, minus, e = np.empty(6), np.empty(6), np.zeros(6)
-                e[k] = h
-                fixed_point.rhs(0.0, y + e, p, plus)
-                fixed_point.rhs(0.0, y - e, p, minus)
-                fd[:, k] = (plus - minus) / (2 * h)
-            J = variational.jacobian(y, p)
-            np.testing.assert_allclose(J, fd, rtol=0, atol=1e-8)
-            # the batch kernel's right-hand side, column by column: f, J δ and the MEGNO integrands s ρ, 2a/s
-            d, f = rng.normal(size=6), np.empty(6)
-            fixed_point.rhs(0.0, y, p, f)
-            Z = np.concatenate([y, d, [0.3, 0.0]])[:, None]
-            aug = np.empty((variational.AUGMENTED, 1))
-            variational._augmented_block(2.0, Z, p[:, None], aug, 1)
-            np.testing.assert_allclose(aug[:, 0], [*f, *(J @ d), 2.0 * (d @ J @ d) / (d @ d), 0.3], rtol=1e-13, atol=1e-14)
+            J = np.stack([(rhs(y + h * e) - rhs(y - h * e)) / (2 * h) for e in np.eye(6)], axis=1)
+            # the augmented right-hand side (x, u, ℓ, a, b) at t = 2, a = 0.3: f, J u − λ u, λ = u·J u, t λ, 2a/t
+            d = rng.normal(size=6)
+            d /= np.linalg.norm(d)
+            aug = f(models.form(augmented), 2.0, np.concatenate([y, d, [0.0, 0.3, 0.0]]), q)
+            lam = d @ J @ d
+            np.testing.assert_allclose(aug[:6], rhs(y), rtol=1e-14, atol=1e-14)
+            np.testing.assert_allclose(aug[6:], [*(J @ d - lam * d), lam, 2.0 * lam, 0.3], rtol=1e-7, atol=1e-8)
             # the linearised flow keeps γ·δγ: d/dt(γ·δγ) = γ̇·δγ + γ·δγ̇ = 0 for every δ (the constraint |γ| = 1)
-            assert abs(f[3:6] @ d[3:6] + y[3:6] @ (J @ d)[3:6]) < 1e-13
+            assert abs(rhs(y)[3:6] @ d[3:6] + y[3:6] @ (J @ d)[3:6]) < 1e-8
 
 
 def test_initial_tangent_is_unit_and_tangent_to_the_sphere():
     y0 = _states(_scene(), [0.3, 1.5, 3.0], [1.0, 2.0, 3.0])
-    d = variational.initial_tangent(y0)
+    d = tangent.direction(y0, slice(3, 6))
     np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, rtol=0, atol=1e-15)
     np.testing.assert_allclose(np.sum(d[:, 3:6] * y0[:, 3:6], axis=1), 0.0, rtol=0, atol=1e-15)
+    z0 = tangent.initial_augmented(y0, d)
+    np.testing.assert_array_equal(z0[:, :6], y0)
+    np.testing.assert_array_equal(z0[:, 12:], 0.0)  # ℓ = ln|δ| = 0 and the MEGNO quadratures start at 0
 
 
 @pytest.mark.parametrize("case", sorted(INTEGRABLE))
@@ -90,9 +93,12 @@ def test_integrable_cases_are_regular(case):
     times = np.array([0.0, 100.0, 300.0, 1000.0])
     megno = megno_run(scene.system.compiled_model(), scene.integrator, times, y0)["megno"]
     # regular quasi-periodic: ⟨Y⟩ → 2 from below, the deviation decaying like ln²t / t; never above 2 (+ rounding).
-    # A chaotic orbit with λ ≥ 0.01 would be at ⟨Y⟩ ≈ λt/2 ≥ 5 by t = 1000.
+    # A chaotic orbit with λ ≥ 0.01 would be at ⟨Y⟩ ≈ λt/2 ≥ 5 by t = 1000. How fast it nears 2 depends on the initial
+    # tangent vector: the slowest here, the Lagrange top's θ0 = 0.1, r0 = 0.1 swing (a long period near the sleeping
+    # top's separatrix), is at 1.44 at t = 1000 and 1.75 at t = 4000, still rising.
     assert np.all(megno <= 2.05), megno
-    np.testing.assert_allclose(megno[:, -1], 2.0, rtol=0, atol=0.55)
+    np.testing.assert_allclose(megno[:, -1], 2.0, rtol=0, atol=0.6)
+    assert np.all((megno[:, -1] > megno[:, -2]) | (megno[:, -1] > 1.9)), megno  # the slow ones still approach 2
 
 
 def _euler_poisson(inertia, com, k):
@@ -187,7 +193,7 @@ def test_indicator_outputs_interface_and_nutation_deviation_against_the_batch_ke
 
 def test_trajectories_are_independent_across_blocks_and_a_failure_stays_local():
     scene = _scene(*CHAOTIC)
-    n = variational.BLOCK + 5  # two blocks, the second partial
+    n = rk4.BLOCK + 5  # two blocks of the batch kernel, the second partial
     y0 = _states(scene, np.linspace(0.2, 2.8, n), np.linspace(0.2, 4.0, n))
     y0[3, 2] = 1e6  # ω h = 1e4: RK4 blows up
     compiled, times = scene.system.compiled_model(), np.array([0.0, 2.0, 4.0])
@@ -198,6 +204,23 @@ def test_trajectories_are_independent_across_blocks_and_a_failure_stays_local():
         alone = megno_run(compiled, scene.integrator, times, y0[j:j + 1])
         for key in ("megno", "fli", "max_nutation_deviation", "final_state"):
             np.testing.assert_array_equal(alone[key][0], batch[key][j])
+
+
+def test_reading_every_step_in_windows_or_the_trajectories_in_groups_changes_nothing(monkeypatch):
+    """A fixed-step run goes on from its last step in windows of time, an adaptive run takes the trajectories in
+    groups, both when the samples would exceed chaos.MEMORY: bit for bit the results of one call."""
+    from gyrolab.analysis import chaos
+
+    scene = _scene(*CHAOTIC)
+    y0 = _states(scene, np.linspace(0.2, 2.8, 300), np.linspace(0.2, 4.0, 300))
+    compiled, times = scene.system.compiled_model(), np.array([0.0, 1.0, 3.0])
+    dop = compose_scene(["integrator=dop853_numba", "integrator.rtol=1e-8", "integrator.atol=1e-8"]).integrator
+    whole = [megno_run(compiled, integrator, times, y0) for integrator in (scene.integrator, dop)]
+    monkeypatch.setattr(chaos, "MEMORY", 1)  # windows of 64 steps (300 steps: 5), groups of 256 trajectories (2)
+    for integrator, expected in zip((scene.integrator, dop), whole):
+        parts = megno_run(compiled, integrator, times, y0)
+        for key in ("megno", "fli", "max_nutation_deviation", "final_state", "steps"):
+            np.testing.assert_array_equal(parts[key], expected[key])
 
 
 def test_a_state_carrying_alpha_gives_the_same_indicators():
