@@ -234,16 +234,32 @@ def compiled_system(system: Any) -> CompiledModel:
     return compile(trace(system.rhs, system.state_size, f"system {system.name} ({forces})"))
 
 
+#: a number whose binary significand has at most this many bits is taken as exact (2, 1.5, 0.25: nothing rounded
+#: it); one with more is taken as rounded (a decimal input such as 0.3, or the result of arithmetic)
+EXACT_BITS = 26
+
+
+def _rounded(numbers: np.ndarray) -> np.ndarray:
+    """Which numbers were (probably) rounded: more than EXACT_BITS significant bits in their significand."""
+    mantissa, _ = np.frexp(numbers)
+    scaled = mantissa * 2.0 ** EXACT_BITS  # an integer exactly when the significand has ≤ EXACT_BITS bits
+    return np.isfinite(numbers) & (scaled != np.round(scaled))
+
+
 def rounding_moved(compiled: CompiledModel) -> CompiledModel:
-    """The same model with the numbers it holds rounded moved by one unit in the last place: a run with it differs
-    from one with the rounded values as one with the exact values would (an error estimate's companion run,
-    ``accuracy.estimate``, so has round-off independent of the run it measures). Every number of the equations
-    moves (up and down alternately), since the trace cannot tell a config's double from a derived one.
+    """The same model with its rounded numbers moved by one unit in the last place: a run with it differs from one
+    with the rounded values as one with the exact values would (an error estimate's companion run,
+    ``accuracy.estimate``, so has round-off independent of the run it measures). The trace cannot tell a config's
+    double from a derived one, so the significand decides (``_rounded``): 0.3 or 2/3 moves (up and down
+    alternately), an exact 2.0 or 1.5 does not. Moving the exact inertias too made the fixed point's companion
+    differ 10× more than its round-off (I_y − I_z amplifies the move) and sent a regular scene's ε = 1e-12 to a
+    double-double companion (tests/accuracy/test_estimate.py).
     """
     params = np.array(compiled.params, dtype=float)
     numbers = params[TRACED_FIRST_CONSTANT:params.size - TRACED_TAIL]
     toward = np.where(np.arange(numbers.size) % 2 == 0, np.inf, -np.inf)
-    params[TRACED_FIRST_CONSTANT:params.size - TRACED_TAIL] = np.nextafter(numbers, toward)
+    moved = np.where(_rounded(numbers), np.nextafter(numbers, toward), numbers)
+    params[TRACED_FIRST_CONSTANT:params.size - TRACED_TAIL] = moved
     return CompiledModel(compiled.model, params)
 
 

@@ -72,20 +72,18 @@ def test_says_why_when_unavailable(monkeypatch):
     assert ds.attrs["error_estimate_method"].startswith("not available")
 
 
-@pytest.mark.parametrize("accuracy, resolved_above, doubles_suffice", [("2e-11", 1e-13, True), ("1e-12", 5e-15, False)])
-def test_near_the_floor_where_truncation_dominates_double_companions_measure_it(accuracy, resolved_above,
-                                                                               doubles_suffice):
+@pytest.mark.parametrize("accuracy, resolved_above", [("2e-11", 1e-13), ("1e-12", 5e-15)])
+def test_near_the_floor_where_truncation_dominates_double_companions_measure_it(accuracy, resolved_above):
     # auto at 2e-11 runs Taylor at tol ~1e-13, below the double-double threshold; on this regular scene its error is
     # truncation, which two double companions (other orders: independent round-off) agree on to far better than it.
-    # At 1e-12 (tol 6.7e-15) they disagreed 8.6× below the error measured with the hand-written fixed-point kernel
-    # (trusted at ROUNDOFF_MARGIN = 6); with the generated one 4.3× (1.6e-14 against 6.8e-14), so the double-double
-    # companion measures: either way the estimate must hold
+    # At 1e-12 (tol 6.7e-15) they disagree ≥ 6× below the error measured: trusted at ROUNDOFF_MARGIN = 6 (no ~20 ms
+    # double-double companion). (With the exact inertias moved by an ulp too, the generated kernel's companions
+    # disagreed 1.6e-14 against an error of 6.8e-14, and the double-double companion ran: model.rounding_moved.)
     overrides = [*SCENE, "integrator=auto", f"accuracy={accuracy}"]
     ds = run(overrides)
     assert ds.attrs["auto_tolerance"] < 1e-12
     method = ds.attrs["error_estimate_method"]
-    if doubles_suffice:
-        assert "double-double" not in method and "second double companion" in method
+    assert "double-double" not in method and "second double companion" in method
     _assert_measures(ds, _actual(ds, overrides), resolved_above=resolved_above)
 
 

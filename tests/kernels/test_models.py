@@ -68,3 +68,19 @@ def test_fresh_cache_compiles_the_form_only_and_a_second_process_loads_it(tmp_pa
     second = child("second")
     assert second["compiled"] == []
     assert second["Y"] == first["Y"]
+
+
+def test_the_companions_model_moves_rounded_numbers_by_one_ulp_and_exact_ones_not():
+    """``rounding_moved``: the reference scene's inertias 2, 1.5, 1 are exact doubles (nothing rounded them) and stay;
+    its torque's numbers (from the decimal centre-of-mass direction) move by exactly one unit in the last place."""
+    from gyrolab.kernels.layout import TRACED_FIRST_CONSTANT, TRACED_TAIL
+    from gyrolab.kernels.model import rounding_moved
+
+    compiled = compose_scene(["experiment=perf_reference"]).compiled
+    before = compiled.params[TRACED_FIRST_CONSTANT:-TRACED_TAIL]
+    after = rounding_moved(compiled).params[TRACED_FIRST_CONSTANT:-TRACED_TAIL]
+    exact = np.isin(before, [2.0, 1.5, 1.0, 0.5, 0.0, -1.0])
+    assert exact.any() and (~exact).any()
+    np.testing.assert_array_equal(after[exact], before[exact])
+    ulps = np.abs(after[~exact] - before[~exact]) / np.spacing(np.abs(before[~exact]))
+    assert np.all((ulps >= 0.5) & (ulps <= 1.0))  # one ulp (half an ulp below a power of two)
