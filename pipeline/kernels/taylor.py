@@ -39,14 +39,6 @@ def order_for(tol: float) -> int:
     return int(min(MAX_ORDER, max(MIN_ORDER, math.ceil(-math.log(tol) / 2.0 + 1.0))))
 
 
-@kernel
-def _norm_inf(row):
-    v = 0.0
-    for x in row:
-        v = max(v, abs(x))
-    return v
-
-
 @inline_kernel
 def step_size(tol, scale, n1, n2, order, safety):
     """Jorba & Zou's step from the max norms n1, n2 of the last two coefficients (order − 1, order) and the

@@ -28,7 +28,7 @@ from numba.extending import intrinsic
 
 from gyrolab.kernels.compiler import inline_kernel, kernel
 from gyrolab.kernels.double_double import dd_add, dd_mul, two_sum
-from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, _norm_inf, order_for, step_size
+from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, _norm_row, order_for, step_size
 
 #: the smallest tolerance the double-double kernel takes (its unit round-off is 2^-106 ≈ 1.2e-32)
 MIN_TOL = 1e-32
@@ -91,8 +91,8 @@ def run(model, p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stat
             Th[0, m], Tl[0, m] = yh[m], yl[m]
         _call_generated(address, t, order, Th, Tl, S, p)
         stats[0] += 1
-        scale = max(1.0, _norm_inf(yh))
-        h = step_size(tol, scale, _norm_inf(Th[order - 1]), _norm_inf(Th[order]), order, safety)
+        scale = max(1.0, _norm_row(Th, 0))  # row 0: the state's high parts
+        h = step_size(tol, scale, _norm_row(Th, order - 1), _norm_row(Th, order), order, safety)
         if not h < np.inf:
             h = t_end - t
         t_new = min(t + h, t_end)
