@@ -9,6 +9,7 @@ are vectorised: for a 2,001 × 6 output they cost a few microseconds of a ~2 ms 
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -68,7 +69,10 @@ def check_inputs(name: str, t_out: Any, y0: Any) -> tuple[np.ndarray, np.ndarray
         raise IntegrationError(f"integrator {name!r} was given an initial state of shape {y0.shape} "
                                f"({np.count_nonzero(~np.isfinite(y0))} non-finite values); it takes one finite "
                                "1-D state")
-    if t_out.ndim != 1 or len(t_out) < 1 or not np.isfinite(t_out).all() or (np.diff(t_out) <= 0).any():
+    # finite ends and every step positive (a NaN compares false, an inf inside makes a step not positive): one
+    # comparison of the shifted times instead of np.diff and np.isfinite (8 of a 160 µs compiled run's 10 µs)
+    if (t_out.ndim != 1 or len(t_out) < 1 or not (math.isfinite(t_out[0]) and math.isfinite(t_out[-1]))
+            or not np.greater(t_out[1:], t_out[:-1]).all()):
         raise IntegrationError(f"integrator {name!r} was given output times that are not finite and strictly "
                                f"increasing (shape {t_out.shape}); t_out[0] is the initial time, then increasing")
     return t_out, y0

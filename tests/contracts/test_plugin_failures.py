@@ -417,8 +417,10 @@ def test_integrate_refuses_bad_inputs():
     fun = lambda t, y: -y  # noqa: E731
     with pytest.raises(IntegrationError, match="initial state of shape \\(2,\\) \\(1 non-finite values\\)"):
         RK4().integrate(fun, np.linspace(0, 1, 3), np.array([1.0, np.nan]))
-    with pytest.raises(IntegrationError, match="strictly increasing"):
-        RK4().integrate(fun, np.array([0.0, 1.0, 0.5]), np.array([1.0, 2.0]))
+    for times in ([0.0, 1.0, 0.5], [0.0, 1.0, 1.0], [0.0, np.nan, 2.0], [0.0, np.inf, 2.0], [0.0, 1.0, np.inf],
+                  [np.nan, 1.0], [-np.inf, 1.0]):
+        with pytest.raises(IntegrationError, match="strictly increasing"):
+            RK4().integrate(fun, np.array(times), np.array([1.0, 2.0]))
     assert RK4().integrate(fun, np.linspace(0, 1, 3), [1.0, 2.0]).y.shape == (3, 2)
 
 
