@@ -24,10 +24,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
+from llvmlite import ir
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from gyrolab.kernels.compiler import inline_kernel, kernel
-from gyrolab.kernels.double_double import fma
 from gyrolab.kernels.models import taylor_coefficients
 
 OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2  # dop853's codes
@@ -71,9 +73,8 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     time to fill). ``model`` is a ``models.Form`` or an int (``models.taylor_coefficients``).
     """
     n = y.size
-    T = np.empty((order + 1, n))
+    T = _coefficient_rows(order + 1, n)
     work = np.zeros((order + 1, 3))
-    v = np.empty(n)
     t = state[0]
     n_out = t_out.size
     t_end = t_out[n_out - 1]
@@ -94,21 +95,9 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
             state[0] = t
             return TOO_SMALL_STEP, i
         while i < n_out and t_out[i] <= t_new:
-            dt = t_out[i] - t
-            _horner(T, order, dt, v)
-            for m in range(n):
-                Y[i, m] = y[m] + (v[m] * dt - carry[m])
+            _dense_output(T, order, t_out[i] - t, y, carry, Y, i)
             i += 1
-        finite = True
-        _horner(T, order, h, v)
-        for m in range(n):
-            # Kahan: y + v·h with the bits lost in the previous additions carried in `carry`
-            inc = v[m] * h - carry[m]
-            s = y[m] + inc
-            carry[m] = (s - y[m]) - inc
-            y[m] = s
-            finite = finite and math.isfinite(s)
-        if not finite:
+        if not _advance(T, order, h, y, carry):
             state[0] = t
             return NOT_FINITE, i
         t = t_new
@@ -117,36 +106,122 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     return OK, i
 
 
+#: lanes of the Horner sums' vectors (AVX-512's; an AVX2 CPU runs each as two, a CPU without vectors as scalars)
+_LANES = 8
+#: doubles readable past the last row of the coefficients (``_coefficient_rows``): the Horner sums load whole vectors
+_PAST_END = 2 * _LANES
+
+
 @inline_kernel
-def _horner(T, order, h, v):
-    """v = Σ_{k=1..order} T[k] h^(k−1) for every component (Horner, each step one fused multiply-add: the update
-    is on the chain of dependent operations from one step to the next, and a fused step takes half the latency of
-    a multiply then an add). Six components' chains run side by side in registers (then three, then one), not one
-    component after another, and each component takes the same operations, so the same results to the bit."""
-    n = v.size
-    m = 0
-    while m + 6 <= n:
-        a0, a1, a2 = T[order, m], T[order, m + 1], T[order, m + 2]
-        a3, a4, a5 = T[order, m + 3], T[order, m + 4], T[order, m + 5]
-        for k in range(order - 1, 0, -1):
-            a0 = fma(a0, h, T[k, m])
-            a1 = fma(a1, h, T[k, m + 1])
-            a2 = fma(a2, h, T[k, m + 2])
-            a3 = fma(a3, h, T[k, m + 3])
-            a4 = fma(a4, h, T[k, m + 4])
-            a5 = fma(a5, h, T[k, m + 5])
-        v[m], v[m + 1], v[m + 2], v[m + 3], v[m + 4], v[m + 5] = a0, a1, a2, a3, a4, a5
-        m += 6
-    while m + 3 <= n:
-        a0, a1, a2 = T[order, m], T[order, m + 1], T[order, m + 2]
-        for k in range(order - 1, 0, -1):
-            a0 = fma(a0, h, T[k, m])
-            a1 = fma(a1, h, T[k, m + 1])
-            a2 = fma(a2, h, T[k, m + 2])
-        v[m], v[m + 1], v[m + 2] = a0, a1, a2
-        m += 3
-    for c in range(m, n):
-        a = T[order, c]
-        for k in range(order - 1, 0, -1):
-            a = fma(a, h, T[k, c])
-        v[c] = a
+def _coefficient_rows(rows, n):
+    """An uninitialised rows × n array followed by _PAST_END zeros, read by ``_emit_horner``'s vector loads: lanes
+    computed and dropped, but left uninitialised a subnormal number there made every output ~4x slower in some
+    processes (each multiply-add on it a microcode assist)."""
+    buffer = np.empty(rows * n + _PAST_END)
+    buffer[rows * n:] = 0.0
+    return buffer[:rows * n].reshape((rows, n))
+
+
+def _emit_horner(context, b, T, T_type, order, h, each):
+    """Emit v = Σ_{k=1..order} T[k] h^(k−1) for every component m, then ``each(m, v_m)`` in the lane's order.
+
+    Sixteen components' Horner chains run side by side in two ``<8 x double>`` registers, each step one fused
+    multiply-add; T must come from ``_coefficient_rows`` (the vectors load whole, past a row's end). A lane takes
+    the same operations as a scalar fused chain, so the same results to the bit. v is handed over in registers,
+    never stored (a vector store read back lane by lane stalls: no store forwarding)."""
+    i32, i64, double = ir.IntType(32), ir.IntType(64), ir.DoubleType()
+    vec = ir.VectorType(double, _LANES)
+    array = context.make_array(T_type)(context, b, T)
+    rows = b.bitcast(array.data, double.as_pointer())
+    n = b.extract_value(array.shape, 1)
+    fma = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * 3), f"llvm.fma.v{_LANES}f64")
+    undef = ir.Constant(vec, ir.Undefined)
+    hv = b.shuffle_vector(b.insert_element(undef, h, ir.Constant(i32, 0)), undef,
+                          ir.Constant(ir.VectorType(i32, _LANES), [0] * _LANES))
+    chunks = b.udiv(b.add(n, ir.Constant(i64, 2 * _LANES - 1)), ir.Constant(i64, 2 * _LANES))
+    with cgutils.for_range(b, chunks) as chunk:
+        columns = [b.add(b.mul(chunk.index, ir.Constant(i64, 2 * _LANES)), ir.Constant(i64, half * _LANES))
+                   for half in (0, 1)]
+
+        def row(k):
+            return [b.load(b.bitcast(b.gep(rows, [b.add(b.mul(k, n), c)]), vec.as_pointer()), align=8)
+                    for c in columns]
+
+        accumulators = [cgutils.alloca_once_value(b, x) for x in row(order)]
+        steps = b.sub(order, ir.Constant(i64, 1))
+        with cgutils.for_range(b, steps) as loop:
+            k = b.sub(steps, loop.index)  # order − 1 down to 1
+            for slot, x in zip(accumulators, row(k)):
+                b.store(b.call(fma, [b.load(slot), hv, x]), slot)
+        for slot, c in zip(accumulators, columns):
+            value = b.load(slot)
+            for lane in range(_LANES):
+                m = b.add(c, ir.Constant(i64, lane))
+                with b.if_then(b.icmp_signed("<", m, n), likely=True):
+                    each(m, b.extract_element(value, ir.Constant(i32, lane)))
+
+
+def _element(context, b, array_type, array, *indices):
+    """Pointer to array[indices] for an array of any layout."""
+    a = context.make_array(array_type)(context, b, array)
+    return cgutils.get_item_pointer2(context, b, a.data, cgutils.unpack_tuple(b, a.shape),
+                                     cgutils.unpack_tuple(b, a.strides), array_type.layout, list(indices))
+
+
+def _arrays(*arrays) -> bool:
+    return all(isinstance(a, types.Array) and a.dtype == types.float64 for a in arrays)
+
+
+@intrinsic
+def _dense_output(typingctx, T, order, dt, y, carry, Y, i):
+    """Y[i] = y + (v·dt − carry), v = Σ_{k≥1} T[k] dt^(k−1) (``_emit_horner``): the state dt after the step's start
+    from its series, with the compensation the state carries."""
+    if not (_arrays(T, y, carry, Y) and T.layout == "C"):
+        return None
+    sig = types.void(T, order, types.float64, y, carry, Y, i)
+
+    def codegen(context, b, signature, args):
+        T_, order_, dt_, y_, carry_, Y_, i_ = args
+        types_ = signature.args
+        i_ = context.cast(b, i_, types_[6], types.intp)
+
+        def each(m, v):
+            y_m, c_m = (b.load(_element(context, b, types_[a], args[a], m)) for a in (3, 4))
+            b.store(b.fadd(y_m, b.fsub(b.fmul(v, dt_), c_m)), _element(context, b, types_[5], Y_, i_, m))
+
+        _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), dt_, each)
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@intrinsic
+def _advance(typingctx, T, order, h, y, carry):
+    """y ← y + v·h as a compensated (Kahan) sum, v = Σ_{k≥1} T[k] h^(k−1) (``_emit_horner``): the bits lost in the
+    additions carried in ``carry``. Returns whether every new component is finite."""
+    if not (_arrays(T, y, carry) and T.layout == "C"):
+        return None
+    sig = types.boolean(T, order, types.float64, y, carry)
+
+    def codegen(context, b, signature, args):
+        T_, order_, h_, y_, carry_ = args
+        types_ = signature.args
+        finite = cgutils.alloca_once_value(b, cgutils.true_bit)
+
+        def each(m, v):
+            y_at, c_at = _element(context, b, types_[3], y_, m), _element(context, b, types_[4], carry_, m)
+            y_m = b.load(y_at)
+            inc = b.fsub(b.fmul(v, h_), b.load(c_at))
+            total = b.fadd(y_m, inc)
+            b.store(b.fsub(b.fsub(total, y_m), inc), c_at)
+            b.store(total, y_at)
+            # finite: |total| < inf (false for NaN and ±inf)
+            magnitude = b.call(cgutils.get_or_insert_function(b.module, ir.FunctionType(ir.DoubleType(),
+                                                              [ir.DoubleType()]), "llvm.fabs.f64"), [total])
+            b.store(b.and_(b.load(finite), b.fcmp_ordered("<", magnitude, ir.Constant(ir.DoubleType(), math.inf))),
+                    finite)
+
+        _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), h_, each)
+        return b.load(finite)
+
+    return sig, codegen

@@ -1,5 +1,6 @@
 """The Taylor step (``taylor.run``) on the fixed point's generated series, against independent computations."""
 
+import numba
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -115,3 +116,29 @@ def test_a_step_below_the_spacing_of_times_stops_with_too_small_step():
     assert (code, reached, t, stats[0], stats[1]) == (taylor.TOO_SMALL_STEP, 1, 1.0, 1, 0)
     np.testing.assert_array_equal(y, y0)
     assert not carry.any() and (out[1:] == -1.0).all()
+
+
+@numba.njit
+def _sums_through_the_step(T, order, h, y, carry, Y):
+    """taylor's dense output into Y[0] and its compensated update of y, on coefficients in its own padded rows."""
+    rows = taylor._coefficient_rows(T.shape[0], T.shape[1])
+    rows[:] = T
+    taylor._dense_output(rows, order, h, y, carry, Y, 0)
+    return taylor._advance(rows, order, h, y, carry)
+
+
+@pytest.mark.parametrize("n", [1, 6, 8, 9, 16, 17, 40])
+@pytest.mark.parametrize("order", [4, 9, 23])
+def test_the_vector_horner_sums_match_numpy_for_every_state_size(n, order):
+    """The step's Horner sums run in vector lanes, sixteen components at a time (past a row's end): every component
+    of any state size gets y + Σ_k T[k] h^k, against numpy's polynomial evaluation of each component."""
+    rng = np.random.default_rng(n * 100 + order)
+    T = rng.normal(size=(order + 1, n)) / np.arange(1, order + 2)[:, None] ** 2
+    y, carry, h = T[0].copy(), rng.normal(scale=1e-17, size=n), 0.37
+    Y = np.full((1, n), np.nan)
+    expected = np.array([np.polyval(T[::-1, m], h) for m in range(n)])
+    assert _sums_through_the_step(T, order, h, y, carry.copy(), Y)
+    np.testing.assert_allclose(Y[0], expected - carry, rtol=1e-14, atol=1e-15)
+    np.testing.assert_allclose(y, expected - carry, rtol=1e-14, atol=1e-15)
+    T[order, n - 1] = np.inf
+    assert not _sums_through_the_step(T, order, h, T[0].copy(), carry.copy(), Y)
