@@ -65,6 +65,11 @@ def companion(method: Any, has_compiled: bool) -> Companion | None:
     finer = method.more_accurate(TIGHTER)
     if finer is not None and (taylor is None or taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW):
         return Companion(*finer)
+    if method.precision != PRECISIONS[0]:
+        # above double precision (double-double near its own floor) a double stand-in would measure its own error, not
+        # the run's (promise_audit_gyrostat, seed 5, scene 25, accuracy 1e-7: a double-double run at tol 2.1e-31,
+        # 2.1e-7 from heyoka's real128, measured "5.2" by the double Taylor at tol 1e-16, and 1e-7 was refused)
+        return _tightest(method)
     if not has_compiled:
         return None
     if taylor is None:
@@ -140,7 +145,9 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
     if pick is None:
         return _unavailable(f"integrator {name!r} already runs at the compiled Taylor method's floor in double "
                             "precision (nothing more accurate to compare with)" if _double_taylor(method) else
-                            f"integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
+                            f"integrator {name!r} cannot be made {LEAST_TIGHTER:g}× more accurate in {method.precision} "
+                            "precision (nothing more accurate to compare with)" if method.precision != PRECISIONS[0]
+                            else f"integrator {name!r} exposes no tolerance or step to tighten and the scene has no "
                             "compiled model for the Taylor method")
     companion_model, refusal = None, None
     if pick.integrator.supports(COMPILED_MODEL) or pick.integrator.supports(PREFERS_COMPILED_MODEL):
@@ -190,6 +197,31 @@ def _unavailable(why: str) -> Comparison:
     reason = f"not available: {why}"
     log.warning("output.error_estimate: %s", reason)
     return Comparison(None, {"error_estimate_method": reason})
+
+
+#: a companion this many times more accurate at least: its own error then adds at most 1/(k − 1) to the estimate
+LEAST_TIGHTER = 4.0
+
+
+def _tightest(method: Any) -> Companion | None:
+    """The method made as much more accurate as it can be, ``TIGHTER`` times and then half as much at each try, last
+    ``LEAST_TIGHTER``; its difference scaled by k/(k − 1) below ``TIGHTER`` (the companion's own error, 1/k of the
+    run's, may cancel part of it). None when not even ``LEAST_TIGHTER`` times is possible: then nothing measures
+    the run (``measurable``)."""
+    factor = TIGHTER
+    while True:
+        finer = method.more_accurate(factor)
+        if finer is not None:
+            integrator, scale, how = finer
+            return Companion(integrator, scale * factor / (factor - 1.0) if factor < TIGHTER else scale, how)
+        if factor == LEAST_TIGHTER:
+            return None
+        factor = max(factor / 2.0, LEAST_TIGHTER)
+
+
+def measurable(method: Any, has_compiled: bool) -> bool:
+    """Whether a run of ``method`` can carry an error estimate (a companion more accurate than it exists)."""
+    return companion(method, has_compiled) is not None
 
 
 def _double_taylor(method: Any) -> Any:

@@ -128,3 +128,26 @@ def test_an_implicit_scipy_method_below_its_newton_floor_is_measured_against_the
     ds = run(overrides)
     assert "compiled Taylor" in ds.attrs["error_estimate_method"]
     _assert_measures(ds, _actual(ds, overrides))
+
+
+def test_a_double_double_run_near_its_floor_is_measured_in_double_double_or_not_at_all():
+    # promise_audit_gyrostat (seed 5, scene 25, accuracy 1e-7): a double-double run at tol 2.1e-31, 2.1e-7 from heyoka's
+    # real128, was "measured" 5.2 by a double-precision stand-in (its own error on a chaotic scene). Near its floor a
+    # double-double run is measured by double-double as much tighter as MIN_TOL (1e-32) allows, at least 4x (its
+    # difference scaled by k/(k - 1)), else not at all
+    from gyrolab.accuracy import estimate, promise
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor, TaylorDoubleDouble
+
+    def dd(tol):
+        return Taylor(precision="double-double", tol=tol)
+
+    assert estimate.companion(dd(1e-24), True).integrator.tol == pytest.approx(1e-26)  # 100x, scale 1
+    near = estimate.companion(dd(2e-31), True)
+    assert type(near.integrator) is TaylorDoubleDouble and near.integrator.tol == pytest.approx(2e-31 / 12.5)
+    assert near.scale == pytest.approx(12.5 / 11.5)
+    assert estimate.companion(dd(4e-32), True).scale == pytest.approx(4 / 3)
+    assert estimate.companion(dd(3e-32), True) is None and not estimate.measurable(dd(3e-32), True)
+    # rule 11's rerun stops where a companion can still measure it: 2.09e-31 asked 17.4x tighter runs 4.35x
+    rerun, _, _ = promise._measurable(dd(2.09e-31).more_accurate, 17.4, compiled=object())
+    assert rerun.tol == pytest.approx(2.09e-31 / 4.35) and estimate.measurable(rerun, True)
+    assert promise._measurable(dd(3e-32).more_accurate, 100.0, compiled=object()) is None
