@@ -451,6 +451,9 @@ def calibration_report(auto_rows: list[dict], alone_rows: list[dict]) -> bool:
                             f"{sum(r['verdict'] == 'BROKEN' for r in alone_rows)} predictions broken without the "
                             f"estimate in {len(alone_rows)} runs"),
         "FLOOR": (not floor_refusals, f"{len(floor_refusals)} targets refused as below a precision's floor"),
+        "ESTIMATE_SLACK": (broken == 0 and all(r["actual"] <= r["eps"] for r in rechecked),
+                           f"{len(rechecked)} runs kept after a recheck, the largest actual/ε among them "
+                           f"{max((r['actual'] / r['eps'] for r in rechecked), default=0.0):.2g}"),
     }
     return table.report(table.PROMISE, results)
 
