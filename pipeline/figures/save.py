@@ -7,12 +7,15 @@ the file: PNG text chunks, the PDF info dictionary (Subject, Keywords), SVG's de
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+import matplotlib
 import matplotlib.pyplot as plt
 import xarray as xr
+from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.style import STYLE
@@ -59,12 +62,30 @@ def save(fig: plt.Figure, stem: str | Path, formats: Iterable[str] = DEFAULT_FOR
     with plt.style.context(STYLE):
         for fmt in formats:
             path = stem.parent / f"{stem.name}.{fmt}"
-            with atomic_path(path) as tmp:
+            with atomic_path(path) as tmp, _laid_out(fig, dpi if fmt == "png" else None):
                 fig.savefig(tmp, format=fmt, dpi=dpi, metadata=_for_format(fmt, metadata or {}), **_LIGHTER.get(fmt, {}))
             written.append(path)
     if close:
         plt.close(fig)
     return written
+
+
+@contextmanager
+def _laid_out(fig: plt.Figure, dpi: int | None) -> Iterator[None]:
+    """A constrained layout computed once at the PNG's ``dpi`` and the engine detached meanwhile: with an engine,
+    savefig draws the figure twice (once to lay it out, with drawing disabled), the same pixels for ~12 % more CPU."""
+    engine = fig.get_layout_engine()
+    if dpi is None or not isinstance(engine, ConstrainedLayoutEngine):
+        yield
+        return
+    fig.set_dpi(dpi)
+    engine.execute(fig)
+    with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+        fig.set_layout_engine(None)  # None, not "none": a placeholder engine would still draw twice
+    try:
+        yield
+    finally:
+        fig.set_layout_engine(engine)
 
 
 def save_all(figures: Mapping[str, plt.Figure], directory: str | Path, ds: xr.Dataset,

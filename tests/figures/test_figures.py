@@ -281,3 +281,24 @@ def test_sweep_x_label_gives_the_swept_keys_unit(key, units, expected):
     ds = _drift_sweep()
     ds["r0"].attrs.update({"override_key": key, **({"units": units} if units else {})})
     assert draw_invariant_drift(ds).axes[0].get_xlabel() == expected
+
+
+def test_a_figure_laid_out_once_has_the_pixels_of_matplotlibs_own_save(run_dir, tmp_path):
+    """save() lays a constrained figure out once at the PNG's dpi (one draw, not two): the pixels are matplotlib's."""
+    import matplotlib.pyplot as plt
+
+    from gyrolab.figures.run import draw_state
+    from gyrolab.figures.save import save
+    from gyrolab.figures.style import STYLE
+
+    ds = xr.load_dataset(run_dir / "run.nc")
+    theirs = draw_state(ds)
+    with plt.style.context(STYLE):
+        theirs.savefig(tmp_path / "theirs.png", dpi=120)
+    ours = draw_state(ds)
+    engine = ours.get_layout_engine()
+    save(ours, tmp_path / "ours", ("png",), 120, close=False)
+    assert ours.get_layout_engine() is engine  # left as it was
+    plt.close("all")
+    with Image.open(tmp_path / "theirs.png") as theirs, Image.open(tmp_path / "ours.png") as ours:
+        assert np.array_equal(np.asarray(theirs), np.asarray(ours))
