@@ -185,15 +185,6 @@ class PeriodicOrbit:
     def __post_init__(self) -> None:
         self.multipliers = np.linalg.eigvals(self.monodromy)
 
-    @property
-    def converged_residual(self) -> float:
-        return self.residuals[-1]
-
-    def convergence_orders(self) -> np.ndarray:
-        """log(e_{k+1})/log(e_k)-style orders: log(e_{k+1}/e_k) / log(e_k/e_{k−1}) (2 for quadratic)."""
-        e = np.asarray(self.residuals)
-        return np.log(e[2:] / e[1:-1]) / np.log(e[1:-1] / e[:-2])
-
 
 def _start(p: float, q: float, r0: float, gpp: float) -> np.ndarray:
     return np.array([p, q, r0, np.sqrt(max(0.0, 1.0 - gpp**2)), 0.0, gpp])

@@ -22,7 +22,7 @@ from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.accuracy.calibration import AUTO_SAMPLE  # auto's pilot sample of a batch (importable here, as before)
 
 # BATCH_INTEGRATORS (like FAST_PATH, ADAPTIVE) is computed from the registry's capabilities by __getattr__ below
-__all__ = ["AUTO_SAMPLE", "BATCH_INTEGRATORS", "BatchSolution",  # noqa: F822 "auto_choice", "batch_kernel_integrators",
+__all__ = ["AUTO_SAMPLE", "BATCH_INTEGRATORS", "BatchSolution",  # noqa: F822 "batch_kernel_integrators",
            "integrate_arrays", "integrate_batch", "integrate_points"]
 
 
@@ -214,13 +214,6 @@ def integrate_points(integrator: Integrator, rhs_of: Callable[[int], RightHandSi
         require_finite_out(out)
     return BatchSolution(times, out, int(steps.max(initial=0)), time.perf_counter() - start, failed, steps,
                          integrator.attributes())
-
-
-def auto_choice(compiled: CompiledModel, auto: Integrator, times: np.ndarray, y0s: np.ndarray,
-                P: np.ndarray) -> tuple[Integrator, dict]:
-    """The method and tolerance an integrator that chooses its method (CHOOSES_METHOD, e.g. ``auto``) runs for a
-    batch: its ``choose_batch_method`` (kept under this name for callers of the old module)."""
-    return auto.choose_batch_method(compiled, times, y0s, P)
 
 
 def _kernel_choices(choosers: bool = True) -> str:
