@@ -131,17 +131,18 @@ def _again(scene: Any, y0: np.ndarray, progress: Any, compiled: Any, choice: Cho
 
 
 def _measurable(finer: Any, factor: float, compiled: Any) -> tuple | None:
-    """``finer(f)`` (``more_accurate`` or ``climbed``) for the largest f ≤ ``factor`` (halving, down to 2) that it
+    """``finer(f)`` (``more_accurate`` or ``climbed``) for f = ``factor``, else the largest f halving down to 2 that it
     allows and whose run an error estimate can still measure, or None: a run kept unmeasured would keep an unchecked
     promise (promise_audit_gyrostat, seed 5, scene 25: double-double at tol 1.2e-32, its floor, ended 1.7e-7 from
     heyoka's real128 where 1e-7 was asked)."""
     f = factor
-    while f >= 2.0:
+    while True:
         candidate = finer(f)
         if candidate is not None and estimate.measurable(candidate[0], compiled is not None):
             return candidate
         f /= 2.0
-    return None
+        if f < 2.0:  # (the factor asked itself may be below 2: a run measured just inside ESTIMATE_SLACK)
+            return None
 
 
 def _refusal(choice: Choice, reason: str, measured: float) -> ConfigError:
