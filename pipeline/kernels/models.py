@@ -171,30 +171,30 @@ def evaluate(model, t, y, p, out):
 
 
 @inline_kernel
-def _taylor_any(model, p, Y, order, work, t):
+def _taylor_any(model, p, Y, order, t):
     if model == TRACED:  # the traced equations' series (taylor_series)
-        taylor_series.coefficients(p, Y, order, work, t)
+        taylor_series.coefficients(p, Y, order, t)
     else:
         raise ValueError("this compiled model has no Taylor coefficients")
 
 
-def taylor_coefficients(model, p, Y, order, work, t=0.0):
+def taylor_coefficients(model, p, Y, order, t=0.0):
     """Fill Y[1..order] from Y[0] (``model`` as in ``rhs``). Compiled code only."""
     raise TypeError("models.taylor_coefficients is called from compiled kernels only")
 
 
 @overload(taylor_coefficients, inline="never", jit_options={"error_model": "numpy"})
-def _taylor_coefficients(model, p, Y, order, work, t=0.0):
+def _taylor_coefficients(model, p, Y, order, t=0.0):
     if isinstance(model, types.Integer):
-        return lambda model, p, Y, order, work, t=0.0: _taylor_any(model, p, Y, order, work, t)
+        return lambda model, p, Y, order, t=0.0: _taylor_any(model, p, Y, order, t)
     return None
 
 
 @overload(taylor_coefficients, inline="always")
-def _taylor_coefficients_traced(model, p, Y, order, work, t=0.0):
+def _taylor_coefficients_traced(model, p, Y, order, t=0.0):
     """The traced form: one call of its generated series kernel (``taylor_series``), inlined into the
     integrator's step (as a call of its own, with the arrays' reference counting, it cost ~30 ns a step:
     a sixth of the step of the reference scene)."""
     if isinstance(model, FormType) and model.id == TRACED:
-        return lambda model, p, Y, order, work, t=0.0: taylor_series.coefficients(p, Y, order, work, t)
+        return lambda model, p, Y, order, t=0.0: taylor_series.coefficients(p, Y, order, t)
     return None

@@ -74,7 +74,6 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     """
     n = y.size
     T = _coefficient_rows(order + 1, n)
-    work = np.zeros((order + 1, 3))
     t = state[0]
     n_out = t_out.size
     t_end = t_out[n_out - 1]
@@ -83,7 +82,7 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     while i < i_stop:
         for m in range(n):
             T[0, m] = y[m]
-        taylor_coefficients(model, p, T, order, work, t)
+        taylor_coefficients(model, p, T, order, t)
         stats[0] += 1
         scale = max(1.0, _norm_row(T, 0))
         h = step_size(tol, scale, _norm_row(T, order - 1), _norm_row(T, order), order, safety)

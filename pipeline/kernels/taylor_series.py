@@ -758,10 +758,9 @@ def _call(typingctx, address, t, order, size, Y, p):
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
-def coefficients(p, Y, order, work, t):
+def coefficients(p, Y, order, t):
     """Fill Y[1..order] from Y[0] for a traced model (``models.TRACED``): one call of the generated kernel
-    (``source``), whose address ``ready`` wrote at p[-4] and its work columns at p[-3] (``layout``). ``work`` is
-    unused (the signature of ``models.taylor_coefficients``)."""
+    (``source``), whose address ``ready`` wrote at p[-4] and its work columns at p[-3] (``layout``)."""
     address = int(p[p.size - 4])
     if address == 0:  # the Taylor kernel was not compiled (``ready`` not called): no series, not a crash
         Y[1:] = np.nan

@@ -339,7 +339,7 @@ def series(p, y, order, times):
     T = np.zeros((order + 1, y.size))
     for _ in range(times):
         T[0] = y
-        taylor_series.coefficients(p, T, order, T, 0.0)
+        taylor_series.coefficients(p, T, order, 0.0)
     return T
 
 

@@ -50,7 +50,7 @@ def test_generated_coefficients_equal_extended_precision_cauchy_products():
     def series(form, p, y, order):
         T = np.zeros((order + 1, y.size))
         T[0] = y
-        models.taylor_coefficients(form, p, T, order, np.zeros((order + 1, 3)))
+        models.taylor_coefficients(form, p, T, order)
         return T
 
     rng = np.random.default_rng(7)
