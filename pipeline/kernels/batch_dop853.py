@@ -22,13 +22,13 @@ import numba
 import numpy as np
 
 from gyrolab.kernels import dop853, models
-from gyrolab.kernels.dop853 import (A, B, C, D, E3, E5, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, N_EXTENDED,
-                                             N_STAGES, NOT_FINITE, OK, SAFETY, TOO_SMALL_STEP)
+from gyrolab.kernels.compiler import kernel
+from gyrolab.kernels.dop853 import (A, B, C, N_EXTENDED, N_STAGES, NOT_FINITE, OK, TOO_SMALL_STEP, emit, step_error,
+                                    step_factor)
 from gyrolab.kernels.models import call_block
 
 LANES = 32  # trajectories advanced in lock step
 TASK = 256  # trajectories per parallel task, at most
-RUNNING = -1  # status of a trajectory not finished yet
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -98,12 +98,11 @@ def task_size(count: int) -> int:
     return int(max(LANES, min(TASK, -(-count // (4 * numba.get_num_threads())))))
 
 
-@numba.njit(cache=True, error_model="numpy")
+@kernel
 def _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status, first, stop):
     """``run_blocks`` for the trajectories first..stop−1, LANES at a time."""
     n = Y0.shape[1]
-    n_out = t_out.size
-    t0, t_bound = t_out[0], t_out[n_out - 1]
+    t0, t_bound = t_out[0], t_out[t_out.size - 1]
     K = np.zeros((N_EXTENDED, n, LANES))
     y = np.zeros((n, LANES))
     f = np.zeros((n, LANES))
@@ -121,7 +120,7 @@ def _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejec
     active = np.zeros(LANES, dtype=np.bool_)  # the lane holds a trajectory
     retry = np.zeros(LANES, dtype=np.bool_)  # the lane's last trial step was rejected
     dense = np.zeros(LANES, dtype=np.bool_)  # the lane's accepted step covers an output time
-    F = np.empty(7)
+    F = np.empty((7, n))
     following = first
     for lane in range(LANES):
         if following < stop:
@@ -131,36 +130,12 @@ def _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejec
                   Y, nfev)
             following += 1
         else:  # an idle lane computes on a finite copy of lane 0 and is never read
-            for c in range(n):
-                y[c, lane] = y[c, 0]
-            for c in range(P.shape[0]):
-                P[c, lane] = P[c, 0]
+            y[:, lane] = y[:, 0]
+            P[:, lane] = P[:, 0]
     busy = min(LANES, stop - first)
     while busy > 0:
-        # each lane's trial step (the single kernel's clamping and minimum step)
-        for lane in range(LANES):
-            if not active[lane]:
-                continue
-            min_step = 10.0 * abs(np.nextafter(t[lane], np.inf) - t[lane])
-            if not retry[lane]:
-                if h_abs[lane] > max_step:
-                    h_abs[lane] = max_step
-                elif h_abs[lane] < min_step:
-                    h_abs[lane] = min_step
-            if h_abs[lane] < min_step:
-                status[traj[lane]] = TOO_SMALL_STEP
-                active[lane] = False  # finished below, after the stages
-                h[lane] = 0.0
-                continue
-            t_new = t[lane] + h_abs[lane]
-            if t_new - t_bound > 0:
-                t_new = t_bound
-            t_next[lane] = t_new
-            h[lane] = t_new - t[lane]
-            h_abs[lane] = abs(h[lane])
-        for c in range(n):
-            for lane in range(LANES):
-                K[0, c, lane] = f[c, lane]
+        _trial_steps(active, retry, t, h_abs, h, t_next, t_bound, max_step, traj, status)
+        K[0] = f
         for s in range(1, N_STAGES):
             _stage(K, s, A[s], y, h, ytmp, sums)
             _stage_times(t, C[s], h, ts)
@@ -168,102 +143,29 @@ def _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejec
         _stage(K, N_STAGES, B, y, h, y_new, sums)
         _stage_times(t, C[N_STAGES], h, ts)
         call_block(block, ts, y_new, P, K[N_STAGES], LANES)
-        # each lane's error norm, acceptance and next step
-        need_dense = False
-        for lane in range(LANES):
-            dense[lane] = False
-            if not active[lane]:
-                continue
-            j = traj[lane]
-            nfev[j] += N_STAGES
-            e5 = 0.0
-            e3 = 0.0
-            for c in range(n):
-                scale = atol + max(abs(y[c, lane]), abs(y_new[c, lane])) * rtol
-                a5 = 0.0
-                a3 = 0.0
-                for l in range(N_STAGES + 1):
-                    a5 += K[l, c, lane] * E5[l]
-                    a3 += K[l, c, lane] * E3[l]
-                a5 /= scale
-                a3 /= scale
-                e5 += a5 * a5
-                e3 += a3 * a3
-            if e5 == 0.0 and e3 == 0.0:
-                error_norm = 0.0
-            else:
-                error_norm = h_abs[lane] * e5 / np.sqrt((e5 + 0.01 * e3) * n)
-            if error_norm >= 1.0:
-                h_abs[lane] *= max(MIN_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
-                retry[lane] = True
-                rejected_steps[j] += 1
-                continue
-            factor = MAX_FACTOR if error_norm == 0.0 else min(MAX_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
-            if retry[lane]:
-                factor = min(1.0, factor)
-            h_abs[lane] *= factor
-            retry[lane] = False
-            steps[j] += 1
-            finite = True
-            for c in range(n):
-                finite = finite and np.isfinite(y_new[c, lane])
-            if not finite:
-                status[j] = NOT_FINITE
-                active[lane] = False
-                continue
-            if t_out[index[lane]] <= t_next[lane]:
-                dense[lane] = True
-                need_dense = True
-        if need_dense:  # the three extra stages of the dense output, for the lanes that need them
-            for s in range(N_STAGES + 1, N_EXTENDED):
+        if _judge(K, y, y_new, h_abs, rtol, atol, active, retry, dense, traj, index, t_out, t_next, steps,
+                  rejected_steps, nfev, status):
+            for s in range(N_STAGES + 1, N_EXTENDED):  # the dense output's three extra stages
                 _stage(K, s, A[s], y, h, ytmp, sums)
                 _stage_times(t, C[s], h, ts)
                 call_block(block, ts, ytmp, P, K[s], LANES)
         for lane in range(LANES):
             j = traj[lane]
-            if j < 0:
-                continue
-            if active[lane] and not retry[lane]:  # an accepted step
-                t_old = t[lane]
-                t_new = t_next[lane]
+            if j < 0 or (active[lane] and retry[lane]):
+                continue  # an idle lane, or a rejected trial: the lane retries with its smaller step
+            if active[lane]:  # an accepted step
                 if dense[lane]:
                     nfev[j] += N_EXTENDED - N_STAGES - 1
-                    hl = h[lane]
-                    while index[lane] < n_out and t_out[index[lane]] <= t_new:
-                        i = index[lane]
-                        x = (t_out[i] - t_old) / hl
-                        for c in range(n):
-                            if t_out[i] == t_new:
-                                Y[j, i, c] = y_new[c, lane]
-                                continue
-                            delta = y_new[c, lane] - y[c, lane]
-                            F[0] = delta
-                            F[1] = hl * f[c, lane] - delta
-                            F[2] = 2.0 * delta - hl * (K[N_STAGES, c, lane] + f[c, lane])
-                            for r in range(4):
-                                acc = 0.0
-                                for l in range(N_EXTENDED):
-                                    acc += D[r, l] * K[l, c, lane]
-                                F[3 + r] = hl * acc
-                            v = 0.0
-                            for r in range(7):
-                                v += F[6 - r]
-                                v *= x if r % 2 == 0 else 1.0 - x
-                            Y[j, i, c] = v + y[c, lane]
-                        index[lane] = i + 1
-                t[lane] = t_new
-                for c in range(n):
-                    y[c, lane] = y_new[c, lane]
-                    f[c, lane] = K[N_STAGES, c, lane]
-                if index[lane] < n_out:
+                    index[lane] = emit(t_out, index[lane], t[lane], t_next[lane], h[lane], y[:, lane],
+                                       y_new[:, lane], f[:, lane], K[:, :, lane], F, Y[j])
+                t[lane] = t_next[lane]
+                y[:, lane] = y_new[:, lane]
+                f[:, lane] = K[N_STAGES, :, lane]
+                if index[lane] < t_out.size:
                     continue
                 status[j] = OK
-            elif active[lane]:
-                continue  # a rejected trial: the lane retries with its smaller step
             else:  # failed: its outputs from here on are NaN
-                for i in range(index[lane], n_out):
-                    for c in range(n):
-                        Y[j, i, c] = np.nan
+                Y[j, index[lane]:] = np.nan
             if following < stop:  # the lane takes the task's next trajectory
                 traj[lane] = following
                 active[lane] = True
@@ -276,6 +178,62 @@ def _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejec
                 active[lane] = False
                 busy -= 1
                 h[lane] = 0.0
-                for c in range(n):
-                    y[c, lane] = 0.0
-                    f[c, lane] = 0.0
+                y[:, lane] = 0.0
+                f[:, lane] = 0.0
+
+
+@kernel
+def _trial_steps(active, retry, t, h_abs, h, t_next, t_bound, max_step, traj, status):
+    """Each active lane's trial step, with the single kernel's clamping and minimum step; a lane whose step is
+    below the minimum is marked TOO_SMALL_STEP and inactive (finished after the stages)."""
+    for lane in range(active.size):
+        if not active[lane]:
+            continue
+        min_step = 10.0 * abs(np.nextafter(t[lane], np.inf) - t[lane])
+        if not retry[lane]:
+            if h_abs[lane] > max_step:
+                h_abs[lane] = max_step
+            elif h_abs[lane] < min_step:
+                h_abs[lane] = min_step
+        if h_abs[lane] < min_step:
+            status[traj[lane]] = TOO_SMALL_STEP
+            active[lane] = False
+            h[lane] = 0.0
+            continue
+        t_new = t[lane] + h_abs[lane]
+        if t_new - t_bound > 0:
+            t_new = t_bound
+        t_next[lane] = t_new
+        h[lane] = t_new - t[lane]
+        h_abs[lane] = abs(h[lane])
+
+
+@kernel
+def _judge(K, y, y_new, h_abs, rtol, atol, active, retry, dense, traj, index, t_out, t_next, steps, rejected_steps,
+           nfev, status):
+    """Each active lane's error norm, acceptance and next step size (the single kernel's controller); marks the
+    accepted steps that cover an output time (``dense``) and returns whether any does."""
+    need_dense = False
+    for lane in range(active.size):
+        dense[lane] = False
+        if not active[lane]:
+            continue
+        j = traj[lane]
+        nfev[j] += N_STAGES
+        error_norm = step_error(K[:, :, lane], y[:, lane], y_new[:, lane], h_abs[lane], rtol, atol)
+        h_abs[lane] *= step_factor(error_norm, retry[lane])
+        retry[lane] = error_norm >= 1.0
+        if retry[lane]:
+            rejected_steps[j] += 1
+            continue
+        steps[j] += 1
+        finite = True
+        for c in range(y_new.shape[0]):
+            finite = finite and np.isfinite(y_new[c, lane])
+        if not finite:
+            status[j] = NOT_FINITE
+            active[lane] = False
+        elif t_out[index[lane]] <= t_next[lane]:
+            dense[lane] = True
+            need_dense = True
+    return need_dense

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from gyrolab.kernels import dop853_tableau as _c
-from gyrolab.kernels.compiler import kernel
+from gyrolab.kernels.compiler import inline_kernel, kernel
 from gyrolab.kernels.models import evaluate, rhs
 
 N_STAGES = _c.N_STAGES  # 12
@@ -80,6 +80,69 @@ def _stage_sum(K, s, a_row, n, out):
         out[i] = acc
 
 
+@inline_kernel
+def step_error(K, y, y_new, h_abs, rtol, atol):
+    """scipy's error norm of the step from y to y_new (K: its stages, rows 0..N_STAGES)."""
+    n = y.size
+    e5 = 0.0
+    e3 = 0.0
+    for m in range(n):
+        scale = atol + max(abs(y[m]), abs(y_new[m])) * rtol
+        a5 = 0.0
+        a3 = 0.0
+        for j in range(N_STAGES + 1):
+            a5 += K[j, m] * E5[j]
+            a3 += K[j, m] * E3[j]
+        a5 /= scale
+        a3 /= scale
+        e5 += a5 * a5
+        e3 += a3 * a3
+    if e5 == 0.0 and e3 == 0.0:
+        return 0.0
+    return h_abs * e5 / math.sqrt((e5 + 0.01 * e3) * n)
+
+
+@inline_kernel
+def step_factor(error_norm, rejected):
+    """scipy's factor of the next step size: after a rejected step (error_norm ≥ 1), or an accepted one (at most 1
+    right after a rejection)."""
+    if error_norm >= 1.0:
+        return max(MIN_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
+    factor = MAX_FACTOR if error_norm == 0.0 else min(MAX_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
+    return min(1.0, factor) if rejected else factor
+
+
+@inline_kernel
+def emit(t_out, i, t, t_new, h, y, y_new, f, K, F, Y):
+    """Fill Y[i], Y[i + 1], ... for the output times in (t, t_new] of the accepted step from y (rate f) to y_new
+    (K: its stages, the dense output's included; F: room for the coefficients, (7, n)) by scipy's 7th-order dense
+    output. Returns the next output index."""
+    for m in range(y.size):
+        delta = y_new[m] - y[m]
+        F[0, m] = delta
+        F[1, m] = h * f[m] - delta
+        F[2, m] = 2.0 * delta - h * (K[N_STAGES, m] + f[m])
+        for r in range(4):
+            acc = 0.0
+            for j in range(N_EXTENDED):
+                acc += D[r, j] * K[j, m]
+            F[3 + r, m] = h * acc
+    while i < t_out.size and t_out[i] <= t_new:
+        if t_out[i] == t_new:
+            for m in range(y.size):
+                Y[i, m] = y_new[m]
+        else:
+            x = (t_out[i] - t) / h
+            for m in range(y.size):
+                v = 0.0
+                for r in range(7):
+                    v += F[6 - r, m]
+                    v *= x if r % 2 == 0 else 1.0 - x
+                Y[i, m] = v + y[m]
+        i += 1
+    return i
+
+
 @kernel
 def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, max_step, stats):
     """Advance until t_out[i_stop − 1] is filled. state = [t, h_abs]; stats = [nfev, steps, rejected].
@@ -95,8 +158,6 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
     dy = np.empty(n)
     ytmp = np.empty(n)
     y_new = np.empty(n)
-    err5 = np.empty(n)
-    err3 = np.empty(n)
     F = np.empty((7, n))
     t, h_abs = state[0], state[1]
     i = i_next
@@ -137,68 +198,27 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
             for m in range(n):
                 y_new[m] = ytmp[m]
             stats[0] += N_STAGES
-            e5 = 0.0
-            e3 = 0.0
-            for m in range(n):
-                scale = atol + max(abs(y[m]), abs(y_new[m])) * rtol
-                a5 = 0.0
-                a3 = 0.0
-                for j in range(N_STAGES + 1):
-                    a5 += K[j, m] * E5[j]
-                    a3 += K[j, m] * E3[j]
-                err5[m] = a5 / scale
-                err3[m] = a3 / scale
-                e5 += err5[m] * err5[m]
-                e3 += err3[m] * err3[m]
-            if e5 == 0.0 and e3 == 0.0:
-                error_norm = 0.0
-            else:
-                error_norm = h_abs * e5 / math.sqrt((e5 + 0.01 * e3) * n)
+            error_norm = step_error(K, y, y_new, h_abs, rtol, atol)
             if error_norm != error_norm:  # NaN in a stage: no step size fixes it, and a NaN step would loop forever
                 state[0], state[1] = t, h_abs
                 return NOT_FINITE, i
-            if error_norm < 1.0:
-                factor = MAX_FACTOR if error_norm == 0.0 else min(MAX_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
-                if rejected:
-                    factor = min(1.0, factor)
-                h_abs *= factor
-                stats[1] += 1
-                for m in range(n):
-                    if not math.isfinite(y_new[m]):
-                        state[0], state[1] = t, h_abs
-                        return NOT_FINITE, i
-                # dense output for the outputs inside (t, t_new] (then on to every one, past i_stop too)
-                if i < i_stop and t_out[i] <= t_new:
-                    dense = True
-                    continue
-                break
-            h_abs *= max(MIN_FACTOR, SAFETY * error_norm ** ERROR_EXPONENT)
-            rejected = True
-            stats[2] += 1
-        if dense:
+            h_abs *= step_factor(error_norm, rejected)
+            if error_norm >= 1.0:
+                rejected = True
+                stats[2] += 1
+                continue
+            stats[1] += 1
             for m in range(n):
-                delta = y_new[m] - y[m]
-                F[0, m] = delta
-                F[1, m] = h * f[m] - delta
-                F[2, m] = 2.0 * delta - h * (K[N_STAGES, m] + f[m])
-                for r in range(4):
-                    acc = 0.0
-                    for j in range(N_EXTENDED):
-                        acc += D[r, j] * K[j, m]
-                    F[3 + r, m] = h * acc
-            while i < t_out.size and t_out[i] <= t_new:
-                if t_out[i] == t_new:
-                    for m in range(n):
-                        Y[i, m] = y_new[m]
-                else:
-                    x = (t_out[i] - t) / h
-                    for m in range(n):
-                        v = 0.0
-                        for r in range(7):
-                            v += F[6 - r, m]
-                            v *= x if r % 2 == 0 else 1.0 - x
-                        Y[i, m] = v + y[m]
-                i += 1
+                if not math.isfinite(y_new[m]):
+                    state[0], state[1] = t, h_abs
+                    return NOT_FINITE, i
+            # dense output for the outputs inside (t, t_new] (then on to every one, past i_stop too)
+            if i < i_stop and t_out[i] <= t_new:
+                dense = True
+                continue
+            break
+        if dense:
+            i = emit(t_out, i, t, t_new, h, y, y_new, f, K, F, Y)
         t = t_new
         for m in range(n):
             y[m] = y_new[m]
