@@ -78,9 +78,9 @@ def rhs_cost(base: list[str], plugin: list[str], compose_scene) -> None:
     from gyrolab.kernels import models
 
     @numba.njit
-    def loop(model, p, y, out, n):
+    def loop(p, y, out, n):
         for i in range(n):
-            models.rhs(model, 1e-9 * i, y, p, out)
+            models.rhs(1e-9 * i, y, p, out)
             y[0] += 1e-300 * out[0]  # a dependency, so that no evaluation is optimised away
         return out[0]
 
@@ -89,11 +89,11 @@ def rhs_cost(base: list[str], plugin: list[str], compose_scene) -> None:
         compiled = compose_scene(overrides).compiled
         y = compose_scene(overrides).system.initial_state()
         out = np.empty_like(y)
-        loop(compiled.model, compiled.params, y, out, 10)
+        loop(compiled.params, y, out, 10)
         best = np.inf
         for _ in range(20):
             start = time.perf_counter()
-            loop(compiled.model, compiled.params, y, out, 100_000)
+            loop(compiled.params, y, out, 100_000)
             best = min(best, time.perf_counter() - start)
         costs.append(best / 100_000 * 1e9)
     print(f"right-hand side: built-in {costs[0]:.1f} ns, plugin {costs[1]:.1f} ns per evaluation "

@@ -596,7 +596,7 @@ def _check_compiled_system(cls: type, system: Any, t: np.ndarray, y: np.ndarray)
     scale = max(1.0, float(np.max(np.abs(y[0]))))
     out = np.empty(len(y[0]))
     for state in [y[0], *(y[0] + 0.1 * scale * rng.normal(size=len(y[0])) for _ in range(10))]:
-        models.evaluate(compiled.model, 0.3, np.ascontiguousarray(state), compiled.params, out)
+        models.evaluate(0.3, np.ascontiguousarray(state), compiled.params, out)
         expected = np.asarray(system.rhs(0.3, state.copy()), dtype=float)
         if not np.allclose(out, expected, rtol=1e-12, atol=1e-12 * max(1.0, float(np.max(np.abs(expected))))):
             raise _fail(cls, f"the compiled right-hand side {out.tolist()} differs from rhs {expected.tolist()} at "

@@ -215,7 +215,7 @@ def poincare_section(compiled: Any, y0: np.ndarray, t_end: float, step: float, l
     f = np.empty((2, at.size, y.shape[1]))
     for side in (0, 1):
         for j, i in enumerate(at + side):
-            models.evaluate(models.form(run_model), float(times[i]), y[i], p, f[side, j])
+            models.evaluate(float(times[i]), y[i], p, f[side, j])
     lo, hi = np.zeros(at.size), np.ones(at.size)
     for _ in range(60):
         mid = 0.5 * (lo + hi)

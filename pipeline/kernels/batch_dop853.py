@@ -55,15 +55,15 @@ def _stage_times(t, c, h, ts):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _load(model, lane, traj, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs, index, Y, nfev):
+def _load(lane, traj, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs, index, Y, nfev):
     """Put trajectory ``traj`` into ``lane``: state, parameters, derivative, scipy's initial step."""
     n = Y0.shape[1]
     y0 = Y0[traj].copy()
     p = Params[traj].copy()
     f0 = np.empty(n)
-    models.rhs(model, t0, y0, p, f0)
+    models.rhs(t0, y0, p, f0)
     stats = np.zeros(3, dtype=np.int64)
-    h_abs[lane] = dop853.initial_step(model, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats)
+    h_abs[lane] = dop853.initial_step(p, t0, y0, f0, t_bound, max_step, rtol, atol, stats)
     nfev[traj] = 1 + stats[0]
     for c in range(n):
         y[c, lane] = y0[c]
@@ -76,10 +76,11 @@ def _load(model, lane, traj, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def run_blocks(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status,
+def run_blocks(block, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status,
                task_size):
     """Every trajectory j (initial state Y0[j], parameters Params[j]) over t_out into Y[j]: the stages by the
-    model's right-hand side by columns at ``block`` (``models.block_rhs``), the rest by ``model`` (a Form).
+    model's right-hand side by columns at ``block`` (``models.block_rhs``), the rest by the model's own
+    right-hand side (its address in each parameter row).
 
     steps/rejected_steps/nfev[j] receive its counts, status[j] OK, TOO_SMALL_STEP or NOT_FINITE
     (its outputs from the failed step on are NaN). t_out has at least two times. Tasks of
@@ -88,7 +89,7 @@ def run_blocks(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, 
     count = Y0.shape[0]
     n_tasks = (count + task_size - 1) // task_size
     for task in numba.prange(n_tasks):  # the loop stays small: numba's parallel pass compiles slowly on big bodies
-        _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status,
+        _task(block, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status,
               task * task_size, min(task * task_size + task_size, count))
 
 
@@ -99,7 +100,7 @@ def task_size(count: int) -> int:
 
 
 @kernel
-def _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status, first, stop):
+def _task(block, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_steps, nfev, status, first, stop):
     """``run_blocks`` for the trajectories first..stop−1, LANES at a time."""
     n = Y0.shape[1]
     t0, t_bound = t_out[0], t_out[t_out.size - 1]
@@ -126,7 +127,7 @@ def _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejec
         if following < stop:
             traj[lane] = following
             active[lane] = True
-            _load(model, lane, following, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs, index,
+            _load(lane, following, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs, index,
                   Y, nfev)
             following += 1
         else:  # an idle lane computes on a finite copy of lane 0 and is never read
@@ -170,7 +171,7 @@ def _task(block, model, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejec
                 traj[lane] = following
                 active[lane] = True
                 retry[lane] = False
-                _load(model, lane, following, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs,
+                _load(lane, following, Y0, Params, t0, t_bound, max_step, rtol, atol, y, f, P, t, h_abs,
                       index, Y, nfev)
                 following += 1
             else:  # idle from now on: a finite state, no step

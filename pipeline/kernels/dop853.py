@@ -42,7 +42,7 @@ def _rms(x, x0, y, atol, rtol):
 
 
 @kernel
-def initial_step(model, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats):
+def initial_step(p, t0, y0, f0, t_bound, max_step, rtol, atol, stats):
     """scipy.integrate._ivp.common.select_initial_step for order 7.
 
     Scalar loops instead of numpy's array expressions, which numba compiles as separate kernels
@@ -61,7 +61,7 @@ def initial_step(model, p, t0, y0, f0, t_bound, max_step, rtol, atol, stats):
     for m in range(n):
         y1[m] = y0[m] + h0 * f0[m]
     f1 = np.empty(n)
-    evaluate(model, t0 + h0, y1, p, f1)
+    evaluate(t0 + h0, y1, p, f1)
     stats[0] += 1
     d2 = _rms(f1, f0, y0, atol, rtol) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
@@ -144,7 +144,7 @@ def emit(t_out, i, t, t_new, h, y, y_new, f, K, F, Y):
 
 
 @kernel
-def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, max_step, stats):
+def run(p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, max_step, stats):
     """Advance until t_out[i_stop − 1] is filled. state = [t, h_abs]; stats = [nfev, steps, rejected].
 
     Returns (status, next output index). y and f are updated in place. The last step fills every
@@ -191,7 +191,7 @@ def run(model, p, t_out, Y, i_next, i_stop, state, y, f, t_bound, rtol, atol, ma
                 _stage_sum(K, s, A[s], n, dy)
                 for m in range(n):
                     ytmp[m] = y[m] + dy[m] * h
-                rhs(model, t + C[s] * h, ytmp, p, K[s])
+                rhs(t + C[s] * h, ytmp, p, K[s])
             if dense:
                 stats[0] += N_EXTENDED - N_STAGES - 1
                 break

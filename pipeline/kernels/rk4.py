@@ -16,7 +16,7 @@ NODES = np.array([0.0, 0.5, 0.5, 1.0])
 
 
 @kernel
-def _advance(model, p, t0, y, interval, steps, K, tmp):
+def _advance(p, t0, y, interval, steps, K, tmp):
     """``steps`` RK4 steps over ``interval`` from t0; K (4 × n) holds the stages.
 
     One loop over the stages, so that ``models.rhs`` is inlined (and typed, on the first compile)
@@ -34,18 +34,18 @@ def _advance(model, p, t0, y, interval, steps, K, tmp):
                 a = h if s == 3 else 0.5 * h
                 for m in range(n):
                     tmp[m] = y[m] + a * K[s - 1, m]
-            rhs(model, t + NODES[s] * h, tmp, p, K[s])
+            rhs(t + NODES[s] * h, tmp, p, K[s])
         for m in range(n):
             y[m] += (h / 6.0) * (K[0, m] + 2.0 * K[1, m] + 2.0 * K[2, m] + K[3, m])
 
 
 @kernel
-def run(model, p, t_out, steps_per_interval, y, Y, i_next, i_stop):
+def run(p, t_out, steps_per_interval, y, Y, i_next, i_stop):
     """Fill Y[i_next:i_stop]; y is advanced in place. Returns the first index left non-finite, or i_stop."""
     n = y.size
     K, tmp = np.empty((4, n)), np.empty(n)
     for i in range(i_next, i_stop):
-        _advance(model, p, t_out[i - 1], y, t_out[i] - t_out[i - 1], steps_per_interval[i - 1], K, tmp)
+        _advance(p, t_out[i - 1], y, t_out[i] - t_out[i - 1], steps_per_interval[i - 1], K, tmp)
         for m in range(n):
             if not math.isfinite(y[m]):
                 return i

@@ -63,14 +63,14 @@ def _norm_row(T, k):
 
 
 @kernel
-def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+def run(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     """Advance until t_out[i_stop − 1] is filled.
 
     Steps are clipped at the run's last output time only, never at i_stop: where a call stops must not
     change the steps (the caller sizes calls by wall time, for progress), so every output the last
     step passes is filled, also beyond i_stop. state = [t]; carry = the Kahan compensation of y (zeros
     at the start); stats = [coefficient evaluations, steps]. Returns (status, index of the next output
-    time to fill). ``model`` is a ``models.Form`` or an int (``models.taylor_coefficients``).
+    time to fill).
     """
     n = y.size
     T = _coefficient_rows(order + 1, n)
@@ -82,7 +82,7 @@ def run(model, p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     while i < i_stop:
         for m in range(n):
             T[0, m] = y[m]
-        taylor_coefficients(model, p, T, order, t)
+        taylor_coefficients(p, T, order, t)
         stats[0] += 1
         scale = max(1.0, _norm_row(T, 0))
         h = step_size(tol, scale, _norm_row(T, order - 1), _norm_row(T, order), order, safety)

@@ -65,14 +65,12 @@ def _call_generated(typingctx, address, t, order, Th, Tl, S, p):
 
 
 @kernel
-def run(model, p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stats):
+def run(p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stats):
     """Advance until t_out[i_stop − 1] is filled: ``taylor.run``'s contract (steps clipped at the last output
     time only, every output a step passes filled, state = [t], stats = [coefficient evaluations, steps],
     returns (status, next output index)) with the state in double-double (yh, yl). Y receives the outputs
-    rounded to double; Ylo their low parts when it has Y's shape (else it is not touched).
-
-    ``model`` is the compiled model's form id (every model runs its generated series, ``series_dd``, whose address
-    and scratch columns end ``p``)."""
+    rounded to double; Ylo their low parts when it has Y's shape (else it is not touched). The series is the
+    model's generated one (``series_dd``), whose address and scratch columns end ``p``."""
     n = yh.size
     Th = np.zeros((order + 1, n))
     Tl = np.zeros((order + 1, n))
@@ -121,7 +119,7 @@ def run(model, p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stat
     return code, i
 
 
-def propagate(p: np.ndarray, tol: float, t_out, y0, order: int | None = None, y0_low=None, model: int = 1):
+def propagate(p: np.ndarray, tol: float, t_out, y0, order: int | None = None, y0_low=None):
     """The states at ``t_out`` from ``y0`` (doubles, or double-doubles with ``y0_low``) in one call into the kernel:
     (high parts, low parts), each (len(t_out), state size), the first row the initial state. For tests, benchmarks
     and callers that want all 32 digits; the integrator plugin (``Taylor(precision="double-double")``) chunks
@@ -135,7 +133,7 @@ def propagate(p: np.ndarray, tol: float, t_out, y0, order: int | None = None, y0
     state = np.array([t_out[0]])
     stats = np.zeros(2, dtype=np.int64)
     order = order_for(tol) if order is None else order
-    status, _ = run(model, p, order, tol, t_out, Y, Ylo, 1, len(t_out), state, yh, yl, stats)
+    status, _ = run(p, order, tol, t_out, Y, Ylo, 1, len(t_out), state, yh, yl, stats)
     if status != OK:
         raise RuntimeError(f"double-double Taylor kernel stopped near t={state[0]:.6g} (status {status})")
     return Y, Ylo

@@ -155,19 +155,18 @@ class DOP853Numba(Tolerances, Integrator):
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
-        form = models.form(compiled)  # kernels compiled for this model only
         f = np.empty_like(y)
-        models.evaluate(form, t_out[0], y, compiled.params, f)
+        models.evaluate(t_out[0], y, compiled.params, f)
         stats = np.zeros(3, dtype=np.int64)
         stats[0] = 1
-        h0 = dop853.initial_step(form, compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
+        h0 = dop853.initial_step(compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
                                  self.rtol, self.atol, stats)
         state = np.array([t_out[0], h0])
         reached = 1
         for first, stop in _Chunks(len(t_out)):
             if reached >= stop:
                 continue  # a long step already filled this chunk's outputs
-            status, reached = dop853.run(form, compiled.params, t_out, out, reached, stop, state, y, f,
+            status, reached = dop853.run(compiled.params, t_out, out, reached, stop, state, y, f,
                                          t_out[-1], self.rtol, self.atol, self.max_step, stats)
             if status != dop853.OK:
                 reason = "the step size fell below the spacing of floating-point numbers" \
@@ -201,14 +200,13 @@ class RK4Numba(Integrator):
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import models, rk4
+        from gyrolab.kernels import rk4
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         steps = interval_steps(self, t_out)
         fun = compiled_rhs(compiled)
-        form = models.form(compiled)  # kernels compiled for this model only
-        reached = _fixed_step(lambda grid, n, rows, first, stop: rk4.run(form, compiled.params, grid, n,
+        reached = _fixed_step(lambda grid, n, rows, first, stop: rk4.run(compiled.params, grid, n,
                                                                          y, rows, first, stop),
                               self.name, fun, t_out, steps, y, out, progress)
         if reached != len(t_out):
@@ -279,11 +277,10 @@ class Taylor(Integrator):
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import models, taylor, taylor_series
+        from gyrolab.kernels import taylor, taylor_series
 
         start = time.perf_counter()
         taylor_series.ready(compiled)  # a traced model's series kernel, compiled on first need (once: then a test)
-        form = models.form(compiled)  # the kernel compiles this model's step only
         t_out, y, out = _outputs(t_out, y0)
         state = np.array([t_out[0]])
         carry = np.zeros(len(y))  # (np.zeros_like costs 2 µs more, per pilot run)
@@ -292,7 +289,7 @@ class Taylor(Integrator):
         for first, stop in _Chunks(len(t_out)):
             if reached >= stop:
                 continue  # a long step already filled this chunk's outputs
-            status, reached = taylor.run(form, compiled.params, self.order, self.tol, t_out, out, reached, stop, state,
+            status, reached = taylor.run(compiled.params, self.order, self.tol, t_out, out, reached, stop, state,
                                          y, carry, stats)
             if status != taylor.OK:
                 raise _taylor_failure(status, state[0])
@@ -388,7 +385,7 @@ def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray,
     for first, stop in _Chunks(len(t_out)):
         if reached >= stop:
             continue  # a long step already filled this chunk's outputs
-        status, reached = taylor_dd.run(compiled.model, compiled.params, method.order, method.tol, t_out, out, no_low, reached, stop,
+        status, reached = taylor_dd.run(compiled.params, method.order, method.tol, t_out, out, no_low, reached, stop,
                                         state, y, low, stats)
         if status != taylor.OK:
             raise _taylor_failure(status, state[0])
@@ -413,7 +410,7 @@ def taylor_dd_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0
     t_out, y, out = _outputs(t_out, y0)
     state = np.array([t_out[0]])
     order = taylor.order_for(tol) if order is None else order
-    status, _ = taylor_dd.run(compiled.model, compiled.params, order, tol, t_out, out, np.empty((0, len(y))), 1, len(t_out), state,
+    status, _ = taylor_dd.run(compiled.params, order, tol, t_out, out, np.empty((0, len(y))), 1, len(t_out), state,
                               y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
     if status != taylor.OK:
         raise _taylor_failure(status, state[0])
@@ -450,12 +447,12 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
     for runs over a few periods inside another method (``auto``'s screen), which need neither progress nor
     statistics (``Taylor.integrate``'s chunks and records cost ~10 µs more, a tenth of the screen)."""
     # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import models, taylor, taylor_series
+    from gyrolab.kernels import taylor, taylor_series
 
     taylor_series.ready(compiled)  # a traced model's series kernel (a scene carrying α is one)
     t_out, y, out = _outputs(t_out, y0)
     state = np.array([t_out[0]])
-    status, _ = taylor.run(models.form(compiled), compiled.params, taylor.order_for(tol), tol, t_out, out, 1,
+    status, _ = taylor.run(compiled.params, taylor.order_for(tol), tol, t_out, out, 1,
                            len(t_out), state, y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
     if status != taylor.OK:
         raise _taylor_failure(status, state[0])

@@ -50,11 +50,9 @@ def compiled_rhs(compiled) -> Callable[[float, np.ndarray], np.ndarray]:
     # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import models
 
-    form = models.form(compiled)
-
     def fun(t: float, y: np.ndarray) -> np.ndarray:
         out = np.empty_like(y)
-        models.evaluate(form, t, y, compiled.params, out)  # the compiled call the kernels share
+        models.evaluate(t, y, compiled.params, out)  # the compiled call the kernels share
         return out
 
     return fun

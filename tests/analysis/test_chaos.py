@@ -55,11 +55,11 @@ def test_generated_tangent_flow_matches_finite_differences_of_the_compiled_rhs()
         augmented = tangent.compiled_megno(compiled)
         q = tangent.megno_params(augmented, p)[0]
 
-        def f(form, t, y, params):
+        def f(t, y, params):
             out = np.empty(len(y))
-            models.evaluate(form, t, np.ascontiguousarray(y), params, out)
+            models.evaluate(t, np.ascontiguousarray(y), params, out)
             return out
-        rhs = lambda y: f(models.form(compiled), 0.0, y, p)  # noqa: E731
+        rhs = lambda y: f(0.0, y, p)  # noqa: E731
         for _ in range(4):
             y = np.concatenate([rng.normal(size=3), rng.normal(size=3)])
             y[3:6] /= np.linalg.norm(y[3:6])
@@ -68,7 +68,7 @@ def test_generated_tangent_flow_matches_finite_differences_of_the_compiled_rhs()
             # the augmented right-hand side (x, u, ℓ, a, b) at t = 2, a = 0.3: f, J u − λ u, λ = u·J u, t λ, 2a/t
             d = rng.normal(size=6)
             d /= np.linalg.norm(d)
-            aug = f(models.form(augmented), 2.0, np.concatenate([y, d, [0.0, 0.3, 0.0]]), q)
+            aug = f(2.0, np.concatenate([y, d, [0.0, 0.3, 0.0]]), q)
             lam = d @ J @ d
             np.testing.assert_allclose(aug[:6], rhs(y), rtol=1e-14, atol=1e-14)
             np.testing.assert_allclose(aug[6:], [*(J @ d - lam * d), lam, 2.0 * lam, 0.3], rtol=1e-7, atol=1e-8)

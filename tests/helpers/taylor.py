@@ -3,18 +3,18 @@
 import numba
 import numpy as np
 
-from gyrolab.kernels import models, taylor, taylor_series
+from gyrolab.kernels import taylor, taylor_series
 from gyrolab.kernels.model import bind
 
 
 @numba.njit(cache=True)
-def _each(model, Params, order, tol, t_out, Y0, Y, steps, status):
+def _each(Params, order, tol, t_out, Y0, Y, steps, status):
     for j in range(Y0.shape[0]):
         y = Y0[j].copy()
         Y[j, 0] = y
         state = np.array([t_out[0]])
         stats = np.zeros(2, dtype=np.int64)
-        code, reached = taylor.run(model, Params[j], order, tol, t_out, Y[j], 1, t_out.size, state, y,
+        code, reached = taylor.run(Params[j], order, tol, t_out, Y[j], 1, t_out.size, state, y,
                                    np.zeros(y.size), stats)
         steps[j], status[j] = stats[1], code
         if code != taylor.OK:
@@ -28,7 +28,7 @@ def single_kernel_runs(compiled, P, integrator, times, y0s):
     assert taylor_series.ready(compiled, P)
     out = np.empty((len(y0s), len(times), y0s.shape[1]))
     steps, status = np.zeros(len(y0s), dtype=np.int64), np.zeros(len(y0s), dtype=np.int64)
-    _each(models.form(compiled), P, integrator.order, integrator.tol, np.asarray(times, dtype=float),
+    _each(P, integrator.order, integrator.tol, np.asarray(times, dtype=float),
           np.ascontiguousarray(y0s, dtype=float), out, steps, status)
     assert not status.any()
     return out, steps

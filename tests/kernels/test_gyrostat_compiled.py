@@ -114,7 +114,7 @@ def test_double_double_gyrostat_keeps_the_jacobi_integral_beyond_double_precisio
     system, y0, expected = setup
     compiled = system.compiled_model()
     _ready_for_double_double(compiled)
-    hi, lo = taylor_dd.propagate(compiled.params, 1e-30, TIMES, y0, model=compiled.model)
+    hi, lo = taylor_dd.propagate(compiled.params, 1e-30, TIMES, y0)
     assert np.max(np.abs(hi - expected)) < 1e-10  # the same motion as the Euler-angle oracle
     y = hi.astype(np.longdouble) + lo.astype(np.longdouble)
     if np.finfo(np.longdouble).eps > 1e-18:

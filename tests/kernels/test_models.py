@@ -1,7 +1,4 @@
-"""Kernels compiled per model form (``models.Form``), and cached: a second process compiles nothing.
-
-The expected values are the run-time dispatch's (an int model), which the forms must reproduce bit for bit.
-"""
+"""The kernels' call of a compiled model, and their cache: a second process compiles nothing."""
 
 from __future__ import annotations
 
@@ -10,27 +7,21 @@ import os
 import subprocess
 import sys
 
-import numba
 import numpy as np
 
 from gyrolab import compose_scene
-from gyrolab.contracts.integrator import CompiledModel
 from gyrolab.kernels import models
 
 
-def test_form_of_a_compiled_model():
-    assert models.form(CompiledModel(models.TRACED, np.zeros(30))).id == models.TRACED
-    assert isinstance(numba.typeof(models.FORMS[models.TRACED]), models.FormType)
-
-
-def test_form_matches_run_time_dispatch_bit_for_bit():
-    compiled = compose_scene(["experiment=perf_reference"]).compiled
+def test_the_compiled_right_hand_side_is_the_systems_own():
+    """``models.evaluate`` (the call every kernel inlines: the generated kernel through the address in p) against
+    the system's numpy ``rhs``, which it was traced from."""
+    scene = compose_scene(["experiment=perf_reference"])
     y = np.array([0.3, -1.1, 2.2, 0.48, 0.6, 0.64])
-    by_int, by_form = np.empty(6), np.empty(6)
-    models.evaluate(models.TRACED, 0.0, y, compiled.params, by_int)
-    models.evaluate(models.form(compiled), 0.0, y, compiled.params, by_form)
-    assert np.array_equal(by_int, by_form)
-    assert np.all(by_form != 0.0)  # every component computed
+    compiled = np.empty(6)
+    models.evaluate(0.0, y, scene.compiled.params, compiled)
+    np.testing.assert_allclose(compiled, scene.system.rhs(0.0, y), rtol=1e-14, atol=1e-15)
+    assert np.all(compiled != 0.0)  # every component computed
 
 
 _CHILD = r'''
@@ -42,12 +33,12 @@ from gyrolab.kernels import models, taylor_series, rk4
 import numba
 
 compiled = compose_scene(["experiment=perf_reference"]).compiled
-p, form = compiled.params, models.form(compiled)
+p = compiled.params
 y0 = np.array([0.3, -1.1, 2.2, 0.48, 0.6, 0.64])
 with event.install_recorder("numba:compile") as rec:
     y, Y, f = y0.copy(), np.zeros((3, 6)), np.empty(6)
-    rk4.run(form, p, np.array([0.0, 0.1, 0.2]), np.array([5, 5]), y, Y, 1, 3)
-    models.evaluate(form, 0.0, y0, p, f)
+    rk4.run(p, np.array([0.0, 0.1, 0.2]), np.array([5, 5]), y, Y, 1, 3)
+    models.evaluate(0.0, y0, p, f)
 compiled = sorted({ev.data["dispatcher"].py_func.__qualname__ for _, ev in rec.buffer if "dispatcher" in ev.data})
 print(json.dumps({"compiled": compiled, "Y": Y.tolist(), "unused": [len(taylor_series.coefficients.signatures)]}))
 '''

@@ -268,7 +268,7 @@ def test_the_traced_equations_match_the_50_digit_reference_too(reference):
     traced = traced_model(system.inertia, system.forces, False)
     _ready_for_double_double(traced)
     t_out, exact = reference
-    errors = _errors(*taylor_dd.propagate(traced.params, 1e-30, t_out, system.initial_state(), model=traced.model),
+    errors = _errors(*taylor_dd.propagate(traced.params, 1e-30, t_out, system.initial_state()),
                      exact)
     assert max(errors) < 1e-29, errors  # measured 3.5e-31 at t = 60
 
@@ -310,7 +310,7 @@ def test_the_form_with_alpha_and_every_torque_term_matches_the_decimal_reference
     y0 = np.concatenate([[0.3, -0.2, 1.1], gamma, alpha])
     t_out = np.array([0.0, 1.5, 3.0])
     traced = _traced_packed_equations(p)
-    hi, lo = taylor_dd.propagate(traced.params, 1e-30, t_out, y0, model=models.TRACED)
+    hi, lo = taylor_dd.propagate(traced.params, 1e-30, t_out, y0)
     errors = _errors(hi, lo, decimal_reference(p, y0, t_out, order=40, tol=Decimal("1e-40")))
     assert max(errors) < 1e-30, errors  # measured 2e-32 (hand-written α form), 2.7e-32 (traced)
 
@@ -379,8 +379,7 @@ def test_a_scene_in_double_double_runs_with_alpha_and_every_builtin_force_and_re
     # the reference for the α form: the same kernel's all digits agree with the stored doubles, and the double
     # kernel agrees to its own round-off
     assert dd_scene.compiled.model == models.TRACED  # a state with α runs the traced equations
-    hi, lo = taylor_dd.propagate(dd_scene.compiled.params, 1e-28, dd_scene.times, dd_scene.system.initial_state(),
-                                 model=models.TRACED)
+    hi, lo = taylor_dd.propagate(dd_scene.compiled.params, 1e-28, dd_scene.times, dd_scene.system.initial_state())
     np.testing.assert_array_equal(solution.y, hi)
     double = compose_scene([*overrides, "integrator.tol=1e-16"])
     np.testing.assert_allclose(double.run().omega.values, solution.y[:, :3], rtol=0, atol=1e-12)

@@ -243,7 +243,7 @@ def test_time_dependent_expression_under_taylor_against_the_equations_by_hand():
     from gyrolab.kernels import taylor
 
     # the kernel called directly before ``ready`` compiled the Taylor kernel: a non-finite status, not a jump to 0
-    status, _ = taylor.run(model.model, model.params, 8, 1e-10, np.linspace(0.0, 1.0, 3), np.empty((3, 6)), 1, 3,
+    status, _ = taylor.run(model.params, 8, 1e-10, np.linspace(0.0, 1.0, 3), np.empty((3, 6)), 1, 3,
                            np.zeros(1), np.ones(6), np.zeros(6), np.zeros(2, dtype=np.int64))
     assert status == taylor.NOT_FINITE
     assert taylor_series.ready(model)

@@ -50,7 +50,7 @@ def test_generated_coefficients_equal_extended_precision_cauchy_products():
     def series(form, p, y, order):
         T = np.zeros((order + 1, y.size))
         T[0] = y
-        models.taylor_coefficients(form, p, T, order)
+        models.taylor_coefficients(p, T, order)
         return T
 
     rng = np.random.default_rng(7)
@@ -58,7 +58,7 @@ def test_generated_coefficients_equal_extended_precision_cauchy_products():
         compiled, packed, y = _random_scene(rng)
         assert taylor_series.ready(compiled)
         for order in (4, 9, 17, 30):
-            got = series(models.form(compiled), compiled.params, y, order)
+            got = series(compiled.model, compiled.params, y, order)
             exact = _extended_coefficients(packed, y, order)
             bound = 2e-15 * (np.arange(order + 1) + 1)[:, None] * np.abs(exact).max(axis=1, keepdims=True)
             assert np.all(np.abs(got - exact.astype(float)) <= bound.astype(float)), order
@@ -75,7 +75,7 @@ def _run(compiled, order, tol, t_out, y0):
     out[0] = y0
     y, state, carry, stats = y0.copy(), np.array([t_out[0]]), np.zeros(y0.size), np.zeros(2, dtype=np.int64)
     assert taylor_series.ready(compiled)
-    code, reached = taylor.run(models.form(compiled), compiled.params, order, tol, t_out, out, 1, t_out.size, state,
+    code, reached = taylor.run(compiled.params, order, tol, t_out, out, 1, t_out.size, state,
                                y, carry, stats)
     return code, reached, out, y, state[0], carry, stats
 

@@ -165,7 +165,7 @@ def test_taylor_steps_do_not_depend_on_how_the_run_is_cut_into_kernel_calls():
         state, carry, stats, reached = np.array([t_out[0]]), np.zeros_like(y), np.zeros(2, dtype=np.int64), 1
         for stop in stops:
             if reached < stop:
-                status, reached = taylor.run(compiled.model, compiled.params, order, tol, t_out, out, reached, stop,
+                status, reached = taylor.run(compiled.params, order, tol, t_out, out, reached, stop,
                                              state, y, carry, stats)
                 assert status == taylor.OK
         return out, int(stats[1])
@@ -195,7 +195,7 @@ def test_a_scene_with_a_plugin_traces_every_force_and_its_compiled_rhs_is_the_py
     for k in range(5):
         y = scene.system.initial_state() + 0.3 * rng.standard_normal(size)
         out = np.empty(size)
-        models.evaluate(compiled.model, 0.1 * k, y, compiled.params, out)
+        models.evaluate(0.1 * k, y, compiled.params, out)
         np.testing.assert_allclose(out, scene.system.rhs(0.1 * k, y), rtol=1e-13, atol=1e-13)
 
 
@@ -213,7 +213,7 @@ def test_taylor_stops_with_one_sentence_when_its_step_cannot_advance_time():
     out = np.empty((3, y0.size))
     out[0] = y0
     state, stats = np.array([1.0]), np.zeros(2, dtype=np.int64)
-    code, reached = taylor.run(compiled.model, compiled.params, 4, 1e-300, t_out, out, 1, 3, state,
+    code, reached = taylor.run(compiled.params, 4, 1e-300, t_out, out, 1, 3, state,
                                y0.copy(), np.zeros(y0.size), stats)
     assert (code, reached, state[0], stats[1]) == (taylor.TOO_SMALL_STEP, 1, 1.0, 0)
     with pytest.raises(IntegrationError, match="^taylor's step fell below the spacing of floating-point numbers "
