@@ -103,6 +103,22 @@ def _outputs(t_out: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     return np.asarray(t_out, dtype=float), y, out
 
 
+def _adaptive(advance: Any, t_out: np.ndarray, state: np.ndarray, progress: ProgressCallback | None,
+              failure: Any) -> None:
+    """Fill ``out[1:]`` by an adaptive kernel ``advance(reached, stop) -> (status, reached)`` called chunk by chunk
+    (``_Chunks``), reporting progress after each; a non-OK status (the kernels share their codes, 0 is OK) raises
+    ``failure(status, t)`` at the time ``state[0]`` it stopped at."""
+    reached = 1
+    for first, stop in _Chunks(len(t_out)):
+        if reached >= stop:
+            continue  # a long step already filled this chunk's outputs
+        status, reached = advance(reached, stop)
+        if status != 0:
+            raise failure(status, state[0])
+        if progress is not None:
+            progress(state[0])
+
+
 def steps_per_interval(t_out: np.ndarray, step: float) -> np.ndarray:
     """Fewest equal steps no longer than ``step`` in each output interval (lands on every output time)."""
     return np.maximum(1, np.ceil(np.diff(t_out) / step * (1.0 - 1e-12))).astype(np.int64)
@@ -148,6 +164,13 @@ class DOP853Numba(Tolerances, Integrator):
     def variational_settings(self) -> VariationalSettings:
         return VariationalSettings(rtol=self.rtol, atol=self.atol, max_step=self.max_step)
 
+    def _failure(self, status: int, t: float) -> IntegrationError:
+        from gyrolab.kernels import dop853  # (loaded by then: the run that failed imported it)
+
+        reason = "the step size fell below the spacing of floating-point numbers" \
+            if status == dop853.TOO_SMALL_STEP else "the state became non-finite"
+        return IntegrationError(f"{self.name} failed near t={t:.6g}: {reason}")
+
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
@@ -162,18 +185,9 @@ class DOP853Numba(Tolerances, Integrator):
         h0 = dop853.initial_step(compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
                                  self.rtol, self.atol, stats)
         state = np.array([t_out[0], h0])
-        reached = 1
-        for first, stop in _Chunks(len(t_out)):
-            if reached >= stop:
-                continue  # a long step already filled this chunk's outputs
-            status, reached = dop853.run(compiled.params, t_out, out, reached, stop, state, y, f,
-                                         t_out[-1], self.rtol, self.atol, self.max_step, stats)
-            if status != dop853.OK:
-                reason = "the step size fell below the spacing of floating-point numbers" \
-                    if status == dop853.TOO_SMALL_STEP else "the state became non-finite"
-                raise IntegrationError(f"{self.name} failed near t={state[0]:.6g}: {reason}")
-            if progress is not None:
-                progress(state[0])
+        _adaptive(lambda reached, stop: dop853.run(compiled.params, t_out, out, reached, stop, state, y, f, t_out[-1],
+                                                   self.rtol, self.atol, self.max_step, stats),
+                  t_out, state, progress, self._failure)
         wall = time.perf_counter() - start
         return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]),
                                                     n_rejected=int(stats[2]), wall_time=wall))
@@ -285,16 +299,9 @@ class Taylor(Integrator):
         state = np.array([t_out[0]])
         carry = np.zeros(len(y))  # (np.zeros_like costs 2 µs more, per pilot run)
         stats = np.zeros(2, dtype=np.int64)
-        reached = 1
-        for first, stop in _Chunks(len(t_out)):
-            if reached >= stop:
-                continue  # a long step already filled this chunk's outputs
-            status, reached = taylor.run(compiled.params, self.order, self.tol, t_out, out, reached, stop, state,
-                                         y, carry, stats)
-            if status != taylor.OK:
-                raise _taylor_failure(status, state[0])
-            if progress is not None:
-                progress(state[0])
+        _adaptive(lambda reached, stop: taylor.run(compiled.params, self.order, self.tol, t_out, out, reached, stop,
+                                                   state, y, carry, stats),
+                  t_out, state, progress, _taylor_failure)
         # one Taylor step costs about as much as `order` right-hand-side evaluations; report the series count
         return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
                                                     wall_time=time.perf_counter() - start))
@@ -372,7 +379,7 @@ def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray,
     double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded to
     double. The initial state is a double, hence exact."""
     # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import taylor, taylor_dd
+    from gyrolab.kernels import taylor_dd
 
     _ready_for_double_double(compiled)
     start = time.perf_counter()
@@ -381,40 +388,11 @@ def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray,
     no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
     state = np.array([t_out[0]])
     stats = np.zeros(2, dtype=np.int64)
-    reached = 1
-    for first, stop in _Chunks(len(t_out)):
-        if reached >= stop:
-            continue  # a long step already filled this chunk's outputs
-        status, reached = taylor_dd.run(compiled.params, method.order, method.tol, t_out, out, no_low, reached, stop,
-                                        state, y, low, stats)
-        if status != taylor.OK:
-            raise _taylor_failure(status, state[0])
-        if progress is not None:
-            progress(state[0])
+    _adaptive(lambda reached, stop: taylor_dd.run(compiled.params, method.order, method.tol, t_out, out, no_low,
+                                                  reached, stop, state, y, low, stats),
+              t_out, state, progress, _taylor_failure)
     return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
                                                 wall_time=time.perf_counter() - start))
-
-
-def taylor_dd_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: np.ndarray,
-                      order: int | None = None) -> np.ndarray:
-    """``taylor_samples`` in double-double: the states at ``t_out`` (rounded to double) of the double-double Taylor
-    method at ``tol`` (≥ ``taylor_dd.MIN_TOL``) and ``order`` (None: its optimal order), in one call into the
-    kernel, for a method choosing its setting from short runs (``auto``'s pilot). A model double-double cannot run
-    raises ConfigError; a failed step raises IntegrationError."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import taylor, taylor_dd
-
-    _ready_for_double_double(compiled)
-    if not tol >= taylor_dd.MIN_TOL:
-        raise ConfigError(f"tol={tol!r} is below double-double's resolution; it must be at least {taylor_dd.MIN_TOL:g}")
-    t_out, y, out = _outputs(t_out, y0)
-    state = np.array([t_out[0]])
-    order = taylor.order_for(tol) if order is None else order
-    status, _ = taylor_dd.run(compiled.params, order, tol, t_out, out, np.empty((0, len(y))), 1, len(t_out), state,
-                              y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
-    if status != taylor.OK:
-        raise _taylor_failure(status, state[0])
-    return out
 
 
 def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -> str | None:

@@ -486,19 +486,11 @@ def test_capabilities_batch_points_and_the_error_estimates_companion():
         integrate_arrays(scene.compiled, scene.integrator, scene.times, y0s)
 
 
-
-def test_the_one_call_samples_for_auto_equal_the_integrator(chaotic):
-    from gyrolab.plugins.integrators.compiled_solvers import taylor_dd_samples
-
+def test_a_parameter_array_of_no_traced_model_is_refused_in_one_sentence(chaotic):
     model, y0 = chaotic
-    p, t_out = model.built_in, np.linspace(0.0, 20.0, 41)
-    samples = taylor_dd_samples(model, 1e-26, t_out, y0)
-    np.testing.assert_array_equal(samples, Taylor(precision="double-double", tol=1e-26).integrate(
-        None, t_out, y0, None, model).y)
-    with pytest.raises(ConfigError, match="names no traced model"):  # a parameter array that is not a traced model's
-        taylor_dd_samples(CompiledModel(models.TRACED, p), 1e-26, t_out, y0)
-    with pytest.raises(ConfigError, match="at least 1e-32"):
-        taylor_dd_samples(model, 1e-33, t_out, y0)
+    with pytest.raises(ConfigError, match="names no traced model"):
+        Taylor(precision="double-double", tol=1e-26).integrate(None, np.linspace(0.0, 1.0, 3), y0, None,
+                                                               CompiledModel(models.TRACED, model.built_in))
 
 
 def test_a_plugin_torque_runs_in_double_double_from_the_scene(tmp_path):
