@@ -106,10 +106,11 @@ def _outputs(t_out: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, np.ndarray,
 def _adaptive(advance: Any, t_out: np.ndarray, state: np.ndarray, progress: ProgressCallback | None,
               failure: Any) -> None:
     """Fill ``out[1:]`` by an adaptive kernel ``advance(reached, stop) -> (status, reached)`` called chunk by chunk
-    (``_Chunks``), reporting progress after each; a non-OK status (the kernels share their codes, 0 is OK) raises
-    ``failure(status, t)`` at the time ``state[0]`` it stopped at."""
+    (``_Chunks``), reporting progress after each, or in one call when no one takes progress (each call costs ~5 µs
+    of numba's argument typing: 4 % of a 0.13 ms gyrostat run); a non-OK status (the kernels share their codes, 0 is
+    OK) raises ``failure(status, t)`` at the time ``state[0]`` it stopped at."""
     reached = 1
-    for first, stop in _Chunks(len(t_out)):
+    for first, stop in _Chunks(len(t_out)) if progress is not None else [(1, len(t_out))]:
         if reached >= stop:
             continue  # a long step already filled this chunk's outputs
         status, reached = advance(reached, stop)
