@@ -34,6 +34,7 @@ import numpy as np
 
 from gyrolab.accuracy.calibration import SHADOW_CHUNKS, SHADOW_OFFSET, TANGENT_SAMPLES, TANGENT_TOLERANCE
 from gyrolab.kernels.model import TRACED, CompiledModel
+from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba
 
 
 @dataclass(frozen=True)
@@ -85,7 +86,6 @@ def _generated(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: 
     run fails. The fixed point's tangent vector starts tangent to |γ| = 1 (``tangent.direction``)."""
     # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import layout, tangent
-    from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba
 
     augmented = tangent.compiled_megno(compiled, quadratures=False)
     params = tangent.megno_params(augmented, compiled.params)[0]

@@ -48,6 +48,8 @@ from gyrolab.contracts.integrator import (BATCH_KERNEL, CHOOSES_METHOD, PRECISIO
                                           TIME_DEPENDENT, VECTOR_LANES, BatchSolution, Choice, CompiledModel,
                                           Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution)
 from gyrolab.errors import ConfigError, GyrolabError, as_number
+from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor, taylor_samples
+from gyrolab.plugins.integrators.step_guard import compiled_rhs
 
 #: what ``auto_predicted_error`` is, stored beside it in every run
 PREDICTION_MEANING = ("an upper estimate of the max-norm error of the stored state at every output time (model units): "
@@ -264,7 +266,6 @@ class Auto(Integrator):
         if self.system is None or compiled is None or t_out[0] != 0.0 or compiled.built_in is None:
             return None  # the regimes' series describe the built-in torques only
         from gyrolab.contracts import registry
-        from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
         span = t_out[-1] - t_out[0]
         candidates = []  # each regime's variants predicted to meet the target, lowest series order first
@@ -347,8 +348,6 @@ class Auto(Integrator):
         spread = getattr(base, "period_spread", None)
         if spread is None:
             return False
-        from gyrolab.plugins.integrators.compiled_solvers import taylor_samples
-
         try:
             with np.errstate(all="ignore"):
                 period = float(base.period(self.system))
@@ -399,8 +398,6 @@ class Auto(Integrator):
         run; the batch then runs the chosen method at the smallest tolerance chosen. A trajectory harder
         than every sampled one may miss the accuracy: sample it (pass it first) when you know it.
         """
-        from gyrolab.plugins.integrators.step_guard import compiled_rhs
-
         P = params
         spread = np.abs(P - P.mean(axis=0)).max(axis=1) if len(P) > 1 else np.zeros(1)
         sample = list(dict.fromkeys([0, int(np.argmax(np.abs(y0s).max(axis=1))), int(np.argmax(spread))]))[:AUTO_SAMPLE]
@@ -429,9 +426,8 @@ def _method(compiled: CompiledModel | None, order: int | None, tol: float) -> In
     """The method auto runs at ``tol``: the compiled Taylor method at ``order`` (None: a compiled model without
     Taylor coefficients, compiled DOP853 instead); scipy's DOP853 without a compiled model."""
     if compiled is not None:
-        from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
-
         return Taylor(order=order, tol=tol) if order is not None else DOP853Numba(rtol=tol, atol=tol)
+    # start-up: scipy.integrate (~0.35 s) only for a scene without a compiled model
     from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
     return DOP853(rtol=tol, atol=tol)

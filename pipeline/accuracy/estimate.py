@@ -32,6 +32,7 @@ import xarray as xr
 from gyrolab.accuracy.calibration import DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
 from gyrolab.kernels.model import rounding_moved
 from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL
+from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
 log = logging.getLogger(__name__)
 
@@ -59,8 +60,6 @@ def companion(method: Any, has_compiled: bool) -> Companion | None:
     """The more accurate run that measures the run of ``method`` (its ``more_accurate``, rule 9 of the contract;
     else the compiled Taylor method at its floor when the scene has a compiled model; else, for a run that is itself
     the double-precision Taylor method near that floor, the method one rung up the precision ladder), or None."""
-    from gyrolab.plugins.integrators.compiled_solvers import Taylor
-
     taylor = _double_taylor(method) if has_compiled else None
     finer = method.more_accurate(TIGHTER)
     if finer is not None and (taylor is None or taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW):

@@ -28,6 +28,7 @@ from gyrolab.contracts.integrator import (
     VariationalSettings,
 )
 from gyrolab.errors import IntegrationError, as_number
+from gyrolab.plugins.integrators.batch_kernels import rk4_batch
 from gyrolab.plugins.integrators.refinement import half_step, interval_steps
 from gyrolab.plugins.integrators.step_guard import check_step
 
@@ -49,8 +50,6 @@ class RK4(Integrator):
 
     def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
                         failures: str) -> BatchSolution:
-        from gyrolab.plugins.integrators.batch_kernels import rk4_batch
-
         return rk4_batch(compiled, self.step, times, y0s, params, failures)
 
     def variational_settings(self) -> VariationalSettings:
