@@ -2,8 +2,9 @@
 
 The right-hand sides are quadratic, so the Taylor coefficients come from
 Cauchy products (``models.taylor_coefficients``). The order follows from the
-tolerance (``order_for``: p = ⌈−ln(tol)/2 + 1⌉, which minimises the work per
-unit time when the coefficients decay geometrically) and the step from the last
+tolerance (``order_for``: Jorba and Zou's p = ⌈−ln(tol)/2 + 1⌉ minimises the series'
+work per unit time when the coefficients decay geometrically; counting a step's other
+work too, the cheapest order is a few higher) and the step from the last
 two coefficients, h = min_k (tol·max(1, ‖y‖)/‖y_k‖)^(1/k) for k = p−1, p,
 times Jorba and Zou's safety factor exp(−0.7/(p−1)). The series is the dense
 output: every output time inside a step is one Horner evaluation, no extra step.
@@ -36,9 +37,29 @@ OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2  # dop853's codes
 MIN_ORDER, MAX_ORDER = 4, 60
 
 
-def order_for(tol: float) -> int:
-    """Jorba & Zou's optimal order for a tolerance: ⌈−ln(tol)/2 + 1⌉, within [MIN_ORDER, MAX_ORDER]."""
-    return int(min(MAX_ORDER, max(MIN_ORDER, math.ceil(-math.log(tol) / 2.0 + 1.0))))
+#: a double step's work besides its series (step size, Kahan update, dense output, the loop), in units of the
+#: series' work per order²: the same series costs ~p² (its Cauchy products) and the rest ~STEP_OVERHEAD. Measured
+#: 2026-11-29 on the Intel Xeon (gyrostat of benchmarks/gyrostat_heyoka.py and the reference scene, orders from
+#: Jorba & Zou's to +5 at half-decade tolerances, the cheapest run reaching each error 1e-6 … 1e-12): 64 made them
+#: 0.84–0.97× (mean 0.93×) and 0.88–0.97× (0.92×) as costly as Jorba & Zou's orders; 32 and 121 gained less
+#: (docs/performance.md, "The order rule"). Double-double steps are series-bound: 0 there.
+STEP_OVERHEAD = 64.0
+
+
+def order_for(tol: float, overhead: float = STEP_OVERHEAD) -> int:
+    """The order of least work per unit time at ``tol``, within [MIN_ORDER, MAX_ORDER]: a step of order p costs
+    ~(overhead + p²) and spans ~tol^(1/p), so the work per unit time (overhead + p²)·e^(L/p), L = −ln tol, is least
+    at the root of 2p³ = L (p² + overhead) (with no overhead p = L/2), rounded up as Jorba & Zou's ⌈L/2 + 1⌉."""
+    L = -math.log(tol)
+    if not L > 0.0:  # (tol ≥ 1: no accuracy asked)
+        return MIN_ORDER
+    p = L / 2.0 + (L * overhead / 2.0) ** (1.0 / 3.0)  # above the root: Newton descends to it monotonically
+    for _ in range(50):
+        step = (2.0 * p ** 3 - L * (p * p + overhead)) / (6.0 * p * p - 2.0 * L * p)
+        p -= step
+        if abs(step) < 1e-9:
+            break
+    return int(min(MAX_ORDER, max(MIN_ORDER, math.ceil(p + 1.0))))
 
 
 @inline_kernel

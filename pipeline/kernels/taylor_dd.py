@@ -132,7 +132,7 @@ def propagate(p: np.ndarray, tol: float, t_out, y0, order: int | None = None, y0
     Y[0], Ylo[0] = yh, yl
     state = np.array([t_out[0]])
     stats = np.zeros(2, dtype=np.int64)
-    order = order_for(tol) if order is None else order
+    order = order_for(tol, overhead=0.0) if order is None else order
     status, _ = run(p, order, tol, t_out, Y, Ylo, 1, len(t_out), state, yh, yl, stats)
     if status != OK:
         raise RuntimeError(f"double-double Taylor kernel stopped near t={state[0]:.6g} (status {status})")

@@ -282,8 +282,8 @@ class Taylor(Integrator):
             if self.tol < MIN_TOL:
                 raise ConfigError(f"integrator.tol={tol!r} is below double-double's resolution; with "
                                   f"integrator.precision=double-double it must be at least {MIN_TOL:g}")
-        if order is None:
-            order = order_for(self.tol)
+        if order is None:  # (a double-double step is series-bound: Jorba & Zou's order, no step overhead)
+            order = order_for(self.tol, **({"overhead": 0.0} if self.precision == DOUBLE_DOUBLE else {}))
         if isinstance(order, bool) or not isinstance(order, int) or not MIN_ORDER <= order <= MAX_ORDER:
             raise ConfigError(f"integrator.order={order!r} must be an integer from {MIN_ORDER} to {MAX_ORDER} "
                               "(or null: chosen from integrator.tol)")

@@ -1,5 +1,7 @@
 """The Taylor step (``taylor.run``) on the fixed point's generated series, against independent computations."""
 
+import math
+
 import numba
 import numpy as np
 import pytest
@@ -88,7 +90,7 @@ def test_reference_scene_against_scipy(tol):
     scene = _reference_scene(tol)
     order, y0 = scene.integrator.order, scene.system.initial_state()
     result = _run(scene.compiled, order, tol, scene.times, y0)
-    assert result[0] == taylor.OK and result[1] == scene.times.size and result[6][1] > 2000
+    assert result[0] == taylor.OK and result[1] == scene.times.size and result[6][1] > 1000  # many chunks' worth
     short = scene.times[scene.times <= 20.0]
     reference = solve_ivp(scene.system.rhs, (0.0, 20.0), y0, method="DOP853", rtol=1e-13, atol=1e-13,
                           t_eval=short).y.T
@@ -142,3 +144,17 @@ def test_the_vector_horner_sums_match_numpy_for_every_state_size(n, order):
     np.testing.assert_allclose(y, expected - carry, rtol=1e-14, atol=1e-15)
     T[order, n - 1] = np.inf
     assert not _sums_through_the_step(T, order, h, T[0].copy(), carry.copy(), Y)
+
+
+@pytest.mark.parametrize("overhead", [0.0, 16.0, taylor.STEP_OVERHEAD, 200.0])
+def test_the_order_rule_takes_the_least_work_per_unit_time(overhead):
+    """``order_for``: with no step overhead Jorba & Zou's ⌈−ln(tol)/2 + 1⌉ (their paper, §3.2); with one, the
+    real p minimising (overhead + p²)·tol^(−1/p) found by brute force over a fine grid, rounded up the same way."""
+    grid = np.linspace(0.5, 80.0, 400_001)
+    for tol in np.logspace(-1, -32, 63):
+        if overhead == 0.0:
+            expected = math.ceil(-math.log(tol) / 2.0 + 1.0)
+        else:
+            work = (overhead + grid ** 2) * np.exp(-math.log(tol) / grid)
+            expected = math.ceil(grid[np.argmin(work)] + 1.0)
+        assert taylor.order_for(tol, overhead) == min(taylor.MAX_ORDER, max(taylor.MIN_ORDER, expected)), tol
