@@ -169,5 +169,3 @@ def _map_on(client: Any, function: Callable[[Task], Result], tasks: Iterable[Tas
     finally:
         pending.clear()
 
-
-__all__ = ["chunk_error", "map_chunks", "scheduler_kind"]

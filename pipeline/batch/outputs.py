@@ -161,5 +161,3 @@ def merge_rows(outputs: Mapping[str, Output], rows: np.ndarray, n_rows: int) -> 
         merged[name] = Output(out.dims, data, out.attrs)
     return merged
 
-
-__all__: Sequence[str] = ["MODES", "Output", "state_outputs", "indicator_outputs", "merge_rows", "output_times"]

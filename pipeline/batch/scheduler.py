@@ -22,7 +22,6 @@ import socket
 import ssl
 import struct
 import time
-from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib.util import find_spec
 
@@ -51,36 +50,6 @@ class Choice:
 
     scheduler: str | None
     source: str
-
-
-def split_scheduler_option(argv: Sequence[str]) -> tuple[str | None, list[str]]:
-    """(the value of ``--scheduler VALUE`` or ``--scheduler=VALUE`` anywhere in ``argv``, the other arguments).
-
-    No override starts with ``--``, so the option can be taken out wherever it stands.
-    """
-    value, rest, args = None, [], list(argv)
-    while args:
-        arg = args.pop(0)
-        option, has_value, text = arg.partition("=")
-        if option != OPTION:
-            rest.append(arg)
-            continue
-        if not has_value:
-            if not args or args[0].startswith("-"):
-                raise ConfigError(f"{OPTION} needs a value: process, local or a Dask scheduler's address "
-                                  f"(e.g. {OPTION} tcp://HOST:8786)")
-            text = args.pop(0)
-        if value is not None:
-            raise ConfigError(f"{OPTION} is given twice ({shorten(value)} and {shorten(text)}); give it once")
-        value = text
-    return value, rest
-
-
-def take_scheduler_option(argv: Sequence[str]) -> list[str]:
-    """``argv`` without ``--scheduler``; its value (or none) becomes the command line's scheduler."""
-    global _command_line
-    _command_line, rest = split_scheduler_option(argv)
-    return rest
 
 
 def use_command_line_scheduler(value: str | None) -> None:
@@ -224,6 +193,3 @@ def _tls_context() -> ssl.SSLContext:
                           "variables; docs/cluster.md)")
     return context
 
-
-__all__ = ["Choice", "check_configured", "choose_scheduler", "probe", "split_scheduler_option", "take_scheduler_option",
-           "use_command_line_scheduler"]

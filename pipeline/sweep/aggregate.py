@@ -63,8 +63,6 @@ PER_JOB_ATTRS = ("config", "hydra_overrides") + tuple(f"integrator_{f.name}" for
 PER_JOB_VARIABLE_ATTRS = ("max_abs_drift",)
 #: run attributes left in the jobs' own run.nc: the sweep has its own (set by ``gyrolab.output.cf.conform``)
 JOB_ONLY_ATTRS = ("job_id", "date_created", "history", "Conventions")
-#: attributes of sweep.nc that legitimately differ between two aggregations of the same sweep
-VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
 #: CF units and long_name of the per-job variables a run's attributes become (others: "run attribute NAME")
 PER_JOB_METADATA = {
     "config": (None, "the job's resolved config (YAML)"),
@@ -80,8 +78,6 @@ PER_JOB_METADATA = {
     "sampling_n_output_requested": (None, "time.n_output as the config gave it"),
     "sampling_warning": (None, "warning when the output times undersample the motion"),
 }
-#: variables of sweep.nc that legitimately differ between two runs of the same sweep
-VOLATILE_VARIABLES = ("integrator_wall_time",)
 
 
 @dataclass

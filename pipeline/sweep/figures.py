@@ -12,11 +12,8 @@ from pathlib import Path
 import xarray as xr
 
 from gyrolab.figures.options import figure_options
-from gyrolab.figures.sweep import choose_x, final_values  # noqa: F401 -- the sweep's own helpers, re-exported
 from gyrolab.figures.sweep import save_figures as draw
 from gyrolab.output.user_yaml import stored_yaml_file
-
-__all__ = ["choose_x", "final_values", "save_sweep_figures"]
 
 
 def save_sweep_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] | None = None,

@@ -125,10 +125,6 @@ def stored_config(stored: xr.Dataset, where: str = "the dataset's config attribu
     return cfg
 
 
-def rerun(stored: xr.Dataset) -> xr.Dataset:
-    return Scene.from_config(stored_config(stored)).run()
-
-
 def compare(stored: xr.Dataset, new: xr.Dataset) -> Comparison:
     result = Comparison()
     for kind, names_old, names_new in (("coordinate", stored.coords, new.coords),

@@ -187,7 +187,8 @@ def test_jobs_of_different_lengths_share_a_sample_dimension(uneven):
 
 
 def test_summary_figures_show_final_values(uneven, tmp_path):
-    from gyrolab.sweep.figures import final_values, save_sweep_figures
+    from gyrolab.figures.sweep import final_values
+    from gyrolab.sweep.figures import save_sweep_figures
 
     ds, runs = uneven
     final = final_values(ds.omega)
