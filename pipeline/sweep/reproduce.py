@@ -12,6 +12,8 @@ platform) is listed as a hint to why.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -180,33 +182,31 @@ def _float_difference(old: xr.DataArray, a: np.ndarray, b: np.ndarray) -> str:
             f"at {where or 'the only value'}; {int((delta > 0).sum())} of {delta.size} values differ")
 
 
-def checked_config(path: Path, stored: xr.Dataset) -> DictConfig:
-    """``stored_config``, with what a foreign dataset lacks said in one sentence."""
+@contextmanager
+def _gyrolabs_only(path: Path) -> Iterator[None]:
+    """A stored config, or variables, without what gyrolab's runs always have: one sentence."""
     try:
-        return stored_config(stored)
+        yield
     except GyrolabError:
         raise
-    except FOREIGN_ERRORS as error:  # a stored config without what gyrolab's runs always have
-        raise not_gyrolabs(path, error, "a run.nc that gyrolab wrote") from None
+    except FOREIGN_ERRORS as error:
+        raise not_gyrolabs(path, error, RUN) from None
+
+
+def checked_config(path: Path, stored: xr.Dataset) -> DictConfig:
+    """``stored_config``, with what a foreign dataset lacks said in one sentence."""
+    with _gyrolabs_only(path):
+        return stored_config(stored)
 
 
 def reproduce(path: Path, stored: xr.Dataset | None = None) -> tuple[Comparison, xr.Dataset]:
     """Rerun the run.nc at ``path`` (``stored``: its dataset, already loaded) and compare."""
     stored = load_run(path) if stored is None else stored
-    expected = "a run.nc that gyrolab wrote"
-    try:
+    with _gyrolabs_only(path):
         scene = Scene.from_config(stored_config(stored))
-    except GyrolabError:
-        raise
-    except FOREIGN_ERRORS as error:  # a stored config without what gyrolab's runs always have
-        raise not_gyrolabs(path, error, expected) from None
     new = scene.run()
-    try:
+    with _gyrolabs_only(path):
         return compare(stored, new), stored
-    except GyrolabError:
-        raise
-    except FOREIGN_ERRORS as error:  # variables that gyrolab's runs always have are missing
-        raise not_gyrolabs(path, error, expected) from None
 
 
 def report(path: Path, comparison: Comparison, stored: xr.Dataset, head: list[str] | None = None) -> list[str]:
