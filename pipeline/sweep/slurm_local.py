@@ -37,6 +37,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from gyrolab.sweep.orphans import alive  # a zombie (dead, not reaped) counts as dead
+
 PACKAGES = ("slurm-wlm", "munge")
 #: the programs the cluster needs; any missing one means the packages are installed first
 PROGRAMS = ("munged", "slurmctld", "slurmd", "sinfo", "sbatch", "squeue", "scancel")
@@ -308,15 +310,6 @@ def _ancestors() -> set[int]:
         except (OSError, ValueError, IndexError):
             break
     return pids
-
-
-def alive(pid: int) -> bool:
-    """Whether ``pid`` runs (a zombie, dead but not reaped by its parent, does not)."""
-    try:
-        stat = (Path("/proc") / str(pid) / "stat").read_text()
-    except OSError:
-        return False
-    return stat.rsplit(")", 1)[1].split()[0] != "Z"
 
 
 def _age(path: Path) -> float:
