@@ -1,19 +1,10 @@
-"""Every file gyrolab writes appears whole or not at all.
+"""Every file gyrolab writes appears whole or not at all (docs/faults.md, "Every file appears whole or not at all").
 
-A result is written to a temporary file beside its final path (same directory,
-so the rename cannot cross file systems), flushed to disk, then renamed over
-the final name (and the directory entry flushed too). A killed process leaves
-at most a temporary file, named ``.<final name>.<random>.tmp``, which the next
-run or resume in that directory removes (``remove_stale_temporaries``, called
-while the directory is locked, see ``gyrolab.output.lock``). A write that
-fails for want of space, quota or permission is one ``OutputError`` sentence
-naming the file and the reason, and leaves no partial file.
-
-The netCDF library reports a full disk or a file-size limit as
-``RuntimeError("NetCDF: HDF error")``, without an errno; the reason is then
-found after the failure (``diagnose``): the process's file-size limit, a
-probe write beside the file (which fails with the real errno when the disk or
-quota is full), and the free space against the expected size of the file.
+A result is written to a temporary file beside its final path (``.<final name>.<random>.tmp``), flushed, then
+renamed over the final name; the next run or resume in that directory removes what a killed write left
+(``remove_stale_temporaries``, while the directory is locked). A failed write is one ``OutputError`` sentence
+naming the file and the reason; the netCDF library reports a full disk or a file-size limit without an errno
+("HDF error"), so ``diagnose`` then finds the reason after the failure.
 """
 
 from __future__ import annotations

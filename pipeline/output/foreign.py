@@ -1,15 +1,10 @@
 """Datasets gyrolab reads (``plot``, ``--animate``, ``reproduce``, ``aggregate``) read as what they claim to be:
 gyrolab's netCDF files. Every reader goes through ``load_dataset``.
 
-A path may be anything a user can type: a text file named ``run.nc``, an empty file, a
-directory, a device, a loop of symbolic links, someone else's netCDF file. Each is one
-ConfigError sentence naming the path and what was expected; the file's contents are never
-echoed (a reader's message quotes at most a variable's name).
-
-A dataset is untrusted input: before anything is read into memory, its declared sizes are checked
-against what gyrolab writes (every value it declares is stored, uncompressed: a 6 kB file declaring
-10⁸ time steps was edited) and against the memory available; after reading, every variable along
-``time`` (or a sweep's ``sample``) must hold numbers, as gyrolab writes them.
+Anything else a user can type (a text file named ``run.nc``, a directory, a device, a loop of links, someone
+else's netCDF file) is one ConfigError sentence naming the path and what was expected, never echoing the file's
+contents. A dataset is untrusted input: its declared sizes are checked against what gyrolab writes and the memory
+available before anything is read, and every variable along ``time`` (or ``sample``) must hold numbers.
 """
 
 from __future__ import annotations

@@ -1,18 +1,10 @@
-"""One writer per directory: a run directory, a sweep job's directory or a sweep's ``sweep.nc``.
+"""One writer per directory: a run directory, a sweep job's directory or a sweep's ``sweep.nc`` (docs/faults.md,
+"One writer per directory").
 
-A lock is an exclusive ``flock`` on a hidden file in the directory
-(``.gyrolab.lock``, holding the owner's pid and host for the messages). The
-kernel drops flock locks when their process ends, however it ends, so a lock
-left by ``kill -9`` is stale by construction and the next run takes it. The
-lock file is removed on release (safely: a taker checks that the file it
-locked is still the one in the directory).
-
-flock works between processes on one machine and on most cluster file
-systems (NFSv4, Lustre and GPFS map it onto their own locks); on a file system
-without it the lock is taken without effect and a warning is logged.
-
-A process may take a lock it already holds (the hold is counted), so a sweep
-job that holds its directory can call code that locks the same directory.
+A lock is an exclusive ``flock`` on ``.gyrolab.lock`` in the directory (holding the owner's pid and host for the
+messages), which the kernel drops when its process ends however it ends; the file is removed on release. On a
+file system without flock the lock is taken without effect and a warning is logged. A process may take a lock
+it already holds (the hold is counted).
 """
 
 from __future__ import annotations

@@ -1,19 +1,11 @@
-"""The trust boundary of a directory gyrolab writes into but may not have created.
+"""The trust boundary of a directory gyrolab writes into but may not have created (docs/faults.md, "A directory
+gyrolab did not create").
 
-A run or sweep directory may come from a colleague, a cluster or an archive: gyrolab trusts the
-directory the user names, never what already sits inside it. So:
-
-- gyrolab's own entries in it (``OWN_DIRS``, ``.gyrolab.lock``, ``multirun.yaml``, ``job.json``, and every
-  ``*.nc``, ``*.log``, ``*.yaml``, ``*.json``, ``*.part``, ``*.chunks`` file; in a sweep directory every entry,
-  its job directories too) are never symbolic links or special files: ``check_tree`` refuses the directory in
-  one sentence before anything is written;
-- a file gyrolab appends to or locks is opened without following a link and must be a regular file
-  (``open_own_file``); a file it replaces is renamed over (a link there is replaced, its target untouched);
-- its folders (``figures``, ``.hydra``) are real folders (``own_dir``);
-- an output the user names (``--animate -o NAME``) is refused when it exists and is not a regular file;
-- pickles are loaded only from folders only the user can write (``private_dir``: submitit's folder).
-
-Each refusal is an ``Untrusted`` ConfigError (exit 2): one sentence naming the path.
+gyrolab trusts the directory the user names, never what already sits inside it: its own entries there are never
+links or special files (``check_tree``), a file it appends to or locks is opened without following a link
+(``open_own_file``), its folders are real folders (``own_dir``), an output the user names is not a link or a
+device (``check_output_target``), and pickles are loaded only from folders only the user can write
+(``private_dir``). Each refusal is an ``Untrusted`` ConfigError (exit 2): one sentence naming the path.
 """
 
 from __future__ import annotations

@@ -2,15 +2,10 @@
 ``config`` attribute, ``multirun.yaml``, ``.hydra/*.yaml``), read as what they claim to be before anything else
 reads them (``stored_yaml``: a directory or a dataset received from someone else is untrusted input).
 
-Hydra turns a YAML problem into a 65–104-line traceback, and expands anchors and aliases without
-bound (a "billion laughs" file hangs it). Each file is checked here first with PyYAML's safe
-loader; any problem is one ConfigError sentence naming the file and line, never its contents:
-
-- syntax errors, tabs, control characters (a NUL byte), text that is not UTF-8;
-- a duplicate key in a mapping (YAML forbids it; Hydra refuses it with a traceback);
-- a file that is not a mapping (a scalar or a list at the top): Hydra's config files are mappings;
-- alias expansion beyond :data:`MAX_EXPANDED_NODES` nodes, a file beyond :data:`MAX_FILE_BYTES`,
-  a folder with more than :data:`MAX_FILES` YAML files.
+Hydra turns a YAML problem into a long traceback and expands anchors and aliases without bound; each file is
+checked here first with PyYAML's safe loader, and any problem (syntax, tabs, control characters, not UTF-8, a
+duplicate key, not a mapping, a tag, beyond ``MAX_EXPANDED_NODES``, ``MAX_DEPTH``, ``MAX_FILE_BYTES`` or
+``MAX_FILES``) is one ConfigError sentence naming the file and line, never its contents (docs/faults.md).
 """
 
 from __future__ import annotations

@@ -1,28 +1,8 @@
 """One dataset per sweep: every job's ``run.nc`` on the sweep's grid, plus a table of failed jobs.
 
-Layout of ``sweep.nc`` (``assemble``):
-
-* one dimension per swept parameter, named after the override key's last
-  part (``body.a`` -> ``a``; the full key, dots as underscores, when that is
-  ambiguous), its coordinate holding the swept values (numbers stay numbers)
-  and the key in ``override_key``;
-* every data variable of the runs over (swept dims..., time, ...), NaN where
-  a job failed or is missing. If the jobs' output times differ (a swept
-  ``time.end``), ``time`` becomes a variable over (swept dims..., sample);
-* per-job quantities as variables over the swept dims: the integrator's
-  statistics (``integrator_nfev``, ``integrator_wall_time``, ...), each
-  invariant's ``<name>_max_abs_drift``, ``config`` (each job's resolved YAML),
-  ``hydra_overrides``, ``job_id``, ``job_dir`` and ``job_status`` (0 missing,
-  1 finished, 2 failed); run attributes that differ between jobs become such
-  variables too (``run_<name>`` if ``<name>`` is taken), equal ones stay
-  global attributes;
-* a table of failed jobs along dimension ``failed_job``: ``failed_job_dir``,
-  ``failed_job_overrides``, ``failed_job_error``, ``failed_job_error_type``,
-  ``failed_job_exit_code``.
-
-``assemble`` only needs each grid point's dataset (or its failure), so a batch
-integrator that computes a whole grid in one process can produce the same
-layout without writing per-job files.
+The layout of ``sweep.nc`` (``assemble``): docs/datasets.md, "sweep.nc — a multirun". ``assemble`` only needs
+each grid point's dataset (or its failure), so a batch integrator that computes a whole grid in one process can
+produce the same layout without writing per-job files.
 """
 
 from __future__ import annotations
