@@ -1,28 +1,12 @@
-"""Where a batch's chunks run: this process, a local Dask cluster, or an existing Dask scheduler.
+"""Where a batch's chunks run: this process, a local Dask cluster, or an existing Dask scheduler (docs/cluster.md).
 
-``map_chunks(function, tasks, on_result, scheduler)`` calls ``function(task)`` for every task and hands
-each result to ``on_result(index, result)`` in the calling process as it arrives (so one process writes
-the output). ``function`` must be a module-level function and the tasks picklable, so that the same call
-runs its chunks in other processes or on other machines:
-
-- ``scheduler`` None or ``"process"``: here, one chunk after another (the compiled kernels use every core
-  through numba's threads);
-- ``"local"``: a Dask ``LocalCluster`` on this machine, one single-threaded worker process per core
-  (numba limited to one thread per worker, so the workers do not oversubscribe the cores);
-- ``"tcp://HOST:PORT"`` (or ``tls://``): an existing Dask scheduler and its workers (``dask scheduler``,
-  ``dask worker``, a dask-jobqueue ``SLURMCluster``: docs/cluster.md). Which addresses a batch may trust,
-  and the bounded check that the peer is a scheduler, are ``gyrolab.batch.scheduler``'s.
-
-``scheduler`` None (``batch.scheduler`` unset) with ``DASK_SCHEDULER_ADDRESS`` set in the environment (Dask's
-own variable, which ``distributed.Client()`` reads too): that scheduler.
-
-At most a few chunks per worker are submitted at a time, so memory is bounded by a few chunks, not by
-the batch. A chunk that fails stops the batch with one sentence naming the chunk.
-
-A batch's chunk task (``gyrolab.batch.runner.ChunkTask``) carries what a worker needs to rebuild the
-compiled model (a plain resolved config): a plugin torque's compiled function is a machine address that
-does not pickle. Each worker process rebuilds it once per config (``gyrolab.batch.runner.run_chunk``) and
-reuses it for the next chunks.
+``map_chunks(function, tasks, on_result, scheduler)`` calls ``function(task)`` for every task and hands each
+result to ``on_result(index, result)`` in the calling process as it arrives (one process writes the output);
+``function`` is module-level and the tasks picklable, so the same call runs them elsewhere. ``scheduler`` None or
+``"process"``: here; ``"local"``: a ``LocalCluster``, one single-threaded worker per core (numba at one thread,
+so workers do not oversubscribe the cores); ``"tcp://HOST:PORT"``/``tls://``: an existing scheduler (which
+addresses a batch trusts: ``gyrolab.batch.scheduler``). At most a few chunks per worker are submitted at a time,
+so memory is bounded by a few chunks; a chunk that fails stops the batch with one sentence naming it.
 """
 
 from __future__ import annotations

@@ -1,12 +1,5 @@
-"""What a batch stores per point (``batch.output``), computed from a chunk's trajectories.
-
-* ``trajectory``: every output variable of the system (as a single run's ``run.nc``) over the output times;
-* ``decimated``: the same at every ``batch.decimate``-th output time (the first and the k-th, 2k-th, ...);
-* ``final``: the final state's variables (angles wrapped to (−π, π]);
-* ``reductions``: ``final`` plus each monitored invariant's ``<name>_max_abs_drift`` (max over the stored
-  samples of |I(t) − I(0)|) and ``max_nutation_deviation`` (max |θ(t) − θ(0)|);
-* ``indicator``: the chaos indicator and the max nutation deviation of ``gyrolab.analysis.chaos``, from the
-  variational equations (``indicator_outputs``).
+"""What a batch stores per point (``batch.output``: trajectory, decimated, final, reductions, indicator; the table in
+docs/batch.md, "What is stored per point"), computed from a chunk's trajectories.
 
 Each output is ``Output(dims, data, attrs)``: ``dims`` the trailing dimensions after the point's (grid)
 dimensions, ``data`` one row per point of the chunk.

@@ -1,16 +1,11 @@
-"""A batch's plan: the grid of points as arrays (initial states, compiled-model parameters), validated.
+"""A batch's plan: the grid of points as arrays (initial states, compiled-model parameters), validated
+(docs/batch.md, "How a grid becomes arrays").
 
-The config is composed once (the fixed overrides and each swept key's first value); the swept keys are
-split by what they feed: ``body.*`` and ``force.*`` build the body, the forces and the compiled model's
-parameters, once per combination of their values (a "combo": usually few), and ``initial.*`` the
-initial states, computed for the whole grid at once by the system's vectorised hook
-``initial_states(initial, columns)`` (the fixed-point system has one; other systems fall back to one
-system per distinct point). No OmegaConf config, scene or dataset is built per point.
-
-Validation stays exact: a point the fast checks cannot vouch for (a value that is not a finite number,
-a combo whose system refuses the base initial state, a row the vectorised hook marks invalid) is checked
-by the single run's own code (``Scene.from_config`` on that point's config), so a failed point carries
-the same one-sentence error a single run of it gives.
+The config is composed once; ``body.*`` and ``force.*`` build the system once per combination of their values
+(a "combo"), ``initial.*`` give the initial states of the whole grid through the system's vectorised hook
+``initial_states(initial, columns)`` (other systems: one system per distinct point). A point the fast checks
+cannot vouch for is checked by the single run's own code (``Scene.from_config`` on that point's config), so a
+failed point carries the same one-sentence error a single run of it gives.
 """
 
 from __future__ import annotations

@@ -1,18 +1,12 @@
-"""Which Dask scheduler a batch trusts, and a check, bounded in time, that the peer is one.
+"""Which Dask scheduler a batch trusts, and a check, bounded in time, that the peer is one (docs/cluster.md, "Whom a
+batch trusts").
 
-Connecting to a Dask scheduler trusts it with code execution: what the scheduler and its workers send
-back is unpickled in this process. So a scheduler's address comes only from places the user sets
-directly for this command — the command line (``gyrolab --batch --scheduler ADDRESS ...``), the
-environment (``DASK_SCHEDULER_ADDRESS``) or Dask's own configuration (``scheduler-address`` in its
-YAML files) — never from a gyrolab config file, an experiment or an override, which are shared and
-copied between people. ``batch.scheduler`` in a config may still say ``process`` or ``local`` (a
-cluster this process starts itself trusts nobody); an address there is refused in one sentence that
-says where to put it.
-
-Before ``distributed`` is handed the address, ``probe`` opens the connection itself and reads the
-peer's greeting with a deadline, without unpickling anything: a silent peer or one that is not a
-Dask scheduler is one sentence after at most ``CONNECT_TIMEOUT`` seconds (``distributed`` alone
-waits minutes for a silent peer and fails with a traceback on garbage).
+Connecting to a Dask scheduler trusts it with code execution (what it sends back is unpickled here), so its
+address comes only from places the user sets for this command: the command line (``--scheduler ADDRESS``), the
+environment (``DASK_SCHEDULER_ADDRESS``) or Dask's own configuration, never a gyrolab config, an experiment or an
+override, which are shared (``batch.scheduler`` there may say ``process`` or ``local``). Before ``distributed``
+is handed the address, ``probe`` reads the peer's greeting with a deadline, unpickling nothing: a silent peer or
+one that is not a Dask scheduler is one sentence after at most ``CONNECT_TIMEOUT`` seconds.
 """
 
 from __future__ import annotations

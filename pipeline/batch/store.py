@@ -1,21 +1,11 @@
-"""A batch's dataset on disk, written chunk by chunk, resumable after a kill.
+"""A batch's dataset on disk, written chunk by chunk, resumable after a kill (its layout: docs/batch.md, "The
+file"; how it resumes: "Resume").
 
-Layout: one dimension per swept parameter (named by ``gyrolab.batch.plan.dim_names``, the swept values as
-its coordinate), the per-point variables of ``batch.output`` over (grid dims..., their own dims), and per
-point ``job_status`` (0 not run, 1 finished, 2 failed: the codes of a multirun's ``sweep.nc``) and
-``job_error`` (an index into ``error_message``, -1 for none).
-
-Writes go to ``NAME.part`` beside the final name; each variable's storage is contiguous and allocated when
-the file is created, so a chunk's write changes data, never the file's structure, and a killed process
-leaves a file that opens. After a chunk's data is synced to disk its index is appended to ``NAME.chunks``
-(the journal, fsynced); a rerun with the same identity continues after the journaled chunks. When every
-chunk is stored the file is closed, synced and renamed to ``NAME``, and the journal removed.
-
-A failed write (a full disk, a quota, a file-size limit) is one ``OutputError`` sentence (exit 3) that
-keeps the finished work: the chunks already journaled stay in ``NAME.part``, and rerunning the same
-command continues after them. Only complete journal lines count, and a torn last line is cut off before
-the journal is appended to again. A ``NAME.part`` that cannot be opened any more (its creation failed, or
-a failure broke the library's metadata) is replaced by a new one, with a warning naming the chunks lost.
+Writes go to ``NAME.part``, whose variables' storage is contiguous and allocated when it is created, so a chunk's
+write changes data, never the file's structure; each chunk synced to disk is journaled in ``NAME.chunks``, and a
+rerun with the same identity continues after the journaled chunks; the complete file is renamed to ``NAME``. A
+failed write is one ``OutputError`` sentence (exit 3) that keeps the journaled chunks; a ``NAME.part`` that no
+longer opens is replaced, with a warning naming the chunks lost.
 """
 
 from __future__ import annotations

@@ -1,12 +1,8 @@
-"""Large sweeps in one command: ``gyrolab --batch KEY=V1,V2 ...`` writes ``<dir>/sweep.nc`` (docs/batch.md).
+"""Large sweeps in one command: ``gyrolab batch KEY=V1,V2 ...`` writes ``<dir>/sweep.nc`` (docs/batch.md).
 
-The grid becomes arrays (``gyrolab.batch.plan``: one composed config, initial states and compiled-model
-parameters for every point, each invalid point a failed entry with the single run's error), runs in chunks
-on the integrator's compiled batch kernel, or one ``integrate`` call per point for an integrator without one
-(``gyrolab.batch.runner``), and streams to one dataset whose dimensions are
-the swept parameters (``gyrolab.batch.store``). Rerunning the same command resumes; ``batch.output`` says
-what is stored per point. Only parameters of the body, the initial state and the forces may vary: the
-system, the forces' list, the integrator and the output times are one for the whole batch.
+The grid becomes arrays (``plan``), runs in chunks (``runner``) and streams to one resumable dataset whose
+dimensions are the swept parameters (``store``). Only parameters of the body, the initial state and the forces
+may vary.
 """
 
 from __future__ import annotations
