@@ -1,10 +1,7 @@
-"""The Hydra callback that turns a multirun into one ``sweep.nc`` (configured in ``conf/config.yaml``).
-
-``on_multirun_start`` starts the sweep's progress display; ``on_multirun_end``
-(run by Hydra on the launching machine once every job has returned, whatever
-the launcher) aggregates the job directories into ``sweep.nc`` and the
-summary figures. The jobs themselves record their outcome (``job.json``) in
-``gyrolab.app``; nothing here runs in the jobs.
+"""The Hydra callback that turns a multirun into one ``sweep.nc`` (configured in ``conf/config.yaml``):
+``on_multirun_start`` starts the sweep's progress display, ``on_multirun_end`` (on the launching machine, once
+every job has returned, whatever the launcher) aggregates the job directories into ``sweep.nc`` and the summary
+figures. Nothing here runs in the jobs.
 """
 
 from __future__ import annotations

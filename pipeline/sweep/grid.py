@@ -1,10 +1,6 @@
-"""The grid of a multirun: one dimension per swept parameter, one job per grid point.
-
-Built from the sweep's overrides exactly as Hydra's basic sweeper builds its
-jobs (the Cartesian product, in command-line order, the last parameter
-varying fastest), so job ``n`` of a sweep is ``Grid.jobs[n]`` whichever
-launcher ran it. A batch integrator that computes a whole grid at once can
-use the same grid to fill the same ``sweep.nc`` layout.
+"""The grid of a multirun: one dimension per swept parameter, one job per grid point, built from the sweep's
+overrides exactly as Hydra's basic sweeper builds its jobs (the Cartesian product, in command-line order, the last
+parameter fastest), so job ``n`` is ``Grid.jobs[n]`` whichever launcher ran it.
 """
 
 from __future__ import annotations

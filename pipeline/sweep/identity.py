@@ -1,14 +1,10 @@
-"""A job's identity: a hash of its resolved config and of the code that runs it.
+"""A job's identity: a hash of its resolved config and of the code that runs it; a sweep run again skips the jobs
+whose identity already has a finished result (the integrators are deterministic).
 
-Two jobs with the same identity compute the same result (the integrators are
-deterministic), so a sweep that is run again skips the jobs whose identity
-already has a finished result in the sweep directory.
-
-The code is what the job loads: gyrolab's own (its version, the git trees of its code folders and the digest
-of their uncommitted changes: a commit that changes only documentation or tests leaves it as it is) and the
-third-party plugins the config names (each ``_target_`` outside gyrolab: its distribution's name and version and
-a digest of the Python files of the package that defines it). Installing, updating or removing a package the job
-does not use leaves every identity as it is.
+The code is what the job loads: gyrolab's own (its version, the git trees of its code folders and the digest of
+their uncommitted changes: a commit of documentation or tests only leaves it as it is) and the third-party plugins
+the config names (each ``_target_`` outside gyrolab: its distribution's name and version and a digest of its
+package's Python files). A package the job does not use changes no identity.
 """
 
 from __future__ import annotations

@@ -1,14 +1,8 @@
 """One job of a sweep: skip it if its result is already there, otherwise run it and record how it ended.
 
-A failing job is recorded, not fatal: the error goes into the job's record
-(and, through the aggregator, into ``sweep.nc``'s table of failed jobs) and
-the sweep goes on. A write failure (no space, quota, permission) fails the
-job like any other error, but is retried when the sweep is run again.
-
-The job's directory is locked while the job runs (``gyrolab.output.lock``):
-when two processes resume one sweep, a job that one of them is running is
-skipped by the other, so no job runs twice. Temporary files that a killed
-job left in its directory are removed before it runs again.
+A failing job is recorded, not fatal (its error reaches ``sweep.nc``'s table of failed jobs); a write failure
+fails the job too, but is retried when the sweep is run again. The job's directory is locked while it runs, so of
+two processes resuming one sweep only one runs a job; temporary files a killed job left are removed first.
 """
 
 from __future__ import annotations

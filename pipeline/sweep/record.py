@@ -1,8 +1,5 @@
-"""A job's record, ``job.json`` next to its ``run.nc``: what ran, with which identity, and how it ended.
-
-The record is written (atomically) after ``run.nc``, so a job killed at any
-point leaves either a complete record or none; a job without a complete
-record is recomputed when the sweep is run again.
+"""A job's record, ``job.json`` next to its ``run.nc``: what ran, with which identity, and how it ended. Written
+(atomically) after ``run.nc``; a job without a complete record is recomputed when the sweep is run again.
 """
 
 from __future__ import annotations

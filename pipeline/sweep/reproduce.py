@@ -1,13 +1,8 @@
-"""``gyrolab --reproduce PATH/run.nc``: rerun a dataset's stored config and say whether the result is identical.
-
-A multirun's ``sweep.nc``: each finished job's ``run.nc`` (``reproduce_sweep``). A batch's ``sweep.nc``:
-``gyrolab.batch.reproduce``; an experiment's dataset: ``gyrolab.experiments.reproduce_task`` (both with the
-comparison of this module).
-
-Identical means every data variable and coordinate is equal bit for bit.
-Otherwise the report names each differing variable with its largest
-absolute difference. Provenance that differs (commit, library versions,
-platform) is listed as a hint to why.
+"""``gyrolab reproduce PATH/run.nc``: rerun a dataset's stored config and say whether the result is identical
+(docs/sweeps.md): every data variable and coordinate equal bit for bit, else each differing variable with its
+largest absolute difference, and the provenance that differs as a hint to why. A multirun's ``sweep.nc``: each
+finished job's ``run.nc`` (``reproduce_sweep``); a batch's: ``gyrolab.batch.reproduce``; an experiment's dataset:
+``gyrolab.experiments.reproduce_task`` (both with ``compare`` of this module).
 """
 
 from __future__ import annotations

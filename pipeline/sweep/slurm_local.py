@@ -1,24 +1,20 @@
-"""A real single-node SLURM on this machine, to try gyrolab's SLURM routes (docs/cluster.md) before a cluster.
+"""A real single-node SLURM on this machine, to try gyrolab's SLURM routes before a cluster (docs/cluster.md, "A
+SLURM on your own machine": what ``start`` installs, writes and starts, and how clients find it through
+``SLURM_CONF`` without touching a system SLURM or munge).
 
     python -m gyrolab.sweep.slurm_local start     # prints: export SLURM_CONF=/tmp/gyrolab-slurm-.../slurm.conf
     eval "$(python -m gyrolab.sweep.slurm_local start)"   # the same, and this shell's sbatch/sinfo use it
     python -m gyrolab.sweep.slurm_local status    # the clusters it started that are running
     python -m gyrolab.sweep.slurm_local stop      # cancel their jobs, stop their daemons, remove their files
 
-What ``start`` installs, writes and starts, and how clients find the cluster through ``SLURM_CONF`` without
-touching a system SLURM or munge: docs/cluster.md, "A SLURM on your own machine". ``start()`` returns the running
-cluster (tests/sweep/test_slurm.py starts its own with it); the command line's ``start`` runs it in a small
-background process that holds the cluster until ``stop`` (or SIGTERM) ends it.
+``start()`` returns the running cluster (tests/sweep/test_slurm.py starts its own with it); the command line's
+``start`` runs it in a small background process that holds the cluster until ``stop`` (or SIGTERM) ends it. A
+process killed before its ``stop()`` leaves daemons behind: each state directory records the pid that started it
+(``owner``), and the next ``start()`` ends the processes of every directory whose owner is gone and removes it.
 
-A process killed before its ``stop()`` leaves daemons behind: every state directory records the
-pid of the process that started it (``owner``), and the next ``start()`` ends the processes of every
-directory whose owner is gone (the processes whose command line or environment names that
-directory) and removes the directory, before it chooses free ports of its own.
-
-Why not cgroups: a container rarely delegates a writable cgroup tree, so processes are tracked by
-parentage (``proctrack/linuxproc``) and tasks are not confined (``task/none``); the node's CPUs and
-memory come from this machine (``nproc``, ``/proc/meminfo`` minus a margin) and are taken as
-configured (``SlurmdParameters=config_overrides``), since a container's CPU quota is not what the
+Why not cgroups: a container rarely delegates a writable cgroup tree, so processes are tracked by parentage
+(``proctrack/linuxproc``) and tasks are not confined; the node's CPUs and memory come from this machine and are
+taken as configured (``SlurmdParameters=config_overrides``), since a container's CPU quota is not what the
 hardware reports.
 """
 

@@ -1,22 +1,14 @@
-"""gyrolab's sweeper: Hydra's basic sweeper that leaves finished jobs out before launching anything.
+"""gyrolab's sweeper: Hydra's basic sweeper that leaves finished jobs out before launching anything
+(docs/cluster.md, "Resuming a multirun").
 
-Resuming a sweep with Hydra's basic sweeper composes every job's config twice (once to validate the
-batch, once to launch it) and starts every job, finished ones included, which then skips itself
-(``gyrolab.sweep.job``): a 1,000-job sweep with 600 jobs done paid ~0.7 s per finished job. This
-sweeper computes each job's identity first (``gyrolab.sweep.identity.job_identity``, the same rule
-the jobs apply) and launches only the jobs whose directory holds no record that settles that
-identity (``JobRecord.reusable_for``). Job numbers, and so job directories and ``sweep.nc``, are
-those of an unfiltered sweep: the remaining jobs are launched in runs of consecutive numbers.
-
-The identities are computed without composing every job: the config of one job per combination
-of config-group choices is composed as Hydra composes it, and each other job's value overrides are
-applied to it with Hydra's own override code (and its values put back afterwards). Applying every
-job's overrides also stands in for the basic sweeper's validation of the whole batch; a job whose
-overrides do not apply is composed in full, so that Hydra reports it before any job starts. A config
-whose values call a resolver (``${hydra:...}``, ``${now:...}``, ``${oc.env:...}``, any other) could
-resolve differently inside the job, so then no job is left out here: every job is launched and skips
-itself, exactly as before. A wrong prediction can only cost a launch, never skip a job: a job is left
-out only when the predicted identity equals the one its finished record holds.
+It computes each job's identity first (``gyrolab.sweep.identity.job_identity``, the rule the jobs apply) and
+launches only the jobs whose directory holds no record that settles it (``JobRecord.reusable_for``), in runs of
+consecutive numbers, so job numbers, directories and ``sweep.nc`` are those of an unfiltered sweep. The identities
+are computed without composing every job: one job per combination of group choices is composed as Hydra does,
+and each other job's value overrides are applied to it with Hydra's own override code (standing in for the basic
+sweeper's validation of the batch; a job whose overrides do not apply is composed in full, so that Hydra reports
+it). A config that calls a resolver could resolve differently inside the job: then every job is launched and
+checks itself. A wrong prediction can only cost a launch, never skip a job.
 """
 
 from __future__ import annotations
