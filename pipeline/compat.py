@@ -1,27 +1,20 @@
 """The one place where gyrolab reaches into Hydra's and xarray's internals: each use is checked against the
-library version it was written for and takes the library's own public path otherwise.
+library version it was written for and takes the library's own public path otherwise (what each gains:
+docs/performance.md, "A sweep's per-job overhead").
 
-Kept for their measured gain (``gyrolab`` with and without each, best of 3, CPU s; Hydra 1.3.8, xarray 2026.9):
+* :func:`composing_once` (Hydra 1.3.x): one composition per command. Inside the block
+  ``ConfigLoaderImpl._load_configuration_impl`` composes the *skeleton* (the defaults list and the config merged
+  from it) once per set of group choices, with Hydra's functions in Hydra's order, and serves each request from
+  a copy: the value overrides applied with Hydra's function, the ``hydra`` node filled by a copy of the tail of
+  Hydra 1.3's ``_load_configuration_impl``; a request Hydra classifies otherwise is Hydra's own.
+  ``tests/compat/test_composing_once.py`` compares both paths for every job of sweeps.
+* :func:`install_dask_free_writes` (xarray ``XARRAY_SUPPORTED``): ``to_netcdf`` without importing Dask for a
+  dataset that holds nothing of Dask's.
+* :func:`run_hydra` (Hydra 1.3.x): ``_run_hydra`` given the namespace of gyrolab's own parser; otherwise
+  ``hydra.main`` on ``sys.argv`` rebuilt from it.
 
-* :func:`composing_once` (Hydra 1.3.x): one composition per command. A plain run composed its config three
-  times (the preflight, Hydra's ``get_mode`` and its run), a sweep of N jobs N + 4 times. Inside the block
-  ``ConfigLoaderImpl._load_configuration_impl`` composes the *skeleton* (the defaults list and the config
-  merged from it, shaped only by the primary config, the search path and the group choices) once per set of
-  group choices, with Hydra's functions in Hydra's order, and serves each request from a copy: the value
-  overrides applied with Hydra's function, the ``hydra`` node filled by a copy of the tail of Hydra 1.3's
-  ``_load_configuration_impl``; a request Hydra classifies otherwise is Hydra's own. Gain: 0.16 s of a 1.9 s
-  run, ~85 ms a sweep job. ``tests/compat/test_composing_once.py`` compares both paths for every job of sweeps.
-* :func:`install_dask_free_writes` (xarray ``XARRAY_SUPPORTED``): with Dask installed, ``to_netcdf`` imports
-  ``dask.array`` and ``distributed`` for any dataset only to learn that nothing in it is Dask's. Gain: 0.45 s
-  of every run and sweep with the ``test`` or ``cluster`` extra (none on the bare install).
-* :func:`run_hydra` (Hydra 1.3.x): ``_run_hydra``, which ``@hydra.main`` calls with the namespace it parsed
-  from ``sys.argv``, given the namespace of gyrolab's own parser; otherwise ``hydra.main`` on ``sys.argv``
-  rebuilt from it.
-
-Dropped: ``xr.Dataset._construct_direct`` for the run dataset (~1 ms of a 25 ms run). Also here, with no
-fallback (``pyproject.toml`` pins ``hydra-core>=1.3,<1.4``): the private functions the preflight composes
-with exactly as Hydra will (the search path, Hydra's argument parser), and those gyrolab's sweeper applies
-job overrides with.
+Also here, with no fallback (``pyproject.toml`` pins ``hydra-core>=1.3,<1.4``): the private functions the
+preflight composes with exactly as Hydra will, and those gyrolab's sweeper applies job overrides with.
 """
 
 from __future__ import annotations

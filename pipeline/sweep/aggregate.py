@@ -190,12 +190,9 @@ def _run_attributes(done: list[tuple[tuple, xr.Dataset]], coords: dict[str, Any]
 def _job_table(grid: Grid, results: Sequence[JobResult], grid_dims: tuple[str, ...]) -> dict[str, Any]:
     """Every job's status, id and directory over the grid, and the failed jobs' table."""
     statuses = np.zeros(grid.shape, dtype=np.int8)
-    job_ids = np.full(grid.shape, "", dtype=object)
-    job_dirs = np.full(grid.shape, "", dtype=object)
-    for n, result in enumerate(results):
-        statuses[grid.index[n]] = STATUS_FLAGS[result.status]
-        job_ids[grid.index[n]] = result.job_id
-        job_dirs[grid.index[n]] = result.job_dir
+    job_ids, job_dirs = np.full(grid.shape, "", dtype=object), np.full(grid.shape, "", dtype=object)
+    for index, result in zip(grid.index, results):
+        statuses[index], job_ids[index], job_dirs[index] = STATUS_FLAGS[result.status], result.job_id, result.job_dir
     return {"job_status": (grid_dims, statuses, {
                 "long_name": "how the job ended", "units": "1",
                 "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8), "flag_meanings": " ".join(STATUS_FLAGS)}),
@@ -225,10 +222,7 @@ def _sample_dim(datasets: Sequence[xr.Dataset]) -> str:
 
 
 def _union(lists: Sequence[Sequence[str]]) -> list[str]:
-    seen: dict[str, None] = {}
-    for items in lists:
-        seen.update(dict.fromkeys(items))
-    return list(seen)
+    return list(dict.fromkeys(item for items in lists for item in items))
 
 
 def _blank(shape: tuple[int, ...], dtype: np.dtype) -> np.ndarray:
@@ -306,38 +300,31 @@ def _cell_variable(values: dict[tuple[int, ...], Any], shape: tuple[int, ...], g
                    name: str) -> tuple:
     """A variable over the swept dims from one value per grid point (missing points: NaN or '')."""
     items = list(values.values())
-    if items and all(_is_number(v) for v in items):
-        out = np.full(shape, np.nan)
-        for index, value in values.items():
-            out[index] = value
-        return grid_dims, out, {}
     arrays = [np.asarray(v) for v in items]
-    if items and all(a.ndim == 1 and a.dtype.kind in "iuf" and a.shape == arrays[0].shape for a in arrays):
-        out = np.full(shape + arrays[0].shape, np.nan)
-        for index, value in values.items():
-            out[index] = value
-        return grid_dims + (f"{name}_index",), out, {}
-    out = np.full(shape, "", dtype=object)
+    if items and all(_is_number(v) for v in items):
+        dims, out = grid_dims, np.full(shape, np.nan)
+    elif items and all(a.ndim == 1 and a.dtype.kind in "iuf" and a.shape == arrays[0].shape for a in arrays):
+        dims, out = grid_dims + (f"{name}_index",), np.full(shape + arrays[0].shape, np.nan)
+    else:
+        dims, out = grid_dims, np.full(shape, "", dtype=object)
+        values = {index: value if isinstance(value, str) else np.array2string(np.asarray(value), separator=", ")
+                  for index, value in values.items()}
     for index, value in values.items():
-        out[index] = value if isinstance(value, str) else np.array2string(np.asarray(value), separator=", ")
-    return grid_dims, out, {}
+        out[index] = value
+    return dims, out, {}
 
 
 def _failure_table(grid: Grid, results: Sequence[JobResult]) -> dict[str, tuple]:
     failed = [(n, r) for n, r in enumerate(results) if r.status == FAILED]
-    dim = ("failed_job",)
-    return {
-        "failed_job_dir": (dim, np.array([r.job_dir for _, r in failed], dtype=object),
-                           {"long_name": "failed job's directory, relative to the sweep directory"}),
-        "failed_job_overrides": (dim, np.array([" ".join(grid.jobs[n]) for n, _ in failed], dtype=object),
-                                 {"long_name": "failed job's overrides"}),
-        "failed_job_error": (dim, np.array([r.error for _, r in failed], dtype=object),
-                             {"long_name": "error message"}),
-        "failed_job_error_type": (dim, np.array([r.error_type for _, r in failed], dtype=object),
-                                  {"long_name": "error class"}),
-        "failed_job_exit_code": (dim, np.array([r.exit_code for _, r in failed], dtype=np.int32),
-                                 {"long_name": "exit code the single-run command would give", "units": "1"}),
-    }
+    columns = {"dir": ([r.job_dir for _, r in failed], "failed job's directory, relative to the sweep directory"),
+               "overrides": ([" ".join(grid.jobs[n]) for n, _ in failed], "failed job's overrides"),
+               "error": ([r.error for _, r in failed], "error message"),
+               "error_type": ([r.error_type for _, r in failed], "error class")}
+    table = {f"failed_job_{name}": (("failed_job",), np.array(values, dtype=object), {"long_name": long_name})
+             for name, (values, long_name) in columns.items()}
+    table["failed_job_exit_code"] = (("failed_job",), np.array([r.exit_code for _, r in failed], dtype=np.int32),
+                                     {"long_name": "exit code the single-run command would give", "units": "1"})
+    return table
 
 
 def _is_number(value: Any) -> bool:
