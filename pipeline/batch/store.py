@@ -10,6 +10,7 @@ longer opens is replaced, with a warning naming the chunks lost.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import os
@@ -28,16 +29,13 @@ from gyrolab.output.cf import CONVENTIONS, now_iso
 from gyrolab.output.provenance import gyrolab_version, provenance
 from gyrolab.output.trust import check_output_target, no_follow
 from gyrolab.sweep import record
-from gyrolab.sweep.aggregate import STATUS_FLAGS
+from gyrolab.sweep.aggregate import STATUS_ATTRS, STATUS_FLAGS
 
 log = logging.getLogger("gyrolab.batch")
 
 FINISHED, FAILED = STATUS_FLAGS[record.FINISHED], STATUS_FLAGS[record.FAILED]
-STATUS_ATTRS = {"long_name": "how the point ended: 0 not run, 1 finished, 2 failed", "units": "1",
-                "flag_values": np.array([0, 1, 2], dtype=np.int8), "flag_meanings": "missing finished failed"}
+STATUS_LONG_NAME = "how the point ended: 0 not run, 1 finished, 2 failed"
 ERROR_ATTRS = {"long_name": "the point's error: index into error_message, -1 for none", "units": "1"}
-#: the counts ``finish`` stores; created (as 0) with the file, so that finishing overwrites them in place
-COUNT_ATTRS = ("n_missing", "n_finished", "n_failed")
 
 
 class Store:
@@ -120,10 +118,8 @@ class Store:
     def _close_quietly(self) -> None:
         nc, self.nc = self.nc, None
         if nc is not None:
-            try:
+            with contextlib.suppress(OSError, RuntimeError):   # the write failed; the journal says what is whole
                 nc.close()
-            except (OSError, RuntimeError):
-                pass   # the write already failed; the journal says which chunks are whole
 
     # -- writing ----------------------------------------------------------------------------------------
     def chunk_done(self, index: int, chunk: Any, result: Any) -> None:
@@ -174,8 +170,7 @@ class Store:
             self._create(None)
         status = self.nc["job_status"][:]
         status = np.asarray(status.filled(0) if np.ma.isMaskedArray(status) else status)
-        counts = {name: np.int64(np.count_nonzero(status == code))
-                  for name, code in (("n_missing", 0), ("n_finished", FINISHED), ("n_failed", FAILED))}
+        counts = {f"n_{name}": np.int64(np.count_nonzero(status == code)) for name, code in STATUS_FLAGS.items()}
         self.nc.setncatts(counts)
         if counts["n_failed"]:
             log.info("batch: %d of %d points failed; their errors are error_message[job_error] where job_status is 2",
@@ -239,7 +234,7 @@ class Store:
         grid = plan.grid_dims
         # no fill value: every point's code is written below (a fill value would make readers mask the codes)
         status = nc.createVariable("job_status", "i1", grid, contiguous=True, fill_value=False)
-        status.setncatts({**STATUS_ATTRS, **self._coordinates_attr()})
+        status.setncatts({"long_name": STATUS_LONG_NAME, **STATUS_ATTRS, **self._coordinates_attr()})
         error = nc.createVariable("job_error", "i4", grid, contiguous=True, fill_value=False)
         error.setncatts({**ERROR_ATTRS, **self._coordinates_attr()})
         shape = plan.shape
@@ -248,7 +243,8 @@ class Store:
         error[:] = plan.error.reshape(shape)
         if result is not None:
             self._create_variables(result, system)
-        nc.setncatts({**self._attributes(system), **{name: np.int64(0) for name in COUNT_ATTRS}})
+        # the counts ``finish`` stores, created (as 0) with the file so that finishing overwrites them in place
+        nc.setncatts({**self._attributes(system), **{f"n_{name}": np.int64(0) for name in STATUS_FLAGS}})
         nc.sync()
         _fsync(self.part)
         _start_journal(self.journal, self.identity)

@@ -9,6 +9,7 @@ naming the file and the reason; the netCDF library reports a full disk or a file
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import resource
@@ -156,9 +157,8 @@ def _fsync_directory(directory: Path) -> None:
     except OSError:
         return
     try:
-        os.fsync(fd)
-    except OSError:
-        pass  # some file systems cannot fsync a directory; the rename has happened all the same
+        with contextlib.suppress(OSError):  # some file systems cannot fsync a directory; the rename happened
+            os.fsync(fd)
     finally:
         os.close(fd)
 
@@ -171,10 +171,8 @@ def remove_stale_temporaries(directory: str | os.PathLike[str]) -> list[Path]:
     """
     removed = []
     for leftover in Path(directory).glob(f".*{TEMP_SUFFIX}"):
-        try:
+        with contextlib.suppress(OSError):  # gone already, or not ours to remove: nothing is lost by leaving it
             if leftover.is_file():
                 leftover.unlink()
                 removed.append(leftover)
-        except OSError:
-            pass  # gone already, or not ours to remove: nothing is lost by leaving it
     return removed

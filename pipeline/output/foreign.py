@@ -19,6 +19,7 @@ import xarray as xr
 
 from gyrolab.errors import ConfigError, shorten
 from gyrolab.output.atomic import _size
+from gyrolab.output.trust import proc_number
 
 #: what a figure module or a rerun raises when a dataset lacks what gyrolab's datasets have
 FOREIGN_ERRORS = (LookupError, ValueError, TypeError, AttributeError, ArithmeticError)
@@ -95,14 +96,8 @@ def check_declared(declared: int, size: int, where: str, expected: str) -> None:
 
 def memory_limit() -> int:
     """Half the memory available now (Linux's MemAvailable), else 4 GiB."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as handle:
-            for line in handle:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024 // 2
-    except (OSError, ValueError, IndexError):
-        pass
-    return 4 * 1024**3
+    available = proc_number("/proc/meminfo", "MemAvailable:")  # kB
+    return available * 1024 // 2 if available is not None else 4 * 1024**3
 
 
 RUN = "a run.nc that gyrolab wrote"

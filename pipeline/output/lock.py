@@ -10,6 +10,7 @@ it already holds (the hold is counted).
 from __future__ import annotations
 
 import atexit
+import contextlib
 import errno
 import fcntl
 import logging
@@ -100,10 +101,8 @@ def unlock(directory: str | os.PathLike[str]) -> None:
     if entry[1] > 0:
         return
     del _held[key]
-    try:
+    with contextlib.suppress(OSError):
         (key / LOCK_NAME).unlink(missing_ok=True)  # still ours: nobody else can hold it while we do
-    except OSError:
-        pass
     os.close(entry[0])  # releases the flock
 
 
@@ -217,11 +216,9 @@ def _write_owner(fd: int, created: bool, info: os.stat_result) -> None:
     """Who holds the lock, for the messages of others: into a file this call created, or a lock file of gyrolab's
     (one link, the user's, a line long)."""
     if created or (info.st_nlink == 1 and info.st_uid == os.geteuid() and info.st_size <= MAX_OWNER_BYTES):
-        try:  # a full disk may refuse this, the lock holds anyway
+        with contextlib.suppress(OSError):  # a full disk may refuse this, the lock holds anyway
             os.ftruncate(fd, 0)
             os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}\n".encode())
-        except OSError:
-            pass
 
 
 #: a lock file holds one line; a larger file is not overwritten

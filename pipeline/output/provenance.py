@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import platform
 import re
@@ -128,8 +129,6 @@ def provenance() -> dict[str, Any]:
         "plugin_packages": plugin_packages(),
     }
     for lib in _libraries():
-        try:
+        with contextlib.suppress(metadata.PackageNotFoundError):
             attrs[f"version_{lib.replace('-', '_')}"] = metadata.version(lib)
-        except metadata.PackageNotFoundError:
-            pass
     return attrs

@@ -10,6 +10,7 @@ device (``check_output_target``), and pickles are loaded only from folders only 
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import stat
@@ -82,10 +83,9 @@ def own_dir(path: str | os.PathLike[str]) -> Path:
     """The folder ``path`` (``figures``, ``.hydra``), created if missing; Untrusted when it is a link or a file."""
     path = Path(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        os.mkdir(path)
-    except FileExistsError:
-        pass
+        with contextlib.suppress(FileExistsError):
+            path.parent.mkdir(parents=True, exist_ok=True)
+            os.mkdir(path)
     except OSError:
         return path  # the write that follows names the reason (a read-only directory, a full disk)
     mode = os.lstat(path).st_mode
@@ -139,11 +139,9 @@ def private_dir(path: str | os.PathLike[str], what: str) -> Path:
     """The folder ``path``, which holds pickles gyrolab loads (``what`` says whose): created owner-only (0700) if
     missing; Untrusted when it is a link, belongs to another user, or others may write it."""
     path = Path(path)
-    try:
+    with contextlib.suppress(FileExistsError):
         path.parent.mkdir(parents=True, exist_ok=True)
         os.mkdir(path, 0o700)
-    except FileExistsError:
-        pass
     info = os.lstat(path)
     if stat.S_ISLNK(info.st_mode) or not stat.S_ISDIR(info.st_mode):
         raise _refusal(path, info.st_mode)
@@ -177,15 +175,17 @@ def check_kernel_cache() -> None:
                             "(numba loads pickles from it); set NUMBA_CACHE_DIR to a folder of yours")
 
 
+def proc_number(path: str, key: str, base: int = 10) -> int | None:
+    """The number after ``key`` in a Linux /proc file (``Umask:`` of ``/proc/self/status``), None without one."""
+    with contextlib.suppress(OSError, ValueError, IndexError), open(path, encoding="ascii") as handle:
+        return next((int(line.split()[1], base) for line in handle if line.startswith(key)), None)
+    return None
+
+
 def umask() -> int:
     """The process's umask, read without changing it (Linux's /proc; elsewhere set and restored at once)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as handle:
-            for line in handle:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError, IndexError):
-        pass
-    mask = os.umask(0o022)
-    os.umask(mask)
+    mask = proc_number("/proc/self/status", "Umask:", 8)
+    if mask is None:
+        mask = os.umask(0o022)
+        os.umask(mask)
     return mask

@@ -10,6 +10,7 @@ duplicate key, not a mapping, a tag, beyond ``MAX_EXPANDED_NODES``, ``MAX_DEPTH`
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
 from pathlib import Path
@@ -159,11 +160,9 @@ def _check_depth(text: str, where: str) -> None:
 def _display(path: Path) -> str:
     """The file as the user can find it: relative to the working directory when inside it."""
     text = str(path)
-    try:
+    with contextlib.suppress(ValueError):
         relative = os.path.relpath(path)
         text = relative if not relative.startswith("..") else text
-    except ValueError:
-        pass
     return shorten(text, 200)
 
 

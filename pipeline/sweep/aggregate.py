@@ -37,6 +37,9 @@ log = logging.getLogger("gyrolab.sweep")
 SWEEP_NAME = "sweep.nc"
 MISSING = "missing"
 STATUS_FLAGS = {MISSING: 0, FINISHED: 1, FAILED: 2}
+#: the CF flag attributes of ``job_status`` (a batch's sweep.nc has the same codes)
+STATUS_ATTRS = {"units": "1", "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8),
+                "flag_meanings": " ".join(STATUS_FLAGS)}
 #: run attributes that are per-job quantities, always variables over the swept dims
 PER_JOB_ATTRS = ("config", "hydra_overrides") + tuple(f"integrator_{f.name}" for f in fields(IntegratorStats))
 #: variable attributes that are per-job quantities
@@ -117,7 +120,7 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
 def _sweep_attributes(grid: Grid, results: Sequence[JobResult], grid_dims: tuple[str, ...],
                       sample: str) -> dict[str, Any]:
     """What the sweep was (its title, dimensions, keys) and how its jobs ended."""
-    counts = {status: sum(r.status == status for r in results) for status in STATUS_FLAGS}
+    counts = {f"n_{status}": sum(r.status == status for r in results) for status in STATUS_FLAGS}
     return {
         "failed_job_description": "dimension failed_job: one entry per failed job, in job order (the failed_job_* "
                                   "variables are its table)",
@@ -127,9 +130,7 @@ def _sweep_attributes(grid: Grid, results: Sequence[JobResult], grid_dims: tuple
         "sweep_dims": " ".join(grid_dims),
         "sweep_keys": " ".join(d.key for d in grid.dims),
         "n_jobs": len(results),
-        "n_finished": counts[FINISHED],
-        "n_failed": counts[FAILED],
-        "n_missing": counts[MISSING],
+        "n_finished": counts["n_finished"], "n_failed": counts["n_failed"], "n_missing": counts["n_missing"],
     }
 
 
@@ -193,9 +194,7 @@ def _job_table(grid: Grid, results: Sequence[JobResult], grid_dims: tuple[str, .
     job_ids, job_dirs = np.full(grid.shape, "", dtype=object), np.full(grid.shape, "", dtype=object)
     for index, result in zip(grid.index, results):
         statuses[index], job_ids[index], job_dirs[index] = STATUS_FLAGS[result.status], result.job_id, result.job_dir
-    return {"job_status": (grid_dims, statuses, {
-                "long_name": "how the job ended", "units": "1",
-                "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8), "flag_meanings": " ".join(STATUS_FLAGS)}),
+    return {"job_status": (grid_dims, statuses, {"long_name": "how the job ended", **STATUS_ATTRS}),
             "job_id": (grid_dims, job_ids, {"long_name": "hash of the job's resolved config and code version"}),
             "job_dir": (grid_dims, job_dirs, {"long_name": "job directory, relative to the sweep directory"}),
             **_failure_table(grid, results)}

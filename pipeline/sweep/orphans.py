@@ -10,6 +10,7 @@ once the launcher is gone (for launchers with processes in between, and other sy
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import ctypes.util
 import logging
@@ -90,13 +91,11 @@ def alive(pid: int) -> bool:
 
 
 def _set_parent_death_signal() -> None:
-    try:
+    with contextlib.suppress(OSError, AttributeError):  # no prctl here: the watchdog alone guards this worker
         libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
         if libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) != 0:
             log.debug("prctl(PR_SET_PDEATHSIG) failed: errno %d; the watchdog alone guards this worker",
                       ctypes.get_errno())
-    except (OSError, AttributeError):
-        pass  # no prctl here: the watchdog alone guards this worker
 
 
 def _watch(launcher: int, parent: int) -> None:

@@ -5,6 +5,7 @@ elsewhere a log line every ``log_every`` seconds.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import sys
 import threading
@@ -60,10 +61,8 @@ class SweepWatcher:
     def _snapshot(self) -> dict[Path, int]:
         out = {}
         for path in record_paths(self.sweep_dir):
-            try:
+            with contextlib.suppress(OSError):
                 out[path] = path.stat().st_mtime_ns
-            except OSError:
-                pass
         return out
 
     def _watch(self) -> None:
