@@ -1,18 +1,13 @@
 """The ``gyrolab`` command: a Hydra app that runs one scene (or a multirun sweep) per invocation.
 
-Before Hydra starts, a preflight turns the usual mistakes — an unknown plugin
-name, a malformed override, an invalid scene, an unwritable output
-directory — into one sentence and a non-zero exit, so that no run directory
-with a partial ``run.nc`` is left behind.
+Before Hydra starts, a preflight turns the usual mistakes (an unknown plugin name, a malformed override, an
+invalid scene, an unwritable output directory) into one sentence and a non-zero exit, so that no run directory
+with a partial ``run.nc`` is left behind. In a multirun each job is resumable and a failing job is recorded, not
+fatal (``gyrolab.sweep.job``); the sweep callback then writes ``sweep.nc``.
 
-In a multirun each job is resumable and a failing job is recorded, not fatal
-(``gyrolab.sweep.job``); the sweep callback then writes ``sweep.nc``.
-
-This module is ``gyrolab run``, the default subcommand, and ``main``; the package holds the rest of the
-command line: ``parser`` (which subcommand a command line names, one argparse parser per other
-subcommand), ``commands`` (``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``, ``completion``)
-and ``completion`` (the bash and zsh script). Logs go to stderr, results to stdout
-(``gyrolab.output.written``).
+This module is ``gyrolab run``, the default subcommand, and ``main``; ``parser`` says which subcommand a command
+line names, ``commands`` runs the others, ``completion`` writes the shell script. Logs go to stderr, results to
+stdout (``gyrolab.output.written``).
 """
 
 from __future__ import annotations

@@ -1,13 +1,9 @@
 """The command line's grammar: which subcommand a command line names, and one argparse parser per subcommand.
 
-``gyrolab run`` (the default: ``gyrolab``, ``gyrolab -m ...``, ``gyrolab experiment=x``) is Hydra's own
-app: its parser is Hydra's (``get_args_parser``, the options Hydra documents) with gyrolab's ``--scheduler`` and
-``--version``, and its namespace goes to Hydra as it is (``gyrolab.compat.run_hydra``). Every subcommand is
-parsed here, options in any position. The old
-spellings (``--batch``, ``--plot``, ``--reproduce``, ``--new-force``, ``--aggregate``) name the same
-subcommands, anywhere on the line, as do the words (``gyrolab batch ...``); options go in any position
-(``gyrolab --batch --config-dir usercfg experiment=r0_scan`` and ``gyrolab batch experiment=r0_scan -cd usercfg``
-are the same command).
+``gyrolab run`` (the default: ``gyrolab``, ``gyrolab -m ...``, ``gyrolab experiment=x``) is Hydra's own app: its
+parser is Hydra's (``get_args_parser``) with gyrolab's ``--scheduler`` and ``--version``, and its namespace goes to
+Hydra as it is (``gyrolab.compat.run_hydra``). The old spellings (``--batch``, ``--plot``, ...) name the same
+subcommands as the words (``gyrolab batch ...``), anywhere on the line; options go in any position.
 """
 
 from __future__ import annotations

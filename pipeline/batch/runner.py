@@ -188,15 +188,9 @@ def run_plan(plan: Plan, path: Path, settings: Settings, only: set[int] | None =
 
 
 def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any]]:
-    """(the integrator every chunk runs, its dataset attributes); None: the config's own (a fixed choice).
-
-    An integrator that chooses its method (CHOOSES_METHOD: ``auto``) chooses here, once for the batch, on the
-    batch's valid points (its ``choose_batch_method``; ``auto``: its pilot on the first point, the largest state
-    and the most unusual parameters, the tightest tolerance): every chunk then runs the same method at the
-    same tolerance. (The chaos indicator needs VARIATIONAL, which such an integrator lacks: refused before.)
-    The attributes always say how the points ran (``batch_path``: the integrator's batch kernel, vectorised
-    or not, or one ``integrate`` call per point).
-    """
+    """(the integrator every chunk runs, its dataset attributes, which always say how the points ran:
+    ``batch_path``); None: the config's own. An integrator that chooses its method (CHOOSES_METHOD) chooses here,
+    once for the batch, on its valid points (docs/batch.md, "integrator=auto chooses once per batch")."""
     if plan.base is None or settings.output == "indicator" or not plan.integrator_class.supports(CHOOSES_METHOD):
         return None, {} if plan.base is None else {"batch_path": batch_path(plan.integrator_class, settings),
                                                    **lane_record(plan.integrator_class, settings)}

@@ -72,16 +72,13 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
 
 
 def flag_violated_invariants(ds: xr.Dataset, invariants: tuple[str, ...], adaptive: bool,
-                             series: dict[str, np.ndarray] | None = None) -> list[str]:
+                             series: dict[str, np.ndarray]) -> None:
     """Flag each monitored invariant whose drift the integration error does not explain
-    (``gyrolab.output.invariant_check``): one warning each, ``invariant_check = "violated"`` and a ``comment``
-    on its variable, and the names in the dataset attribute ``violated_invariants``. The figures do not
-    draw a flagged invariant as conserved. Returns the flagged names. ``series``: the invariants' values when the
-    caller holds them (each ``ds[name]`` builds a DataArray: ~20 µs apiece)."""
+    (``gyrolab.output.invariant_check``; ``series``: the invariants' values): one warning each,
+    ``invariant_check = "violated"`` and a ``comment`` on its variable, and the names in the dataset attribute
+    ``violated_invariants``. The figures do not draw a flagged invariant as conserved."""
     times = ds.variables["time"].values if "time" in ds.variables else np.empty(0)
     span = float(times[-1] - times[0]) if times.size else 0.0
-    if series is None:
-        series = {name: ds[name].values for name in invariants if name in ds}
     found = violated_invariants(series, invariants, ds.attrs, adaptive, span)
     for name, (drift, allowed) in found.items():
         sentence = violation_sentence(name, drift, allowed)
@@ -90,7 +87,6 @@ def flag_violated_invariants(ds: xr.Dataset, invariants: tuple[str, ...], adapti
                                "comment": sentence})
     if found:
         ds.attrs["violated_invariants"] = " ".join(found)
-    return list(found)
 
 
 def scene_attributes(scene: Scene) -> tuple[dict[str, Any], dict[str, Any]]:

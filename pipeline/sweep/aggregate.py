@@ -393,11 +393,9 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
                     launcher: str = "", output: Any | None = None) -> SweepSummary:
     """Write ``sweep_dir/sweep.nc`` (and summary figures) from the sweep's job directories.
 
-    ``hydra_cfg`` is the multirun's ``hydra`` config node; without it, it is
-    read from ``sweep_dir/multirun.yaml`` (which Hydra writes at the start of
-    every sweep). ``figures=None``: as the sweep's callback was configured.
-    ``output``: the multirun's ``output`` section (the figures' formats and dpi); without it, read from
-    ``multirun.yaml`` too.
+    ``hydra_cfg`` and ``output``: the multirun's ``hydra`` node and ``output`` section (the figures' formats and
+    dpi); without them, read from ``sweep_dir/multirun.yaml``. ``figures=None``: as the sweep's callback was
+    configured.
     """
     sweep_dir = Path(sweep_dir)
     check_tree(sweep_dir, sweep=True)

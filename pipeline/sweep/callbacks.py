@@ -42,12 +42,9 @@ def reset() -> None:
 
 
 class SweepCallback(Callback):
-    """Aggregate a multirun into ``<sweep dir>/sweep.nc``; ``figures``: also draw the summary figures.
-
-    For a single run it also locks the run directory before Hydra writes anything there
-    (``on_run_start``), so that a second run into a directory in use is refused in one sentence
-    (exit 2) without touching the first run's files.
-    """
+    """Aggregate a multirun into ``<sweep dir>/sweep.nc``; ``figures``: also draw the summary figures. For a single
+    run it locks the run directory before Hydra writes there (``on_run_start``): a second run into a directory in
+    use is refused in one sentence (exit 2) without touching the first run's files."""
 
     def __init__(self, figures: bool = True, progress: bool = True) -> None:
         self.figures = bool(figures)
@@ -120,13 +117,9 @@ class SweepCallback(Callback):
 
 
 def _tolerate_hydra_record_failures() -> None:
-    """A full disk while Hydra saves a job's ``.hydra/*.yaml`` is a warning, not the end of the sweep.
-
-    Hydra writes those copies of the config (non-atomically) before the job starts; an OSError there
-    would abort the whole multirun with a traceback. The config is also in the job's ``job.json``
-    and ``run.nc``, so the copy is dropped (no partial file is left) and the job goes on: a job
-    that then cannot write its results fails alone, in one sentence, like any other write failure.
-    """
+    """A full disk while Hydra saves a job's ``.hydra/*.yaml`` (before the job starts; an OSError there would abort
+    the multirun with a traceback) is a warning: the config is also in the job's ``job.json`` and ``run.nc``, so
+    the copy is dropped (no partial file left) and the job goes on, failing alone if it cannot write its results."""
     save = hydra_utils._save_config
     if getattr(save, "_gyrolab_tolerant", False):
         return

@@ -31,12 +31,8 @@ log = logging.getLogger("gyrolab.sweep")
 
 
 def draws_job_figures(output: object) -> bool:
-    """Whether a sweep job draws its own figures: only with ``output.job_figures=true`` (and figures on).
-
-    Off by default so that a sweep does not wait on pictures (four figures cost ~2 CPU s per job, the
-    integration of a short scene ~0.1 s); the sweep's own figures are drawn as before, and
-    ``gyrolab --plot SWEEP_DIR`` draws every job's figures from its ``run.nc`` when they are wanted.
-    """
+    """Whether a sweep job draws its own figures: only with ``output.job_figures=true`` (and figures on), so that
+    a sweep does not wait on pictures; ``gyrolab plot SWEEP_DIR`` draws them from the jobs' ``run.nc``."""
     get = getattr(output, "get", None)
     if get is None:
         return False
@@ -47,13 +43,10 @@ def run_sweep_job(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_
                   work: Callable[[str], Path]) -> JobRecord:
     """Run ``work(job_id)`` (which writes the job's dataset and returns its path) unless already done.
 
-    Never raises for a failing scene: a GyrolabError is recorded as a
-    deterministic failure (the same config and code fail the same way, so it
-    is not retried), except a write failure (``OutputError``: the disk may
-    have room next time); any other exception is recorded too, with its
-    traceback in the job's log, and retried when the sweep is run again. A
-    job that another live process is running is left to it (status
-    ``ELSEWHERE``, nothing written).
+    Never raises for a failing scene: a GyrolabError is recorded as a deterministic failure (not retried), except
+    a write failure (``OutputError``: the disk may have room next time); any other exception is recorded too, with
+    its traceback in the job's log, and retried when the sweep is run again. A job that another live process is
+    running is left to it (status ``ELSEWHERE``, nothing written).
     """
     job_dir = Path(job_dir)
     guard_worker()  # in a launcher's worker process: die with the launching process

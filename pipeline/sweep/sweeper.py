@@ -53,13 +53,9 @@ _RESOLVER = re.compile(r"\$\{\s*[\w.]+\s*:")
 
 
 class ResumingSweeper(Sweeper):
-    """Hydra's basic sweeper (same jobs, same numbers, same ``max_batch_size`` and ``params``) that does
-    not launch the jobs a previous run of the same sweep already settled.
-
-    It derives from Hydra's ``Sweeper`` and calls the basic sweeper's functions rather than subclassing
-    it: Hydra re-imports its own plugin modules when it scans them, which would leave a subclass with
-    a stale base class.
-    """
+    """Hydra's basic sweeper (same jobs, numbers, ``max_batch_size`` and ``params``) that does not launch the jobs
+    a previous run of the same sweep settled. It calls the basic sweeper's functions rather than subclassing it:
+    Hydra re-imports its plugin modules when it scans them, which would leave a subclass with a stale base."""
 
     def __init__(self, max_batch_size: int | None = None, params: dict[str, str] | None = None) -> None:
         super().__init__()
@@ -119,12 +115,10 @@ class ResumingSweeper(Sweeper):
 def claim(sweep_dir: Path, config: DictConfig) -> None:
     """Make ``sweep_dir`` this sweep's (its ``multirun.yaml``), or refuse it in one sentence (ConfigError).
 
-    One sweep directory, one sweep: a directory holding another sweep (another grid of jobs in its
-    ``multirun.yaml``) or a batch (a ``sweep.nc`` without one) is refused, as ``gyrolab batch`` refuses another
-    batch; the same sweep again resumes. The check and the write of ``multirun.yaml`` happen under the sweep
-    directory's lock, so two sweeps started at once cannot interleave: the later one finds the earlier one's.
-    Nothing already in the directory is followed (``gyrolab.output.trust.check_tree``), and submitit's folder,
-    whose pickles the jobs load, is the user's alone (``private_dir``).
+    One sweep directory, one sweep: another sweep or a batch there is refused, the same sweep again resumes. The
+    check and the write of ``multirun.yaml`` happen under the directory's lock, so two sweeps started at once
+    cannot interleave. Nothing in the directory is followed (``check_tree``), and submitit's folder, whose pickles
+    the jobs load, is the user's alone (``private_dir``).
     """
     check_tree(sweep_dir, sweep=True)
     try_lock(sweep_dir, blocking=True)
