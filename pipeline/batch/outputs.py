@@ -104,12 +104,9 @@ def _drifts(system: Any, y: np.ndarray) -> dict[str, tuple[np.ndarray, dict[str,
     for name in system.invariants:
         series = np.asarray(values[name], dtype=float)
         drift = np.max(np.abs(series - series[:, :1]), axis=1)
-        out[name + DRIFT_SUFFIX] = (drift, _drift_attrs(name, units))
+        out[name + DRIFT_SUFFIX] = (drift, {"units": units.get(name, "1"),
+                                            "long_name": f"max |{name}(t) − {name}(0)| over the stored samples"})
     return out
-
-
-def _drift_attrs(name: str, units: Mapping[str, str]) -> dict[str, str]:
-    return {"units": units.get(name, "1"), "long_name": f"max |{name}(t) − {name}(0)| over the stored samples"}
 
 
 def _units(system: Any) -> dict[str, str]:

@@ -69,12 +69,8 @@ _QUOTABLE_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_.]{0,79}$")
 _QUOTABLE_VALUE = re.compile(r"^[0-9A-Za-z_.+-]{1,24}$")
 
 
-def _key_name(key: str, column: int) -> str:
-    return repr(key) if _QUOTABLE_KEY.match(key) else f"{column} (not a dotted key name)"
-
-
 def _check_key(key: str, keys: list[str], plain: dict[str, Any], sections: Sequence[str], where: str) -> None:
-    column = _key_name(key, keys.index(key) + 1)
+    column = repr(key) if _QUOTABLE_KEY.match(key) else f"{keys.index(key) + 1} (not a dotted key name)"
     if not key:
         raise ConfigError(f"{where}: the header has an empty column name; name a config key in every column")
     if keys.count(key) > 1:

@@ -68,13 +68,9 @@ def _conform_variable(ds: xr.Dataset, name: Any) -> None:
         if name == "time":  # elapsed model time is the T axis (no calendar claimed: see the docstring)
             attrs.setdefault("axis", "T")
         variable.encoding["_FillValue"] = None
-        if _is_text(variable):
+        kind = variable.dtype.kind
+        if kind == "U" or (kind == "O" and all(isinstance(v, str) for v in variable.values.ravel())):  # text
             variable.encoding["dtype"] = "S1"
-
-
-def _is_text(variable: xr.Variable) -> bool:
-    kind = variable.dtype.kind
-    return kind == "U" or (kind == "O" and all(isinstance(v, str) for v in variable.values.ravel()))
 
 
 def unit_attributes(body: Any) -> dict[str, Any]:

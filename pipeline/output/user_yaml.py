@@ -44,11 +44,8 @@ def check_user_config_dir(directory: str, option: str) -> None:
             if count > MAX_FILES:
                 raise ConfigError(f"{option} {shorten(directory)!r} holds more than {MAX_FILES} YAML files; give the "
                                   "folder of your configs only")
-            check_user_yaml(Path(root) / name)
-
-
-def check_user_yaml(path: Path) -> None:
-    check_yaml_text(_read(path, _display(path)), _display(path))
+            where = _display(Path(root) / name)
+            check_yaml_text(_read(Path(root) / name, where), where)
 
 
 def _read(path: Path, where: str, *, kind: str = "a config folder holds") -> bytes:

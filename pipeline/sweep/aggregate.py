@@ -401,7 +401,7 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
     check_tree(sweep_dir, sweep=True)
     if hydra_cfg is None:
         hydra_cfg = stored_hydra(sweep_dir)
-        launcher = launcher or _short_target(hydra_cfg.get("launcher", {}).get("_target_", ""))
+        launcher = launcher or str(hydra_cfg.get("launcher", {}).get("_target_", "")).rsplit(".", 1)[-1]
     if figures is None:
         figures = bool(OmegaConf.select(hydra_cfg, "callbacks.sweep.figures", default=True))
     grid = Grid.from_hydra(hydra_cfg)
@@ -460,10 +460,6 @@ def wait_for_jobs(sweep_dir: Path) -> None:
                 log.info("waiting for job %s, run by another gyrolab process (%s)",
                          Path(root).relative_to(sweep_dir).as_posix(), owner)
             wait_for(Path(root))
-
-
-def _short_target(target: str) -> str:
-    return str(target).rsplit(".", 1)[-1]
 
 
 def log_summary(summary: SweepSummary) -> None:
