@@ -210,8 +210,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
         else:
             systems[c] = built
     reference = next(iter(systems.values()), None)
-    if reference is not None:
-        _same_structure(systems)
+    _same_structure(systems)
 
     # initial states: vectorised over the points, or one system per distinct point
     y0 = np.full((n_points, reference.system.state_size if reference else 0), np.nan)
@@ -249,9 +248,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
             combo_params[combo[n]] = params
 
     valid = ~errors.failed
-    base = None
-    if valid.any():
-        base = _with_values(plain, values_of(int(np.argmax(valid))))
+    base = _with_values(plain, values_of(int(np.argmax(valid)))) if valid.any() else None
     times = _batch_times(plain, systems, y0, combo, valid)
     layout = " × ".join(f"{name} {n}" for name, n in zip(dim_names(dims), shape)) if points is None else \
         f"a list ({points['kind']}) over {', '.join(d.key for d in dims)}"

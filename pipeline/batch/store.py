@@ -27,7 +27,7 @@ from gyrolab.errors import ConfigError, OutputError
 from gyrolab.output.atomic import TEMP_SUFFIX, _fsync, _fsync_directory, _library_failure, diagnose, reason
 from gyrolab.output.cf import CONVENTIONS, now_iso
 from gyrolab.output.provenance import gyrolab_version, provenance
-from gyrolab.output.trust import check_output_target, no_follow
+from gyrolab.output.trust import check_output_target, open_own_file
 from gyrolab.sweep import record
 from gyrolab.sweep.aggregate import STATUS_ATTRS, STATUS_FLAGS
 
@@ -143,7 +143,7 @@ class Store:
                     self._write(name, chunk, out.data)
         self.nc.sync()
         _fsync(self.part)
-        with open(self.journal, "a", encoding="utf-8", opener=no_follow) as journal:
+        with open(self.journal, "a", encoding="utf-8", opener=open_own_file) as journal:
             journal.write(f"{index}\n")
             journal.flush()
             os.fsync(journal.fileno())
@@ -340,7 +340,7 @@ def _identity_of(path: Path) -> str:
 
 
 def _start_journal(path: Path, identity: str) -> None:
-    with open(path, "w", encoding="utf-8", opener=no_follow) as journal:
+    with open(path, "w", encoding="utf-8", opener=open_own_file) as journal:
         journal.write(f"identity {identity}\n")
         journal.flush()
         os.fsync(journal.fileno())
@@ -363,7 +363,7 @@ def _cut_torn_line(path: Path) -> None:
     """Cut a journal's unterminated last line (a write that failed half-way), so that appending stays exact."""
     data = path.read_bytes()
     if data and not data.endswith(b"\n"):
-        with open(path, "r+b", opener=no_follow) as journal:
+        with open(path, "r+b", opener=open_own_file) as journal:
             journal.truncate(data.rfind(b"\n") + 1)
             journal.flush()
             os.fsync(journal.fileno())

@@ -18,7 +18,6 @@ import os
 import socket
 from collections.abc import Iterator
 from contextlib import contextmanager
-from functools import cache
 from pathlib import Path
 
 from gyrolab.errors import ConfigError, OutputError
@@ -69,8 +68,6 @@ def try_lock(directory: str | os.PathLike[str], *, blocking: bool = False) -> bo
         raise OutputError(f"cannot lock {str(directory)!r}: {reason(error)}") from None
     if fd is None:
         return False
-    if not _held:
-        _release_at_exit()
     _held[key] = [fd, 1]
     return True
 
@@ -86,10 +83,7 @@ def release_all() -> None:
         unlock(key)
 
 
-@cache
-def _release_at_exit() -> None:
-    """Release the held locks on every exit Python sees (sys.exit, an uncaught exception, Ctrl-C)."""
-    atexit.register(release_all)
+atexit.register(release_all)  # on every exit Python sees (sys.exit, an uncaught exception, Ctrl-C)
 
 
 def unlock(directory: str | os.PathLike[str]) -> None:

@@ -114,11 +114,6 @@ def open_own_file(path: str | os.PathLike[str], flags: int, mode: int = 0o644) -
     return fd
 
 
-def no_follow(path: str, flags: int) -> int:
-    """An ``opener`` for ``open()``: ``open_own_file`` (no link followed, a regular file only)."""
-    return open_own_file(path, flags)
-
-
 def check_output_target(path: str | os.PathLike[str], option: str = "") -> Path:
     """A file gyrolab is about to replace (``option``: the option that named it, ``-o``): refused when it exists and
     is not a regular file (a device node, a link, a folder), which writing would replace."""

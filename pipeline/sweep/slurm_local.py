@@ -57,6 +57,7 @@ class Unavailable(RuntimeError):
 
 #: the file in a state directory that marks a cluster the command line started (``stop`` ends only those)
 HELD = "held-by-command-line"
+NONE_RUNNING = "slurm_local: no cluster started by 'python -m gyrolab.sweep.slurm_local start' is running"
 
 
 @dataclass
@@ -402,8 +403,7 @@ def _status_command(base: Path) -> int:
     for owner, directory in clusters:
         print(f"SLURM_CONF={directory / 'slurm.conf'}  (pid {owner})")
     if not clusters:
-        print("slurm_local: no cluster started by 'python -m gyrolab.sweep.slurm_local start' is running",
-              file=sys.stderr)
+        print(NONE_RUNNING, file=sys.stderr)
     return 0
 
 
@@ -420,8 +420,7 @@ def _stop_command(base: Path, timeout: float = 60) -> int:
         print(f"slurm_local: {'did not stop within ' + str(timeout) + ' s' if (owner, directory) in left else 'stopped'}"
               f" {directory}", file=sys.stderr)
     if not clusters:
-        print("slurm_local: no cluster started by 'python -m gyrolab.sweep.slurm_local start' is running",
-              file=sys.stderr)
+        print(NONE_RUNNING, file=sys.stderr)
     return 1 if left else 0
 
 
@@ -438,13 +437,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="where the state directories go (default: the system's temporary directory)")
     args = parser.parse_args(argv)
     base = args.base or Path(tempfile.gettempdir())
-    if args.action == "_hold":
-        return _hold(args.base)
-    if args.action == "start":
-        return _start_command(args.base)
-    if args.action == "status":
-        return _status_command(base)
-    return _stop_command(base)
+    if args.action in ("_hold", "start"):
+        return (_hold if args.action == "_hold" else _start_command)(args.base)
+    return (_status_command if args.action == "status" else _stop_command)(base)
 
 
 if __name__ == "__main__":
