@@ -427,12 +427,12 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
         failures=[(" ".join(grid.jobs[n]), r.error) for n, r in enumerate(results) if r.status == FAILED],
         write_failures=sum(r.status == FAILED and r.error_type == "OutputError" for r in results))
     if figures and grid.dims and summary.finished:
-        from gyrolab.sweep.figures import save_sweep_figures  # matplotlib only when figures are drawn
+        from gyrolab.figures.sweep import save_figures  # matplotlib only when figures are drawn
 
-        if output is None:
-            summary.figures = save_sweep_figures(ds, sweep_dir / "figures")
-        else:  # the sweep's own config, in memory: no second reading of multirun.yaml (~0.1 s of YAML)
-            summary.figures = save_sweep_figures(ds, sweep_dir / "figures", *figure_options(output))
+        if output is None:  # the sweep's figure formats and dpi, as multirun.yaml stores them (else the defaults)
+            saved = sweep_dir / "multirun.yaml"
+            output = stored_yaml_file(saved).get("output") if saved.is_file() else None
+        summary.figures = save_figures(ds, sweep_dir / "figures", *figure_options(output))
     return summary
 
 
