@@ -102,15 +102,13 @@ def show_warnings_in_one_line() -> None:
 
 
 def preflight(args: argparse.Namespace) -> argparse.Namespace:
-    """Validate the command line (``args``: ``gyrolab run``'s options, ``gyrolab.app.parser.run_parser``) before
-    Hydra creates any output directory; the options Hydra should run (``+group=x`` may become ``group=x``).
+    """Validate the command line (``args``: ``gyrolab run``'s options) before Hydra creates any output directory;
+    the options Hydra should run (``+group=x`` may become ``group=x``).
 
-    The config is composed exactly as Hydra will compose it (the same search path,
-    primary config and overrides, from a user's ``--config-dir`` too; inside ``main``, Hydra's run is
-    then served from this composition, ``gyrolab.compat.composing_once``), checked by
-    ``gyrolab.engine.safety`` (no config can run code), against the schema (unknown
-    keys, types), the budget, and the scene's own validation. For a plain run the scene it builds is the one
-    the run integrates (``take_prepared``).
+    The config is composed exactly as Hydra will compose it (Hydra's run is then served from this composition,
+    ``gyrolab.compat.composing_once``), checked by ``gyrolab.engine.safety`` (no config can run code), against the
+    schema, the budget, and the scene's own validation. For a plain run the scene it builds is the one the run
+    integrates (``take_prepared``).
     """
     if args.experimental_rerun is not None:  # Hydra unpickles the file: whoever wrote it runs code as you
         raise ConfigError(f"--experimental-rerun {shorten(args.experimental_rerun)} would load a pickle, which runs "
@@ -218,11 +216,8 @@ def accuracy_notes(configs: Sequence[DictConfig], overrides: Sequence[str]) -> l
 
 
 def _output_dir_text(cfg: DictConfig, mode: str) -> str:
-    """``hydra.run.dir`` (or ``hydra.sweep.dir``) resolved as Hydra will resolve it, or one sentence why not.
-
-    ``${hydra:...}`` needs the Hydra config registered, as it is inside the run; a key that only
-    exists once the job runs (``hydra.runtime.*``) cannot name the directory before it exists.
-    """
+    """``hydra.run.dir`` (or ``hydra.sweep.dir``) resolved as Hydra will resolve it (``${hydra:...}`` needs the Hydra
+    config registered), or one sentence why not (``hydra.runtime.*`` exists only once the job runs)."""
     key = f"hydra.{mode}.dir"
     try:
         HydraConfig.instance().set_config(copy.deepcopy(cfg))  # set_config marks its argument read-only
@@ -236,11 +231,7 @@ def _output_dir_text(cfg: DictConfig, mode: str) -> str:
 
 def _plus_group_as_override(source: ConfigSource, argv: list[str], overrides: Sequence[Override]) -> list[str]:
     """The overrides ``argv`` with ``+experiment=mine`` as ``experiment=mine`` when the primary config already lists
-    the group.
-
-    Hydra refuses to add a group its defaults list has (``experiment: null`` in gyrolab's
-    config.yaml); both spellings are common, so both select the option.
-    """
+    the group: Hydra refuses to add a group its defaults list has; both spellings are common."""
     adds = [o for o in overrides if o.is_add() and o.key_or_group in SELECTABLE_GROUPS and o.package is None]
     if not adds:
         return argv
@@ -444,13 +435,8 @@ def _only_hydras_files(out_dir: Path) -> bool:
 
 
 def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None, figures: bool = True) -> Path:
-    """Run the scene, write ``run.nc`` (and figures) in ``out_dir``; GyrolabError on bad input or a failed run.
-
-    ``figures=False`` (a multirun's jobs unless ``output.job_figures``): the scene's figures are not drawn.
-
-    ``out_dir`` is locked meanwhile (a second run into it is refused in one sentence) and cleared of
-    the temporary files that killed writes left there (``gyrolab.output.lock.writing_in``).
-    """
+    """Run the scene, write ``run.nc`` (and, unless ``figures=False``, figures) in ``out_dir``, locked meanwhile and
+    cleared of what killed writes left (``writing_in``); GyrolabError on bad input or a failed run."""
     with writing_in(out_dir):
         return _run_locked(cfg, out_dir, job_id, figures)
 
@@ -516,11 +502,8 @@ def run_subcommand(command: str, args: argparse.Namespace) -> int:
 
 
 def absolute_config_path(args: argparse.Namespace) -> argparse.Namespace:
-    """``args`` with a relative ``--config-path`` made absolute from the working directory.
-
-    Hydra reads a relative --config-path against the folder of the app's source file,
-    which is inside the installed package; a user means the working directory.
-    """
+    """``args`` with a relative ``--config-path`` made absolute from the working directory (Hydra reads it against
+    the folder of the app's source file, inside the installed package; a user means the working directory)."""
     path = args.config_path
     if path and not path.startswith("pkg://"):
         args.config_path = os.path.abspath(path)

@@ -74,15 +74,9 @@ def _conform_variable(ds: xr.Dataset, name: Any) -> None:
 
 
 def unit_attributes(body: Any) -> dict[str, Any]:
-    """Machine-readable model units of ``body`` (netCDF-safe global attributes).
-
-    ``time_unit``/``rate_unit``/``energy_unit``: what one model unit of time, angular rate and
-    energy is (``s``, ``rad/s``, ``J`` for an SI body; ``1/c``, ``c``, ``C c2`` in the papers'
-    nondimensional form, c² = M g ℓ / C). An SI fixed-point body also gives the papers' scales in
-    SI: ``time_scale_s`` = 1/c and ``energy_scale_J`` = C c², so t/time_scale_s and
-    E/energy_scale_J are the papers' nondimensional time and energy. A nondimensional body is
-    scale-free: it has no SI scale, and says so in ``time_unit_description``.
-    """
+    """Machine-readable model units of ``body`` (netCDF-safe global attributes): ``time_unit``, ``rate_unit``,
+    ``energy_unit``, ``time_unit_description`` and, for an SI fixed-point body, the papers' scales ``time_scale_s``
+    = 1/c and ``energy_scale_J`` = C c² (docs/datasets.md, "Conventions common to every dataset")."""
     time_label, rate_label = body.time_label, body.rate_label
     si = body.units == "si"
     attrs: dict[str, Any] = {"time_unit": time_label, "rate_unit": rate_label}
