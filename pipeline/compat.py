@@ -272,17 +272,9 @@ def composing_once() -> Iterator[CompositionMemo]:
 # ``dask.array``, and ``utils.is_dask_collection``, which imports ``dask.base``), and asks Dask's scheduler whether
 # to close the file after every write (``writers._get_netcdf_autoclose``) and which write lock to take
 # (``locks.get_write_lock``, which imports ``distributed``). A guard in front of each gives Dask's or xarray's own
-# answer without the import where the answer cannot depend on Dask, and asks otherwise:
-#
-# * ``array_type("dask")`` while ``dask.array`` is not imported: no object can be an instance of its ``Array``
-#   class, so there is no type to test against (``()``, xarray's answer without Dask);
-# * ``is_dask_collection(x)`` for an ``x`` without a ``__dask_graph__`` method: False (Dask's first test);
-# * autoclose for a dataset without chunks: False (xarray: ``have_chunks and ...``);
-# * the write lock while ``distributed`` is not imported (so no Dask client exists) and Dask's config names no
-#   scheduler: xarray's threaded lock (what it takes without Dask and under Dask's default).
-#
-# Once Dask is in use (a batch on a Dask scheduler, a chunked dataset), xarray decides as before. An xarray
-# without one of these functions keeps it unguarded.
+# answer without the import where the answer cannot depend on Dask (each guard says why), and asks otherwise: once
+# Dask is in use (a batch on a Dask scheduler, a chunked dataset), xarray decides as before. An xarray without one
+# of these functions keeps it unguarded.
 
 _GUARD = "_gyrolab_scheduler_guard"
 
