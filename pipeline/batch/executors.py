@@ -20,17 +20,13 @@ from collections.abc import Callable, Iterable
 from importlib.util import find_spec
 from typing import Any, TypeVar
 
-from gyrolab.batch import scheduler as scheduler_module
+from gyrolab.batch.scheduler import CONNECT_TIMEOUT, IN_PROCESS, LOCAL, probe
 from gyrolab.errors import ConfigError, GyrolabError, OutputError, shorten
 from gyrolab.output.atomic import reason
 
 Task = TypeVar("Task")
 Result = TypeVar("Result")
 
-IN_PROCESS = scheduler_module.IN_PROCESS
-LOCAL = scheduler_module.LOCAL
-#: seconds to wait for a scheduler to answer before saying it cannot be reached
-CONNECT_TIMEOUT = scheduler_module.CONNECT_TIMEOUT
 #: chunks submitted per worker thread at a time: one running, one queued (memory: a few chunks per worker)
 CHUNKS_PER_THREAD = 2
 #: the errnos of a write that failed for want of space: a chunk failing so is a full disk (exit 3), not a bug
@@ -113,7 +109,7 @@ def _client(kind: str, scheduler: str, source: str) -> Any:
                                dashboard_address=None, silence_logs=logging.ERROR, env=dict(WORKER_ENV),
                                local_directory=str(scratch))
         return Client(cluster, set_as_default=False)
-    scheduler_module.probe(scheduler, source, CONNECT_TIMEOUT)
+    probe(scheduler, source, CONNECT_TIMEOUT)
     try:
         return Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError) as error:

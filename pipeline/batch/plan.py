@@ -259,7 +259,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
         log.warning("%s", ignored)
         attributes[ACCURACY_IGNORED_ATTRIBUTE] = ignored
     return Plan(dims=dims, names=dim_names(dims), plain=plain, base=base, times=times, y0=y0, combo=combo,
-                combo_values=combo_values, combo_params=combo_params, error=errors.index, messages=errors.messages,
+                combo_values=combo_values, combo_params=combo_params, error=errors.index, messages=list(errors.codes),
                 attributes=attributes, points=points,
                 systems={c: built.system for c, built in systems.items()})
 
@@ -349,17 +349,10 @@ class _Errors:
 
     def __init__(self, n: int) -> None:
         self.index = np.full(n, -1, dtype=np.int32)
-        self.messages: list[str] = []
-        self._known: dict[str, int] = {}
-
-    def code(self, message: str) -> int:
-        if message not in self._known:
-            self._known[message] = len(self.messages)
-            self.messages.append(message)
-        return self._known[message]
+        self.codes: dict[str, int] = {}   # message -> its index, in order of first appearance
 
     def set(self, where: np.ndarray | int, message: str) -> None:
-        self.index[where] = self.code(message)
+        self.index[where] = self.codes.setdefault(message, len(self.codes))
 
     @property
     def failed(self) -> np.ndarray:

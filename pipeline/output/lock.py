@@ -189,21 +189,17 @@ def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
 def _open_lock_file(path: Path, create: bool) -> tuple[int | None, bool]:
     """(an fd on ``path``, whether this call created the file); (None, False) when it is gone and not to be
     created."""
+    if not create:
+        try:
+            return open_own_file(path, os.O_RDWR), False
+        except FileNotFoundError:
+            return None, False
     while True:
         try:
-            if not create:
+            return open_own_file(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644), True
+        except FileExistsError:
+            with contextlib.suppress(FileNotFoundError):  # removed between the two opens: again
                 return open_own_file(path, os.O_RDWR), False
-            try:
-                return open_own_file(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644), True
-            except FileExistsError:
-                try:
-                    return open_own_file(path, os.O_RDWR), False
-                except FileNotFoundError:
-                    continue  # removed between the two opens: again
-        except FileNotFoundError:
-            if not create:
-                return None, False
-            raise
 
 
 def _write_owner(fd: int, created: bool, info: os.stat_result) -> None:

@@ -214,12 +214,10 @@ def _check_keys(node: yaml.MappingNode, where: str) -> None:
         if not isinstance(k, yaml.ScalarNode):
             raise ConfigError(f"{where}, line {k.start_mark.line + 1}: a key is a list or a mapping; keys of a "
                               "config are plain names")
-        if isinstance(k, yaml.ScalarNode):
-            if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
-                raise ConfigError(f"{where}, line {k.start_mark.line + 1}: the key {shorten(k.value, 60)!r} "
-                                  f"is given twice in one mapping (first on line {seen[k.value]}); "
-                                  "give each key once")
-            seen[k.value] = k.start_mark.line + 1
+        if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
+            raise ConfigError(f"{where}, line {k.start_mark.line + 1}: the key {shorten(k.value, 60)!r} "
+                              f"is given twice in one mapping (first on line {seen[k.value]}); give each key once")
+        seen[k.value] = k.start_mark.line + 1
 
 
 def _children(node: yaml.Node) -> list[yaml.Node]:
