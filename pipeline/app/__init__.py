@@ -66,7 +66,7 @@ from gyrolab.output.dataset import write_dataset
 from gyrolab.output.lock import LOCK_NAME, release_all, writing_in
 from gyrolab.output.provenance import gyrolab_version
 from gyrolab.output.trust import check_kernel_cache, check_tree
-from gyrolab.output.written import announce_written
+from gyrolab.output.written import announce_written, fail
 from gyrolab.sweep import callbacks
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
@@ -77,11 +77,6 @@ if TYPE_CHECKING:
     from gyrolab.sweep.aggregate import SweepSummary
 
 log = logging.getLogger("gyrolab")
-
-
-def fail(error: GyrolabError) -> None:
-    print(f"gyrolab: error: {error}", file=sys.stderr)
-    sys.exit(error.exit_code)
 
 
 def show_warnings_in_one_line() -> None:

@@ -89,19 +89,14 @@ def _prefixes(key: str, groups: Sequence[str]) -> list[str]:
     return [".".join(parts[:n]) + "." for n in range(1, len(parts)) if n > 1 or parts[0] not in groups]
 
 
-def option_words() -> dict[str, list[str]]:
-    """Each subcommand's options (``run``: Hydra's and the old spellings)."""
-    options = {"run": run_options()}
-    for name, parser in build_parsers().items():
-        options[name] = [s for action in parser._actions for s in action.option_strings]
-    return options
-
-
 def script(shell: str) -> str:
     """The completion script for ``shell`` (bash, or zsh through its bash compatibility)."""
     if shell not in SHELLS:
         raise ConfigError(f"no completion for shell {shell!r}; valid choices: {', '.join(SHELLS)}")
-    options = option_words()
+    parsers = build_parsers()
+    # each subcommand's options (run: Hydra's and the old spellings)
+    options = {"run": run_options(), **{name: [s for action in parser._actions for s in action.option_strings]
+                                        for name, parser in parsers.items()}}
     config = config_words()
     plot_words = [w for w in config if w.startswith("output.")]
     lines = [
@@ -117,7 +112,7 @@ def script(shell: str) -> str:
         f"_gyrolab_config={_quote(chr(10).join(config))}",
         f"_gyrolab_plot_config={_quote(chr(10).join(plot_words))}",
         f"_gyrolab_path_commands={_quote(' '.join(PATH_COMMANDS))}",
-        f"_gyrolab_value_options={_quote(' '.join(sorted(value_options({'run': run_parser(), **build_parsers()}))))}",
+        f"_gyrolab_value_options={_quote(' '.join(sorted(value_options({'run': run_parser(), **parsers}))))}",
     ]
     for name, words in options.items():
         lines.append(f"_gyrolab_options_{name.replace('-', '_')}={_quote(chr(10).join(words))}")

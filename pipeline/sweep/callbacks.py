@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import functools
 import logging
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +19,7 @@ from gyrolab.errors import GyrolabError, OutputError
 from gyrolab.output.atomic import reason
 from gyrolab.output.lock import lock, unlock
 from gyrolab.output.trust import check_output_target, own_dir
+from gyrolab.output.written import fail
 from gyrolab.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.orphans import announce_launcher, forget_launcher
@@ -62,8 +62,7 @@ class SweepCallback(Callback):
         try:
             lock(run_dir)
         except GyrolabError as error:
-            print(f"gyrolab: error: {error}", file=sys.stderr)
-            sys.exit(error.exit_code)
+            fail(error)
         self._locked = run_dir
 
     def on_run_end(self, config: DictConfig, **kwargs: Any) -> None:

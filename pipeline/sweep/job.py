@@ -21,9 +21,9 @@ from gyrolab.sweep.record import (
     ELSEWHERE,
     FAILED,
     FINISHED,
+    RECORD_NAME,
     JobRecord,
     read_record,
-    remove_record,
     write_record,
 )
 
@@ -83,7 +83,7 @@ def _run_locked(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_nu
     if previous is not None and previous.reusable_for(job_id, job_dir):
         log.info("job %s: %s earlier (job id %s); skipped", job_num, previous.status, job_id)
         return mark_skipped(job_dir, previous, job_num, overrides)
-    remove_record(job_dir)  # a stale record (other config or code) must not outlive this attempt
+    (job_dir / RECORD_NAME).unlink(missing_ok=True)  # no stale record (other config or code) outlives this try
     base = JobRecord(job_id=job_id, status=FAILED, overrides=list(overrides), code_version=code, job_num=job_num)
     try:
         path = work(job_id)

@@ -80,10 +80,6 @@ def read_record(job_dir: Path) -> JobRecord | None:
     return record
 
 
-def remove_record(job_dir: Path) -> None:
-    (Path(job_dir) / RECORD_NAME).unlink(missing_ok=True)
-
-
 def record_paths(sweep_dir: Path) -> Iterator[Path]:
     """Every job record under ``sweep_dir``, skipping hidden folders (.hydra, .submitit)."""
     for root, dirs, files in os.walk(sweep_dir):

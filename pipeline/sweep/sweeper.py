@@ -17,7 +17,6 @@ import dataclasses
 import logging
 import os
 import re
-import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -37,6 +36,7 @@ from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.lock import try_lock, unlock
 from gyrolab.output.trust import check_tree, private_dir
+from gyrolab.output.written import fail
 from gyrolab.sweep.aggregate import SWEEP_NAME, stored_hydra
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import code_version, job_identity
@@ -80,8 +80,7 @@ class ResumingSweeper(Sweeper):
         try:
             claim(sweep_dir, self.config)
         except GyrolabError as error:  # as the sweep callback refuses a directory in use: one sentence
-            print(f"gyrolab: error: {error}", file=sys.stderr)
-            sys.exit(error.exit_code)
+            fail(error)
 
         tic = time.perf_counter()
         settled, unsure = check_jobs(self.config, self.hydra_context.config_loader, jobs)
