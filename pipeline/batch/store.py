@@ -209,10 +209,9 @@ class Store:
         system = _reference_system(plan)
         if plan.points is not None:
             nc.createDimension(POINT, plan.size)
-            var = nc.createVariable(POINT, "i4", (POINT,))
-            var[:] = np.arange(plan.size, dtype=np.int32)
-            var.setncatts({"long_name": "index of the point in the batch's list (a points file's data row, from 0)",
-                           "units": "1"})
+            _variable(nc, POINT, POINT, np.arange(plan.size, dtype=np.int32),
+                      {"long_name": "index of the point in the batch's list (a points file's data row, from 0)",
+                       "units": "1"})
         for name, dim in zip(plan.names, plan.dims):
             if plan.points is None:
                 nc.createDimension(name, len(dim.values))
@@ -221,13 +220,8 @@ class Store:
                 values = values.astype(np.int32) if np.abs(values).max() < 2**31 else values.astype(np.float64)
             attrs = {"long_name": f"swept parameter {dim.key}" + (" of each point" if plan.points else ""),
                      "override_key": dim.key, **_key_units(dim.key, system)}
-            along = POINT if plan.points is not None else name
-            if values.dtype.kind == "O":
-                _text_variable(nc, name, along, values, attrs)
-            else:
-                var = nc.createVariable(name, values.dtype, (along,))
-                var[:] = values
-                var.setncatts(attrs)
+            (_text_variable if values.dtype.kind == "O" else _variable)(
+                nc, name, POINT if plan.points is not None else name, values, attrs)
         nc.createDimension("error_kind", len(self.messages))
         _text_variable(nc, "error_message", "error_kind", self.messages,
                        {"long_name": "the one-sentence errors of the failed points (job_error indexes them)"})
@@ -273,9 +267,8 @@ class Store:
 
         if dim == "time":
             times = output_times(self.plan.times, self.settings.output, self.settings.decimate)
-            var = self.nc.createVariable("time", "f8", ("time",))
-            var[:] = times
-            var.setncatts(time_attributes(system.body) if system is not None else {"long_name": "time", "axis": "T"})
+            _variable(self.nc, "time", "time", times,
+                      time_attributes(system.body) if system is not None else {"long_name": "time", "axis": "T"})
         elif dim == "axis" and size == 3:
             _text_variable(self.nc, "axis", "axis", ["x", "y", "z"], {"units": "1", "long_name": "principal body axis"})
 
@@ -309,6 +302,12 @@ class Store:
             if value is not None:
                 attrs[key] = int(value) if isinstance(value, (bool, np.bool_)) else value
         return attrs
+
+
+def _variable(nc: netCDF4.Dataset, name: str, dim: str, values: np.ndarray, attrs: dict[str, Any]) -> None:
+    var = nc.createVariable(name, values.dtype, (dim,))
+    var[:] = values
+    var.setncatts(attrs)
 
 
 def _text_variable(nc: netCDF4.Dataset, name: str, dim: str, values: Any, attrs: dict[str, Any]) -> None:

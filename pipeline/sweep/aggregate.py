@@ -95,9 +95,7 @@ class SweepSummary:
 
 
 def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
-    """The sweep dataset of ``grid`` from ``results[n]``, the outcome of job ``n``."""
-    if len(results) != len(grid.jobs):
-        raise ValueError(f"{len(results)} results for a grid of {len(grid.jobs)} jobs")
+    """The sweep dataset of ``grid`` from ``results[n]``, the outcome of job ``n`` (one per job)."""
     done = [(grid.index[n], r.dataset) for n, r in enumerate(results) if r.status == FINISHED]
     names = _dim_names(grid, [ds for _, ds in done])
     grid_dims = tuple(names)

@@ -73,13 +73,9 @@ def job_identity(cfg: DictConfig | dict[str, Any], code: str | None = None) -> s
 def _targets(node: Any) -> set[str]:
     """Every ``_target_`` string in a plain config."""
     if isinstance(node, dict):
-        found = {str(node["_target_"])} if isinstance(node.get("_target_"), str) else set()
-        for value in node.values():
-            found |= _targets(value)
-        return found
-    if isinstance(node, list):
-        return set().union(*(_targets(value) for value in node)) if node else set()
-    return set()
+        own = {str(node["_target_"])} if isinstance(node.get("_target_"), str) else set()
+        return own.union(*map(_targets, node.values()))
+    return set().union(*map(_targets, node)) if isinstance(node, list) else set()
 
 
 @cache
