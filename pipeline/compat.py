@@ -91,8 +91,6 @@ def hydra_argv(args: argparse.Namespace) -> list[str]:
     return [*words, *args.overrides]
 
 
-# --- one composition per command (Hydra 1.3) ---
-
 @dataclass
 class Skeleton:
     """The config Hydra merged from one defaults list, before any value override, and what goes with it."""
@@ -266,8 +264,6 @@ def composing_once() -> Iterator[CompositionMemo]:
         active = None
 
 
-# --- writes without Dask (xarray) ---
-#
 # xarray's string coder asks whether a char array is a Dask array (``pycompat.array_type("dask")``, which imports
 # ``dask.array``, and ``utils.is_dask_collection``, which imports ``dask.base``), and asks Dask's scheduler whether
 # to close the file after every write (``writers._get_netcdf_autoclose``) and which write lock to take

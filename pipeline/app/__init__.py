@@ -540,12 +540,10 @@ def shell_completion(args: argparse.Namespace) -> int:
 def main() -> None:
     """Console entry point ``gyrolab`` (also ``python -m gyrolab``): the subcommand named on the command line
     (``gyrolab.app.parser``), by default ``run``, Hydra's app (preflight, then ``_task``)."""
-    # The interpreter's last garbage collection walks every object numba, scipy, xarray and Hydra created:
-    # ~1 s of every command's wall time (0.1 s after a freeze, measured). Files are closed explicitly, so
-    # nothing needs that collection's finalisers.
+    # the interpreter's last garbage collection walks every object numba, scipy, xarray and Hydra created (files are
+    # closed explicitly, so none of its finalisers is needed), and what the imports built lives until exit: frozen,
+    # neither is walked again (docs/batch.md, "Scaling")
     atexit.register(gc.freeze)
-    # What the imports built lives until exit, so no collection during the command need walk it again (−0.07 CPU s
-    # of the default run, measured).
     gc.freeze()
     show_warnings_in_one_line()
     quiet_logging_failures()

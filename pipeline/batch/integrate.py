@@ -55,10 +55,9 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
         raise ConfigError(f"initial_states has shape {y0s.shape}; it must be (trajectories, {size})")
     compiled = scene.system.compiled_model()
     integrator = scene.integrator
-    # An integrator that chooses its method (auto) chooses once for the batch, on a few of its trajectories
-    # (its choose_batch_method: the tightest of their choices), and runs that choice's vectorised kernel over all
-    # of them; one run per trajectory in Python cost ~23x the CPU. Only a choice asked to be free to leave double
-    # precision per trajectory (auto's integrator.extended_precision=true) keeps one run, and one choice, per trajectory.
+    # An integrator that chooses its method (auto) chooses once for the batch (choose_batch_method) and runs that
+    # choice's vectorised kernel over all trajectories, unless asked to be free to leave double precision per
+    # trajectory (auto's integrator.extended_precision=true): then one run, and one choice, per trajectory.
     per_point = integrator.supports(CHOOSES_METHOD) and getattr(integrator, "per_trajectory", False)
     if not integrator.supports(BATCH_KERNEL) or per_point or compiled is None:
         if params is not None:

@@ -329,9 +329,6 @@ def _combos(dims: Sequence[Dim], axes: Sequence[tuple[list[Any], np.ndarray]], n
     return combo.astype(np.int32).ravel(), combo_values
 
 
-# ----------------------------------------------------------------------------- pieces
-
-
 @dataclass
 class _Built:
     system: Any

@@ -251,8 +251,6 @@ def plan_tasks(plan: Plan, settings: Settings) -> list[ChunkTask]:
     return [task for task in tasks if task is not None]
 
 
-# ----------------------------------------------------------------------------- in a worker
-
 _CONTEXTS: dict[str, Any] = {}
 
 
@@ -348,9 +346,6 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
     return ChunkResult(index=task.index, outputs=merge_rows(outputs, task.rows, task.n_rows), failed=all_failed,
                        kernel_time=kernel_time, wall_time=time.perf_counter() - start, settings=settings,
                        first_in_process=first)
-
-
-# ----------------------------------------------------------------------------- progress
 
 
 class _Progress:

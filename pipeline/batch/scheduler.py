@@ -93,9 +93,6 @@ def _dask_configured() -> str:
     return str(dask.config.get("scheduler-address", None) or "").strip()
 
 
-# ----------------------------------------------------------------------------- is the peer a scheduler?
-
-
 def probe(address: str, source: str, timeout: float = CONNECT_TIMEOUT) -> None:
     """ConfigError in one sentence unless a Dask scheduler greets us at ``address`` within ``timeout`` s.
 

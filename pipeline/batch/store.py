@@ -48,7 +48,6 @@ class Store:
         #: the integrator's settings every chunk ran with (``auto``: its choice for the batch), as attributes
         self.integrator_attributes: dict[str, Any] = {}
 
-    # -- opening: new, resumed or already complete ---------------------------------------------------
     def open(self) -> set[int] | None:
         """The chunks already stored (a resumed run), or None when ``path`` holds this batch complete."""
         if self.path.exists():
@@ -121,7 +120,6 @@ class Store:
             with contextlib.suppress(OSError, RuntimeError):   # the write failed; the journal says what is whole
                 nc.close()
 
-    # -- writing ----------------------------------------------------------------------------------------
     def chunk_done(self, index: int, chunk: Any, result: Any) -> None:
         """Store a chunk's result (None: a chunk without a valid point) and journal it; OutputError (the
         journaled chunks kept) when a write fails."""
@@ -186,7 +184,6 @@ class Store:
         data = np.asarray(data)
         self.nc[name][chunk.slab] = data.reshape(chunk.shape + data.shape[1:])
 
-    # -- creating ------------------------------------------------------------------------------------------
     def _create(self, result: Any) -> None:
         """Create ``.part`` whole (every variable's storage allocated); a failure leaves neither it nor a journal
         (nothing was finished), so the rerun starts cleanly."""

@@ -91,9 +91,6 @@ class SweepSummary:
     figures: list[Path] = field(default_factory=list)
 
 
-# ----------------------------------------------------------------------------- assembling
-
-
 def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
     """The sweep dataset of ``grid`` from ``results[n]``, the outcome of job ``n`` (one per job)."""
     done = [(grid.index[n], r.dataset) for n, r in enumerate(results) if r.status == FINISHED]
@@ -341,9 +338,6 @@ def _same(a: Any, b: Any) -> bool:
 
 def _all_same(values: Sequence[Any]) -> bool:
     return all(_same(v, values[0]) for v in values[1:])
-
-
-# ----------------------------------------------------------------------------- from a sweep directory
 
 
 def collect(sweep_dir: Path, grid: Grid) -> list[JobResult]:
