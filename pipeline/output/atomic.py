@@ -77,18 +77,12 @@ def atomic_path(path: str | os.PathLike[str], *, expected_bytes: int | None = No
         os.chmod(tmp, 0o666 & ~umask())  # mkstemp makes the file private; results are ordinary files
         os.replace(tmp, path)
         _fsync_directory(path.parent)
-    except OutputError:
+    except BaseException as error:  # the temporary file goes; a failed write (not bad content) is one sentence
+        failed_write = not isinstance(error, OutputError) and (isinstance(error, OSError) or _library_failure(error))
+        why = diagnose(error, tmp, expected_bytes) if failed_write else ""
         tmp.unlink(missing_ok=True)
-        raise
-    except (OSError, RuntimeError) as error:
-        if not isinstance(error, OSError) and not _library_failure(error):
-            tmp.unlink(missing_ok=True)
-            raise
-        why = diagnose(error, tmp, expected_bytes)
-        tmp.unlink(missing_ok=True)
-        raise OutputError(f"cannot write {str(path)!r}: {why}") from None
-    except BaseException:
-        tmp.unlink(missing_ok=True)
+        if failed_write:
+            raise OutputError(f"cannot write {str(path)!r}: {why}") from None
         raise
 
 

@@ -353,32 +353,27 @@ def collect(sweep_dir: Path, grid: Grid) -> list[JobResult]:
         key, mtime = tuple(record.overrides), path.stat().st_mtime
         if key not in found or found[key][0] < mtime:  # a stale copy elsewhere: the newest record wins
             found[key] = (mtime, path.parent, record)
-    results = []
-    for job in grid.jobs:
-        if job not in found:
-            results.append(JobResult())
-            continue
-        _, job_dir, record = found[job]
-        where = job_dir.relative_to(sweep_dir).as_posix()
-        common = {"job_id": record.job_id, "job_dir": where, "skipped": record.skipped}
-        if record.status == FAILED:
-            results.append(JobResult(FAILED, error=record.error, error_type=record.error_type,
-                                     exit_code=record.exit_code, **common))
-            continue
-        try:
-            ds = load_dataset(job_dir / str(record.run), "a run.nc that gyrolab wrote", decode_times=False,
-                              decode_timedelta=False)
-        except ConfigError as error:
-            log.warning("job %s: %s; counted as missing", where, error)
-            results.append(JobResult())
-            continue
-        if ds.attrs.get("job_id") != record.job_id:
-            log.warning("job %s: its dataset belongs to another job (id %s, record %s); counted as missing",
-                        where, ds.attrs.get("job_id"), record.job_id)
-            results.append(JobResult())
-            continue
-        results.append(JobResult(FINISHED, dataset=ds, **common))
-    return results
+    return [_result(sweep_dir, *found[job][1:]) if job in found else JobResult() for job in grid.jobs]
+
+
+def _result(sweep_dir: Path, job_dir: Path, record: JobRecord) -> JobResult:
+    """How the job of ``record`` ended: failed, finished with its dataset, or missing (a dataset that is not its)."""
+    where = job_dir.relative_to(sweep_dir).as_posix()
+    common = {"job_id": record.job_id, "job_dir": where, "skipped": record.skipped}
+    if record.status == FAILED:
+        return JobResult(FAILED, error=record.error, error_type=record.error_type, exit_code=record.exit_code,
+                         **common)
+    try:
+        ds = load_dataset(job_dir / str(record.run), "a run.nc that gyrolab wrote", decode_times=False,
+                          decode_timedelta=False)
+    except ConfigError as error:
+        log.warning("job %s: %s; counted as missing", where, error)
+        return JobResult()
+    if ds.attrs.get("job_id") != record.job_id:
+        log.warning("job %s: its dataset belongs to another job (id %s, record %s); counted as missing",
+                    where, ds.attrs.get("job_id"), record.job_id)
+        return JobResult()
+    return JobResult(FINISHED, dataset=ds, **common)
 
 
 def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: bool | None = None,
