@@ -1,13 +1,11 @@
-"""Shell completion for bash and zsh: ``eval "$(gyrolab completion bash)"`` (or ``zsh``).
+"""Shell completion for bash and zsh: ``eval "$(gyrolab completion bash)"`` (or ``zsh``; also Hydra's spelling
+``gyrolab --shell-completion install=bash``, since Hydra's own completion cannot see an installed app's
+subcommands).
 
-The script carries every word it can offer, computed once when it is generated (so a TAB costs no
-Python start-up): the subcommands, each subcommand's options, the config groups with their options
-(``integrator=`` then ``integrator=taylor``), the config's keys one level at a time (``time.`` then
-``time.end=``) and ``true``/``false`` for boolean keys. ``gyrolab --shell-completion install=bash``
-(Hydra's spelling) prints the same script: Hydra's own completion cannot see an installed console script's
-app, nor gyrolab's subcommands. Generate the script again after installing a plugin. The options of a config
-group in the folder a command line names with ``--config-dir DIR`` (``DIR/experiment/*.yaml``, ...) are read by
-the shell when TAB is pressed, so a user's own experiments are offered without generating anything.
+The script carries every word it can offer, computed once when it is generated (a TAB costs no Python start-up):
+the subcommands and their options, the config groups with their options, the config's keys one level at a time
+and ``true``/``false`` for boolean keys; generate it again after installing a plugin. A group's options in the
+folder of ``--config-dir DIR`` are read by the shell when TAB is pressed.
 """
 
 from __future__ import annotations

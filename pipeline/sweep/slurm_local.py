@@ -33,6 +33,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from gyrolab.output.trust import proc_number
 from gyrolab.sweep.orphans import alive  # a zombie (dead, not reaped) counts as dead
 
 PACKAGES = ("slurm-wlm", "munge")
@@ -195,7 +196,7 @@ def slurm_conf(directory: Path, node: str) -> str:
     """A minimal slurm.conf for one node, this host, everything under ``directory``."""
     controller_port, node_port = _free_ports(2)
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    memory = max(512, _mem_total_mib() - MEMORY_MARGIN_MIB)
+    memory = max(512, (proc_number("/proc/meminfo", "MemTotal:") or 2048 * 1024) // 1024 - MEMORY_MARGIN_MIB)
     return f"""\
 # written by gyrolab.sweep.slurm_local for one cluster
 ClusterName=gyrolabtest
@@ -325,20 +326,11 @@ def _free_ports(count: int) -> list[int]:
         return [probe.getsockname()[1] for probe in probes]
 
 
-def _mem_total_mib() -> int:
-    for line in Path("/proc/meminfo").read_text().splitlines():
-        if line.startswith("MemTotal:"):
-            return int(line.split()[1]) // 1024
-    return 2048
-
-
 def _sbin_path() -> str:
     """PATH with the sbin directories (the daemons live there; a non-login root shell may lack them)."""
     parts = os.environ.get("PATH", "").split(os.pathsep)
     return os.pathsep.join(parts + [d for d in ("/usr/sbin", "/sbin", "/usr/local/sbin") if d not in parts])
 
-
-# -- the command line: start (in a background process that holds the cluster), status, stop ----------------------
 
 def _hold(base: Path | None) -> int:
     """Start a cluster, tell the parent on stdout, then keep it until SIGTERM, SIGINT or SIGHUP."""
