@@ -43,18 +43,11 @@ from gyrolab.app.parser import parse_command_line, run_parser
 from gyrolab.batch.scheduler import check_configured, use_command_line_scheduler
 from gyrolab.compat import composing_once, install_dask_free_writes, run_hydra
 from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
-from gyrolab.engine.config import (
-    SELECTABLE_GROUPS,
-    ConfigSource,
-    check_scene_config,
-    compose_config,
-    group_options,
-    hydra_for,
-    register_plugin_configs,
-    use_source,
-)
+from gyrolab.engine.config import (SELECTABLE_GROUPS, ConfigSource, check_scene_config, compose_config, group_options,
+                                   hydra_for, register_plugin_configs, use_source)
 from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
 from gyrolab.engine.safety import check_config, check_output_dir
+from gyrolab.engine.schemas import REQUIRED_SECTIONS  # sections every run needs, with a key to show
 from gyrolab.engine.scene import Scene
 from gyrolab.engine.unread import ACCURACY, given_keys, ignored_accuracy, unread_accuracy
 from gyrolab.engine.unread import refusal as unread_refusal
@@ -269,8 +262,6 @@ def parse_overrides(texts: Sequence[str]) -> list[Override]:
 OVERRIDE_FORMS = "key=value (time.end=50), group=option (integrator=rk4), +key=value (add), ~key (delete)"
 MAX_OVERRIDE_CHARS = 10_000
 MAX_KEY_CHARS = 200
-#: sections every run needs, with a key to show in the message
-from gyrolab.engine.schemas import REQUIRED_SECTIONS  # noqa: E402  (derived from the schemas)
 
 
 def _job_overrides(overrides: Sequence[Override], chosen: dict[int, str]) -> list[str]:

@@ -17,14 +17,8 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.app.parser import ALIASES, COMMANDS, build_parsers, run_parser, value_options
 from gyrolab.compat import get_args_parser
-from gyrolab.engine.config import (
-    CONFIG_MODULE,
-    SELECTABLE_GROUPS,
-    compose_config,
-    group_options,
-    hydra_for,
-    register_plugin_configs,
-)
+from gyrolab.engine.config import (CONFIG_MODULE, SELECTABLE_GROUPS, compose_config, group_options, hydra_for,
+                                   register_plugin_configs)
 from gyrolab.errors import ConfigError
 
 SHELLS = ("bash", "zsh")

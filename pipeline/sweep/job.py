@@ -17,15 +17,7 @@ from gyrolab.errors import GyrolabError, OutputError
 from gyrolab.output.lock import clear_temporaries, owner_of, try_lock, unlock
 from gyrolab.sweep.identity import code_version, job_code, job_identity
 from gyrolab.sweep.orphans import guard_worker
-from gyrolab.sweep.record import (
-    ELSEWHERE,
-    FAILED,
-    FINISHED,
-    RECORD_NAME,
-    JobRecord,
-    read_record,
-    write_record,
-)
+from gyrolab.sweep.record import ELSEWHERE, FAILED, FINISHED, RECORD_NAME, JobRecord, read_record, write_record
 
 log = logging.getLogger("gyrolab.sweep")
 
