@@ -53,13 +53,9 @@ def _library_failure(error: BaseException) -> bool:
 
 @contextmanager
 def atomic_path(path: str | os.PathLike[str], *, expected_bytes: int | None = None) -> Iterator[Path]:
-    """Yield a temporary path to write; on success it is renamed to ``path``, on failure removed.
-
-    OSErrors raised while writing, and the netCDF library's "HDF error" (a full disk or a file-size
-    limit), become one ``OutputError`` naming ``path`` and the reason. ``expected_bytes``, the
-    approximate size of the finished file, lets the reason of an errno-less failure be found from
-    the free space.
-    """
+    """Yield a temporary path to write; on success it is renamed to ``path``, on failure removed, and a failed write
+    (an OSError, netCDF's "HDF error") is one ``OutputError`` naming ``path`` and the reason. ``expected_bytes``
+    (the finished file's approximate size) lets the reason of an errno-less failure be found from the free space."""
     path = Path(path)
     if path.parent.name in OWN_DIRS:
         own_dir(path.parent)  # figures/, .hydra/: a real folder, not a link out of the run directory
@@ -158,11 +154,8 @@ def _fsync_directory(directory: Path) -> None:
 
 
 def remove_stale_temporaries(directory: str | os.PathLike[str]) -> list[Path]:
-    """Remove temporary files that killed writes left in ``directory`` (not recursive).
-
-    Call it only while holding the directory's lock (``gyrolab.output.lock``): a temporary file of a
-    write in progress is indistinguishable from a stale one. Returns the files removed.
-    """
+    """Remove (and return) the temporary files that killed writes left in ``directory`` (not recursive). Only while
+    holding the directory's lock: a temporary file of a write in progress looks like a stale one."""
     removed = []
     for leftover in Path(directory).glob(f".*{TEMP_SUFFIX}"):
         with contextlib.suppress(OSError):  # gone already, or not ours to remove: nothing is lost by leaving it

@@ -37,9 +37,8 @@ FRAME_AXES = ("x_radial", "y_along_track", "z_normal")
 def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.Variable]], tuple[
         dict[str, xr.Variable], dict[str, Any]]] | None = None, integrator: Integrator | None = None) -> xr.Dataset:
     """The run dataset of ``scene`` from ``solution``; ``add`` (given the trajectory's variables) returns more
-    variables and attributes to put in while it is assembled (``Scene.run``'s error estimate): inserting a
-    variable into a built dataset aligns and merges again (~0.4 ms each). ``integrator``:
-    the one that ran, when not the scene's own (``auto`` run again aimed tighter, rule 11 of its contract)."""
+    variables and attributes to put in while it is assembled (``Scene.run``'s error estimate; cheaper than merging
+    into a built dataset). ``integrator``: the one that ran, when not the scene's own (``auto`` run again)."""
     system, integrator = scene.system, integrator or scene.integrator
     body = system.body
     # each state component contiguous (column-major): the derived variables' arithmetic runs faster, same values
@@ -112,18 +111,14 @@ def scene_attributes(scene: Scene) -> tuple[dict[str, Any], dict[str, Any]]:
 
 
 def time_attributes(body: ModelUnits) -> dict[str, str]:
-    """CF attributes of a time coordinate in ``body``'s model units: elapsed time, not a calendar date
-    (so no ``standard_name: time``, which CF reserves for ``<unit> since <epoch>``), marked as the T axis
-    (CF §4: ``axis`` identifies the time coordinate without claiming a calendar)."""
+    """CF attributes of a time coordinate in ``body``'s model units: elapsed time, not a calendar date, so the
+    T axis without ``standard_name: time`` (docs/datasets.md, "The expected CF finding")."""
     return {"units": body.time_unit, "long_name": f"time [{body.time_label}]", "axis": "T"}
 
 
 def write_dataset(ds: xr.Dataset, path: Path) -> Path:
-    """Write ``ds`` to ``path`` atomically (``gyrolab.output.atomic``).
-
-    A full disk, a quota or a file-size limit (which netCDF reports as "HDF error") is one
-    ``OutputError`` naming the file and the reason, and leaves no file at ``path``.
-    """
+    """Write ``ds`` to ``path`` atomically (``gyrolab.output.atomic``: a failed write is one ``OutputError``
+    sentence naming the file and the reason, and leaves no file at ``path``)."""
     path = Path(path)
     with atomic_path(path, expected_bytes=int(ds.nbytes)) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4")

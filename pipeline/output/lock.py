@@ -73,11 +73,8 @@ def try_lock(directory: str | os.PathLike[str], *, blocking: bool = False) -> bo
 
 
 def release_all() -> None:
-    """Release every lock this process holds and remove its lock file (the end of a command, however it ends).
-
-    A single run's directory is locked by Hydra's ``on_run_start`` callback, whose ``on_run_end`` Hydra
-    skips when the job exits with an error: without this, a failed run left its ``.gyrolab.lock``.
-    """
+    """Release every lock this process holds and remove its lock file (the end of a command, however it ends: Hydra
+    skips the callback's ``on_run_end`` when a run fails, which would leave its ``.gyrolab.lock``)."""
     for key in list(_held):
         _held[key][1] = 1
         unlock(key)
@@ -150,12 +147,9 @@ def wait_for(directory: str | os.PathLike[str]) -> None:
 
 
 def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
-    """An fd holding an exclusive flock on ``path`` (the file now in the directory), or None when busy.
-
-    The file is opened without following a link and must be a regular file (``gyrolab.output.trust``): a planted
-    ``.gyrolab.lock`` link is refused, never truncated. The owner's line is written only into a file this call
-    created, or a lock file of gyrolab's (one link, the user's, a line long).
-    """
+    """An fd holding an exclusive flock on ``path`` (the file now in the directory), or None when busy. The file is
+    opened without following a link (a planted ``.gyrolab.lock`` link is refused, never truncated); the owner's
+    line is written only into a file this call created, or a lock file of gyrolab's (``_write_owner``)."""
     while True:
         fd, created = _open_lock_file(path, create)
         if fd is None:

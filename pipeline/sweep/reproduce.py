@@ -105,12 +105,8 @@ def reproduce_sweep(path: Path, stored: xr.Dataset, points: str | None = None) -
 
 
 def stored_config(stored: xr.Dataset, where: str = "the dataset's config attribute") -> DictConfig:
-    """The config a dataset stores, read with a safe YAML loader and checked as any config is.
-
-    A dataset may come from someone else: its config is parsed without YAML tags,
-    may not contain interpolations (gyrolab stores it resolved), may name only
-    registered plugins (``gyrolab.engine.safety``) and must be within the budget.
-    """
+    """The config a dataset stores, checked as any config is: a dataset may come from someone else (no YAML tags,
+    no interpolation, registered plugins only: ``gyrolab.engine.safety``; within the budget)."""
     cfg = check_stored_config(stored.attrs["config"], where)
     plain = OmegaConf.to_container(cfg)
     time = plain.get("time")

@@ -277,11 +277,9 @@ def _write_munge_key(path: Path) -> None:
 
 
 def _kill_processes_naming(directory: Path) -> None:
-    """SIGKILL every process (not this one or its ancestors) of the cluster in ``directory``: whose command
-    line names it (the daemons), and whose environment names it and that is slurmstepd (started by slurmd
-    with its environment) or a job (``SLURM_JOB_ID``, submitted with ``SLURM_CONF`` in its environment).
-    A process that merely has ``SLURM_CONF`` set (a user's shell after ``eval "$(... start)"``, an editor
-    or a notebook started from it, ``sbatch --wait``) is not the cluster's and is left alone."""
+    """SIGKILL every process (not this one or its ancestors) of the cluster in ``directory``: whose command line
+    names it (the daemons), or whose environment names it and that is slurmstepd or a job (``SLURM_JOB_ID``); one
+    that merely has ``SLURM_CONF`` set (a user's shell after ``eval "$(... start)"``) is left alone."""
     needle = str(directory).encode()
     spared = _ancestors()
     for entry in Path("/proc").iterdir():

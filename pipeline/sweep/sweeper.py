@@ -210,12 +210,8 @@ class _Base:
 
 
 class IdentityPredictor:
-    """Job identities of a sweep's jobs as the jobs themselves will compute them (None: not predictable).
-
-    Per job it costs a few override applications and one resolution of the config, not a composition:
-    the job's value overrides that differ from the composed job's are applied to that job's config, the
-    identity computed, and the composed job's values put back.
-    """
+    """Job identities of a sweep's jobs as the jobs themselves will compute them (None: not predictable), each
+    from a composed job's config with the job's differing value overrides applied, then put back."""
 
     def __init__(self, master: DictConfig, loader: ConfigLoaderImpl) -> None:
         self.master, self.loader = master, loader
@@ -304,12 +300,8 @@ def _patched(base: _Base, changed: Sequence[Override]) -> dict[str, Any] | None:
 
 
 def register_plugin() -> None:
-    """Make sure Hydra knows gyrolab's sweeper (``hydra_plugins.gyrolab_sweeper``) in this process.
-
-    Hydra finds it by scanning the ``hydra_plugins`` namespace package, except in an editable install
-    (``pip install -e .``, the README's): setuptools' editable finder serves the package on import but cannot
-    list it, so Hydra's scan does not see it, and the class is registered here by its real name.
-    """
+    """Make sure Hydra knows gyrolab's sweeper (``hydra_plugins.gyrolab_sweeper``) in this process: in an editable
+    install setuptools' finder serves the package on import but cannot list it, so Hydra's scan misses it."""
     plugins = Plugins.instance()  # scans first: a scan re-executes the plugin modules it finds
     from hydra_plugins.gyrolab_sweeper import GyrolabSweeper  # after the scan above, which re-executes it
 
