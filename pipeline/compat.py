@@ -237,11 +237,9 @@ active: CompositionMemo | None = None
 
 @contextmanager
 def composing_once() -> Iterator[CompositionMemo]:
-    """Within the block every Hydra composition in this process goes through one :class:`CompositionMemo`.
-
-    Scoped to one command: the YAML files, the working directory and the environment are taken to stay
-    as they are while it runs (the tail that reads the last two runs for every request anyway).
-    """
+    """Within the block every Hydra composition in this process goes through one :class:`CompositionMemo`, scoped to
+    one command: the YAML files are taken to stay as they are while it runs (the tail reads the working directory
+    and the environment for every request anyway)."""
     global active
     if active is not None:  # nested (a command run from a command): the outer memo serves
         yield active

@@ -353,16 +353,14 @@ EXTRA_LAUNCHERS = {
 def check_launcher_installed(overrides: Sequence[Override]) -> None:
     """A launcher of the ``cluster`` extra, chosen without the extra installed, is one sentence."""
     for o in overrides:
-        if o.key_or_group != "hydra/launcher" or o.is_delete():
-            continue
-        name = str(o.value())
-        module = EXTRA_LAUNCHERS.get(name)
-        if module is not None and not _importable(module, find_spec):
-            raise ConfigError(f"hydra/launcher={name} needs the sweep launchers, which are not installed; "
+        chosen = o.key_or_group == "hydra/launcher" and not o.is_delete()
+        module = EXTRA_LAUNCHERS.get(str(o.value())) if chosen else None
+        if module is not None and not _importable(module):
+            raise ConfigError(f"hydra/launcher={o.value()} needs the sweep launchers, which are not installed; "
                               'install them with: pip install "gyrolab[cluster]"')
 
 
-def _importable(module: str, find_spec) -> bool:  # noqa: ANN001 - importlib.util.find_spec
+def _importable(module: str) -> bool:
     """Whether ``module`` can be imported (find_spec raises, rather than says None, when a parent package is missing)."""
     try:
         return find_spec(module) is not None

@@ -89,11 +89,8 @@ def _where(kind: str, scheduler: str) -> str:
 
 
 def _client(kind: str, scheduler: str, source: str) -> Any:
-    """A connected ``distributed.Client`` (closing it also closes a local cluster it started).
-
-    An address is first probed (``gyrolab.batch.scheduler.probe``: a silent peer or one that is not a Dask
-    scheduler is one sentence within ``CONNECT_TIMEOUT``), then connected with the same bound.
-    """
+    """A connected ``distributed.Client`` (closing it also closes a local cluster it started); an address is first
+    probed (``gyrolab.batch.scheduler.probe``), then connected within the same ``CONNECT_TIMEOUT``."""
     import logging
 
     from distributed import Client, LocalCluster

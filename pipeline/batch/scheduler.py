@@ -53,11 +53,9 @@ def use_command_line_scheduler(value: str | None) -> None:
 
 
 def choose_scheduler(configured: object = None) -> Choice:
-    """The scheduler of a batch: the command line's, else ``batch.scheduler``'s ``process``/``local``, else
-    Dask's own (``DASK_SCHEDULER_ADDRESS``, then Dask's configuration files), else this process.
-
-    ``configured`` is ``batch.scheduler`` from the config: an address there is refused (module docstring).
-    """
+    """The scheduler of a batch: the command line's, else ``batch.scheduler``'s (``configured``: ``process`` or
+    ``local``; an address there is refused), else Dask's own (``DASK_SCHEDULER_ADDRESS``, its configuration files),
+    else this process."""
     text = check_configured(configured)
     if _command_line is not None:
         return Choice(_command_line or None, f"the command line ({OPTION})")
@@ -94,12 +92,9 @@ def _dask_configured() -> str:
 
 
 def probe(address: str, source: str, timeout: float = CONNECT_TIMEOUT) -> None:
-    """ConfigError in one sentence unless a Dask scheduler greets us at ``address`` within ``timeout`` s.
-
-    Reads the first message a Dask peer sends on a new connection (its handshake: a length-prefixed
-    msgpack mapping with the keys ``compression`` and ``python``), decoded with plain msgpack, which
-    never runs code. Over ``tls://`` the connection uses Dask's TLS settings (``distributed.comm.tls``).
-    """
+    """ConfigError in one sentence unless a Dask scheduler greets us at ``address`` within ``timeout`` s: the first
+    message a Dask peer sends (its handshake, a length-prefixed msgpack mapping with the keys ``compression`` and
+    ``python``) decoded with plain msgpack, which never runs code; ``tls://`` with Dask's TLS settings."""
     from distributed.comm.addressing import parse_address, parse_host_port
 
     where = f"at {address} (from {source})"

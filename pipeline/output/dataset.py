@@ -88,9 +88,8 @@ def flag_violated_invariants(ds: xr.Dataset, invariants: tuple[str, ...], adapti
 
 
 def scene_attributes(scene: Scene) -> tuple[dict[str, Any], dict[str, Any]]:
-    """The run dataset's global attributes that depend on the scene alone: those that go before the integrator's
-    record and those after it. ``Scene.dataset_attributes`` computes them once per scene (~0.1 ms of a run);
-    every run's dataset then shares their values, so arrays among them are read-only copies."""
+    """The run dataset's global attributes that depend on the scene alone (those before the integrator's record,
+    those after it), computed once per scene and shared by its runs' datasets: arrays among them are read-only."""
     system = scene.system
     before: dict[str, Any] = {
         "title": system.title(),

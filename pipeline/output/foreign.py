@@ -30,13 +30,13 @@ def load_dataset(path: str | os.PathLike[str], expected: str, **options) -> xr.D
     path = Path(path)
     where = shorten(str(path))
     try:
-        mode = os.stat(path).st_mode
+        info = os.stat(path)
     except OSError as error:
         reason = "a loop of symbolic links" if error.errno == 40 else (error.strerror or "cannot be read")
         raise ConfigError(f"cannot read {where!r} ({reason}); give {expected}") from None
-    if not stat.S_ISREG(mode):
+    if not stat.S_ISREG(info.st_mode):
         raise ConfigError(f"{where!r} is not a regular file; give {expected}")
-    size = os.stat(path).st_size
+    size = info.st_size
     if size == 0:
         raise ConfigError(f"{where!r} is empty; give {expected}")
     unreadable = ConfigError(f"cannot read {where!r} as a netCDF dataset (it is not a netCDF file gyrolab can read); "

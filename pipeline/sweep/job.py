@@ -33,13 +33,10 @@ def draws_job_figures(output: object) -> bool:
 
 def run_sweep_job(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_num: int | None,
                   work: Callable[[str], Path]) -> JobRecord:
-    """Run ``work(job_id)`` (which writes the job's dataset and returns its path) unless already done.
-
-    Never raises for a failing scene: a GyrolabError is recorded as a deterministic failure (not retried), except
-    a write failure (``OutputError``: the disk may have room next time); any other exception is recorded too, with
-    its traceback in the job's log, and retried when the sweep is run again. A job that another live process is
-    running is left to it (status ``ELSEWHERE``, nothing written).
-    """
+    """Run ``work(job_id)`` (which writes the job's dataset and returns its path) unless already done; never raises
+    for a failing scene. A GyrolabError is recorded as a deterministic failure (not retried) except a write failure
+    (``OutputError``: the disk may have room next time); any other exception is recorded, with its traceback in the
+    job's log, and retried. A job another live process runs is left to it (``ELSEWHERE``, nothing written)."""
     job_dir = Path(job_dir)
     guard_worker()  # in a launcher's worker process: die with the launching process
     try:

@@ -55,11 +55,8 @@ def write_record(job_dir: Path, record: JobRecord) -> Path:
 
 
 def read_record(job_dir: Path) -> JobRecord | None:
-    """The record in ``job_dir``, or None when there is none (or it is unreadable: treated as unfinished).
-
-    A record is untrusted input (a sweep directory may come from someone else): at most MAX_RECORD_BYTES, a JSON
-    mapping whose ``run`` is a file name in the job directory, nested no deeper than Python can parse.
-    """
+    """The record in ``job_dir``, or None when there is none or it is not what gyrolab writes (untrusted input: at
+    most MAX_RECORD_BYTES, a JSON mapping whose ``run`` is a file name in the job directory); None is unfinished."""
     try:
         fd = open_own_file(Path(job_dir) / RECORD_NAME, os.O_RDONLY)
         with os.fdopen(fd, "rb") as handle:
