@@ -91,12 +91,9 @@ def show_warnings_in_one_line() -> None:
 
 def preflight(args: argparse.Namespace) -> argparse.Namespace:
     """Validate the command line (``args``: ``gyrolab run``'s options) before Hydra creates any output directory;
-    the options Hydra should run (``+group=x`` may become ``group=x``).
-
-    The config is composed exactly as Hydra will compose it (Hydra's run is then served from this composition,
-    ``gyrolab.compat.composing_once``), checked by ``gyrolab.engine.safety`` (no config can run code), against the
-    schema, the budget, and the scene's own validation. For a plain run the scene it builds is the one the run
-    integrates (``take_prepared``).
+    the options Hydra should run (``+group=x`` may become ``group=x``). The config is composed as Hydra will (whose
+    run is then served from it: ``composing_once``) and checked (``engine.safety``, the schema, the budget, the
+    scene's own validation); a plain run integrates the scene built here (``take_prepared``).
     """
     if args.experimental_rerun is not None:  # Hydra unpickles the file: whoever wrote it runs code as you
         raise ConfigError(f"--experimental-rerun {shorten(args.experimental_rerun)} would load a pickle, which runs "

@@ -114,9 +114,8 @@ class Plan:
         return self.combo_params[self.combo[start:stop]]
 
     def identity(self, chunk: int) -> str:
-        """20 hex digits over the code it loads (gyrolab's and its plugins': ``job_code``), the composed config
-        (without the settings that do not change the result), the grid and the chunk size: the same command gives
-        the same identity."""
+        """20 hex digits over the code it loads (``job_code``), the composed config (without the settings that do not
+        change the result), the grid and the chunk size: the same command gives the same identity."""
         plain = copy.deepcopy(self.plain)
         for key in NOT_IN_IDENTITY:
             (plain.get("batch") or {}).pop(key, None)

@@ -64,8 +64,7 @@ def _read(path: Path, where: str, *, kind: str = "a config folder holds") -> byt
 
 def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> yaml.Node | None:
     """ConfigError (one sentence naming ``where`` and the line) unless ``data`` is a plain YAML mapping within the
-    limits (module docstring); the composed node (None for an empty text). ``stored``: a config gyrolab stored
-    (the sentences say that it was edited)."""
+    limits; the composed node (None for an empty text). ``stored``: the sentences say a stored config was edited."""
     node = _composed(_decoded(data, where), where, stored)
     if node is None:
         return None  # an empty file is an empty config
@@ -125,8 +124,7 @@ def _check_top_level(node: yaml.Node, where: str, stored: bool) -> None:
 
 def stored_yaml(data: bytes | str, where: str) -> dict:
     """A config gyrolab stored (a dataset's ``config`` attribute, ``multirun.yaml``, ``.hydra/config.yaml``) as
-    plain data, after the checks of a user's file: a directory or a dataset received from someone else is
-    untrusted input (anchors, depth, tags, size)."""
+    plain data, after the checks of a user's file (it may come from someone else)."""
     if not isinstance(data, (str, bytes)):
         raise ConfigError(f"{where} is not text; a stored config is a YAML mapping that gyrolab wrote")
     if check_yaml_text(data, where, stored=True) is None:

@@ -54,9 +54,8 @@ class Grid:
 
     @classmethod
     def from_overrides(cls, overrides: Sequence[str], *, repeats: bool = False, max_jobs: float | None = None) -> Grid:
-        """ConfigError for a malformed override, a non-discrete sweep or a value given twice (unless ``repeats``:
-        a batch's zipped keys may repeat values); for more than ``max_jobs`` jobs (the budget's points by default),
-        counted before anything is expanded."""
+        """ConfigError for a malformed override, a non-discrete sweep, a value given twice (unless ``repeats``: a
+        batch's zipped keys), more than ``max_jobs`` jobs (default: the budget's points), counted unexpanded."""
         parser = OverridesParser.create()
         try:
             parsed = parser.parse_overrides(list(overrides))

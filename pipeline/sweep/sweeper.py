@@ -112,13 +112,10 @@ class ResumingSweeper(Sweeper):
 
 
 def claim(sweep_dir: Path, config: DictConfig) -> None:
-    """Make ``sweep_dir`` this sweep's (its ``multirun.yaml``), or refuse it in one sentence (ConfigError).
-
-    One sweep directory, one sweep: another sweep or a batch there is refused, the same sweep again resumes. The
-    check and the write of ``multirun.yaml`` happen under the directory's lock, so two sweeps started at once
-    cannot interleave. Nothing in the directory is followed (``check_tree``), and submitit's folder, whose pickles
-    the jobs load, is the user's alone (``private_dir``).
-    """
+    """Make ``sweep_dir`` this sweep's (its ``multirun.yaml``), or refuse it in one sentence (ConfigError): another
+    sweep or a batch there is refused, the same sweep again resumes; under the directory's lock, so two sweeps
+    started at once cannot interleave. Nothing there is followed (``check_tree``), and submitit's folder, whose
+    pickles the jobs load, is the user's alone (``private_dir``)."""
     check_tree(sweep_dir, sweep=True)
     try_lock(sweep_dir, blocking=True)
     try:
