@@ -191,9 +191,8 @@ def take_prepared(cfg: DictConfig) -> Prepared | None:
 
 def accuracy_notes(configs: Sequence[DictConfig], overrides: Sequence[str]) -> list[str | None]:
     """Each config's note on an ``accuracy`` its integrator does not read (``gyrolab.engine.unread``), or None; a
-    ConfigError when the command line gives ``accuracy`` and no job's integrator reads it. A sweep over integrators
-    (``-m integrator=auto,taylor accuracy=1e-8``) gives the target to the jobs that read it; the others run at their
-    own settings, warn and record it, as for a value from a config file."""
+    ConfigError when the command line gives ``accuracy`` and no job's integrator reads it (a sweep over integrators
+    gives the target to the jobs that read it; the others warn and record it, as for a value from a config file)."""
     notes = [ignored_accuracy(composed, overrides) for composed in configs]
     if ACCURACY in given_keys(overrides) and all(notes):
         raise unread_refusal(configs[0], unread_accuracy(configs[0]))

@@ -95,9 +95,8 @@ def batch(args: argparse.Namespace) -> int:
 
 
 def plot(args: argparse.Namespace) -> int:
-    """``gyrolab plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]``: redraw every figure of the
-    datasets under PATH (``gyrolab.figures.redraw``) with the current style, formats and dpi; nothing is
-    integrated. ``--animate RUN`` animates a run instead (``gyrolab.figures.animation``)."""
+    """``gyrolab plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]``: redraw every figure of the datasets
+    under PATH (nothing is integrated); ``--animate RUN`` animates a run instead (``gyrolab.figures.animation``)."""
     paths = [a for a in args.arguments if "=" not in a]
     overrides = [a for a in args.arguments if "=" in a]
     foreign = [o for o in overrides if not o.startswith("output.")]

@@ -127,9 +127,8 @@ class Plan:
 
 
 def split_overrides(overrides: Sequence[str]) -> tuple[list[str], list[Dim]]:
-    """(the fixed overrides, the swept dimensions) of a command line, each override parsed as the
-    multirun's grid parses it (``Grid.from_overrides``: its errors, its typed values; a value given twice
-    is refused by ``make_plan`` for a grid, allowed for zipped keys)."""
+    """(the fixed overrides, the swept dimensions) of a command line, each override parsed as the multirun's grid
+    parses it (``Grid.from_overrides``; a value given twice is refused by ``make_plan`` for a grid, not a zip)."""
     fixed, dims = [], []
     for override in overrides:
         grid = Grid.from_overrides([override], repeats=True)

@@ -71,10 +71,9 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
 
 def flag_violated_invariants(ds: xr.Dataset, invariants: tuple[str, ...], adaptive: bool,
                              series: dict[str, np.ndarray]) -> None:
-    """Flag each monitored invariant whose drift the integration error does not explain
-    (``gyrolab.output.invariant_check``; ``series``: the invariants' values): one warning each,
-    ``invariant_check = "violated"`` and a ``comment`` on its variable, and the names in the dataset attribute
-    ``violated_invariants``. The figures do not draw a flagged invariant as conserved."""
+    """Flag each monitored invariant whose drift the integration error does not explain (``invariant_check``;
+    ``series``: the invariants' values): a warning, ``invariant_check = "violated"`` and a ``comment`` on its
+    variable, its name in the attribute ``violated_invariants`` (the figures do not draw it as conserved)."""
     times = ds.variables["time"].values if "time" in ds.variables else np.empty(0)
     span = float(times[-1] - times[0]) if times.size else 0.0
     found = violated_invariants(series, invariants, ds.attrs, adaptive, span)

@@ -151,9 +151,8 @@ def private_dir(path: str | os.PathLike[str], what: str) -> Path:
 
 
 def check_kernel_cache() -> None:
-    """Untrusted when numba's cache folder (compiled kernels, whose index numba unpickles) or its parent belongs to
-    another user or may be written by anyone (a shared temporary directory another user prepared). Called before
-    any kernel is loaded (a command that runs kernels: run, batch, reproduce)."""
+    """Untrusted when numba's cache folder (whose index numba unpickles) or its parent belongs to another user or may
+    be written by anyone; called before any kernel is loaded (run, batch, reproduce)."""
     # the folder numba uses once it is set up in this process, else the one it will use (found without importing
     # numba, which a run of scipy's integrators never needs)
     numba = sys.modules.get("numba")

@@ -167,8 +167,7 @@ class OverridesDoNotApply(Exception):
 def check_jobs(master: DictConfig, loader: ConfigLoaderImpl,
                jobs: Sequence[Sequence[str]]) -> tuple[dict[int, tuple[Path, JobRecord]], list[int]]:
     """(the jobs whose directory holds a record that settles their identity, by job number; the jobs whose
-    overrides did not apply). A job whose identity cannot be predicted outside it is not settled here: it
-    is launched and checks itself."""
+    overrides did not apply). A job whose identity is not predictable here is launched and checks itself."""
     sweep_dir = Path(master.hydra.sweep.dir)
     predictor = IdentityPredictor(master, loader)
     settled, unsure = {}, []
