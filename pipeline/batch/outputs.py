@@ -41,11 +41,8 @@ def output_times(times: np.ndarray, mode: str, decimate: int) -> np.ndarray:
 
 def state_outputs(mode: str, decimate: int, times: np.ndarray, y: np.ndarray,
                   groups: Sequence[tuple[Any, np.ndarray]]) -> dict[str, Output]:
-    """The outputs of ``mode`` (not ``indicator``) for trajectories ``y`` (points × times × state).
-
-    ``groups`` are (system, rows): the rows of ``y`` to compute with each system — the system built with
-    those points' body and forces (energy and units depend on them); other rows stay NaN.
-    """
+    """The outputs of ``mode`` (not ``indicator``) for trajectories ``y`` (points × times × state); ``groups``:
+    (system, rows), each system built with its rows' body and forces (energy and units depend on them)."""
     outputs: dict[str, Output] = {}
     for system, index in groups:
         index = np.asarray(index)

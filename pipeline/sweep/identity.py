@@ -80,9 +80,8 @@ def _targets(node: Any) -> set[str]:
 
 @cache
 def _plugin_code(target: str) -> str:
-    """'' for gyrolab's own classes; else 'distribution==version module@digest' of the plugin's module (the
-    distribution whose entry point names it; the digest: of its package's Python files, so that an editable
-    install's new commit counts even when its version stays)."""
+    """'' for gyrolab's own classes; else 'distribution==version module@digest' of the plugin's module (the digest of
+    its package's Python files: an editable install's new commit counts even when its version stays)."""
     target = _normalise(target)
     module = target.rpartition(".")[0]
     if not module or module == "gyrolab" or module.startswith("gyrolab."):

@@ -75,9 +75,8 @@ def parse_points(text: str | None, n_points: int, what: str = "point") -> list[i
 
 
 def reproduce_sweep(path: Path, stored: xr.Dataset, points: str | None = None) -> tuple[Comparison, list[str]]:
-    """(the comparison, the report's head) of reproducing the finished jobs of a multirun's sweep.nc, each from its
-    own run.nc (``job_dir``, relative to the sweep directory); ``points``: only these jobs (flat numbers over the
-    swept dimensions, C order). A failed job left no run.nc: it is named, not rerun."""
+    """(the comparison, the report's head) of reproducing the finished jobs of a multirun's sweep.nc (``points``: only
+    these, flat C-order numbers), each from its own run.nc; a failed job left none: it is named, not rerun."""
     path = Path(path)
     status = np.asarray(stored["job_status"].values).ravel()
     dirs = [str(d) for d in np.asarray(stored["job_dir"].values).ravel()]
