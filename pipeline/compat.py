@@ -65,9 +65,8 @@ def hydra_supported() -> bool:
 
 def run_hydra(args: argparse.Namespace, parser: argparse.ArgumentParser, task_function: Any, config_path: str,
               config_name: str) -> None:
-    """What ``@hydra.main(config_path, config_name, version_base="1.3")`` does with a command line, given it parsed
-    (``args``, by ``parser``: Hydra's options and gyrolab's) rather than read from ``sys.argv``. Under a Hydra
-    outside ``HYDRA_SUPPORTED``: ``hydra.main`` itself, on a ``sys.argv`` rebuilt from ``args`` (``hydra_argv``)."""
+    """What ``@hydra.main(config_path, config_name, version_base="1.3")`` does with a command line ``parser`` parsed
+    into ``args``; outside ``HYDRA_SUPPORTED``: ``hydra.main`` itself, on a ``sys.argv`` rebuilt from ``args``."""
     hydra_version.setbase("1.3")
     if hydra_supported():
         _run_hydra(args=args, args_parser=parser, task_function=task_function, config_path=config_path,

@@ -55,9 +55,8 @@ def value_options(parsers: dict[str, argparse.ArgumentParser]) -> set[str]:
 
 
 def split_command(argv: Sequence[str], value_options: set[str]) -> tuple[str, list[str]]:
-    """(the subcommand ``argv`` names, the rest of ``argv``): a subcommand word before the first override,
-    or an old ``--batch``-style spelling anywhere (``--plot=PATH`` keeps PATH); ``run`` when none is named.
-    ``value_options``: the options whose value is the next word."""
+    """(the subcommand ``argv`` names, the rest of ``argv``): a word before the first override, or an old
+    ``--batch``-style spelling anywhere (``--plot=PATH`` keeps PATH), else ``run``; ``value_options`` take a value."""
     argv = list(argv)
     takes_value = False
     bare_words_allowed = True
@@ -127,8 +126,8 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
                        "line (initial.r0=1,2,3 body.a=range(1,2,0.25)) and hydra.sweeper.params of the config or an "
                        "experiment. Only body, initial and force parameters may vary (docs/batch.md).\n"
                        "Example: gyrolab batch initial.r0=10,20,40 time.end=20 hydra.sweep.dir=grid")
-    batch.add_argument("overrides", nargs="*", metavar="KEY=VALUE",
-                       help="overrides and sweeps (a=1,2 b=range(0,1,0.1)); hydra.sweep.dir=DIR names the output folder")
+    batch.add_argument("overrides", nargs="*", metavar="KEY=VALUE", help="overrides and sweeps (a=1,2 "
+                       "b=range(0,1,0.1)); hydra.sweep.dir=DIR names the output folder")
     batch.add_argument("--scheduler", metavar="ADDRESS",
                        help="where chunks run: process (this process, the default), local (a local Dask cluster) "
                             "or a Dask scheduler's address tcp://HOST:PORT (the same as batch.scheduler=...)")
@@ -165,7 +164,8 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
 
     completion = _subparser("completion", ".\nbash: eval \"$(gyrolab completion bash)\" (in ~/.bashrc); zsh: eval "
                             "\"$(gyrolab completion zsh)\" (in ~/.zshrc).\nIt completes subcommands, options, config "
-                            "groups, their options and config keys; run it again after installing a plugin.", epilog=None)
+                            "groups, their options and config keys; run it again after installing a plugin.",
+                            epilog=None)
     completion.add_argument("shell", choices=("bash", "zsh"), help="the shell")
     _source_options(completion)
     return {"batch": batch, "plot": plot, "reproduce": reproduce, "aggregate": aggregate, "new-force": new_force,

@@ -38,9 +38,8 @@ WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_TH
 def map_chunks(function: Callable[[Task], Result], tasks: Iterable[Task],
                on_result: Callable[[int, Result], None], scheduler: str | None = None,
                source: str = "the caller") -> None:
-    """Run ``function`` on every task where ``scheduler`` says; ``on_result(index, result)`` for each result,
-    in this process, in the order they complete (in task order when they run here). ``source`` says where
-    the scheduler's address came from (named in the log and in the sentence when it cannot be reached)."""
+    """Run ``function`` on every task where ``scheduler`` says; ``on_result(index, result)`` for each result, here,
+    as they complete (in task order when they run here); ``source``: where the scheduler's address came from."""
     kind = scheduler_kind(scheduler)
     if kind == "process":
         for index, task in enumerate(tasks):
