@@ -93,8 +93,7 @@ def preflight(args: argparse.Namespace) -> argparse.Namespace:
     """Validate the command line (``args``: ``gyrolab run``'s options) before Hydra creates any output directory;
     the options Hydra should run (``+group=x`` may become ``group=x``). The config is composed as Hydra will (whose
     run is then served from it: ``composing_once``) and checked (``engine.safety``, the schema, the budget, the
-    scene's own validation); a plain run integrates the scene built here (``take_prepared``).
-    """
+    scene's own validation); a plain run integrates the scene built here (``take_prepared``)."""
     if args.experimental_rerun is not None:  # Hydra unpickles the file: whoever wrote it runs code as you
         raise ConfigError(f"--experimental-rerun {shorten(args.experimental_rerun)} would load a pickle, which runs "
                           "whatever code its writer put there; rerun a dataset with gyrolab reproduce PATH/run.nc")
@@ -465,9 +464,8 @@ def _quiet_console() -> None:
 
 
 def run_command(argv: Sequence[str]) -> int | None:
-    """The subcommand ``argv`` names (``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``,
-    ``completion``, or an old spelling ``--batch``, ...; options in any position): its exit status, or None for
-    ``run`` (Hydra's app, the default)."""
+    """The exit status of the subcommand ``argv`` names (options in any position), or None for ``run`` (Hydra's
+    app, the default)."""
     command, args = parse_command_line(argv)
     return None if command == "run" else run_subcommand(command, args)
 

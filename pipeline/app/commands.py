@@ -129,9 +129,8 @@ def _animate(args: argparse.Namespace) -> int:
 
 
 def reproduce(args: argparse.Namespace) -> int:
-    """``gyrolab reproduce PATH``: a run.nc, an experiment's dataset (the experiment runs again), a sweep.nc of
-    ``gyrolab batch`` or of ``gyrolab -m`` (``--points``: some of its points or jobs); the comparison report on
-    stdout; 0 if identical, else 1."""
+    """``gyrolab reproduce PATH`` (a run.nc, an experiment's dataset, a sweep.nc of ``gyrolab batch`` or ``-m``, with
+    ``--points`` some of its points or jobs): the comparison report on stdout; 0 if identical, else 1."""
     path = Path(one_path("reproduce", args.paths, "reproduce PATH/run.nc"))
     check_kernel_cache()
     log_to_stderr()

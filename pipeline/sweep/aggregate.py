@@ -378,12 +378,9 @@ def _result(sweep_dir: Path, job_dir: Path, record: JobRecord) -> JobResult:
 
 def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: bool | None = None,
                     launcher: str = "", output: Any | None = None) -> SweepSummary:
-    """Write ``sweep_dir/sweep.nc`` (and summary figures) from the sweep's job directories.
-
-    ``hydra_cfg`` and ``output``: the multirun's ``hydra`` node and ``output`` section (the figures' formats and
-    dpi); without them, read from ``sweep_dir/multirun.yaml``. ``figures=None``: as the sweep's callback was
-    configured.
-    """
+    """Write ``sweep_dir/sweep.nc`` (and summary figures) from the sweep's job directories. ``hydra_cfg``, ``output``:
+    the multirun's ``hydra`` node and ``output`` section, else read from ``sweep_dir/multirun.yaml``;
+    ``figures=None``: as the sweep's callback was configured."""
     sweep_dir = Path(sweep_dir)
     check_tree(sweep_dir, sweep=True)
     if hydra_cfg is None:
