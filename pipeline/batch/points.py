@@ -1,8 +1,6 @@
-"""An explicit list of points from a CSV file (``batch.points_file=PATH``).
-
-The header names config keys (``initial.r0,initial.theta0,body.a``), each row is one point: the value of
-every key there, a finite number. The file is read whole (its SHA-256 goes into the batch's identity, so
-an edited file is another command); any problem is one sentence (ConfigError), before anything is written.
+"""An explicit list of points from a CSV file (``batch.points_file=PATH``; docs/batch.md, "A list of points instead
+of a grid"): the header names config keys, each row is one point; the file is read whole (its SHA-256 goes into the
+batch's identity); any problem is one sentence (ConfigError), before anything is written.
 """
 
 from __future__ import annotations

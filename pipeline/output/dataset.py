@@ -1,8 +1,6 @@
-"""The run dataset: trajectory, invariants and Euler angles with CF metadata and provenance.
-
-Attributes hold only netCDF-safe values (str, numbers, numeric arrays): the
-resolved config is stored as one YAML string, so a run can be rebuilt from
-its own dataset (``Scene.from_config(OmegaConf.create(ds.attrs["config"]))``).
+"""The run dataset: trajectory, invariants and Euler angles with CF metadata and provenance. Attributes hold only
+netCDF-safe values: the resolved config is one YAML string, so a run can be rebuilt from its own dataset
+(``Scene.from_config(OmegaConf.create(ds.attrs["config"]))``).
 """
 
 from __future__ import annotations

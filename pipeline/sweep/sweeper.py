@@ -276,9 +276,8 @@ def _as_change(o: Override) -> Override:
 
 
 def _patched(base: _Base, changed: Sequence[Override]) -> dict[str, Any] | None:
-    """The job's config as plain data: the composed job's, with the changed values read back from the config
-    they were applied to (so typed as Hydra types them); None when that is not the whole story (the config
-    or a new value interpolates, or a key goes through a list)."""
+    """The job's config as plain data: the composed job's with the changed values read back where they were applied
+    (typed as Hydra types them); None when the config or a new value interpolates, or a key goes through a list."""
     if base.plain is None or any("${" in o.input_line for o in changed):
         return None
     plain = dict(base.plain)
