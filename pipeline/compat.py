@@ -1,27 +1,20 @@
 """The one place where gyrolab reaches into Hydra's and xarray's internals: each use is checked against the
-library version it was written for and takes the library's own public path otherwise.
+library version it was written for and takes the library's own public path otherwise (what each gains:
+docs/performance.md, "A sweep's per-job overhead").
 
-Kept for their measured gain (``gyrolab`` with and without each, best of 3, CPU s; Hydra 1.3.8, xarray 2026.9):
+* :func:`composing_once` (Hydra 1.3.x): one composition per command. Inside the block
+  ``ConfigLoaderImpl._load_configuration_impl`` composes the *skeleton* (the defaults list and the config merged
+  from it) once per set of group choices, with Hydra's functions in Hydra's order, and serves each request from
+  a copy: the value overrides applied with Hydra's function, the ``hydra`` node filled by a copy of the tail of
+  Hydra 1.3's ``_load_configuration_impl``; a request Hydra classifies otherwise is Hydra's own.
+  ``tests/compat/test_composing_once.py`` compares both paths for every job of sweeps.
+* :func:`install_dask_free_writes` (xarray ``XARRAY_SUPPORTED``): ``to_netcdf`` without importing Dask for a
+  dataset that holds nothing of Dask's.
+* :func:`run_hydra` (Hydra 1.3.x): ``_run_hydra`` given the namespace of gyrolab's own parser; otherwise
+  ``hydra.main`` on ``sys.argv`` rebuilt from it.
 
-* :func:`composing_once` (Hydra 1.3.x): one composition per command. A plain run composed its config three
-  times (the preflight, Hydra's ``get_mode`` and its run), a sweep of N jobs N + 4 times. Inside the block
-  ``ConfigLoaderImpl._load_configuration_impl`` composes the *skeleton* (the defaults list and the config
-  merged from it, shaped only by the primary config, the search path and the group choices) once per set of
-  group choices, with Hydra's functions in Hydra's order, and serves each request from a copy: the value
-  overrides applied with Hydra's function, the ``hydra`` node filled by a copy of the tail of Hydra 1.3's
-  ``_load_configuration_impl``; a request Hydra classifies otherwise is Hydra's own. Gain: 0.16 s of a 1.9 s
-  run, ~85 ms a sweep job. ``tests/compat/test_composing_once.py`` compares both paths for every job of sweeps.
-* :func:`install_dask_free_writes` (xarray ``XARRAY_SUPPORTED``): with Dask installed, ``to_netcdf`` imports
-  ``dask.array`` and ``distributed`` for any dataset only to learn that nothing in it is Dask's. Gain: 0.45 s
-  of every run and sweep with the ``test`` or ``cluster`` extra (none on the bare install).
-* :func:`run_hydra` (Hydra 1.3.x): ``_run_hydra``, which ``@hydra.main`` calls with the namespace it parsed
-  from ``sys.argv``, given the namespace of gyrolab's own parser; otherwise ``hydra.main`` on ``sys.argv``
-  rebuilt from it.
-
-Dropped: ``xr.Dataset._construct_direct`` for the run dataset (~1 ms of a 25 ms run). Also here, with no
-fallback (``pyproject.toml`` pins ``hydra-core>=1.3,<1.4``): the private functions the preflight composes
-with exactly as Hydra will (the search path, Hydra's argument parser), and those gyrolab's sweeper applies
-job overrides with.
+Also here, with no fallback (``pyproject.toml`` pins ``hydra-core>=1.3,<1.4``): the private functions the
+preflight composes with exactly as Hydra will, and those gyrolab's sweeper applies job overrides with.
 """
 
 from __future__ import annotations
@@ -72,9 +65,8 @@ def hydra_supported() -> bool:
 
 def run_hydra(args: argparse.Namespace, parser: argparse.ArgumentParser, task_function: Any, config_path: str,
               config_name: str) -> None:
-    """What ``@hydra.main(config_path, config_name, version_base="1.3")`` does with a command line, given it parsed
-    (``args``, by ``parser``: Hydra's options and gyrolab's) rather than read from ``sys.argv``. Under a Hydra
-    outside ``HYDRA_SUPPORTED``: ``hydra.main`` itself, on a ``sys.argv`` rebuilt from ``args`` (``hydra_argv``)."""
+    """What ``@hydra.main(config_path, config_name, version_base="1.3")`` does with a command line ``parser`` parsed
+    into ``args``; outside ``HYDRA_SUPPORTED``: ``hydra.main`` itself, on a ``sys.argv`` rebuilt from ``args``."""
     hydra_version.setbase("1.3")
     if hydra_supported():
         _run_hydra(args=args, args_parser=parser, task_function=task_function, config_path=config_path,
@@ -97,8 +89,6 @@ def hydra_argv(args: argparse.Namespace) -> list[str]:
             words += action.option_strings[:1] if action.nargs == 0 else [action.option_strings[0], str(value)]
     return [*words, *args.overrides]
 
-
-# --- one composition per command (Hydra 1.3) ---
 
 @dataclass
 class Skeleton:
@@ -246,11 +236,9 @@ active: CompositionMemo | None = None
 
 @contextmanager
 def composing_once() -> Iterator[CompositionMemo]:
-    """Within the block every Hydra composition in this process goes through one :class:`CompositionMemo`.
-
-    Scoped to one command: the YAML files, the working directory and the environment are taken to stay
-    as they are while it runs (the tail that reads the last two runs for every request anyway).
-    """
+    """Within the block every Hydra composition in this process goes through one :class:`CompositionMemo`, scoped to
+    one command: the YAML files are taken to stay as they are while it runs (the tail reads the working directory
+    and the environment for every request anyway)."""
     global active
     if active is not None:  # nested (a command run from a command): the outer memo serves
         yield active
@@ -273,23 +261,13 @@ def composing_once() -> Iterator[CompositionMemo]:
         active = None
 
 
-# --- writes without Dask (xarray) ---
-#
 # xarray's string coder asks whether a char array is a Dask array (``pycompat.array_type("dask")``, which imports
 # ``dask.array``, and ``utils.is_dask_collection``, which imports ``dask.base``), and asks Dask's scheduler whether
 # to close the file after every write (``writers._get_netcdf_autoclose``) and which write lock to take
 # (``locks.get_write_lock``, which imports ``distributed``). A guard in front of each gives Dask's or xarray's own
-# answer without the import where the answer cannot depend on Dask, and asks otherwise:
-#
-# * ``array_type("dask")`` while ``dask.array`` is not imported: no object can be an instance of its ``Array``
-#   class, so there is no type to test against (``()``, xarray's answer without Dask);
-# * ``is_dask_collection(x)`` for an ``x`` without a ``__dask_graph__`` method: False (Dask's first test);
-# * autoclose for a dataset without chunks: False (xarray: ``have_chunks and ...``);
-# * the write lock while ``distributed`` is not imported (so no Dask client exists) and Dask's config names no
-#   scheduler: xarray's threaded lock (what it takes without Dask and under Dask's default).
-#
-# Once Dask is in use (a batch on a Dask scheduler, a chunked dataset), xarray decides as before. An xarray
-# without one of these functions keeps it unguarded.
+# answer without the import where the answer cannot depend on Dask (each guard says why), and asks otherwise: once
+# Dask is in use (a batch on a Dask scheduler, a chunked dataset), xarray decides as before. An xarray without one
+# of these functions keeps it unguarded.
 
 _GUARD = "_gyrolab_scheduler_guard"
 

@@ -1,10 +1,8 @@
-"""``gyrolab --new-force NAME``: a new force-plugin package, a renamed copy of the example plugin.
+"""``gyrolab new-force NAME``: a new force-plugin package, a renamed copy of the example plugin.
 
 The templates below are the files of ``examples/gyrolab-viscous-drag`` (a test checks that
-``new_force_package("viscous_drag")`` reproduces that directory exactly, and runs its tests):
-linear drag, torque −c ω, with its pyproject entry point, a README and tests that call
-``gyrolab.testing.check_force``. Edit the torque, the parameters, ``preserves_area_integral``
-and the tests' exact solution; ``python -m pytest tests`` then tells you what the contract needs.
+``new_force_package("viscous_drag")`` reproduces that directory exactly, and runs its tests): linear drag, torque
+−c ω, with its entry point, a README and tests that call ``gyrolab.testing.check_force``.
 """
 
 from __future__ import annotations

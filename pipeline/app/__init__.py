@@ -1,18 +1,13 @@
 """The ``gyrolab`` command: a Hydra app that runs one scene (or a multirun sweep) per invocation.
 
-Before Hydra starts, a preflight turns the usual mistakes — an unknown plugin
-name, a malformed override, an invalid scene, an unwritable output
-directory — into one sentence and a non-zero exit, so that no run directory
-with a partial ``run.nc`` is left behind.
+Before Hydra starts, a preflight turns the usual mistakes (an unknown plugin name, a malformed override, an
+invalid scene, an unwritable output directory) into one sentence and a non-zero exit, so that no run directory
+with a partial ``run.nc`` is left behind. In a multirun each job is resumable and a failing job is recorded, not
+fatal (``gyrolab.sweep.job``); the sweep callback then writes ``sweep.nc``.
 
-In a multirun each job is resumable and a failing job is recorded, not fatal
-(``gyrolab.sweep.job``); the sweep callback then writes ``sweep.nc``.
-
-This module is ``gyrolab run``, the default subcommand, and ``main``; the package holds the rest of the
-command line: ``parser`` (which subcommand a command line names, one argparse parser per other
-subcommand), ``commands`` (``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``, ``completion``)
-and ``completion`` (the bash and zsh script). Logs go to stderr, results to stdout
-(``gyrolab.output.written``).
+This module is ``gyrolab run``, the default subcommand, and ``main``; ``parser`` says which subcommand a command
+line names, ``commands`` runs the others, ``completion`` writes the shell script. Logs go to stderr, results to
+stdout (``gyrolab.output.written``).
 """
 
 from __future__ import annotations
@@ -48,18 +43,11 @@ from gyrolab.app.parser import parse_command_line, run_parser
 from gyrolab.batch.scheduler import check_configured, use_command_line_scheduler
 from gyrolab.compat import composing_once, install_dask_free_writes, run_hydra
 from gyrolab.engine.budget import check_budget, check_sweep_size, check_tolerances
-from gyrolab.engine.config import (
-    SELECTABLE_GROUPS,
-    ConfigSource,
-    check_scene_config,
-    compose_config,
-    group_options,
-    hydra_for,
-    register_plugin_configs,
-    use_source,
-)
+from gyrolab.engine.config import (SELECTABLE_GROUPS, ConfigSource, check_scene_config, compose_config, group_options,
+                                   hydra_for, register_plugin_configs, use_source)
 from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_terminal
 from gyrolab.engine.safety import check_config, check_output_dir
+from gyrolab.engine.schemas import REQUIRED_SECTIONS  # sections every run needs, with a key to show
 from gyrolab.engine.scene import Scene
 from gyrolab.engine.unread import ACCURACY, given_keys, ignored_accuracy, unread_accuracy
 from gyrolab.engine.unread import refusal as unread_refusal
@@ -71,7 +59,7 @@ from gyrolab.output.dataset import write_dataset
 from gyrolab.output.lock import LOCK_NAME, release_all, writing_in
 from gyrolab.output.provenance import gyrolab_version
 from gyrolab.output.trust import check_kernel_cache, check_tree
-from gyrolab.output.written import announce_written
+from gyrolab.output.written import announce_written, fail
 from gyrolab.sweep import callbacks
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
@@ -82,11 +70,6 @@ if TYPE_CHECKING:
     from gyrolab.sweep.aggregate import SweepSummary
 
 log = logging.getLogger("gyrolab")
-
-
-def fail(error: GyrolabError) -> None:
-    print(f"gyrolab: error: {error}", file=sys.stderr)
-    sys.exit(error.exit_code)
 
 
 def show_warnings_in_one_line() -> None:
@@ -107,16 +90,10 @@ def show_warnings_in_one_line() -> None:
 
 
 def preflight(args: argparse.Namespace) -> argparse.Namespace:
-    """Validate the command line (``args``: ``gyrolab run``'s options, ``gyrolab.app.parser.run_parser``) before
-    Hydra creates any output directory; the options Hydra should run (``+group=x`` may become ``group=x``).
-
-    The config is composed exactly as Hydra will compose it (the same search path,
-    primary config and overrides, from a user's ``--config-dir`` too; inside ``main``, Hydra's run is
-    then served from this composition, ``gyrolab.compat.composing_once``), checked by
-    ``gyrolab.engine.safety`` (no config can run code), against the schema (unknown
-    keys, types), the budget, and the scene's own validation. For a plain run the scene it builds is the one
-    the run integrates (``take_prepared``).
-    """
+    """Validate the command line (``args``: ``gyrolab run``'s options) before Hydra creates any output directory;
+    the options Hydra should run (``+group=x`` may become ``group=x``). The config is composed as Hydra will (whose
+    run is then served from it: ``composing_once``) and checked (``engine.safety``, the schema, the budget, the
+    scene's own validation); a plain run integrates the scene built here (``take_prepared``)."""
     if args.experimental_rerun is not None:  # Hydra unpickles the file: whoever wrote it runs code as you
         raise ConfigError(f"--experimental-rerun {shorten(args.experimental_rerun)} would load a pickle, which runs "
                           "whatever code its writer put there; rerun a dataset with gyrolab reproduce PATH/run.nc")
@@ -213,9 +190,8 @@ def take_prepared(cfg: DictConfig) -> Prepared | None:
 
 def accuracy_notes(configs: Sequence[DictConfig], overrides: Sequence[str]) -> list[str | None]:
     """Each config's note on an ``accuracy`` its integrator does not read (``gyrolab.engine.unread``), or None; a
-    ConfigError when the command line gives ``accuracy`` and no job's integrator reads it. A sweep over integrators
-    (``-m integrator=auto,taylor accuracy=1e-8``) gives the target to the jobs that read it; the others run at their
-    own settings, warn and record it, as for a value from a config file."""
+    ConfigError when the command line gives ``accuracy`` and no job's integrator reads it (a sweep over integrators
+    gives the target to the jobs that read it; the others warn and record it, as for a value from a config file)."""
     notes = [ignored_accuracy(composed, overrides) for composed in configs]
     if ACCURACY in given_keys(overrides) and all(notes):
         raise unread_refusal(configs[0], unread_accuracy(configs[0]))
@@ -223,11 +199,8 @@ def accuracy_notes(configs: Sequence[DictConfig], overrides: Sequence[str]) -> l
 
 
 def _output_dir_text(cfg: DictConfig, mode: str) -> str:
-    """``hydra.run.dir`` (or ``hydra.sweep.dir``) resolved as Hydra will resolve it, or one sentence why not.
-
-    ``${hydra:...}`` needs the Hydra config registered, as it is inside the run; a key that only
-    exists once the job runs (``hydra.runtime.*``) cannot name the directory before it exists.
-    """
+    """``hydra.run.dir`` (or ``hydra.sweep.dir``) resolved as Hydra will resolve it (``${hydra:...}`` needs the Hydra
+    config registered), or one sentence why not (``hydra.runtime.*`` exists only once the job runs)."""
     key = f"hydra.{mode}.dir"
     try:
         HydraConfig.instance().set_config(copy.deepcopy(cfg))  # set_config marks its argument read-only
@@ -241,11 +214,7 @@ def _output_dir_text(cfg: DictConfig, mode: str) -> str:
 
 def _plus_group_as_override(source: ConfigSource, argv: list[str], overrides: Sequence[Override]) -> list[str]:
     """The overrides ``argv`` with ``+experiment=mine`` as ``experiment=mine`` when the primary config already lists
-    the group.
-
-    Hydra refuses to add a group its defaults list has (``experiment: null`` in gyrolab's
-    config.yaml); both spellings are common, so both select the option.
-    """
+    the group: Hydra refuses to add a group its defaults list has; both spellings are common."""
     adds = [o for o in overrides if o.is_add() and o.key_or_group in SELECTABLE_GROUPS and o.package is None]
     if not adds:
         return argv
@@ -288,8 +257,6 @@ def parse_overrides(texts: Sequence[str]) -> list[Override]:
 OVERRIDE_FORMS = "key=value (time.end=50), group=option (integrator=rk4), +key=value (add), ~key (delete)"
 MAX_OVERRIDE_CHARS = 10_000
 MAX_KEY_CHARS = 200
-#: sections every run needs, with a key to show in the message
-from gyrolab.engine.schemas import REQUIRED_SECTIONS  # noqa: E402  (derived from the schemas)
 
 
 def _job_overrides(overrides: Sequence[Override], chosen: dict[int, str]) -> list[str]:
@@ -381,16 +348,14 @@ EXTRA_LAUNCHERS = {
 def check_launcher_installed(overrides: Sequence[Override]) -> None:
     """A launcher of the ``cluster`` extra, chosen without the extra installed, is one sentence."""
     for o in overrides:
-        if o.key_or_group != "hydra/launcher" or o.is_delete():
-            continue
-        name = str(o.value())
-        module = EXTRA_LAUNCHERS.get(name)
-        if module is not None and not _importable(module, find_spec):
-            raise ConfigError(f"hydra/launcher={name} needs the sweep launchers, which are not installed; "
+        chosen = o.key_or_group == "hydra/launcher" and not o.is_delete()
+        module = EXTRA_LAUNCHERS.get(str(o.value())) if chosen else None
+        if module is not None and not _importable(module):
+            raise ConfigError(f"hydra/launcher={o.value()} needs the sweep launchers, which are not installed; "
                               'install them with: pip install "gyrolab[cluster]"')
 
 
-def _importable(module: str, find_spec) -> bool:  # noqa: ANN001 - importlib.util.find_spec
+def _importable(module: str) -> bool:
     """Whether ``module`` can be imported (find_spec raises, rather than says None, when a parent package is missing)."""
     try:
         return find_spec(module) is not None
@@ -449,13 +414,8 @@ def _only_hydras_files(out_dir: Path) -> bool:
 
 
 def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None, figures: bool = True) -> Path:
-    """Run the scene, write ``run.nc`` (and figures) in ``out_dir``; GyrolabError on bad input or a failed run.
-
-    ``figures=False`` (a multirun's jobs unless ``output.job_figures``): the scene's figures are not drawn.
-
-    ``out_dir`` is locked meanwhile (a second run into it is refused in one sentence) and cleared of
-    the temporary files that killed writes left there (``gyrolab.output.lock.writing_in``).
-    """
+    """Run the scene, write ``run.nc`` (and, unless ``figures=False``, figures) in ``out_dir``, locked meanwhile and
+    cleared of what killed writes left (``writing_in``); GyrolabError on bad input or a failed run."""
     with writing_in(out_dir):
         return _run_locked(cfg, out_dir, job_id, figures)
 
@@ -504,9 +464,8 @@ def _quiet_console() -> None:
 
 
 def run_command(argv: Sequence[str]) -> int | None:
-    """The subcommand ``argv`` names (``batch``, ``plot``, ``reproduce``, ``aggregate``, ``new-force``,
-    ``completion``, or an old spelling ``--batch``, ...; options in any position): its exit status, or None for
-    ``run`` (Hydra's app, the default)."""
+    """The exit status of the subcommand ``argv`` names (options in any position), or None for ``run`` (Hydra's
+    app, the default)."""
     command, args = parse_command_line(argv)
     return None if command == "run" else run_subcommand(command, args)
 
@@ -521,11 +480,8 @@ def run_subcommand(command: str, args: argparse.Namespace) -> int:
 
 
 def absolute_config_path(args: argparse.Namespace) -> argparse.Namespace:
-    """``args`` with a relative ``--config-path`` made absolute from the working directory.
-
-    Hydra reads a relative --config-path against the folder of the app's source file,
-    which is inside the installed package; a user means the working directory.
-    """
+    """``args`` with a relative ``--config-path`` made absolute from the working directory (Hydra reads it against
+    the folder of the app's source file, inside the installed package; a user means the working directory)."""
     path = args.config_path
     if path and not path.startswith("pkg://"):
         args.config_path = os.path.abspath(path)
@@ -567,12 +523,10 @@ def shell_completion(args: argparse.Namespace) -> int:
 def main() -> None:
     """Console entry point ``gyrolab`` (also ``python -m gyrolab``): the subcommand named on the command line
     (``gyrolab.app.parser``), by default ``run``, Hydra's app (preflight, then ``_task``)."""
-    # The interpreter's last garbage collection walks every object numba, scipy, xarray and Hydra created:
-    # ~1 s of every command's wall time (0.1 s after a freeze, measured). Files are closed explicitly, so
-    # nothing needs that collection's finalisers.
+    # the interpreter's last garbage collection walks every object numba, scipy, xarray and Hydra created (files are
+    # closed explicitly, so none of its finalisers is needed), and what the imports built lives until exit: frozen,
+    # neither is walked again (docs/batch.md, "Scaling")
     atexit.register(gc.freeze)
-    # What the imports built lives until exit, so no collection during the command need walk it again (−0.07 CPU s
-    # of the default run, measured).
     gc.freeze()
     show_warnings_in_one_line()
     quiet_logging_failures()

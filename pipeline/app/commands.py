@@ -95,9 +95,8 @@ def batch(args: argparse.Namespace) -> int:
 
 
 def plot(args: argparse.Namespace) -> int:
-    """``gyrolab plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]``: redraw every figure of the
-    datasets under PATH (``gyrolab.figures.redraw``) with the current style, formats and dpi; nothing is
-    integrated. ``--animate RUN`` animates a run instead (``gyrolab.figures.animation``)."""
+    """``gyrolab plot PATH [output.figure_formats=[png,pdf]] [output.dpi=300]``: redraw every figure of the datasets
+    under PATH (nothing is integrated); ``--animate RUN`` animates a run instead (``gyrolab.figures.animation``)."""
     paths = [a for a in args.arguments if "=" not in a]
     overrides = [a for a in args.arguments if "=" in a]
     foreign = [o for o in overrides if not o.startswith("output.")]
@@ -130,9 +129,8 @@ def _animate(args: argparse.Namespace) -> int:
 
 
 def reproduce(args: argparse.Namespace) -> int:
-    """``gyrolab reproduce PATH``: a run.nc, an experiment's dataset (the experiment runs again), a sweep.nc of
-    ``gyrolab batch`` or of ``gyrolab -m`` (``--points``: some of its points or jobs); the comparison report on
-    stdout; 0 if identical, else 1."""
+    """``gyrolab reproduce PATH`` (a run.nc, an experiment's dataset, a sweep.nc of ``gyrolab batch`` or ``-m``, with
+    ``--points`` some of its points or jobs): the comparison report on stdout; 0 if identical, else 1."""
     path = Path(one_path("reproduce", args.paths, "reproduce PATH/run.nc"))
     check_kernel_cache()
     log_to_stderr()

@@ -1,13 +1,9 @@
 """The command line's grammar: which subcommand a command line names, and one argparse parser per subcommand.
 
-``gyrolab run`` (the default: ``gyrolab``, ``gyrolab -m ...``, ``gyrolab experiment=x``) is Hydra's own
-app: its parser is Hydra's (``get_args_parser``, the options Hydra documents) with gyrolab's ``--scheduler`` and
-``--version``, and its namespace goes to Hydra as it is (``gyrolab.compat.run_hydra``). Every subcommand is
-parsed here, options in any position. The old
-spellings (``--batch``, ``--plot``, ``--reproduce``, ``--new-force``, ``--aggregate``) name the same
-subcommands, anywhere on the line, as do the words (``gyrolab batch ...``); options go in any position
-(``gyrolab --batch --config-dir usercfg experiment=r0_scan`` and ``gyrolab batch experiment=r0_scan -cd usercfg``
-are the same command).
+``gyrolab run`` (the default: ``gyrolab``, ``gyrolab -m ...``, ``gyrolab experiment=x``) is Hydra's own app: its
+parser is Hydra's (``get_args_parser``) with gyrolab's ``--scheduler`` and ``--version``, and its namespace goes to
+Hydra as it is (``gyrolab.compat.run_hydra``). The old spellings (``--batch``, ``--plot``, ...) name the same
+subcommands as the words (``gyrolab batch ...``), anywhere on the line; options go in any position.
 """
 
 from __future__ import annotations
@@ -59,9 +55,8 @@ def value_options(parsers: dict[str, argparse.ArgumentParser]) -> set[str]:
 
 
 def split_command(argv: Sequence[str], value_options: set[str]) -> tuple[str, list[str]]:
-    """(the subcommand ``argv`` names, the rest of ``argv``): a subcommand word before the first override,
-    or an old ``--batch``-style spelling anywhere (``--plot=PATH`` keeps PATH); ``run`` when none is named.
-    ``value_options``: the options whose value is the next word."""
+    """(the subcommand ``argv`` names, the rest of ``argv``): a word before the first override, or an old
+    ``--batch``-style spelling anywhere (``--plot=PATH`` keeps PATH), else ``run``; ``value_options`` take a value."""
     argv = list(argv)
     takes_value = False
     bare_words_allowed = True
@@ -109,10 +104,6 @@ def _source_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--config-name", "-cn", metavar="NAME", help="the primary config (default: config)")
 
 
-def _overrides(parser: argparse.ArgumentParser, what: str) -> None:
-    parser.add_argument("overrides", nargs="*", metavar="KEY=VALUE", help=what)
-
-
 def run_parser() -> argparse.ArgumentParser:
     """``gyrolab run``'s parser: Hydra's own (``--help`` is Hydra's app help, from the config), with gyrolab's
     ``--version`` for Hydra's and ``--scheduler``."""
@@ -124,30 +115,29 @@ def run_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _subparser(name: str, details: str, epilog: str | None = LOGGING_CONVENTION) -> _Parser:
+    return _Parser(prog=f"gyrolab {name}", formatter_class=argparse.RawDescriptionHelpFormatter, epilog=epilog,
+                   description=_sentence(COMMANDS[name]) + details)
+
+
 def build_parsers() -> dict[str, argparse.ArgumentParser]:
     """One parser per subcommand except ``run`` (``run_parser``); each one's ``--help`` lists its options."""
-    epilog = LOGGING_CONVENTION
-    formatter = argparse.RawDescriptionHelpFormatter
-    parsers: dict[str, argparse.ArgumentParser] = {}
-
-    batch = _Parser(prog="gyrolab batch", formatter_class=formatter, epilog=epilog,
-                    description=_sentence(COMMANDS["batch"]) + ".\nThe sweep comes from the same place as for -m: the command "
-                    "line (initial.r0=1,2,3 body.a=range(1,2,0.25)) and hydra.sweeper.params of the config or an "
-                    "experiment. Only body, initial and force parameters may vary (docs/batch.md).\n"
-                    "Example: gyrolab batch initial.r0=10,20,40 time.end=20 hydra.sweep.dir=grid")
-    _overrides(batch, "overrides and sweeps (a=1,2 b=range(0,1,0.1)); hydra.sweep.dir=DIR names the output folder")
+    batch = _subparser("batch", ".\nThe sweep comes from the same place as for -m: the command "
+                       "line (initial.r0=1,2,3 body.a=range(1,2,0.25)) and hydra.sweeper.params of the config or an "
+                       "experiment. Only body, initial and force parameters may vary (docs/batch.md).\n"
+                       "Example: gyrolab batch initial.r0=10,20,40 time.end=20 hydra.sweep.dir=grid")
+    batch.add_argument("overrides", nargs="*", metavar="KEY=VALUE", help="overrides and sweeps (a=1,2 "
+                       "b=range(0,1,0.1)); hydra.sweep.dir=DIR names the output folder")
     batch.add_argument("--scheduler", metavar="ADDRESS",
                        help="where chunks run: process (this process, the default), local (a local Dask cluster) "
                             "or a Dask scheduler's address tcp://HOST:PORT (the same as batch.scheduler=...)")
     batch.add_argument("-m", "--multirun", action="store_true",
                        help="accepted for symmetry with gyrolab run -m: a batch is always a sweep")
     _source_options(batch)
-    parsers["batch"] = batch
 
-    plot = _Parser(prog="gyrolab plot", formatter_class=formatter, epilog=epilog,
-                   description=_sentence(COMMANDS["plot"]) + "; nothing is integrated.\n"
-                   "Examples: gyrolab plot outputs/ output.figure_formats=[png,pdf] output.dpi=300\n"
-                   "          gyrolab plot --animate outputs/2026-01-01/12-00-00/run.nc")
+    plot = _subparser("plot", "; nothing is integrated.\n"
+                      "Examples: gyrolab plot outputs/ output.figure_formats=[png,pdf] output.dpi=300\n"
+                      "          gyrolab plot --animate outputs/2026-01-01/12-00-00/run.nc")
     plot.add_argument("arguments", nargs="*", metavar="PATH | output.KEY=VALUE",
                       help="a dataset or a folder searched for datasets, and output.* settings only: "
                            "output.figure_formats=[png,pdf,svg], output.dpi=300")
@@ -159,36 +149,27 @@ def build_parsers() -> dict[str, argparse.ArgumentParser]:
     animation.add_argument("-o", "--output", metavar="FILE",
                            help="the file to write (default: RUN's folder/figures/animation.FORMAT)")
     _source_options(plot)
-    parsers["plot"] = plot
 
-    reproduce = _Parser(prog="gyrolab reproduce", formatter_class=formatter, epilog=epilog,
-                        description=_sentence(COMMANDS["reproduce"]) + ".\nExit status 0: identical; 1: it differs "
-                        "(the report on stdout says where).")
+    reproduce = _subparser("reproduce", ".\nExit status 0: identical; 1: it differs (the report on stdout says where).")
     reproduce.add_argument("paths", nargs="*", metavar="PATH", help="a run.nc, an experiment's dataset, or a "
                            "sweep.nc (of gyrolab batch or gyrolab -m) written by gyrolab")
     reproduce.add_argument("--points", metavar="LIST", help="a sweep.nc: rerun only these points (jobs), by number "
                            "(0,5,10-19; point n is grid position numpy.unravel_index(n, shape)); default: all")
-    parsers["reproduce"] = reproduce
 
-    aggregate = _Parser(prog="gyrolab aggregate", formatter_class=formatter, epilog=epilog,
-                        description=_sentence(COMMANDS["aggregate"]) + " (after an interrupted multirun, or a full disk).")
+    aggregate = _subparser("aggregate", " (after an interrupted multirun, or a full disk).")
     aggregate.add_argument("paths", nargs="*", metavar="SWEEP_DIR", help="the folder of a multirun (hydra.sweep.dir)")
-    parsers["aggregate"] = aggregate
 
-    new_force = _Parser(prog="gyrolab new-force", formatter_class=formatter, epilog=epilog,
-                        description=_sentence(COMMANDS["new-force"]) + " (a package with its tests, docs/plugins.md).")
+    new_force = _subparser("new-force", " (a package with its tests, docs/plugins.md).")
     new_force.add_argument("names", nargs="*", metavar="NAME", help="the force's name (a Python identifier)")
-    parsers["new-force"] = new_force
 
-    completion = _Parser(prog="gyrolab completion", formatter_class=formatter,
-                         description=_sentence(COMMANDS["completion"]) + ".\nbash: eval \"$(gyrolab completion bash)\" "
-                         "(in ~/.bashrc); zsh: eval \"$(gyrolab completion zsh)\" (in ~/.zshrc).\n"
-                         "It completes subcommands, options, config groups, their options and config keys; "
-                         "run it again after installing a plugin.")
+    completion = _subparser("completion", ".\nbash: eval \"$(gyrolab completion bash)\" (in ~/.bashrc); zsh: eval "
+                            "\"$(gyrolab completion zsh)\" (in ~/.zshrc).\nIt completes subcommands, options, config "
+                            "groups, their options and config keys; run it again after installing a plugin.",
+                            epilog=None)
     completion.add_argument("shell", choices=("bash", "zsh"), help="the shell")
     _source_options(completion)
-    parsers["completion"] = completion
-    return parsers
+    return {"batch": batch, "plot": plot, "reproduce": reproduce, "aggregate": aggregate, "new-force": new_force,
+            "completion": completion}
 
 
 def one_path(command: str, paths: Sequence[str], usage: str) -> str:

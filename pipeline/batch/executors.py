@@ -1,28 +1,12 @@
-"""Where a batch's chunks run: this process, a local Dask cluster, or an existing Dask scheduler.
+"""Where a batch's chunks run: this process, a local Dask cluster, or an existing Dask scheduler (docs/cluster.md).
 
-``map_chunks(function, tasks, on_result, scheduler)`` calls ``function(task)`` for every task and hands
-each result to ``on_result(index, result)`` in the calling process as it arrives (so one process writes
-the output). ``function`` must be a module-level function and the tasks picklable, so that the same call
-runs its chunks in other processes or on other machines:
-
-- ``scheduler`` None or ``"process"``: here, one chunk after another (the compiled kernels use every core
-  through numba's threads);
-- ``"local"``: a Dask ``LocalCluster`` on this machine, one single-threaded worker process per core
-  (numba limited to one thread per worker, so the workers do not oversubscribe the cores);
-- ``"tcp://HOST:PORT"`` (or ``tls://``): an existing Dask scheduler and its workers (``dask scheduler``,
-  ``dask worker``, a dask-jobqueue ``SLURMCluster``: docs/cluster.md). Which addresses a batch may trust,
-  and the bounded check that the peer is a scheduler, are ``gyrolab.batch.scheduler``'s.
-
-``scheduler`` None (``batch.scheduler`` unset) with ``DASK_SCHEDULER_ADDRESS`` set in the environment (Dask's
-own variable, which ``distributed.Client()`` reads too): that scheduler.
-
-At most a few chunks per worker are submitted at a time, so memory is bounded by a few chunks, not by
-the batch. A chunk that fails stops the batch with one sentence naming the chunk.
-
-A batch's chunk task (``gyrolab.batch.runner.ChunkTask``) carries what a worker needs to rebuild the
-compiled model (a plain resolved config): a plugin torque's compiled function is a machine address that
-does not pickle. Each worker process rebuilds it once per config (``gyrolab.batch.runner.run_chunk``) and
-reuses it for the next chunks.
+``map_chunks(function, tasks, on_result, scheduler)`` calls ``function(task)`` for every task and hands each
+result to ``on_result(index, result)`` in the calling process as it arrives (one process writes the output);
+``function`` is module-level and the tasks picklable, so the same call runs them elsewhere. ``scheduler`` None or
+``"process"``: here; ``"local"``: a ``LocalCluster``, one single-threaded worker per core (numba at one thread,
+so workers do not oversubscribe the cores); ``"tcp://HOST:PORT"``/``tls://``: an existing scheduler (which
+addresses a batch trusts: ``gyrolab.batch.scheduler``). At most a few chunks per worker are submitted at a time,
+so memory is bounded by a few chunks; a chunk that fails stops the batch with one sentence naming it.
 """
 
 from __future__ import annotations
@@ -36,17 +20,13 @@ from collections.abc import Callable, Iterable
 from importlib.util import find_spec
 from typing import Any, TypeVar
 
-from gyrolab.batch import scheduler as scheduler_module
+from gyrolab.batch.scheduler import CONNECT_TIMEOUT, IN_PROCESS, LOCAL, probe
 from gyrolab.errors import ConfigError, GyrolabError, OutputError, shorten
 from gyrolab.output.atomic import reason
 
 Task = TypeVar("Task")
 Result = TypeVar("Result")
 
-IN_PROCESS = scheduler_module.IN_PROCESS
-LOCAL = scheduler_module.LOCAL
-#: seconds to wait for a scheduler to answer before saying it cannot be reached
-CONNECT_TIMEOUT = scheduler_module.CONNECT_TIMEOUT
 #: chunks submitted per worker thread at a time: one running, one queued (memory: a few chunks per worker)
 CHUNKS_PER_THREAD = 2
 #: the errnos of a write that failed for want of space: a chunk failing so is a full disk (exit 3), not a bug
@@ -58,9 +38,8 @@ WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_TH
 def map_chunks(function: Callable[[Task], Result], tasks: Iterable[Task],
                on_result: Callable[[int, Result], None], scheduler: str | None = None,
                source: str = "the caller") -> None:
-    """Run ``function`` on every task where ``scheduler`` says; ``on_result(index, result)`` for each result,
-    in this process, in the order they complete (in task order when they run here). ``source`` says where
-    the scheduler's address came from (named in the log and in the sentence when it cannot be reached)."""
+    """Run ``function`` on every task where ``scheduler`` says; ``on_result(index, result)`` for each result, here,
+    as they complete (in task order when they run here); ``source``: where the scheduler's address came from."""
     kind = scheduler_kind(scheduler)
     if kind == "process":
         for index, task in enumerate(tasks):
@@ -109,11 +88,8 @@ def _where(kind: str, scheduler: str) -> str:
 
 
 def _client(kind: str, scheduler: str, source: str) -> Any:
-    """A connected ``distributed.Client`` (closing it also closes a local cluster it started).
-
-    An address is first probed (``gyrolab.batch.scheduler.probe``: a silent peer or one that is not a Dask
-    scheduler is one sentence within ``CONNECT_TIMEOUT``), then connected with the same bound.
-    """
+    """A connected ``distributed.Client`` (closing it also closes a local cluster it started); an address is first
+    probed (``gyrolab.batch.scheduler.probe``), then connected within the same ``CONNECT_TIMEOUT``."""
     import logging
 
     from distributed import Client, LocalCluster
@@ -129,7 +105,7 @@ def _client(kind: str, scheduler: str, source: str) -> Any:
                                dashboard_address=None, silence_logs=logging.ERROR, env=dict(WORKER_ENV),
                                local_directory=str(scratch))
         return Client(cluster, set_as_default=False)
-    scheduler_module.probe(scheduler, source, CONNECT_TIMEOUT)
+    probe(scheduler, source, CONNECT_TIMEOUT)
     try:
         return Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError) as error:
@@ -169,5 +145,3 @@ def _map_on(client: Any, function: Callable[[Task], Result], tasks: Iterable[Tas
     finally:
         pending.clear()
 
-
-__all__ = ["chunk_error", "map_chunks", "scheduler_kind"]

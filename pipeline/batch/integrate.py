@@ -19,32 +19,6 @@ from gyrolab.contracts import CompiledModel, Integrator
 from gyrolab.contracts.integrator import BATCH_KERNEL, CHOOSES_METHOD, BatchSolution, RightHandSide
 from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.accuracy.calibration import AUTO_SAMPLE  # auto's pilot sample of a batch (importable here, as before)
-
-# BATCH_INTEGRATORS (like FAST_PATH, ADAPTIVE) is computed from the registry's capabilities by __getattr__ below
-__all__ = ["AUTO_SAMPLE", "BATCH_INTEGRATORS", "BatchSolution",  # noqa: F822 "batch_kernel_integrators",
-           "integrate_arrays", "integrate_batch", "integrate_points"]
-
-
-def batch_kernel_integrators() -> list[str]:
-    """The registered integrators with a batch kernel (capability BATCH_KERNEL), fixed-step ones first."""
-    from gyrolab.contracts.capabilities import integrators_with
-
-    return integrators_with(BATCH_KERNEL)
-
-
-def __getattr__(name: str) -> object:
-    """``BATCH_INTEGRATORS``, ``FAST_PATH``, ``ADAPTIVE``: the old tables of names, now derived from capabilities
-    (computed when asked for: listing them loads every registered integrator class)."""
-    from gyrolab.contracts.capabilities import integrator_classes
-
-    if name == "BATCH_INTEGRATORS":
-        return tuple(batch_kernel_integrators())
-    if name in ("FAST_PATH", "ADAPTIVE"):
-        adaptive = name == "ADAPTIVE"
-        return tuple(n for n, cls in integrator_classes().items()
-                     if cls.supports(BATCH_KERNEL) and bool(getattr(cls, "adaptive", False)) == adaptive)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray | None = None) -> BatchSolution:
@@ -81,10 +55,9 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
         raise ConfigError(f"initial_states has shape {y0s.shape}; it must be (trajectories, {size})")
     compiled = scene.system.compiled_model()
     integrator = scene.integrator
-    # An integrator that chooses its method (auto) chooses once for the batch, on a few of its trajectories
-    # (its choose_batch_method: the tightest of their choices), and runs that choice's vectorised kernel over all
-    # of them; one run per trajectory in Python cost ~23x the CPU. Only a choice asked to be free to leave double
-    # precision per trajectory (auto's integrator.extended_precision=true) keeps one run, and one choice, per trajectory.
+    # An integrator that chooses its method (auto) chooses once for the batch (choose_batch_method) and runs that
+    # choice's vectorised kernel over all trajectories, unless asked to be free to leave double precision per
+    # trajectory (auto's integrator.extended_precision=true): then one run, and one choice, per trajectory.
     per_point = integrator.supports(CHOOSES_METHOD) and getattr(integrator, "per_trajectory", False)
     if not integrator.supports(BATCH_KERNEL) or per_point or compiled is None:
         if params is not None:

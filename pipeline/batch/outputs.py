@@ -1,12 +1,5 @@
-"""What a batch stores per point (``batch.output``), computed from a chunk's trajectories.
-
-* ``trajectory``: every output variable of the system (as a single run's ``run.nc``) over the output times;
-* ``decimated``: the same at every ``batch.decimate``-th output time (the first and the k-th, 2k-th, ...);
-* ``final``: the final state's variables (angles wrapped to (−π, π]);
-* ``reductions``: ``final`` plus each monitored invariant's ``<name>_max_abs_drift`` (max over the stored
-  samples of |I(t) − I(0)|) and ``max_nutation_deviation`` (max |θ(t) − θ(0)|);
-* ``indicator``: the chaos indicator and the max nutation deviation of ``gyrolab.analysis.chaos``, from the
-  variational equations (``indicator_outputs``).
+"""What a batch stores per point (``batch.output``: trajectory, decimated, final, reductions, indicator; the table in
+docs/batch.md, "What is stored per point"), computed from a chunk's trajectories.
 
 Each output is ``Output(dims, data, attrs)``: ``dims`` the trailing dimensions after the point's (grid)
 dimensions, ``data`` one row per point of the chunk.
@@ -48,11 +41,8 @@ def output_times(times: np.ndarray, mode: str, decimate: int) -> np.ndarray:
 
 def state_outputs(mode: str, decimate: int, times: np.ndarray, y: np.ndarray,
                   groups: Sequence[tuple[Any, np.ndarray]]) -> dict[str, Output]:
-    """The outputs of ``mode`` (not ``indicator``) for trajectories ``y`` (points × times × state).
-
-    ``groups`` are (system, rows): the rows of ``y`` to compute with each system — the system built with
-    those points' body and forces (energy and units depend on them); other rows stay NaN.
-    """
+    """The outputs of ``mode`` (not ``indicator``) for trajectories ``y`` (points × times × state); ``groups``:
+    (system, rows), each system built with its rows' body and forces (energy and units depend on them)."""
     outputs: dict[str, Output] = {}
     for system, index in groups:
         index = np.asarray(index)
@@ -111,12 +101,9 @@ def _drifts(system: Any, y: np.ndarray) -> dict[str, tuple[np.ndarray, dict[str,
     for name in system.invariants:
         series = np.asarray(values[name], dtype=float)
         drift = np.max(np.abs(series - series[:, :1]), axis=1)
-        out[name + DRIFT_SUFFIX] = (drift, _drift_attrs(name, units))
+        out[name + DRIFT_SUFFIX] = (drift, {"units": units.get(name, "1"),
+                                            "long_name": f"max |{name}(t) − {name}(0)| over the stored samples"})
     return out
-
-
-def _drift_attrs(name: str, units: Mapping[str, str]) -> dict[str, str]:
-    return {"units": units.get(name, "1"), "long_name": f"max |{name}(t) − {name}(0)| over the stored samples"}
 
 
 def _units(system: Any) -> dict[str, str]:
@@ -161,5 +148,3 @@ def merge_rows(outputs: Mapping[str, Output], rows: np.ndarray, n_rows: int) -> 
         merged[name] = Output(out.dims, data, out.attrs)
     return merged
 
-
-__all__: Sequence[str] = ["MODES", "Output", "state_outputs", "indicator_outputs", "merge_rows", "output_times"]

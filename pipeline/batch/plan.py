@@ -1,16 +1,11 @@
-"""A batch's plan: the grid of points as arrays (initial states, compiled-model parameters), validated.
+"""A batch's plan: the grid of points as arrays (initial states, compiled-model parameters), validated
+(docs/batch.md, "How a grid becomes arrays").
 
-The config is composed once (the fixed overrides and each swept key's first value); the swept keys are
-split by what they feed: ``body.*`` and ``force.*`` build the body, the forces and the compiled model's
-parameters, once per combination of their values (a "combo": usually few), and ``initial.*`` the
-initial states, computed for the whole grid at once by the system's vectorised hook
-``initial_states(initial, columns)`` (the fixed-point system has one; other systems fall back to one
-system per distinct point). No OmegaConf config, scene or dataset is built per point.
-
-Validation stays exact: a point the fast checks cannot vouch for (a value that is not a finite number,
-a combo whose system refuses the base initial state, a row the vectorised hook marks invalid) is checked
-by the single run's own code (``Scene.from_config`` on that point's config), so a failed point carries
-the same one-sentence error a single run of it gives.
+The config is composed once; ``body.*`` and ``force.*`` build the system once per combination of their values
+(a "combo"), ``initial.*`` give the initial states of the whole grid through the system's vectorised hook
+``initial_states(initial, columns)`` (other systems: one system per distinct point). A point the fast checks
+cannot vouch for is checked by the single run's own code (``Scene.from_config`` on that point's config), so a
+failed point carries the same one-sentence error a single run of it gives.
 """
 
 from __future__ import annotations
@@ -119,9 +114,8 @@ class Plan:
         return self.combo_params[self.combo[start:stop]]
 
     def identity(self, chunk: int) -> str:
-        """20 hex digits over the code it loads (gyrolab's and its plugins': ``job_code``), the composed config
-        (without the settings that do not change the result), the grid and the chunk size: the same command gives
-        the same identity."""
+        """20 hex digits over the code it loads (``job_code``), the composed config (without the settings that do not
+        change the result), the grid and the chunk size: the same command gives the same identity."""
         plain = copy.deepcopy(self.plain)
         for key in NOT_IN_IDENTITY:
             (plain.get("batch") or {}).pop(key, None)
@@ -133,9 +127,8 @@ class Plan:
 
 
 def split_overrides(overrides: Sequence[str]) -> tuple[list[str], list[Dim]]:
-    """(the fixed overrides, the swept dimensions) of a command line, each override parsed as the
-    multirun's grid parses it (``Grid.from_overrides``: its errors, its typed values; a value given twice
-    is refused by ``make_plan`` for a grid, allowed for zipped keys)."""
+    """(the fixed overrides, the swept dimensions) of a command line, each override parsed as the multirun's grid
+    parses it (``Grid.from_overrides``; a value given twice is refused by ``make_plan`` for a grid, not a zip)."""
     fixed, dims = [], []
     for override in overrides:
         grid = Grid.from_overrides([override], repeats=True)
@@ -215,8 +208,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
         else:
             systems[c] = built
     reference = next(iter(systems.values()), None)
-    if reference is not None:
-        _same_structure(systems)
+    _same_structure(systems)
 
     # initial states: vectorised over the points, or one system per distinct point
     y0 = np.full((n_points, reference.system.state_size if reference else 0), np.nan)
@@ -254,9 +246,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
             combo_params[combo[n]] = params
 
     valid = ~errors.failed
-    base = None
-    if valid.any():
-        base = _with_values(plain, values_of(int(np.argmax(valid))))
+    base = _with_values(plain, values_of(int(np.argmax(valid)))) if valid.any() else None
     times = _batch_times(plain, systems, y0, combo, valid)
     layout = " × ".join(f"{name} {n}" for name, n in zip(dim_names(dims), shape)) if points is None else \
         f"a list ({points['kind']}) over {', '.join(d.key for d in dims)}"
@@ -267,7 +257,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
         log.warning("%s", ignored)
         attributes[ACCURACY_IGNORED_ATTRIBUTE] = ignored
     return Plan(dims=dims, names=dim_names(dims), plain=plain, base=base, times=times, y0=y0, combo=combo,
-                combo_values=combo_values, combo_params=combo_params, error=errors.index, messages=errors.messages,
+                combo_values=combo_values, combo_params=combo_params, error=errors.index, messages=list(errors.codes),
                 attributes=attributes, points=points,
                 systems={c: built.system for c, built in systems.items()})
 
@@ -337,9 +327,6 @@ def _combos(dims: Sequence[Dim], axes: Sequence[tuple[list[Any], np.ndarray]], n
     return combo.astype(np.int32).ravel(), combo_values
 
 
-# ----------------------------------------------------------------------------- pieces
-
-
 @dataclass
 class _Built:
     system: Any
@@ -357,17 +344,10 @@ class _Errors:
 
     def __init__(self, n: int) -> None:
         self.index = np.full(n, -1, dtype=np.int32)
-        self.messages: list[str] = []
-        self._known: dict[str, int] = {}
-
-    def code(self, message: str) -> int:
-        if message not in self._known:
-            self._known[message] = len(self.messages)
-            self.messages.append(message)
-        return self._known[message]
+        self.codes: dict[str, int] = {}   # message -> its index, in order of first appearance
 
     def set(self, where: np.ndarray | int, message: str) -> None:
-        self.index[where] = self.code(message)
+        self.index[where] = self.codes.setdefault(message, len(self.codes))
 
     @property
     def failed(self) -> np.ndarray:

@@ -1,8 +1,6 @@
-"""An explicit list of points from a CSV file (``batch.points_file=PATH``).
-
-The header names config keys (``initial.r0,initial.theta0,body.a``), each row is one point: the value of
-every key there, a finite number. The file is read whole (its SHA-256 goes into the batch's identity, so
-an edited file is another command); any problem is one sentence (ConfigError), before anything is written.
+"""An explicit list of points from a CSV file (``batch.points_file=PATH``; docs/batch.md, "A list of points instead
+of a grid"): the header names config keys, each row is one point; the file is read whole (its SHA-256 goes into the
+batch's identity); any problem is one sentence (ConfigError), before anything is written.
 """
 
 from __future__ import annotations
@@ -69,12 +67,8 @@ _QUOTABLE_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_.]{0,79}$")
 _QUOTABLE_VALUE = re.compile(r"^[0-9A-Za-z_.+-]{1,24}$")
 
 
-def _key_name(key: str, column: int) -> str:
-    return repr(key) if _QUOTABLE_KEY.match(key) else f"{column} (not a dotted key name)"
-
-
 def _check_key(key: str, keys: list[str], plain: dict[str, Any], sections: Sequence[str], where: str) -> None:
-    column = _key_name(key, keys.index(key) + 1)
+    column = repr(key) if _QUOTABLE_KEY.match(key) else f"{keys.index(key) + 1} (not a dotted key name)"
     if not key:
         raise ConfigError(f"{where}: the header has an empty column name; name a config key in every column")
     if keys.count(key) > 1:

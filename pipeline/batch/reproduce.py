@@ -1,12 +1,10 @@
 """``gyrolab reproduce PATH/sweep.nc`` for a batch: rerun its points and compare them bit for bit.
 
-A batch's ``sweep.nc`` stores everything its rerun needs: the composed config (``config``), the swept keys and
-their values as typed (``batch_grid``; a list of points: the keys, with each point's values in the ``point``
-coordinates, or the points file the config names) and the batch's settings. The plan is rebuilt from them,
-cut into the same chunks, and the chosen chunks are run again in this process (never on a Dask scheduler)
-into a temporary file; the chosen points of both files are then compared variable by variable
-(``gyrolab.sweep.reproduce.compare``). ``--points`` chooses points by number (point n is grid position
-``numpy.unravel_index(n, shape)``, or the n-th point of a list); only the chunks holding them run.
+The plan is rebuilt from what the ``sweep.nc`` stores (``config``; ``batch_grid``: the swept keys and values as
+typed; a list's values in the ``point`` coordinates, or the points file the config names), cut into the same
+chunks, and the chunks holding the chosen points (``--points``, by number: point n is grid position
+``numpy.unravel_index(n, shape)``, or the n-th point of a list) run again in this process into a temporary file;
+the chosen points of both files are then compared (``gyrolab.sweep.reproduce.compare``).
 """
 
 from __future__ import annotations

@@ -1,12 +1,11 @@
 """Running a plan: chunks of points, each a picklable task integrated by the integrator's batch kernel (capability
-BATCH_KERNEL), or by one ``integrate`` call per point with that point's system (``integrate_points``) for an
-integrator without one.
+BATCH_KERNEL), or by one ``integrate`` call per point with that point's system (``integrate_points``)
+(docs/batch.md, "Chunks, kernels, progress").
 
-``run_plan(plan, path, settings)`` cuts the grid into chunks (each a block of the grid, so that it is one
-hyperslab of the stored dataset), skips the chunks a killed run of the same command already stored,
-hands the others to ``gyrolab.batch.executors.map_chunks(run_chunk, ...)`` and streams each result to
-the store as it arrives. ``run_chunk`` is a module-level function: a worker rebuilds the compiled model
-and the integrator from the task's plain config (once per process and config, see ``_context``).
+``run_plan(plan, path, settings)`` cuts the grid into chunks (each one hyperslab of the stored dataset), skips
+those a killed run of the same command already stored, hands the others to ``executors.map_chunks(run_chunk,
+...)`` and streams each result to the store as it arrives. A worker rebuilds the compiled model and the
+integrator from the task's plain config, once per process and config (``_context``).
 """
 
 from __future__ import annotations
@@ -189,15 +188,9 @@ def run_plan(plan: Plan, path: Path, settings: Settings, only: set[int] | None =
 
 
 def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any]]:
-    """(the integrator every chunk runs, its dataset attributes); None: the config's own (a fixed choice).
-
-    An integrator that chooses its method (CHOOSES_METHOD: ``auto``) chooses here, once for the batch, on the
-    batch's valid points (its ``choose_batch_method``; ``auto``: its pilot on the first point, the largest state
-    and the most unusual parameters, the tightest tolerance): every chunk then runs the same method at the
-    same tolerance. (The chaos indicator needs VARIATIONAL, which such an integrator lacks: refused before.)
-    The attributes always say how the points ran (``batch_path``: the integrator's batch kernel, vectorised
-    or not, or one ``integrate`` call per point).
-    """
+    """(the integrator every chunk runs, its dataset attributes, which always say how the points ran:
+    ``batch_path``); None: the config's own. An integrator that chooses its method (CHOOSES_METHOD) chooses here,
+    once for the batch, on its valid points (docs/batch.md, "integrator=auto chooses once per batch")."""
     if plan.base is None or settings.output == "indicator" or not plan.integrator_class.supports(CHOOSES_METHOD):
         return None, {} if plan.base is None else {"batch_path": batch_path(plan.integrator_class, settings),
                                                    **lane_record(plan.integrator_class, settings)}
@@ -257,8 +250,6 @@ def plan_tasks(plan: Plan, settings: Settings) -> list[ChunkTask]:
     tasks = (chunk_task(plan, block, i, settings, integrator) for i, block in enumerate(blocks))
     return [task for task in tasks if task is not None]
 
-
-# ----------------------------------------------------------------------------- in a worker
 
 _CONTEXTS: dict[str, Any] = {}
 
@@ -355,9 +346,6 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
     return ChunkResult(index=task.index, outputs=merge_rows(outputs, task.rows, task.n_rows), failed=all_failed,
                        kernel_time=kernel_time, wall_time=time.perf_counter() - start, settings=settings,
                        first_in_process=first)
-
-
-# ----------------------------------------------------------------------------- progress
 
 
 class _Progress:

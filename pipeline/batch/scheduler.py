@@ -1,18 +1,12 @@
-"""Which Dask scheduler a batch trusts, and a check, bounded in time, that the peer is one.
+"""Which Dask scheduler a batch trusts, and a check, bounded in time, that the peer is one (docs/cluster.md, "Whom a
+batch trusts").
 
-Connecting to a Dask scheduler trusts it with code execution: what the scheduler and its workers send
-back is unpickled in this process. So a scheduler's address comes only from places the user sets
-directly for this command — the command line (``gyrolab --batch --scheduler ADDRESS ...``), the
-environment (``DASK_SCHEDULER_ADDRESS``) or Dask's own configuration (``scheduler-address`` in its
-YAML files) — never from a gyrolab config file, an experiment or an override, which are shared and
-copied between people. ``batch.scheduler`` in a config may still say ``process`` or ``local`` (a
-cluster this process starts itself trusts nobody); an address there is refused in one sentence that
-says where to put it.
-
-Before ``distributed`` is handed the address, ``probe`` opens the connection itself and reads the
-peer's greeting with a deadline, without unpickling anything: a silent peer or one that is not a
-Dask scheduler is one sentence after at most ``CONNECT_TIMEOUT`` seconds (``distributed`` alone
-waits minutes for a silent peer and fails with a traceback on garbage).
+Connecting to a Dask scheduler trusts it with code execution (what it sends back is unpickled here), so its
+address comes only from places the user sets for this command: the command line (``--scheduler ADDRESS``), the
+environment (``DASK_SCHEDULER_ADDRESS``) or Dask's own configuration, never a gyrolab config, an experiment or an
+override, which are shared (``batch.scheduler`` there may say ``process`` or ``local``). Before ``distributed``
+is handed the address, ``probe`` reads the peer's greeting with a deadline, unpickling nothing: a silent peer or
+one that is not a Dask scheduler is one sentence after at most ``CONNECT_TIMEOUT`` seconds.
 """
 
 from __future__ import annotations
@@ -22,7 +16,6 @@ import socket
 import ssl
 import struct
 import time
-from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib.util import find_spec
 
@@ -53,36 +46,6 @@ class Choice:
     source: str
 
 
-def split_scheduler_option(argv: Sequence[str]) -> tuple[str | None, list[str]]:
-    """(the value of ``--scheduler VALUE`` or ``--scheduler=VALUE`` anywhere in ``argv``, the other arguments).
-
-    No override starts with ``--``, so the option can be taken out wherever it stands.
-    """
-    value, rest, args = None, [], list(argv)
-    while args:
-        arg = args.pop(0)
-        option, has_value, text = arg.partition("=")
-        if option != OPTION:
-            rest.append(arg)
-            continue
-        if not has_value:
-            if not args or args[0].startswith("-"):
-                raise ConfigError(f"{OPTION} needs a value: process, local or a Dask scheduler's address "
-                                  f"(e.g. {OPTION} tcp://HOST:8786)")
-            text = args.pop(0)
-        if value is not None:
-            raise ConfigError(f"{OPTION} is given twice ({shorten(value)} and {shorten(text)}); give it once")
-        value = text
-    return value, rest
-
-
-def take_scheduler_option(argv: Sequence[str]) -> list[str]:
-    """``argv`` without ``--scheduler``; its value (or none) becomes the command line's scheduler."""
-    global _command_line
-    _command_line, rest = split_scheduler_option(argv)
-    return rest
-
-
 def use_command_line_scheduler(value: str | None) -> None:
     """Set the command line's scheduler (what ``--scheduler VALUE`` does; None: not given)."""
     global _command_line
@@ -90,11 +53,9 @@ def use_command_line_scheduler(value: str | None) -> None:
 
 
 def choose_scheduler(configured: object = None) -> Choice:
-    """The scheduler of a batch: the command line's, else ``batch.scheduler``'s ``process``/``local``, else
-    Dask's own (``DASK_SCHEDULER_ADDRESS``, then Dask's configuration files), else this process.
-
-    ``configured`` is ``batch.scheduler`` from the config: an address there is refused (module docstring).
-    """
+    """The scheduler of a batch: the command line's, else ``batch.scheduler``'s (``configured``: ``process`` or
+    ``local``; an address there is refused), else Dask's own (``DASK_SCHEDULER_ADDRESS``, its configuration files),
+    else this process."""
     text = check_configured(configured)
     if _command_line is not None:
         return Choice(_command_line or None, f"the command line ({OPTION})")
@@ -130,16 +91,10 @@ def _dask_configured() -> str:
     return str(dask.config.get("scheduler-address", None) or "").strip()
 
 
-# ----------------------------------------------------------------------------- is the peer a scheduler?
-
-
 def probe(address: str, source: str, timeout: float = CONNECT_TIMEOUT) -> None:
-    """ConfigError in one sentence unless a Dask scheduler greets us at ``address`` within ``timeout`` s.
-
-    Reads the first message a Dask peer sends on a new connection (its handshake: a length-prefixed
-    msgpack mapping with the keys ``compression`` and ``python``), decoded with plain msgpack, which
-    never runs code. Over ``tls://`` the connection uses Dask's TLS settings (``distributed.comm.tls``).
-    """
+    """ConfigError in one sentence unless a Dask scheduler greets us at ``address`` within ``timeout`` s: the first
+    message a Dask peer sends (its handshake, a length-prefixed msgpack mapping with the keys ``compression`` and
+    ``python``) decoded with plain msgpack, which never runs code; ``tls://`` with Dask's TLS settings."""
     from distributed.comm.addressing import parse_address, parse_host_port
 
     where = f"at {address} (from {source})"
@@ -224,6 +179,3 @@ def _tls_context() -> ssl.SSLContext:
                           "variables; docs/cluster.md)")
     return context
 
-
-__all__ = ["Choice", "check_configured", "choose_scheduler", "probe", "split_scheduler_option", "take_scheduler_option",
-           "use_command_line_scheduler"]

@@ -1,25 +1,16 @@
-"""A batch's dataset on disk, written chunk by chunk, resumable after a kill.
+"""A batch's dataset on disk, written chunk by chunk, resumable after a kill (its layout: docs/batch.md, "The
+file"; how it resumes: "Resume").
 
-Layout: one dimension per swept parameter (named by ``gyrolab.batch.plan.dim_names``, the swept values as
-its coordinate), the per-point variables of ``batch.output`` over (grid dims..., their own dims), and per
-point ``job_status`` (0 not run, 1 finished, 2 failed: the codes of a multirun's ``sweep.nc``) and
-``job_error`` (an index into ``error_message``, -1 for none).
-
-Writes go to ``NAME.part`` beside the final name; each variable's storage is contiguous and allocated when
-the file is created, so a chunk's write changes data, never the file's structure, and a killed process
-leaves a file that opens. After a chunk's data is synced to disk its index is appended to ``NAME.chunks``
-(the journal, fsynced); a rerun with the same identity continues after the journaled chunks. When every
-chunk is stored the file is closed, synced and renamed to ``NAME``, and the journal removed.
-
-A failed write (a full disk, a quota, a file-size limit) is one ``OutputError`` sentence (exit 3) that
-keeps the finished work: the chunks already journaled stay in ``NAME.part``, and rerunning the same
-command continues after them. Only complete journal lines count, and a torn last line is cut off before
-the journal is appended to again. A ``NAME.part`` that cannot be opened any more (its creation failed, or
-a failure broke the library's metadata) is replaced by a new one, with a warning naming the chunks lost.
+Writes go to ``NAME.part``, whose variables' storage is contiguous and allocated when it is created, so a chunk's
+write changes data, never the file's structure; each chunk synced to disk is journaled in ``NAME.chunks``, and a
+rerun with the same identity continues after the journaled chunks; the complete file is renamed to ``NAME``. A
+failed write is one ``OutputError`` sentence (exit 3) that keeps the journaled chunks; a ``NAME.part`` that no
+longer opens is replaced, with a warning naming the chunks lost.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import os
@@ -36,18 +27,15 @@ from gyrolab.errors import ConfigError, OutputError
 from gyrolab.output.atomic import TEMP_SUFFIX, _fsync, _fsync_directory, _library_failure, diagnose, reason
 from gyrolab.output.cf import CONVENTIONS, now_iso
 from gyrolab.output.provenance import gyrolab_version, provenance
-from gyrolab.output.trust import check_output_target, no_follow
+from gyrolab.output.trust import check_output_target, open_own_file
 from gyrolab.sweep import record
-from gyrolab.sweep.aggregate import STATUS_FLAGS
+from gyrolab.sweep.aggregate import STATUS_ATTRS, STATUS_FLAGS
 
 log = logging.getLogger("gyrolab.batch")
 
 FINISHED, FAILED = STATUS_FLAGS[record.FINISHED], STATUS_FLAGS[record.FAILED]
-STATUS_ATTRS = {"long_name": "how the point ended: 0 not run, 1 finished, 2 failed", "units": "1",
-                "flag_values": np.array([0, 1, 2], dtype=np.int8), "flag_meanings": "missing finished failed"}
+STATUS_LONG_NAME = "how the point ended: 0 not run, 1 finished, 2 failed"
 ERROR_ATTRS = {"long_name": "the point's error: index into error_message, -1 for none", "units": "1"}
-#: the counts ``finish`` stores; created (as 0) with the file, so that finishing overwrites them in place
-COUNT_ATTRS = ("n_missing", "n_finished", "n_failed")
 
 
 class Store:
@@ -60,7 +48,6 @@ class Store:
         #: the integrator's settings every chunk ran with (``auto``: its choice for the batch), as attributes
         self.integrator_attributes: dict[str, Any] = {}
 
-    # -- opening: new, resumed or already complete ---------------------------------------------------
     def open(self) -> set[int] | None:
         """The chunks already stored (a resumed run), or None when ``path`` holds this batch complete."""
         if self.path.exists():
@@ -130,12 +117,9 @@ class Store:
     def _close_quietly(self) -> None:
         nc, self.nc = self.nc, None
         if nc is not None:
-            try:
+            with contextlib.suppress(OSError, RuntimeError):   # the write failed; the journal says what is whole
                 nc.close()
-            except (OSError, RuntimeError):
-                pass   # the write already failed; the journal says which chunks are whole
 
-    # -- writing ----------------------------------------------------------------------------------------
     def chunk_done(self, index: int, chunk: Any, result: Any) -> None:
         """Store a chunk's result (None: a chunk without a valid point) and journal it; OutputError (the
         journaled chunks kept) when a write fails."""
@@ -157,7 +141,7 @@ class Store:
                     self._write(name, chunk, out.data)
         self.nc.sync()
         _fsync(self.part)
-        with open(self.journal, "a", encoding="utf-8", opener=no_follow) as journal:
+        with open(self.journal, "a", encoding="utf-8", opener=open_own_file) as journal:
             journal.write(f"{index}\n")
             journal.flush()
             os.fsync(journal.fileno())
@@ -184,8 +168,7 @@ class Store:
             self._create(None)
         status = self.nc["job_status"][:]
         status = np.asarray(status.filled(0) if np.ma.isMaskedArray(status) else status)
-        counts = {name: np.int64(np.count_nonzero(status == code))
-                  for name, code in (("n_missing", 0), ("n_finished", FINISHED), ("n_failed", FAILED))}
+        counts = {f"n_{name}": np.int64(np.count_nonzero(status == code)) for name, code in STATUS_FLAGS.items()}
         self.nc.setncatts(counts)
         if counts["n_failed"]:
             log.info("batch: %d of %d points failed; their errors are error_message[job_error] where job_status is 2",
@@ -201,7 +184,6 @@ class Store:
         data = np.asarray(data)
         self.nc[name][chunk.slab] = data.reshape(chunk.shape + data.shape[1:])
 
-    # -- creating ------------------------------------------------------------------------------------------
     def _create(self, result: Any) -> None:
         """Create ``.part`` whole (every variable's storage allocated); a failure leaves neither it nor a journal
         (nothing was finished), so the rerun starts cleanly."""
@@ -224,10 +206,9 @@ class Store:
         system = _reference_system(plan)
         if plan.points is not None:
             nc.createDimension(POINT, plan.size)
-            var = nc.createVariable(POINT, "i4", (POINT,))
-            var[:] = np.arange(plan.size, dtype=np.int32)
-            var.setncatts({"long_name": "index of the point in the batch's list (a points file's data row, from 0)",
-                           "units": "1"})
+            _variable(nc, POINT, POINT, np.arange(plan.size, dtype=np.int32),
+                      {"long_name": "index of the point in the batch's list (a points file's data row, from 0)",
+                       "units": "1"})
         for name, dim in zip(plan.names, plan.dims):
             if plan.points is None:
                 nc.createDimension(name, len(dim.values))
@@ -236,20 +217,15 @@ class Store:
                 values = values.astype(np.int32) if np.abs(values).max() < 2**31 else values.astype(np.float64)
             attrs = {"long_name": f"swept parameter {dim.key}" + (" of each point" if plan.points else ""),
                      "override_key": dim.key, **_key_units(dim.key, system)}
-            along = POINT if plan.points is not None else name
-            if values.dtype.kind == "O":
-                _text_variable(nc, name, along, values, attrs)
-            else:
-                var = nc.createVariable(name, values.dtype, (along,))
-                var[:] = values
-                var.setncatts(attrs)
+            (_text_variable if values.dtype.kind == "O" else _variable)(
+                nc, name, POINT if plan.points is not None else name, values, attrs)
         nc.createDimension("error_kind", len(self.messages))
         _text_variable(nc, "error_message", "error_kind", self.messages,
                        {"long_name": "the one-sentence errors of the failed points (job_error indexes them)"})
         grid = plan.grid_dims
         # no fill value: every point's code is written below (a fill value would make readers mask the codes)
         status = nc.createVariable("job_status", "i1", grid, contiguous=True, fill_value=False)
-        status.setncatts({**STATUS_ATTRS, **self._coordinates_attr()})
+        status.setncatts({"long_name": STATUS_LONG_NAME, **STATUS_ATTRS, **self._coordinates_attr()})
         error = nc.createVariable("job_error", "i4", grid, contiguous=True, fill_value=False)
         error.setncatts({**ERROR_ATTRS, **self._coordinates_attr()})
         shape = plan.shape
@@ -258,7 +234,8 @@ class Store:
         error[:] = plan.error.reshape(shape)
         if result is not None:
             self._create_variables(result, system)
-        nc.setncatts({**self._attributes(system), **{name: np.int64(0) for name in COUNT_ATTRS}})
+        # the counts ``finish`` stores, created (as 0) with the file so that finishing overwrites them in place
+        nc.setncatts({**self._attributes(system), **{f"n_{name}": np.int64(0) for name in STATUS_FLAGS}})
         nc.sync()
         _fsync(self.part)
         _start_journal(self.journal, self.identity)
@@ -287,9 +264,8 @@ class Store:
 
         if dim == "time":
             times = output_times(self.plan.times, self.settings.output, self.settings.decimate)
-            var = self.nc.createVariable("time", "f8", ("time",))
-            var[:] = times
-            var.setncatts(time_attributes(system.body) if system is not None else {"long_name": "time", "axis": "T"})
+            _variable(self.nc, "time", "time", times,
+                      time_attributes(system.body) if system is not None else {"long_name": "time", "axis": "T"})
         elif dim == "axis" and size == 3:
             _text_variable(self.nc, "axis", "axis", ["x", "y", "z"], {"units": "1", "long_name": "principal body axis"})
 
@@ -325,6 +301,12 @@ class Store:
         return attrs
 
 
+def _variable(nc: netCDF4.Dataset, name: str, dim: str, values: np.ndarray, attrs: dict[str, Any]) -> None:
+    var = nc.createVariable(name, values.dtype, (dim,))
+    var[:] = values
+    var.setncatts(attrs)
+
+
 def _text_variable(nc: netCDF4.Dataset, name: str, dim: str, values: Any, attrs: dict[str, Any]) -> None:
     """Text along ``dim`` as a UTF-8 char array (as xarray writes text, so CF checkers read it)."""
     texts = [str(v) for v in values]
@@ -354,7 +336,7 @@ def _identity_of(path: Path) -> str:
 
 
 def _start_journal(path: Path, identity: str) -> None:
-    with open(path, "w", encoding="utf-8", opener=no_follow) as journal:
+    with open(path, "w", encoding="utf-8", opener=open_own_file) as journal:
         journal.write(f"identity {identity}\n")
         journal.flush()
         os.fsync(journal.fileno())
@@ -377,7 +359,7 @@ def _cut_torn_line(path: Path) -> None:
     """Cut a journal's unterminated last line (a write that failed half-way), so that appending stays exact."""
     data = path.read_bytes()
     if data and not data.endswith(b"\n"):
-        with open(path, "r+b", opener=no_follow) as journal:
+        with open(path, "r+b", opener=open_own_file) as journal:
             journal.truncate(data.rfind(b"\n") + 1)
             journal.flush()
             os.fsync(journal.fileno())

@@ -1,12 +1,8 @@
-"""Large sweeps in one command: ``gyrolab --batch KEY=V1,V2 ...`` writes ``<dir>/sweep.nc`` (docs/batch.md).
+"""Large sweeps in one command: ``gyrolab batch KEY=V1,V2 ...`` writes ``<dir>/sweep.nc`` (docs/batch.md).
 
-The grid becomes arrays (``gyrolab.batch.plan``: one composed config, initial states and compiled-model
-parameters for every point, each invalid point a failed entry with the single run's error), runs in chunks
-on the integrator's compiled batch kernel, or one ``integrate`` call per point for an integrator without one
-(``gyrolab.batch.runner``), and streams to one dataset whose dimensions are
-the swept parameters (``gyrolab.batch.store``). Rerunning the same command resumes; ``batch.output`` says
-what is stored per point. Only parameters of the body, the initial state and the forces may vary: the
-system, the forces' list, the integrator and the output times are one for the whole batch.
+The grid becomes arrays (``plan``), runs in chunks (``runner``) and streams to one resumable dataset whose
+dimensions are the swept parameters (``store``). Only parameters of the body, the initial state and the forces
+may vary.
 """
 
 from __future__ import annotations
@@ -28,10 +24,8 @@ SWEEP_NAME = "sweep.nc"
 
 
 def run_batch_sweep(overrides: Sequence[str], out_dir: Path) -> Path:
-    """Run the grid of ``overrides`` as one batch; write (or resume) and return ``out_dir/sweep.nc``.
-
-    ``out_dir`` is locked meanwhile (a second batch into it is refused in one sentence).
-    """
+    """Run the grid of ``overrides`` as one batch; write (or resume) and return ``out_dir/sweep.nc``, the folder
+    locked meanwhile (a second batch into it is refused in one sentence)."""
     fixed, dims = split_overrides(overrides)
     return run_batch(fixed, dims, Path(out_dir) / SWEEP_NAME).path
 
@@ -69,9 +63,8 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
 
 
 def check_integrator(plan: Plan, settings: Settings | None = None) -> None:
-    """Refuse, in one sentence, an integrator that lacks a capability the batch needs: the chaos indicators
-    (``batch.output=indicator``) need VARIATIONAL. Any integrator runs the other outputs: one with a batch kernel
-    (BATCH_KERNEL) in one call per chunk, any other with one ``integrate`` call per point."""
+    """Refuse, in one sentence, an integrator without VARIATIONAL for the chaos indicators (``batch.output=indicator``);
+    any integrator runs the other outputs (one without a batch kernel: one ``integrate`` call per point)."""
     from gyrolab.contracts.capabilities import integrators_with, or_list
 
     output = settings.output if settings is not None else Settings.from_config(plan.plain.get("batch")).output

@@ -1,23 +1,15 @@
-"""Every file gyrolab writes appears whole or not at all.
+"""Every file gyrolab writes appears whole or not at all (docs/faults.md, "Every file appears whole or not at all").
 
-A result is written to a temporary file beside its final path (same directory,
-so the rename cannot cross file systems), flushed to disk, then renamed over
-the final name (and the directory entry flushed too). A killed process leaves
-at most a temporary file, named ``.<final name>.<random>.tmp``, which the next
-run or resume in that directory removes (``remove_stale_temporaries``, called
-while the directory is locked, see ``gyrolab.output.lock``). A write that
-fails for want of space, quota or permission is one ``OutputError`` sentence
-naming the file and the reason, and leaves no partial file.
-
-The netCDF library reports a full disk or a file-size limit as
-``RuntimeError("NetCDF: HDF error")``, without an errno; the reason is then
-found after the failure (``diagnose``): the process's file-size limit, a
-probe write beside the file (which fails with the real errno when the disk or
-quota is full), and the free space against the expected size of the file.
+A result is written to a temporary file beside its final path (``.<final name>.<random>.tmp``), flushed, then
+renamed over the final name; the next run or resume in that directory removes what a killed write left
+(``remove_stale_temporaries``, while the directory is locked). A failed write is one ``OutputError`` sentence
+naming the file and the reason; the netCDF library reports a full disk or a file-size limit without an errno
+("HDF error"), so ``diagnose`` then finds the reason after the failure.
 """
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import resource
@@ -61,13 +53,9 @@ def _library_failure(error: BaseException) -> bool:
 
 @contextmanager
 def atomic_path(path: str | os.PathLike[str], *, expected_bytes: int | None = None) -> Iterator[Path]:
-    """Yield a temporary path to write; on success it is renamed to ``path``, on failure removed.
-
-    OSErrors raised while writing, and the netCDF library's "HDF error" (a full disk or a file-size
-    limit), become one ``OutputError`` naming ``path`` and the reason. ``expected_bytes``, the
-    approximate size of the finished file, lets the reason of an errno-less failure be found from
-    the free space.
-    """
+    """Yield a temporary path to write; on success it is renamed to ``path``, on failure removed, and a failed write
+    (an OSError, netCDF's "HDF error") is one ``OutputError`` naming ``path`` and the reason. ``expected_bytes``
+    (the finished file's approximate size) lets the reason of an errno-less failure be found from the free space."""
     path = Path(path)
     if path.parent.name in OWN_DIRS:
         own_dir(path.parent)  # figures/, .hydra/: a real folder, not a link out of the run directory
@@ -85,18 +73,12 @@ def atomic_path(path: str | os.PathLike[str], *, expected_bytes: int | None = No
         os.chmod(tmp, 0o666 & ~umask())  # mkstemp makes the file private; results are ordinary files
         os.replace(tmp, path)
         _fsync_directory(path.parent)
-    except OutputError:
+    except BaseException as error:  # the temporary file goes; a failed write (not bad content) is one sentence
+        failed_write = not isinstance(error, OutputError) and (isinstance(error, OSError) or _library_failure(error))
+        why = diagnose(error, tmp, expected_bytes) if failed_write else ""
         tmp.unlink(missing_ok=True)
-        raise
-    except (OSError, RuntimeError) as error:
-        if not isinstance(error, OSError) and not _library_failure(error):
-            tmp.unlink(missing_ok=True)
-            raise
-        why = diagnose(error, tmp, expected_bytes)
-        tmp.unlink(missing_ok=True)
-        raise OutputError(f"cannot write {str(path)!r}: {why}") from None
-    except BaseException:
-        tmp.unlink(missing_ok=True)
+        if failed_write:
+            raise OutputError(f"cannot write {str(path)!r}: {why}") from None
         raise
 
 
@@ -165,25 +147,19 @@ def _fsync_directory(directory: Path) -> None:
     except OSError:
         return
     try:
-        os.fsync(fd)
-    except OSError:
-        pass  # some file systems cannot fsync a directory; the rename has happened all the same
+        with contextlib.suppress(OSError):  # some file systems cannot fsync a directory; the rename happened
+            os.fsync(fd)
     finally:
         os.close(fd)
 
 
 def remove_stale_temporaries(directory: str | os.PathLike[str]) -> list[Path]:
-    """Remove temporary files that killed writes left in ``directory`` (not recursive).
-
-    Call it only while holding the directory's lock (``gyrolab.output.lock``): a temporary file of a
-    write in progress is indistinguishable from a stale one. Returns the files removed.
-    """
+    """Remove (and return) the temporary files that killed writes left in ``directory`` (not recursive). Only while
+    holding the directory's lock: a temporary file of a write in progress looks like a stale one."""
     removed = []
     for leftover in Path(directory).glob(f".*{TEMP_SUFFIX}"):
-        try:
+        with contextlib.suppress(OSError):  # gone already, or not ours to remove: nothing is lost by leaving it
             if leftover.is_file():
                 leftover.unlink()
                 removed.append(leftover)
-        except OSError:
-            pass  # gone already, or not ours to remove: nothing is lost by leaving it
     return removed

@@ -1,31 +1,11 @@
 """CF-1.8 conventions for every dataset gyrolab writes (checked by compliance-checker's ``cf:1.8`` suite).
 
-``conform(ds, title, source)`` is the last step of every dataset builder (run, regime run, sweep,
-experiments). It makes the netCDF file a CF-1.8 file without changing what the dataset holds:
-
-* global attributes ``Conventions: CF-1.8``, ``title``, ``history`` (one line: when, which gyrolab,
-  what made the file) and ``date_created`` (ISO 8601, UTC); a builder's own ``title`` is kept;
-* coordinates carry no ``_FillValue`` (CF §2.5.1: a coordinate has no missing values), set through
-  the variable's netCDF encoding, so the in-memory dataset is unchanged;
-* string-valued coordinates (``axis`` = x, y, z; ``frame_axis``; a swept integrator's names; case
-  labels) are stored as character arrays (CF §2.2, the labels of §6.1): a CF coordinate variable is
-  numeric (§1.3), and compliance-checker's monotonicity check fails on a string one. xarray reads
-  them back as the same strings, so ``ds.omega.sel(axis="z")`` keeps working;
-* 64-bit integers become 32-bit (CF-1.8 §2.2 lists byte, short, int, float, double, char; int64
-  arrives only with CF-1.9), or float64 (exact to 2**53) when a value is outside the int32 range;
-* ``standard_name: time`` is dropped wherever the units are not ``<unit> since <epoch>``: gyrolab's
-  time is elapsed model time (s, or a nondimensional unit), not a calendar date (CF §4.4). The
-  ``time`` coordinate carries ``axis: T`` (CF §4: axis identifies a coordinate's direction without
-  claiming a calendar). The one message compliance-checker (6.x) still prints comes from its §5.1
-  heuristic that a dimension named ``time`` must carry that standard name; claiming a calendar would
-  be false, so it stays (docs/datasets.md);
-* every variable and coordinate has a ``long_name`` (CF §3.3 wants one where there is no
-  ``standard_name``): one a builder forgot (a third-party system's variable, say) becomes the
-  variable's name, logged; gyrolab's own builders give real ones (tests/output/test_cf.py).
-
-``unit_attributes(body)`` gives the machine-readable scales of a body's model units (global
-attributes ``time_unit``, ``energy_unit``, ``rate_unit`` and, for an SI fixed-point body, the
-papers' nondimensional scales ``time_scale_s`` = 1/c and ``energy_scale_J`` = C c²).
+``conform(ds, title, source)`` is the last step of every dataset builder (run, regime run, sweep, experiments): it
+makes the netCDF file a CF-1.8 file without changing what the dataset holds (global attributes, coordinates
+without ``_FillValue``, text coordinates as characters, 32-bit integers, no ``standard_name: time`` without an
+epoch, a ``long_name`` everywhere; each with its CF section: docs/datasets.md, "Conventions common to every
+dataset" and "The expected CF finding"). ``unit_attributes(body)`` gives the machine-readable scales of a body's
+model units.
 """
 
 from __future__ import annotations
@@ -88,25 +68,15 @@ def _conform_variable(ds: xr.Dataset, name: Any) -> None:
         if name == "time":  # elapsed model time is the T axis (no calendar claimed: see the docstring)
             attrs.setdefault("axis", "T")
         variable.encoding["_FillValue"] = None
-        if _is_text(variable):
+        kind = variable.dtype.kind
+        if kind == "U" or (kind == "O" and all(isinstance(v, str) for v in variable.values.ravel())):  # text
             variable.encoding["dtype"] = "S1"
 
 
-def _is_text(variable: xr.Variable) -> bool:
-    kind = variable.dtype.kind
-    return kind == "U" or (kind == "O" and all(isinstance(v, str) for v in variable.values.ravel()))
-
-
 def unit_attributes(body: Any) -> dict[str, Any]:
-    """Machine-readable model units of ``body`` (netCDF-safe global attributes).
-
-    ``time_unit``/``rate_unit``/``energy_unit``: what one model unit of time, angular rate and
-    energy is (``s``, ``rad/s``, ``J`` for an SI body; ``1/c``, ``c``, ``C c2`` in the papers'
-    nondimensional form, c² = M g ℓ / C). An SI fixed-point body also gives the papers' scales in
-    SI: ``time_scale_s`` = 1/c and ``energy_scale_J`` = C c², so t/time_scale_s and
-    E/energy_scale_J are the papers' nondimensional time and energy. A nondimensional body is
-    scale-free: it has no SI scale, and says so in ``time_unit_description``.
-    """
+    """Machine-readable model units of ``body`` (netCDF-safe global attributes): ``time_unit``, ``rate_unit``,
+    ``energy_unit``, ``time_unit_description`` and, for an SI fixed-point body, the papers' scales ``time_scale_s``
+    = 1/c and ``energy_scale_J`` = C c² (docs/datasets.md, "Conventions common to every dataset")."""
     time_label, rate_label = body.time_label, body.rate_label
     si = body.units == "si"
     attrs: dict[str, Any] = {"time_unit": time_label, "rate_unit": rate_label}

@@ -1,8 +1,6 @@
-"""The run dataset: trajectory, invariants and Euler angles with CF metadata and provenance.
-
-Attributes hold only netCDF-safe values (str, numbers, numeric arrays): the
-resolved config is stored as one YAML string, so a run can be rebuilt from
-its own dataset (``Scene.from_config(OmegaConf.create(ds.attrs["config"]))``).
+"""The run dataset: trajectory, invariants and Euler angles with CF metadata and provenance. Attributes hold only
+netCDF-safe values: the resolved config is one YAML string, so a run can be rebuilt from its own dataset
+(``Scene.from_config(OmegaConf.create(ds.attrs["config"]))``).
 """
 
 from __future__ import annotations
@@ -37,13 +35,11 @@ FRAME_AXES = ("x_radial", "y_along_track", "z_normal")
 def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.Variable]], tuple[
         dict[str, xr.Variable], dict[str, Any]]] | None = None, integrator: Integrator | None = None) -> xr.Dataset:
     """The run dataset of ``scene`` from ``solution``; ``add`` (given the trajectory's variables) returns more
-    variables and attributes to put in while it is assembled (``Scene.run``'s error estimate): inserting a
-    variable into a built dataset aligns and merges again (~0.4 ms each). ``integrator``:
-    the one that ran, when not the scene's own (``auto`` run again aimed tighter, rule 11 of its contract)."""
+    variables and attributes to put in while it is assembled (``Scene.run``'s error estimate; cheaper than merging
+    into a built dataset). ``integrator``: the one that ran, when not the scene's own (``auto`` run again)."""
     system, integrator = scene.system, integrator or scene.integrator
     body = system.body
-    # each state component contiguous (column-major): the derived variables' arithmetic, one component at a time,
-    # runs ~2× faster on contiguous columns than on strided ones (0.1 ms of a 3 ms run), with the same values
+    # each state component contiguous (column-major): the derived variables' arithmetic runs faster, same values
     variables = system.variables(solution.t, np.asfortranarray(solution.y))
     series = {name: variables[name].values for name in system.invariants}
     for name, values in series.items():
@@ -72,16 +68,12 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
 
 
 def flag_violated_invariants(ds: xr.Dataset, invariants: tuple[str, ...], adaptive: bool,
-                             series: dict[str, np.ndarray] | None = None) -> list[str]:
-    """Flag each monitored invariant whose drift the integration error does not explain
-    (``gyrolab.output.invariant_check``): one warning each, ``invariant_check = "violated"`` and a ``comment``
-    on its variable, and the names in the dataset attribute ``violated_invariants``. The figures do not
-    draw a flagged invariant as conserved. Returns the flagged names. ``series``: the invariants' values when the
-    caller holds them (each ``ds[name]`` builds a DataArray: ~20 µs apiece)."""
+                             series: dict[str, np.ndarray]) -> None:
+    """Flag each monitored invariant whose drift the integration error does not explain (``invariant_check``;
+    ``series``: the invariants' values): a warning, ``invariant_check = "violated"`` and a ``comment`` on its
+    variable, its name in the attribute ``violated_invariants`` (the figures do not draw it as conserved)."""
     times = ds.variables["time"].values if "time" in ds.variables else np.empty(0)
     span = float(times[-1] - times[0]) if times.size else 0.0
-    if series is None:
-        series = {name: ds[name].values for name in invariants if name in ds}
     found = violated_invariants(series, invariants, ds.attrs, adaptive, span)
     for name, (drift, allowed) in found.items():
         sentence = violation_sentence(name, drift, allowed)
@@ -90,13 +82,11 @@ def flag_violated_invariants(ds: xr.Dataset, invariants: tuple[str, ...], adapti
                                "comment": sentence})
     if found:
         ds.attrs["violated_invariants"] = " ".join(found)
-    return list(found)
 
 
 def scene_attributes(scene: Scene) -> tuple[dict[str, Any], dict[str, Any]]:
-    """The run dataset's global attributes that depend on the scene alone: those that go before the integrator's
-    record and those after it. ``Scene.dataset_attributes`` computes them once per scene (~0.1 ms of a run);
-    every run's dataset then shares their values, so arrays among them are read-only copies."""
+    """The run dataset's global attributes that depend on the scene alone (those before the integrator's record,
+    those after it), computed once per scene and shared by its runs' datasets: arrays among them are read-only."""
     system = scene.system
     before: dict[str, Any] = {
         "title": system.title(),
@@ -117,18 +107,14 @@ def scene_attributes(scene: Scene) -> tuple[dict[str, Any], dict[str, Any]]:
 
 
 def time_attributes(body: ModelUnits) -> dict[str, str]:
-    """CF attributes of a time coordinate in ``body``'s model units: elapsed time, not a calendar date
-    (so no ``standard_name: time``, which CF reserves for ``<unit> since <epoch>``), marked as the T axis
-    (CF §4: ``axis`` identifies the time coordinate without claiming a calendar)."""
+    """CF attributes of a time coordinate in ``body``'s model units: elapsed time, not a calendar date, so the
+    T axis without ``standard_name: time`` (docs/datasets.md, "The expected CF finding")."""
     return {"units": body.time_unit, "long_name": f"time [{body.time_label}]", "axis": "T"}
 
 
 def write_dataset(ds: xr.Dataset, path: Path) -> Path:
-    """Write ``ds`` to ``path`` atomically (``gyrolab.output.atomic``).
-
-    A full disk, a quota or a file-size limit (which netCDF reports as "HDF error") is one
-    ``OutputError`` naming the file and the reason, and leaves no file at ``path``.
-    """
+    """Write ``ds`` to ``path`` atomically (``gyrolab.output.atomic``: a failed write is one ``OutputError``
+    sentence naming the file and the reason, and leaves no file at ``path``)."""
     path = Path(path)
     with atomic_path(path, expected_bytes=int(ds.nbytes)) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4")

@@ -1,15 +1,10 @@
 """Datasets gyrolab reads (``plot``, ``--animate``, ``reproduce``, ``aggregate``) read as what they claim to be:
 gyrolab's netCDF files. Every reader goes through ``load_dataset``.
 
-A path may be anything a user can type: a text file named ``run.nc``, an empty file, a
-directory, a device, a loop of symbolic links, someone else's netCDF file. Each is one
-ConfigError sentence naming the path and what was expected; the file's contents are never
-echoed (a reader's message quotes at most a variable's name).
-
-A dataset is untrusted input: before anything is read into memory, its declared sizes are checked
-against what gyrolab writes (every value it declares is stored, uncompressed: a 6 kB file declaring
-10⁸ time steps was edited) and against the memory available; after reading, every variable along
-``time`` (or a sweep's ``sample``) must hold numbers, as gyrolab writes them.
+Anything else a user can type (a text file named ``run.nc``, a directory, a device, a loop of links, someone
+else's netCDF file) is one ConfigError sentence naming the path and what was expected, never echoing the file's
+contents. A dataset is untrusted input: its declared sizes are checked against what gyrolab writes and the memory
+available before anything is read, and every variable along ``time`` (or ``sample``) must hold numbers.
 """
 
 from __future__ import annotations
@@ -24,6 +19,7 @@ import xarray as xr
 
 from gyrolab.errors import ConfigError, shorten
 from gyrolab.output.atomic import _size
+from gyrolab.output.trust import proc_number
 
 #: what a figure module or a rerun raises when a dataset lacks what gyrolab's datasets have
 FOREIGN_ERRORS = (LookupError, ValueError, TypeError, AttributeError, ArithmeticError)
@@ -34,13 +30,13 @@ def load_dataset(path: str | os.PathLike[str], expected: str, **options) -> xr.D
     path = Path(path)
     where = shorten(str(path))
     try:
-        mode = os.stat(path).st_mode
+        info = os.stat(path)
     except OSError as error:
         reason = "a loop of symbolic links" if error.errno == 40 else (error.strerror or "cannot be read")
         raise ConfigError(f"cannot read {where!r} ({reason}); give {expected}") from None
-    if not stat.S_ISREG(mode):
+    if not stat.S_ISREG(info.st_mode):
         raise ConfigError(f"{where!r} is not a regular file; give {expected}")
-    size = os.stat(path).st_size
+    size = info.st_size
     if size == 0:
         raise ConfigError(f"{where!r} is empty; give {expected}")
     unreadable = ConfigError(f"cannot read {where!r} as a netCDF dataset (it is not a netCDF file gyrolab can read); "
@@ -100,14 +96,8 @@ def check_declared(declared: int, size: int, where: str, expected: str) -> None:
 
 def memory_limit() -> int:
     """Half the memory available now (Linux's MemAvailable), else 4 GiB."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as handle:
-            for line in handle:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024 // 2
-    except (OSError, ValueError, IndexError):
-        pass
-    return 4 * 1024**3
+    available = proc_number("/proc/meminfo", "MemAvailable:")  # kB
+    return available * 1024 // 2 if available is not None else 4 * 1024**3
 
 
 RUN = "a run.nc that gyrolab wrote"

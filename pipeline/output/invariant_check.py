@@ -1,30 +1,15 @@
 """Is a monitored invariant really conserved? Its drift against what the integration error explains.
 
-A scene monitors an invariant because its forces claim it (``Force`` rules 5 and 6). The scene checks a
-third-party force's claims when it is built (``gyrolab.contracts.claims``); this is the check of the run
-itself, made where the drifts are computed (``gyrolab.output.dataset``). An invariant ``I`` is flagged
-*violated* when its largest drift exceeds every bound the integration error could explain:
+A scene monitors an invariant because its forces claim it (``Force`` rules 5 and 6); this is the check of the
+run itself, made where the drifts are computed (``gyrolab.output.dataset``). An invariant ``I`` is flagged
+*violated* when
 
-    max_t |I(t) − I(0)|  >  S · max(FLOOR, E_tol, E_step, E_kin)
+    max_t |I(t) − I(0)|  >  S · max(FLOOR, E_tol, E_step, E_kin),      S = max(1, max_t |I(t)|)
 
-* ``S = max(1, max_t |I(t)|)``: the invariant's scale (at least one model or SI unit: generous for
-  small quantities, never tighter than FLOOR in absolute terms);
-* ``FLOOR = 1e-6``: below that no drift is called a violation;
-* ``E_tol = EXPLAINED × τ × max(1, n_steps)`` for adaptive methods with a known tolerance τ
-  (``integrator_rtol``/``integrator_atol``, ``integrator_tol``, ``auto_tolerance``): each step's local
-  error is within about τ of the state's scale, and a non-symplectic method adds them up;
-* ``E_step = (h ν)^p · max(1, ν T)`` for fixed-step methods of step h (``integrator_step``) on a scene
-  whose fastest rate ν is known (``sampling_fastest_rate``), over the span T: the global error of a
-  method of order p (``integrator_order`` when the dataset states it, else 2 — an upper bound for every
-  method of order ≥ 2 while hν < 1), with its constant taken as one. It matters for methods that keep
-  |γ| exactly (Lie–Poisson), whose kinematic drift says nothing of the energy's;
-* ``E_kin = EXPLAINED × (the drift of |γ| and of the frame's orthonormality)``: those are conserved
-  whatever the torque, so their drift is the integration error this run actually made (a method that
-  does not keep them by construction errs on them as on the dynamics).
-
-``EXPLAINED = 1e3``. A run whose integrator says nothing it could be judged by (an adaptive method
-without a tolerance attribute, a fixed-step one without ``integrator_step`` and no kinematic invariant)
-is not judged. The kinematic invariants themselves are never flagged: they are the yardstick.
+with E_tol the adaptive method's tolerance summed over its steps, E_step a fixed-step method's global error and
+E_kin ``EXPLAINED`` × the drift of the kinematic invariants, which every torque conserves (the yardstick, never
+flagged themselves); each term and why: docs/plugins.md, "After the run". A run whose integrator gives none of
+them is not judged.
 """
 
 from __future__ import annotations

@@ -1,23 +1,16 @@
-"""One writer per directory: a run directory, a sweep job's directory or a sweep's ``sweep.nc``.
+"""One writer per directory: a run directory, a sweep job's directory or a sweep's ``sweep.nc`` (docs/faults.md,
+"One writer per directory").
 
-A lock is an exclusive ``flock`` on a hidden file in the directory
-(``.gyrolab.lock``, holding the owner's pid and host for the messages). The
-kernel drops flock locks when their process ends, however it ends, so a lock
-left by ``kill -9`` is stale by construction and the next run takes it. The
-lock file is removed on release (safely: a taker checks that the file it
-locked is still the one in the directory).
-
-flock works between processes on one machine and on most cluster file
-systems (NFSv4, Lustre and GPFS map it onto their own locks); on a file system
-without it the lock is taken without effect and a warning is logged.
-
-A process may take a lock it already holds (the hold is counted), so a sweep
-job that holds its directory can call code that locks the same directory.
+A lock is an exclusive ``flock`` on ``.gyrolab.lock`` in the directory (holding the owner's pid and host for the
+messages), which the kernel drops when its process ends however it ends; the file is removed on release. On a
+file system without flock the lock is taken without effect and a warning is logged. A process may take a lock
+it already holds (the hold is counted).
 """
 
 from __future__ import annotations
 
 import atexit
+import contextlib
 import errno
 import fcntl
 import logging
@@ -25,7 +18,6 @@ import os
 import socket
 from collections.abc import Iterator
 from contextlib import contextmanager
-from functools import cache
 from pathlib import Path
 
 from gyrolab.errors import ConfigError, OutputError
@@ -76,27 +68,19 @@ def try_lock(directory: str | os.PathLike[str], *, blocking: bool = False) -> bo
         raise OutputError(f"cannot lock {str(directory)!r}: {reason(error)}") from None
     if fd is None:
         return False
-    if not _held:
-        _release_at_exit()
     _held[key] = [fd, 1]
     return True
 
 
 def release_all() -> None:
-    """Release every lock this process holds and remove its lock file (the end of a command, however it ends).
-
-    A single run's directory is locked by Hydra's ``on_run_start`` callback, whose ``on_run_end`` Hydra
-    skips when the job exits with an error: without this, a failed run left its ``.gyrolab.lock``.
-    """
+    """Release every lock this process holds and remove its lock file (the end of a command, however it ends: Hydra
+    skips the callback's ``on_run_end`` when a run fails, which would leave its ``.gyrolab.lock``)."""
     for key in list(_held):
         _held[key][1] = 1
         unlock(key)
 
 
-@cache
-def _release_at_exit() -> None:
-    """Release the held locks on every exit Python sees (sys.exit, an uncaught exception, Ctrl-C)."""
-    atexit.register(release_all)
+atexit.register(release_all)  # on every exit Python sees (sys.exit, an uncaught exception, Ctrl-C)
 
 
 def unlock(directory: str | os.PathLike[str]) -> None:
@@ -108,10 +92,8 @@ def unlock(directory: str | os.PathLike[str]) -> None:
     if entry[1] > 0:
         return
     del _held[key]
-    try:
+    with contextlib.suppress(OSError):
         (key / LOCK_NAME).unlink(missing_ok=True)  # still ours: nobody else can hold it while we do
-    except OSError:
-        pass
     os.close(entry[0])  # releases the flock
 
 
@@ -165,12 +147,9 @@ def wait_for(directory: str | os.PathLike[str]) -> None:
 
 
 def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
-    """An fd holding an exclusive flock on ``path`` (the file now in the directory), or None when busy.
-
-    The file is opened without following a link and must be a regular file (``gyrolab.output.trust``): a planted
-    ``.gyrolab.lock`` link is refused, never truncated. The owner's line is written only into a file this call
-    created, or a lock file of gyrolab's (one link, the user's, a line long).
-    """
+    """An fd holding an exclusive flock on ``path`` (the file now in the directory), or None when busy. The file is
+    opened without following a link (a planted ``.gyrolab.lock`` link is refused, never truncated); the owner's
+    line is written only into a file this call created, or a lock file of gyrolab's (``_write_owner``)."""
     while True:
         fd, created = _open_lock_file(path, create)
         if fd is None:
@@ -204,32 +183,26 @@ def _acquire(path: Path, *, blocking: bool, create: bool = True) -> int | None:
 def _open_lock_file(path: Path, create: bool) -> tuple[int | None, bool]:
     """(an fd on ``path``, whether this call created the file); (None, False) when it is gone and not to be
     created."""
+    if not create:
+        try:
+            return open_own_file(path, os.O_RDWR), False
+        except FileNotFoundError:
+            return None, False
     while True:
         try:
-            if not create:
+            return open_own_file(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644), True
+        except FileExistsError:
+            with contextlib.suppress(FileNotFoundError):  # removed between the two opens: again
                 return open_own_file(path, os.O_RDWR), False
-            try:
-                return open_own_file(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644), True
-            except FileExistsError:
-                try:
-                    return open_own_file(path, os.O_RDWR), False
-                except FileNotFoundError:
-                    continue  # removed between the two opens: again
-        except FileNotFoundError:
-            if not create:
-                return None, False
-            raise
 
 
 def _write_owner(fd: int, created: bool, info: os.stat_result) -> None:
     """Who holds the lock, for the messages of others: into a file this call created, or a lock file of gyrolab's
     (one link, the user's, a line long)."""
     if created or (info.st_nlink == 1 and info.st_uid == os.geteuid() and info.st_size <= MAX_OWNER_BYTES):
-        try:  # a full disk may refuse this, the lock holds anyway
+        with contextlib.suppress(OSError):  # a full disk may refuse this, the lock holds anyway
             os.ftruncate(fd, 0)
             os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}\n".encode())
-        except OSError:
-            pass
 
 
 #: a lock file holds one line; a larger file is not overwritten

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import platform
 import re
@@ -105,15 +106,9 @@ def plugin_packages() -> str:
 
 @cache
 def provenance() -> dict[str, Any]:
-    """Attributes every dataset carries (netCDF-safe).
-
-    ``git_dirty`` is 1 when tracked files differ from ``git_commit`` or new
-    code files (under ``CODE_PATHS``) are not committed yet, 0 when clean, -1
-    when unknown (not a git checkout of gyrolab, or git unavailable);
-    ``git_diff_sha256`` is the sha256 of the uncommitted code changes, new
-    files included, so that two dirty trees can be told apart ("" when only
-    documentation or tests differ: a job's identity, which reads it, stays).
-    """
+    """Attributes every dataset carries (netCDF-safe). ``git_dirty``: 1 when the code (``CODE_PATHS``, new files
+    too) differs from ``git_commit``, 0 when clean, -1 when unknown; ``git_diff_sha256``: of those changes, so that
+    two dirty trees differ ("" when only documentation or tests differ: a job's identity, which reads it, stays)."""
     commit = _git("rev-parse", "HEAD") if _in_own_checkout() else None
     status = _git("status", "--porcelain", "--untracked-files=no") if commit else None
     untracked = _untracked_code() if commit else []
@@ -128,8 +123,6 @@ def provenance() -> dict[str, Any]:
         "plugin_packages": plugin_packages(),
     }
     for lib in _libraries():
-        try:
+        with contextlib.suppress(metadata.PackageNotFoundError):
             attrs[f"version_{lib.replace('-', '_')}"] = metadata.version(lib)
-        except metadata.PackageNotFoundError:
-            pass
     return attrs

@@ -1,23 +1,16 @@
-"""The trust boundary of a directory gyrolab writes into but may not have created.
+"""The trust boundary of a directory gyrolab writes into but may not have created (docs/faults.md, "A directory
+gyrolab did not create").
 
-A run or sweep directory may come from a colleague, a cluster or an archive: gyrolab trusts the
-directory the user names, never what already sits inside it. So:
-
-- gyrolab's own entries in it (``OWN_DIRS``, ``.gyrolab.lock``, ``multirun.yaml``, ``job.json``, and every
-  ``*.nc``, ``*.log``, ``*.yaml``, ``*.json``, ``*.part``, ``*.chunks`` file; in a sweep directory every entry,
-  its job directories too) are never symbolic links or special files: ``check_tree`` refuses the directory in
-  one sentence before anything is written;
-- a file gyrolab appends to or locks is opened without following a link and must be a regular file
-  (``open_own_file``); a file it replaces is renamed over (a link there is replaced, its target untouched);
-- its folders (``figures``, ``.hydra``) are real folders (``own_dir``);
-- an output the user names (``--animate -o NAME``) is refused when it exists and is not a regular file;
-- pickles are loaded only from folders only the user can write (``private_dir``: submitit's folder).
-
-Each refusal is an ``Untrusted`` ConfigError (exit 2): one sentence naming the path.
+gyrolab trusts the directory the user names, never what already sits inside it: its own entries there are never
+links or special files (``check_tree``), a file it appends to or locks is opened without following a link
+(``open_own_file``), its folders are real folders (``own_dir``), an output the user names is not a link or a
+device (``check_output_target``), and pickles are loaded only from folders only the user can write
+(``private_dir``). Each refusal is an ``Untrusted`` ConfigError (exit 2): one sentence naming the path.
 """
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import stat
@@ -90,10 +83,9 @@ def own_dir(path: str | os.PathLike[str]) -> Path:
     """The folder ``path`` (``figures``, ``.hydra``), created if missing; Untrusted when it is a link or a file."""
     path = Path(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        os.mkdir(path)
-    except FileExistsError:
-        pass
+        with contextlib.suppress(FileExistsError):
+            path.parent.mkdir(parents=True, exist_ok=True)
+            os.mkdir(path)
     except OSError:
         return path  # the write that follows names the reason (a read-only directory, a full disk)
     mode = os.lstat(path).st_mode
@@ -122,11 +114,6 @@ def open_own_file(path: str | os.PathLike[str], flags: int, mode: int = 0o644) -
     return fd
 
 
-def no_follow(path: str, flags: int) -> int:
-    """An ``opener`` for ``open()``: ``open_own_file`` (no link followed, a regular file only)."""
-    return open_own_file(path, flags)
-
-
 def check_output_target(path: str | os.PathLike[str], option: str = "") -> Path:
     """A file gyrolab is about to replace (``option``: the option that named it, ``-o``): refused when it exists and
     is not a regular file (a device node, a link, a folder), which writing would replace."""
@@ -147,11 +134,9 @@ def private_dir(path: str | os.PathLike[str], what: str) -> Path:
     """The folder ``path``, which holds pickles gyrolab loads (``what`` says whose): created owner-only (0700) if
     missing; Untrusted when it is a link, belongs to another user, or others may write it."""
     path = Path(path)
-    try:
+    with contextlib.suppress(FileExistsError):
         path.parent.mkdir(parents=True, exist_ok=True)
         os.mkdir(path, 0o700)
-    except FileExistsError:
-        pass
     info = os.lstat(path)
     if stat.S_ISLNK(info.st_mode) or not stat.S_ISDIR(info.st_mode):
         raise _refusal(path, info.st_mode)
@@ -166,9 +151,8 @@ def private_dir(path: str | os.PathLike[str], what: str) -> Path:
 
 
 def check_kernel_cache() -> None:
-    """Untrusted when numba's cache folder (compiled kernels, whose index numba unpickles) or its parent belongs to
-    another user or may be written by anyone (a shared temporary directory another user prepared). Called before
-    any kernel is loaded (a command that runs kernels: run, batch, reproduce)."""
+    """Untrusted when numba's cache folder (whose index numba unpickles) or its parent belongs to another user or may
+    be written by anyone; called before any kernel is loaded (run, batch, reproduce)."""
     # the folder numba uses once it is set up in this process, else the one it will use (found without importing
     # numba, which a run of scipy's integrators never needs)
     numba = sys.modules.get("numba")
@@ -185,15 +169,17 @@ def check_kernel_cache() -> None:
                             "(numba loads pickles from it); set NUMBA_CACHE_DIR to a folder of yours")
 
 
+def proc_number(path: str, key: str, base: int = 10) -> int | None:
+    """The number after ``key`` in a Linux /proc file (``Umask:`` of ``/proc/self/status``), None without one."""
+    with contextlib.suppress(OSError, ValueError, IndexError), open(path, encoding="ascii") as handle:
+        return next((int(line.split()[1], base) for line in handle if line.startswith(key)), None)
+    return None
+
+
 def umask() -> int:
     """The process's umask, read without changing it (Linux's /proc; elsewhere set and restored at once)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as handle:
-            for line in handle:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError, IndexError):
-        pass
-    mask = os.umask(0o022)
-    os.umask(mask)
+    mask = proc_number("/proc/self/status", "Umask:", 8)
+    if mask is None:
+        mask = os.umask(0o022)
+        os.umask(mask)
     return mask

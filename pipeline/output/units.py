@@ -1,15 +1,10 @@
-"""CF units of the quantities a run records as attributes or a sweep varies as a key.
+"""CF units of the quantities a run records as attributes or a sweep varies as a key (docs/datasets.md, "Conventions
+common to every dataset").
 
-A sweep turns run attributes that differ between jobs (``integrator_rtol``, ``body_a``,
-``sampling_fastest_rate``, ``initial_omega``, ...) into variables, and a swept override key (``body.a``,
-``initial.r0``, ``integrator.rtol``) into a coordinate; both need ``units``. ``quantity_units(name, body_units)``
-gives them from the quantity's name (an attribute name, or an override key with dots as underscores) and
-the body's unit system (``si`` or ``nondimensional``).
-
-In the nondimensional form every model quantity is a pure number (``"1"``, CF style; the scale is in the
-global attribute ``time_unit`` and its kin), except angles, which stay ``rad``. A quantity gyrolab does not
-know (a third-party force's parameter, say) is therefore ``"1"`` for a nondimensional body and has no
-units for an SI body (``None``): gyrolab does not guess a dimension.
+``quantity_units(name, body_units)`` gives them from the quantity's name (an attribute name, or an override key
+with dots as underscores) and the body's unit system: in the nondimensional form every model quantity is a pure
+number (``"1"``) except angles (``rad``); a quantity gyrolab does not know is ``"1"`` for a nondimensional body
+and has no units for an SI body (``None``): gyrolab does not guess a dimension.
 """
 
 from __future__ import annotations

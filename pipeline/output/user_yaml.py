@@ -2,19 +2,15 @@
 ``config`` attribute, ``multirun.yaml``, ``.hydra/*.yaml``), read as what they claim to be before anything else
 reads them (``stored_yaml``: a directory or a dataset received from someone else is untrusted input).
 
-Hydra turns a YAML problem into a 65–104-line traceback, and expands anchors and aliases without
-bound (a "billion laughs" file hangs it). Each file is checked here first with PyYAML's safe
-loader; any problem is one ConfigError sentence naming the file and line, never its contents:
-
-- syntax errors, tabs, control characters (a NUL byte), text that is not UTF-8;
-- a duplicate key in a mapping (YAML forbids it; Hydra refuses it with a traceback);
-- a file that is not a mapping (a scalar or a list at the top): Hydra's config files are mappings;
-- alias expansion beyond :data:`MAX_EXPANDED_NODES` nodes, a file beyond :data:`MAX_FILE_BYTES`,
-  a folder with more than :data:`MAX_FILES` YAML files.
+Hydra turns a YAML problem into a long traceback and expands anchors and aliases without bound; each file is
+checked here first with PyYAML's safe loader, and any problem (syntax, tabs, control characters, not UTF-8, a
+duplicate key, not a mapping, a tag, beyond ``MAX_EXPANDED_NODES``, ``MAX_DEPTH``, ``MAX_FILE_BYTES`` or
+``MAX_FILES``) is one ConfigError sentence naming the file and line, never its contents (docs/faults.md).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
 from pathlib import Path
@@ -48,11 +44,8 @@ def check_user_config_dir(directory: str, option: str) -> None:
             if count > MAX_FILES:
                 raise ConfigError(f"{option} {shorten(directory)!r} holds more than {MAX_FILES} YAML files; give the "
                                   "folder of your configs only")
-            check_user_yaml(Path(root) / name)
-
-
-def check_user_yaml(path: Path) -> None:
-    check_yaml_text(_read(path, _display(path)), _display(path))
+            where = _display(Path(root) / name)
+            check_yaml_text(_read(Path(root) / name, where), where)
 
 
 def _read(path: Path, where: str, *, kind: str = "a config folder holds") -> bytes:
@@ -71,8 +64,7 @@ def _read(path: Path, where: str, *, kind: str = "a config folder holds") -> byt
 
 def check_yaml_text(data: bytes | str, where: str, *, stored: bool = False) -> yaml.Node | None:
     """ConfigError (one sentence naming ``where`` and the line) unless ``data`` is a plain YAML mapping within the
-    limits (module docstring); the composed node (None for an empty text). ``stored``: a config gyrolab stored
-    (the sentences say that it was edited)."""
+    limits; the composed node (None for an empty text). ``stored``: the sentences say a stored config was edited."""
     node = _composed(_decoded(data, where), where, stored)
     if node is None:
         return None  # an empty file is an empty config
@@ -132,8 +124,7 @@ def _check_top_level(node: yaml.Node, where: str, stored: bool) -> None:
 
 def stored_yaml(data: bytes | str, where: str) -> dict:
     """A config gyrolab stored (a dataset's ``config`` attribute, ``multirun.yaml``, ``.hydra/config.yaml``) as
-    plain data, after the checks of a user's file: a directory or a dataset received from someone else is
-    untrusted input (anchors, depth, tags, size)."""
+    plain data, after the checks of a user's file (it may come from someone else)."""
     if not isinstance(data, (str, bytes)):
         raise ConfigError(f"{where} is not text; a stored config is a YAML mapping that gyrolab wrote")
     if check_yaml_text(data, where, stored=True) is None:
@@ -164,11 +155,9 @@ def _check_depth(text: str, where: str) -> None:
 def _display(path: Path) -> str:
     """The file as the user can find it: relative to the working directory when inside it."""
     text = str(path)
-    try:
+    with contextlib.suppress(ValueError):
         relative = os.path.relpath(path)
         text = relative if not relative.startswith("..") else text
-    except ValueError:
-        pass
     return shorten(text, 200)
 
 
@@ -223,12 +212,10 @@ def _check_keys(node: yaml.MappingNode, where: str) -> None:
         if not isinstance(k, yaml.ScalarNode):
             raise ConfigError(f"{where}, line {k.start_mark.line + 1}: a key is a list or a mapping; keys of a "
                               "config are plain names")
-        if isinstance(k, yaml.ScalarNode):
-            if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
-                raise ConfigError(f"{where}, line {k.start_mark.line + 1}: the key {shorten(k.value, 60)!r} "
-                                  f"is given twice in one mapping (first on line {seen[k.value]}); "
-                                  "give each key once")
-            seen[k.value] = k.start_mark.line + 1
+        if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
+            raise ConfigError(f"{where}, line {k.start_mark.line + 1}: the key {shorten(k.value, 60)!r} "
+                              f"is given twice in one mapping (first on line {seen[k.value]}); give each key once")
+        seen[k.value] = k.start_mark.line + 1
 
 
 def _children(node: yaml.Node) -> list[yaml.Node]:

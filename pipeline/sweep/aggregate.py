@@ -1,28 +1,8 @@
 """One dataset per sweep: every job's ``run.nc`` on the sweep's grid, plus a table of failed jobs.
 
-Layout of ``sweep.nc`` (``assemble``):
-
-* one dimension per swept parameter, named after the override key's last
-  part (``body.a`` -> ``a``; the full key, dots as underscores, when that is
-  ambiguous), its coordinate holding the swept values (numbers stay numbers)
-  and the key in ``override_key``;
-* every data variable of the runs over (swept dims..., time, ...), NaN where
-  a job failed or is missing. If the jobs' output times differ (a swept
-  ``time.end``), ``time`` becomes a variable over (swept dims..., sample);
-* per-job quantities as variables over the swept dims: the integrator's
-  statistics (``integrator_nfev``, ``integrator_wall_time``, ...), each
-  invariant's ``<name>_max_abs_drift``, ``config`` (each job's resolved YAML),
-  ``hydra_overrides``, ``job_id``, ``job_dir`` and ``job_status`` (0 missing,
-  1 finished, 2 failed); run attributes that differ between jobs become such
-  variables too (``run_<name>`` if ``<name>`` is taken), equal ones stay
-  global attributes;
-* a table of failed jobs along dimension ``failed_job``: ``failed_job_dir``,
-  ``failed_job_overrides``, ``failed_job_error``, ``failed_job_error_type``,
-  ``failed_job_exit_code``.
-
-``assemble`` only needs each grid point's dataset (or its failure), so a batch
-integrator that computes a whole grid in one process can produce the same
-layout without writing per-job files.
+The layout of ``sweep.nc`` (``assemble``): docs/datasets.md, "sweep.nc — a multirun". ``assemble`` only needs
+each grid point's dataset (or its failure), so a batch integrator that computes a whole grid in one process can
+produce the same layout without writing per-job files.
 """
 
 from __future__ import annotations
@@ -57,14 +37,15 @@ log = logging.getLogger("gyrolab.sweep")
 SWEEP_NAME = "sweep.nc"
 MISSING = "missing"
 STATUS_FLAGS = {MISSING: 0, FINISHED: 1, FAILED: 2}
+#: the CF flag attributes of ``job_status`` (a batch's sweep.nc has the same codes)
+STATUS_ATTRS = {"units": "1", "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8),
+                "flag_meanings": " ".join(STATUS_FLAGS)}
 #: run attributes that are per-job quantities, always variables over the swept dims
 PER_JOB_ATTRS = ("config", "hydra_overrides") + tuple(f"integrator_{f.name}" for f in fields(IntegratorStats))
 #: variable attributes that are per-job quantities
 PER_JOB_VARIABLE_ATTRS = ("max_abs_drift",)
 #: run attributes left in the jobs' own run.nc: the sweep has its own (set by ``gyrolab.output.cf.conform``)
 JOB_ONLY_ATTRS = ("job_id", "date_created", "history", "Conventions")
-#: attributes of sweep.nc that legitimately differ between two aggregations of the same sweep
-VOLATILE_ATTRS = ("date_created", "history", "sweep_launcher")
 #: CF units and long_name of the per-job variables a run's attributes become (others: "run attribute NAME")
 PER_JOB_METADATA = {
     "config": (None, "the job's resolved config (YAML)"),
@@ -80,8 +61,6 @@ PER_JOB_METADATA = {
     "sampling_n_output_requested": (None, "time.n_output as the config gave it"),
     "sampling_warning": (None, "warning when the output times undersample the motion"),
 }
-#: variables of sweep.nc that legitimately differ between two runs of the same sweep
-VOLATILE_VARIABLES = ("integrator_wall_time",)
 
 
 @dataclass
@@ -112,13 +91,8 @@ class SweepSummary:
     figures: list[Path] = field(default_factory=list)
 
 
-# ----------------------------------------------------------------------------- assembling
-
-
 def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
-    """The sweep dataset of ``grid`` from ``results[n]``, the outcome of job ``n``."""
-    if len(results) != len(grid.jobs):
-        raise ValueError(f"{len(results)} results for a grid of {len(grid.jobs)} jobs")
+    """The sweep dataset of ``grid`` from ``results[n]``, the outcome of job ``n`` (one per job)."""
     done = [(grid.index[n], r.dataset) for n, r in enumerate(results) if r.status == FINISHED]
     names = _dim_names(grid, [ds for _, ds in done])
     grid_dims = tuple(names)
@@ -141,7 +115,7 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
 def _sweep_attributes(grid: Grid, results: Sequence[JobResult], grid_dims: tuple[str, ...],
                       sample: str) -> dict[str, Any]:
     """What the sweep was (its title, dimensions, keys) and how its jobs ended."""
-    counts = {status: sum(r.status == status for r in results) for status in STATUS_FLAGS}
+    counts = {f"n_{status}": sum(r.status == status for r in results) for status in STATUS_FLAGS}
     return {
         "failed_job_description": "dimension failed_job: one entry per failed job, in job order (the failed_job_* "
                                   "variables are its table)",
@@ -151,9 +125,7 @@ def _sweep_attributes(grid: Grid, results: Sequence[JobResult], grid_dims: tuple
         "sweep_dims": " ".join(grid_dims),
         "sweep_keys": " ".join(d.key for d in grid.dims),
         "n_jobs": len(results),
-        "n_finished": counts[FINISHED],
-        "n_failed": counts[FAILED],
-        "n_missing": counts[MISSING],
+        "n_finished": counts["n_finished"], "n_failed": counts["n_failed"], "n_missing": counts["n_missing"],
     }
 
 
@@ -214,15 +186,10 @@ def _run_attributes(done: list[tuple[tuple, xr.Dataset]], coords: dict[str, Any]
 def _job_table(grid: Grid, results: Sequence[JobResult], grid_dims: tuple[str, ...]) -> dict[str, Any]:
     """Every job's status, id and directory over the grid, and the failed jobs' table."""
     statuses = np.zeros(grid.shape, dtype=np.int8)
-    job_ids = np.full(grid.shape, "", dtype=object)
-    job_dirs = np.full(grid.shape, "", dtype=object)
-    for n, result in enumerate(results):
-        statuses[grid.index[n]] = STATUS_FLAGS[result.status]
-        job_ids[grid.index[n]] = result.job_id
-        job_dirs[grid.index[n]] = result.job_dir
-    return {"job_status": (grid_dims, statuses, {
-                "long_name": "how the job ended", "units": "1",
-                "flag_values": np.array(list(STATUS_FLAGS.values()), dtype=np.int8), "flag_meanings": " ".join(STATUS_FLAGS)}),
+    job_ids, job_dirs = np.full(grid.shape, "", dtype=object), np.full(grid.shape, "", dtype=object)
+    for index, result in zip(grid.index, results):
+        statuses[index], job_ids[index], job_dirs[index] = STATUS_FLAGS[result.status], result.job_id, result.job_dir
+    return {"job_status": (grid_dims, statuses, {"long_name": "how the job ended", **STATUS_ATTRS}),
             "job_id": (grid_dims, job_ids, {"long_name": "hash of the job's resolved config and code version"}),
             "job_dir": (grid_dims, job_dirs, {"long_name": "job directory, relative to the sweep directory"}),
             **_failure_table(grid, results)}
@@ -249,10 +216,7 @@ def _sample_dim(datasets: Sequence[xr.Dataset]) -> str:
 
 
 def _union(lists: Sequence[Sequence[str]]) -> list[str]:
-    seen: dict[str, None] = {}
-    for items in lists:
-        seen.update(dict.fromkeys(items))
-    return list(seen)
+    return list(dict.fromkeys(item for items in lists for item in items))
 
 
 def _blank(shape: tuple[int, ...], dtype: np.dtype) -> np.ndarray:
@@ -330,38 +294,31 @@ def _cell_variable(values: dict[tuple[int, ...], Any], shape: tuple[int, ...], g
                    name: str) -> tuple:
     """A variable over the swept dims from one value per grid point (missing points: NaN or '')."""
     items = list(values.values())
-    if items and all(_is_number(v) for v in items):
-        out = np.full(shape, np.nan)
-        for index, value in values.items():
-            out[index] = value
-        return grid_dims, out, {}
     arrays = [np.asarray(v) for v in items]
-    if items and all(a.ndim == 1 and a.dtype.kind in "iuf" and a.shape == arrays[0].shape for a in arrays):
-        out = np.full(shape + arrays[0].shape, np.nan)
-        for index, value in values.items():
-            out[index] = value
-        return grid_dims + (f"{name}_index",), out, {}
-    out = np.full(shape, "", dtype=object)
+    if items and all(_is_number(v) for v in items):
+        dims, out = grid_dims, np.full(shape, np.nan)
+    elif items and all(a.ndim == 1 and a.dtype.kind in "iuf" and a.shape == arrays[0].shape for a in arrays):
+        dims, out = grid_dims + (f"{name}_index",), np.full(shape + arrays[0].shape, np.nan)
+    else:
+        dims, out = grid_dims, np.full(shape, "", dtype=object)
+        values = {index: value if isinstance(value, str) else np.array2string(np.asarray(value), separator=", ")
+                  for index, value in values.items()}
     for index, value in values.items():
-        out[index] = value if isinstance(value, str) else np.array2string(np.asarray(value), separator=", ")
-    return grid_dims, out, {}
+        out[index] = value
+    return dims, out, {}
 
 
 def _failure_table(grid: Grid, results: Sequence[JobResult]) -> dict[str, tuple]:
     failed = [(n, r) for n, r in enumerate(results) if r.status == FAILED]
-    dim = ("failed_job",)
-    return {
-        "failed_job_dir": (dim, np.array([r.job_dir for _, r in failed], dtype=object),
-                           {"long_name": "failed job's directory, relative to the sweep directory"}),
-        "failed_job_overrides": (dim, np.array([" ".join(grid.jobs[n]) for n, _ in failed], dtype=object),
-                                 {"long_name": "failed job's overrides"}),
-        "failed_job_error": (dim, np.array([r.error for _, r in failed], dtype=object),
-                             {"long_name": "error message"}),
-        "failed_job_error_type": (dim, np.array([r.error_type for _, r in failed], dtype=object),
-                                  {"long_name": "error class"}),
-        "failed_job_exit_code": (dim, np.array([r.exit_code for _, r in failed], dtype=np.int32),
-                                 {"long_name": "exit code the single-run command would give", "units": "1"}),
-    }
+    columns = {"dir": ([r.job_dir for _, r in failed], "failed job's directory, relative to the sweep directory"),
+               "overrides": ([" ".join(grid.jobs[n]) for n, _ in failed], "failed job's overrides"),
+               "error": ([r.error for _, r in failed], "error message"),
+               "error_type": ([r.error_type for _, r in failed], "error class")}
+    table = {f"failed_job_{name}": (("failed_job",), np.array(values, dtype=object), {"long_name": long_name})
+             for name, (values, long_name) in columns.items()}
+    table["failed_job_exit_code"] = (("failed_job",), np.array([r.exit_code for _, r in failed], dtype=np.int32),
+                                     {"long_name": "exit code the single-run command would give", "units": "1"})
+    return table
 
 
 def _is_number(value: Any) -> bool:
@@ -383,9 +340,6 @@ def _all_same(values: Sequence[Any]) -> bool:
     return all(_same(v, values[0]) for v in values[1:])
 
 
-# ----------------------------------------------------------------------------- from a sweep directory
-
-
 def collect(sweep_dir: Path, grid: Grid) -> list[JobResult]:
     """Each grid job's outcome, from the job records under ``sweep_dir`` (matched by their overrides)."""
     sweep_dir = Path(sweep_dir)
@@ -399,49 +353,39 @@ def collect(sweep_dir: Path, grid: Grid) -> list[JobResult]:
         key, mtime = tuple(record.overrides), path.stat().st_mtime
         if key not in found or found[key][0] < mtime:  # a stale copy elsewhere: the newest record wins
             found[key] = (mtime, path.parent, record)
-    results = []
-    for job in grid.jobs:
-        if job not in found:
-            results.append(JobResult())
-            continue
-        _, job_dir, record = found[job]
-        where = job_dir.relative_to(sweep_dir).as_posix()
-        common = {"job_id": record.job_id, "job_dir": where, "skipped": record.skipped}
-        if record.status == FAILED:
-            results.append(JobResult(FAILED, error=record.error, error_type=record.error_type,
-                                     exit_code=record.exit_code, **common))
-            continue
-        try:
-            ds = load_dataset(job_dir / str(record.run), "a run.nc that gyrolab wrote", decode_times=False,
-                              decode_timedelta=False)
-        except ConfigError as error:
-            log.warning("job %s: %s; counted as missing", where, error)
-            results.append(JobResult())
-            continue
-        if ds.attrs.get("job_id") != record.job_id:
-            log.warning("job %s: its dataset belongs to another job (id %s, record %s); counted as missing",
-                        where, ds.attrs.get("job_id"), record.job_id)
-            results.append(JobResult())
-            continue
-        results.append(JobResult(FINISHED, dataset=ds, **common))
-    return results
+    return [_result(sweep_dir, *found[job][1:]) if job in found else JobResult() for job in grid.jobs]
+
+
+def _result(sweep_dir: Path, job_dir: Path, record: JobRecord) -> JobResult:
+    """How the job of ``record`` ended: failed, finished with its dataset, or missing (a dataset that is not its)."""
+    where = job_dir.relative_to(sweep_dir).as_posix()
+    common = {"job_id": record.job_id, "job_dir": where, "skipped": record.skipped}
+    if record.status == FAILED:
+        return JobResult(FAILED, error=record.error, error_type=record.error_type, exit_code=record.exit_code,
+                         **common)
+    try:
+        ds = load_dataset(job_dir / str(record.run), "a run.nc that gyrolab wrote", decode_times=False,
+                          decode_timedelta=False)
+    except ConfigError as error:
+        log.warning("job %s: %s; counted as missing", where, error)
+        return JobResult()
+    if ds.attrs.get("job_id") != record.job_id:
+        log.warning("job %s: its dataset belongs to another job (id %s, record %s); counted as missing",
+                    where, ds.attrs.get("job_id"), record.job_id)
+        return JobResult()
+    return JobResult(FINISHED, dataset=ds, **common)
 
 
 def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: bool | None = None,
                     launcher: str = "", output: Any | None = None) -> SweepSummary:
-    """Write ``sweep_dir/sweep.nc`` (and summary figures) from the sweep's job directories.
-
-    ``hydra_cfg`` is the multirun's ``hydra`` config node; without it, it is
-    read from ``sweep_dir/multirun.yaml`` (which Hydra writes at the start of
-    every sweep). ``figures=None``: as the sweep's callback was configured.
-    ``output``: the multirun's ``output`` section (the figures' formats and dpi); without it, read from
-    ``multirun.yaml`` too.
-    """
+    """Write ``sweep_dir/sweep.nc`` (and summary figures) from the sweep's job directories. ``hydra_cfg``, ``output``:
+    the multirun's ``hydra`` node and ``output`` section, else read from ``sweep_dir/multirun.yaml``;
+    ``figures=None``: as the sweep's callback was configured."""
     sweep_dir = Path(sweep_dir)
     check_tree(sweep_dir, sweep=True)
     if hydra_cfg is None:
         hydra_cfg = stored_hydra(sweep_dir)
-        launcher = launcher or _short_target(hydra_cfg.get("launcher", {}).get("_target_", ""))
+        launcher = launcher or str(hydra_cfg.get("launcher", {}).get("_target_", "")).rsplit(".", 1)[-1]
     if figures is None:
         figures = bool(OmegaConf.select(hydra_cfg, "callbacks.sweep.figures", default=True))
     grid = Grid.from_hydra(hydra_cfg)
@@ -467,12 +411,12 @@ def aggregate_sweep(sweep_dir: Path, *, hydra_cfg: Any | None = None, figures: b
         failures=[(" ".join(grid.jobs[n]), r.error) for n, r in enumerate(results) if r.status == FAILED],
         write_failures=sum(r.status == FAILED and r.error_type == "OutputError" for r in results))
     if figures and grid.dims and summary.finished:
-        from gyrolab.sweep.figures import save_sweep_figures  # matplotlib only when figures are drawn
+        from gyrolab.figures.sweep import save_figures  # matplotlib only when figures are drawn
 
-        if output is None:
-            summary.figures = save_sweep_figures(ds, sweep_dir / "figures")
-        else:  # the sweep's own config, in memory: no second reading of multirun.yaml (~0.1 s of YAML)
-            summary.figures = save_sweep_figures(ds, sweep_dir / "figures", *figure_options(output))
+        if output is None:  # the sweep's figure formats and dpi, as multirun.yaml stores them (else the defaults)
+            saved = sweep_dir / "multirun.yaml"
+            output = stored_yaml_file(saved).get("output") if saved.is_file() else None
+        summary.figures = save_figures(ds, sweep_dir / "figures", *figure_options(output))
     return summary
 
 
@@ -500,10 +444,6 @@ def wait_for_jobs(sweep_dir: Path) -> None:
                 log.info("waiting for job %s, run by another gyrolab process (%s)",
                          Path(root).relative_to(sweep_dir).as_posix(), owner)
             wait_for(Path(root))
-
-
-def _short_target(target: str) -> str:
-    return str(target).rsplit(".", 1)[-1]
 
 
 def log_summary(summary: SweepSummary) -> None:

@@ -1,17 +1,13 @@
-"""The Hydra callback that turns a multirun into one ``sweep.nc`` (configured in ``conf/config.yaml``).
-
-``on_multirun_start`` starts the sweep's progress display; ``on_multirun_end``
-(run by Hydra on the launching machine once every job has returned, whatever
-the launcher) aggregates the job directories into ``sweep.nc`` and the
-summary figures. The jobs themselves record their outcome (``job.json``) in
-``gyrolab.app``; nothing here runs in the jobs.
+"""The Hydra callback that turns a multirun into one ``sweep.nc`` (configured in ``conf/config.yaml``):
+``on_multirun_start`` starts the sweep's progress display, ``on_multirun_end`` (on the launching machine, once
+every job has returned, whatever the launcher) aggregates the job directories into ``sweep.nc`` and the summary
+figures. Nothing here runs in the jobs.
 """
 
 from __future__ import annotations
 
 import functools
 import logging
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +19,7 @@ from gyrolab.errors import GyrolabError, OutputError
 from gyrolab.output.atomic import reason
 from gyrolab.output.lock import lock, unlock
 from gyrolab.output.trust import check_output_target, own_dir
+from gyrolab.output.written import fail
 from gyrolab.sweep.aggregate import SweepSummary, aggregate_sweep, log_summary
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.orphans import announce_launcher, forget_launcher
@@ -45,12 +42,9 @@ def reset() -> None:
 
 
 class SweepCallback(Callback):
-    """Aggregate a multirun into ``<sweep dir>/sweep.nc``; ``figures``: also draw the summary figures.
-
-    For a single run it also locks the run directory before Hydra writes anything there
-    (``on_run_start``), so that a second run into a directory in use is refused in one sentence
-    (exit 2) without touching the first run's files.
-    """
+    """Aggregate a multirun into ``<sweep dir>/sweep.nc``; ``figures``: also draw the summary figures. For a single
+    run it locks the run directory before Hydra writes there (``on_run_start``): a second run into a directory in
+    use is refused in one sentence (exit 2) without touching the first run's files."""
 
     def __init__(self, figures: bool = True, progress: bool = True) -> None:
         self.figures = bool(figures)
@@ -68,8 +62,7 @@ class SweepCallback(Callback):
         try:
             lock(run_dir)
         except GyrolabError as error:
-            print(f"gyrolab: error: {error}", file=sys.stderr)
-            sys.exit(error.exit_code)
+            fail(error)
         self._locked = run_dir
 
     def on_run_end(self, config: DictConfig, **kwargs: Any) -> None:
@@ -123,13 +116,9 @@ class SweepCallback(Callback):
 
 
 def _tolerate_hydra_record_failures() -> None:
-    """A full disk while Hydra saves a job's ``.hydra/*.yaml`` is a warning, not the end of the sweep.
-
-    Hydra writes those copies of the config (non-atomically) before the job starts; an OSError there
-    would abort the whole multirun with a traceback. The config is also in the job's ``job.json``
-    and ``run.nc``, so the copy is dropped (no partial file is left) and the job goes on: a job
-    that then cannot write its results fails alone, in one sentence, like any other write failure.
-    """
+    """A full disk while Hydra saves a job's ``.hydra/*.yaml`` (before the job starts; an OSError there would abort
+    the multirun with a traceback) is a warning: the config is also in the job's ``job.json`` and ``run.nc``, so
+    the copy is dropped (no partial file left) and the job goes on, failing alone if it cannot write its results."""
     save = hydra_utils._save_config
     if getattr(save, "_gyrolab_tolerant", False):
         return

@@ -1,10 +1,6 @@
-"""The grid of a multirun: one dimension per swept parameter, one job per grid point.
-
-Built from the sweep's overrides exactly as Hydra's basic sweeper builds its
-jobs (the Cartesian product, in command-line order, the last parameter
-varying fastest), so job ``n`` of a sweep is ``Grid.jobs[n]`` whichever
-launcher ran it. A batch integrator that computes a whole grid at once can
-use the same grid to fill the same ``sweep.nc`` layout.
+"""The grid of a multirun: one dimension per swept parameter, one job per grid point, built from the sweep's
+overrides exactly as Hydra's basic sweeper builds its jobs (the Cartesian product, in command-line order, the last
+parameter fastest), so job ``n`` is ``Grid.jobs[n]`` whichever launcher ran it.
 """
 
 from __future__ import annotations
@@ -58,9 +54,8 @@ class Grid:
 
     @classmethod
     def from_overrides(cls, overrides: Sequence[str], *, repeats: bool = False, max_jobs: float | None = None) -> Grid:
-        """ConfigError for a malformed override, a non-discrete sweep or a value given twice (unless ``repeats``:
-        a batch's zipped keys may repeat values); for more than ``max_jobs`` jobs (the budget's points by default),
-        counted before anything is expanded."""
+        """ConfigError for a malformed override, a non-discrete sweep, a value given twice (unless ``repeats``: a
+        batch's zipped keys), more than ``max_jobs`` jobs (default: the budget's points), counted unexpanded."""
         parser = OverridesParser.create()
         try:
             parsed = parser.parse_overrides(list(overrides))

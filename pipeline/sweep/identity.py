@@ -1,14 +1,9 @@
-"""A job's identity: a hash of its resolved config and of the code that runs it.
-
-Two jobs with the same identity compute the same result (the integrators are
-deterministic), so a sweep that is run again skips the jobs whose identity
-already has a finished result in the sweep directory.
-
-The code is what the job loads: gyrolab's own (its version, the git trees of its code folders and the digest
-of their uncommitted changes: a commit that changes only documentation or tests leaves it as it is) and the
-third-party plugins the config names (each ``_target_`` outside gyrolab: its distribution's name and version and
-a digest of the Python files of the package that defines it). Installing, updating or removing a package the job
-does not use leaves every identity as it is.
+"""A job's identity: a hash of its resolved config and of the code that runs it; a sweep run again skips the jobs
+whose identity already has a finished result (the integrators are deterministic). The code is what the job loads:
+gyrolab's own (its version, the git trees of its code folders, the digest of their uncommitted changes) and the
+third-party plugins the config names (each ``_target_`` outside gyrolab: its distribution, version and a digest of
+its package's Python files); a commit of documentation or tests only, or a package the job does not use, changes
+no identity.
 """
 
 from __future__ import annotations
@@ -77,20 +72,15 @@ def job_identity(cfg: DictConfig | dict[str, Any], code: str | None = None) -> s
 def _targets(node: Any) -> set[str]:
     """Every ``_target_`` string in a plain config."""
     if isinstance(node, dict):
-        found = {str(node["_target_"])} if isinstance(node.get("_target_"), str) else set()
-        for value in node.values():
-            found |= _targets(value)
-        return found
-    if isinstance(node, list):
-        return set().union(*(_targets(value) for value in node)) if node else set()
-    return set()
+        own = {str(node["_target_"])} if isinstance(node.get("_target_"), str) else set()
+        return own.union(*map(_targets, node.values()))
+    return set().union(*map(_targets, node)) if isinstance(node, list) else set()
 
 
 @cache
 def _plugin_code(target: str) -> str:
-    """'' for gyrolab's own classes; else 'distribution==version module@digest' of the plugin's module (the
-    distribution whose entry point names it; the digest: of its package's Python files, so that an editable
-    install's new commit counts even when its version stays)."""
+    """'' for gyrolab's own classes; else 'distribution==version module@digest' of the plugin's module (the digest of
+    its package's Python files: an editable install's new commit counts even when its version stays)."""
     target = _normalise(target)
     module = target.rpartition(".")[0]
     if not module or module == "gyrolab" or module.startswith("gyrolab."):

@@ -1,14 +1,8 @@
 """One job of a sweep: skip it if its result is already there, otherwise run it and record how it ended.
 
-A failing job is recorded, not fatal: the error goes into the job's record
-(and, through the aggregator, into ``sweep.nc``'s table of failed jobs) and
-the sweep goes on. A write failure (no space, quota, permission) fails the
-job like any other error, but is retried when the sweep is run again.
-
-The job's directory is locked while the job runs (``gyrolab.output.lock``):
-when two processes resume one sweep, a job that one of them is running is
-skipped by the other, so no job runs twice. Temporary files that a killed
-job left in its directory are removed before it runs again.
+A failing job is recorded, not fatal (its error reaches ``sweep.nc``'s table of failed jobs); a write failure
+fails the job too, but is retried when the sweep is run again. The job's directory is locked while it runs, so of
+two processes resuming one sweep only one runs a job; temporary files a killed job left are removed first.
 """
 
 from __future__ import annotations
@@ -23,26 +17,14 @@ from gyrolab.errors import GyrolabError, OutputError
 from gyrolab.output.lock import clear_temporaries, owner_of, try_lock, unlock
 from gyrolab.sweep.identity import code_version, job_code, job_identity
 from gyrolab.sweep.orphans import guard_worker
-from gyrolab.sweep.record import (
-    ELSEWHERE,
-    FAILED,
-    FINISHED,
-    JobRecord,
-    read_record,
-    remove_record,
-    write_record,
-)
+from gyrolab.sweep.record import ELSEWHERE, FAILED, FINISHED, RECORD_NAME, JobRecord, read_record, write_record
 
 log = logging.getLogger("gyrolab.sweep")
 
 
 def draws_job_figures(output: object) -> bool:
-    """Whether a sweep job draws its own figures: only with ``output.job_figures=true`` (and figures on).
-
-    Off by default so that a sweep does not wait on pictures (four figures cost ~2 CPU s per job, the
-    integration of a short scene ~0.1 s); the sweep's own figures are drawn as before, and
-    ``gyrolab --plot SWEEP_DIR`` draws every job's figures from its ``run.nc`` when they are wanted.
-    """
+    """Whether a sweep job draws its own figures: only with ``output.job_figures=true`` (and figures on), so that
+    a sweep does not wait on pictures; ``gyrolab plot SWEEP_DIR`` draws them from the jobs' ``run.nc``."""
     get = getattr(output, "get", None)
     if get is None:
         return False
@@ -51,16 +33,10 @@ def draws_job_figures(output: object) -> bool:
 
 def run_sweep_job(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_num: int | None,
                   work: Callable[[str], Path]) -> JobRecord:
-    """Run ``work(job_id)`` (which writes the job's dataset and returns its path) unless already done.
-
-    Never raises for a failing scene: a GyrolabError is recorded as a
-    deterministic failure (the same config and code fail the same way, so it
-    is not retried), except a write failure (``OutputError``: the disk may
-    have room next time); any other exception is recorded too, with its
-    traceback in the job's log, and retried when the sweep is run again. A
-    job that another live process is running is left to it (status
-    ``ELSEWHERE``, nothing written).
-    """
+    """Run ``work(job_id)`` (which writes the job's dataset and returns its path) unless already done; never raises
+    for a failing scene. A GyrolabError is recorded as a deterministic failure (not retried) except a write failure
+    (``OutputError``: the disk may have room next time); any other exception is recorded, with its traceback in the
+    job's log, and retried. A job another live process runs is left to it (``ELSEWHERE``, nothing written)."""
     job_dir = Path(job_dir)
     guard_worker()  # in a launcher's worker process: die with the launching process
     try:
@@ -96,7 +72,7 @@ def _run_locked(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_nu
     if previous is not None and previous.reusable_for(job_id, job_dir):
         log.info("job %s: %s earlier (job id %s); skipped", job_num, previous.status, job_id)
         return mark_skipped(job_dir, previous, job_num, overrides)
-    remove_record(job_dir)  # a stale record (other config or code) must not outlive this attempt
+    (job_dir / RECORD_NAME).unlink(missing_ok=True)  # no stale record (other config or code) outlives this try
     base = JobRecord(job_id=job_id, status=FAILED, overrides=list(overrides), code_version=code, job_num=job_num)
     try:
         path = work(job_id)

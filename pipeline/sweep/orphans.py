@@ -1,26 +1,16 @@
-"""Sweep jobs in worker processes die with the process that launched the sweep.
+"""Sweep jobs in worker processes die with the process that launched the sweep (docs/faults.md, "Workers die with
+the launching process").
 
-Launchers that run jobs in other processes on this machine (joblib/loky
-workers, submitit's local executor) leave them running when the launching
-``gyrolab -m`` is killed (``kill -9``, a closed terminal, an out-of-memory
-kill): orphans that go on computing and writing. The launching process
-announces itself in the environment (``LAUNCHER_ENV``, "host:pid", set by the
-sweep callback before any job starts; workers inherit it), and each job, when
-it starts in another process on the same host, arms two guards:
-
-* Linux ``prctl(PR_SET_PDEATHSIG, SIGKILL)`` when its direct parent is the
-  launcher: the kernel kills the worker the moment the launcher dies;
-* a watchdog thread that checks every ``POLL`` seconds that the launcher is
-  still alive (a dead or zombie launcher, or a changed parent pid, ends the
-  worker), for launchers with processes in between and for other systems.
-
-Jobs on other hosts (SLURM) are the scheduler's: they are not guarded, and
-``scancel`` stops them. A killed job leaves no partial file (writes are
-atomic) and its lock dies with it, so resuming the sweep runs it again.
+The launching process announces itself in the environment (``LAUNCHER_ENV``, "host:pid", set by the sweep
+callback; workers inherit it); a job that starts in another process on the same host arms Linux
+``prctl(PR_SET_PDEATHSIG, SIGKILL)`` when its parent is the launcher, and a watchdog thread that ends the worker
+once the launcher is gone (for launchers with processes in between, and other systems). Jobs on other hosts
+(SLURM) are the scheduler's.
 """
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import ctypes.util
 import logging
@@ -101,13 +91,11 @@ def alive(pid: int) -> bool:
 
 
 def _set_parent_death_signal() -> None:
-    try:
+    with contextlib.suppress(OSError, AttributeError):  # no prctl here: the watchdog alone guards this worker
         libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
         if libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) != 0:
             log.debug("prctl(PR_SET_PDEATHSIG) failed: errno %d; the watchdog alone guards this worker",
                       ctypes.get_errno())
-    except (OSError, AttributeError):
-        pass  # no prctl here: the watchdog alone guards this worker
 
 
 def _watch(launcher: int, parent: int) -> None:

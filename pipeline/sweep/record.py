@@ -1,8 +1,5 @@
-"""A job's record, ``job.json`` next to its ``run.nc``: what ran, with which identity, and how it ended.
-
-The record is written (atomically) after ``run.nc``, so a job killed at any
-point leaves either a complete record or none; a job without a complete
-record is recomputed when the sweep is run again.
+"""A job's record, ``job.json`` next to its ``run.nc``: what ran, with which identity, and how it ended. Written
+(atomically) after ``run.nc``; a job without a complete record is recomputed when the sweep is run again.
 """
 
 from __future__ import annotations
@@ -58,11 +55,8 @@ def write_record(job_dir: Path, record: JobRecord) -> Path:
 
 
 def read_record(job_dir: Path) -> JobRecord | None:
-    """The record in ``job_dir``, or None when there is none (or it is unreadable: treated as unfinished).
-
-    A record is untrusted input (a sweep directory may come from someone else): at most MAX_RECORD_BYTES, a JSON
-    mapping whose ``run`` is a file name in the job directory, nested no deeper than Python can parse.
-    """
+    """The record in ``job_dir``, or None when there is none or it is not what gyrolab writes (untrusted input: at
+    most MAX_RECORD_BYTES, a JSON mapping whose ``run`` is a file name in the job directory); None is unfinished."""
     try:
         fd = open_own_file(Path(job_dir) / RECORD_NAME, os.O_RDONLY)
         with os.fdopen(fd, "rb") as handle:
@@ -81,10 +75,6 @@ def read_record(job_dir: Path) -> JobRecord | None:
             and isinstance(record.job_id, str) and isinstance(record.status, str)):
         return None
     return record
-
-
-def remove_record(job_dir: Path) -> None:
-    (Path(job_dir) / RECORD_NAME).unlink(missing_ok=True)
 
 
 def record_paths(sweep_dir: Path) -> Iterator[Path]:

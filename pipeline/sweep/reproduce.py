@@ -1,17 +1,14 @@
-"""``gyrolab --reproduce PATH/run.nc``: rerun a dataset's stored config and say whether the result is identical.
-
-A multirun's ``sweep.nc``: each finished job's ``run.nc`` (``reproduce_sweep``). A batch's ``sweep.nc``:
-``gyrolab.batch.reproduce``; an experiment's dataset: ``gyrolab.experiments.reproduce_task`` (both with the
-comparison of this module).
-
-Identical means every data variable and coordinate is equal bit for bit.
-Otherwise the report names each differing variable with its largest
-absolute difference. Provenance that differs (commit, library versions,
-platform) is listed as a hint to why.
+"""``gyrolab reproduce PATH/run.nc``: rerun a dataset's stored config and say whether the result is identical
+(docs/sweeps.md): every data variable and coordinate equal bit for bit, else each differing variable with its
+largest absolute difference, and the provenance that differs as a hint to why. A multirun's ``sweep.nc``: each
+finished job's ``run.nc`` (``reproduce_sweep``); a batch's: ``gyrolab.batch.reproduce``; an experiment's dataset:
+``gyrolab.experiments.reproduce_task`` (both with ``compare`` of this module).
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -78,9 +75,8 @@ def parse_points(text: str | None, n_points: int, what: str = "point") -> list[i
 
 
 def reproduce_sweep(path: Path, stored: xr.Dataset, points: str | None = None) -> tuple[Comparison, list[str]]:
-    """(the comparison, the report's head) of reproducing the finished jobs of a multirun's sweep.nc, each from its
-    own run.nc (``job_dir``, relative to the sweep directory); ``points``: only these jobs (flat numbers over the
-    swept dimensions, C order). A failed job left no run.nc: it is named, not rerun."""
+    """(the comparison, the report's head) of reproducing the finished jobs of a multirun's sweep.nc (``points``: only
+    these, flat C-order numbers), each from its own run.nc; a failed job left none: it is named, not rerun."""
     path = Path(path)
     status = np.asarray(stored["job_status"].values).ravel()
     dirs = [str(d) for d in np.asarray(stored["job_dir"].values).ravel()]
@@ -108,12 +104,8 @@ def reproduce_sweep(path: Path, stored: xr.Dataset, points: str | None = None) -
 
 
 def stored_config(stored: xr.Dataset, where: str = "the dataset's config attribute") -> DictConfig:
-    """The config a dataset stores, read with a safe YAML loader and checked as any config is.
-
-    A dataset may come from someone else: its config is parsed without YAML tags,
-    may not contain interpolations (gyrolab stores it resolved), may name only
-    registered plugins (``gyrolab.engine.safety``) and must be within the budget.
-    """
+    """The config a dataset stores, checked as any config is: a dataset may come from someone else (no YAML tags,
+    no interpolation, registered plugins only: ``gyrolab.engine.safety``; within the budget)."""
     cfg = check_stored_config(stored.attrs["config"], where)
     plain = OmegaConf.to_container(cfg)
     time = plain.get("time")
@@ -123,10 +115,6 @@ def stored_config(stored: xr.Dataset, where: str = "the dataset's config attribu
         probe.time.n_output = 2
         check_budget(plain, Scene.from_config(probe).system.initial_state().size)
     return cfg
-
-
-def rerun(stored: xr.Dataset) -> xr.Dataset:
-    return Scene.from_config(stored_config(stored)).run()
 
 
 def compare(stored: xr.Dataset, new: xr.Dataset) -> Comparison:
@@ -184,33 +172,31 @@ def _float_difference(old: xr.DataArray, a: np.ndarray, b: np.ndarray) -> str:
             f"at {where or 'the only value'}; {int((delta > 0).sum())} of {delta.size} values differ")
 
 
-def checked_config(path: Path, stored: xr.Dataset) -> DictConfig:
-    """``stored_config``, with what a foreign dataset lacks said in one sentence."""
+@contextmanager
+def _gyrolabs_only(path: Path) -> Iterator[None]:
+    """A stored config, or variables, without what gyrolab's runs always have: one sentence."""
     try:
-        return stored_config(stored)
+        yield
     except GyrolabError:
         raise
-    except FOREIGN_ERRORS as error:  # a stored config without what gyrolab's runs always have
-        raise not_gyrolabs(path, error, "a run.nc that gyrolab wrote") from None
+    except FOREIGN_ERRORS as error:
+        raise not_gyrolabs(path, error, RUN) from None
+
+
+def checked_config(path: Path, stored: xr.Dataset) -> DictConfig:
+    """``stored_config``, with what a foreign dataset lacks said in one sentence."""
+    with _gyrolabs_only(path):
+        return stored_config(stored)
 
 
 def reproduce(path: Path, stored: xr.Dataset | None = None) -> tuple[Comparison, xr.Dataset]:
     """Rerun the run.nc at ``path`` (``stored``: its dataset, already loaded) and compare."""
     stored = load_run(path) if stored is None else stored
-    expected = "a run.nc that gyrolab wrote"
-    try:
+    with _gyrolabs_only(path):
         scene = Scene.from_config(stored_config(stored))
-    except GyrolabError:
-        raise
-    except FOREIGN_ERRORS as error:  # a stored config without what gyrolab's runs always have
-        raise not_gyrolabs(path, error, expected) from None
     new = scene.run()
-    try:
+    with _gyrolabs_only(path):
         return compare(stored, new), stored
-    except GyrolabError:
-        raise
-    except FOREIGN_ERRORS as error:  # variables that gyrolab's runs always have are missing
-        raise not_gyrolabs(path, error, expected) from None
 
 
 def report(path: Path, comparison: Comparison, stored: xr.Dataset, head: list[str] | None = None) -> list[str]:

@@ -1,24 +1,20 @@
-"""A real single-node SLURM on this machine, to try gyrolab's SLURM routes (docs/cluster.md) before a cluster.
+"""A real single-node SLURM on this machine, to try gyrolab's SLURM routes before a cluster (docs/cluster.md, "A
+SLURM on your own machine": what ``start`` installs, writes and starts, and how clients find it through
+``SLURM_CONF`` without touching a system SLURM or munge).
 
     python -m gyrolab.sweep.slurm_local start     # prints: export SLURM_CONF=/tmp/gyrolab-slurm-.../slurm.conf
     eval "$(python -m gyrolab.sweep.slurm_local start)"   # the same, and this shell's sbatch/sinfo use it
     python -m gyrolab.sweep.slurm_local status    # the clusters it started that are running
     python -m gyrolab.sweep.slurm_local stop      # cancel their jobs, stop their daemons, remove their files
 
-What ``start`` installs, writes and starts, and how clients find the cluster through ``SLURM_CONF`` without
-touching a system SLURM or munge: docs/cluster.md, "A SLURM on your own machine". ``start()`` returns the running
-cluster (tests/sweep/test_slurm.py starts its own with it); the command line's ``start`` runs it in a small
-background process that holds the cluster until ``stop`` (or SIGTERM) ends it.
+``start()`` returns the running cluster (tests/sweep/test_slurm.py starts its own with it); the command line's
+``start`` runs it in a small background process that holds the cluster until ``stop`` (or SIGTERM) ends it. A
+process killed before its ``stop()`` leaves daemons behind: each state directory records the pid that started it
+(``owner``), and the next ``start()`` ends the processes of every directory whose owner is gone and removes it.
 
-A process killed before its ``stop()`` leaves daemons behind: every state directory records the
-pid of the process that started it (``owner``), and the next ``start()`` ends the processes of every
-directory whose owner is gone (the processes whose command line or environment names that
-directory) and removes the directory, before it chooses free ports of its own.
-
-Why not cgroups: a container rarely delegates a writable cgroup tree, so processes are tracked by
-parentage (``proctrack/linuxproc``) and tasks are not confined (``task/none``); the node's CPUs and
-memory come from this machine (``nproc``, ``/proc/meminfo`` minus a margin) and are taken as
-configured (``SlurmdParameters=config_overrides``), since a container's CPU quota is not what the
+Why not cgroups: a container rarely delegates a writable cgroup tree, so processes are tracked by parentage
+(``proctrack/linuxproc``) and tasks are not confined; the node's CPUs and memory come from this machine and are
+taken as configured (``SlurmdParameters=config_overrides``), since a container's CPU quota is not what the
 hardware reports.
 """
 
@@ -36,6 +32,9 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from gyrolab.output.trust import proc_number
+from gyrolab.sweep.orphans import alive  # a zombie (dead, not reaped) counts as dead
 
 PACKAGES = ("slurm-wlm", "munge")
 #: the programs the cluster needs; any missing one means the packages are installed first
@@ -59,6 +58,7 @@ class Unavailable(RuntimeError):
 
 #: the file in a state directory that marks a cluster the command line started (``stop`` ends only those)
 HELD = "held-by-command-line"
+NONE_RUNNING = "slurm_local: no cluster started by 'python -m gyrolab.sweep.slurm_local start' is running"
 
 
 @dataclass
@@ -196,7 +196,7 @@ def slurm_conf(directory: Path, node: str) -> str:
     """A minimal slurm.conf for one node, this host, everything under ``directory``."""
     controller_port, node_port = _free_ports(2)
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    memory = max(512, _mem_total_mib() - MEMORY_MARGIN_MIB)
+    memory = max(512, (proc_number("/proc/meminfo", "MemTotal:") or 2048 * 1024) // 1024 - MEMORY_MARGIN_MIB)
     return f"""\
 # written by gyrolab.sweep.slurm_local for one cluster
 ClusterName=gyrolabtest
@@ -277,11 +277,9 @@ def _write_munge_key(path: Path) -> None:
 
 
 def _kill_processes_naming(directory: Path) -> None:
-    """SIGKILL every process (not this one or its ancestors) of the cluster in ``directory``: whose command
-    line names it (the daemons), and whose environment names it and that is slurmstepd (started by slurmd
-    with its environment) or a job (``SLURM_JOB_ID``, submitted with ``SLURM_CONF`` in its environment).
-    A process that merely has ``SLURM_CONF`` set (a user's shell after ``eval "$(... start)"``, an editor
-    or a notebook started from it, ``sbatch --wait``) is not the cluster's and is left alone."""
+    """SIGKILL every process (not this one or its ancestors) of the cluster in ``directory``: whose command line
+    names it (the daemons), or whose environment names it and that is slurmstepd or a job (``SLURM_JOB_ID``); one
+    that merely has ``SLURM_CONF`` set (a user's shell after ``eval "$(... start)"``) is left alone."""
     needle = str(directory).encode()
     spared = _ancestors()
     for entry in Path("/proc").iterdir():
@@ -310,15 +308,6 @@ def _ancestors() -> set[int]:
     return pids
 
 
-def alive(pid: int) -> bool:
-    """Whether ``pid`` runs (a zombie, dead but not reaped by its parent, does not)."""
-    try:
-        stat = (Path("/proc") / str(pid) / "stat").read_text()
-    except OSError:
-        return False
-    return stat.rsplit(")", 1)[1].split()[0] != "Z"
-
-
 def _age(path: Path) -> float:
     try:
         return time.time() - path.stat().st_mtime
@@ -335,20 +324,11 @@ def _free_ports(count: int) -> list[int]:
         return [probe.getsockname()[1] for probe in probes]
 
 
-def _mem_total_mib() -> int:
-    for line in Path("/proc/meminfo").read_text().splitlines():
-        if line.startswith("MemTotal:"):
-            return int(line.split()[1]) // 1024
-    return 2048
-
-
 def _sbin_path() -> str:
     """PATH with the sbin directories (the daemons live there; a non-login root shell may lack them)."""
     parts = os.environ.get("PATH", "").split(os.pathsep)
     return os.pathsep.join(parts + [d for d in ("/usr/sbin", "/sbin", "/usr/local/sbin") if d not in parts])
 
-
-# -- the command line: start (in a background process that holds the cluster), status, stop ----------------------
 
 def _hold(base: Path | None) -> int:
     """Start a cluster, tell the parent on stdout, then keep it until SIGTERM, SIGINT or SIGHUP."""
@@ -413,8 +393,7 @@ def _status_command(base: Path) -> int:
     for owner, directory in clusters:
         print(f"SLURM_CONF={directory / 'slurm.conf'}  (pid {owner})")
     if not clusters:
-        print("slurm_local: no cluster started by 'python -m gyrolab.sweep.slurm_local start' is running",
-              file=sys.stderr)
+        print(NONE_RUNNING, file=sys.stderr)
     return 0
 
 
@@ -431,8 +410,7 @@ def _stop_command(base: Path, timeout: float = 60) -> int:
         print(f"slurm_local: {'did not stop within ' + str(timeout) + ' s' if (owner, directory) in left else 'stopped'}"
               f" {directory}", file=sys.stderr)
     if not clusters:
-        print("slurm_local: no cluster started by 'python -m gyrolab.sweep.slurm_local start' is running",
-              file=sys.stderr)
+        print(NONE_RUNNING, file=sys.stderr)
     return 1 if left else 0
 
 
@@ -449,13 +427,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="where the state directories go (default: the system's temporary directory)")
     args = parser.parse_args(argv)
     base = args.base or Path(tempfile.gettempdir())
-    if args.action == "_hold":
-        return _hold(args.base)
-    if args.action == "start":
-        return _start_command(args.base)
-    if args.action == "status":
-        return _status_command(base)
-    return _stop_command(base)
+    if args.action in ("_hold", "start"):
+        return (_hold if args.action == "_hold" else _start_command)(args.base)
+    return (_status_command if args.action == "status" else _stop_command)(base)
 
 
 if __name__ == "__main__":

@@ -1,22 +1,14 @@
-"""gyrolab's sweeper: Hydra's basic sweeper that leaves finished jobs out before launching anything.
+"""gyrolab's sweeper: Hydra's basic sweeper that leaves finished jobs out before launching anything
+(docs/cluster.md, "Resuming a multirun").
 
-Resuming a sweep with Hydra's basic sweeper composes every job's config twice (once to validate the
-batch, once to launch it) and starts every job, finished ones included, which then skips itself
-(``gyrolab.sweep.job``): a 1,000-job sweep with 600 jobs done paid ~0.7 s per finished job. This
-sweeper computes each job's identity first (``gyrolab.sweep.identity.job_identity``, the same rule
-the jobs apply) and launches only the jobs whose directory holds no record that settles that
-identity (``JobRecord.reusable_for``). Job numbers, and so job directories and ``sweep.nc``, are
-those of an unfiltered sweep: the remaining jobs are launched in runs of consecutive numbers.
-
-The identities are computed without composing every job: the config of one job per combination
-of config-group choices is composed as Hydra composes it, and each other job's value overrides are
-applied to it with Hydra's own override code (and its values put back afterwards). Applying every
-job's overrides also stands in for the basic sweeper's validation of the whole batch; a job whose
-overrides do not apply is composed in full, so that Hydra reports it before any job starts. A config
-whose values call a resolver (``${hydra:...}``, ``${now:...}``, ``${oc.env:...}``, any other) could
-resolve differently inside the job, so then no job is left out here: every job is launched and skips
-itself, exactly as before. A wrong prediction can only cost a launch, never skip a job: a job is left
-out only when the predicted identity equals the one its finished record holds.
+It computes each job's identity first (``gyrolab.sweep.identity.job_identity``, the rule the jobs apply) and
+launches only the jobs whose directory holds no record that settles it (``JobRecord.reusable_for``), in runs of
+consecutive numbers, so job numbers, directories and ``sweep.nc`` are those of an unfiltered sweep. The identities
+are computed without composing every job: one job per combination of group choices is composed as Hydra does,
+and each other job's value overrides are applied to it with Hydra's own override code (standing in for the basic
+sweeper's validation of the batch; a job whose overrides do not apply is composed in full, so that Hydra reports
+it). A config that calls a resolver could resolve differently inside the job: then every job is launched and
+checks itself. A wrong prediction can only cost a launch, never skip a job.
 """
 
 from __future__ import annotations
@@ -25,7 +17,6 @@ import dataclasses
 import logging
 import os
 import re
-import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -45,6 +36,7 @@ from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.lock import try_lock, unlock
 from gyrolab.output.trust import check_tree, private_dir
+from gyrolab.output.written import fail
 from gyrolab.sweep.aggregate import SWEEP_NAME, stored_hydra
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import code_version, job_identity
@@ -61,13 +53,9 @@ _RESOLVER = re.compile(r"\$\{\s*[\w.]+\s*:")
 
 
 class ResumingSweeper(Sweeper):
-    """Hydra's basic sweeper (same jobs, same numbers, same ``max_batch_size`` and ``params``) that does
-    not launch the jobs a previous run of the same sweep already settled.
-
-    It derives from Hydra's ``Sweeper`` and calls the basic sweeper's functions rather than subclassing
-    it: Hydra re-imports its own plugin modules when it scans them, which would leave a subclass with
-    a stale base class.
-    """
+    """Hydra's basic sweeper (same jobs, numbers, ``max_batch_size`` and ``params``) that does not launch the jobs
+    a previous run of the same sweep settled. It calls the basic sweeper's functions rather than subclassing it:
+    Hydra re-imports its plugin modules when it scans them, which would leave a subclass with a stale base."""
 
     def __init__(self, max_batch_size: int | None = None, params: dict[str, str] | None = None) -> None:
         super().__init__()
@@ -92,8 +80,7 @@ class ResumingSweeper(Sweeper):
         try:
             claim(sweep_dir, self.config)
         except GyrolabError as error:  # as the sweep callback refuses a directory in use: one sentence
-            print(f"gyrolab: error: {error}", file=sys.stderr)
-            sys.exit(error.exit_code)
+            fail(error)
 
         tic = time.perf_counter()
         settled, unsure = check_jobs(self.config, self.hydra_context.config_loader, jobs)
@@ -125,15 +112,10 @@ class ResumingSweeper(Sweeper):
 
 
 def claim(sweep_dir: Path, config: DictConfig) -> None:
-    """Make ``sweep_dir`` this sweep's (its ``multirun.yaml``), or refuse it in one sentence (ConfigError).
-
-    One sweep directory, one sweep: a directory holding another sweep (another grid of jobs in its
-    ``multirun.yaml``) or a batch (a ``sweep.nc`` without one) is refused, as ``gyrolab batch`` refuses another
-    batch; the same sweep again resumes. The check and the write of ``multirun.yaml`` happen under the sweep
-    directory's lock, so two sweeps started at once cannot interleave: the later one finds the earlier one's.
-    Nothing already in the directory is followed (``gyrolab.output.trust.check_tree``), and submitit's folder,
-    whose pickles the jobs load, is the user's alone (``private_dir``).
-    """
+    """Make ``sweep_dir`` this sweep's (its ``multirun.yaml``), or refuse it in one sentence (ConfigError): another
+    sweep or a batch there is refused, the same sweep again resumes; under the directory's lock, so two sweeps
+    started at once cannot interleave. Nothing there is followed (``check_tree``), and submitit's folder, whose
+    pickles the jobs load, is the user's alone (``private_dir``)."""
     check_tree(sweep_dir, sweep=True)
     try_lock(sweep_dir, blocking=True)
     try:
@@ -185,8 +167,7 @@ class OverridesDoNotApply(Exception):
 def check_jobs(master: DictConfig, loader: ConfigLoaderImpl,
                jobs: Sequence[Sequence[str]]) -> tuple[dict[int, tuple[Path, JobRecord]], list[int]]:
     """(the jobs whose directory holds a record that settles their identity, by job number; the jobs whose
-    overrides did not apply). A job whose identity cannot be predicted outside it is not settled here: it
-    is launched and checks itself."""
+    overrides did not apply). A job whose identity is not predictable here is launched and checks itself."""
     sweep_dir = Path(master.hydra.sweep.dir)
     predictor = IdentityPredictor(master, loader)
     settled, unsure = {}, []
@@ -225,12 +206,8 @@ class _Base:
 
 
 class IdentityPredictor:
-    """Job identities of a sweep's jobs as the jobs themselves will compute them (None: not predictable).
-
-    Per job it costs a few override applications and one resolution of the config, not a composition:
-    the job's value overrides that differ from the composed job's are applied to that job's config, the
-    identity computed, and the composed job's values put back.
-    """
+    """Job identities of a sweep's jobs as the jobs themselves will compute them (None: not predictable), each
+    from a composed job's config with the job's differing value overrides applied, then put back."""
 
     def __init__(self, master: DictConfig, loader: ConfigLoaderImpl) -> None:
         self.master, self.loader = master, loader
@@ -299,9 +276,8 @@ def _as_change(o: Override) -> Override:
 
 
 def _patched(base: _Base, changed: Sequence[Override]) -> dict[str, Any] | None:
-    """The job's config as plain data: the composed job's, with the changed values read back from the config
-    they were applied to (so typed as Hydra types them); None when that is not the whole story (the config
-    or a new value interpolates, or a key goes through a list)."""
+    """The job's config as plain data: the composed job's with the changed values read back where they were applied
+    (typed as Hydra types them); None when the config or a new value interpolates, or a key goes through a list."""
     if base.plain is None or any("${" in o.input_line for o in changed):
         return None
     plain = dict(base.plain)
@@ -319,12 +295,8 @@ def _patched(base: _Base, changed: Sequence[Override]) -> dict[str, Any] | None:
 
 
 def register_plugin() -> None:
-    """Make sure Hydra knows gyrolab's sweeper (``hydra_plugins.gyrolab_sweeper``) in this process.
-
-    Hydra finds it by scanning the ``hydra_plugins`` namespace package, except in an editable install
-    (``pip install -e .``, the README's): setuptools' editable finder serves the package on import but cannot
-    list it, so Hydra's scan does not see it, and the class is registered here by its real name.
-    """
+    """Make sure Hydra knows gyrolab's sweeper (``hydra_plugins.gyrolab_sweeper``) in this process: in an editable
+    install setuptools' finder serves the package on import but cannot list it, so Hydra's scan misses it."""
     plugins = Plugins.instance()  # scans first: a scan re-executes the plugin modules it finds
     from hydra_plugins.gyrolab_sweeper import GyrolabSweeper  # after the scan above, which re-executes it
 

@@ -1,14 +1,11 @@
-"""Progress of a running sweep, watched from the process that launched it.
-
-Jobs may run in this process, in worker processes or on other machines; all
-of them leave a record in the sweep directory when they end, so the watcher
-counts records that appeared (or were rewritten) since the sweep started.
-On a terminal it draws one bar for the sweep; elsewhere it logs a line every
-``log_every`` seconds.
+"""Progress of a running sweep, watched from the process that launched it: the records that appeared (or were
+rewritten) in the sweep directory since it started, wherever the jobs run. On a terminal one bar for the sweep;
+elsewhere a log line every ``log_every`` seconds.
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import sys
 import threading
@@ -64,10 +61,8 @@ class SweepWatcher:
     def _snapshot(self) -> dict[Path, int]:
         out = {}
         for path in record_paths(self.sweep_dir):
-            try:
+            with contextlib.suppress(OSError):
                 out[path] = path.stat().st_mtime_ns
-            except OSError:
-                pass
         return out
 
     def _watch(self) -> None:

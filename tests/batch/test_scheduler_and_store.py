@@ -95,27 +95,14 @@ def test_where_the_address_comes_from(monkeypatch):
         assert scheduler.choose_scheduler(None) == scheduler.Choice("tcp://10.0.0.2:8786",
                                                                     "the environment (DASK_SCHEDULER_ADDRESS)")
         assert scheduler.choose_scheduler("local").scheduler == "local"   # an explicit harmless choice
-        rest = scheduler.take_scheduler_option(["--batch", "--scheduler", "tcp://10.0.0.1:8786", "initial.r0=1,2"])
-        assert rest == ["--batch", "initial.r0=1,2"]
-        assert scheduler.choose_scheduler(None) == scheduler.Choice("tcp://10.0.0.1:8786",
-                                                                    "the command line (--scheduler)")
-        with pytest.raises(ConfigError, match="not read from a config"):   # the command line does not excuse it
-            scheduler.choose_scheduler("tcp://10.0.0.9:8786")
-
-
-@pytest.mark.parametrize("argv, value, rest", [
-    (["--scheduler=local", "a=1"], "local", ["a=1"]),
-    (["a=1", "--scheduler", "tcp://h:1"], "tcp://h:1", ["a=1"]),
-    (["a=1"], None, ["a=1"]),
-])
-def test_the_option_is_taken_out_wherever_it_stands(argv, value, rest):
-    assert scheduler.split_scheduler_option(argv) == (value, rest)
-
-
-@pytest.mark.parametrize("argv", [["--scheduler"], ["--scheduler", "--batch"], ["--scheduler=a", "--scheduler=b"]])
-def test_a_malformed_option_is_one_sentence(argv):
-    with pytest.raises(ConfigError, match="--scheduler"):
-        scheduler.split_scheduler_option(argv)
+        scheduler.use_command_line_scheduler("tcp://10.0.0.1:8786")
+        try:
+            assert scheduler.choose_scheduler(None) == scheduler.Choice("tcp://10.0.0.1:8786",
+                                                                        "the command line (--scheduler)")
+            with pytest.raises(ConfigError, match="not read from a config"):   # the command line does not excuse it
+                scheduler.choose_scheduler("tcp://10.0.0.9:8786")
+        finally:
+            scheduler.use_command_line_scheduler(None)
 
 
 def test_a_config_with_an_address_is_refused_on_the_command_line_before_anything_is_written(tmp_path):

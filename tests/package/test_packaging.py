@@ -97,4 +97,5 @@ def test_wheel_installs_only_gyrolab(tmp_path):
         names = archive.namelist()
     assert {top for top in tops if not top.endswith(".dist-info")} == {"gyrolab", "hydra_plugins"}
     assert "gyrolab/conf/config.yaml" in names and "gyrolab/plugins/forces/newtonian.py" in names
+    assert "gyrolab/app/completion.bash" in names  # the shell function of gyrolab completion
     assert "hydra_plugins/gyrolab_sweeper/__init__.py" in names and "hydra_plugins/__init__.py" not in names

@@ -187,13 +187,14 @@ def test_jobs_of_different_lengths_share_a_sample_dimension(uneven):
 
 
 def test_summary_figures_show_final_values(uneven, tmp_path):
-    from gyrolab.sweep.figures import final_values, save_sweep_figures
+    from gyrolab.figures.options import figure_options
+    from gyrolab.figures.sweep import final_values, save_figures
 
     ds, runs = uneven
     final = final_values(ds.omega)
     for i, r in enumerate(runs):
         np.testing.assert_array_equal(final.isel(n_output=i).values, r.omega.isel(time=-1).values)
-    paths = save_sweep_figures(ds, tmp_path)
+    paths = save_figures(ds, tmp_path, *figure_options(None))
     assert sorted(p.name for p in paths) == ["sweep_cost.png", "sweep_final_state.png", "sweep_invariant_drift.png"]
     assert all(p.stat().st_size > 10_000 for p in paths)
 
