@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from gyrolab.accuracy.calibration import SHADOW_CHUNKS, SHADOW_OFFSET, TANGENT_SAMPLES, TANGENT_TOLERANCE
-from gyrolab.kernels.model import TRACED, CompiledModel
+from gyrolab.kernels.model import CompiledModel
 from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba
 
 
@@ -74,7 +74,7 @@ def amplification(compiled: Any, fun: Any, y0: np.ndarray, t0: float, t_pilot: f
     generated for ``compiled``.
     """
     span = float(t_end - t0)
-    growth = None if compiled is None or compiled.model != TRACED else _generated(compiled, y0, t0, t_pilot, t_end)
+    growth = None if compiled is None else _generated(compiled, y0, t0, t_pilot, t_end)
     if growth is not None:
         return Amplification(*growth, span, "tangent flow generated from the equations (compiled DOP853)")
     return Amplification(*_shadow_pair(method, fun, compiled, y0, t0, t_pilot, t_end), span,
@@ -97,7 +97,7 @@ def _generated(compiled: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: 
     method = DOP853Numba(rtol=TANGENT_TOLERANCE, atol=TANGENT_TOLERANCE)
     try:
         z = method.integrate(None, times, tangent.initial_augmented(x0, tangent.direction(x0, sphere), False)[0],
-                             None, CompiledModel(augmented.model, params)).y
+                             None, CompiledModel(params)).y
     except Exception:  # noqa: BLE001  (a failed tangent run: the shadow pair measures instead)
         return None
     log = np.maximum.accumulate(np.maximum(z[:, -1], 0.0))

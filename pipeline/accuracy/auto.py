@@ -407,7 +407,7 @@ class Auto(Integrator):
         for j in sample:
             single = type(self)(accuracy=self.accuracy, pilot_fraction=self.pilot_fraction, safety=self.safety,
                                 extended_precision=False)  # the vectorised kernels run in double precision
-            model = CompiledModel(compiled.model, P[j])
+            model = CompiledModel(P[j])
             choices.append(single.integrate(compiled_rhs(model), times, y0s[j], None, model, series=False).choice)
         choice = min(choices, key=lambda c: c.attributes["auto_tolerance"])  # the chosen method (Taylor or DOP853)
         return choice.method, {"accuracy": self.accuracy, "auto_sampled_trajectories": len(sample),

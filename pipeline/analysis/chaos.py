@@ -204,7 +204,7 @@ def poincare_section(compiled: Any, y0: np.ndarray, t_end: float, step: float, l
     if not -1.0 < level < 1.0:
         raise ConfigError(f"section level γ3 = {level} must lie strictly between -1 and 1")
     p = np.ascontiguousarray(np.atleast_2d(row)[0])
-    run_model = model.CompiledModel(compiled.model, p)
+    run_model = model.CompiledModel(p)
     y0 = np.asarray(y0, dtype=float).ravel()
     times = np.arange(int(np.ceil(t_end / step)) + 1) * step
     try:

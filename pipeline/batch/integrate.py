@@ -172,7 +172,7 @@ def integrate_points(integrator: Integrator, rhs_of: Callable[[int], RightHandSi
     for j in range(count):
         model = None
         if uses_model:
-            model = compiled if params is None else CompiledModel(compiled.model, np.array(params[j], dtype=float))
+            model = compiled if params is None else CompiledModel(np.array(params[j], dtype=float))
         try:
             run = integrator.integrate(rhs_of(j), times, y0s[j], None, model)
         except IntegrationError:

@@ -428,7 +428,7 @@ def _scalar_point(plain: dict[str, Any], values: Mapping[str, Any], n: int,
 
 
 def _same_structure(systems: Mapping[int, _Built]) -> None:
-    models = {(b.compiled.model, b.system.state_size, b.compiled.params.size) for b in systems.values()}
+    models = {(b.compiled.form, b.compiled.params.size) for b in systems.values()}
     if len(models) > 1:
         raise ConfigError("the swept values change the compiled model's form (its torques or state), which one batch "
                           "cannot integrate together; sweep them with gyrolab -m")

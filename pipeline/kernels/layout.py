@@ -11,7 +11,7 @@ integers as compile-time constants, so ``p[U_Z + 1]`` compiles to the same machi
     p[CARRIES_ALPHA]    1.0 when the state carries α (9 components), else 0.0 (state (ω, γ))
     p[INV_INERTIA + k]  1/I_k (the inner loops multiply instead of dividing)
 
-A model compiled from its traced equations (``model``, form ``models.TRACED``) has a layout of its own:
+A model compiled from its traced equations (``model``) has a layout of its own:
 
     p[TRACED_ADDRESS]                the right-hand side kernel's address
     p[TRACED_FIRST_CONSTANT:-TRACED_TAIL]   the equations' numbers, in the order the trace met them

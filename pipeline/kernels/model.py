@@ -8,8 +8,7 @@
   ``models.rhs`` run through its address;
 - the Taylor coefficients' kernel (``taylor_series``, compiled when ``taylor`` first needs it).
 
-The compiled model (``CompiledModel``) is the form id ``models.TRACED`` and the parameter array, laid out
-as ``layout`` says for it: the right-hand side kernel's address, the program's numbers (the only thing that
+The compiled model (``CompiledModel``) is the parameter array, laid out as ``layout`` says for it: the right-hand side kernel's address, the program's numbers (the only thing that
 changes between two scenes of the same form), and the Taylor kernel's address and work columns.
 Every system, the fixed point with its built-in torques included, is compiled from its equations here.
 """
@@ -24,19 +23,20 @@ import numpy as np
 from gyrolab.kernels.expression import Expr, Graph, NotCompilable, check_torques, load_generated, symbols
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT, TRACED_TAIL
 
-#: form id of a model compiled from its traced equations (``models.TRACED``; here to avoid importing numba's models)
-TRACED = 1
-
-
 @dataclass(frozen=True)
 class CompiledModel:
-    """A system in the compiled kernels' form: a form id (``gyrolab.kernels.models``) and its parameter array."""
+    """A system in the compiled kernels' form: its parameter array (``layout``), which names its generated kernels."""
 
-    model: int
     params: np.ndarray
     #: the fixed point's packed parameters (``fixed_point.pack``) when every torque has a built-in form: what the
     #: Lie–Poisson splitting and the regimes' series read; None for every other model
     built_in: np.ndarray | None = None
+
+    @property
+    def form(self) -> float:
+        """What names the equations' form: the address of their generated right-hand side, the same for two models
+        whose equations differ in their numbers only (one batch can run those together)."""
+        return float(self.params[TRACED_ADDRESS])
 
 
 _UNARY = {"neg": "-{0}", "sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
@@ -193,14 +193,14 @@ def compile(model: Model) -> CompiledModel:
     params = np.zeros(TRACED_FIRST_CONSTANT + len(model.constants) + TRACED_TAIL)
     params[TRACED_ADDRESS] = float(address)
     params[TRACED_FIRST_CONSTANT:-TRACED_TAIL] = model.constants
-    return CompiledModel(TRACED, params)
+    return CompiledModel(params)
 
 
 def traced_model(compiled: CompiledModel) -> Model:
     """The model behind a traced compiled model; ValueError when its parameter array names none compiled in this
     process (a hand-made array, or one from another process: ``bind`` its rows first)."""
     address = int(compiled.params[TRACED_ADDRESS]) if np.isfinite(compiled.params[TRACED_ADDRESS]) else 0
-    if compiled.model != TRACED or address not in MODELS:
+    if address not in MODELS:
         raise ValueError("this compiled model's parameter array names no traced model of this process")
     return MODELS[address]
 
@@ -217,8 +217,6 @@ def state_size(compiled: CompiledModel) -> int | None:
 def bind(compiled: CompiledModel, rows: np.ndarray) -> np.ndarray:
     """Parameter rows (a batch's, possibly built in another process) with the kernel addresses of ``compiled``, this
     process's compiled form of the same model: an address is only valid in the process that compiled it."""
-    if compiled.model != TRACED:
-        return rows
     traced_model(compiled)  # (raises for a parameter array that is no traced model's)
     rows = np.array(rows, dtype=float)
     rows[:, TRACED_ADDRESS] = compiled.params[TRACED_ADDRESS]
@@ -260,7 +258,7 @@ def rounding_moved(compiled: CompiledModel) -> CompiledModel:
     toward = np.where(np.arange(numbers.size) % 2 == 0, np.inf, -np.inf)
     moved = np.where(_rounded(numbers), np.nextafter(numbers, toward), numbers)
     params[TRACED_FIRST_CONSTANT:params.size - TRACED_TAIL] = moved
-    return CompiledModel(compiled.model, params)
+    return CompiledModel(params)
 
 
-__all__ = ["CompiledModel", "Model", "NotCompilable", "TRACED", "compile", "compiled_system", "trace"]
+__all__ = ["CompiledModel", "Model", "NotCompilable", "compile", "compiled_system", "trace"]

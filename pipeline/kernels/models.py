@@ -5,7 +5,7 @@ numba caches a kernel only if the functions it calls are module globals
 process), hence calls through addresses instead of callbacks.
 
 Every model (the fixed point with its built-in or plugin torques, the orbiting gyrostat, a plugin system) is
-compiled from its traced equations (``model``): one form, ``TRACED``, whose right-hand side is one call of
+compiled from its traced equations (``model``): one form, whose right-hand side is one call of
 the generated kernel through its address (stored in ``p``) and whose Taylor coefficients are one call of the
 generated series kernel (``taylor_series``): the integrator kernels, cached once, serve every model.
 Measured (benchmarks/plugin_speed.py): the indirect call itself costs little.
@@ -24,9 +24,6 @@ from numba.extending import intrinsic
 from gyrolab.kernels.layout import TRACED_ADDRESS
 from gyrolab.kernels import model as _model, taylor_series
 from gyrolab.kernels.compiler import inline_kernel, kernel
-
-#: A model compiled from its traced equations (``model``): every model.
-TRACED = _model.TRACED
 
 
 @intrinsic

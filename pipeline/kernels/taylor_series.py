@@ -55,7 +55,7 @@ from gyrolab.kernels import simd
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before the decorators)
 from gyrolab.kernels.expression import Expr, binary_power, generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
-from gyrolab.kernels.model import TRACED, Model, traced_model
+from gyrolab.kernels.model import Model, traced_model
 from gyrolab.kernels.recurrences import AUXILIARY, Functions
 
 ZERO, ONE, MINUS_ONE = "0.0", "1.0", "-1.0"
@@ -694,8 +694,6 @@ def ready(compiled: Any, rows: np.ndarray | None = None) -> bool:
     ``compiled.params`` (and into every row of ``rows``, a batch's per-trajectory parameters). Nothing compiles
     before: most runs never use taylor, and a Taylor kernel's first compilation costs 0.2–1 s.
     """
-    if compiled.model != TRACED:
-        return False
     p = compiled.params
     if p[p.size - 4] == 0.0:
         address = int(p[TRACED_ADDRESS])
@@ -759,7 +757,7 @@ def _call(typingctx, address, t, order, size, Y, p):
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def coefficients(p, Y, order, t):
-    """Fill Y[1..order] from Y[0] for a traced model (``models.TRACED``): one call of the generated kernel
+    """Fill Y[1..order] from Y[0] for a traced model: one call of the generated kernel
     (``source``), whose address ``ready`` wrote at p[-4] and its work columns at p[-3] (``layout``)."""
     address = int(p[p.size - 4])
     if address == 0:  # the Taylor kernel was not compiled (``ready`` not called): no series, not a crash

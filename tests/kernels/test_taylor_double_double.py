@@ -21,7 +21,7 @@ import pytest
 from gyrolab.contracts import CompiledModel
 from gyrolab.engine.scene import compose_scene
 from gyrolab.errors import ConfigError
-from gyrolab.kernels import double_double as dd, models, taylor_dd
+from gyrolab.kernels import double_double as dd, taylor_dd
 from gyrolab.kernels.layout import (
     CARRIES_ALPHA, GAMMA, GRADIENT, INERTIA, INV_INERTIA, LINEAR, N_PARAMS, N_X, N_Y, N_Z, OMEGA, U_X, U_Y, U_Z,
 )
@@ -378,7 +378,6 @@ def test_a_scene_in_double_double_runs_with_alpha_and_every_builtin_force_and_re
     assert seen and seen[-1] == 30.0 and solution.y.dtype == np.float64
     # the reference for the α form: the same kernel's all digits agree with the stored doubles, and the double
     # kernel agrees to its own round-off
-    assert dd_scene.compiled.model == models.TRACED  # a state with α runs the traced equations
     hi, lo = taylor_dd.propagate(dd_scene.compiled.params, 1e-28, dd_scene.times, dd_scene.system.initial_state())
     np.testing.assert_array_equal(solution.y, hi)
     double = compose_scene([*overrides, "integrator.tol=1e-16"])
@@ -490,7 +489,7 @@ def test_a_parameter_array_of_no_traced_model_is_refused_in_one_sentence(chaotic
     model, y0 = chaotic
     with pytest.raises(ConfigError, match="names no traced model"):
         Taylor(precision="double-double", tol=1e-26).integrate(None, np.linspace(0.0, 1.0, 3), y0, None,
-                                                               CompiledModel(models.TRACED, model.built_in))
+                                                               CompiledModel(model.built_in))
 
 
 def test_a_plugin_torque_runs_in_double_double_from_the_scene(tmp_path):

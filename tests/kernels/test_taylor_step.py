@@ -49,7 +49,7 @@ def test_generated_coefficients_equal_extended_precision_cauchy_products():
     import numba
 
     @numba.njit
-    def series(form, p, y, order):
+    def series(p, y, order):
         T = np.zeros((order + 1, y.size))
         T[0] = y
         models.taylor_coefficients(p, T, order)
@@ -60,7 +60,7 @@ def test_generated_coefficients_equal_extended_precision_cauchy_products():
         compiled, packed, y = _random_scene(rng)
         assert taylor_series.ready(compiled)
         for order in (4, 9, 17, 30):
-            got = series(compiled.model, compiled.params, y, order)
+            got = series(compiled.params, y, order)
             exact = _extended_coefficients(packed, y, order)
             bound = 2e-15 * (np.arange(order + 1) + 1)[:, None] * np.abs(exact).max(axis=1, keepdims=True)
             assert np.all(np.abs(got - exact.astype(float)) <= bound.astype(float)), order

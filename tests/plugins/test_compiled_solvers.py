@@ -193,7 +193,6 @@ def test_a_scene_with_a_plugin_traces_every_force_and_its_compiled_rhs_is_the_py
                            "force.magnetic.moment=[0.3,-0.2,0.5]", f"force.magnetic.direction={direction}", "output.euler_angles=false"])
     assert scene.system.initial_state().size == size
     compiled = scene.compiled
-    assert compiled.model == models.TRACED
     rng = np.random.default_rng(12)
     for k in range(5):
         y = scene.system.initial_state() + 0.3 * rng.standard_normal(size)
