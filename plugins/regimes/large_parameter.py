@@ -77,8 +77,6 @@ class SlowSpinSeries:
         """Five shootings; use ``series_for`` (cached per (a, b, k, θ0))."""
         model = FixedPointModel(np.array([a, b, 1.0]), np.array([0.0, 0.0, 1.0]), k)
         section = Section("turning", float(np.cos(theta0)))
-        from gyrolab.physics import pendulum  # scipy.special: imported when a series is built, not with the plugin
-
         T0 = pendulum.period(b, pendulum.kappa(a, k), theta0)
         swing = shoot_section(model, section, np.zeros(2), T0, 0.0)
         if abs(swing.period - T0) > 1e-9 * T0:
@@ -166,9 +164,6 @@ class LargeParameter(FixedPointRegime):
     parameter = "r0/c"
     parameter_long_name = "slow-spin parameter ε = r0/c (spin about the body z axis in units of c = √(Mgℓ/C))"
     order = {"pq": 8.0, "r": 9.0, "gamma": 8.0, "gamma3": 8.0, "period": 8.0}
-
-    def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200) -> None:
-        super().__init__(formula=formula, periods=periods, samples_per_period=samples_per_period)
 
     def parameter_value(self, system) -> float:
         return float(self.scene(system).r0)

@@ -97,7 +97,6 @@ class SmallParameter(FixedPointRegime):
     parameter = "c/r0"
     parameter_long_name = "Poincaré's small parameter ε = c/r0 = √(Mgℓ/C)/r0 (Ismail's (2021) 1/μ)"
     order = {"pq": 3.0, "r": 4.0, "gamma": 4.0, "gamma3": 4.0, "period": 4.0}
-    printed_order = {"pq": 3.0, "r": 2.0, "gamma": 2.0, "gamma3": 4.0, "period": 2.0}
     # ``period`` of the default instance is the closed forms' (finite_tilt_frequency, exact through ε³); the exact
     # orbit's and every listed order's frequency differ from it by the terms from ε⁴ on, which are far below the
     # frequency itself where an order is listed (ε below half the radius of convergence, the order's own estimate
