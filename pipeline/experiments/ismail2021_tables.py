@@ -27,8 +27,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.cf import conform
-from gyrolab.output.dataset import write_dataset
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.schemas import Task
 
@@ -147,6 +146,4 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         "inferred_parameters": f"A = {A:g} (published), W = {W_P2} (fitted by the research), τ = 2πt/100",
         "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
     conform(ds, source="ismail2021_tables experiment")
-    written.append(write_dataset(ds, out_dir / "ismail2021_tables.nc"))
-    written += draw_figures("ismail2021_tables.nc", ds, out_dir, cfg.get("output"))
-    return written
+    return written + write_and_draw("ismail2021_tables.nc", ds, out_dir, cfg.get("output"))

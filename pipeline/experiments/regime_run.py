@@ -36,14 +36,11 @@ from gyrolab.engine.scene import Scene
 from gyrolab.engine.schemas import Task
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.cf import conform, unit_attributes
-from gyrolab.output.dataset import time_attributes, write_dataset
+from gyrolab.output.dataset import time_attributes
 from gyrolab.output.provenance import provenance
-from gyrolab.physics.attitude import (
-    angles_from_states,  # noqa: F401  (imported from here by earlier code)
-    frame_from_angles,
-)
+from gyrolab.physics.attitude import angles_from_states, frame_from_angles
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
@@ -248,9 +245,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     ignored = ignored_accuracy(cfg, _task_overrides())  # the app logged it; regime.nc records it
     if ignored:
         ds.attrs[ACCURACY_IGNORED_ATTRIBUTE] = ignored
-    written = [write_dataset(ds, Path(out_dir) / "regime.nc")]
-    written += draw_figures("regime.nc", ds, out_dir, cfg.get("output"))
-    return written
+    return write_and_draw("regime.nc", ds, out_dir, cfg.get("output"))
 
 
 def _task_overrides() -> list[str]:

@@ -29,9 +29,8 @@ from gyrolab.engine.scene import Scene
 from gyrolab.engine.schemas import Task
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.experiments.regime_run import build_regime, compute, errors, prepare
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.cf import conform
-from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from gyrolab.plugins.regimes.base import nondimensional_scene
@@ -125,8 +124,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     ds.attrs["n_expected_warnings"] = len(_expected)
     ds.attrs["expected_warnings"] = "\n".join(_expected) or "none"
     conform(ds, source="regime_validity experiment")
-    written = [write_dataset(ds, Path(out_dir) / "regime_validity.nc")]
-    written += draw_figures("regime_validity.nc", ds, out_dir, cfg.get("output"))
+    written = write_and_draw("regime_validity.nc", ds, out_dir, cfg.get("output"))
     if _expected:
         log.warning("%d expected domain warnings (points probed on purpose near resonances, at the edge of a "
                     "regime's domain or with non-physical bodies); their text is in %s (attribute expected_warnings)",
@@ -139,7 +137,7 @@ def _regime_errors(cfg: DictConfig, regime_name: str, values: list[float]) -> tu
     of a regime's series at each value of its parameter."""
     errs: dict[str, dict[str, list]] = {against: {k: [] for k in KEYS} for against in ("orbit", "full")}
     status = []
-    theory = getattr(_regime_class(_group(cfg, regime_name)), "order", {})
+    theory = getattr(registry.load("regime", _group(cfg, regime_name)), "order", {})
     for value in values:
         sub = _cfg_for(cfg, regime_name, _r0_for(regime_name, value, cfg))
         try:
@@ -345,10 +343,6 @@ def _resonance_dataset(sweep: dict) -> xr.Dataset:
               "side": ("side", sweep["sides"], {"units": "1", "long_name": "side of the resonance: sign of ω − n"}),
               "resonance_distance": ("resonance_distance", sweep["distances"], {"units": "1", "long_name": "|ω − n|"})}
     return xr.Dataset(data, coords=coords)
-
-
-def _regime_class(name: str):
-    return registry.load("regime", name)
 
 
 def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:

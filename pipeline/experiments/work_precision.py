@@ -30,10 +30,9 @@ from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene
 from gyrolab.engine.schemas import Task
 from gyrolab.errors import ConfigError
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.kernels import layout
 from gyrolab.output.cf import conform
-from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
 from gyrolab.physics.reference import fixed_point_reference
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
@@ -131,9 +130,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                      rows[-1]["nfev"])
     result = _dataset(rows, cfg, reference_name, repeats)
     result.attrs["scene"] = scene_title
-    written = [write_dataset(result, out_dir / "work_precision.nc")]
-    written += draw_figures("work_precision.nc", result, out_dir, cfg.get("output"))
-    return written
+    return write_and_draw("work_precision.nc", result, out_dir, cfg.get("output"))
 
 
 def _dataset(rows: list[dict[str, Any]], cfg: DictConfig, reference_name: str, repeats: int) -> xr.Dataset:

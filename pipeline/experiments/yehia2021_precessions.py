@@ -25,14 +25,14 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.cf import conform
-from gyrolab.output.dataset import FRAME_AXES, write_dataset
+from gyrolab.output.dataset import FRAME_AXES
 from gyrolab.errors import ConfigError, as_number
 from gyrolab.analysis.precession.cases import CASES, Case
 from gyrolab.analysis.precession.classify import classify
 from gyrolab.analysis.precession.closed_forms import check_closed_forms
 from gyrolab.analysis.precession.motion import body_config, euler_residual, magnetic_config, vector_residual, window
 from gyrolab.analysis.precession.stability import Floquet, floquet
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 from gyrolab.engine import schemas
@@ -146,9 +146,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     ds = _dataset(rows, closed, cfg).merge(traced, combine_attrs="override")
     ds.attrs.update(traced.attrs)
     ds = conform(ds, source="yehia2021_precessions experiment")
-    written = [csv_path, write_dataset(ds, out_dir / "precession_cases.nc")]
-    written += draw_figures("precession_cases.nc", ds, out_dir, cfg.get("output"))
-    return written
+    return [csv_path, *write_and_draw("precession_cases.nc", ds, out_dir, cfg.get("output"))]
 
 
 def trace_variables(rows: list[dict[str, Any]], traces: dict[str, xr.Dataset]) -> xr.Dataset:
