@@ -182,8 +182,7 @@ def continue_family(model: FixedPointModel, section: Section, start: FamilyPoint
     """
     if start.r0 <= 0 or r0_end <= 0:
         raise ConfigError("continuation in ln r0 needs r0 > 0 at both ends")
-    x = start.y0[1] if section.kind == "gamma_prime" else start.y0[4]
-    z = np.array([start.y0[0], x, np.log(start.period), np.log(start.r0)])
+    z = _family_z(section, start)
     direction = np.sign(np.log(r0_end) - z[3])
     t = _tangent(model, section, z)
     if t[3] * direction < 0:

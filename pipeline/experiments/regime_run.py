@@ -45,7 +45,6 @@ from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
 log = logging.getLogger(__name__)
-SOURCES = ("analytic", "full", "orbit")
 SOURCE_NAMES = {"analytic": "analytic solution", "full": "full model from the analytic t = 0 state",
                 "orbit": "exact periodic orbit (Newton shooting)",
                 "reduced": "reduced quasilinear system integrated numerically"}

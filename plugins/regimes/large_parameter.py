@@ -185,10 +185,10 @@ class LargeParameter(FixedPointRegime):
             if not s.r0 > 0:
                 raise ConfigError(f"regime large_parameter with formula=printed needs r0 > 0 (μ = c/r0), got "
                                   f"r0/c={s.r0:.4g}")
-            frequency = paper.printed_frequency(self._printed_params(s))
+            frequency = paper.printed_frequency(printed_params(s))
             if frequency < 0:
                 return [PRINTED_WARNING, f"the printed frequency 2π/(2π + α) is negative here (α = "
-                        f"{paper.printed_period_correction(self._printed_params(s)):.4g} < −2π, Ω = {frequency:.4g}): "
+                        f"{paper.printed_period_correction(printed_params(s)):.4g} < −2π, Ω = {frequency:.4g}): "
                         f"the printed period is {2 * np.pi / (frequency * s.r0):.6g}/c; its magnitude sets the window"]
             return [PRINTED_WARNING]
         if abs(s.x0) > 1e-9 or abs(s.y0) > 1e-9 or s.z0 < 0:
@@ -223,9 +223,6 @@ class LargeParameter(FixedPointRegime):
                             "exists but a perturbed motion leaves it")
         return warnings + self.reseat_warnings(system)
 
-    def _printed_params(self, s: NondimensionalScene) -> paper.Params:
-        return paper.Params(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k, mu=1.0 / s.r0, g0=s.gamma0pp)
-
     def _state(self, s, t):
         if self.formula == "printed":
             return printed_reading_state(t, s)
@@ -234,12 +231,12 @@ class LargeParameter(FixedPointRegime):
     def _period(self, s):
         if self.formula == "printed":
             # the printed frequency can be negative (check_domain says so): a period is a length of time
-            return abs(2 * np.pi / (paper.printed_frequency(self._printed_params(s)) * s.r0))
+            return abs(2 * np.pi / (paper.printed_frequency(printed_params(s)) * s.r0))
         return self.series(s).period(s.r0)
 
     def _euler(self, s, t):
         if self.formula == "printed":
-            return paper.printed_euler(t, self._printed_params(s))
+            return paper.printed_euler(t, printed_params(s))
         T = self._period(s)
         t = np.asarray(t, dtype=float)
         dense = np.linspace(0.0, max(float(t.max()), T), 1000 * int(np.ceil(max(float(t.max()), T) / T)) + 1)
@@ -255,12 +252,15 @@ class LargeParameter(FixedPointRegime):
         return y
 
 
+def printed_params(s: NondimensionalScene) -> paper.Params:
+    """The paper's parameters of scene ``s`` under its own reading μ = c/r0."""
+    return paper.Params(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k, mu=1.0 / s.r0, g0=s.gamma0pp)
+
+
 def printed_reading_state(t: np.ndarray, s) -> np.ndarray:
     """Printed (35) under the paper's own reading μ = c/r0 (τ = r0 t, p = c p1, r = r0 r1).
 
     ``s`` is a ``NondimensionalScene``; returns (n, 6) in units of c at times t (1/c).
     """
-    mu = 1.0 / s.r0
-    P = paper.Params(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k, mu=mu, g0=s.gamma0pp)
-    S = paper.printed_scaled(s.r0 * np.asarray(t, dtype=float), P)
+    S = paper.printed_scaled(s.r0 * np.asarray(t, dtype=float), printed_params(s))
     return np.stack([S["p1"], S["q1"], s.r0 * S["r1"], S["g1"], S["g2"], S["g3"]], axis=-1)
