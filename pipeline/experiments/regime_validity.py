@@ -81,11 +81,21 @@ def _scales(regime, system) -> dict[str, float]:
             "gamma": g, "gamma3": g, "period": 1 / (s.r0 * s.c)}
 
 
-def _append_missing(errs: dict) -> None:
-    """NaN for every error of a point that was refused or has no orbit."""
-    for table in errs.values():
-        for k in KEYS:
-            table[k].append(np.nan)
+def _point(sub: DictConfig, where: str, against: tuple[str, ...] = ("orbit", "full"), *, check: bool = True):
+    """(status, {against: relative error per key}, the regime or None) of the analytic solution over one period:
+    ``refused`` outside the regime's domain (``check=False`` skips that check), ``failed`` where no exact orbit is
+    found near it (the errors are then NaN)."""
+    nan = {a: dict.fromkeys(KEYS, np.nan) for a in against}
+    try:
+        scene, regime = _prepare(sub, where)[:2] if check else (Scene.from_config(sub), build_regime(sub))
+    except ConfigError as error:
+        return f"refused: {error}", nan, None
+    try:
+        result = compute(scene, regime, np.linspace(0, regime.period(scene.system), 241), full="full" in against)
+    except IntegrationError as error:  # no exact orbit near the series (far outside its domain)
+        return f"failed: {error}", nan, regime
+    sc, found = _scales(regime, scene.system), {a: errors(result, a) for a in against}
+    return "ok", {a: {k: e.get(k, np.nan) / sc[k] for k in KEYS} for a, e in found.items()}, regime
 
 
 def _r0_for(regime: str, value: float, cfg: DictConfig) -> float:
@@ -140,27 +150,13 @@ def _regime_errors(cfg: DictConfig, regime_name: str, values: list[float]) -> tu
     theory = getattr(registry.load("regime", _group(cfg, regime_name)), "order", {})
     for value in values:
         sub = _cfg_for(cfg, regime_name, _r0_for(regime_name, value, cfg))
-        try:
-            scene, regime, _ = _prepare(sub, f"{regime_name} at {cfg.regime_validity[regime_name]['parameter']} = "
-                                             f"{value:g}")
-        except ConfigError as error:
-            status.append(f"refused: {error}")
-            _append_missing(errs)
-            continue
-        theory = regime.order  # the instance's: a branch may have other orders than the class default
-        t = np.linspace(0, regime.period(scene.system), 241)
-        try:
-            result = compute(scene, regime, t)
-        except IntegrationError as error:  # no exact orbit near the series (far outside its domain)
-            status.append(f"failed: {error}")
-            _append_missing(errs)
-            continue
-        status.append("ok")
-        sc = _scales(regime, scene.system)
-        for against in errs:
-            e = errors(result, against)
+        state, e, regime = _point(sub, f"{regime_name} at {cfg.regime_validity[regime_name]['parameter']} = {value:g}")
+        status.append(state)
+        if regime is not None:
+            theory = regime.order  # the instance's: a branch may have other orders than the class default
+        for against, table in errs.items():
             for k in KEYS:
-                errs[against][k].append(e.get(k, np.nan) / sc[k] if k in e else np.nan)
+                table[k].append(e[against][k])
     return errs, status, theory
 
 
@@ -219,23 +215,9 @@ def resonance_point(cfg: DictConfig, omega: float, *, check: bool = True) -> tup
 
     ``check=False`` skips the regime's domain check (to measure the error inside the refused band).
     """
-    sub = resonance_cfg(cfg, omega)
-    nan = {k: np.nan for k in KEYS}
-    try:
-        if check:
-            scene, regime, _ = _prepare(sub, f"resonance sweep at ω = {float(omega):g}")
-        else:
-            scene, regime = Scene.from_config(sub), build_regime(sub)
-    except ConfigError as error:
-        return f"refused: {error}", nan
-    T = regime.period(scene.system)
-    try:
-        result = compute(scene, regime, np.linspace(0, T, 241), full=False)
-    except IntegrationError as error:
-        return f"failed: {error}", nan
-    sc = _scales(regime, scene.system)
-    e = errors(result, "orbit")
-    return "ok", {k: e[k] / sc[k] for k in KEYS}
+    status, e, _ = _point(resonance_cfg(cfg, omega), f"resonance sweep at ω = {float(omega):g}", ("orbit",),
+                          check=check)
+    return status, e["orbit"]
 
 
 def resonance_sweep(cfg: DictConfig) -> dict:
