@@ -264,16 +264,14 @@ def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any],
                                    {"units": "1", "long_name": f"direction cosines of the vertical (γ, γ', γ''), {label}"})
         for name, values in result["angles"].get(source, {}).items():
             data[f"{name}_{source}"] = ("time", values, {"units": "rad", "long_name": f"Euler angle {name}, {label}"})
-    for against in [k for k in ("full", "orbit") if k in result["states"]]:
-        d = np.max(np.abs(result["states"]["analytic"] - result["states"][against]), axis=0)
-        data[f"max_error_vs_{against}"] = ("component", d, {
-            "units": "1", "long_name": f"max |analytic − {SOURCE_NAMES[against]}| over the window, per component "
-                                       f"(model units of ω, γ)"})
-    if "reduced" in result["states"] and orbit is not None:
-        d = np.max(np.abs(result["states"]["reduced"] - result["states"]["orbit"]), axis=0)
-        data["max_error_reduced_vs_orbit"] = ("component", d, {
-            "units": "1", "long_name": f"max |{SOURCE_NAMES['reduced']} − {SOURCE_NAMES['orbit']}| over the window, "
-                                       "per component (model units of ω, γ)"})
+    states = result["states"]
+    for name, a, b, what in (("max_error_vs_full", "analytic", "full", "analytic"),
+                             ("max_error_vs_orbit", "analytic", "orbit", "analytic"),
+                             ("max_error_reduced_vs_orbit", "reduced", "orbit", SOURCE_NAMES["reduced"])):
+        if a in states and b in states:  # the orbit's states exist only when it was found
+            data[name] = ("component", np.max(np.abs(states[a] - states[b]), axis=0), {
+                "units": "1", "long_name": f"max |{what} − {SOURCE_NAMES[b]}| over the window, per component "
+                                           "(model units of ω, γ)"})
     if orbit is not None:
         data.update(orbit_variables(orbit, body))
     data["period_analytic"] = ((), result["period_analytic"], {"units": body.time_unit,

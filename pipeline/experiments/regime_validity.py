@@ -28,11 +28,10 @@ from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene
 from gyrolab.engine.schemas import Task
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.experiments.regime_run import build_regime, compute, errors, prepare
+from gyrolab.experiments.regime_run import build_regime, compute, errors, integrate, prepare
 from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.cf import conform
 from gyrolab.output.provenance import provenance
-from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from gyrolab.plugins.regimes.base import nondimensional_scene
 from gyrolab.plugins.regimes.large_parameter import printed_reading_state
 
@@ -341,9 +340,8 @@ def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:
         approx = printed_reading_state(t, s)
         y0 = approx[0].copy()
         y0[3:6] /= np.linalg.norm(y0[3:6])
-        model = scene.system.compiled_model()
         y0 = np.concatenate([y0, scene.system.initial_state()[6:]])[: scene.system.state_size]
-        exact = Taylor(order=24, tol=1e-16).integrate(scene.system.rhs, t, y0, None, model).y
+        exact = integrate(scene, y0, t, taylor=True)
         errs.append(float(np.abs(approx[:, 5] - exact[:, 5]).max()))
     rows.append(("large_parameter", mus, {"orbit": {"gamma3": errs}}, {}, ["evidence"] * len(mus)))
     verdict = ("large_parameter (paper's reading μ = c/r0): γ'' error of the printed formulas against the full model "
