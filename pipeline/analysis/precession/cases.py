@@ -145,8 +145,8 @@ CASES: list[Case] = [
           _II, _params(AA, BA, CA, (0, 0, _K3_191L), (0, 0, 0.6), H1, H3, W)),
     _case('19.2', '4.1.1 II A!=B', 'cos th0=1/2, m=-Omega, h1=-sqrt3 h3, k1=2 mu1 h3/Omega, k2=2 mu2 h3/Omega, '
           'k3=(Omega^2(A+B-C)+2 mu3 h3)/Omega',
-          _II, _params(AA, BA, CA, (2 * MU[0] * H3 / W, 2 * MU[1] * H3 / W, (W ** 2 * (AA + BA - CA) + 2 * MU[2] * H3) / W),
-                       MU, -_S3 * H3, H3, W)),
+          _II, _params(AA, BA, CA, (2 * MU[0] * H3 / W, 2 * MU[1] * H3 / W,
+                                    (W ** 2 * (AA + BA - CA) + 2 * MU[2] * H3) / W), MU, -_S3 * H3, H3, W)),
     _case('22', '4.1.1 II A=B', 'theta0=0, mu=0, k1=k2=0',
           _II_AB, _params(AS, AS, CS, (0, 0, K3), (0, 0, 0), H1, H3, W)),
     _case('23', '4.1.1 II A=B', 'theta0=0, h1=0, k1=mu1 h3/(m+Omega), k2=mu2 h3/(m+Omega)',
