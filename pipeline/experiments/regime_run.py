@@ -241,15 +241,11 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         ds = ds.assign_coords(coords).assign(data)
         ds.attrs.update(attrs)
         log.info("%s: %s", regime.name, ", ".join(f"{k} = {v}" for k, v in attrs.items() if not isinstance(v, list)))
-    ignored = ignored_accuracy(cfg, _task_overrides())  # the app logged it; regime.nc records it
+    # the app logged it; regime.nc records it (the command line's overrides of the running Hydra job, none outside one)
+    ignored = ignored_accuracy(cfg, list(HydraConfig.get().overrides.task) if HydraConfig.initialized() else [])
     if ignored:
         ds.attrs[ACCURACY_IGNORED_ATTRIBUTE] = ignored
     return write_and_draw("regime.nc", ds, out_dir, cfg.get("output"))
-
-
-def _task_overrides() -> list[str]:
-    """The command line's overrides of the running Hydra job (none outside one)."""
-    return list(HydraConfig.get().overrides.task) if HydraConfig.initialized() else []
 
 
 def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any], warnings: list[str]) -> xr.Dataset:

@@ -79,10 +79,6 @@ def _scene_for(cfg: DictConfig, method: str, key: str, value: float) -> Scene:
     return Scene.from_config(scene_cfg)
 
 
-def _final(ds: xr.Dataset) -> np.ndarray:
-    return np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
-
-
 def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
     """Final (ω, γ) of the scene from the most accurate reference available, and its name."""
     compiled = scene.system.compiled_model()
@@ -121,7 +117,8 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                 ds = scene.run()
                 best = min(best, time.process_time() - start)
                 best_wall = min(best_wall, time.perf_counter() - start_wall)
-            error = float(np.max(np.abs(_final(ds) - reference)))
+            final = np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
+            error = float(np.max(np.abs(final - reference)))
             drift = float(ds.energy.attrs["max_abs_drift"]) if "energy" in ds else np.nan
             rows.append({"method": method, "setting": f"{key}={value:g}", "error": error, "cpu_time": best, "wall_time": best_wall,
                          "nfev": int(ds.attrs["integrator_nfev"]), "energy_drift": drift,

@@ -114,17 +114,13 @@ def frame_indices(n_times: int, frames: int) -> np.ndarray:
     return np.unique(np.linspace(0, n_times - 1, min(frames, n_times)).round().astype(int))
 
 
-def _time_text(ds: xr.Dataset, t: float) -> str:
-    units = unit(ds, ds["time"].attrs.get("units"), "time")
-    return f"t = {t:.3f}" + (f" ({units})" if units else "")
-
-
 def motion_figure(ds: xr.Dataset, indices: np.ndarray) -> tuple[plt.Figure, Callable[[int], None]]:
     """The figure and ``update(k)``, which draws frame ``k`` (output index ``indices[k]``) and titles it with its
     time."""
     with plt.style.context(STYLE):
         rotation, names, down, what = attitude(ds)
         t = ds["time"].values
+        units = unit(ds, ds["time"].attrs.get("units"), "time")
         apex = rotation[:, :, 2]                                   # body z axis in the fixed frame
         fig = plt.figure(figsize=(SIZE, SIZE + 0.4), layout="none")
         fig.subplots_adjust(left=0.02, right=0.92, top=0.95, bottom=0.1)
@@ -153,7 +149,7 @@ def motion_figure(ds: xr.Dataset, indices: np.ndarray) -> tuple[plt.Figure, Call
                 line.set_data_3d([0.0, R[0, j]], [0.0, R[1, j]], [0.0, R[2, j]])
             path = apex[indices[: k + 1]]
             trace.set_data_3d(path[:, 0], path[:, 1], path[:, 2])
-            title.set_text(f"{what}, {_time_text(ds, float(t[i]))}")
+            title.set_text(f"{what}, t = {float(t[i]):.3f}" + (f" ({units})" if units else ""))
 
         update(0)
         return fig, update

@@ -29,10 +29,6 @@ def _spec(ds: xr.Dataset) -> dict[str, Any]:
         return {}
 
 
-def _regimes(ds: xr.Dataset) -> list[str]:
-    return [str(d).removesuffix("_parameter") for d in ds.dims if str(d).endswith("_parameter")]
-
-
 def _regime_panel(ax: plt.Axes, ds: xr.Dataset, name: str, spec: dict[str, Any]) -> None:
     dim = f"{name}_parameter"
     x = ds[dim].values.astype(float)
@@ -103,7 +99,7 @@ def _draw_resonance(ax: plt.Axes, i: int, n: float, s: float, sides: np.ndarray,
 @styled
 def draw_regime_validity(ds: xr.Dataset) -> plt.Figure:
     spec = _spec(ds)
-    regimes = _regimes(ds)
+    regimes = [str(d).removesuffix("_parameter") for d in ds.dims if str(d).endswith("_parameter")]
     n = len(regimes) + ("resonance_error_max_vs_orbit" in ds)
     ncols = min(3, n)
     nrows = -(-n // ncols)

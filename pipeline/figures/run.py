@@ -29,16 +29,13 @@ INVARIANTS = {"energy": ("energy E", "energy"), "jacobi_integral": ("Jacobi inte
               "frame_error": ("frame orthonormality error", "1")}
 
 
-def _vector_name(ds: xr.Dataset) -> str:
-    return "orbit normal" if ds.attrs.get("system") == "orbiting_gyrostat" else "vertical Z"
-
-
 def _rows(ds: xr.Dataset) -> list[tuple[str, list[int], list[str], str]]:
     """(variable, components, legend labels, y label) of the state panels: p, q | r | γ."""
     rate = unit(ds, ds["omega"].attrs.get("units"), "rate")
     kind = "absolute " if "absolute" in ds["omega"].attrs.get("long_name", "") else ""  # the gyrostat's ω
+    vector = "orbit normal" if ds.attrs.get("system") == "orbiting_gyrostat" else "vertical Z"
     return [("omega", [0, 1], ["p", "q"], label(f"{kind}p, q", rate)), ("omega", [2], ["r"], label(f"{kind}r", rate)),
-            ("gamma", [0, 1, 2], list(GAMMA), f"γ ({_vector_name(ds)}\nin body axes)")]
+            ("gamma", [0, 1, 2], list(GAMMA), f"γ ({vector}\nin body axes)")]
 
 
 @styled
