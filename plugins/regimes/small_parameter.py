@@ -39,10 +39,9 @@ from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
 RESONANCES = (1.0, 2.0, 3.0)
 WARN_DISTANCE = 0.1
 # Refusal band around a resonance, |n² − ω²| < divisor_threshold(n, ε), where the error against the exact orbit
-# reaches ~1e-2 (measured by regime_validity's resonance sweep, body I, c/r0 = 0.1, 0.05, 0.025; docs/regimes.md):
-# near ω = 2 the error is 5.7 ε^2.96 / |4 − ω²|^0.95 (the ε³ terms carry one small divisor), hence ε³/|n² − ω²|
-# ≤ 1/580; near ω = 1 (1:1 with the γ-mode) it blows up at |1 − ω²| ≈ 0.11, 0.042, 0.017, i.e. ∝ ε^(4/3): the
-# detuning at which a weakly nonlinear oscillator with forcing ε and frequency shift ε²A² folds.
+# reaches ~1e-2: ε³/|n² − ω²| ≤ 1/580 near ω = 2, 3 (one small divisor in the ε³ terms), ∝ ε^(4/3) near ω = 1 (the
+# fold of a weakly nonlinear oscillator); measured by regime_validity's resonance sweep (docs/regimes.md, "across
+# the resonances").
 REFUSE_CUBIC = 580.0
 REFUSE_ONE_TO_ONE = 2.28
 
@@ -57,9 +56,8 @@ def divisor_threshold(n: float, eps: float) -> float:
     return min(rule, n * n - (n - WARN_DISTANCE) ** 2)
 
 
-# The series is computed at least through this order: the order above the one used gives its error estimate,
-# and the radius of convergence is estimated from the upper half of the coefficients (Domb–Sykes on Ω: within
-# 0.5 % of the Lagrange top's exact branch point at order 32; on body I it moves by < 2 % from order 24 to 40).
+# The series is computed at least through this order: the order above the one used gives its error estimate, and
+# the radius of convergence is estimated from the upper half of the coefficients (docs/regimes.md, "Radius").
 RADIUS_ORDER = 32
 MAX_ORDER = 60
 CANDIDATES = 3  # orders offered to integrator=auto (it measures each, lowest first, and takes the first that meets)
