@@ -10,10 +10,8 @@ the motion by O(1). This plugin is the slow-spin regime built from the right gen
 * **Family**: the periodic orbit through the swing's turning point, q(0) = 0, r(0) = r0, γ''(0) = cos θ0
   (``gyrolab.analysis.continuation``, section ``turning``), continues the swing for small r0/c: the shooting
   Jacobian is regular at r0 = 0 unless the swing has an out-of-plane Floquet multiplier 1.
-* **Series** in ε = r0/c (numeric, ``SlowSpinSeries``): at fixed phase q, γ, γ'' and the period are even in ε,
-  p, r, γ' odd (time reversal and the body's mirror symmetry). Zeroth order: the swing; first order: the
-  variational equations along it (exact); orders 2…7: fitted per phase point to the exact orbits at
-  ε = 0.01 … 0.04. Error orders 8 (q, γ, γ'', period) and 9 (p, r, γ'), measured 8.6 and 9.6.
+* **Series** in ε = r0/c (numeric, ``SlowSpinSeries``: the swing, its variational equations, orders 2…7 fitted
+  to exact orbits). Error orders 8 (q, γ, γ'', period) and 9 (p, r, γ'), measured 8.6 and 9.6.
 * **Domain** (refused outside, one sentence): centre of mass on the +z axis, tilt about the y axis
   (φ0 = ±π/2), 0.05 ≤ θ0 ≤ 3 with 1 + κ cos θ > 0 (κ = k(a − 1)), an out-of-plane stability index of the swing
   |s0 − 2| ≥ 0.05 (s = ρ + 1/ρ; s = 2 is a multiplier 1, where the family branches), 0 < r0/c ≤ 0.2; warned

@@ -19,9 +19,8 @@ p, q 3; r, γ, γ', γ'' 4; period 4 (corrected) — the printed r, γ, γ' are 
 variables whose next term vanishes by the (ε, p, q) → (−ε, −p, −q) symmetry — and the series' radius of
 convergence in ε, estimated from its coefficients, is the smallest c/r0 at which it can be used.
 
-The default (``order`` unset) keeps the paper's closed forms, with one fix: the frequency is the finite-tilt
-one, Ω = 1 − ε²[x0'√(1 − γ0''²) − z0'γ0'' + (k/4)(b − a − γ0''²(a + 3b − 4))] + O(ε⁴) (``finite_tilt_frequency``,
-exact in γ0'' at this order), where (36) keeps only the −z0'γ0'' tilt term (its error is O(ε²γ0''²)).
+The default (``order`` unset) keeps the paper's closed forms, with one fix: the frequency is the finite-tilt one
+(``finite_tilt_frequency``), where (36) keeps only the −z0'γ0'' tilt term (its error is O(ε²γ0''²)).
 """
 
 from __future__ import annotations
