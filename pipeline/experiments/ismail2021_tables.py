@@ -105,7 +105,6 @@ def table2() -> np.ndarray:
     return np.column_stack([p[:, 0], g[:, 0], p[:, 1], g[:, 1]])
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("ismail2021_tables").sets_all(
     ("system", "body", "force", "initial", "time", "integrator", "accuracy"),
     "it regenerates the paper's two tables from the paper's own parameters")

@@ -143,7 +143,6 @@ def bands(r0: np.ndarray, error: np.ndarray, tol: float) -> str:
     return f"r0/c {r0[ok].min():.3g}–{r0[ok].max():.3g}"
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("orbit_family", section="orbit_family", settings=schemas.OrbitFamily).sets_all(
     ("system", "body", "force", "initial", "time", "integrator", "accuracy"),
     "each family of orbit_family.families sets its own body, Newtonian k and tilt, and the continuation its spins "

@@ -203,7 +203,6 @@ def errors(result: dict[str, Any], against: str = "orbit") -> dict[str, float]:
     return out
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("regime", reads=("regime",))
 
 

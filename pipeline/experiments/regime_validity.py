@@ -104,7 +104,6 @@ def _r0_for(regime: str, value: float, cfg: DictConfig) -> float:
     return 1.0 / value  # c/r0 in units of c
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("regime_validity", section="regime_validity")
 
 

@@ -25,7 +25,6 @@ from gyrolab.engine.schemas import Task
 log = logging.getLogger(__name__)
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("shaker_omega3", reads=("regime",))
 
 

@@ -45,7 +45,6 @@ TIMING = ("cpu_time: time.process_time() around Scene.run() (CPU time of the who
 SETTING_KEYS = {"rtol": ("rtol", "atol"), "tol": ("tol",), "step": ("step",), "accuracy": ("accuracy",)}
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("work_precision", reads=("output.error_estimate",), section="work_precision",
             settings=schemas.WorkPrecision, sets={
                 "integrator": "it runs every method of work_precision.methods",

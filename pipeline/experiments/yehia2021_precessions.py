@@ -109,7 +109,6 @@ def stability_of(system, case: Case, verdict: str, residual: float) -> tuple[Flo
     return Floquet("not a solution" if verdict == "fails" else "unclear", float("nan"), np.array([])), why
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("yehia2021_precessions", reads=("output.error_estimate",), section="yehia2021",
             settings=schemas.Yehia2021).sets_all(
     ("body", "force", "initial", "time"),
