@@ -86,9 +86,7 @@ def draw_invariants(ds: xr.Dataset) -> plt.Figure:
             exact.append(symbol)
             continue
         ax.plot(ds["time"].values, drift, lw=0.8, label=label(symbol, unit(ds, ds[name].attrs.get("units"), kind)))
-    ax.set_yscale("log")
-    ax.set_xlabel(time_label(ds))
-    ax.set_ylabel("absolute drift |I(t) − I(0)|")
+    ax.set(yscale="log", xlabel=time_label(ds), ylabel="absolute drift |I(t) − I(0)|")
     ax.grid(True, which="both", alpha=0.25)
     if exact:
         panel_note(ax, f"conserved exactly (not drawn): {', '.join(exact)}")
@@ -145,9 +143,8 @@ def draw_body_axis(ds: xr.Dataset) -> plt.Figure:
     start, end = traces[0][0][0], traces[0][0][-1]
     ax.scatter(*start, color="C2", s=14, depthshade=False, label="start")
     ax.scatter(*end, color="C1", s=14, marker="s", depthshade=False, label="end")
-    ax.set_xlabel(names[0], labelpad=-6)
-    ax.set_ylabel(names[1], labelpad=-6)
-    ax.set_zlabel(names[2], labelpad=-6)
+    for setter, name in zip((ax.set_xlabel, ax.set_ylabel, ax.set_zlabel), names):
+        setter(name, labelpad=-6)
     if down:
         ax.invert_zaxis()  # Z along the weight: drawn pointing down
     legend_outside(fig, [ax], ncols=2, where="lower center")
