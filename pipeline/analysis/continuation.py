@@ -94,8 +94,7 @@ def _evaluate(model: FixedPointModel, section: Section, z: np.ndarray, r0: float
     yT, phi = model.flow(y0, T)
     scale = max(1.0, float(np.max(np.abs(y0))))
     D = section.derivative(u)
-    e_r = np.zeros(6)
-    e_r[2] = 1.0
+    e_r = np.eye(6)[2]  # the direction of r0
     J = np.column_stack([phi @ D - D, model.rhs(yT) * T, (phi @ e_r - e_r) * r0]) / scale
     res = (yT - y0) / scale
     return float(np.max(np.abs(res))), res, J, y0, phi

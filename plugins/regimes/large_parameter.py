@@ -80,8 +80,7 @@ class SlowSpinSeries:
         if abs(swing.period - T0) > 1e-9 * T0:
             raise IntegrationError(f"the r0 = 0 orbit has period {swing.period:.12g}, not the pendulum's {T0:.12g}")
         _, _, J, _, phi = _evaluate(model, section, np.array([0.0, 0.0, np.log(T0), 0.0]), 0.0)
-        e_r = np.zeros(6)
-        e_r[2] = 1.0
+        e_r = np.eye(6)[2]
         scale = max(1.0, float(np.max(np.abs(swing.y0))))
         dz = np.linalg.lstsq(J[:, :3], -(phi @ e_r - e_r) / scale, rcond=None)[0]
         first = section.derivative(np.zeros(2)) @ dz[:2] + e_r
