@@ -104,10 +104,7 @@ def redraw(path: str | Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int 
     path = Path(path)
     if path.is_dir():  # a job directory that is a link would take its figures outside (a file's: own_dir)
         check_tree(path, sweep=True)
-    written = []
-    for dataset in datasets(path):
-        written += draw_dataset(dataset, formats, dpi)
-    return written
+    return [written for dataset in datasets(path) for written in draw_dataset(dataset, formats, dpi)]
 
 
 def write_and_draw(name: str, ds: xr.Dataset, out_dir: str | Path, output: object | None) -> list[Path]:

@@ -343,11 +343,9 @@ def _resonance_warnings(w2: float, eps: float) -> list[str]:
                               f"{divisor_threshold(n, eps):.3g} at c/r0 = {eps:.3g}; choose a, b with |ω − {n:g}| ≥ "
                               f"{refusal_distance(n, eps):.3g} or spin faster"
                               + (" (or regime=resonant_omega3)" if n == 3 else ""))
-    warnings = []
-    for n in RESONANCES:
-        if w2 > 0 and abs(w - n) < WARN_DISTANCE:
-            warnings.append(f"ω = {w:.4g} is within {WARN_DISTANCE:g} of the excluded resonance ω = {n:g}: "
-                            f"terms ∝ 1/({n:g}² − ω²) = {1 / (n * n - w2):.3g} amplify the error")
+    warnings = [f"ω = {w:.4g} is within {WARN_DISTANCE:g} of the excluded resonance ω = {n:g}: terms ∝ "
+                f"1/({n:g}² − ω²) = {1 / (n * n - w2):.3g} amplify the error"
+                for n in RESONANCES if w2 > 0 and abs(w - n) < WARN_DISTANCE]
     if w2 <= 0:
         warnings.append(f"ω² = {w2:.4g} ≤ 0 (A, B on both sides of C): the generating p-mode is not an "
                         "oscillation; the expansion is untested there")
