@@ -138,9 +138,7 @@ def trace(name: str, f: dict) -> dict[str, Any]:
 
 def bands(r0: np.ndarray, error: np.ndarray, tol: float) -> str:
     ok = np.isfinite(error) & (error <= tol)
-    if not ok.any():
-        return "nowhere"
-    return f"r0/c {r0[ok].min():.3g}–{r0[ok].max():.3g}"
+    return f"r0/c {r0[ok].min():.3g}–{r0[ok].max():.3g}" if ok.any() else "nowhere"
 
 
 TASK = Task("orbit_family", section="orbit_family", settings=schemas.OrbitFamily).sets_all(

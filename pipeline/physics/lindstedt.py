@@ -55,9 +55,7 @@ class Body:
 
 def _cauchy(u: np.ndarray, v: np.ndarray, k: int) -> np.ndarray:
     """ε^k coefficient of the product of two series held as (order, grid) arrays (entries above k ignored)."""
-    if k < 0:
-        return np.zeros(u.shape[1])
-    return np.einsum("jm,jm->m", u[: k + 1], v[k::-1])
+    return np.einsum("jm,jm->m", u[: k + 1], v[k::-1]) if k >= 0 else np.zeros(u.shape[1])
 
 
 @dataclass

@@ -221,9 +221,7 @@ class LargeParameter(FixedPointRegime):
         return warnings + self.reseat_warnings(system)
 
     def _state(self, s, t):
-        if self.formula == "printed":
-            return printed_reading_state(t, s)
-        return self.series(s).state(t, s.r0)
+        return printed_reading_state(t, s) if self.formula == "printed" else self.series(s).state(t, s.r0)
 
     def _period(self, s):
         if self.formula == "printed":

@@ -162,9 +162,7 @@ class SmallParameter(FixedPointRegime):
 
     def diagnostics(self, system) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
         """Series coefficients, radius of convergence, small divisors and the measured order-N error slope."""
-        if self.series_order is None:
-            return {}, {}, {}
-        return series_diagnostics(self, system)
+        return ({}, {}, {}) if self.series_order is None else series_diagnostics(self, system)
 
     def params(self, s: NondimensionalScene) -> paper.Params:
         return paper.Params(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k, mu=s.r0, g0=s.gamma0pp)
