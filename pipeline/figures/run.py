@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from gyrolab.figures.labels import GAMMA, label, time_label, unit, var_label
+from gyrolab.figures.labels import GAMMA, label, time_label, unit
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.save import metadata_of, save
 from gyrolab.figures.style import (DOUBLE, SINGLE, fast_window, legend_outside, log_positive, panel_note, styled,
@@ -106,7 +106,7 @@ def draw_euler_angles(ds: xr.Dataset) -> plt.Figure:
     for ax, (name, symbol) in zip(axes[:, 0], names):
         if trace(ax, ds["time"].values, ds[name].values, color="C0"):
             notes.append(symbol.split()[-1])
-        ax.set_ylabel(var_label(ds, name, symbol.split()[-1], "angle"))
+        ax.set_ylabel(label(symbol.split()[-1], unit(ds, ds[name].attrs.get("units"), "angle")))
     axes[-1, 0].set_xlabel(time_label(ds))
     if notes:
         panel_note(axes[0, 0], f"{', '.join(notes)}: min–max envelope (too dense to draw as lines)")
