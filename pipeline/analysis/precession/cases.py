@@ -26,7 +26,6 @@ class Case:
     condition: str
     motion: Precession
     params: GyrostatParameters
-    note: str = ""
 
     @property
     def case(self) -> str:
@@ -47,9 +46,8 @@ def _params(A, B, C, k=(0.0, 0.0, 0.0), mu=(0.0, 0.0, 0.0), h1=0.0, h3=0.0, Omeg
                               tuple(float(x) for x in mu), (float(h1), 0.0, float(h3)), float(Omega))
 
 
-def _case(label, section, printed, motion, params, note=""):
-    return Case(label, section, printed, Precession(float(motion["n"]), float(motion["m"]), float(motion["psi0"]),
-                                                     float(motion["theta0"])), params, note)
+def _case(label, section, printed, motion, params):
+    return Case(label, section, printed, Precession(*(float(motion[k]) for k in ("n", "m", "psi0", "theta0"))), params)
 
 
 _S3 = np.sqrt(3.0)
