@@ -228,19 +228,16 @@ def resonance_sweep(cfg: DictConfig) -> dict:
     shape = (len(resonances), 2, len(distances))
     err = {k: np.full(shape, np.nan) for k in (*KEYS, "max")}
     status = np.empty(shape, dtype=object)
-    omega = np.empty(shape)
+    omega = np.array(resonances)[:, None, None] + sides[:, None] * distances  # (resonance, side, distance)
     exponents = {k: np.full(len(resonances), np.nan) for k in (*KEYS, "max")}
     holds = np.full(len(resonances), np.nan)
     verdicts = []
     for i, n in enumerate(resonances):
-        for j, side in enumerate(sides):
-            for m, d in enumerate(distances):
-                w = n + side * d
-                omega[i, j, m] = w
-                status[i, j, m], e = resonance_point(cfg, w)
-                for k in KEYS:
-                    err[k][i, j, m] = e[k]
-                err["max"][i, j, m] = max(e.values()) if status[i, j, m] == "ok" else np.nan
+        for j, m in np.ndindex(shape[1:]):
+            status[i, j, m], e = resonance_point(cfg, omega[i, j, m])
+            for k in KEYS:
+                err[k][i, j, m] = e[k]
+            err["max"][i, j, m] = max(e.values()) if status[i, j, m] == "ok" else np.nan
         small = np.abs(n * n - omega[i] ** 2)
         for k in exponents:
             exponents[k][i] = _growth_exponent(err[k][i], small, distances, fit_within)
