@@ -94,8 +94,7 @@ def _evaluate(model: FixedPointModel, section: Section, z: np.ndarray, r0: float
     yT, phi = model.flow(y0, T)
     scale = max(1.0, float(np.max(np.abs(y0))))
     D = section.derivative(u)
-    e_r = np.zeros(6)
-    e_r[2] = 1.0
+    e_r = np.eye(6)[2]  # the direction of r0
     J = np.column_stack([phi @ D - D, model.rhs(yT) * T, (phi @ e_r - e_r) * r0]) / scale
     res = (yT - y0) / scale
     return float(np.max(np.abs(res))), res, J, y0, phi
@@ -182,8 +181,7 @@ def continue_family(model: FixedPointModel, section: Section, start: FamilyPoint
     """
     if start.r0 <= 0 or r0_end <= 0:
         raise ConfigError("continuation in ln r0 needs r0 > 0 at both ends")
-    x = start.y0[1] if section.kind == "gamma_prime" else start.y0[4]
-    z = np.array([start.y0[0], x, np.log(start.period), np.log(start.r0)])
+    z = _family_z(section, start)
     direction = np.sign(np.log(r0_end) - z[3])
     t = _tangent(model, section, z)
     if t[3] * direction < 0:

@@ -9,21 +9,24 @@ from gyrolab.analysis.periodic import FixedPointModel, shoot
 from gyrolab.physics.lindstedt import Body, LindstedtSeries
 
 
+def _model(body: Body) -> FixedPointModel:
+    """The full model in the body's nondimensional units (c = 1: inertia (a, b, 1), U = (x0', y0', z0'), N = k)."""
+    return FixedPointModel(np.array([body.a, body.b, 1.0]), np.array([body.x0, body.y0, body.z0]), float(body.k))
+
+
 def exact_orbit(body: Body, eps: float, tilt: float, guess: LindstedtSeries | None = None):
     """The exact periodic orbit through r1 = 1, γ' = 0, γ'' = tilt at ε (Newton shooting on the full model).
 
-    Shot in the body's nondimensional units (c = 1: inertia (a, b, 1), U = (x0', y0', z0'), N = k), from the
-    series' initial state and period when ``guess`` is given. Returns the ``PeriodicOrbit`` (its state in c units,
-    r = r1/ε, period in 1/c: T = ε T_τ).
+    Shot in the body's nondimensional units (``_model``), from the series' initial state and period when ``guess``
+    is given. Returns the ``PeriodicOrbit`` (its state in c units, r = r1/ε, period in 1/c: T = ε T_τ).
     """
-    model = FixedPointModel(np.array([body.a, body.b, 1.0]), np.array([body.x0, body.y0, body.z0]), float(body.k))
     if guess is not None:
         y0 = guess.scaled(eps, np.array([0.0]))[0]
         period = 2 * np.pi / guess.frequency(eps)
     else:
         y0, period = np.zeros(6), 2 * np.pi
     y0 = np.array([y0[0], y0[1], 1.0 / eps, np.sqrt(1 - tilt**2), 0.0, tilt])
-    return shoot(model, y0, eps * period)
+    return shoot(_model(body), y0, eps * period)
 
 
 def series_error(sol: LindstedtSeries, orbit, eps: float, order: int, samples: int = 64) -> dict[str, float]:
@@ -31,8 +34,7 @@ def series_error(sol: LindstedtSeries, orbit, eps: float, order: int, samples: i
 
     ``state``: max over (p1, q1, r1, γ, γ', γ'') at the orbit's own times; ``period``: |T_τ − T_τ,exact|/T_τ,exact.
     """
-    model = FixedPointModel(np.array([sol.body.a, sol.body.b, 1.0]),
-                            np.array([sol.body.x0, sol.body.y0, sol.body.z0]), float(sol.body.k))
+    model = _model(sol.body)
     t = np.linspace(0.0, orbit.period, samples + 1)
     exact = [orbit.y0]
     y = orbit.y0

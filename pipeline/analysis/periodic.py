@@ -208,8 +208,7 @@ def shoot(model: FixedPointModel, y0: np.ndarray, period: float, *, tol: float =
         raise ConfigError(f"shooting starts on the section γ'(0) = 0; got γ'(0)={y0[4]:.3g}")
     r0, gpp = y0[2], y0[5]
     scale = max(1.0, float(np.max(np.abs(y0))))
-    D = np.zeros((6, 2))
-    D[0, 0] = D[1, 1] = 1.0
+    D = np.eye(6, 2)  # ∂y0/∂(p0, q0)
 
     def attempt(u):
         s0 = _start(u[0], u[1], r0, gpp)

@@ -27,8 +27,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.cf import conform
-from gyrolab.output.dataset import write_dataset
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.schemas import Task
 
@@ -106,7 +105,6 @@ def table2() -> np.ndarray:
     return np.column_stack([p[:, 0], g[:, 0], p[:, 1], g[:, 1]])
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("ismail2021_tables").sets_all(
     ("system", "body", "force", "initial", "time", "integrator", "accuracy"),
     "it regenerates the paper's two tables from the paper's own parameters")
@@ -147,6 +145,4 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         "inferred_parameters": f"A = {A:g} (published), W = {W_P2} (fitted by the research), τ = 2πt/100",
         "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
     conform(ds, source="ismail2021_tables experiment")
-    written.append(write_dataset(ds, out_dir / "ismail2021_tables.nc"))
-    written += draw_figures("ismail2021_tables.nc", ds, out_dir, cfg.get("output"))
-    return written
+    return written + write_and_draw("ismail2021_tables.nc", ds, out_dir, cfg.get("output"))

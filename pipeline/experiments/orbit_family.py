@@ -13,7 +13,6 @@ relative error of the series against the point (max of |Δy(0)|/max(1, |y(0)|) a
 
 from __future__ import annotations
 
-import inspect
 import logging
 from pathlib import Path
 from typing import Any
@@ -34,9 +33,8 @@ from gyrolab.analysis.periodic import FixedPointModel
 from gyrolab.engine import schemas
 from gyrolab.engine.schemas import Task
 from gyrolab.errors import ConfigError, IntegrationError, as_number
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.cf import conform
-from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
 from gyrolab.physics import pendulum
 from gyrolab.plugins.regimes import large_parameter as slow
@@ -68,13 +66,12 @@ def _scene(f: dict, r0: float) -> NondimensionalScene:
     return NondimensionalScene(f["a"], f["b"], *map(float, f["com"]), f["k"], 1.0, float(r0), f["theta0"], 0.0, False)
 
 
-def fast_spin_orders() -> list[int | None]:
-    """The orders ``small_parameter`` accepts (3, 6, 10 when it has ``order``; else only the paper's: None)."""
-    return [3, 6, 10] if "order" in inspect.signature(SmallParameter.__init__).parameters else [None]
+#: the orders of ``small_parameter``'s series whose error is recorded along the families
+FAST_SPIN_ORDERS = (3, 6, 10)
 
 
-def fast_spin_error(f: dict, point: FamilyPoint, order: int | None) -> float:
-    regime = SmallParameter() if order is None else SmallParameter(order=order)  # type: ignore[call-arg]
+def fast_spin_error(f: dict, point: FamilyPoint, order: int) -> float:
+    regime = SmallParameter(order=order)
     s = _scene(f, point.r0)
     y = regime._state(s, np.array([0.0]))[0]
     return _error(y, regime._period(s), point)
@@ -129,8 +126,8 @@ def trace(name: str, f: dict) -> dict[str, Any]:
     ended = ("reached r0/c = {:.4g}".format(reached) if (np.log(f["r0_end"]) - np.log(reached))
              * np.sign(np.log(f["r0_end"]) - np.log(f["r0_start"])) <= 0 else
              f"stopped at r0/c = {reached:.4g} with period {points[-1].period:.4g}: {points.stop_reason}")
-    errors = {f"order_{o or 'paper'}": [fast_spin_error(f, p, o) if p.r0 >= 1 else np.nan for p in points]
-              for o in fast_spin_orders()}
+    errors = {f"order_{o}": [fast_spin_error(f, p, o) if p.r0 >= 1 else np.nan for p in points]
+              for o in FAST_SPIN_ORDERS}
     errors["slow"] = [slow_spin_error(f, p) for p in points]
     log.info("family %s: %d points, %s; bifurcations: %s", name, len(points), ended,
              ", ".join(f"{e.kind} at r0/c = {e.r0:.5g}" for e in located) or "none")
@@ -141,12 +138,9 @@ def trace(name: str, f: dict) -> dict[str, Any]:
 
 def bands(r0: np.ndarray, error: np.ndarray, tol: float) -> str:
     ok = np.isfinite(error) & (error <= tol)
-    if not ok.any():
-        return "nowhere"
-    return f"r0/c {r0[ok].min():.3g}–{r0[ok].max():.3g}"
+    return f"r0/c {r0[ok].min():.3g}–{r0[ok].max():.3g}" if ok.any() else "nowhere"
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("orbit_family", section="orbit_family", settings=schemas.OrbitFamily).sets_all(
     ("system", "body", "force", "initial", "time", "integrator", "accuracy"),
     "each family of orbit_family.families sets its own body, Newtonian k and tilt, and the continuation its spins "
@@ -160,8 +154,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         raise ConfigError("orbit_family.families must name at least one family (body, theta0, section, r0_start, r0_end)")
     traces = [trace(name, _family_spec(name, f)) for name, f in families.items()]
     ds = dataset(traces, cfg)
-    out_dir = Path(out_dir)
-    return [write_dataset(ds, out_dir / "orbit_family.nc"), *draw_figures("orbit_family.nc", ds, out_dir, cfg.get("output"))]
+    return write_and_draw("orbit_family.nc", ds, out_dir, cfg.get("output"))
 
 
 def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:

@@ -36,19 +36,15 @@ from gyrolab.engine.scene import Scene
 from gyrolab.engine.schemas import Task
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.cf import conform, unit_attributes
-from gyrolab.output.dataset import time_attributes, write_dataset
+from gyrolab.output.dataset import time_attributes
 from gyrolab.output.provenance import provenance
-from gyrolab.physics.attitude import (
-    angles_from_states,  # noqa: F401  (imported from here by earlier code)
-    frame_from_angles,
-)
+from gyrolab.physics.attitude import angles_from_states, frame_from_angles
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
 log = logging.getLogger(__name__)
-SOURCES = ("analytic", "full", "orbit")
 SOURCE_NAMES = {"analytic": "analytic solution", "full": "full model from the analytic t = 0 state",
                 "orbit": "exact periodic orbit (Newton shooting)",
                 "reduced": "reduced quasilinear system integrated numerically"}
@@ -207,7 +203,6 @@ def errors(result: dict[str, Any], against: str = "orbit") -> dict[str, float]:
     return out
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("regime", reads=("regime",))
 
 
@@ -245,17 +240,11 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
         ds = ds.assign_coords(coords).assign(data)
         ds.attrs.update(attrs)
         log.info("%s: %s", regime.name, ", ".join(f"{k} = {v}" for k, v in attrs.items() if not isinstance(v, list)))
-    ignored = ignored_accuracy(cfg, _task_overrides())  # the app logged it; regime.nc records it
+    # the app logged it; regime.nc records it (the command line's overrides of the running Hydra job, none outside one)
+    ignored = ignored_accuracy(cfg, list(HydraConfig.get().overrides.task) if HydraConfig.initialized() else [])
     if ignored:
         ds.attrs[ACCURACY_IGNORED_ATTRIBUTE] = ignored
-    written = [write_dataset(ds, Path(out_dir) / "regime.nc")]
-    written += draw_figures("regime.nc", ds, out_dir, cfg.get("output"))
-    return written
-
-
-def _task_overrides() -> list[str]:
-    """The command line's overrides of the running Hydra job (none outside one)."""
-    return list(HydraConfig.get().overrides.task) if HydraConfig.initialized() else []
+    return write_and_draw("regime.nc", ds, out_dir, cfg.get("output"))
 
 
 def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any], warnings: list[str]) -> xr.Dataset:
@@ -270,16 +259,14 @@ def dataset(scene: Scene, regime: Regime, t: np.ndarray, result: dict[str, Any],
                                    {"units": "1", "long_name": f"direction cosines of the vertical (γ, γ', γ''), {label}"})
         for name, values in result["angles"].get(source, {}).items():
             data[f"{name}_{source}"] = ("time", values, {"units": "rad", "long_name": f"Euler angle {name}, {label}"})
-    for against in [k for k in ("full", "orbit") if k in result["states"]]:
-        d = np.max(np.abs(result["states"]["analytic"] - result["states"][against]), axis=0)
-        data[f"max_error_vs_{against}"] = ("component", d, {
-            "units": "1", "long_name": f"max |analytic − {SOURCE_NAMES[against]}| over the window, per component "
-                                       f"(model units of ω, γ)"})
-    if "reduced" in result["states"] and orbit is not None:
-        d = np.max(np.abs(result["states"]["reduced"] - result["states"]["orbit"]), axis=0)
-        data["max_error_reduced_vs_orbit"] = ("component", d, {
-            "units": "1", "long_name": f"max |{SOURCE_NAMES['reduced']} − {SOURCE_NAMES['orbit']}| over the window, "
-                                       "per component (model units of ω, γ)"})
+    states = result["states"]
+    for name, a, b, what in (("max_error_vs_full", "analytic", "full", "analytic"),
+                             ("max_error_vs_orbit", "analytic", "orbit", "analytic"),
+                             ("max_error_reduced_vs_orbit", "reduced", "orbit", SOURCE_NAMES["reduced"])):
+        if a in states and b in states:  # the orbit's states exist only when it was found
+            data[name] = ("component", np.max(np.abs(states[a] - states[b]), axis=0), {
+                "units": "1", "long_name": f"max |{what} − {SOURCE_NAMES[b]}| over the window, per component "
+                                           "(model units of ω, γ)"})
     if orbit is not None:
         data.update(orbit_variables(orbit, body))
     data["period_analytic"] = ((), result["period_analytic"], {"units": body.time_unit,

@@ -28,12 +28,10 @@ from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene
 from gyrolab.engine.schemas import Task
 from gyrolab.errors import ConfigError, IntegrationError
-from gyrolab.experiments.regime_run import build_regime, compute, errors, prepare
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.experiments.regime_run import build_regime, compute, errors, integrate, prepare
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.cf import conform
-from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
-from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from gyrolab.plugins.regimes.base import nondimensional_scene
 from gyrolab.plugins.regimes.large_parameter import printed_reading_state
 
@@ -82,11 +80,21 @@ def _scales(regime, system) -> dict[str, float]:
             "gamma": g, "gamma3": g, "period": 1 / (s.r0 * s.c)}
 
 
-def _append_missing(errs: dict) -> None:
-    """NaN for every error of a point that was refused or has no orbit."""
-    for table in errs.values():
-        for k in KEYS:
-            table[k].append(np.nan)
+def _point(sub: DictConfig, where: str, against: tuple[str, ...] = ("orbit", "full"), *, check: bool = True):
+    """(status, {against: relative error per key}, the regime or None) of the analytic solution over one period:
+    ``refused`` outside the regime's domain (``check=False`` skips that check), ``failed`` where no exact orbit is
+    found near it (the errors are then NaN)."""
+    nan = {a: dict.fromkeys(KEYS, np.nan) for a in against}
+    try:
+        scene, regime = _prepare(sub, where)[:2] if check else (Scene.from_config(sub), build_regime(sub))
+    except ConfigError as error:
+        return f"refused: {error}", nan, None
+    try:
+        result = compute(scene, regime, np.linspace(0, regime.period(scene.system), 241), full="full" in against)
+    except IntegrationError as error:  # no exact orbit near the series (far outside its domain)
+        return f"failed: {error}", nan, regime
+    sc, found = _scales(regime, scene.system), {a: errors(result, a) for a in against}
+    return "ok", {a: {k: e.get(k, np.nan) / sc[k] for k in KEYS} for a, e in found.items()}, regime
 
 
 def _r0_for(regime: str, value: float, cfg: DictConfig) -> float:
@@ -96,7 +104,6 @@ def _r0_for(regime: str, value: float, cfg: DictConfig) -> float:
     return 1.0 / value  # c/r0 in units of c
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("regime_validity", section="regime_validity")
 
 
@@ -125,8 +132,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     ds.attrs["n_expected_warnings"] = len(_expected)
     ds.attrs["expected_warnings"] = "\n".join(_expected) or "none"
     conform(ds, source="regime_validity experiment")
-    written = [write_dataset(ds, Path(out_dir) / "regime_validity.nc")]
-    written += draw_figures("regime_validity.nc", ds, out_dir, cfg.get("output"))
+    written = write_and_draw("regime_validity.nc", ds, out_dir, cfg.get("output"))
     if _expected:
         log.warning("%d expected domain warnings (points probed on purpose near resonances, at the edge of a "
                     "regime's domain or with non-physical bodies); their text is in %s (attribute expected_warnings)",
@@ -139,30 +145,16 @@ def _regime_errors(cfg: DictConfig, regime_name: str, values: list[float]) -> tu
     of a regime's series at each value of its parameter."""
     errs: dict[str, dict[str, list]] = {against: {k: [] for k in KEYS} for against in ("orbit", "full")}
     status = []
-    theory = getattr(_regime_class(_group(cfg, regime_name)), "order", {})
+    theory = getattr(registry.load("regime", _group(cfg, regime_name)), "order", {})
     for value in values:
         sub = _cfg_for(cfg, regime_name, _r0_for(regime_name, value, cfg))
-        try:
-            scene, regime, _ = _prepare(sub, f"{regime_name} at {cfg.regime_validity[regime_name]['parameter']} = "
-                                             f"{value:g}")
-        except ConfigError as error:
-            status.append(f"refused: {error}")
-            _append_missing(errs)
-            continue
-        theory = regime.order  # the instance's: a branch may have other orders than the class default
-        t = np.linspace(0, regime.period(scene.system), 241)
-        try:
-            result = compute(scene, regime, t)
-        except IntegrationError as error:  # no exact orbit near the series (far outside its domain)
-            status.append(f"failed: {error}")
-            _append_missing(errs)
-            continue
-        status.append("ok")
-        sc = _scales(regime, scene.system)
-        for against in errs:
-            e = errors(result, against)
+        state, e, regime = _point(sub, f"{regime_name} at {cfg.regime_validity[regime_name]['parameter']} = {value:g}")
+        status.append(state)
+        if regime is not None:
+            theory = regime.order  # the instance's: a branch may have other orders than the class default
+        for against, table in errs.items():
             for k in KEYS:
-                errs[against][k].append(e.get(k, np.nan) / sc[k] if k in e else np.nan)
+                table[k].append(e[against][k])
     return errs, status, theory
 
 
@@ -221,23 +213,9 @@ def resonance_point(cfg: DictConfig, omega: float, *, check: bool = True) -> tup
 
     ``check=False`` skips the regime's domain check (to measure the error inside the refused band).
     """
-    sub = resonance_cfg(cfg, omega)
-    nan = {k: np.nan for k in KEYS}
-    try:
-        if check:
-            scene, regime, _ = _prepare(sub, f"resonance sweep at ω = {float(omega):g}")
-        else:
-            scene, regime = Scene.from_config(sub), build_regime(sub)
-    except ConfigError as error:
-        return f"refused: {error}", nan
-    T = regime.period(scene.system)
-    try:
-        result = compute(scene, regime, np.linspace(0, T, 241), full=False)
-    except IntegrationError as error:
-        return f"failed: {error}", nan
-    sc = _scales(regime, scene.system)
-    e = errors(result, "orbit")
-    return "ok", {k: e[k] / sc[k] for k in KEYS}
+    status, e, _ = _point(resonance_cfg(cfg, omega), f"resonance sweep at ω = {float(omega):g}", ("orbit",),
+                          check=check)
+    return status, e["orbit"]
 
 
 def resonance_sweep(cfg: DictConfig) -> dict:
@@ -250,19 +228,16 @@ def resonance_sweep(cfg: DictConfig) -> dict:
     shape = (len(resonances), 2, len(distances))
     err = {k: np.full(shape, np.nan) for k in (*KEYS, "max")}
     status = np.empty(shape, dtype=object)
-    omega = np.empty(shape)
+    omega = np.array(resonances)[:, None, None] + sides[:, None] * distances  # (resonance, side, distance)
     exponents = {k: np.full(len(resonances), np.nan) for k in (*KEYS, "max")}
     holds = np.full(len(resonances), np.nan)
     verdicts = []
     for i, n in enumerate(resonances):
-        for j, side in enumerate(sides):
-            for m, d in enumerate(distances):
-                w = n + side * d
-                omega[i, j, m] = w
-                status[i, j, m], e = resonance_point(cfg, w)
-                for k in KEYS:
-                    err[k][i, j, m] = e[k]
-                err["max"][i, j, m] = max(e.values()) if status[i, j, m] == "ok" else np.nan
+        for j, m in np.ndindex(shape[1:]):
+            status[i, j, m], e = resonance_point(cfg, omega[i, j, m])
+            for k in KEYS:
+                err[k][i, j, m] = e[k]
+            err["max"][i, j, m] = max(e.values()) if status[i, j, m] == "ok" else np.nan
         small = np.abs(n * n - omega[i] ** 2)
         for k in exponents:
             exponents[k][i] = _growth_exponent(err[k][i], small, distances, fit_within)
@@ -347,10 +322,6 @@ def _resonance_dataset(sweep: dict) -> xr.Dataset:
     return xr.Dataset(data, coords=coords)
 
 
-def _regime_class(name: str):
-    return registry.load("regime", name)
-
-
 def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:
     """Printed (35) under μ = c/r0 against the full model: γ'' error over one τ period (Ismail (2021) report §3)."""
     errs = []
@@ -365,9 +336,8 @@ def _large_parameter_evidence(cfg: DictConfig, rows: list) -> str:
         approx = printed_reading_state(t, s)
         y0 = approx[0].copy()
         y0[3:6] /= np.linalg.norm(y0[3:6])
-        model = scene.system.compiled_model()
         y0 = np.concatenate([y0, scene.system.initial_state()[6:]])[: scene.system.state_size]
-        exact = Taylor(order=24, tol=1e-16).integrate(scene.system.rhs, t, y0, None, model).y
+        exact = integrate(scene, y0, t, taylor=True)
         errs.append(float(np.abs(approx[:, 5] - exact[:, 5]).max()))
     rows.append(("large_parameter", mus, {"orbit": {"gamma3": errs}}, {}, ["evidence"] * len(mus)))
     verdict = ("large_parameter (paper's reading μ = c/r0): γ'' error of the printed formulas against the full model "

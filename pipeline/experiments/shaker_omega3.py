@@ -16,21 +16,19 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab.output.cf import conform, unit_attributes
-from gyrolab.output.dataset import time_attributes, write_dataset
+from gyrolab.output.dataset import time_attributes
 from gyrolab.experiments.regime_run import compute, prepare
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("shaker_omega3", reads=("regime",))
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
-    out_dir = Path(out_dir)
     scene, regime, warnings = prepare(cfg)
     t = scene.times
     result = compute(scene, regime, t, full=False)
@@ -49,6 +47,4 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                      **{f"max_error_{k}": v for k, v in errors.items()},
                      "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
     conform(ds, source="shaker_omega3 experiment (ω = 3 Euler angles against the exact orbit)")
-    written = [write_dataset(ds, out_dir / "shaker_omega3.nc")]
-    written += draw_figures("shaker_omega3.nc", ds, out_dir, cfg.get("output"))
-    return written
+    return write_and_draw("shaker_omega3.nc", ds, out_dir, cfg.get("output"))

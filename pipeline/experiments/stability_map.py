@@ -82,7 +82,6 @@ def _axis_values(settings: DictConfig, key: str, span: Any, n: int) -> np.ndarra
     return spaced(first, last, n) if n > 1 else np.array([first])
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("stability_map", reads=("batch",), section="stability_map", settings=schemas.StabilityMap).sets_all(
     ("initial.theta0", "initial.r0"),
     "the map's grid sets it, from stability_map.theta0, stability_map.r0 and their n_ and _spacing settings")

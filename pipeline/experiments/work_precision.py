@@ -30,10 +30,9 @@ from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene
 from gyrolab.engine.schemas import Task
 from gyrolab.errors import ConfigError
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.kernels import layout
 from gyrolab.output.cf import conform
-from gyrolab.output.dataset import write_dataset
 from gyrolab.output.provenance import provenance
 from gyrolab.physics.reference import fixed_point_reference
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
@@ -46,7 +45,6 @@ TIMING = ("cpu_time: time.process_time() around Scene.run() (CPU time of the who
 SETTING_KEYS = {"rtol": ("rtol", "atol"), "tol": ("tol",), "step": ("step",), "accuracy": ("accuracy",)}
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("work_precision", reads=("output.error_estimate",), section="work_precision",
             settings=schemas.WorkPrecision, sets={
                 "integrator": "it runs every method of work_precision.methods",
@@ -78,10 +76,6 @@ def _scene_for(cfg: DictConfig, method: str, key: str, value: float) -> Scene:
         scene_cfg.output.figures = False
         scene_cfg.time.n_output = 2
     return Scene.from_config(scene_cfg)
-
-
-def _final(ds: xr.Dataset) -> np.ndarray:
-    return np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
 
 
 def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
@@ -122,7 +116,8 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                 ds = scene.run()
                 best = min(best, time.process_time() - start)
                 best_wall = min(best_wall, time.perf_counter() - start_wall)
-            error = float(np.max(np.abs(_final(ds) - reference)))
+            final = np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]])
+            error = float(np.max(np.abs(final - reference)))
             drift = float(ds.energy.attrs["max_abs_drift"]) if "energy" in ds else np.nan
             rows.append({"method": method, "setting": f"{key}={value:g}", "error": error, "cpu_time": best, "wall_time": best_wall,
                          "nfev": int(ds.attrs["integrator_nfev"]), "energy_drift": drift,
@@ -131,9 +126,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                      rows[-1]["nfev"])
     result = _dataset(rows, cfg, reference_name, repeats)
     result.attrs["scene"] = scene_title
-    written = [write_dataset(result, out_dir / "work_precision.nc")]
-    written += draw_figures("work_precision.nc", result, out_dir, cfg.get("output"))
-    return written
+    return write_and_draw("work_precision.nc", result, out_dir, cfg.get("output"))
 
 
 def _dataset(rows: list[dict[str, Any]], cfg: DictConfig, reference_name: str, repeats: int) -> xr.Dataset:

@@ -25,14 +25,14 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.cf import conform
-from gyrolab.output.dataset import FRAME_AXES, write_dataset
+from gyrolab.output.dataset import FRAME_AXES
 from gyrolab.errors import ConfigError, as_number
 from gyrolab.analysis.precession.cases import CASES, Case
 from gyrolab.analysis.precession.classify import classify
 from gyrolab.analysis.precession.closed_forms import check_closed_forms
 from gyrolab.analysis.precession.motion import body_config, euler_residual, magnetic_config, vector_residual, window
 from gyrolab.analysis.precession.stability import Floquet, floquet
-from gyrolab.figures.redraw import draw_figures
+from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 from gyrolab.engine import schemas
@@ -109,7 +109,6 @@ def stability_of(system, case: Case, verdict: str, residual: float) -> tuple[Flo
     return Floquet("not a solution" if verdict == "fails" else "unclear", float("nan"), np.array([])), why
 
 
-#: what the task reads and sets (gyrolab.experiments derives its tables from it)
 TASK = Task("yehia2021_precessions", reads=("output.error_estimate",), section="yehia2021",
             settings=schemas.Yehia2021).sets_all(
     ("body", "force", "initial", "time"),
@@ -146,30 +145,27 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     ds = _dataset(rows, closed, cfg).merge(traced, combine_attrs="override")
     ds.attrs.update(traced.attrs)
     ds = conform(ds, source="yehia2021_precessions experiment")
-    written = [csv_path, write_dataset(ds, out_dir / "precession_cases.nc")]
-    written += draw_figures("precession_cases.nc", ds, out_dir, cfg.get("output"))
-    return written
+    return [csv_path, *write_and_draw("precession_cases.nc", ds, out_dir, cfg.get("output"))]
 
 
 def trace_variables(rows: list[dict[str, Any]], traces: dict[str, xr.Dataset]) -> xr.Dataset:
     """The body z axis of every case's integration, in the orbital and inertial frames (what the figures draw)."""
+    def padded(name: str) -> np.ndarray:
+        """``name`` of every case's integration, stacked along case, NaN past each one's end."""
+        arrays = [traces[row["label"]][name].values for row in rows]
+        out = np.full((len(arrays), max(len(a) for a in arrays), *arrays[0].shape[1:]), np.nan)
+        for i, values in enumerate(arrays):
+            out[i, : len(values)] = values
+        return out
+
     data = {}
     for name in ("body_axis_orbital", "body_axis_inertial"):
-        first = traces[rows[0]["label"]][name]
-        n = max(traces[r["label"]].sizes["time"] for r in rows)
-        values = np.full((len(rows), n, 3), np.nan)
-        for i, row in enumerate(rows):
-            trace = traces[row["label"]][name].values
-            values[i, : len(trace)] = trace
-        data[name] = (("case", "sample", "frame_axis"), values, {
-            "units": "1", "long_name": first.attrs.get("long_name", name) + ", over the integration of each case"})
+        data[name] = (("case", "sample", "frame_axis"), padded(name), {
+            "units": "1", "long_name": traces[rows[0]["label"]][name].attrs.get("long_name", name)
+            + ", over the integration of each case"})
     # the output times of each case's integration (they differ between cases: a variable along sample, NaN-padded)
     first_time = traces[rows[0]["label"]]["time"]
-    times = np.full((len(rows), data["body_axis_orbital"][1].shape[1]), np.nan)
-    for i, row in enumerate(rows):
-        t = traces[row["label"]]["time"].values
-        times[i, : len(t)] = t
-    data["trace_time"] = (("case", "sample"), times, {
+    data["trace_time"] = (("case", "sample"), padded("time"), {
         "units": first_time.attrs.get("units", "1"),
         "long_name": f"{first_time.attrs.get('long_name', 'time')} of each case's integration (NaN past its end)"})
     coords = {"case": ("case", np.array([r["label"] for r in rows]), {"long_name": "case label"}),

@@ -114,53 +114,45 @@ def frame_indices(n_times: int, frames: int) -> np.ndarray:
     return np.unique(np.linspace(0, n_times - 1, min(frames, n_times)).round().astype(int))
 
 
-def _time_text(ds: xr.Dataset, t: float) -> str:
-    units = unit(ds, ds["time"].attrs.get("units"), "time")
-    return f"t = {t:.3f}" + (f" ({units})" if units else "")
-
-
 def motion_figure(ds: xr.Dataset, indices: np.ndarray) -> tuple[plt.Figure, Callable[[int], None]]:
     """The figure and ``update(k)``, which draws frame ``k`` (output index ``indices[k]``) and titles it with its
     time."""
     with plt.style.context(STYLE):
-        return _motion_figure(ds, indices)
+        rotation, names, down, what = attitude(ds)
+        t = ds["time"].values
+        units = unit(ds, ds["time"].attrs.get("units"), "time")
+        apex = rotation[:, :, 2]                                   # body z axis in the fixed frame
+        fig = plt.figure(figsize=(SIZE, SIZE + 0.4), layout="none")
+        fig.subplots_adjust(left=0.02, right=0.92, top=0.95, bottom=0.1)
+        ax = fig.add_subplot(projection="3d")
+        unit_sphere(ax, n=19)
+        ax.set_xlim(-1, 1), ax.set_ylim(-1, 1), ax.set_zlim(-1, 1)
+        ax.set_xlabel(names[0], labelpad=-6), ax.set_ylabel(names[1], labelpad=-6), ax.set_zlabel(names[2], labelpad=-6)
+        if down:
+            ax.invert_zaxis()                                      # Z along the weight: drawn pointing down
+        ax.plot(*apex[indices].T, color="0.6", lw=0.4, ls=":")     # the whole apex trace, faint
+        trace, = ax.plot([], [], [], color=AXIS_COLOURS[2], lw=0.9, alpha=0.8, label="apex trace (tip of body z)")
+        curves = ellipsoid_curves(principal_moments(ds))
+        shells = [ax.plot([], [], [], color="0.45", lw=0.6)[0] for _ in curves]
+        shells[0].set_label("inertia ellipsoid")
+        axes = [ax.plot([], [], [], color=colour, lw=2.0, label=f"body {name} axis")[0]
+                for colour, name in zip(AXIS_COLOURS, "xyz")]
+        fig.legend(handles=[*axes, shells[0], trace], loc="lower center", ncols=3, fontsize=7, frameon=False)
+        title = fig.suptitle("")
 
+        def update(k: int) -> None:
+            i = int(indices[k])
+            R = rotation[i]
+            for line, shell in zip(shells, curves):
+                line.set_data_3d(*(shell @ R.T).T)
+            for j, line in enumerate(axes):
+                line.set_data_3d([0.0, R[0, j]], [0.0, R[1, j]], [0.0, R[2, j]])
+            path = apex[indices[: k + 1]]
+            trace.set_data_3d(path[:, 0], path[:, 1], path[:, 2])
+            title.set_text(f"{what}, t = {float(t[i]):.3f}" + (f" ({units})" if units else ""))
 
-def _motion_figure(ds: xr.Dataset, indices: np.ndarray) -> tuple[plt.Figure, Callable[[int], None]]:
-    rotation, names, down, what = attitude(ds)
-    t = ds["time"].values
-    apex = rotation[:, :, 2]                                   # body z axis in the fixed frame
-    fig = plt.figure(figsize=(SIZE, SIZE + 0.4), layout="none")
-    fig.subplots_adjust(left=0.02, right=0.92, top=0.95, bottom=0.1)
-    ax = fig.add_subplot(projection="3d")
-    unit_sphere(ax, n=19)
-    ax.set_xlim(-1, 1), ax.set_ylim(-1, 1), ax.set_zlim(-1, 1)
-    ax.set_xlabel(names[0], labelpad=-6), ax.set_ylabel(names[1], labelpad=-6), ax.set_zlabel(names[2], labelpad=-6)
-    if down:
-        ax.invert_zaxis()                                      # Z along the weight: drawn pointing down
-    ax.plot(*apex[indices].T, color="0.6", lw=0.4, ls=":")     # the whole apex trace, faint
-    trace, = ax.plot([], [], [], color=AXIS_COLOURS[2], lw=0.9, alpha=0.8, label="apex trace (tip of body z)")
-    curves = ellipsoid_curves(principal_moments(ds))
-    shells = [ax.plot([], [], [], color="0.45", lw=0.6)[0] for _ in curves]
-    shells[0].set_label("inertia ellipsoid")
-    axes = [ax.plot([], [], [], color=colour, lw=2.0, label=f"body {name} axis")[0]
-            for colour, name in zip(AXIS_COLOURS, "xyz")]
-    fig.legend(handles=[*axes, shells[0], trace], loc="lower center", ncols=3, fontsize=7, frameon=False)
-    title = fig.suptitle("")
-
-    def update(k: int) -> None:
-        i = int(indices[k])
-        R = rotation[i]
-        for line, shell in zip(shells, curves):
-            line.set_data_3d(*(shell @ R.T).T)
-        for j, line in enumerate(axes):
-            line.set_data_3d([0.0, R[0, j]], [0.0, R[1, j]], [0.0, R[2, j]])
-        path = apex[indices[: k + 1]]
-        trace.set_data_3d(path[:, 0], path[:, 1], path[:, 2])
-        title.set_text(f"{what}, {_time_text(ds, float(t[i]))}")
-
-    update(0)
-    return fig, update
+        update(0)
+        return fig, update
 
 
 def _load(path: Path) -> tuple[xr.Dataset, Path]:

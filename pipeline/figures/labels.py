@@ -51,6 +51,3 @@ def label(name: str, unit_text: str) -> str:
 def time_label(ds: xr.Dataset, symbol: str = "t") -> str:
     return label(f"time {symbol}", unit(ds, ds["time"].attrs.get("units"), "time"))
 
-
-def var_label(ds: xr.Dataset, variable: str, name: str, kind: str) -> str:
-    return label(name, unit(ds, ds[variable].attrs.get("units"), kind))

@@ -114,8 +114,7 @@ def draw_orbit_family(ds: xr.Dataset) -> plt.Figure:
                 error_ax.plot(r0, np.where(errors > 0, errors, np.nan), styles[k % len(styles)], color=colour, lw=0.8,
                               label=f"_{family}_{name}")
     if zoom is not None:
-        zoom.set_xlim(*window)
-        zoom.set_ylim(*heights)
+        zoom.set(xlim=window, ylim=heights)
         zoom.tick_params(labelsize=6)
         zoom.set_title(f"turning arcs, r0 (units of c) from {window[0]:.3g} to {window[1]:.3g}", fontsize=6.5)
         amplitude_ax.indicate_inset_zoom(zoom, edgecolor="0.4")
@@ -126,13 +125,9 @@ def draw_orbit_family(ds: xr.Dataset) -> plt.Figure:
     period_ax.plot([], [], "o", ms=3, color="0.3", ls="none", label="stable (filled) / unstable (open)")
     for kind, style in EVENT_STYLES.items():
         period_ax.plot([], [], color="0.3", ls="none", label=f"{kind} (located)", **style)
-    period_ax.set_yscale("log")
-    period_ax.set_ylabel("period (units of 1/c)")
+    period_ax.set(yscale="log", ylabel="period (units of 1/c)")
     amplitude_ax.set_ylabel("nutation amplitude (rad)")
-    error_ax.set_yscale("log")
-    error_ax.set_ylabel("series error vs exact orbit")
-    error_ax.set_xscale("log")
-    error_ax.set_xlabel("spin r0 (units of c)")
+    error_ax.set(yscale="log", ylabel="series error vs exact orbit", xscale="log", xlabel="spin r0 (units of c)")
     legend_outside(fig, [period_ax, amplitude_ax, error_ax], ncols=2)
     fig.suptitle("Periodic-orbit families from fast spin (right) to slow spin (left)")
     return fig

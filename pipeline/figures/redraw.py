@@ -16,6 +16,7 @@ import xarray as xr
 
 from gyrolab.errors import ConfigError, GyrolabError, shorten
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS, figure_options
+from gyrolab.output.dataset import write_dataset
 from gyrolab.output.foreign import FOREIGN_ERRORS, load_dataset, not_gyrolabs
 from gyrolab.output.trust import check_tree
 from gyrolab.output.user_yaml import stored_yaml
@@ -103,10 +104,12 @@ def redraw(path: str | Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int 
     path = Path(path)
     if path.is_dir():  # a job directory that is a link would take its figures outside (a file's: own_dir)
         check_tree(path, sweep=True)
-    written = []
-    for dataset in datasets(path):
-        written += draw_dataset(dataset, formats, dpi)
-    return written
+    return [written for dataset in datasets(path) for written in draw_dataset(dataset, formats, dpi)]
+
+
+def write_and_draw(name: str, ds: xr.Dataset, out_dir: str | Path, output: object | None) -> list[Path]:
+    """Write ``ds`` as ``out_dir/name`` and draw its figures (``draw_figures``); returns the dataset's path first."""
+    return [write_dataset(ds, Path(out_dir) / name), *draw_figures(name, ds, out_dir, output)]
 
 
 def draw_figures(name: str, ds: xr.Dataset, out_dir: str | Path, output: object | None) -> list[Path]:

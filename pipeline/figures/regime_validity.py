@@ -29,10 +29,6 @@ def _spec(ds: xr.Dataset) -> dict[str, Any]:
         return {}
 
 
-def _regimes(ds: xr.Dataset) -> list[str]:
-    return [str(d).removesuffix("_parameter") for d in ds.dims if str(d).endswith("_parameter")]
-
-
 def _regime_panel(ax: plt.Axes, ds: xr.Dataset, name: str, spec: dict[str, Any]) -> None:
     dim = f"{name}_parameter"
     x = ds[dim].values.astype(float)
@@ -50,10 +46,8 @@ def _regime_panel(ax: plt.Axes, ds: xr.Dataset, name: str, spec: dict[str, Any])
                 label=legend + (f", slope {slope:.2f}" if slope is not None else ""))
         if np.any(e == 0):
             zeros.append(legend)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
     parameter = str((spec.get(name) or {}).get("parameter", "expansion parameter"))
-    ax.set_xlabel(PARAMETERS.get(parameter, parameter))
+    ax.set(xscale="log", yscale="log", xlabel=PARAMETERS.get(parameter, parameter))
     notes = _regime_notes(ds, name, x, zeros)
     ax.set_title(name.replace("_", " ") + ("\n" + "; ".join(notes) if notes else ""), fontsize=7)
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.22), ncols=2, fontsize=6)
@@ -80,10 +74,7 @@ def _resonance_panel(ax: plt.Axes, ds: xr.Dataset, spec: dict[str, Any]) -> None
     tolerance = (spec.get("resonance_sweep") or {}).get("tolerance")
     if tolerance is not None:
         ax.axhline(float(tolerance), color="k", lw=0.7, ls=":", label=f"tolerance {float(tolerance):g}")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("|ω − n| (grey: refused)")
-    ax.set_ylabel("max error vs exact orbit")
+    ax.set(xscale="log", yscale="log", xlabel="|ω − n| (grey: refused)", ylabel="max error vs exact orbit")
     r0 = (spec.get("resonance_sweep") or {}).get("r0")
     ax.set_title("small parameter across ω = n" + (f", c/r₀ = {1 / float(r0):g}" if r0 else ""), fontsize=7)
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.22), ncols=2, fontsize=6)
@@ -103,7 +94,7 @@ def _draw_resonance(ax: plt.Axes, i: int, n: float, s: float, sides: np.ndarray,
 @styled
 def draw_regime_validity(ds: xr.Dataset) -> plt.Figure:
     spec = _spec(ds)
-    regimes = _regimes(ds)
+    regimes = [str(d).removesuffix("_parameter") for d in ds.dims if str(d).endswith("_parameter")]
     n = len(regimes) + ("resonance_error_max_vs_orbit" in ds)
     ncols = min(3, n)
     nrows = -(-n // ncols)

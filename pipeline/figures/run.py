@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from gyrolab.figures.labels import GAMMA, label, time_label, unit, var_label
+from gyrolab.figures.labels import GAMMA, label, time_label, unit
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.save import metadata_of, save
 from gyrolab.figures.style import (DOUBLE, SINGLE, fast_window, legend_outside, log_positive, panel_note, styled,
@@ -29,16 +29,13 @@ INVARIANTS = {"energy": ("energy E", "energy"), "jacobi_integral": ("Jacobi inte
               "frame_error": ("frame orthonormality error", "1")}
 
 
-def _vector_name(ds: xr.Dataset) -> str:
-    return "orbit normal" if ds.attrs.get("system") == "orbiting_gyrostat" else "vertical Z"
-
-
 def _rows(ds: xr.Dataset) -> list[tuple[str, list[int], list[str], str]]:
     """(variable, components, legend labels, y label) of the state panels: p, q | r | γ."""
     rate = unit(ds, ds["omega"].attrs.get("units"), "rate")
     kind = "absolute " if "absolute" in ds["omega"].attrs.get("long_name", "") else ""  # the gyrostat's ω
+    vector = "orbit normal" if ds.attrs.get("system") == "orbiting_gyrostat" else "vertical Z"
     return [("omega", [0, 1], ["p", "q"], label(f"{kind}p, q", rate)), ("omega", [2], ["r"], label(f"{kind}r", rate)),
-            ("gamma", [0, 1, 2], list(GAMMA), f"γ ({_vector_name(ds)}\nin body axes)")]
+            ("gamma", [0, 1, 2], list(GAMMA), f"γ ({vector}\nin body axes)")]
 
 
 @styled
@@ -89,9 +86,7 @@ def draw_invariants(ds: xr.Dataset) -> plt.Figure:
             exact.append(symbol)
             continue
         ax.plot(ds["time"].values, drift, lw=0.8, label=label(symbol, unit(ds, ds[name].attrs.get("units"), kind)))
-    ax.set_yscale("log")
-    ax.set_xlabel(time_label(ds))
-    ax.set_ylabel("absolute drift |I(t) − I(0)|")
+    ax.set(yscale="log", xlabel=time_label(ds), ylabel="absolute drift |I(t) − I(0)|")
     ax.grid(True, which="both", alpha=0.25)
     if exact:
         panel_note(ax, f"conserved exactly (not drawn): {', '.join(exact)}")
@@ -111,7 +106,7 @@ def draw_euler_angles(ds: xr.Dataset) -> plt.Figure:
     for ax, (name, symbol) in zip(axes[:, 0], names):
         if trace(ax, ds["time"].values, ds[name].values, color="C0"):
             notes.append(symbol.split()[-1])
-        ax.set_ylabel(var_label(ds, name, symbol.split()[-1], "angle"))
+        ax.set_ylabel(label(symbol.split()[-1], unit(ds, ds[name].attrs.get("units"), "angle")))
     axes[-1, 0].set_xlabel(time_label(ds))
     if notes:
         panel_note(axes[0, 0], f"{', '.join(notes)}: min–max envelope (too dense to draw as lines)")
@@ -148,9 +143,8 @@ def draw_body_axis(ds: xr.Dataset) -> plt.Figure:
     start, end = traces[0][0][0], traces[0][0][-1]
     ax.scatter(*start, color="C2", s=14, depthshade=False, label="start")
     ax.scatter(*end, color="C1", s=14, marker="s", depthshade=False, label="end")
-    ax.set_xlabel(names[0], labelpad=-6)
-    ax.set_ylabel(names[1], labelpad=-6)
-    ax.set_zlabel(names[2], labelpad=-6)
+    for setter, name in zip((ax.set_xlabel, ax.set_ylabel, ax.set_zlabel), names):
+        setter(name, labelpad=-6)
     if down:
         ax.invert_zaxis()  # Z along the weight: drawn pointing down
     legend_outside(fig, [ax], ncols=2, where="lower center")

@@ -188,11 +188,8 @@ def draw_stability_map(ds: xr.Dataset) -> plt.Figure:
         dev_ax.set_axis_off()
     r_unit = _rate_unit(ds)
     for ax in (map_ax, dev_ax):
-        ax.set_xscale("log" if log_r else "linear")
-        ax.set_xlim(r_lo, r_hi)
-        ax.set_ylim(t_lo, t_hi)
-        ax.set_xlabel(f"initial spin r0 ({r_unit})")
-        ax.set_ylabel("initial nutation θ0 (rad)")
+        ax.set(xscale="log" if log_r else "linear", xlim=(r_lo, r_hi), ylim=(t_lo, t_hi),
+               xlabel=f"initial spin r0 ({r_unit})", ylabel="initial nutation θ0 (rad)")
         ax.grid(False)
     if n_sections:
         _draw_sections(fig, grid, ds, map_ax, n_sections)

@@ -61,8 +61,7 @@ def subplots(nrows: int = 1, ncols: int = 1, *, width: float = SINGLE, height: f
              **kwargs: Any) -> tuple[plt.Figure, np.ndarray]:
     """A grid of panels at a journal column width (``SINGLE`` or ``DOUBLE``); axes always 2-D."""
     height = height if height is not None else 1.0 + 1.7 * nrows
-    fig, axes = plt.subplots(nrows, ncols, figsize=(width, height), squeeze=False, **kwargs)
-    return fig, axes
+    return plt.subplots(nrows, ncols, figsize=(width, height), squeeze=False, **kwargs)
 
 
 def legend_outside(fig: plt.Figure, axes: Sequence[plt.Axes] | None = None, *, ncols: int | None = None,

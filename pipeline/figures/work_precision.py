@@ -57,11 +57,8 @@ def _draw(ds: xr.Dataset, x: str, methods: list[str], xlabel: str) -> plt.Figure
         drawn[method] = (xs, errs)
         if np.any(errs <= 0):
             zeros.append(method)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
+    ax.set(xscale="log", yscale="log", xlabel=xlabel, ylabel="max-norm error of the final (ω, γ)")
     ax.grid(True, which="both", alpha=0.2)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel("max-norm error of the final (ω, γ)")
     if zeros:
         panel_note(ax, f"error exactly 0 (not drawn): {', '.join(zeros)}")
     legend_outside(fig, [ax], ncols=2)

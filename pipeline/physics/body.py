@@ -33,6 +33,11 @@ _NONDIM_KEYS = ("a", "b", "com_direction")
 UNIT_TOLERANCE = 1e-9
 
 
+def _model_unit(si: str) -> property:
+    """A CF unit that is ``si`` for an SI body and "1" in a nondimensional form."""
+    return property(lambda self: si if self.units == "si" else "1", doc=f"{si!r} (SI) or '1' (nondimensional)")
+
+
 class ModelUnits:
     """CF units of a body's model quantities: SI, or dimensionless ("1") in a nondimensional form.
 
@@ -40,26 +45,11 @@ class ModelUnits:
     """
 
     units: str
-
-    @property
-    def time_unit(self) -> str:
-        return "s" if self.units == "si" else "1"
-
-    @property
-    def rate_unit(self) -> str:
-        return "rad s-1" if self.units == "si" else "1"
-
-    @property
-    def torque_unit(self) -> str:
-        return "N m" if self.units == "si" else "1"
-
-    @property
-    def energy_unit(self) -> str:
-        return "J" if self.units == "si" else "1"
-
-    @property
-    def momentum_unit(self) -> str:
-        return "kg m2 s-1" if self.units == "si" else "1"
+    time_unit = _model_unit("s")
+    rate_unit = _model_unit("rad s-1")
+    torque_unit = _model_unit("N m")
+    energy_unit = _model_unit("J")
+    momentum_unit = _model_unit("kg m2 s-1")
 
 
 @dataclass(frozen=True)

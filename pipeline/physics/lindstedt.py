@@ -55,9 +55,7 @@ class Body:
 
 def _cauchy(u: np.ndarray, v: np.ndarray, k: int) -> np.ndarray:
     """ε^k coefficient of the product of two series held as (order, grid) arrays (entries above k ignored)."""
-    if k < 0:
-        return np.zeros(u.shape[1])
-    return np.einsum("jm,jm->m", u[: k + 1], v[k::-1])
+    return np.einsum("jm,jm->m", u[: k + 1], v[k::-1]) if k >= 0 else np.zeros(u.shape[1])
 
 
 @dataclass
@@ -106,9 +104,7 @@ class LindstedtSeries:
         ``root``: least-squares slope of log‖Y_k‖ over the upper half of the orders (Cauchy–Hadamard);
         ``domb_sykes``: the ratios |Ω_k/Ω_{k−2}|^½ extrapolated linearly in 1/k to 1/k = 0 (``domb_sykes_norm``:
         the same with ‖Y_k‖); ``pade``: the smallest |pole| of the diagonal Padé approximant of Ω (in ε², when Ω is
-        even in ε as at a fixed tilt). On the Lagrange top, whose Ω(ε) is known in closed form (steady precession,
-        branch point ε = 1/(2√(aγ0''))), ``domb_sykes`` is within 0.5 % at order 32, ``root`` within 3 % below
-        (tests/physics/test_lindstedt.py).
+        even in ε as at a fixed tilt). Their accuracy on the Lagrange top: docs/regimes.md, "Radius of convergence".
         """
         n = self.norms()
         ks = np.arange(len(n))
@@ -141,11 +137,9 @@ class LindstedtSeries:
     def radius_of_convergence(self) -> float:
         """The median of the root-test, Domb–Sykes (Ω) and Padé estimates: robust to one of them failing.
 
-        Far from resonances Domb–Sykes is the sharpest (the Lagrange top's branch point within 0.5 %) and the
-        root test is biased low (the k^(−3/2) of a square-root branch point: up to 20 % at order 32); near ω = n
-        several complex singularities crowd, the ratios oscillate and Domb–Sykes can be off by 5×, while the root
-        test and Padé agree within a few per cent; Padé alone sometimes returns a spurious pole (a Froissart
-        doublet).
+        Far from resonances Domb–Sykes is the sharpest and the root test biased low (the k^(−3/2) of a square-root
+        branch point); near ω = n the Domb–Sykes ratios oscillate, and Padé alone sometimes returns a spurious pole
+        (a Froissart doublet): measured in docs/regimes.md, "Radius of convergence".
         """
         cached = self.__dict__.get("_radius_of_convergence")  # coefficients never change; auto asks every run
         if cached is None:

@@ -107,7 +107,9 @@ class FixedPointRegime(Regime):
     """Base of the built-in regimes: nondimensional formulas, mapped to the scene's model units.
 
     ``periods`` and ``samples_per_period`` set the window of a regime run (t from 0 to
-    ``periods`` periods of the analytic orbit).
+    ``periods`` periods of the analytic orbit). Subclasses implement the nondimensional solution (time in 1/c,
+    rates in c): ``_state(s, t)`` (n, 6), ``_period(s)`` and ``_euler(s, t)`` (θ, φ and ψ from ψ0 = 0) of a
+    ``NondimensionalScene`` s.
     """
 
     #: Every orbit ``integrator=auto`` may take from this regime (each of ``series_candidates``) has its period
@@ -122,16 +124,6 @@ class FixedPointRegime(Regime):
                 raise ConfigError(f"regime.{key}={value!r} must be a positive integer")
         self.periods = periods
         self.samples_per_period = samples_per_period
-
-    # Subclasses implement the nondimensional solution (time in 1/c, rates in c).
-    def _state(self, s: NondimensionalScene, t: np.ndarray) -> np.ndarray:
-        raise NotImplementedError
-
-    def _period(self, s: NondimensionalScene) -> float:
-        raise NotImplementedError
-
-    def _euler(self, s: NondimensionalScene, t: np.ndarray) -> dict[str, np.ndarray]:
-        raise NotImplementedError
 
     def scene(self, system: System) -> NondimensionalScene:
         return nondimensional_scene(system, self.name)

@@ -26,18 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 
-@dataclass(frozen=True)
-class Params:
-    """Body and orbit in the paper's nondimensional form (time unit 1/c)."""
-
-    a: float
-    b: float
-    x0: float
-    y0: float
-    z0: float
-    k: float  # N/c²
-    mu: float  # r0/c
-    g0: float  # γ0'' = cos θ0
+class BodyRatios:
+    """A1 = (1−b)/a, B1 = (a−1)/b, C1 = b−a of a body with a = A/C, b = B/C (both papers' notation)."""
 
     @property
     def A1(self) -> float:
@@ -50,6 +40,20 @@ class Params:
     @property
     def C1(self) -> float:
         return self.b - self.a
+
+
+@dataclass(frozen=True)
+class Params(BodyRatios):
+    """Body and orbit in the paper's nondimensional form (time unit 1/c)."""
+
+    a: float
+    b: float
+    x0: float
+    y0: float
+    z0: float
+    k: float  # N/c²
+    mu: float  # r0/c
+    g0: float  # γ0'' = cos θ0
 
     @property
     def omega2(self) -> float:
@@ -176,9 +180,14 @@ def scaled_to_model(S: dict[str, np.ndarray], P: Params) -> np.ndarray:
 # -- reduced quasilinear system (000 eq. 1: the scaled equations integrated in τ) ---------------------
 def scaled_rhs(tau: float, Y: np.ndarray, P: Params) -> np.ndarray:
     """The paper's eq. (1) in τ = r0 t, Y = (p1, q1, r1, γ, γ', γ''); exact (it is the full model rescaled)."""
+    return euler_poisson_scaled(Y, 1 / P.mu, P)
+
+
+def euler_poisson_scaled(Y: np.ndarray, e: float, P: BodyRatios) -> np.ndarray:
+    """The Euler–Poisson equations of both papers' scalings: d/dτ of Y = (p1, q1, r1, γ, γ', γ'') with small
+    parameter ``e`` and the body, centre-of-mass direction and k of ``P`` (its fields a, b, x0, y0, z0, k)."""
     a, b, x, y, z, k, A1, B1, C1 = P.a, P.b, P.x0, P.y0, P.z0, P.k, P.A1, P.B1, P.C1
     p, q, r, g1, g2, g3 = Y
-    e = 1 / P.mu
     return np.array([
         -A1 * q * r + e / a * (g3 * y - g2 * z + k * a * A1 * g2 * g3),
         -B1 * p * r + e / b * (g1 * z - g3 * x + k * b * B1 * g3 * g1),

@@ -10,10 +10,8 @@ the motion by O(1). This plugin is the slow-spin regime built from the right gen
 * **Family**: the periodic orbit through the swing's turning point, q(0) = 0, r(0) = r0, γ''(0) = cos θ0
   (``gyrolab.analysis.continuation``, section ``turning``), continues the swing for small r0/c: the shooting
   Jacobian is regular at r0 = 0 unless the swing has an out-of-plane Floquet multiplier 1.
-* **Series** in ε = r0/c (numeric, ``SlowSpinSeries``): at fixed phase q, γ, γ'' and the period are even in ε,
-  p, r, γ' odd (time reversal and the body's mirror symmetry). Zeroth order: the swing; first order: the
-  variational equations along it (exact); orders 2…7: fitted per phase point to the exact orbits at
-  ε = 0.01 … 0.04. Error orders 8 (q, γ, γ'', period) and 9 (p, r, γ'), measured 8.6 and 9.6.
+* **Series** in ε = r0/c (numeric, ``SlowSpinSeries``: the swing, its variational equations, orders 2…7 fitted
+  to exact orbits). Error orders 8 (q, γ, γ'', period) and 9 (p, r, γ'), measured 8.6 and 9.6.
 * **Domain** (refused outside, one sentence): centre of mass on the +z axis, tilt about the y axis
   (φ0 = ±π/2), 0.05 ≤ θ0 ≤ 3 with 1 + κ cos θ > 0 (κ = k(a − 1)), an out-of-plane stability index of the swing
   |s0 − 2| ≥ 0.05 (s = ρ + 1/ρ; s = 2 is a multiplier 1, where the family branches), 0 < r0/c ≤ 0.2; warned
@@ -77,15 +75,12 @@ class SlowSpinSeries:
         """Five shootings; use ``series_for`` (cached per (a, b, k, θ0))."""
         model = FixedPointModel(np.array([a, b, 1.0]), np.array([0.0, 0.0, 1.0]), k)
         section = Section("turning", float(np.cos(theta0)))
-        from gyrolab.physics import pendulum  # scipy.special: imported when a series is built, not with the plugin
-
         T0 = pendulum.period(b, pendulum.kappa(a, k), theta0)
         swing = shoot_section(model, section, np.zeros(2), T0, 0.0)
         if abs(swing.period - T0) > 1e-9 * T0:
             raise IntegrationError(f"the r0 = 0 orbit has period {swing.period:.12g}, not the pendulum's {T0:.12g}")
         _, _, J, _, phi = _evaluate(model, section, np.array([0.0, 0.0, np.log(T0), 0.0]), 0.0)
-        e_r = np.zeros(6)
-        e_r[2] = 1.0
+        e_r = np.eye(6)[2]
         scale = max(1.0, float(np.max(np.abs(swing.y0))))
         dz = np.linalg.lstsq(J[:, :3], -(phi @ e_r - e_r) / scale, rcond=None)[0]
         first = section.derivative(np.zeros(2)) @ dz[:2] + e_r
@@ -167,9 +162,6 @@ class LargeParameter(FixedPointRegime):
     parameter_long_name = "slow-spin parameter ε = r0/c (spin about the body z axis in units of c = √(Mgℓ/C))"
     order = {"pq": 8.0, "r": 9.0, "gamma": 8.0, "gamma3": 8.0, "period": 8.0}
 
-    def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200) -> None:
-        super().__init__(formula=formula, periods=periods, samples_per_period=samples_per_period)
-
     def parameter_value(self, system) -> float:
         return float(self.scene(system).r0)
 
@@ -190,10 +182,10 @@ class LargeParameter(FixedPointRegime):
             if not s.r0 > 0:
                 raise ConfigError(f"regime large_parameter with formula=printed needs r0 > 0 (μ = c/r0), got "
                                   f"r0/c={s.r0:.4g}")
-            frequency = paper.printed_frequency(self._printed_params(s))
+            frequency = paper.printed_frequency(printed_params(s))
             if frequency < 0:
                 return [PRINTED_WARNING, f"the printed frequency 2π/(2π + α) is negative here (α = "
-                        f"{paper.printed_period_correction(self._printed_params(s)):.4g} < −2π, Ω = {frequency:.4g}): "
+                        f"{paper.printed_period_correction(printed_params(s)):.4g} < −2π, Ω = {frequency:.4g}): "
                         f"the printed period is {2 * np.pi / (frequency * s.r0):.6g}/c; its magnitude sets the window"]
             return [PRINTED_WARNING]
         if abs(s.x0) > 1e-9 or abs(s.y0) > 1e-9 or s.z0 < 0:
@@ -228,23 +220,18 @@ class LargeParameter(FixedPointRegime):
                             "exists but a perturbed motion leaves it")
         return warnings + self.reseat_warnings(system)
 
-    def _printed_params(self, s: NondimensionalScene) -> paper.Params:
-        return paper.Params(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k, mu=1.0 / s.r0, g0=s.gamma0pp)
-
     def _state(self, s, t):
-        if self.formula == "printed":
-            return printed_reading_state(t, s)
-        return self.series(s).state(t, s.r0)
+        return printed_reading_state(t, s) if self.formula == "printed" else self.series(s).state(t, s.r0)
 
     def _period(self, s):
         if self.formula == "printed":
             # the printed frequency can be negative (check_domain says so): a period is a length of time
-            return abs(2 * np.pi / (paper.printed_frequency(self._printed_params(s)) * s.r0))
+            return abs(2 * np.pi / (paper.printed_frequency(printed_params(s)) * s.r0))
         return self.series(s).period(s.r0)
 
     def _euler(self, s, t):
         if self.formula == "printed":
-            return paper.printed_euler(t, self._printed_params(s))
+            return paper.printed_euler(t, printed_params(s))
         T = self._period(s)
         t = np.asarray(t, dtype=float)
         dense = np.linspace(0.0, max(float(t.max()), T), 1000 * int(np.ceil(max(float(t.max()), T) / T)) + 1)
@@ -260,12 +247,15 @@ class LargeParameter(FixedPointRegime):
         return y
 
 
+def printed_params(s: NondimensionalScene) -> paper.Params:
+    """The paper's parameters of scene ``s`` under its own reading μ = c/r0."""
+    return paper.Params(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k, mu=1.0 / s.r0, g0=s.gamma0pp)
+
+
 def printed_reading_state(t: np.ndarray, s) -> np.ndarray:
     """Printed (35) under the paper's own reading μ = c/r0 (τ = r0 t, p = c p1, r = r0 r1).
 
     ``s`` is a ``NondimensionalScene``; returns (n, 6) in units of c at times t (1/c).
     """
-    mu = 1.0 / s.r0
-    P = paper.Params(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k, mu=mu, g0=s.gamma0pp)
-    S = paper.printed_scaled(s.r0 * np.asarray(t, dtype=float), P)
+    S = paper.printed_scaled(s.r0 * np.asarray(t, dtype=float), printed_params(s))
     return np.stack([S["p1"], S["q1"], s.r0 * S["r1"], S["g1"], S["g2"], S["g3"]], axis=-1)

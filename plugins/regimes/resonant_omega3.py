@@ -29,7 +29,6 @@ from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
 OMEGA_TOLERANCE = 1e-6
 BRANCHES = ("i", "ii", "iii", "iv")
 BRANCH_ORDER = {"pq": 1.0, "r": 2.0, "gamma": 2.0, "gamma3": 2.0, "period": 2.0}
-PRINTED_BRANCH_ORDER = {"pq": 0.0, "r": 2.0, "gamma": 1.0, "gamma3": 1.0, "period": 2.0}
 
 
 class ResonantOmega3(FixedPointRegime):
@@ -37,7 +36,6 @@ class ResonantOmega3(FixedPointRegime):
     parameter = "mu"
     parameter_long_name = "Shaker et al.'s small parameter μ = c√(cos θ0)/r0"
     order = {"pq": 3.0, "r": 4.0, "gamma": 4.0, "gamma3": 4.0, "period": 4.0}
-    printed_order = {"pq": 1.0, "r": 4.0, "gamma": 2.0, "gamma3": 2.0, "period": 2.0}
 
     def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200,
                  branch: str = "i", sign: int = 1, phase_deg: float = 45.0) -> None:
@@ -59,7 +57,6 @@ class ResonantOmega3(FixedPointRegime):
         self.branch, self.sign, self.phase_deg = branch, int(sign), phase
         if branch != "i":
             self.order = BRANCH_ORDER
-            self.printed_order = PRINTED_BRANCH_ORDER
 
     def constants(self, s: NondimensionalScene) -> paper.Constants:
         C = paper.Constants(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k_gt=s.k, theta0=s.theta0)

@@ -33,6 +33,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from gyrolab.plugins.regimes.ismail2021 import BodyRatios, euler_poisson_scaled
+
 
 def omega3_b(a: float) -> float:
     """b = B/C that makes ω = 3 for a = A/C (report §2)."""
@@ -40,7 +42,7 @@ def omega3_b(a: float) -> float:
 
 
 @dataclass(frozen=True)
-class Constants:
+class Constants(BodyRatios):
     """Constants of the ω = 3 series (eqs. 7, 21, 26, 28); ``printed`` says which a2, L310, α."""
 
     a: float
@@ -53,18 +55,6 @@ class Constants:
     printed: bool = False
     M1: float = 0.0  # generating p-mode amplitudes of (16)/(23): zero for branch (i)
     M2: float = 0.0
-
-    @property
-    def A1(self) -> float:
-        return (1.0 - self.b) / self.a
-
-    @property
-    def B1(self) -> float:
-        return (self.a - 1.0) / self.b
-
-    @property
-    def C1(self) -> float:
-        return self.b - self.a
 
     @property
     def g0(self) -> float:
@@ -179,15 +169,7 @@ def scaled_rhs(tau: float, Y: np.ndarray, mu: float, C: Constants) -> np.ndarray
 
     Exact: it is the full model rescaled (tests/plugins/regimes/test_resonant_omega3.py).
     """
-    a, b, x, y, z, k, A1, B1, C1 = C.a, C.b, C.x0, C.y0, C.z0, C.k, C.A1, C.B1, C.C1
-    p, q, r, g1, g2, g3 = Y
-    return np.array([
-        -A1 * q * r + mu / a * (y * g3 - z * g2 + k * a * A1 * g2 * g3),
-        -B1 * p * r + mu / b * (z * g1 - x * g3 + k * b * B1 * g3 * g1),
-        mu**2 * (-C1 * p * q + x * g2 - y * g1 + k * C1 * g1 * g2),
-        r * g2 - mu * q * g3,
-        mu * p * g3 - r * g1,
-        mu * (q * g1 - p * g2)])
+    return euler_poisson_scaled(Y, mu, C)
 
 
 def period(r0: float, C: Constants) -> float:
@@ -274,8 +256,3 @@ def euler(t: np.ndarray, r0: float, C: Constants, *, printed_phi2: bool | None =
     rate = r0 - (1.0 / r0) * (0.5 * np.cos(th0) * (e1 - e2 / A1) + np.sin(th0) * (x + 0.25 * k * C1 * tn))
     phi = 0.5 * np.pi + rate * t + mu**2 * (ph2(s) - ph2(0.0))
     return dict(theta=theta, psi=psi, phi=phi)
-
-
-#: The body of the suggested figure (report §9): A:B:C = 14:5:35 (non-physical), μ = 0.1.
-FIGURE_BODY = dict(a=0.4, b=1.0 / 7.0, x0=0.48, y0=0.36, z0=0.8, k_gt=1.0, theta0=float(np.arctan(0.75)))
-FIGURE_R0 = float(np.sqrt(0.8) / 0.1)

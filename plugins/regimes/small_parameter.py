@@ -19,9 +19,8 @@ p, q 3; r, γ, γ', γ'' 4; period 4 (corrected) — the printed r, γ, γ' are 
 variables whose next term vanishes by the (ε, p, q) → (−ε, −p, −q) symmetry — and the series' radius of
 convergence in ε, estimated from its coefficients, is the smallest c/r0 at which it can be used.
 
-The default (``order`` unset) keeps the paper's closed forms, with one fix: the frequency is the finite-tilt
-one, Ω = 1 − ε²[x0'√(1 − γ0''²) − z0'γ0'' + (k/4)(b − a − γ0''²(a + 3b − 4))] + O(ε⁴) (``finite_tilt_frequency``,
-exact in γ0'' at this order), where (36) keeps only the −z0'γ0'' tilt term (its error is O(ε²γ0''²)).
+The default (``order`` unset) keeps the paper's closed forms, with one fix: the frequency is the finite-tilt one
+(``finite_tilt_frequency``), where (36) keeps only the −z0'γ0'' tilt term (its error is O(ε²γ0''²)).
 """
 
 from __future__ import annotations
@@ -39,10 +38,9 @@ from gyrolab.plugins.regimes.base import FixedPointRegime, NondimensionalScene
 RESONANCES = (1.0, 2.0, 3.0)
 WARN_DISTANCE = 0.1
 # Refusal band around a resonance, |n² − ω²| < divisor_threshold(n, ε), where the error against the exact orbit
-# reaches ~1e-2 (measured by regime_validity's resonance sweep, body I, c/r0 = 0.1, 0.05, 0.025; docs/regimes.md):
-# near ω = 2 the error is 5.7 ε^2.96 / |4 − ω²|^0.95 (the ε³ terms carry one small divisor), hence ε³/|n² − ω²|
-# ≤ 1/580; near ω = 1 (1:1 with the γ-mode) it blows up at |1 − ω²| ≈ 0.11, 0.042, 0.017, i.e. ∝ ε^(4/3): the
-# detuning at which a weakly nonlinear oscillator with forcing ε and frequency shift ε²A² folds.
+# reaches ~1e-2: ε³/|n² − ω²| ≤ 1/580 near ω = 2, 3 (one small divisor in the ε³ terms), ∝ ε^(4/3) near ω = 1 (the
+# fold of a weakly nonlinear oscillator); measured by regime_validity's resonance sweep (docs/regimes.md, "across
+# the resonances").
 REFUSE_CUBIC = 580.0
 REFUSE_ONE_TO_ONE = 2.28
 
@@ -57,9 +55,8 @@ def divisor_threshold(n: float, eps: float) -> float:
     return min(rule, n * n - (n - WARN_DISTANCE) ** 2)
 
 
-# The series is computed at least through this order: the order above the one used gives its error estimate,
-# and the radius of convergence is estimated from the upper half of the coefficients (Domb–Sykes on Ω: within
-# 0.5 % of the Lagrange top's exact branch point at order 32; on body I it moves by < 2 % from order 24 to 40).
+# The series is computed at least through this order: the order above the one used gives its error estimate, and
+# the radius of convergence is estimated from the upper half of the coefficients (docs/regimes.md, "Radius").
 RADIUS_ORDER = 32
 MAX_ORDER = 60
 CANDIDATES = 3  # orders offered to integrator=auto (it measures each, lowest first, and takes the first that meets)
@@ -97,7 +94,6 @@ class SmallParameter(FixedPointRegime):
     parameter = "c/r0"
     parameter_long_name = "Poincaré's small parameter ε = c/r0 = √(Mgℓ/C)/r0 (Ismail's (2021) 1/μ)"
     order = {"pq": 3.0, "r": 4.0, "gamma": 4.0, "gamma3": 4.0, "period": 4.0}
-    printed_order = {"pq": 3.0, "r": 2.0, "gamma": 2.0, "gamma3": 4.0, "period": 2.0}
     # ``period`` of the default instance is the closed forms' (finite_tilt_frequency, exact through ε³); the exact
     # orbit's and every listed order's frequency differ from it by the terms from ε⁴ on, which are far below the
     # frequency itself where an order is listed (ε below half the radius of convergence, the order's own estimate
@@ -166,9 +162,7 @@ class SmallParameter(FixedPointRegime):
 
     def diagnostics(self, system) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
         """Series coefficients, radius of convergence, small divisors and the measured order-N error slope."""
-        if self.series_order is None:
-            return {}, {}, {}
-        return series_diagnostics(self, system)
+        return ({}, {}, {}) if self.series_order is None else series_diagnostics(self, system)
 
     def params(self, s: NondimensionalScene) -> paper.Params:
         return paper.Params(a=s.a, b=s.b, x0=s.x0, y0=s.y0, z0=s.z0, k=s.k, mu=s.r0, g0=s.gamma0pp)
@@ -347,11 +341,9 @@ def _resonance_warnings(w2: float, eps: float) -> list[str]:
                               f"{divisor_threshold(n, eps):.3g} at c/r0 = {eps:.3g}; choose a, b with |ω − {n:g}| ≥ "
                               f"{refusal_distance(n, eps):.3g} or spin faster"
                               + (" (or regime=resonant_omega3)" if n == 3 else ""))
-    warnings = []
-    for n in RESONANCES:
-        if w2 > 0 and abs(w - n) < WARN_DISTANCE:
-            warnings.append(f"ω = {w:.4g} is within {WARN_DISTANCE:g} of the excluded resonance ω = {n:g}: "
-                            f"terms ∝ 1/({n:g}² − ω²) = {1 / (n * n - w2):.3g} amplify the error")
+    warnings = [f"ω = {w:.4g} is within {WARN_DISTANCE:g} of the excluded resonance ω = {n:g}: terms ∝ "
+                f"1/({n:g}² − ω²) = {1 / (n * n - w2):.3g} amplify the error"
+                for n in RESONANCES if w2 > 0 and abs(w - n) < WARN_DISTANCE]
     if w2 <= 0:
         warnings.append(f"ω² = {w2:.4g} ≤ 0 (A, B on both sides of C): the generating p-mode is not an "
                         "oscillation; the expansion is untested there")

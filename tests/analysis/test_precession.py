@@ -296,7 +296,3 @@ def test_bad_input_is_one_sentence(overrides, words):
         compose_scene([*GYROSTAT, *overrides])
     assert words in str(error.value) and "\n" not in str(error.value)
 
-
-def test_precession_parameters_must_be_numbers():
-    with pytest.raises(ConfigError, match="precession.n"):
-        Precession.from_config({"n": "fast", "m": 1, "psi0": 0, "theta0": 1}, "precession")

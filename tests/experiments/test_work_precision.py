@@ -9,6 +9,7 @@ import xarray as xr
 
 from gyrolab.engine.config import compose_config
 from gyrolab.experiments import run_task, work_precision
+from gyrolab.figures import redraw
 
 
 def test_work_precision_task(tmp_path):
@@ -52,7 +53,7 @@ def test_cpu_time_is_the_minimum_of_the_repeats_and_the_timing_is_recorded(tmp_p
         captured.append(ds)
         raise _Stop
 
-    monkeypatch.setattr(work_precision, "write_dataset", capture)
+    monkeypatch.setattr(redraw, "write_dataset", capture)  # work_precision writes through redraw.write_and_draw
     cfg = compose_config(["experiment=work_precision", "time.end=1", "work_precision.repeats=3",
                           "~work_precision.methods", "+work_precision.methods={dop853_numba: {rtol: [1e-6]}}"])
     with pytest.raises(_Stop):

@@ -13,7 +13,7 @@ it (the null space of the residual's Jacobian): 0 = isolated, d > 0 = a d-parame
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq, least_squares, minimize_scalar
@@ -33,7 +33,6 @@ class Solution:
     values: dict[str, float]
     residual: float
     family_dimension: int
-    checks: dict[str, float] = field(default_factory=dict)
 
 
 def _split(x: np.ndarray, names: list[str], fixed: dict[str, float], params: GyrostatParameters):

@@ -16,7 +16,6 @@ import numpy as np
 
 from gyrolab.physics.attitude import frame_from_angles, nutation_and_spin
 from gyrolab.contracts.integrator import Integrator
-from gyrolab.errors import as_number
 from gyrolab.plugins.forces.magnetic import Magnetic
 from gyrolab.plugins.forces.newtonian import Newtonian
 from gyrolab.physics.gyrostat_body import GyrostatBody
@@ -32,11 +31,6 @@ class Precession:
     m: float
     psi0: float
     theta0: float
-
-    @classmethod
-    def from_config(cls, cfg: dict, where: str) -> Precession:
-        """Read n, m, psi0, theta0; one-sentence ConfigError when one is missing or not a number."""
-        return cls(*(as_number(cfg.get(key), f"{where}.{key}") for key in ("n", "m", "psi0", "theta0")))
 
     def angles(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.asarray(t, dtype=float)
