@@ -132,7 +132,8 @@ def _task(block, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_ste
             following += 1
         else:  # an idle lane computes on a finite copy of lane 0 and is never read
             y[:, lane] = y[:, 0]
-            P[:, lane] = P[:, 0]
+            for c in range(P.shape[0]):  # (P holds a parameter per row, a lane per column)
+                P[c, lane] = P[c, 0]
     busy = min(LANES, stop - first)
     while busy > 0:
         _trial_steps(active, retry, t, h_abs, h, t_next, t_bound, max_step, traj, status)
