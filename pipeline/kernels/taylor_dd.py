@@ -77,6 +77,8 @@ def run(p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stats):
     vh, vl = np.empty(n), np.empty(n)
     S = np.zeros((order + 1) * 2 * int(p[p.size - 1]))
     address = int(p[p.size - 2])
+    if address == 0:  # the series was not compiled (``series_dd.ready`` not called): no step, not a crash
+        return NOT_FINITE, i_next
     low = Ylo.shape[0] == Y.shape[0]
     t = state[0]
     n_out = t_out.size

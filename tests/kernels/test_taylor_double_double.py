@@ -527,3 +527,13 @@ def test_the_batch_plan_asks_the_double_double_class_for_capabilities():
     from types import SimpleNamespace
 
     assert batch_path(TaylorDoubleDouble, SimpleNamespace(output="final")) == "one integrate() call per point"
+
+
+def test_a_model_whose_double_double_series_was_never_compiled_stops_instead_of_crashing():
+    """``taylor_dd.propagate`` on the parameters of a model ``series_dd.ready`` never saw: the kernel reads the series'
+    address as 0 and stops with a status (it called address 0 before, a segmentation fault)."""
+    system = compose_scene(["experiment=gyrostat"]).system
+    params = system.compiled_model().params.copy()
+    params[-2:] = 0.0  # (layout: the double-double series' address and scratch columns, 0 until ready)
+    with pytest.raises(RuntimeError, match="status 2"):
+        taylor_dd.propagate(params, 1e-26, np.linspace(0.0, 1.0, 3), system.initial_state())
