@@ -283,7 +283,7 @@ class Taylor(Integrator):
                 raise ConfigError(f"integrator.tol={tol!r} is below double-double's resolution; with "
                                   f"integrator.precision=double-double it must be at least {MIN_TOL:g}")
         if order is None:  # (a double-double step is series-bound: Jorba & Zou's order, no step overhead)
-            order = order_for(self.tol, **({"overhead": 0.0} if self.precision == DOUBLE_DOUBLE else {}))
+            order = order_for(self.tol, overhead=0.0) if self.precision == DOUBLE_DOUBLE else order_for(self.tol)
         if isinstance(order, bool) or not isinstance(order, int) or not MIN_ORDER <= order <= MAX_ORDER:
             raise ConfigError(f"integrator.order={order!r} must be an integer from {MIN_ORDER} to {MAX_ORDER} "
                               "(or null: chosen from integrator.tol)")
@@ -422,7 +422,7 @@ def _ready_for_double_double(compiled: CompiledModel) -> None:
 
 
 def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: np.ndarray) -> np.ndarray:
-    """The states at ``t_out`` of the Taylor method at ``tol`` (its optimal order), in one call into the kernel:
+    """The states at ``t_out`` of the Taylor method at ``tol`` (Jorba & Zou's order), in one call into the kernel:
     for runs over a few periods inside another method (``auto``'s screen), which need neither progress nor
     statistics (``Taylor.integrate``'s chunks and records cost ~10 µs more, a tenth of the screen)."""
     # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
@@ -431,7 +431,8 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
     taylor_series.ready(compiled)  # a traced model's series kernel (a scene carrying α is one)
     t_out, y, out = _outputs(t_out, y0)
     state = np.array([t_out[0]])
-    status, _ = taylor.run(compiled.params, taylor.order_for(tol), tol, t_out, out, 1,
+    # auto's screen: Jorba & Zou's order, as every run auto makes (its calibration was measured with them)
+    status, _ = taylor.run(compiled.params, taylor.order_for(tol, overhead=0.0), tol, t_out, out, 1,
                            len(t_out), state, y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
     if status != taylor.OK:
         raise _taylor_failure(status, state[0])
