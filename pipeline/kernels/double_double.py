@@ -11,7 +11,7 @@ The error-free transformations are exact:
 * ``quick_two_sum(a, b)``: the same in 3 flops when |a| ≥ |b| (Dekker);
 * ``two_prod(a, b) = (p, e)`` with p = fl(a·b) and p + e = a·b exactly: e = fma(a, b, −p), one fused
   multiply-add (``fma``: LLVM's ``llvm.fma.f64``, one instruction on x86-64 with FMA, a correctly rounded
-  library call elsewhere); ``two_prod_dekker`` is the same by Veltkamp splitting, no FMA (17 flops).
+  library call elsewhere).
 
 The double-double operations round: ``dd_add`` (the accurate "IEEE" addition, relative error ≤ 2u² even
 under cancellation), ``dd_mul`` and ``dd_mul_d`` (≤ ~4u²), ``dd_div_d`` (a double-double over a double,
@@ -72,26 +72,6 @@ def two_prod(a, b):
     return p, e
 
 
-_SPLITTER = 134217729.0  # 2^27 + 1: Veltkamp's splitting constant for 53-bit doubles
-
-
-@inline_kernel
-def _split(a):
-    t = _SPLITTER * a
-    hi = t - (t - a)
-    return hi, a - hi
-
-
-@inline_kernel
-def two_prod_dekker(a, b):
-    """``two_prod`` by Dekker's algorithm (Veltkamp splitting), without a fused multiply-add."""
-    p = a * b
-    ah, al = _split(a)
-    bh, bl = _split(b)
-    e = ((ah * bh - p) + ah * bl + al * bh) + al * bl
-    return p, e
-
-
 @inline_kernel
 def dd_norm(hi, lo):
     """The normalised double-double of hi + lo (any two doubles)."""
@@ -107,12 +87,6 @@ def dd_add(ah, al, bh, bl):
     s, e = quick_two_sum(s, e)
     e += f
     return quick_two_sum(s, e)
-
-
-@inline_kernel
-def dd_sub(ah, al, bh, bl):
-    """a − b (``dd_add`` of −b)."""
-    return dd_add(ah, al, -bh, -bl)
 
 
 @inline_kernel
