@@ -175,6 +175,33 @@ def estimate_check(ds, truth: np.ndarray, floor: float) -> dict:
     return found
 
 
+def best_double(scene: Scene, common: list[str], truth: np.ndarray) -> float:
+    """The largest error over the output times of double precision's best on the scene (taylor at ``BEST_TOL``):
+    a refusal, or a climb to double-double, of a target it ends 10x below was needless."""
+    ds = compose_scene(["integrator=taylor", f"integrator.tol={BEST_TOL:g}", *common, *scene.overrides]).run()
+    return float(max(errors.max() for errors in _errors(ds, truth)))
+
+
+def needless(auto_rows: list[dict], eps_of) -> dict:
+    """Counts of auto's refusals for double precision's reach and of its climbs to double-double, and of those a
+    double run did not need (``best_double`` 10x below ε; issue 32 asks them to stay under 2 % of the targets),
+    printed with a command reproducing each needless one."""
+    refusals = [r for r in auto_rows if r["verdict"] == "refused" and "best_double" in r]
+    climbs = [r for r in auto_rows if r["verdict"] != "refused" and "best_double" in r]
+    found = {"refused_for_double_precision": len(refusals), "climbed_to_double_double": len(climbs)}
+    for what, rows in (("refusal", refusals), ("climb", climbs)):
+        rows = [r for r in rows if r["best_double"] < eps_of(r) / 10]
+        found[f"{'refused' if what == 'refusal' else 'climbed'}_needlessly"] = len(rows)
+        for r in rows:
+            print(f"  needless {what} (scene {r['scene']}, ε {eps_of(r):g}): taylor tol {BEST_TOL:g} ends "
+                  f"{r['best_double']:.2g} away; reproduce: {_command(r['overrides'])}")
+    share = (found["refused_needlessly"] + found["climbed_needlessly"]) / max(len(auto_rows), 1)
+    print(f"refusals for double precision's reach: {len(refusals)}, climbs to double-double: {len(climbs)}; needless "
+          f"(taylor at tol {BEST_TOL:g} ends 10x below ε over every output time): {found['refused_needlessly']} "
+          f"refusals, {found['climbed_needlessly']} climbs, {share:.1%} of the {len(auto_rows)} targets (target <= 2 %)")
+    return found
+
+
 def audit_auto(scene: Scene, eps: float, truth: np.ndarray, common: list[str], floor: float,
                estimate: bool = True) -> dict:
     """auto at ``eps`` on the scene; ``estimate=False``: with output.error_estimate=false, its prediction alone
@@ -187,9 +214,7 @@ def audit_auto(scene: Scene, eps: float, truth: np.ndarray, common: list[str], f
     except ConfigError as error:
         refused = {"verdict": "refused", "why": str(error), "cpu": time.process_time() - start, "overrides": overrides}
         if estimate and "double precision" in str(error):  # was it needed? double precision's best on this scene
-            best = compose_scene(["integrator=taylor", f"integrator.tol={BEST_TOL:g}", *common, *scene.overrides]).run()
-            refused["best_double"] = float(np.max(np.abs(np.concatenate(
-                [best.omega.values[-1], best.gamma.values[-1], best.alpha.values[-1]]) - truth[-1])))
+            refused["best_double"] = best_double(scene, common, truth)
         return refused
     except GyrolabError as error:  # a gyrolab error other than a refusal: still one sentence, but not a refusal
         return {"verdict": "BROKEN", "why": f"{type(error).__name__}: {error}", "cpu": time.process_time() - start,
@@ -200,7 +225,9 @@ def audit_auto(scene: Scene, eps: float, truth: np.ndarray, common: list[str], f
     actual = float(max(omega_errors.max(), attitude_errors.max()))
     predicted = float(ds.attrs["auto_predicted_error"])
     kept = actual <= eps and actual <= predicted
+    climbed = str(ds.attrs.get("auto_precision")) == "double-double"
     return {"verdict": "kept" if kept else "BROKEN", "actual": actual,
+            **({"best_double": best_double(scene, common, truth)} if climbed and estimate else {}),
             "actual_max_over_time": actual, "actual_final": float(max(omega_errors[-1], attitude_errors[-1])),
             "precision": str(ds.attrs.get("auto_precision")), "actual_omega_gamma":
             float(np.abs(np.concatenate([ds.omega.values[-1], ds.gamma.values[-1]]) - truth[-1, :6]).max()),
@@ -387,9 +414,7 @@ def main(argv: list[str] | None = None) -> int:
           f"{alone_counts['kept']} kept, {alone_counts['refused']} refused, {alone_counts['BROKEN']} BROKEN; worst "
           f"actual/ε {_g(max((r['actual'] / r['eps'] for r in alone_measured), default=math.nan))}, worst "
           f"actual/predicted {_g(alone_worst)}")
-    needless = [r for r in auto_rows if r.get("best_double", math.inf) < r_eps(r) / 10]
-    print(f"refusals for double precision's reach: {sum('best_double' in r for r in auto_rows)}, of which "
-          f"{len(needless)} where taylor at tol {BEST_TOL:g} ends 10× below ε (a needless refusal, not a broken promise)")
+    needless_counts = needless(auto_rows, r_eps)
     broken = [r for r in auto_rows if r["verdict"] == "BROKEN"]
     broken += [{**r, "estimate_off": True} for r in alone_rows if r["verdict"] == "BROKEN"]
     underestimates = [r for r in [*({**r, "integrator": "auto"} for r in measured), *other_rows]
@@ -412,8 +437,7 @@ def main(argv: list[str] | None = None) -> int:
                    "auto_rechecked": rechecked, "worst_max_over_time_over_eps": worst_over_time,
                    **{f"prediction_alone_{k}": v for k, v in alone_counts.items()},
                    "prediction_alone_worst_actual_over_predicted": alone_worst,
-                   "refused_for_double_precision": sum("best_double" in r for r in auto_rows),
-                   "refused_needlessly": len(needless),
+                   **needless_counts,
                    "estimates": {k: {**v, "min_ratio": v["min_ratio"] if v["judged"] else None,
                                      "min_ratio_per_time": v["min_ratio_per_time"]
                                      if math.isfinite(v["min_ratio_per_time"]) else None}

@@ -41,7 +41,7 @@ from gyrolab.errors import GyrolabError
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gyrostat_reference as gr  # noqa: E402  (benchmarks/ is not a package)
-from promise_audit import (ACCURACIES, BEST_TOL, ESTIMATE_FACTOR, ROUNDOFF, Scene, _command, _g,  # noqa: E402
+from promise_audit import (ACCURACIES, BEST_TOL, ESTIMATE_FACTOR, ROUNDOFF, Scene, _command, _g, needless,  # noqa: E402
                            audit_auto, compact, estimate_check, estimates_by_integrator,
                            print_estimate_table, r_eps)
 from results_file import write_results  # noqa: E402
@@ -207,12 +207,8 @@ def main(argv: list[str] | None = None) -> int:
                  str(v["under"]), str(v["under_per_time"])]
         table_rows.append(cells)
         print("| " + " | ".join(cells) + " |")
-    needless = [r for r in auto_rows if r.get("best_double", math.inf) < r_eps(r) / 10]
-    print(f"\nrefusals for double precision's reach: {sum('best_double' in r for r in auto_rows)}, of which "
-          f"{len(needless)} where taylor at tol {BEST_TOL:g} ends 10× below ε (a needless refusal, not a broken promise)")
-    for r in needless:
-        print(f"  needless refusal (scene {r['scene']}, ε {r_eps(r):g}): taylor tol {BEST_TOL:g} ends "
-              f"{r['best_double']:.2g} away; reproduce: {_command(r['overrides'])}")
+    print()
+    needless_counts = needless(auto_rows, r_eps)
     broken = [r for r in auto_rows if r["promise"] == "BROKEN"]
     underestimates = [r for r in [*({**r, "integrator": "auto"} for r in measured), *other_rows]
                       if (r.get("estimate") or {}).get("under")]
@@ -241,8 +237,7 @@ def main(argv: list[str] | None = None) -> int:
                    **{f"auto_{k}": v for k, v in counts.items()}, "worst_final_over_eps": worst_final,
                    "worst_max_over_time_over_eps": worst_all, "worst_actual_over_predicted": worst_pred,
                    "runs_above_prediction": above_predicted,
-                   "refused_for_double_precision": sum("best_double" in r for r in auto_rows),
-                   "refused_needlessly": len(needless), "reference_rhs_check_max": max(checks),
+                   **needless_counts, "reference_rhs_check_max": max(checks),
                    "estimates": {k: {**v, "min_ratio": v["min_ratio"] if v["judged"] else None,
                                      "min_ratio_per_time": v["min_ratio_per_time"]
                                      if math.isfinite(v["min_ratio_per_time"]) else None}
