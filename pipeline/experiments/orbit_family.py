@@ -1,14 +1,6 @@
-"""``experiment=orbit_family``: the exact periodic orbit of the heavy body followed from fast to slow spin.
-
-For each family of ``orbit_family.families`` (a body, a tilt θ0 = arccos γ''(0), a section and a start): the orbit is
-found by shooting at the start spin (from the fast-spin series of ``small_parameter`` at r0/c = 100, or from the
-pendulum swing at r0/c = 0.01) and continued by pseudo-arclength in ln r0 (``gyrolab.analysis.continuation``) toward
-the other end. Per point: r0/c, period, initial state, Floquet multipliers, stability index s = ρ + 1/ρ, stable,
-the nutation amplitude (max θ − min θ), the bifurcations met (fold, branch point, period doubling), and the
-relative error of the series against the point (max of |Δy(0)|/max(1, |y(0)|) and |ΔT|/T): the fast-spin series
-(``small_parameter``; each ``regime.order`` it accepts, else the paper's order) for r0/c ≥ 1 and the slow-spin series
-(``large_parameter``) inside its domain. Writes ``orbit_family.nc`` (dimension ``point``) and
-``figures/orbit_family.png``. Numbers and verdict: docs/regimes.md.
+"""``experiment=orbit_family``: the exact periodic orbit of the heavy body followed from fast to slow spin, each
+family of ``orbit_family.families`` shot at its start spin (from the fast-spin series or the pendulum swing) and
+continued in ln r0, with the series' errors along it (docs/regimes.md, "Orbit families from fast to slow spin").
 """
 
 from __future__ import annotations

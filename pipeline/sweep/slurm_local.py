@@ -1,21 +1,10 @@
-"""A real single-node SLURM on this machine, to try gyrolab's SLURM routes before a cluster (docs/cluster.md, "A
-SLURM on your own machine": what ``start`` installs, writes and starts, and how clients find it through
-``SLURM_CONF`` without touching a system SLURM or munge).
+"""A real single-node SLURM on this machine, to try gyrolab's SLURM routes before a cluster (``python -m
+gyrolab.sweep.slurm_local start|status|stop``; docs/cluster.md, "A SLURM on your own machine").
 
-    python -m gyrolab.sweep.slurm_local start     # prints: export SLURM_CONF=/tmp/gyrolab-slurm-.../slurm.conf
-    eval "$(python -m gyrolab.sweep.slurm_local start)"   # the same, and this shell's sbatch/sinfo use it
-    python -m gyrolab.sweep.slurm_local status    # the clusters it started that are running
-    python -m gyrolab.sweep.slurm_local stop      # cancel their jobs, stop their daemons, remove their files
-
-``start()`` returns the running cluster (tests/sweep/test_slurm.py starts its own with it); the command line's
-``start`` runs it in a small background process that holds the cluster until ``stop`` (or SIGTERM) ends it. A
-process killed before its ``stop()`` leaves daemons behind: each state directory records the pid that started it
-(``owner``), and the next ``start()`` ends the processes of every directory whose owner is gone and removes it.
-
-Why not cgroups: a container rarely delegates a writable cgroup tree, so processes are tracked by parentage
-(``proctrack/linuxproc``) and tasks are not confined; the node's CPUs and memory come from this machine and are
-taken as configured (``SlurmdParameters=config_overrides``), since a container's CPU quota is not what the
-hardware reports.
+A process killed before its ``stop()`` leaves daemons behind: each state directory records the pid that started it
+(``owner``), and the next ``start()`` ends the processes of every directory whose owner is gone. No cgroups (a
+container rarely delegates a writable cgroup tree): processes are tracked by parentage, and the node's CPUs and
+memory are taken as configured (``SlurmdParameters=config_overrides``), since a container's quota is not the hardware's.
 """
 
 from __future__ import annotations
