@@ -7,16 +7,9 @@ A section fixes γ''(0) = cos θ0 and r(0) = r0 and one more coordinate, leaving
 * ``"turning"`` — q(0) = 0, unknowns (p0, γ'0): the turning point of a swing about the body y axis, the section
   that stays transversal at r0 = 0, where the seeds' one contains the whole planar pendulum orbit (γ' ≡ 0).
 
-The return residual y(T) − y(0) has rank 3 (three first integrals); Newton's step is the least-squares one with the
-exact Jacobian [Φ(T)D − D, f(y(T)), (Φ(T) − 1) e_r r0] (Φ the monodromy matrix from the compiled Taylor flow).
-Continuation unknowns z = (p0, x0, ln T, ln r0); the tangent is the null vector of that 6 × 4 Jacobian, and the
-corrector adds the arclength condition t·(z − z_pred) = 0.
-
-Stability: the monodromy matrix has four trivial multipliers 1 (|γ| = 1, energy, area integral, flow) and one
-reciprocal pair ρ, 1/ρ, so s = tr Φ(T) − 4 = ρ + 1/ρ without identifying eigenvalues: |s| < 2 elliptic (linearly
-stable, ρ on the unit circle), |s| > 2 hyperbolic (unstable). Along a family: s crossing +2 is a multiplier through
-1 (a branch point, or a fold when d ln r0/ds changes sign there too), s crossing −2 a period doubling; a sign
-change of d ln r0/ds is a fold in r0.
+Continuation unknowns z = (p0, x0, ln T, ln r0), with the exact Jacobian [Φ(T)D − D, f(y(T)), (Φ(T) − 1) e_r r0];
+the tangent is its null vector. Stability from s = tr Φ(T) − 4 = ρ + 1/ρ (four trivial multipliers 1), bifurcations
+from s crossing ±2 and d ln r0/ds changing sign (docs/regimes.md, "Orbit families from fast to slow spin").
 """
 
 from __future__ import annotations

@@ -1,20 +1,7 @@
-"""A regime run (``gyrolab regime=NAME ...``): the analytic periodic solution against the full model and the exact orbit.
-
-For the scene's body, forces, spin r0 and tilt θ0, the regime's analytic
-periodic orbit (``Regime.solution``) is compared over ``regime.periods``
-periods with
-
-* the full model integrated from the analytic orbit's own t = 0 state with
-  the scene's integrator ("full"), and
-* the exact periodic orbit of the full model through the same r0, θ0, γ'(0) = 0
-  (Newton shooting from the analytic one, ``gyrolab.analysis.periodic``), sampled with
-  the compiled Taylor method ("orbit"), and
-* the regime's reduced system (``regime.reduced_rhs``: Ismail (2021) eq. 14, Shaker et al. eq. 1) integrated
-  with the scene's integrator plugin from its own τ = 0 state and mapped back ("reduced"), for regimes
-  that have one.
-
-Writes ``regime.nc`` (every variable with CF units and long_name; domain
-warnings in the attribute ``regime_warnings``) and ``figures/regime_comparison.png``.
+"""A regime run (``gyrolab regime=NAME ...``): the analytic periodic solution against the full model integrated from
+its t = 0 state ("full"), the exact periodic orbit through the same r0, θ0, γ'(0) = 0 ("orbit", Newton shooting),
+and the regime's reduced system where it has one ("reduced"; docs/regimes.md, "Reduced systems"). Writes
+``regime.nc`` and ``figures/regime_comparison.png``.
 """
 
 from __future__ import annotations
@@ -149,12 +136,8 @@ def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True,
 
 def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[np.ndarray, str] | None:
     """The regime's reduced system integrated over t by the scene's integrator plugin: ((n, 6) model-unit states,
-    a description of the method); None if the regime has none.
-
-    The reduced system is written in τ = c r0 t; it is integrated in t (d/dt = c r0 d/dτ) so that the plugin's
-    settings (a fixed step, tolerances) mean what they mean for the full model. A compiled-only integrator cannot
-    take it (it has no compiled form), nor can ``auto`` (its choice is made for the full model): scipy's DOP853
-    with the same tolerances (1e-12 where there are none) stands in, and the dataset says so.
+    a description of the method); None if the regime has none. Integrated in t, not τ = c r0 t, so that the plugin's
+    settings mean what they mean for the full model (docs/regimes.md, "Reduced systems").
     """
     if not hasattr(regime, "reduced_rhs"):
         return None

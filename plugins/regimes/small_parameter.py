@@ -1,26 +1,11 @@
 """Fast spin about a fixed point: Poincaré's small-parameter periodic solution, ε = c/r0 ≪ 1 (Ismail (2021), corrected).
 
-Ismail (2021) calls this a "large-parameter" method for small r0,
-but its equations (1)-(2) are consistent only with μ = r0/c (report §3 of
-``docs/derivations/seed000_large_parameter.md``): it is the classical fast-top
-expansion in ε = 1/μ = c/r0 = √(Mgℓ/C)/r0. This plugin is that expansion,
-with the corrected (35), (36), (38)-(39) (``gyrolab.plugins.regimes.ismail2021``);
-``formula=printed`` evaluates the paper's printed formulas in the same
-consistent scaling.
-
-Domain: ε < 1 (warning above 0.2), ω away from the resonances 1, 2, 3 of
-the generating system (refused where |n² − ω²| < ``divisor_threshold(n, ε)``, a band that
-narrows as the spin grows: ε^(4/3) at ω = 1, ε³ at ω = 2, 3), and γ0'' = cos θ0 = O(ε) (the derivation sets
-γ0'' = Γ/μ; warning when Γ = γ0''/ε > 3). Theory error orders in ε:
-p, q 3; r, γ, γ', γ'' 4; period 4 (corrected) — the printed r, γ, γ' are 2.
-
-``order=N`` replaces the closed forms by the numeric Poincaré–Lindstedt series through ε^N at the scene's own
-(finite) tilt (``gyrolab.physics.lindstedt``): every variable's error is O(ε^(N+1)) — O(ε^(N+2)) for the
-variables whose next term vanishes by the (ε, p, q) → (−ε, −p, −q) symmetry — and the series' radius of
-convergence in ε, estimated from its coefficients, is the smallest c/r0 at which it can be used.
-
-The default (``order`` unset) keeps the paper's closed forms, with one fix: the frequency is the finite-tilt one
-(``finite_tilt_frequency``), where (36) keeps only the −z0'γ0'' tilt term (its error is O(ε²γ0''²)).
+Ismail's (2021) "large-parameter" method is consistent only with μ = r0/c (report §3 of
+``docs/derivations/seed000_large_parameter.md``): it is the classical fast-top expansion in ε = 1/μ. This plugin is
+that expansion with the corrected (35), (36), (38)-(39) (``gyrolab.plugins.regimes.ismail2021``; ``formula=printed``:
+the printed ones), with the finite-tilt frequency (``finite_tilt_frequency``); ``order=N`` replaces the closed forms
+by the numeric Poincaré–Lindstedt series through ε^N (``gyrolab.physics.lindstedt``). Domain, refusal bands at the
+resonances ω = 1, 2, 3 and the measured orders: docs/regimes.md.
 """
 
 from __future__ import annotations

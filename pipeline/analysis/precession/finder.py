@@ -1,13 +1,6 @@
-"""Find regular precessions numerically: solve R(t) ≡ 0 for (n, m, θ0, ψ0) and chosen free parameters.
-
-The existence conditions are that the vector residual of the ``orbiting_gyrostat`` equations
-vanishes at every time along ψ = nt + ψ0, θ = θ0, φ = mt. The finder samples R at ``samples``
-times over ``orbits`` orbits and minimises Σ|R|² by Levenberg–Marquardt-type least squares
-(scipy ``least_squares``) from a quasi-random set of starts in the search window; converged
-points (max residual < ``accept``) are polished and de-duplicated by the motion they describe
-(same body-frame state at the sample times, so θ0 ∈ {0, π} solutions that differ only in how
-n + m is split count once). Each solution carries the dimension of the solution family through
-it (the null space of the residual's Jacobian): 0 = isolated, d > 0 = a d-parameter family.
+"""Find regular precessions numerically: solve R(t) ≡ 0 for (n, m, θ0, ψ0) and chosen free parameters, least squares
+from quasi-random starts, solutions de-duplicated by the body-frame motion and each with the dimension of its family
+(docs/gyrostat.md, "Finder").
 """
 
 from __future__ import annotations
