@@ -27,9 +27,10 @@ from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.cf import conform, unit_attributes
 from gyrolab.output.dataset import time_attributes
 from gyrolab.output.provenance import provenance
-from gyrolab.physics.attitude import angles_from_states, frame_from_angles
+from gyrolab.physics.attitude import angles_from_states
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from gyrolab.plugins.integrators.scipy_solvers import DOP853
+from gyrolab.plugins.regimes.base import with_alpha
 
 log = logging.getLogger(__name__)
 SOURCE_NAMES = {"analytic": "analytic solution", "full": "full model from the analytic t = 0 state",
@@ -93,15 +94,6 @@ def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = Fal
     return integrator.integrate(system.rhs, t, y0, None, system.compiled_model() if wants else None).y
 
 
-def with_alpha(scene: Scene, regime: Regime, y6: np.ndarray) -> np.ndarray:
-    """A 6-state in the system's layout (α from ψ0 and the state's θ, φ)."""
-    if scene.system.state_size == 6:
-        return y6
-    psi0 = float(regime.euler_angles(scene.system, np.array([0.0]))["psi"][0])
-    alpha, _, _ = frame_from_angles(psi0, float(np.arccos(np.clip(y6[5], -1, 1))), float(np.arctan2(y6[3], y6[4])))
-    return np.concatenate([y6, alpha])
-
-
 def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True,
             allow_no_orbit: bool = False) -> dict[str, Any]:
     """States (n, 6) and Euler angles of the three sources, the exact orbit and its analytic period.
@@ -126,7 +118,7 @@ def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True,
         # recorded (and stated by the figure) because far outside the series' domain the scaling is visible
         out["analytic_gamma0_norm"] = float(np.linalg.norm(regime.initial_state(system)[3:6]))
     for source, y0 in runs.items():
-        y = integrate(scene, with_alpha(scene, regime, y0), t, taylor=source == "orbit")
+        y = integrate(scene, with_alpha(regime, system, y0), t, taylor=source == "orbit")
         states[source] = y[:, :6]
         variables = system.variables(t, y)
         angles[source] = {k: variables[k].values for k in ("psi", "theta", "phi") if k in variables}

@@ -227,10 +227,7 @@ PartitionName={PARTITION} Nodes={node} Default=YES MaxTime=INFINITE State=UP
 def clean_leftovers(base: Path) -> None:
     """End the processes of, and remove, every cluster directory whose starting process is gone."""
     for directory in base.glob(PREFIX + "*"):
-        try:
-            owner = int((directory / "owner").read_text())
-        except (OSError, ValueError):
-            owner = None
+        owner = _pid_in(directory / "owner")
         if owner is not None and alive(owner):
             continue
         if owner is None and _age(directory) < 60:   # another session is creating it right now
@@ -347,15 +344,15 @@ def _hold(base: Path | None) -> int:
 
 def held_clusters(base: Path) -> list[tuple[int, Path]]:
     """(holding process, state directory) of every running cluster the command line started under ``base``."""
-    found = []
-    for directory in sorted(base.glob(PREFIX + "*")):
-        try:
-            owner = int((directory / HELD).read_text())
-        except (OSError, ValueError):
-            continue
-        if alive(owner):
-            found.append((owner, directory))
-    return found
+    held = ((_pid_in(directory / HELD), directory) for directory in sorted(base.glob(PREFIX + "*")))
+    return [(owner, directory) for owner, directory in held if owner is not None and alive(owner)]
+
+
+def _pid_in(path: Path) -> int | None:
+    try:
+        return int(path.read_text())
+    except (OSError, ValueError):
+        return None
 
 
 def _start_command(base: Path | None) -> int:

@@ -103,6 +103,15 @@ def _with_magnetic_moment(system: System, regime: str, nd: dict, names: list[str
     return nd
 
 
+def with_alpha(regime: Regime, system: System, y6: np.ndarray) -> np.ndarray:
+    """A 6-state (ω, γ) in the system's layout: α appended from the regime's ψ0 and the state's θ, φ when carried."""
+    if system.state_size == 6:
+        return y6
+    psi0 = float(regime.euler_angles(system, np.array([0.0]))["psi"][0])
+    alpha, _, _ = frame_from_angles(psi0, float(np.arccos(np.clip(y6[5], -1, 1))), float(np.arctan2(y6[3], y6[4])))
+    return np.concatenate([y6, alpha])
+
+
 class FixedPointRegime(Regime):
     """Base of the built-in regimes: nondimensional formulas, mapped to the scene's model units.
 
@@ -151,12 +160,7 @@ class FixedPointRegime(Regime):
         """The orbit's t = 0 state in the system's layout (α appended from ψ0, θ(0), φ(0) when carried)."""
         y = self.initial_state(system)
         y[3:6] /= np.linalg.norm(y[3:6])  # the series satisfies |γ| = 1 to its order only
-        if system.state_size == 6:
-            return y
-        angles = self.euler_angles(system, np.array([0.0]))
-        alpha, _, _ = frame_from_angles(float(angles["psi"][0]), float(np.arccos(np.clip(y[5], -1, 1))),
-                                        float(np.arctan2(y[3], y[4])))
-        return np.concatenate([y, alpha])
+        return with_alpha(self, system, y)
 
     def reseat_warnings(self, system: System) -> list[str]:
         """Warnings naming the scene's initial values the orbit replaces (p0, q0, φ0)."""

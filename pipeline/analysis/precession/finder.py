@@ -94,13 +94,9 @@ def _rest_torque(params: GyrostatParameters, theta0: float, chi: float) -> np.nd
 
 def find_normal_rests(params: GyrostatParameters, theta0: float, *, grid: int = 720,
                       accept: float = 1e-12) -> list[Solution]:
-    """Every rest in the orbital frame with the body z axis on the orbit normal (θ0 = 0 or π, n ± m = 0).
-
-    Only ψ0 ∓ φ0 = χ matters. The γ-component of the (constant) residual does not contain k (k × Ωγ ⊥ γ):
-    its zeros in χ ∈ [0, 2π) are found on a grid (sign changes, then Brent; grazing minima polished) from the
-    system's right-hand side; at each zero the two components ⊥ γ, linear in (k1, k2), fix k1, k2 (k3 as given).
-    A γ-component that vanishes for every χ (A = B with h1 μ·β ≡ 0) is a one-parameter family: one
-    representative χ = 0 with ``family_dimension`` 1. Each solution is re-checked by the vector residual.
+    """Every rest in the orbital frame with the body z axis on the orbit normal (θ0 = 0 or π, n ± m = 0): the zeros in
+    χ of the residual's γ-component (which does not contain k), then k1, k2 from the components ⊥ γ; a γ-component
+    zero for every χ is a family, one representative χ = 0 with ``family_dimension`` 1 (docs/gyrostat.md).
     """
     sigma = 1.0 if np.cos(theta0) > 0 else -1.0
     theta0 = 0.0 if sigma > 0 else np.pi
