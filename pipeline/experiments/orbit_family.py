@@ -62,11 +62,14 @@ def _scene(f: dict, r0: float) -> NondimensionalScene:
 FAST_SPIN_ORDERS = (3, 6, 10)
 
 
+def _fast_spin(f: dict, r0: float, order: int | None = None) -> tuple[np.ndarray, float]:
+    """The fast-spin series' (``small_parameter``, the paper's closed forms or ``order``) t = 0 state and period."""
+    regime, s = SmallParameter(order=order), _scene(f, r0)
+    return regime._state(s, np.array([0.0]))[0], regime._period(s)
+
+
 def fast_spin_error(f: dict, point: FamilyPoint, order: int) -> float:
-    regime = SmallParameter(order=order)
-    s = _scene(f, point.r0)
-    y = regime._state(s, np.array([0.0]))[0]
-    return _error(y, regime._period(s), point)
+    return _error(*_fast_spin(f, point.r0, order), point)
 
 
 def slow_spin_error(f: dict, point: FamilyPoint) -> float:
@@ -87,10 +90,8 @@ def start_point(f: dict, model: FixedPointModel, section: Section) -> FamilyPoin
     if section.kind == "turning":  # from the pendulum swing (slow-spin series when in its domain)
         T0 = pendulum.period(f["b"], pendulum.kappa(f["a"], f["k"]), f["theta0"])
         return shoot_section(model, section, np.zeros(2), T0, r0)
-    s = _scene(f, r0)
-    regime = SmallParameter()
-    y = regime._state(s, np.array([0.0]))[0]
-    return shoot_section(model, section, y[:2], regime._period(s), r0)
+    y, period = _fast_spin(f, r0)
+    return shoot_section(model, section, y[:2], period, r0)
 
 
 def amplitude(model: FixedPointModel, point: FamilyPoint, samples: int = 48) -> float:

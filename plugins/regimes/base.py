@@ -115,15 +115,12 @@ def with_alpha(regime: Regime, system: System, y6: np.ndarray) -> np.ndarray:
 class FixedPointRegime(Regime):
     """Base of the built-in regimes: nondimensional formulas, mapped to the scene's model units.
 
-    ``periods`` and ``samples_per_period`` set the window of a regime run (t from 0 to
-    ``periods`` periods of the analytic orbit). Subclasses implement the nondimensional solution (time in 1/c,
-    rates in c): ``_state(s, t)`` (n, 6), ``_period(s)`` and ``_euler(s, t)`` (θ, φ and ψ from ψ0 = 0) of a
-    ``NondimensionalScene`` s.
+    ``periods`` and ``samples_per_period`` set the window of a regime run. Subclasses implement the nondimensional
+    solution (time in 1/c, rates in c) of a ``NondimensionalScene`` s: ``_state(s, t)`` (n, 6), ``_period(s)`` and
+    ``_euler(s, t)`` (ψ from ψ0 = 0).
     """
 
-    #: Every orbit ``integrator=auto`` may take from this regime (each of ``series_candidates``) has its period
-    #: within this factor of ``period(system)``, which is cheap (no series built, no shooting); None: unknown or
-    #: expensive. auto then rules the regime out from one period of the scene's own motion (``Auto._misses_orbits``).
+    #: the contract's ``period_spread`` (``gyrolab.contracts.regime``, item 11); None: no cheap screen for auto
     period_spread: float | None = None
 
     def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200) -> None:

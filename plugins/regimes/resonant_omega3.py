@@ -97,11 +97,8 @@ class ResonantOmega3(FixedPointRegime):
         return out
 
     def reduced_rhs(self, system):
-        """Shaker et al.'s scaled system (eq. 1 in the variables of eq. 5) for this scene: ``(rhs, Y0, to_model)``.
-
-        ``rhs(τ, Y)`` is d/dτ of Y = (p1, q1, r1, γ1, γ1', γ1''), τ = r0 t (exact rescaling of the full model,
-        ``shaker_omega3.scaled_rhs``); Y0 is the analytic orbit's τ = 0 state; ``to_model(Y)`` maps (6, n)
-        back to (n, 6) model-unit states at t = τ/(c r0).
+        """Shaker et al.'s scaled system (eq. 1 in the variables of eq. 5, an exact rescaling of the full model) for this
+        scene: ``(rhs, Y0, to_model)`` as ``SmallParameter.reduced_rhs``, Y = (p1, q1, r1, γ1, γ1', γ1'').
         """
         s = self.scene(system)
         C = self.constants(s)
