@@ -12,7 +12,7 @@ import numpy as np
 from scipy.optimize import brentq, least_squares, minimize_scalar
 from scipy.stats import qmc
 
-from gyrolab.analysis.precession.motion import Precession, build_system, states, vector_residual
+from gyrolab.analysis.precession.motion import Precession, build_system, defect, states, vector_residual
 from gyrolab.errors import ConfigError
 from gyrolab.physics.gyrostat_euler import GyrostatParameters
 
@@ -58,11 +58,7 @@ def find_precessions(params: GyrostatParameters, window: dict[str, tuple[float, 
 
     def residual(x: np.ndarray) -> np.ndarray:
         motion, p, _ = _split(x, names, fixed, params)
-        system = build_system(p, motion)
-        y, y_dot = states(system, motion, t)
-        defect = y_dot - system.derivative(y)
-        defect[:, 0:3] *= system.inertia
-        return defect.ravel() / scale
+        return defect(build_system(p, motion), motion, t).ravel() / scale
 
     points = qmc.scale(qmc.Sobol(len(names), seed=seed).random(starts), low, high)
     found: list[Solution] = []
@@ -87,9 +83,7 @@ def find_precessions(params: GyrostatParameters, window: dict[str, tuple[float, 
 def _rest_torque(params: GyrostatParameters, theta0: float, chi: float) -> np.ndarray:
     """I(ω̇ − f_ω) of the system's own right-hand side for the body at rest in the orbital frame at (χ, θ0)."""
     motion = Precession(0.0, 0.0, chi, theta0)
-    system = build_system(params, motion)
-    y, y_dot = states(system, motion, np.zeros(1))
-    return ((y_dot - system.derivative(y))[0, 0:3] * system.inertia).astype(float)
+    return defect(build_system(params, motion), motion, np.zeros(1))[0, 0:3]
 
 
 def find_normal_rests(params: GyrostatParameters, theta0: float, *, grid: int = 720,
