@@ -97,8 +97,8 @@ class ResonantOmega3(FixedPointRegime):
         return out
 
     def reduced_rhs(self, system):
-        """Shaker et al.'s scaled system (eq. 1 in the variables of eq. 5, an exact rescaling of the full model) for this
-        scene: ``(rhs, Y0, to_model)`` as ``SmallParameter.reduced_rhs``, Y = (p1, q1, r1, γ1, γ1', γ1'').
+        """Shaker et al.'s scaled system (eq. 1 in the variables of eq. 5, an exact rescaling of the full model) for
+        this scene: ``(rhs, Y0, to_model)`` as ``SmallParameter.reduced_rhs``, Y = (p1, q1, r1, γ1, γ1', γ1'').
         """
         s = self.scene(system)
         C = self.constants(s)

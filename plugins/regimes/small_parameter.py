@@ -114,9 +114,10 @@ class SmallParameter(FixedPointRegime):
                               order=order)
 
     def series_candidates(self, system, accuracy: float) -> list[tuple[SmallParameter, float]]:
-        """(regime at order N, its predicted max error in model units: the first omitted term), the lowest ``CANDIDATES``
-        orders predicted to meet ``accuracy``, after the closed forms (auto measures them) when the regime has no order
-        of its own; none beyond half the radius of convergence, where the estimate is not trustworthy.
+        """(regime at order N, its predicted max error in model units: the first omitted term), the lowest
+        ``CANDIDATES`` orders predicted to meet ``accuracy``, after the closed forms (auto measures them) when the
+        regime has no order of its own; none beyond half the radius of convergence, where the estimate is not
+        trustworthy.
         """
         s = self.scene(system)
         out = [(self, float("nan"))] if self.series_order is None else []  # the closed forms, measured by auto
@@ -187,7 +188,7 @@ class SmallParameter(FixedPointRegime):
     def reduced_rhs(self, system):
         """The reduced quasilinear system (000 eq. 14 through the μ⁻³ terms) for this scene: ``(rhs, Z0, to_model)``,
         ``rhs(τ, Z)`` = d/dτ of Z = (p2, ṗ2, γ2, γ̇2) (τ = r0 t), Z0 the orbit's τ = 0 state, ``to_model`` mapping a
-        (4, n) solution to (n, 6) model-unit states (errors and the printed variant: docs/regimes.md, "Reduced systems").
+        (4, n) solution to (n, 6) model-unit states (errors, the printed variant: docs/regimes.md, "Reduced systems").
         """
         s = self.scene(system)
         P = self.params(s)
