@@ -7,16 +7,9 @@ A section fixes γ''(0) = cos θ0 and r(0) = r0 and one more coordinate, leaving
 * ``"turning"`` — q(0) = 0, unknowns (p0, γ'0): the turning point of a swing about the body y axis, the section
   that stays transversal at r0 = 0, where the seeds' one contains the whole planar pendulum orbit (γ' ≡ 0).
 
-The return residual y(T) − y(0) has rank 3 (three first integrals); Newton's step is the least-squares one with the
-exact Jacobian [Φ(T)D − D, f(y(T)), (Φ(T) − 1) e_r r0] (Φ the monodromy matrix from the compiled Taylor flow).
-Continuation unknowns z = (p0, x0, ln T, ln r0); the tangent is the null vector of that 6 × 4 Jacobian, and the
-corrector adds the arclength condition t·(z − z_pred) = 0.
-
-Stability: the monodromy matrix has four trivial multipliers 1 (|γ| = 1, energy, area integral, flow) and one
-reciprocal pair ρ, 1/ρ, so s = tr Φ(T) − 4 = ρ + 1/ρ without identifying eigenvalues: |s| < 2 elliptic (linearly
-stable, ρ on the unit circle), |s| > 2 hyperbolic (unstable). Along a family: s crossing +2 is a multiplier through
-1 (a branch point, or a fold when d ln r0/ds changes sign there too), s crossing −2 a period doubling; a sign
-change of d ln r0/ds is a fold in r0.
+Continuation unknowns z = (p0, x0, ln T, ln r0), with the exact Jacobian [Φ(T)D − D, f(y(T)), (Φ(T) − 1) e_r r0];
+the tangent is its null vector. Stability from s = tr Φ(T) − 4 = ρ + 1/ρ (four trivial multipliers 1), bifurcations
+from s crossing ±2 and d ln r0/ds changing sign (docs/regimes.md, "Orbit families from fast to slow spin").
 """
 
 from __future__ import annotations
@@ -172,12 +165,9 @@ class Family(list):
 def continue_family(model: FixedPointModel, section: Section, start: FamilyPoint, r0_end: float, *,
                     step: float = 0.1, max_step: float = 0.4, min_step: float = 1e-4, max_points: int = 400,
                     max_period: float = 200.0) -> Family:
-    """Pseudo-arclength continuation from ``start`` (r0 > 0) until ln r0 passes ln ``r0_end``.
-
-    Step control: grow by 1.3 after an easy correction (≤ 4 iterations), halve after a failure; stops (and
-    returns what it has) below ``min_step``, after ``max_points`` points or when the period exceeds ``max_period``
-    (an orbit approaching an equilibrium or a homoclinic loop: the period diverges). The returned ``Family``'s
-    ``stop_reason`` names which of these ended it ("reached r0_end" when none did).
+    """Pseudo-arclength continuation from ``start`` (r0 > 0) until ln r0 passes ln ``r0_end``, the step grown by 1.3
+    after a success and halved after a failure; stops early below ``min_step``, after ``max_points`` points or past
+    ``max_period`` (the period diverges near an equilibrium or a homoclinic loop), as ``stop_reason`` says.
     """
     if start.r0 <= 0 or r0_end <= 0:
         raise ConfigError("continuation in ln r0 needs r0 > 0 at both ends")
@@ -236,13 +226,9 @@ class Event:
 
 def locate_events(model: FixedPointModel, section: Section, points: list[FamilyPoint],
                   events: list[tuple[int, str]] | None = None, tol: float = 1e-9) -> list[Event]:
-    """Each bifurcation of ``bifurcations(points)`` located in r0, not just bracketed by two family points.
-
-    A branch point or a period doubling is where s = ρ + 1/ρ crosses +2 or −2 between two points: the crossing
-    is solved for by regula falsi (Illinois) along the family between the two points, each trial an orbit of the
-    family found by the continuation's corrector, to |s ∓ 2| < ``tol`` (the points themselves may lie 40 % apart
-    in r0). A fold is
-    where ln r0 turns along the family: the vertex of the parabola through the three points around it.
+    """Each bifurcation of ``bifurcations(points)`` located in r0, not just bracketed by two family points: a crossing
+    of s = ±2 by regula falsi along the family to |s ∓ 2| < ``tol``, a fold by the vertex of the parabola of ln r0
+    through the three points around it (docs/regimes.md, "Orbit families from fast to slow spin").
     """
     located = []
     for index, kind in bifurcations(points) if events is None else events:

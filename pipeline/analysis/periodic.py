@@ -1,22 +1,9 @@
 """Exact periodic orbits of the heavy body about a fixed point: Newton shooting and Floquet multipliers.
 
-The body-frame motion (ω, γ) of the Euler–Poisson equations
-
-    I ω̇ = (Iω) × ω + U × γ + N γ × Iγ,        γ̇ = γ × ω
-
-(uniform gravity U = M g r_c, Newtonian centre N; ``FixedPoint.compiled_model``
-parameters) is integrated together with its variational equations
-(δ̇ = J(y) δ for the six columns of the monodromy matrix) by a Taylor series
-method of high order compiled with numba: the right-hand sides are quadratic,
-so every Taylor coefficient is a Cauchy product (Jorba & Zou, Exp. Math. 14, 2005).
-
-Shooting (the setting of Ismail (2021) and Shaker et al.): the orbit passes through a
-point with r = r0, γ' = 0, γ'' = γ0'' fixed (γ = +√(1 − γ''²)); the unknowns
-are p(0), q(0) and the period T. The residual is the 6-component return map
-y(T) − y(0); the three first integrals make it rank 3, so Newton's step is the
-least-squares (Gauss–Newton) solution, which converges quadratically on a
-zero-residual problem. The Jacobian is exact: [Φ(T)D − D, f(y(T))] with
-D = ∂y0/∂(p0, q0) and Φ the monodromy matrix.
+The body-frame motion (ω, γ), I ω̇ = (Iω) × ω + U × γ + N γ × Iγ, γ̇ = γ × ω, is integrated with its variational
+equations by a numba-compiled Taylor method of high order (the right-hand sides are quadratic: every coefficient is a
+Cauchy product). The return residual has rank 3 (three first integrals), so Newton's step is the least-squares one,
+with the exact Jacobian [Φ(T)D − D, f(y(T))] (docs/regimes.md, "Exact orbits").
 """
 
 from __future__ import annotations
@@ -194,14 +181,9 @@ def shoot(model: FixedPointModel, y0: np.ndarray, period: float, *, tol: float =
           max_iter: int = 40) -> PeriodicOrbit:
     """Damped Gauss–Newton shooting from a guess y0 = (p, q, r0, γ, 0, γ0'') and period; r, γ', γ'' stay fixed.
 
-    A full Newton step is taken unless the return residual (max-norm, relative to max(1, |y0|)) exceeds
-    the worst of the last four; then it is halved until the residual decreases. Near the orbit every step
-    is full and convergence is quadratic. Stops when the residual is below
-    ``tol`` or no step along the Newton direction decreases it (the rounding floor). The result is an
-    orbit only if the residual is below ``accept``: a stall above it means there is no orbit near the
-    guess, or Newton cannot reach it (IntegrationError). The default ``accept`` is tight on purpose:
-    near a family of almost-periodic motions (Shaker et al.'s amplitude circle, report §6) the return residual
-    of a point that is *not* on an orbit can be as small as 1e-10.
+    Stops below ``tol`` or at the rounding floor; an orbit only below ``accept`` (IntegrationError otherwise), tight
+    on purpose: near Shaker et al.'s amplitude circle a point *not* on an orbit returns to within 1e-10
+    (docs/regimes.md, "Exact orbits").
     """
     y0 = np.asarray(y0, dtype=float)
     if abs(y0[4]) > 1e-12:

@@ -1,12 +1,6 @@
-"""Where a batch's chunks run: this process, a local Dask cluster, or an existing Dask scheduler (docs/cluster.md).
-
-``map_chunks(function, tasks, on_result, scheduler)`` calls ``function(task)`` for every task and hands each
-result to ``on_result(index, result)`` in the calling process as it arrives (one process writes the output);
-``function`` is module-level and the tasks picklable, so the same call runs them elsewhere. ``scheduler`` None or
-``"process"``: here; ``"local"``: a ``LocalCluster``, one single-threaded worker per core (numba at one thread,
-so workers do not oversubscribe the cores); ``"tcp://HOST:PORT"``/``tls://``: an existing scheduler (which
-addresses a batch trusts: ``gyrolab.batch.scheduler``). At most a few chunks per worker are submitted at a time,
-so memory is bounded by a few chunks; a chunk that fails stops the batch with one sentence naming it.
+"""Where a batch's chunks run: this process, a local Dask cluster (one single-threaded worker per core, so numba does
+not oversubscribe them), or an existing Dask scheduler (docs/cluster.md). One process writes the output; at most a
+few chunks per worker are submitted at a time, so memory is bounded by a few chunks.
 """
 
 from __future__ import annotations

@@ -65,9 +65,8 @@ def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray
                               f"choose its method per trajectory ({_kernel_choices(choosers=False)}), "
                               f"not {integrator.name}")
         _require_finite(y0s)
-        solution = integrate_points(integrator, lambda j: scene.system.rhs, scene.times, y0s,
-                                    scene.compiled, None, failures="raise")
-        return solution
+        return integrate_points(integrator, lambda j: scene.system.rhs, scene.times, y0s, scene.compiled, None,
+                                failures="raise")
     return integrate_arrays(compiled, integrator, scene.times, y0s, params)
 
 

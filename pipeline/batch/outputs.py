@@ -1,8 +1,5 @@
-"""What a batch stores per point (``batch.output``: trajectory, decimated, final, reductions, indicator; the table in
-docs/batch.md, "What is stored per point"), computed from a chunk's trajectories.
-
-Each output is ``Output(dims, data, attrs)``: ``dims`` the trailing dimensions after the point's (grid)
-dimensions, ``data`` one row per point of the chunk.
+"""What a batch stores per point (``batch.output``; docs/batch.md, "What is stored per point"), computed from a
+chunk's trajectories: each ``Output(dims, data, attrs)`` has one row of ``data`` per point, ``dims`` after the grid's.
 """
 
 from __future__ import annotations

@@ -1,11 +1,5 @@
 """A batch's plan: the grid of points as arrays (initial states, compiled-model parameters), validated
-(docs/batch.md, "How a grid becomes arrays").
-
-The config is composed once; ``body.*`` and ``force.*`` build the system once per combination of their values
-(a "combo"), ``initial.*`` give the initial states of the whole grid through the system's vectorised hook
-``initial_states(initial, columns)`` (other systems: one system per distinct point). A point the fast checks
-cannot vouch for is checked by the single run's own code (``Scene.from_config`` on that point's config), so a
-failed point carries the same one-sentence error a single run of it gives.
+(docs/batch.md, "How a grid becomes arrays": combos, the vectorised hook, and why validation stays exact).
 """
 
 from __future__ import annotations

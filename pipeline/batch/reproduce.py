@@ -1,10 +1,5 @@
-"""``gyrolab reproduce PATH/sweep.nc`` for a batch: rerun its points and compare them bit for bit.
-
-The plan is rebuilt from what the ``sweep.nc`` stores (``config``; ``batch_grid``: the swept keys and values as
-typed; a list's values in the ``point`` coordinates, or the points file the config names), cut into the same
-chunks, and the chunks holding the chosen points (``--points``, by number: point n is grid position
-``numpy.unravel_index(n, shape)``, or the n-th point of a list) run again in this process into a temporary file;
-the chosen points of both files are then compared (``gyrolab.sweep.reproduce.compare``).
+"""``gyrolab reproduce PATH/sweep.nc`` for a batch: the plan rebuilt from the stored ``config`` and ``batch_grid``, the
+chunks holding the chosen points (``--points``) run again in this process, and those points compared bit for bit.
 """
 
 from __future__ import annotations

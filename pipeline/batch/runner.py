@@ -1,11 +1,5 @@
-"""Running a plan: chunks of points, each a picklable task integrated by the integrator's batch kernel (capability
-BATCH_KERNEL), or by one ``integrate`` call per point with that point's system (``integrate_points``)
-(docs/batch.md, "Chunks, kernels, progress").
-
-``run_plan(plan, path, settings)`` cuts the grid into chunks (each one hyperslab of the stored dataset), skips
-those a killed run of the same command already stored, hands the others to ``executors.map_chunks(run_chunk,
-...)`` and streams each result to the store as it arrives. A worker rebuilds the compiled model and the
-integrator from the task's plain config, once per process and config (``_context``).
+"""Running a plan: chunks of points, each a picklable task integrated by the integrator's batch kernel, or by one
+``integrate`` call per point with that point's system (docs/batch.md, "Chunks, kernels, progress").
 """
 
 from __future__ import annotations

@@ -1,12 +1,5 @@
 """Which Dask scheduler a batch trusts, and a check, bounded in time, that the peer is one (docs/cluster.md, "Whom a
-batch trusts").
-
-Connecting to a Dask scheduler trusts it with code execution (what it sends back is unpickled here), so its
-address comes only from places the user sets for this command: the command line (``--scheduler ADDRESS``), the
-environment (``DASK_SCHEDULER_ADDRESS``) or Dask's own configuration, never a gyrolab config, an experiment or an
-override, which are shared (``batch.scheduler`` there may say ``process`` or ``local``). Before ``distributed``
-is handed the address, ``probe`` reads the peer's greeting with a deadline, unpickling nothing: a silent peer or
-one that is not a Dask scheduler is one sentence after at most ``CONNECT_TIMEOUT`` seconds.
+batch trusts"): a scheduler runs code in this process, so its address never comes from a (shared) config.
 """
 
 from __future__ import annotations

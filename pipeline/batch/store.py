@@ -1,11 +1,6 @@
-"""A batch's dataset on disk, written chunk by chunk, resumable after a kill (its layout: docs/batch.md, "The
-file"; how it resumes: "Resume").
-
-Writes go to ``NAME.part``, whose variables' storage is contiguous and allocated when it is created, so a chunk's
-write changes data, never the file's structure; each chunk synced to disk is journaled in ``NAME.chunks``, and a
-rerun with the same identity continues after the journaled chunks; the complete file is renamed to ``NAME``. A
-failed write is one ``OutputError`` sentence (exit 3) that keeps the journaled chunks; a ``NAME.part`` that no
-longer opens is replaced, with a warning naming the chunks lost.
+"""A batch's dataset on disk, written chunk by chunk to ``NAME.part`` (journaled in ``NAME.chunks``), resumable after
+a kill (docs/batch.md, "The file" and "Resume"). A ``NAME.part`` that no longer opens is replaced, with a warning
+naming the chunks lost.
 """
 
 from __future__ import annotations

@@ -1,8 +1,5 @@
-"""Large sweeps in one command: ``gyrolab batch KEY=V1,V2 ...`` writes ``<dir>/sweep.nc`` (docs/batch.md).
-
-The grid becomes arrays (``plan``), runs in chunks (``runner``) and streams to one resumable dataset whose
-dimensions are the swept parameters (``store``). Only parameters of the body, the initial state and the forces
-may vary.
+"""Large sweeps in one command: ``gyrolab batch KEY=V1,V2 ...`` writes ``<dir>/sweep.nc`` (docs/batch.md): the plan,
+run in chunks, streamed to one resumable dataset; only body, initial-state and force parameters may vary.
 """
 
 from __future__ import annotations
@@ -62,14 +59,12 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
     return stats
 
 
-def check_integrator(plan: Plan, settings: Settings | None = None) -> None:
+def check_integrator(plan: Plan, settings: Settings) -> None:
     """Refuse, in one sentence, an integrator without VARIATIONAL for the chaos indicators (``batch.output=indicator``);
     any integrator runs the other outputs (one without a batch kernel: one ``integrate`` call per point)."""
     from gyrolab.contracts.capabilities import integrators_with, or_list
 
-    output = settings.output if settings is not None else Settings.from_config(plan.plain.get("batch")).output
-    integrator = plan.integrator_class
-    if output == "indicator" and not integrator.supports(VARIATIONAL):
+    if settings.output == "indicator" and not plan.integrator_class.supports(VARIATIONAL):
         raise ConfigError(f"integrator {plan.integrator_name!r} has no variational equations (capability "
                           f"{VARIATIONAL}), which the chaos indicators of batch.output=indicator need; valid choices: "
                           f"{or_list(integrators_with(VARIATIONAL))}")

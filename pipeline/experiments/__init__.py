@@ -1,8 +1,5 @@
-"""Experiments: tasks built from many scenes (``task: NAME`` in an experiment config).
-
-A plain run has ``task: scene``; an experiment file sets another task and
-its own section, and the app hands the composed config to the task's
-``run(cfg, out_dir)``, which writes its dataset and figures in ``out_dir``.
+"""Experiments: tasks built from many scenes (``task: NAME`` in an experiment config, its own section beside the
+scene's); the app hands the composed config to the task's ``run(cfg, out_dir)``, which writes its dataset and figures.
 """
 
 from __future__ import annotations

@@ -1,19 +1,9 @@
 """Tables 1 and 2 of Ismail (2021) regenerated, with their deviation from the published values.
 
-What the tables are (docs/derivations/seed000_large_parameter.md §7, reverse-engineered there):
-the table's t is not τ: τ = 2πt/100, and the derivative columns are d/dτ.
-
-* Table 1 ("analytic") is the generating solution only: γ2 = cos τ, dγ2/dτ = −sin τ,
-  p2 = A cos τ, dp2/dτ = −A sin τ with A = 1.88117·10⁻¹⁵ (the published p2(0): numerically zero,
-  M1 = M2 = 0).
-* Table 2 ("Runge–Kutta") is classical RK4 with step Δτ = π/10 on two uncoupled linear oscillators,
-  p2'' + W²p2 = 0 (p2(0) = A, W = 0.99607889, fitted by the research to the published p2 column) and
-  γ2'' + γ2 = 0.
-
-They contain no O(μ⁻¹) or O(μ⁻²) content (no p1, q1, r1, γ'', period, no full-model integration):
-Table 1 − Table 2 is RK4 truncation error, not a test of the expansion. Only W and A are inferred.
-Writes ``table1.csv``, ``table2.csv`` (columns t,p2,gamma2,dp2,dgamma2), ``ismail2021_tables.nc`` and
-``figures/ismail2021_tables.png``.
+Table 1 is the generating solution only, Table 2 classical RK4 (Δτ = π/10) on two uncoupled linear oscillators, the
+table's t being 100τ/2π (docs/derivations/seed000_large_parameter.md §7): their difference is RK4 truncation error,
+not a test of the expansion (erratum 000-11). Only W and A are inferred. Writes ``table1.csv``, ``table2.csv``,
+``ismail2021_tables.nc`` and ``figures/ismail2021_tables.png``.
 """
 
 from __future__ import annotations

@@ -1,14 +1,6 @@
-"""``experiment=orbit_family``: the exact periodic orbit of the heavy body followed from fast to slow spin.
-
-For each family of ``orbit_family.families`` (a body, a tilt θ0 = arccos γ''(0), a section and a start): the orbit is
-found by shooting at the start spin (from the fast-spin series of ``small_parameter`` at r0/c = 100, or from the
-pendulum swing at r0/c = 0.01) and continued by pseudo-arclength in ln r0 (``gyrolab.analysis.continuation``) toward
-the other end. Per point: r0/c, period, initial state, Floquet multipliers, stability index s = ρ + 1/ρ, stable,
-the nutation amplitude (max θ − min θ), the bifurcations met (fold, branch point, period doubling), and the
-relative error of the series against the point (max of |Δy(0)|/max(1, |y(0)|) and |ΔT|/T): the fast-spin series
-(``small_parameter``; each ``regime.order`` it accepts, else the paper's order) for r0/c ≥ 1 and the slow-spin series
-(``large_parameter``) inside its domain. Writes ``orbit_family.nc`` (dimension ``point``) and
-``figures/orbit_family.png``. Numbers and verdict: docs/regimes.md.
+"""``experiment=orbit_family``: the exact periodic orbit of the heavy body followed from fast to slow spin, each
+family of ``orbit_family.families`` shot at its start spin (from the fast-spin series or the pendulum swing) and
+continued in ln r0, with the series' errors along it (docs/regimes.md, "Orbit families from fast to slow spin").
 """
 
 from __future__ import annotations
@@ -70,11 +62,14 @@ def _scene(f: dict, r0: float) -> NondimensionalScene:
 FAST_SPIN_ORDERS = (3, 6, 10)
 
 
+def _fast_spin(f: dict, r0: float, order: int | None = None) -> tuple[np.ndarray, float]:
+    """The fast-spin series' (``small_parameter``, the paper's closed forms or ``order``) t = 0 state and period."""
+    regime, s = SmallParameter(order=order), _scene(f, r0)
+    return regime._state(s, np.array([0.0]))[0], regime._period(s)
+
+
 def fast_spin_error(f: dict, point: FamilyPoint, order: int) -> float:
-    regime = SmallParameter(order=order)
-    s = _scene(f, point.r0)
-    y = regime._state(s, np.array([0.0]))[0]
-    return _error(y, regime._period(s), point)
+    return _error(*_fast_spin(f, point.r0, order), point)
 
 
 def slow_spin_error(f: dict, point: FamilyPoint) -> float:
@@ -95,10 +90,8 @@ def start_point(f: dict, model: FixedPointModel, section: Section) -> FamilyPoin
     if section.kind == "turning":  # from the pendulum swing (slow-spin series when in its domain)
         T0 = pendulum.period(f["b"], pendulum.kappa(f["a"], f["k"]), f["theta0"])
         return shoot_section(model, section, np.zeros(2), T0, r0)
-    s = _scene(f, r0)
-    regime = SmallParameter()
-    y = regime._state(s, np.array([0.0]))[0]
-    return shoot_section(model, section, y[:2], regime._period(s), r0)
+    y, period = _fast_spin(f, r0)
+    return shoot_section(model, section, y[:2], period, r0)
 
 
 def amplitude(model: FixedPointModel, point: FamilyPoint, samples: int = 48) -> float:

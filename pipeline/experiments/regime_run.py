@@ -1,20 +1,7 @@
-"""A regime run (``gyrolab regime=NAME ...``): the analytic periodic solution against the full model and the exact orbit.
-
-For the scene's body, forces, spin r0 and tilt θ0, the regime's analytic
-periodic orbit (``Regime.solution``) is compared over ``regime.periods``
-periods with
-
-* the full model integrated from the analytic orbit's own t = 0 state with
-  the scene's integrator ("full"), and
-* the exact periodic orbit of the full model through the same r0, θ0, γ'(0) = 0
-  (Newton shooting from the analytic one, ``gyrolab.analysis.periodic``), sampled with
-  the compiled Taylor method ("orbit"), and
-* the regime's reduced system (``regime.reduced_rhs``: Ismail (2021) eq. 14, Shaker et al. eq. 1) integrated
-  with the scene's integrator plugin from its own τ = 0 state and mapped back ("reduced"), for regimes
-  that have one.
-
-Writes ``regime.nc`` (every variable with CF units and long_name; domain
-warnings in the attribute ``regime_warnings``) and ``figures/regime_comparison.png``.
+"""A regime run (``gyrolab regime=NAME ...``): the analytic periodic solution against the full model integrated from
+its t = 0 state ("full"), the exact periodic orbit through the same r0, θ0, γ'(0) = 0 ("orbit", Newton shooting),
+and the regime's reduced system where it has one ("reduced"; docs/regimes.md, "Reduced systems"). Writes
+``regime.nc`` and ``figures/regime_comparison.png``.
 """
 
 from __future__ import annotations
@@ -40,9 +27,10 @@ from gyrolab.figures.redraw import write_and_draw
 from gyrolab.output.cf import conform, unit_attributes
 from gyrolab.output.dataset import time_attributes
 from gyrolab.output.provenance import provenance
-from gyrolab.physics.attitude import angles_from_states, frame_from_angles
+from gyrolab.physics.attitude import angles_from_states
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 from gyrolab.plugins.integrators.scipy_solvers import DOP853
+from gyrolab.plugins.regimes.base import with_alpha
 
 log = logging.getLogger(__name__)
 SOURCE_NAMES = {"analytic": "analytic solution", "full": "full model from the analytic t = 0 state",
@@ -106,15 +94,6 @@ def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = Fal
     return integrator.integrate(system.rhs, t, y0, None, system.compiled_model() if wants else None).y
 
 
-def with_alpha(scene: Scene, regime: Regime, y6: np.ndarray) -> np.ndarray:
-    """A 6-state in the system's layout (α from ψ0 and the state's θ, φ)."""
-    if scene.system.state_size == 6:
-        return y6
-    psi0 = float(regime.euler_angles(scene.system, np.array([0.0]))["psi"][0])
-    alpha, _, _ = frame_from_angles(psi0, float(np.arccos(np.clip(y6[5], -1, 1))), float(np.arctan2(y6[3], y6[4])))
-    return np.concatenate([y6, alpha])
-
-
 def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True,
             allow_no_orbit: bool = False) -> dict[str, Any]:
     """States (n, 6) and Euler angles of the three sources, the exact orbit and its analytic period.
@@ -139,7 +118,7 @@ def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True,
         # recorded (and stated by the figure) because far outside the series' domain the scaling is visible
         out["analytic_gamma0_norm"] = float(np.linalg.norm(regime.initial_state(system)[3:6]))
     for source, y0 in runs.items():
-        y = integrate(scene, with_alpha(scene, regime, y0), t, taylor=source == "orbit")
+        y = integrate(scene, with_alpha(regime, system, y0), t, taylor=source == "orbit")
         states[source] = y[:, :6]
         variables = system.variables(t, y)
         angles[source] = {k: variables[k].values for k in ("psi", "theta", "phi") if k in variables}
@@ -149,12 +128,8 @@ def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True,
 
 def reduced_solution(scene: Scene, regime: Regime, t: np.ndarray) -> tuple[np.ndarray, str] | None:
     """The regime's reduced system integrated over t by the scene's integrator plugin: ((n, 6) model-unit states,
-    a description of the method); None if the regime has none.
-
-    The reduced system is written in τ = c r0 t; it is integrated in t (d/dt = c r0 d/dτ) so that the plugin's
-    settings (a fixed step, tolerances) mean what they mean for the full model. A compiled-only integrator cannot
-    take it (it has no compiled form), nor can ``auto`` (its choice is made for the full model): scipy's DOP853
-    with the same tolerances (1e-12 where there are none) stands in, and the dataset says so.
+    a description of the method); None if the regime has none. Integrated in t, not τ = c r0 t, so that the plugin's
+    settings mean what they mean for the full model (docs/regimes.md, "Reduced systems").
     """
     if not hasattr(regime, "reduced_rhs"):
         return None

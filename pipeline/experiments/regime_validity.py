@@ -1,17 +1,6 @@
-"""Validity of each regime: error of the analytic solution against the exact orbit and the full model over a log range.
-
-For each regime in ``regime_validity.regimes`` the scene is rebuilt with its spin r0 set so that the
-regime's parameter takes each value of a log range (``regime_validity.<regime>.values``); points
-outside the domain are recorded as refused (NaN, with the reason). Error orders are fitted inside
-``fit_below`` and compared with the theory's; a verdict is written to the dataset attrs and the log.
-``large_parameter`` is refused by design: its row evaluates the evidence instead (the printed
-formulas under the paper's reading μ = c/r0 against the full model, γ'' error over one τ period).
-
-``regime_validity.resonance_sweep`` sweeps the body's natural frequency ω (ω² = (a−1)(b−1)/(ab), set
-through a = (1−b)/(1−b+ω²b) at fixed b) across the resonances ω → n excluded by ``small_parameter``
-(its series has small divisors n² − ω²), at one fixed c/r0 inside the domain: the error against the exact
-orbit as a function of |ω − n| on both sides, the fitted growth e ∝ |n² − ω²|^−s, the distance from
-which the error stays below ``tolerance``, and the points refused (check_domain) or where shooting fails.
+"""Validity of each regime: error of the analytic solution against the exact orbit and the full model over a log range
+of its parameter, fitted orders against the theory's, and ``small_parameter`` across the resonances ω → n
+(docs/regimes.md, "Verdict"). ``large_parameter``'s row is the evidence against the paper's reading μ = c/r0.
 """
 
 from __future__ import annotations

@@ -1,9 +1,6 @@
-"""Shaker et al.'s Euler angles θ, ψ, φ against t: the ω = 3 series against the full model (report §9 body).
-
-The body is the research's suggestion (docs/derivations/seed001_resonant_omega3.md §9): a = 0.4,
-b = 1/7 (A:B:C = 14:5:35, non-physical, ω = 3), r_c = (0.48, 0.36, 0.8), k = N/c² = 1, θ0 = arctan 0.75,
-μ = 0.1 (r0 = 8.944 c), t ∈ [0, 20]/c. The full model starts from the exact periodic orbit (shooting),
-as the research did. Writes ``shaker_omega3.nc`` and ``figures/shaker_omega3_euler.png``.
+"""Shaker et al.'s Euler angles θ, ψ, φ against t: the ω = 3 series against the full model on the exact periodic orbit,
+for the research's body (``conf/experiment/shaker_omega3.yaml``; docs/derivations/seed001_resonant_omega3.md §9).
+Writes ``shaker_omega3.nc`` and ``figures/shaker_omega3_euler.png``.
 """
 
 from __future__ import annotations

@@ -1,10 +1,5 @@
-"""``gyrolab experiment=stability_map``: the chaos indicator over a grid θ0 × r0 as one resumable batch.
-
-The grid (``stability_map.theta0``/``r0`` ranges, ``n_theta0`` × ``n_r0`` points, or ``batch.points`` as a
-square grid) is run by ``gyrolab.batch.sweep.run_batch`` with ``batch.output=indicator``
-(``gyrolab.analysis.chaos.indicator_outputs``: MEGNO and the max nutation deviation per point) into
-``stability_map.nc`` with dimensions (``theta0``, ``r0``); rerunning the same command in the same run
-directory continues a killed map. The figure is ``gyrolab.figures.stability_map.draw``.
+"""``gyrolab experiment=stability_map``: the chaos indicator over a grid θ0 × r0 as one resumable batch
+(docs/batch.md, "experiment=stability_map"; docs/stability_map.md).
 """
 
 from __future__ import annotations

@@ -1,16 +1,8 @@
 """Work against precision: every integrator × setting on one scene, errors against a reference of known accuracy.
 
-For each method and setting (``work_precision.methods``), the scene is run
-``repeats`` times and the smallest CPU time of the process (``time.process_time``: every thread of the
-process, so numba's parallel kernels count all their threads' work) is kept, with the wall time of the
-same run for reference; on a shared machine the wall time of a run depends on who else is running,
-the CPU time much less, and the minimum drops the repeats that were preempted. The final state's (ω, γ) is compared
-with a reference: the extended-precision Taylor method (``gyrolab.physics.reference``)
-when the scene is uniform gravity + Newtonian field, otherwise the compiled
-Taylor method at tol 1e-18 (recorded in the dataset, with its lower trust).
-Writes ``work_precision.nc`` (dims: run; its ``timing`` attribute says how it was timed) and figures error
-vs CPU time and
-error vs right-hand-side evaluations.
+Timed by the minimum CPU time of the process (``time.process_time``: numba's parallel kernels count all their
+threads) over ``repeats`` runs: on a shared machine the wall time depends on who else runs, and the minimum drops
+the preempted repeats. The dataset's ``timing`` and reference attributes say how it was measured.
 """
 
 from __future__ import annotations

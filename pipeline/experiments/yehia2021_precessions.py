@@ -1,15 +1,8 @@
-"""Every regular-precession case of Yehia & El-kenani (2021), sections 4.1.1, 4.1.2, 4.2, checked on the full model.
-
-For each case of ``gyrolab.analysis.precession.cases`` (concrete parameters satisfying the printed — or, in an
-extra row, the corrected — conditions): (a) the residual along ψ = nt + ψ0, θ = θ0, φ = mt of the vector
-equations (the ``orbiting_gyrostat`` system with its force plugins) and of the Euler-angle equations;
-(b) a scene of the configured integrator from the precession's initial state, max |θ − θ0| over
-``yehia2021.orbits`` orbits; (c) Floquet multipliers, only for a motion that holds: the multipliers of the
-variational equations along a prescribed motion that does not satisfy the equations describe no motion, so
-``stable`` is left empty for a non-solution and ``stability_note`` says why. Verdict (vector evidence only):
-``holds`` when the vector residual < ``residual_tolerance`` and the first orbit stays within 1e-6 of θ0,
-``fails`` when the residual > 1e-6. Writes precession_cases.csv, precession_cases.nc (all rows, new families and the
-closed-form check) and one figure per geometric class.
+"""Every regular-precession case of Yehia & El-kenani (2021), sections 4.1.1, 4.1.2, 4.2, checked on the full model:
+the residual along the prescribed motion (vector and Euler-angle equations), an integration from its initial state,
+and Floquet multipliers for a motion that holds only (those along a non-solution describe no motion). Verdicts and
+tolerances: docs/gyrostat.md, "Regular precession". Writes precession_cases.csv, precession_cases.nc and one figure
+per geometric class.
 """
 
 from __future__ import annotations

@@ -1,8 +1,5 @@
-"""One dataset per sweep: every job's ``run.nc`` on the sweep's grid, plus a table of failed jobs.
-
-The layout of ``sweep.nc`` (``assemble``): docs/datasets.md, "sweep.nc — a multirun". ``assemble`` only needs
-each grid point's dataset (or its failure), so a batch integrator that computes a whole grid in one process can
-produce the same layout without writing per-job files.
+"""One dataset per sweep: every job's ``run.nc`` on the sweep's grid, plus a table of failed jobs (the layout:
+docs/datasets.md, "sweep.nc — a multirun").
 """
 
 from __future__ import annotations

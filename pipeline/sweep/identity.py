@@ -1,9 +1,6 @@
-"""A job's identity: a hash of its resolved config and of the code that runs it; a sweep run again skips the jobs
-whose identity already has a finished result (the integrators are deterministic). The code is what the job loads:
-gyrolab's own (its version, the git trees of its code folders, the digest of their uncommitted changes) and the
-third-party plugins the config names (each ``_target_`` outside gyrolab: its distribution, version and a digest of
-its package's Python files); a commit of documentation or tests only, or a package the job does not use, changes
-no identity.
+"""A job's identity: a hash of its resolved config and of the code it loads, gyrolab's own (version, git trees of its
+code folders, uncommitted changes) and the third-party plugins the config names; a sweep run again skips the jobs
+whose identity has a settled result (docs/cluster.md, "Resuming a multirun").
 """
 
 from __future__ import annotations

@@ -1,8 +1,5 @@
-"""One job of a sweep: skip it if its result is already there, otherwise run it and record how it ended.
-
-A failing job is recorded, not fatal (its error reaches ``sweep.nc``'s table of failed jobs); a write failure
-fails the job too, but is retried when the sweep is run again. The job's directory is locked while it runs, so of
-two processes resuming one sweep only one runs a job; temporary files a killed job left are removed first.
+"""One job of a sweep: skip it if its result is already there, otherwise run it, its directory locked, and record how
+it ended; a failing job is recorded, not fatal, and a write failure is retried when the sweep is run again.
 """
 
 from __future__ import annotations

@@ -1,11 +1,5 @@
 """Sweep jobs in worker processes die with the process that launched the sweep (docs/faults.md, "Workers die with
-the launching process").
-
-The launching process announces itself in the environment (``LAUNCHER_ENV``, "host:pid", set by the sweep
-callback; workers inherit it); a job that starts in another process on the same host arms Linux
-``prctl(PR_SET_PDEATHSIG, SIGKILL)`` when its parent is the launcher, and a watchdog thread that ends the worker
-once the launcher is gone (for launchers with processes in between, and other systems). Jobs on other hosts
-(SLURM) are the scheduler's.
+the launching process"); the launcher announces itself to its workers in ``LAUNCHER_ENV`` ("host:pid").
 """
 
 from __future__ import annotations

@@ -1,8 +1,6 @@
-"""``gyrolab reproduce PATH/run.nc``: rerun a dataset's stored config and say whether the result is identical
-(docs/sweeps.md): every data variable and coordinate equal bit for bit, else each differing variable with its
-largest absolute difference, and the provenance that differs as a hint to why. A multirun's ``sweep.nc``: each
-finished job's ``run.nc`` (``reproduce_sweep``); a batch's: ``gyrolab.batch.reproduce``; an experiment's dataset:
-``gyrolab.experiments.reproduce_task`` (both with ``compare`` of this module).
+"""``gyrolab reproduce PATH/run.nc``: rerun a dataset's stored config and compare bit for bit (docs/sweeps.md,
+"Reproduce a result"); also a multirun's ``sweep.nc`` job by job (``reproduce_sweep``). Batches
+(``gyrolab.batch.reproduce``) and experiments (``gyrolab.experiments.reproduce_task``) use ``compare`` of this module.
 """
 
 from __future__ import annotations

@@ -1,21 +1,10 @@
-"""A real single-node SLURM on this machine, to try gyrolab's SLURM routes before a cluster (docs/cluster.md, "A
-SLURM on your own machine": what ``start`` installs, writes and starts, and how clients find it through
-``SLURM_CONF`` without touching a system SLURM or munge).
+"""A real single-node SLURM on this machine, to try gyrolab's SLURM routes before a cluster (``python -m
+gyrolab.sweep.slurm_local start|status|stop``; docs/cluster.md, "A SLURM on your own machine").
 
-    python -m gyrolab.sweep.slurm_local start     # prints: export SLURM_CONF=/tmp/gyrolab-slurm-.../slurm.conf
-    eval "$(python -m gyrolab.sweep.slurm_local start)"   # the same, and this shell's sbatch/sinfo use it
-    python -m gyrolab.sweep.slurm_local status    # the clusters it started that are running
-    python -m gyrolab.sweep.slurm_local stop      # cancel their jobs, stop their daemons, remove their files
-
-``start()`` returns the running cluster (tests/sweep/test_slurm.py starts its own with it); the command line's
-``start`` runs it in a small background process that holds the cluster until ``stop`` (or SIGTERM) ends it. A
-process killed before its ``stop()`` leaves daemons behind: each state directory records the pid that started it
-(``owner``), and the next ``start()`` ends the processes of every directory whose owner is gone and removes it.
-
-Why not cgroups: a container rarely delegates a writable cgroup tree, so processes are tracked by parentage
-(``proctrack/linuxproc``) and tasks are not confined; the node's CPUs and memory come from this machine and are
-taken as configured (``SlurmdParameters=config_overrides``), since a container's CPU quota is not what the
-hardware reports.
+A process killed before its ``stop()`` leaves daemons behind: each state directory records the pid that started it
+(``owner``), and the next ``start()`` ends the processes of every directory whose owner is gone. No cgroups (a
+container rarely delegates a writable cgroup tree): processes are tracked by parentage, and the node's CPUs and
+memory are taken as configured (``SlurmdParameters=config_overrides``), since a container's quota is not the hardware's.
 """
 
 from __future__ import annotations
@@ -238,10 +227,7 @@ PartitionName={PARTITION} Nodes={node} Default=YES MaxTime=INFINITE State=UP
 def clean_leftovers(base: Path) -> None:
     """End the processes of, and remove, every cluster directory whose starting process is gone."""
     for directory in base.glob(PREFIX + "*"):
-        try:
-            owner = int((directory / "owner").read_text())
-        except (OSError, ValueError):
-            owner = None
+        owner = _pid_in(directory / "owner")
         if owner is not None and alive(owner):
             continue
         if owner is None and _age(directory) < 60:   # another session is creating it right now
@@ -358,15 +344,15 @@ def _hold(base: Path | None) -> int:
 
 def held_clusters(base: Path) -> list[tuple[int, Path]]:
     """(holding process, state directory) of every running cluster the command line started under ``base``."""
-    found = []
-    for directory in sorted(base.glob(PREFIX + "*")):
-        try:
-            owner = int((directory / HELD).read_text())
-        except (OSError, ValueError):
-            continue
-        if alive(owner):
-            found.append((owner, directory))
-    return found
+    held = ((_pid_in(directory / HELD), directory) for directory in sorted(base.glob(PREFIX + "*")))
+    return [(owner, directory) for owner, directory in held if owner is not None and alive(owner)]
+
+
+def _pid_in(path: Path) -> int | None:
+    try:
+        return int(path.read_text())
+    except (OSError, ValueError):
+        return None
 
 
 def _start_command(base: Path | None) -> int:

@@ -1,14 +1,8 @@
 """gyrolab's sweeper: Hydra's basic sweeper that leaves finished jobs out before launching anything
-(docs/cluster.md, "Resuming a multirun").
+(docs/cluster.md, "Resuming a multirun": how identities are predicted without composing every job).
 
-It computes each job's identity first (``gyrolab.sweep.identity.job_identity``, the rule the jobs apply) and
-launches only the jobs whose directory holds no record that settles it (``JobRecord.reusable_for``), in runs of
-consecutive numbers, so job numbers, directories and ``sweep.nc`` are those of an unfiltered sweep. The identities
-are computed without composing every job: one job per combination of group choices is composed as Hydra does,
-and each other job's value overrides are applied to it with Hydra's own override code (standing in for the basic
-sweeper's validation of the batch; a job whose overrides do not apply is composed in full, so that Hydra reports
-it). A config that calls a resolver could resolve differently inside the job: then every job is launched and
-checks itself. A wrong prediction can only cost a launch, never skip a job.
+A job whose overrides do not apply to its composed group choices is composed in full, so that Hydra reports it.
+A wrong prediction can only cost a launch, never skip a job.
 """
 
 from __future__ import annotations

@@ -103,18 +103,24 @@ def _with_magnetic_moment(system: System, regime: str, nd: dict, names: list[str
     return nd
 
 
+def with_alpha(regime: Regime, system: System, y6: np.ndarray) -> np.ndarray:
+    """A 6-state (ω, γ) in the system's layout: α appended from the regime's ψ0 and the state's θ, φ when carried."""
+    if system.state_size == 6:
+        return y6
+    psi0 = float(regime.euler_angles(system, np.array([0.0]))["psi"][0])
+    alpha, _, _ = frame_from_angles(psi0, float(np.arccos(np.clip(y6[5], -1, 1))), float(np.arctan2(y6[3], y6[4])))
+    return np.concatenate([y6, alpha])
+
+
 class FixedPointRegime(Regime):
     """Base of the built-in regimes: nondimensional formulas, mapped to the scene's model units.
 
-    ``periods`` and ``samples_per_period`` set the window of a regime run (t from 0 to
-    ``periods`` periods of the analytic orbit). Subclasses implement the nondimensional solution (time in 1/c,
-    rates in c): ``_state(s, t)`` (n, 6), ``_period(s)`` and ``_euler(s, t)`` (θ, φ and ψ from ψ0 = 0) of a
-    ``NondimensionalScene`` s.
+    ``periods`` and ``samples_per_period`` set the window of a regime run. Subclasses implement the nondimensional
+    solution (time in 1/c, rates in c) of a ``NondimensionalScene`` s: ``_state(s, t)`` (n, 6), ``_period(s)`` and
+    ``_euler(s, t)`` (ψ from ψ0 = 0).
     """
 
-    #: Every orbit ``integrator=auto`` may take from this regime (each of ``series_candidates``) has its period
-    #: within this factor of ``period(system)``, which is cheap (no series built, no shooting); None: unknown or
-    #: expensive. auto then rules the regime out from one period of the scene's own motion (``Auto._misses_orbits``).
+    #: the contract's ``period_spread`` (``gyrolab.contracts.regime``, item 11); None: no cheap screen for auto
     period_spread: float | None = None
 
     def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200) -> None:
@@ -151,12 +157,7 @@ class FixedPointRegime(Regime):
         """The orbit's t = 0 state in the system's layout (α appended from ψ0, θ(0), φ(0) when carried)."""
         y = self.initial_state(system)
         y[3:6] /= np.linalg.norm(y[3:6])  # the series satisfies |γ| = 1 to its order only
-        if system.state_size == 6:
-            return y
-        angles = self.euler_angles(system, np.array([0.0]))
-        alpha, _, _ = frame_from_angles(float(angles["psi"][0]), float(np.arccos(np.clip(y[5], -1, 1))),
-                                        float(np.arctan2(y[3], y[4])))
-        return np.concatenate([y, alpha])
+        return with_alpha(self, system, y)
 
     def reseat_warnings(self, system: System) -> list[str]:
         """Warnings naming the scene's initial values the orbit replaces (p0, q0, φ0)."""

@@ -406,10 +406,8 @@ def reduced_rhs(tau: float, Z: np.ndarray, P: Params, Z0: np.ndarray, printed: b
 
         p̈2 + ω²p2 = μ⁻²F2 + μ⁻³F3,   γ̈2 + γ2 = μ⁻²Φ2 + μ⁻³Φ3      (``order=2`` drops the μ⁻³ terms)
 
-    Z0 is the initial state (it enters through s11, s12, s21, s22 of (12)). Error against the full model over a
-    period (tests/plugins/regimes/test_erratum_000_4.py): O(μ⁻⁴) from a generic state (``order=2``: O(μ⁻³)); on the periodic
-    orbit of (35) p, q O(μ⁻⁵), γ's O(μ⁻⁴) (``order=2``: p, q O(μ⁻³)). ``printed`` uses the printed Φ2, F3, Φ3
-    (errata 000-3, 000-4): p, q error O(μ⁻³), γ's O(μ⁻²) (O(μ⁻³) when γ0'' = O(μ⁻¹): the Φ2 typo ∝ γ0''(1 − γ0'')).
+    Z0 is the initial state (it enters through s11, s12, s21, s22 of (12)); ``printed`` uses the printed Φ2, F3, Φ3
+    (errata 000-3, 000-4). Errors against the full model: docs/regimes.md, "Reduced systems".
     """
     if order not in (2, 3):
         raise ValueError(f"order={order!r}: the reduced system (14) is available through μ⁻² or μ⁻³ (order 2 or 3)")

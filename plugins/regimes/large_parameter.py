@@ -1,24 +1,10 @@
 """Slow spin about a fixed point (small r0/c): the perturbed physical pendulum — Ismail's (2021) "new domain", done right.
 
-Ismail (2021) claims a "large-parameter" solution for small r0 with μ = c/r0, but its equations (1)-(2)
-hold only for μ = r0/c (``docs/derivations/seed000_large_parameter.md`` §3): read as printed its formulas miss
-the motion by O(1). This plugin is the slow-spin regime built from the right generating motion instead:
-
-* **Generating orbit** (r0 = 0): with the centre of mass on the body z axis and the body released from rest with
-  z tilted by θ0 about the body y axis (φ0 = ±π/2), the motion is an exact planar physical pendulum
-  (``gyrolab.physics.pendulum``: period by quadrature, elliptic functions for k = 0).
-* **Family**: the periodic orbit through the swing's turning point, q(0) = 0, r(0) = r0, γ''(0) = cos θ0
-  (``gyrolab.analysis.continuation``, section ``turning``), continues the swing for small r0/c: the shooting
-  Jacobian is regular at r0 = 0 unless the swing has an out-of-plane Floquet multiplier 1.
-* **Series** in ε = r0/c (numeric, ``SlowSpinSeries``: the swing, its variational equations, orders 2…7 fitted
-  to exact orbits). Error orders 8 (q, γ, γ'', period) and 9 (p, r, γ'), measured 8.6 and 9.6.
-* **Domain** (refused outside, one sentence): centre of mass on the +z axis, tilt about the y axis
-  (φ0 = ±π/2), 0.05 ≤ θ0 ≤ 3 with 1 + κ cos θ > 0 (κ = k(a − 1)), an out-of-plane stability index of the swing
-  |s0 − 2| ≥ 0.05 (s = ρ + 1/ρ; s = 2 is a multiplier 1, where the family branches), 0 < r0/c ≤ 0.2; warned
-  above r0/c = 0.1 (docs/regimes.md for the measured errors).
-
-``formula=printed`` evaluates the paper's printed (35) under its own reading μ = c/r0 for any body, with a
-warning that it misses the motion by O(1); the run records the measured error (``max_error_vs_full``).
+The pendulum swing at r0 = 0 (``gyrolab.physics.pendulum``), continued through its turning-point section
+(``gyrolab.analysis.continuation``), as a numeric series in ε = r0/c fitted to exact orbits (``SlowSpinSeries``).
+Method, domain and measured errors: docs/regimes.md, "large_parameter: slow spin, the perturbed physical pendulum".
+``formula=printed`` evaluates the paper's printed (35) under its own reading μ = c/r0, which misses the motion by
+O(1) (``docs/derivations/seed000_large_parameter.md`` §3); the run records the measured error.
 """
 
 from __future__ import annotations
@@ -47,15 +33,9 @@ PRINTED_WARNING = ("regime.formula=printed evaluates Ismail's (2021) printed (35
 
 @dataclass
 class SlowSpinSeries:
-    """The numeric slow-spin series for one body and tilt (nondimensional: time 1/c, rates c).
-
-    y(s T(ε); ε) = y_P(s T0) + ε Φ(s T0) ∂y0/∂ε + Σ_{j=2..7} ε^j y_j(s),  T(ε) = T0 + T2 ε² + T4 ε⁴ + T6 ε⁶,
-    s ∈ [0, 1) the phase. y_P, T0: the pendulum swing (exact); the first-order term: the variational equations
-    along it (exact). At fixed phase q, γ, γ'' and T are even in ε and p, r, γ' odd (the orbit at −ε is the
-    one at ε with p, r, γ' reversed: tests/plugins/regimes/test_large_parameter.py checks it to rounding), so y_j, T_j
-    (j ≥ 2) are, per phase point, the least-squares fit in (ε², ε⁴, ε⁶) or (ε³, ε⁵, ε⁷) of the remainder
-    y − y_P − ε y1 of the exact orbits at ε = FIT_SPINS; stored as Fourier coefficients (``HARMONICS`` phase
-    points). The top coefficient absorbs the truncation: the defended orders are those measured (docs/regimes.md).
+    """The numeric slow-spin series for one body and tilt (nondimensional: time 1/c, rates c):
+    y(s T(ε); ε) = y_P(s T0) + ε Φ(s T0) ∂y0/∂ε + Σ_{j=2..7} ε^j y_j(s), T(ε) = T0 + T2 ε² + T4 ε⁴ + T6 ε⁶, the y_j
+    fitted with their parity in ε to the exact orbits at ε = FIT_SPINS (docs/regimes.md, "Series (numeric)").
     """
 
     a: float

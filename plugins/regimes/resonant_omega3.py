@@ -1,21 +1,9 @@
 """The resonant case ω = 3 (Shaker, El-Barki & Ismail), branches (i)-(iv) of eq. (23), corrected or printed.
 
-Fast spin with the small parameter μ = c√(cos θ0)/r0 and the 3:1 resonance
-of the generating system, ω² = (C−A)(C−B)/(AB) = 9. Since ω² − 1 =
-C(C−A−B)/(AB), ω = 3 requires A + B < C: no real rigid body has it
-(``docs/derivations/seed001_resonant_omega3.md`` §3). The scene must say so
-explicitly with ``body.allow_nonphysical=true``.
-
-Theory error orders in μ (report §6): p, q 3; r, γ's 4; period 4 (corrected);
-printed: p, q 1 (wrong ℓ1), γ'' 2, γ, γ' 2 (their O(μ²) terms are not printed), period 2.
-
-``branch`` selects the solution of (23): ``i`` (M1 = M2 = 0, the default and the
-paper's worked case), ``iii`` (M1 = ``sign``·√(a2/a1), M2 = 0), and, in the printed
-reading only, ``ii`` (M2 = ``sign``·√(a2/a1)) and ``iv`` (phase ``phase_deg`` on the
-amplitude circle). Corrected, (ii) and (iv) are refused: the resonant forcing
-M3³L310 ≠ 0 locks the p-mode phase to branch (iii) (erratum 001-6). Branch (iii)
-orders: p, q 1 (the O(μ) amplitude correction is not derived), r, γ's, period 2
-(``shaker_omega3`` module docstring; tests/plugins/regimes/test_resonant_omega3_branches.py).
+Fast spin with μ = c√(cos θ0)/r0 ≪ 1; ω = 3 requires A + B < C, so the scene must admit a non-physical body
+(``body.allow_nonphysical=true``; ``docs/derivations/seed001_resonant_omega3.md`` §3). The branches and their
+measured orders: docs/regimes.md, "resonant_omega3"; (ii) and (iv) run only as printed (erratum 001-6). Theory
+orders in μ (report §6): p, q 3; r, γ's, period 4; printed: p, q 1 (wrong ℓ1), γ's and period 2.
 """
 
 from __future__ import annotations
@@ -109,11 +97,8 @@ class ResonantOmega3(FixedPointRegime):
         return out
 
     def reduced_rhs(self, system):
-        """Shaker et al.'s scaled system (eq. 1 in the variables of eq. 5) for this scene: ``(rhs, Y0, to_model)``.
-
-        ``rhs(τ, Y)`` is d/dτ of Y = (p1, q1, r1, γ1, γ1', γ1''), τ = r0 t (exact rescaling of the full model,
-        ``shaker_omega3.scaled_rhs``); Y0 is the analytic orbit's τ = 0 state; ``to_model(Y)`` maps (6, n)
-        back to (n, 6) model-unit states at t = τ/(c r0).
+        """Shaker et al.'s scaled system (eq. 1 in the variables of eq. 5, an exact rescaling of the full model) for
+        this scene: ``(rhs, Y0, to_model)`` as ``SmallParameter.reduced_rhs``, Y = (p1, q1, r1, γ1, γ1', γ1'').
         """
         s = self.scene(system)
         C = self.constants(s)

@@ -16,15 +16,9 @@ Normalisation: r(0) = r0, γ''(0) = γ0'', γ'(0) = 0 (φ(0) = π/2), ψ(0) = 0.
 Measured accuracy of the corrected series (report §6): p, q O(μ³) relative to
 c√γ0''; r/r0, γ/γ0'' O(μ⁴); period O(μ⁴); Euler angles O(μ⁴).
 
-Branches of (23) (the generating p-mode p2 = M1 cos 3τ + M2 sin 3τ, E² = M1² + M2²):
-(i) M1 = M2 = 0 is the full series above. (iii) M1 = ±√(a2/a1), M2 = 0: the paper gives
-only the amplitude; the solution here is the case-(i) series with the p-mode amplitude
-μℓ1 replaced by M1 (exact in every term linear in the p-mode, i.e. to O(μ) in γ, γ', γ'';
-the O(μ) amplitude correction β1 and the M1² terms of r and the period are not derived),
-so p, q are O(μ) and the rest O(μ²) (measured: tests/plugins/regimes/test_resonant_omega3_branches.py).
-(ii) M1 = 0 and (iv) 0 < |M2| < E are not periodic solutions unless L310 = 0 (erratum
-001-6): the resonant forcing M3³L310 locks the p-mode phase to ε = 0, π. They exist
-only as the printed reading, as the generating solution (16).
+Branches of (23) (the generating p-mode p2 = M1 cos 3τ + M2 sin 3τ, E² = M1² + M2²): (i) M1 = M2 = 0, the full
+series above; (iii) the case-(i) series with the p-mode amplitude μℓ1 replaced by M1 = ±√(a2/a1); (ii) and (iv)
+only as printed, the generating solution (16) (erratum 001-6). Their orders: docs/regimes.md, "resonant_omega3".
 """
 
 from __future__ import annotations

@@ -1,26 +1,11 @@
 """Fast spin about a fixed point: Poincaré's small-parameter periodic solution, ε = c/r0 ≪ 1 (Ismail (2021), corrected).
 
-Ismail (2021) calls this a "large-parameter" method for small r0,
-but its equations (1)-(2) are consistent only with μ = r0/c (report §3 of
-``docs/derivations/seed000_large_parameter.md``): it is the classical fast-top
-expansion in ε = 1/μ = c/r0 = √(Mgℓ/C)/r0. This plugin is that expansion,
-with the corrected (35), (36), (38)-(39) (``gyrolab.plugins.regimes.ismail2021``);
-``formula=printed`` evaluates the paper's printed formulas in the same
-consistent scaling.
-
-Domain: ε < 1 (warning above 0.2), ω away from the resonances 1, 2, 3 of
-the generating system (refused where |n² − ω²| < ``divisor_threshold(n, ε)``, a band that
-narrows as the spin grows: ε^(4/3) at ω = 1, ε³ at ω = 2, 3), and γ0'' = cos θ0 = O(ε) (the derivation sets
-γ0'' = Γ/μ; warning when Γ = γ0''/ε > 3). Theory error orders in ε:
-p, q 3; r, γ, γ', γ'' 4; period 4 (corrected) — the printed r, γ, γ' are 2.
-
-``order=N`` replaces the closed forms by the numeric Poincaré–Lindstedt series through ε^N at the scene's own
-(finite) tilt (``gyrolab.physics.lindstedt``): every variable's error is O(ε^(N+1)) — O(ε^(N+2)) for the
-variables whose next term vanishes by the (ε, p, q) → (−ε, −p, −q) symmetry — and the series' radius of
-convergence in ε, estimated from its coefficients, is the smallest c/r0 at which it can be used.
-
-The default (``order`` unset) keeps the paper's closed forms, with one fix: the frequency is the finite-tilt one
-(``finite_tilt_frequency``), where (36) keeps only the −z0'γ0'' tilt term (its error is O(ε²γ0''²)).
+Ismail's (2021) "large-parameter" method is consistent only with μ = r0/c (report §3 of
+``docs/derivations/seed000_large_parameter.md``): it is the classical fast-top expansion in ε = 1/μ. This plugin is
+that expansion with the corrected (35), (36), (38)-(39) (``gyrolab.plugins.regimes.ismail2021``; ``formula=printed``:
+the printed ones), with the finite-tilt frequency (``finite_tilt_frequency``); ``order=N`` replaces the closed forms
+by the numeric Poincaré–Lindstedt series through ε^N (``gyrolab.physics.lindstedt``). Domain, refusal bands at the
+resonances ω = 1, 2, 3 and the measured orders: docs/regimes.md.
 """
 
 from __future__ import annotations
@@ -94,10 +79,8 @@ class SmallParameter(FixedPointRegime):
     parameter = "c/r0"
     parameter_long_name = "Poincaré's small parameter ε = c/r0 = √(Mgℓ/C)/r0 (Ismail's (2021) 1/μ)"
     order = {"pq": 3.0, "r": 4.0, "gamma": 4.0, "gamma3": 4.0, "period": 4.0}
-    # ``period`` of the default instance is the closed forms' (finite_tilt_frequency, exact through ε³); the exact
-    # orbit's and every listed order's frequency differ from it by the terms from ε⁴ on, which are far below the
-    # frequency itself where an order is listed (ε below half the radius of convergence, the order's own estimate
-    # below the accuracy): a factor 2 either way is generous.
+    # the closed forms' period is exact through ε³; every listed order's differs from it from ε⁴ on, far below the
+    # period where an order is listed (ε below half the radius of convergence): a factor 2 either way is generous
     period_spread = 2.0
 
     def __init__(self, *, formula: str = "corrected", periods: int = 3, samples_per_period: int = 200,
@@ -131,13 +114,10 @@ class SmallParameter(FixedPointRegime):
                               order=order)
 
     def series_candidates(self, system, accuracy: float) -> list[tuple[SmallParameter, float]]:
-        """(regime at order N, its predicted max error in model units), the lowest ``CANDIDATES`` orders predicted
-        to meet ``accuracy``, lowest first, after the closed forms (no prediction: auto measures them) when the
-        regime has no order of its own.
-
-        The prediction is the first omitted term (``LindstedtSeries.error_estimate``) in model units (p, q
-        scale with c, r with c/ε = c r0); only orders predicted to meet ``accuracy`` are listed (none when the scene's ε
-        is beyond half the radius of convergence, where the estimate is not trustworthy).
+        """(regime at order N, its predicted max error in model units: the first omitted term), the lowest
+        ``CANDIDATES`` orders predicted to meet ``accuracy``, after the closed forms (auto measures them) when the
+        regime has no order of its own; none beyond half the radius of convergence, where the estimate is not
+        trustworthy.
         """
         s = self.scene(system)
         out = [(self, float("nan"))] if self.series_order is None else []  # the closed forms, measured by auto
@@ -206,14 +186,9 @@ class SmallParameter(FixedPointRegime):
         return []
 
     def reduced_rhs(self, system):
-        """The reduced quasilinear system (000 eq. 14 through the μ⁻³ terms, corrected F3, Φ3) for this scene.
-
-        Returns ``(rhs, Z0, to_model)``: ``rhs(τ, Z)`` gives d/dτ of Z = (p2, ṗ2, γ2, γ̇2) (τ = r0 t, any
-        integrator); Z0 is the orbit's τ = 0 state (that of ``initial_state`` with r = r0, γ'' = γ0'');
-        ``to_model(Z, Z0)`` maps a (4, n) solution back to (n, 6) model-unit states (p, q, r, γ, γ', γ'')
-        at t = τ/(c r0). ``formula=printed`` uses the printed Φ2, F3, Φ3 (errata 000-3, 000-4). Error against the
-        full model over a period: O(μ⁻⁴) from a generic state, p, q O(μ⁻⁵) on the periodic orbit
-        (tests/plugins/regimes/test_erratum_000_4.py).
+        """The reduced quasilinear system (000 eq. 14 through the μ⁻³ terms) for this scene: ``(rhs, Z0, to_model)``,
+        ``rhs(τ, Z)`` = d/dτ of Z = (p2, ṗ2, γ2, γ̇2) (τ = r0 t), Z0 the orbit's τ = 0 state, ``to_model`` mapping a
+        (4, n) solution to (n, 6) model-unit states (errors, the printed variant: docs/regimes.md, "Reduced systems").
         """
         s = self.scene(system)
         P = self.params(s)

@@ -55,14 +55,9 @@ _S3 = np.sqrt(3.0)
 
 def normal_rest(inertia, mu, h3, Omega, theta0: float, chi: float, k3: float = 0.0, h1: float | None = None,
                 N: float | None = None) -> GyrostatParameters:
-    """Parameters that make θ0 ∈ {0, π}, n ± m = 0 (rest in the orbital frame, ω = Ωγ) a solution.
-
-    σ = cos θ0 = ±1, χ = ψ0 − σφ0 (only ψ ± φ matters): α = (cos χ, −σ sin χ, 0), β = (sin χ, σ cos χ, 0),
-    γ = (0, 0, σ). The residual is constant; its γ-component does not contain k and gives
-        h1 (μ1 sin χ + σ μ2 cos χ) = −(3/2) N/3 (A − B) sin 2χ          (μ·β h1 = −(N/2)(A − B) sin 2χ),
-    its components ⊥ γ give k1 = (μ1 h3 − σ μ3 h1 cos χ)/Ω, k2 = (μ2 h3 + μ3 h1 sin χ)/Ω; C, k3, μ3, h3 free.
-    Branches: μ·β ≠ 0 → h1 from the first equation (any A, B); μ·β = 0 → needs (A − B) sin 2χ = 0, h1 free
-    (``h1`` must then be given). Derivation in docs/gyrostat.md; verified by the vector residual (tests)."""
+    """Parameters that make θ0 ∈ {0, π}, n ± m = 0 (rest in the orbital frame, ω = Ωγ) a solution at χ = ψ0 − σφ0:
+    h1 μ·β = −(N/2)(A − B) sin 2χ, and k1, k2 from the components ⊥ γ; where μ·β = 0, ``h1`` is free and must be
+    given (derivation and branches: docs/gyrostat.md, "Rest on the orbit normal")."""
     A, B, C = map(float, inertia)
     sigma = float(np.sign(np.cos(theta0)))
     s, c = np.sin(chi), np.cos(chi)

@@ -1,21 +1,7 @@
-"""Classification of a regular precession ψ = nt + ψ0, θ = θ0, φ = mt (definitions in docs/gyrostat.md).
-
-Angular velocity relative to the orbital frame: ω′ = n γ + m e3; absolute: ω = (n + Ω) γ + m e3
-(the orbital frame turns about the inertially fixed γ at Ω), so in the inertial frame the same
-motion has precession rate n + Ω. In a frame, with precession rate ν about γ and spin m:
-
-* **rest** if ν γ + m e3 = 0;
-* **permanent rotation** if the angular velocity is constant in the body and in the frame:
-  e3 ∥ γ (θ0 ∈ {0, π}) or ν = 0 or m = 0;
-* **regular precession** otherwise (both rates non-zero, e3 ∦ γ).
-
-Geometric type, defined when e3 is fixed in the orbital frame (n = 0 or θ0 ∈ {0, π}), from the
-surface the body's z axis (a line through the centre of mass) sweeps in inertial space as the
-orbital frame turns about the orbit normal through the Earth's centre: **cylindrical** if e3 ∥ γ;
-**conical** if e3 lies in the radial–normal plane (α, γ) (the line meets the orbit-normal axis);
-**hyperboloidal** if e3 has an along-track component (one-sheet hyperboloid). e3 in orbital
-components is (sin ψ0 sin θ0, −cos ψ0 sin θ0, cos θ0). With these definitions the paper's labels
-"conical" (17) and "hyperboloidal" (19), (24) are interchanged.
+"""Classification of a regular precession ψ = nt + ψ0, θ = θ0, φ = mt: rest, permanent rotation or regular
+precession in the orbital and inertial frames (ω = (n + Ω) γ + m e3), and the geometric type of the surface the body
+z axis sweeps (definitions, and why the paper's "conical" and "hyperboloidal" are interchanged: docs/gyrostat.md,
+"Classification").
 """
 
 from __future__ import annotations

@@ -1,13 +1,6 @@
-"""Find regular precessions numerically: solve R(t) ≡ 0 for (n, m, θ0, ψ0) and chosen free parameters.
-
-The existence conditions are that the vector residual of the ``orbiting_gyrostat`` equations
-vanishes at every time along ψ = nt + ψ0, θ = θ0, φ = mt. The finder samples R at ``samples``
-times over ``orbits`` orbits and minimises Σ|R|² by Levenberg–Marquardt-type least squares
-(scipy ``least_squares``) from a quasi-random set of starts in the search window; converged
-points (max residual < ``accept``) are polished and de-duplicated by the motion they describe
-(same body-frame state at the sample times, so θ0 ∈ {0, π} solutions that differ only in how
-n + m is split count once). Each solution carries the dimension of the solution family through
-it (the null space of the residual's Jacobian): 0 = isolated, d > 0 = a d-parameter family.
+"""Find regular precessions numerically: solve R(t) ≡ 0 for (n, m, θ0, ψ0) and chosen free parameters, least squares
+from quasi-random starts, solutions de-duplicated by the body-frame motion and each with the dimension of its family
+(docs/gyrostat.md, "Finder").
 """
 
 from __future__ import annotations
@@ -19,7 +12,7 @@ import numpy as np
 from scipy.optimize import brentq, least_squares, minimize_scalar
 from scipy.stats import qmc
 
-from gyrolab.analysis.precession.motion import Precession, build_system, states, vector_residual
+from gyrolab.analysis.precession.motion import Precession, build_system, defect, states, vector_residual
 from gyrolab.errors import ConfigError
 from gyrolab.physics.gyrostat_euler import GyrostatParameters
 
@@ -65,11 +58,7 @@ def find_precessions(params: GyrostatParameters, window: dict[str, tuple[float, 
 
     def residual(x: np.ndarray) -> np.ndarray:
         motion, p, _ = _split(x, names, fixed, params)
-        system = build_system(p, motion)
-        y, y_dot = states(system, motion, t)
-        defect = y_dot - system.derivative(y)
-        defect[:, 0:3] *= system.inertia
-        return defect.ravel() / scale
+        return defect(build_system(p, motion), motion, t).ravel() / scale
 
     points = qmc.scale(qmc.Sobol(len(names), seed=seed).random(starts), low, high)
     found: list[Solution] = []
@@ -94,20 +83,14 @@ def find_precessions(params: GyrostatParameters, window: dict[str, tuple[float, 
 def _rest_torque(params: GyrostatParameters, theta0: float, chi: float) -> np.ndarray:
     """I(ω̇ − f_ω) of the system's own right-hand side for the body at rest in the orbital frame at (χ, θ0)."""
     motion = Precession(0.0, 0.0, chi, theta0)
-    system = build_system(params, motion)
-    y, y_dot = states(system, motion, np.zeros(1))
-    return ((y_dot - system.derivative(y))[0, 0:3] * system.inertia).astype(float)
+    return defect(build_system(params, motion), motion, np.zeros(1))[0, 0:3]
 
 
 def find_normal_rests(params: GyrostatParameters, theta0: float, *, grid: int = 720,
                       accept: float = 1e-12) -> list[Solution]:
-    """Every rest in the orbital frame with the body z axis on the orbit normal (θ0 = 0 or π, n ± m = 0).
-
-    Only ψ0 ∓ φ0 = χ matters. The γ-component of the (constant) residual does not contain k (k × Ωγ ⊥ γ):
-    its zeros in χ ∈ [0, 2π) are found on a grid (sign changes, then Brent; grazing minima polished) from the
-    system's right-hand side; at each zero the two components ⊥ γ, linear in (k1, k2), fix k1, k2 (k3 as given).
-    A γ-component that vanishes for every χ (A = B with h1 μ·β ≡ 0) is a one-parameter family: one
-    representative χ = 0 with ``family_dimension`` 1. Each solution is re-checked by the vector residual.
+    """Every rest in the orbital frame with the body z axis on the orbit normal (θ0 = 0 or π, n ± m = 0): the zeros in
+    χ of the residual's γ-component (which does not contain k), then k1, k2 from the components ⊥ γ; a γ-component
+    zero for every χ is a family, one representative χ = 0 with ``family_dimension`` 1 (docs/gyrostat.md).
     """
     sigma = 1.0 if np.cos(theta0) > 0 else -1.0
     theta0 = 0.0 if sigma > 0 else np.pi

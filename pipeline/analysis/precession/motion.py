@@ -82,12 +82,17 @@ def window(system: OrbitingGyrostat, orbits: float = 5.0, points: int = 1001) ->
     return np.linspace(0.0, orbits * 2 * np.pi / system.Omega, points)
 
 
-def vector_residual(system: OrbitingGyrostat, motion: Precession, t: np.ndarray) -> float:
-    """max over t of the residual: |I (ω̇ − f_ω)| (torque) and |ė − f_e| of the Poisson equations."""
+def defect(system: OrbitingGyrostat, motion: Precession, t: np.ndarray) -> np.ndarray:
+    """The residual at times t, shape (len(t), 9): I (ω̇ − f_ω) (torque) and ė − f_e of the Poisson equations."""
     y, y_dot = states(system, motion, t)
-    defect = y_dot - system.derivative(y)
-    defect[:, 0:3] *= system.inertia
-    return float(np.max(np.abs(defect)))
+    out = y_dot - system.derivative(y)
+    out[:, 0:3] *= system.inertia
+    return out
+
+
+def vector_residual(system: OrbitingGyrostat, motion: Precession, t: np.ndarray) -> float:
+    """max over t of the residual's components (``defect``)."""
+    return float(np.max(np.abs(defect(system, motion, t))))
 
 
 def euler_residual(params: GyrostatParameters, motion: Precession, t: np.ndarray) -> float:

@@ -1,23 +1,7 @@
-"""Linear stability of a regular precession: Floquet multipliers of the full vector equations.
-
-In body axes the state y = (ω, α, γ) of a precession is periodic when n/m is rational
-(T = 2π q/|m| for n/m = p/q; n = 0: 2π/|m|) and, at θ0 = 0 or π, depends only on ψ ± φ
-(T = 2π/|n ± m|); a rate of zero makes it an equilibrium of the body-frame equations.
-The monodromy matrix Φ(T) comes from the variational equations Φ̇ = Df(y(t)) Φ along the
-exact motion, Df by complex-step differentiation of the system's own right-hand side
-(exact to rounding, whatever force plugins it carries). For an equilibrium the multipliers
-over one orbit are exp(λ·2π/Ω), λ the eigenvalues of Df.
-
-Trivial multipliers equal to 1 come from the constraints |α| = |γ| = 1, α·γ = 0, the flow
-direction and the Jacobi integral (and from symmetries); being in Jordan blocks they are
-computed only to about the square root of the integration error. The motion is called
-linearly (spectrally) stable when every |ρ| ≤ 1 + ``tolerance``, the tolerance tied to the
-integration accuracy: tolerance = max(10 √rtol, 10 δ), δ the largest change of a sorted |ρ|
-between the monodromy at ``rtol`` and at 100·``rtol`` (a direct estimate of the numerical
-error, which also catches larger Jordan blocks); 3.2e-5 at the default rtol = 1e-11, where the
-trivial multipliers of the catalogue deviate from 1 by ≤ 1.1e-6. An unstable motion has a
-reciprocal pair |ρ|, 1/|ρ| with |ρ| > 1 (the flow is Hamiltonian on the constraint set).
-Spectral stability is necessary, not sufficient, for stability.
+"""Linear stability of a regular precession: Floquet multipliers of the full vector equations over the body-frame
+period, Df by complex steps of the system's own right-hand side, with a stability tolerance tied to the integration
+accuracy (trivial multipliers 1 sit in Jordan blocks: docs/gyrostat.md, "Regular precession"). Spectral stability is
+necessary, not sufficient, for stability.
 """
 
 from __future__ import annotations

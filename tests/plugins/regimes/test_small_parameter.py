@@ -11,7 +11,8 @@ import xarray as xr
 
 from gyrolab.engine.config import compose_config
 from gyrolab.errors import ConfigError
-from gyrolab.experiments.regime_run import errors, exact_orbit, integrate, prepare, with_alpha
+from gyrolab.experiments.regime_run import errors, exact_orbit, integrate, prepare
+from gyrolab.plugins.regimes.base import with_alpha
 from gyrolab.plugins.regimes import ismail2021 as paper
 
 from tests.helpers.regimes import (
@@ -271,7 +272,7 @@ def test_order_10_shows_its_error_slope_and_radius(order10):
     # at the scene's ε the order-10 series is the exact orbit to ~ε¹¹ (5e-15 relative): round-off level
     orbit = exact_orbit(scene, regime)
     t = np.linspace(0.0, orbit.period, 9)
-    y = integrate(scene, with_alpha(scene, regime, orbit.y0), t, taylor=True)
+    y = integrate(scene, with_alpha(regime, scene.system, orbit.y0), t, taylor=True)
     assert np.max(np.abs(regime.solution(scene.system, t) - y[:, :6]) / np.array([1, 1, 20, 1, 1, 1])) < 1e-12
     assert regime.period(scene.system) == pytest.approx(orbit.period, rel=1e-13)
     # Euler angles of the series (ψ integrated spectrally) against those of the integrated orbit
@@ -344,7 +345,7 @@ def test_vertical_magnetic_field_adds_to_the_weight():
     assert [s.x0, s.y0, s.z0] == pytest.approx(U / np.linalg.norm(U))
     orbit = exact_orbit(scene, regime)
     t = np.linspace(0.0, orbit.period, 9)
-    y = integrate(scene, with_alpha(scene, regime, orbit.y0), t, taylor=True)[:, :6]
+    y = integrate(scene, with_alpha(regime, scene.system, orbit.y0), t, taylor=True)[:, :6]
     error = np.abs(regime.solution(scene.system, t) - y) / np.array([s.c, s.c, s.c * s.r0, 1, 1, 1])
     assert np.max(error) < 5 * (1 / s.r0) ** 7  # 6.6e-10 = 1.6 ε⁷ at ε = c/r0 = 0.0456; 2.4e-2 without the field
     with pytest.raises(ConfigError, match="vertical magnetic field"):
