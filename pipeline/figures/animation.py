@@ -27,11 +27,10 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 import xarray as xr
-from matplotlib.figure import Figure
 
 from gyrolab.errors import ConfigError
 from gyrolab.figures.labels import unit
-from gyrolab.figures.style import RC, figure, unit_sphere
+from gyrolab.figures.style import RC, Figure, figure, unit_sphere
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.foreign import load_run
 from gyrolab.output.trust import check_output_target

@@ -11,9 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
-from matplotlib.figure import Figure
 
-from gyrolab.figures.style import DOUBLE, legend_outside, styled, subplots
+from gyrolab.figures.style import DOUBLE, Figure, legend_outside, styled, subplots
 
 #: located bifurcations are markers explained in the legend (text labels of nearby events overprinted each other):
 #: open shapes of decreasing size, so that events located at the same orbit (a fold that is also a period

@@ -13,11 +13,10 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from matplotlib.figure import Figure
 
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.save import save_all
-from gyrolab.figures.style import DOUBLE, figure, legend_outside, styled, unit_sphere
+from gyrolab.figures.style import DOUBLE, Figure, figure, legend_outside, styled, unit_sphere
 
 FRAMES = {"orbital": ("body_axis_orbital", ("α (radial)", "β (along-track)", "γ (normal)")),
           "inertial": ("body_axis_inertial", ("X", "Y", "Z (normal)"))}

@@ -4,10 +4,9 @@ exact periodic orbit and (where the regime has one) the reduced system, for p, q
 from __future__ import annotations
 
 import xarray as xr
-from matplotlib.figure import Figure
 
 from gyrolab.figures.labels import label, time_label, unit
-from gyrolab.figures.style import DOUBLE, legend_outside, panel_note, styled, subplots
+from gyrolab.figures.style import DOUBLE, Figure, legend_outside, panel_note, styled, subplots
 
 #: source suffix -> (legend, line style); drawn in this order
 SOURCES = {"orbit": ("exact periodic orbit (Newton shooting)", dict(ls="-", lw=2.2, color="0.75")),

@@ -11,10 +11,8 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
-from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 
-from gyrolab.figures.style import DOUBLE, log_positive, styled, subplots
+from gyrolab.figures.style import DOUBLE, Axes, Figure, log_positive, styled, subplots
 from gyrolab.output.user_yaml import stored_yaml
 
 #: error key -> (legend, marker); one color per key in every panel

@@ -14,13 +14,12 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from matplotlib.figure import Figure
 
 from gyrolab.figures.labels import GAMMA, label, time_label, unit
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.save import metadata_of, save
-from gyrolab.figures.style import (DOUBLE, SINGLE, fast_window, figure, legend_outside, log_positive, panel_note,
-                                   styled, subplots, trace, unit_sphere)
+from gyrolab.figures.style import (DOUBLE, SINGLE, Figure, fast_window, figure, legend_outside, log_positive,
+                                   panel_note, styled, subplots, trace, unit_sphere)
 
 #: invariant variable -> (symbol in a legend, kind of unit)
 INVARIANTS = {"energy": ("energy E", "energy"), "jacobi_integral": ("Jacobi integral H", "energy"),

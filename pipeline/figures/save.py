@@ -14,11 +14,10 @@ from typing import Any
 
 import matplotlib
 import xarray as xr
-from matplotlib.figure import Figure
 from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
-from gyrolab.figures.style import RC
+from gyrolab.figures.style import RC, Figure
 from gyrolab.output.atomic import atomic_path
 
 logging.getLogger("fontTools").setLevel(logging.WARNING)  # PDF font subsetting logs every table at INFO

@@ -4,10 +4,9 @@ full model on the exact periodic orbit (the mean spin is removed from φ to show
 from __future__ import annotations
 
 import xarray as xr
-from matplotlib.figure import Figure
 
 from gyrolab.figures.labels import time_label
-from gyrolab.figures.style import SINGLE, legend_outside, styled, subplots
+from gyrolab.figures.style import SINGLE, Figure, legend_outside, styled, subplots
 
 
 @styled

@@ -17,14 +17,12 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 import matplotlib
-from matplotlib.axes import Axes
 from matplotlib.colors import Normalize
-from matplotlib.figure import Figure
 
 from gyrolab.errors import ConfigError, OutputError
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.save import save_all
-from gyrolab.figures.style import DOUBLE, figure, panel_note, styled
+from gyrolab.figures.style import DOUBLE, Axes, Figure, figure, panel_note, styled
 from gyrolab.output.user_yaml import stored_yaml
 
 #: colour scale of MEGNO: 0 (stable periodic) … 2 (quasi-periodic) … CLIP and beyond (chaotic)

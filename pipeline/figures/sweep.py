@@ -16,15 +16,13 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 
 from gyrolab.figures.evaluations import nfev_notes
 from gyrolab.figures.labels import GAMMA, OMEGA, label, unit
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.run import INVARIANTS
 from gyrolab.figures.save import save_all
-from gyrolab.figures.style import DOUBLE, SINGLE, legend_outside, panel_note, styled, subplots
+from gyrolab.figures.style import DOUBLE, SINGLE, Axes, Figure, legend_outside, panel_note, styled, subplots
 from gyrolab.output.units import KINDS
 
 MAX_SERIES = 8

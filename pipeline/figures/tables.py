@@ -6,10 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
-from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 
-from gyrolab.figures.style import DOUBLE, legend_outside, log_positive, styled, subplots
+from gyrolab.figures.style import DOUBLE, Axes, Figure, legend_outside, log_positive, styled, subplots
 
 COLUMN = "gamma2"
 

@@ -17,9 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
-from matplotlib.figure import Figure
 
-from gyrolab.figures.style import SINGLE, legend_outside, log_positive, panel_note, styled, subplots
+from gyrolab.figures.style import SINGLE, Figure, legend_outside, log_positive, panel_note, styled, subplots
 from gyrolab.figures.evaluations import chooses_method, nfev_counts
 
 MARKERS = "osD^v<>ph*"
