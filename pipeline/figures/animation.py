@@ -24,13 +24,13 @@ import shutil
 from collections.abc import Callable
 from pathlib import Path
 
-import matplotlib.pyplot as plt
+import matplotlib
 import numpy as np
 import xarray as xr
 
 from gyrolab.errors import ConfigError
 from gyrolab.figures.labels import unit
-from gyrolab.figures.style import STYLE, unit_sphere
+from gyrolab.figures.style import RC, Figure, figure, unit_sphere
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.foreign import load_run
 from gyrolab.output.trust import check_output_target
@@ -114,15 +114,15 @@ def frame_indices(n_times: int, frames: int) -> np.ndarray:
     return np.unique(np.linspace(0, n_times - 1, min(frames, n_times)).round().astype(int))
 
 
-def motion_figure(ds: xr.Dataset, indices: np.ndarray) -> tuple[plt.Figure, Callable[[int], None]]:
+def motion_figure(ds: xr.Dataset, indices: np.ndarray) -> tuple[Figure, Callable[[int], None]]:
     """The figure and ``update(k)``, which draws frame ``k`` (output index ``indices[k]``) and titles it with its
     time."""
-    with plt.style.context(STYLE):
+    with matplotlib.rc_context(RC):
         rotation, names, down, what = attitude(ds)
         t = ds["time"].values
         units = unit(ds, ds["time"].attrs.get("units"), "time")
         apex = rotation[:, :, 2]                                   # body z axis in the fixed frame
-        fig = plt.figure(figsize=(SIZE, SIZE + 0.4), layout="none")
+        fig = figure(SIZE, SIZE + 0.4, layout="none")
         fig.subplots_adjust(left=0.02, right=0.92, top=0.95, bottom=0.1)
         ax = fig.add_subplot(projection="3d")
         unit_sphere(ax, n=19)
@@ -194,16 +194,14 @@ def animate(path: str | os.PathLike[str], output: str | os.PathLike[str] | None 
     indices = frame_indices(ds.sizes["time"], int(frames))
     target = Path(output) if output is not None else file.parent / "figures" / f"animation.{fmt}"
     fig, update = motion_figure(ds, indices)
-    try:  # written beside the target under a temporary name, renamed when complete (the format is named)
-        with atomic_path(target) as tmp, plt.style.context(STYLE):
-            (_write_gif if fmt == "gif" else _write_mp4)(fig, update, len(indices), fps, tmp)
-    finally:
-        plt.close(fig)
+    # written beside the target under a temporary name, renamed when complete (the format is named)
+    with atomic_path(target) as tmp, matplotlib.rc_context(RC):
+        (_write_gif if fmt == "gif" else _write_mp4)(fig, update, len(indices), fps, tmp)
     log.info("wrote %s (%d frames)", target, len(indices))
     return target
 
 
-def _write_gif(fig: plt.Figure, update: Callable[[int], None], n: int, fps: float, path: Path) -> None:
+def _write_gif(fig: Figure, update: Callable[[int], None], n: int, fps: float, path: Path) -> None:
     from PIL import Image  # start-up: PIL only for a GIF
 
     fig.set_dpi(GIF_DPI)
@@ -216,7 +214,7 @@ def _write_gif(fig: plt.Figure, update: Callable[[int], None], n: int, fps: floa
     images[0].save(path, format="GIF", save_all=True, append_images=images[1:], duration=round(1000 / fps), loop=0)
 
 
-def _write_mp4(fig: plt.Figure, update: Callable[[int], None], n: int, fps: float, path: Path) -> None:
+def _write_mp4(fig: Figure, update: Callable[[int], None], n: int, fps: float, path: Path) -> None:
     from matplotlib.animation import FFMpegWriter  # start-up: only for an MP4
 
     writer = FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p", "-f", "mp4"])

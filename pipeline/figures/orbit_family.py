@@ -9,11 +9,10 @@ against the exact orbit with the 1e-6 and 1e-3 levels that bound the bands in ``
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from gyrolab.figures.style import DOUBLE, legend_outside, styled, subplots
+from gyrolab.figures.style import DOUBLE, Figure, legend_outside, styled, subplots
 
 #: located bifurcations are markers explained in the legend (text labels of nearby events overprinted each other):
 #: open shapes of decreasing size, so that events located at the same orbit (a fold that is also a period
@@ -80,7 +79,7 @@ def zoom_window(ds: xr.Dataset, families: list[str]) -> tuple[tuple[float, float
 
 
 @styled
-def draw_orbit_family(ds: xr.Dataset) -> plt.Figure:
+def draw_orbit_family(ds: xr.Dataset) -> Figure:
     fig, axes = subplots(3, 1, width=DOUBLE, height=7.4, sharex="col")
     period_ax, amplitude_ax, error_ax = axes[:, 0]
     families = list(dict.fromkeys(str(f) for f in ds["family"].values))

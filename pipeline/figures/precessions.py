@@ -11,13 +11,12 @@ from __future__ import annotations
 from collections.abc import Iterable
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.save import save_all
-from gyrolab.figures.style import DOUBLE, legend_outside, styled, unit_sphere
+from gyrolab.figures.style import DOUBLE, Figure, figure, legend_outside, styled, unit_sphere
 
 FRAMES = {"orbital": ("body_axis_orbital", ("α (radial)", "β (along-track)", "γ (normal)")),
           "inertial": ("body_axis_inertial", ("X", "Y", "Z (normal)"))}
@@ -69,10 +68,10 @@ def _panel(ax, ds: xr.Dataset, cases: list[int], frame: str, variable: str, name
 
 
 @styled
-def draw_class(ds: xr.Dataset, geometric: str) -> plt.Figure:
+def draw_class(ds: xr.Dataset, geometric: str) -> Figure:
     cases = [i for i, (g, v) in enumerate(zip(ds["geometric"].values, ds["verdict"].values))
              if str(g) == geometric and str(v) == "holds"]
-    fig = plt.figure(figsize=(DOUBLE, 4.4), layout="none")  # 3-D axes: margins by hand
+    fig = figure(DOUBLE, 4.4, layout="none")  # 3-D axes: margins by hand
     fig.subplots_adjust(left=0.0, right=0.93, top=0.9, bottom=0.2, wspace=0.12)
     for j, (frame, (variable, names)) in enumerate(FRAMES.items()):
         ax = fig.add_subplot(1, 2, j + 1, projection="3d")

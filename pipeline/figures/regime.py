@@ -3,11 +3,10 @@ exact periodic orbit and (where the regime has one) the reduced system, for p, q
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import xarray as xr
 
 from gyrolab.figures.labels import label, time_label, unit
-from gyrolab.figures.style import DOUBLE, legend_outside, panel_note, styled, subplots
+from gyrolab.figures.style import DOUBLE, Figure, legend_outside, panel_note, styled, subplots
 
 #: source suffix -> (legend, line style); drawn in this order
 SOURCES = {"orbit": ("exact periodic orbit (Newton shooting)", dict(ls="-", lw=2.2, color="0.75")),
@@ -24,7 +23,7 @@ OUTSIDE_NOTE = 1e-3
 
 
 @styled
-def draw_regime_comparison(ds: xr.Dataset) -> plt.Figure:
+def draw_regime_comparison(ds: xr.Dataset) -> Figure:
     rate = unit(ds, ds["omega_analytic"].attrs.get("units"), "rate")
     panels = [("omega", 0, label("p", rate)), ("omega", 1, label("q", rate)), ("omega", 2, label("r", rate)),
               ("gamma", 2, "γ₃ = cos θ")]

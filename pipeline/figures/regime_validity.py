@@ -9,11 +9,10 @@ from __future__ import annotations
 
 from typing import Any
 
-import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from gyrolab.figures.style import DOUBLE, log_positive, styled, subplots
+from gyrolab.figures.style import DOUBLE, Axes, Figure, log_positive, styled, subplots
 from gyrolab.output.user_yaml import stored_yaml
 
 #: error key -> (legend, marker); one color per key in every panel
@@ -29,7 +28,7 @@ def _spec(ds: xr.Dataset) -> dict[str, Any]:
         return {}
 
 
-def _regime_panel(ax: plt.Axes, ds: xr.Dataset, name: str, spec: dict[str, Any]) -> None:
+def _regime_panel(ax: Axes, ds: xr.Dataset, name: str, spec: dict[str, Any]) -> None:
     dim = f"{name}_parameter"
     x = ds[dim].values.astype(float)
     zeros: list[str] = []
@@ -64,7 +63,7 @@ def _regime_notes(ds: xr.Dataset, name: str, x: np.ndarray, zeros: list[str]) ->
         notes.append(f"exact zeros not drawn: {', '.join(zeros)}")
     return notes
 
-def _resonance_panel(ax: plt.Axes, ds: xr.Dataset, spec: dict[str, Any]) -> None:
+def _resonance_panel(ax: Axes, ds: xr.Dataset, spec: dict[str, Any]) -> None:
     d = ds["resonance_distance"].values.astype(float)
     errors = ds["resonance_error_max_vs_orbit"].values
     status = ds["resonance_status"].values
@@ -80,7 +79,7 @@ def _resonance_panel(ax: plt.Axes, ds: xr.Dataset, spec: dict[str, Any]) -> None
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.22), ncols=2, fontsize=6)
 
 
-def _draw_resonance(ax: plt.Axes, i: int, n: float, s: float, sides: np.ndarray, d: np.ndarray, errors: np.ndarray,
+def _draw_resonance(ax: Axes, i: int, n: float, s: float, sides: np.ndarray, d: np.ndarray, errors: np.ndarray,
                     status: np.ndarray) -> None:
     """The error towards resonance ω = n from both sides, and the distances where it was refused (grey)."""
     for j, side in enumerate(sides):
@@ -92,7 +91,7 @@ def _draw_resonance(ax: plt.Axes, i: int, n: float, s: float, sides: np.ndarray,
         ax.axvspan(min(d) * 0.8, max(refused) * 1.1, color="0.5", alpha=0.12, lw=0)
 
 @styled
-def draw_regime_validity(ds: xr.Dataset) -> plt.Figure:
+def draw_regime_validity(ds: xr.Dataset) -> Figure:
     spec = _spec(ds)
     regimes = [str(d).removesuffix("_parameter") for d in ds.dims if str(d).endswith("_parameter")]
     n = len(regimes) + ("resonance_error_max_vs_orbit" in ds)

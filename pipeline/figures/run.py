@@ -9,19 +9,17 @@ from __future__ import annotations
 
 import gc
 import multiprocessing
-import os
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
 from gyrolab.figures.labels import GAMMA, label, time_label, unit
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.save import metadata_of, save
-from gyrolab.figures.style import (DOUBLE, SINGLE, fast_window, legend_outside, log_positive, panel_note, styled,
-                                   subplots, trace, unit_sphere)
+from gyrolab.figures.style import (DOUBLE, SINGLE, Figure, fast_window, figure, legend_outside, log_positive,
+                                   panel_note, styled, subplots, trace, unit_sphere)
 
 #: invariant variable -> (symbol in a legend, kind of unit)
 INVARIANTS = {"energy": ("energy E", "energy"), "jacobi_integral": ("Jacobi integral H", "energy"),
@@ -39,7 +37,7 @@ def _rows(ds: xr.Dataset) -> list[tuple[str, list[int], list[str], str]]:
 
 
 @styled
-def draw_state(ds: xr.Dataset) -> plt.Figure:
+def draw_state(ds: xr.Dataset) -> Figure:
     """ω = (p, q, r) and γ = (γ₁, γ₂, γ₃) against time: p, q and r on separate axes; the full span (as an
     envelope where the line would be a solid band) and, when it differs, the leading window."""
     t = ds["time"].values
@@ -68,7 +66,7 @@ def draw_state(ds: xr.Dataset) -> plt.Figure:
 
 
 @styled
-def draw_invariants(ds: xr.Dataset) -> plt.Figure:
+def draw_invariants(ds: xr.Dataset) -> Figure:
     """Absolute drift |I(t) − I(0)| of every monitored first integral (log scale; exact zeros are gaps)."""
     fig, axes = subplots(1, 1, width=SINGLE, height=2.9)
     ax = axes[0, 0]
@@ -97,7 +95,7 @@ def draw_invariants(ds: xr.Dataset) -> plt.Figure:
 
 
 @styled
-def draw_euler_angles(ds: xr.Dataset) -> plt.Figure:
+def draw_euler_angles(ds: xr.Dataset) -> Figure:
     """Euler angles ψ, θ, φ (z-x-z, unwrapped) against time."""
     names = [(n, s) for n, s in (("psi", "precession ψ"), ("theta", "nutation θ"), ("phi", "proper rotation φ"))
              if n in ds]
@@ -115,13 +113,13 @@ def draw_euler_angles(ds: xr.Dataset) -> plt.Figure:
 
 
 @styled
-def draw_body_axis(ds: xr.Dataset) -> plt.Figure:
+def draw_body_axis(ds: xr.Dataset) -> Figure:
     """Trace of the body z axis on the unit sphere of the fixed (or orbital/inertial) frame.
 
     gyrolab's fixed Z points along the weight (down): the Z axis of the plot is drawn pointing down, so
     that up on the page is up in the world.
     """
-    fig = plt.figure(figsize=(SINGLE, SINGLE + 0.4), layout="none")  # 3-D axes: margins by hand
+    fig = figure(SINGLE, SINGLE + 0.4, layout="none")  # 3-D axes: margins by hand
     fig.subplots_adjust(left=0.0, right=0.9, top=0.93, bottom=0.14)
     ax = fig.add_subplot(projection="3d")
     unit_sphere(ax)
@@ -152,7 +150,7 @@ def draw_body_axis(ds: xr.Dataset) -> plt.Figure:
     return fig
 
 
-FIGURES: dict[str, Callable[[xr.Dataset], plt.Figure]] = {
+FIGURES: dict[str, Callable[[xr.Dataset], Figure]] = {
     "state": draw_state,
     "invariant_drift": draw_invariants,
     "euler_angles": draw_euler_angles,
@@ -166,24 +164,32 @@ def _draw(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ...], 
 
 
 def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] = DEFAULT_FORMATS,
-                 dpi: int = DEFAULT_DPI, workers: int | None = None) -> list[Path]:
-    """Draw every run figure into ``directory``; on Linux the figures are drawn by forked workers in parallel."""
+                 dpi: int = DEFAULT_DPI) -> list[Path]:
+    """Draw every run figure into ``directory``. On Linux a forked worker draws the state figure (about half the
+    work) while this process draws the others: one fork, not a pool of two (docs/performance.md, "The default
+    run")."""
     directory, formats = Path(directory), tuple(formats)
-    workers = min(len(FIGURES), os.cpu_count() or 1) if workers is None else workers
     jobs = [(name, ds, directory, formats, dpi) for name in FIGURES]
-    if workers > 1 and "fork" in multiprocessing.get_all_start_methods() and not multiprocessing.current_process().daemon:
-        # forked after matplotlib is imported: a worker costs milliseconds, not an import; the parent's objects are
-        # frozen out of the workers' collections and a short-lived worker collects nothing (~0.25 s CPU a run)
+    pool = None
+    if "fork" in multiprocessing.get_all_start_methods() and not multiprocessing.current_process().daemon:
+        # forked after matplotlib is imported: the worker costs milliseconds, not an import; the parent's objects
+        # are frozen out of its collections and, short-lived, it collects nothing
         gc.freeze()
-        pool = multiprocessing.get_context("fork").Pool(workers, initializer=gc.disable)
-        try:
-            results = pool.starmap(_draw, jobs)
-        finally:
-            # close and join, not the context manager's terminate(): terminate kills the workers, and one killed while
-            # it held the task queue's lock left another blocked on that lock and the run waiting for it (a hung run)
+        pool = multiprocessing.get_context("fork").Pool(1, initializer=gc.disable)
+        forked = pool.apply_async(_draw, jobs.pop(0))
+    collecting = gc.isenabled()
+    gc.disable()  # what a figure builds lives until it is saved: a collection meanwhile finds nothing to free
+    try:
+        results = [_draw(*job) for job in jobs]
+        if pool is not None:
+            results.insert(0, forked.get())
+    finally:
+        if collecting:
+            gc.enable()
+        if pool is not None:
+            # close and join, not the context manager's terminate(): terminate kills the worker, and one killed while
+            # it held the task queue's lock left the run waiting for that lock (a hung run)
             pool.close()
             pool.join()
             gc.unfreeze()
-    else:
-        results = [_draw(*job) for job in jobs]
     return [path for paths in results for path in paths]

@@ -13,12 +13,11 @@ from pathlib import Path
 from typing import Any
 
 import matplotlib
-import matplotlib.pyplot as plt
 import xarray as xr
 from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
-from gyrolab.figures.style import STYLE
+from gyrolab.figures.style import RC, Figure
 from gyrolab.output.atomic import atomic_path
 
 logging.getLogger("fontTools").setLevel(logging.WARNING)  # PDF font subsetting logs every table at INFO
@@ -54,24 +53,22 @@ def _for_format(fmt: str, md: Mapping[str, str]) -> dict[str, Any]:
     return {"Title": md.get("Title", ""), "Creator": md.get("Software", "gyrolab"), "Description": text}
 
 
-def save(fig: plt.Figure, stem: str | Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int = DEFAULT_DPI,
-         metadata: Mapping[str, str] | None = None, *, close: bool = True) -> list[Path]:
+def save(fig: Figure, stem: str | Path, formats: Iterable[str] = DEFAULT_FORMATS, dpi: int = DEFAULT_DPI,
+         metadata: Mapping[str, str] | None = None) -> list[Path]:
     """Write ``fig`` to ``stem.<format>`` for each format (``gyrolab.output.atomic``); returns the paths."""
     stem = Path(stem)
     written = []
-    with plt.style.context(STYLE):
+    with matplotlib.rc_context(RC):
         for fmt in formats:
             path = stem.parent / f"{stem.name}.{fmt}"
             with atomic_path(path) as tmp, _laid_out(fig, dpi if fmt == "png" else None):
                 fig.savefig(tmp, format=fmt, dpi=dpi, metadata=_for_format(fmt, metadata or {}), **_LIGHTER.get(fmt, {}))
             written.append(path)
-    if close:
-        plt.close(fig)
     return written
 
 
 @contextmanager
-def _laid_out(fig: plt.Figure, dpi: int | None) -> Iterator[None]:
+def _laid_out(fig: Figure, dpi: int | None) -> Iterator[None]:
     """A constrained layout computed once at the PNG's ``dpi`` and the engine detached meanwhile: with an engine,
     savefig draws the figure twice (once to lay it out, with drawing disabled), the same pixels for ~12 % more CPU."""
     engine = fig.get_layout_engine()
@@ -88,7 +85,7 @@ def _laid_out(fig: plt.Figure, dpi: int | None) -> Iterator[None]:
         fig.set_layout_engine(engine)
 
 
-def save_all(figures: Mapping[str, plt.Figure], directory: str | Path, ds: xr.Dataset,
+def save_all(figures: Mapping[str, Figure], directory: str | Path, ds: xr.Dataset,
              formats: Iterable[str] = DEFAULT_FORMATS, dpi: int = DEFAULT_DPI) -> list[Path]:
     """Save named figures drawn from ``ds`` into ``directory``, each with ``ds``'s provenance."""
     written = []

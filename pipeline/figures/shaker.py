@@ -3,15 +3,14 @@ full model on the exact periodic orbit (the mean spin is removed from φ to show
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import xarray as xr
 
 from gyrolab.figures.labels import time_label
-from gyrolab.figures.style import SINGLE, legend_outside, styled, subplots
+from gyrolab.figures.style import SINGLE, Figure, legend_outside, styled, subplots
 
 
 @styled
-def draw_shaker(ds: xr.Dataset) -> plt.Figure:
+def draw_shaker(ds: xr.Dataset) -> Figure:
     fig, axes = subplots(3, 1, width=SINGLE, height=4.6, sharex="col")
     t = ds["time"].values
     for ax, (name, ylabel) in zip(axes[:, 0], (("theta", "θ (rad)"), ("psi", "ψ (rad)"),

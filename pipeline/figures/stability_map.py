@@ -14,15 +14,15 @@ import math
 from collections.abc import Iterable
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
+import matplotlib
 from matplotlib.colors import Normalize
 
 from gyrolab.errors import ConfigError, OutputError
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.save import save_all
-from gyrolab.figures.style import DOUBLE, panel_note, styled
+from gyrolab.figures.style import DOUBLE, Axes, Figure, figure, panel_note, styled
 from gyrolab.output.user_yaml import stored_yaml
 
 #: colour scale of MEGNO: 0 (stable periodic) … 2 (quasi-periodic) … CLIP and beyond (chaotic)
@@ -114,7 +114,7 @@ def _indicator_label(ds: xr.Dataset) -> str:
     return f"{name} ({attrs.get('units', '1')})"
 
 
-def _mark_regimes(ax: plt.Axes, ds: xr.Dataset, r_lo: float, r_hi: float) -> None:
+def _mark_regimes(ax: Axes, ds: xr.Dataset, r_lo: float, r_hi: float) -> None:
     c = _r0_scale(ds)
     if c is None:
         panel_note(ax, "regime domains not drawn: c unknown for this r0 unit")
@@ -135,7 +135,7 @@ def _mark_regimes(ax: plt.Axes, ds: xr.Dataset, r_lo: float, r_hi: float) -> Non
         panel_note(ax, f"resonance ω = 3 is not on this map ({text}: a property of the body, not of θ0, r0)")
 
 
-def _mark_examples(ax: plt.Axes, ds: xr.Dataset, t_lo: float, t_hi: float, r_lo: float, r_hi: float) -> None:
+def _mark_examples(ax: Axes, ds: xr.Dataset, t_lo: float, t_hi: float, r_lo: float, r_hi: float) -> None:
     c = _r0_scale(ds)
     if c is None:
         return
@@ -150,11 +150,11 @@ def _sections(ds: xr.Dataset) -> int:
 
 
 @styled
-def draw_stability_map(ds: xr.Dataset) -> plt.Figure:
+def draw_stability_map(ds: xr.Dataset) -> Figure:
     if "indicator" not in ds or not {"theta0", "r0"} <= set(ds["indicator"].dims):
         raise OutputError("a stability map needs a variable 'indicator' over the dimensions (theta0, r0)")
     n_sections = _sections(ds)
-    fig = plt.figure(figsize=(DOUBLE, 3.6 + (2.2 if n_sections else 0.0)))
+    fig = figure(DOUBLE, 3.6 + (2.2 if n_sections else 0.0))
     grid = fig.add_gridspec(2 if n_sections else 1, max(2, n_sections), height_ratios=[1.7, 1] if n_sections else [1])
     top = grid[0, :].subgridspec(1, 2, width_ratios=[1.25, 1])
     map_ax, dev_ax = fig.add_subplot(top[0]), fig.add_subplot(top[1])
@@ -164,7 +164,7 @@ def draw_stability_map(ds: xr.Dataset) -> plt.Figure:
     indicator = _values(ds, "indicator")
     is_megno = str(ds["indicator"].attrs.get("indicator_name", "MEGNO")) == "MEGNO"
     norm = Normalize(0.0, CLIP) if is_megno else Normalize(*np.nanpercentile(indicator, [1, 99]))
-    cmap = plt.get_cmap("magma").with_extremes(bad="0.75")
+    cmap = matplotlib.colormaps["magma"].with_extremes(bad="0.75")
     mesh = map_ax.pcolormesh(r_edges, t_edges, np.ma.masked_invalid(indicator), cmap=cmap, norm=norm,
                              shading="flat", rasterized=True)
     bar = fig.colorbar(mesh, ax=map_ax, extend="max" if is_megno else "neither", pad=0.02)
@@ -200,7 +200,7 @@ def draw_stability_map(ds: xr.Dataset) -> plt.Figure:
     return fig
 
 
-def _draw_sections(fig: plt.Figure, grid, ds: xr.Dataset, map_ax: plt.Axes, count: int) -> None:
+def _draw_sections(fig: Figure, grid, ds: xr.Dataset, map_ax: Axes, count: int) -> None:
     for k in range(count):
         ax = fig.add_subplot(grid[1, k])
         phi = ds["section_phi"].values[k]

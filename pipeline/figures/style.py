@@ -2,7 +2,8 @@
 
 ``STYLE`` (``gyrolab.mplstyle``) is applied by ``styled`` around every ``draw_*`` function and by
 ``gyrolab.figures.save.save`` around writing, so a figure looks the same whatever the caller's
-matplotlib settings, and the caller's settings are left as they were.
+matplotlib settings, and the caller's settings are left as they were. Figures are ``Figure`` objects
+rendered by Agg (``figure``), not pyplot's: nothing to close, and pyplot is not imported.
 """
 
 from __future__ import annotations
@@ -15,10 +16,14 @@ from typing import Any, TypeVar
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.axes import Axes  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 
 STYLE = Path(__file__).with_name("gyrolab.mplstyle")
+#: the style's settings, read once: ``matplotlib.rc_context(RC)`` is ``matplotlib.style.context(STYLE)``
+RC = matplotlib.rc_params_from_file(STYLE, use_default_template=False)
 #: journal column widths in inches (single column, double column / full page width)
 SINGLE = 3.5
 DOUBLE = 7.1
@@ -34,7 +39,7 @@ def styled(draw: F) -> F:
     """Run a drawing function inside gyrolab's style context; its log axes get readable ticks."""
     @functools.wraps(draw)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        with plt.style.context(STYLE):
+        with matplotlib.rc_context(RC):
             fig = draw(*args, **kwargs)
             for ax in fig.axes:
                 if ax.name == "rectilinear":
@@ -43,7 +48,7 @@ def styled(draw: F) -> F:
     return wrapper  # type: ignore[return-value]
 
 
-def tidy_log(ax: plt.Axes) -> None:
+def tidy_log(ax: Axes) -> None:
     """Log axes: no labels on minor ticks (they collide on narrow panels); an axis spanning less than
     about two decades gets majors at 1, 2, 5 × 10ⁿ instead, so it is never left without a label."""
     for axis, limits in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
@@ -57,14 +62,21 @@ def tidy_log(ax: plt.Axes) -> None:
         axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
+def figure(width: float, height: float, **kwargs: Any) -> Figure:
+    """A figure of ``width`` × ``height`` inches rendered by Agg (``kwargs``: ``Figure``'s, e.g. ``layout``)."""
+    fig = Figure(figsize=(width, height), **kwargs)
+    FigureCanvasAgg(fig)
+    return fig
+
+
 def subplots(nrows: int = 1, ncols: int = 1, *, width: float = SINGLE, height: float | None = None,
-             **kwargs: Any) -> tuple[plt.Figure, np.ndarray]:
+             **kwargs: Any) -> tuple[Figure, np.ndarray]:
     """A grid of panels at a journal column width (``SINGLE`` or ``DOUBLE``); axes always 2-D."""
-    height = height if height is not None else 1.0 + 1.7 * nrows
-    return plt.subplots(nrows, ncols, figsize=(width, height), squeeze=False, **kwargs)
+    fig = figure(width, height if height is not None else 1.0 + 1.7 * nrows)
+    return fig, fig.subplots(nrows, ncols, squeeze=False, **kwargs)
 
 
-def legend_outside(fig: plt.Figure, axes: Sequence[plt.Axes] | None = None, *, ncols: int | None = None,
+def legend_outside(fig: Figure, axes: Sequence[Axes] | None = None, *, ncols: int | None = None,
                    where: str = "lower center") -> None:
     """One legend for the figure, outside every panel (it never covers data); duplicates merged."""
     handles, labels = {}, []
@@ -78,7 +90,7 @@ def legend_outside(fig: plt.Figure, axes: Sequence[plt.Axes] | None = None, *, n
         fig.legend([handles[label] for label in labels], labels, loc=loc, ncols=ncols or min(len(labels), 4))
 
 
-def panel_note(ax: plt.Axes, text: str) -> None:
+def panel_note(ax: Axes, text: str) -> None:
     """A short note above the panel's upper left corner (outside the data); notes accumulate, one per line."""
     before = ax.get_title(loc="left")
     ax.set_title(f"{before}\n{text}" if before else text, loc="left", fontsize=6.5, color="0.3")
@@ -94,7 +106,7 @@ def oscillations(y: np.ndarray) -> int:
     return int(np.count_nonzero(sign[1:] * sign[:-1] < 0) // 2)
 
 
-def trace(ax: plt.Axes, t: np.ndarray, y: np.ndarray, *, label: str | None = None, **style: Any) -> bool:
+def trace(ax: Axes, t: np.ndarray, y: np.ndarray, *, label: str | None = None, **style: Any) -> bool:
     """A line, or the min–max envelope of the series over ``ENVELOPE_BINS`` bins when the line would
     be a solid band (more than ``MAX_OSCILLATIONS`` oscillations); True when the envelope was drawn.
     Each bin spans about two oscillations, so the band is the envelope, not the oscillation itself."""

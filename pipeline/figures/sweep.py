@@ -14,7 +14,6 @@ import itertools
 from collections.abc import Iterable
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
@@ -23,7 +22,7 @@ from gyrolab.figures.labels import GAMMA, OMEGA, label, unit
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.run import INVARIANTS
 from gyrolab.figures.save import save_all
-from gyrolab.figures.style import DOUBLE, SINGLE, legend_outside, panel_note, styled, subplots
+from gyrolab.figures.style import DOUBLE, SINGLE, Axes, Figure, legend_outside, panel_note, styled, subplots
 from gyrolab.output.units import KINDS
 
 MAX_SERIES = 8
@@ -90,7 +89,7 @@ def _ylabel(name: str, unit_text: str) -> str:
     return text if len(text) <= LABEL_WIDTH or not unit_text else f"{name}\n({unit_text})"
 
 
-def _draw(ds: xr.Dataset, panels: list[Panel], title: str) -> plt.Figure:
+def _draw(ds: xr.Dataset, panels: list[Panel], title: str) -> Figure:
     dims = ds.attrs["sweep_dims"].split()
     xdim = choose_x(ds, dims)
     ncols = min(3, len(panels))
@@ -108,19 +107,19 @@ def _draw(ds: xr.Dataset, panels: list[Panel], title: str) -> plt.Figure:
 
 
 @styled
-def draw_final_state(ds: xr.Dataset) -> plt.Figure:
+def draw_final_state(ds: xr.Dataset) -> Figure:
     """ω and γ at the last output time of every job against the swept values."""
     return _draw(ds, _final_state(ds), "Final state")
 
 
 @styled
-def draw_invariant_drift(ds: xr.Dataset) -> plt.Figure:
+def draw_invariant_drift(ds: xr.Dataset) -> Figure:
     """Each monitored invariant's max |I(t) − I(0)| against the swept values (log scale)."""
     return _draw(ds, _drift(ds), "Drift of the invariants")
 
 
 @styled
-def draw_cost(ds: xr.Dataset) -> plt.Figure:
+def draw_cost(ds: xr.Dataset) -> Figure:
     """Integrator evaluations and wall time against the swept values (log scale)."""
     fig = _draw(ds, _cost(ds), "Cost")
     notes = [f"{name}: {what}" for name, what in nfev_notes(ds).items()]   # what each integrator's count counts
@@ -129,7 +128,7 @@ def draw_cost(ds: xr.Dataset) -> plt.Figure:
     return fig
 
 
-def _panel(ax: plt.Axes, da: xr.DataArray, xdim: str, log: bool, ds: xr.Dataset) -> None:
+def _panel(ax: Axes, da: xr.DataArray, xdim: str, log: bool, ds: xr.Dataset) -> None:
     x = da[xdim].values
     numeric = x.dtype.kind in "iuf"
     positions = x.astype(float) if numeric else np.arange(len(x), dtype=float)

@@ -4,16 +4,15 @@ drawn on it: they are marked ▼ on the bottom edge of the panel and the legend 
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from gyrolab.figures.style import DOUBLE, legend_outside, log_positive, styled, subplots
+from gyrolab.figures.style import DOUBLE, Axes, Figure, legend_outside, log_positive, styled, subplots
 
 COLUMN = "gamma2"
 
 
-def _zeros(ax: plt.Axes, t: np.ndarray, values: np.ndarray, color: str) -> None:
+def _zeros(ax: Axes, t: np.ndarray, values: np.ndarray, color: str) -> None:
     zero = values == 0
     if zero.any():
         ax.plot(t[zero], np.zeros(int(zero.sum())), "v", color=color, ms=4, clip_on=False,
@@ -21,7 +20,7 @@ def _zeros(ax: plt.Axes, t: np.ndarray, values: np.ndarray, color: str) -> None:
 
 
 @styled
-def draw_tables(ds: xr.Dataset) -> plt.Figure:
+def draw_tables(ds: xr.Dataset) -> Figure:
     fig, axes = subplots(1, 2, width=DOUBLE, height=3.0)
     left, right = axes[0]
     t = ds["t"].values

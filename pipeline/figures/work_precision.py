@@ -15,11 +15,10 @@ legend says which coincide, so no series hides another.
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
-from gyrolab.figures.style import SINGLE, legend_outside, log_positive, panel_note, styled, subplots
+from gyrolab.figures.style import SINGLE, Figure, legend_outside, log_positive, panel_note, styled, subplots
 from gyrolab.figures.evaluations import chooses_method, nfev_counts
 
 MARKERS = "osD^v<>ph*"
@@ -41,7 +40,7 @@ def _coincide(xs: np.ndarray, errs: np.ndarray, other: tuple[np.ndarray, np.ndar
     return bool(np.any(np.isclose(xs[:, None], ox[None, :], rtol=1e-9) & np.isclose(errs[:, None], oe[None, :], rtol=1e-9)))
 
 
-def _draw(ds: xr.Dataset, x: str, methods: list[str], xlabel: str) -> plt.Figure:
+def _draw(ds: xr.Dataset, x: str, methods: list[str], xlabel: str) -> Figure:
     fig, axes = subplots(1, 1, width=SINGLE, height=3.6)
     ax = axes[0, 0]
     everyone = _methods(ds)
@@ -66,7 +65,7 @@ def _draw(ds: xr.Dataset, x: str, methods: list[str], xlabel: str) -> plt.Figure
 
 
 @styled
-def draw_error_vs_wall_time(ds: xr.Dataset) -> plt.Figure:
+def draw_error_vs_wall_time(ds: xr.Dataset) -> Figure:
     """Error against the smallest CPU time of a whole run, every method (auto: pilot runs included).
 
     The figure keeps its name; a file written before CPU time was measured is drawn against its wall time.
@@ -83,7 +82,7 @@ def draw_error_vs_wall_time(ds: xr.Dataset) -> plt.Figure:
 
 
 @styled
-def draw_error_vs_nfev(ds: xr.Dataset) -> plt.Figure:
+def draw_error_vs_nfev(ds: xr.Dataset) -> Figure:
     """Error against right-hand-side calls, for the methods whose evaluations are right-hand-side calls."""
     methods = _methods(ds)
     counts = _nfev_counts(ds)

@@ -297,7 +297,7 @@ def test_a_figure_laid_out_once_has_the_pixels_of_matplotlibs_own_save(run_dir, 
         theirs.savefig(tmp_path / "theirs.png", dpi=120)
     ours = draw_state(ds)
     engine = ours.get_layout_engine()
-    save(ours, tmp_path / "ours", ("png",), 120, close=False)
+    save(ours, tmp_path / "ours", ("png",), 120)
     assert ours.get_layout_engine() is engine  # left as it was
     plt.close("all")
     with Image.open(tmp_path / "theirs.png") as theirs, Image.open(tmp_path / "ours.png") as ours:
