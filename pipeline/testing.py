@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.contracts.claims import _rotation, random_states, rotation_torque  # noqa: F401
+from gyrolab.contracts.claims import random_states, rotation_torque
 from gyrolab.contracts.claims import axes_of as _axes
 from gyrolab.contracts.force import Force
 from gyrolab.contracts.integrator import COMPILED_MODEL, Integrator, IntegratorStats, Solution
@@ -78,6 +78,20 @@ def _fail(cls: type, message: str) -> AssertionError:
     return AssertionError(f"{cls.__name__}: {message}")
 
 
+def _check_class(cls: type, contract: type, key: str) -> None:
+    """``cls`` subclasses ``contract`` and its ``name`` is a config key (``key`` says where the config names it)."""
+    if not (isinstance(cls, type) and issubclass(cls, contract)):
+        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.{contract.__name__}")
+    name = getattr(cls, "name", None)
+    if not isinstance(name, str) or not _NAME.match(name):
+        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ ({key})")
+
+
+def _as_config(params: dict[str, Any]) -> dict[str, Any]:
+    """The kit's keyword parameters as a config gives them (arrays as lists)."""
+    return {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
+
+
 def check_force(cls: type, body: Any = None, *, n_states: int = 20, **params: Any) -> None:
     """Check a force plugin class against the Force contract; AssertionError names the first violation.
 
@@ -98,33 +112,22 @@ def check_force(cls: type, body: Any = None, *, n_states: int = 20, **params: An
     AssertionError
         Naming the first rule the plugin breaks.
     """
-    if not (isinstance(cls, type) and issubclass(cls, Force)):
-        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Force")
+    _check_class(cls, Force, "the config key force.NAME")
     body = _test_body() if body is None else body
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not _NAME.match(name):
-        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config key force.NAME)")
-    where = f"force.{name}"
-    params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}  # as a config gives them
-    try:
-        force = build_force(cls, dict(params), where, body)
-    except ConfigError as exc:
-        raise _fail(cls, f"building it with {params} raised ConfigError: {exc}") from None
-    _check_declarations(cls, force)
+    where = f"force.{cls.name}"
+    params = _as_config(params)
+    force = _build_plugin(lambda **kw: build_force(cls, kw, where, body), cls, params)
+    axes = force.required_axes
+    if not isinstance(axes, (set, frozenset)) or not set(axes) <= {0, 1, 2}:
+        raise _fail(cls, f"required_axes={axes!r} must be a frozenset of axis indices 0, 1, 2")
     omegas, frames = random_states(n_states)
     torques = _check_torque(cls, force, omegas, frames)
     _check_area_flag(cls, force, torques, frames)
     if force.conservative:
         _check_potential(cls, force, frames)
-    _check_attributes(cls, force)
-    _check_bad_parameters(cls, body, where, params)
+    _check_mapping(cls, force.attributes(), "attributes()")
+    _check_bad_parameters(cls, params, "", lambda **kw: build_force(cls, kw, where, body))
     _check_compiled(cls, force, body, omegas, frames)
-
-
-def _check_declarations(cls: type, force: Force) -> None:
-    axes = force.required_axes
-    if not isinstance(axes, (set, frozenset)) or not set(axes) <= {0, 1, 2}:
-        raise _fail(cls, f"required_axes={axes!r} must be a frozenset of axis indices 0, 1, 2")
 
 
 def _check_torque(cls: type, force: Force, omegas: np.ndarray, frames: np.ndarray) -> np.ndarray:
@@ -189,31 +192,6 @@ def _netcdf_safe(value: Any) -> bool:
         items = list(np.asarray(value, dtype=object).reshape(-1))
         return bool(items) and all(not isinstance(v, (bool, np.bool_, str)) and _netcdf_safe(v) for v in items)
     return False
-
-
-def _check_attributes(cls: type, force: Force) -> None:
-    _check_mapping(cls, force.attributes(), "attributes()")
-
-
-def _check_bad_parameters(cls: type, body: Any, where: str, params: dict[str, Any]) -> None:
-    for key, param in inspect.signature(cls.__init__).parameters.items():
-        if param.kind is not inspect.Parameter.KEYWORD_ONLY or (param.default is None and key not in params):
-            continue  # a parameter off by default is checked when the caller gives it
-        for bad in ("abc",):  # NaN and inf never reach a plugin: the scene refuses non-finite config values
-            try:
-                build_force(cls, {**params, key: bad}, where, body)
-            except ConfigError as exc:
-                message = str(exc)
-                if key not in message or "\n" in message.strip():
-                    raise _fail(cls, f"{key}={bad!r} raised a ConfigError that does not name the parameter in one "
-                                     f"line: {message!r}") from None
-                continue
-            except Exception as exc:  # noqa: BLE001  (anything but ConfigError is the violation)
-                raise _fail(cls, f"{key}={bad!r} raised {type(exc).__name__}: {exc}; raise gyrolab.errors."
-                                 "ConfigError naming the parameter (gyrolab.errors.as_number validates numbers)") \
-                    from None
-            raise _fail(cls, f"{key}={bad!r} was accepted; validate the parameter and raise gyrolab.errors."
-                             "ConfigError (gyrolab.errors.as_number does it for numbers)")
 
 
 def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, frames: np.ndarray) -> None:
@@ -350,19 +328,15 @@ def check_integrator(cls: type, **params: Any) -> None:
     and no torque, whose ω turns at a constant rate), ``nfev`` > 0 only, and rule 7 is skipped (a blow-up has no
     compiled model).
     """
-    if not (isinstance(cls, type) and issubclass(cls, Integrator)):
-        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Integrator")
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not _NAME.match(name):
-        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config's integrator=NAME)")
+    _check_class(cls, Integrator, "the config's integrator=NAME")
     if not isinstance(getattr(cls, "adaptive", None), bool):
         raise _fail(cls, f"adaptive={getattr(cls, 'adaptive', None)!r} must be declared True or False")
     capabilities = getattr(cls, "capabilities", frozenset())
     if not isinstance(capabilities, frozenset) or not all(isinstance(c, str) for c in capabilities):
         raise _fail(cls, f"capabilities={capabilities!r} must be a frozenset of capability names (str)")
-    params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
-    integrator = _build_plugin(cls, params)
-    _check_bad_plugin_parameters(cls, params, "integrator")
+    params = _as_config(params)
+    integrator = _build_plugin(cls, cls, params)
+    _check_bad_parameters(cls, params, "integrator.", cls)
     if cls.supports(COMPILED_MODEL):
         stats = _check_exact_problem(cls, integrator, free_top_problem())
     else:
@@ -372,10 +346,10 @@ def check_integrator(cls: type, **params: Any) -> None:
     _check_mapping(cls, integrator.attributes(), "attributes()")
 
 
-def _build_plugin(cls: type, params: dict[str, Any], *args: Any) -> Any:
-    """The plugin built with ``params`` (after the positional ``args`` a scene passes: a system's body, ...)."""
+def _build_plugin(build: Any, cls: type, params: dict[str, Any]) -> Any:
+    """``build(**params)``: the plugin ``cls`` built as a scene builds it."""
     try:
-        return cls(*args, **params)
+        return build(**params)
     except ConfigError as exc:
         raise _fail(cls, f"building it with {params} raised ConfigError: {exc}") from None
 
@@ -482,23 +456,24 @@ def _check_mapping(cls: type, attrs: Any, what: str) -> None:
                              "list of finite numbers (no bool, None or dict)")
 
 
-def _check_bad_plugin_parameters(cls: type, params: dict[str, Any], group: str, *args: Any) -> None:
-    """Every keyword parameter set to "abc" must raise one ConfigError line naming it (as ``check_force`` rule 6)."""
+def _check_bad_parameters(cls: type, params: dict[str, Any], prefix: str, build: Any) -> None:
+    """Every keyword parameter set to "abc" must make ``build(**params)`` raise one ConfigError line naming it
+    (NaN and inf never reach a plugin: the scene refuses non-finite config values)."""
     for key, param in inspect.signature(cls.__init__).parameters.items():
         if param.kind is not inspect.Parameter.KEYWORD_ONLY or (param.default is None and key not in params):
-            continue
+            continue  # a parameter off by default is checked when the caller gives it
         try:
-            cls(*args, **{**params, key: "abc"})
+            build(**{**params, key: "abc"})
         except ConfigError as exc:
             message = str(exc)
             if key not in message or "\n" in message.strip():
-                raise _fail(cls, f"{group}.{key}='abc' raised a ConfigError that does not name the parameter in "
+                raise _fail(cls, f"{prefix}{key}='abc' raised a ConfigError that does not name the parameter in "
                                  f"one line: {message!r}") from None
             continue
-        except Exception as exc:  # noqa: BLE001
-            raise _fail(cls, f"{group}.{key}='abc' raised {type(exc).__name__}: {exc}; raise gyrolab.errors."
+        except Exception as exc:  # noqa: BLE001  (anything but ConfigError is the violation)
+            raise _fail(cls, f"{prefix}{key}='abc' raised {type(exc).__name__}: {exc}; raise gyrolab.errors."
                              "ConfigError naming the parameter (gyrolab.errors.as_number validates numbers)") from None
-        raise _fail(cls, f"{group}.{key}='abc' was accepted; validate the parameter and raise gyrolab.errors."
+        raise _fail(cls, f"{prefix}{key}='abc' was accepted; validate the parameter and raise gyrolab.errors."
                          "ConfigError (gyrolab.errors.as_number does it for numbers)")
 
 
@@ -558,11 +533,7 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
        one, computes ``rhs`` (to 1e-12) at random states and its Taylor integrator follows the DOP853 trajectory of 6.
        A system that cannot be traced is warned about (it runs with the Python integrators only), not failed.
     """
-    if not (isinstance(cls, type) and issubclass(cls, System)):
-        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.System")
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not _NAME.match(name):
-        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config's system=NAME)")
+    _check_class(cls, System, "the config's system=NAME")
     body_type = getattr(cls, "body_type", None)
     if not callable(getattr(body_type, "from_config", None)):
         raise _fail(cls, f"body_type={body_type!r} must be a class with from_config(body section)")
@@ -573,8 +544,11 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
     built_forces = [build_force(force_cls, dict(force_params), f"force.{force_cls.name}", built_body)
                     for force_cls, force_params in forces]
     output = {"euler_angles": True} if output is None else dict(output)
-    system = _build_plugin(cls, params, built_body, built_forces, dict(initial), output)
-    _check_bad_plugin_parameters(cls, params, "system", built_body, built_forces, dict(initial), output)
+    def build(**kw: Any) -> Any:
+        return cls(built_body, built_forces, dict(initial), output, **kw)
+
+    system = _build_plugin(build, cls, params)
+    _check_bad_parameters(cls, params, "system.", build)
     y0 = _check_state(cls, system)
     t, y = _integrate_tightly(cls, system, y0, span)
     _check_variables(cls, system, t, y)
@@ -722,12 +696,11 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     7. ``euler_angles(system, t)`` has exactly the keys psi, theta, phi, each a finite array of shape (n,);
     8. ``attributes()`` is netCDF-safe.
     """
-    if not (isinstance(cls, type) and issubclass(cls, Regime)):
-        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Regime")
+    _check_class(cls, Regime, "the config's regime=NAME")
     _check_regime_declarations(cls)
-    params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
-    regime = _build_plugin(cls, params)
-    _check_bad_plugin_parameters(cls, params, "regime")
+    params = _as_config(params)
+    regime = _build_plugin(cls, cls, params)
+    _check_bad_parameters(cls, params, "regime.", cls)
     if isinstance(scene, System):
         system = scene
     else:
@@ -763,9 +736,6 @@ def _check_regime_numbers(cls: type, regime: Any, system: Any) -> None:
 
 
 def _check_regime_declarations(cls: type) -> None:
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not _NAME.match(name):
-        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config's regime=NAME)")
     systems = getattr(cls, "systems", None)
     if not isinstance(systems, tuple) or not systems or not all(isinstance(s, str) for s in systems):
         raise _fail(cls, f"systems={systems!r} must be a non-empty tuple of the system names it is derived for")
