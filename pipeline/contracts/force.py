@@ -30,18 +30,8 @@ class Force(ABC):
        bad input. A ``ValueError`` or ``TypeError`` escaping ``__init__``
        (``float("abc")``) is reported by gyrolab as one sentence naming the
        parameter; any other exception as one sentence naming the plugin.
-
-       What ``body`` offers (read it in ``__init__``, keep what the torque
-       needs as plain floats or arrays): for ``system=fixed_point`` a
-       ``gyrolab.physics.body.Body`` with ``units`` (``"si"`` or
-       ``"nondimensional"``), ``inertia`` (A, B, C), ``weight_moment``
-       (M g r_c, a torque), ``g`` (SI only, else None), ``nonphysical``,
-       ``source`` (the config as given) and the unit names ``time_unit``,
-       ``rate_unit``, ``torque_unit``, ``energy_unit``, ``momentum_unit``
-       (for ``attributes()``); for ``system=orbiting_gyrostat`` a
-       ``gyrolab.physics.gyrostat_body.GyrostatBody`` (``inertia``,
-       ``gyrostatic_momentum``, ``orbit_rate``, ``units``, the same unit
-       names); a system plugin passes its own ``body_type``.
+       Read what the torque needs from ``body`` in ``__init__`` and keep it as
+       plain floats or arrays (docs/plugins.md, "What body offers a force").
     2. ``required_axes`` names the reference-frame axes (0, 1, 2) whose body
        components ``torque`` and ``potential`` read. A system carries an axis
        only if some force (or the output) needs it, so ask for no more; an axis
@@ -79,16 +69,9 @@ class Force(ABC):
        trace; not with ``integrator.precision=double-double``), ``gyrolab batch`` and
        ``auto``, but not with ``lie_poisson``, which takes the built-in forms only.
 
-    What gyrolab enforces on a third-party force (gyrolab's own are trusted),
-    each failure one sentence naming the force (docs/plugins.md, "What the
-    engine checks"): when the scene is built, the claims of rules 5 and 6 are
-    measured at the initial state and seeded random states
-    (``gyrolab.contracts.claims``; a false one is a ConfigError); during a run
-    on the Python right-hand side, a torque that raises or breaks rule 3
-    (None, a string, a wrong shape, NaN) ends the run as an IntegrationError
-    (``gyrolab.engine.force_guard``); after it, an invariant whose drift the
-    integration error does not explain is flagged in ``run.nc``
-    (``gyrolab.output.invariant_check``).
+    gyrolab checks a third-party force's claims (rules 5, 6) when the scene is
+    built and its torque (rule 3) during a run, each failure one sentence naming
+    the force (docs/plugins.md, "What the engine checks").
     """
 
     name: ClassVar[str]

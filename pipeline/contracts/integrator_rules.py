@@ -2,8 +2,7 @@
 
 ``Integrator.__init_subclass__`` wraps each subclass's own ``integrate`` with :func:`checked`, so the
 rules hold for gyrolab's integrators and third-party ones alike without asking anyone to rename a
-method (as scipy's ``OdeSolver.step`` owns the checks around a solver's ``_step_impl``). The checks
-are vectorised: for a 2,001 × 6 output they cost a few microseconds of a ~2 ms compiled run.
+method (as scipy's ``OdeSolver.step`` owns the checks around a solver's ``_step_impl``).
 """
 
 from __future__ import annotations
@@ -70,7 +69,7 @@ def check_inputs(name: str, t_out: Any, y0: Any) -> tuple[np.ndarray, np.ndarray
                                f"({np.count_nonzero(~np.isfinite(y0))} non-finite values); it takes one finite "
                                "1-D state")
     # finite ends and every step positive (a NaN compares false, an inf inside makes a step not positive): one
-    # comparison of the shifted times instead of np.diff and np.isfinite (8 of a 160 µs compiled run's 10 µs)
+    # comparison of the shifted times, cheaper than np.diff and np.isfinite
     if (t_out.ndim != 1 or len(t_out) < 1 or not (math.isfinite(t_out[0]) and math.isfinite(t_out[-1]))
             or not np.greater(t_out[1:], t_out[:-1]).all()):
         raise IntegrationError(f"integrator {name!r} was given output times that are not finite and strictly "

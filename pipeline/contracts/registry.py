@@ -1,17 +1,9 @@
 """One registry of plugins: gyrolab's built-ins plus ``gyrolab.*`` entry points.
 
-Names are listed without importing anything; a plugin's module is imported
-the first time a scene asks for it. A config's ``_target_`` may only name a
-registered class of the group's contract, so a YAML file cannot make gyrolab
-call arbitrary code.
-
-A third-party plugin that cannot be used — its module fails to import (any
-exception), its entry point names no subclass of the contract, or its
-``__init__`` takes ``**params`` — never breaks a command that does not use it:
-``load`` raises one ``ConfigError`` naming the plugin, its distribution, its
-entry point and the error, and whoever lists every plugin (the config
-composition) turns that into one ``PluginLoadWarning`` and goes on, as xarray
-does with its backends.
+Names are listed without importing anything; a plugin's module is imported the first time a scene asks for it.
+A third-party plugin that cannot be used never breaks a command that does not use it (docs/plugins.md, "What the
+engine checks", "Installing"): ``load`` raises one ``ConfigError`` naming it, which the config composition turns
+into one ``PluginLoadWarning``.
 """
 
 from __future__ import annotations

@@ -1,16 +1,5 @@
-"""Requests gyrolab refuses before anything runs: tolerances outside (0, 1), and plainly infeasible work.
-
-The budget (docs/configs.md "Your own configs"): the state array of one run at most
-:data:`MAX_STATE_BYTES` (n_output × state size × 8 bytes), and at most
-:data:`MAX_STEPS` integrator steps, estimated from below:
-
-- a fixed-step integrator (``step``) or a step bound (``max_step``) takes at least
-  span / step steps;
-- any integrator takes at least one step per output interval, and at least one step
-  per :data:`RADIANS_PER_STEP` radians the body turns (|ω0| × span; an adaptive
-  method that resolves the rotation does far more).
-
-A top-level ``allow_large=true`` lifts the budget for people who mean it.
+"""Requests gyrolab refuses before anything runs: tolerances outside (0, 1), and plainly infeasible work
+(the budget: docs/configs.md, "Your own configs"; ``allow_large=true`` lifts it).
 """
 
 from __future__ import annotations

@@ -1,16 +1,7 @@
-"""The scene's Python right-hand side, guarded when a third-party force takes part.
-
-gyrolab's own forces (``gyrolab.plugins.forces``) are trusted and run unguarded. A plugin force's
-torque may raise, return None, a string, the wrong shape or NaN; in the bare right-hand side that
-ends as a traceback deep inside scipy, or — for NaN — as a DOP853 that rejects every step and never
-returns. :class:`GuardedRhs` makes each of these one ``IntegrationError`` sentence naming the force:
-
-* the first call inspects every plugin torque (type, dtype, shape (3,), finite);
-* every call checks that the derivative is finite (one vectorised test, ~1 µs) and turns any
-  exception into a sentence; on a failure the state is inspected again to name the force at fault.
-
-The compiled path does not call the Python torque (it runs the traced one, ``expression``); a
-torque that cannot be traced runs here.
+"""The scene's Python right-hand side, guarded when a third-party force takes part (docs/plugins.md, "What the
+engine checks"): a plugin torque that raises, returns None or the wrong shape, or NaN (on which DOP853 would reject
+every step and never return) becomes one ``IntegrationError`` sentence naming the force. gyrolab's own forces run
+unguarded.
 """
 
 from __future__ import annotations

@@ -30,13 +30,9 @@ COMPILE_LOGGERS = ("gyrolab.kernels.expression",)
 
 @contextlib.contextmanager
 def compile_notes_on_console(stream: TextIO | None = None) -> Iterator[None]:
-    """Show the compile notes of ``COMPILE_LOGGERS`` on ``stream`` (stderr) while logging is not configured yet.
-
-    The command's preflight builds the scene before Hydra configures logging, and building it compiles a force
-    plugin's torque (once; later processes load the cache). Without a handler Python drops an INFO record, and
-    the run itself no longer compiles: the note "compiling force NAME, once" was never seen. Nothing changes
-    when logging is configured already (a handler on the root logger).
-    """
+    """Show the compile notes of ``COMPILE_LOGGERS`` on ``stream`` (stderr) while logging is not configured yet:
+    the preflight builds the scene (compiling a plugin torque, once) before Hydra configures logging, and Python
+    drops an INFO record without a handler."""
     if logging.getLogger().handlers:
         yield
         return

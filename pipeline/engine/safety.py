@@ -1,12 +1,7 @@
 """No config and no dataset can run code: the one place where gyrolab decides what a config may name.
 
-Threat model: a YAML file (an experiment, a primary config, a whole ``--config-dir``) or a ``run.nc`` that someone
-else wrote; installed packages are trusted (they could run code anyway), text is not. :func:`check_config` is
-applied by the preflight to every composed config (each group choice of a sweep too) before Hydra creates a
-directory, instantiates a callback or configures logging, and by ``reproduce`` and ``batch`` to the configs they
-build. The rules (allowlisted ``_target_``s, Hydra's logging configs, paths inside the run directory, thread
-counts only in ``env_set``, the launchers' shell lines) are listed in docs/safety.md, "Safety and failures"; each
-refusal is one ConfigError sentence naming the key.
+The threat model and the rules are in docs/safety.md, "Safety and failures"; :func:`check_config` is applied to
+every composed config before Hydra creates a directory, instantiates a callback or configures logging.
 """
 
 from __future__ import annotations

@@ -1,21 +1,8 @@
-"""Config values a run would not read: refused when the user gave them, said and recorded when a config file did.
+"""Config values a run would not read: refused when the user gave them, said and recorded when a config file did
+(docs/configs.md, "Values a run does not read").
 
-A value that is set but read by nothing is the worst defect a scientific tool can have: the run succeeds and
-the user believes they got what they asked for. ``integrator=taylor accuracy=1e-8`` ran Taylor at its own
-tolerance, exit 0, and nothing said that the 1e-8 target went nowhere.
-
-The top-level ``accuracy`` is read only by an integrator whose settings refer to it (``conf/integrator/auto.yaml``:
-``accuracy: ${accuracy}``; a user's ``integrator.tol='${accuracy}'`` reads it too). Whether it is read is read
-off the composed config — does a value of the integrator's node refer to ``accuracy``, directly or through other
-keys? — never off the integrator's name. What happens when it is not read depends on who set it (docs/configs.md, "Values a run
-does not read"):
-
-* given explicitly (the command line, ``compose_scene``'s overrides, a sweep's value for every job): the
-  user asked for that target and would not get it, so the run is refused before anything is written, in one
-  sentence naming the value, the integrator and the ways out;
-* from a config file (an experiment's default for ``integrator=auto``: ``experiment=perf_reference
-  integrator=taylor`` is a legitimate comparison): the run proceeds, logs one warning and records the same
-  sentence in its dataset (``accuracy_ignored``), so that the dataset cannot be mistaken for a run at that target.
+The top-level ``accuracy`` is read only by an integrator whose settings refer to it (``accuracy: ${accuracy}``),
+which is read off the composed config, never off the integrator's name.
 """
 
 from __future__ import annotations
