@@ -34,6 +34,7 @@ from gyrolab.compat import Hydra, create_automatic_config_search_path
 from gyrolab.contracts import registry
 from gyrolab.engine.schemas import (
     SELECTABLE_GROUPS,
+    leaves,
     missing_section,
     plugin_schema,
     required_sections,
@@ -67,18 +68,11 @@ class ConfigSource:
     def from_args(cls, config_path: str | None, config_name: str | None, config_dir: str | None) -> ConfigSource:
         """The source Hydra would use for these command-line options; ConfigError for a missing directory."""
         if config_dir is not None:
-            config_dir = os.path.abspath(config_dir)
-            if not os.path.isdir(config_dir):
-                raise ConfigError(f"--config-dir {config_dir!r} is not a directory; give the folder that holds "
-                                  "your YAML files (e.g. --config-dir myconf)")
-            check_user_config_dir(config_dir, "--config-dir")
+            config_dir = _user_dir(config_dir, "--config-dir", "your YAML files (e.g. --config-dir myconf)")
             warn_shadowed(config_dir, "--config-dir")
         if config_path is not None and not config_path.startswith("pkg://"):
-            config_path = os.path.abspath(config_path)
-            if not os.path.isdir(config_path):
-                raise ConfigError(f"--config-path {config_path!r} is not a directory; give the folder that holds "
-                                  "your primary config (e.g. --config-path myconf --config-name mine)")
-            check_user_config_dir(config_path, "--config-path")
+            config_path = _user_dir(config_path, "--config-path",
+                                    "your primary config (e.g. --config-path myconf --config-name mine)")
         if config_name is not None:
             config_name = config_name.removesuffix(".yaml")
             if not config_name or "\0" in config_name:
@@ -100,6 +94,15 @@ class ConfigSource:
 
 
 _source = ConfigSource()
+
+
+def _user_dir(path: str, option: str, holds: str) -> str:
+    """``path`` made absolute and checked as a user's config folder; ConfigError when it is no directory."""
+    path = os.path.abspath(path)
+    if not os.path.isdir(path):
+        raise ConfigError(f"{option} {path!r} is not a directory; give the folder that holds {holds}")
+    check_user_config_dir(path, option)
+    return path
 
 
 @cache
@@ -227,9 +230,7 @@ def compose_config(overrides: Sequence[str], *, return_hydra_config: bool = Fals
 
 
 def _running_config_name() -> str:
-    if HydraConfig.initialized():
-        return HydraConfig.get().job.config_name or _source.config_name
-    return _source.config_name
+    return (HydraConfig.get().job.config_name if HydraConfig.initialized() else None) or _source.config_name
 
 
 def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bool, run_mode: RunMode,
@@ -272,6 +273,10 @@ def _unknown_option(text: str) -> ConfigError | None:
         valid = group_options(group)
     except Exception:  # noqa: BLE001 - the list is a hint
         valid = []
+    return _unknown(group, option, valid)
+
+
+def _unknown(group: str, option: str, valid: Sequence[str]) -> ConfigError:
     close = difflib.get_close_matches(option, valid, n=1)
     hint = f"; did you mean {group}={close[0]}?" if close else ""
     return ConfigError(f"unknown {group} {shorten(repr(option))}{hint} (valid choices: {choices(valid)})")
@@ -281,9 +286,7 @@ def friendly_missing(error: MissingConfigException, config_name: str = CONFIG_NA
     missing = error.missing_cfg_file or ""
     group, _, option = missing.rpartition("/")
     if group and error.options is not None:
-        close = difflib.get_close_matches(option, error.options, n=1)
-        hint = f"; did you mean {group}={close[0]}?" if close else ""
-        return ConfigError(f"unknown {group} {shorten(repr(option))}{hint} (valid choices: {choices(error.options)})")
+        return _unknown(group, option, error.options)
     if missing == config_name or "Primary config" in str(error):
         return ConfigError(f"primary config {config_name!r} not found in {_source.config_path}"
                            f"{' or ' + _source.config_dir if _source.config_dir else ''}; --config-name names a "
@@ -327,9 +330,7 @@ def _known_names(overrides: Sequence[str], key: str, config_name: str) -> list[s
                                                           run_mode=RunMode.RUN, from_shell=False)
     except Exception:  # noqa: BLE001 - the hint is best effort; the sentence stands without it
         return []
-    names = list(key_paths(cfg))
-    names += [group for group in SELECTABLE_GROUPS]
-    return names
+    return [*key_paths(cfg), *SELECTABLE_GROUPS]
 
 
 def key_paths(node: Any, prefix: str = "") -> Iterator[str]:
@@ -397,17 +398,13 @@ MAX_MAGNITUDE = 1e100
 
 def _check_magnitudes(where: str, node: Any) -> None:
     """ConfigError for a number beyond :data:`MAX_MAGNITUDE` (``initial.r0=1e300`` overflows the first product)."""
-    if isinstance(node, dict):
-        for key, value in node.items():
-            _check_magnitudes(f"{where}.{key}", value)
-    elif isinstance(node, list):
-        for i, value in enumerate(node):
-            _check_magnitudes(f"{where}[{i}]", value)
-    elif isinstance(node, (int, float)) and not isinstance(node, bool):
+    for path, value in leaves(node, where):
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            continue
         try:
-            large = MAX_MAGNITUDE < abs(float(node)) < float("inf")  # inf and nan: require_finite says so
+            large = MAX_MAGNITUDE < abs(float(value)) < float("inf")  # inf and nan: require_finite says so
         except OverflowError:
             large = True
         if large:
-            raise ConfigError(f"{where}={shorten(repr(node), 40)} is too large; gyrolab takes numbers up to "
+            raise ConfigError(f"{path}={shorten(repr(value), 40)} is too large; gyrolab takes numbers up to "
                               f"{MAX_MAGNITUDE:.0e} in magnitude (use nondimensional or scaled units)")

@@ -23,7 +23,7 @@ from omegaconf import DictConfig, ListConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
-from gyrolab.engine.schemas import resolve_plain
+from gyrolab.engine.schemas import leaves, resolve_plain
 from gyrolab.errors import ConfigError, shorten
 from gyrolab.output.user_yaml import stored_yaml
 
@@ -122,7 +122,7 @@ def check_stored_config(text: str, where: str) -> DictConfig:
     plain = stored_yaml(text, where)
     if not isinstance(plain, dict):
         raise ConfigError(f"{where} is not a YAML mapping of config sections; give a run.nc that gyrolab wrote")
-    for path, value in _leaves(plain):
+    for path, value in leaves(plain):
         if isinstance(value, str) and "${" in value:
             raise ConfigError(f"{where}: {path}={shorten(repr(value))} is an interpolation, but a stored config is "
                               "resolved; the dataset was edited, and gyrolab will not rerun it")
@@ -244,17 +244,6 @@ def _resolved_hydra(cfg: DictConfig, run_dir: Path, job_subdir: bool) -> dict[st
 def _output_dir(run_dir: Path, hydra: dict[str, Any], job_subdir: bool) -> Path:
     out = Path(os.path.abspath(run_dir))
     return out / str((hydra.get("sweep") or {}).get("subdir", "")) if job_subdir else out
-
-
-def _leaves(node: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
-    if isinstance(node, dict):
-        for key, value in node.items():
-            yield from _leaves(value, f"{prefix}.{key}" if prefix else str(key))
-    elif isinstance(node, list):
-        for i, value in enumerate(node):
-            yield from _leaves(value, f"{prefix}[{i}]")
-    else:
-        yield prefix, node
 
 
 def _items(node: Any, prefix: str = "") -> Iterator[tuple[str, str, Any]]:

@@ -68,7 +68,6 @@ class Scene:
     system: System
     integrator: Integrator
     times: np.ndarray
-    #: ``time.n_output`` as the config gave it: ``"auto"`` or a number of samples
     n_output_requested: int | str = AUTO
     #: why the config's ``accuracy`` is not read by this scene's integrator, when a config file set it
     #: (``gyrolab.engine.unread``; a given one is refused): recorded in every run dataset as ``accuracy_ignored``
@@ -115,12 +114,13 @@ class Scene:
             reason = system.compile_error or f"system {system.name!r} has no compiled form"
             raise ConfigError(
                 f"integrator {integrator.name!r} runs compiled models only, and {reason}; "
-                f"choose {_choices_with(accept=lambda c: not c.supports(COMPILED_MODEL))}"
+                f"choose {or_list(integrators_with(accept=lambda c: not c.supports(COMPILED_MODEL)))}"
             )
         refusal = integrator.refusal(compiled, system) if compiled is not None else None
         if refusal:
-            valid = _choices_with(accept=lambda c: (c.supports(COMPILED_MODEL) or c.supports(PREFERS_COMPILED_MODEL))
-                                  and c is not type(integrator) and c.refusal(compiled, system) is None)
+            valid = or_list(integrators_with(accept=lambda c: (c.supports(COMPILED_MODEL)
+                                                               or c.supports(PREFERS_COMPILED_MODEL))
+                                             and c is not type(integrator) and c.refusal(compiled, system) is None))
             raise ConfigError(f"integrator {integrator.name!r} {refusal}; choose {valid}")
 
     def log_notes(self) -> None:
@@ -284,12 +284,7 @@ def _check_time_dependent(timed: Sequence[str], system: System, integrator: Inte
     if timed and integrator is not None and not integrator.supports(TIME_DEPENDENT):
         raise ConfigError(f"integrator {integrator.name!r} does not integrate time-dependent forces (capability "
                           f"{TIME_DEPENDENT}) and force {timed[0]!r} is one; valid choices: "
-                          f"{_choices_with(TIME_DEPENDENT)}")
-
-
-def _choices_with(*capabilities: str, accept: Any = None) -> str:
-    """The registered integrators with ``capabilities`` (and passing ``accept``), as "a, b or c"."""
-    return or_list(integrators_with(*capabilities, accept=accept))
+                          f"{or_list(integrators_with(TIME_DEPENDENT))}")
 
 
 def _plugin_class(group: str, node: Any, where: str) -> type:

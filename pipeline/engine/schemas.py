@@ -27,7 +27,7 @@ import difflib
 import re
 import types
 import typing
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cache
 from typing import Any, Dict, List, Optional
@@ -594,21 +594,33 @@ def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
         return OmegaConf.to_container(cfg, resolve=True, throw_on_missing=True)
     except OmegaConfBaseException as error:
         key = getattr(error, "full_key", None) or "?"
-        raw = _raw_value(cfg, key)
+        raw = raw_value(cfg, key)
         reason = first_line(error).split(" full_key:")[0]
         return_hint = "refer to an existing key, e.g. ${time.end}, or give a plain value"
-        raise ConfigError(f"{shorten(key)}={shorten(str(raw))} cannot be resolved ({shorten(reason, 160)}); "
+        raise ConfigError(f"{shorten(key)}={shorten(str('?' if raw is None else raw))} cannot be resolved ({shorten(reason, 160)}); "
                           f"{return_hint}") from None
 
 
-def _raw_value(cfg: DictConfig, key: str) -> Any:
+def leaves(node: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    """(dotted path, value) of every value that is neither a dict nor a list, at any depth (``a.b[0]``)."""
+    if isinstance(node, dict):
+        for key, value in node.items():
+            yield from leaves(value, f"{prefix}.{key}" if prefix else str(key))
+    elif isinstance(node, list):
+        for i, value in enumerate(node):
+            yield from leaves(value, f"{prefix}[{i}]")
+    else:
+        yield prefix, node
+
+
+def raw_value(cfg: DictConfig, key: str) -> Any:
+    """The unresolved value of dotted ``key`` (None when the config has no such key)."""
     node: Any = cfg
-    try:
-        for part in key.split("."):
-            node = node._get_node(part)
-        return node._value()
-    except Exception:  # noqa: BLE001 - only for the message
-        return "?"
+    for part in key.split("."):
+        node = node._get_node(part, validate_access=False) if isinstance(node, DictConfig) else None
+        if node is None:
+            return None
+    return OmegaConf.to_container(node, resolve=False) if isinstance(node, DictConfig) else node._value()
 
 
 def first_line(error: Exception) -> str:

@@ -15,7 +15,7 @@ from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
-from gyrolab.engine.schemas import keys_with
+from gyrolab.engine.schemas import keys_with, raw_value
 from gyrolab.contracts.capabilities import integrators_with, or_list
 from gyrolab.contracts.integrator import CHOOSES_METHOD
 from gyrolab.errors import ConfigError, GyrolabError
@@ -76,19 +76,9 @@ def _refers_to(cfg: DictConfig, value: Any, where: str, seen: set[str]) -> bool:
             return True
         if key not in seen:
             seen.add(key)
-            if _refers_to(cfg, _raw(cfg, key), key, seen):
+            if _refers_to(cfg, raw_value(cfg, key), key, seen):
                 return True
     return False
-
-
-def _raw(cfg: DictConfig, key: str) -> Any:
-    """The unresolved value of ``key`` (None when the config has no such key)."""
-    node: Any = cfg
-    for part in key.split("."):
-        if not isinstance(node, DictConfig) or part not in node:
-            return None
-        node = node._get_node(part)
-    return OmegaConf.to_container(node, resolve=False) if isinstance(node, DictConfig) else node._value()
 
 
 def unread_accuracy(cfg: DictConfig) -> str | None:
@@ -103,10 +93,10 @@ def unread_accuracy(cfg: DictConfig) -> str | None:
         return None
     name, own = integrator_name(cfg), _own_settings(cfg.get("integrator"))
     settings = f" ({', '.join(f'integrator.{k}={v!r}' for k, v in own)})" if own else ""
-    if name in _readers():  # its own accuracy setting was given a value: it replaces the top-level one
+    readers = _readers()
+    if name in readers:  # its own accuracy setting was given a value: it replaces the top-level one
         return f"{ACCURACY}={value!r} is not read: integrator={name} runs at its own settings{settings}, which replace it"
-    target = (f"the target of integrator={or_list(_readers())} only" if _readers()
-              else "read by no registered integrator's settings")
+    target = f"the target of integrator={or_list(readers)} only" if readers else "read by no registered integrator's settings"
     return f"{ACCURACY}={value!r} is {target}; integrator={name} does not read it and runs at its own settings{settings}"
 
 
@@ -124,8 +114,7 @@ def refusal(cfg: DictConfig, value_sentence: str) -> ConfigError:
 
 
 def _readers() -> list[str]:
-    """The registered integrators that pick their method for a target accuracy (CHOOSES_METHOD): the ones whose
-    packaged settings read ``accuracy`` (named in the sentences as the way to ask for a target)."""
+    """The integrators that choose their method for a target (CHOOSES_METHOD), named as the way to ask for one."""
     return integrators_with(CHOOSES_METHOD)
 
 
