@@ -37,13 +37,10 @@ class Force(ABC):
        only if some force (or the output) needs it, so ask for no more; an axis
        not declared is passed as ``None``.
     3. ``torque(omega, axes)`` returns the torque in body axes, model units,
-       for one state (vectors of shape (3,)). Write it as arithmetic on the
-       vectors (numpy operations, ``gyrolab.physics.vectors`` helpers, np.sqrt,
-       np.exp, np.sin, ...): gyrolab traces it once into compiled code, so it runs
-       under the compiled integrators, ``gyrolab batch`` and ``auto`` at machine speed.
-       A torque that branches on the state (``if``, comparisons, ``max``) or
-       converts it to a float (``float()``, ``math.*``) runs with the Python
-       integrators only; the log and any compiled integrator say which construct.
+       for one state (vectors of shape (3,)). Written as numpy arithmetic on the
+       vectors it is traced once into compiled code; one that branches on the
+       state or converts it to a float runs with the Python integrators only
+       (docs/plugins.md, "How a plain-Python torque runs compiled").
     4. ``time_dependent = True`` declares a torque that also depends on time:
        it is then called as ``torque(omega, axes, t)``. Such a force has no
        conserved energy (its ``potential`` is not used).
@@ -63,11 +60,9 @@ class Force(ABC):
        SI and the nondimensional form where the body allows it (netCDF-safe
        values: str, int, float, lists of numbers; names of letters, digits, _).
     8. Optionally, ``compiled_terms()`` returns the torque as ``CompiledTerms``,
-       the built-in forms every compiled integrator (Taylor and Lie–Poisson too)
-       evaluates; a traced torque (rule 3) runs with ``dop853_numba``,
-       ``rk4_numba``, ``taylor`` (its Taylor coefficients propagated through the
-       trace; not with ``integrator.precision=double-double``), ``gyrolab batch`` and
-       ``auto``, but not with ``lie_poisson``, which takes the built-in forms only.
+       the built-in forms every compiled integrator evaluates (which ones take a
+       traced torque instead: docs/plugins.md, "Which integrators take a compiled
+       plugin torque").
 
     gyrolab checks a third-party force's claims (rules 5, 6) when the scene is
     built and its torque (rule 3) during a run, each failure one sentence naming

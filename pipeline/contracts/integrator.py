@@ -65,10 +65,8 @@ class Solution:
     choice: Choice | None = None
 
 
-# ----------------------------------------------------------------------------------------------------------
-# Capabilities: what an integrator can do, declared by the integrator and asked for by the engine (which never
-# tests an integrator's name). Each is a rule of the contract (C1-C7 in ``Integrator``'s docstring); docs/plugins.md,
-# "Integrator capabilities", says what the engine does with each and which built-ins have it.
+# Capabilities (rule 8 of ``Integrator``): declared by the integrator, asked for by the engine, never its name;
+# docs/plugins.md, "Integrator capabilities", says what the engine does with each and which built-ins have it.
 
 #: C1: integrates the system's compiled model (``compiled``) instead of calling ``fun``
 COMPILED_MODEL = "compiled_model"
@@ -130,8 +128,6 @@ class VariationalSettings:
     @property
     def fixed_step(self) -> bool:
         return self.step is not None
-
-# ----------------------------------------------------------------------------------------------------------
 
 
 class Integrator(ABC):

@@ -39,15 +39,11 @@ class System(ABC):
     5. ``attributes()`` describes the system's parameters and initial state
        for the dataset; ``title()`` names the scene in a few words for figures.
     6. ``compiled_model()`` returns the system (with its forces) in the
-       compiled kernels' form, which the compiled integrators (``taylor``,
-       ``dop853_numba``, ``rk4_numba``, ``gyrolab batch``) run. The default
-       traces ``rhs`` once on symbols (``gyrolab.kernels.model``): a system
-       whose ``rhs`` is numpy arithmetic without branches on the state gets
-       every compiled kernel without writing one. When it cannot be traced it
-       returns None and sets ``compile_error`` to one sentence saying why (the
-       scene and ``gyrolab batch`` quote it when a compiled integrator is
-       asked for). Override it to return None for a system that must not be
-       compiled.
+       compiled kernels' form. The default traces ``rhs`` once on symbols
+       (``gyrolab.kernels.model``; docs/plugins.md, "System plugins"); when it
+       cannot be traced it returns None and sets ``compile_error`` to one
+       sentence saying why. Override it to return None for a system that must
+       not be compiled.
     7. Optionally, ``invariant_values(y)`` returns each monitored invariant
        (``invariants``) along states of shape (..., state size), vectorised
        over any leading dimensions; ``gyrolab batch`` (``gyrolab.batch.outputs``)

@@ -34,7 +34,6 @@ from gyrolab.compat import Hydra, create_automatic_config_search_path
 from gyrolab.contracts import registry
 from gyrolab.engine.schemas import (
     SELECTABLE_GROUPS,
-    leaves,
     missing_section,
     plugin_schema,
     required_sections,
@@ -44,7 +43,7 @@ from gyrolab.engine.schemas import (
 from gyrolab.engine.schemas import first_line as _first_line
 from gyrolab.engine.schemas import sentence as schema_sentence
 from gyrolab.engine.unread import refuse_given_accuracy
-from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
+from gyrolab.errors import ConfigError, GyrolabWarning, choices, leaves, shorten
 from gyrolab.output.user_yaml import check_user_config_dir
 
 CONFIG_MODULE = "gyrolab.conf"

@@ -23,8 +23,8 @@ from omegaconf import DictConfig, ListConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
-from gyrolab.engine.schemas import leaves, resolve_plain
-from gyrolab.errors import ConfigError, shorten
+from gyrolab.engine.schemas import resolve_plain
+from gyrolab.errors import ConfigError, leaves, shorten
 from gyrolab.output.user_yaml import stored_yaml
 
 #: ``_target_`` values allowed under ``hydra`` besides the installed launchers and sweepers

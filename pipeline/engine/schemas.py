@@ -27,7 +27,7 @@ import difflib
 import re
 import types
 import typing
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cache
 from typing import Any, Dict, List, Optional
@@ -599,18 +599,6 @@ def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
         return_hint = "refer to an existing key, e.g. ${time.end}, or give a plain value"
         raise ConfigError(f"{shorten(key)}={shorten(str('?' if raw is None else raw))} cannot be resolved ({shorten(reason, 160)}); "
                           f"{return_hint}") from None
-
-
-def leaves(node: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
-    """(dotted path, value) of every value that is neither a dict nor a list, at any depth (``a.b[0]``)."""
-    if isinstance(node, dict):
-        for key, value in node.items():
-            yield from leaves(value, f"{prefix}.{key}" if prefix else str(key))
-    elif isinstance(node, list):
-        for i, value in enumerate(node):
-            yield from leaves(value, f"{prefix}[{i}]")
-    else:
-        yield prefix, node
 
 
 def raw_value(cfg: DictConfig, key: str) -> Any:
