@@ -307,26 +307,8 @@ def check_integrator(cls: type, **params: Any) -> None:
 
     Notes
     -----
-    The rules checked, in order:
-
-    1. ``name`` is a config key, ``adaptive`` a bool, ``capabilities`` (when declared) a frozenset of str;
-    2. it builds with ``params``; every keyword parameter given a nonsense value ("abc") raises gyrolab's
-       one-sentence ``ConfigError`` naming the parameter;
-    3. on the harmonic oscillator x'' = −x from t = 0.5 to 10.5 it returns a ``Solution`` at exactly the requested
-       ``t_out`` (the same values), with ``y`` of shape (n, 2), finite, ``y[0]`` = y0, the input y0 left unchanged;
-    4. its error against cos, −sin is within ``ERROR_FACTOR`` × max(rtol, atol) (adaptive methods with ``rtol``
-       and ``atol`` attributes), or below ``FIXED_STEP_ERROR`` (others);
-    5. it counts its work: ``stats`` is an ``IntegratorStats`` with 0 < ``nfev`` ≤ the calls of ``fun`` the kit
-       counted (it never counts evaluations it did not make) and ``n_steps`` ≥ 1;
-    6. it calls ``progress(t)`` when given, with times within the integration interval;
-    7. on y' = y², y(0) = 1, which blows up at t = 1, it raises ``gyrolab.errors.IntegrationError`` (one line), never
-       returns non-finite values, and never returns a finite "solution" past the blow-up;
-    8. ``attributes()`` and ``stats.attributes()`` are netCDF-safe.
-
-    A compiled integrator (``COMPILED_MODEL``) integrates the compiled model it is given, not ``fun``: rules
-    3–6 are then checked on the free symmetric top (``free_top_problem``: gyrolab's fixed-point system with A = B
-    and no torque, whose ω turns at a constant rate), ``nfev`` > 0 only, and rule 7 is skipped (a blow-up has no
-    compiled model).
+    The rules it checks, in order, on a harmonic oscillator, a blow-up and (for a compiled integrator) the free
+    symmetric top are listed in docs/plugins.md, "Integrator plugins".
     """
     _check_class(cls, Integrator, "the config's integrator=NAME")
     if not isinstance(getattr(cls, "adaptive", None), bool):
@@ -355,7 +337,7 @@ def _build_plugin(build: Any, cls: type, params: dict[str, Any]) -> Any:
 
 
 def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> Any:
-    """Rules 3–6 of ``check_integrator`` on one problem with a known solution; returns the run's stats."""
+    """``check_integrator``'s checks on one problem with a known solution; returns the run's stats."""
     calls = [0]
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
@@ -382,7 +364,7 @@ def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> A
 
 
 def _check_samples(cls: type, solution: Solution, t_out: np.ndarray, y0: np.ndarray, on: str) -> None:
-    """Rule 3: the solution is sampled at exactly ``t_out``, finite, with the state size, starting at ``y0``."""
+    """The solution is sampled at exactly ``t_out``, finite, with the state size, starting at ``y0``."""
     t, y = np.asarray(solution.t), np.asarray(solution.y)
     if t.shape != t_out.shape or not np.array_equal(t, t_out):
         raise _fail(cls, f"Solution.t is {np.round(t, 12).tolist()}, not the requested t_out "
@@ -397,7 +379,7 @@ def _check_samples(cls: type, solution: Solution, t_out: np.ndarray, y0: np.ndar
 
 def _check_accuracy(cls: type, integrator: Any, problem: ExactProblem, y: np.ndarray, t_out: np.ndarray,
                     on: str) -> None:
-    """Rule 4: the error against the exact solution is within the integrator's own tolerance."""
+    """The error against the exact solution is within the integrator's own tolerance."""
     error = float(np.max(np.abs(y[:, problem.compared] - problem.exact(t_out))))
     rtol, atol = getattr(integrator, "rtol", None), getattr(integrator, "atol", None)
     if cls.adaptive and rtol is not None and atol is not None:
@@ -410,7 +392,7 @@ def _check_accuracy(cls: type, integrator: Any, problem: ExactProblem, y: np.nda
 
 
 def _checked_stats(cls: type, solution: Solution, problem: ExactProblem, calls: int) -> IntegratorStats:
-    """Rule 5: the run's stats count the evaluations made (at most ``calls`` for a Python right-hand side) and
+    """The run's stats count the evaluations made (at most ``calls`` for a Python right-hand side) and
     the steps taken."""
     stats = solution.stats
     if not isinstance(stats, IntegratorStats):
@@ -504,9 +486,9 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
     output : dict, optional
         The ``output`` section (``{"euler_angles": True}`` by default).
     span : float
-        The time span of the invariant check (rule 6).
+        The time span of the invariant check.
     invariant_tolerance : float
-        Relative drift allowed to each invariant over ``span`` (rule 6).
+        Relative drift allowed to each invariant over ``span``.
     **params
         The system's own parameters.
 
@@ -517,21 +499,8 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
 
     Notes
     -----
-    The rules checked, in order:
-
-    1. ``name`` is a config key; ``body_type`` has ``from_config``, which builds the body from ``body``;
-    2. the system builds with ``(body, forces, initial, output, **params)``;
-    3. ``state_size`` is a positive int; ``initial_state()`` a finite float array of shape (state_size,);
-    4. ``rhs(t, y0)`` is a finite float array of shape (state_size,) and leaves y0 unchanged;
-    5. ``invariants`` is a tuple of str; ``variables(t, y)`` of a trajectory is a dict of ``xarray.Variable`` on
-       dims starting with ``time``, each with CF ``units`` and ``long_name`` (non-empty str), and every invariant is
-       one of them, on dims ``("time",)``;
-    6. integrated over [0, ``span``] with scipy's DOP853 at rtol = atol = 1e-12, every invariant stays within
-       ``invariant_tolerance`` × max(1, |v0|) of its initial value (an invariant that drifts is no invariant);
-    7. ``attributes()`` is netCDF-safe; ``title()`` a non-empty one-line str;
-    8. its compiled model (``compiled_model()``: by default its ``rhs`` traced, ``gyrolab.kernels.model``), if it has
-       one, computes ``rhs`` (to 1e-12) at random states and its Taylor integrator follows the DOP853 trajectory of 6.
-       A system that cannot be traced is warned about (it runs with the Python integrators only), not failed.
+    The rules it checks, in order, are listed in docs/plugins.md, "System plugins"; a system whose ``rhs`` cannot
+    be traced is warned about (it runs with the Python integrators only), not failed.
     """
     _check_class(cls, System, "the config's system=NAME")
     body_type = getattr(cls, "body_type", None)
@@ -561,7 +530,7 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
 
 
 def _check_compiled_system(cls: type, system: Any, t: np.ndarray, y: np.ndarray) -> None:
-    """Rule 8 of ``check_system``: the compiled model against the Python right-hand side and trajectory."""
+    """``check_system``'s last check: the compiled model against the Python right-hand side and trajectory."""
     compiled = system.compiled_model()
     if compiled is None:
         warnings.warn(f"{cls.__name__} runs with the Python integrators only: {system.compile_error}", stacklevel=3)
@@ -682,19 +651,7 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
 
     Notes
     -----
-    The rules checked, in order:
-
-    1. ``name`` is a config key; ``systems`` a non-empty tuple of system names; ``parameter`` and
-       ``parameter_long_name`` str; ``order`` a dict of variable name → number;
-    2. it builds with ``params``; every keyword parameter given a nonsense value ("abc") raises gyrolab's
-       one-sentence ``ConfigError`` naming the parameter;
-    3. the scene's system is one of ``systems``; ``check_domain(system)`` returns a list of one-line str;
-    4. ``parameter_value(system)`` is a finite number;
-    5. ``initial_state(system)`` is a finite float array of shape (6,), and ``solution(system, [0])`` (shape (1, 6))
-       equals it;
-    6. ``period(system)`` is finite and > 0; ``solution(system, t)`` over one period has shape (n, 6), finite;
-    7. ``euler_angles(system, t)`` has exactly the keys psi, theta, phi, each a finite array of shape (n,);
-    8. ``attributes()`` is netCDF-safe.
+    The rules it checks, in order, are listed in docs/plugins.md, "Regime plugins".
     """
     _check_class(cls, Regime, "the config's regime=NAME")
     _check_regime_declarations(cls)
@@ -719,7 +676,7 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
 
 
 def _check_regime_numbers(cls: type, regime: Any, system: Any) -> None:
-    """Rules 4–6: a finite parameter value, a start state matching the solution at 0, a finite positive period
+    """A finite parameter value, a start state matching the solution at 0, a finite positive period
     over which the solution is finite, of shape (n, 6)."""
     value = regime.parameter_value(system)
     if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) or not math.isfinite(float(value)):
