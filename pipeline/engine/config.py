@@ -159,18 +159,12 @@ def hydra_for(source: ConfigSource | None = None) -> Iterator[None]:
 
 @cache
 def register_plugin_configs() -> None:
-    """Give every third-party plugin a config node: its schema (its class's ``schema`` dataclass, else one made from
-    its ``__init__`` keyword defaults: ``gyrolab.engine.schemas.plugin_schema``) with its ``_target_``.
-
-    Built-in plugins have YAML files in ``conf/``; a plugin package only
-    registers an entry point, and this makes ``force=[..., its_name]`` work.
-    A system plugin that declares ``default_body`` (its ``body`` section, a dict) also
-    gets the body option ``body=NAME``, which selects the system as ``conf/body/gyrostat_*.yaml``
-    select theirs (Hydra cannot let a system option override the body group that follows it).
-    A plugin that cannot be used (its module fails to import, ``**params``, ...) costs one
-    ``PluginLoadWarning`` and gets a node without parameters, so that a scene naming it composes
-    and is then refused by ``registry.load`` in one sentence, while every other command works.
-    """
+    """Give every third-party plugin a config node, its schema (``gyrolab.engine.schemas.plugin_schema``) with its
+    ``_target_``, so that ``force=[..., its_name]`` works as the built-ins' YAML files do. A system plugin's
+    ``default_body`` also becomes the body option ``body=NAME``, which selects the system (as
+    ``conf/body/gyrostat_*.yaml`` do: a system option cannot override the body group that follows it). A plugin that
+    cannot be used costs one ``PluginLoadWarning`` and gets a node without parameters: a scene naming it composes
+    and is then refused by ``registry.load`` in one sentence."""
     store = ConfigStore.instance()
     for group in registry.GROUPS:
         for name, target in registry.external(group).items():
@@ -367,9 +361,7 @@ def _check_degenerate_vectors(plain: dict[str, Any]) -> None:
 
     (Zero field directions and axes are refused by the plugins that normalise them.)
     """
-    forces = plain.get("force") or {}
-    if not isinstance(forces, dict):
-        return
+    forces = plain.get("force") or {}  # a dict: the schema's
     magnetic = forces.get("magnetic")
     if isinstance(magnetic, dict) and _is_zero(magnetic.get("moment")):
         raise ConfigError(f"force.magnetic.moment={magnetic['moment']} is a zero vector, so the magnetic force would "

@@ -95,12 +95,7 @@ class Scene:
         _check_time_dependent(timed, system, integrator)
         requested = plain["time"].get("n_output", AUTO)
         times = _output_times(plain["time"], fastest_rate(system))
-        try:
-            integrator.prepare(system)
-        except GyrolabError:
-            raise
-        except Exception as exc:  # noqa: BLE001 - a third-party integrator's prepare: one sentence naming it
-            raise init_failure(type(integrator), "integrator", exc) from exc
+        _guarded(type(integrator), "integrator", integrator.prepare, system)
         scene = cls(config=cfg, system=system, integrator=integrator, times=times, n_output_requested=requested)
         scene._check_compiled_model()
         scene.log_notes()
@@ -310,11 +305,15 @@ def _params(cls: type, node: DictConfig, where: str) -> dict[str, Any]:
 
 
 def _build(cls: type, node: DictConfig, where: str, *args: Any) -> Any:
-    """Instantiate a registered plugin class with its config parameters; whatever its ``__init__`` raises
-    (RuntimeError, ImportError, SyntaxError, ...) becomes one ConfigError naming the plugin."""
-    params = _params(cls, node, where)
+    """Instantiate a registered plugin class with its config parameters."""
+    return _guarded(cls, where, cls, *args, **_params(cls, node, where))
+
+
+def _guarded(cls: type, where: str, call: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+    """``call(*args, **kwargs)`` of plugin ``cls`` (its ``__init__``, an integrator's ``prepare``); whatever it
+    raises (RuntimeError, ImportError, SyntaxError, ...) becomes one ConfigError naming the plugin."""
     try:
-        return cls(*args, **params)
+        return call(*args, **kwargs)
     except GyrolabError:
         raise
     except Exception as exc:  # noqa: BLE001 - a plugin may raise anything; the user gets one sentence

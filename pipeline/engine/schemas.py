@@ -7,8 +7,7 @@ group option, or of a top-level value, while composing (the primary config's sec
 ``~output.dpi`` deletes as in any Hydra app). :func:`validate` applies every schema to a composed config (the
 preflight's; a user's primary config or option that names none; a dataset's stored config), a group's chosen by
 its ``_target_``; :func:`sentence` turns OmegaConf's error into one sentence naming the key, the value and what is
-expected. A third-party plugin's schema
-is its class's ``schema`` dataclass, else one made from its ``__init__`` keywords (:func:`plugin_schema`).
+expected. A third-party plugin's schema is its class's ``schema`` dataclass, else :func:`plugin_schema`'s.
 
 Field metadata says what a type cannot: ``TOLERANCE`` (in (0, 1), read by the budget's check), ``OWN_SETTING`` (an
 integrator's own accuracy setting, named when the top-level ``accuracy`` is not read), ``example`` (a required
