@@ -65,10 +65,6 @@ AREA_RTOL = 1e-12
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
-def _test_body():
-    return Body.from_config({"units": "nondimensional", "a": 0.7, "b": 0.9, "com_direction": [0.3, 0.4, 0.866025403784]})
-
-
 def _call(force: Force, omega: np.ndarray, frame: np.ndarray, t: float) -> Any:
     axes = _axes(force, frame)
     return force.torque(omega, axes, t) if force.time_dependent else force.torque(omega, axes)
@@ -113,7 +109,9 @@ def check_force(cls: type, body: Any = None, *, n_states: int = 20, **params: An
         Naming the first rule the plugin breaks.
     """
     _check_class(cls, Force, "the config key force.NAME")
-    body = _test_body() if body is None else body
+    if body is None:  # triaxial, with an off-axis centre of mass
+        body = Body.from_config({"units": "nondimensional", "a": 0.7, "b": 0.9,
+                                 "com_direction": [0.3, 0.4, 0.866025403784]})
     where = f"force.{cls.name}"
     params = _as_config(params)
     force = _build_plugin(lambda **kw: build_force(cls, kw, where, body), cls, params)

@@ -28,7 +28,7 @@ def checked(integrate: Callable[..., Any]) -> Callable[..., Any]:
 
     @functools.wraps(integrate)
     def wrapper(self: Any, fun: Any, t_out: Any, y0: Any, *args: Any, **kwargs: Any) -> Any:
-        name = _name(self)
+        name = str(getattr(self, "name", type(self).__name__))
         t_out, y0 = check_inputs(name, t_out, y0)
         compiled = args[1] if len(args) > 1 else kwargs.get("compiled")
         if compiled is not None:
@@ -54,10 +54,6 @@ def _check_compiled_size(name: str, compiled: Any, y0: np.ndarray) -> None:
     if size is not None and size != len(y0):
         raise IntegrationError(f"integrator {name!r} was given an initial state of {len(y0)} components for a "
                                f"compiled model of {size}; pass the system's own state (System.initial_state())")
-
-
-def _name(integrator: Any) -> str:
-    return str(getattr(integrator, "name", type(integrator).__name__))
 
 
 def check_inputs(name: str, t_out: Any, y0: Any) -> tuple[np.ndarray, np.ndarray]:

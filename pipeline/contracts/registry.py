@@ -77,10 +77,8 @@ def external(group: str) -> dict[str, str]:
     found: dict[str, Any] = {}
     for ep in entry_points(group=ep_group):
         if ep.name in BUILTINS[group] or ep.name in found:
-            warnings.warn(
-                f"ignoring {ep_group} entry point {ep.name!r} ({ep.value}): the name is already registered",
-                stacklevel=2,
-            )
+            warnings.warn(f"ignoring {ep_group} entry point {ep.name!r} ({ep.value}): the name is already registered",
+                          stacklevel=2)
             continue
         found[ep.name] = ep
     _ENTRY_POINTS[group] = found
@@ -113,7 +111,8 @@ def unusable_warning(group: str, name: str, error: ConfigError) -> None:
 
 def targets(group: str) -> dict[str, str]:
     """All registered plugins of a group: name -> 'module:Class'."""
-    _check_group(group)
+    if group not in GROUPS:
+        raise ConfigError(f"unknown plugin group {group!r}; valid choices: {choices(GROUPS)}")
     return {**BUILTINS[group], **external(group)}
 
 
@@ -145,16 +144,13 @@ def load(group: str, name: str) -> type:
     except Exception as exc:  # noqa: BLE001 - a third-party module may raise anything on import
         if name in BUILTINS[group]:
             raise  # gyrolab's own: a bug, with its traceback
-        raise ConfigError(
-            f"{group} plugin {name!r} from {origin(group, name)} cannot be imported "
-            f"({type(exc).__name__}: {shorten(str(exc), 160)}); fix or uninstall that distribution"
-        ) from None
+        raise ConfigError(f"{group} plugin {name!r} from {origin(group, name)} cannot be imported "
+                          f"({type(exc).__name__}: {shorten(str(exc), 160)}); fix or uninstall that "
+                          "distribution") from None
     _, contract = GROUPS[group]
     if not (inspect.isclass(cls) and issubclass(cls, contract)):
-        raise ConfigError(
-            f"{group} plugin {name!r} from {origin(group, name)} is not a {contract.__name__} subclass; "
-            "fix the plugin package's entry point"
-        )
+        raise ConfigError(f"{group} plugin {name!r} from {origin(group, name)} is not a {contract.__name__} "
+                          "subclass; fix the plugin package's entry point")
     return cls
 
 
@@ -163,10 +159,8 @@ def resolve_target(group: str, target: Any, where: str) -> tuple[str, type]:
     by_target = {_normalise(t): n for n, t in targets(group).items()}
     name = by_target.get(_normalise(str(target)))
     if name is None:
-        raise ConfigError(
-            f"{where}._target_={target!r} is not a registered {group} plugin; "
-            f"choose one by name ({group}=NAME), valid names: {choices(targets(group))}"
-        )
+        raise ConfigError(f"{where}._target_={target!r} is not a registered {group} plugin; "
+                          f"choose one by name ({group}=NAME), valid names: {choices(targets(group))}")
     return name, load(group, name)
 
 
@@ -181,17 +175,10 @@ def default_params(cls: type) -> dict[str, Any]:
     signature = inspect.signature(cls.__init__)
     variadic = [p.name for p in signature.parameters.values() if p.kind is p.VAR_KEYWORD]
     if variadic:
-        raise ConfigError(
-            f"plugin {getattr(cls, 'name', cls.__name__)!r} ({cls.__module__}.{cls.__qualname__}) takes "
-            f"**{variadic[0]} in __init__, so its parameters are unknown; declare each parameter as a keyword "
-            "with a default (def __init__(self, body, *, coefficient=0.1))"
-        )
+        raise ConfigError(f"plugin {getattr(cls, 'name', cls.__name__)!r} ({cls.__module__}.{cls.__qualname__}) takes "
+                          f"**{variadic[0]} in __init__, so its parameters are unknown; declare each parameter as a "
+                          "keyword with a default (def __init__(self, body, *, coefficient=0.1))")
     for p in signature.parameters.values():
         if p.kind is p.KEYWORD_ONLY or (p.kind is p.POSITIONAL_OR_KEYWORD and p.default is not p.empty):
             params[p.name] = None if p.default is p.empty else p.default
     return params
-
-
-def _check_group(group: str) -> None:
-    if group not in GROUPS:
-        raise ConfigError(f"unknown plugin group {group!r}; valid choices: {choices(GROUPS)}")

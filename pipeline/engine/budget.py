@@ -67,11 +67,9 @@ def estimated_steps(plain: dict[str, Any]) -> tuple[float, str]:
     initial = plain.get("initial") or {}
     rates = [initial.get(k) for k in ("p0", "q0", "r0")]
     if all(isinstance(r, (int, float)) and not isinstance(r, bool) for r in rates):
-        turn = math.sqrt(sum(float(r) ** 2 for r in rates)) * span
-        candidates.append((turn / RADIANS_PER_STEP, f"time.end={time['end']:g} (|ω0| = "
-                                                    f"{math.sqrt(sum(float(r) ** 2 for r in rates)):.3g} rad per "
-                                                    f"time unit over a span of {span:.3g}, one step per "
-                                                    f"{RADIANS_PER_STEP:g} rad at most)"))
+        rate = math.sqrt(sum(float(r) ** 2 for r in rates))
+        candidates.append((rate * span / RADIANS_PER_STEP, f"time.end={time['end']:g} (|ω0| = {rate:.3g} rad per time "
+                           f"unit over a span of {span:.3g}, one step per {RADIANS_PER_STEP:g} rad at most)"))
     return max(candidates, key=lambda c: c[0])
 
 

@@ -18,15 +18,11 @@ from gyrolab.errors import GyrolabError, IntegrationError, shorten
 _RULE = "torque(omega, axes) must return a finite float array of shape (3,) (gyrolab.contracts.Force, rule 3)"
 
 
-def is_builtin(force: Force) -> bool:
-    """True for gyrolab's own force classes (``registry.BUILTINS``), which the guard trusts."""
-    cls = type(force)
-    return f"{cls.__module__}:{cls.__qualname__}" in registry.BUILTINS["force"].values()
-
-
 def plugin_forces(forces: Sequence[Force]) -> list[Force]:
-    """The forces that are not gyrolab's own (third-party plugins and ad-hoc subclasses)."""
-    return [f for f in forces if not is_builtin(f)]
+    """The forces that are not gyrolab's own classes (``registry.BUILTINS``, trusted): third-party plugins and
+    ad-hoc subclasses."""
+    builtin = set(registry.BUILTINS["force"].values())
+    return [f for f in forces if f"{type(f).__module__}:{type(f).__qualname__}" not in builtin]
 
 
 class GuardedRhs:

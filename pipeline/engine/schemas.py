@@ -462,7 +462,8 @@ def _validation_subject(error: ValidationError, key: str, schema: Any) -> tuple[
     if key or merge is None:
         value = getattr(error, "value", None)
         value = OmegaConf.to_container(value) if isinstance(value, (DictConfig, ListConfig)) else value
-        return key, _field_type(schema, key.rpartition(".")[2].split("[")[0]), value
+        name = key.rpartition(".")[2].split("[")[0]
+        return key, typing.get_type_hints(schema).get(name) if dataclasses.is_dataclass(schema) else None, value
     parent = getattr(error, "parent_node", None)
     for name in (parent.keys() if isinstance(parent, DictConfig) else ()):
         node = parent._get_node(name)
@@ -486,12 +487,6 @@ def _mismatch_sentence(key: str, value: Any, hint: Any) -> str:
         return (f"{key}={shorten(repr(value))}: `{key}` is a section, not a value; set one of its keys "
                 f"(e.g. {key}.{example}=...)")
     return _type_sentence(key, value, hint)
-
-
-def _field_type(schema: Any, name: str) -> Any:
-    if not dataclasses.is_dataclass(schema):
-        return None
-    return typing.get_type_hints(schema).get(name)
 
 
 def _is_list(hint: Any) -> bool:
@@ -594,9 +589,10 @@ def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
     except OmegaConfBaseException as error:
         key = getattr(error, "full_key", None) or "?"
         raw = raw_value(cfg, key)
+        raw = "?" if raw is None else raw
         reason = first_line(error).split(" full_key:")[0]
         return_hint = "refer to an existing key, e.g. ${time.end}, or give a plain value"
-        raise ConfigError(f"{shorten(key)}={shorten(str('?' if raw is None else raw))} cannot be resolved ({shorten(reason, 160)}); "
+        raise ConfigError(f"{shorten(key)}={shorten(str(raw))} cannot be resolved ({shorten(reason, 160)}); "
                           f"{return_hint}") from None
 
 

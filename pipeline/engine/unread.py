@@ -96,7 +96,8 @@ def unread_accuracy(cfg: DictConfig) -> str | None:
     readers = _readers()
     if name in readers:  # its own accuracy setting was given a value: it replaces the top-level one
         return f"{ACCURACY}={value!r} is not read: integrator={name} runs at its own settings{settings}, which replace it"
-    target = f"the target of integrator={or_list(readers)} only" if readers else "read by no registered integrator's settings"
+    target = (f"the target of integrator={or_list(readers)} only" if readers
+              else "read by no registered integrator's settings")
     return f"{ACCURACY}={value!r} is {target}; integrator={name} does not read it and runs at its own settings{settings}"
 
 
