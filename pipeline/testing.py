@@ -102,11 +102,6 @@ def check_force(cls: type, body: Any = None, *, n_states: int = 20, **params: An
         How many random states the torque is checked on.
     **params
         The plugin's keyword parameters for the checks (its defaults when omitted).
-
-    Raises
-    ------
-    AssertionError
-        Naming the first rule the plugin breaks.
     """
     _check_class(cls, Force, "the config key force.NAME")
     if body is None:  # triaxial, with an off-axis centre of mass
@@ -249,17 +244,14 @@ class ExactProblem:
     compiled: Any = None
 
 
-def _oscillator(t: float, y: np.ndarray) -> np.ndarray:
-    """x'' = −x written as y = (x, v): the exact solution from (1, 0) at t0 is (cos(t − t0), −sin(t − t0))."""
-    return np.array([y[1], -y[0]])
-
-
 def oscillator_problem() -> ExactProblem:
+    """x'' = −x written as y = (x, v): the exact solution from (1, 0) at t0 is (cos(t − t0), −sin(t − t0))."""
     def exact(t: np.ndarray) -> np.ndarray:
         dt = t - OSCILLATOR_TIMES[0]
         return np.stack([np.cos(dt), -np.sin(dt)], axis=1)
 
-    return ExactProblem("the harmonic oscillator x'' = −x", _oscillator, np.array([1.0, 0.0]), exact, slice(0, 2))
+    return ExactProblem("the harmonic oscillator x'' = −x", lambda t, y: np.array([y[1], -y[0]]), np.array([1.0, 0.0]),
+                        exact, slice(0, 2))
 
 
 #: The free symmetric top of ``free_top_problem``: A = B = 0.8 C, no torque, ω0 = (0.1, −0.05, 5).
@@ -284,10 +276,6 @@ def free_top_problem() -> ExactProblem:
                         system.initial_state(), exact, slice(0, 3), system.compiled_model())
 
 
-def _blow_up(t: float, y: np.ndarray) -> np.ndarray:
-    return y * y
-
-
 def check_integrator(cls: type, **params: Any) -> None:
     """Check an integrator plugin class against the Integrator contract; AssertionError names the first violation.
 
@@ -297,11 +285,6 @@ def check_integrator(cls: type, **params: Any) -> None:
         The integrator plugin class (a subclass of ``gyrolab.contracts.Integrator``).
     **params
         The plugin's keyword parameters for the checks (its defaults when omitted).
-
-    Raises
-    ------
-    AssertionError
-        Naming the first rule the plugin breaks.
 
     Notes
     -----
@@ -408,7 +391,7 @@ def _checked_stats(cls: type, solution: Solution, problem: ExactProblem, calls: 
 def _check_blow_up(cls: type, integrator: Any) -> None:
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            solution = unchecked(integrator)(_blow_up, BLOW_UP_TIMES.copy(), np.array([1.0]), None, None)
+            solution = unchecked(integrator)(lambda t, y: y * y, BLOW_UP_TIMES.copy(), np.array([1.0]), None, None)
     except IntegrationError as exc:
         if "\n" in str(exc).strip():
             raise _fail(cls, f"its IntegrationError on y' = y² is not one line: {str(exc)!r}") from None
@@ -489,11 +472,6 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
         Relative drift allowed to each invariant over ``span``.
     **params
         The system's own parameters.
-
-    Raises
-    ------
-    AssertionError
-        Naming the first rule the plugin breaks.
 
     Notes
     -----
@@ -641,11 +619,6 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
         default scene when empty) or a built system.
     **params
         The regime's keyword parameters.
-
-    Raises
-    ------
-    AssertionError
-        Naming the first rule the plugin breaks.
 
     Notes
     -----

@@ -1,11 +1,8 @@
-"""A force's claims, checked by numbers: its potential belongs to its torque, its area-integral flag is true.
+"""A force's claims, checked by numbers: its potential belongs to its torque (``Force`` rule 5), its area-integral
+flag is true (rule 6); a false claim would make gyrolab monitor, and draw as conserved, a quantity that is not.
 
-A force that declares ``potential(axes)`` claims that its torque is Σ e_i × ∂V/∂e_i (``Force`` rule 5);
-one that declares ``preserves_area_integral = True`` claims torque·γ = 0 for every state (rule 6). A
-false claim makes gyrolab monitor, and draw as conserved, a quantity that is not. The scene checks a
-third-party force's claims when it is built (``check_claims``) at the initial state and a few
-deterministic random states; ``gyrolab.testing.check_force`` checks them at more states, more tightly.
-The numeric helpers live here, below the engine, so that both use the same derivative.
+The scene checks a third-party force's claims when it is built (docs/plugins.md, "What the engine checks");
+``gyrolab.testing.check_force`` checks them more tightly, with the same derivative from here.
 """
 
 from __future__ import annotations

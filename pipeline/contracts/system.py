@@ -21,15 +21,12 @@ class System(ABC):
 
     1. ``body_type`` is the class that reads the ``body`` config section
        (``body_type.from_config(cfg)``); forces are built with that body.
-       A third-party system declares its default ``body`` section as
-       ``default_body`` (a dict): gyrolab registers it as the option
-       ``body=NAME``, which selects the system, and its keys as valid body keys.
+       ``default_body`` (a dict, optional) becomes the body option ``body=NAME``
+       (docs/plugins.md, "System plugins").
     2. ``__init__(self, body, forces, initial, output, *, param=default, ...)``
-       receives the body, the built forces, the ``initial`` and ``output``
-       config sections and the system's own parameters (each a keyword with a
-       default: ``**params`` is refused); it validates the initial
-       state (one-sentence ``ConfigError``) and decides the state layout.
-       It carries only the state its forces and requested outputs need.
+       validates the ``initial`` section (one-sentence ``ConfigError``) and
+       decides the state layout: only the state its forces and requested
+       outputs need. Its own parameters are keywords with defaults.
     3. ``initial_state()`` returns y0; ``rhs(t, y)`` returns dy/dt (model
        units) for one state; it is the integrators' inner loop.
     4. ``variables(t, y)`` turns a trajectory (n, size) into xarray
@@ -58,9 +55,8 @@ class System(ABC):
        builds one system per distinct point.
     9. Optionally, ``reference_frame(y)`` returns the body components of the
        reference axes at state ``y`` as a (3, 3) array (rows α, β, γ), or
-       None when the state does not carry them (the default). The scene checks
-       a third-party force's claims (``gyrolab.contracts.claims``) at the
-       initial state's frame when it is known, and at seeded random frames.
+       None when the state does not carry them (the default); the scene checks
+       a third-party force's claims at that frame (``gyrolab.contracts.claims``).
     10. ``_batch_units`` is a cache the batch owns (the units of the system's
         variables, ``gyrolab.batch.outputs``); implementers leave it alone.
     """

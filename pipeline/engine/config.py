@@ -142,10 +142,6 @@ def use_source(source: ConfigSource) -> None:
     _source = source
 
 
-def current_source() -> ConfigSource:
-    return _source
-
-
 @contextmanager
 def hydra_for(source: ConfigSource | None = None) -> Iterator[None]:
     """A Hydra initialised on ``source`` (default: the current one) for the duration of the block."""

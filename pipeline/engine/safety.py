@@ -52,11 +52,6 @@ def hydra_targets() -> frozenset[str]:
     return HYDRA_TARGETS | found
 
 
-def plugin_targets() -> frozenset[str]:
-    """Every registered gyrolab plugin class, as a dotted path."""
-    return frozenset(registry._normalise(t) for group in registry.GROUPS for t in registry.targets(group).values())
-
-
 def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: Sequence[str] = (),
                  job_subdir: bool = False) -> None:
     """ConfigError (one sentence naming the key) unless ``cfg`` is safe to hand to Hydra and gyrolab.
@@ -87,7 +82,7 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
 
 def _check_plugin_targets(scene: dict) -> None:
     """ConfigError unless every ``_target_`` of the scene names a registered gyrolab plugin."""
-    allowed_plugins = plugin_targets()
+    allowed_plugins = {registry._normalise(t) for group in registry.GROUPS for t in registry.targets(group).values()}
     for path, value in _targets(scene):
         if registry._normalise(str(value)) not in allowed_plugins:
             group = path.split(".", 1)[0]

@@ -255,18 +255,8 @@ def compose_scene(overrides: Sequence[str] = ()) -> Scene:
 
 
 def run(overrides: Sequence[str] = ()) -> xr.Dataset:
-    """Compose, build and integrate a scene: ``compose_scene(overrides).run()``.
-
-    Parameters
-    ----------
-    overrides : sequence of str
-        Hydra overrides, as for `compose_scene`.
-
-    Returns
-    -------
-    xarray.Dataset
-        The run's dataset (what ``run.nc`` holds); nothing is written to disk.
-    """
+    """Compose, build and integrate a scene: ``compose_scene(overrides).run()``, the run's dataset (what ``run.nc``
+    holds; nothing is written to disk)."""
     return compose_scene(overrides).run()
 
 

@@ -1,13 +1,10 @@
 """The config's schemas: one dataclass per config section and group option, in Hydra's ``ConfigStore``.
 
-The YAML files extend them (``conf/integrator/rk45.yaml``: ``defaults: [/schema/integrator/tolerances@_here_,
-_self_]``; ``conf/config.yaml``: ``defaults: [gyrolab_schema, ...]``), as in Hydra's
-``examples/tutorials/structured_configs/``, so that Hydra refuses an unknown key or a value of the wrong type of a
-group option, or of a top-level value, while composing (the primary config's sections are any mapping then, so that
-``~output.dpi`` deletes as in any Hydra app). :func:`validate` applies every schema to a composed config (the
-preflight's; a user's primary config or option that names none; a dataset's stored config), a group's chosen by
-its ``_target_``; :func:`sentence` turns OmegaConf's error into one sentence naming the key, the value and what is
-expected. A third-party plugin's schema is its class's ``schema`` dataclass, else :func:`plugin_schema`'s.
+The YAML files extend them, as in Hydra's ``examples/tutorials/structured_configs/`` (docs/configs.md, "Your own
+configs"), so that Hydra checks keys and types while composing (the primary config's sections are any mapping
+then, so that ``~output.dpi`` deletes as in any Hydra app); :func:`validate` applies every schema to a composed
+config after composing, a group's chosen by its ``_target_``; :func:`sentence` turns OmegaConf's error into one
+sentence naming the key, the value and what is expected.
 
 Field metadata says what a type cannot: ``TOLERANCE`` (in (0, 1), read by the budget's check), ``OWN_SETTING`` (an
 integrator's own accuracy setting, named when the top-level ``accuracy`` is not read), ``example`` (a required

@@ -93,7 +93,7 @@ def unread_accuracy(cfg: DictConfig) -> str | None:
         return None
     name, own = integrator_name(cfg), _own_settings(cfg.get("integrator"))
     settings = f" ({', '.join(f'integrator.{k}={v!r}' for k, v in own)})" if own else ""
-    readers = _readers()
+    readers = integrators_with(CHOOSES_METHOD)  # they choose their method for a target: the way to ask for one
     if name in readers:  # its own accuracy setting was given a value: it replaces the top-level one
         return f"{ACCURACY}={value!r} is not read: integrator={name} runs at its own settings{settings}, which replace it"
     target = (f"the target of integrator={or_list(readers)} only" if readers
@@ -105,18 +105,13 @@ def refusal(cfg: DictConfig, value_sentence: str) -> ConfigError:
     """The one-sentence refusal of an explicitly given ``accuracy`` the integrator does not read, with the ways out."""
     value = OmegaConf.select(cfg, ACCURACY)
     name, own = integrator_name(cfg), [f"integrator.{k}" for k, _ in _own_settings(cfg.get("integrator"))]
-    readers = _readers()
+    readers = integrators_with(CHOOSES_METHOD)
     if name in readers:
         ways = [f"drop {' and '.join(own)} to aim at {ACCURACY}={value!r}", f"drop {ACCURACY}={value!r}"]
     else:
         ways = [f"ask integrator={readers[0]} {ACCURACY}={value!r}"] if readers else []
         ways.append(f"set {' and '.join(own) or 'the integrator settings'} instead (and drop {ACCURACY}={value!r})")
     return ConfigError(f"{value_sentence}: {' or '.join(ways)}")
-
-
-def _readers() -> list[str]:
-    """The integrators that choose their method for a target (CHOOSES_METHOD), named as the way to ask for one."""
-    return integrators_with(CHOOSES_METHOD)
 
 
 def ignored_accuracy(cfg: DictConfig, overrides: Sequence[str]) -> str | None:
