@@ -33,10 +33,10 @@ from omegaconf.errors import ConfigKeyError, OmegaConfBaseException, ValidationE
 from gyrolab.compat import Hydra, create_automatic_config_search_path
 from gyrolab.contracts import registry
 from gyrolab.engine.schemas import (
+    REQUIRED_SECTIONS,
     SELECTABLE_GROUPS,
     missing_section,
     plugin_schema,
-    required_sections,
     unknown_key_sentence,
     validate,
 )
@@ -342,7 +342,7 @@ def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
     Keys and types are the schemas' (:func:`gyrolab.engine.schemas.validate`: a user's primary config or a stored
     one that does not name them is checked against them too).
     """
-    for section in required_sections():
+    for section in REQUIRED_SECTIONS:
         if section not in cfg or OmegaConf.is_missing(cfg, section) or cfg[section] is None:
             raise ConfigError(missing_section(section))
     plain = validate(cfg)

@@ -73,10 +73,14 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
         raise ConfigError(f"hydra.mode={mode.rsplit('.', 1)[-1]} disagrees with the command line; start a sweep "
                           "with -m (gyrolab -m KEY=V1,V2 ...) and a single run without it")
     _check_paths(plain_hydra, Path(run_dir))
-    out = _output_dir(run_dir, plain_hydra, job_subdir)
+    out = Path(os.path.abspath(run_dir))
+    out = out / str((plain_hydra.get("sweep") or {}).get("subdir", "")) if job_subdir else out
     for name in ("job_logging", "hydra_logging"):
         _check_logging(plain_hydra.get(name), f"hydra.{name}", out)
-    _check_env_set((plain_hydra.get("job") or {}).get("env_set") or {})
+    for key in (plain_hydra.get("job") or {}).get("env_set") or {}:
+        if not ENV_ALLOWED.match(str(key)):
+            raise ConfigError(f"hydra.job.env_set.{shorten(str(key))} is not allowed; a config may set thread counts "
+                              "only (OMP_NUM_THREADS, MKL_NUM_THREADS, ...); set other variables in your shell")
     _check_launcher_shell(plain_hydra.get("launcher") or {}, command_line)
 
 
@@ -101,14 +105,6 @@ def _check_hydra_targets(plain_hydra: dict) -> None:
             raise ConfigError(f"{path}={shorten(repr(value))} is not allowed; under hydra a config may name only "
                               f"gyrolab's sweep callback and the installed launchers and sweepers "
                               f"({', '.join(sorted(t.rsplit('.', 1)[1] for t in allowed))})")
-
-
-def _check_env_set(env_set: Any) -> None:
-    """ConfigError unless ``hydra.job.env_set`` sets thread counts only."""
-    for key in env_set:
-        if not ENV_ALLOWED.match(str(key)):
-            raise ConfigError(f"hydra.job.env_set.{shorten(str(key))} is not allowed; a config may set thread counts "
-                              "only (OMP_NUM_THREADS, MKL_NUM_THREADS, ...); set other variables in your shell")
 
 
 def check_stored_config(text: str, where: str) -> DictConfig:
@@ -234,11 +230,6 @@ def _resolved_hydra(cfg: DictConfig, run_dir: Path, job_subdir: bool) -> dict[st
         raise ConfigError(f"{shorten(str(key))} cannot be resolved before the run "
                           f"({shorten(str(error).splitlines()[0], 120)}); give a plain value") from None
     return plain
-
-
-def _output_dir(run_dir: Path, hydra: dict[str, Any], job_subdir: bool) -> Path:
-    out = Path(os.path.abspath(run_dir))
-    return out / str((hydra.get("sweep") or {}).get("subdir", "")) if job_subdir else out
 
 
 def _items(node: Any, prefix: str = "") -> Iterator[tuple[str, str, Any]]:

@@ -47,8 +47,7 @@ class Scene:
     """Everything one run needs, built and validated once; ``run()`` integrates and writes nothing.
 
     Build one with `compose_scene` (from Hydra overrides) or ``Scene.from_config`` (from a composed
-    config). A scene is reusable: ``run()`` may be called again, and `integrate_batch` integrates it
-    from many initial states.
+    config). A scene is reusable: ``run()`` may be called again.
 
     Attributes
     ----------
@@ -81,10 +80,8 @@ class Scene:
         require_finite(plain, "")
         system_cls = _plugin_class("system", cfg.system, "system")
         body = system_cls.body_type.from_config(plain["body"])
-        forces = [
-            build_force(_plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
-            for name, node in (cfg.get("force") or {}).items()
-        ]
+        forces = [build_force(_plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
+                  for name, node in (cfg.get("force") or {}).items()]
         system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
         if check is not None:
             check(system)
@@ -93,10 +90,10 @@ class Scene:
         _check_time_dependent(timed, system)
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
         _check_time_dependent(timed, system, integrator)
-        requested = plain["time"].get("n_output", AUTO)
         times = _output_times(plain["time"], fastest_rate(system))
         _guarded(type(integrator), "integrator", integrator.prepare, system)
-        scene = cls(config=cfg, system=system, integrator=integrator, times=times, n_output_requested=requested)
+        scene = cls(config=cfg, system=system, integrator=integrator, times=times,
+                    n_output_requested=plain["time"].get("n_output", AUTO))
         scene._check_compiled_model()
         scene.log_notes()
         return scene

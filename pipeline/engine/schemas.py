@@ -422,7 +422,7 @@ def sentence(error: OmegaConfBaseException, prefix: str = "") -> ConfigError:
     """One sentence for OmegaConf's schema errors: the key (under ``prefix``), the value, what is expected."""
     key = prefix + str(getattr(error, "full_key", None) or "")
     schema = getattr(error, "object_type", None)
-    if isinstance(error, MissingMandatoryValue) and key in required_sections():
+    if isinstance(error, MissingMandatoryValue) and key in REQUIRED_SECTIONS:
         return ConfigError(missing_section(key))
     if isinstance(error, ConfigKeyError) and dataclasses.is_dataclass(schema):
         parent = key.rpartition(".")[0]
@@ -438,7 +438,7 @@ def sentence(error: OmegaConfBaseException, prefix: str = "") -> ConfigError:
 
 def unknown_key_sentence(key: str, known: Sequence[str], override: str = "", cause: str = "") -> str:
     """"`time.ennd` is not a key of `time`; did you mean `time.end`?" (with the valid keys if none is close)."""
-    parent, _, leaf = key.rpartition(".")
+    parent = key.rpartition(".")[0]
     where = f"`{parent}`" if parent else "the config"
     close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
     if "ValidationError" in cause or "ConfigTypeError" in cause:
@@ -480,7 +480,7 @@ def _mismatch_sentence(key: str, value: Any, hint: Any) -> str:
         return f"{key}={shorten(repr(value))}: a list and a section (a mapping) do not match; {key} must be {_words(hint)}"
     if section:
         base = _strip_optional(hint)
-        example = required_sections().get(key) or (_example(base) if dataclasses.is_dataclass(base) else "NAME")
+        example = REQUIRED_SECTIONS.get(key) or (_example(base) if dataclasses.is_dataclass(base) else "NAME")
         return (f"{key}={shorten(repr(value))}: `{key}` is a section, not a value; set one of its keys "
                 f"(e.g. {key}.{example}=...)")
     return _type_sentence(key, value, hint)
@@ -519,18 +519,13 @@ def _type_sentence(key: str, value: Any, hint: Any, alt: Any = None) -> str:
 
 # ---- tables derived from the schemas ------------------------------------------------------------------------
 
-@cache
-def required_sections() -> dict[str, str]:
-    """Sections every run needs (no default in the schema), each with a key to show: ``{"time": "end", ...}``."""
-    return {f.name: f.metadata["example"] for f in dataclasses.fields(Gyrolab) if "example" in f.metadata}
-
-
-#: sections every run needs, with a key to show in the sentences (``gyrolab.app`` refuses ``~time``)
-REQUIRED_SECTIONS = required_sections()
+#: sections every run needs (no default in the schema), each with a key to show in the sentences: ``{"time": "end",
+#: ...}`` (``gyrolab.app`` refuses ``~time``)
+REQUIRED_SECTIONS = {f.name: f.metadata["example"] for f in dataclasses.fields(Gyrolab) if "example" in f.metadata}
 
 
 def missing_section(section: str) -> str:
-    example = required_sections()[section]
+    example = REQUIRED_SECTIONS[section]
     how = f"choose one ({section}=NAME)" if example == "_target_" else f"set its keys instead (e.g. {section}.{example}=...)"
     return f"the config has no `{section}` section (deleted with ~{section}?); every run needs it: {how}"
 
