@@ -201,14 +201,12 @@ def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, fram
     except expression.NotCompilable as exc:
         warnings.warn(f"{cls.__name__} runs with the Python integrators only: {exc}", stacklevel=3)
         return
-    address = int(compiled.params[model.TRACED_ADDRESS])
-    kernel = ctypes.CFUNCTYPE(None, ctypes.c_double, *[ctypes.POINTER(ctypes.c_double)] * 3)(address)
-    p = compiled.params
     ptr = ctypes.POINTER(ctypes.c_double)
+    kernel = ctypes.CFUNCTYPE(None, ctypes.c_double, ptr, ptr, ptr)(int(compiled.params[model.TRACED_ADDRESS]))
     for k, (omega, frame) in enumerate(zip(omegas, frames)):
         y = np.concatenate([omega, frame[2], frame[0]])
         out = np.zeros(3)
-        kernel(0.7 * k, y.ctypes.data_as(ptr), p.ctypes.data_as(ptr), out.ctypes.data_as(ptr))
+        kernel(0.7 * k, y.ctypes.data_as(ptr), compiled.params.ctypes.data_as(ptr), out.ctypes.data_as(ptr))
         expected = np.asarray(_call(force, omega.copy(), frame, 0.7 * k), dtype=float)
         if not np.allclose(out, expected, rtol=1e-12, atol=1e-14 * max(1.0, np.max(np.abs(expected)))):
             raise _fail(cls, f"the compiled torque {out.tolist()} differs from the Python torque {expected.tolist()} "

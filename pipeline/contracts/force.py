@@ -27,9 +27,8 @@ class Force(ABC):
        defaults are the plugin's default config; ``**params`` is refused, as it
        would accept any key and advertise none); it validates them and raises
        ``gyrolab.errors.ConfigError`` (one sentence, naming the bad value) on
-       bad input. A ``ValueError`` or ``TypeError`` escaping ``__init__``
-       (``float("abc")``) is reported by gyrolab as one sentence naming the
-       parameter; any other exception as one sentence naming the plugin.
+       bad input (what gyrolab makes of other exceptions: docs/plugins.md,
+       "What the engine checks").
        Read what the torque needs from ``body`` in ``__init__`` and keep it as
        plain floats or arrays (docs/plugins.md, "What body offers a force").
     2. ``required_axes`` names the reference-frame axes (0, 1, 2) whose body
