@@ -121,12 +121,10 @@ def check_claims(force: Any, omegas: np.ndarray, frames: np.ndarray, t0: float =
         broken = np.flatnonzero(along > AREA_RTOL * size)
         if broken.size:
             worst = int(broken[0])  # the first state that breaks the claim: the initial one when it does
-            raise ConfigError(
-                f"{where}: force {force.name!r} declares preserves_area_integral = True, but its torque has the "
-                f"component torque·γ = {along[worst]:.3g} along the vertical γ (|torque| = {size[worst]:.3g}, "
-                f"{labels[worst]}), so Iω·γ is not conserved; "
-                "declare preserves_area_integral = False"
-            )
+            raise ConfigError(f"{where}: force {force.name!r} declares preserves_area_integral = True, but its torque "
+                              f"has the component torque·γ = {along[worst]:.3g} along the vertical γ (|torque| = "
+                              f"{size[worst]:.3g}, {labels[worst]}), so Iω·γ is not conserved; declare "
+                              "preserves_area_integral = False")
     if getattr(force, "conservative", False):
         for k, (torque, frame) in enumerate(zip(torques, frames)):
             _check_potential(force, torque, frame, labels[k], where)
@@ -144,9 +142,7 @@ def _check_potential(force: Any, torque: np.ndarray, frame: np.ndarray, label: s
     allowed = POTENTIAL_RTOL * max(float(np.max(np.abs(torque))), float(np.max(np.abs(expected)))) \
         + ROUNDOFF_FACTOR * np.finfo(float).eps * abs(value) / ROTATION_STEP
     if not error <= allowed:
-        raise ConfigError(
-            f"{where}: the potential of force {force.name!r} does not belong to its torque: at "
-            f"{label} the torque is {np.round(torque, 9).tolist()} "
-            f"but Σ e_i × ∂V/∂e_i of the potential is {np.round(expected, 9).tolist()} (difference {error:.3g}); "
-            "fix potential or torque, or remove potential if the force is not conservative"
-        )
+        raise ConfigError(f"{where}: the potential of force {force.name!r} does not belong to its torque: at {label} "
+                          f"the torque is {np.round(torque, 9).tolist()} but Σ e_i × ∂V/∂e_i of the potential is "
+                          f"{np.round(expected, 9).tolist()} (difference {error:.3g}); fix potential or torque, or "
+                          "remove potential if the force is not conservative")

@@ -99,7 +99,6 @@ def check_declared(force: Force, where: str) -> None:
     """ConfigError unless the force declares ``preserves_area_integral`` as a bool (rule 6)."""
     flag = getattr(force, "preserves_area_integral", None)
     if not isinstance(flag, (bool, np.bool_)):
-        raise ConfigError(
-            f"{where} ({type(force).__name__}) must declare preserves_area_integral = True or False: True only "
-            "when its torque has no component along the vertical Z (γ) for every state; see gyrolab.contracts.Force"
-        )
+        raise ConfigError(f"{where} ({type(force).__name__}) must declare preserves_area_integral = True or False: "
+                          "True only when its torque has no component along the vertical Z (γ) for every state; "
+                          "see gyrolab.contracts.Force")

@@ -98,8 +98,7 @@ def origin(group: str, name: str) -> str:
     ep = _ENTRY_POINTS.get(group, {}).get(name)
     if ep is None:
         return f"gyrolab's built-in {BUILTINS[group].get(name, '?')}"
-    dist = getattr(ep, "dist", None)
-    dist_name = getattr(dist, "name", None) if dist is not None else None
+    dist_name = getattr(getattr(ep, "dist", None), "name", None)
     where = f"distribution {dist_name!r}" if dist_name else "an unknown distribution"
     return f"{where} (entry point {ep.name} = {ep.value})"
 

@@ -104,10 +104,8 @@ class Scene:
         integrator, system, compiled = self.integrator, self.system, self.compiled
         if integrator.supports(COMPILED_MODEL) and compiled is None:
             reason = system.compile_error or f"system {system.name!r} has no compiled form"
-            raise ConfigError(
-                f"integrator {integrator.name!r} runs compiled models only, and {reason}; "
-                f"choose {or_list(integrators_with(accept=lambda c: not c.supports(COMPILED_MODEL)))}"
-            )
+            raise ConfigError(f"integrator {integrator.name!r} runs compiled models only, and {reason}; "
+                              f"choose {or_list(integrators_with(accept=lambda c: not c.supports(COMPILED_MODEL)))}")
         refusal = integrator.refusal(compiled, system) if compiled is not None else None
         if refusal:
             valid = or_list(integrators_with(accept=lambda c: (c.supports(COMPILED_MODEL)
