@@ -530,27 +530,18 @@ def missing_section(section: str) -> str:
     return f"the config has no `{section}` section (deleted with ~{section}?); every run needs it: {how}"
 
 
-def _all_schemas() -> list[type]:
-    found = [Gyrolab, Time, Output, Batch]
-    for schemas in BUILTIN.values():
-        found += [s for s in schemas.values() if s not in found]
-    return found
-
-
 @cache
 def keys_with(flag: str) -> tuple[str, ...]:
     """Field names whose metadata has ``flag`` in any schema (``tolerance``: rtol, atol, tol, accuracy)."""
-    names = [f.name for s in _all_schemas() for f in dataclasses.fields(s) if f.metadata.get(flag)]
-    return tuple(dict.fromkeys(names))
+    schemas = [Gyrolab, Time, Output, Batch, *(s for group in BUILTIN.values() for s in group.values())]
+    return tuple(dict.fromkeys(f.name for s in schemas for f in dataclasses.fields(s) if f.metadata.get(flag)))
 
 
 @cache
 def only_declared_keys() -> tuple[str, ...]:
     """Dotted keys only the runs that declare them read (``batch``, ``output.error_estimate``, ...)."""
-    found = []
-    for prefix, schema in (("", Gyrolab), ("output.", Output)):
-        found += [prefix + f.name for f in dataclasses.fields(schema) if f.metadata.get("only_declared")]
-    return tuple(found)
+    return tuple(prefix + f.name for prefix, schema in (("", Gyrolab), ("output.", Output))
+                 for f in dataclasses.fields(schema) if f.metadata.get("only_declared"))
 
 
 # ---- what a task reads and sets -----------------------------------------------------------------------------
