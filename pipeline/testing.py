@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.contracts.claims import random_states, rotation_torque
+from gyrolab.contracts.claims import POTENTIAL_RTOL, random_states, rotation_torque
 from gyrolab.contracts.claims import axes_of as _axes
 from gyrolab.contracts.force import Force
 from gyrolab.contracts.integrator import COMPILED_MODEL, Integrator, IntegratorStats, Solution
@@ -58,9 +58,7 @@ from gyrolab.plugins.systems.fixed_point import FixedPoint
 
 __all__ = ["check_force", "check_integrator", "check_regime", "check_system", "random_states", "rotation_torque"]
 
-#: Relative tolerance of the finite-difference potential check (central differences, h = 1e-5).
-POTENTIAL_RTOL = 1e-6
-#: torque·γ below this fraction of |torque| counts as "no component along the vertical".
+#: torque·γ below this fraction of |torque| counts as "no component along the vertical" (tighter than the scene's)
 AREA_RTOL = 1e-12
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 

@@ -30,13 +30,10 @@ CLAIM_SEED = 20211
 def random_states(n: int = 20, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """``n`` random angular velocities (n, 3) and attitudes (n, 3, 3): rows α, β, γ, a right-handed frame."""
     rng = np.random.default_rng(seed)
-    frames = np.empty((n, 3, 3))
-    for k in range(n):
-        q, r = np.linalg.qr(rng.normal(size=(3, 3)))
-        q = q * np.sign(np.diag(r))
-        if np.linalg.det(q) < 0:
-            q[:, 0] = -q[:, 0]
-        frames[k] = q.T  # rows e_0, e_1, e_2 with e_0 × e_1 = e_2
+    q, r = np.linalg.qr(rng.normal(size=(n, 3, 3)))
+    q = q * np.sign(np.diagonal(r, axis1=1, axis2=2))[:, None, :]
+    q[np.linalg.det(q) < 0, :, 0] *= -1
+    frames = np.ascontiguousarray(q.transpose(0, 2, 1))  # rows e_0, e_1, e_2 with e_0 × e_1 = e_2
     return rng.normal(scale=2.0, size=(n, 3)), frames
 
 

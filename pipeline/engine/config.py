@@ -27,7 +27,7 @@ from hydra.core.global_hydra import GlobalHydra
 from hydra.core.hydra_config import HydraConfig
 from hydra.errors import HydraException, MissingConfigException, OverrideParseException
 from hydra.types import RunMode
-from omegaconf import DictConfig, OmegaConf, open_dict
+from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import ConfigKeyError, OmegaConfBaseException, ValidationError
 
 from gyrolab.compat import Hydra, create_automatic_config_search_path
@@ -240,13 +240,10 @@ def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bo
     except (ValueError, TypeError) as error:  # Hydra's defaults list on a malformed group override
         raise ConfigError(f"cannot compose the config with {shorten(' '.join(overrides), 120)} "
                           f"({shorten(_first_line(error), 120)})") from None
-    if not return_hydra_config and "hydra" in cfg:
-        with open_dict(cfg):
-            del cfg["hydra"]
     # checked by the schemas, used as any mapping (an experiment sets whole sections); Hydra's own node stays typed
     plain = OmegaConf.create(OmegaConf.to_container(OmegaConf.masked_copy(cfg, [k for k in cfg if k != "hydra"]),
                                                     resolve=False))
-    if "hydra" in cfg:
+    if return_hydra_config and "hydra" in cfg:
         plain.hydra = cfg.hydra
     OmegaConf.set_struct(plain, True)
     return plain
