@@ -195,7 +195,6 @@ class Integrator(ABC):
     def attributes(self) -> dict[str, Any]:
         return {}
 
-    # ------------------------------------------------------------------------------------------------------
     # Capabilities (rule 8): the declaration and the hooks that go with them.
 
     #: what this integrator can do: capability constants of this module (rule 8)

@@ -129,12 +129,8 @@ def _import(target: str) -> type:
 
 
 def load(group: str, name: str) -> type:
-    """The plugin class registered under ``name``; one ConfigError sentence otherwise.
-
-    The sentence lists the valid names for an unknown one; for a third-party plugin that cannot be
-    used it names the plugin, its distribution and entry point, and the error (import errors of any
-    type: a plugin's module may raise anything while it is imported).
-    """
+    """The plugin class registered under ``name``; one ConfigError sentence otherwise (the valid names for an unknown
+    one; the plugin, its distribution, its entry point and the error for one that cannot be used)."""
     registered = targets(group)
     if name not in registered:
         raise ConfigError(f"unknown {group} {name!r}; valid choices: {choices(registered)}")
@@ -164,12 +160,8 @@ def resolve_target(group: str, target: Any, where: str) -> tuple[str, type]:
 
 
 def default_params(cls: type) -> dict[str, Any]:
-    """A plugin's config parameters and defaults, read from its ``__init__`` keywords.
-
-    The signature is the plugin's config schema, so it must be explicit: an ``__init__`` taking
-    ``**params`` would accept any key (a typo included) and advertise none, and is refused in one
-    sentence (as xarray's backends ``detect_parameters`` refuses ``**kwargs``).
-    """
+    """A plugin's config parameters and defaults, read from its ``__init__`` keywords; ``**params`` would accept any
+    key (a typo included) and advertise none, and is refused (as xarray's backends refuse ``**kwargs``)."""
     params: dict[str, Any] = {}
     signature = inspect.signature(cls.__init__)
     variadic = [p.name for p in signature.parameters.values() if p.kind is p.VAR_KEYWORD]

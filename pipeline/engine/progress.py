@@ -1,10 +1,6 @@
-"""Progress of long integrations and sweeps: a tqdm bar on a terminal, the log otherwise.
-
-On a terminal (stderr is a TTY) a run shows a bar once it has lasted
-``BAR_DELAY`` seconds (quick runs stay silent) and removes it when done.
-Elsewhere (files, pipes, notebooks, cluster logs) nothing is drawn and a line
-is logged every ``every`` seconds instead. Sweep jobs turn integration bars
-off (``allow_bars(False)``): the sweep shows one bar for all its jobs.
+"""Progress of long integrations and sweeps: a tqdm bar on a terminal (after ``BAR_DELAY`` seconds), a log line
+every ``every`` seconds elsewhere (docs/faults.md, "Progress of long runs"); sweep jobs draw no bar of their own
+(``allow_bars(False)``): the sweep shows one for all its jobs.
 """
 
 from __future__ import annotations
@@ -111,9 +107,7 @@ class Progress:
         first = self._t_last is None
         since, t_since = self._last, self._t_last
         self._last, self._t_last = now, t
-        if first:
-            # the time before the first report includes a compiled method's compilation (and its start-up):
-            # a pace from it is no pace of the integration, so no estimate until a stretch has been measured
+        if first:  # its time includes a compiled method's compilation: no pace until a stretch has been measured
             log.info("%s: %3.0f%% (t=%.6g of %.6g), %s elapsed (compilation included), measuring the pace",
                      self.label, 100 * fraction, t, self.t_end, duration(elapsed))
             return

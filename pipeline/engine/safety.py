@@ -328,13 +328,9 @@ _OUTPUT_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.+-]*(/[A-Za-z0-9_][A-Za-z0-
 
 
 def confined_output_path(out_dir: str | os.PathLike[str], name: Any, key: str) -> Path:
-    """``out_dir/name`` when it stays inside ``out_dir`` (symlinks resolved), else one ConfigError sentence.
-
-    Every file a config names for writing (``stability_map.file``) goes through here: a relative path
-    without ``..``, ending in ``.nc``, whose resolved location (through any symlink already in the run
-    directory) is inside the resolved run directory — so ``../elsewhere/x.pth`` or a link into
-    site-packages cannot make gyrolab write a file Python would load.
-    """
+    """``out_dir/name`` when it stays inside ``out_dir`` (symlinks resolved), else one ConfigError sentence: every file
+    a config names for writing goes through here, so that it cannot make gyrolab write a file Python would load
+    (docs/faults.md, "Paths: results stay inside the run directory")."""
     text = str(name) if isinstance(name, (str, os.PathLike)) else ""
     parts = Path(text).parts
     if not _OUTPUT_NAME.match(text) or ".." in parts or len(text) > 255:

@@ -314,13 +314,9 @@ def init_failure(cls: type, where: str, exc: BaseException) -> ConfigError:
 
 
 def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
-    """Instantiate a force plugin; its ValueError/TypeError becomes one ConfigError naming the parameter.
-
-    ``node`` is the force's config (a DictConfig or a dict of parameters). The culprit is found by
-    building the force with each given parameter alone; any other exception becomes one sentence
-    naming the plugin (``init_failure``); the force must declare its area-integral flag.
-    An AttributeError (the force reads something the system's body does not have) is one ConfigError too.
-    """
+    """Instantiate a force plugin from its config (a DictConfig or a dict of parameters); its ValueError/TypeError
+    becomes one ConfigError naming the parameter (the culprit: the one that fails alone), any other exception one
+    naming the plugin."""
     if not isinstance(node, DictConfig):
         node = OmegaConf.create(dict(node))
     params = _params(cls, node, where)
