@@ -625,10 +625,7 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     params = _as_config(params)
     regime = _build_plugin(cls, cls, params)
     _check_bad_parameters(cls, params, "regime.", cls)
-    if isinstance(scene, System):
-        system = scene
-    else:
-        system = compose_scene(list(scene)).system
+    system = scene if isinstance(scene, System) else compose_scene(list(scene)).system
     if system.name not in cls.systems:
         raise _fail(cls, f"the kit's scene has system {system.name!r}, not one of systems={cls.systems}; give a "
                          "scene the regime is derived for (scene=[...overrides...])")

@@ -152,10 +152,8 @@ class Integrator(ABC):
        with one sentence saying when and why.
     5. It calls ``progress(t)``, when given, every few steps (cheap; the
        callback decides whether to report).
-    6. A compiled integrator declares ``COMPILED_MODEL`` (rule 8) and integrates the
-       ``compiled`` model it is given (the system's ``compiled_model()``)
-       instead of calling ``fun``; the scene refuses it, before integrating,
-       for a system or force that has no compiled form.
+    6. A compiled integrator (``COMPILED_MODEL``, rule 8) integrates the ``compiled`` model it is given (the
+       system's ``compiled_model()``) instead of calling ``fun``.
     7. ``attributes()`` gives its settings for the dataset.
     8. It declares what it can do in ``capabilities`` (a frozenset of this module's capability constants,
        C1–C7, each with its hook; docs/plugins.md, "Integrator capabilities", says what the engine does with
@@ -166,8 +164,7 @@ class Integrator(ABC):
     10. ``prepare(system)`` is called once by the scene before integrating
         (default: nothing); ``auto`` uses it to consult the system's regimes.
     11. ``precision`` names its rung on the precision ladder (``PRECISIONS``); ``climbed(factor)``, optional:
-        the same method one rung up, ``factor`` times more accurate (the double Taylor method in
-        double-double), which ``gyrolab.accuracy`` runs where ``more_accurate`` has reached its floor.
+        the same method one rung up, which ``gyrolab.accuracy`` runs where ``more_accurate`` has reached its floor.
         A CHOOSES_METHOD integrator returns what it chose with its solution (``Solution.choice``, a ``Choice``).
 
     Every subclass's own ``integrate`` is wrapped when the class is defined (``gyrolab.contracts.integrator_rules``),

@@ -103,11 +103,6 @@ def origin(group: str, name: str) -> str:
     return f"{where} (entry point {ep.name} = {ep.value})"
 
 
-def unusable_warning(group: str, name: str, error: ConfigError) -> None:
-    """One warning line for a third-party plugin that cannot be used (``load`` said why)."""
-    warnings.warn(f"{error}; gyrolab goes on without it", PluginLoadWarning, stacklevel=2)
-
-
 def targets(group: str) -> dict[str, str]:
     """All registered plugins of a group: name -> 'module:Class'."""
     if group not in GROUPS:

@@ -1,10 +1,6 @@
-"""Hydra composition for gyrolab: where configs come from, plugin config nodes, friendly errors.
-
-A :class:`ConfigSource` says where Hydra finds the primary config and the config
-groups: the packaged ``gyrolab.conf`` by default, or a user's directory given with
-``--config-dir`` / ``--config-path`` / ``--config-name`` (and ``hydra.searchpath``).
-The search path is built with Hydra's own functions, exactly as ``@hydra.main``
-builds it, so the config the preflight validates is the config that runs.
+"""Hydra composition for gyrolab: where configs come from (:class:`ConfigSource`), plugin config nodes, friendly
+errors. The search path is built with Hydra's own functions, exactly as ``@hydra.main`` builds it, so that the
+config the preflight validates is the config that runs.
 """
 
 from __future__ import annotations
@@ -168,7 +164,7 @@ def register_plugin_configs() -> None:
                 cls = registry.load(group, name)
                 node: Any = OmegaConf.merge(OmegaConf.structured(plugin_schema(cls)), {"_target_": target})
             except ConfigError as error:
-                registry.unusable_warning(group, name, error)
+                warnings.warn(f"{error}; gyrolab goes on without it", registry.PluginLoadWarning, stacklevel=1)
                 cls, node = None, {"_target_": target}
             # A force option nests under its own name so that several can be selected at once.
             store.store(group=group, name=name, node={name: node} if group == "force" else node)
@@ -333,12 +329,9 @@ def key_paths(node: Any, prefix: str = "") -> Iterator[str]:
 # ---- the scene config: its schemas (gyrolab.engine.schemas), then what a type cannot say ----------------------
 
 def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
-    """The scene config resolved to plain values; ConfigError for a missing section, an unknown key, a wrong type,
-    a bad reference, a number too large to compute with or a torque that silently vanishes.
-
-    Keys and types are the schemas' (:func:`gyrolab.engine.schemas.validate`: a user's primary config or a stored
-    one that does not name them is checked against them too).
-    """
+    """The scene config resolved to plain values (keys and types: :func:`gyrolab.engine.schemas.validate`);
+    ConfigError for a missing section, an unknown key, a wrong type, a bad reference, a number too large to compute
+    with or a torque that silently vanishes."""
     for section in REQUIRED_SECTIONS:
         if section not in cfg or OmegaConf.is_missing(cfg, section) or cfg[section] is None:
             raise ConfigError(missing_section(section))

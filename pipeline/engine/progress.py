@@ -126,11 +126,8 @@ class Progress:
 
 
 class LinesAboveBar:
-    """A stream wrapper that prints whole lines above a tqdm bar (clears it, writes, redraws).
-
-    Installed as ``sys.stdout``/``sys.stderr`` while a sweep bar is shown, so
-    that log lines written in the same process do not run into the bar.
-    """
+    """A stream wrapper that prints whole lines above a tqdm bar (clears it, writes, redraws): installed as
+    ``sys.stdout``/``sys.stderr`` while a sweep bar is shown, so that log lines do not run into the bar."""
 
     def __init__(self, stream: TextIO, bar: Any) -> None:
         self._stream, self._bar = stream, bar

@@ -48,25 +48,16 @@ class Scene:
 
     Build one with `compose_scene` (from Hydra overrides) or ``Scene.from_config`` (from a composed
     config). A scene is reusable: ``run()`` may be called again.
-
-    Attributes
-    ----------
-    config : omegaconf.DictConfig
-        The resolved config the scene was built from (stored in every dataset it writes).
-    system : gyrolab.contracts.System
-        The equations of motion with the body, forces and initial state.
-    integrator : gyrolab.contracts.Integrator
-        The integrator, configured.
-    times : numpy.ndarray
-        The output times (model time units).
-    n_output_requested : int or str
-        ``time.n_output`` as the config gave it: ``"auto"`` or a number of samples.
     """
 
+    #: the resolved config the scene was built from (stored in every dataset it writes)
     config: DictConfig
+    #: the equations of motion with the body, forces and initial state
     system: System
     integrator: Integrator
+    #: the output times (model time units)
     times: np.ndarray
+    #: ``time.n_output`` as the config gave it: ``"auto"`` or a number of samples
     n_output_requested: int | str = AUTO
     #: why the config's ``accuracy`` is not read by this scene's integrator, when a config file set it
     #: (``gyrolab.engine.unread``; a given one is refused): recorded in every run dataset as ``accuracy_ignored``
@@ -129,9 +120,8 @@ class Scene:
 
     @cached_property
     def dataset_attributes(self) -> tuple[dict[str, Any], dict[str, Any]]:
-        """The run dataset's attributes that depend on the scene alone (``output.dataset.scene_attributes``),
-        computed once per scene as ``config_yaml``; plus ``integrator_nfev_counts``, what the integrator's evaluation
-        count counts where that is not right-hand-side calls (its ``evaluation_label``: figures read it)."""
+        """The run dataset's attributes that depend on the scene alone (``output.dataset.scene_attributes``, plus
+        ``accuracy_ignored`` and the integrator's ``evaluation_label``), computed once per scene."""
         before, after = scene_attributes(self)
         if self.accuracy_ignored:
             before = {**before, ACCURACY_IGNORED_ATTRIBUTE: self.accuracy_ignored}

@@ -23,8 +23,7 @@ from gyrolab.errors import ConfigError, GyrolabError
 ACCURACY = "accuracy"
 #: the run dataset's global attribute saying that the config's ``accuracy`` was not read, and why
 ACCURACY_IGNORED_ATTRIBUTE = "accuracy_ignored"
-#: an integrator's own accuracy settings, named in the sentences (what the user can set instead): the schemas'
-#: tolerances and steps (``gyrolab.engine.schemas``)
+#: an integrator's own accuracy settings (the schemas' tolerances and steps), named as what the user can set instead
 OWN_SETTINGS = keys_with("own")
 #: an interpolation's references: ``${key}``, ``${..key}``, ``${oc.select:key,default}`` (a resolver's name is
 #: captured too, and found in no config)
