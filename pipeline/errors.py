@@ -8,7 +8,7 @@ non-zero before any ``run.nc`` is written.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
 
@@ -56,23 +56,26 @@ def choices(names: Iterable[str]) -> str:
     return ", ".join(names) if names else "(none registered)"
 
 
+def leaves(node: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    """(dotted path, value) of every value that is neither a mapping nor a list, at any depth (``a.b[0]``)."""
+    if isinstance(node, Mapping):
+        for key, value in node.items():
+            yield from leaves(value, f"{prefix}.{key}" if prefix else str(key))
+    elif isinstance(node, (list, tuple)):
+        for i, value in enumerate(node):
+            yield from leaves(value, f"{prefix}[{i}]")
+    else:
+        yield prefix, node
+
+
 def require_finite(value: Any, where: str) -> None:
     """Raise ConfigError if a number (or any number nested in lists/dicts) is NaN or inf."""
-    if isinstance(value, bool) or value is None or isinstance(value, str):
-        return
-    if isinstance(value, Mapping):
-        for key, item in value.items():
-            require_finite(item, f"{where}.{key}" if where else str(key))
-        return
-    if isinstance(value, (list, tuple)):
-        for i, item in enumerate(value):
-            require_finite(item, f"{where}[{i}]")
-        return
-    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_FLOAT_INT:
-        raise ConfigError(f"{where}={shorten(str(value))} is too large to be represented as a 64-bit float "
-                          f"({len(str(abs(value)))} digits); every numeric setting must be below 1.8e308")
-    if isinstance(value, float) and not math.isfinite(value):
-        raise ConfigError(f"{where}={value} is not a finite number; every numeric setting must be finite")
+    for path, item in leaves(value, where):
+        if isinstance(item, int) and not isinstance(item, bool) and abs(item) > MAX_FLOAT_INT:
+            raise ConfigError(f"{path}={shorten(str(item))} is too large to be represented as a 64-bit float "
+                              f"({len(str(abs(item)))} digits); every numeric setting must be below 1.8e308")
+        if isinstance(item, float) and not math.isfinite(item):
+            raise ConfigError(f"{path}={item} is not a finite number; every numeric setting must be finite")
 
 
 def as_vector3(value: Any, where: str) -> tuple[float, float, float]:

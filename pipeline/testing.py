@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.contracts.claims import _rotation, random_states, rotation_torque  # noqa: F401
+from gyrolab.contracts.claims import POTENTIAL_RTOL, random_states, rotation_torque
 from gyrolab.contracts.claims import axes_of as _axes
 from gyrolab.contracts.force import Force
 from gyrolab.contracts.integrator import COMPILED_MODEL, Integrator, IntegratorStats, Solution
@@ -58,15 +58,9 @@ from gyrolab.plugins.systems.fixed_point import FixedPoint
 
 __all__ = ["check_force", "check_integrator", "check_regime", "check_system", "random_states", "rotation_torque"]
 
-#: Relative tolerance of the finite-difference potential check (central differences, h = 1e-5).
-POTENTIAL_RTOL = 1e-6
-#: torque·γ below this fraction of |torque| counts as "no component along the vertical".
+#: torque·γ below this fraction of |torque| counts as "no component along the vertical" (tighter than the scene's)
 AREA_RTOL = 1e-12
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
-
-
-def _test_body():
-    return Body.from_config({"units": "nondimensional", "a": 0.7, "b": 0.9, "com_direction": [0.3, 0.4, 0.866025403784]})
 
 
 def _call(force: Force, omega: np.ndarray, frame: np.ndarray, t: float) -> Any:
@@ -76,6 +70,20 @@ def _call(force: Force, omega: np.ndarray, frame: np.ndarray, t: float) -> Any:
 
 def _fail(cls: type, message: str) -> AssertionError:
     return AssertionError(f"{cls.__name__}: {message}")
+
+
+def _check_class(cls: type, contract: type, key: str) -> None:
+    """``cls`` subclasses ``contract`` and its ``name`` is a config key (``key`` says where the config names it)."""
+    if not (isinstance(cls, type) and issubclass(cls, contract)):
+        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.{contract.__name__}")
+    name = getattr(cls, "name", None)
+    if not isinstance(name, str) or not _NAME.match(name):
+        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ ({key})")
+
+
+def _as_config(params: dict[str, Any]) -> dict[str, Any]:
+    """The kit's keyword parameters as a config gives them (arrays as lists)."""
+    return {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
 
 
 def check_force(cls: type, body: Any = None, *, n_states: int = 20, **params: Any) -> None:
@@ -92,39 +100,25 @@ def check_force(cls: type, body: Any = None, *, n_states: int = 20, **params: An
         How many random states the torque is checked on.
     **params
         The plugin's keyword parameters for the checks (its defaults when omitted).
-
-    Raises
-    ------
-    AssertionError
-        Naming the first rule the plugin breaks.
     """
-    if not (isinstance(cls, type) and issubclass(cls, Force)):
-        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Force")
-    body = _test_body() if body is None else body
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not _NAME.match(name):
-        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config key force.NAME)")
-    where = f"force.{name}"
-    params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}  # as a config gives them
-    try:
-        force = build_force(cls, dict(params), where, body)
-    except ConfigError as exc:
-        raise _fail(cls, f"building it with {params} raised ConfigError: {exc}") from None
-    _check_declarations(cls, force)
+    _check_class(cls, Force, "the config key force.NAME")
+    if body is None:  # triaxial, with an off-axis centre of mass
+        body = Body.from_config({"units": "nondimensional", "a": 0.7, "b": 0.9,
+                                 "com_direction": [0.3, 0.4, 0.866025403784]})
+    where = f"force.{cls.name}"
+    params = _as_config(params)
+    force = _build_plugin(lambda **kw: build_force(cls, kw, where, body), cls, params)
+    axes = force.required_axes
+    if not isinstance(axes, (set, frozenset)) or not set(axes) <= {0, 1, 2}:
+        raise _fail(cls, f"required_axes={axes!r} must be a frozenset of axis indices 0, 1, 2")
     omegas, frames = random_states(n_states)
     torques = _check_torque(cls, force, omegas, frames)
     _check_area_flag(cls, force, torques, frames)
     if force.conservative:
         _check_potential(cls, force, frames)
-    _check_attributes(cls, force)
-    _check_bad_parameters(cls, body, where, params)
+    _check_mapping(cls, force.attributes(), "attributes()")
+    _check_bad_parameters(cls, params, "", lambda **kw: build_force(cls, kw, where, body))
     _check_compiled(cls, force, body, omegas, frames)
-
-
-def _check_declarations(cls: type, force: Force) -> None:
-    axes = force.required_axes
-    if not isinstance(axes, (set, frozenset)) or not set(axes) <= {0, 1, 2}:
-        raise _fail(cls, f"required_axes={axes!r} must be a frozenset of axis indices 0, 1, 2")
 
 
 def _check_torque(cls: type, force: Force, omegas: np.ndarray, frames: np.ndarray) -> np.ndarray:
@@ -191,31 +185,6 @@ def _netcdf_safe(value: Any) -> bool:
     return False
 
 
-def _check_attributes(cls: type, force: Force) -> None:
-    _check_mapping(cls, force.attributes(), "attributes()")
-
-
-def _check_bad_parameters(cls: type, body: Any, where: str, params: dict[str, Any]) -> None:
-    for key, param in inspect.signature(cls.__init__).parameters.items():
-        if param.kind is not inspect.Parameter.KEYWORD_ONLY or (param.default is None and key not in params):
-            continue  # a parameter off by default is checked when the caller gives it
-        for bad in ("abc",):  # NaN and inf never reach a plugin: the scene refuses non-finite config values
-            try:
-                build_force(cls, {**params, key: bad}, where, body)
-            except ConfigError as exc:
-                message = str(exc)
-                if key not in message or "\n" in message.strip():
-                    raise _fail(cls, f"{key}={bad!r} raised a ConfigError that does not name the parameter in one "
-                                     f"line: {message!r}") from None
-                continue
-            except Exception as exc:  # noqa: BLE001  (anything but ConfigError is the violation)
-                raise _fail(cls, f"{key}={bad!r} raised {type(exc).__name__}: {exc}; raise gyrolab.errors."
-                                 "ConfigError naming the parameter (gyrolab.errors.as_number validates numbers)") \
-                    from None
-            raise _fail(cls, f"{key}={bad!r} was accepted; validate the parameter and raise gyrolab.errors."
-                             "ConfigError (gyrolab.errors.as_number does it for numbers)")
-
-
 def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, frames: np.ndarray) -> None:
     if force.compiled_terms() is not None:
         return  # a built-in form; the system's tests compare it with the Python right-hand side
@@ -230,14 +199,12 @@ def _check_compiled(cls: type, force: Force, body: Any, omegas: np.ndarray, fram
     except expression.NotCompilable as exc:
         warnings.warn(f"{cls.__name__} runs with the Python integrators only: {exc}", stacklevel=3)
         return
-    address = int(compiled.params[model.TRACED_ADDRESS])
-    kernel = ctypes.CFUNCTYPE(None, ctypes.c_double, *[ctypes.POINTER(ctypes.c_double)] * 3)(address)
-    p = compiled.params
     ptr = ctypes.POINTER(ctypes.c_double)
+    kernel = ctypes.CFUNCTYPE(None, ctypes.c_double, ptr, ptr, ptr)(int(compiled.params[model.TRACED_ADDRESS]))
     for k, (omega, frame) in enumerate(zip(omegas, frames)):
         y = np.concatenate([omega, frame[2], frame[0]])
         out = np.zeros(3)
-        kernel(0.7 * k, y.ctypes.data_as(ptr), p.ctypes.data_as(ptr), out.ctypes.data_as(ptr))
+        kernel(0.7 * k, y.ctypes.data_as(ptr), compiled.params.ctypes.data_as(ptr), out.ctypes.data_as(ptr))
         expected = np.asarray(_call(force, omega.copy(), frame, 0.7 * k), dtype=float)
         if not np.allclose(out, expected, rtol=1e-12, atol=1e-14 * max(1.0, np.max(np.abs(expected)))):
             raise _fail(cls, f"the compiled torque {out.tolist()} differs from the Python torque {expected.tolist()} "
@@ -273,17 +240,14 @@ class ExactProblem:
     compiled: Any = None
 
 
-def _oscillator(t: float, y: np.ndarray) -> np.ndarray:
-    """x'' = −x written as y = (x, v): the exact solution from (1, 0) at t0 is (cos(t − t0), −sin(t − t0))."""
-    return np.array([y[1], -y[0]])
-
-
 def oscillator_problem() -> ExactProblem:
+    """x'' = −x written as y = (x, v): the exact solution from (1, 0) at t0 is (cos(t − t0), −sin(t − t0))."""
     def exact(t: np.ndarray) -> np.ndarray:
         dt = t - OSCILLATOR_TIMES[0]
         return np.stack([np.cos(dt), -np.sin(dt)], axis=1)
 
-    return ExactProblem("the harmonic oscillator x'' = −x", _oscillator, np.array([1.0, 0.0]), exact, slice(0, 2))
+    return ExactProblem("the harmonic oscillator x'' = −x", lambda t, y: np.array([y[1], -y[0]]), np.array([1.0, 0.0]),
+                        exact, slice(0, 2))
 
 
 #: The free symmetric top of ``free_top_problem``: A = B = 0.8 C, no torque, ω0 = (0.1, −0.05, 5).
@@ -308,10 +272,6 @@ def free_top_problem() -> ExactProblem:
                         system.initial_state(), exact, slice(0, 3), system.compiled_model())
 
 
-def _blow_up(t: float, y: np.ndarray) -> np.ndarray:
-    return y * y
-
-
 def check_integrator(cls: type, **params: Any) -> None:
     """Check an integrator plugin class against the Integrator contract; AssertionError names the first violation.
 
@@ -322,47 +282,20 @@ def check_integrator(cls: type, **params: Any) -> None:
     **params
         The plugin's keyword parameters for the checks (its defaults when omitted).
 
-    Raises
-    ------
-    AssertionError
-        Naming the first rule the plugin breaks.
-
     Notes
     -----
-    The rules checked, in order:
-
-    1. ``name`` is a config key, ``adaptive`` a bool, ``capabilities`` (when declared) a frozenset of str;
-    2. it builds with ``params``; every keyword parameter given a nonsense value ("abc") raises gyrolab's
-       one-sentence ``ConfigError`` naming the parameter;
-    3. on the harmonic oscillator x'' = −x from t = 0.5 to 10.5 it returns a ``Solution`` at exactly the requested
-       ``t_out`` (the same values), with ``y`` of shape (n, 2), finite, ``y[0]`` = y0, the input y0 left unchanged;
-    4. its error against cos, −sin is within ``ERROR_FACTOR`` × max(rtol, atol) (adaptive methods with ``rtol``
-       and ``atol`` attributes), or below ``FIXED_STEP_ERROR`` (others);
-    5. it counts its work: ``stats`` is an ``IntegratorStats`` with 0 < ``nfev`` ≤ the calls of ``fun`` the kit
-       counted (it never counts evaluations it did not make) and ``n_steps`` ≥ 1;
-    6. it calls ``progress(t)`` when given, with times within the integration interval;
-    7. on y' = y², y(0) = 1, which blows up at t = 1, it raises ``gyrolab.errors.IntegrationError`` (one line), never
-       returns non-finite values, and never returns a finite "solution" past the blow-up;
-    8. ``attributes()`` and ``stats.attributes()`` are netCDF-safe.
-
-    A compiled integrator (``COMPILED_MODEL``) integrates the compiled model it is given, not ``fun``: rules
-    3–6 are then checked on the free symmetric top (``free_top_problem``: gyrolab's fixed-point system with A = B
-    and no torque, whose ω turns at a constant rate), ``nfev`` > 0 only, and rule 7 is skipped (a blow-up has no
-    compiled model).
+    The rules it checks, in order, on a harmonic oscillator, a blow-up and (for a compiled integrator) the free
+    symmetric top are listed in docs/plugins.md, "Integrator plugins".
     """
-    if not (isinstance(cls, type) and issubclass(cls, Integrator)):
-        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Integrator")
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not _NAME.match(name):
-        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config's integrator=NAME)")
+    _check_class(cls, Integrator, "the config's integrator=NAME")
     if not isinstance(getattr(cls, "adaptive", None), bool):
         raise _fail(cls, f"adaptive={getattr(cls, 'adaptive', None)!r} must be declared True or False")
     capabilities = getattr(cls, "capabilities", frozenset())
     if not isinstance(capabilities, frozenset) or not all(isinstance(c, str) for c in capabilities):
         raise _fail(cls, f"capabilities={capabilities!r} must be a frozenset of capability names (str)")
-    params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
-    integrator = _build_plugin(cls, params)
-    _check_bad_plugin_parameters(cls, params, "integrator")
+    params = _as_config(params)
+    integrator = _build_plugin(cls, cls, params)
+    _check_bad_parameters(cls, params, "integrator.", cls)
     if cls.supports(COMPILED_MODEL):
         stats = _check_exact_problem(cls, integrator, free_top_problem())
     else:
@@ -372,16 +305,16 @@ def check_integrator(cls: type, **params: Any) -> None:
     _check_mapping(cls, integrator.attributes(), "attributes()")
 
 
-def _build_plugin(cls: type, params: dict[str, Any], *args: Any) -> Any:
-    """The plugin built with ``params`` (after the positional ``args`` a scene passes: a system's body, ...)."""
+def _build_plugin(build: Any, cls: type, params: dict[str, Any]) -> Any:
+    """``build(**params)``: the plugin ``cls`` built as a scene builds it."""
     try:
-        return cls(*args, **params)
+        return build(**params)
     except ConfigError as exc:
         raise _fail(cls, f"building it with {params} raised ConfigError: {exc}") from None
 
 
 def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> Any:
-    """Rules 3–6 of ``check_integrator`` on one problem with a known solution; returns the run's stats."""
+    """``check_integrator``'s checks on one problem with a known solution; returns the run's stats."""
     calls = [0]
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
@@ -408,7 +341,7 @@ def _check_exact_problem(cls: type, integrator: Any, problem: ExactProblem) -> A
 
 
 def _check_samples(cls: type, solution: Solution, t_out: np.ndarray, y0: np.ndarray, on: str) -> None:
-    """Rule 3: the solution is sampled at exactly ``t_out``, finite, with the state size, starting at ``y0``."""
+    """The solution is sampled at exactly ``t_out``, finite, with the state size, starting at ``y0``."""
     t, y = np.asarray(solution.t), np.asarray(solution.y)
     if t.shape != t_out.shape or not np.array_equal(t, t_out):
         raise _fail(cls, f"Solution.t is {np.round(t, 12).tolist()}, not the requested t_out "
@@ -423,7 +356,7 @@ def _check_samples(cls: type, solution: Solution, t_out: np.ndarray, y0: np.ndar
 
 def _check_accuracy(cls: type, integrator: Any, problem: ExactProblem, y: np.ndarray, t_out: np.ndarray,
                     on: str) -> None:
-    """Rule 4: the error against the exact solution is within the integrator's own tolerance."""
+    """The error against the exact solution is within the integrator's own tolerance."""
     error = float(np.max(np.abs(y[:, problem.compared] - problem.exact(t_out))))
     rtol, atol = getattr(integrator, "rtol", None), getattr(integrator, "atol", None)
     if cls.adaptive and rtol is not None and atol is not None:
@@ -436,7 +369,7 @@ def _check_accuracy(cls: type, integrator: Any, problem: ExactProblem, y: np.nda
 
 
 def _checked_stats(cls: type, solution: Solution, problem: ExactProblem, calls: int) -> IntegratorStats:
-    """Rule 5: the run's stats count the evaluations made (at most ``calls`` for a Python right-hand side) and
+    """The run's stats count the evaluations made (at most ``calls`` for a Python right-hand side) and
     the steps taken."""
     stats = solution.stats
     if not isinstance(stats, IntegratorStats):
@@ -454,7 +387,7 @@ def _checked_stats(cls: type, solution: Solution, problem: ExactProblem, calls: 
 def _check_blow_up(cls: type, integrator: Any) -> None:
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            solution = unchecked(integrator)(_blow_up, BLOW_UP_TIMES.copy(), np.array([1.0]), None, None)
+            solution = unchecked(integrator)(lambda t, y: y * y, BLOW_UP_TIMES.copy(), np.array([1.0]), None, None)
     except IntegrationError as exc:
         if "\n" in str(exc).strip():
             raise _fail(cls, f"its IntegrationError on y' = y² is not one line: {str(exc)!r}") from None
@@ -482,23 +415,24 @@ def _check_mapping(cls: type, attrs: Any, what: str) -> None:
                              "list of finite numbers (no bool, None or dict)")
 
 
-def _check_bad_plugin_parameters(cls: type, params: dict[str, Any], group: str, *args: Any) -> None:
-    """Every keyword parameter set to "abc" must raise one ConfigError line naming it (as ``check_force`` rule 6)."""
+def _check_bad_parameters(cls: type, params: dict[str, Any], prefix: str, build: Any) -> None:
+    """Every keyword parameter set to "abc" must make ``build(**params)`` raise one ConfigError line naming it
+    (NaN and inf never reach a plugin: the scene refuses non-finite config values)."""
     for key, param in inspect.signature(cls.__init__).parameters.items():
         if param.kind is not inspect.Parameter.KEYWORD_ONLY or (param.default is None and key not in params):
-            continue
+            continue  # a parameter off by default is checked when the caller gives it
         try:
-            cls(*args, **{**params, key: "abc"})
+            build(**{**params, key: "abc"})
         except ConfigError as exc:
             message = str(exc)
             if key not in message or "\n" in message.strip():
-                raise _fail(cls, f"{group}.{key}='abc' raised a ConfigError that does not name the parameter in "
+                raise _fail(cls, f"{prefix}{key}='abc' raised a ConfigError that does not name the parameter in "
                                  f"one line: {message!r}") from None
             continue
-        except Exception as exc:  # noqa: BLE001
-            raise _fail(cls, f"{group}.{key}='abc' raised {type(exc).__name__}: {exc}; raise gyrolab.errors."
+        except Exception as exc:  # noqa: BLE001  (anything but ConfigError is the violation)
+            raise _fail(cls, f"{prefix}{key}='abc' raised {type(exc).__name__}: {exc}; raise gyrolab.errors."
                              "ConfigError naming the parameter (gyrolab.errors.as_number validates numbers)") from None
-        raise _fail(cls, f"{group}.{key}='abc' was accepted; validate the parameter and raise gyrolab.errors."
+        raise _fail(cls, f"{prefix}{key}='abc' was accepted; validate the parameter and raise gyrolab.errors."
                          "ConfigError (gyrolab.errors.as_number does it for numbers)")
 
 
@@ -529,40 +463,18 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
     output : dict, optional
         The ``output`` section (``{"euler_angles": True}`` by default).
     span : float
-        The time span of the invariant check (rule 6).
+        The time span of the invariant check.
     invariant_tolerance : float
-        Relative drift allowed to each invariant over ``span`` (rule 6).
+        Relative drift allowed to each invariant over ``span``.
     **params
         The system's own parameters.
 
-    Raises
-    ------
-    AssertionError
-        Naming the first rule the plugin breaks.
-
     Notes
     -----
-    The rules checked, in order:
-
-    1. ``name`` is a config key; ``body_type`` has ``from_config``, which builds the body from ``body``;
-    2. the system builds with ``(body, forces, initial, output, **params)``;
-    3. ``state_size`` is a positive int; ``initial_state()`` a finite float array of shape (state_size,);
-    4. ``rhs(t, y0)`` is a finite float array of shape (state_size,) and leaves y0 unchanged;
-    5. ``invariants`` is a tuple of str; ``variables(t, y)`` of a trajectory is a dict of ``xarray.Variable`` on
-       dims starting with ``time``, each with CF ``units`` and ``long_name`` (non-empty str), and every invariant is
-       one of them, on dims ``("time",)``;
-    6. integrated over [0, ``span``] with scipy's DOP853 at rtol = atol = 1e-12, every invariant stays within
-       ``invariant_tolerance`` × max(1, |v0|) of its initial value (an invariant that drifts is no invariant);
-    7. ``attributes()`` is netCDF-safe; ``title()`` a non-empty one-line str;
-    8. its compiled model (``compiled_model()``: by default its ``rhs`` traced, ``gyrolab.kernels.model``), if it has
-       one, computes ``rhs`` (to 1e-12) at random states and its Taylor integrator follows the DOP853 trajectory of 6.
-       A system that cannot be traced is warned about (it runs with the Python integrators only), not failed.
+    The rules it checks, in order, are listed in docs/plugins.md, "System plugins"; a system whose ``rhs`` cannot
+    be traced is warned about (it runs with the Python integrators only), not failed.
     """
-    if not (isinstance(cls, type) and issubclass(cls, System)):
-        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.System")
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not _NAME.match(name):
-        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config's system=NAME)")
+    _check_class(cls, System, "the config's system=NAME")
     body_type = getattr(cls, "body_type", None)
     if not callable(getattr(body_type, "from_config", None)):
         raise _fail(cls, f"body_type={body_type!r} must be a class with from_config(body section)")
@@ -573,8 +485,11 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
     built_forces = [build_force(force_cls, dict(force_params), f"force.{force_cls.name}", built_body)
                     for force_cls, force_params in forces]
     output = {"euler_angles": True} if output is None else dict(output)
-    system = _build_plugin(cls, params, built_body, built_forces, dict(initial), output)
-    _check_bad_plugin_parameters(cls, params, "system", built_body, built_forces, dict(initial), output)
+    def build(**kw: Any) -> Any:
+        return cls(built_body, built_forces, dict(initial), output, **kw)
+
+    system = _build_plugin(build, cls, params)
+    _check_bad_parameters(cls, params, "system.", build)
     y0 = _check_state(cls, system)
     t, y = _integrate_tightly(cls, system, y0, span)
     _check_variables(cls, system, t, y)
@@ -587,7 +502,7 @@ def check_system(cls: type, body: dict[str, Any], initial: dict[str, Any], *, fo
 
 
 def _check_compiled_system(cls: type, system: Any, t: np.ndarray, y: np.ndarray) -> None:
-    """Rule 8 of ``check_system``: the compiled model against the Python right-hand side and trajectory."""
+    """``check_system``'s last check: the compiled model against the Python right-hand side and trajectory."""
     compiled = system.compiled_model()
     if compiled is None:
         warnings.warn(f"{cls.__name__} runs with the Python integrators only: {system.compile_error}", stacklevel=3)
@@ -701,37 +616,16 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
     **params
         The regime's keyword parameters.
 
-    Raises
-    ------
-    AssertionError
-        Naming the first rule the plugin breaks.
-
     Notes
     -----
-    The rules checked, in order:
-
-    1. ``name`` is a config key; ``systems`` a non-empty tuple of system names; ``parameter`` and
-       ``parameter_long_name`` str; ``order`` a dict of variable name → number;
-    2. it builds with ``params``; every keyword parameter given a nonsense value ("abc") raises gyrolab's
-       one-sentence ``ConfigError`` naming the parameter;
-    3. the scene's system is one of ``systems``; ``check_domain(system)`` returns a list of one-line str;
-    4. ``parameter_value(system)`` is a finite number;
-    5. ``initial_state(system)`` is a finite float array of shape (6,), and ``solution(system, [0])`` (shape (1, 6))
-       equals it;
-    6. ``period(system)`` is finite and > 0; ``solution(system, t)`` over one period has shape (n, 6), finite;
-    7. ``euler_angles(system, t)`` has exactly the keys psi, theta, phi, each a finite array of shape (n,);
-    8. ``attributes()`` is netCDF-safe.
+    The rules it checks, in order, are listed in docs/plugins.md, "Regime plugins".
     """
-    if not (isinstance(cls, type) and issubclass(cls, Regime)):
-        raise AssertionError(f"{cls!r} is not a subclass of gyrolab.contracts.Regime")
+    _check_class(cls, Regime, "the config's regime=NAME")
     _check_regime_declarations(cls)
-    params = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in params.items()}
-    regime = _build_plugin(cls, params)
-    _check_bad_plugin_parameters(cls, params, "regime")
-    if isinstance(scene, System):
-        system = scene
-    else:
-        system = compose_scene(list(scene)).system
+    params = _as_config(params)
+    regime = _build_plugin(cls, cls, params)
+    _check_bad_parameters(cls, params, "regime.", cls)
+    system = scene if isinstance(scene, System) else compose_scene(list(scene)).system
     if system.name not in cls.systems:
         raise _fail(cls, f"the kit's scene has system {system.name!r}, not one of systems={cls.systems}; give a "
                          "scene the regime is derived for (scene=[...overrides...])")
@@ -746,7 +640,7 @@ def check_regime(cls: type, scene: Any = (), **params: Any) -> None:
 
 
 def _check_regime_numbers(cls: type, regime: Any, system: Any) -> None:
-    """Rules 4–6: a finite parameter value, a start state matching the solution at 0, a finite positive period
+    """A finite parameter value, a start state matching the solution at 0, a finite positive period
     over which the solution is finite, of shape (n, 6)."""
     value = regime.parameter_value(system)
     if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) or not math.isfinite(float(value)):
@@ -763,9 +657,6 @@ def _check_regime_numbers(cls: type, regime: Any, system: Any) -> None:
 
 
 def _check_regime_declarations(cls: type) -> None:
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not _NAME.match(name):
-        raise _fail(cls, f"name={name!r} must be a string of letters, digits and _ (the config's regime=NAME)")
     systems = getattr(cls, "systems", None)
     if not isinstance(systems, tuple) or not systems or not all(isinstance(s, str) for s in systems):
         raise _fail(cls, f"systems={systems!r} must be a non-empty tuple of the system names it is derived for")

@@ -1,10 +1,5 @@
-"""The registered integrators by capability: the valid choices a refusal lists, never a table of names.
-
-A refusal for a missing capability (``--batch`` chaos indicators asked of an integrator without VARIATIONAL,
-a compiled-only integrator on a system without a compiled form) names the integrator, the capability and the
-integrators that have it, found here: every registered integrator class (built-ins and ``gyrolab.integrators``
-entry points) is loaded and asked; a third-party class that fails to import is left out of the list (its own
-use says why, in its own sentence).
+"""The registered integrators by capability: the valid choices a refusal for a missing capability lists, found by
+asking every registered integrator class, never a table of names.
 """
 
 from __future__ import annotations

@@ -1,11 +1,8 @@
-"""A force's claims, checked by numbers: its potential belongs to its torque, its area-integral flag is true.
+"""A force's claims, checked by numbers: its potential belongs to its torque (``Force`` rule 5), its area-integral
+flag is true (rule 6); a false claim would make gyrolab monitor, and draw as conserved, a quantity that is not.
 
-A force that declares ``potential(axes)`` claims that its torque is Σ e_i × ∂V/∂e_i (``Force`` rule 5);
-one that declares ``preserves_area_integral = True`` claims torque·γ = 0 for every state (rule 6). A
-false claim makes gyrolab monitor, and draw as conserved, a quantity that is not. The scene checks a
-third-party force's claims when it is built (``check_claims``) at the initial state and a few
-deterministic random states; ``gyrolab.testing.check_force`` checks them at more states, more tightly.
-The numeric helpers live here, below the engine, so that both use the same derivative.
+The scene checks a third-party force's claims when it is built (docs/plugins.md, "What the engine checks");
+``gyrolab.testing.check_force`` checks them more tightly, with the same derivative from here.
 """
 
 from __future__ import annotations
@@ -33,13 +30,10 @@ CLAIM_SEED = 20211
 def random_states(n: int = 20, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """``n`` random angular velocities (n, 3) and attitudes (n, 3, 3): rows α, β, γ, a right-handed frame."""
     rng = np.random.default_rng(seed)
-    frames = np.empty((n, 3, 3))
-    for k in range(n):
-        q, r = np.linalg.qr(rng.normal(size=(3, 3)))
-        q = q * np.sign(np.diag(r))
-        if np.linalg.det(q) < 0:
-            q[:, 0] = -q[:, 0]
-        frames[k] = q.T  # rows e_0, e_1, e_2 with e_0 × e_1 = e_2
+    q, r = np.linalg.qr(rng.normal(size=(n, 3, 3)))
+    q = q * np.sign(np.diagonal(r, axis1=1, axis2=2))[:, None, :]
+    q[np.linalg.det(q) < 0, :, 0] *= -1
+    frames = np.ascontiguousarray(q.transpose(0, 2, 1))  # rows e_0, e_1, e_2 with e_0 × e_1 = e_2
     return rng.normal(scale=2.0, size=(n, 3)), frames
 
 
@@ -124,12 +118,10 @@ def check_claims(force: Any, omegas: np.ndarray, frames: np.ndarray, t0: float =
         broken = np.flatnonzero(along > AREA_RTOL * size)
         if broken.size:
             worst = int(broken[0])  # the first state that breaks the claim: the initial one when it does
-            raise ConfigError(
-                f"{where}: force {force.name!r} declares preserves_area_integral = True, but its torque has the "
-                f"component torque·γ = {along[worst]:.3g} along the vertical γ (|torque| = {size[worst]:.3g}, "
-                f"{labels[worst]}), so Iω·γ is not conserved; "
-                "declare preserves_area_integral = False"
-            )
+            raise ConfigError(f"{where}: force {force.name!r} declares preserves_area_integral = True, but its torque "
+                              f"has the component torque·γ = {along[worst]:.3g} along the vertical γ (|torque| = "
+                              f"{size[worst]:.3g}, {labels[worst]}), so Iω·γ is not conserved; declare "
+                              "preserves_area_integral = False")
     if getattr(force, "conservative", False):
         for k, (torque, frame) in enumerate(zip(torques, frames)):
             _check_potential(force, torque, frame, labels[k], where)
@@ -147,9 +139,7 @@ def _check_potential(force: Any, torque: np.ndarray, frame: np.ndarray, label: s
     allowed = POTENTIAL_RTOL * max(float(np.max(np.abs(torque))), float(np.max(np.abs(expected)))) \
         + ROUNDOFF_FACTOR * np.finfo(float).eps * abs(value) / ROTATION_STEP
     if not error <= allowed:
-        raise ConfigError(
-            f"{where}: the potential of force {force.name!r} does not belong to its torque: at "
-            f"{label} the torque is {np.round(torque, 9).tolist()} "
-            f"but Σ e_i × ∂V/∂e_i of the potential is {np.round(expected, 9).tolist()} (difference {error:.3g}); "
-            "fix potential or torque, or remove potential if the force is not conservative"
-        )
+        raise ConfigError(f"{where}: the potential of force {force.name!r} does not belong to its torque: at {label} "
+                          f"the torque is {np.round(torque, 9).tolist()} but Σ e_i × ∂V/∂e_i of the potential is "
+                          f"{np.round(expected, 9).tolist()} (difference {error:.3g}); fix potential or torque, or "
+                          "remove potential if the force is not conservative")

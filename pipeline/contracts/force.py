@@ -27,33 +27,19 @@ class Force(ABC):
        defaults are the plugin's default config; ``**params`` is refused, as it
        would accept any key and advertise none); it validates them and raises
        ``gyrolab.errors.ConfigError`` (one sentence, naming the bad value) on
-       bad input. A ``ValueError`` or ``TypeError`` escaping ``__init__``
-       (``float("abc")``) is reported by gyrolab as one sentence naming the
-       parameter; any other exception as one sentence naming the plugin.
-
-       What ``body`` offers (read it in ``__init__``, keep what the torque
-       needs as plain floats or arrays): for ``system=fixed_point`` a
-       ``gyrolab.physics.body.Body`` with ``units`` (``"si"`` or
-       ``"nondimensional"``), ``inertia`` (A, B, C), ``weight_moment``
-       (M g r_c, a torque), ``g`` (SI only, else None), ``nonphysical``,
-       ``source`` (the config as given) and the unit names ``time_unit``,
-       ``rate_unit``, ``torque_unit``, ``energy_unit``, ``momentum_unit``
-       (for ``attributes()``); for ``system=orbiting_gyrostat`` a
-       ``gyrolab.physics.gyrostat_body.GyrostatBody`` (``inertia``,
-       ``gyrostatic_momentum``, ``orbit_rate``, ``units``, the same unit
-       names); a system plugin passes its own ``body_type``.
+       bad input (what gyrolab makes of other exceptions: docs/plugins.md,
+       "What the engine checks").
+       Read what the torque needs from ``body`` in ``__init__`` and keep it as
+       plain floats or arrays (docs/plugins.md, "What body offers a force").
     2. ``required_axes`` names the reference-frame axes (0, 1, 2) whose body
        components ``torque`` and ``potential`` read. A system carries an axis
        only if some force (or the output) needs it, so ask for no more; an axis
        not declared is passed as ``None``.
     3. ``torque(omega, axes)`` returns the torque in body axes, model units,
-       for one state (vectors of shape (3,)). Write it as arithmetic on the
-       vectors (numpy operations, ``gyrolab.physics.vectors`` helpers, np.sqrt,
-       np.exp, np.sin, ...): gyrolab traces it once into compiled code, so it runs
-       under the compiled integrators, ``gyrolab batch`` and ``auto`` at machine speed.
-       A torque that branches on the state (``if``, comparisons, ``max``) or
-       converts it to a float (``float()``, ``math.*``) runs with the Python
-       integrators only; the log and any compiled integrator say which construct.
+       for one state (vectors of shape (3,)). Written as numpy arithmetic on the
+       vectors it is traced once into compiled code; one that branches on the
+       state or converts it to a float runs with the Python integrators only
+       (docs/plugins.md, "How a plain-Python torque runs compiled").
     4. ``time_dependent = True`` declares a torque that also depends on time:
        it is then called as ``torque(omega, axes, t)``. Such a force has no
        conserved energy (its ``potential`` is not used).
@@ -73,22 +59,13 @@ class Force(ABC):
        SI and the nondimensional form where the body allows it (netCDF-safe
        values: str, int, float, lists of numbers; names of letters, digits, _).
     8. Optionally, ``compiled_terms()`` returns the torque as ``CompiledTerms``,
-       the built-in forms every compiled integrator (Taylor and Lie–Poisson too)
-       evaluates; a traced torque (rule 3) runs with ``dop853_numba``,
-       ``rk4_numba``, ``taylor`` (its Taylor coefficients propagated through the
-       trace; not with ``integrator.precision=double-double``), ``gyrolab batch`` and
-       ``auto``, but not with ``lie_poisson``, which takes the built-in forms only.
+       the built-in forms every compiled integrator evaluates (which ones take a
+       traced torque instead: docs/plugins.md, "Which integrators take a compiled
+       plugin torque").
 
-    What gyrolab enforces on a third-party force (gyrolab's own are trusted),
-    each failure one sentence naming the force (docs/plugins.md, "What the
-    engine checks"): when the scene is built, the claims of rules 5 and 6 are
-    measured at the initial state and seeded random states
-    (``gyrolab.contracts.claims``; a false one is a ConfigError); during a run
-    on the Python right-hand side, a torque that raises or breaks rule 3
-    (None, a string, a wrong shape, NaN) ends the run as an IntegrationError
-    (``gyrolab.engine.force_guard``); after it, an invariant whose drift the
-    integration error does not explain is flagged in ``run.nc``
-    (``gyrolab.output.invariant_check``).
+    gyrolab checks a third-party force's claims (rules 5, 6) when the scene is
+    built and its torque (rule 3) during a run, each failure one sentence naming
+    the force (docs/plugins.md, "What the engine checks").
     """
 
     name: ClassVar[str]
@@ -122,7 +99,6 @@ def check_declared(force: Force, where: str) -> None:
     """ConfigError unless the force declares ``preserves_area_integral`` as a bool (rule 6)."""
     flag = getattr(force, "preserves_area_integral", None)
     if not isinstance(flag, (bool, np.bool_)):
-        raise ConfigError(
-            f"{where} ({type(force).__name__}) must declare preserves_area_integral = True or False: True only "
-            "when its torque has no component along the vertical Z (γ) for every state; see gyrolab.contracts.Force"
-        )
+        raise ConfigError(f"{where} ({type(force).__name__}) must declare preserves_area_integral = True or False: "
+                          "True only when its torque has no component along the vertical Z (γ) for every state; "
+                          "see gyrolab.contracts.Force")

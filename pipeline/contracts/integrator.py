@@ -29,7 +29,7 @@ class IntegratorStats:
 
     def attributes(self) -> dict[str, Any]:
         """netCDF-safe attributes (unknown counts are left out, not stored as a fake number)."""
-        # getattr over the fields: dataclasses.asdict deep-copies every value (~0.1 ms of a run's dataset)
+        # getattr over the fields: dataclasses.asdict deep-copies every value
         values = ((f.name, getattr(self, f.name)) for f in fields(self))
         return {f"integrator_{k}": v for k, v in values if v is not None}
 
@@ -65,10 +65,8 @@ class Solution:
     choice: Choice | None = None
 
 
-# ----------------------------------------------------------------------------------------------------------
-# Capabilities: what an integrator can do, declared by the integrator and asked for by the engine (which never
-# tests an integrator's name). Each is a rule of the contract (C1-C7 in ``Integrator``'s docstring); docs/plugins.md,
-# "Integrator capabilities", says what the engine does with each and which built-ins have it.
+# Capabilities (rule 8 of ``Integrator``): declared by the integrator, asked for by the engine, never its name;
+# docs/plugins.md, "Integrator capabilities", says what the engine does with each and which built-ins have it.
 
 #: C1: integrates the system's compiled model (``compiled``) instead of calling ``fun``
 COMPILED_MODEL = "compiled_model"
@@ -131,8 +129,6 @@ class VariationalSettings:
     def fixed_step(self) -> bool:
         return self.step is not None
 
-# ----------------------------------------------------------------------------------------------------------
-
 
 class Integrator(ABC):
     """A method that integrates an initial-value problem.
@@ -156,54 +152,24 @@ class Integrator(ABC):
        with one sentence saying when and why.
     5. It calls ``progress(t)``, when given, every few steps (cheap; the
        callback decides whether to report).
-    6. A compiled integrator declares ``COMPILED_MODEL`` (rule 8) and integrates the
-       ``compiled`` model it is given (the system's ``compiled_model()``)
-       instead of calling ``fun``; the scene refuses it, before integrating,
-       for a system or force that has no compiled form.
+    6. A compiled integrator (``COMPILED_MODEL``, rule 8) integrates the ``compiled`` model it is given (the
+       system's ``compiled_model()``) instead of calling ``fun``.
     7. ``attributes()`` gives its settings for the dataset.
-    8. It declares what it can do in ``capabilities`` (a frozenset of the module's capability constants)
-       and the engine asks ``supports(capability)``, never for an integrator's name:
-
-       C1. ``COMPILED_MODEL``: it integrates the ``compiled`` model it is given (rule 6). The scene refuses
-           it for a system without a compiled form, and asks ``refusal(compiled, system)`` whether it can run the one it has.
-       C2. ``PREFERS_COMPILED_MODEL``: it takes the compiled model when the system has one, else calls
-           ``fun``.
-       C3. ``TIME_DEPENDENT``: it passes the true time to ``fun`` (and to a compiled model), so the scene
-           lets it integrate time-dependent forces; others are refused for them.
-       C4. ``BATCH_KERNEL``: ``integrate_batch(compiled, times, y0s, params, failures)`` integrates many
-           trajectories of a compiled model in one call; ``gyrolab batch`` and
-           ``gyrolab.batch.integrate.integrate_arrays`` call it. Without it ``gyrolab batch`` still runs the
-           integrator, with one ``integrate`` call per point.
-       C5. ``VECTOR_LANES``: its batch kernel advances trajectories together in SIMD lanes (a batch
-           dataset's ``batch_path`` attribute says so).
-       C6. ``VARIATIONAL``: ``variational_settings()`` says how the chaos indicators' compiled variational
-           equations run with its method (fixed-step RK4 or adaptive DOP853, and with which step or
-           tolerances); the indicators are refused for other integrators.
-       C7. ``CHOOSES_METHOD``: it chooses a method and tolerance itself: per scene in ``integrate``, per
-           batch in ``choose_batch_method(compiled, times, y0s, params)``, which ``gyrolab batch`` calls once
-           before the chunks; its evaluation counts include that choice's pilot runs.
-
-       ``evaluation_label``, when set, says what its evaluation count ``nfev`` counts where that is not
-       right-hand-side calls (run datasets store it as ``integrator_nfev_counts``; figures read it).
+    8. It declares what it can do in ``capabilities`` (a frozenset of this module's capability constants,
+       C1–C7, each with its hook; docs/plugins.md, "Integrator capabilities", says what the engine does with
+       each) and the engine asks ``supports(capability)``, never for an integrator's name.
+       ``evaluation_label``, when set, says what ``nfev`` counts where that is not right-hand-side calls.
     9. ``more_accurate(factor)``, optional: a more accurate run of the same method, which
        ``output.error_estimate`` compares with this one to measure the stored trajectory's error.
     10. ``prepare(system)`` is called once by the scene before integrating
         (default: nothing); ``auto`` uses it to consult the system's regimes.
     11. ``precision`` names its rung on the precision ladder (``PRECISIONS``); ``climbed(factor)``, optional:
-        the same method one rung up, ``factor`` times more accurate (the double Taylor method in
-        double-double), which ``gyrolab.accuracy`` runs where ``more_accurate`` has reached its floor.
-        A CHOOSES_METHOD integrator returns what it chose with its solution (``Solution.choice``, a ``Choice``:
-        the method that ran and the error it promises at every output time); ``gyrolab.accuracy`` measures the
-        run and, while the measurement breaks the promise, runs that method made more accurate instead.
+        the same method one rung up, which ``gyrolab.accuracy`` runs where ``more_accurate`` has reached its floor.
+        A CHOOSES_METHOD integrator returns what it chose with its solution (``Solution.choice``, a ``Choice``).
 
-    What gyrolab enforces (``gyrolab.contracts.integrator_rules``): every
-    subclass's ``integrate`` — built-in or third-party, under its own name —
-    is wrapped when the class is defined, so that each call checks y0 (finite,
-    1-D) and ``t_out`` (strictly increasing), then the returned ``Solution``
-    (``t`` of len(t_out), ``y`` of shape (len(t_out), len(y0)), all finite,
-    ``IntegratorStats``). A violation, or any exception that is not a
-    ``gyrolab.errors.GyrolabError``, ends the run as one ``IntegrationError``
-    sentence naming the integrator (exit code 3); nothing is written.
+    Every subclass's own ``integrate`` is wrapped when the class is defined (``gyrolab.contracts.integrator_rules``),
+    so that each call is checked against rules 2–4; a violation is one ``IntegrationError`` sentence naming the
+    integrator (docs/plugins.md, "What the engine checks").
     """
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -226,7 +192,6 @@ class Integrator(ABC):
     def attributes(self) -> dict[str, Any]:
         return {}
 
-    # ------------------------------------------------------------------------------------------------------
     # Capabilities (rule 8): the declaration and the hooks that go with them.
 
     #: what this integrator can do: capability constants of this module (rule 8)

@@ -64,7 +64,7 @@ class Regime(ABC):
     parameter_long_name: ClassVar[str]
     #: the theory's error order of each variable in the parameter (error ∝ parameter**order)
     order: ClassVar[dict[str, float]] = {}
-    #: rule 10: bound of the true period around ``period(system)``, or None (no screen)
+    #: rule 11: bound of the true period around ``period(system)``, or None (no screen)
     period_spread: ClassVar[float | None] = None
 
     def __init__(self, *, formula: str = "corrected") -> None:
@@ -97,11 +97,11 @@ class Regime(ABC):
         """ψ, θ, φ of the analytic solution at times t."""
 
     def diagnostics(self, system: System) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
-        """Rule 8: (data variables, coordinates, attributes) of extra evidence; none by default."""
+        """Rule 9: (data variables, coordinates, attributes) of extra evidence; none by default."""
         return {}, {}, {}
 
     def series_candidates(self, system: System, accuracy: float) -> list[tuple[Regime, float]]:
-        """Rule 9: variants predicted to meet ``accuracy`` with their predicted max error; itself, unpredicted."""
+        """Rule 10: variants predicted to meet ``accuracy`` with their predicted max error; itself, unpredicted."""
         return [(self, float("nan"))]
 
     def attributes(self) -> dict[str, Any]:

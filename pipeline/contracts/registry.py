@@ -1,17 +1,9 @@
 """One registry of plugins: gyrolab's built-ins plus ``gyrolab.*`` entry points.
 
-Names are listed without importing anything; a plugin's module is imported
-the first time a scene asks for it. A config's ``_target_`` may only name a
-registered class of the group's contract, so a YAML file cannot make gyrolab
-call arbitrary code.
-
-A third-party plugin that cannot be used — its module fails to import (any
-exception), its entry point names no subclass of the contract, or its
-``__init__`` takes ``**params`` — never breaks a command that does not use it:
-``load`` raises one ``ConfigError`` naming the plugin, its distribution, its
-entry point and the error, and whoever lists every plugin (the config
-composition) turns that into one ``PluginLoadWarning`` and goes on, as xarray
-does with its backends.
+Names are listed without importing anything; a plugin's module is imported the first time a scene asks for it.
+A third-party plugin that cannot be used never breaks a command that does not use it (docs/plugins.md, "What the
+engine checks", "Installing"): ``load`` raises one ``ConfigError`` naming it, which the config composition turns
+into one ``PluginLoadWarning``.
 """
 
 from __future__ import annotations
@@ -85,10 +77,8 @@ def external(group: str) -> dict[str, str]:
     found: dict[str, Any] = {}
     for ep in entry_points(group=ep_group):
         if ep.name in BUILTINS[group] or ep.name in found:
-            warnings.warn(
-                f"ignoring {ep_group} entry point {ep.name!r} ({ep.value}): the name is already registered",
-                stacklevel=2,
-            )
+            warnings.warn(f"ignoring {ep_group} entry point {ep.name!r} ({ep.value}): the name is already registered",
+                          stacklevel=2)
             continue
         found[ep.name] = ep
     _ENTRY_POINTS[group] = found
@@ -108,20 +98,15 @@ def origin(group: str, name: str) -> str:
     ep = _ENTRY_POINTS.get(group, {}).get(name)
     if ep is None:
         return f"gyrolab's built-in {BUILTINS[group].get(name, '?')}"
-    dist = getattr(ep, "dist", None)
-    dist_name = getattr(dist, "name", None) if dist is not None else None
+    dist_name = getattr(getattr(ep, "dist", None), "name", None)
     where = f"distribution {dist_name!r}" if dist_name else "an unknown distribution"
     return f"{where} (entry point {ep.name} = {ep.value})"
 
 
-def unusable_warning(group: str, name: str, error: ConfigError) -> None:
-    """One warning line for a third-party plugin that cannot be used (``load`` said why)."""
-    warnings.warn(f"{error}; gyrolab goes on without it", PluginLoadWarning, stacklevel=2)
-
-
 def targets(group: str) -> dict[str, str]:
     """All registered plugins of a group: name -> 'module:Class'."""
-    _check_group(group)
+    if group not in GROUPS:
+        raise ConfigError(f"unknown plugin group {group!r}; valid choices: {choices(GROUPS)}")
     return {**BUILTINS[group], **external(group)}
 
 
@@ -139,12 +124,8 @@ def _import(target: str) -> type:
 
 
 def load(group: str, name: str) -> type:
-    """The plugin class registered under ``name``; one ConfigError sentence otherwise.
-
-    The sentence lists the valid names for an unknown one; for a third-party plugin that cannot be
-    used it names the plugin, its distribution and entry point, and the error (import errors of any
-    type: a plugin's module may raise anything while it is imported).
-    """
+    """The plugin class registered under ``name``; one ConfigError sentence otherwise (the valid names for an unknown
+    one; the plugin, its distribution, its entry point and the error for one that cannot be used)."""
     registered = targets(group)
     if name not in registered:
         raise ConfigError(f"unknown {group} {name!r}; valid choices: {choices(registered)}")
@@ -153,16 +134,13 @@ def load(group: str, name: str) -> type:
     except Exception as exc:  # noqa: BLE001 - a third-party module may raise anything on import
         if name in BUILTINS[group]:
             raise  # gyrolab's own: a bug, with its traceback
-        raise ConfigError(
-            f"{group} plugin {name!r} from {origin(group, name)} cannot be imported "
-            f"({type(exc).__name__}: {shorten(str(exc), 160)}); fix or uninstall that distribution"
-        ) from None
+        raise ConfigError(f"{group} plugin {name!r} from {origin(group, name)} cannot be imported "
+                          f"({type(exc).__name__}: {shorten(str(exc), 160)}); fix or uninstall that "
+                          "distribution") from None
     _, contract = GROUPS[group]
     if not (inspect.isclass(cls) and issubclass(cls, contract)):
-        raise ConfigError(
-            f"{group} plugin {name!r} from {origin(group, name)} is not a {contract.__name__} subclass; "
-            "fix the plugin package's entry point"
-        )
+        raise ConfigError(f"{group} plugin {name!r} from {origin(group, name)} is not a {contract.__name__} "
+                          "subclass; fix the plugin package's entry point")
     return cls
 
 
@@ -171,35 +149,22 @@ def resolve_target(group: str, target: Any, where: str) -> tuple[str, type]:
     by_target = {_normalise(t): n for n, t in targets(group).items()}
     name = by_target.get(_normalise(str(target)))
     if name is None:
-        raise ConfigError(
-            f"{where}._target_={target!r} is not a registered {group} plugin; "
-            f"choose one by name ({group}=NAME), valid names: {choices(targets(group))}"
-        )
+        raise ConfigError(f"{where}._target_={target!r} is not a registered {group} plugin; "
+                          f"choose one by name ({group}=NAME), valid names: {choices(targets(group))}")
     return name, load(group, name)
 
 
 def default_params(cls: type) -> dict[str, Any]:
-    """A plugin's config parameters and defaults, read from its ``__init__`` keywords.
-
-    The signature is the plugin's config schema, so it must be explicit: an ``__init__`` taking
-    ``**params`` would accept any key (a typo included) and advertise none, and is refused in one
-    sentence (as xarray's backends ``detect_parameters`` refuses ``**kwargs``).
-    """
+    """A plugin's config parameters and defaults, read from its ``__init__`` keywords; ``**params`` would accept any
+    key (a typo included) and advertise none, and is refused (as xarray's backends refuse ``**kwargs``)."""
     params: dict[str, Any] = {}
     signature = inspect.signature(cls.__init__)
     variadic = [p.name for p in signature.parameters.values() if p.kind is p.VAR_KEYWORD]
     if variadic:
-        raise ConfigError(
-            f"plugin {getattr(cls, 'name', cls.__name__)!r} ({cls.__module__}.{cls.__qualname__}) takes "
-            f"**{variadic[0]} in __init__, so its parameters are unknown; declare each parameter as a keyword "
-            "with a default (def __init__(self, body, *, coefficient=0.1))"
-        )
+        raise ConfigError(f"plugin {getattr(cls, 'name', cls.__name__)!r} ({cls.__module__}.{cls.__qualname__}) takes "
+                          f"**{variadic[0]} in __init__, so its parameters are unknown; declare each parameter as a "
+                          "keyword with a default (def __init__(self, body, *, coefficient=0.1))")
     for p in signature.parameters.values():
         if p.kind is p.KEYWORD_ONLY or (p.kind is p.POSITIONAL_OR_KEYWORD and p.default is not p.empty):
             params[p.name] = None if p.default is p.empty else p.default
     return params
-
-
-def _check_group(group: str) -> None:
-    if group not in GROUPS:
-        raise ConfigError(f"unknown plugin group {group!r}; valid choices: {choices(GROUPS)}")

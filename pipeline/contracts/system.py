@@ -21,15 +21,12 @@ class System(ABC):
 
     1. ``body_type`` is the class that reads the ``body`` config section
        (``body_type.from_config(cfg)``); forces are built with that body.
-       A third-party system declares its default ``body`` section as
-       ``default_body`` (a dict): gyrolab registers it as the option
-       ``body=NAME``, which selects the system, and its keys as valid body keys.
+       ``default_body`` (a dict, optional) becomes the body option ``body=NAME``
+       (docs/plugins.md, "System plugins").
     2. ``__init__(self, body, forces, initial, output, *, param=default, ...)``
-       receives the body, the built forces, the ``initial`` and ``output``
-       config sections and the system's own parameters (each a keyword with a
-       default: ``**params`` is refused); it validates the initial
-       state (one-sentence ``ConfigError``) and decides the state layout.
-       It carries only the state its forces and requested outputs need.
+       validates the ``initial`` section (one-sentence ``ConfigError``) and
+       decides the state layout: only the state its forces and requested
+       outputs need. Its own parameters are keywords with defaults.
     3. ``initial_state()`` returns y0; ``rhs(t, y)`` returns dy/dt (model
        units) for one state; it is the integrators' inner loop.
     4. ``variables(t, y)`` turns a trajectory (n, size) into xarray
@@ -39,15 +36,11 @@ class System(ABC):
     5. ``attributes()`` describes the system's parameters and initial state
        for the dataset; ``title()`` names the scene in a few words for figures.
     6. ``compiled_model()`` returns the system (with its forces) in the
-       compiled kernels' form, which the compiled integrators (``taylor``,
-       ``dop853_numba``, ``rk4_numba``, ``gyrolab batch``) run. The default
-       traces ``rhs`` once on symbols (``gyrolab.kernels.model``): a system
-       whose ``rhs`` is numpy arithmetic without branches on the state gets
-       every compiled kernel without writing one. When it cannot be traced it
-       returns None and sets ``compile_error`` to one sentence saying why (the
-       scene and ``gyrolab batch`` quote it when a compiled integrator is
-       asked for). Override it to return None for a system that must not be
-       compiled.
+       compiled kernels' form. The default traces ``rhs`` once on symbols
+       (``gyrolab.kernels.model``; docs/plugins.md, "System plugins"); when it
+       cannot be traced it returns None and sets ``compile_error`` to one
+       sentence saying why. Override it to return None for a system that must
+       not be compiled.
     7. Optionally, ``invariant_values(y)`` returns each monitored invariant
        (``invariants``) along states of shape (..., state size), vectorised
        over any leading dimensions; ``gyrolab batch`` (``gyrolab.batch.outputs``)
@@ -62,9 +55,8 @@ class System(ABC):
        builds one system per distinct point.
     9. Optionally, ``reference_frame(y)`` returns the body components of the
        reference axes at state ``y`` as a (3, 3) array (rows α, β, γ), or
-       None when the state does not carry them (the default). The scene checks
-       a third-party force's claims (``gyrolab.contracts.claims``) at the
-       initial state's frame when it is known, and at seeded random frames.
+       None when the state does not carry them (the default); the scene checks
+       a third-party force's claims at that frame (``gyrolab.contracts.claims``).
     10. ``_batch_units`` is a cache the batch owns (the units of the system's
         variables, ``gyrolab.batch.outputs``); implementers leave it alone.
     """

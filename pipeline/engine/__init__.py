@@ -1,4 +1,3 @@
-"""From a config to a run: Hydra composition (``config``), the plugin registry
-(``registry``), the scene that ties system, forces and integrator together
-(``scene``), batch integration (``batch``) and progress reporting (``progress``).
+"""From a config to a run: composition (``config``, ``schemas``), the checks before a run (``safety``, ``budget``,
+``unread``), the scene that ties system, forces and integrator together (``scene``) and progress reporting.
 """

@@ -1,16 +1,5 @@
-"""Requests gyrolab refuses before anything runs: tolerances outside (0, 1), and plainly infeasible work.
-
-The budget (docs/configs.md "Your own configs"): the state array of one run at most
-:data:`MAX_STATE_BYTES` (n_output × state size × 8 bytes), and at most
-:data:`MAX_STEPS` integrator steps, estimated from below:
-
-- a fixed-step integrator (``step``) or a step bound (``max_step``) takes at least
-  span / step steps;
-- any integrator takes at least one step per output interval, and at least one step
-  per :data:`RADIANS_PER_STEP` radians the body turns (|ω0| × span; an adaptive
-  method that resolves the rotation does far more).
-
-A top-level ``allow_large=true`` lifts the budget for people who mean it.
+"""Requests gyrolab refuses before anything runs: tolerances outside (0, 1), and plainly infeasible work
+(the budget: docs/configs.md, "Your own configs"; ``allow_large=true`` lifts it).
 """
 
 from __future__ import annotations
@@ -78,11 +67,9 @@ def estimated_steps(plain: dict[str, Any]) -> tuple[float, str]:
     initial = plain.get("initial") or {}
     rates = [initial.get(k) for k in ("p0", "q0", "r0")]
     if all(isinstance(r, (int, float)) and not isinstance(r, bool) for r in rates):
-        turn = math.sqrt(sum(float(r) ** 2 for r in rates)) * span
-        candidates.append((turn / RADIANS_PER_STEP, f"time.end={time['end']:g} (|ω0| = "
-                                                    f"{math.sqrt(sum(float(r) ** 2 for r in rates)):.3g} rad per "
-                                                    f"time unit over a span of {span:.3g}, one step per "
-                                                    f"{RADIANS_PER_STEP:g} rad at most)"))
+        rate = math.sqrt(sum(float(r) ** 2 for r in rates))
+        candidates.append((rate * span / RADIANS_PER_STEP, f"time.end={time['end']:g} (|ω0| = {rate:.3g} rad per time "
+                           f"unit over a span of {span:.3g}, one step per {RADIANS_PER_STEP:g} rad at most)"))
     return max(candidates, key=lambda c: c[0])
 
 

@@ -1,10 +1,6 @@
-"""Hydra composition for gyrolab: where configs come from, plugin config nodes, friendly errors.
-
-A :class:`ConfigSource` says where Hydra finds the primary config and the config
-groups: the packaged ``gyrolab.conf`` by default, or a user's directory given with
-``--config-dir`` / ``--config-path`` / ``--config-name`` (and ``hydra.searchpath``).
-The search path is built with Hydra's own functions, exactly as ``@hydra.main``
-builds it, so the config the preflight validates is the config that runs.
+"""Hydra composition for gyrolab: where configs come from (:class:`ConfigSource`), plugin config nodes, friendly
+errors. The search path is built with Hydra's own functions, exactly as ``@hydra.main`` builds it, so that the
+config the preflight validates is the config that runs.
 """
 
 from __future__ import annotations
@@ -27,23 +23,23 @@ from hydra.core.global_hydra import GlobalHydra
 from hydra.core.hydra_config import HydraConfig
 from hydra.errors import HydraException, MissingConfigException, OverrideParseException
 from hydra.types import RunMode
-from omegaconf import DictConfig, OmegaConf, open_dict
+from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import ConfigKeyError, OmegaConfBaseException, ValidationError
 
 from gyrolab.compat import Hydra, create_automatic_config_search_path
 from gyrolab.contracts import registry
 from gyrolab.engine.schemas import (
+    REQUIRED_SECTIONS,
     SELECTABLE_GROUPS,
     missing_section,
     plugin_schema,
-    required_sections,
     unknown_key_sentence,
     validate,
 )
 from gyrolab.engine.schemas import first_line as _first_line
 from gyrolab.engine.schemas import sentence as schema_sentence
 from gyrolab.engine.unread import refuse_given_accuracy
-from gyrolab.errors import ConfigError, GyrolabWarning, choices, shorten
+from gyrolab.errors import ConfigError, GyrolabWarning, choices, leaves, shorten
 from gyrolab.output.user_yaml import check_user_config_dir
 
 CONFIG_MODULE = "gyrolab.conf"
@@ -67,18 +63,11 @@ class ConfigSource:
     def from_args(cls, config_path: str | None, config_name: str | None, config_dir: str | None) -> ConfigSource:
         """The source Hydra would use for these command-line options; ConfigError for a missing directory."""
         if config_dir is not None:
-            config_dir = os.path.abspath(config_dir)
-            if not os.path.isdir(config_dir):
-                raise ConfigError(f"--config-dir {config_dir!r} is not a directory; give the folder that holds "
-                                  "your YAML files (e.g. --config-dir myconf)")
-            check_user_config_dir(config_dir, "--config-dir")
+            config_dir = _user_dir(config_dir, "--config-dir", "your YAML files (e.g. --config-dir myconf)")
             warn_shadowed(config_dir, "--config-dir")
         if config_path is not None and not config_path.startswith("pkg://"):
-            config_path = os.path.abspath(config_path)
-            if not os.path.isdir(config_path):
-                raise ConfigError(f"--config-path {config_path!r} is not a directory; give the folder that holds "
-                                  "your primary config (e.g. --config-path myconf --config-name mine)")
-            check_user_config_dir(config_path, "--config-path")
+            config_path = _user_dir(config_path, "--config-path",
+                                    "your primary config (e.g. --config-path myconf --config-name mine)")
         if config_name is not None:
             config_name = config_name.removesuffix(".yaml")
             if not config_name or "\0" in config_name:
@@ -100,6 +89,15 @@ class ConfigSource:
 
 
 _source = ConfigSource()
+
+
+def _user_dir(path: str, option: str, holds: str) -> str:
+    """``path`` made absolute and checked as a user's config folder; ConfigError when it is no directory."""
+    path = os.path.abspath(path)
+    if not os.path.isdir(path):
+        raise ConfigError(f"{option} {path!r} is not a directory; give the folder that holds {holds}")
+    check_user_config_dir(path, option)
+    return path
 
 
 @cache
@@ -140,10 +138,6 @@ def use_source(source: ConfigSource) -> None:
     _source = source
 
 
-def current_source() -> ConfigSource:
-    return _source
-
-
 @contextmanager
 def hydra_for(source: ConfigSource | None = None) -> Iterator[None]:
     """A Hydra initialised on ``source`` (default: the current one) for the duration of the block."""
@@ -157,18 +151,12 @@ def hydra_for(source: ConfigSource | None = None) -> Iterator[None]:
 
 @cache
 def register_plugin_configs() -> None:
-    """Give every third-party plugin a config node: its schema (its class's ``schema`` dataclass, else one made from
-    its ``__init__`` keyword defaults: ``gyrolab.engine.schemas.plugin_schema``) with its ``_target_``.
-
-    Built-in plugins have YAML files in ``conf/``; a plugin package only
-    registers an entry point, and this makes ``force=[..., its_name]`` work.
-    A system plugin that declares ``default_body`` (its ``body`` section, a dict) also
-    gets the body option ``body=NAME``, which selects the system as ``conf/body/gyrostat_*.yaml``
-    select theirs (Hydra cannot let a system option override the body group that follows it).
-    A plugin that cannot be used (its module fails to import, ``**params``, ...) costs one
-    ``PluginLoadWarning`` and gets a node without parameters, so that a scene naming it composes
-    and is then refused by ``registry.load`` in one sentence, while every other command works.
-    """
+    """Give every third-party plugin a config node, its schema (``gyrolab.engine.schemas.plugin_schema``) with its
+    ``_target_``, so that ``force=[..., its_name]`` works as the built-ins' YAML files do. A system plugin's
+    ``default_body`` also becomes the body option ``body=NAME``, which selects the system (as
+    ``conf/body/gyrostat_*.yaml`` do: a system option cannot override the body group that follows it). A plugin that
+    cannot be used costs one ``PluginLoadWarning`` and gets a node without parameters: a scene naming it composes
+    and is then refused by ``registry.load`` in one sentence."""
     store = ConfigStore.instance()
     for group in registry.GROUPS:
         for name, target in registry.external(group).items():
@@ -176,7 +164,7 @@ def register_plugin_configs() -> None:
                 cls = registry.load(group, name)
                 node: Any = OmegaConf.merge(OmegaConf.structured(plugin_schema(cls)), {"_target_": target})
             except ConfigError as error:
-                registry.unusable_warning(group, name, error)
+                warnings.warn(f"{error}; gyrolab goes on without it", registry.PluginLoadWarning, stacklevel=1)
                 cls, node = None, {"_target_": target}
             # A force option nests under its own name so that several can be selected at once.
             store.store(group=group, name=name, node={name: node} if group == "force" else node)
@@ -227,9 +215,7 @@ def compose_config(overrides: Sequence[str], *, return_hydra_config: bool = Fals
 
 
 def _running_config_name() -> str:
-    if HydraConfig.initialized():
-        return HydraConfig.get().job.config_name or _source.config_name
-    return _source.config_name
+    return (HydraConfig.get().job.config_name if HydraConfig.initialized() else None) or _source.config_name
 
 
 def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bool, run_mode: RunMode,
@@ -250,13 +236,10 @@ def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bo
     except (ValueError, TypeError) as error:  # Hydra's defaults list on a malformed group override
         raise ConfigError(f"cannot compose the config with {shorten(' '.join(overrides), 120)} "
                           f"({shorten(_first_line(error), 120)})") from None
-    if not return_hydra_config and "hydra" in cfg:
-        with open_dict(cfg):
-            del cfg["hydra"]
     # checked by the schemas, used as any mapping (an experiment sets whole sections); Hydra's own node stays typed
     plain = OmegaConf.create(OmegaConf.to_container(OmegaConf.masked_copy(cfg, [k for k in cfg if k != "hydra"]),
                                                     resolve=False))
-    if "hydra" in cfg:
+    if return_hydra_config and "hydra" in cfg:
         plain.hydra = cfg.hydra
     OmegaConf.set_struct(plain, True)
     return plain
@@ -272,6 +255,10 @@ def _unknown_option(text: str) -> ConfigError | None:
         valid = group_options(group)
     except Exception:  # noqa: BLE001 - the list is a hint
         valid = []
+    return _unknown(group, option, valid)
+
+
+def _unknown(group: str, option: str, valid: Sequence[str]) -> ConfigError:
     close = difflib.get_close_matches(option, valid, n=1)
     hint = f"; did you mean {group}={close[0]}?" if close else ""
     return ConfigError(f"unknown {group} {shorten(repr(option))}{hint} (valid choices: {choices(valid)})")
@@ -281,9 +268,7 @@ def friendly_missing(error: MissingConfigException, config_name: str = CONFIG_NA
     missing = error.missing_cfg_file or ""
     group, _, option = missing.rpartition("/")
     if group and error.options is not None:
-        close = difflib.get_close_matches(option, error.options, n=1)
-        hint = f"; did you mean {group}={close[0]}?" if close else ""
-        return ConfigError(f"unknown {group} {shorten(repr(option))}{hint} (valid choices: {choices(error.options)})")
+        return _unknown(group, option, error.options)
     if missing == config_name or "Primary config" in str(error):
         return ConfigError(f"primary config {config_name!r} not found in {_source.config_path}"
                            f"{' or ' + _source.config_dir if _source.config_dir else ''}; --config-name names a "
@@ -327,9 +312,7 @@ def _known_names(overrides: Sequence[str], key: str, config_name: str) -> list[s
                                                           run_mode=RunMode.RUN, from_shell=False)
     except Exception:  # noqa: BLE001 - the hint is best effort; the sentence stands without it
         return []
-    names = list(key_paths(cfg))
-    names += [group for group in SELECTABLE_GROUPS]
-    return names
+    return [*key_paths(cfg), *SELECTABLE_GROUPS]
 
 
 def key_paths(node: Any, prefix: str = "") -> Iterator[str]:
@@ -346,13 +329,10 @@ def key_paths(node: Any, prefix: str = "") -> Iterator[str]:
 # ---- the scene config: its schemas (gyrolab.engine.schemas), then what a type cannot say ----------------------
 
 def check_scene_config(cfg: DictConfig) -> dict[str, Any]:
-    """The scene config resolved to plain values; ConfigError for a missing section, an unknown key, a wrong type,
-    a bad reference, a number too large to compute with or a torque that silently vanishes.
-
-    Keys and types are the schemas' (:func:`gyrolab.engine.schemas.validate`: a user's primary config or a stored
-    one that does not name them is checked against them too).
-    """
-    for section in required_sections():
+    """The scene config resolved to plain values (keys and types: :func:`gyrolab.engine.schemas.validate`);
+    ConfigError for a missing section, an unknown key, a wrong type, a bad reference, a number too large to compute
+    with or a torque that silently vanishes."""
+    for section in REQUIRED_SECTIONS:
         if section not in cfg or OmegaConf.is_missing(cfg, section) or cfg[section] is None:
             raise ConfigError(missing_section(section))
     plain = validate(cfg)
@@ -367,9 +347,7 @@ def _check_degenerate_vectors(plain: dict[str, Any]) -> None:
 
     (Zero field directions and axes are refused by the plugins that normalise them.)
     """
-    forces = plain.get("force") or {}
-    if not isinstance(forces, dict):
-        return
+    forces = plain.get("force") or {}  # a dict: the schema's
     magnetic = forces.get("magnetic")
     if isinstance(magnetic, dict) and _is_zero(magnetic.get("moment")):
         raise ConfigError(f"force.magnetic.moment={magnetic['moment']} is a zero vector, so the magnetic force would "
@@ -397,17 +375,13 @@ MAX_MAGNITUDE = 1e100
 
 def _check_magnitudes(where: str, node: Any) -> None:
     """ConfigError for a number beyond :data:`MAX_MAGNITUDE` (``initial.r0=1e300`` overflows the first product)."""
-    if isinstance(node, dict):
-        for key, value in node.items():
-            _check_magnitudes(f"{where}.{key}", value)
-    elif isinstance(node, list):
-        for i, value in enumerate(node):
-            _check_magnitudes(f"{where}[{i}]", value)
-    elif isinstance(node, (int, float)) and not isinstance(node, bool):
+    for path, value in leaves(node, where):
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            continue
         try:
-            large = MAX_MAGNITUDE < abs(float(node)) < float("inf")  # inf and nan: require_finite says so
+            large = MAX_MAGNITUDE < abs(float(value)) < float("inf")  # inf and nan: require_finite says so
         except OverflowError:
             large = True
         if large:
-            raise ConfigError(f"{where}={shorten(repr(node), 40)} is too large; gyrolab takes numbers up to "
+            raise ConfigError(f"{path}={shorten(repr(value), 40)} is too large; gyrolab takes numbers up to "
                               f"{MAX_MAGNITUDE:.0e} in magnitude (use nondimensional or scaled units)")

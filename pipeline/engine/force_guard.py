@@ -1,16 +1,7 @@
-"""The scene's Python right-hand side, guarded when a third-party force takes part.
-
-gyrolab's own forces (``gyrolab.plugins.forces``) are trusted and run unguarded. A plugin force's
-torque may raise, return None, a string, the wrong shape or NaN; in the bare right-hand side that
-ends as a traceback deep inside scipy, or — for NaN — as a DOP853 that rejects every step and never
-returns. :class:`GuardedRhs` makes each of these one ``IntegrationError`` sentence naming the force:
-
-* the first call inspects every plugin torque (type, dtype, shape (3,), finite);
-* every call checks that the derivative is finite (one vectorised test, ~1 µs) and turns any
-  exception into a sentence; on a failure the state is inspected again to name the force at fault.
-
-The compiled path does not call the Python torque (it runs the traced one, ``expression``); a
-torque that cannot be traced runs here.
+"""The scene's Python right-hand side, guarded when a third-party force takes part (docs/plugins.md, "What the
+engine checks"): a plugin torque that raises, returns None or the wrong shape, or NaN (on which DOP853 would reject
+every step and never return) becomes one ``IntegrationError`` sentence naming the force. gyrolab's own forces run
+unguarded.
 """
 
 from __future__ import annotations
@@ -27,15 +18,11 @@ from gyrolab.errors import GyrolabError, IntegrationError, shorten
 _RULE = "torque(omega, axes) must return a finite float array of shape (3,) (gyrolab.contracts.Force, rule 3)"
 
 
-def is_builtin(force: Force) -> bool:
-    """True for gyrolab's own force classes (``registry.BUILTINS``), which the guard trusts."""
-    cls = type(force)
-    return f"{cls.__module__}:{cls.__qualname__}" in registry.BUILTINS["force"].values()
-
-
 def plugin_forces(forces: Sequence[Force]) -> list[Force]:
-    """The forces that are not gyrolab's own (third-party plugins and ad-hoc subclasses)."""
-    return [f for f in forces if not is_builtin(f)]
+    """The forces that are not gyrolab's own classes (``registry.BUILTINS``, trusted): third-party plugins and
+    ad-hoc subclasses."""
+    builtin = set(registry.BUILTINS["force"].values())
+    return [f for f in forces if f"{type(f).__module__}:{type(f).__qualname__}" not in builtin]
 
 
 class GuardedRhs:

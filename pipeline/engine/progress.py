@@ -1,10 +1,6 @@
-"""Progress of long integrations and sweeps: a tqdm bar on a terminal, the log otherwise.
-
-On a terminal (stderr is a TTY) a run shows a bar once it has lasted
-``BAR_DELAY`` seconds (quick runs stay silent) and removes it when done.
-Elsewhere (files, pipes, notebooks, cluster logs) nothing is drawn and a line
-is logged every ``every`` seconds instead. Sweep jobs turn integration bars
-off (``allow_bars(False)``): the sweep shows one bar for all its jobs.
+"""Progress of long integrations and sweeps: a tqdm bar on a terminal (after ``BAR_DELAY`` seconds), a log line
+every ``every`` seconds elsewhere (docs/faults.md, "Progress of long runs"); sweep jobs draw no bar of their own
+(``allow_bars(False)``): the sweep shows one for all its jobs.
 """
 
 from __future__ import annotations
@@ -30,13 +26,9 @@ COMPILE_LOGGERS = ("gyrolab.kernels.expression",)
 
 @contextlib.contextmanager
 def compile_notes_on_console(stream: TextIO | None = None) -> Iterator[None]:
-    """Show the compile notes of ``COMPILE_LOGGERS`` on ``stream`` (stderr) while logging is not configured yet.
-
-    The command's preflight builds the scene before Hydra configures logging, and building it compiles a force
-    plugin's torque (once; later processes load the cache). Without a handler Python drops an INFO record, and
-    the run itself no longer compiles: the note "compiling force NAME, once" was never seen. Nothing changes
-    when logging is configured already (a handler on the root logger).
-    """
+    """Show the compile notes of ``COMPILE_LOGGERS`` on ``stream`` (stderr) while logging is not configured yet:
+    the preflight builds the scene (compiling a plugin torque, once) before Hydra configures logging, and Python
+    drops an INFO record without a handler."""
     if logging.getLogger().handlers:
         yield
         return
@@ -115,9 +107,7 @@ class Progress:
         first = self._t_last is None
         since, t_since = self._last, self._t_last
         self._last, self._t_last = now, t
-        if first:
-            # the time before the first report includes a compiled method's compilation (and its start-up):
-            # a pace from it is no pace of the integration, so no estimate until a stretch has been measured
+        if first:  # its time includes a compiled method's compilation: no pace until a stretch has been measured
             log.info("%s: %3.0f%% (t=%.6g of %.6g), %s elapsed (compilation included), measuring the pace",
                      self.label, 100 * fraction, t, self.t_end, duration(elapsed))
             return
@@ -136,11 +126,8 @@ class Progress:
 
 
 class LinesAboveBar:
-    """A stream wrapper that prints whole lines above a tqdm bar (clears it, writes, redraws).
-
-    Installed as ``sys.stdout``/``sys.stderr`` while a sweep bar is shown, so
-    that log lines written in the same process do not run into the bar.
-    """
+    """A stream wrapper that prints whole lines above a tqdm bar (clears it, writes, redraws): installed as
+    ``sys.stdout``/``sys.stderr`` while a sweep bar is shown, so that log lines do not run into the bar."""
 
     def __init__(self, stream: TextIO, bar: Any) -> None:
         self._stream, self._bar = stream, bar

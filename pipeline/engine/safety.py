@@ -1,12 +1,7 @@
 """No config and no dataset can run code: the one place where gyrolab decides what a config may name.
 
-Threat model: a YAML file (an experiment, a primary config, a whole ``--config-dir``) or a ``run.nc`` that someone
-else wrote; installed packages are trusted (they could run code anyway), text is not. :func:`check_config` is
-applied by the preflight to every composed config (each group choice of a sweep too) before Hydra creates a
-directory, instantiates a callback or configures logging, and by ``reproduce`` and ``batch`` to the configs they
-build. The rules (allowlisted ``_target_``s, Hydra's logging configs, paths inside the run directory, thread
-counts only in ``env_set``, the launchers' shell lines) are listed in docs/safety.md, "Safety and failures"; each
-refusal is one ConfigError sentence naming the key.
+The threat model and the rules are in docs/safety.md, "Safety and failures"; :func:`check_config` is applied to
+every composed config before Hydra creates a directory, instantiates a callback or configures logging.
 """
 
 from __future__ import annotations
@@ -29,7 +24,7 @@ from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
 from gyrolab.engine.schemas import resolve_plain
-from gyrolab.errors import ConfigError, shorten
+from gyrolab.errors import ConfigError, leaves, shorten
 from gyrolab.output.user_yaml import stored_yaml
 
 #: ``_target_`` values allowed under ``hydra`` besides the installed launchers and sweepers
@@ -57,11 +52,6 @@ def hydra_targets() -> frozenset[str]:
     return HYDRA_TARGETS | found
 
 
-def plugin_targets() -> frozenset[str]:
-    """Every registered gyrolab plugin class, as a dotted path."""
-    return frozenset(registry._normalise(t) for group in registry.GROUPS for t in registry.targets(group).values())
-
-
 def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: Sequence[str] = (),
                  job_subdir: bool = False) -> None:
     """ConfigError (one sentence naming the key) unless ``cfg`` is safe to hand to Hydra and gyrolab.
@@ -83,16 +73,20 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
         raise ConfigError(f"hydra.mode={mode.rsplit('.', 1)[-1]} disagrees with the command line; start a sweep "
                           "with -m (gyrolab -m KEY=V1,V2 ...) and a single run without it")
     _check_paths(plain_hydra, Path(run_dir))
-    out = _output_dir(run_dir, plain_hydra, job_subdir)
+    out = Path(os.path.abspath(run_dir))
+    out = out / str((plain_hydra.get("sweep") or {}).get("subdir", "")) if job_subdir else out
     for name in ("job_logging", "hydra_logging"):
         _check_logging(plain_hydra.get(name), f"hydra.{name}", out)
-    _check_env_set((plain_hydra.get("job") or {}).get("env_set") or {})
+    for key in (plain_hydra.get("job") or {}).get("env_set") or {}:
+        if not ENV_ALLOWED.match(str(key)):
+            raise ConfigError(f"hydra.job.env_set.{shorten(str(key))} is not allowed; a config may set thread counts "
+                              "only (OMP_NUM_THREADS, MKL_NUM_THREADS, ...); set other variables in your shell")
     _check_launcher_shell(plain_hydra.get("launcher") or {}, command_line)
 
 
 def _check_plugin_targets(scene: dict) -> None:
     """ConfigError unless every ``_target_`` of the scene names a registered gyrolab plugin."""
-    allowed_plugins = plugin_targets()
+    allowed_plugins = {registry._normalise(t) for group in registry.GROUPS for t in registry.targets(group).values()}
     for path, value in _targets(scene):
         if registry._normalise(str(value)) not in allowed_plugins:
             group = path.split(".", 1)[0]
@@ -113,21 +107,13 @@ def _check_hydra_targets(plain_hydra: dict) -> None:
                               f"({', '.join(sorted(t.rsplit('.', 1)[1] for t in allowed))})")
 
 
-def _check_env_set(env_set: Any) -> None:
-    """ConfigError unless ``hydra.job.env_set`` sets thread counts only."""
-    for key in env_set:
-        if not ENV_ALLOWED.match(str(key)):
-            raise ConfigError(f"hydra.job.env_set.{shorten(str(key))} is not allowed; a config may set thread counts "
-                              "only (OMP_NUM_THREADS, MKL_NUM_THREADS, ...); set other variables in your shell")
-
-
 def check_stored_config(text: str, where: str) -> DictConfig:
     """A config stored in a dataset, checked as a user's YAML file is (``gyrolab.output.user_yaml.stored_yaml``:
     tags, anchors, depth, size); ConfigError for interpolations."""
     plain = stored_yaml(text, where)
     if not isinstance(plain, dict):
         raise ConfigError(f"{where} is not a YAML mapping of config sections; give a run.nc that gyrolab wrote")
-    for path, value in _leaves(plain):
+    for path, value in leaves(plain):
         if isinstance(value, str) and "${" in value:
             raise ConfigError(f"{where}: {path}={shorten(repr(value))} is an interpolation, but a stored config is "
                               "resolved; the dataset was edited, and gyrolab will not rerun it")
@@ -246,22 +232,6 @@ def _resolved_hydra(cfg: DictConfig, run_dir: Path, job_subdir: bool) -> dict[st
     return plain
 
 
-def _output_dir(run_dir: Path, hydra: dict[str, Any], job_subdir: bool) -> Path:
-    out = Path(os.path.abspath(run_dir))
-    return out / str((hydra.get("sweep") or {}).get("subdir", "")) if job_subdir else out
-
-
-def _leaves(node: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
-    if isinstance(node, dict):
-        for key, value in node.items():
-            yield from _leaves(value, f"{prefix}.{key}" if prefix else str(key))
-    elif isinstance(node, list):
-        for i, value in enumerate(node):
-            yield from _leaves(value, f"{prefix}[{i}]")
-    else:
-        yield prefix, node
-
-
 def _items(node: Any, prefix: str = "") -> Iterator[tuple[str, str, Any]]:
     """(path, key, value) of every mapping entry, at any depth (lists too)."""
     if isinstance(node, dict):
@@ -358,13 +328,9 @@ _OUTPUT_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.+-]*(/[A-Za-z0-9_][A-Za-z0-
 
 
 def confined_output_path(out_dir: str | os.PathLike[str], name: Any, key: str) -> Path:
-    """``out_dir/name`` when it stays inside ``out_dir`` (symlinks resolved), else one ConfigError sentence.
-
-    Every file a config names for writing (``stability_map.file``) goes through here: a relative path
-    without ``..``, ending in ``.nc``, whose resolved location (through any symlink already in the run
-    directory) is inside the resolved run directory — so ``../elsewhere/x.pth`` or a link into
-    site-packages cannot make gyrolab write a file Python would load.
-    """
+    """``out_dir/name`` when it stays inside ``out_dir`` (symlinks resolved), else one ConfigError sentence: every file
+    a config names for writing goes through here, so that it cannot make gyrolab write a file Python would load
+    (docs/faults.md, "Paths: results stay inside the run directory")."""
     text = str(name) if isinstance(name, (str, os.PathLike)) else ""
     parts = Path(text).parts
     if not _OUTPUT_NAME.match(text) or ".." in parts or len(text) > 255:

@@ -47,26 +47,15 @@ class Scene:
     """Everything one run needs, built and validated once; ``run()`` integrates and writes nothing.
 
     Build one with `compose_scene` (from Hydra overrides) or ``Scene.from_config`` (from a composed
-    config). A scene is reusable: ``run()`` may be called again, and `integrate_batch` integrates it
-    from many initial states.
-
-    Attributes
-    ----------
-    config : omegaconf.DictConfig
-        The resolved config the scene was built from (stored in every dataset it writes).
-    system : gyrolab.contracts.System
-        The equations of motion with the body, forces and initial state.
-    integrator : gyrolab.contracts.Integrator
-        The integrator, configured.
-    times : numpy.ndarray
-        The output times (model time units).
-    n_output_requested : int or str
-        ``time.n_output`` as the config gave it: ``"auto"`` or a number of samples.
+    config). A scene is reusable: ``run()`` may be called again.
     """
 
+    #: the resolved config the scene was built from (stored in every dataset it writes)
     config: DictConfig
+    #: the equations of motion with the body, forces and initial state
     system: System
     integrator: Integrator
+    #: the output times (model time units)
     times: np.ndarray
     #: ``time.n_output`` as the config gave it: ``"auto"`` or a number of samples
     n_output_requested: int | str = AUTO
@@ -82,10 +71,8 @@ class Scene:
         require_finite(plain, "")
         system_cls = _plugin_class("system", cfg.system, "system")
         body = system_cls.body_type.from_config(plain["body"])
-        forces = [
-            build_force(_plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
-            for name, node in (cfg.get("force") or {}).items()
-        ]
+        forces = [build_force(_plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
+                  for name, node in (cfg.get("force") or {}).items()]
         system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
         if check is not None:
             check(system)
@@ -94,15 +81,10 @@ class Scene:
         _check_time_dependent(timed, system)
         integrator = _build(_plugin_class("integrator", cfg.integrator, "integrator"), cfg.integrator, "integrator")
         _check_time_dependent(timed, system, integrator)
-        requested = plain["time"].get("n_output", AUTO)
         times = _output_times(plain["time"], fastest_rate(system))
-        try:
-            integrator.prepare(system)
-        except GyrolabError:
-            raise
-        except Exception as exc:  # noqa: BLE001 - a third-party integrator's prepare: one sentence naming it
-            raise init_failure(type(integrator), "integrator", exc) from exc
-        scene = cls(config=cfg, system=system, integrator=integrator, times=times, n_output_requested=requested)
+        _guarded(type(integrator), "integrator", integrator.prepare, system)
+        scene = cls(config=cfg, system=system, integrator=integrator, times=times,
+                    n_output_requested=plain["time"].get("n_output", AUTO))
         scene._check_compiled_model()
         scene.log_notes()
         return scene
@@ -113,14 +95,13 @@ class Scene:
         integrator, system, compiled = self.integrator, self.system, self.compiled
         if integrator.supports(COMPILED_MODEL) and compiled is None:
             reason = system.compile_error or f"system {system.name!r} has no compiled form"
-            raise ConfigError(
-                f"integrator {integrator.name!r} runs compiled models only, and {reason}; "
-                f"choose {_choices_with(accept=lambda c: not c.supports(COMPILED_MODEL))}"
-            )
+            raise ConfigError(f"integrator {integrator.name!r} runs compiled models only, and {reason}; "
+                              f"choose {or_list(integrators_with(accept=lambda c: not c.supports(COMPILED_MODEL)))}")
         refusal = integrator.refusal(compiled, system) if compiled is not None else None
         if refusal:
-            valid = _choices_with(accept=lambda c: (c.supports(COMPILED_MODEL) or c.supports(PREFERS_COMPILED_MODEL))
-                                  and c is not type(integrator) and c.refusal(compiled, system) is None)
+            valid = or_list(integrators_with(accept=lambda c: (c.supports(COMPILED_MODEL)
+                                                               or c.supports(PREFERS_COMPILED_MODEL))
+                                             and c is not type(integrator) and c.refusal(compiled, system) is None))
             raise ConfigError(f"integrator {integrator.name!r} {refusal}; choose {valid}")
 
     def log_notes(self) -> None:
@@ -139,9 +120,8 @@ class Scene:
 
     @cached_property
     def dataset_attributes(self) -> tuple[dict[str, Any], dict[str, Any]]:
-        """The run dataset's attributes that depend on the scene alone (``output.dataset.scene_attributes``),
-        computed once per scene as ``config_yaml``; plus ``integrator_nfev_counts``, what the integrator's evaluation
-        count counts where that is not right-hand-side calls (its ``evaluation_label``: figures read it)."""
+        """The run dataset's attributes that depend on the scene alone (``output.dataset.scene_attributes``, plus
+        ``accuracy_ignored`` and the integrator's ``evaluation_label``), computed once per scene."""
         before, after = scene_attributes(self)
         if self.accuracy_ignored:
             before = {**before, ACCURACY_IGNORED_ATTRIBUTE: self.accuracy_ignored}
@@ -260,18 +240,8 @@ def compose_scene(overrides: Sequence[str] = ()) -> Scene:
 
 
 def run(overrides: Sequence[str] = ()) -> xr.Dataset:
-    """Compose, build and integrate a scene: ``compose_scene(overrides).run()``.
-
-    Parameters
-    ----------
-    overrides : sequence of str
-        Hydra overrides, as for `compose_scene`.
-
-    Returns
-    -------
-    xarray.Dataset
-        The run's dataset (what ``run.nc`` holds); nothing is written to disk.
-    """
+    """Compose, build and integrate a scene: ``compose_scene(overrides).run()``, the run's dataset (what ``run.nc``
+    holds; nothing is written to disk)."""
     return compose_scene(overrides).run()
 
 
@@ -284,12 +254,7 @@ def _check_time_dependent(timed: Sequence[str], system: System, integrator: Inte
     if timed and integrator is not None and not integrator.supports(TIME_DEPENDENT):
         raise ConfigError(f"integrator {integrator.name!r} does not integrate time-dependent forces (capability "
                           f"{TIME_DEPENDENT}) and force {timed[0]!r} is one; valid choices: "
-                          f"{_choices_with(TIME_DEPENDENT)}")
-
-
-def _choices_with(*capabilities: str, accept: Any = None) -> str:
-    """The registered integrators with ``capabilities`` (and passing ``accept``), as "a, b or c"."""
-    return or_list(integrators_with(*capabilities, accept=accept))
+                          f"{or_list(integrators_with(TIME_DEPENDENT))}")
 
 
 def _plugin_class(group: str, node: Any, where: str) -> type:
@@ -315,11 +280,15 @@ def _params(cls: type, node: DictConfig, where: str) -> dict[str, Any]:
 
 
 def _build(cls: type, node: DictConfig, where: str, *args: Any) -> Any:
-    """Instantiate a registered plugin class with its config parameters; whatever its ``__init__`` raises
-    (RuntimeError, ImportError, SyntaxError, ...) becomes one ConfigError naming the plugin."""
-    params = _params(cls, node, where)
+    """Instantiate a registered plugin class with its config parameters."""
+    return _guarded(cls, where, cls, *args, **_params(cls, node, where))
+
+
+def _guarded(cls: type, where: str, call: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+    """``call(*args, **kwargs)`` of plugin ``cls`` (its ``__init__``, an integrator's ``prepare``); whatever it
+    raises (RuntimeError, ImportError, SyntaxError, ...) becomes one ConfigError naming the plugin."""
     try:
-        return cls(*args, **params)
+        return call(*args, **kwargs)
     except GyrolabError:
         raise
     except Exception as exc:  # noqa: BLE001 - a plugin may raise anything; the user gets one sentence
@@ -335,13 +304,9 @@ def init_failure(cls: type, where: str, exc: BaseException) -> ConfigError:
 
 
 def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
-    """Instantiate a force plugin; its ValueError/TypeError becomes one ConfigError naming the parameter.
-
-    ``node`` is the force's config (a DictConfig or a dict of parameters). The culprit is found by
-    building the force with each given parameter alone; any other exception becomes one sentence
-    naming the plugin (``init_failure``); the force must declare its area-integral flag.
-    An AttributeError (the force reads something the system's body does not have) is one ConfigError too.
-    """
+    """Instantiate a force plugin from its config (a DictConfig or a dict of parameters); its ValueError/TypeError
+    becomes one ConfigError naming the parameter (the culprit: the one that fails alone), any other exception one
+    naming the plugin."""
     if not isinstance(node, DictConfig):
         node = OmegaConf.create(dict(node))
     params = _params(cls, node, where)

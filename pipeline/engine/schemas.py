@@ -1,14 +1,10 @@
 """The config's schemas: one dataclass per config section and group option, in Hydra's ``ConfigStore``.
 
-The YAML files extend them (``conf/integrator/rk45.yaml``: ``defaults: [/schema/integrator/tolerances@_here_,
-_self_]``; ``conf/config.yaml``: ``defaults: [gyrolab_schema, ...]``), as in Hydra's
-``examples/tutorials/structured_configs/``, so that Hydra refuses an unknown key or a value of the wrong type of a
-group option, or of a top-level value, while composing (the primary config's sections are any mapping then, so that
-``~output.dpi`` deletes as in any Hydra app). :func:`validate` applies every schema to a composed config (the
-preflight's; a user's primary config or option that names none; a dataset's stored config), a group's chosen by
-its ``_target_``; :func:`sentence` turns OmegaConf's error into one sentence naming the key, the value and what is
-expected. A third-party plugin's schema
-is its class's ``schema`` dataclass, else one made from its ``__init__`` keywords (:func:`plugin_schema`).
+The YAML files extend them, as in Hydra's ``examples/tutorials/structured_configs/`` (docs/configs.md, "Your own
+configs"), so that Hydra checks keys and types while composing (the primary config's sections are any mapping
+then, so that ``~output.dpi`` deletes as in any Hydra app); :func:`validate` applies every schema to a composed
+config after composing, a group's chosen by its ``_target_``; :func:`sentence` turns OmegaConf's error into one
+sentence naming the key, the value and what is expected.
 
 Field metadata says what a type cannot: ``TOLERANCE`` (in (0, 1), read by the budget's check), ``OWN_SETTING`` (an
 integrator's own accuracy setting, named when the top-level ``accuracy`` is not read), ``example`` (a required
@@ -426,7 +422,7 @@ def sentence(error: OmegaConfBaseException, prefix: str = "") -> ConfigError:
     """One sentence for OmegaConf's schema errors: the key (under ``prefix``), the value, what is expected."""
     key = prefix + str(getattr(error, "full_key", None) or "")
     schema = getattr(error, "object_type", None)
-    if isinstance(error, MissingMandatoryValue) and key in required_sections():
+    if isinstance(error, MissingMandatoryValue) and key in REQUIRED_SECTIONS:
         return ConfigError(missing_section(key))
     if isinstance(error, ConfigKeyError) and dataclasses.is_dataclass(schema):
         parent = key.rpartition(".")[0]
@@ -442,7 +438,7 @@ def sentence(error: OmegaConfBaseException, prefix: str = "") -> ConfigError:
 
 def unknown_key_sentence(key: str, known: Sequence[str], override: str = "", cause: str = "") -> str:
     """"`time.ennd` is not a key of `time`; did you mean `time.end`?" (with the valid keys if none is close)."""
-    parent, _, leaf = key.rpartition(".")
+    parent = key.rpartition(".")[0]
     where = f"`{parent}`" if parent else "the config"
     close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
     if "ValidationError" in cause or "ConfigTypeError" in cause:
@@ -463,7 +459,8 @@ def _validation_subject(error: ValidationError, key: str, schema: Any) -> tuple[
     if key or merge is None:
         value = getattr(error, "value", None)
         value = OmegaConf.to_container(value) if isinstance(value, (DictConfig, ListConfig)) else value
-        return key, _field_type(schema, key.rpartition(".")[2].split("[")[0]), value
+        name = key.rpartition(".")[2].split("[")[0]
+        return key, typing.get_type_hints(schema).get(name) if dataclasses.is_dataclass(schema) else None, value
     parent = getattr(error, "parent_node", None)
     for name in (parent.keys() if isinstance(parent, DictConfig) else ()):
         node = parent._get_node(name)
@@ -483,16 +480,10 @@ def _mismatch_sentence(key: str, value: Any, hint: Any) -> str:
         return f"{key}={shorten(repr(value))}: a list and a section (a mapping) do not match; {key} must be {_words(hint)}"
     if section:
         base = _strip_optional(hint)
-        example = required_sections().get(key) or (_example(base) if dataclasses.is_dataclass(base) else "NAME")
+        example = REQUIRED_SECTIONS.get(key) or (_example(base) if dataclasses.is_dataclass(base) else "NAME")
         return (f"{key}={shorten(repr(value))}: `{key}` is a section, not a value; set one of its keys "
                 f"(e.g. {key}.{example}=...)")
     return _type_sentence(key, value, hint)
-
-
-def _field_type(schema: Any, name: str) -> Any:
-    if not dataclasses.is_dataclass(schema):
-        return None
-    return typing.get_type_hints(schema).get(name)
 
 
 def _is_list(hint: Any) -> bool:
@@ -528,43 +519,29 @@ def _type_sentence(key: str, value: Any, hint: Any, alt: Any = None) -> str:
 
 # ---- tables derived from the schemas ------------------------------------------------------------------------
 
-@cache
-def required_sections() -> dict[str, str]:
-    """Sections every run needs (no default in the schema), each with a key to show: ``{"time": "end", ...}``."""
-    return {f.name: f.metadata["example"] for f in dataclasses.fields(Gyrolab) if "example" in f.metadata}
-
-
-#: sections every run needs, with a key to show in the sentences (``gyrolab.app`` refuses ``~time``)
-REQUIRED_SECTIONS = required_sections()
+#: sections every run needs (no default in the schema), each with a key to show in the sentences: ``{"time": "end",
+#: ...}`` (``gyrolab.app`` refuses ``~time``)
+REQUIRED_SECTIONS = {f.name: f.metadata["example"] for f in dataclasses.fields(Gyrolab) if "example" in f.metadata}
 
 
 def missing_section(section: str) -> str:
-    example = required_sections()[section]
+    example = REQUIRED_SECTIONS[section]
     how = f"choose one ({section}=NAME)" if example == "_target_" else f"set its keys instead (e.g. {section}.{example}=...)"
     return f"the config has no `{section}` section (deleted with ~{section}?); every run needs it: {how}"
-
-
-def _all_schemas() -> list[type]:
-    found = [Gyrolab, Time, Output, Batch]
-    for schemas in BUILTIN.values():
-        found += [s for s in schemas.values() if s not in found]
-    return found
 
 
 @cache
 def keys_with(flag: str) -> tuple[str, ...]:
     """Field names whose metadata has ``flag`` in any schema (``tolerance``: rtol, atol, tol, accuracy)."""
-    names = [f.name for s in _all_schemas() for f in dataclasses.fields(s) if f.metadata.get(flag)]
-    return tuple(dict.fromkeys(names))
+    schemas = [Gyrolab, Time, Output, Batch, *(s for group in BUILTIN.values() for s in group.values())]
+    return tuple(dict.fromkeys(f.name for s in schemas for f in dataclasses.fields(s) if f.metadata.get(flag)))
 
 
 @cache
 def only_declared_keys() -> tuple[str, ...]:
     """Dotted keys only the runs that declare them read (``batch``, ``output.error_estimate``, ...)."""
-    found = []
-    for prefix, schema in (("", Gyrolab), ("output.", Output)):
-        found += [prefix + f.name for f in dataclasses.fields(schema) if f.metadata.get("only_declared")]
-    return tuple(found)
+    return tuple(prefix + f.name for prefix, schema in (("", Gyrolab), ("output.", Output))
+                 for f in dataclasses.fields(schema) if f.metadata.get("only_declared"))
 
 
 # ---- what a task reads and sets -----------------------------------------------------------------------------
@@ -594,21 +571,22 @@ def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
         return OmegaConf.to_container(cfg, resolve=True, throw_on_missing=True)
     except OmegaConfBaseException as error:
         key = getattr(error, "full_key", None) or "?"
-        raw = _raw_value(cfg, key)
+        raw = raw_value(cfg, key)
+        raw = "?" if raw is None else raw
         reason = first_line(error).split(" full_key:")[0]
         return_hint = "refer to an existing key, e.g. ${time.end}, or give a plain value"
         raise ConfigError(f"{shorten(key)}={shorten(str(raw))} cannot be resolved ({shorten(reason, 160)}); "
                           f"{return_hint}") from None
 
 
-def _raw_value(cfg: DictConfig, key: str) -> Any:
+def raw_value(cfg: DictConfig, key: str) -> Any:
+    """The unresolved value of dotted ``key`` (None when the config has no such key)."""
     node: Any = cfg
-    try:
-        for part in key.split("."):
-            node = node._get_node(part)
-        return node._value()
-    except Exception:  # noqa: BLE001 - only for the message
-        return "?"
+    for part in key.split("."):
+        node = node._get_node(part, validate_access=False) if isinstance(node, DictConfig) else None
+        if node is None:
+            return None
+    return OmegaConf.to_container(node, resolve=False) if isinstance(node, DictConfig) else node._value()
 
 
 def first_line(error: Exception) -> str:

@@ -1,21 +1,8 @@
-"""Config values a run would not read: refused when the user gave them, said and recorded when a config file did.
+"""Config values a run would not read: refused when the user gave them, said and recorded when a config file did
+(docs/configs.md, "Values a run does not read").
 
-A value that is set but read by nothing is the worst defect a scientific tool can have: the run succeeds and
-the user believes they got what they asked for. ``integrator=taylor accuracy=1e-8`` ran Taylor at its own
-tolerance, exit 0, and nothing said that the 1e-8 target went nowhere.
-
-The top-level ``accuracy`` is read only by an integrator whose settings refer to it (``conf/integrator/auto.yaml``:
-``accuracy: ${accuracy}``; a user's ``integrator.tol='${accuracy}'`` reads it too). Whether it is read is read
-off the composed config — does a value of the integrator's node refer to ``accuracy``, directly or through other
-keys? — never off the integrator's name. What happens when it is not read depends on who set it (docs/configs.md, "Values a run
-does not read"):
-
-* given explicitly (the command line, ``compose_scene``'s overrides, a sweep's value for every job): the
-  user asked for that target and would not get it, so the run is refused before anything is written, in one
-  sentence naming the value, the integrator and the ways out;
-* from a config file (an experiment's default for ``integrator=auto``: ``experiment=perf_reference
-  integrator=taylor`` is a legitimate comparison): the run proceeds, logs one warning and records the same
-  sentence in its dataset (``accuracy_ignored``), so that the dataset cannot be mistaken for a run at that target.
+The top-level ``accuracy`` is read only by an integrator whose settings refer to it (``accuracy: ${accuracy}``),
+which is read off the composed config, never off the integrator's name.
 """
 
 from __future__ import annotations
@@ -28,7 +15,7 @@ from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
 from gyrolab.contracts import registry
-from gyrolab.engine.schemas import keys_with
+from gyrolab.engine.schemas import keys_with, raw_value
 from gyrolab.contracts.capabilities import integrators_with, or_list
 from gyrolab.contracts.integrator import CHOOSES_METHOD
 from gyrolab.errors import ConfigError, GyrolabError
@@ -36,8 +23,7 @@ from gyrolab.errors import ConfigError, GyrolabError
 ACCURACY = "accuracy"
 #: the run dataset's global attribute saying that the config's ``accuracy`` was not read, and why
 ACCURACY_IGNORED_ATTRIBUTE = "accuracy_ignored"
-#: an integrator's own accuracy settings, named in the sentences (what the user can set instead): the schemas'
-#: tolerances and steps (``gyrolab.engine.schemas``)
+#: an integrator's own accuracy settings (the schemas' tolerances and steps), named as what the user can set instead
 OWN_SETTINGS = keys_with("own")
 #: an interpolation's references: ``${key}``, ``${..key}``, ``${oc.select:key,default}`` (a resolver's name is
 #: captured too, and found in no config)
@@ -89,19 +75,9 @@ def _refers_to(cfg: DictConfig, value: Any, where: str, seen: set[str]) -> bool:
             return True
         if key not in seen:
             seen.add(key)
-            if _refers_to(cfg, _raw(cfg, key), key, seen):
+            if _refers_to(cfg, raw_value(cfg, key), key, seen):
                 return True
     return False
-
-
-def _raw(cfg: DictConfig, key: str) -> Any:
-    """The unresolved value of ``key`` (None when the config has no such key)."""
-    node: Any = cfg
-    for part in key.split("."):
-        if not isinstance(node, DictConfig) or part not in node:
-            return None
-        node = node._get_node(part)
-    return OmegaConf.to_container(node, resolve=False) if isinstance(node, DictConfig) else node._value()
 
 
 def unread_accuracy(cfg: DictConfig) -> str | None:
@@ -116,9 +92,10 @@ def unread_accuracy(cfg: DictConfig) -> str | None:
         return None
     name, own = integrator_name(cfg), _own_settings(cfg.get("integrator"))
     settings = f" ({', '.join(f'integrator.{k}={v!r}' for k, v in own)})" if own else ""
-    if name in _readers():  # its own accuracy setting was given a value: it replaces the top-level one
+    readers = integrators_with(CHOOSES_METHOD)  # they choose their method for a target: the way to ask for one
+    if name in readers:  # its own accuracy setting was given a value: it replaces the top-level one
         return f"{ACCURACY}={value!r} is not read: integrator={name} runs at its own settings{settings}, which replace it"
-    target = (f"the target of integrator={or_list(_readers())} only" if _readers()
+    target = (f"the target of integrator={or_list(readers)} only" if readers
               else "read by no registered integrator's settings")
     return f"{ACCURACY}={value!r} is {target}; integrator={name} does not read it and runs at its own settings{settings}"
 
@@ -127,19 +104,13 @@ def refusal(cfg: DictConfig, value_sentence: str) -> ConfigError:
     """The one-sentence refusal of an explicitly given ``accuracy`` the integrator does not read, with the ways out."""
     value = OmegaConf.select(cfg, ACCURACY)
     name, own = integrator_name(cfg), [f"integrator.{k}" for k, _ in _own_settings(cfg.get("integrator"))]
-    readers = _readers()
+    readers = integrators_with(CHOOSES_METHOD)
     if name in readers:
         ways = [f"drop {' and '.join(own)} to aim at {ACCURACY}={value!r}", f"drop {ACCURACY}={value!r}"]
     else:
         ways = [f"ask integrator={readers[0]} {ACCURACY}={value!r}"] if readers else []
         ways.append(f"set {' and '.join(own) or 'the integrator settings'} instead (and drop {ACCURACY}={value!r})")
     return ConfigError(f"{value_sentence}: {' or '.join(ways)}")
-
-
-def _readers() -> list[str]:
-    """The registered integrators that pick their method for a target accuracy (CHOOSES_METHOD): the ones whose
-    packaged settings read ``accuracy`` (named in the sentences as the way to ask for a target)."""
-    return integrators_with(CHOOSES_METHOD)
 
 
 def ignored_accuracy(cfg: DictConfig, overrides: Sequence[str]) -> str | None:

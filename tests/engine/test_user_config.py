@@ -54,13 +54,13 @@ def test_the_preflight_composes_the_users_config(argv, expected, myconf, monkeyp
     """Each form passes the preflight, which composes from the user's folder (the runs above: Hydra agrees)."""
     from gyrolab import app
     from gyrolab.app.parser import parse_run
-    from gyrolab.engine.config import ConfigSource, compose_config, current_source, use_source
+    from gyrolab.engine.config import ConfigSource, compose_config, use_source
 
     args = app.absolute_config_path(parse_run([a.format(conf=myconf) for a in argv]))
     try:
         app.preflight(parse_run([*[a.format(conf=myconf) for a in argv], "hydra.run.dir=out"]))
         overrides = args.overrides
-        cfg = compose_config(overrides, config_name=current_source().config_name)
+        cfg = compose_config(overrides)  # composes from the source the preflight set
     finally:
         use_source(ConfigSource())
     assert (cfg.integrator._target_.rsplit(".", 1)[1], cfg.body.a, cfg.time.n_output) == expected
