@@ -52,6 +52,9 @@ class Choice:
     #: with ``method`` None: the more accurate run that measures it, and the run to take instead when it breaks
     check: Integrator | None = None
     instead: Callable[[], Solution] | None = None
+    #: the run is kept only where its measured error meets ``promised``, else ``instead`` runs (``auto``'s double run
+    #: on a chaotic scene whose predicted round-off asked for double-double: ``integrate(..., measured=True)``)
+    measure_first: bool = False
 
 
 @dataclass
