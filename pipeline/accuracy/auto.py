@@ -111,10 +111,10 @@ class Auto(Integrator):
         return {"accuracy": self.accuracy}
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None = None,
-                  compiled: CompiledModel | None = None, series: bool = True, measured: bool = False) -> Solution:
+                  compiled: CompiledModel | None = None, series: bool = True, estimated: bool = False) -> Solution:
         """The cheapest method predicted to meet the accuracy (``series``: a regime's analytic series among the
         candidates), run; what it chose and promises is the solution's ``choice`` (nothing is kept on ``self``).
-        ``measured``: the caller measures the run's error (``gyrolab.accuracy.promise``), so a climb predicted from a
+        ``estimated``: the caller measures the run's error (``gyrolab.accuracy.promise``), so a climb predicted from a
         chaotic scene's growth is tried in double first (``Choice.measure_first``)."""
         # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.taylor import order_for
@@ -127,7 +127,7 @@ class Auto(Integrator):
             solution = self._series(fun, t_out, y0, compiled, start)
             if solution is not None:
                 solution.choice.instead = lambda: self.integrate(fun, t_out, y0, progress, compiled, series=False,
-                                                                 measured=measured)
+                                                                 estimated=estimated)
                 return solution
         span = t_out[-1] - t_out[0]
         t_pilot = t_out[0] + span * self.pilot_fraction
@@ -186,9 +186,10 @@ class Auto(Integrator):
         final = functools.partial(self._final, fun, t_out, y0, progress, compiled, start, per_tol, growth,
                                   pilot_nfev, chaos)
         if climbed:
-            up, tol_up, roundoff_up, why_up = self._climb(compiled, make, per_tol, roundoff, steps, amp, t_out)
-            if not (chaotic and measured):
-                return final(up, tol_up, roundoff_up, why_up)
+            up = self._climb(compiled, make, per_tol, roundoff, steps, amp, t_out)  # raises "even in double-double"
+            predicted = functools.partial(final, *up) if isinstance(up, tuple) else functools.partial(_raise, up)
+            if not (chaotic and estimated):
+                return predicted()
             # A chaotic scene's round-off is predicted from the tangent run's growth, which scatters by orders of
             # magnitude (docs/integrators.md, "Needless climbs"): run in double first and keep it only when its
             # error estimate measures the target met; else climb as predicted (``Choice.measure_first``).
@@ -201,7 +202,7 @@ class Auto(Integrator):
             promised = self.accuracy / ESTIMATE_SLACK
             solution.choice = replace(solution.choice, promised=promised, measure_first=True,
                                       attributes={**solution.choice.attributes, "auto_predicted_error": promised},
-                                      instead=lambda: final(up, tol_up, roundoff_up, why_up))
+                                      instead=predicted)
             return solution
         if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
@@ -237,10 +238,11 @@ class Auto(Integrator):
             Choice(method, choice, self.accuracy, promised, self.extended_precision))
 
     def _climb(self, compiled: CompiledModel | None, make: Any, per_tol: float, roundoff: float, steps: float,
-               amp: Any, t_out: np.ndarray) -> tuple[Integrator, float, float, str]:
+               amp: Any, t_out: np.ndarray) -> tuple[Integrator, float, float, str] | ConfigError:
         """(the method one rung up the precision ladder, its tolerance, its round-off, why) where double precision's
         round-off on this scene (``roundoff``) is above the accuracy; else one ConfigError sentence naming λ and
-        the horizon, whose advice is a target the scene reaches (``at_least``: rounded up, with room for the
+        the horizon (raised when double-double cannot reach the target either, returned when the ladder stops at
+        double precision), whose advice is a target the scene reaches (``at_least``: rounded up, with room for the
         truncation error).
 
         The truncation error per unit tolerance is the pilot's (measured at its order; the double-double run takes
@@ -265,7 +267,8 @@ class Auto(Integrator):
             raise self._refusal("double-double", best_dd, chaotic, amp, t_out, "")
         climb = ", or integrator.extended_precision=true (auto then climbs to double-double)" if (
             up is not None and best_dd < self.accuracy) else ""
-        raise self._refusal("double precision", roundoff, chaotic, amp, t_out, climb)
+        # returned, not raised: on a chaotic scene the caller may try double first, measured (``integrate``)
+        return self._refusal("double precision", roundoff, chaotic, amp, t_out, climb)
 
     def _refusal(self, rung: str, error: float, chaotic: bool, amp: Any, t_out: np.ndarray,
                  climb: str) -> ConfigError:
@@ -554,6 +557,10 @@ def _comes_back(y: np.ndarray, y0: np.ndarray, margin: float) -> bool:
         if near:
             return True
     return False
+
+
+def _raise(error: Exception) -> Any:
+    raise error
 
 
 def _final_run(method: Integrator, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,

@@ -53,8 +53,8 @@ def measured_run(scene: Any, y0: np.ndarray, progress: Any, compiled: Any) -> tu
     integrator = scene.integrator
     wanted = estimate.wanted(scene)
     # an integrator choosing its method (C7) may try a cheaper one first when its run will be measured
-    measured = {"measured": True} if wanted and integrator.supports(CHOOSES_METHOD) else {}
-    solution = integrator.integrate(scene.rhs, scene.times, y0, progress, compiled, **measured)
+    estimated = {"estimated": True} if wanted and integrator.supports(CHOOSES_METHOD) else {}
+    solution = integrator.integrate(scene.rhs, scene.times, y0, progress, compiled, **estimated)
     _log_stats(integrator.name, solution)
     ran = Ran(integrator, solution.choice)
     if not wanted:
@@ -62,9 +62,9 @@ def measured_run(scene: Any, y0: np.ndarray, progress: Any, compiled: Any) -> tu
     comparison = _compare(scene, solution)
     if ran.choice is not None and ran.choice.measure_first and (comparison.max_error is None
                                                                 or _unkept(comparison.max_error, ran.choice)):
-        log.info("%s: the error estimate measured %s in %s precision: running %s", integrator.name,
-                 "nothing" if comparison.max_error is None else f"{comparison.max_error:.2g}",
-                 ran.choice.method.precision, "as predicted (one rung up)")
+        log.info("%s: the error estimate measured %s in %s precision, not %g below accuracy=%g: as predicted, one "
+                 "rung up (or refused)", integrator.name, "nothing" if comparison.max_error is None
+                 else f"{comparison.max_error:.2g}", ran.choice.method.precision, ESTIMATE_SLACK, ran.choice.target)
         solution = ran.choice.instead()
         _log_stats(integrator.name, solution)
         ran.choice = solution.choice
