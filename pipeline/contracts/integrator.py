@@ -197,7 +197,9 @@ class Integrator(ABC):
         double-double), which ``gyrolab.accuracy`` runs where ``more_accurate`` has reached its floor.
         A CHOOSES_METHOD integrator returns what it chose with its solution (``Solution.choice``, a ``Choice``:
         the method that ran and the error it promises at every output time); ``gyrolab.accuracy`` measures the
-        run and, while the measurement breaks the promise, runs that method made more accurate instead.
+        run and, while the measurement breaks the promise, runs that method made more accurate instead. It calls
+        ``integrate(..., estimated=True)`` when it will measure the run, so that the integrator may try a cheaper
+        choice first (``Choice.measure_first``: kept only where measured, else ``Choice.instead`` runs).
 
     What gyrolab enforces (``gyrolab.contracts.integrator_rules``): every
     subclass's ``integrate`` — built-in or third-party, under its own name —
