@@ -35,13 +35,14 @@ from __future__ import annotations
 import functools
 import math
 import time
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from gyrolab.accuracy.amplification import amplification
-from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_FLOOR, FIRST_RATIO,
-                                          FLOOR, MAX_GROWTH, MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE,
+from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_FLOOR,
+                                          ESTIMATE_SLACK, FIRST_RATIO, FLOOR, MAX_GROWTH, MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE,
                                           MISS_MARGIN, PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
                                           SHADOW_TOLERANCE, TIGHT_RATIO, UNMEASURED_PER_TOL)
 from gyrolab.contracts.integrator import (BATCH_KERNEL, CHOOSES_METHOD, PRECISIONS, PREFERS_COMPILED_MODEL,
@@ -110,9 +111,11 @@ class Auto(Integrator):
         return {"accuracy": self.accuracy}
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None = None,
-                  compiled: CompiledModel | None = None, series: bool = True) -> Solution:
+                  compiled: CompiledModel | None = None, series: bool = True, estimated: bool = False) -> Solution:
         """The cheapest method predicted to meet the accuracy (``series``: a regime's analytic series among the
-        candidates), run; what it chose and promises is the solution's ``choice`` (nothing is kept on ``self``)."""
+        candidates), run; what it chose and promises is the solution's ``choice`` (nothing is kept on ``self``).
+        ``estimated``: the caller measures the run's error (``gyrolab.accuracy.promise``), so a climb predicted from a
+        chaotic scene's growth is tried in double first (``Choice.measure_first``)."""
         # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.taylor import order_for
         from gyrolab.kernels.taylor_series import ready
@@ -123,7 +126,8 @@ class Auto(Integrator):
         if series:
             solution = self._series(fun, t_out, y0, compiled, start)
             if solution is not None:
-                solution.choice.instead = lambda: self.integrate(fun, t_out, y0, progress, compiled, series=False)
+                solution.choice.instead = lambda: self.integrate(fun, t_out, y0, progress, compiled, series=False,
+                                                                 estimated=estimated)
                 return solution
         span = t_out[-1] - t_out[0]
         t_pilot = t_out[0] + span * self.pilot_fraction
@@ -177,16 +181,41 @@ class Auto(Integrator):
         if chaotic:
             chaos["auto_precision_horizon"] = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
         climbed = roundoff > self.accuracy
-        method, why = None, (f"double precision's round-off on this scene (about {roundoff:.1g} over ~{steps:.0f} "
-                             f"steps) is below accuracy={self.accuracy:g}")
+        why = (f"double precision's round-off on this scene (about {roundoff:.1g} over ~{steps:.0f} steps) is below "
+               f"accuracy={self.accuracy:g}")
+        final = functools.partial(self._final, fun, t_out, y0, progress, compiled, start, per_tol, growth,
+                                  pilot_nfev, chaos)
         if climbed:
-            method, chosen, roundoff, why = self._climb(compiled, make, per_tol, roundoff, steps, amp, t_out)
-        elif CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
+            up = self._climb(compiled, make, per_tol, roundoff, steps, amp, t_out)  # raises "even in double-double"
+            predicted = functools.partial(final, *up) if isinstance(up, tuple) else functools.partial(_raise, up)
+            if not (chaotic and estimated):
+                return predicted()
+            # A chaotic scene's round-off is predicted from the tangent run's growth, which scatters by orders of
+            # magnitude (docs/integrators.md, "Needless climbs"): run in double first and keep it only when its
+            # error estimate measures the target met; else climb as predicted (``Choice.measure_first``).
+            chosen = min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
+            resumed = (tight, pilot_times, inside, t_pilot) if tight_tol <= chosen else None
+            solution = final(make(max(chosen, Taylor.TOLERANCE_FLOOR)), chosen, 0.0, (
+                f"double precision's round-off on this chaotic scene is predicted at about {roundoff:.1g} over "
+                f"~{steps:.0f} steps, above accuracy={self.accuracy:g}, from a growth that scatters: run in double "
+                f"first, kept only where its error estimate measures the target met"), resumed)
+            promised = self.accuracy / ESTIMATE_SLACK
+            solution.choice = replace(solution.choice, promised=promised, measure_first=True,
+                                      attributes={**solution.choice.attributes, "auto_predicted_error": promised},
+                                      instead=predicted)
+            return solution
+        if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
-        if method is None:
-            method = make(chosen)
         # the pilot's tight run is as accurate when its tolerance is: the run continues from its end
-        resumed = (tight, pilot_times, inside, t_pilot) if tight_tol <= chosen and not climbed else None
+        resumed = (tight, pilot_times, inside, t_pilot) if tight_tol <= chosen else None
+        return final(make(chosen), chosen, roundoff, why, resumed)
+
+    def _final(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None,
+               compiled: CompiledModel | None, start: float, per_tol: float, growth: float, pilot_nfev: int,
+               chaos: dict, method: Integrator, chosen: float, roundoff: float, why: str,
+               resumed: tuple | None = None) -> Solution:
+        """``method``'s run at tolerance ``chosen`` over the output times, with what it promises (its truncation error
+        and ``roundoff``) and the attributes saying what was chosen and why (``why``)."""
         y, final_stats, n_steps = _final_run(method, fun, t_out, y0, progress, compiled, resumed)
         promised = CALIBRATION * per_tol * chosen + roundoff
         choice = {
@@ -209,10 +238,11 @@ class Auto(Integrator):
             Choice(method, choice, self.accuracy, promised, self.extended_precision))
 
     def _climb(self, compiled: CompiledModel | None, make: Any, per_tol: float, roundoff: float, steps: float,
-               amp: Any, t_out: np.ndarray) -> tuple[Integrator, float, float, str]:
+               amp: Any, t_out: np.ndarray) -> tuple[Integrator, float, float, str] | ConfigError:
         """(the method one rung up the precision ladder, its tolerance, its round-off, why) where double precision's
         round-off on this scene (``roundoff``) is above the accuracy; else one ConfigError sentence naming λ and
-        the horizon, whose advice is a target the scene reaches (``at_least``: rounded up, with room for the
+        the horizon (raised when double-double cannot reach the target either, returned when the ladder stops at
+        double precision), whose advice is a target the scene reaches (``at_least``: rounded up, with room for the
         truncation error).
 
         The truncation error per unit tolerance is the pilot's (measured at its order; the double-double run takes
@@ -237,7 +267,8 @@ class Auto(Integrator):
             raise self._refusal("double-double", best_dd, chaotic, amp, t_out, "")
         climb = ", or integrator.extended_precision=true (auto then climbs to double-double)" if (
             up is not None and best_dd < self.accuracy) else ""
-        raise self._refusal("double precision", roundoff, chaotic, amp, t_out, climb)
+        # returned, not raised: on a chaotic scene the caller may try double first, measured (``integrate``)
+        return self._refusal("double precision", roundoff, chaotic, amp, t_out, climb)
 
     def _refusal(self, rung: str, error: float, chaotic: bool, amp: Any, t_out: np.ndarray,
                  climb: str) -> ConfigError:
@@ -526,6 +557,10 @@ def _comes_back(y: np.ndarray, y0: np.ndarray, margin: float) -> bool:
         if near:
             return True
     return False
+
+
+def _raise(error: Exception) -> Any:
+    raise error
 
 
 def _final_run(method: Integrator, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,

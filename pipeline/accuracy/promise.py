@@ -24,7 +24,7 @@ import numpy as np
 from gyrolab.accuracy import estimate
 from gyrolab.accuracy.auto import at_least
 from gyrolab.accuracy.calibration import ESTIMATE_SLACK, MAX_RECHECKS, RECHECK_MARGIN
-from gyrolab.contracts.integrator import Choice, Integrator, Solution
+from gyrolab.contracts.integrator import CHOOSES_METHOD, Choice, Integrator, Solution
 from gyrolab.errors import ConfigError
 
 log = logging.getLogger(__name__)
@@ -51,12 +51,26 @@ def measured_run(scene: Any, y0: np.ndarray, progress: Any, compiled: Any) -> tu
     """``scene``'s run, its error measured where wanted (``estimate.wanted``) and its promise kept: (the solution,
     what ran for the dataset, the estimate's ``variables`` for ``build_dataset`` or None)."""
     integrator = scene.integrator
-    solution = integrator.integrate(scene.rhs, scene.times, y0, progress, compiled)
+    wanted = estimate.wanted(scene)
+    # an integrator choosing its method (C7) may try a cheaper one first when its run will be measured
+    estimated = {"estimated": True} if wanted and integrator.supports(CHOOSES_METHOD) else {}
+    solution = integrator.integrate(scene.rhs, scene.times, y0, progress, compiled, **estimated)
     _log_stats(integrator.name, solution)
     ran = Ran(integrator, solution.choice)
-    if not estimate.wanted(scene):
+    if not wanted:
         return solution, ran, None
     comparison = _compare(scene, solution)
+    if ran.choice is not None and ran.choice.measure_first and (comparison.max_error is None
+                                                                or _unkept(comparison.max_error, ran.choice)):
+        log.info("%s: the error estimate measured %s in %s precision, not %g below accuracy=%g: as predicted, one "
+                 "rung up (or refused)", integrator.name, "nothing" if comparison.max_error is None
+                 else f"{comparison.max_error:.2g}", ran.choice.method.precision, ESTIMATE_SLACK, ran.choice.target)
+        measured_in = {f"auto_measured_in_{ran.choice.method.precision}": comparison.max_error} \
+            if comparison.max_error is not None else {}
+        solution = ran.choice.instead()
+        _log_stats(integrator.name, solution)
+        ran.choice = replace(solution.choice, attributes={**solution.choice.attributes, **measured_in})
+        comparison = _compare(scene, solution)
     while comparison.max_error is not None and ran.choice is not None and ran.choice.promised is not None \
             and _unkept(comparison.max_error, ran.choice):
         measured, choice = comparison.max_error, ran.choice

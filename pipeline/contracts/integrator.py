@@ -52,6 +52,9 @@ class Choice:
     #: with ``method`` None: the more accurate run that measures it, and the run to take instead when it breaks
     check: Integrator | None = None
     instead: Callable[[], Solution] | None = None
+    #: the run is kept only where its measured error meets ``promised``, else ``instead`` runs (``auto``'s double run
+    #: on a chaotic scene whose predicted round-off asked for double-double: ``integrate(..., estimated=True)``)
+    measure_first: bool = False
 
 
 @dataclass
@@ -165,7 +168,9 @@ class Integrator(ABC):
         (default: nothing); ``auto`` uses it to consult the system's regimes.
     11. ``precision`` names its rung on the precision ladder (``PRECISIONS``); ``climbed(factor)``, optional:
         the same method one rung up, which ``gyrolab.accuracy`` runs where ``more_accurate`` has reached its floor.
-        A CHOOSES_METHOD integrator returns what it chose with its solution (``Solution.choice``, a ``Choice``).
+        A CHOOSES_METHOD integrator returns what it chose with its solution (``Solution.choice``, a ``Choice``);
+        ``gyrolab.accuracy`` calls ``integrate(..., estimated=True)`` when it will measure the run, and the
+        integrator may then try a cheaper choice first (``Choice.measure_first``).
 
     Every subclass's own ``integrate`` is wrapped when the class is defined (``gyrolab.contracts.integrator_rules``),
     so that each call is checked against rules 2–4; a violation is one ``IntegrationError`` sentence naming the
