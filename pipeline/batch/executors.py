@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import errno
 import itertools
+import logging
 import os
+import tempfile
 import uuid
 from pathlib import Path
 from collections.abc import Callable, Iterable
@@ -17,6 +19,7 @@ from typing import Any, TypeVar
 from gyrolab.batch.scheduler import CONNECT_TIMEOUT, IN_PROCESS, LOCAL, probe
 from gyrolab.errors import ConfigError, GyrolabError, OutputError, shorten
 from gyrolab.output.atomic import reason
+from gyrolab.output.trust import private_dir
 
 Task = TypeVar("Task")
 Result = TypeVar("Result")
@@ -84,14 +87,11 @@ def _where(kind: str, scheduler: str) -> str:
 def _client(kind: str, scheduler: str, source: str) -> Any:
     """A connected ``distributed.Client`` (closing it also closes a local cluster it started); an address is first
     probed (``gyrolab.batch.scheduler.probe``), then connected within the same ``CONNECT_TIMEOUT``."""
-    import logging
 
-    from distributed import Client, LocalCluster
+    from distributed import Client, LocalCluster  # optional (the cluster extra): imported when used
 
     if kind == "local":
-        import tempfile
 
-        from gyrolab.output.trust import private_dir
 
         # workers spill pickles to their scratch folder and load them back: one only this user can write
         scratch = private_dir(Path(tempfile.gettempdir()) / f"gyrolab-dask-{os.geteuid()}", "Dask's scratch folder")
@@ -111,7 +111,7 @@ def _client(kind: str, scheduler: str, source: str) -> Any:
 def _map_on(client: Any, function: Callable[[Task], Result], tasks: Iterable[Task],
             on_result: Callable[[int, Result], None], *, where: str) -> None:
     """Submit at most ``CHUNKS_PER_THREAD`` chunks per worker thread; hand results over as they complete."""
-    from distributed import as_completed
+    from distributed import as_completed  # optional (the cluster extra)
 
     threads = sum(client.nthreads().values()) or 1
     limit = max(2, CHUNKS_PER_THREAD * threads)

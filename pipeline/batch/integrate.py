@@ -16,9 +16,12 @@ from collections.abc import Callable
 import numpy as np
 
 from gyrolab.contracts import CompiledModel, Integrator
-from gyrolab.contracts.integrator import BATCH_KERNEL, CHOOSES_METHOD, BatchSolution, RightHandSide
+from gyrolab.contracts.capabilities import integrators_with, or_list
+from gyrolab.contracts.integrator import (BATCH_KERNEL, CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL,
+                                          BatchSolution, RightHandSide)
 from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError, IntegrationError
+from gyrolab.plugins.integrators.batch_kernels import require_finite_out
 
 
 def integrate_batch(scene: Scene, initial_states: np.ndarray, params: np.ndarray | None = None) -> BatchSolution:
@@ -156,8 +159,6 @@ def integrate_points(integrator: Integrator, rhs_of: Callable[[int], RightHandSi
     BatchSolution
         The states at ``times`` for every trajectory, the steps taken and the failed mask.
     """
-    from gyrolab.contracts.integrator import COMPILED_MODEL, PREFERS_COMPILED_MODEL
-    from gyrolab.plugins.integrators.batch_kernels import require_finite_out
 
     start = time.perf_counter()
     times = np.asarray(times, dtype=float)
@@ -190,7 +191,6 @@ def integrate_points(integrator: Integrator, rhs_of: Callable[[int], RightHandSi
 
 def _kernel_choices(choosers: bool = True) -> str:
     """The integrators with a batch kernel as "a, b or c" (without those that choose their method: ``choosers``)."""
-    from gyrolab.contracts.capabilities import integrators_with, or_list
 
     return or_list(integrators_with(BATCH_KERNEL, accept=None if choosers else lambda c: not c.supports(CHOOSES_METHOD)))
 

@@ -19,12 +19,14 @@ from typing import Any
 import numpy as np
 from omegaconf import OmegaConf
 
+from gyrolab.batch.points import read_points_file
 from gyrolab.engine import scene as scene_module
 from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene, build_force, fastest_rate
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, GyrolabError, require_finite
 from gyrolab.sweep.grid import Dim, Grid, _refuse_repeats
+from gyrolab.output.cf import unit_attributes
 from gyrolab.sweep.identity import canonical_config, job_code
 
 log = logging.getLogger("gyrolab.batch")
@@ -270,7 +272,6 @@ def _points(dims: tuple[Dim, ...], plain: dict[str, Any]) -> tuple[tuple[Dim, ..
         if zipped:
             raise ConfigError("batch.zip=true zips command-line sweeps and batch.points_file is a list already; "
                               "give one of them")
-        from gyrolab.batch.points import read_points_file
 
         columns, digest = read_points_file(path, plain, VARIABLE_SECTIONS)
         return columns, {"kind": "points_file", "points_file": str(path), "points_file_sha256": digest}
@@ -431,7 +432,6 @@ def _same_structure(systems: Mapping[int, _Built]) -> None:
 def _common_attributes(systems: Mapping[int, _Built], swept_initial: bool) -> dict[str, Any]:
     """The attributes a single run's dataset gets from its system and body that are the same for every point
     (those of the initial state only when no initial key is swept)."""
-    from gyrolab.output.cf import unit_attributes
 
     if not systems:
         return {}

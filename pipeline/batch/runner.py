@@ -16,13 +16,16 @@ import numpy as np
 from omegaconf import OmegaConf
 
 from gyrolab.batch import executors
+from gyrolab.batch.integrate import integrate_arrays, integrate_points
 from gyrolab.batch.outputs import MODES, Output, indicator_outputs, merge_rows, state_outputs
 from gyrolab.batch.plan import Plan, _with_values
 from gyrolab.batch.scheduler import choose_scheduler
 from gyrolab.batch.store import Store
 from gyrolab.contracts.integrator import BATCH_KERNEL, CHOOSES_METHOD, VECTOR_LANES
 from gyrolab.engine.progress import duration
+from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError
+from gyrolab.kernels.vector_width import lane_attributes
 
 log = logging.getLogger("gyrolab.batch")
 
@@ -188,7 +191,6 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
     if plan.base is None or settings.output == "indicator" or not plan.integrator_class.supports(CHOOSES_METHOD):
         return None, {} if plan.base is None else {"batch_path": batch_path(plan.integrator_class, settings),
                                                    **lane_record(plan.integrator_class, settings)}
-    from gyrolab.engine.scene import Scene
 
     scene = Scene.from_config(OmegaConf.create(plan.base))
     valid = np.flatnonzero(plan.valid)
@@ -216,7 +218,6 @@ def lane_record(integrator: type, settings: Settings) -> dict[str, int]:
     """The lane width a vectorised batch kernel was compiled for and the CPU's vector width (empty otherwise)."""
     if settings.output == "indicator" or not integrator.supports(BATCH_KERNEL) or not integrator.supports(VECTOR_LANES):
         return {}
-    from gyrolab.kernels.vector_width import lane_attributes
 
     return lane_attributes()
 
@@ -252,7 +253,6 @@ def _context(key: str, config: dict[str, Any]) -> dict[str, Any]:
     """The scene of a batch's config (its compiled model, integrator), built once per process."""
     context = _CONTEXTS.get(key)
     if context is None:
-        from gyrolab.engine.scene import Scene
 
         scene = Scene.from_config(OmegaConf.create(config))
         context = {"scene": scene, "compiled": scene.system.compiled_model(), "systems": {}}
@@ -284,7 +284,6 @@ def _system(context: dict[str, Any], config: dict[str, Any], values: dict[str, A
     key = _combo_key(values)
     system = context["systems"].get(key)
     if system is None:
-        from gyrolab.engine.scene import Scene
 
         system = Scene.from_config(OmegaConf.create(_with_values(config, values))).system
         context["systems"][key] = system
@@ -296,7 +295,6 @@ _kernels_called = False   # whether this process has run a chunk (its kernels ar
 
 def run_chunk(task: ChunkTask) -> ChunkResult:
     """Integrate one chunk's valid points and compute what ``task.output`` stores."""
-    from gyrolab.batch.integrate import integrate_arrays, integrate_points
 
     global _kernels_called
     first, _kernels_called = not _kernels_called, True

@@ -79,7 +79,7 @@ def _dask_configured() -> str:
     """Dask's ``scheduler-address`` setting (its YAML files), read only when Dask is installed."""
     if find_spec("dask") is None:
         return ""
-    import dask.config
+    import dask.config  # optional (the cluster extra)
 
     return str(dask.config.get("scheduler-address", None) or "").strip()
 
@@ -88,7 +88,7 @@ def probe(address: str, source: str, timeout: float = CONNECT_TIMEOUT) -> None:
     """ConfigError in one sentence unless a Dask scheduler greets us at ``address`` within ``timeout`` s: the first
     message a Dask peer sends (its handshake, a length-prefixed msgpack mapping with the keys ``compression`` and
     ``python``) decoded with plain msgpack, which never runs code; ``tls://`` with Dask's TLS settings."""
-    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.addressing import parse_address, parse_host_port  # optional (the cluster extra)
 
     where = f"at {address} (from {source})"
     scheme, location = parse_address(address)
@@ -124,7 +124,7 @@ def probe(address: str, source: str, timeout: float = CONNECT_TIMEOUT) -> None:
 
 def _greeting(connection: socket.socket, deadline: float) -> dict | None:
     """The peer's handshake mapping, or None when what it sends is not one."""
-    import msgpack
+    import msgpack  # optional (the cluster extra: distributed's)
 
     (size,) = struct.unpack("Q", _receive(connection, 8, deadline))
     if not 16 <= size <= MAX_GREETING_BYTES:
@@ -163,7 +163,7 @@ def _receive(connection: socket.socket, n: int, deadline: float) -> bytes:
 
 def _tls_context() -> ssl.SSLContext:
     """The client's TLS context from Dask's configuration (``distributed.comm.tls.*``)."""
-    from distributed.security import Security
+    from distributed.security import Security  # optional (the cluster extra)
 
     context = Security().get_connection_args("client").get("ssl_context")
     if context is None:

@@ -18,11 +18,14 @@ from omegaconf import OmegaConf
 
 from gyrolab.batch.outputs import output_times
 from gyrolab.batch.plan import POINT
+from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError, OutputError
 from gyrolab.output.atomic import TEMP_SUFFIX, _fsync, _fsync_directory, _library_failure, diagnose, reason
 from gyrolab.output.cf import CONVENTIONS, now_iso
+from gyrolab.output.dataset import time_attributes
 from gyrolab.output.provenance import gyrolab_version, provenance
 from gyrolab.output.trust import check_output_target, open_own_file
+from gyrolab.output.units import quantity_units
 from gyrolab.sweep import record
 from gyrolab.sweep.aggregate import STATUS_ATTRS, STATUS_FLAGS
 
@@ -255,7 +258,6 @@ class Store:
         return {"coordinates": " ".join(self.plan.names)} if self.plan.points is not None else {}
 
     def _coordinate(self, dim: str, size: int, system: Any) -> None:
-        from gyrolab.output.dataset import time_attributes
 
         if dim == "time":
             times = output_times(self.plan.times, self.settings.output, self.settings.decimate)
@@ -363,7 +365,6 @@ def _cut_torn_line(path: Path) -> None:
 def _reference_system(plan: Any) -> Any:
     if plan.base is None:
         return None
-    from gyrolab.engine.scene import Scene
 
     return Scene.from_config(OmegaConf.create(plan.base)).system
 
@@ -371,7 +372,6 @@ def _reference_system(plan: Any) -> Any:
 def _key_units(key: str, system: Any) -> dict[str, str]:
     """CF units of a swept key where gyrolab knows them (``gyrolab.output.units``: every key of a nondimensional
     body, the known keys of an SI one)."""
-    from gyrolab.output.units import quantity_units
 
     units = quantity_units(key, system.body.units if system is not None else None)
     return {"units": units} if units else {}

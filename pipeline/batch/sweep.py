@@ -9,10 +9,13 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import netCDF4
+
 from gyrolab.batch import executors
 from gyrolab.batch.plan import Dim, Plan, make_plan, split_overrides
 from gyrolab.batch.runner import RunStats, Settings, run_plan
 from gyrolab.batch.scheduler import probe
+from gyrolab.contracts.capabilities import integrators_with, or_list
 from gyrolab.contracts.integrator import VARIATIONAL
 from gyrolab.errors import ConfigError
 from gyrolab.output.lock import writing_in
@@ -29,7 +32,6 @@ def run_batch_sweep(overrides: Sequence[str], out_dir: Path) -> Path:
 
 def failed_points(path: Path) -> str | None:
     """One sentence when points of the finished batch at ``path`` failed (the command then exits 1), else None."""
-    import netCDF4
 
     with netCDF4.Dataset(path, "r") as nc:
         failed, total = int(getattr(nc, "n_failed", 0)), int(getattr(nc, "n_points", 0))
@@ -62,7 +64,6 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
 def check_integrator(plan: Plan, settings: Settings) -> None:
     """Refuse, in one sentence, an integrator without VARIATIONAL for the chaos indicators (``batch.output=indicator``);
     any integrator runs the other outputs (one without a batch kernel: one ``integrate`` call per point)."""
-    from gyrolab.contracts.capabilities import integrators_with, or_list
 
     if settings.output == "indicator" and not plan.integrator_class.supports(VARIATIONAL):
         raise ConfigError(f"integrator {plan.integrator_name!r} has no variational equations (capability "
