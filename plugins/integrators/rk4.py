@@ -13,20 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.contracts.integrator import (
-    BATCH_KERNEL,
-    TIME_DEPENDENT,
-    VARIATIONAL,
-    VECTOR_LANES,
-    BatchSolution,
-    CompiledModel,
-    Integrator,
-    IntegratorStats,
-    ProgressCallback,
-    RightHandSide,
-    Solution,
-    VariationalSettings,
-)
+from gyrolab.contracts.integrator import (BATCH_KERNEL, TIME_DEPENDENT, VARIATIONAL, VECTOR_LANES, BatchSolution,
+                                          CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide,
+                                          Solution, VariationalSettings)
 from gyrolab.errors import IntegrationError, as_number
 from gyrolab.plugins.integrators.batch_kernels import rk4_batch
 from gyrolab.plugins.integrators.refinement import half_step, interval_steps

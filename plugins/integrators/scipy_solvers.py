@@ -17,17 +17,8 @@ from typing import ClassVar
 import numpy as np
 from scipy import integrate
 
-from gyrolab.contracts.integrator import (
-    TIME_DEPENDENT,
-    VARIATIONAL,
-    CompiledModel,
-    Integrator,
-    IntegratorStats,
-    ProgressCallback,
-    RightHandSide,
-    Solution,
-    VariationalSettings,
-)
+from gyrolab.contracts.integrator import (TIME_DEPENDENT, VARIATIONAL, CompiledModel, Integrator, IntegratorStats,
+                                          ProgressCallback, RightHandSide, Solution, VariationalSettings)
 from gyrolab.errors import IntegrationError
 from gyrolab.plugins.integrators.tolerances import Tolerances
 

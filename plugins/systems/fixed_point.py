@@ -146,42 +146,36 @@ class FixedPoint(System):
         body = self.body
         omega, gamma = y[:, 0:3], y[:, 3:6]
         out: dict[str, xr.Variable] = {
-            "omega": _var(("time", "axis"), omega, body.rate_unit,
+            "omega": variable(("time", "axis"), omega, body.rate_unit,
                           f"angular velocity (p, q, r) in body axes [{body.rate_label}]"),
-            "gamma": _var(("time", "axis"), gamma, "1", "direction cosines of the fixed vertical Z in body axes"),
+            "gamma": variable(("time", "axis"), gamma, "1", "direction cosines of the fixed vertical Z in body axes"),
         }
         values = self.invariant_values(y)
         if "energy" in values:
-            out["energy"] = _var("time", values["energy"], body.energy_unit,
+            out["energy"] = variable("time", values["energy"], body.energy_unit,
                                  "total energy: kinetic ½ω·Iω plus the forces' potentials")
         if "area_integral" in values:
-            out["area_integral"] = _var("time", values["area_integral"], body.momentum_unit,
+            out["area_integral"] = variable("time", values["area_integral"], body.momentum_unit,
                                         "area integral: angular momentum about the vertical, Iω·γ")
-        out["gamma_norm"] = _var("time", values["gamma_norm"], "1",
+        out["gamma_norm"] = variable("time", values["gamma_norm"], "1",
                                  "norm of the direction-cosine vector |γ| (exactly 1)")
         if self.carries_alpha:
-            out["alpha"] = _var(("time", "axis"), y[:, 6:9], "1", "direction cosines of the fixed X axis in body axes")
-            out["frame_error"] = _var("time", values["frame_error"], "1",
+            out["alpha"] = variable(("time", "axis"), y[:, 6:9], "1",
+                                    "direction cosines of the fixed X axis in body axes")
+            out["frame_error"] = variable("time", values["frame_error"], "1",
                                       "orthonormality error of (α, γ): max(| |α| − 1 |, |α·γ|)")
         if self.euler_angles:
             psi, theta, phi = euler_angles(y[:, 6:9], gamma)
-            out["psi"] = _var("time", psi, "rad", "precession angle ψ (unwrapped)")
+            out["psi"] = variable("time", psi, "rad", "precession angle ψ (unwrapped)")
         else:
             theta, phi = nutation_and_spin(gamma)
             phi = np.unwrap(phi)
-        out["theta"] = _var("time", theta, "rad", "nutation angle θ")
-        out["phi"] = _var("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
+        out["theta"] = variable("time", theta, "rad", "nutation angle θ")
+        out["phi"] = variable("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
         return out
 
     def attributes(self) -> dict[str, Any]:
-        attrs: dict[str, Any] = {"system": self.name, "state_size": self.state_size}
-        attrs.update(self.body.attributes())
-        attrs["initial_omega"] = self.initial.omega
-        attrs["initial_gamma"] = self.initial.gamma
-        for force in self.forces:
-            for key, value in force.attributes().items():
-                attrs[f"force_{force.name}_{key}"] = np.asarray(value, dtype=float) if isinstance(value, list) else value
-        return attrs
+        return system_attributes(self, initial_omega=self.initial.omega, initial_gamma=self.initial.gamma)
 
     def compiled_model(self) -> CompiledModel | None:
         """The equations traced (``System``), carrying the built-in forms' parameters when every torque has one
@@ -231,7 +225,18 @@ def traced_model(inertia: np.ndarray, forces: Sequence[Force], carries_alpha: bo
                                      9 if carries_alpha else 6, f"system fixed_point ({names})"))
 
 
-def _var(dims: str | tuple[str, ...], data: np.ndarray, units: str, long_name: str) -> xr.Variable:
+def system_attributes(system: System, **initial: Any) -> dict[str, Any]:
+    """A built-in system's dataset attributes: its name and state size, the body's, ``initial`` and every force's
+    (``force_<name>_<key>``, a list as a float array)."""
+    attrs: dict[str, Any] = {"system": system.name, "state_size": system.state_size, **system.body.attributes(),
+                             **initial}
+    for force in system.forces:
+        for key, value in force.attributes().items():
+            attrs[f"force_{force.name}_{key}"] = np.asarray(value, dtype=float) if isinstance(value, list) else value
+    return attrs
+
+
+def variable(dims: str | tuple[str, ...], data: np.ndarray, units: str, long_name: str) -> xr.Variable:
     # fastpath: the data is a float ndarray already, so xarray need not probe it for duck arrays (whose first
     # probe imports dask.array, ~1 s, when dask is installed: a batch's final variables paid it)
     attrs = {"units": units, "long_name": long_name}

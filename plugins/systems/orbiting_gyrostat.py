@@ -32,6 +32,7 @@ from gyrolab.physics.initial import InitialAttitude
 from gyrolab.physics.vectors import cross, dot, norm
 from gyrolab.physics.gyrostat_body import GyrostatBody
 from gyrolab.physics.gyrostat_euler import GyrostatParameters, kinematic_matrix
+from gyrolab.plugins.systems.fixed_point import system_attributes, variable
 
 INITIAL_KEYS = ("p0", "q0", "r0", "psi0", "theta0", "phi0", "gamma0", "euler_rates0")
 
@@ -132,40 +133,33 @@ class OrbitingGyrostat(System):
         beta = cross(gamma, alpha)
         rate = f"[{body.rate_label}]"
         out: dict[str, xr.Variable] = {
-            "omega": _var(("time", "axis"), omega, body.rate_unit,
+            "omega": variable(("time", "axis"), omega, body.rate_unit,
                           f"absolute angular velocity (p, q, r) in body axes {rate}"),
-            "omega_relative": _var(("time", "axis"), omega - self.Omega * gamma, body.rate_unit,
+            "omega_relative": variable(("time", "axis"), omega - self.Omega * gamma, body.rate_unit,
                                    f"angular velocity relative to the orbital frame ω′ = ω − Ωγ in body axes {rate}"),
-            "alpha": _var(("time", "axis"), alpha, "1", "direction cosines of the radial axis α in body axes"),
-            "beta": _var(("time", "axis"), beta, "1", "direction cosines of the along-track axis β in body axes"),
-            "gamma": _var(("time", "axis"), gamma, "1", "direction cosines of the orbit normal γ in body axes"),
+            "alpha": variable(("time", "axis"), alpha, "1", "direction cosines of the radial axis α in body axes"),
+            "beta": variable(("time", "axis"), beta, "1", "direction cosines of the along-track axis β in body axes"),
+            "gamma": variable(("time", "axis"), gamma, "1", "direction cosines of the orbit normal γ in body axes"),
         }
         if "jacobi_integral" in self.invariants:
-            out["jacobi_integral"] = _var("time", self.jacobi_integral(y), body.energy_unit,
+            out["jacobi_integral"] = variable("time", self.jacobi_integral(y), body.energy_unit,
                                           "Jacobi integral ½ω·Iω − Ωγ·(Iω + k) + V")
-        out["frame_error"] = _var("time", np.maximum.reduce([np.abs(norm(alpha) - 1), np.abs(norm(gamma) - 1),
+        out["frame_error"] = variable("time", np.maximum.reduce([np.abs(norm(alpha) - 1), np.abs(norm(gamma) - 1),
                                                              np.abs(dot(alpha, gamma))]),
                                   "1", "orthonormality error of (α, γ): max(| |α| − 1 |, | |γ| − 1 |, |α·γ|)")
         psi, theta, phi = euler_angles(alpha, gamma)
-        out["psi"] = _var("time", psi, "rad", "precession angle ψ relative to the orbital frame (unwrapped)")
-        out["theta"] = _var("time", theta, "rad", "nutation angle θ: body z axis from the orbit normal")
-        out["phi"] = _var("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
+        out["psi"] = variable("time", psi, "rad", "precession angle ψ relative to the orbital frame (unwrapped)")
+        out["theta"] = variable("time", theta, "rad", "nutation angle θ: body z axis from the orbit normal")
+        out["phi"] = variable("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
         axis_orbital = np.stack([alpha[:, 2], beta[:, 2], gamma[:, 2]], axis=1)
-        out["body_axis_orbital"] = _var(("time", "frame_axis"), axis_orbital, "1",
+        out["body_axis_orbital"] = variable(("time", "frame_axis"), axis_orbital, "1",
                                         "body z axis in the orbital frame (radial, along-track, normal)")
-        out["body_axis_inertial"] = _var(("time", "frame_axis"), to_inertial(axis_orbital, self.Omega * t), "1",
+        out["body_axis_inertial"] = variable(("time", "frame_axis"), to_inertial(axis_orbital, self.Omega * t), "1",
                                          "body z axis in the inertial frame (X = radial at t = 0, Z = orbit normal)")
         return out
 
     def attributes(self) -> dict[str, Any]:
-        attrs: dict[str, Any] = {"system": self.name, "state_size": self.state_size}
-        attrs.update(self.body.attributes())
-        attrs["initial_euler_angles"] = np.array(self.angles)
-        attrs["initial_omega"] = self.omega0
-        for force in self.forces:
-            for key, value in force.attributes().items():
-                attrs[f"force_{force.name}_{key}"] = np.asarray(value, dtype=float) if isinstance(value, list) else value
-        return attrs
+        return system_attributes(self, initial_euler_angles=np.array(self.angles), initial_omega=self.omega0)
 
     def title(self) -> str:
         A, B, C = self.inertia
@@ -202,6 +196,3 @@ def _initial(cfg: dict[str, Any], Omega: float) -> tuple[tuple[float, float, flo
     omega = attitude.omega if rates is None else kinematic_matrix(theta, phi) @ rates + Omega * gamma
     return (psi, theta, phi), omega, alpha, gamma
 
-
-def _var(dims: str | tuple[str, ...], data: np.ndarray, units: str, long_name: str) -> xr.Variable:
-    return xr.Variable(dims, np.asarray(data, dtype=float), attrs={"units": units, "long_name": long_name})
