@@ -1,13 +1,8 @@
 """Heavy rigid body about a fixed point: the Euler–Poisson equations in vector form.
 
-In principal body axes (Ismail (2021) eq. 1, Shaker et al. eq. 1, any textbook):
-
-    I ω̇ = (I ω) × ω + Σ torques,        γ̇ = γ × ω,
-
-with γ the body components of the fixed vertical Z. The state is (ω, γ),
-plus α — the body components of the fixed X axis, α̇ = α × ω — only when
-the scene needs the full attitude: Euler-angle output (ψ needs it) or a
-force acting along a non-vertical direction. β = γ × α is never stored.
+In principal body axes (Ismail (2021) eq. 1, Shaker et al. eq. 1): I ω̇ = (I ω) × ω + Σ torques, γ̇ = γ × ω, with γ
+the body components of the fixed vertical Z. The state is (ω, γ), plus α — the fixed X axis, α̇ = α × ω — only when
+the scene needs the full attitude: Euler-angle output (ψ needs it) or a force along a non-vertical direction.
 """
 
 from __future__ import annotations

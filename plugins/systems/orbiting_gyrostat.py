@@ -1,19 +1,13 @@
 """Satellite-gyrostat on a circular orbit: gravity-gradient and magnetic torques (Yehia & El-kenani (2021)).
 
-Yehia & El-kenani, J. Appl. Comput. Mech. 7(4) (2021) 2120–2128, eqs. (1)–(3), in vector
-form (docs/gyrostat.md). Body axes are principal, I = diag(A, B, C); k is the rotors'
-constant momentum. The system's reference frame is the orbital frame: axis 0 = α
-(radial, from the Earth to the satellite), 1 = β (along-track), 2 = γ (orbit normal),
-which turns about the inertially fixed γ at the orbit rate Ω. With ω the absolute
-angular velocity and ω′ = ω − Ωγ the one relative to the orbital frame:
+In body axes (principal, I = diag(A, B, C); k the rotors' constant momentum), with ω the absolute angular velocity,
+ω′ = ω − Ωγ the one relative to the orbital frame (axis 0 = α radial, 1 = β along-track, 2 = γ orbit normal):
 
     I ω̇ = (I ω + k) × ω + Σ torques,     α̇ = α × ω′,     γ̇ = γ × ω′  (= γ × ω),
 
-state y = (ω, α, γ); β = γ × α is computed when a force needs it. The torques are the
-``newtonian`` plugin about axis 0 (N α × Iα, N = 3Ω²; paper: V = (3/2)Ω² α·Iα) and the
-``magnetic`` plugin with its direction in the orbital frame (paper: V = +μ·(h1 α + h3 γ),
-i.e. ``moment`` = μ and field·direction = −(h1, 0, h3)). Jacobi integral (L has no
-explicit time): H = ½ ω·Iω − Ω γ·(Iω + k) + Σ V.
+state y = (ω, α, γ); β = γ × α is computed when a force needs it. The torques are the ``newtonian`` plugin about
+axis 0 and the ``magnetic`` plugin with its direction in the orbital frame; the model, the paper's sign conventions
+and the Jacobi integral: docs/gyrostat.md.
 """
 
 from __future__ import annotations
