@@ -80,12 +80,6 @@ class FixedPoint(System):
         parts = [omega, gamma, alpha] if self.carries_alpha else [omega, gamma]
         return np.concatenate(parts, axis=1), ok
 
-    def _axes(self, y: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray]:
-        gamma = y[..., 3:6]
-        alpha = y[..., 6:9] if self.carries_alpha else None
-        beta = cross(gamma, alpha) if self.needs_beta else None
-        return alpha, beta, gamma
-
     def reference_frame(self, y: np.ndarray) -> np.ndarray:
         """Rows α, β, γ at state ``y``. Without α in the state every force reads γ only, so any frame with
         that γ serves (α is then the unit vector of e × γ, e the body axis least aligned with γ)."""
@@ -114,8 +108,9 @@ class FixedPoint(System):
         return tuple(names)
 
     def energy(self, y: np.ndarray) -> np.ndarray:
-        omega = y[..., 0:3]
-        axes = self._axes(y)
+        omega, gamma = y[..., 0:3], y[..., 3:6]
+        alpha = y[..., 6:9] if self.carries_alpha else None
+        axes = (alpha, cross(gamma, alpha) if self.needs_beta else None, gamma)
         energy = 0.5 * dot(omega, self.inertia * omega)
         for force in self.forces:
             energy = energy + force.potential(axes)
@@ -142,23 +137,23 @@ class FixedPoint(System):
         omega, gamma = y[:, 0:3], y[:, 3:6]
         out: dict[str, xr.Variable] = {
             "omega": variable(("time", "axis"), omega, body.rate_unit,
-                          f"angular velocity (p, q, r) in body axes [{body.rate_label}]"),
+                              f"angular velocity (p, q, r) in body axes [{body.rate_label}]"),
             "gamma": variable(("time", "axis"), gamma, "1", "direction cosines of the fixed vertical Z in body axes"),
         }
         values = self.invariant_values(y)
         if "energy" in values:
             out["energy"] = variable("time", values["energy"], body.energy_unit,
-                                 "total energy: kinetic ½ω·Iω plus the forces' potentials")
+                                     "total energy: kinetic ½ω·Iω plus the forces' potentials")
         if "area_integral" in values:
             out["area_integral"] = variable("time", values["area_integral"], body.momentum_unit,
-                                        "area integral: angular momentum about the vertical, Iω·γ")
+                                            "area integral: angular momentum about the vertical, Iω·γ")
         out["gamma_norm"] = variable("time", values["gamma_norm"], "1",
-                                 "norm of the direction-cosine vector |γ| (exactly 1)")
+                                     "norm of the direction-cosine vector |γ| (exactly 1)")
         if self.carries_alpha:
             out["alpha"] = variable(("time", "axis"), y[:, 6:9], "1",
                                     "direction cosines of the fixed X axis in body axes")
             out["frame_error"] = variable("time", values["frame_error"], "1",
-                                      "orthonormality error of (α, γ): max(| |α| − 1 |, |α·γ|)")
+                                          "orthonormality error of (α, γ): max(| |α| − 1 |, |α·γ|)")
         if self.euler_angles:
             psi, theta, phi = euler_angles(y[:, 6:9], gamma)
             out["psi"] = variable("time", psi, "rad", "precession angle ψ (unwrapped)")

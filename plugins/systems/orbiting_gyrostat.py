@@ -128,28 +128,32 @@ class OrbitingGyrostat(System):
         rate = f"[{body.rate_label}]"
         out: dict[str, xr.Variable] = {
             "omega": variable(("time", "axis"), omega, body.rate_unit,
-                          f"absolute angular velocity (p, q, r) in body axes {rate}"),
+                              f"absolute angular velocity (p, q, r) in body axes {rate}"),
             "omega_relative": variable(("time", "axis"), omega - self.Omega * gamma, body.rate_unit,
-                                   f"angular velocity relative to the orbital frame ω′ = ω − Ωγ in body axes {rate}"),
+                                       f"angular velocity relative to the orbital frame ω′ = ω − Ωγ in body axes "
+                                       f"{rate}"),
             "alpha": variable(("time", "axis"), alpha, "1", "direction cosines of the radial axis α in body axes"),
             "beta": variable(("time", "axis"), beta, "1", "direction cosines of the along-track axis β in body axes"),
             "gamma": variable(("time", "axis"), gamma, "1", "direction cosines of the orbit normal γ in body axes"),
         }
         if "jacobi_integral" in self.invariants:
             out["jacobi_integral"] = variable("time", self.jacobi_integral(y), body.energy_unit,
-                                          "Jacobi integral ½ω·Iω − Ωγ·(Iω + k) + V")
-        out["frame_error"] = variable("time", np.maximum.reduce([np.abs(norm(alpha) - 1), np.abs(norm(gamma) - 1),
-                                                             np.abs(dot(alpha, gamma))]),
-                                  "1", "orthonormality error of (α, γ): max(| |α| − 1 |, | |γ| − 1 |, |α·γ|)")
+                                              "Jacobi integral ½ω·Iω − Ωγ·(Iω + k) + V")
+        frame_error = np.maximum.reduce([np.abs(norm(alpha) - 1), np.abs(norm(gamma) - 1), np.abs(dot(alpha, gamma))])
+        out["frame_error"] = variable("time", frame_error, "1",
+                                      "orthonormality error of (α, γ): max(| |α| − 1 |, | |γ| − 1 |, |α·γ|)")
         psi, theta, phi = euler_angles(alpha, gamma)
         out["psi"] = variable("time", psi, "rad", "precession angle ψ relative to the orbital frame (unwrapped)")
         out["theta"] = variable("time", theta, "rad", "nutation angle θ: body z axis from the orbit normal")
         out["phi"] = variable("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
         axis_orbital = np.stack([alpha[:, 2], beta[:, 2], gamma[:, 2]], axis=1)
         out["body_axis_orbital"] = variable(("time", "frame_axis"), axis_orbital, "1",
-                                        "body z axis in the orbital frame (radial, along-track, normal)")
-        out["body_axis_inertial"] = variable(("time", "frame_axis"), to_inertial(axis_orbital, self.Omega * t), "1",
-                                         "body z axis in the inertial frame (X = radial at t = 0, Z = orbit normal)")
+                                            "body z axis in the orbital frame (radial, along-track, normal)")
+        c, s = np.cos(self.Omega * t), np.sin(self.Omega * t)  # the orbital frame turned by Ωt about the normal
+        axis_inertial = np.stack([c * alpha[:, 2] - s * beta[:, 2], s * alpha[:, 2] + c * beta[:, 2], gamma[:, 2]],
+                                 axis=-1)
+        out["body_axis_inertial"] = variable(("time", "frame_axis"), axis_inertial, "1", "body z axis in the "
+                                             "inertial frame (X = radial at t = 0, Z = orbit normal)")
         return out
 
     def attributes(self) -> dict[str, Any]:
@@ -160,13 +164,6 @@ class OrbitingGyrostat(System):
         forces = " + ".join(f.name for f in self.forces) or "no torque"
         return (f"satellite-gyrostat on a circular orbit, A,B,C=({A:.4g}, {B:.4g}, {C:.4g}), "
                 f"k=({', '.join(f'{x:.3g}' for x in self.k)}), Ω={self.Omega:.4g}; {forces}")
-
-
-def to_inertial(orbital: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """Orbital-frame components → inertial ones, the orbital frame turned by u = Ωt about the normal."""
-    c, s = np.cos(u), np.sin(u)
-    x, y, z = orbital[..., 0], orbital[..., 1], orbital[..., 2]
-    return np.stack([c * x - s * y, s * x + c * y, z], axis=-1)
 
 
 def _initial(cfg: dict[str, Any], Omega: float) -> tuple[tuple[float, float, float], np.ndarray, np.ndarray, np.ndarray]:
