@@ -397,8 +397,8 @@ def _method(compiled: CompiledModel | None, order: int | None, tol: float) -> In
 
 
 def at_least(value: float) -> str:
-    """``value`` rounded up to one significant digit, as a refusal's advice writes it (rounding to nearest may go
-    below what the scene needs: "ask for accuracy ≥ 1e-10" for 1.4e-10 was refused again)."""
+    """``value`` rounded up to one significant digit, as a refusal's advice writes it (to nearest could advise a
+    target the scene refuses again)."""
     exponent = math.floor(math.log10(value))
     digit = math.ceil(value / 10.0 ** exponent * (1 - 1e-12))
     return f"{digit}e{exponent}" if digit < 10 else f"1e{exponent + 1}"

@@ -68,8 +68,7 @@ def dop853_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
         count = y0s.shape[0]
         rejected, nfev = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
         args = (times, y0s, out, integrator.rtol, integrator.atol, integrator.max_step, steps, rejected, nfev, status)
-        batch_dop853.run_blocks(models.block_rhs(compiled), P, *args,
-                                batch_dop853.task_size(count))
+        batch_dop853.run_blocks(models.block_rhs(compiled), P, *args, batch_dop853.task_size(count))
 
     return _adaptive(integrator, kernel, times, y0s, failures)
 

@@ -1,8 +1,7 @@
 """Classical fourth-order Runge–Kutta with a fixed step: the method of Ismail (2021) and Shaker et al.
 
-The step ``step`` is an upper bound: each interval between output times is
-split into the fewest equal steps not longer than ``step``, so the method
-lands exactly on every output time (the papers tabulate at such times).
+The step ``step`` is an upper bound: each interval between output times is split into the fewest equal steps not longer
+than ``step``, so the method lands exactly on every output time (the papers tabulate at such times).
 """
 
 from __future__ import annotations

@@ -1,11 +1,9 @@
 """scipy's ODE solvers (``scipy.integrate``) behind gyrolab's integrator contract.
 
-The solver is stepped directly (as ``solve_ivp`` does) so that gyrolab can
-count accepted and rejected steps, sample the dense output only at the
-requested times, and stop with a clear error on a non-finite state.
-Rejected steps are known for the explicit Runge–Kutta pairs: each attempt
-costs exactly ``n_stages`` evaluations, so the evaluations spent inside one
-``step()`` call count its attempts. Radau, BDF and LSODA do not expose them.
+The solver is stepped directly (as ``solve_ivp`` does) so that gyrolab can count accepted and rejected steps, sample the
+dense output only at the requested times, and stop with a clear error on a non-finite state. Rejected steps are known
+for the explicit Runge–Kutta pairs: each attempt costs exactly ``n_stages`` evaluations, so the evaluations spent inside
+one ``step()`` call count its attempts. Radau, BDF and LSODA do not expose them.
 """
 
 from __future__ import annotations

@@ -1,9 +1,8 @@
 """A fixed step must resolve the motion: refuse steps that turn the state by more than half a radian.
 
-Without it a fixed-step method can return finite garbage (a splitting stays
-bounded whatever the step; RK4 is stable up to h·rate ≈ 2.8 but wrong long
-before). The rate is estimated from the right-hand side, ‖f(y)‖∞ / ‖y‖∞:
-for the rotations of rigid-body motion it is the fastest angular velocity.
+Without it a fixed-step method can return finite garbage (a splitting stays bounded whatever the step; RK4 is stable up
+to h·rate ≈ 2.8 but wrong long before). The rate is estimated from the right-hand side, ‖f(y)‖∞ / ‖y‖∞: for the
+rotations of rigid-body motion it is the fastest angular velocity.
 """
 
 from __future__ import annotations
