@@ -149,21 +149,19 @@ class Auto(Integrator):
         steps = tight.stats.n_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / order))
         roundoff = EPS * scale * (math.sqrt(steps) if taylor else steps)
         chaotic = amp.factor > (1.0 / self.pilot_fraction) ** MAX_GROWTH  # faster than any power law the pilot fits
-        if chaotic:  # round-off committed early grows with the perturbations: up to e^{max ln|δ|}
-            roundoff *= CHAOS_MARGIN * math.exp(min(max(amp.log_span, 0.0), 700.0))
         chaos = {"auto_lyapunov_exponent": amp.lyapunov, "auto_amplification": amp.factor,
                  "auto_amplification_method": amp.how, "auto_chaotic": int(chaotic)}
-        if chaotic:
+        if chaotic:  # round-off committed early grows with the perturbations: up to e^{max ln|δ|}
+            roundoff *= CHAOS_MARGIN * math.exp(min(max(amp.log_span, 0.0), 700.0))
             chaos["auto_precision_horizon"] = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
         climbed = roundoff > self.accuracy
-        method, why = None, (f"double precision's round-off on this scene (about {roundoff:.1g} over ~{steps:.0f} "
-                             f"steps) is below accuracy={self.accuracy:g}")
         if climbed:
             method, chosen, roundoff, why = self._climb(compiled, make, per_tol, roundoff, steps, amp, chaotic, t_out)
-        elif CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
-            chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
-        if method is None:
-            method = make(chosen)
+        else:
+            if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
+                chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
+            method, why = make(chosen), (f"double precision's round-off on this scene (about {roundoff:.1g} over "
+                                         f"~{steps:.0f} steps) is below accuracy={self.accuracy:g}")
         # the pilot's tight run is as accurate when its tolerance is: the run continues from its end
         resumed = (tight, pilot_times, inside, t_pilot) if tight_tol <= chosen and not climbed else None
         y, final_stats, n_steps = _final_run(method, fun, t_out, y0, progress, compiled, resumed)

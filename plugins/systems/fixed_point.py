@@ -38,7 +38,6 @@ class FixedPoint(System):
         self.needs_beta = 1 in needed
         self.inertia = body.inertia
 
-    # -- state ---------------------------------------------------------------
     @property
     def state_size(self) -> int:
         return 9 if self.carries_alpha else 6
@@ -94,7 +93,6 @@ class FixedPoint(System):
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         return euler_poisson(t, y, self.inertia, self.forces, self.carries_alpha, self.needs_beta)
 
-    # -- invariants ------------------------------------------------------------
     @property
     def invariants(self) -> tuple[str, ...]:
         names = []
@@ -131,7 +129,6 @@ class FixedPoint(System):
             values["frame_error"] = np.maximum(np.abs(norm(alpha) - 1.0), np.abs(dot(alpha, gamma)))
         return values
 
-    # -- outputs ---------------------------------------------------------------
     def variables(self, t: np.ndarray, y: np.ndarray) -> dict[str, xr.Variable]:
         body = self.body
         omega, gamma = y[:, 0:3], y[:, 3:6]

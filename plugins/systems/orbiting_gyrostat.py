@@ -53,7 +53,6 @@ class OrbitingGyrostat(System):
         self.needs_beta = any(1 in f.required_axes for f in self.forces)
         self.angles, self.omega0, self.alpha0, self.gamma0 = _initial(dict(initial), self.Omega)
 
-    # -- state ---------------------------------------------------------------
     @property
     def state_size(self) -> int:
         return 9
@@ -83,7 +82,6 @@ class OrbitingGyrostat(System):
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         return self.derivative(y)
 
-    # -- invariants ------------------------------------------------------------
     @property
     def invariants(self) -> tuple[str, ...]:
         conservative = all(f.conservative for f in self.forces)
@@ -102,7 +100,6 @@ class OrbitingGyrostat(System):
         return (0.5 * dot(omega, self.inertia * omega) - self.Omega * dot(gamma, self.inertia * omega + self.k)
                 + self.potential(y))
 
-    # -- the paper's parameters -------------------------------------------------
     def parameters(self) -> GyrostatParameters:
         """(A, B, C, k, μ, h, Ω, N) of the paper's model; ConfigError for forces outside it."""
         N, mu, h = 0.0, np.zeros(3), np.zeros(3)
@@ -120,7 +117,6 @@ class OrbitingGyrostat(System):
             raise ConfigError("the paper's model has one magnetic dipole; give one magnetic force")
         return GyrostatParameters(tuple(self.inertia), tuple(self.k), tuple(mu), tuple(h), self.Omega, N)
 
-    # -- outputs ---------------------------------------------------------------
     def variables(self, t: np.ndarray, y: np.ndarray) -> dict[str, xr.Variable]:
         body = self.body
         omega, alpha, gamma = y[:, 0:3], y[:, 3:6], y[:, 6:9]
