@@ -1,27 +1,18 @@
 """How much a scene amplifies small errors over its span: the growth of a perturbation along the trajectory.
 
-``auto``'s pilot measures the integration error over the first part of the span and extrapolates it. On a regular
-motion errors grow like a power of t (a phase drift), which the pilot's fit sees; on a chaotic one they grow like
-e^{λt}, and a pilot over a tenth of the span sees at most the start of it (issue 22: asked 1e-6 on
-``initial=slow_spin`` over t = 300, the old pilot predicted 1e-6 and the error was 1.46). What governs the growth of
-an error committed at time s is the tangent flow from s to the end, so this module measures it directly, over the
-whole span: the running maximum of ln|δ(t)| of a tangent vector δ, |δ(0)| = 1 (the fast Lyapunov indicator's
-quantity, Froeschlé et al. 1997), at the end of the pilot and at the end of the span. Their difference bounds how
-much more an error already present at the end of the pilot can grow by the end (up to the direction of δ, which
-aligns with the most expanding one within a few Lyapunov times on a chaotic motion).
+``auto``'s pilot sees at most the start of a chaotic motion's e^{λt} growth (docs/performance.md, "Chaotic scenes").
+What governs the growth of an error committed at time s is the tangent flow from s to the end, so this module
+measures it over the whole span: the running maximum of ln|δ(t)| of a tangent vector δ, |δ(0)| = 1 (the fast
+Lyapunov indicator's quantity, Froeschlé et al. 1997), at the pilot's end and at the span's end. Their difference
+bounds how much more an error present at the pilot's end can grow by the end. Two ways to follow δ, the cheapest
+that applies:
 
-Two ways to follow δ, the cheapest that applies:
+* the tangent flow generated from the traced model's equations (``pipeline/kernels/tangent.py``), one compiled DOP853
+  run over the span, ln|δ| sampled at ``TANGENT_SAMPLES`` times and the pilot's end;
+* without a compiled model, a shadow pair started ``SHADOW_OFFSET`` away, integrated by the given method chunk by
+  chunk and renormalised after each (Benettin et al. 1980), so the separation stays in the linear regime.
 
-* the tangent flow generated from a traced model's equations (``pipeline/kernels/tangent.py``: the fixed point in
-  (ω, γ) when no torque reads α, the orbiting gyrostat, plugin torques and systems; state, unit tangent vector and
-  ln|δ|, without the MEGNO quadratures), compiled DOP853 — one compiled call over the span, ln|δ| sampled at
-  ``TANGENT_SAMPLES`` times and the pilot's end (its dense output: the steps of a run to the span's end);
-* a shadow pair for a model with none (no compiled model): the trajectory and a companion started ``SHADOW_OFFSET`` away, integrated
-  by the given method chunk by chunk and renormalised after each chunk (Benettin et al. 1980), so the
-  companion's separation stays in the linear regime.
-
-The tangent run's own accuracy matters little: a growth factor known to a few per cent is plenty for a bound that
-carries a safety factor.
+A growth factor known to a few per cent is plenty for a bound that carries a safety factor: the tangent run is loose.
 """
 
 from __future__ import annotations

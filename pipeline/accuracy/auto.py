@@ -1,33 +1,19 @@
 """Accuracy-targeted choice: the cheapest integrator and setting predicted to reach ``accuracy``.
 
-A tolerance is not an accuracy: how the final error depends on it varies with the scene (on the reference scene the
-final error of the Taylor method is 24 to 470 times its per-step tolerance depending on the order; on the extremes
-matrix the ratio spans four decades), and no per-step error control predicts how local errors grow into the global
-one. So ``auto`` measures that dependence on the scene itself with a short pilot: two runs over the first
-``pilot_fraction`` of the time span, at tolerances τ and τ_t ≤ τ/10 and the same order, give the error of the τ run
-along the pilot (hence a growth exponent q, error ∝ t^q). At a fixed order the error is proportional to the tolerance
-(checked in the tests), so the full span at tolerance τ' is predicted to end with error err(τ) · (τ'/τ) ·
-(T/T_pilot)^q, with q ≥ 2: a non-symplectic method drifts in energy linearly on a near-integrable motion, so its phase
-error grows quadratically. ``auto`` picks τ' to meet ``accuracy`` with a safety factor and records the prediction
-multiplied by ``CALIBRATION`` (``calibration.TABLE``: the measurement behind it and the benchmark that checks it).
-The pilot is not wasted: its tight run is at least as accurate as the final one, so it is the first
-``pilot_fraction`` of the trajectory and the final run continues from its end. A pilot round that re-centres τ (the
-first prediction asked for a tolerance more than ``RECENTRE`` times looser) or loosens it (only round-off seen) reuses
-the previous round's τ run as its tight run, so each later round costs one run, not two.
+A tolerance is not an accuracy (on the reference scene the Taylor method's final error is 24 to 470 times its
+tolerance, depending on the order), so ``auto`` measures the dependence on the scene itself: a pilot over the first
+``pilot_fraction`` of the span, two runs at τ and τ_t ≤ τ/10 with one order, gives the error at τ and its growth
+exponent q (error ∝ t^q, q ≥ 2: a non-symplectic method's phase error grows at least quadratically). At a fixed order
+the error is proportional to the tolerance, so the span at τ' is predicted to end with err(τ) · (τ'/τ) ·
+(T/T_pilot)^q, recorded times ``CALIBRATION`` (``calibration.TABLE``). The pilot's tight run is the start of the
+trajectory, and the final run continues from its end; a later pilot round reuses the previous round's τ run as its
+tight run.
 
-Candidates, fastest first: an expansion regime's analytic series (no integration at all), when the scene lies in the
-regime's domain, starts on the periodic orbit the series describes, and the series' error — measured over one period
-against a tight Taylor run and extrapolated linearly in time, as a phase drift — meets the target; then the compiled
-Taylor method when the scene has a compiled model; otherwise scipy's DOP853. Before any series is built, a regime that
-declares ``period_spread`` is ruled out when the scene's own motion never comes back near its start over the orbit's
-period range (``Auto._misses_orbits``: a necessary condition of the series check, ~0.25 ms; building and checking the
-series costs ~2 ms, 0.4 s on a process's first call).
-
-Round-off: the Taylor state update is compensated (Kahan), so round-off grows as a random walk, about eps·|y|·√steps
-(measured on the reference scene: 9e-15 over 2,700 steps, where this estimate gives 6e-14), amplified on a chaotic
-scene by the growth of perturbations. Where it is above the target, ``auto`` climbs the precision ladder (the method's
-``climbed``: the Taylor method in double-double) unless ``extended_precision`` is false, and refuses only what the
-highest rung allowed cannot reach (``Auto._refusal``).
+Candidates, fastest first: a regime's analytic series (the scene starts on its orbit and the series' measured error
+meets the target), the compiled Taylor method when the scene has a compiled model, else DOP853. Where double
+precision's round-off (a random walk, eps·|y|·√steps, amplified on a chaotic scene) is above the target, ``auto``
+climbs to double-double unless ``extended_precision`` is false, and refuses only what the highest rung allowed cannot
+reach. The measurements behind each step: docs/performance.md, "integrator=auto accuracy=ε" and "Chaotic scenes".
 """
 
 from __future__ import annotations
@@ -81,12 +67,10 @@ class Auto(Integrator):
         self.safety = as_number(safety, "integrator.safety", positive=True)
         if extended_precision is not None and not isinstance(extended_precision, (bool, np.bool_)):
             raise ConfigError(f"integrator.extended_precision={extended_precision!r} must be true, false or null")
-        #: whether a target double precision cannot reach may be met in double-double (integrator=taylor
-        #: integrator.precision=double-double) instead of being refused: yes unless forbidden (false)
+        #: a target double precision cannot reach is met in double-double instead of refused, unless false
         self.extended_precision = extended_precision is not False
-        #: asked for explicitly (true): a batch then runs one choice per trajectory, each free to climb; by default
-        #: (null) a batch chooses once, in double precision, for its vectorised kernel (one run per trajectory in
-        #: Python costs ~23× the CPU)
+        #: true: a batch runs one choice per trajectory, each free to climb (by default it chooses once, in double
+        #: precision, for its vectorised kernel: one run per trajectory in Python costs ~23× the CPU)
         self.per_trajectory = extended_precision is True
         self.system: Any = None  # the scene's system (``prepare``): its regimes' series are candidates
 
@@ -104,8 +88,7 @@ class Auto(Integrator):
             advice = "" if self.extended_precision else ", or integrator.extended_precision=true"
             raise ConfigError(f"accuracy={self.accuracy:g} is below what {what} reaches on this scene "
                               f"(about {floor * scale:.1g} for states of size {scale:.3g}, stored as doubles); ask "
-                              f"for accuracy ≥ "
-                              f"{at_least(10 * floor * scale)}{advice}")
+                              f"for accuracy ≥ {at_least(10 * floor * scale)}{advice}")
 
     def attributes(self) -> dict[str, Any]:
         return {"accuracy": self.accuracy}
@@ -135,9 +118,8 @@ class Auto(Integrator):
         inside = t_out[t_out < t_pilot]
         pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * _PILOT_GRID, inside)
         tau, pilot_nfev = min(max(self.accuracy * FIRST_RATIO, MIN_TOLERANCE), MAX_TOLERANCE / 10), 0
-        # one order for the pilot and the final run (error ∝ tolerance), the optimal one for the expected tolerance:
-        # Jorba & Zou's, which auto's calibration (the pilot's error growth, its margins) was measured with; the
-        # plain taylor integrator's least-work orders err ~2-4x more per unit tolerance and broke a promise test
+        # one order for the pilot and the final run (error ∝ tolerance): Jorba & Zou's for the expected tolerance,
+        # which the calibration was measured with (docs/performance.md, "The order rule")
         order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10), overhead=0.0)
         taylor = compiled is not None and ready(compiled)  # whether the compiled model has Taylor coefficients
         make = functools.partial(_method, compiled, order if taylor else None)
@@ -160,25 +142,21 @@ class Auto(Integrator):
             else:  # at a fixed order, extrapolating to tighter tolerances is safe (the leading term dominates more)
                 break
         if loose[1].stats.n_steps < MIN_PILOT_STEPS:
-            # The pilot's stretch held a few steps, clipped by its end rather than set by τ: its runs at τ and τ_t
-            # take nearly the same steps, so their difference says nothing of the error's dependence on the
-            # tolerance (initial.r0=32 time.end=0.25: one step each, difference 0, tol 1e-5 chosen for 1e-9, error
-            # 5.7e-5). The whole span is then a few dozen steps: take the prior, cheaply conservative.
+            # a pilot of a few steps, clipped by its end rather than set by τ, measures nothing of the error's
+            # dependence on the tolerance (MIN_PILOT_STEPS): the span is a few dozen steps, take the prior
             per_tol = max(per_tol, UNMEASURED_PER_TOL)
             chosen = min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
         elif not measured:  # only round-off seen up to pilot_tau: never extrapolate far beyond the loosest τ tried
             chosen = min(chosen, RECENTRE * pilot_tau)
-        # Round-off of the compensated Taylor update grows as a random walk over the steps (see the module's
-        # note), that of scipy's plain update by up to an ulp per step: a target below it cannot be met in
-        # double precision, whatever the tolerance.
+        # round-off of the compensated Taylor update grows as a random walk over the steps, that of scipy's plain
+        # update by up to an ulp per step: a target below it is not met in double precision, whatever the tolerance
         steps = tight.stats.n_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / order))
         roundoff = EPS * scale * (math.sqrt(steps) if taylor else steps)
         chaotic = amp.factor > (1.0 / self.pilot_fraction) ** MAX_GROWTH  # faster than any power law the pilot fits
-        if chaotic:  # round-off committed early grows with the perturbations: up to e^{max ln|δ|}
-            roundoff *= CHAOS_MARGIN * math.exp(min(max(amp.log_span, 0.0), 700.0))
         chaos = {"auto_lyapunov_exponent": amp.lyapunov, "auto_amplification": amp.factor,
                  "auto_amplification_method": amp.how, "auto_chaotic": int(chaotic)}
-        if chaotic:
+        if chaotic:  # round-off committed early grows with the perturbations: up to e^{max ln|δ|}
+            roundoff *= CHAOS_MARGIN * math.exp(min(max(amp.log_span, 0.0), 700.0))
             chaos["auto_precision_horizon"] = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
         climbed = roundoff > self.accuracy
         why = (f"double precision's round-off on this scene (about {roundoff:.1g} over ~{steps:.0f} steps) is below "
@@ -186,7 +164,7 @@ class Auto(Integrator):
         final = functools.partial(self._final, fun, t_out, y0, progress, compiled, start, per_tol, growth,
                                   pilot_nfev, chaos)
         if climbed:
-            up = self._climb(compiled, make, per_tol, roundoff, steps, amp, t_out)  # raises "even in double-double"
+            up = self._climb(compiled, make, per_tol, roundoff, steps, amp, chaotic, t_out)  # raises if dd can't
             predicted = functools.partial(final, *up) if isinstance(up, tuple) else functools.partial(_raise, up)
             if not (chaotic and estimated):
                 return predicted()
@@ -238,16 +216,12 @@ class Auto(Integrator):
             Choice(method, choice, self.accuracy, promised, self.extended_precision))
 
     def _climb(self, compiled: CompiledModel | None, make: Any, per_tol: float, roundoff: float, steps: float,
-               amp: Any, t_out: np.ndarray) -> tuple[Integrator, float, float, str] | ConfigError:
+               amp: Any, chaotic: bool, t_out: np.ndarray) -> tuple[Integrator, float, float, str] | ConfigError:
         """(the method one rung up the precision ladder, its tolerance, its round-off, why) where double precision's
-        round-off on this scene (``roundoff``) is above the accuracy; else one ConfigError sentence naming λ and
-        the horizon (raised when double-double cannot reach the target either, returned when the ladder stops at
-        double precision), whose advice is a target the scene reaches (``at_least``: rounded up, with room for the
-        truncation error).
-
-        The truncation error per unit tolerance is the pilot's (measured at its order; the double-double run takes
-        the optimal, higher order for its tolerance, hence fewer and larger steps: no more error per unit
-        tolerance); the round-off is double precision's estimate scaled by the ratio of the two unit round-offs."""
+        round-off on this scene (``roundoff``) is above the accuracy; else one ConfigError sentence (``_refusal``):
+        raised when double-double cannot reach the target either, returned when the ladder stops at double
+        precision. The truncation error per unit tolerance is the pilot's (the double-double run's higher order errs
+        no more per unit tolerance); the round-off is double precision's scaled by the ratio of the unit round-offs."""
         # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.taylor_dd import MIN_TOL
 
@@ -258,7 +232,6 @@ class Auto(Integrator):
         up = make(tol).climbed(1.0)  # the next rung's method at tol, when the chosen method has one
         if up is not None and (compiled is None or type(up[0]).refusal(compiled, self.system) is not None):
             up = None  # (a model without a double-double form)
-        chaotic = amp.factor > (1.0 / self.pilot_fraction) ** MAX_GROWTH
         if up is not None and self.extended_precision:
             if best_dd < self.accuracy:
                 return up[0], tol, roundoff_dd, (
@@ -317,18 +290,15 @@ class Auto(Integrator):
             if name in far and np.isfinite(estimate):
                 continue
             try:
-                # A variant with a predicted error (a series order) comes from a regime whose series is built and
-                # whose domain admits the scene: its start is cheap, so it goes first (most scenes miss the orbit,
-                # and the domain check evaluates it again). Otherwise the domain check goes first: a refusal is
-                # cheap where the orbit may not be (a shooting method).
+                # a variant with a predicted error has a built series whose start is cheap: checked before the
+                # domain (most scenes miss the orbit); otherwise the domain check is the cheap one (a shooting)
                 if not np.isfinite(estimate) and regime.check_domain(self.system):
                     continue  # outside the domain, or near its edge (warnings): no confidence in the series
                 with np.errstate(all="ignore"):  # an orbit may evaluate to inf/nan: a miss
                     distance = float(np.max(np.abs(regime.initial_state(self.system)[:6] - y0[:6])))
                 if not distance <= tolerance:
-                    # Variants of one regime (series orders) approximate the same orbit, each predicted within
-                    # accuracy/safety of it (series_candidates lists only those): the scene misses every one by
-                    # at least distance − 2·accuracy/safety; MISS_MARGIN covers the prediction being an estimate.
+                    # a regime's variants approximate one orbit, each within accuracy/safety of it: the scene
+                    # misses every one by ≥ distance − 2·accuracy/safety (MISS_MARGIN: the prediction is an estimate)
                     if np.isfinite(estimate) and distance > tolerance + 2 * MISS_MARGIN * self.accuracy / self.safety:
                         far.add(name)
                     continue  # the scene does not start on the orbit the series describes
@@ -364,20 +334,10 @@ class Auto(Integrator):
 
     def _misses_orbits(self, base: Any, fun: RightHandSide, y0: np.ndarray, compiled: CompiledModel,
                        span: float) -> bool:
-        """Whether the scene is certainly on none of the orbits ``base``'s variants describe, from the scene's own
-        motion over one period: a necessary condition of the series check below, evaluated before any series
-        is built (it would cost ~2 ms warm, ~0.4 s on a process's first call, on the many scenes that start on
-        no regime's orbit).
-
-        The check below takes a variant only when the scene starts within accuracy/(10·safety) of the variant's
-        orbit (its start S(0)) and the variant stays within accuracy/safety of the scene's motion Φ over a window
-        ending at its period T_S (all of the period once the span covers it); the variant is periodic,
-        S(T_S) = S(0), hence |Φ(T_S) − y0| ≤ 1.1·accuracy/safety. The regime's ``period_spread`` bounds T_S to
-        [T/spread, T·spread] around its cheap ``period`` T, and Φ is sampled on a grid there: T_S is within
-        half a spacing h of a grid time, where Φ differs from Φ(T_S) by at most max|Φ'|·h/2. So a scene whose
-        motion stays farther than 1.1·accuracy/safety + max|Φ'|·h/2 (+ the integration error) from y0 over
-        the whole range cannot be taken, and the regime is skipped.
-        """
+        """Whether the scene is certainly on none of the orbits ``base``'s variants describe: its own motion stays
+        farther than 1.1·accuracy/safety + max|Φ'|·h/2 from y0 over the period range ``period_spread`` allows.
+        A necessary condition of the series check, before any series is built (~2 ms warm, ~0.4 s on a process's
+        first call); the argument: docs/performance.md, "The series check, screened"."""
         spread = getattr(base, "period_spread", None)
         if spread is None:
             return False
@@ -467,8 +427,8 @@ def _method(compiled: CompiledModel | None, order: int | None, tol: float) -> In
 
 
 def at_least(value: float) -> str:
-    """``value`` rounded up to one significant digit, as a refusal's advice writes it (rounding to nearest may go
-    below what the scene needs: "ask for accuracy ≥ 1e-10" for 1.4e-10 was refused again)."""
+    """``value`` rounded up to one significant digit, as a refusal's advice writes it (to nearest could advise a
+    target the scene refuses again)."""
     exponent = math.floor(math.log10(value))
     digit = math.ceil(value / 10.0 ** exponent * (1 - 1e-12))
     return f"{digit}e{exponent}" if digit < 10 else f"1e{exponent + 1}"
@@ -476,11 +436,9 @@ def at_least(value: float) -> str:
 
 def _amplified(per_tol: float, growth: float, factor: float, fraction: float, margin: float) -> float:
     """The pilot's predicted final error per unit tolerance, raised where the motion amplifies errors faster than
-    the pilot's power law: an error E present at the pilot's end grows by up to ``factor`` (the tangent flow's
-    growth after the pilot, ``amplification``), and the 1/fraction − 1 later stretches each commit as much again
-    at most, so the final error is at most E · factor / fraction, against E · (1/fraction)^growth extrapolated.
-    Beyond the pilot's largest power law (a chaotic scene) the factor carries ``margin``: it is measured along one
-    numerical trajectory, which a chaotic flow lets scatter."""
+    the pilot's power law: an error E at the pilot's end grows by up to ``factor`` (``amplification``) and each of
+    the 1/fraction − 1 later stretches commits as much at most, so the final error is ≤ E · factor / fraction.
+    Beyond the largest power law (chaos) the factor carries ``margin``: one numerical trajectory's growth scatters."""
     extrapolated = (1.0 / fraction) ** growth
     if factor > (1.0 / fraction) ** MAX_GROWTH:
         factor *= margin

@@ -40,13 +40,11 @@ _c = _constant
 TIGHTER = _c("TIGHTER", 100.0, PERF, "companion this many times more accurate: reference scene at 1e-6, 0.55 ms and "
              "176× more accurate (1000×: 0.68 ms, 1660×)")
 DOUBLE_DOUBLE_BELOW = _c("DOUBLE_DOUBLE_BELOW", 3e-15, ROUNDOFF, "a double Taylor run whose companion tol is below "
-                         "this is measured by two double companions (then double-double): one alone measured every "
-                         "run at tol 3e-13 within 0.68–1.92× of the actual error (227 runs, seeds 5 and 11, 120 scenes "
-                         "each; Intel Xeon, 2026-11-29), at 1e-13 0.20–4.2× (2 of 228 outside 1/2 … 2×)")
+                         "this is measured by two double companions: one alone measured every run at tol 3e-13 within "
+                         "0.68–1.92× of the actual error (227 runs, seeds 5 and 11), at 1e-13 0.20–4.2×")
 ROUNDOFF_MARGIN = _c("ROUNDOFF_MARGIN", 6.0, ROUNDOFF, "a double companion near the floor is trusted when two disagree "
-                     "this many times below what it measures: seeds 5 and 11 (1,217 runs), trusted at 6: 448, one "
-                     "below 1/2 of the error (0.47), as at 10 (354 trusted); at 4: 550, two (worst 0.27); Intel Xeon, "
-                     "2026-11-29")
+                     "this many times below what it measures: seeds 5 and 11, one of 448 trusted below 1/2 of the "
+                     "error, as at 10 (354 trusted); at 4, two of 550")
 # the growth of perturbations (``amplification``)
 TANGENT_TOLERANCE = _c("TANGENT_TOLERANCE", 1e-5, CHAOS, "tangent run's tolerance: slow_spin over t = 300 grows e^19.3 "
                        "at 1e-5, e^17.4 at 1e-4, e^23.3 at 1e-3")
@@ -85,8 +83,8 @@ RECHECK_MARGIN = _c("RECHECK_MARGIN", 3.0, PROMISE, "a broken promise reruns aim
                     "have met it; extremes matrix and reference scene: measured ≤ 0.47× the prediction")
 MAX_RECHECKS = _c("MAX_RECHECKS", 2, PROMISE, "runs made more accurate before the recheck refuses")
 ESTIMATE_SLACK = _c("ESTIMATE_SLACK", 2.0, PROMISE, "a run is kept when its measured error is this many times below "
-                    "the target, the error estimate's own accuracy (within 2x of the actual error); audit seed 2026, "
-                    "scene 61: measured 0.98e-11 of 1e-11 and ended 1.0e-11 away")
+                    "the target, the estimate's own accuracy: audit seed 2026, scene 61 measured 0.98e-11 of 1e-11, "
+                    "ended 1.0e-11 away")
 
 
 def report(benchmark: str, measured: dict[str, tuple[bool, str]]) -> bool:

@@ -1,21 +1,18 @@
 """A measured error for the stored trajectory (``output.error_estimate``): a companion run on the same output times.
 
 A tolerance is not an error, and a recorded prediction is only a prediction; what a user can check is a measurement.
-The companion integrates the same scene with the method that ran made more accurate by a known factor, as the method
-itself says (``Integrator.more_accurate``, rule 9): tolerances ``TIGHTER`` times smaller (|y − y_companion| then
-estimates the run's error to within ~1/``TIGHTER``), or for a fixed-step method of order p half the step and
-Richardson's factor 2^p / (2^p − 1); an analytic series (``auto``) is measured against the compiled Taylor method at
-tol 1e-15. Where the method is at its floor, the compiled Taylor method at tol 1e-16 stands in when the scene has a
-compiled model. A double-precision Taylor run near that floor may err mostly by round-off, which another double run
-shares in size: two double companions run first (one at another order with 1/I moved by its rounding: what double runs
-share shows as their disagreement); where they disagree ``ROUNDOFF_MARGIN`` times below the error the first measures,
-that measurement stands, else the method one rung up the precision ladder (``climbed``: double-double, ~30× a double
-run's time) measures it. The estimate costs one more integration: it is on by default for the integrators that choose
-their method (``output.error_estimate: null``), ``true``/``false`` choose it for any integrator.
+The companion is the method that ran made more accurate by a known factor, as the method itself says
+(``Integrator.more_accurate``, rule 9): ``TIGHTER`` times smaller tolerances, or half the step and Richardson's factor;
+an analytic series (``auto``) is measured against the compiled Taylor method at tol 1e-15. At a method's floor the
+compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model. A double Taylor run near that floor
+errs mostly by round-off, which another double run shares: two double companions measure what they share by their
+disagreement, and where it is not ``ROUNDOFF_MARGIN`` times below the error, the method one rung up (``climbed``:
+double-double) measures it. On by default for the integrators that choose their method (``output.error_estimate:
+null``); ``true``/``false`` choose it for any integrator. The audits behind these rules: docs/integrators.md.
 
-It is stored as ``error_estimate_omega`` (ω's max-norm error at each output time, in ω's units) and
-``error_estimate_attitude`` (the direction cosines', dimensionless) for systems whose state starts with ω; as
-``error_estimate`` (the whole state's) for other systems.
+Stored as ``error_estimate_omega`` (ω's max-norm error at each output time, in ω's units) and
+``error_estimate_attitude`` (the direction cosines') for systems whose state starts with ω; as ``error_estimate``
+(the whole state's) for other systems.
 """
 
 from __future__ import annotations
@@ -41,9 +38,8 @@ class Companion:
     integrator: Any
     scale: float  # error of the stored run ≈ scale · |y − y_companion|
     how: str
-    #: near the Taylor floor: (a double companion ``TIGHTER`` times tighter, a second one at its tolerance, another
-    #: order and 1/I moved by its rounding) tried before ``integrator`` (double-double, ~30× their time): their
-    #: disagreement measures what the double companion shares with the run (``compare``)
+    #: near the Taylor floor: two double companions (the second at another order, 1/I moved by its rounding) tried
+    #: before ``integrator`` (double-double, ~30× their time): their disagreement measures what they share (``compare``)
     double_first: tuple[Any, Any] | None = None
 
 
@@ -65,17 +61,16 @@ def companion(method: Any, has_compiled: bool) -> Companion | None:
     if finer is not None and (taylor is None or taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW):
         return Companion(*finer)
     if method.precision != PRECISIONS[0]:
-        # above double precision (double-double near its own floor) a double stand-in would measure its own error, not
-        # the run's (promise_audit_gyrostat, seed 5, scene 25, accuracy 1e-7: a double-double run at tol 2.1e-31,
-        # 2.1e-7 from heyoka's real128, measured "5.2" by the double Taylor at tol 1e-16, and 1e-7 was refused)
+        # above double precision a double stand-in would measure its own error, not the run's (docs/integrators.md:
+        # the gyrostat audit's scene 25)
         return _tightest(method)
     if not has_compiled:
         return None
     if taylor is None:
         return Companion(Taylor(tol=Taylor.TOLERANCE_FLOOR), 1.0, f"compiled Taylor at tol {Taylor.TOLERANCE_FLOOR:g} "
                          f"({method.name} cannot be made {TIGHTER:g}× more accurate)")
-    # A double Taylor run near the floor errs mostly by round-off, which another double run shares (promise_audit: auto
-    # at 1e-12 chose tol 1.5e-16; the stand-in differed by 1.7e-14 where both were 2.1e-12 off): double-double has none
+    # a double Taylor run near the floor errs mostly by round-off, which another double run shares: double-double has
+    # none (docs/integrators.md, "A broken promise nobody was told of")
     from gyrolab.kernels.taylor import MAX_ORDER
 
     up, _, _ = taylor.climbed(TIGHTER)
@@ -161,14 +156,9 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
     y = np.asarray(y, dtype=float)
     how = pick.how
     if pick.double_first is not None:
-        # Near the floor the run's error may be mostly round-off, which a double companion shares in size: it can
-        # agree with the run far more closely than either agrees with the truth. Two double companions measure
-        # what double runs share by their disagreement: another order (other steps: independent round-off) and
-        # the model's one rounded parameter, 1/I, moved by its rounding's size (every double run multiplies by the
-        # same rounded 1/I; a fast top amplifies it: benchmarks/roundoff_margin.py, seed 11, scene 81 at tol 1e-15,
-        # double companions 7.7e-12 apart measured 5.2e-10 where the run was 1.3e-9 from the truth). Where that
-        # is ROUNDOFF_MARGIN times below what the first measures, the measurement stands (the reference scene at
-        # accuracy 1e-10: ~1 ms instead of the double-double companion's ~17 ms).
+        # a double companion may share the run's round-off: a second one at another order (independent round-off)
+        # with 1/I, the one rounded parameter every double run shares, moved by its rounding, measures that by their
+        # disagreement; ROUNDOFF_MARGIN times below the first's measurement, it stands (~1 ms, not double-double's 17)
         first = pick.double_first[0].integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
         second = pick.double_first[1].integrate(scene.system.rhs, scene.times, y0, None,
                                                 rounding_moved(companion_model)).y  # (kernels.model's)
@@ -206,7 +196,7 @@ def _tightest(method: Any) -> Companion | None:
     """The method made as much more accurate as it can be, ``TIGHTER`` times and then half as much at each try, last
     ``LEAST_TIGHTER``; its difference scaled by k/(k − 1) below ``TIGHTER`` (the companion's own error, 1/k of the
     run's, may cancel part of it). None when not even ``LEAST_TIGHTER`` times is possible: then nothing measures
-    the run (``measurable``)."""
+    the run."""
     factor = TIGHTER
     while True:
         finer = method.more_accurate(factor)
@@ -216,11 +206,6 @@ def _tightest(method: Any) -> Companion | None:
         if factor == LEAST_TIGHTER:
             return None
         factor = max(factor / 2.0, LEAST_TIGHTER)
-
-
-def measurable(method: Any, has_compiled: bool) -> bool:
-    """Whether a run of ``method`` can carry an error estimate (a companion more accurate than it exists)."""
-    return companion(method, has_compiled) is not None
 
 
 def _double_taylor(method: Any) -> Any:

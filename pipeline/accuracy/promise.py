@@ -1,16 +1,12 @@
 """The recheck: a run's promise held against the measurement of its error, at every output time.
 
-A run that chose its method (``Solution.choice``) promises a max-norm error at every stored output time
-(``Choice.promised``, ``auto_predicted_error``). The error estimate (``estimate.compare``) measures the error at
-every output time; while its largest value breaks the promise, the method that ran is run again made as much more
-accurate as the measurement asks (``RECHECK_MARGIN`` × measured / target: at a fixed order the error is proportional
-to the tolerance; ``more_accurate``, else one rung up the precision ladder, ``climbed``; never past what an error
-estimate can still measure), at most ``MAX_RECHECKS`` times, then one ConfigError sentence whose advice is a target
-the measurement shows reachable. A run is kept only when measured ``ESTIMATE_SLACK`` times below the target (the
-estimate's own accuracy), and a rerun promises that. A measured error above
-the prediction but ``RECHECK_MARGIN`` times below the target keeps the run, the recorded prediction raised to
-``RECHECK_MARGIN`` × the measurement. An analytic series whose measured error breaks its prediction is replaced by
-the integration (``Choice.instead``).
+A run that chose its method (``Solution.choice``) promises a max-norm error at every output time (``Choice.promised``).
+While the error estimate (``estimate.compare``) breaks it, or is within ``ESTIMATE_SLACK`` of the target (the
+estimate's own accuracy), the method runs again made as much more accurate as the measurement asks (``more_accurate``,
+else ``climbed``), at most ``MAX_RECHECKS`` times, then one ConfigError sentence. A measured error above the
+prediction but ``RECHECK_MARGIN`` times below the target keeps the run, its prediction raised; an analytic series
+that breaks its prediction is integrated instead (``Choice.instead``). Why: docs/integrators.md, "auto checks its
+promise against that measurement".
 """
 
 from __future__ import annotations
@@ -93,8 +89,7 @@ def measured_run(scene: Any, y0: np.ndarray, progress: Any, compiled: Any) -> tu
 
 def _unkept(measured: float, choice: Choice) -> bool:
     """Whether a measured error breaks the promise: above the prediction, or within the estimate's own accuracy of
-    the target (``ESTIMATE_SLACK``; audit seed 2026, scene 61 at 1e-11: predicted 1e-11, measured 0.98e-11, 1.0e-11
-    from the real128 reference)."""
+    the target (``ESTIMATE_SLACK``)."""
     return measured > choice.promised or ESTIMATE_SLACK * measured > choice.target
 
 
@@ -131,9 +126,7 @@ def _again(scene: Any, y0: np.ndarray, progress: Any, compiled: Any, choice: Cho
     settings = {f"auto_{k.removeprefix('integrator_')}": v for k, v in method.attributes().items()}
     attributes = {**choice.attributes, **settings, "auto_method": method.name,
                   "auto_tolerance": settings.get("auto_tol", settings.get("auto_rtol")),
-                  # error ∝ tolerance at a fixed order: aimed RECHECK_MARGIN times below the target, measured again
-                  # and kept when ESTIMATE_SLACK times below it (the estimate's own accuracy: near a floor the error
-                  # need not scale with the tolerance, and a rerun kept at the target's edge broke it)
+                  # aimed RECHECK_MARGIN times below the target (error ∝ tolerance), kept ESTIMATE_SLACK times below
                   "auto_predicted_error": choice.target / ESTIMATE_SLACK, "auto_precision": method.precision,
                   "auto_recheck": f"{what}: {finer[2]} ({how})"}
     if method.precision != choice.method.precision:
@@ -147,12 +140,11 @@ def _again(scene: Any, y0: np.ndarray, progress: Any, compiled: Any, choice: Cho
 def _measurable(finer: Any, factor: float, compiled: Any) -> tuple | None:
     """``finer(f)`` (``more_accurate`` or ``climbed``) for f = ``factor``, else the largest f halving down to 2 that it
     allows and whose run an error estimate can still measure, or None: a run kept unmeasured would keep an unchecked
-    promise (promise_audit_gyrostat, seed 5, scene 25: double-double at tol 1.2e-32, its floor, ended 1.7e-7 from
-    heyoka's real128 where 1e-7 was asked)."""
+    promise."""
     f = factor
     while True:
         candidate = finer(f)
-        if candidate is not None and estimate.measurable(candidate[0], compiled is not None):
+        if candidate is not None and estimate.companion(candidate[0], compiled is not None) is not None:
             return candidate
         f /= 2.0
         if f < 2.0:  # (the factor asked itself may be below 2: a run measured just inside ESTIMATE_SLACK)

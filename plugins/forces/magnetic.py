@@ -1,12 +1,9 @@
 """Magnetic dipole of the body in a uniform field: torque m × B, potential −m·B.
 
-``moment`` is the body's dipole m in body axes, ``field`` the strength B and
-``direction`` the field's unit direction in the system's reference frame
-(for ``fixed_point``: the fixed space frame X, Y, Z, with Z the vertical; for
-``orbiting_gyrostat``: the orbital frame α radial, β along-track, γ orbit normal).
-SI: A m² and T (torque in N m); nondimensional: the product m·B in units of
-C c². A vertical field needs only γ; any other direction needs the horizontal
-axes too, so the system then carries the full attitude (and only then).
+``moment`` is the body's dipole m in body axes, ``field`` the strength B and ``direction`` the field's unit direction
+in the system's reference frame (``fixed_point``: X, Y, Z with Z the vertical; ``orbiting_gyrostat``: the orbital
+frame). SI: A m² and T; nondimensional: m·B in units of C c². A non-vertical field makes the system carry the full
+attitude (and only then).
 """
 
 from __future__ import annotations

@@ -1,16 +1,10 @@
 """Newtonian attracting centre: the gravity-gradient torque N e × I e about a reference axis e.
 
-The papers' Newtonian field (Ismail (2021) eq. 1, Shaker et al. eq. 7): a centre at
-distance R from the fixed point along Z adds, to first order in ℓ/R, the
-gravity-gradient torque N γ × Iγ with potential V = ½ N γ·Iγ. Give ``R`` (m)
-for an SI body, which uses its g, or ``k = N/c²`` for a nondimensional body.
-
-A body on a circular orbit (``orbiting_gyrostat``, Yehia & El-kenani (2021) eq. 3) tells the
-force which reference axis points to the centre (``body.attracting_axis``: 0,
-the radial axis α) and its coefficient N = 3Ω² (``body.gravity_gradient``):
-torque 3Ω² α × Iα, V = (3/2)Ω² α·Iα. Leave k and R null there (or k = N/Ω²,
-3 on a Keplerian orbit; another value is logged as a warning), or give ``N``
-directly (any body, model units).
+The papers' Newtonian field (Ismail (2021) eq. 1, Shaker et al. eq. 7): a centre at distance R from the fixed point
+along Z adds, to first order in ℓ/R, the torque N γ × Iγ with potential V = ½ N γ·Iγ. Give ``R`` (m) for an SI
+body, which uses its g, or ``k = N/c²`` for a nondimensional body. A body on a circular orbit (``orbiting_gyrostat``)
+says which axis points to the centre (``body.attracting_axis``) and N = 3Ω² (``body.gravity_gradient``): leave k and
+R null there (k = N/Ω² = 3 on a Keplerian orbit; docs/gyrostat.md). ``N`` may be given directly (model units).
 """
 
 from __future__ import annotations

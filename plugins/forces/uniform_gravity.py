@@ -1,9 +1,8 @@
 """Uniform gravity on a heavy body: torque M g r_c × γ (Ismail (2021) eq. 1, Shaker et al. eq. 1).
 
-γ is the unit vector of the fixed vertical Z, which in the papers points
-along the weight (towards the attracting centre); the potential is
-V = −M g r_c · γ. The weight moment M g r_c comes from the body (SI), or is the
-unit direction r_c' with c² = 1 (nondimensional form).
+γ is the unit vector of the fixed vertical Z, which in the papers points along the weight (towards the attracting
+centre); the potential is V = −M g r_c · γ. The weight moment M g r_c comes from the body (SI), or is the unit direction
+r_c' with c² = 1 (nondimensional form).
 """
 
 from __future__ import annotations

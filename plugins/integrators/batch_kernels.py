@@ -1,18 +1,10 @@
 """The built-in integrators' batch kernels (capability BATCH_KERNEL): many trajectories of one compiled model per call.
 
-The compiled kernels run in parallel over trajectories (``numba.prange``):
-- RK4 (``rk4``, ``rk4_numba``): fixed step, by blocks of trajectories stored column-wise, so the arithmetic
-  vectorises across trajectories (7× faster than one trajectory per thread); every model's stages are its
-  right-hand side by columns, generated from its equations (``models.block_rhs``).
-- DOP853 (``dop853_numba``): adaptive, each trajectory with its own step control (scipy's controller, as the
-  single run), by lanes vectorised across trajectories (``pipeline/kernels/batch_dop853.py``), the stages by the
-  same generated right-hand side by columns.
-- Taylor (``taylor``): adaptive, each trajectory with the single run's order and step rule, by lanes of one
-  vector register (8 on AVX-512, 4 on AVX2) vectorised across trajectories, the series generated from the
-  model's equations (``pipeline/kernels/batch_taylor.py``).
-
-Each function is an integrator's ``integrate_batch``: the arrays come validated from
-``gyrolab.batch.integrate.integrate_arrays``.
+They run in parallel over trajectories and vectorise across them, every model's stages generated from its equations
+(``models.block_rhs``, ``pipeline/kernels/batch_dop853.py``, ``batch_taylor.py``): RK4 (``rk4``, ``rk4_numba``) with a
+fixed step; DOP853 (``dop853_numba``) and Taylor (``taylor``) adaptive, each trajectory with the single run's step
+control. Each function is an integrator's ``integrate_batch``: the arrays come validated from
+``gyrolab.batch.integrate.integrate_arrays``. Measurements: docs/performance.md, "Batches: adaptive kernels".
 """
 
 from __future__ import annotations
@@ -76,8 +68,7 @@ def dop853_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
         count = y0s.shape[0]
         rejected, nfev = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
         args = (times, y0s, out, integrator.rtol, integrator.atol, integrator.max_step, steps, rejected, nfev, status)
-        batch_dop853.run_blocks(models.block_rhs(compiled), P, *args,
-                                batch_dop853.task_size(count))
+        batch_dop853.run_blocks(models.block_rhs(compiled), P, *args, batch_dop853.task_size(count))
 
     return _adaptive(integrator, kernel, times, y0s, failures)
 

@@ -1,8 +1,7 @@
 """Classical fourth-order Runge–Kutta with a fixed step: the method of Ismail (2021) and Shaker et al.
 
-The step ``step`` is an upper bound: each interval between output times is
-split into the fewest equal steps not longer than ``step``, so the method
-lands exactly on every output time (the papers tabulate at such times).
+The step ``step`` is an upper bound: each interval between output times is split into the fewest equal steps not longer
+than ``step``, so the method lands exactly on every output time (the papers tabulate at such times).
 """
 
 from __future__ import annotations
@@ -13,20 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.contracts.integrator import (
-    BATCH_KERNEL,
-    TIME_DEPENDENT,
-    VARIATIONAL,
-    VECTOR_LANES,
-    BatchSolution,
-    CompiledModel,
-    Integrator,
-    IntegratorStats,
-    ProgressCallback,
-    RightHandSide,
-    Solution,
-    VariationalSettings,
-)
+from gyrolab.contracts.integrator import (BATCH_KERNEL, TIME_DEPENDENT, VARIATIONAL, VECTOR_LANES, BatchSolution,
+                                          CompiledModel, Integrator, IntegratorStats, ProgressCallback, RightHandSide,
+                                          Solution, VariationalSettings)
 from gyrolab.errors import IntegrationError, as_number
 from gyrolab.plugins.integrators.batch_kernels import rk4_batch
 from gyrolab.plugins.integrators.refinement import half_step, interval_steps

@@ -1,11 +1,9 @@
 """scipy's ODE solvers (``scipy.integrate``) behind gyrolab's integrator contract.
 
-The solver is stepped directly (as ``solve_ivp`` does) so that gyrolab can
-count accepted and rejected steps, sample the dense output only at the
-requested times, and stop with a clear error on a non-finite state.
-Rejected steps are known for the explicit Runge–Kutta pairs: each attempt
-costs exactly ``n_stages`` evaluations, so the evaluations spent inside one
-``step()`` call count its attempts. Radau, BDF and LSODA do not expose them.
+The solver is stepped directly (as ``solve_ivp`` does) so that gyrolab can count accepted and rejected steps, sample the
+dense output only at the requested times, and stop with a clear error on a non-finite state. Rejected steps are known
+for the explicit Runge–Kutta pairs: each attempt costs exactly ``n_stages`` evaluations, so the evaluations spent inside
+one ``step()`` call count its attempts. Radau, BDF and LSODA do not expose them.
 """
 
 from __future__ import annotations
@@ -17,17 +15,8 @@ from typing import ClassVar
 import numpy as np
 from scipy import integrate
 
-from gyrolab.contracts.integrator import (
-    TIME_DEPENDENT,
-    VARIATIONAL,
-    CompiledModel,
-    Integrator,
-    IntegratorStats,
-    ProgressCallback,
-    RightHandSide,
-    Solution,
-    VariationalSettings,
-)
+from gyrolab.contracts.integrator import (TIME_DEPENDENT, VARIATIONAL, CompiledModel, Integrator, IntegratorStats,
+                                          ProgressCallback, RightHandSide, Solution, VariationalSettings)
 from gyrolab.errors import IntegrationError
 from gyrolab.plugins.integrators.tolerances import Tolerances
 
@@ -107,11 +96,9 @@ class LSODA(ScipySolver):
     solver_class = integrate.LSODA
 
 
-#: scipy's implicit solvers stop their Newton iterations at max(10 ε / rtol, min(0.03, √rtol)) (``Radau`` and ``BDF``
-#: ``newton_tol``), which loosens as rtol shrinks below (10 ε)^(2/3) ≈ 1.7e-10: a tighter run is then not reliably
-#: more accurate (benchmarks/promise_audit.py: Radau on a fast top, r0 = 26, t = 5.3, stayed at 2–4e-9 from rtol 1e-10
-#: to 1e-12, and its companion at rtol/100 estimated 0.08× the actual error). Below it their error estimate takes the
-#: compiled Taylor method's stand-in (``gyrolab.accuracy.estimate``).
+#: scipy's implicit solvers stop their Newton iterations at max(10 ε / rtol, min(0.03, √rtol)), which loosens below
+#: (10 ε)^(2/3) ≈ 1.7e-10: a tighter run is then not more accurate, and their error estimate takes the compiled Taylor
+#: method's stand-in (docs/integrators.md, "scipy's Radau stalls")
 IMPLICIT_NEWTON_FLOOR = (10 * float(np.finfo(float).eps)) ** (2.0 / 3.0)
 
 

@@ -1,13 +1,8 @@
 """Heavy rigid body about a fixed point: the Euler–Poisson equations in vector form.
 
-In principal body axes (Ismail (2021) eq. 1, Shaker et al. eq. 1, any textbook):
-
-    I ω̇ = (I ω) × ω + Σ torques,        γ̇ = γ × ω,
-
-with γ the body components of the fixed vertical Z. The state is (ω, γ),
-plus α — the body components of the fixed X axis, α̇ = α × ω — only when
-the scene needs the full attitude: Euler-angle output (ψ needs it) or a
-force acting along a non-vertical direction. β = γ × α is never stored.
+In principal body axes (Ismail (2021) eq. 1, Shaker et al. eq. 1): I ω̇ = (I ω) × ω + Σ torques, γ̇ = γ × ω, with γ
+the body components of the fixed vertical Z. The state is (ω, γ), plus α — the fixed X axis, α̇ = α × ω — only when
+the scene needs the full attitude: Euler-angle output (ψ needs it) or a force along a non-vertical direction.
 """
 
 from __future__ import annotations
@@ -43,7 +38,6 @@ class FixedPoint(System):
         self.needs_beta = 1 in needed
         self.inertia = body.inertia
 
-    # -- state ---------------------------------------------------------------
     @property
     def state_size(self) -> int:
         return 9 if self.carries_alpha else 6
@@ -85,12 +79,6 @@ class FixedPoint(System):
         parts = [omega, gamma, alpha] if self.carries_alpha else [omega, gamma]
         return np.concatenate(parts, axis=1), ok
 
-    def _axes(self, y: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray]:
-        gamma = y[..., 3:6]
-        alpha = y[..., 6:9] if self.carries_alpha else None
-        beta = cross(gamma, alpha) if self.needs_beta else None
-        return alpha, beta, gamma
-
     def reference_frame(self, y: np.ndarray) -> np.ndarray:
         """Rows α, β, γ at state ``y``. Without α in the state every force reads γ only, so any frame with
         that γ serves (α is then the unit vector of e × γ, e the body axis least aligned with γ)."""
@@ -105,7 +93,6 @@ class FixedPoint(System):
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         return euler_poisson(t, y, self.inertia, self.forces, self.carries_alpha, self.needs_beta)
 
-    # -- invariants ------------------------------------------------------------
     @property
     def invariants(self) -> tuple[str, ...]:
         names = []
@@ -119,8 +106,9 @@ class FixedPoint(System):
         return tuple(names)
 
     def energy(self, y: np.ndarray) -> np.ndarray:
-        omega = y[..., 0:3]
-        axes = self._axes(y)
+        omega, gamma = y[..., 0:3], y[..., 3:6]
+        alpha = y[..., 6:9] if self.carries_alpha else None
+        axes = (alpha, cross(gamma, alpha) if self.needs_beta else None, gamma)
         energy = 0.5 * dot(omega, self.inertia * omega)
         for force in self.forces:
             energy = energy + force.potential(axes)
@@ -141,47 +129,40 @@ class FixedPoint(System):
             values["frame_error"] = np.maximum(np.abs(norm(alpha) - 1.0), np.abs(dot(alpha, gamma)))
         return values
 
-    # -- outputs ---------------------------------------------------------------
     def variables(self, t: np.ndarray, y: np.ndarray) -> dict[str, xr.Variable]:
         body = self.body
         omega, gamma = y[:, 0:3], y[:, 3:6]
         out: dict[str, xr.Variable] = {
-            "omega": _var(("time", "axis"), omega, body.rate_unit,
-                          f"angular velocity (p, q, r) in body axes [{body.rate_label}]"),
-            "gamma": _var(("time", "axis"), gamma, "1", "direction cosines of the fixed vertical Z in body axes"),
+            "omega": variable(("time", "axis"), omega, body.rate_unit,
+                              f"angular velocity (p, q, r) in body axes [{body.rate_label}]"),
+            "gamma": variable(("time", "axis"), gamma, "1", "direction cosines of the fixed vertical Z in body axes"),
         }
         values = self.invariant_values(y)
         if "energy" in values:
-            out["energy"] = _var("time", values["energy"], body.energy_unit,
-                                 "total energy: kinetic ½ω·Iω plus the forces' potentials")
+            out["energy"] = variable("time", values["energy"], body.energy_unit,
+                                     "total energy: kinetic ½ω·Iω plus the forces' potentials")
         if "area_integral" in values:
-            out["area_integral"] = _var("time", values["area_integral"], body.momentum_unit,
-                                        "area integral: angular momentum about the vertical, Iω·γ")
-        out["gamma_norm"] = _var("time", values["gamma_norm"], "1",
-                                 "norm of the direction-cosine vector |γ| (exactly 1)")
+            out["area_integral"] = variable("time", values["area_integral"], body.momentum_unit,
+                                            "area integral: angular momentum about the vertical, Iω·γ")
+        out["gamma_norm"] = variable("time", values["gamma_norm"], "1",
+                                     "norm of the direction-cosine vector |γ| (exactly 1)")
         if self.carries_alpha:
-            out["alpha"] = _var(("time", "axis"), y[:, 6:9], "1", "direction cosines of the fixed X axis in body axes")
-            out["frame_error"] = _var("time", values["frame_error"], "1",
-                                      "orthonormality error of (α, γ): max(| |α| − 1 |, |α·γ|)")
+            out["alpha"] = variable(("time", "axis"), y[:, 6:9], "1",
+                                    "direction cosines of the fixed X axis in body axes")
+            out["frame_error"] = variable("time", values["frame_error"], "1",
+                                          "orthonormality error of (α, γ): max(| |α| − 1 |, |α·γ|)")
         if self.euler_angles:
             psi, theta, phi = euler_angles(y[:, 6:9], gamma)
-            out["psi"] = _var("time", psi, "rad", "precession angle ψ (unwrapped)")
+            out["psi"] = variable("time", psi, "rad", "precession angle ψ (unwrapped)")
         else:
             theta, phi = nutation_and_spin(gamma)
             phi = np.unwrap(phi)
-        out["theta"] = _var("time", theta, "rad", "nutation angle θ")
-        out["phi"] = _var("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
+        out["theta"] = variable("time", theta, "rad", "nutation angle θ")
+        out["phi"] = variable("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
         return out
 
     def attributes(self) -> dict[str, Any]:
-        attrs: dict[str, Any] = {"system": self.name, "state_size": self.state_size}
-        attrs.update(self.body.attributes())
-        attrs["initial_omega"] = self.initial.omega
-        attrs["initial_gamma"] = self.initial.gamma
-        for force in self.forces:
-            for key, value in force.attributes().items():
-                attrs[f"force_{force.name}_{key}"] = np.asarray(value, dtype=float) if isinstance(value, list) else value
-        return attrs
+        return system_attributes(self, initial_omega=self.initial.omega, initial_gamma=self.initial.gamma)
 
     def compiled_model(self) -> CompiledModel | None:
         """The equations traced (``System``), carrying the built-in forms' parameters when every torque has one
@@ -231,7 +212,18 @@ def traced_model(inertia: np.ndarray, forces: Sequence[Force], carries_alpha: bo
                                      9 if carries_alpha else 6, f"system fixed_point ({names})"))
 
 
-def _var(dims: str | tuple[str, ...], data: np.ndarray, units: str, long_name: str) -> xr.Variable:
+def system_attributes(system: System, **initial: Any) -> dict[str, Any]:
+    """A built-in system's dataset attributes: its name and state size, the body's, ``initial`` and every force's
+    (``force_<name>_<key>``, a list as a float array)."""
+    attrs: dict[str, Any] = {"system": system.name, "state_size": system.state_size, **system.body.attributes(),
+                             **initial}
+    for force in system.forces:
+        for key, value in force.attributes().items():
+            attrs[f"force_{force.name}_{key}"] = np.asarray(value, dtype=float) if isinstance(value, list) else value
+    return attrs
+
+
+def variable(dims: str | tuple[str, ...], data: np.ndarray, units: str, long_name: str) -> xr.Variable:
     # fastpath: the data is a float ndarray already, so xarray need not probe it for duck arrays (whose first
     # probe imports dask.array, ~1 s, when dask is installed: a batch's final variables paid it)
     attrs = {"units": units, "long_name": long_name}

@@ -1,19 +1,13 @@
 """Satellite-gyrostat on a circular orbit: gravity-gradient and magnetic torques (Yehia & El-kenani (2021)).
 
-Yehia & El-kenani, J. Appl. Comput. Mech. 7(4) (2021) 2120–2128, eqs. (1)–(3), in vector
-form (docs/gyrostat.md). Body axes are principal, I = diag(A, B, C); k is the rotors'
-constant momentum. The system's reference frame is the orbital frame: axis 0 = α
-(radial, from the Earth to the satellite), 1 = β (along-track), 2 = γ (orbit normal),
-which turns about the inertially fixed γ at the orbit rate Ω. With ω the absolute
-angular velocity and ω′ = ω − Ωγ the one relative to the orbital frame:
+In body axes (principal, I = diag(A, B, C); k the rotors' constant momentum), with ω the absolute angular velocity,
+ω′ = ω − Ωγ the one relative to the orbital frame (axis 0 = α radial, 1 = β along-track, 2 = γ orbit normal):
 
     I ω̇ = (I ω + k) × ω + Σ torques,     α̇ = α × ω′,     γ̇ = γ × ω′  (= γ × ω),
 
-state y = (ω, α, γ); β = γ × α is computed when a force needs it. The torques are the
-``newtonian`` plugin about axis 0 (N α × Iα, N = 3Ω²; paper: V = (3/2)Ω² α·Iα) and the
-``magnetic`` plugin with its direction in the orbital frame (paper: V = +μ·(h1 α + h3 γ),
-i.e. ``moment`` = μ and field·direction = −(h1, 0, h3)). Jacobi integral (L has no
-explicit time): H = ½ ω·Iω − Ω γ·(Iω + k) + Σ V.
+state y = (ω, α, γ); β = γ × α is computed when a force needs it. The torques are the ``newtonian`` plugin about
+axis 0 and the ``magnetic`` plugin with its direction in the orbital frame; the model, the paper's sign conventions
+and the Jacobi integral: docs/gyrostat.md.
 """
 
 from __future__ import annotations
@@ -32,6 +26,7 @@ from gyrolab.physics.initial import InitialAttitude
 from gyrolab.physics.vectors import cross, dot, norm
 from gyrolab.physics.gyrostat_body import GyrostatBody
 from gyrolab.physics.gyrostat_euler import GyrostatParameters, kinematic_matrix
+from gyrolab.plugins.systems.fixed_point import system_attributes, variable
 
 INITIAL_KEYS = ("p0", "q0", "r0", "psi0", "theta0", "phi0", "gamma0", "euler_rates0")
 
@@ -58,7 +53,6 @@ class OrbitingGyrostat(System):
         self.needs_beta = any(1 in f.required_axes for f in self.forces)
         self.angles, self.omega0, self.alpha0, self.gamma0 = _initial(dict(initial), self.Omega)
 
-    # -- state ---------------------------------------------------------------
     @property
     def state_size(self) -> int:
         return 9
@@ -88,7 +82,6 @@ class OrbitingGyrostat(System):
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         return self.derivative(y)
 
-    # -- invariants ------------------------------------------------------------
     @property
     def invariants(self) -> tuple[str, ...]:
         conservative = all(f.conservative for f in self.forces)
@@ -107,7 +100,6 @@ class OrbitingGyrostat(System):
         return (0.5 * dot(omega, self.inertia * omega) - self.Omega * dot(gamma, self.inertia * omega + self.k)
                 + self.potential(y))
 
-    # -- the paper's parameters -------------------------------------------------
     def parameters(self) -> GyrostatParameters:
         """(A, B, C, k, μ, h, Ω, N) of the paper's model; ConfigError for forces outside it."""
         N, mu, h = 0.0, np.zeros(3), np.zeros(3)
@@ -125,60 +117,49 @@ class OrbitingGyrostat(System):
             raise ConfigError("the paper's model has one magnetic dipole; give one magnetic force")
         return GyrostatParameters(tuple(self.inertia), tuple(self.k), tuple(mu), tuple(h), self.Omega, N)
 
-    # -- outputs ---------------------------------------------------------------
     def variables(self, t: np.ndarray, y: np.ndarray) -> dict[str, xr.Variable]:
         body = self.body
         omega, alpha, gamma = y[:, 0:3], y[:, 3:6], y[:, 6:9]
         beta = cross(gamma, alpha)
         rate = f"[{body.rate_label}]"
         out: dict[str, xr.Variable] = {
-            "omega": _var(("time", "axis"), omega, body.rate_unit,
-                          f"absolute angular velocity (p, q, r) in body axes {rate}"),
-            "omega_relative": _var(("time", "axis"), omega - self.Omega * gamma, body.rate_unit,
-                                   f"angular velocity relative to the orbital frame ω′ = ω − Ωγ in body axes {rate}"),
-            "alpha": _var(("time", "axis"), alpha, "1", "direction cosines of the radial axis α in body axes"),
-            "beta": _var(("time", "axis"), beta, "1", "direction cosines of the along-track axis β in body axes"),
-            "gamma": _var(("time", "axis"), gamma, "1", "direction cosines of the orbit normal γ in body axes"),
+            "omega": variable(("time", "axis"), omega, body.rate_unit,
+                              f"absolute angular velocity (p, q, r) in body axes {rate}"),
+            "omega_relative": variable(("time", "axis"), omega - self.Omega * gamma, body.rate_unit,
+                                       f"angular velocity relative to the orbital frame ω′ = ω − Ωγ in body axes "
+                                       f"{rate}"),
+            "alpha": variable(("time", "axis"), alpha, "1", "direction cosines of the radial axis α in body axes"),
+            "beta": variable(("time", "axis"), beta, "1", "direction cosines of the along-track axis β in body axes"),
+            "gamma": variable(("time", "axis"), gamma, "1", "direction cosines of the orbit normal γ in body axes"),
         }
         if "jacobi_integral" in self.invariants:
-            out["jacobi_integral"] = _var("time", self.jacobi_integral(y), body.energy_unit,
-                                          "Jacobi integral ½ω·Iω − Ωγ·(Iω + k) + V")
-        out["frame_error"] = _var("time", np.maximum.reduce([np.abs(norm(alpha) - 1), np.abs(norm(gamma) - 1),
-                                                             np.abs(dot(alpha, gamma))]),
-                                  "1", "orthonormality error of (α, γ): max(| |α| − 1 |, | |γ| − 1 |, |α·γ|)")
+            out["jacobi_integral"] = variable("time", self.jacobi_integral(y), body.energy_unit,
+                                              "Jacobi integral ½ω·Iω − Ωγ·(Iω + k) + V")
+        frame_error = np.maximum.reduce([np.abs(norm(alpha) - 1), np.abs(norm(gamma) - 1), np.abs(dot(alpha, gamma))])
+        out["frame_error"] = variable("time", frame_error, "1",
+                                      "orthonormality error of (α, γ): max(| |α| − 1 |, | |γ| − 1 |, |α·γ|)")
         psi, theta, phi = euler_angles(alpha, gamma)
-        out["psi"] = _var("time", psi, "rad", "precession angle ψ relative to the orbital frame (unwrapped)")
-        out["theta"] = _var("time", theta, "rad", "nutation angle θ: body z axis from the orbit normal")
-        out["phi"] = _var("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
+        out["psi"] = variable("time", psi, "rad", "precession angle ψ relative to the orbital frame (unwrapped)")
+        out["theta"] = variable("time", theta, "rad", "nutation angle θ: body z axis from the orbit normal")
+        out["phi"] = variable("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
         axis_orbital = np.stack([alpha[:, 2], beta[:, 2], gamma[:, 2]], axis=1)
-        out["body_axis_orbital"] = _var(("time", "frame_axis"), axis_orbital, "1",
-                                        "body z axis in the orbital frame (radial, along-track, normal)")
-        out["body_axis_inertial"] = _var(("time", "frame_axis"), to_inertial(axis_orbital, self.Omega * t), "1",
-                                         "body z axis in the inertial frame (X = radial at t = 0, Z = orbit normal)")
+        out["body_axis_orbital"] = variable(("time", "frame_axis"), axis_orbital, "1",
+                                            "body z axis in the orbital frame (radial, along-track, normal)")
+        c, s = np.cos(self.Omega * t), np.sin(self.Omega * t)  # the orbital frame turned by Ωt about the normal
+        axis_inertial = np.stack([c * alpha[:, 2] - s * beta[:, 2], s * alpha[:, 2] + c * beta[:, 2], gamma[:, 2]],
+                                 axis=-1)
+        out["body_axis_inertial"] = variable(("time", "frame_axis"), axis_inertial, "1", "body z axis in the "
+                                             "inertial frame (X = radial at t = 0, Z = orbit normal)")
         return out
 
     def attributes(self) -> dict[str, Any]:
-        attrs: dict[str, Any] = {"system": self.name, "state_size": self.state_size}
-        attrs.update(self.body.attributes())
-        attrs["initial_euler_angles"] = np.array(self.angles)
-        attrs["initial_omega"] = self.omega0
-        for force in self.forces:
-            for key, value in force.attributes().items():
-                attrs[f"force_{force.name}_{key}"] = np.asarray(value, dtype=float) if isinstance(value, list) else value
-        return attrs
+        return system_attributes(self, initial_euler_angles=np.array(self.angles), initial_omega=self.omega0)
 
     def title(self) -> str:
         A, B, C = self.inertia
         forces = " + ".join(f.name for f in self.forces) or "no torque"
         return (f"satellite-gyrostat on a circular orbit, A,B,C=({A:.4g}, {B:.4g}, {C:.4g}), "
                 f"k=({', '.join(f'{x:.3g}' for x in self.k)}), Ω={self.Omega:.4g}; {forces}")
-
-
-def to_inertial(orbital: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """Orbital-frame components → inertial ones, the orbital frame turned by u = Ωt about the normal."""
-    c, s = np.cos(u), np.sin(u)
-    x, y, z = orbital[..., 0], orbital[..., 1], orbital[..., 2]
-    return np.stack([c * x - s * y, s * x + c * y, z], axis=-1)
 
 
 def _initial(cfg: dict[str, Any], Omega: float) -> tuple[tuple[float, float, float], np.ndarray, np.ndarray, np.ndarray]:
@@ -202,6 +183,3 @@ def _initial(cfg: dict[str, Any], Omega: float) -> tuple[tuple[float, float, flo
     omega = attitude.omega if rates is None else kinematic_matrix(theta, phi) @ rates + Omega * gamma
     return (psi, theta, phi), omega, alpha, gamma
 
-
-def _var(dims: str | tuple[str, ...], data: np.ndarray, units: str, long_name: str) -> xr.Variable:
-    return xr.Variable(dims, np.asarray(data, dtype=float), attrs={"units": units, "long_name": long_name})
