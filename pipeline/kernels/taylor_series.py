@@ -739,6 +739,7 @@ def _call(typingctx, address, t, order, size, Y, p):
         with b.if_else(small) as (on_stack, on_heap):
             with on_stack:
                 stack_w = b.alloca(double, size=size_)
+                stack_w.align = 64  # (else its alignment follows the process's random stack base: steps ~15 % apart)
                 stack_block = b.block
             with on_heap:
                 heap_w = b.bitcast(context.nrt.allocate(b, b.mul(size_, ir.Constant(i64, 8))), double_ptr)
