@@ -13,7 +13,8 @@ import time
 
 import numpy as np
 
-from gyrolab.contracts.integrator import BatchSolution, CompiledModel
+from gyrolab.contracts.capabilities import integrators_with, or_list
+from gyrolab.contracts.integrator import BATCH_KERNEL, BatchSolution, CompiledModel
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.kernels.model import bind
 
@@ -26,7 +27,7 @@ def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.n
     """Fixed-step RK4 with the fewest equal steps no longer than ``step`` in each output interval."""
     # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import models, rk4
-    from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval
+    from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval  # (it imports this module)
 
     start = time.perf_counter()
     P = bind(compiled, P)
@@ -94,9 +95,6 @@ def _adaptive(integrator: object, kernel: object, times: np.ndarray, y0s: np.nda
 
 def _batch_alternatives(compiled: CompiledModel) -> str:
     """The registered integrators with a batch kernel that can run ``compiled``."""
-    from gyrolab.contracts.capabilities import integrators_with, or_list
-    from gyrolab.contracts.integrator import BATCH_KERNEL
-
     return or_list(integrators_with(BATCH_KERNEL, accept=lambda cls: cls.refusal(compiled) is None))
 
 
