@@ -5,8 +5,9 @@ While the error estimate (``estimate.compare``) breaks it, or is within ``ESTIMA
 estimate's own accuracy), the method runs again made as much more accurate as the measurement asks (``more_accurate``,
 else ``climbed``), at most ``MAX_RECHECKS`` times, then one ConfigError sentence. A measured error above the
 prediction but ``RECHECK_MARGIN`` times below the target keeps the run, its prediction raised; an analytic series
-that breaks its prediction is integrated instead (``Choice.instead``). Why: docs/integrators.md, "auto checks its
-promise against that measurement".
+that breaks its prediction is integrated instead (``Choice.instead``), as is a run tried first (``measure_first``:
+auto's double run on a chaotic scene) that the measurement does not keep. Why: docs/integrators.md, "auto checks its
+promise against that measurement" and "Needless climbs".
 """
 
 from __future__ import annotations
