@@ -171,9 +171,10 @@ class Auto(Integrator):
             # A chaotic scene's round-off is predicted from the tangent run's growth, which scatters by orders of
             # magnitude (docs/integrators.md, "Needless climbs"): run in double first and keep it only when its
             # error estimate measures the target met; else climb as predicted (``Choice.measure_first``).
-            chosen = min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE)
+            chosen = max(min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE),
+                         Taylor.TOLERANCE_FLOOR)  # (the tolerance recorded is the one run)
             resumed = (tight, pilot_times, inside, t_pilot) if tight_tol <= chosen else None
-            solution = final(make(max(chosen, Taylor.TOLERANCE_FLOOR)), chosen, 0.0, (
+            solution = final(make(chosen), chosen, 0.0, (
                 f"double precision's round-off on this chaotic scene is predicted at about {roundoff:.1g} over "
                 f"~{steps:.0f} steps, above accuracy={self.accuracy:g}, from a growth that scatters: run in double "
                 f"first, kept only where its error estimate measures the target met"), resumed)
