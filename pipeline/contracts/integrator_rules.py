@@ -29,8 +29,9 @@ def checked(integrate: Callable[..., Any]) -> Callable[..., Any]:
     @functools.wraps(integrate)
     def wrapper(self: Any, fun: Any, t_out: Any, y0: Any, *args: Any, **kwargs: Any) -> Any:
         name = str(getattr(self, "name", type(self).__name__))
-        t_out, y0 = check_inputs(name, t_out, y0)
         compiled = args[1] if len(args) > 1 else kwargs.get("compiled")
+        finite, increasing = _scans(compiled)
+        t_out, y0 = check_inputs(name, t_out, y0, finite, increasing)
         if compiled is not None:
             _check_compiled_size(name, compiled, y0)
         try:
@@ -40,7 +41,7 @@ def checked(integrate: Callable[..., Any]) -> Callable[..., Any]:
         except Exception as exc:  # noqa: BLE001 - a plugin may raise anything; the user gets one sentence
             raise IntegrationError(f"integrator {name!r} raised {type(exc).__name__}: "
                                    f"{shorten(str(exc), 200) or '(no message)'}") from exc
-        check_solution(name, solution, t_out, len(y0))
+        check_solution(name, solution, t_out, len(y0), finite)
         return solution
 
     setattr(wrapper, _CHECKED, True)
@@ -56,24 +57,42 @@ def _check_compiled_size(name: str, compiled: Any, y0: np.ndarray) -> None:
                                f"compiled model of {size}; pass the system's own state (System.initial_state())")
 
 
-def check_inputs(name: str, t_out: Any, y0: Any) -> tuple[np.ndarray, np.ndarray]:
+def _scans(compiled: Any) -> tuple[Callable[[np.ndarray], bool], Callable[[np.ndarray], bool]]:
+    """(all finite, strictly increasing): compiled (``gyrolab.kernels.scans``) for a run with a compiled model, which
+    has numba loaded; numpy's otherwise (a scipy run never imports numba for them)."""
+    if compiled is None:
+        return _finite, _increasing
+    # start-up: numba is imported only by a run that has a compiled model
+    from gyrolab.kernels import scans
+
+    return scans.all_finite, scans.increasing
+
+
+def _finite(a: np.ndarray) -> bool:
+    return bool(np.isfinite(a).all())
+
+
+def _increasing(t: np.ndarray) -> bool:
+    # a NaN compares false, an inf inside makes a step not positive: one comparison of the shifted times
+    return math.isfinite(t[0]) and math.isfinite(t[-1]) and bool(np.greater(t[1:], t[:-1]).all())
+
+
+def check_inputs(name: str, t_out: Any, y0: Any, finite: Callable[[np.ndarray], bool],
+                 increasing: Callable[[np.ndarray], bool]) -> tuple[np.ndarray, np.ndarray]:
     """``t_out`` and ``y0`` as float arrays; IntegrationError unless y0 is finite and 1-D and t_out increases."""
-    t_out = np.asarray(t_out, dtype=float)
-    y0 = np.asarray(y0, dtype=float)
-    if y0.ndim != 1 or not np.isfinite(y0).all():
+    t_out = np.ascontiguousarray(t_out, dtype=float)
+    y0 = np.ascontiguousarray(y0, dtype=float)
+    if y0.ndim != 1 or not finite(y0):
         raise IntegrationError(f"integrator {name!r} was given an initial state of shape {y0.shape} "
                                f"({np.count_nonzero(~np.isfinite(y0))} non-finite values); it takes one finite "
                                "1-D state")
-    # finite ends and every step positive (a NaN compares false, an inf inside makes a step not positive): one
-    # comparison of the shifted times, cheaper than np.diff and np.isfinite
-    if (t_out.ndim != 1 or len(t_out) < 1 or not (math.isfinite(t_out[0]) and math.isfinite(t_out[-1]))
-            or not np.greater(t_out[1:], t_out[:-1]).all()):
+    if t_out.ndim != 1 or len(t_out) < 1 or not increasing(t_out):
         raise IntegrationError(f"integrator {name!r} was given output times that are not finite and strictly "
                                f"increasing (shape {t_out.shape}); t_out[0] is the initial time, then increasing")
     return t_out, y0
 
 
-def check_solution(name: str, solution: Any, t_out: np.ndarray, size: int) -> None:
+def check_solution(name: str, solution: Any, t_out: np.ndarray, size: int, finite: Callable[[np.ndarray], bool]) -> None:
     """IntegrationError (one sentence naming the integrator and what is wrong) unless ``solution`` keeps the
     contract: a ``Solution`` with ``t`` of len(t_out), ``y`` of shape (len(t_out), size), all finite, and stats."""
     # import cycle: contracts.integrator imports this module
@@ -94,7 +113,8 @@ def check_solution(name: str, solution: Any, t_out: np.ndarray, size: int) -> No
     if not isinstance(solution.stats, IntegratorStats):
         raise IntegrationError(f"integrator {name!r} returned stats of type {type(solution.stats).__name__}; "
                                f"Solution.stats must be an IntegratorStats (evaluations, steps, wall time) {rule}")
-    if not np.isfinite(y).all():  # one vectorised pass; the rest runs only on failure
+    # one vectorised pass (the compiled scan takes C-ordered doubles); the rest runs only on failure
+    if not (finite(y) if y.dtype == np.float64 and y.flags.c_contiguous else _finite(y)):
         bad = ~np.isfinite(y)
         first = int(np.argmax(bad.any(axis=1)))
         raise IntegrationError(f"integrator {name!r} returned {int(bad.sum())} non-finite values of {n}×{size} "

@@ -411,17 +411,25 @@ def test_a_broken_integrator_is_one_integration_error_naming_it(plugins, integra
         assert needle in text, text
 
 
-def test_integrate_refuses_bad_inputs():
+@pytest.mark.parametrize("compiled", [False, True], ids=["numpy scans", "compiled scans"])
+def test_integrate_refuses_bad_inputs(compiled):
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
     from gyrolab.plugins.integrators.rk4 import RK4
 
-    fun = lambda t, y: -y  # noqa: E731
-    with pytest.raises(IntegrationError, match="initial state of shape \\(2,\\) \\(1 non-finite values\\)"):
-        RK4().integrate(fun, np.linspace(0, 1, 3), np.array([1.0, np.nan]))
+    if compiled:  # a run with a compiled model scans with gyrolab.kernels.scans
+        scene = compose_scene(["integrator=taylor", *SHORT, "output.euler_angles=false"])
+        fun, model, good, method = None, scene.compiled, scene.system.initial_state(), Taylor(tol=1e-9)
+    else:
+        fun, model, good, method = (lambda t, y: -y), None, np.array([1.0, 2.0]), RK4()
+    bad = good.copy()
+    bad[-1] = np.nan
+    with pytest.raises(IntegrationError, match=f"initial state of shape \\({len(good)},\\) \\(1 non-finite values\\)"):
+        method.integrate(fun, np.linspace(0, 1, 3), bad, None, model)
     for times in ([0.0, 1.0, 0.5], [0.0, 1.0, 1.0], [0.0, np.nan, 2.0], [0.0, np.inf, 2.0], [0.0, 1.0, np.inf],
                   [np.nan, 1.0], [-np.inf, 1.0]):
         with pytest.raises(IntegrationError, match="strictly increasing"):
-            RK4().integrate(fun, np.array(times), np.array([1.0, 2.0]))
-    assert RK4().integrate(fun, np.linspace(0, 1, 3), [1.0, 2.0]).y.shape == (3, 2)
+            method.integrate(fun, np.array(times), good, None, model)
+    assert method.integrate(fun, np.linspace(0, 1, 3), list(good), None, model).y.shape == (3, len(good))
 
 
 # ---- the command line: exit code, one line, no traceback, no run.nc ------------------------------------------
