@@ -44,7 +44,7 @@ from numba.extending import intrinsic
 from gyrolab.kernels import simd, taylor
 from gyrolab.kernels.compiler import kernel
 from gyrolab.kernels.expression import generated_module
-from gyrolab.kernels.layout import TRACED_FIRST_CONSTANT
+from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import CompiledModel, traced_model
 from gyrolab.kernels.recurrences import AUXILIARY, Functions, splat_int
 from gyrolab.kernels.taylor_series import plan
@@ -284,16 +284,17 @@ def _columns(program: dict) -> int:
     return max(len(_layout(program["series"])), 1)
 
 
-#: (series address, constants address, numbers, W's columns) of each model's generated lanes, or None
+#: (series address, constants address, numbers, W's columns) of each form's generated lanes, by its rhs kernel's address
 _KERNELS: dict[tuple[int, int], tuple[int, int, int, int] | None] = {}
 
 
 def lanes_kernel(compiled: CompiledModel) -> tuple[int, int, int, int]:
     """The generated lanes of a compiled model: (series address, constants address, numbers, W's columns), compiled
     (or loaded from the disk cache) on first need."""
-    model, first = traced_model(compiled), TRACED_FIRST_CONSTANT
-    key = (id(model), first)
+    first = TRACED_FIRST_CONSTANT
+    key = (int(compiled.params[TRACED_ADDRESS]), first)  # the right-hand side kernel's address names the form
     if key not in _KERNELS:
+        model = traced_model(compiled)
         program = plan(model, first)
         module = generated_module(source(program), "gyrolab_lanes", f"{model.what} (Taylor lanes)")
         _KERNELS[key] = (int(module.kernel.address), int(module.constants.address), max(len(program["names"]), 1),
