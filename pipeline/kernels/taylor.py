@@ -114,8 +114,11 @@ def run(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
         if h <= 0.0:  # the step is below the spacing of floating-point numbers at t: no progress is possible
             state[0] = t
             return TOO_SMALL_STEP, i
-        while i < n_out and t_out[i] <= t_new:
-            _dense_output(T, order, t_out[i] - t, y, carry, Y, i)
+        while i + 1 < n_out and t_out[i + 1] <= t_new:  # outputs by pairs: two Horner chains in the time of one
+            _dense_output(T, order, (t_out[i] - t, t_out[i + 1] - t), y, carry, Y, i)
+            i += 2
+        if i < n_out and t_out[i] <= t_new:
+            _dense_output(T, order, (t_out[i] - t,), y, carry, Y, i)
             i += 1
         if not _advance(T, order, h, y, carry):
             state[0] = t
@@ -142,11 +145,14 @@ def _coefficient_rows(rows, n):
     return buffer[:rows * n].reshape((rows, n))
 
 
-def _emit_horner(context, b, T, T_type, order, h, each):
-    """Emit v = Σ_{k=1..order} T[k] h^(k−1) for every component m, then ``each(m, v_m)`` in the lane's order.
+def _emit_horner(context, b, T, T_type, order, hs, each, each_vector=None):
+    """Emit v_j = Σ_{k=1..order} T[k] h_j^(k−1) for every component m and every h_j of ``hs``, then ``each(j, m,
+    v_jm)`` in the lane's order, or, given ``each_vector``, ``each_vector(j, c, v)`` once per vector of components
+    c … c + 7 (lanes m ≥ n are junk).
 
-    Sixteen components' Horner chains run side by side in two ``<8 x double>`` registers, each step one fused
-    multiply-add; T must come from ``_coefficient_rows`` (the vectors load whole, past a row's end). A lane takes
+    Sixteen components' Horner chains run side by side in two ``<8 x double>`` registers per h_j, each step one
+    fused multiply-add; T must come from ``_coefficient_rows`` (the vectors load whole, past a row's end). A chain is
+    bound by the latency of its multiply-adds, so two h_j (two output times) take about the time of one. A lane takes
     the same operations as a scalar fused chain, so the same results to the bit. v is handed over in registers,
     never stored (a vector store read back lane by lane stalls: no store forwarding)."""
     i32, i64, double = ir.IntType(32), ir.IntType(64), ir.DoubleType()
@@ -155,9 +161,7 @@ def _emit_horner(context, b, T, T_type, order, h, each):
     rows = b.bitcast(array.data, double.as_pointer())
     n = b.extract_value(array.shape, 1)
     fma = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * 3), f"llvm.fma.v{_LANES}f64")
-    undef = ir.Constant(vec, ir.Undefined)
-    hv = b.shuffle_vector(b.insert_element(undef, h, ir.Constant(i32, 0)), undef,
-                          ir.Constant(ir.VectorType(i32, _LANES), [0] * _LANES))
+    hvs = [_splat(b, h) for h in hs]
     chunks = b.udiv(b.add(n, ir.Constant(i64, 2 * _LANES - 1)), ir.Constant(i64, 2 * _LANES))
     with cgutils.for_range(b, chunks) as chunk:
         columns = [b.add(b.mul(chunk.index, ir.Constant(i64, 2 * _LANES)), ir.Constant(i64, half * _LANES))
@@ -167,18 +171,60 @@ def _emit_horner(context, b, T, T_type, order, h, each):
             return [b.load(b.bitcast(b.gep(rows, [b.add(b.mul(k, n), c)]), vec.as_pointer()), align=8)
                     for c in columns]
 
-        accumulators = [cgutils.alloca_once_value(b, x) for x in row(order)]
+        accumulators = [[cgutils.alloca_once_value(b, x) for x in row(order)] for _ in hvs]
         steps = b.sub(order, ir.Constant(i64, 1))
         with cgutils.for_range(b, steps) as loop:
             k = b.sub(steps, loop.index)  # order − 1 down to 1
-            for slot, x in zip(accumulators, row(k)):
-                b.store(b.call(fma, [b.load(slot), hv, x]), slot)
-        for slot, c in zip(accumulators, columns):
-            value = b.load(slot)
-            for lane in range(_LANES):
-                m = b.add(c, ir.Constant(i64, lane))
-                with b.if_then(b.icmp_signed("<", m, n), likely=True):
-                    each(m, b.extract_element(value, ir.Constant(i32, lane)))
+            x_k = row(k)
+            for hv, slots in zip(hvs, accumulators):
+                for slot, x in zip(slots, x_k):
+                    b.store(b.call(fma, [b.load(slot), hv, x]), slot)
+        for j, slots in enumerate(accumulators):
+            for slot, c in zip(slots, columns):
+                value = b.load(slot)
+                if each_vector is not None:
+                    with b.if_then(b.icmp_signed("<", c, n), likely=True):
+                        each_vector(j, c, value)
+                    continue
+                for lane in range(_LANES):
+                    m = b.add(c, ir.Constant(i64, lane))
+                    with b.if_then(b.icmp_signed("<", m, n), likely=True):
+                        each(j, m, b.extract_element(value, ir.Constant(i32, lane)))
+
+
+_LANE_INDEX = ir.Constant(ir.VectorType(ir.IntType(64), _LANES), list(range(_LANES)))
+
+
+def _splat(b, x):
+    """``x`` (a scalar value) in every lane of a vector."""
+    vec = ir.VectorType(x.type, _LANES)
+    undef = ir.Constant(vec, ir.Undefined)
+    return b.shuffle_vector(b.insert_element(undef, x, ir.Constant(ir.IntType(32), 0)), undef,
+                            ir.Constant(ir.VectorType(ir.IntType(32), _LANES), [0] * _LANES))
+
+
+def _data(context, b, array_type, array):
+    """The data pointer (double*) of a C-contiguous array."""
+    return b.bitcast(context.make_array(array_type)(context, b, array).data, ir.DoubleType().as_pointer())
+
+
+def _masked_load(b, pointer, mask):
+    """The 8 doubles from ``pointer`` where ``mask`` is set, 0 elsewhere (nothing read there)."""
+    vec = ir.VectorType(ir.DoubleType(), _LANES)
+    load = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec.as_pointer(), ir.IntType(32),
+                                                                          mask.type, vec]),
+                                          f"llvm.masked.load.v{_LANES}f64.p0")
+    return b.call(load, [b.bitcast(pointer, vec.as_pointer()), ir.Constant(ir.IntType(32), 8), mask,
+                         ir.Constant(vec, [0.0] * _LANES)])
+
+
+def _masked_store(b, value, pointer, mask):
+    """Store the lanes of ``value`` where ``mask`` is set at ``pointer`` (nothing written elsewhere)."""
+    vec = value.type
+    store = cgutils.get_or_insert_function(b.module, ir.FunctionType(ir.VoidType(), [vec, vec.as_pointer(),
+                                                                                     ir.IntType(32), mask.type]),
+                                           f"llvm.masked.store.v{_LANES}f64.p0")
+    b.call(store, [value, b.bitcast(pointer, vec.as_pointer()), ir.Constant(ir.IntType(32), 8), mask])
 
 
 def _element(context, b, array_type, array, *indices):
@@ -193,23 +239,30 @@ def _arrays(*arrays) -> bool:
 
 
 @intrinsic
-def _dense_output(typingctx, T, order, dt, y, carry, Y, i):
-    """Y[i] = y + (v·dt − carry), v = Σ_{k≥1} T[k] dt^(k−1) (``_emit_horner``): the state dt after the step's start
-    from its series, with the compensation the state carries."""
-    if not (_arrays(T, y, carry, Y) and T.layout == "C"):
+def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
+    """Y[i + j] = y + (v_j·dt_j − carry), v_j = Σ_{k≥1} T[k] dt_j^(k−1) (``_emit_horner``), for each dt_j of the tuple
+    ``dts`` (one or two): the state dt_j after the step's start from its series, with the compensation the state
+    carries."""
+    if not (_arrays(T, y, carry, Y) and all(a.layout == "C" for a in (T, y, carry, Y))
+            and isinstance(dts, types.UniTuple)):
         return None
-    sig = types.void(T, order, types.float64, y, carry, Y, i)
+    sig = types.void(T, order, dts, y, carry, Y, i)
 
     def codegen(context, b, signature, args):
-        T_, order_, dt_, y_, carry_, Y_, i_ = args
+        T_, order_, dts_, y_, carry_, Y_, i_ = args
         types_ = signature.args
         i_ = context.cast(b, i_, types_[6], types.intp)
+        hs = [b.extract_value(dts_, j) for j in range(types_[2].count)]
 
-        def each(m, v):
-            y_m, c_m = (b.load(_element(context, b, types_[a], args[a], m)) for a in (3, 4))
-            b.store(b.fadd(y_m, b.fsub(b.fmul(v, dt_), c_m)), _element(context, b, types_[5], Y_, i_, m))
+        def each_vector(j, c, v):  # a scalar y_m + (v_m·dt − c_m) on 8 components at once: masked loads, stores
+            mask = b.icmp_unsigned("<", b.add(_splat(b, c), _LANE_INDEX), _splat(b, n))
+            y_v, c_v = (_masked_load(b, b.gep(_data(context, b, types_[a], args[a]), [c]), mask) for a in (3, 4))
+            row = b.gep(_data(context, b, types_[5], Y_), [b.add(b.mul(b.add(i_, ir.Constant(i_.type, j)), n), c)])
+            _masked_store(b, b.fadd(y_v, b.fsub(b.fmul(v, _splat(b, hs[j])), c_v)), row, mask)
 
-        _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), dt_, each)
+        n = b.extract_value(context.make_array(types_[3])(context, b, y_).shape, 0)
+        _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), hs, None,
+                     each_vector)
         return context.get_dummy_value()
 
     return sig, codegen
@@ -228,7 +281,7 @@ def _advance(typingctx, T, order, h, y, carry):
         types_ = signature.args
         finite = cgutils.alloca_once_value(b, cgutils.true_bit)
 
-        def each(m, v):
+        def each(_, m, v):
             y_at, c_at = _element(context, b, types_[3], y_, m), _element(context, b, types_[4], carry_, m)
             y_m = b.load(y_at)
             inc = b.fsub(b.fmul(v, h_), b.load(c_at))
@@ -241,7 +294,7 @@ def _advance(typingctx, T, order, h, y, carry):
             b.store(b.and_(b.load(finite), b.fcmp_ordered("<", magnitude, ir.Constant(ir.DoubleType(), math.inf))),
                     finite)
 
-        _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), h_, each)
+        _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), [h_], each)
         return b.load(finite)
 
     return sig, codegen

@@ -122,26 +122,30 @@ def test_a_step_below_the_spacing_of_times_stops_with_too_small_step():
 
 @numba.njit
 def _sums_through_the_step(T, order, h, y, carry, Y):
-    """taylor's dense output into Y[0] and its compensated update of y, on coefficients in its own padded rows."""
+    """taylor's dense output into Y[0] at h, into Y[1] and Y[2] at (h/3, h/2) (a pair), and its compensated update of
+    y, on coefficients in its own padded rows."""
     rows = taylor._coefficient_rows(T.shape[0], T.shape[1])
     rows[:] = T
-    taylor._dense_output(rows, order, h, y, carry, Y, 0)
+    taylor._dense_output(rows, order, (h,), y, carry, Y, 0)
+    taylor._dense_output(rows, order, (h / 3, h / 2), y, carry, Y, 1)
     return taylor._advance(rows, order, h, y, carry)
 
 
 @pytest.mark.parametrize("n", [1, 6, 8, 9, 16, 17, 40])
 @pytest.mark.parametrize("order", [4, 9, 23])
 def test_the_vector_horner_sums_match_numpy_for_every_state_size(n, order):
-    """The step's Horner sums run in vector lanes, sixteen components at a time (past a row's end): every component
-    of any state size gets y + Σ_k T[k] h^k, against numpy's polynomial evaluation of each component."""
+    """The step's Horner sums run in vector lanes, sixteen components at a time (past a row's end), the outputs one
+    or two at a time: every component of any state size gets y + Σ_k T[k] h^k, against numpy's polynomial
+    evaluation of each component, and the masked stores write nothing past the rows they fill (row 3 stays NaN)."""
     rng = np.random.default_rng(n * 100 + order)
     T = rng.normal(size=(order + 1, n)) / np.arange(1, order + 2)[:, None] ** 2
     y, carry, h = T[0].copy(), rng.normal(scale=1e-17, size=n), 0.37
-    Y = np.full((1, n), np.nan)
-    expected = np.array([np.polyval(T[::-1, m], h) for m in range(n)])
+    Y = np.full((4, n), np.nan)
+    expected = np.array([[np.polyval(T[::-1, m], x) for m in range(n)] for x in (h, h / 3, h / 2)])
     assert _sums_through_the_step(T, order, h, y, carry.copy(), Y)
-    np.testing.assert_allclose(Y[0], expected - carry, rtol=1e-14, atol=1e-15)
-    np.testing.assert_allclose(y, expected - carry, rtol=1e-14, atol=1e-15)
+    np.testing.assert_allclose(Y[:3], expected - carry, rtol=1e-14, atol=1e-15)
+    assert np.isnan(Y[3]).all()
+    np.testing.assert_allclose(y, expected[0] - carry, rtol=1e-14, atol=1e-15)
     T[order, n - 1] = np.inf
     assert not _sums_through_the_step(T, order, h, T[0].copy(), carry.copy(), Y)
 
