@@ -132,7 +132,7 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
     """Run the companion of ``method``'s run of ``scene`` (stored states ``y``, integration time ``wall_time``; with
     ``check``, a run that is no integration, measured against ``check``) and compare: the measured error estimate,
     or why none is available."""
-    compiled_model = scene.system.compiled_model()
+    compiled_model = scene.compiled_model
     pick = companion(method, compiled_model is not None) if check is None else Companion(check, 1.0, (
         f"{check.name} ({', '.join(f'{k} {v}' for k, v in check.attributes().items())}) against the analytic series"))
     name = getattr(method, "name", type(method).__name__)
@@ -145,10 +145,10 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
                             "compiled model for the Taylor method")
     companion_model, refusal = None, None
     if pick.integrator.supports(COMPILED_MODEL) or pick.integrator.supports(PREFERS_COMPILED_MODEL):
-        # the scene's own model is prepared for its integrator (a plugin torque's Taylor kernel compiled); another
-        # one is prepared by the companion's refusal hook, which also says when it cannot run it
-        companion_model = scene.compiled if scene.compiled is not None else compiled_model
-        refusal = pick.integrator.refusal(companion_model, scene.system) if companion_model is not None else None
+        # the companion's refusal hook prepares the model (a plugin torque's Taylor kernel compiled), or says when
+        # it cannot run it
+        companion_model = compiled_model
+        refusal = pick.integrator.refusal(compiled_model, scene.system) if compiled_model is not None else None
         if refusal and pick.double_first is None:  # (near the floor the double companions may still suffice)
             return _unavailable(f"the companion ({pick.how}) {refusal}")
     start = time.perf_counter()

@@ -129,11 +129,17 @@ class Scene:
         return before, ({**after, NFEV_COUNTS_ATTRIBUTE: label} if label else after)
 
     @cached_property
+    def compiled_model(self) -> CompiledModel | None:
+        """The system's compiled model, traced once per scene (~1 ms), whether or not the integrator uses it (the error
+        estimate's Taylor companion may)."""
+        return self.system.compiled_model()
+
+    @cached_property
     def compiled(self) -> CompiledModel | None:
-        """The system's compiled model, when the integrator uses one (packed once per scene)."""
+        """The system's compiled model, when the integrator uses one."""
         integrator = self.integrator
         wants = integrator.supports(COMPILED_MODEL) or integrator.supports(PREFERS_COMPILED_MODEL)
-        return self.system.compiled_model() if wants else None
+        return self.compiled_model if wants else None
 
     @cached_property
     def rhs(self) -> Callable[[float, np.ndarray], np.ndarray]:
