@@ -145,17 +145,15 @@ def _coefficient_rows(rows, n):
     return buffer[:rows * n].reshape((rows, n))
 
 
-def _emit_horner(context, b, T, T_type, order, hs, each, each_vector=None):
-    """Emit v_j = Σ_{k=1..order} T[k] h_j^(k−1) for every component m and every h_j of ``hs``, then ``each(j, m,
-    v_jm)`` in the lane's order, or, given ``each_vector``, ``each_vector(j, c, v)`` once per vector of components
-    c … c + 7 (lanes m ≥ n are junk).
+def _emit_horner(context, b, T, T_type, order, hs, each):
+    """Emit v_j = Σ_{k=1..order} T[k] h_j^(k−1) for every component and every h_j of ``hs``, then ``each(j, c, v)``
+    once per vector v of components c … c + 7 (lanes past the state's end are junk: ``_lanes_in``).
 
     Sixteen components' Horner chains run side by side in two ``<8 x double>`` registers per h_j, each step one
     fused multiply-add; T must come from ``_coefficient_rows`` (the vectors load whole, past a row's end). A chain is
     bound by the latency of its multiply-adds, so two h_j (two output times) take about the time of one. A lane takes
-    the same operations as a scalar fused chain, so the same results to the bit. v is handed over in registers,
-    never stored (a vector store read back lane by lane stalls: no store forwarding)."""
-    i32, i64, double = ir.IntType(32), ir.IntType(64), ir.DoubleType()
+    the same operations as a scalar fused chain, so the same results to the bit."""
+    i64, double = ir.IntType(64), ir.DoubleType()
     vec = ir.VectorType(double, _LANES)
     array = context.make_array(T_type)(context, b, T)
     rows = b.bitcast(array.data, double.as_pointer())
@@ -181,15 +179,8 @@ def _emit_horner(context, b, T, T_type, order, hs, each, each_vector=None):
                     b.store(b.call(fma, [b.load(slot), hv, x]), slot)
         for j, slots in enumerate(accumulators):
             for slot, c in zip(slots, columns):
-                value = b.load(slot)
-                if each_vector is not None:
-                    with b.if_then(b.icmp_signed("<", c, n), likely=True):
-                        each_vector(j, c, value)
-                    continue
-                for lane in range(_LANES):
-                    m = b.add(c, ir.Constant(i64, lane))
-                    with b.if_then(b.icmp_signed("<", m, n), likely=True):
-                        each(j, m, b.extract_element(value, ir.Constant(i32, lane)))
+                with b.if_then(b.icmp_signed("<", c, n), likely=True):
+                    each(j, c, b.load(slot))
 
 
 _LANE_INDEX = ir.Constant(ir.VectorType(ir.IntType(64), _LANES), list(range(_LANES)))
@@ -227,11 +218,9 @@ def _masked_store(b, value, pointer, mask):
     b.call(store, [value, b.bitcast(pointer, vec.as_pointer()), ir.Constant(ir.IntType(32), 8), mask])
 
 
-def _element(context, b, array_type, array, *indices):
-    """Pointer to array[indices] for an array of any layout."""
-    a = context.make_array(array_type)(context, b, array)
-    return cgutils.get_item_pointer2(context, b, a.data, cgutils.unpack_tuple(b, a.shape),
-                                     cgutils.unpack_tuple(b, a.strides), array_type.layout, list(indices))
+def _lanes_in(b, c, n):
+    """The mask of the lanes c … c + 7 that are components (below n)."""
+    return b.icmp_unsigned("<", b.add(_splat(b, c), _LANE_INDEX), _splat(b, n))
 
 
 def _arrays(*arrays) -> bool:
@@ -254,15 +243,14 @@ def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
         i_ = context.cast(b, i_, types_[6], types.intp)
         hs = [b.extract_value(dts_, j) for j in range(types_[2].count)]
 
-        def each_vector(j, c, v):  # a scalar y_m + (v_m·dt − c_m) on 8 components at once: masked loads, stores
-            mask = b.icmp_unsigned("<", b.add(_splat(b, c), _LANE_INDEX), _splat(b, n))
+        def each(j, c, v):  # y_m + (v_m·dt − c_m) on 8 components at once: masked loads and stores
+            mask = _lanes_in(b, c, n)
             y_v, c_v = (_masked_load(b, b.gep(_data(context, b, types_[a], args[a]), [c]), mask) for a in (3, 4))
             row = b.gep(_data(context, b, types_[5], Y_), [b.add(b.mul(b.add(i_, ir.Constant(i_.type, j)), n), c)])
             _masked_store(b, b.fadd(y_v, b.fsub(b.fmul(v, _splat(b, hs[j])), c_v)), row, mask)
 
         n = b.extract_value(context.make_array(types_[3])(context, b, y_).shape, 0)
-        _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), hs, None,
-                     each_vector)
+        _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), hs, each)
         return context.get_dummy_value()
 
     return sig, codegen
@@ -272,27 +260,31 @@ def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
 def _advance(typingctx, T, order, h, y, carry):
     """y ← y + v·h as a compensated (Kahan) sum, v = Σ_{k≥1} T[k] h^(k−1) (``_emit_horner``): the bits lost in the
     additions carried in ``carry``. Returns whether every new component is finite."""
-    if not (_arrays(T, y, carry) and T.layout == "C"):
+    if not (_arrays(T, y, carry) and all(a.layout == "C" for a in (T, y, carry))):
         return None
     sig = types.boolean(T, order, types.float64, y, carry)
 
     def codegen(context, b, signature, args):
         T_, order_, h_, y_, carry_ = args
         types_ = signature.args
+        n = b.extract_value(context.make_array(types_[3])(context, b, y_).shape, 0)
         finite = cgutils.alloca_once_value(b, cgutils.true_bit)
+        vec = ir.VectorType(ir.DoubleType(), _LANES)
+        fabs = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec]), f"llvm.fabs.v{_LANES}f64")
+        every = cgutils.get_or_insert_function(b.module, ir.FunctionType(ir.IntType(1), [ir.VectorType(
+            ir.IntType(1), _LANES)]), f"llvm.vector.reduce.and.v{_LANES}i1")
 
-        def each(_, m, v):
-            y_at, c_at = _element(context, b, types_[3], y_, m), _element(context, b, types_[4], carry_, m)
-            y_m = b.load(y_at)
-            inc = b.fsub(b.fmul(v, h_), b.load(c_at))
-            total = b.fadd(y_m, inc)
-            b.store(b.fsub(b.fsub(total, y_m), inc), c_at)
-            b.store(total, y_at)
-            # finite: |total| < inf (false for NaN and ±inf)
-            magnitude = b.call(cgutils.get_or_insert_function(b.module, ir.FunctionType(ir.DoubleType(),
-                                                              [ir.DoubleType()]), "llvm.fabs.f64"), [total])
-            b.store(b.and_(b.load(finite), b.fcmp_ordered("<", magnitude, ir.Constant(ir.DoubleType(), math.inf))),
-                    finite)
+        def each(_, c, v):  # the Kahan update of 8 components at once: masked loads and stores
+            mask = _lanes_in(b, c, n)
+            y_at, c_at = (b.gep(_data(context, b, types_[a], args[a]), [c]) for a in (3, 4))
+            y_v = _masked_load(b, y_at, mask)
+            inc = b.fsub(b.fmul(v, _splat(b, h_)), _masked_load(b, c_at, mask))
+            total = b.fadd(y_v, inc)
+            _masked_store(b, b.fsub(b.fsub(total, y_v), inc), c_at, mask)
+            _masked_store(b, total, y_at, mask)
+            # finite: |total| < inf (false for NaN and ±inf), in every lane that is a component
+            bounded = b.fcmp_ordered("<", b.call(fabs, [total]), ir.Constant(vec, [math.inf] * _LANES))
+            b.store(b.and_(b.load(finite), b.call(every, [b.or_(bounded, b.not_(mask))])), finite)
 
         _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), [h_], each)
         return b.load(finite)
