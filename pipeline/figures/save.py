@@ -58,7 +58,9 @@ def save(fig: Figure, stem: str | Path, formats: Iterable[str] = DEFAULT_FORMATS
     """Write ``fig`` to ``stem.<format>`` for each format (``gyrolab.output.atomic``); returns the paths."""
     stem = Path(stem)
     written = []
-    with matplotlib.rc_context(RC):
+    # savefig gives a figure without an engine the rcParams' default one when done (the style's: constrained)
+    unlaid = {} if fig.get_layout_engine() is not None else {"figure.constrained_layout.use": False}
+    with matplotlib.rc_context({**RC, **unlaid}):
         for fmt in formats:
             path = stem.parent / f"{stem.name}.{fmt}"
             with atomic_path(path) as tmp, _laid_out(fig, dpi if fmt == "png" else None):

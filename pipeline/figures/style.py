@@ -62,18 +62,64 @@ def tidy_log(ax: Axes) -> None:
         axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
-def figure(width: float, height: float, **kwargs: Any) -> Figure:
-    """A figure of ``width`` × ``height`` inches rendered by Agg (``kwargs``: ``Figure``'s, e.g. ``layout``)."""
-    fig = Figure(figsize=(width, height), **kwargs)
+def figure(width: float, height: float, layout: str | None = None) -> Figure:
+    """A figure of ``width`` × ``height`` inches rendered by Agg; ``layout="none"``: no layout engine at all (margins
+    by hand or ``fit``), not matplotlib's placeholder, with which savefig would draw the figure twice."""
+    with matplotlib.rc_context({"figure.constrained_layout.use": False} if layout == "none" else {}):
+        fig = Figure(figsize=(width, height), layout=None if layout == "none" else layout)
     FigureCanvasAgg(fig)
     return fig
 
 
 def subplots(nrows: int = 1, ncols: int = 1, *, width: float = SINGLE, height: float | None = None,
-             **kwargs: Any) -> tuple[Figure, np.ndarray]:
+             layout: str | None = None, **kwargs: Any) -> tuple[Figure, np.ndarray]:
     """A grid of panels at a journal column width (``SINGLE`` or ``DOUBLE``); axes always 2-D."""
-    fig = figure(width, height if height is not None else 1.0 + 1.7 * nrows)
+    fig = figure(width, height if height is not None else 1.0 + 1.7 * nrows, layout)
     return fig, fig.subplots(nrows, ncols, squeeze=False, **kwargs)
+
+
+def fit(fig: Figure, axes: np.ndarray) -> None:
+    """Fixed margins and gaps for a grid of panels (``subplots(layout="none")``), measured once from what lies
+    outside the panels: tick and axis labels, notes, legends beside a panel, the figure's title and legends. The
+    room the constrained layout gives, at a fraction of its cost (it walks every panel's ticks four times):
+    docs/performance.md, "The default run". Measured with the panels at their largest, so at their final size
+    they get no more ticks, hence no wider labels, than measured."""
+    for ax in axes.flat:
+        tidy_log(ax)  # the final ticks of the log axes are the ones measured
+    rc, renderer = matplotlib.rcParams, fig.canvas.get_renderer()
+    scale, pad = 72 / fig.dpi, 72 * rc["figure.constrained_layout.w_pad"]  # points per pixel; points
+    width, height = fig.get_size_inches() * 72
+    fig.subplots_adjust(left=0.02, right=0.98, bottom=0.02, top=0.98, wspace=0.02, hspace=0.02)
+
+    def size(artists: Sequence[Any], i: int) -> float:  # widest (0) or tallest (1) visible, non-empty one, in points
+        return max((a.get_window_extent(renderer).size[i] * scale for a in artists if a is not None and a.get_visible()
+                    and getattr(a, "get_text", lambda: "drawn")()), default=0.0)
+
+    def stack(*parts: tuple[float, float]) -> float:  # (size, gap before it): the sizes that are not 0, with gaps
+        return sum(extent + gap for extent, gap in parts if extent)
+
+    sides = np.zeros(axes.shape + (4,))  # left, bottom, top, right of each panel, in points
+    for index, ax in np.ndenumerate(axes):
+        xticks, yticks = ax.xaxis.get_majorticklabels(), ax.yaxis.get_majorticklabels()
+        sides[index] = (
+            stack((size(yticks, 0), rc["ytick.major.pad"]), (size([ax.yaxis.label], 0), rc["axes.labelpad"])),
+            stack((size(xticks, 1), rc["xtick.major.pad"]), (size([ax.xaxis.label], 1), rc["axes.labelpad"])),
+            max(stack((size([ax.title, ax._left_title, ax._right_title], 1), rc["axes.titlepad"]),
+                    (size([ax.yaxis.offsetText], 1), pad)), size(yticks, 1) / 2),
+            max(stack((size([ax.get_legend()], 0), 0.01 * width / axes.shape[1])), size(xticks, 0) / 2))
+    top = pad + sides[0, :, 2].max()
+    if fig._suptitle is not None:
+        fig._suptitle.set(y=1 - pad / height, va="top")
+        top += height - fig._suptitle.get_window_extent(renderer).y0 * scale
+    bottom = pad + sides[-1, :, 1].max() + max((box.get_window_extent(renderer).y1 * scale for box in fig.legends),
+                                               default=0.0)  # a figure legend sits at the bottom edge
+    left, right = pad + sides[:, 0, 0].max(), pad + sides[:, -1, 3].max()
+    wgap = max((sides[:, j, 3].max() + sides[:, j + 1, 0].max() + 2 * pad for j in range(axes.shape[1] - 1)), default=0)
+    hgap = max((sides[i, :, 1].max() + sides[i + 1, :, 2].max() + 2 * pad for i in range(axes.shape[0] - 1)), default=0)
+    panel_w = (width - left - right - wgap * (axes.shape[1] - 1)) / axes.shape[1]
+    panel_h = (height - top - bottom - hgap * (axes.shape[0] - 1)) / axes.shape[0]
+    fig.subplots_adjust(left=left / width, right=1 - right / width, bottom=bottom / height, top=1 - top / height,
+                        wspace=wgap / panel_w, hspace=hgap / panel_h)
 
 
 def legend_outside(fig: Figure, axes: Sequence[Axes] | None = None, *, ncols: int | None = None,
