@@ -163,7 +163,7 @@ FIGURES: dict[str, Callable[[xr.Dataset], Figure]] = {
 
 
 def _draw(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ...], dpi: int) -> list[Path]:
-    fig = FIGURES[name](ds)
+    fig = FIGURES[name](ds, dpi=dpi if "png" in formats else None)
     return save(fig, directory / name, formats, dpi, metadata_of(ds, fig._suptitle.get_text() if fig._suptitle else name))
 
 

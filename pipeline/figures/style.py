@@ -36,10 +36,11 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 
 def styled(draw: F) -> F:
-    """Run a drawing function inside gyrolab's style context; its log axes get readable ticks."""
+    """Run a drawing function inside gyrolab's style context; its log axes get readable ticks. ``dpi``: the figure's,
+    when it is to be saved at that dpi (what it measures then, e.g. in ``fit``, is what the save draws: measured once)."""
     @functools.wraps(draw)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        with matplotlib.rc_context(RC):
+    def wrapper(*args: Any, dpi: float | None = None, **kwargs: Any) -> Any:
+        with matplotlib.rc_context({**RC, **({"figure.dpi": dpi} if dpi else {})}):
             fig = draw(*args, **kwargs)
             for ax in fig.axes:
                 if ax.name == "rectilinear":
