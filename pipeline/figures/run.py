@@ -181,15 +181,11 @@ def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] =
         gc.freeze()
         pool = multiprocessing.get_context("fork").Pool(1, initializer=gc.disable)
         forked = pool.apply_async(_draw, jobs.pop(0))
-    collecting = gc.isenabled()
-    gc.disable()  # what a figure builds lives until it is saved: a collection meanwhile finds nothing to free
     try:
         results = [_draw(*job) for job in jobs]
         if pool is not None:
             results.insert(0, forked.get())
     finally:
-        if collecting:
-            gc.enable()
         if pool is not None:
             # close and join, not the context manager's terminate(): terminate kills the worker, and one killed while
             # it held the task queue's lock left the run waiting for that lock (a hung run)
