@@ -80,47 +80,39 @@ def subplots(nrows: int = 1, ncols: int = 1, *, width: float = SINGLE, height: f
 
 
 def fit(fig: Figure, axes: np.ndarray) -> None:
-    """Fixed margins and gaps for a grid of panels (``subplots(layout="none")``), measured once from what lies
-    outside the panels: tick and axis labels, notes, legends beside a panel, the figure's title and legends. The
-    room the constrained layout gives, at a fraction of its cost (it walks every panel's ticks four times):
-    docs/performance.md, "The default run". Measured with the panels at their largest, so at their final size
-    they get no more ticks, hence no wider labels, than measured."""
-    for ax in axes.flat:
-        tidy_log(ax)  # the final ticks of the log axes are the ones measured
-    rc, renderer = matplotlib.rcParams, fig.canvas.get_renderer()
-    scale, pad = 72 / fig.dpi, 72 * rc["figure.constrained_layout.w_pad"]  # points per pixel; points
-    width, height = fig.get_size_inches() * 72
-    fig.subplots_adjust(left=0.02, right=0.98, bottom=0.02, top=0.98, wspace=0.02, hspace=0.02)
+    """Fixed margins for a grid of panels (``subplots(layout="none")``) measured once from the text around them (tick
+    and axis labels, notes, legends beside a panel, the figure's title and legend): the constrained layout's room at
+    a fraction of its cost (docs/performance.md, "The default run"). Measured with the panels at their largest: at
+    their final size they get no more ticks, so no wider labels. Sizes in points."""
+    rc, renderer, (width, height) = matplotlib.rcParams, fig.canvas.get_renderer(), fig.get_size_inches() * 72
+    scale, pad, (rows, cols) = 72 / fig.dpi, 72 * rc["figure.constrained_layout.w_pad"], axes.shape
+    fig.subplots_adjust(0.02, 0.02, 0.98, 0.98, 0.02, 0.02)
 
-    def size(artists: Sequence[Any], i: int) -> float:  # widest (0) or tallest (1) visible, non-empty one, in points
-        return max((a.get_window_extent(renderer).size[i] * scale for a in artists if a is not None and a.get_visible()
-                    and getattr(a, "get_text", lambda: "drawn")()), default=0.0)
+    def size(artists: Sequence[Any], i: int, gap: float = 0.0) -> float:  # widest (i=0) or tallest (1) shown, + gap
+        extent = max((a.get_window_extent(renderer).size[i] * scale for a in artists if a is not None and a.get_visible()
+                      and getattr(a, "get_text", lambda: "drawn")()), default=0.0)
+        return extent + gap if extent else 0.0
 
-    def stack(*parts: tuple[float, float]) -> float:  # (size, gap before it): the sizes that are not 0, with gaps
-        return sum(extent + gap for extent, gap in parts if extent)
-
-    sides = np.zeros(axes.shape + (4,))  # left, bottom, top, right of each panel, in points
-    for index, ax in np.ndenumerate(axes):
-        xticks, yticks = ax.xaxis.get_majorticklabels(), ax.yaxis.get_majorticklabels()
-        sides[index] = (
-            stack((size(yticks, 0), rc["ytick.major.pad"]), (size([ax.yaxis.label], 0), rc["axes.labelpad"])),
-            stack((size(xticks, 1), rc["xtick.major.pad"]), (size([ax.xaxis.label], 1), rc["axes.labelpad"])),
-            max(stack((size([ax.title, ax._left_title, ax._right_title], 1), rc["axes.titlepad"]),
-                    (size([ax.yaxis.offsetText], 1), pad)), size(yticks, 1) / 2),
-            max(stack((size([ax.get_legend()], 0), 0.01 * width / axes.shape[1])), size(xticks, 0) / 2))
-    top = pad + sides[0, :, 2].max()
+    sides = np.zeros((rows, cols, 4))  # left, bottom, top, right of each panel
+    for (i, j), ax in np.ndenumerate(axes):
+        tidy_log(ax)  # the log axes' final ticks are the ones measured
+        x, y = ax.xaxis.get_majorticklabels(), ax.yaxis.get_majorticklabels()
+        sides[i, j] = (size(y, 0, rc["ytick.major.pad"]) + size([ax.yaxis.label], 0, rc["axes.labelpad"]),
+                       size(x, 1, rc["xtick.major.pad"]) + size([ax.xaxis.label], 1, rc["axes.labelpad"]),
+                       max(size([ax.title, ax._left_title, ax._right_title], 1, rc["axes.titlepad"])
+                           + size([ax.yaxis.offsetText], 1, pad), size(y, 1) / 2),
+                       max(size([ax.get_legend()], 0, 0.01 * width / cols), size(x, 0) / 2))
     if fig._suptitle is not None:
         fig._suptitle.set(y=1 - pad / height, va="top")
-        top += height - fig._suptitle.get_window_extent(renderer).y0 * scale
+    top = pad + sides[0, :, 2].max() + size([fig._suptitle], 1, pad)
     bottom = pad + sides[-1, :, 1].max() + max((box.get_window_extent(renderer).y1 * scale for box in fig.legends),
                                                default=0.0)  # a figure legend sits at the bottom edge
     left, right = pad + sides[:, 0, 0].max(), pad + sides[:, -1, 3].max()
-    wgap = max((sides[:, j, 3].max() + sides[:, j + 1, 0].max() + 2 * pad for j in range(axes.shape[1] - 1)), default=0)
-    hgap = max((sides[i, :, 1].max() + sides[i + 1, :, 2].max() + 2 * pad for i in range(axes.shape[0] - 1)), default=0)
-    panel_w = (width - left - right - wgap * (axes.shape[1] - 1)) / axes.shape[1]
-    panel_h = (height - top - bottom - hgap * (axes.shape[0] - 1)) / axes.shape[0]
-    fig.subplots_adjust(left=left / width, right=1 - right / width, bottom=bottom / height, top=1 - top / height,
-                        wspace=wgap / panel_w, hspace=hgap / panel_h)
+    wgap = max((sides[:, j, 3].max() + sides[:, j + 1, 0].max() + 2 * pad for j in range(cols - 1)), default=0.0)
+    hgap = max((sides[i, :, 1].max() + sides[i + 1, :, 2].max() + 2 * pad for i in range(rows - 1)), default=0.0)
+    fig.subplots_adjust(left / width, bottom / height, 1 - right / width, 1 - top / height,
+                        wgap * cols / (width - left - right - wgap * (cols - 1)),
+                        hgap * rows / (height - top - bottom - hgap * (rows - 1)))
 
 
 def legend_outside(fig: Figure, axes: Sequence[Axes] | None = None, *, ncols: int | None = None,
