@@ -155,11 +155,9 @@ def trace(ax: Axes, t: np.ndarray, y: np.ndarray, *, label: str | None = None, *
     if n <= MAX_OSCILLATIONS or len(t) < 4 * bins:
         ax.plot(t, y, label=label, **style)
         return False
-    edges = np.linspace(0, len(t), bins + 1).astype(int)
-    with np.errstate(all="ignore"):
-        low = np.array([np.nanmin(y[a:b]) for a, b in zip(edges[:-1], edges[1:])])
-        high = np.array([np.nanmax(y[a:b]) for a, b in zip(edges[:-1], edges[1:])])
-    centres = np.array([t[a:b].mean() for a, b in zip(edges[:-1], edges[1:])])
+    edges = np.linspace(0, len(t), bins + 1).astype(int)  # bins of at least 4 samples
+    low, high = np.fmin.reduceat(y, edges[:-1]), np.fmax.reduceat(y, edges[:-1])  # NaN only where all are
+    centres = np.add.reduceat(t, edges[:-1]) / np.diff(edges)
     color = style.get("color")
     band = ax.fill_between(centres, low, high, alpha=0.45, lw=0, color=color, label=label)
     ax.plot(centres, low, lw=0.4, color=band.get_facecolor()[0][:3])
