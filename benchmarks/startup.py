@@ -58,8 +58,9 @@ def measure(name: str, cache: str, site: str) -> dict[str, float]:
     return json.loads(result.stdout.strip().splitlines()[-1])
 
 
-#: issue 24 item 4: the default ``gyrolab`` end to end on an idle 2-core machine, CPU s (process and children)
-DEFAULT_TARGETS = {"true": 2.5, "false": 1.5}
+#: the default ``gyrolab`` end to end on an idle 2-core machine: wall s (issue 24 item 4) and, with its figures, CPU s
+#: of the process and its children (issue 34: "the default run stays ≤ 2.5 s CPU")
+DEFAULT_TARGETS = {"true": (2.5, 2.5), "false": (1.5, None)}
 
 
 def import_breakdown(top: int = 12) -> None:
@@ -86,14 +87,15 @@ def import_breakdown(top: int = 12) -> None:
 
 
 def default_run() -> None:
-    """Wall and CPU s of the default ``gyrolab`` (its process and figure workers), with and without figures, best
-    of 3; the wall time is the target's measure (an idle machine), the CPU time the steadier one on a busy one."""
+    """Wall and CPU s of the default ``gyrolab``, with and without figures, best of 3. The CPU time is the run's
+    children's (``RUSAGE_CHILDREN``): the ``gyrolab`` process and every process it waited for, so the forked worker
+    that draws a figure (joined by the run) and the ``git`` calls of the provenance count."""
     import importlib.util
     import resource
     import time
 
     verdicts, rows = [], []
-    for figures, target in DEFAULT_TARGETS.items():
+    for figures, (wall_target, cpu_target) in DEFAULT_TARGETS.items():
         best_cpu = best_wall = float("inf")
         for _ in range(3):
             with tempfile.TemporaryDirectory() as tmp:
@@ -105,11 +107,13 @@ def default_run() -> None:
                 best_wall = min(best_wall, time.perf_counter() - start)
                 usage = resource.getrusage(resource.RUSAGE_CHILDREN)
                 best_cpu = min(best_cpu, usage.ru_utime + usage.ru_stime - before)
-        verdicts.append(best_wall <= target)
+        passed = best_wall <= wall_target and (cpu_target is None or best_cpu <= cpu_target)
+        verdicts.append(passed)
+        target = f"≤ {wall_target} s wall" + (f", ≤ {cpu_target} s CPU" if cpu_target is not None else "")
         print(f"default gyrolab, output.figures={figures}: {best_wall:.2f} s wall, {best_cpu:.2f} s CPU "
-              f"(target ≤ {target} s wall)")
+              f"(target {target})")
         rows.append([f"`gyrolab output.figures={str(figures).lower()}`", f"{best_wall:.2f}", f"{best_cpu:.2f}",
-                     f"≤ {target}", "PASS" if best_wall <= target else "FAIL"])
+                     target, "PASS" if passed else "FAIL"])
     print(f"{'PASS' if all(verdicts) else 'FAIL'}: default run within its targets")
     # xarray asks Dask for its scheduler on every to_netcdf when Dask is installed (the test and cluster extras),
     # importing distributed (~0.45 s): say which install the numbers are for
@@ -120,12 +124,12 @@ def default_run() -> None:
     write_results("startup_default_run", {"rows": rows, "dask_installed": dask}, {"default_run": {
         "caption": f"The default `gyrolab` end to end in a fresh process (best of 3; Dask "
                    f"{'installed: the test extras' if dask else 'not installed: the README install'}). "
-                   f"The targets are wall times on an idle 2-core machine.",
-        "header": ["command", "wall s", "CPU s", "target wall s", "verdict"], "rows": rows}},
+                   f"The targets are for an idle 2-core machine; CPU s counts the run's figure worker.",
+        "header": ["command", "wall s", "CPU s", "target", "verdict"], "rows": rows}},
         clock="time.perf_counter (wall) and the children's CPU time (getrusage)",
         command="benchmarks/startup.py --default-run",
-        summary=[[f"the default {row[0]} end to end (wall{', README install' if not dask else ''})", f"{row[1]} s",
-                  f"{row[3]} s", row[4]] for row in rows])
+        summary=[[f"the default {row[0]} end to end{' (README install)' if not dask else ''}",
+                  f"{row[1]} s wall, {row[2]} s CPU", row[3], row[4]] for row in rows])
 
 
 def main() -> None:

@@ -18,7 +18,7 @@ import xarray as xr
 from gyrolab.figures.labels import GAMMA, label, time_label, unit
 from gyrolab.figures.options import DEFAULT_DPI, DEFAULT_FORMATS
 from gyrolab.figures.save import metadata_of, save
-from gyrolab.figures.style import (DOUBLE, SINGLE, Figure, fast_window, figure, legend_outside, log_positive,
+from gyrolab.figures.style import (DOUBLE, SINGLE, Figure, fast_window, figure, fit, legend_outside, log_positive,
                                    panel_note, styled, subplots, trace, unit_sphere)
 
 #: invariant variable -> (symbol in a legend, kind of unit)
@@ -44,7 +44,7 @@ def draw_state(ds: xr.Dataset) -> Figure:
     rows = _rows(ds)
     window = fast_window(t, [ds[v].values[:, i] for v, comps, _, _ in rows for i in comps])
     ncols = 1 if window == slice(None) else 2
-    fig, axes = subplots(3, ncols, width=SINGLE if ncols == 1 else DOUBLE, height=5.2, sharex="col")
+    fig, axes = subplots(3, ncols, width=SINGLE if ncols == 1 else DOUBLE, height=5.2, layout="none", sharex="col")
     enveloped = []
     for row, (name, comps, labels, ylabel) in enumerate(rows):
         for j, (i, lab) in enumerate(zip(comps, labels)):
@@ -62,13 +62,14 @@ def draw_state(ds: xr.Dataset) -> Figure:
                                               if enveloped else ""))
         panel_note(axes[0, 1], f"leading window, t ≤ {t[window][-1]:.3g}")
     fig.suptitle("Angular velocity and direction cosines in body axes")
+    fit(fig, axes)
     return fig
 
 
 @styled
 def draw_invariants(ds: xr.Dataset) -> Figure:
     """Absolute drift |I(t) − I(0)| of every monitored first integral (log scale; exact zeros are gaps)."""
-    fig, axes = subplots(1, 1, width=SINGLE, height=2.9)
+    fig, axes = subplots(1, 1, width=SINGLE, height=2.9, layout="none")
     ax = axes[0, 0]
     exact, violated = [], []
     for name in ds.attrs.get("monitored_invariants", "").split():
@@ -91,6 +92,7 @@ def draw_invariants(ds: xr.Dataset) -> Figure:
     if violated:
         panel_note(ax, f"NOT conserved by this run (flagged violated in run.nc, not drawn): {', '.join(violated)}")
     legend_outside(fig, [ax], ncols=1)
+    fit(fig, axes)
     return fig
 
 
@@ -99,7 +101,8 @@ def draw_euler_angles(ds: xr.Dataset) -> Figure:
     """Euler angles ψ, θ, φ (z-x-z, unwrapped) against time."""
     names = [(n, s) for n, s in (("psi", "precession ψ"), ("theta", "nutation θ"), ("phi", "proper rotation φ"))
              if n in ds]
-    fig, axes = subplots(len(names), 1, width=SINGLE, height=1.0 + 1.3 * len(names), sharex="col")
+    fig, axes = subplots(len(names), 1, width=SINGLE, height=1.0 + 1.3 * len(names), layout="none",
+                         sharex="col")
     notes = []
     for ax, (name, symbol) in zip(axes[:, 0], names):
         if trace(ax, ds["time"].values, ds[name].values, color="C0"):
@@ -109,6 +112,7 @@ def draw_euler_angles(ds: xr.Dataset) -> Figure:
     if notes:
         panel_note(axes[0, 0], f"{', '.join(notes)}: min–max envelope (too dense to draw as lines)")
     fig.suptitle("Euler angles (z-x-z)")
+    fit(fig, axes)
     return fig
 
 
@@ -159,7 +163,7 @@ FIGURES: dict[str, Callable[[xr.Dataset], Figure]] = {
 
 
 def _draw(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ...], dpi: int) -> list[Path]:
-    fig = FIGURES[name](ds)
+    fig = FIGURES[name](ds, dpi=dpi if "png" in formats else None)
     return save(fig, directory / name, formats, dpi, metadata_of(ds, fig._suptitle.get_text() if fig._suptitle else name))
 
 
@@ -177,15 +181,11 @@ def save_figures(ds: xr.Dataset, directory: str | Path, formats: Iterable[str] =
         gc.freeze()
         pool = multiprocessing.get_context("fork").Pool(1, initializer=gc.disable)
         forked = pool.apply_async(_draw, jobs.pop(0))
-    collecting = gc.isenabled()
-    gc.disable()  # what a figure builds lives until it is saved: a collection meanwhile finds nothing to free
     try:
         results = [_draw(*job) for job in jobs]
         if pool is not None:
             results.insert(0, forked.get())
     finally:
-        if collecting:
-            gc.enable()
         if pool is not None:
             # close and join, not the context manager's terminate(): terminate kills the worker, and one killed while
             # it held the task queue's lock left the run waiting for that lock (a hung run)

@@ -36,10 +36,11 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 
 def styled(draw: F) -> F:
-    """Run a drawing function inside gyrolab's style context; its log axes get readable ticks."""
+    """Run a drawing function inside gyrolab's style context; its log axes get readable ticks. ``dpi``: the figure's,
+    when it is to be saved at that dpi (what it measures then, e.g. in ``fit``, is what the save draws: measured once)."""
     @functools.wraps(draw)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        with matplotlib.rc_context(RC):
+    def wrapper(*args: Any, dpi: float | None = None, **kwargs: Any) -> Any:
+        with matplotlib.rc_context({**RC, **({"figure.dpi": dpi} if dpi else {})}):
             fig = draw(*args, **kwargs)
             for ax in fig.axes:
                 if ax.name == "rectilinear":
@@ -62,18 +63,56 @@ def tidy_log(ax: Axes) -> None:
         axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
-def figure(width: float, height: float, **kwargs: Any) -> Figure:
-    """A figure of ``width`` × ``height`` inches rendered by Agg (``kwargs``: ``Figure``'s, e.g. ``layout``)."""
-    fig = Figure(figsize=(width, height), **kwargs)
+def figure(width: float, height: float, layout: str | None = None) -> Figure:
+    """A figure of ``width`` × ``height`` inches rendered by Agg; ``layout="none"``: no layout engine at all (margins
+    by hand or ``fit``), not matplotlib's placeholder, with which savefig would draw the figure twice."""
+    with matplotlib.rc_context({"figure.constrained_layout.use": False} if layout == "none" else {}):
+        fig = Figure(figsize=(width, height), layout=None if layout == "none" else layout)
     FigureCanvasAgg(fig)
     return fig
 
 
 def subplots(nrows: int = 1, ncols: int = 1, *, width: float = SINGLE, height: float | None = None,
-             **kwargs: Any) -> tuple[Figure, np.ndarray]:
+             layout: str | None = None, **kwargs: Any) -> tuple[Figure, np.ndarray]:
     """A grid of panels at a journal column width (``SINGLE`` or ``DOUBLE``); axes always 2-D."""
-    fig = figure(width, height if height is not None else 1.0 + 1.7 * nrows)
+    fig = figure(width, height if height is not None else 1.0 + 1.7 * nrows, layout)
     return fig, fig.subplots(nrows, ncols, squeeze=False, **kwargs)
+
+
+def fit(fig: Figure, axes: np.ndarray) -> None:
+    """Fixed margins for a grid of panels (``subplots(layout="none")``) measured once from the text around them (tick
+    and axis labels, notes, legends beside a panel, the figure's title and legend): the constrained layout's room at
+    a fraction of its cost (docs/performance.md, "The default run"). Measured with the panels at their largest: at
+    their final size they get no more ticks, so no wider labels. Sizes in points."""
+    rc, renderer, (width, height) = matplotlib.rcParams, fig.canvas.get_renderer(), fig.get_size_inches() * 72
+    scale, pad, (rows, cols) = 72 / fig.dpi, 72 * rc["figure.constrained_layout.w_pad"], axes.shape
+    fig.subplots_adjust(0.02, 0.02, 0.98, 0.98, 0.02, 0.02)
+
+    def size(artists: Sequence[Any], i: int, gap: float = 0.0) -> float:  # widest (i=0) or tallest (1) shown, + gap
+        extent = max((a.get_window_extent(renderer).size[i] * scale for a in artists if a is not None and a.get_visible()
+                      and getattr(a, "get_text", lambda: "drawn")()), default=0.0)
+        return extent + gap if extent else 0.0
+
+    sides = np.zeros((rows, cols, 4))  # left, bottom, top, right of each panel
+    for (i, j), ax in np.ndenumerate(axes):
+        tidy_log(ax)  # the log axes' final ticks are the ones measured
+        x, y = ax.xaxis.get_majorticklabels(), ax.yaxis.get_majorticklabels()
+        sides[i, j] = (size(y, 0, rc["ytick.major.pad"]) + size([ax.yaxis.label], 0, rc["axes.labelpad"]),
+                       size(x, 1, rc["xtick.major.pad"]) + size([ax.xaxis.label], 1, rc["axes.labelpad"]),
+                       max(size([ax.title, ax._left_title, ax._right_title], 1, rc["axes.titlepad"])
+                           + size([ax.yaxis.offsetText], 1, pad), size(y, 1) / 2),
+                       max(size([ax.get_legend()], 0, 0.01 * width / cols), size(x, 0) / 2))
+    if fig._suptitle is not None:
+        fig._suptitle.set(y=1 - pad / height, va="top")
+    top = pad + sides[0, :, 2].max() + size([fig._suptitle], 1, pad)
+    bottom = pad + sides[-1, :, 1].max() + max((box.get_window_extent(renderer).y1 * scale for box in fig.legends),
+                                               default=0.0)  # a figure legend sits at the bottom edge
+    left, right = pad + sides[:, 0, 0].max(), pad + sides[:, -1, 3].max()
+    wgap = max((sides[:, j, 3].max() + sides[:, j + 1, 0].max() + 2 * pad for j in range(cols - 1)), default=0.0)
+    hgap = max((sides[i, :, 1].max() + sides[i + 1, :, 2].max() + 2 * pad for i in range(rows - 1)), default=0.0)
+    fig.subplots_adjust(left / width, bottom / height, 1 - right / width, 1 - top / height,
+                        wgap * cols / (width - left - right - wgap * (cols - 1)),
+                        hgap * rows / (height - top - bottom - hgap * (rows - 1)))
 
 
 def legend_outside(fig: Figure, axes: Sequence[Axes] | None = None, *, ncols: int | None = None,
@@ -116,11 +155,9 @@ def trace(ax: Axes, t: np.ndarray, y: np.ndarray, *, label: str | None = None, *
     if n <= MAX_OSCILLATIONS or len(t) < 4 * bins:
         ax.plot(t, y, label=label, **style)
         return False
-    edges = np.linspace(0, len(t), bins + 1).astype(int)
-    with np.errstate(all="ignore"):
-        low = np.array([np.nanmin(y[a:b]) for a, b in zip(edges[:-1], edges[1:])])
-        high = np.array([np.nanmax(y[a:b]) for a, b in zip(edges[:-1], edges[1:])])
-    centres = np.array([t[a:b].mean() for a, b in zip(edges[:-1], edges[1:])])
+    edges = np.linspace(0, len(t), bins + 1).astype(int)  # bins of at least 4 samples
+    low, high = np.fmin.reduceat(y, edges[:-1]), np.fmax.reduceat(y, edges[:-1])  # NaN only where all are
+    centres = np.add.reduceat(t, edges[:-1]) / np.diff(edges)
     color = style.get("color")
     band = ax.fill_between(centres, low, high, alpha=0.45, lw=0, color=color, label=label)
     ax.plot(centres, low, lw=0.4, color=band.get_facecolor()[0][:3])

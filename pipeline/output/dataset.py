@@ -10,7 +10,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
+import pandas as pd
 import xarray as xr
+from xarray.indexes import PandasIndex
 
 from gyrolab.compat import install_dask_free_writes
 from gyrolab.contracts.integrator import Integrator, Solution
@@ -30,6 +32,12 @@ install_dask_free_writes()
 
 #: labels of the ``frame_axis`` dimension (the orbiting gyrostat's orbital and inertial frames)
 FRAME_AXES = ("x_radial", "y_along_track", "z_normal")
+#: the label coordinates of run datasets with their indexes, built once (a dataset copies them: ~0.1 ms a run less)
+LABELS = xr.Coordinates({
+    "axis": ("axis", np.array(["x", "y", "z"]), {"units": "1", "long_name": "principal body axis"}),
+    "frame_axis": ("frame_axis", np.array(FRAME_AXES), {
+        "units": "1", "long_name": "frame axis: orbital (radial, along-track, orbit normal) or inertial (X, Y, Z: the "
+                                   "orbital axes at t = 0)"})})
 
 
 def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.Variable]], tuple[
@@ -48,14 +56,11 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
     if add is not None:
         added, added_attrs = add(variables)
         variables.update(added)
-    coords = {
-        "time": ("time", solution.t, time_attributes(body)),
-        "axis": ("axis", np.array(["x", "y", "z"]), {"units": "1", "long_name": "principal body axis"}),
-    }
-    if any("frame_axis" in v.dims for v in variables.values()):
-        coords["frame_axis"] = ("frame_axis", np.array(FRAME_AXES), {
-            "units": "1", "long_name": "frame axis: orbital (radial, along-track, orbit normal) or inertial (X, Y, Z: "
-                                       "the orbital axes at t = 0)"})
+    labels = ["axis"] + [name for name in ("frame_axis",) if any(name in v.dims for v in variables.values())]
+    time = PandasIndex(pd.Index(solution.t), "time")  # given with its index: xarray builds no index for the labels
+    coords = xr.Coordinates({**time.create_variables({"time": xr.Variable("time", solution.t, time_attributes(body))}),
+                             **{name: LABELS.variables[name] for name in labels}},
+                            indexes={"time": time, **{name: LABELS.xindexes[name] for name in labels}})
     ds = xr.Dataset(variables, coords=coords)
     before, after = scene.dataset_attributes  # the scene's own, once per scene
     ds.attrs.update(before)

@@ -283,22 +283,65 @@ def test_sweep_x_label_gives_the_swept_keys_unit(key, units, expected):
     assert draw_invariant_drift(ds).axes[0].get_xlabel() == expected
 
 
-def test_a_figure_laid_out_once_has_the_pixels_of_matplotlibs_own_save(run_dir, tmp_path):
+def test_a_figure_laid_out_once_has_the_pixels_of_matplotlibs_own_save(tmp_path):
     """save() lays a constrained figure out once at the PNG's dpi (one draw, not two): the pixels are matplotlib's."""
     import matplotlib.pyplot as plt
 
-    from gyrolab.figures.run import draw_state
     from gyrolab.figures.save import save
     from gyrolab.figures.style import STYLE
+    from gyrolab.figures.sweep import draw_invariant_drift
 
-    ds = xr.load_dataset(run_dir / "run.nc")
-    theirs = draw_state(ds)
+    theirs = draw_invariant_drift(_drift_sweep())
     with plt.style.context(STYLE):
         theirs.savefig(tmp_path / "theirs.png", dpi=120)
-    ours = draw_state(ds)
+    ours = draw_invariant_drift(_drift_sweep())
     engine = ours.get_layout_engine()
+    assert engine is not None
     save(ours, tmp_path / "ours", ("png",), 120)
     assert ours.get_layout_engine() is engine  # left as it was
     plt.close("all")
     with Image.open(tmp_path / "theirs.png") as theirs, Image.open(tmp_path / "ours.png") as ours:
         assert np.array_equal(np.asarray(theirs), np.asarray(ours))
+
+
+def _drawn_texts(fig):
+    """Every text a figure draws (tick labels of ticks in view only: matplotlib keeps others, undrawn)."""
+    texts = [fig._suptitle, *fig.texts, *(text for legend in fig.legends for text in legend.get_texts())]
+    for ax in fig.axes:
+        texts += [ax.title, ax._left_title, ax._right_title, ax.xaxis.label, ax.yaxis.label, ax.xaxis.offsetText,
+                  ax.yaxis.offsetText, *(ax.get_legend().get_texts() if ax.get_legend() else [])]
+        for axis in (ax.xaxis, ax.yaxis):
+            low, high = sorted(axis.get_view_interval())
+            texts += [tick.label1 for tick in axis.get_major_ticks() if low <= tick.get_loc() <= high]
+    return [text for text in texts if text is not None and text.get_visible() and text.get_text()]
+
+
+@pytest.mark.parametrize("overrides", [TINY, ["experiment=gyrostat", *TINY], ["body=si_gyroscope", *TINY], ["initial=hanging", *TINY]])
+def test_run_figures_laid_out_by_hand_keep_every_text_inside_the_figure_and_off_other_panels(overrides, tmp_path):
+    """The run's grids of panels get fixed margins measured from their text (style.fit), not a layout engine: no text
+    is clipped by the figure's edge or runs into another panel, at the dpi of the PNG, and saving leaves no engine."""
+    from gyrolab.figures.run import draw_euler_angles, draw_invariants, draw_state
+    from gyrolab.figures.save import save
+
+    ds = Scene.from_config(compose_config(overrides)).run()
+    for draw in (draw_state, draw_invariants, draw_euler_angles):
+        fig = draw(ds)
+        save(fig, tmp_path / draw.__name__, ("png", "pdf"), 200)
+        assert fig.get_layout_engine() is None
+        fig.set_dpi(200)
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        edge = fig.bbox
+        panels = [ax.get_window_extent(renderer) for ax in fig.axes]
+        texts = _drawn_texts(fig)
+        assert len(texts) > 10
+        for text in texts:
+            box = text.get_window_extent(renderer)
+            assert edge.x0 <= box.x0 and box.x1 <= edge.x1 + 1 and edge.y0 <= box.y0 and box.y1 <= edge.y1 + 1, \
+                f"{draw.__name__}: {text.get_text()!r} is clipped by the figure's edge"
+        for ax, panel in zip(fig.axes, panels):
+            for label in (ax.xaxis.label, ax.yaxis.label, *ax.get_xticklabels(), *ax.get_yticklabels()):
+                if label.get_visible() and label.get_text():
+                    box = label.get_window_extent(renderer)
+                    assert not any(_overlap(box, other) for other in panels if other is not panel), \
+                        f"{draw.__name__}: {label.get_text()!r} runs into another panel"
