@@ -22,7 +22,7 @@ from omegaconf import OmegaConf
 from gyrolab.batch.points import read_points_file
 from gyrolab.engine import scene as scene_module
 from gyrolab.engine.config import compose_config
-from gyrolab.engine.scene import Scene, build_force, fastest_rate
+from gyrolab.engine.scene import Scene, body_and_forces, fastest_rate
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, GyrolabError, require_finite
 from gyrolab.sweep.grid import Dim, Grid, _refuse_repeats
@@ -388,13 +388,9 @@ def _build_combo(plain: dict[str, Any], values: Mapping[str, Any]) -> _Built | _
     try:
         require_finite({k: v for k, v in point.items() if k != "initial"}, "")
         cfg = OmegaConf.create(point)
-        system_cls = scene_module._plugin_class("system", cfg.system, "system")
-        body = system_cls.body_type.from_config(point["body"])
-        forces = [build_force(scene_module._plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
-                  for name, node in (cfg.get("force") or {}).items()]
+        body_and_forces(cfg, point)   # built for their errors only; the scene builds its own
     except GyrolabError as error:
         return _Failure(str(error), exact=True)
-    del body, forces   # built for their errors only; the scene builds its own
     try:
         scene = Scene.from_config(cfg)   # the rest of the single run's checks, on the base initial state
     except GyrolabError as error:

@@ -159,10 +159,9 @@ def run_plan(plan: Plan, path: Path, settings: Settings, only: set[int] | None =
         return RunStats(path)
     integrator, store.integrator_attributes = batch_integrator(plan, settings)
     pending = [i for i in range(len(blocks)) if i not in done and (only is None or i in only)]
-    tasks, empty = [], []
-    for i in pending:
-        task = chunk_task(plan, blocks[i], i, settings, integrator)
-        (tasks if task is not None else empty).append(task if task is not None else i)
+    built = {i: chunk_task(plan, blocks[i], i, settings, integrator) for i in pending}
+    tasks = [task for task in built.values() if task is not None]
+    empty = [i for i, task in built.items() if task is None]
     log.info("batch: %d points in %d chunks of ≤ %d (%s), %d stored already, %d to run; output %s", plan.size,
              len(blocks), size, settings.output, len(done), len(tasks), path)
     for i in empty:   # no valid point: only the points' errors, which the store wrote when it was created
@@ -218,7 +217,6 @@ def lane_record(integrator: type, settings: Settings) -> dict[str, int]:
     """The lane width a vectorised batch kernel was compiled for and the CPU's vector width (empty otherwise)."""
     if settings.output == "indicator" or not integrator.supports(BATCH_KERNEL) or not integrator.supports(VECTOR_LANES):
         return {}
-
     return lane_attributes()
 
 

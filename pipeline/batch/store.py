@@ -139,10 +139,7 @@ class Store:
                     self._write(name, chunk, out.data)
         self.nc.sync()
         _fsync(self.part)
-        with open(self.journal, "a", encoding="utf-8", opener=open_own_file) as journal:
-            journal.write(f"{index}\n")
-            journal.flush()
-            os.fsync(journal.fileno())
+        _write_journal(self.journal, "a", f"{index}\n")
 
     def finish(self) -> None:
         """Close the complete file and give it its final name (OutputError, the chunks kept, if that fails)."""
@@ -186,14 +183,11 @@ class Store:
         """Create ``.part`` whole (every variable's storage allocated); a failure leaves neither it nor a journal
         (nothing was finished), so the rerun starts cleanly."""
         try:
-            self._create_file(result)
-        except (OSError, RuntimeError) as error:
-            if not isinstance(error, OSError) and not _library_failure(error):
-                raise
-            failure = self._failed(error, set())
+            self._guarded(self._create_file, result)
+        except OutputError:
             self.part.unlink(missing_ok=True)
             self.journal.unlink(missing_ok=True)
-            raise failure from None
+            raise
 
     def _create_file(self, result: Any) -> None:
         plan = self.plan
@@ -325,16 +319,18 @@ def _open(path: Path, mode: str) -> netCDF4.Dataset:
 
 
 def _identity_of(path: Path) -> str:
-    nc = _open(path, "r")
-    try:
+    with _open(path, "r") as nc:
         return str(getattr(nc, "batch_identity", "none (not a gyrolab batch)"))
-    finally:
-        nc.close()
 
 
 def _start_journal(path: Path, identity: str) -> None:
-    with open(path, "w", encoding="utf-8", opener=open_own_file) as journal:
-        journal.write(f"identity {identity}\n")
+    _write_journal(path, "w", f"identity {identity}\n")
+
+
+def _write_journal(path: Path, mode: str, text: str) -> None:
+    """Write (``mode`` "w") or append ("a") ``text`` to a journal, on the disk when this returns."""
+    with open(path, mode, encoding="utf-8", opener=open_own_file) as journal:
+        journal.write(text)
         journal.flush()
         os.fsync(journal.fileno())
 
