@@ -49,7 +49,7 @@ from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_ter
 from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.engine.schemas import REQUIRED_SECTIONS  # sections every run needs, with a key to show
 from gyrolab.engine.scene import Scene
-from gyrolab.engine.unread import ACCURACY, given_keys, ignored_accuracy, unread_accuracy
+from gyrolab.engine.unread import ACCURACY, given_overrides, ignored_accuracy, unread_accuracy
 from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.experiments import TASKS, check_task, refuse_unread, run_task, task_of
@@ -193,7 +193,7 @@ def accuracy_notes(configs: Sequence[DictConfig], overrides: Sequence[str]) -> l
     ConfigError when the command line gives ``accuracy`` and no job's integrator reads it (a sweep over integrators
     gives the target to the jobs that read it; the others warn and record it, as for a value from a config file)."""
     notes = [ignored_accuracy(composed, overrides) for composed in configs]
-    if ACCURACY in given_keys(overrides) and all(notes):
+    if ACCURACY in given_overrides(overrides) and all(notes):
         raise unread_refusal(configs[0], unread_accuracy(configs[0]))
     return notes
 
