@@ -175,8 +175,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
     dims, points = _points(dims, plain)
     if points is None:
         shape = tuple(len(d.values) for d in dims)
-        axes = [(list(d.values), _along(np.arange(len(d.values), dtype=np.int32), axis, shape))
-                for axis, d in enumerate(dims)]
+        axes = [(list(d.values), codes.ravel()) for d, codes in zip(dims, np.indices(shape, dtype=np.int32))]
     else:
         shape = (len(dims[0].values),)
         axes = [_distinct(d) for d in dims]
@@ -294,14 +293,9 @@ def _distinct(dim: Dim) -> tuple[list[Any], np.ndarray]:
     if not dim.labels:   # a points file's column: floats
         values, codes = np.unique(np.asarray(dim.values, dtype=float), return_inverse=True)
         return values.tolist(), codes.astype(np.int32).ravel()
-    index: dict[str, int] = {}
-    values, codes = [], np.empty(len(dim.values), dtype=np.int32)
-    for n, (label, value) in enumerate(zip(dim.labels, dim.values)):
-        if label not in index:
-            index[label] = len(values)
-            values.append(value)
-        codes[n] = index[label]
-    return values, codes
+    index: dict[str, int] = {}   # each distinct label's number, in order of first appearance
+    codes = np.array([index.setdefault(label, len(index)) for label in dim.labels], dtype=np.int32)
+    return [dim.values[n] for n in np.unique(codes, return_index=True)[1]], codes
 
 
 def _combos(dims: Sequence[Dim], axes: Sequence[tuple[list[Any], np.ndarray]], n_points: int
@@ -356,13 +350,6 @@ def _key(dim: Dim) -> str:
 def _finite_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) \
         and abs(value) < 1.7e308
-
-
-def _along(mask: np.ndarray, axis: int, shape: tuple[int, ...]) -> np.ndarray:
-    """A per-value mask of dimension ``axis`` spread over the whole grid (flat, C order)."""
-    view = [1] * len(shape)
-    view[axis] = shape[axis]
-    return np.broadcast_to(mask.reshape(view), shape).ravel()
 
 
 def _column(axis: tuple[list[Any], np.ndarray], rows: np.ndarray) -> np.ndarray:
