@@ -25,7 +25,7 @@ from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene, body_and_forces, fastest_rate
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, GyrolabError, require_finite
-from gyrolab.sweep.grid import Dim, Grid, _refuse_repeats
+from gyrolab.sweep.grid import Dim, Grid, _refuse_repeats, dim_names
 from gyrolab.output.cf import unit_attributes
 from gyrolab.sweep.identity import canonical_config, job_code
 
@@ -141,13 +141,6 @@ def split_overrides(overrides: Sequence[str]) -> tuple[list[str], list[Dim]]:
             raise ConfigError(f"a batch sweep varies body, initial and force parameters only, not {dim.key!r}; "
                               "sweep it with gyrolab -m instead")
     return fixed, dims
-
-
-def dim_names(dims: Sequence[Dim]) -> tuple[str, ...]:
-    """Each dimension named by its key's last part (``initial.theta0`` -> ``theta0``), the whole key with
-    dots as underscores where two would share a name."""
-    short = [d.short_name for d in dims]
-    return tuple(s if short.count(s) == 1 else d.key.lstrip("+~").replace(".", "_") for s, d in zip(short, dims))
 
 
 def _not_finite_points(axes: list, n_points: int) -> np.ndarray:

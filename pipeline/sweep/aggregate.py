@@ -26,7 +26,7 @@ from gyrolab.output.trust import check_tree
 from gyrolab.output.units import quantity_units
 from gyrolab.output.user_yaml import stored_yaml_file
 from gyrolab.output.written import announce_written
-from gyrolab.sweep.grid import Grid
+from gyrolab.sweep.grid import Grid, dim_names
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
 
 log = logging.getLogger("gyrolab.sweep")
@@ -91,14 +91,14 @@ class SweepSummary:
 def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
     """The sweep dataset of ``grid`` from ``results[n]``, the outcome of job ``n`` (one per job)."""
     done = [(grid.index[n], r.dataset) for n, r in enumerate(results) if r.status == FINISHED]
-    names = _dim_names(grid, [ds for _, ds in done])
-    grid_dims = tuple(names)
+    reserved = {"time", "sample", "axis", "failed_job"}.union(*(set(ds.variables) | set(ds.dims) for _, ds in done))
+    grid_dims = dim_names(grid.dims, reserved)
     shape = grid.shape
     body_units = _body_units([ds for _, ds in done])
     coords: dict[str, Any] = {
         name: (name, values, {"long_name": f"swept parameter {dim.key}", "override_key": dim.key,
                               **_units(values, quantity_units(dim.key, body_units))})
-        for name, dim in zip(names, grid.dims) for values in [dim.coordinate()]
+        for name, dim in zip(grid_dims, grid.dims) for values in [dim.coordinate()]
     }
     sample = _sample_dim([ds for _, ds in done])
     data_vars = _stacked_variables(done, coords, shape, grid_dims, sample, body_units) if done else {}
@@ -190,20 +190,6 @@ def _job_table(grid: Grid, results: Sequence[JobResult], grid_dims: tuple[str, .
             "job_id": (grid_dims, job_ids, {"long_name": "hash of the job's resolved config and code version"}),
             "job_dir": (grid_dims, job_dirs, {"long_name": "job directory, relative to the sweep directory"}),
             **_failure_table(grid, results)}
-
-
-def _dim_names(grid: Grid, datasets: Sequence[xr.Dataset]) -> list[str]:
-    reserved = {"time", "sample", "axis", "failed_job"}
-    for ds in datasets:
-        reserved |= set(ds.variables) | set(ds.dims)
-    shorts = [d.short_name for d in grid.dims]
-    names = []
-    for dim, short in zip(grid.dims, shorts):
-        name = short if shorts.count(short) == 1 and short not in reserved else dim.key.lstrip("+~").replace(".", "_")
-        while name in reserved or name in names:
-            name = f"sweep_{name}"
-        names.append(name)
-    return names
 
 
 def _sample_dim(datasets: Sequence[xr.Dataset]) -> str:

@@ -91,6 +91,19 @@ class Grid:
         return cls.from_overrides(overrides, max_jobs=MAX_JOBS)
 
 
+def dim_names(dims: Sequence[Dim], reserved: set[str] | frozenset[str] = frozenset()) -> tuple[str, ...]:
+    """Each dimension named by its key's last part (``initial.theta0`` -> ``theta0``), the whole key with dots as
+    underscores where two would share a name or it is ``reserved``, prefixed ``sweep_`` while it is still taken."""
+    shorts = [d.short_name for d in dims]
+    names: list[str] = []
+    for dim, short in zip(dims, shorts):
+        name = short if shorts.count(short) == 1 and short not in reserved else dim.key.lstrip("+~").replace(".", "_")
+        while name in reserved or name in names:
+            name = f"sweep_{name}"
+        names.append(name)
+    return tuple(names)
+
+
 def _choices(parsed: Sequence[Any], repeats: bool) -> tuple[dict[str, list[str]], dict[str, list[Any]]]:
     """(key -> its job overrides in first-seen order, as Hydra does; swept key -> its typed values); ConfigError
     for a sweep that is not discrete or, unless ``repeats``, gives a value twice."""
