@@ -151,8 +151,21 @@ def _stacked_variables(done: list[tuple[tuple, xr.Dataset]], coords: dict[str, A
 
 
 def _add_per_job_attrs(data_vars: dict[str, Any], coords: dict[str, Any], done: list, name: str,
-                       shape: tuple[int, ...], grid_dims: tuple[str, ...], body_units: str) -> None:
-    for attr, variable in _per_job_attrs(done, name, shape, grid_dims, body_units).items():
+                       shape: tuple[int, ...], grid_dims: tuple[str, ...], body_units: str | None) -> None:
+    """The attributes of ``name`` that are per job by nature or differ between jobs, as variables over the grid."""
+    having = [(index, ds[name]) for index, ds in done if name in ds.variables]
+    for attr in _union([list(da.attrs) for _, da in having]):
+        values = {index: da.attrs[attr] for index, da in having if attr in da.attrs}
+        if attr not in PER_JOB_VARIABLE_ATTRS and len(values) == len(having) and _all_same(list(values.values())):
+            continue
+        variable = _cell_variable(values, shape, grid_dims, f"{name}_{attr}")
+        if attr == "max_abs_drift":
+            variable[2].update({"long_name": f"max |{name}(t) − {name}(0)|",
+                                "units": having[0][1].attrs.get("units", "1")})
+        else:
+            units = (having[0][1].attrs.get("units") if attr == "invariant_allowed_drift"
+                     else quantity_units(attr, body_units))
+            variable[2].update({"long_name": f"attribute {attr} of {name}, per job", **_units(variable[1], units)})
         data_vars[f"{name}_{attr}"] = variable
         _index_coordinate(coords, variable, f"{name}_{attr}")
 
@@ -227,7 +240,7 @@ def _stack(done: Sequence[tuple[tuple[int, ...], xr.Dataset]], name: str, shape:
 
 
 def _common_attrs(arrays: Sequence[xr.DataArray]) -> dict[str, Any]:
-    """Attributes equal in every job (the others become per-job variables, see ``_per_job_attrs``)."""
+    """Attributes equal in every job (the others become per-job variables, see ``_add_per_job_attrs``)."""
     return {k: v for k, v in arrays[0].attrs.items() if k not in PER_JOB_VARIABLE_ATTRS
             and all(k in da.attrs and _same(v, da.attrs[k]) for da in arrays)}
 
@@ -252,25 +265,6 @@ def _index_coordinate(coords: dict[str, Any], variable: tuple, key: str) -> None
             coords[dim] = (dim, np.arange(size, dtype=np.int32), {
                 "long_name": f"component of run attribute {key} (as stored in each job's run.nc, from 0)",
                 "units": "1"})
-
-
-def _per_job_attrs(done: Sequence[tuple[tuple[int, ...], xr.Dataset]], name: str, shape: tuple[int, ...],
-                   grid_dims: tuple[str, ...], body_units: str | None = None) -> dict[str, tuple]:
-    having = [(index, ds[name]) for index, ds in done if name in ds.variables]
-    out = {}
-    for attr in _union([list(da.attrs) for _, da in having]):
-        values = {index: da.attrs[attr] for index, da in having if attr in da.attrs}
-        if attr in PER_JOB_VARIABLE_ATTRS or len(values) < len(having) or not _all_same(list(values.values())):
-            out[attr] = _cell_variable(values, shape, grid_dims, f"{name}_{attr}")
-            if attr == "max_abs_drift":
-                out[attr][2].update({"long_name": f"max |{name}(t) − {name}(0)|",
-                                     "units": having[0][1].attrs.get("units", "1")})
-            else:
-                units = (having[0][1].attrs.get("units") if attr == "invariant_allowed_drift"
-                         else quantity_units(attr, body_units))
-                out[attr][2].update({"long_name": f"attribute {attr} of {name}, per job",
-                                     **_units(out[attr][1], units)})
-    return out
 
 
 def _cell_variable(values: dict[tuple[int, ...], Any], shape: tuple[int, ...], grid_dims: tuple[str, ...],
