@@ -106,9 +106,6 @@ class Plan:
             return type(cls.__new__(cls, **settings))
         return cls
 
-    def params(self, start: int, stop: int) -> np.ndarray:
-        return self.combo_params[self.combo[start:stop]]
-
     def identity(self, chunk: int) -> str:
         """20 hex digits over the code it loads (``job_code``), the composed config (without the settings that do not
         change the result), the grid and the chunk size: the same command gives the same identity."""

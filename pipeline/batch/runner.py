@@ -232,7 +232,7 @@ def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integra
     combos = {int(c): (plan.combo_values[c] if c != base_combo else {}) for c in np.unique(combo)}
     return ChunkTask(index=index, config=plan.base, config_key=plan.base_key, output=settings.output,
                      decimate=settings.decimate, times=plan.times, rows=rows, y0=plan.y0[points],
-                     params=plan.params(chunk.start, chunk.stop)[rows], combo=combo, combos=combos,
+                     params=plan.combo_params[combo], combo=combo, combos=combos,
                      n_rows=chunk.stop - chunk.start, integrator=integrator)
 
 

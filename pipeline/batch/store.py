@@ -195,7 +195,9 @@ class Store:
         nc = netCDF4.Dataset(self.part, "w", format="NETCDF4")
         self.nc = nc
         nc.set_auto_mask(False)
-        system = _reference_system(plan)
+        # the base point's system: the title, the time's attributes, the units of the swept keys (gyrolab knows those
+        # of every key of a nondimensional body and the known keys of an SI one: gyrolab.output.units)
+        system = Scene.from_config(OmegaConf.create(plan.base)).system if plan.base is not None else None
         if plan.points is not None:
             nc.createDimension(POINT, plan.size)
             _variable(nc, POINT, POINT, np.arange(plan.size, dtype=np.int32),
@@ -207,8 +209,9 @@ class Store:
             values = dim.coordinate()
             if values.dtype.kind in "iu":
                 values = values.astype(np.int32) if np.abs(values).max() < 2**31 else values.astype(np.float64)
+            units = quantity_units(dim.key, system.body.units if system is not None else None)
             attrs = {"long_name": f"swept parameter {dim.key}" + (" of each point" if plan.points else ""),
-                     "override_key": dim.key, **_key_units(dim.key, system)}
+                     "override_key": dim.key, **({"units": units} if units else {})}
             (_text_variable if values.dtype.kind == "O" else _variable)(
                 nc, name, POINT if plan.points is not None else name, values, attrs)
         nc.createDimension("error_kind", len(self.messages))
@@ -357,17 +360,3 @@ def _cut_torn_line(path: Path) -> None:
             journal.flush()
             os.fsync(journal.fileno())
 
-
-def _reference_system(plan: Any) -> Any:
-    if plan.base is None:
-        return None
-
-    return Scene.from_config(OmegaConf.create(plan.base)).system
-
-
-def _key_units(key: str, system: Any) -> dict[str, str]:
-    """CF units of a swept key where gyrolab knows them (``gyrolab.output.units``: every key of a nondimensional
-    body, the known keys of an SI one)."""
-
-    units = quantity_units(key, system.body.units if system is not None else None)
-    return {"units": units} if units else {}
