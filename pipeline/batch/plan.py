@@ -140,16 +140,6 @@ def split_overrides(overrides: Sequence[str]) -> tuple[list[str], list[Dim]]:
     return fixed, dims
 
 
-def _not_finite_points(axes: list, n_points: int) -> np.ndarray:
-    """The points with a swept value that is not a finite number: the single run's checks decide them (rare)."""
-    suspect = np.zeros(n_points, dtype=bool)
-    for values, codes in axes:
-        odd = np.array([not _finite_number(v) for v in values], dtype=bool)
-        if odd.any():
-            suspect |= odd[codes]
-    return suspect
-
-
 def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any] | None = None) -> Plan:
     """The plan of the swept keys ``dims`` over the config composed from ``fixed`` (or given as ``plain``): their
     grid, or the explicit list of points of ``batch.zip``/``batch.points_file``."""
@@ -177,7 +167,11 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
     def values_of(n: int) -> dict[str, Any]:
         return {d.key: values[codes[n]] for d, (values, codes) in zip(dims, axes)}
 
-    suspect = _not_finite_points(axes, n_points)
+    suspect = np.zeros(n_points, dtype=bool)   # a swept value that is not a finite number: the single run decides
+    for values, codes in axes:
+        odd = np.array([not _finite_number(v) for v in values], dtype=bool)
+        if odd.any():
+            suspect |= odd[codes]
 
     # body and forces once per combination of their swept values
     combo, combo_values = _combos([dims[i] for i in param_axes], [axes[i] for i in param_axes], n_points)
@@ -193,7 +187,9 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
         else:
             systems[c] = built
     reference = next(iter(systems.values()), None)
-    _same_structure(systems)
+    if len({(b.compiled.form, b.compiled.params.size) for b in systems.values()}) > 1:
+        raise ConfigError("the swept values change the compiled model's form (its torques or state), which one batch "
+                          "cannot integrate together; sweep them with gyrolab -m")
 
     # initial states: vectorised over the points, or one system per distinct point
     y0 = np.full((n_points, reference.system.state_size if reference else 0), np.nan)
@@ -393,13 +389,6 @@ def _scalar_point(plain: dict[str, Any], values: Mapping[str, Any], n: int,
         errors.set(n, str(error))
         return None
     return scene.system.initial_state(), _compiled(scene).params
-
-
-def _same_structure(systems: Mapping[int, _Built]) -> None:
-    models = {(b.compiled.form, b.compiled.params.size) for b in systems.values()}
-    if len(models) > 1:
-        raise ConfigError("the swept values change the compiled model's form (its torques or state), which one batch "
-                          "cannot integrate together; sweep them with gyrolab -m")
 
 
 def _common_attributes(systems: Mapping[int, _Built], swept_initial: bool) -> dict[str, Any]:

@@ -94,13 +94,15 @@ def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
     reserved = {"time", "sample", "axis", "failed_job"}.union(*(set(ds.variables) | set(ds.dims) for _, ds in done))
     grid_dims = dim_names(grid.dims, reserved)
     shape = grid.shape
-    body_units = _body_units([ds for _, ds in done])
+    systems = {ds.attrs.get("body_units") for _, ds in done}   # si or nondimensional, None when they differ
+    body_units = systems.pop() if len(systems) == 1 else None
     coords: dict[str, Any] = {
         name: (name, values, {"long_name": f"swept parameter {dim.key}", "override_key": dim.key,
                               **_units(values, quantity_units(dim.key, body_units))})
         for name, dim in zip(grid_dims, grid.dims) for values in [dim.coordinate()]
     }
-    sample = _sample_dim([ds for _, ds in done])
+    times = [ds["time"].values for _, ds in done]   # sample: the jobs' output times differ
+    sample = "time" if all(np.array_equal(t, times[0]) for t in times[1:]) else "sample"
     data_vars = _stacked_variables(done, coords, shape, grid_dims, sample, body_units) if done else {}
     common = _run_attributes(done, coords, data_vars, shape, grid_dims, body_units)
     data_vars.update(_job_table(grid, results, grid_dims))
@@ -205,12 +207,6 @@ def _job_table(grid: Grid, results: Sequence[JobResult], grid_dims: tuple[str, .
             **_failure_table(grid, results)}
 
 
-def _sample_dim(datasets: Sequence[xr.Dataset]) -> str:
-    """'time' if every job has the same output times (the usual case), else 'sample'."""
-    times = [ds["time"].values for ds in datasets]
-    return "time" if all(np.array_equal(t, times[0]) for t in times[1:]) else "sample"
-
-
 def _union(lists: Sequence[Sequence[str]]) -> list[str]:
     return list(dict.fromkeys(item for items in lists for item in items))
 
@@ -243,12 +239,6 @@ def _common_attrs(arrays: Sequence[xr.DataArray]) -> dict[str, Any]:
     """Attributes equal in every job (the others become per-job variables, see ``_add_per_job_attrs``)."""
     return {k: v for k, v in arrays[0].attrs.items() if k not in PER_JOB_VARIABLE_ATTRS
             and all(k in da.attrs and _same(v, da.attrs[k]) for da in arrays)}
-
-
-def _body_units(datasets: Sequence[xr.Dataset]) -> str | None:
-    """The jobs' body unit system (``si``/``nondimensional``), None when they differ or do not say."""
-    systems = {ds.attrs.get("body_units") for ds in datasets}
-    return systems.pop() if len(systems) == 1 else None
 
 
 def _units(values: Any, units: str | None) -> dict[str, str]:
