@@ -13,7 +13,6 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -413,17 +412,12 @@ def _batch_times(plain: dict[str, Any], systems: Mapping[int, _Built], y0: np.nd
     if time_cfg.get("n_output", "auto") == "auto":
         rates = []
         for c, built in systems.items():
-            rows = np.flatnonzero(valid & (combo == c))
-            if not rows.size:
-                continue
-            inertia = np.asarray(getattr(built.system.body, "inertia", np.ones(3)), dtype=float)
-            omega = y0[rows, :3]
-            fastest = y0[rows[int(np.argmax(np.einsum("ij,j,ij->i", omega, inertia, omega)))]]
-            shim = SimpleNamespace(body=built.system.body, forces=built.system.forces,
-                                   state_size=built.system.state_size, initial_state=lambda s=fastest: s)
-            value = fastest_rate(shim)
-            if value is not None:
-                rates.append(value)
+            omega = y0[valid & (combo == c), :3]
+            if len(omega):
+                inertia = np.asarray(getattr(built.system.body, "inertia", np.ones(3)), dtype=float)
+                energetic = omega[int(np.argmax(np.einsum("ij,j,ij->i", omega, inertia, omega)))]
+                rates.append(fastest_rate(built.system, energetic))
+        rates = [r for r in rates if r is not None]
         rate = max(rates) if rates else None
     return scene_module._output_times(time_cfg, rate)
 

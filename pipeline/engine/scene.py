@@ -356,8 +356,9 @@ def check_force_claims(system: System, t0: float = 0.0) -> None:
             check_claims(force, omegas, frames, t0, f"force.{force.name}", initial=frame0 is not None)
 
 
-def fastest_rate(system: System) -> float | None:
-    """An upper estimate ν of the fastest angular frequency in the stored series (model units).
+def fastest_rate(system: System, omega0: np.ndarray | None = None) -> float | None:
+    """An upper estimate ν of the fastest angular frequency in the stored series (model units), from the initial ω
+    (``omega0``: another one, e.g. a batch's most energetic).
 
     A body turning at |ω| moves every body-frame vector (γ, α) at up to |ω|, and its
     nutation and the body-frame motion of ω run at up to (I_max/I_min) |ω| (a symmetric top
@@ -374,7 +375,7 @@ def fastest_rate(system: System) -> float | None:
         return None
     inertia = np.asarray(body.inertia, dtype=float)
     i_min, i_max = float(inertia.min()), float(inertia.max())
-    omega0 = np.asarray(system.initial_state()[:3], dtype=float)
+    omega0 = np.asarray(system.initial_state()[:3] if omega0 is None else omega0, dtype=float)
     orbit = float(getattr(body, "orbit_rate", 0.0) or 0.0)
     spread = 0.5 * (i_max - i_min)
     dv = 2.0 * float(np.linalg.norm(getattr(body, "weight_moment", np.zeros(3))))
