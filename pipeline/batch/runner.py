@@ -318,11 +318,9 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
         if integrator.supports(BATCH_KERNEL):
             solution = integrate_arrays(compiled, integrator, task.times, task.y0, task.params, failures="mark")
         else:   # one integrate() call per point, each with its own system's right-hand side: a single run's numbers
-            system_of_row = np.empty(len(task.rows), dtype=object)
-            for system, rows in groups:
-                system_of_row[rows] = system
-            solution = integrate_points(integrator, lambda j: system_of_row[j].rhs, task.times, task.y0, compiled,
-                                        task.params, failures="mark")
+            rhs = {int(j): system.rhs for system, rows in groups for j in rows}
+            solution = integrate_points(integrator, rhs.__getitem__, task.times, task.y0, compiled, task.params,
+                                        failures="mark")
         kernel_time = solution.wall_time
         failed = np.asarray(solution.failed, dtype=bool)
         settings = solution.settings

@@ -161,8 +161,7 @@ class Store:
     def _finish(self) -> None:
         if self.nc is None:
             self._create(None)
-        status = self.nc["job_status"][:]
-        status = np.asarray(status.filled(0) if np.ma.isMaskedArray(status) else status)
+        status = np.asarray(self.nc["job_status"][:])   # auto-masking is off (_open, _create_file)
         counts = {f"n_{name}": np.int64(np.count_nonzero(status == code)) for name, code in STATUS_FLAGS.items()}
         self.nc.setncatts(counts)
         if counts["n_failed"]:
