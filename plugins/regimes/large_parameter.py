@@ -10,6 +10,7 @@ O(1) (``docs/derivations/seed000_large_parameter.md`` §3); the run records the 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 
@@ -108,7 +109,6 @@ class SlowSpinSeries:
 
 
 HARMONICS = 256
-_CACHE: dict[tuple, "SlowSpinSeries"] = {}  # (a, b, k, θ0) → series: building one takes 5 shootings
 POWERS = (2, 3, 4, 5, 6, 7)
 EVEN, ODD = [1, 3, 5], [0, 2, 4]  # q, γ, γ'' even in ε at fixed phase; p, r, γ' odd (time reversal + mirror)
 
@@ -129,11 +129,9 @@ def _sample(model: FixedPointModel, y0: np.ndarray, times: np.ndarray, tangent: 
     return states if tangent is None else (states, moved)
 
 
+@cache   # building one takes 5 shootings
 def series_for(a: float, b: float, k: float, theta0: float) -> SlowSpinSeries:
-    key = (float(a), float(b), float(k), float(theta0))
-    if key not in _CACHE:
-        _CACHE[key] = SlowSpinSeries.build(*key)
-    return _CACHE[key]
+    return SlowSpinSeries.build(float(a), float(b), float(k), float(theta0))
 
 
 class LargeParameter(FixedPointRegime):
