@@ -188,8 +188,7 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
     ``batch_path``); None: the config's own. An integrator that chooses its method (CHOOSES_METHOD) chooses here,
     once for the batch, on its valid points (docs/batch.md, "integrator=auto chooses once per batch")."""
     if plan.base is None or settings.output == "indicator" or not plan.integrator_class.supports(CHOOSES_METHOD):
-        return None, {} if plan.base is None else {"batch_path": batch_path(plan.integrator_class, settings),
-                                                   **lane_record(plan.integrator_class, settings)}
+        return None, {} if plan.base is None else path_attributes(plan.integrator_class, settings)
 
     scene = Scene.from_config(OmegaConf.create(plan.base))
     valid = np.flatnonzero(plan.valid)
@@ -200,24 +199,19 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
                               else f"{k.removeprefix('integrator_')}={v}" for k, v in method.attributes().items())
     log.info("batch: %s chose %s (%s) for every chunk, in %.1f s", plan.integrator_name, method.name, settings_text,
              time.perf_counter() - start)
-    return method, {**{k: v for k, v in choice.items() if v is not None},
-                    "batch_path": batch_path(type(method), settings), **lane_record(type(method), settings)}
+    return method, {**{k: v for k, v in choice.items() if v is not None}, **path_attributes(type(method), settings)}
 
 
-def batch_path(integrator: type, settings: Settings) -> str:
-    """How a batch's points run with ``integrator`` (stored as the dataset's ``batch_path`` attribute)."""
+def path_attributes(integrator: type, settings: Settings) -> dict[str, Any]:
+    """How a batch's points run with ``integrator`` (the dataset's ``batch_path``) and, for a vectorised batch kernel,
+    the lane width it was compiled for and the CPU's vector width."""
     if settings.output == "indicator":
-        return "variational kernel"
+        return {"batch_path": "variational kernel"}
     if not integrator.supports(BATCH_KERNEL):
-        return "one integrate() call per point"
-    return "batch kernel, vectorised across trajectories" if integrator.supports(VECTOR_LANES) else "batch kernel"
-
-
-def lane_record(integrator: type, settings: Settings) -> dict[str, int]:
-    """The lane width a vectorised batch kernel was compiled for and the CPU's vector width (empty otherwise)."""
-    if settings.output == "indicator" or not integrator.supports(BATCH_KERNEL) or not integrator.supports(VECTOR_LANES):
-        return {}
-    return lane_attributes()
+        return {"batch_path": "one integrate() call per point"}
+    if not integrator.supports(VECTOR_LANES):
+        return {"batch_path": "batch kernel"}
+    return {"batch_path": "batch kernel, vectorised across trajectories", **lane_attributes()}
 
 
 def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integrator: Any = None) -> ChunkTask | None:
