@@ -63,7 +63,7 @@ from gyrolab.output.written import announce_written, fail
 from gyrolab.sweep import callbacks
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
-from gyrolab.sweep.job import draws_job_figures, run_sweep_job
+from gyrolab.sweep.job import run_sweep_job
 from gyrolab.sweep.sweeper import register_plugin
 
 if TYPE_CHECKING:
@@ -392,7 +392,8 @@ def _task(cfg: DictConfig) -> None:
     if hydra_cfg.mode == RunMode.MULTIRUN:
         allow_bars(False)  # the sweep shows one bar for all its jobs
         _quiet_console()
-        job_figures = draws_job_figures(cfg.output)
+        # a job draws its figures only with output.job_figures=true: gyrolab plot SWEEP_DIR draws them from run.nc
+        job_figures = bool(cfg.output.get("figures", True)) and bool(cfg.output.get("job_figures", False))
         run_sweep_job(cfg, out_dir, list(hydra_cfg.overrides.task), hydra_cfg.job.num,
                       lambda job_id: _run_one(cfg, out_dir, job_id, figures=job_figures))
         return

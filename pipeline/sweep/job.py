@@ -19,15 +19,6 @@ from gyrolab.sweep.record import ELSEWHERE, FAILED, FINISHED, RECORD_NAME, JobRe
 log = logging.getLogger("gyrolab.sweep")
 
 
-def draws_job_figures(output: object) -> bool:
-    """Whether a sweep job draws its own figures: only with ``output.job_figures=true`` (and figures on), so that
-    a sweep does not wait on pictures; ``gyrolab plot SWEEP_DIR`` draws them from the jobs' ``run.nc``."""
-    get = getattr(output, "get", None)
-    if get is None:
-        return False
-    return bool(get("figures", True)) and bool(get("job_figures", False))
-
-
 def run_sweep_job(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_num: int | None,
                   work: Callable[[str], Path]) -> JobRecord:
     """Run ``work(job_id)`` (which writes the job's dataset and returns its path) unless already done; never raises
