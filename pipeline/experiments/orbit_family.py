@@ -92,11 +92,7 @@ def start_point(f: dict, model: FixedPointModel, section: Section) -> FamilyPoin
 
 def amplitude(model: FixedPointModel, point: FamilyPoint, samples: int = 48) -> float:
     """Nutation amplitude max θ − min θ over one period (θ = arccos γ'')."""
-    theta, y, now = [np.arccos(np.clip(point.y0[5], -1, 1))], point.y0, 0.0
-    for t in np.linspace(0, point.period, samples + 1)[1:]:
-        y, _ = model.flow(y, t - now, np.zeros((6, 0)))
-        now = t
-        theta.append(np.arccos(np.clip(y[5], -1, 1)))
+    theta = np.arccos(np.clip(model.sample(point.y0, np.linspace(0, point.period, samples + 1))[:, 5], -1, 1))
     return float(np.max(theta) - np.min(theta))
 
 
