@@ -5,7 +5,6 @@ docs/datasets.md, "sweep.nc — a multirun").
 from __future__ import annotations
 
 import logging
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -403,14 +402,12 @@ def stored_hydra(sweep_dir: Path) -> DictConfig:
 
 def wait_for_jobs(sweep_dir: Path) -> None:
     """Wait for the jobs of this sweep that another process is running (a concurrent resume)."""
-    for root, dirs, files in os.walk(sweep_dir):
-        dirs[:] = sorted(d for d in dirs if not d.startswith("."))
-        if LOCK_NAME in files and Path(root) != Path(sweep_dir):
-            owner = owner_of(Path(root))
-            if owner:
-                log.info("waiting for job %s, run by another gyrolab process (%s)",
-                         Path(root).relative_to(sweep_dir).as_posix(), owner)
-            wait_for(Path(root))
+    for job_dir in (path.parent for path in record_paths(sweep_dir, LOCK_NAME) if path.parent != Path(sweep_dir)):
+        owner = owner_of(job_dir)
+        if owner:
+            log.info("waiting for job %s, run by another gyrolab process (%s)", job_dir.relative_to(sweep_dir).as_posix(),
+                     owner)
+        wait_for(job_dir)
 
 
 def log_summary(summary: SweepSummary) -> None:
