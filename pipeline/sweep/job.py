@@ -64,12 +64,9 @@ def _run_locked(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_nu
     base = JobRecord(job_id=job_id, status=FAILED, overrides=list(overrides), code_version=code, job_num=job_num)
     try:
         path = work(job_id)
-    except OutputError as error:
+    except GyrolabError as error:   # a failed write (OutputError) may succeed next time: not deterministic
         log.error("job %s failed: %s", job_num, error)
-        record = _failed(base, error, error.exit_code, deterministic=False)
-    except GyrolabError as error:
-        log.error("job %s failed: %s", job_num, error)
-        record = _failed(base, error, error.exit_code, deterministic=True)
+        record = _failed(base, error, error.exit_code, deterministic=not isinstance(error, OutputError))
     except Exception as error:  # noqa: BLE001 - a bug in one job must not take the sweep down
         log.exception("job %s crashed", job_num)
         record = _failed(base, error, 1, deterministic=False)
