@@ -273,13 +273,10 @@ def _system(context: dict[str, Any], config: dict[str, Any], values: dict[str, A
     """The system with a point's body and force values (built once per process and combination)."""
     if not values:
         return context["scene"].system
-    key = _combo_key(values)
-    system = context["systems"].get(key)
-    if system is None:
-
-        system = Scene.from_config(OmegaConf.create(_with_values(config, values))).system
-        context["systems"][key] = system
-    return system
+    systems, key = context["systems"], _combo_key(values)
+    if key not in systems:
+        systems[key] = Scene.from_config(OmegaConf.create(_with_values(config, values))).system
+    return systems[key]
 
 
 _kernels_called = False   # whether this process has run a chunk (its kernels are loaded)
