@@ -464,13 +464,6 @@ def _quiet_console() -> None:
             handler.setLevel(logging.WARNING)
 
 
-def run_command(argv: Sequence[str]) -> int | None:
-    """The exit status of the subcommand ``argv`` names (options in any position), or None for ``run`` (Hydra's
-    app, the default)."""
-    command, args = parse_command_line(argv)
-    return None if command == "run" else run_subcommand(command, args)
-
-
 def run_subcommand(command: str, args: argparse.Namespace) -> int:
     """Run ``command`` (not ``run``) with its parsed options (``gyrolab.app.commands``)."""
     from gyrolab.app.commands import RUNNERS  # import cycle: commands imports gyrolab.app
