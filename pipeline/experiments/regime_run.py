@@ -17,7 +17,7 @@ from omegaconf import DictConfig
 
 from gyrolab.analysis.periodic import FixedPointModel, PeriodicOrbit, shoot
 from gyrolab.contracts import registry
-from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL
+from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL
 from gyrolab.contracts.regime import Regime
 from gyrolab.engine.scene import Scene, plugin_params
 from gyrolab.engine.schemas import Task
@@ -83,9 +83,7 @@ def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = Fal
     system = scene.system
     if taylor:
         return Taylor(order=24, tol=1e-16).integrate(system.rhs, t, y0, None, system.compiled_model()).y
-    integrator = scene.integrator
-    wants = integrator.supports(COMPILED_MODEL) or integrator.supports(PREFERS_COMPILED_MODEL)
-    return integrator.integrate(system.rhs, t, y0, None, system.compiled_model() if wants else None).y
+    return scene.integrator.integrate(system.rhs, t, y0, None, scene.compiled).y
 
 
 def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True,
