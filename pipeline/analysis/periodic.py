@@ -158,6 +158,20 @@ class FixedPointModel:
             raise IntegrationError(f"the shooting integration became non-finite before t={t:.6g}")
         return y, phi
 
+    def sample(self, y0: np.ndarray, times: np.ndarray, tangent: np.ndarray | None = None):
+        """States y(t) (n, 6) of the flow from y0 at ``times`` (any order, ≥ 0); with ``tangent`` also Φ(t)·tangent,
+        returned as the pair (states, tangents)."""
+        states, moved = np.empty((len(times), 6)), np.empty((len(times), 6))
+        y, phi, now = np.asarray(y0, dtype=float), np.eye(6) if tangent is not None else np.zeros((6, 0)), 0.0
+        for i in np.argsort(times):
+            if times[i] > now:
+                y, phi = self.flow(y, times[i] - now, phi)
+                now = times[i]
+            states[i] = y
+            if tangent is not None:
+                moved[i] = phi @ tangent
+        return states if tangent is None else (states, moved)
+
 
 @dataclass
 class PeriodicOrbit:

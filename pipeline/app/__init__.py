@@ -49,7 +49,7 @@ from gyrolab.engine.progress import allow_bars, compile_notes_on_console, on_ter
 from gyrolab.engine.safety import check_config, check_output_dir
 from gyrolab.engine.schemas import REQUIRED_SECTIONS  # sections every run needs, with a key to show
 from gyrolab.engine.scene import Scene
-from gyrolab.engine.unread import ACCURACY, given_keys, ignored_accuracy, unread_accuracy
+from gyrolab.engine.unread import ACCURACY, given_overrides, ignored_accuracy, unread_accuracy
 from gyrolab.engine.unread import refusal as unread_refusal
 from gyrolab.errors import ConfigError, GyrolabError, GyrolabWarning, choices, require_finite, shorten
 from gyrolab.experiments import TASKS, check_task, refuse_unread, run_task, task_of
@@ -63,7 +63,7 @@ from gyrolab.output.written import announce_written, fail
 from gyrolab.sweep import callbacks
 from gyrolab.sweep.grid import Grid
 from gyrolab.sweep.identity import job_identity
-from gyrolab.sweep.job import draws_job_figures, run_sweep_job
+from gyrolab.sweep.job import run_sweep_job
 from gyrolab.sweep.sweeper import register_plugin
 
 if TYPE_CHECKING:
@@ -193,7 +193,7 @@ def accuracy_notes(configs: Sequence[DictConfig], overrides: Sequence[str]) -> l
     ConfigError when the command line gives ``accuracy`` and no job's integrator reads it (a sweep over integrators
     gives the target to the jobs that read it; the others warn and record it, as for a value from a config file)."""
     notes = [ignored_accuracy(composed, overrides) for composed in configs]
-    if ACCURACY in given_keys(overrides) and all(notes):
+    if ACCURACY in given_overrides(overrides) and all(notes):
         raise unread_refusal(configs[0], unread_accuracy(configs[0]))
     return notes
 
@@ -392,7 +392,8 @@ def _task(cfg: DictConfig) -> None:
     if hydra_cfg.mode == RunMode.MULTIRUN:
         allow_bars(False)  # the sweep shows one bar for all its jobs
         _quiet_console()
-        job_figures = draws_job_figures(cfg.output)
+        # a job draws its figures only with output.job_figures=true: gyrolab plot SWEEP_DIR draws them from run.nc
+        job_figures = bool(cfg.output.get("figures", True)) and bool(cfg.output.get("job_figures", False))
         run_sweep_job(cfg, out_dir, list(hydra_cfg.overrides.task), hydra_cfg.job.num,
                       lambda job_id: _run_one(cfg, out_dir, job_id, figures=job_figures))
         return
@@ -461,13 +462,6 @@ def _quiet_console() -> None:
     for handler in logging.getLogger().handlers:
         if isinstance(handler, logging.StreamHandler) and not isinstance(handler, logging.FileHandler):
             handler.setLevel(logging.WARNING)
-
-
-def run_command(argv: Sequence[str]) -> int | None:
-    """The exit status of the subcommand ``argv`` names (options in any position), or None for ``run`` (Hydra's
-    app, the default)."""
-    command, args = parse_command_line(argv)
-    return None if command == "run" else run_subcommand(command, args)
 
 
 def run_subcommand(command: str, args: argparse.Namespace) -> int:

@@ -106,7 +106,12 @@ def plot(args: argparse.Namespace) -> int:
         if paths:
             raise ConfigError(f"plot --animate takes the run to animate as its value; drop "
                               f"{shorten(' '.join(paths))!r} or redraw it with a separate gyrolab plot PATH")
-        return _animate(args)
+        from gyrolab.figures.animation import animate  # matplotlib's writers only when an animation is asked for
+
+        options = {"output": args.output, "fmt": args.format, "frames": args.frames, "fps": args.fps}
+        log_to_stderr()
+        announce_written(animate(args.animate, **{k: v for k, v in options.items() if v is not None}))
+        return 0
     animation_options = [name for name in ("format", "frames", "fps", "output") if getattr(args, name) is not None]
     if animation_options:
         raise ConfigError(f"plot --{animation_options[0]} is an option of --animate; usage: gyrolab plot "
@@ -116,15 +121,6 @@ def plot(args: argparse.Namespace) -> int:
     formats, dpi = figure_options(compose_config(overrides).output)
     for written in redraw(Path(path), formats, dpi):
         announce_written(written)
-    return 0
-
-
-def _animate(args: argparse.Namespace) -> int:
-    from gyrolab.figures.animation import animate  # matplotlib's writers only when an animation is asked for
-    options = {"output": args.output, "fmt": args.format, "frames": args.frames, "fps": args.fps}
-    log_to_stderr()
-    written = animate(args.animate, **{k: v for k, v in options.items() if v is not None})
-    announce_written(written)
     return 0
 
 

@@ -10,6 +10,7 @@ folder of ``--config-dir DIR`` are read by the shell when TAB is pressed.
 
 from __future__ import annotations
 
+import shlex
 from collections.abc import Iterator, Sequence
 from importlib.resources import files
 
@@ -99,20 +100,17 @@ def script(shell: str) -> str:
     if shell == "zsh":
         lines += ["autoload -U +X compinit && compinit", "autoload -U +X bashcompinit && bashcompinit"]
     lines += [
-        f"_gyrolab_commands={_quote(' '.join(COMMANDS))}",
-        f"_gyrolab_aliases={_quote(' '.join(ALIASES))}",
-        f"_gyrolab_config={_quote(chr(10).join(config))}",
-        f"_gyrolab_plot_config={_quote(chr(10).join(plot_words))}",
-        f"_gyrolab_path_commands={_quote(' '.join(PATH_COMMANDS))}",
-        f"_gyrolab_value_options={_quote(' '.join(sorted(value_options({'run': run_parser(), **parsers}))))}",
+        f"_gyrolab_commands={shlex.quote(' '.join(COMMANDS))}",
+        f"_gyrolab_aliases={shlex.quote(' '.join(ALIASES))}",
+        f"_gyrolab_config={shlex.quote(chr(10).join(config))}",
+        f"_gyrolab_plot_config={shlex.quote(chr(10).join(plot_words))}",
+        f"_gyrolab_path_commands={shlex.quote(' '.join(PATH_COMMANDS))}",
+        f"_gyrolab_value_options={shlex.quote(' '.join(sorted(value_options({'run': run_parser(), **parsers}))))}",
     ]
     for name, words in options.items():
-        lines.append(f"_gyrolab_options_{name.replace('-', '_')}={_quote(chr(10).join(words))}")
+        lines.append(f"_gyrolab_options_{name.replace('-', '_')}={shlex.quote(chr(10).join(words))}")
     # the shell function (completion.bash): finds the word under the cursor (readline splits key=value at =; the word
     # is put together again), the subcommand named so far, and offers the words of one level below the cursor
     lines.append("\n" + (files("gyrolab.app") / "completion.bash").read_text())
     return "\n".join(lines)
 
-
-def _quote(text: str) -> str:
-    return "'" + text.replace("'", "'\\''") + "'"

@@ -43,11 +43,6 @@ def parse_command_line(argv: Sequence[str]) -> tuple[str, argparse.Namespace]:
     return command, parsers[command].parse_intermixed_args(rest)
 
 
-def parse_run(argv: Sequence[str]) -> argparse.Namespace:
-    """``gyrolab run``'s options (``argv`` without the word ``run``)."""
-    return run_parser().parse_intermixed_args(list(argv))
-
-
 def value_options(parsers: dict[str, argparse.ArgumentParser]) -> set[str]:
     """The options of any subcommand that take a value (the next word is then a value, not a subcommand)."""
     return {option for parser in parsers.values() for action in parser._actions if action.nargs != 0

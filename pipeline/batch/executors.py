@@ -47,7 +47,8 @@ def map_chunks(function: Callable[[Task], Result], tasks: Iterable[Task],
             on_result(index, result)
         return
     with _client(kind, str(scheduler), source) as client:
-        _map_on(client, function, tasks, on_result, where=_where(kind, str(scheduler)))
+        where = "on the local Dask cluster" if kind == "local" else f"on the Dask cluster at {scheduler}"
+        _map_on(client, function, tasks, on_result, where=where)
 
 
 def scheduler_kind(scheduler: str | None) -> str:
@@ -78,10 +79,6 @@ def chunk_error(index: int, error: BaseException, where: str) -> GyrolabError:
         return OutputError(f"chunk {index} of the batch failed {where}: a file could not be written ({reason(error)}); "
                            "the finished chunks are kept: free some space and rerun the same command")
     return GyrolabError(f"chunk {index} of the batch failed {where} ({type(error).__name__}: {message})")
-
-
-def _where(kind: str, scheduler: str) -> str:
-    return "on the local Dask cluster" if kind == "local" else f"on the Dask cluster at {scheduler}"
 
 
 def _client(kind: str, scheduler: str, source: str) -> Any:

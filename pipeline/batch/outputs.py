@@ -138,10 +138,7 @@ def indicator_outputs(compiled: Any, integrator: Any, times: np.ndarray, y0s: np
 
 def merge_rows(outputs: Mapping[str, Output], rows: np.ndarray, n_rows: int) -> dict[str, Output]:
     """Outputs computed for ``rows`` only, spread over ``n_rows`` (NaN in the others)."""
-    merged = {}
-    for name, out in outputs.items():
-        data = np.full((n_rows,) + out.data.shape[1:], np.nan)
-        data[rows] = out.data
-        merged[name] = Output(out.dims, data, out.attrs)
+    merged: dict[str, Output] = {}
+    _place(merged, {name: (out.dims, out.data, out.attrs) for name, out in outputs.items()}, rows, n_rows)
     return merged
 

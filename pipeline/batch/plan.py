@@ -13,7 +13,6 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -22,10 +21,10 @@ from omegaconf import OmegaConf
 from gyrolab.batch.points import read_points_file
 from gyrolab.engine import scene as scene_module
 from gyrolab.engine.config import compose_config
-from gyrolab.engine.scene import Scene, build_force, fastest_rate
+from gyrolab.engine.scene import Scene, body_and_forces, fastest_rate
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, GyrolabError, require_finite
-from gyrolab.sweep.grid import Dim, Grid, _refuse_repeats
+from gyrolab.sweep.grid import Dim, Grid, _refuse_repeats, dim_names
 from gyrolab.output.cf import unit_attributes
 from gyrolab.sweep.identity import canonical_config, job_code
 
@@ -106,9 +105,6 @@ class Plan:
             return type(cls.__new__(cls, **settings))
         return cls
 
-    def params(self, start: int, stop: int) -> np.ndarray:
-        return self.combo_params[self.combo[start:stop]]
-
     def identity(self, chunk: int) -> str:
         """20 hex digits over the code it loads (``job_code``), the composed config (without the settings that do not
         change the result), the grid and the chunk size: the same command gives the same identity."""
@@ -143,23 +139,6 @@ def split_overrides(overrides: Sequence[str]) -> tuple[list[str], list[Dim]]:
     return fixed, dims
 
 
-def dim_names(dims: Sequence[Dim]) -> tuple[str, ...]:
-    """Each dimension named by its key's last part (``initial.theta0`` -> ``theta0``), the whole key with
-    dots as underscores where two would share a name."""
-    short = [d.short_name for d in dims]
-    return tuple(s if short.count(s) == 1 else d.key.lstrip("+~").replace(".", "_") for s, d in zip(short, dims))
-
-
-def _not_finite_points(axes: list, n_points: int) -> np.ndarray:
-    """The points with a swept value that is not a finite number: the single run's checks decide them (rare)."""
-    suspect = np.zeros(n_points, dtype=bool)
-    for values, codes in axes:
-        odd = np.array([not _finite_number(v) for v in values], dtype=bool)
-        if odd.any():
-            suspect |= odd[codes]
-    return suspect
-
-
 def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any] | None = None) -> Plan:
     """The plan of the swept keys ``dims`` over the config composed from ``fixed`` (or given as ``plain``): their
     grid, or the explicit list of points of ``batch.zip``/``batch.points_file``."""
@@ -175,8 +154,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
     dims, points = _points(dims, plain)
     if points is None:
         shape = tuple(len(d.values) for d in dims)
-        axes = [(list(d.values), _along(np.arange(len(d.values), dtype=np.int32), axis, shape))
-                for axis, d in enumerate(dims)]
+        axes = [(list(d.values), codes.ravel()) for d, codes in zip(dims, np.indices(shape, dtype=np.int32))]
     else:
         shape = (len(dims[0].values),)
         axes = [_distinct(d) for d in dims]
@@ -188,7 +166,11 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
     def values_of(n: int) -> dict[str, Any]:
         return {d.key: values[codes[n]] for d, (values, codes) in zip(dims, axes)}
 
-    suspect = _not_finite_points(axes, n_points)
+    suspect = np.zeros(n_points, dtype=bool)   # a swept value that is not a finite number: the single run decides
+    for values, codes in axes:
+        odd = np.array([not _finite_number(v) for v in values], dtype=bool)
+        if odd.any():
+            suspect |= odd[codes]
 
     # body and forces once per combination of their swept values
     combo, combo_values = _combos([dims[i] for i in param_axes], [axes[i] for i in param_axes], n_points)
@@ -204,7 +186,9 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
         else:
             systems[c] = built
     reference = next(iter(systems.values()), None)
-    _same_structure(systems)
+    if len({(b.compiled.form, b.compiled.params.size) for b in systems.values()}) > 1:
+        raise ConfigError("the swept values change the compiled model's form (its torques or state), which one batch "
+                          "cannot integrate together; sweep them with gyrolab -m")
 
     # initial states: vectorised over the points, or one system per distinct point
     y0 = np.full((n_points, reference.system.state_size if reference else 0), np.nan)
@@ -294,14 +278,9 @@ def _distinct(dim: Dim) -> tuple[list[Any], np.ndarray]:
     if not dim.labels:   # a points file's column: floats
         values, codes = np.unique(np.asarray(dim.values, dtype=float), return_inverse=True)
         return values.tolist(), codes.astype(np.int32).ravel()
-    index: dict[str, int] = {}
-    values, codes = [], np.empty(len(dim.values), dtype=np.int32)
-    for n, (label, value) in enumerate(zip(dim.labels, dim.values)):
-        if label not in index:
-            index[label] = len(values)
-            values.append(value)
-        codes[n] = index[label]
-    return values, codes
+    index: dict[str, int] = {}   # each distinct label's number, in order of first appearance
+    codes = np.array([index.setdefault(label, len(index)) for label in dim.labels], dtype=np.int32)
+    return [dim.values[n] for n in np.unique(codes, return_index=True)[1]], codes
 
 
 def _combos(dims: Sequence[Dim], axes: Sequence[tuple[list[Any], np.ndarray]], n_points: int
@@ -358,13 +337,6 @@ def _finite_number(value: Any) -> bool:
         and abs(value) < 1.7e308
 
 
-def _along(mask: np.ndarray, axis: int, shape: tuple[int, ...]) -> np.ndarray:
-    """A per-value mask of dimension ``axis`` spread over the whole grid (flat, C order)."""
-    view = [1] * len(shape)
-    view[axis] = shape[axis]
-    return np.broadcast_to(mask.reshape(view), shape).ravel()
-
-
 def _column(axis: tuple[list[Any], np.ndarray], rows: np.ndarray) -> np.ndarray:
     """A swept key's values (floats, NaN for any other) at ``rows`` of the points."""
     values, codes = axis
@@ -388,13 +360,9 @@ def _build_combo(plain: dict[str, Any], values: Mapping[str, Any]) -> _Built | _
     try:
         require_finite({k: v for k, v in point.items() if k != "initial"}, "")
         cfg = OmegaConf.create(point)
-        system_cls = scene_module._plugin_class("system", cfg.system, "system")
-        body = system_cls.body_type.from_config(point["body"])
-        forces = [build_force(scene_module._plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
-                  for name, node in (cfg.get("force") or {}).items()]
+        body_and_forces(cfg, point)   # built for their errors only; the scene builds its own
     except GyrolabError as error:
         return _Failure(str(error), exact=True)
-    del body, forces   # built for their errors only; the scene builds its own
     try:
         scene = Scene.from_config(cfg)   # the rest of the single run's checks, on the base initial state
     except GyrolabError as error:
@@ -422,13 +390,6 @@ def _scalar_point(plain: dict[str, Any], values: Mapping[str, Any], n: int,
     return scene.system.initial_state(), _compiled(scene).params
 
 
-def _same_structure(systems: Mapping[int, _Built]) -> None:
-    models = {(b.compiled.form, b.compiled.params.size) for b in systems.values()}
-    if len(models) > 1:
-        raise ConfigError("the swept values change the compiled model's form (its torques or state), which one batch "
-                          "cannot integrate together; sweep them with gyrolab -m")
-
-
 def _common_attributes(systems: Mapping[int, _Built], swept_initial: bool) -> dict[str, Any]:
     """The attributes a single run's dataset gets from its system and body that are the same for every point
     (those of the initial state only when no initial key is swept)."""
@@ -451,17 +412,12 @@ def _batch_times(plain: dict[str, Any], systems: Mapping[int, _Built], y0: np.nd
     if time_cfg.get("n_output", "auto") == "auto":
         rates = []
         for c, built in systems.items():
-            rows = np.flatnonzero(valid & (combo == c))
-            if not rows.size:
-                continue
-            inertia = np.asarray(getattr(built.system.body, "inertia", np.ones(3)), dtype=float)
-            omega = y0[rows, :3]
-            fastest = y0[rows[int(np.argmax(np.einsum("ij,j,ij->i", omega, inertia, omega)))]]
-            shim = SimpleNamespace(body=built.system.body, forces=built.system.forces,
-                                   state_size=built.system.state_size, initial_state=lambda s=fastest: s)
-            value = fastest_rate(shim)
-            if value is not None:
-                rates.append(value)
+            omega = y0[valid & (combo == c), :3]
+            if len(omega):
+                inertia = np.asarray(getattr(built.system.body, "inertia", np.ones(3)), dtype=float)
+                energetic = omega[int(np.argmax(np.einsum("ij,j,ij->i", omega, inertia, omega)))]
+                rates.append(fastest_rate(built.system, energetic))
+        rates = [r for r in rates if r is not None]
         rate = max(rates) if rates else None
     return scene_module._output_times(time_cfg, rate)
 

@@ -16,12 +16,12 @@ import numpy as np
 import xarray as xr
 from omegaconf import OmegaConf
 
-from gyrolab.batch.plan import POINT, Dim, dim_names, make_plan
+from gyrolab.batch.plan import POINT, Dim, make_plan
 from gyrolab.batch.runner import Settings, chunk_size, chunks, run_plan
 from gyrolab.batch.sweep import check_integrator
 from gyrolab.engine.safety import check_stored_config
 from gyrolab.errors import ConfigError, shorten
-from gyrolab.sweep.grid import Grid
+from gyrolab.sweep.grid import Grid, dim_names
 from gyrolab.sweep.reproduce import Comparison, compare, parse_points
 
 log = logging.getLogger("gyrolab.batch")

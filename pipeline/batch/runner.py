@@ -159,10 +159,9 @@ def run_plan(plan: Plan, path: Path, settings: Settings, only: set[int] | None =
         return RunStats(path)
     integrator, store.integrator_attributes = batch_integrator(plan, settings)
     pending = [i for i in range(len(blocks)) if i not in done and (only is None or i in only)]
-    tasks, empty = [], []
-    for i in pending:
-        task = chunk_task(plan, blocks[i], i, settings, integrator)
-        (tasks if task is not None else empty).append(task if task is not None else i)
+    built = {i: chunk_task(plan, blocks[i], i, settings, integrator) for i in pending}
+    tasks = [task for task in built.values() if task is not None]
+    empty = [i for i, task in built.items() if task is None]
     log.info("batch: %d points in %d chunks of ≤ %d (%s), %d stored already, %d to run; output %s", plan.size,
              len(blocks), size, settings.output, len(done), len(tasks), path)
     for i in empty:   # no valid point: only the points' errors, which the store wrote when it was created
@@ -189,8 +188,7 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
     ``batch_path``); None: the config's own. An integrator that chooses its method (CHOOSES_METHOD) chooses here,
     once for the batch, on its valid points (docs/batch.md, "integrator=auto chooses once per batch")."""
     if plan.base is None or settings.output == "indicator" or not plan.integrator_class.supports(CHOOSES_METHOD):
-        return None, {} if plan.base is None else {"batch_path": batch_path(plan.integrator_class, settings),
-                                                   **lane_record(plan.integrator_class, settings)}
+        return None, {} if plan.base is None else path_attributes(plan.integrator_class, settings)
 
     scene = Scene.from_config(OmegaConf.create(plan.base))
     valid = np.flatnonzero(plan.valid)
@@ -201,25 +199,19 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
                               else f"{k.removeprefix('integrator_')}={v}" for k, v in method.attributes().items())
     log.info("batch: %s chose %s (%s) for every chunk, in %.1f s", plan.integrator_name, method.name, settings_text,
              time.perf_counter() - start)
-    return method, {**{k: v for k, v in choice.items() if v is not None},
-                    "batch_path": batch_path(type(method), settings), **lane_record(type(method), settings)}
+    return method, {**{k: v for k, v in choice.items() if v is not None}, **path_attributes(type(method), settings)}
 
 
-def batch_path(integrator: type, settings: Settings) -> str:
-    """How a batch's points run with ``integrator`` (stored as the dataset's ``batch_path`` attribute)."""
+def path_attributes(integrator: type, settings: Settings) -> dict[str, Any]:
+    """How a batch's points run with ``integrator`` (the dataset's ``batch_path``) and, for a vectorised batch kernel,
+    the lane width it was compiled for and the CPU's vector width."""
     if settings.output == "indicator":
-        return "variational kernel"
+        return {"batch_path": "variational kernel"}
     if not integrator.supports(BATCH_KERNEL):
-        return "one integrate() call per point"
-    return "batch kernel, vectorised across trajectories" if integrator.supports(VECTOR_LANES) else "batch kernel"
-
-
-def lane_record(integrator: type, settings: Settings) -> dict[str, int]:
-    """The lane width a vectorised batch kernel was compiled for and the CPU's vector width (empty otherwise)."""
-    if settings.output == "indicator" or not integrator.supports(BATCH_KERNEL) or not integrator.supports(VECTOR_LANES):
-        return {}
-
-    return lane_attributes()
+        return {"batch_path": "one integrate() call per point"}
+    if not integrator.supports(VECTOR_LANES):
+        return {"batch_path": "batch kernel"}
+    return {"batch_path": "batch kernel, vectorised across trajectories", **lane_attributes()}
 
 
 def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integrator: Any = None) -> ChunkTask | None:
@@ -234,7 +226,7 @@ def chunk_task(plan: Plan, chunk: Chunk, index: int, settings: Settings, integra
     combos = {int(c): (plan.combo_values[c] if c != base_combo else {}) for c in np.unique(combo)}
     return ChunkTask(index=index, config=plan.base, config_key=plan.base_key, output=settings.output,
                      decimate=settings.decimate, times=plan.times, rows=rows, y0=plan.y0[points],
-                     params=plan.params(chunk.start, chunk.stop)[rows], combo=combo, combos=combos,
+                     params=plan.combo_params[combo], combo=combo, combos=combos,
                      n_rows=chunk.stop - chunk.start, integrator=integrator)
 
 
@@ -281,13 +273,10 @@ def _system(context: dict[str, Any], config: dict[str, Any], values: dict[str, A
     """The system with a point's body and force values (built once per process and combination)."""
     if not values:
         return context["scene"].system
-    key = _combo_key(values)
-    system = context["systems"].get(key)
-    if system is None:
-
-        system = Scene.from_config(OmegaConf.create(_with_values(config, values))).system
-        context["systems"][key] = system
-    return system
+    systems, key = context["systems"], _combo_key(values)
+    if key not in systems:
+        systems[key] = Scene.from_config(OmegaConf.create(_with_values(config, values))).system
+    return systems[key]
 
 
 _kernels_called = False   # whether this process has run a chunk (its kernels are loaded)
@@ -320,11 +309,9 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
         if integrator.supports(BATCH_KERNEL):
             solution = integrate_arrays(compiled, integrator, task.times, task.y0, task.params, failures="mark")
         else:   # one integrate() call per point, each with its own system's right-hand side: a single run's numbers
-            system_of_row = np.empty(len(task.rows), dtype=object)
-            for system, rows in groups:
-                system_of_row[rows] = system
-            solution = integrate_points(integrator, lambda j: system_of_row[j].rhs, task.times, task.y0, compiled,
-                                        task.params, failures="mark")
+            rhs = {int(j): system.rhs for system, rows in groups for j in rows}
+            solution = integrate_points(integrator, rhs.__getitem__, task.times, task.y0, compiled, task.params,
+                                        failures="mark")
         kernel_time = solution.wall_time
         failed = np.asarray(solution.failed, dtype=bool)
         settings = solution.settings

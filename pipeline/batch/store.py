@@ -139,10 +139,7 @@ class Store:
                     self._write(name, chunk, out.data)
         self.nc.sync()
         _fsync(self.part)
-        with open(self.journal, "a", encoding="utf-8", opener=open_own_file) as journal:
-            journal.write(f"{index}\n")
-            journal.flush()
-            os.fsync(journal.fileno())
+        _write_journal(self.journal, "a", f"{index}\n")
 
     def finish(self) -> None:
         """Close the complete file and give it its final name (OutputError, the chunks kept, if that fails)."""
@@ -164,8 +161,7 @@ class Store:
     def _finish(self) -> None:
         if self.nc is None:
             self._create(None)
-        status = self.nc["job_status"][:]
-        status = np.asarray(status.filled(0) if np.ma.isMaskedArray(status) else status)
+        status = np.asarray(self.nc["job_status"][:])   # auto-masking is off (_open, _create_file)
         counts = {f"n_{name}": np.int64(np.count_nonzero(status == code)) for name, code in STATUS_FLAGS.items()}
         self.nc.setncatts(counts)
         if counts["n_failed"]:
@@ -186,14 +182,11 @@ class Store:
         """Create ``.part`` whole (every variable's storage allocated); a failure leaves neither it nor a journal
         (nothing was finished), so the rerun starts cleanly."""
         try:
-            self._create_file(result)
-        except (OSError, RuntimeError) as error:
-            if not isinstance(error, OSError) and not _library_failure(error):
-                raise
-            failure = self._failed(error, set())
+            self._guarded(self._create_file, result)
+        except OutputError:
             self.part.unlink(missing_ok=True)
             self.journal.unlink(missing_ok=True)
-            raise failure from None
+            raise
 
     def _create_file(self, result: Any) -> None:
         plan = self.plan
@@ -201,7 +194,9 @@ class Store:
         nc = netCDF4.Dataset(self.part, "w", format="NETCDF4")
         self.nc = nc
         nc.set_auto_mask(False)
-        system = _reference_system(plan)
+        # the base point's system: the title, the time's attributes, the units of the swept keys (gyrolab knows those
+        # of every key of a nondimensional body and the known keys of an SI one: gyrolab.output.units)
+        system = Scene.from_config(OmegaConf.create(plan.base)).system if plan.base is not None else None
         if plan.points is not None:
             nc.createDimension(POINT, plan.size)
             _variable(nc, POINT, POINT, np.arange(plan.size, dtype=np.int32),
@@ -213,8 +208,9 @@ class Store:
             values = dim.coordinate()
             if values.dtype.kind in "iu":
                 values = values.astype(np.int32) if np.abs(values).max() < 2**31 else values.astype(np.float64)
+            units = quantity_units(dim.key, system.body.units if system is not None else None)
             attrs = {"long_name": f"swept parameter {dim.key}" + (" of each point" if plan.points else ""),
-                     "override_key": dim.key, **_key_units(dim.key, system)}
+                     "override_key": dim.key, **({"units": units} if units else {})}
             (_text_variable if values.dtype.kind == "O" else _variable)(
                 nc, name, POINT if plan.points is not None else name, values, attrs)
         nc.createDimension("error_kind", len(self.messages))
@@ -325,16 +321,18 @@ def _open(path: Path, mode: str) -> netCDF4.Dataset:
 
 
 def _identity_of(path: Path) -> str:
-    nc = _open(path, "r")
-    try:
+    with _open(path, "r") as nc:
         return str(getattr(nc, "batch_identity", "none (not a gyrolab batch)"))
-    finally:
-        nc.close()
 
 
 def _start_journal(path: Path, identity: str) -> None:
-    with open(path, "w", encoding="utf-8", opener=open_own_file) as journal:
-        journal.write(f"identity {identity}\n")
+    _write_journal(path, "w", f"identity {identity}\n")
+
+
+def _write_journal(path: Path, mode: str, text: str) -> None:
+    """Write (``mode`` "w") or append ("a") ``text`` to a journal, on the disk when this returns."""
+    with open(path, mode, encoding="utf-8", opener=open_own_file) as journal:
+        journal.write(text)
         journal.flush()
         os.fsync(journal.fileno())
 
@@ -361,17 +359,3 @@ def _cut_torn_line(path: Path) -> None:
             journal.flush()
             os.fsync(journal.fileno())
 
-
-def _reference_system(plan: Any) -> Any:
-    if plan.base is None:
-        return None
-
-    return Scene.from_config(OmegaConf.create(plan.base)).system
-
-
-def _key_units(key: str, system: Any) -> dict[str, str]:
-    """CF units of a swept key where gyrolab knows them (``gyrolab.output.units``: every key of a nondimensional
-    body, the known keys of an SI one)."""
-
-    units = quantity_units(key, system.body.units if system is not None else None)
-    return {"units": units} if units else {}

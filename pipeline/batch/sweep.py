@@ -4,6 +4,7 @@ run in chunks, streamed to one resumable dataset; only body, initial-state and f
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -52,11 +53,9 @@ def run_batch(fixed: Sequence[str], dims: Sequence[Dim], path: Path, *,
     if executors.scheduler_kind(settings.scheduler) == "address":   # a bad peer is refused before any directory
         probe(str(settings.scheduler), settings.scheduler_source, executors.CONNECT_TIMEOUT)
     plan_time = time.perf_counter() - start
-    if not lock:
+    # locked after the cheap checks: a bad grid leaves no directory
+    with writing_in(path.parent, "sweep directory") if lock else contextlib.nullcontext():
         stats = run_plan(plan, path, settings)
-    else:
-        with writing_in(path.parent, "sweep directory"):  # after the cheap checks: a bad grid leaves no directory
-            stats = run_plan(plan, path, settings)
     stats.plan_time = plan_time
     return stats
 

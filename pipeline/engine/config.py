@@ -204,7 +204,8 @@ def compose_config(overrides: Sequence[str], *, return_hydra_config: bool = Fals
     """
     register_plugin_configs()
     if GlobalHydra.instance().is_initialized():
-        cfg = _compose(overrides, config_name or _running_config_name(), return_hydra_config, run_mode,
+        running = HydraConfig.get().job.config_name if HydraConfig.initialized() else None
+        cfg = _compose(overrides, config_name or running or _source.config_name, return_hydra_config, run_mode,
                        from_shell)
     else:
         with hydra_for(_source):
@@ -212,10 +213,6 @@ def compose_config(overrides: Sequence[str], *, return_hydra_config: bool = Fals
     if refuse_unread:
         refuse_given_accuracy(cfg, overrides)
     return cfg
-
-
-def _running_config_name() -> str:
-    return (HydraConfig.get().job.config_name if HydraConfig.initialized() else None) or _source.config_name
 
 
 def _compose(overrides: Sequence[str], config_name: str, return_hydra_config: bool, run_mode: RunMode,

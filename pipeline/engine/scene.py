@@ -69,10 +69,7 @@ class Scene:
         built, before the output times are allocated or the integrator built."""
         plain = OmegaConf.to_container(cfg, resolve=True)
         require_finite(plain, "")
-        system_cls = _plugin_class("system", cfg.system, "system")
-        body = system_cls.body_type.from_config(plain["body"])
-        forces = [build_force(_plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
-                  for name, node in (cfg.get("force") or {}).items()]
+        system_cls, body, forces = body_and_forces(cfg, plain)
         system = _build(system_cls, cfg.system, "system", body, forces, plain["initial"], plain.get("output") or {})
         if check is not None:
             check(system)
@@ -251,6 +248,14 @@ def run(overrides: Sequence[str] = ()) -> xr.Dataset:
     return compose_scene(overrides).run()
 
 
+def body_and_forces(cfg: DictConfig, plain: dict[str, Any]) -> tuple[type, Any, list[Any]]:
+    """(the system's class, its body, its forces) of a composed config (``plain``: resolved), in this order."""
+    system_cls = _plugin_class("system", cfg.system, "system")
+    body = system_cls.body_type.from_config(plain["body"])
+    return system_cls, body, [build_force(_plugin_class("force", node, f"force.{name}"), node, f"force.{name}", body)
+                              for name, node in (cfg.get("force") or {}).items()]
+
+
 def _check_time_dependent(timed: Sequence[str], system: System, integrator: Integrator | None = None) -> None:
     """ConfigError when time-dependent forces (``timed``) act in a system, or (given) an integrator, that does not
     support them."""
@@ -271,7 +276,7 @@ def _plugin_class(group: str, node: Any, where: str) -> type:
     return cls
 
 
-def _params(cls: type, node: DictConfig, where: str) -> dict[str, Any]:
+def plugin_params(cls: type, node: DictConfig, where: str) -> dict[str, Any]:
     """A plugin's config parameters, each one a keyword of its ``__init__`` (no nested instantiation)."""
     params = {k: v for k, v in OmegaConf.to_container(node, resolve=True).items() if k != "_target_"}
     for key, value in params.items():
@@ -287,7 +292,7 @@ def _params(cls: type, node: DictConfig, where: str) -> dict[str, Any]:
 
 def _build(cls: type, node: DictConfig, where: str, *args: Any) -> Any:
     """Instantiate a registered plugin class with its config parameters."""
-    return _guarded(cls, where, cls, *args, **_params(cls, node, where))
+    return _guarded(cls, where, cls, *args, **plugin_params(cls, node, where))
 
 
 def _guarded(cls: type, where: str, call: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
@@ -315,7 +320,7 @@ def build_force(cls: type, node: Any, where: str, body: Any) -> Any:
     naming the plugin."""
     if not isinstance(node, DictConfig):
         node = OmegaConf.create(dict(node))
-    params = _params(cls, node, where)
+    params = plugin_params(cls, node, where)
     try:
         force = cls(body, **params)
     except GyrolabError:
@@ -357,8 +362,9 @@ def check_force_claims(system: System, t0: float = 0.0) -> None:
             check_claims(force, omegas, frames, t0, f"force.{force.name}", initial=frame0 is not None)
 
 
-def fastest_rate(system: System) -> float | None:
-    """An upper estimate ν of the fastest angular frequency in the stored series (model units).
+def fastest_rate(system: System, omega0: np.ndarray | None = None) -> float | None:
+    """An upper estimate ν of the fastest angular frequency in the stored series (model units), from the initial ω
+    (``omega0``: another one, e.g. a batch's most energetic).
 
     A body turning at |ω| moves every body-frame vector (γ, α) at up to |ω|, and its
     nutation and the body-frame motion of ω run at up to (I_max/I_min) |ω| (a symmetric top
@@ -375,7 +381,7 @@ def fastest_rate(system: System) -> float | None:
         return None
     inertia = np.asarray(body.inertia, dtype=float)
     i_min, i_max = float(inertia.min()), float(inertia.max())
-    omega0 = np.asarray(system.initial_state()[:3], dtype=float)
+    omega0 = np.asarray(system.initial_state()[:3] if omega0 is None else omega0, dtype=float)
     orbit = float(getattr(body, "orbit_rate", 0.0) or 0.0)
     spread = 0.5 * (i_max - i_min)
     dv = 2.0 * float(np.linalg.norm(getattr(body, "weight_moment", np.zeros(3))))

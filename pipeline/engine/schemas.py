@@ -480,7 +480,8 @@ def _mismatch_sentence(key: str, value: Any, hint: Any) -> str:
         return f"{key}={shorten(repr(value))}: a list and a section (a mapping) do not match; {key} must be {_words(hint)}"
     if section:
         base = _strip_optional(hint)
-        example = REQUIRED_SECTIONS.get(key) or (_example(base) if dataclasses.is_dataclass(base) else "NAME")
+        example = REQUIRED_SECTIONS.get(key) or (dataclasses.fields(base)[0].name if dataclasses.is_dataclass(base)
+                                                 else "NAME")
         return (f"{key}={shorten(repr(value))}: `{key}` is a section, not a value; set one of its keys "
                 f"(e.g. {key}.{example}=...)")
     return _type_sentence(key, value, hint)
@@ -493,11 +494,6 @@ def _is_list(hint: Any) -> bool:
 def _strip_optional(hint: Any) -> Any:
     args = [a for a in typing.get_args(hint) if a is not type(None)]
     return args[0] if typing.get_origin(hint) in (typing.Union, types.UnionType) and len(args) == 1 else hint
-
-
-def _example(schema: type) -> str:
-    names = [f.name for f in dataclasses.fields(schema)]
-    return "end" if "end" in names else names[0]
 
 
 _WORDS = {bool: "true or false", int: "an integer", float: "a number", str: "a string"}

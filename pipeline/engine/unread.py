@@ -41,11 +41,6 @@ def given_overrides(overrides: Sequence[str]) -> dict[str, str]:
     return given
 
 
-def given_keys(overrides: Sequence[str]) -> set[str]:
-    """The keys an override list gives a value (``given_overrides``' keys)."""
-    return set(given_overrides(overrides))
-
-
 def covers(key: str, given: str) -> bool:
     """Whether config key ``key`` is ``given`` or a section holding it (``batch`` covers ``batch.output``)."""
     return given == key or given.startswith(key + ".")
@@ -120,14 +115,14 @@ def ignored_accuracy(cfg: DictConfig, overrides: Sequence[str]) -> str | None:
     if sentence is None:
         return None
     source = ("the sweep gives it to every job, and the jobs whose integrator reads it aim at it"
-              if ACCURACY in given_keys(overrides) else "a config file set it, as a default for the integrators "
+              if ACCURACY in given_overrides(overrides) else "a config file set it, as a default for the integrators "
               "that read it")
     return f"{sentence}, so this run does not aim at that accuracy ({source})"
 
 
 def refuse_given_accuracy(cfg: DictConfig, overrides: Sequence[str]) -> None:
     """ConfigError when ``overrides`` give ``accuracy`` and the integrator of ``cfg`` does not read it."""
-    if ACCURACY not in given_keys(overrides):
+    if ACCURACY not in given_overrides(overrides):
         return
     sentence = unread_accuracy(cfg)
     if sentence is not None:

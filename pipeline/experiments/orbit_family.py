@@ -68,10 +68,6 @@ def _fast_spin(f: dict, r0: float, order: int | None = None) -> tuple[np.ndarray
     return regime._state(s, np.array([0.0]))[0], regime._period(s)
 
 
-def fast_spin_error(f: dict, point: FamilyPoint, order: int) -> float:
-    return _error(*_fast_spin(f, point.r0, order), point)
-
-
 def slow_spin_error(f: dict, point: FamilyPoint) -> float:
     on_axis = abs(f["com"][0]) < 1e-12 and abs(f["com"][1]) < 1e-12 and f["com"][2] > 0
     if not (on_axis and 0 < point.r0 <= slow.MAX_SPIN and slow.MIN_TILT <= f["theta0"] <= slow.MAX_TILT):
@@ -96,11 +92,7 @@ def start_point(f: dict, model: FixedPointModel, section: Section) -> FamilyPoin
 
 def amplitude(model: FixedPointModel, point: FamilyPoint, samples: int = 48) -> float:
     """Nutation amplitude max θ − min θ over one period (θ = arccos γ'')."""
-    theta, y, now = [np.arccos(np.clip(point.y0[5], -1, 1))], point.y0, 0.0
-    for t in np.linspace(0, point.period, samples + 1)[1:]:
-        y, _ = model.flow(y, t - now, np.zeros((6, 0)))
-        now = t
-        theta.append(np.arccos(np.clip(y[5], -1, 1)))
+    theta = np.arccos(np.clip(model.sample(point.y0, np.linspace(0, point.period, samples + 1))[:, 5], -1, 1))
     return float(np.max(theta) - np.min(theta))
 
 
@@ -119,7 +111,7 @@ def trace(name: str, f: dict) -> dict[str, Any]:
     ended = ("reached r0/c = {:.4g}".format(reached) if (np.log(f["r0_end"]) - np.log(reached))
              * np.sign(np.log(f["r0_end"]) - np.log(f["r0_start"])) <= 0 else
              f"stopped at r0/c = {reached:.4g} with period {points[-1].period:.4g}: {points.stop_reason}")
-    errors = {f"order_{o}": [fast_spin_error(f, p, o) if p.r0 >= 1 else np.nan for p in points]
+    errors = {f"order_{o}": [_error(*_fast_spin(f, p.r0, o), p) if p.r0 >= 1 else np.nan for p in points]
               for o in FAST_SPIN_ORDERS}
     errors["slow"] = [slow_spin_error(f, p) for p in points]
     log.info("family %s: %d points, %s; bifurcations: %s", name, len(points), ended,

@@ -13,13 +13,13 @@ from typing import Any
 import numpy as np
 import xarray as xr
 from hydra.core.hydra_config import HydraConfig
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 from gyrolab.analysis.periodic import FixedPointModel, PeriodicOrbit, shoot
 from gyrolab.contracts import registry
-from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PREFERS_COMPILED_MODEL
+from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL
 from gyrolab.contracts.regime import Regime
-from gyrolab.engine.scene import Scene
+from gyrolab.engine.scene import Scene, plugin_params
 from gyrolab.engine.schemas import Task
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, IntegrationError
@@ -45,13 +45,7 @@ def build_regime(cfg: DictConfig) -> Regime:
         raise ConfigError(f"regime must be selected by name (regime=NAME); valid choices: "
                           f"{', '.join(registry.names('regime'))}")
     _, cls = registry.resolve_target("regime", node._target_, "regime")
-    params = {k: v for k, v in OmegaConf.to_container(node, resolve=True).items() if k != "_target_"}
-    accepted = registry.default_params(cls)
-    unknown = sorted(set(params) - set(accepted))
-    if unknown:
-        raise ConfigError(f"regime.{unknown[0]} is not a parameter of {cls.__name__}; valid parameters: "
-                          f"{', '.join(sorted(accepted))}")
-    return cls(**params)
+    return cls(**plugin_params(cls, node, "regime"))
 
 
 #: |γ(0)| of the series further than this from 1 is reported as a warning (the figure states any rescaling)
@@ -89,9 +83,7 @@ def integrate(scene: Scene, y0: np.ndarray, t: np.ndarray, *, taylor: bool = Fal
     system = scene.system
     if taylor:
         return Taylor(order=24, tol=1e-16).integrate(system.rhs, t, y0, None, system.compiled_model()).y
-    integrator = scene.integrator
-    wants = integrator.supports(COMPILED_MODEL) or integrator.supports(PREFERS_COMPILED_MODEL)
-    return integrator.integrate(system.rhs, t, y0, None, system.compiled_model() if wants else None).y
+    return scene.integrator.integrate(system.rhs, t, y0, None, scene.compiled).y
 
 
 def compute(scene: Scene, regime: Regime, t: np.ndarray, *, full: bool = True,

@@ -41,13 +41,6 @@ COLUMNS = ("case", "formula", "residual_vector", "residual_euler_angles", "max_t
            "condition", "stability_note")
 
 
-def _settings(cfg: DictConfig) -> dict[str, float]:
-    spec = OmegaConf.to_container(cfg.get("yehia2021") or {}, resolve=True)
-    orbits = as_number(spec.get("orbits", 5), "yehia2021.orbits", positive=True)
-    tol = as_number(spec.get("residual_tolerance", 1e-10), "yehia2021.residual_tolerance", positive=True)
-    return {"orbits": orbits, "residual_tolerance": tol}
-
-
 def _scene(cfg: DictConfig, case: Case, orbits: float) -> Scene:
     scene_cfg = OmegaConf.create(OmegaConf.to_container(cfg, resolve=True))
     with open_dict(scene_cfg):
@@ -109,12 +102,14 @@ TASK = Task("yehia2021_precessions", reads=("output.error_estimate",), section="
 
 
 def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
-    settings = _settings(cfg)
+    spec = OmegaConf.to_container(cfg.get("yehia2021") or {}, resolve=True)
+    orbits = as_number(spec.get("orbits", 5), "yehia2021.orbits", positive=True)
+    tol = as_number(spec.get("residual_tolerance", 1e-10), "yehia2021.residual_tolerance", positive=True)
     if cfg.get("system", {}).get("_target_", "").split(".")[-1] != "OrbitingGyrostat":
         raise ConfigError("experiment yehia2021_precessions needs system=orbiting_gyrostat (select a gyrostat body)")
     rows, traces = [], {}
     for case in CASES:
-        row, ds = evaluate(cfg, case, settings["orbits"], settings["residual_tolerance"])
+        row, ds = evaluate(cfg, case, orbits, tol)
         rows.append(row)
         traces[case.label] = ds
     closed = check_closed_forms()

@@ -5,7 +5,6 @@ docs/datasets.md, "sweep.nc — a multirun").
 from __future__ import annotations
 
 import logging
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -26,7 +25,7 @@ from gyrolab.output.trust import check_tree
 from gyrolab.output.units import quantity_units
 from gyrolab.output.user_yaml import stored_yaml_file
 from gyrolab.output.written import announce_written
-from gyrolab.sweep.grid import Grid
+from gyrolab.sweep.grid import Grid, dim_names
 from gyrolab.sweep.record import FAILED, FINISHED, JobRecord, read_record, record_paths
 
 log = logging.getLogger("gyrolab.sweep")
@@ -91,16 +90,18 @@ class SweepSummary:
 def assemble(grid: Grid, results: Sequence[JobResult]) -> xr.Dataset:
     """The sweep dataset of ``grid`` from ``results[n]``, the outcome of job ``n`` (one per job)."""
     done = [(grid.index[n], r.dataset) for n, r in enumerate(results) if r.status == FINISHED]
-    names = _dim_names(grid, [ds for _, ds in done])
-    grid_dims = tuple(names)
+    reserved = {"time", "sample", "axis", "failed_job"}.union(*(set(ds.variables) | set(ds.dims) for _, ds in done))
+    grid_dims = dim_names(grid.dims, reserved)
     shape = grid.shape
-    body_units = _body_units([ds for _, ds in done])
+    systems = {ds.attrs.get("body_units") for _, ds in done}   # si or nondimensional, None when they differ
+    body_units = systems.pop() if len(systems) == 1 else None
     coords: dict[str, Any] = {
         name: (name, values, {"long_name": f"swept parameter {dim.key}", "override_key": dim.key,
                               **_units(values, quantity_units(dim.key, body_units))})
-        for name, dim in zip(names, grid.dims) for values in [dim.coordinate()]
+        for name, dim in zip(grid_dims, grid.dims) for values in [dim.coordinate()]
     }
-    sample = _sample_dim([ds for _, ds in done])
+    times = [ds["time"].values for _, ds in done]   # sample: the jobs' output times differ
+    sample = "time" if all(np.array_equal(t, times[0]) for t in times[1:]) else "sample"
     data_vars = _stacked_variables(done, coords, shape, grid_dims, sample, body_units) if done else {}
     common = _run_attributes(done, coords, data_vars, shape, grid_dims, body_units)
     data_vars.update(_job_table(grid, results, grid_dims))
@@ -151,8 +152,21 @@ def _stacked_variables(done: list[tuple[tuple, xr.Dataset]], coords: dict[str, A
 
 
 def _add_per_job_attrs(data_vars: dict[str, Any], coords: dict[str, Any], done: list, name: str,
-                       shape: tuple[int, ...], grid_dims: tuple[str, ...], body_units: str) -> None:
-    for attr, variable in _per_job_attrs(done, name, shape, grid_dims, body_units).items():
+                       shape: tuple[int, ...], grid_dims: tuple[str, ...], body_units: str | None) -> None:
+    """The attributes of ``name`` that are per job by nature or differ between jobs, as variables over the grid."""
+    having = [(index, ds[name]) for index, ds in done if name in ds.variables]
+    for attr in _union([list(da.attrs) for _, da in having]):
+        values = {index: da.attrs[attr] for index, da in having if attr in da.attrs}
+        if attr not in PER_JOB_VARIABLE_ATTRS and len(values) == len(having) and _all_same(list(values.values())):
+            continue
+        variable = _cell_variable(values, shape, grid_dims, f"{name}_{attr}")
+        if attr == "max_abs_drift":
+            variable[2].update({"long_name": f"max |{name}(t) − {name}(0)|",
+                                "units": having[0][1].attrs.get("units", "1")})
+        else:
+            units = (having[0][1].attrs.get("units") if attr == "invariant_allowed_drift"
+                     else quantity_units(attr, body_units))
+            variable[2].update({"long_name": f"attribute {attr} of {name}, per job", **_units(variable[1], units)})
         data_vars[f"{name}_{attr}"] = variable
         _index_coordinate(coords, variable, f"{name}_{attr}")
 
@@ -192,26 +206,6 @@ def _job_table(grid: Grid, results: Sequence[JobResult], grid_dims: tuple[str, .
             **_failure_table(grid, results)}
 
 
-def _dim_names(grid: Grid, datasets: Sequence[xr.Dataset]) -> list[str]:
-    reserved = {"time", "sample", "axis", "failed_job"}
-    for ds in datasets:
-        reserved |= set(ds.variables) | set(ds.dims)
-    shorts = [d.short_name for d in grid.dims]
-    names = []
-    for dim, short in zip(grid.dims, shorts):
-        name = short if shorts.count(short) == 1 and short not in reserved else dim.key.lstrip("+~").replace(".", "_")
-        while name in reserved or name in names:
-            name = f"sweep_{name}"
-        names.append(name)
-    return names
-
-
-def _sample_dim(datasets: Sequence[xr.Dataset]) -> str:
-    """'time' if every job has the same output times (the usual case), else 'sample'."""
-    times = [ds["time"].values for ds in datasets]
-    return "time" if all(np.array_equal(t, times[0]) for t in times[1:]) else "sample"
-
-
 def _union(lists: Sequence[Sequence[str]]) -> list[str]:
     return list(dict.fromkeys(item for items in lists for item in items))
 
@@ -241,15 +235,9 @@ def _stack(done: Sequence[tuple[tuple[int, ...], xr.Dataset]], name: str, shape:
 
 
 def _common_attrs(arrays: Sequence[xr.DataArray]) -> dict[str, Any]:
-    """Attributes equal in every job (the others become per-job variables, see ``_per_job_attrs``)."""
+    """Attributes equal in every job (the others become per-job variables, see ``_add_per_job_attrs``)."""
     return {k: v for k, v in arrays[0].attrs.items() if k not in PER_JOB_VARIABLE_ATTRS
             and all(k in da.attrs and _same(v, da.attrs[k]) for da in arrays)}
-
-
-def _body_units(datasets: Sequence[xr.Dataset]) -> str | None:
-    """The jobs' body unit system (``si``/``nondimensional``), None when they differ or do not say."""
-    systems = {ds.attrs.get("body_units") for ds in datasets}
-    return systems.pop() if len(systems) == 1 else None
 
 
 def _units(values: Any, units: str | None) -> dict[str, str]:
@@ -266,25 +254,6 @@ def _index_coordinate(coords: dict[str, Any], variable: tuple, key: str) -> None
             coords[dim] = (dim, np.arange(size, dtype=np.int32), {
                 "long_name": f"component of run attribute {key} (as stored in each job's run.nc, from 0)",
                 "units": "1"})
-
-
-def _per_job_attrs(done: Sequence[tuple[tuple[int, ...], xr.Dataset]], name: str, shape: tuple[int, ...],
-                   grid_dims: tuple[str, ...], body_units: str | None = None) -> dict[str, tuple]:
-    having = [(index, ds[name]) for index, ds in done if name in ds.variables]
-    out = {}
-    for attr in _union([list(da.attrs) for _, da in having]):
-        values = {index: da.attrs[attr] for index, da in having if attr in da.attrs}
-        if attr in PER_JOB_VARIABLE_ATTRS or len(values) < len(having) or not _all_same(list(values.values())):
-            out[attr] = _cell_variable(values, shape, grid_dims, f"{name}_{attr}")
-            if attr == "max_abs_drift":
-                out[attr][2].update({"long_name": f"max |{name}(t) − {name}(0)|",
-                                     "units": having[0][1].attrs.get("units", "1")})
-            else:
-                units = (having[0][1].attrs.get("units") if attr == "invariant_allowed_drift"
-                         else quantity_units(attr, body_units))
-                out[attr][2].update({"long_name": f"attribute {attr} of {name}, per job",
-                                     **_units(out[attr][1], units)})
-    return out
 
 
 def _cell_variable(values: dict[tuple[int, ...], Any], shape: tuple[int, ...], grid_dims: tuple[str, ...],
@@ -433,14 +402,12 @@ def stored_hydra(sweep_dir: Path) -> DictConfig:
 
 def wait_for_jobs(sweep_dir: Path) -> None:
     """Wait for the jobs of this sweep that another process is running (a concurrent resume)."""
-    for root, dirs, files in os.walk(sweep_dir):
-        dirs[:] = sorted(d for d in dirs if not d.startswith("."))
-        if LOCK_NAME in files and Path(root) != Path(sweep_dir):
-            owner = owner_of(Path(root))
-            if owner:
-                log.info("waiting for job %s, run by another gyrolab process (%s)",
-                         Path(root).relative_to(sweep_dir).as_posix(), owner)
-            wait_for(Path(root))
+    for job_dir in (path.parent for path in record_paths(sweep_dir, LOCK_NAME) if path.parent != Path(sweep_dir)):
+        owner = owner_of(job_dir)
+        if owner:
+            log.info("waiting for job %s, run by another gyrolab process (%s)", job_dir.relative_to(sweep_dir).as_posix(),
+                     owner)
+        wait_for(job_dir)
 
 
 def log_summary(summary: SweepSummary) -> None:

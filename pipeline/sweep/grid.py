@@ -14,7 +14,7 @@ import numpy as np
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import OverrideParseException
 
-from gyrolab.engine.budget import check_points, sweep_points
+from gyrolab.engine.budget import check_sweep_size, sweep_points
 from gyrolab.errors import ConfigError, shorten
 
 #: jobs of a multirun (each its own directory and launch): beyond it, gyrolab batch is the tool
@@ -61,7 +61,11 @@ class Grid:
             parsed = parser.parse_overrides(list(overrides))
         except OverrideParseException as error:
             raise ConfigError(f"malformed sweep override: {str(error).strip().splitlines()[0]}") from None
-        _check_budget(parsed, max_jobs)
+        n, named = sweep_points(parsed)
+        if max_jobs is not None and n > max_jobs:
+            raise ConfigError(f"{shorten(named)} makes {n:.3g} jobs, beyond the {max_jobs:.0e} jobs of a multirun "
+                              "(one directory each); the sweep directory was edited, or run it with gyrolab batch")
+        check_sweep_size(parsed)
         choices, typed = _choices(parsed, repeats)
         dims = tuple(Dim(key, tuple(c.split("=", 1)[1] for c in choices[key]), tuple(typed[key]))
                      for key in choices if key in typed)
@@ -87,6 +91,19 @@ class Grid:
         return cls.from_overrides(overrides, max_jobs=MAX_JOBS)
 
 
+def dim_names(dims: Sequence[Dim], reserved: set[str] | frozenset[str] = frozenset()) -> tuple[str, ...]:
+    """Each dimension named by its key's last part (``initial.theta0`` -> ``theta0``), the whole key with dots as
+    underscores where two would share a name or it is ``reserved``, prefixed ``sweep_`` while it is still taken."""
+    shorts = [d.short_name for d in dims]
+    names: list[str] = []
+    for dim, short in zip(dims, shorts):
+        name = short if shorts.count(short) == 1 and short not in reserved else dim.key.lstrip("+~").replace(".", "_")
+        while name in reserved or name in names:
+            name = f"sweep_{name}"
+        names.append(name)
+    return tuple(names)
+
+
 def _choices(parsed: Sequence[Any], repeats: bool) -> tuple[dict[str, list[str]], dict[str, list[Any]]]:
     """(key -> its job overrides in first-seen order, as Hydra does; swept key -> its typed values); ConfigError
     for a sweep that is not discrete or, unless ``repeats``, gives a value twice."""
@@ -108,16 +125,6 @@ def _choices(parsed: Sequence[Any], repeats: bool) -> tuple[dict[str, list[str]]
             _refuse_repeats(key, labels, typed[key])
     return choices, typed
 
-
-def _check_budget(parsed: Sequence[Any], max_jobs: float | None) -> None:
-    """ConfigError for more than ``max_jobs`` jobs, or more points than the budget allows, counted unexpanded."""
-    n, named = sweep_points(parsed)
-    allow_large = any(o.key_or_group == "allow_large" and not o.is_sweep_override() and o.value() is True
-                      for o in parsed)
-    if max_jobs is not None and n > max_jobs:
-        raise ConfigError(f"{shorten(named)} makes {n:.3g} jobs, beyond the {max_jobs:.0e} jobs of a multirun "
-                          "(one directory each); the sweep directory was edited, or run it with gyrolab batch")
-    check_points(n, named, allow_large=allow_large)
 
 def _refuse_repeats(key: str, labels: list[str], values: list[Any]) -> None:
     seen: dict[str, str] = {}

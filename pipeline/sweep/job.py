@@ -19,15 +19,6 @@ from gyrolab.sweep.record import ELSEWHERE, FAILED, FINISHED, RECORD_NAME, JobRe
 log = logging.getLogger("gyrolab.sweep")
 
 
-def draws_job_figures(output: object) -> bool:
-    """Whether a sweep job draws its own figures: only with ``output.job_figures=true`` (and figures on), so that
-    a sweep does not wait on pictures; ``gyrolab plot SWEEP_DIR`` draws them from the jobs' ``run.nc``."""
-    get = getattr(output, "get", None)
-    if get is None:
-        return False
-    return bool(get("figures", True)) and bool(get("job_figures", False))
-
-
 def run_sweep_job(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_num: int | None,
                   work: Callable[[str], Path]) -> JobRecord:
     """Run ``work(job_id)`` (which writes the job's dataset and returns its path) unless already done; never raises
@@ -73,12 +64,9 @@ def _run_locked(cfg: DictConfig, job_dir: Path, overrides: Sequence[str], job_nu
     base = JobRecord(job_id=job_id, status=FAILED, overrides=list(overrides), code_version=code, job_num=job_num)
     try:
         path = work(job_id)
-    except OutputError as error:
+    except GyrolabError as error:   # a failed write (OutputError) may succeed next time: not deterministic
         log.error("job %s failed: %s", job_num, error)
-        record = _failed(base, error, error.exit_code, deterministic=False)
-    except GyrolabError as error:
-        log.error("job %s failed: %s", job_num, error)
-        record = _failed(base, error, error.exit_code, deterministic=True)
+        record = _failed(base, error, error.exit_code, deterministic=not isinstance(error, OutputError))
     except Exception as error:  # noqa: BLE001 - a bug in one job must not take the sweep down
         log.exception("job %s crashed", job_num)
         record = _failed(base, error, 1, deterministic=False)

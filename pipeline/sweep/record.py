@@ -77,9 +77,9 @@ def read_record(job_dir: Path) -> JobRecord | None:
     return record
 
 
-def record_paths(sweep_dir: Path) -> Iterator[Path]:
-    """Every job record under ``sweep_dir``, skipping hidden folders (.hydra, .submitit)."""
+def record_paths(sweep_dir: Path, name: str = RECORD_NAME) -> Iterator[Path]:
+    """Every job record (or file ``name``) under ``sweep_dir``, skipping hidden folders (.hydra, .submitit)."""
     for root, dirs, files in os.walk(sweep_dir):
         dirs[:] = sorted(d for d in dirs if not d.startswith("."))
-        if RECORD_NAME in files:
-            yield Path(root) / RECORD_NAME
+        if name in files:
+            yield Path(root) / name

@@ -8,6 +8,7 @@ A wrong prediction can only cost a launch, never skip a job.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import os
 import re
@@ -208,7 +209,7 @@ class IdentityPredictor:
         self.groups = set((master.hydra.runtime.get("choices") or {}).keys())
         self.parser = OverridesParser.create(config_loader=loader)
         self.code = code_version()
-        self._parsed: dict[str, Override] = {}
+        self._parse = functools.cache(self.parser.parse_override)   # each distinct override parsed once
         #: group choices -> the composed job with those choices (None: its config calls a resolver)
         self._bases: dict[tuple[str, ...], _Base | None] = {}
 
@@ -254,11 +255,6 @@ class IdentityPredictor:
         finally:
             for o in changed:  # back to the composed job's values
                 ConfigLoaderImpl._apply_overrides_to_config([_as_change(base.applied[o.key_or_group])], base.scene)
-
-    def _parse(self, text: str) -> Override:
-        if text not in self._parsed:
-            self._parsed[text] = self.parser.parse_override(text)
-        return self._parsed[text]
 
     def _is_group(self, o: Override) -> bool:
         return o.key_or_group in self.groups or o.key_or_group.startswith("hydra/")

@@ -10,6 +10,7 @@ O(1) (``docs/derivations/seed000_large_parameter.md`` §3); the run records the 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 
@@ -65,14 +66,14 @@ class SlowSpinSeries:
         dz = np.linalg.lstsq(J[:, :3], -(phi @ e_r - e_r) / scale, rcond=None)[0]
         first = section.derivative(np.zeros(2)) @ dz[:2] + e_r
         phases = np.arange(HARMONICS) / HARMONICS
-        base = _sample(model, swing.y0, T0 * phases, first)
+        base = model.sample(swing.y0, T0 * phases, first)
         eps = np.array(FIT_SPINS)
         remainders, periods = [], []
         u = np.zeros(2)
         for e in eps:
             point = shoot_section(model, section, u + e * dz[:2], T0, float(e))
             u = np.array([point.y0[0], point.y0[4]]) - e * dz[:2]
-            exact = _sample(model, point.y0, point.period * phases)
+            exact = model.sample(point.y0, point.period * phases)
             remainders.append(exact - base[0] - e * base[1])
             periods.append(point.period - T0)
         remainders = np.array(remainders)
@@ -97,7 +98,7 @@ class SlowSpinSeries:
     def state(self, t: np.ndarray, eps: float) -> np.ndarray:
         """The series at times t (phase s = t/T(ε) mod 1)."""
         phase = np.mod(np.asarray(t, dtype=float) / self.period(eps), 1.0)
-        swing = _sample(self.model, self.section.state(np.zeros(2), 0.0), self.T0 * phase, self.first)
+        swing = self.model.sample(self.section.state(np.zeros(2), 0.0), self.T0 * phase, self.first)
         out = swing[0] + eps * swing[1]
         modes = np.arange(self.spectra.shape[1])
         weights = np.where((modes == 0) | (2 * modes == HARMONICS), 1.0, 2.0) / HARMONICS
@@ -108,32 +109,13 @@ class SlowSpinSeries:
 
 
 HARMONICS = 256
-_CACHE: dict[tuple, "SlowSpinSeries"] = {}  # (a, b, k, θ0) → series: building one takes 5 shootings
 POWERS = (2, 3, 4, 5, 6, 7)
 EVEN, ODD = [1, 3, 5], [0, 2, 4]  # q, γ, γ'' even in ε at fixed phase; p, r, γ' odd (time reversal + mirror)
 
 
-def _sample(model: FixedPointModel, y0: np.ndarray, times: np.ndarray, tangent: np.ndarray | None = None):
-    """States y(t) (n, 6) of the flow from y0 at ``times`` (any order, ≥ 0); with ``tangent`` also Φ(t)·tangent,
-    returned as the pair (states, tangents)."""
-    order = np.argsort(times)
-    states, moved = np.empty((len(times), 6)), np.empty((len(times), 6))
-    y, phi, now = np.asarray(y0, dtype=float), np.eye(6), 0.0
-    for i in order:
-        if times[i] > now:
-            y, phi = model.flow(y, times[i] - now, phi)
-            now = times[i]
-        states[i] = y
-        if tangent is not None:
-            moved[i] = phi @ tangent
-    return states if tangent is None else (states, moved)
-
-
+@cache   # building one takes 5 shootings
 def series_for(a: float, b: float, k: float, theta0: float) -> SlowSpinSeries:
-    key = (float(a), float(b), float(k), float(theta0))
-    if key not in _CACHE:
-        _CACHE[key] = SlowSpinSeries.build(*key)
-    return _CACHE[key]
+    return SlowSpinSeries.build(float(a), float(b), float(k), float(theta0))
 
 
 class LargeParameter(FixedPointRegime):

@@ -47,7 +47,7 @@ def test_plan_equals_single_runs_state_params_and_errors():
         else:
             assert plan.error[n] < 0, point
             np.testing.assert_array_equal(plan.y0[n], single.system.initial_state())
-            np.testing.assert_array_equal(plan.params(n, n + 1)[0], single.system.compiled_model().params)
+            np.testing.assert_array_equal(plan.combo_params[plan.combo[n]], single.system.compiled_model().params)
     assert plan.valid.sum() == 1   # a = 1.5, θ0 = 0.3, r0 = 5
     gamma = plan_from_overrides([*FIXED, "initial.theta0=null", "initial.phi0=null",
                                  "initial.gamma0=[0,0,1],[0,0.6,0.8],[0,0,2]"])

@@ -8,7 +8,7 @@ import pytest
 import xarray as xr
 
 from gyrolab import compose_scene
-from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, given_keys, reads_accuracy
+from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, given_overrides, reads_accuracy
 from gyrolab.engine.config import compose_config
 from gyrolab.errors import ConfigError
 
@@ -75,7 +75,7 @@ def test_a_batch_given_an_accuracy_its_integrator_does_not_read_is_refused(cli, 
 
 
 def test_accuracy_null_and_deleting_it_are_not_values():
-    assert given_keys(["accuracy=1e-8", "+batch.output=final", "~time.n_output", "++x.y=1"]) == {
+    assert set(given_overrides(["accuracy=1e-8", "+batch.output=final", "~time.n_output", "++x.y=1"])) == {
         "accuracy", "batch.output", "x.y"}
     compose_scene(["integrator=taylor", "accuracy=null", "time.end=1"])
 

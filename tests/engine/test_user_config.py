@@ -53,12 +53,12 @@ def test_user_primary_config_runs(myconf, tmp_path, monkeypatch, capsys):
 def test_the_preflight_composes_the_users_config(argv, expected, myconf, monkeypatch):
     """Each form passes the preflight, which composes from the user's folder (the runs above: Hydra agrees)."""
     from gyrolab import app
-    from gyrolab.app.parser import parse_run
+    from gyrolab.app.parser import parse_command_line
     from gyrolab.engine.config import ConfigSource, compose_config, use_source
 
-    args = app.absolute_config_path(parse_run([a.format(conf=myconf) for a in argv]))
+    args = app.absolute_config_path(parse_command_line([a.format(conf=myconf) for a in argv])[1])
     try:
-        app.preflight(parse_run([*[a.format(conf=myconf) for a in argv], "hydra.run.dir=out"]))
+        app.preflight(parse_command_line([*[a.format(conf=myconf) for a in argv], "hydra.run.dir=out"])[1])
         overrides = args.overrides
         cfg = compose_config(overrides)  # composes from the source the preflight set
     finally:
@@ -97,10 +97,10 @@ def test_the_preflight_validates_the_users_config(myconf, tmp_path, monkeypatch,
 def test_run_dir_may_use_hydra_resolvers(tmp_path, monkeypatch):
     # ${hydra:...} in the run directory is Hydra's own idiom: the preflight resolves it as the run will
     from gyrolab import app
-    from gyrolab.app.parser import parse_run
+    from gyrolab.app.parser import parse_command_line
 
     monkeypatch.chdir(tmp_path)
-    args = app.preflight(parse_run(["hydra.run.dir=${hydra:runtime.cwd}/by_cwd", "time.end=1"]))
+    args = app.preflight(parse_command_line(["hydra.run.dir=${hydra:runtime.cwd}/by_cwd", "time.end=1"])[1])
     assert "hydra.run.dir=${hydra:runtime.cwd}/by_cwd" in args.overrides
 
 

@@ -8,8 +8,8 @@ import pytest
 import xarray as xr
 from PIL import Image
 
-from gyrolab.app import preflight, run_command
-from gyrolab.app.parser import parse_run
+from gyrolab.app import preflight, run_subcommand
+from gyrolab.app.parser import parse_command_line
 from gyrolab.engine.config import compose_config
 from gyrolab.engine.scene import Scene
 from gyrolab.errors import ConfigError
@@ -41,7 +41,8 @@ def test_plot_redraws_the_same_figures_in_the_formats_and_dpi_asked_with_provena
     assert drawn == ["body_axis_sphere.png", "euler_angles.png", "invariant_drift.png", "state.png"]
     for path in (run_dir / "figures").iterdir():
         path.unlink()
-    assert run_command(["--plot", str(run_dir), "output.figure_formats=[png,pdf,svg]", "output.dpi=50"]) == 0
+    assert run_subcommand(*parse_command_line(["--plot", str(run_dir), "output.figure_formats=[png,pdf,svg]",
+                                                "output.dpi=50"])) == 0
     figures = run_dir / "figures"
     stems = {p.removesuffix(".png") for p in drawn}
     for fmt in ("png", "pdf", "svg"):
@@ -73,13 +74,13 @@ def test_bad_figure_settings_are_one_sentence(output, words):
 
 def test_bad_format_is_refused_before_anything_runs(tmp_path):
     with pytest.raises(ConfigError, match="valid: pdf, png, svg"):
-        preflight(parse_run(["output.figure_formats=[png,eps]", f"hydra.run.dir={tmp_path / 'out'}"]))
+        preflight(parse_command_line(["output.figure_formats=[png,eps]", f"hydra.run.dir={tmp_path / 'out'}"])[1])
     assert not (tmp_path / "out").exists()
 
 
 def test_plot_of_a_path_without_datasets_is_one_sentence(tmp_path):
     with pytest.raises(ConfigError, match="no gyrolab dataset"):
-        run_command(["--plot", str(tmp_path)])
+        run_subcommand(*parse_command_line(["--plot", str(tmp_path)]))
 
 
 def test_body_axis_sphere_draws_z_along_the_weight(run_dir):

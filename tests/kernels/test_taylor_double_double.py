@@ -510,7 +510,7 @@ def test_a_plugin_torque_runs_in_double_double_from_the_scene(tmp_path):
 
 def test_the_batch_plan_asks_the_double_double_class_for_capabilities():
     from gyrolab.batch.plan import Plan
-    from gyrolab.batch.runner import batch_path
+    from gyrolab.batch.runner import path_attributes
     from gyrolab.plugins.integrators.compiled_solvers import TaylorDoubleDouble
 
     for precision, cls in (("double", Taylor), ("double-double", TaylorDoubleDouble)):
@@ -520,7 +520,8 @@ def test_the_batch_plan_asks_the_double_double_class_for_capabilities():
         assert plan.integrator_class is cls
     from types import SimpleNamespace
 
-    assert batch_path(TaylorDoubleDouble, SimpleNamespace(output="final")) == "one integrate() call per point"
+    assert path_attributes(TaylorDoubleDouble, SimpleNamespace(output="final")) == {
+        "batch_path": "one integrate() call per point"}
 
 
 def test_a_model_whose_double_double_series_was_never_compiled_stops_instead_of_crashing():

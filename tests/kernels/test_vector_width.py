@@ -71,14 +71,15 @@ def test_numba_cpu_features_override_sets_the_width(monkeypatch):
 def test_lane_record_only_for_vectorised_kernels():
     from types import SimpleNamespace
 
-    from gyrolab.batch.runner import lane_record
+    from gyrolab.batch.runner import path_attributes
     from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor
     from gyrolab.plugins.integrators.scipy_solvers import RK45
 
     for cls in (Taylor, DOP853Numba):
-        assert lane_record(cls, SimpleNamespace(output="final")) == vector_width.lane_attributes()
-        assert lane_record(cls, SimpleNamespace(output="indicator")) == {}
-    assert lane_record(RK45, SimpleNamespace(output="final")) == {}
+        assert path_attributes(cls, SimpleNamespace(output="final")) == {
+            "batch_path": "batch kernel, vectorised across trajectories", **vector_width.lane_attributes()}
+        assert path_attributes(cls, SimpleNamespace(output="indicator")) == {"batch_path": "variational kernel"}
+    assert path_attributes(RK45, SimpleNamespace(output="final")) == {"batch_path": "one integrate() call per point"}
 
 
 def test_batch_dataset_records_lane_width(tmp_path):

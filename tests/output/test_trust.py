@@ -240,12 +240,12 @@ def test_a_bomb_in_a_jobs_stored_config_refuses_plot_of_the_sweep(sweep):
 
 def test_hydras_experimental_rerun_which_unpickles_is_refused(tmp_path, monkeypatch):
     from gyrolab.app import preflight
-    from gyrolab.app.parser import parse_run
+    from gyrolab.app.parser import parse_command_line
 
     monkeypatch.chdir(tmp_path)
     (tmp_path / "config.pickle").write_bytes(b"cos\nsystem\n(S'touch PWNED'\ntR.")
     with pytest.raises(ConfigError, match="would load a pickle"):
-        preflight(parse_run(["--experimental-rerun", "config.pickle"]))
+        preflight(parse_command_line(["--experimental-rerun", "config.pickle"])[1])
     assert not (tmp_path / "PWNED").exists()
 
 
