@@ -70,6 +70,8 @@ EPSILONS = [10.0 ** -k for k in range(6, 14)]
 #: Tolerances 10^(-k/4): each method's cost to reach ε is read off its work-precision curve at this resolution (a
 #: decade grid made the comparison hinge on where each curve crosses ε between two decades: up to ~1.2x either way).
 QUARTER_DECADES = [10.0 ** (-k / 4) for k in range(72)]
+#: heyoka's tolerances, its bare runs' and those doing auto's work alike (the latter are read at the former's choice)
+PEER_TOLERANCES = QUARTER_DECADES[24:61] + [float(np.finfo(float).eps)]
 WALL = False  # set by --wall
 MEDIANS = {}  # contestant -> median time over the rounds of its last ``interleaved`` call
 
@@ -97,7 +99,7 @@ def heyoka_contestants():
             return ta.propagate_grid(GRID)[-1][-1]
         return call, ta.order
 
-    return {tol: contestant(tol) for tol in QUARTER_DECADES[24:61] + [np.finfo(float).eps]}
+    return {tol: contestant(tol) for tol in PEER_TOLERANCES}
 
 
 def heyoka_same_work():
@@ -126,8 +128,7 @@ def heyoka_same_work():
         (d, hy.sum([hy.diff(f, x) * dx for x, dx in zip(state, tangent)])) for d, f in zip(tangent, rhs)]
     start = np.concatenate([Y0, direction(Y0[None, :], slice(3, 6))[0]])
     chaos = hy.taylor_adaptive(variational, start, tol=TANGENT_TOLERANCE)
-    runs = {tol: hy.taylor_adaptive(list(zip(state, rhs)), Y0, tol=tol) for tol in
-            [10.0 ** -k for k in range(6, 16)] + [np.finfo(float).eps]}
+    runs = {tol: hy.taylor_adaptive(list(zip(state, rhs)), Y0, tol=tol) for tol in PEER_TOLERANCES}
 
     def contestant(tol):
         # auto's companion stops at the Taylor kernel's floor, 1e-16 (``Taylor.TOLERANCE_FLOOR``): so does this one
