@@ -246,10 +246,11 @@ def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
         def each(j, c, v):  # y_m + (v_m·dt − c_m) on 8 components at once: masked loads and stores
             mask = _lanes_in(b, c, n)
             y_v, c_v = (_masked_load(b, b.gep(_data(context, b, types_[a], args[a]), [c]), mask) for a in (3, 4))
-            row = b.gep(_data(context, b, types_[5], Y_), [b.add(b.mul(b.add(i_, ir.Constant(i_.type, j)), n), c)])
+            row = b.gep(_data(context, b, types_[5], Y_), [b.add(b.mul(b.add(i_, ir.Constant(i_.type, j)), width), c)])
             _masked_store(b, b.fadd(y_v, b.fsub(b.fmul(v, _splat(b, hs[j])), c_v)), row, mask)
 
         n = b.extract_value(context.make_array(types_[3])(context, b, y_).shape, 0)
+        width = b.extract_value(context.make_array(types_[5])(context, b, Y_).shape, 1)  # Y's row length (≥ n)
         _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), hs, each)
         return context.get_dummy_value()
 

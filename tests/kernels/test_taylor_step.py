@@ -136,15 +136,16 @@ def _sums_through_the_step(T, order, h, y, carry, Y):
 def test_the_vector_horner_sums_match_numpy_for_every_state_size(n, order):
     """The step's Horner sums run in vector lanes, sixteen components at a time (past a row's end), the outputs one
     or two at a time: every component of any state size gets y + Σ_k T[k] h^k, against numpy's polynomial
-    evaluation of each component, and the masked stores write nothing past the rows they fill (row 3 stays NaN)."""
+    evaluation of each component, and the masked stores write nothing past the components they fill (row 3 and the
+    columns past the state's size, in an output array wider than the state, stay NaN)."""
     rng = np.random.default_rng(n * 100 + order)
     T = rng.normal(size=(order + 1, n)) / np.arange(1, order + 2)[:, None] ** 2
     y, carry, h = T[0].copy(), rng.normal(scale=1e-17, size=n), 0.37
-    Y = np.full((4, n), np.nan)
+    Y = np.full((4, n + 3), np.nan)
     expected = np.array([[np.polyval(T[::-1, m], x) for m in range(n)] for x in (h, h / 3, h / 2)])
     assert _sums_through_the_step(T, order, h, y, carry.copy(), Y)
-    np.testing.assert_allclose(Y[:3], expected - carry, rtol=1e-14, atol=1e-15)
-    assert np.isnan(Y[3]).all()
+    np.testing.assert_allclose(Y[:3, :n], expected - carry, rtol=1e-14, atol=1e-15)
+    assert np.isnan(Y[3]).all() and np.isnan(Y[:, n:]).all()
     np.testing.assert_allclose(y, expected[0] - carry, rtol=1e-14, atol=1e-15)
     T[order, n - 1] = np.inf
     assert not _sums_through_the_step(T, order, h, T[0].copy(), carry.copy(), Y)
