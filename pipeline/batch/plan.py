@@ -371,7 +371,7 @@ def _build_combo(plain: dict[str, Any], values: Mapping[str, Any]) -> _Built | _
 
 
 def _compiled(scene: Scene) -> Any:
-    compiled = scene.system.compiled_model()
+    compiled = scene.compiled_model
     if compiled is None:
         reason = getattr(scene.system, "compile_error", None) or f"system {scene.system.name!r} has no compiled form"
         raise ConfigError(f"a batch runs the compiled batch kernels, and {reason}; sweep this scene with gyrolab -m")

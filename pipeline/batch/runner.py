@@ -193,7 +193,7 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
     scene = Scene.from_config(OmegaConf.create(plan.base))
     valid = np.flatnonzero(plan.valid)
     start = time.perf_counter()
-    method, choice = scene.integrator.choose_batch_method(scene.system.compiled_model(), plan.times, plan.y0[valid],
+    method, choice = scene.integrator.choose_batch_method(scene.compiled_model, plan.times, plan.y0[valid],
                                                           plan.combo_params[plan.combo[valid]])
     settings_text = ", ".join(f"{k.removeprefix('integrator_')}={v:.3g}" if isinstance(v, float)
                               else f"{k.removeprefix('integrator_')}={v}" for k, v in method.attributes().items())
@@ -247,7 +247,7 @@ def _context(key: str, config: dict[str, Any]) -> dict[str, Any]:
     if context is None:
 
         scene = Scene.from_config(OmegaConf.create(config))
-        context = {"scene": scene, "compiled": scene.system.compiled_model(), "systems": {}}
+        context = {"scene": scene, "compiled": scene.compiled_model, "systems": {}}
         _CONTEXTS.clear()   # one batch at a time per process
         _CONTEXTS[key] = context
     return context

@@ -139,13 +139,13 @@ def _add_sections(path: Path, plain: dict, points: Sequence[Sequence[float]], t_
         cfg = OmegaConf.create(plain)
         cfg.initial.theta0, cfg.initial.r0 = (as_number(v, f"stability_map.sections[{n}]") for v in point)
         scenes.append(Scene.from_config(cfg))
-    compiled = scenes[0].system.compiled_model()
+    compiled = scenes[0].compiled_model
     step = as_number(plain["integrator"].get("step") or 0.01, "integrator.step")
     theta0, r0 = (np.array([float(p[k]) for p in points]) for k in (0, 1))
     with xr.open_dataset(path) as stored:
         ds = stored.drop_vars([v for v in stored.variables if str(v).startswith("section_")]).load()
     sections = section_dataset(compiled, np.stack([s.system.initial_state() for s in scenes]), theta0, r0, t_end,
-                               step, np.stack([s.system.compiled_model().params for s in scenes]),
+                               step, np.stack([s.compiled_model.params for s in scenes]),
                                rate_units=ds.r0.attrs.get("units", "1"))
     # conform: the rewrite must stay CF-1.8 like the store's file (no _FillValue on the coordinates, history)
     merged = ds.merge(sections, combine_attrs="drop_conflicts")

@@ -72,7 +72,7 @@ def _scene_for(cfg: DictConfig, method: str, key: str, value: float) -> Scene:
 
 def reference_state(scene: Scene) -> tuple[np.ndarray, str]:
     """Final (ω, γ) of the scene from the most accurate reference available, and its name."""
-    compiled = scene.system.compiled_model()
+    compiled = scene.compiled_model
     if compiled is None or compiled.built_in is None:  # the built-in torque forms only
         raise ConfigError("work_precision needs a scene whose forces have compiled forms (for its reference run)")
     p = compiled.built_in
