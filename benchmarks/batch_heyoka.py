@@ -73,21 +73,32 @@ def problem(n: int):
     return scene.system.compiled_model(), y0s
 
 
-def heyoka_contestant(compiled, y0s: np.ndarray, tol: float, lanes: int):
-    """A callable returning the final states (n, 6) from heyoka's batch mode, or None without heyoka."""
-    try:
-        import heyoka as hy
-    except ImportError:
-        return None
-    p = compiled.params
-    A, B, C = p[0:3]
-    u0, u1, u2 = p[9:12]  # U_2 = m g r_c: the torque U_2 × γ
-    k = p[14]
-    w0, w1, w2, g0, g1, g2 = hy.make_vars("w0", "w1", "w2", "g0", "g1", "g2")
-    system = [(w0, ((B - C) * w1 * w2 + u1 * g2 - u2 * g1 + k * (C - B) * g1 * g2) / A),
-              (w1, ((C - A) * w2 * w0 + u2 * g0 - u0 * g2 + k * (A - C) * g2 * g0) / B),
-              (w2, ((A - B) * w0 * w1 + u0 * g1 - u1 * g0 + k * (B - A) * g0 * g1) / C),
-              (g0, g1 * w2 - g2 * w1), (g1, g2 * w0 - g0 * w2), (g2, g0 * w1 - g1 * w0)]
+def heyoka_system(compiled):
+    """The reference scene's equations for heyoka (``perf_reference``'s body, centre of mass and k), checked against
+    gyrolab's compiled right-hand side at a few states: a benchmark comparing two different problems would say
+    nothing (the compiled model's parameters are not a layout to read: indexing them once gave heyoka a moment of
+    inertia of 1e14, whose runs never ended)."""
+    import heyoka as hy
+
+    from perf_reference import INERTIA, K, R_C
+
+    (A, B, C), (u0, u1, u2), k = INERTIA, R_C, K
+    w0, w1, w2, g0, g1, g2 = state = hy.make_vars("w0", "w1", "w2", "g0", "g1", "g2")
+    rhs = [((B - C) * w1 * w2 + u1 * g2 - u2 * g1 + k * (C - B) * g1 * g2) / A,
+           ((C - A) * w2 * w0 + u2 * g0 - u0 * g2 + k * (A - C) * g2 * g0) / B,
+           ((A - B) * w0 * w1 + u0 * g1 - u1 * g0 + k * (B - A) * g0 * g1) / C,
+           g1 * w2 - g2 * w1, g2 * w0 - g0 * w2, g0 * w1 - g1 * w0]
+    ours, theirs = compiled_rhs(compiled), hy.cfunc(rhs, state)
+    for y in np.random.default_rng(1).normal(size=(4, 6)):
+        if not np.allclose(ours(0.0, y), theirs(y), rtol=1e-13, atol=1e-13):
+            raise SystemExit(f"heyoka's equations differ from gyrolab's at y = {y}: {theirs(y)} vs {ours(0.0, y)}")
+    return list(zip(state, rhs))
+
+
+def heyoka_contestant(system, y0s: np.ndarray, tol: float, lanes: int):
+    """A callable returning the final states (n, 6) from heyoka's batch mode on ``system`` (``heyoka_system``)."""
+    import heyoka as hy
+
     first = np.ascontiguousarray(y0s[:lanes].T)
     integrators = [hy.taylor_adaptive_batch(system, first, tol=tol)]
     integrators += [copy.deepcopy(integrators[0]) for _ in range(THREADS - 1)]
@@ -179,16 +190,16 @@ def main() -> None:
         settings[("gyrolab dop853_numba", tol)] = f"rtol=atol={tol:.0e}"
     auto = Auto(accuracy=TARGET)
     contestants[("gyrolab auto", TARGET)] = gyrolab_contestant(compiled, y0s, auto)
-    for tol in [1e-9, 3e-10, 1e-10, 3e-11]:
+    try:
+        system = heyoka_system(compiled)
+    except ImportError:
+        system = None
+        print("heyoka is not installed (pip install -e '.[bench]'): its rows are skipped")
+    for tol in [1e-9, 3e-10, 1e-10, 3e-11] if system is not None else []:
         for lanes in HEYOKA_LANES:
-            peer = heyoka_contestant(compiled, y0s, tol, lanes)
-            if peer is None:
-                break
-            contestants[("heyoka batch", (tol, lanes))] = peer[0]
-            settings[("heyoka batch", (tol, lanes))] = f"tol={tol:.0e}, order {peer[1]}, batch size {lanes}, {THREADS} threads"
-        if peer is None:
-            print("heyoka is not installed (pip install -e '.[bench]'): its rows are skipped")
-            break
+            call, order = heyoka_contestant(system, y0s, tol, lanes)
+            contestants[("heyoka batch", (tol, lanes))] = call
+            settings[("heyoka batch", (tol, lanes))] = f"tol={tol:.0e}, order {order}, batch size {lanes}, {THREADS} threads"
     small = y0s[:64]  # compile gyrolab's kernels before timing
     for key, call in contestants.items():
         if key[0].startswith("gyrolab"):
