@@ -2,6 +2,7 @@
 
     python benchmarks/one_pass_estimate.py               # the reference scene, t ∈ [0, 300], 3,001 outputs (~2 min)
     python benchmarks/one_pass_estimate.py --end 30      # shorter
+    python benchmarks/one_pass_estimate.py --rule gyrolab   # gyrolab's own step rule and orders
 
 Today ``output.error_estimate`` runs a companion (the method at tol/100) and ``auto`` a separate tangent run for its
 chaos measure: two more integrations, ~4× the run's own cost (docs/performance.md). This prototype (plain numpy, no
@@ -12,7 +13,7 @@ for its order p, so the tangent series' omitted terms shrink like e^(−2m)):
 
     e(t_k + s) = Σ_{j ≤ m} E_j s^j + Σ_{j = p+1}^{p+extra} c_j s^j,   E_0 = e(t_k),   (j+1) E_{j+1} = [J(y) e]_j
 
-The step rule is heyoka's and gyrolab's (Jorba & Zou: order ⌈−ln(tol)/2⌉ + 1, h = ρ e^(−2) e^(−0.7/(p−1))). Printed:
+Two step rules (``--rule``): heyoka's and gyrolab's, both Jorba & Zou's, gyrolab's with longer steps. Printed:
 the estimated max-norm error over the actual one (against the extended-precision reference,
 ``gyrolab.physics.reference``) at every output time, and the extra work in right-hand-side bilinear evaluations.
 Results and the design they support: docs/integrators.md, "A one-pass error estimate".
@@ -25,6 +26,7 @@ import math
 
 import numpy as np
 
+from gyrolab.kernels.taylor import order_for
 from gyrolab.physics.reference import fixed_point_reference
 
 INERTIA = np.array([2.0, 1.5, 1.0])  # the reference scene (experiment=perf_reference)
@@ -70,17 +72,20 @@ def horner(c: np.ndarray, s: float) -> np.ndarray:
     return out
 
 
-def run(tol: float, grid: np.ndarray, m: int, extra: int) -> tuple[np.ndarray, np.ndarray, int, int]:
-    """(states, estimated signed errors at the output times, steps, order) of one Taylor run."""
-    p = int(math.ceil(-math.log(tol) / 2)) + 1
+def run(tol: float, grid: np.ndarray, m: int, extra: int, rule: str) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """(states, estimated signed errors at the output times, steps, order) of one Taylor run; ``rule``: heyoka's
+    steps (h = ρ e^(−2) e^(−0.7/(p−1)), order ⌈−ln(tol)/2⌉ + 1) or gyrolab's (``kernels.taylor``: its ``order_for``, and
+    h = min_k (tol·scale/‖c_k‖)^(1/k) e^(−0.7/(p−1)), longer steps at its higher orders)."""
+    p = int(math.ceil(-math.log(tol) / 2)) + 1 if rule == "heyoka" else order_for(tol)
     y, t, e, k, steps = Y0.copy(), 0.0, np.zeros(6), 1, 0
     out, est = np.zeros((len(grid), 6)), np.zeros((len(grid), 6))
     out[0] = y
     while k < len(grid):
         c = coefficients(y, p + extra)
         scale = max(1.0, float(np.max(np.abs(y))))
-        rho = min((scale / np.max(np.abs(c[j]))) ** (1.0 / j) for j in (p - 1, p))
-        h = rho * math.exp(-2.0 - 0.7 / (p - 1))
+        within = 1.0 if rule == "heyoka" else tol  # (heyoka's ρ has no tolerance in it: its order has)
+        h = min((within * scale / np.max(np.abs(c[j]))) ** (1.0 / j) for j in (p - 1, p)) * math.exp(-0.7 / (p - 1))
+        h *= math.exp(-2.0) if rule == "heyoka" else 1.0
         E = tangent_coefficients(c, e, m)
         while k < len(grid) and grid[k] <= t + h:  # the propagated error, plus this step's truncation up to s
             s = grid[k] - t
@@ -94,16 +99,17 @@ def run(tol: float, grid: np.ndarray, m: int, extra: int) -> tuple[np.ndarray, n
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--end", type=float, default=300.0)
+    parser.add_argument("--rule", choices=("heyoka", "gyrolab"), default="heyoka", help="the step rule (default heyoka)")
     args = parser.parse_args()
     grid = np.linspace(0.0, args.end, int(round(10 * args.end)) + 1)
     reference = fixed_point_reference(INERTIA, R_C, K, Y0, grid).astype(float)
-    print(f"reference scene, t ∈ [0, {args.end:g}], {len(grid):,} outputs; estimated / actual max-norm error at "
+    print(f"{args.rule}'s step rule; reference scene, t ∈ [0, {args.end:g}], {len(grid):,} outputs; estimated / actual max-norm error at "
           f"every output time where the actual one is above 1e-13\n")
     print("| tol | order p | steps | m | extra terms | actual final | estimate / actual: min – max | extra work |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
     for tol in (1e-6, 1e-8, 1e-10, 1e-12):
-        for m, extra in ((4, 2), (6, 1), (6, 2)):
-            y, est, steps, p = run(tol, grid, m, extra)
+        for m, extra in ((4, 2), (6, 1), (6, 2)) if args.rule == "heyoka" else ((6, 2), (10, 2), (10, 4)):
+            y, est, steps, p = run(tol, grid, m, extra, args.rule)
             actual = np.abs(y - reference).max(axis=1)
             measured = actual > 1e-13
             ratio = np.abs(est).max(axis=1)[measured] / actual[measured]
