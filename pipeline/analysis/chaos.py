@@ -26,7 +26,8 @@ from gyrolab.contracts.capabilities import integrators_with, or_list
 from gyrolab.contracts.integrator import VARIATIONAL
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.kernels import layout, model, models, tangent
-from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, RK4Numba, steps_per_interval
+from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, RK4Numba
+from gyrolab.plugins.integrators.refinement import steps_per_interval
 
 INDICATOR_NAME = "MEGNO"
 INDICATOR_DEFINITION = ("MEGNO <Y>(t_end) (Cincotta & Simo 2000): time mean of Y(t) = (2/t) int_0^t s d'.d/d.d ds "

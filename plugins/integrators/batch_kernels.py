@@ -17,6 +17,7 @@ from gyrolab.contracts.capabilities import integrators_with, or_list
 from gyrolab.contracts.integrator import BATCH_KERNEL, BatchSolution, CompiledModel
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.kernels.model import bind
+from gyrolab.plugins.integrators.refinement import steps_per_interval
 
 #: why an adaptive batch kernel stopped a trajectory, by its status code
 _REASONS = {1: "its step fell below the spacing of floating-point numbers", 2: "it became non-finite"}
@@ -27,7 +28,6 @@ def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.n
     """Fixed-step RK4 with the fewest equal steps no longer than ``step`` in each output interval."""
     # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
     from gyrolab.kernels import models, rk4
-    from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval  # (it imports this module)
 
     start = time.perf_counter()
     P = bind(compiled, P)

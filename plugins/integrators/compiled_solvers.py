@@ -31,6 +31,7 @@ from gyrolab.contracts.integrator import (
 from gyrolab.errors import ConfigError, IntegrationError, as_number
 from gyrolab.plugins.integrators import batch_kernels
 from gyrolab.plugins.integrators.refinement import half_step, interval_steps
+from gyrolab.plugins.integrators.rk4 import RK4
 from gyrolab.plugins.integrators.tolerances import Tolerances
 from gyrolab.plugins.integrators.step_guard import check_step, compiled_rhs
 
@@ -120,11 +121,6 @@ def _adaptive(advance: Any, t_out: np.ndarray, state: np.ndarray, progress: Prog
             progress(state[0])
 
 
-def steps_per_interval(t_out: np.ndarray, step: float) -> np.ndarray:
-    """Fewest equal steps no longer than ``step`` in each output interval (lands on every output time)."""
-    return np.maximum(1, np.ceil(np.diff(t_out) / step * (1.0 - 1e-12))).astype(np.int64)
-
-
 def _fixed_step(kernel: Any, name: str, fun: RightHandSide, t_out: np.ndarray, steps: np.ndarray, y: np.ndarray,
                 out: np.ndarray, progress: ProgressCallback | None) -> int:
     """Fill ``out[1:]`` with a compiled fixed-step ``kernel(grid, steps, rows, first, stop) -> reached``.
@@ -194,23 +190,11 @@ class DOP853Numba(Tolerances, Integrator):
                                                     n_rejected=int(stats[2]), wall_time=wall))
 
 
-class RK4Numba(Integrator):
+class RK4Numba(RK4):
+    """``rk4``'s method, settings and batch kernel, its single runs compiled too."""
+
     name = "rk4_numba"
-    adaptive = False
     capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL})
-
-    def __init__(self, *, step: float = 0.01) -> None:
-        self.step = as_number(step, "integrator.step", positive=True)
-
-    def more_accurate(self, factor: float):
-        return half_step(self, 4)
-
-    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
-                        failures: str) -> BatchSolution:
-        return batch_kernels.rk4_batch(compiled, self.step, times, y0s, params, failures)
-
-    def variational_settings(self) -> VariationalSettings:
-        return VariationalSettings(step=self.step)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
@@ -230,9 +214,6 @@ class RK4Numba(Integrator):
         n_steps = int(steps.sum())
         return Solution(t_out, out, IntegratorStats(nfev=4 * n_steps, n_steps=n_steps, n_rejected=0,
                                                     wall_time=time.perf_counter() - start))
-
-    def attributes(self) -> dict[str, Any]:
-        return {"integrator_step": self.step}
 
 
 class Taylor(Integrator):
@@ -361,7 +342,24 @@ class TaylorDoubleDouble(Taylor):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        return _taylor_double_double(self, fun, t_out, y0, progress, compiled)
+        """``Taylor.integrate`` in double-double (``gyrolab.kernels.taylor_dd``): the state carried in
+        double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded
+        to double. The initial state is a double, hence exact."""
+        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
+        from gyrolab.kernels import taylor_dd
+
+        _ready_for_double_double(compiled)
+        start = time.perf_counter()
+        t_out, y, out = _outputs(t_out, y0)
+        low = np.zeros(len(y))  # the state's low parts
+        no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
+        state = np.array([t_out[0]])
+        stats = np.zeros(2, dtype=np.int64)
+        _adaptive(lambda reached, stop: taylor_dd.run(compiled.params, self.order, self.tol, t_out, out, no_low,
+                                                      reached, stop, state, y, low, stats),
+                  t_out, state, progress, _taylor_failure)
+        return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
+                                                    wall_time=time.perf_counter() - start))
 
     def more_accurate(self, factor: float):
         # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
@@ -372,28 +370,6 @@ class TaylorDoubleDouble(Taylor):
             return None
         return (Taylor(order=self.order, tol=tol, precision=DOUBLE_DOUBLE), 1.0,
                 f"taylor double-double at tol {tol:.3g} ({factor:g}× tighter), same order")
-
-
-def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
-                          progress: ProgressCallback | None, compiled: CompiledModel) -> Solution:
-    """``Taylor.integrate`` in double-double (``gyrolab.kernels.taylor_dd``): the state carried in
-    double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded to
-    double. The initial state is a double, hence exact."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import taylor_dd
-
-    _ready_for_double_double(compiled)
-    start = time.perf_counter()
-    t_out, y, out = _outputs(t_out, y0)
-    low = np.zeros(len(y))  # the state's low parts
-    no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
-    state = np.array([t_out[0]])
-    stats = np.zeros(2, dtype=np.int64)
-    _adaptive(lambda reached, stop: taylor_dd.run(compiled.params, method.order, method.tol, t_out, out, no_low,
-                                                  reached, stop, state, y, low, stats),
-              t_out, state, progress, _taylor_failure)
-    return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
-                                                wall_time=time.perf_counter() - start))
 
 
 def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -> str | None:
