@@ -17,17 +17,13 @@ from gyrolab.physics.attitude import frame_from_angles
 from gyrolab.contracts.regime import Regime
 from gyrolab.contracts.system import System
 from gyrolab.errors import ConfigError
+from gyrolab.plugins.regimes.ismail2021 import BodyRatios
 
 SUPPORTED_FORCES = ("uniform_gravity", "newtonian", "magnetic")
 
 
 @dataclass(frozen=True)
-class NondimensionalScene:
-    a: float
-    b: float
-    x0: float
-    y0: float
-    z0: float
+class NondimensionalScene(BodyRatios):
     k: float  # N/c²
     c: float  # √(Mgℓ/C) in model rate units (1 for a nondimensional body)
     r0: float  # initial spin in units of c
