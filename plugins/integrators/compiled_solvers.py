@@ -13,21 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.contracts.integrator import (
-    BATCH_KERNEL,
-    COMPILED_MODEL,
-    TIME_DEPENDENT,
-    VARIATIONAL,
-    VECTOR_LANES,
-    BatchSolution,
-    CompiledModel,
-    Integrator,
-    IntegratorStats,
-    ProgressCallback,
-    RightHandSide,
-    Solution,
-    VariationalSettings,
-)
+from gyrolab.contracts.integrator import (BATCH_KERNEL, COMPILED_MODEL, TIME_DEPENDENT, VARIATIONAL, VECTOR_LANES,
+                                          BatchSolution, CompiledModel, Integrator, IntegratorStats, ProgressCallback,
+                                          RightHandSide, Solution, VariationalSettings)
 from gyrolab.errors import ConfigError, IntegrationError, as_number
 from gyrolab.plugins.integrators import batch_kernels
 from gyrolab.plugins.integrators.refinement import half_step, interval_steps
@@ -170,8 +158,7 @@ class DOP853Numba(Tolerances, Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import dop853, models
+        from gyrolab.kernels import dop853, models  # start-up: the kernel imports numba
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
@@ -198,8 +185,7 @@ class RK4Numba(RK4):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import rk4
+        from gyrolab.kernels import rk4  # start-up: the kernel imports numba
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
@@ -232,8 +218,7 @@ class Taylor(Integrator):
 
     @classmethod
     def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import taylor_series
+        from gyrolab.kernels import taylor_series  # start-up: the kernel imports numba
 
         if taylor_series.ready(compiled):   # (compiles a traced torque's Taylor kernel, once)
             return None
@@ -251,14 +236,15 @@ class Taylor(Integrator):
         return super().__new__(cls)
 
     def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = "double") -> None:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels.taylor import MAX_ORDER, MIN_ORDER, order_for
+        from gyrolab.kernels.taylor import MAX_ORDER, MIN_ORDER, order_for  # start-up: the kernel imports numba
 
-        self.precision = _taylor_precision(precision)
+        if not isinstance(precision, str) or precision not in PRECISIONS:
+            raise ConfigError(f"integrator.precision={precision!r} is not available; valid choices: "
+                              f"{', '.join(PRECISIONS)}")
+        self.precision = precision
         self.tol = as_number(tol, "integrator.tol", positive=True)
         if self.precision == DOUBLE_DOUBLE:
-            # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-            from gyrolab.kernels.taylor_dd import MIN_TOL
+            from gyrolab.kernels.taylor_dd import MIN_TOL  # start-up: the kernel imports numba
 
             if self.tol < MIN_TOL:
                 raise ConfigError(f"integrator.tol={tol!r} is below double-double's resolution; with "
@@ -272,8 +258,7 @@ class Taylor(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import taylor, taylor_series
+        from gyrolab.kernels import taylor, taylor_series  # start-up: the kernel imports numba
 
         start = time.perf_counter()
         taylor_series.ready(compiled)  # a traced model's series kernel, compiled on first need (once: then a test)
@@ -299,8 +284,7 @@ class Taylor(Integrator):
 
     def climbed(self, factor: float):
         """Rule 11: the double-double rung, ``factor`` times more accurate (None: already on it)."""
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels.taylor_dd import MIN_TOL
+        from gyrolab.kernels.taylor_dd import MIN_TOL  # start-up: the kernel imports numba
 
         tol = max(self.tol / factor, MIN_TOL)
         return None if self.precision != DOUBLE else (Taylor(tol=tol, precision=DOUBLE_DOUBLE), 1.0, (
@@ -313,14 +297,6 @@ class Taylor(Integrator):
 #: ``Taylor``'s arithmetic: ``integrator.precision``
 DOUBLE, DOUBLE_DOUBLE = "double", "double-double"
 PRECISIONS = (DOUBLE, DOUBLE_DOUBLE)
-
-
-def _taylor_precision(precision: Any) -> str:
-    """``integrator.precision`` checked: one of ``PRECISIONS``, else one ConfigError sentence listing them."""
-    if not isinstance(precision, str) or precision not in PRECISIONS:
-        raise ConfigError(f"integrator.precision={precision!r} is not available; valid choices: "
-                          f"{', '.join(PRECISIONS)}")
-    return precision
 
 
 class TaylorDoubleDouble(Taylor):
@@ -345,8 +321,7 @@ class TaylorDoubleDouble(Taylor):
         """``Taylor.integrate`` in double-double (``gyrolab.kernels.taylor_dd``): the state carried in
         double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded
         to double. The initial state is a double, hence exact."""
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import taylor_dd
+        from gyrolab.kernels import taylor_dd  # start-up: the kernel imports numba
 
         _ready_for_double_double(compiled)
         start = time.perf_counter()
@@ -362,8 +337,7 @@ class TaylorDoubleDouble(Taylor):
                                                     wall_time=time.perf_counter() - start))
 
     def more_accurate(self, factor: float):
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels.taylor_dd import MIN_TOL
+        from gyrolab.kernels.taylor_dd import MIN_TOL  # start-up: the kernel imports numba
 
         tol = self.tol / factor
         if tol < MIN_TOL:
@@ -374,8 +348,7 @@ class TaylorDoubleDouble(Taylor):
 
 def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -> str | None:
     """None when double-double can run ``compiled`` (compiling a traced model's series on first need), else why."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import series_dd
+    from gyrolab.kernels import series_dd  # start-up: the kernel imports numba
     from gyrolab.kernels.expression import NotCompilable
 
     try:
@@ -401,8 +374,7 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
     """The states at ``t_out`` of the Taylor method at ``tol`` (Jorba & Zou's order), in one call into the kernel:
     for runs over a few periods inside another method (``auto``'s screen), which need neither progress nor
     statistics (``Taylor.integrate``'s chunks and records cost ~10 µs more, a tenth of the screen)."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import taylor, taylor_series
+    from gyrolab.kernels import taylor, taylor_series  # start-up: the kernel imports numba
 
     taylor_series.ready(compiled)  # a traced model's series kernel (a scene carrying α is one)
     t_out, y, out = _outputs(t_out, y0)
@@ -417,8 +389,7 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
 
 def _taylor_failure(status: int, t: float) -> IntegrationError:
     """The one-sentence error for a Taylor kernel's non-OK ``status``, stopped at time ``t``."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import taylor
+    from gyrolab.kernels import taylor  # start-up: the kernel imports numba
 
     if status == taylor.TOO_SMALL_STEP:
         return IntegrationError(f"taylor's step fell below the spacing of floating-point numbers near t={t:.6g} "
@@ -454,8 +425,7 @@ class LiePoisson(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import lie_poisson
+        from gyrolab.kernels import lie_poisson  # start-up: the kernel imports numba
 
         if compiled.built_in is None:
             raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian with the built-in torque "
