@@ -109,31 +109,35 @@ def _adaptive(advance: Any, t_out: np.ndarray, state: np.ndarray, progress: Prog
             progress(state[0])
 
 
-def _fixed_step(kernel: Any, name: str, fun: RightHandSide, t_out: np.ndarray, steps: np.ndarray, y: np.ndarray,
-                out: np.ndarray, progress: ProgressCallback | None) -> int:
-    """Fill ``out[1:]`` with a compiled fixed-step ``kernel(grid, steps, rows, first, stop) -> reached``.
-
-    Returns the index of the first output left non-finite, or ``len(t_out)``. Progress is reported
-    after each chunk, and after each piece of an output interval too long for one chunk.
-    """
-    gaps = np.diff(t_out)
-    chunks = _Chunks(len(t_out), steps)
+def _fixed_step(method: Any, kernel: Any, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel,
+                progress: ProgressCallback | None, evaluations: int, step_text: str = "") -> Solution:
+    """``method``'s run by a compiled fixed-step ``kernel(grid, steps, y, rows, first, stop) -> reached``
+    (``evaluations`` right-hand-side evaluations a step). Progress is reported after each chunk, and after each piece
+    of an output interval too long for one chunk; the first output left non-finite is one IntegrationError
+    (``step_text`` after its time)."""
+    start = time.perf_counter()
+    t_out, y, out = _outputs(t_out, y0)
+    steps = interval_steps(method, t_out)
+    fun, gaps, chunks = compiled_rhs(compiled), np.diff(t_out), _Chunks(len(t_out), steps)
     for first, stop in chunks:
-        check_step(name, fun, t_out[first - 1], y, float(gaps[first - 1] / steps[first - 1]))
+        check_step(method.name, fun, t_out[first - 1], y, float(gaps[first - 1] / steps[first - 1]))
         budget = chunks.step_budget
         if stop - first == 1 and steps[first - 1] > budget:  # one long interval: in pieces
             rows = np.empty((math.ceil(steps[first - 1] / budget) + 1, len(y)))
-            finite = _interval_in_pieces(lambda tau, sub, j: kernel(tau, sub, rows, j, j + 1) == j + 1,
+            finite = _interval_in_pieces(lambda tau, sub, j: kernel(tau, sub, y, rows, j, j + 1) == j + 1,
                                          t_out[first - 1], t_out[first], int(steps[first - 1]), budget, progress)
             out[first] = y
             reached = stop if finite else first
         else:
-            reached = kernel(t_out, steps, out, first, stop)
+            reached = kernel(t_out, steps, y, out, first, stop)
         if reached != stop:
-            return reached
+            raise IntegrationError(f"{method.name} produced a non-finite state before t={t_out[reached]:.6g}"
+                                   f"{step_text}; reduce integrator.step")
         if progress is not None:
             progress(t_out[stop - 1])
-    return len(t_out)
+    n_steps = int(steps.sum())
+    return Solution(t_out, out, IntegratorStats(nfev=evaluations * n_steps, n_steps=n_steps, n_rejected=0,
+                                                wall_time=time.perf_counter() - start))
 
 
 class DOP853Numba(Tolerances, Integrator):
@@ -187,19 +191,8 @@ class RK4Numba(RK4):
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         from gyrolab.kernels import rk4  # start-up: the kernel imports numba
 
-        start = time.perf_counter()
-        t_out, y, out = _outputs(t_out, y0)
-        steps = interval_steps(self, t_out)
-        fun = compiled_rhs(compiled)
-        reached = _fixed_step(lambda grid, n, rows, first, stop: rk4.run(compiled.params, grid, n,
-                                                                         y, rows, first, stop),
-                              self.name, fun, t_out, steps, y, out, progress)
-        if reached != len(t_out):
-            raise IntegrationError(f"rk4_numba produced a non-finite state before t={t_out[reached]:.6g} "
-                                   f"with step {self.step:.3g}; reduce integrator.step")
-        n_steps = int(steps.sum())
-        return Solution(t_out, out, IntegratorStats(nfev=4 * n_steps, n_steps=n_steps, n_rejected=0,
-                                                    wall_time=time.perf_counter() - start))
+        return _fixed_step(self, lambda *run: rk4.run(compiled.params, *run), t_out, y0, compiled, progress, 4,
+                           f" with step {self.step:.3g}")
 
 
 class Taylor(Integrator):
@@ -430,21 +423,10 @@ class LiePoisson(Integrator):
         if compiled.built_in is None:
             raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian with the built-in torque "
                               "forms only; valid systems: fixed_point with uniform_gravity, newtonian, magnetic")
-        start = time.perf_counter()
-        t_out, y, out = _outputs(t_out, y0)
-        steps = interval_steps(self, t_out)
         w = lie_poisson.weights(self.order)
-        fun = compiled_rhs(compiled)
-        reached = _fixed_step(lambda grid, n, rows, first, stop: lie_poisson.run(compiled.built_in, grid, n, w, y,
-                                                                                 rows, first, stop),
-                              self.name, fun, t_out, steps, y, out, progress)
-        if reached != len(t_out):
-            raise IntegrationError(f"lie_poisson produced a non-finite state before t={t_out[reached]:.6g}; "
-                                   "reduce integrator.step")
-        n_steps = int(steps.sum())
         # per step: len(w) Strang stages, each with 2 kicks (one torque evaluation each)
-        return Solution(t_out, out, IntegratorStats(nfev=2 * len(w) * n_steps, n_steps=n_steps, n_rejected=0,
-                                                    wall_time=time.perf_counter() - start))
+        return _fixed_step(self, lambda grid, n, *run: lie_poisson.run(compiled.built_in, grid, n, w, *run), t_out, y0,
+                           compiled, progress, 2 * len(w))
 
     def attributes(self) -> dict[str, Any]:
         return {"integrator_step": self.step, "integrator_order": self.order}
