@@ -43,20 +43,17 @@ FLI_SAMPLES = 256
 #: result of one call), an adaptive run takes the trajectories in groups (each its own steps: independent)
 MEMORY = 64 * 2**20
 
-def _traced(compiled: Any) -> Any:
-    """The traced model behind ``compiled``; one ConfigError when there is none (no compiled model)."""
-    try:
-        return model.traced_model(compiled)
-    except (ValueError, AttributeError):
-        raise ConfigError("chaos indicators need a system compiled from its equations (its compiled_model()); this "
-                          "system has none") from None
-
 
 def _initial_states(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     """The initial states the tangent flow runs (``tangent.flow_size`` leading components) and its parameter rows,
     checked: one ConfigError per bad input. A fixed point (``compiled.built_in``) also needs torques about the
     vertical only and |γ| = 1."""
-    if _traced(compiled).time_dependent:
+    try:
+        traced = model.traced_model(compiled)
+    except (ValueError, AttributeError):  # no compiled model
+        raise ConfigError("chaos indicators need a system compiled from its equations (its compiled_model()); this "
+                          "system has none") from None
+    if traced.time_dependent:
         raise ConfigError("chaos indicators of a model compiled from its equations need autonomous equations; a "
                           "time-dependent force has none here")
     y0s = np.atleast_2d(np.asarray(y0s, dtype=float))

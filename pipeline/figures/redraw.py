@@ -22,18 +22,9 @@ from gyrolab.output.trust import check_tree
 from gyrolab.output.user_yaml import stored_yaml
 
 #: dataset file name -> the gyrolab.figures module that draws its figures
-KINDS = {
-    "run.nc": "run",
-    "sweep.nc": "sweep",
-    "regime.nc": "regime",
-    "regime_validity.nc": "regime_validity",
-    "work_precision.nc": "work_precision",
-    "ismail2021_tables.nc": "tables",
-    "precession_cases.nc": "precessions",
-    "shaker_omega3.nc": "shaker",
-    "orbit_family.nc": "orbit_family",
-    "stability_map.nc": "stability_map",
-}
+KINDS = {"run.nc": "run", "sweep.nc": "sweep", "regime.nc": "regime", "regime_validity.nc": "regime_validity",
+         "work_precision.nc": "work_precision", "ismail2021_tables.nc": "tables", "precession_cases.nc": "precessions",
+         "shaker_omega3.nc": "shaker", "orbit_family.nc": "orbit_family", "stability_map.nc": "stability_map"}
 
 #: a variable every dataset of a kind has, for kinds whose figures would otherwise quietly draw nothing
 SIGNATURES = {"run.nc": "time", "sweep.nc": "job_status"}

@@ -139,8 +139,7 @@ def _mark_examples(ax: Axes, ds: xr.Dataset, t_lo: float, t_hi: float, r_lo: flo
     c = _r0_scale(ds)
     if c is None:
         return
-    markers = ("*", "P", "X")
-    for (label, theta0, r0), marker in zip(EXAMPLES, markers):
+    for (label, theta0, r0), marker in zip(EXAMPLES, ("*", "P", "X")):
         if t_lo <= theta0 <= t_hi and r_lo <= r0 * c <= r_hi:
             ax.plot(r0 * c, theta0, marker, ms=8, mfc="white", mec="black", mew=0.7, ls="none", label=label)
 

@@ -41,11 +41,10 @@ def conform(ds: xr.Dataset, title: str | None = None, source: str = "") -> xr.Da
     for name in list(ds.variables):
         _conform_variable(ds, name)
     created = now_iso()
-    what = f": {source}" if source else ""
     ds.attrs["Conventions"] = CONVENTIONS
     ds.attrs["title"] = ds.attrs.get("title") or title or "gyrolab dataset"
     ds.attrs["date_created"] = created
-    ds.attrs["history"] = f"{created} written by gyrolab {gyrolab_version()}{what}"
+    ds.attrs["history"] = f"{created} written by gyrolab {gyrolab_version()}" + (f": {source}" if source else "")
     return ds
 
 

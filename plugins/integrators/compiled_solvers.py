@@ -92,9 +92,10 @@ def _outputs(t_out: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     return np.asarray(t_out, dtype=float), y, out
 
 
-def _adaptive(advance: Any, t_out: np.ndarray, state: np.ndarray, progress: ProgressCallback | None,
-              failure: Any) -> None:
-    """Fill ``out[1:]`` by an adaptive kernel ``advance(reached, stop) -> (status, reached)`` called chunk by chunk
+def _adaptive(advance: Any, t_out: np.ndarray, out: np.ndarray, state: np.ndarray, stats: np.ndarray,
+              progress: ProgressCallback | None, failure: Any, start: float) -> Solution:
+    """The run since ``start`` (``stats``: the kernel's evaluations, steps and, when it counts them, rejected steps)
+    filling ``out[1:]`` by an adaptive kernel ``advance(reached, stop) -> (status, reached)`` called chunk by chunk
     (``_Chunks``), reporting progress after each, or in one call when no one takes progress (each call costs ~5 µs
     of numba's argument typing: 4 % of a 0.13 ms gyrostat run); a non-OK status (the kernels share their codes, 0 is
     OK) raises ``failure(status, t)`` at the time ``state[0]`` it stopped at."""
@@ -107,6 +108,9 @@ def _adaptive(advance: Any, t_out: np.ndarray, state: np.ndarray, progress: Prog
             raise failure(status, state[0])
         if progress is not None:
             progress(state[0])
+    return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]),
+                                                n_rejected=int(stats[2]) if len(stats) > 2 else 0,
+                                                wall_time=time.perf_counter() - start))
 
 
 def _fixed_step(method: Any, kernel: Any, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel,
@@ -173,12 +177,9 @@ class DOP853Numba(Tolerances, Integrator):
         h0 = dop853.initial_step(compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
                                  self.rtol, self.atol, stats)
         state = np.array([t_out[0], h0])
-        _adaptive(lambda reached, stop: dop853.run(compiled.params, t_out, out, reached, stop, state, y, f, t_out[-1],
-                                                   self.rtol, self.atol, self.max_step, stats),
-                  t_out, state, progress, self._failure)
-        wall = time.perf_counter() - start
-        return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]),
-                                                    n_rejected=int(stats[2]), wall_time=wall))
+        return _adaptive(lambda reached, stop: dop853.run(compiled.params, t_out, out, reached, stop, state, y, f,
+                                                          t_out[-1], self.rtol, self.atol, self.max_step, stats),
+                         t_out, out, state, stats, progress, self._failure, start)
 
 
 class RK4Numba(RK4):
@@ -259,12 +260,10 @@ class Taylor(Integrator):
         state = np.array([t_out[0]])
         carry = np.zeros(len(y))  # (np.zeros_like costs 2 µs more, per pilot run)
         stats = np.zeros(2, dtype=np.int64)
-        _adaptive(lambda reached, stop: taylor.run(compiled.params, self.order, self.tol, t_out, out, reached, stop,
-                                                   state, y, carry, stats),
-                  t_out, state, progress, _taylor_failure)
-        # one Taylor step costs about as much as `order` right-hand-side evaluations; report the series count
-        return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
-                                                    wall_time=time.perf_counter() - start))
+        # one Taylor step costs about as much as `order` right-hand-side evaluations; the series count is reported
+        return _adaptive(lambda reached, stop: taylor.run(compiled.params, self.order, self.tol, t_out, out, reached,
+                                                          stop, state, y, carry, stats),
+                         t_out, out, state, stats, progress, _taylor_failure, start)
 
     #: below this tol the double-precision kernel gains nothing (round-off)
     TOLERANCE_FLOOR = 1e-16
@@ -323,11 +322,9 @@ class TaylorDoubleDouble(Taylor):
         no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
         state = np.array([t_out[0]])
         stats = np.zeros(2, dtype=np.int64)
-        _adaptive(lambda reached, stop: taylor_dd.run(compiled.params, self.order, self.tol, t_out, out, no_low,
-                                                      reached, stop, state, y, low, stats),
-                  t_out, state, progress, _taylor_failure)
-        return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
-                                                    wall_time=time.perf_counter() - start))
+        return _adaptive(lambda reached, stop: taylor_dd.run(compiled.params, self.order, self.tol, t_out, out, no_low,
+                                                             reached, stop, state, y, low, stats),
+                         t_out, out, state, stats, progress, _taylor_failure, start)
 
     def more_accurate(self, factor: float):
         from gyrolab.kernels.taylor_dd import MIN_TOL  # start-up: the kernel imports numba

@@ -124,8 +124,7 @@ class FixedPointRegime(Regime):
         for key, value in (("periods", periods), ("samples_per_period", samples_per_period)):
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ConfigError(f"regime.{key}={value!r} must be a positive integer")
-        self.periods = periods
-        self.samples_per_period = samples_per_period
+        self.periods, self.samples_per_period = periods, samples_per_period
 
     def scene(self, system: System) -> NondimensionalScene:
         return nondimensional_scene(system, self.name)
