@@ -246,11 +246,9 @@ def section_dataset(compiled: Any, y0s: np.ndarray, theta0: np.ndarray, r0: np.n
     runs = [poincare_section(compiled, y0, t_end, step, None, None if params is None else np.atleast_2d(params)[j],
                              max_points) for j, y0 in enumerate(y0s)]
     width = max([1] + [len(run["t"]) for run in runs])
-    phi = np.full((len(runs), width), np.nan)
-    r = np.full((len(runs), width), np.nan)
+    phi, r = np.full((2, len(runs), width), np.nan)  # NaN past a point's last crossing
     for j, run in enumerate(runs):
-        phi[j, :len(run["t"])] = run["phi"]
-        r[j, :len(run["t"])] = run["r"]
+        phi[j, :len(run["t"])], r[j, :len(run["t"])] = run["phi"], run["r"]
     dims = ("section_point", "crossing")
     return xr.Dataset({
         "section_phi": (dims, phi, {"units": "rad", "long_name": "proper-rotation angle phi at upward crossings of "

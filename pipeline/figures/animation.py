@@ -101,9 +101,7 @@ def ellipsoid_curves(moments: np.ndarray, n: int = 48) -> list[np.ndarray]:
     s = np.linspace(0.0, 2.0 * np.pi, n)
     c, sn, zero = np.cos(s), np.sin(s), np.zeros(n)
     unit_curves = [np.stack([c, sn, zero], 1), np.stack([c, zero, sn], 1), np.stack([zero, c, sn], 1)]
-    for z in (-0.5, 0.5):
-        r = np.sqrt(1 - z * z)
-        unit_curves.append(np.stack([r * c, r * sn, np.full(n, z)], 1))
+    unit_curves += [np.stack([np.sqrt(1 - z * z) * c, np.sqrt(1 - z * z) * sn, np.full(n, z)], 1) for z in (-0.5, 0.5)]
     return [curve * semi for curve in unit_curves]
 
 

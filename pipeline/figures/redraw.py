@@ -81,9 +81,7 @@ def datasets(path: Path) -> list[Path]:
     if not path.is_dir():
         raise ConfigError(f"--plot: {str(path)!r} is neither a directory nor a dataset file")
     found = [path / name for name in KINDS if (path / name).is_file()]
-    for nested in sorted(path.glob("*/run.nc")):  # a sweep's jobs
-        if _drew_figures(nested):
-            found.append(nested)
+    found += [nested for nested in sorted(path.glob("*/run.nc")) if _drew_figures(nested)]  # a sweep's jobs
     if not found:
         raise ConfigError(f"--plot: no gyrolab dataset in {str(path)!r} (looked for {', '.join(KINDS)}, "
                           "and */run.nc in a sweep directory)")

@@ -35,13 +35,9 @@ class Magnetic(Force):
                               "a unit vector")
         self.required_axes = frozenset(i for i in range(3) if self.direction[i] != 0.0)
         self.preserves_area_integral = self.required_axes <= {2}
-        self.units = body.units
 
     def _field_in_body(self, axes: Axes) -> np.ndarray:
-        field = 0.0
-        for i in self.required_axes:
-            field = field + (self.field * self.direction[i]) * axes[i]
-        return field
+        return sum(((self.field * self.direction[i]) * axes[i] for i in self.required_axes), 0.0)
 
     def torque(self, omega: np.ndarray, axes: Axes) -> np.ndarray:
         return cross(self.moment, self._field_in_body(axes))

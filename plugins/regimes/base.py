@@ -158,12 +158,10 @@ class FixedPointRegime(Regime):
         """Warnings naming the scene's initial values the orbit replaces (p0, q0, φ0)."""
         y = self.initial_state(system)
         given = np.concatenate([system.initial.omega, system.initial.gamma])
-        out = []
-        if np.max(np.abs(given[:2] - y[:2])) > 1e-12 or abs(given[4]) > 1e-12:
-            out.append(f"the analytic orbit starts from its own p0={y[0]:.6g}, q0={y[1]:.6g}, φ0=π/2 "
-                       f"(the scene gave p0={given[0]:.6g}, q0={given[1]:.6g}, γ'0={given[4]:.3g}); "
-                       "r0 and θ0 are the scene's")
-        return out
+        if not (np.max(np.abs(given[:2] - y[:2])) > 1e-12 or abs(given[4]) > 1e-12):
+            return []
+        return [f"the analytic orbit starts from its own p0={y[0]:.6g}, q0={y[1]:.6g}, φ0=π/2 (the scene gave "
+                f"p0={given[0]:.6g}, q0={given[1]:.6g}, γ'0={given[4]:.3g}); r0 and θ0 are the scene's"]
 
     def attributes(self) -> dict[str, Any]:
         return {**super().attributes(), "regime_parameter_long_name": self.parameter_long_name}
