@@ -26,7 +26,8 @@ from gyrolab.contracts.capabilities import integrators_with, or_list
 from gyrolab.contracts.integrator import VARIATIONAL
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.kernels import layout, model, models, tangent
-from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, RK4Numba, steps_per_interval
+from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, RK4Numba
+from gyrolab.plugins.integrators.refinement import steps_per_interval
 
 INDICATOR_NAME = "MEGNO"
 INDICATOR_DEFINITION = ("MEGNO <Y>(t_end) (Cincotta & Simo 2000): time mean of Y(t) = (2/t) int_0^t s d'.d/d.d ds "
@@ -42,20 +43,17 @@ FLI_SAMPLES = 256
 #: result of one call), an adaptive run takes the trajectories in groups (each its own steps: independent)
 MEMORY = 64 * 2**20
 
-def _traced(compiled: Any) -> Any:
-    """The traced model behind ``compiled``; one ConfigError when there is none (no compiled model)."""
-    try:
-        return model.traced_model(compiled)
-    except (ValueError, AttributeError):
-        raise ConfigError("chaos indicators need a system compiled from its equations (its compiled_model()); this "
-                          "system has none") from None
-
 
 def _initial_states(compiled: Any, y0s: np.ndarray, params: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     """The initial states the tangent flow runs (``tangent.flow_size`` leading components) and its parameter rows,
     checked: one ConfigError per bad input. A fixed point (``compiled.built_in``) also needs torques about the
     vertical only and |γ| = 1."""
-    if _traced(compiled).time_dependent:
+    try:
+        traced = model.traced_model(compiled)
+    except (ValueError, AttributeError):  # no compiled model
+        raise ConfigError("chaos indicators need a system compiled from its equations (its compiled_model()); this "
+                          "system has none") from None
+    if traced.time_dependent:
         raise ConfigError("chaos indicators of a model compiled from its equations need autonomous equations; a "
                           "time-dependent force has none here")
     y0s = np.atleast_2d(np.asarray(y0s, dtype=float))
@@ -248,11 +246,9 @@ def section_dataset(compiled: Any, y0s: np.ndarray, theta0: np.ndarray, r0: np.n
     runs = [poincare_section(compiled, y0, t_end, step, None, None if params is None else np.atleast_2d(params)[j],
                              max_points) for j, y0 in enumerate(y0s)]
     width = max([1] + [len(run["t"]) for run in runs])
-    phi = np.full((len(runs), width), np.nan)
-    r = np.full((len(runs), width), np.nan)
+    phi, r = np.full((2, len(runs), width), np.nan)  # NaN past a point's last crossing
     for j, run in enumerate(runs):
-        phi[j, :len(run["t"])] = run["phi"]
-        r[j, :len(run["t"])] = run["r"]
+        phi[j, :len(run["t"])], r[j, :len(run["t"])] = run["phi"], run["r"]
     dims = ("section_point", "crossing")
     return xr.Dataset({
         "section_phi": (dims, phi, {"units": "rad", "long_name": "proper-rotation angle phi at upward crossings of "

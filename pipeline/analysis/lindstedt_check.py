@@ -57,11 +57,7 @@ def error_ladder(sol: LindstedtSeries, order: int, tilt: float, *, target: float
             mid = np.sqrt(lo * hi)
             lo, hi = (mid, hi) if sol.error_estimate(mid, order) < target else (lo, mid)
     eps = hi * step ** np.arange(points)
-    state, period = [], []
-    for e in eps:
-        err = series_error(sol, exact_orbit(sol.body, float(e), tilt, sol), float(e), order)
-        state.append(err["state"])
-        period.append(err["period"])
-    state = np.array(state)
+    errors = [series_error(sol, exact_orbit(sol.body, float(e), tilt, sol), float(e), order) for e in eps]
+    state, period = (np.array([err[key] for err in errors]) for key in ("state", "period"))
     slope = float(np.polyfit(np.log(eps), np.log(state), 1)[0])
-    return {"eps": eps, "state": state, "period": np.array(period), "slope": slope}
+    return {"eps": eps, "state": state, "period": period, "slope": slope}

@@ -187,10 +187,6 @@ class PeriodicOrbit:
         self.multipliers = np.linalg.eigvals(self.monodromy)
 
 
-def _start(p: float, q: float, r0: float, gpp: float) -> np.ndarray:
-    return np.array([p, q, r0, np.sqrt(max(0.0, 1.0 - gpp**2)), 0.0, gpp])
-
-
 def shoot(model: FixedPointModel, y0: np.ndarray, period: float, *, tol: float = 1e-13, accept: float = 1e-11,
           max_iter: int = 40) -> PeriodicOrbit:
     """Damped Gauss–Newton shooting from a guess y0 = (p, q, r0, γ, 0, γ0'') and period; r, γ', γ'' stay fixed.
@@ -207,7 +203,7 @@ def shoot(model: FixedPointModel, y0: np.ndarray, period: float, *, tol: float =
     D = np.eye(6, 2)  # ∂y0/∂(p0, q0)
 
     def attempt(u):
-        s0 = _start(u[0], u[1], r0, gpp)
+        s0 = np.array([u[0], u[1], r0, np.sqrt(max(0.0, 1.0 - gpp**2)), 0.0, gpp])
         sT, phi = model.flow(s0, u[2])
         res = sT - s0
         return float(np.max(np.abs(res))) / scale, res, s0, sT, phi

@@ -101,9 +101,7 @@ def ellipsoid_curves(moments: np.ndarray, n: int = 48) -> list[np.ndarray]:
     s = np.linspace(0.0, 2.0 * np.pi, n)
     c, sn, zero = np.cos(s), np.sin(s), np.zeros(n)
     unit_curves = [np.stack([c, sn, zero], 1), np.stack([c, zero, sn], 1), np.stack([zero, c, sn], 1)]
-    for z in (-0.5, 0.5):
-        r = np.sqrt(1 - z * z)
-        unit_curves.append(np.stack([r * c, r * sn, np.full(n, z)], 1))
+    unit_curves += [np.stack([np.sqrt(1 - z * z) * c, np.sqrt(1 - z * z) * sn, np.full(n, z)], 1) for z in (-0.5, 0.5)]
     return [curve * semi for curve in unit_curves]
 
 
@@ -155,15 +153,6 @@ def motion_figure(ds: xr.Dataset, indices: np.ndarray) -> tuple[Figure, Callable
         return fig, update
 
 
-def _load(path: Path) -> tuple[xr.Dataset, Path]:
-    """The run at ``path`` through the loader every reader uses (``gyrolab.output.foreign.load_run``)."""
-    path = Path(path)
-    file = path / "run.nc" if path.is_dir() else path
-    if not file.is_file():
-        raise ConfigError(f"--animate: {str(path)!r} is neither a run.nc nor a run directory holding one")
-    return load_run(file), file
-
-
 def _check(fmt: str, frames: int, fps: float) -> str:
     fmt = str(fmt).lower().lstrip(".")
     if fmt not in FORMATS:
@@ -188,7 +177,11 @@ def animate(path: str | os.PathLike[str], output: str | os.PathLike[str] | None 
     fmt = _check(fmt, frames, fps)
     if output is not None:
         check_output_target(output, "-o")
-    ds, file = _load(Path(path))
+    path = Path(path)
+    file = path / "run.nc" if path.is_dir() else path
+    if not file.is_file():
+        raise ConfigError(f"--animate: {str(path)!r} is neither a run.nc nor a run directory holding one")
+    ds = load_run(file)  # the loader every reader uses
     if "time" not in ds.dims or ds["time"].ndim != 1 or not np.all(np.isfinite(ds["time"].values)):
         raise ConfigError(f"{str(file)!r} has no time axis of finite times to animate; the dataset was edited")
     indices = frame_indices(ds.sizes["time"], int(frames))

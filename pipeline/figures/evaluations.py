@@ -58,7 +58,4 @@ def _run_attribute(ds: xr.Dataset, key: str) -> xr.DataArray | None:
     swept coordinate ``KEY``."""
     if key in ds.attrs:
         return xr.DataArray(ds.attrs[key])
-    for name in (f"run_{key}", key):
-        if name in ds.variables:
-            return ds[name]
-    return None
+    return next((ds[name] for name in (f"run_{key}", key) if name in ds.variables), None)

@@ -22,18 +22,9 @@ from gyrolab.output.trust import check_tree
 from gyrolab.output.user_yaml import stored_yaml
 
 #: dataset file name -> the gyrolab.figures module that draws its figures
-KINDS = {
-    "run.nc": "run",
-    "sweep.nc": "sweep",
-    "regime.nc": "regime",
-    "regime_validity.nc": "regime_validity",
-    "work_precision.nc": "work_precision",
-    "ismail2021_tables.nc": "tables",
-    "precession_cases.nc": "precessions",
-    "shaker_omega3.nc": "shaker",
-    "orbit_family.nc": "orbit_family",
-    "stability_map.nc": "stability_map",
-}
+KINDS = {"run.nc": "run", "sweep.nc": "sweep", "regime.nc": "regime", "regime_validity.nc": "regime_validity",
+         "work_precision.nc": "work_precision", "ismail2021_tables.nc": "tables", "precession_cases.nc": "precessions",
+         "shaker_omega3.nc": "shaker", "orbit_family.nc": "orbit_family", "stability_map.nc": "stability_map"}
 
 #: a variable every dataset of a kind has, for kinds whose figures would otherwise quietly draw nothing
 SIGNATURES = {"run.nc": "time", "sweep.nc": "job_status"}
@@ -90,9 +81,7 @@ def datasets(path: Path) -> list[Path]:
     if not path.is_dir():
         raise ConfigError(f"--plot: {str(path)!r} is neither a directory nor a dataset file")
     found = [path / name for name in KINDS if (path / name).is_file()]
-    for nested in sorted(path.glob("*/run.nc")):  # a sweep's jobs
-        if _drew_figures(nested):
-            found.append(nested)
+    found += [nested for nested in sorted(path.glob("*/run.nc")) if _drew_figures(nested)]  # a sweep's jobs
     if not found:
         raise ConfigError(f"--plot: no gyrolab dataset in {str(path)!r} (looked for {', '.join(KINDS)}, "
                           "and */run.nc in a sweep directory)")

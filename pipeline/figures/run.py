@@ -154,12 +154,9 @@ def draw_body_axis(ds: xr.Dataset) -> Figure:
     return fig
 
 
-FIGURES: dict[str, Callable[[xr.Dataset], Figure]] = {
-    "state": draw_state,
-    "invariant_drift": draw_invariants,
-    "euler_angles": draw_euler_angles,
-    "body_axis_sphere": draw_body_axis,
-}
+FIGURES: dict[str, Callable[[xr.Dataset], Figure]] = {"state": draw_state, "invariant_drift": draw_invariants,
+                                                       "euler_angles": draw_euler_angles,
+                                                       "body_axis_sphere": draw_body_axis}
 
 
 def _draw(name: str, ds: xr.Dataset, directory: Path, formats: tuple[str, ...], dpi: int) -> list[Path]:

@@ -30,9 +30,8 @@ PROVENANCE_KEYS = ("gyrolab_version", "git_commit", "git_dirty", "git_diff_sha25
 def metadata_of(ds: xr.Dataset, title: str | None = None) -> dict[str, str]:
     """The provenance a figure drawn from ``ds`` carries: title, version, commit, resolved config."""
     md = {"Title": str(title or ds.attrs.get("title", "")), "Software": f"gyrolab {ds.attrs.get('gyrolab_version', '')}"}
-    for key in PROVENANCE_KEYS:
-        if str(ds.attrs.get(key, "")) != "":
-            md[f"gyrolab:{key}"] = str(ds.attrs[key])
+    md.update({f"gyrolab:{key}": str(ds.attrs[key]) for key in PROVENANCE_KEYS
+               if str(ds.attrs.get(key, "")) != ""})
     if ds.attrs.get("config"):
         md["gyrolab:config"] = str(ds.attrs["config"])
     return md

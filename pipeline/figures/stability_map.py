@@ -139,21 +139,16 @@ def _mark_examples(ax: Axes, ds: xr.Dataset, t_lo: float, t_hi: float, r_lo: flo
     c = _r0_scale(ds)
     if c is None:
         return
-    markers = ("*", "P", "X")
-    for (label, theta0, r0), marker in zip(EXAMPLES, markers):
+    for (label, theta0, r0), marker in zip(EXAMPLES, ("*", "P", "X")):
         if t_lo <= theta0 <= t_hi and r_lo <= r0 * c <= r_hi:
             ax.plot(r0 * c, theta0, marker, ms=8, mfc="white", mec="black", mew=0.7, ls="none", label=label)
-
-
-def _sections(ds: xr.Dataset) -> int:
-    return int(ds.sizes.get("section_point", 0)) if "section_phi" in ds else 0
 
 
 @styled
 def draw_stability_map(ds: xr.Dataset) -> Figure:
     if "indicator" not in ds or not {"theta0", "r0"} <= set(ds["indicator"].dims):
         raise OutputError("a stability map needs a variable 'indicator' over the dimensions (theta0, r0)")
-    n_sections = _sections(ds)
+    n_sections = int(ds.sizes.get("section_point", 0)) if "section_phi" in ds else 0
     fig = figure(DOUBLE, 3.6 + (2.2 if n_sections else 0.0))
     grid = fig.add_gridspec(2 if n_sections else 1, max(2, n_sections), height_ratios=[1.7, 1] if n_sections else [1])
     top = grid[0, :].subgridspec(1, 2, width_ratios=[1.25, 1])

@@ -118,15 +118,14 @@ def fit(fig: Figure, axes: np.ndarray) -> None:
 def legend_outside(fig: Figure, axes: Sequence[Axes] | None = None, *, ncols: int | None = None,
                    where: str = "lower center") -> None:
     """One legend for the figure, outside every panel (it never covers data); duplicates merged."""
-    handles, labels = {}, []
+    handles = {}  # label -> handle, in the order first met
     for ax in (axes if axes is not None else fig.axes):
         for handle, label in zip(*ax.get_legend_handles_labels()):
             if label not in handles and not label.startswith("_"):
                 handles[label] = handle
-                labels.append(label)
-    if labels:  # without a layout engine (3-D figures, margins set by hand) the caller leaves room for it
+    if handles:  # without a layout engine (3-D figures, margins set by hand) the caller leaves room for it
         loc = f"outside {where}" if fig.get_layout_engine() is not None else where
-        fig.legend([handles[label] for label in labels], labels, loc=loc, ncols=ncols or min(len(labels), 4))
+        fig.legend(list(handles.values()), list(handles), loc=loc, ncols=ncols or min(len(handles), 4))
 
 
 def panel_note(ax: Axes, text: str) -> None:

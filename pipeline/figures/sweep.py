@@ -75,12 +75,9 @@ def _drift(ds: xr.Dataset) -> list[Panel]:
 
 
 def _cost(ds: xr.Dataset) -> list[Panel]:
-    panels = []
-    if "integrator_nfev" in ds:
-        panels.append(("integrator evaluations", "evaluations", ds["integrator_nfev"], True))
-    if "integrator_wall_time" in ds:
-        panels.append(("integrator wall time", "wall time (s)", ds["integrator_wall_time"], True))
-    return panels
+    costs = (("integrator_nfev", "integrator evaluations", "evaluations"),
+             ("integrator_wall_time", "integrator wall time", "wall time (s)"))
+    return [(title, ylabel, ds[name], True) for name, title, ylabel in costs if name in ds]
 
 
 def _ylabel(name: str, unit_text: str) -> str:

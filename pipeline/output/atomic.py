@@ -113,11 +113,8 @@ def diagnose(error: BaseException, tmp: Path, expected_bytes: int | None = None)
     except OSError as probe:
         if probe.errno in _TRUSTED:
             return reason(probe)
-    try:
+    with contextlib.suppress(OSError):
         stats = os.statvfs(tmp.parent)
-    except OSError:
-        stats = None
-    if stats is not None:
         free = (stats.f_bfree if os.geteuid() == 0 else stats.f_bavail) * stats.f_frsize
         free += written + PROBE_BYTES  # the temporary file is removed: its blocks count as free
         if expected_bytes is not None and free < expected_bytes:

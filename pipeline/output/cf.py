@@ -41,11 +41,10 @@ def conform(ds: xr.Dataset, title: str | None = None, source: str = "") -> xr.Da
     for name in list(ds.variables):
         _conform_variable(ds, name)
     created = now_iso()
-    what = f": {source}" if source else ""
     ds.attrs["Conventions"] = CONVENTIONS
     ds.attrs["title"] = ds.attrs.get("title") or title or "gyrolab dataset"
     ds.attrs["date_created"] = created
-    ds.attrs["history"] = f"{created} written by gyrolab {gyrolab_version()}{what}"
+    ds.attrs["history"] = f"{created} written by gyrolab {gyrolab_version()}" + (f": {source}" if source else "")
     return ds
 
 
@@ -78,11 +77,10 @@ def unit_attributes(body: Any) -> dict[str, Any]:
     ``energy_unit``, ``time_unit_description`` and, for an SI fixed-point body, the papers' scales ``time_scale_s``
     = 1/c and ``energy_scale_J`` = C c² (docs/datasets.md, "Conventions common to every dataset")."""
     time_label, rate_label = body.time_label, body.rate_label
-    si = body.units == "si"
     attrs: dict[str, Any] = {"time_unit": time_label, "rate_unit": rate_label}
     nondim = body.nondimensional() if hasattr(body, "nondimensional") else {}
     c2 = nondim.get("c2")
-    if si:
+    if body.units == "si":
         attrs["energy_unit"] = "J"
         if c2 is not None and c2 > 0:
             attrs["time_scale_s"] = 1.0 / math.sqrt(c2)

@@ -63,11 +63,7 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
                             indexes={"time": time, **{name: LABELS.xindexes[name] for name in labels}})
     ds = xr.Dataset(variables, coords=coords)
     before, after = scene.dataset_attributes  # the scene's own, once per scene
-    ds.attrs.update(before)
-    ds.attrs.update(integrator.attributes())
-    ds.attrs.update(solution.stats.attributes())
-    ds.attrs.update(after)
-    ds.attrs.update(added_attrs)
+    ds.attrs.update({**before, **integrator.attributes(), **solution.stats.attributes(), **after, **added_attrs})
     flag_violated_invariants(ds, system.invariants, integrator.adaptive, series)
     return conform(ds, source=f"run of system {system.name} with integrator {integrator.name}")
 

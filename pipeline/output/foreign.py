@@ -88,16 +88,11 @@ def check_declared(declared: int, size: int, where: str, expected: str) -> None:
         raise ConfigError(f"{where!r} declares {_size(declared)} of data in a file of {_size(size)}; gyrolab stores "
                           f"every value it declares (at most {SPARSE_FACTOR}× the file's size), so the dataset was "
                           f"edited; give {expected}")
-    limit = memory_limit()
+    available = proc_number("/proc/meminfo", "MemAvailable:")  # kB (Linux); elsewhere the limit is 4 GiB
+    limit = available * 1024 // 2 if available is not None else 4 * 1024**3
     if declared > limit:
         raise ConfigError(f"{where!r} declares {_size(declared)} of data, more than the limit of {_size(limit)} "
                           f"(half the memory available); give {expected}, or read it on a larger machine")
-
-
-def memory_limit() -> int:
-    """Half the memory available now (Linux's MemAvailable), else 4 GiB."""
-    available = proc_number("/proc/meminfo", "MemAvailable:")  # kB
-    return available * 1024 // 2 if available is not None else 4 * 1024**3
 
 
 RUN = "a run.nc that gyrolab wrote"

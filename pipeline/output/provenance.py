@@ -44,12 +44,6 @@ def _in_own_checkout() -> bool:
     return top is not None and Path(top).resolve() == SOURCE_ROOT
 
 
-def _untracked_code() -> list[str]:
-    """New files under CODE_PATHS that git does not track yet (they may be imported all the same)."""
-    listed = _git("ls-files", "--others", "--exclude-standard", "--", *CODE_PATHS)
-    return sorted(line for line in (listed or "").splitlines() if line)
-
-
 @cache
 def code_tree() -> str:
     """20 hex digits over the git objects of CODE_PATHS at HEAD ('' outside a git checkout of gyrolab): unlike
@@ -111,7 +105,9 @@ def provenance() -> dict[str, Any]:
     two dirty trees differ ("" when only documentation or tests differ: a job's identity, which reads it, stays)."""
     commit = _git("rev-parse", "HEAD") if _in_own_checkout() else None
     status = _git("status", "--porcelain", "--untracked-files=no") if commit else None
-    untracked = _untracked_code() if commit else []
+    # new files under CODE_PATHS that git does not track yet (they may be imported all the same)
+    listed = _git("ls-files", "--others", "--exclude-standard", "--", *CODE_PATHS) if commit else None
+    untracked = sorted(line for line in (listed or "").splitlines() if line)
     dirty = -1 if status is None else int(bool(status or untracked))
     attrs: dict[str, Any] = {
         "gyrolab_version": gyrolab_version(),

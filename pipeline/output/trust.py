@@ -61,10 +61,8 @@ def check_tree(directory: str | os.PathLike[str], *, sweep: bool = False) -> Non
     directory = Path(directory)
     try:
         entries = list(os.scandir(directory))
-    except (FileNotFoundError, NotADirectoryError):
-        return
     except OSError:
-        return  # unreadable: the writes that follow say so
+        return  # missing, or unreadable: the writes that follow say so
     for entry in sorted(entries, key=lambda e: e.name):
         if not (sweep or _own(entry.name)):
             continue

@@ -24,31 +24,20 @@ UNIT_TOLERANCE = 1e-9
 class Magnetic(Force):
     name = "magnetic"
 
-    def __init__(
-        self,
-        body: Body,
-        *,
-        moment: Sequence[float] = (0.0, 0.0, 1.0),
-        field: float = 0.0,
-        direction: Sequence[float] = (0.0, 0.0, 1.0),
-    ) -> None:
+    def __init__(self, body: Body, *, moment: Sequence[float] = (0.0, 0.0, 1.0), field: float = 0.0,
+                 direction: Sequence[float] = (0.0, 0.0, 1.0)) -> None:
         self.moment = np.array(as_vector3(moment, "force.magnetic.moment"))
         self.field = as_number(field, "force.magnetic.field")
         self.direction = np.array(as_vector3(direction, "force.magnetic.direction"))
         length = float(np.linalg.norm(self.direction))
         if abs(length - 1.0) > UNIT_TOLERANCE:
-            raise ConfigError(
-                f"force.magnetic.direction={self.direction.tolist()} has norm {length:.12g}; it must be a unit vector"
-            )
+            raise ConfigError(f"force.magnetic.direction={self.direction.tolist()} has norm {length:.12g}; it must be "
+                              "a unit vector")
         self.required_axes = frozenset(i for i in range(3) if self.direction[i] != 0.0)
         self.preserves_area_integral = self.required_axes <= {2}
-        self.units = body.units
 
     def _field_in_body(self, axes: Axes) -> np.ndarray:
-        field = 0.0
-        for i in self.required_axes:
-            field = field + (self.field * self.direction[i]) * axes[i]
-        return field
+        return sum(((self.field * self.direction[i]) * axes[i] for i in self.required_axes), 0.0)
 
     def torque(self, omega: np.ndarray, axes: Axes) -> np.ndarray:
         return cross(self.moment, self._field_in_body(axes))

@@ -17,6 +17,7 @@ from gyrolab.contracts.capabilities import integrators_with, or_list
 from gyrolab.contracts.integrator import BATCH_KERNEL, BatchSolution, CompiledModel
 from gyrolab.errors import ConfigError, IntegrationError
 from gyrolab.kernels.model import bind
+from gyrolab.plugins.integrators.refinement import steps_per_interval
 
 #: why an adaptive batch kernel stopped a trajectory, by its status code
 _REASONS = {1: "its step fell below the spacing of floating-point numbers", 2: "it became non-finite"}
@@ -25,9 +26,7 @@ _REASONS = {1: "its step fell below the spacing of floating-point numbers", 2: "
 def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
               failures: str) -> BatchSolution:
     """Fixed-step RK4 with the fewest equal steps no longer than ``step`` in each output interval."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import models, rk4
-    from gyrolab.plugins.integrators.compiled_solvers import steps_per_interval  # (it imports this module)
+    from gyrolab.kernels import models, rk4  # start-up: the kernel imports numba
 
     start = time.perf_counter()
     P = bind(compiled, P)
@@ -43,15 +42,15 @@ def rk4_batch(compiled: CompiledModel, step: float, times: np.ndarray, y0s: np.n
 def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
                  failures: str) -> BatchSolution:
     """The Taylor method at ``integrator.order`` and ``integrator.tol`` (``Taylor``'s settings)."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import batch_taylor, taylor_series
+    from gyrolab.kernels import batch_taylor, taylor_series  # start-up: the kernel imports numba
 
     P = bind(compiled, P)
 
     def kernel(out: np.ndarray, steps: np.ndarray, status: np.ndarray) -> None:
-        if not taylor_series.ready(compiled, P):
+        if not taylor_series.ready(compiled, P):  # the registered batch kernels that can run it are the choices
+            valid = or_list(integrators_with(BATCH_KERNEL, accept=lambda cls: cls.refusal(compiled) is None))
             raise ConfigError(f"integrator {integrator.name} has no Taylor coefficients for this compiled model; "
-                              f"valid choices for this model: {_batch_alternatives(compiled)}")
+                              f"valid choices for this model: {valid}")
         batch_taylor.run_lanes(compiled, P, integrator.order, integrator.tol, times, y0s, out, steps, status)
 
     return _adaptive(integrator, kernel, times, y0s, failures)
@@ -60,8 +59,7 @@ def taylor_batch(integrator: object, compiled: CompiledModel, times: np.ndarray,
 def dop853_batch(integrator: object, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, P: np.ndarray,
                  failures: str) -> BatchSolution:
     """DOP853 with ``integrator.rtol``, ``atol`` and ``max_step`` (scipy's step control)."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import batch_dop853, models
+    from gyrolab.kernels import batch_dop853, models  # start-up: the kernel imports numba
 
     P = bind(compiled, P)
 
@@ -91,11 +89,6 @@ def _adaptive(integrator: object, kernel: object, times: np.ndarray, y0s: np.nda
                                f"{_REASONS.get(int(status[bad]), 'unknown status')}")
     return BatchSolution(times, out, int(steps.max(initial=0)), time.perf_counter() - start, failed, steps,
                          integrator.attributes())
-
-
-def _batch_alternatives(compiled: CompiledModel) -> str:
-    """The registered integrators with a batch kernel that can run ``compiled``."""
-    return or_list(integrators_with(BATCH_KERNEL, accept=lambda cls: cls.refusal(compiled) is None))
 
 
 def require_finite_out(out: np.ndarray) -> None:

@@ -13,24 +13,13 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.contracts.integrator import (
-    BATCH_KERNEL,
-    COMPILED_MODEL,
-    TIME_DEPENDENT,
-    VARIATIONAL,
-    VECTOR_LANES,
-    BatchSolution,
-    CompiledModel,
-    Integrator,
-    IntegratorStats,
-    ProgressCallback,
-    RightHandSide,
-    Solution,
-    VariationalSettings,
-)
+from gyrolab.contracts.integrator import (BATCH_KERNEL, COMPILED_MODEL, TIME_DEPENDENT, VARIATIONAL, VECTOR_LANES,
+                                          BatchSolution, CompiledModel, Integrator, IntegratorStats, ProgressCallback,
+                                          RightHandSide, Solution, VariationalSettings)
 from gyrolab.errors import ConfigError, IntegrationError, as_number
 from gyrolab.plugins.integrators import batch_kernels
 from gyrolab.plugins.integrators.refinement import half_step, interval_steps
+from gyrolab.plugins.integrators.rk4 import RK4
 from gyrolab.plugins.integrators.tolerances import Tolerances
 from gyrolab.plugins.integrators.step_guard import check_step, compiled_rhs
 
@@ -103,9 +92,10 @@ def _outputs(t_out: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     return np.asarray(t_out, dtype=float), y, out
 
 
-def _adaptive(advance: Any, t_out: np.ndarray, state: np.ndarray, progress: ProgressCallback | None,
-              failure: Any) -> None:
-    """Fill ``out[1:]`` by an adaptive kernel ``advance(reached, stop) -> (status, reached)`` called chunk by chunk
+def _adaptive(advance: Any, t_out: np.ndarray, out: np.ndarray, state: np.ndarray, stats: np.ndarray,
+              progress: ProgressCallback | None, failure: Any, start: float) -> Solution:
+    """The run since ``start`` (``stats``: the kernel's evaluations, steps and, when it counts them, rejected steps)
+    filling ``out[1:]`` by an adaptive kernel ``advance(reached, stop) -> (status, reached)`` called chunk by chunk
     (``_Chunks``), reporting progress after each, or in one call when no one takes progress (each call costs ~5 µs
     of numba's argument typing: 4 % of a 0.13 ms gyrostat run); a non-OK status (the kernels share their codes, 0 is
     OK) raises ``failure(status, t)`` at the time ``state[0]`` it stopped at."""
@@ -118,38 +108,40 @@ def _adaptive(advance: Any, t_out: np.ndarray, state: np.ndarray, progress: Prog
             raise failure(status, state[0])
         if progress is not None:
             progress(state[0])
+    return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]),
+                                                n_rejected=int(stats[2]) if len(stats) > 2 else 0,
+                                                wall_time=time.perf_counter() - start))
 
 
-def steps_per_interval(t_out: np.ndarray, step: float) -> np.ndarray:
-    """Fewest equal steps no longer than ``step`` in each output interval (lands on every output time)."""
-    return np.maximum(1, np.ceil(np.diff(t_out) / step * (1.0 - 1e-12))).astype(np.int64)
-
-
-def _fixed_step(kernel: Any, name: str, fun: RightHandSide, t_out: np.ndarray, steps: np.ndarray, y: np.ndarray,
-                out: np.ndarray, progress: ProgressCallback | None) -> int:
-    """Fill ``out[1:]`` with a compiled fixed-step ``kernel(grid, steps, rows, first, stop) -> reached``.
-
-    Returns the index of the first output left non-finite, or ``len(t_out)``. Progress is reported
-    after each chunk, and after each piece of an output interval too long for one chunk.
-    """
-    gaps = np.diff(t_out)
-    chunks = _Chunks(len(t_out), steps)
+def _fixed_step(method: Any, kernel: Any, t_out: np.ndarray, y0: np.ndarray, compiled: CompiledModel,
+                progress: ProgressCallback | None, evaluations: int, step_text: str = "") -> Solution:
+    """``method``'s run by a compiled fixed-step ``kernel(grid, steps, y, rows, first, stop) -> reached``
+    (``evaluations`` right-hand-side evaluations a step). Progress is reported after each chunk, and after each piece
+    of an output interval too long for one chunk; the first output left non-finite is one IntegrationError
+    (``step_text`` after its time)."""
+    start = time.perf_counter()
+    t_out, y, out = _outputs(t_out, y0)
+    steps = interval_steps(method, t_out)
+    fun, gaps, chunks = compiled_rhs(compiled), np.diff(t_out), _Chunks(len(t_out), steps)
     for first, stop in chunks:
-        check_step(name, fun, t_out[first - 1], y, float(gaps[first - 1] / steps[first - 1]))
+        check_step(method.name, fun, t_out[first - 1], y, float(gaps[first - 1] / steps[first - 1]))
         budget = chunks.step_budget
         if stop - first == 1 and steps[first - 1] > budget:  # one long interval: in pieces
             rows = np.empty((math.ceil(steps[first - 1] / budget) + 1, len(y)))
-            finite = _interval_in_pieces(lambda tau, sub, j: kernel(tau, sub, rows, j, j + 1) == j + 1,
+            finite = _interval_in_pieces(lambda tau, sub, j: kernel(tau, sub, y, rows, j, j + 1) == j + 1,
                                          t_out[first - 1], t_out[first], int(steps[first - 1]), budget, progress)
             out[first] = y
             reached = stop if finite else first
         else:
-            reached = kernel(t_out, steps, out, first, stop)
+            reached = kernel(t_out, steps, y, out, first, stop)
         if reached != stop:
-            return reached
+            raise IntegrationError(f"{method.name} produced a non-finite state before t={t_out[reached]:.6g}"
+                                   f"{step_text}; reduce integrator.step")
         if progress is not None:
             progress(t_out[stop - 1])
-    return len(t_out)
+    n_steps = int(steps.sum())
+    return Solution(t_out, out, IntegratorStats(nfev=evaluations * n_steps, n_steps=n_steps, n_rejected=0,
+                                                wall_time=time.perf_counter() - start))
 
 
 class DOP853Numba(Tolerances, Integrator):
@@ -174,8 +166,7 @@ class DOP853Numba(Tolerances, Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import dop853, models
+        from gyrolab.kernels import dop853, models  # start-up: the kernel imports numba
 
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
@@ -186,53 +177,23 @@ class DOP853Numba(Tolerances, Integrator):
         h0 = dop853.initial_step(compiled.params, t_out[0], y, f, t_out[-1], self.max_step,
                                  self.rtol, self.atol, stats)
         state = np.array([t_out[0], h0])
-        _adaptive(lambda reached, stop: dop853.run(compiled.params, t_out, out, reached, stop, state, y, f, t_out[-1],
-                                                   self.rtol, self.atol, self.max_step, stats),
-                  t_out, state, progress, self._failure)
-        wall = time.perf_counter() - start
-        return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]),
-                                                    n_rejected=int(stats[2]), wall_time=wall))
+        return _adaptive(lambda reached, stop: dop853.run(compiled.params, t_out, out, reached, stop, state, y, f,
+                                                          t_out[-1], self.rtol, self.atol, self.max_step, stats),
+                         t_out, out, state, stats, progress, self._failure, start)
 
 
-class RK4Numba(Integrator):
+class RK4Numba(RK4):
+    """``rk4``'s method, settings and batch kernel, its single runs compiled too."""
+
     name = "rk4_numba"
-    adaptive = False
     capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL})
-
-    def __init__(self, *, step: float = 0.01) -> None:
-        self.step = as_number(step, "integrator.step", positive=True)
-
-    def more_accurate(self, factor: float):
-        return half_step(self, 4)
-
-    def integrate_batch(self, compiled: CompiledModel, times: np.ndarray, y0s: np.ndarray, params: np.ndarray,
-                        failures: str) -> BatchSolution:
-        return batch_kernels.rk4_batch(compiled, self.step, times, y0s, params, failures)
-
-    def variational_settings(self) -> VariationalSettings:
-        return VariationalSettings(step=self.step)
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import rk4
+        from gyrolab.kernels import rk4  # start-up: the kernel imports numba
 
-        start = time.perf_counter()
-        t_out, y, out = _outputs(t_out, y0)
-        steps = interval_steps(self, t_out)
-        fun = compiled_rhs(compiled)
-        reached = _fixed_step(lambda grid, n, rows, first, stop: rk4.run(compiled.params, grid, n,
-                                                                         y, rows, first, stop),
-                              self.name, fun, t_out, steps, y, out, progress)
-        if reached != len(t_out):
-            raise IntegrationError(f"rk4_numba produced a non-finite state before t={t_out[reached]:.6g} "
-                                   f"with step {self.step:.3g}; reduce integrator.step")
-        n_steps = int(steps.sum())
-        return Solution(t_out, out, IntegratorStats(nfev=4 * n_steps, n_steps=n_steps, n_rejected=0,
-                                                    wall_time=time.perf_counter() - start))
-
-    def attributes(self) -> dict[str, Any]:
-        return {"integrator_step": self.step}
+        return _fixed_step(self, lambda *run: rk4.run(compiled.params, *run), t_out, y0, compiled, progress, 4,
+                           f" with step {self.step:.3g}")
 
 
 class Taylor(Integrator):
@@ -251,8 +212,7 @@ class Taylor(Integrator):
 
     @classmethod
     def refusal(cls, compiled: CompiledModel, system: Any = None) -> str | None:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import taylor_series
+        from gyrolab.kernels import taylor_series  # start-up: the kernel imports numba
 
         if taylor_series.ready(compiled):   # (compiles a traced torque's Taylor kernel, once)
             return None
@@ -270,14 +230,15 @@ class Taylor(Integrator):
         return super().__new__(cls)
 
     def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = "double") -> None:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels.taylor import MAX_ORDER, MIN_ORDER, order_for
+        from gyrolab.kernels.taylor import MAX_ORDER, MIN_ORDER, order_for  # start-up: the kernel imports numba
 
-        self.precision = _taylor_precision(precision)
+        if not isinstance(precision, str) or precision not in PRECISIONS:
+            raise ConfigError(f"integrator.precision={precision!r} is not available; valid choices: "
+                              f"{', '.join(PRECISIONS)}")
+        self.precision = precision
         self.tol = as_number(tol, "integrator.tol", positive=True)
         if self.precision == DOUBLE_DOUBLE:
-            # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-            from gyrolab.kernels.taylor_dd import MIN_TOL
+            from gyrolab.kernels.taylor_dd import MIN_TOL  # start-up: the kernel imports numba
 
             if self.tol < MIN_TOL:
                 raise ConfigError(f"integrator.tol={tol!r} is below double-double's resolution; with "
@@ -291,8 +252,7 @@ class Taylor(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import taylor, taylor_series
+        from gyrolab.kernels import taylor, taylor_series  # start-up: the kernel imports numba
 
         start = time.perf_counter()
         taylor_series.ready(compiled)  # a traced model's series kernel, compiled on first need (once: then a test)
@@ -300,12 +260,10 @@ class Taylor(Integrator):
         state = np.array([t_out[0]])
         carry = np.zeros(len(y))  # (np.zeros_like costs 2 µs more, per pilot run)
         stats = np.zeros(2, dtype=np.int64)
-        _adaptive(lambda reached, stop: taylor.run(compiled.params, self.order, self.tol, t_out, out, reached, stop,
-                                                   state, y, carry, stats),
-                  t_out, state, progress, _taylor_failure)
-        # one Taylor step costs about as much as `order` right-hand-side evaluations; report the series count
-        return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
-                                                    wall_time=time.perf_counter() - start))
+        # one Taylor step costs about as much as `order` right-hand-side evaluations; the series count is reported
+        return _adaptive(lambda reached, stop: taylor.run(compiled.params, self.order, self.tol, t_out, out, reached,
+                                                          stop, state, y, carry, stats),
+                         t_out, out, state, stats, progress, _taylor_failure, start)
 
     #: below this tol the double-precision kernel gains nothing (round-off)
     TOLERANCE_FLOOR = 1e-16
@@ -318,8 +276,7 @@ class Taylor(Integrator):
 
     def climbed(self, factor: float):
         """Rule 11: the double-double rung, ``factor`` times more accurate (None: already on it)."""
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels.taylor_dd import MIN_TOL
+        from gyrolab.kernels.taylor_dd import MIN_TOL  # start-up: the kernel imports numba
 
         tol = max(self.tol / factor, MIN_TOL)
         return None if self.precision != DOUBLE else (Taylor(tol=tol, precision=DOUBLE_DOUBLE), 1.0, (
@@ -332,14 +289,6 @@ class Taylor(Integrator):
 #: ``Taylor``'s arithmetic: ``integrator.precision``
 DOUBLE, DOUBLE_DOUBLE = "double", "double-double"
 PRECISIONS = (DOUBLE, DOUBLE_DOUBLE)
-
-
-def _taylor_precision(precision: Any) -> str:
-    """``integrator.precision`` checked: one of ``PRECISIONS``, else one ConfigError sentence listing them."""
-    if not isinstance(precision, str) or precision not in PRECISIONS:
-        raise ConfigError(f"integrator.precision={precision!r} is not available; valid choices: "
-                          f"{', '.join(PRECISIONS)}")
-    return precision
 
 
 class TaylorDoubleDouble(Taylor):
@@ -361,11 +310,24 @@ class TaylorDoubleDouble(Taylor):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        return _taylor_double_double(self, fun, t_out, y0, progress, compiled)
+        """``Taylor.integrate`` in double-double (``gyrolab.kernels.taylor_dd``): the state carried in
+        double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded
+        to double. The initial state is a double, hence exact."""
+        from gyrolab.kernels import taylor_dd  # start-up: the kernel imports numba
+
+        _ready_for_double_double(compiled)
+        start = time.perf_counter()
+        t_out, y, out = _outputs(t_out, y0)
+        low = np.zeros(len(y))  # the state's low parts
+        no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
+        state = np.array([t_out[0]])
+        stats = np.zeros(2, dtype=np.int64)
+        return _adaptive(lambda reached, stop: taylor_dd.run(compiled.params, self.order, self.tol, t_out, out, no_low,
+                                                             reached, stop, state, y, low, stats),
+                         t_out, out, state, stats, progress, _taylor_failure, start)
 
     def more_accurate(self, factor: float):
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels.taylor_dd import MIN_TOL
+        from gyrolab.kernels.taylor_dd import MIN_TOL  # start-up: the kernel imports numba
 
         tol = self.tol / factor
         if tol < MIN_TOL:
@@ -374,32 +336,9 @@ class TaylorDoubleDouble(Taylor):
                 f"taylor double-double at tol {tol:.3g} ({factor:g}× tighter), same order")
 
 
-def _taylor_double_double(method: Taylor, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
-                          progress: ProgressCallback | None, compiled: CompiledModel) -> Solution:
-    """``Taylor.integrate`` in double-double (``gyrolab.kernels.taylor_dd``): the state carried in
-    double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded to
-    double. The initial state is a double, hence exact."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import taylor_dd
-
-    _ready_for_double_double(compiled)
-    start = time.perf_counter()
-    t_out, y, out = _outputs(t_out, y0)
-    low = np.zeros(len(y))  # the state's low parts
-    no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
-    state = np.array([t_out[0]])
-    stats = np.zeros(2, dtype=np.int64)
-    _adaptive(lambda reached, stop: taylor_dd.run(compiled.params, method.order, method.tol, t_out, out, no_low,
-                                                  reached, stop, state, y, low, stats),
-              t_out, state, progress, _taylor_failure)
-    return Solution(t_out, out, IntegratorStats(nfev=int(stats[0]), n_steps=int(stats[1]), n_rejected=0,
-                                                wall_time=time.perf_counter() - start))
-
-
 def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -> str | None:
     """None when double-double can run ``compiled`` (compiling a traced model's series on first need), else why."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import series_dd
+    from gyrolab.kernels import series_dd  # start-up: the kernel imports numba
     from gyrolab.kernels.expression import NotCompilable
 
     try:
@@ -425,8 +364,7 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
     """The states at ``t_out`` of the Taylor method at ``tol`` (Jorba & Zou's order), in one call into the kernel:
     for runs over a few periods inside another method (``auto``'s screen), which need neither progress nor
     statistics (``Taylor.integrate``'s chunks and records cost ~10 µs more, a tenth of the screen)."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import taylor, taylor_series
+    from gyrolab.kernels import taylor, taylor_series  # start-up: the kernel imports numba
 
     taylor_series.ready(compiled)  # a traced model's series kernel (a scene carrying α is one)
     t_out, y, out = _outputs(t_out, y0)
@@ -441,8 +379,7 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
 
 def _taylor_failure(status: int, t: float) -> IntegrationError:
     """The one-sentence error for a Taylor kernel's non-OK ``status``, stopped at time ``t``."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import taylor
+    from gyrolab.kernels import taylor  # start-up: the kernel imports numba
 
     if status == taylor.TOO_SMALL_STEP:
         return IntegrationError(f"taylor's step fell below the spacing of floating-point numbers near t={t:.6g} "
@@ -478,27 +415,15 @@ class LiePoisson(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
-        # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels import lie_poisson
+        from gyrolab.kernels import lie_poisson  # start-up: the kernel imports numba
 
         if compiled.built_in is None:
             raise ConfigError("integrator lie_poisson splits the fixed-point Hamiltonian with the built-in torque "
                               "forms only; valid systems: fixed_point with uniform_gravity, newtonian, magnetic")
-        start = time.perf_counter()
-        t_out, y, out = _outputs(t_out, y0)
-        steps = interval_steps(self, t_out)
         w = lie_poisson.weights(self.order)
-        fun = compiled_rhs(compiled)
-        reached = _fixed_step(lambda grid, n, rows, first, stop: lie_poisson.run(compiled.built_in, grid, n, w, y,
-                                                                                 rows, first, stop),
-                              self.name, fun, t_out, steps, y, out, progress)
-        if reached != len(t_out):
-            raise IntegrationError(f"lie_poisson produced a non-finite state before t={t_out[reached]:.6g}; "
-                                   "reduce integrator.step")
-        n_steps = int(steps.sum())
         # per step: len(w) Strang stages, each with 2 kicks (one torque evaluation each)
-        return Solution(t_out, out, IntegratorStats(nfev=2 * len(w) * n_steps, n_steps=n_steps, n_rejected=0,
-                                                    wall_time=time.perf_counter() - start))
+        return _fixed_step(self, lambda grid, n, *run: lie_poisson.run(compiled.built_in, grid, n, w, *run), t_out, y0,
+                           compiled, progress, 2 * len(w))
 
     def attributes(self) -> dict[str, Any]:
         return {"integrator_step": self.step, "integrator_order": self.order}

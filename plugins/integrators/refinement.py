@@ -22,6 +22,9 @@ def interval_steps(method: Any, t_out: np.ndarray) -> np.ndarray:
     companion made by ``half_step``, exactly twice its coarse method's in every interval. (Halving the step alone
     left an interval shorter than half the step with one step in both runs: identical runs, an estimate of 0.)"""
     halvings = getattr(method, "halvings", 0)
-    coarse = method.step * 2 ** halvings
-    return np.maximum(1, np.ceil(np.diff(np.asarray(t_out, dtype=float)) / coarse * (1.0 - 1e-12))).astype(np.int64) \
-        * 2 ** halvings
+    return steps_per_interval(t_out, method.step * 2 ** halvings) * 2 ** halvings
+
+
+def steps_per_interval(t_out: np.ndarray, step: float) -> np.ndarray:
+    """Fewest equal steps no longer than ``step`` in each output interval (lands on every output time)."""
+    return np.maximum(1, np.ceil(np.diff(np.asarray(t_out, dtype=float)) / step * (1.0 - 1e-12))).astype(np.int64)

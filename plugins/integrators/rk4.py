@@ -77,9 +77,8 @@ class RK4(Integrator):
                     progress(t + h)  # inside a long output interval too (Progress reports by elapsed time)
             n_steps += m
             if not np.all(np.isfinite(y)):
-                raise IntegrationError(
-                    f"rk4 produced a non-finite state before t={t_out[i]:.6g} with step {h:.3g}; reduce integrator.step"
-                )
+                raise IntegrationError(f"rk4 produced a non-finite state before t={t_out[i]:.6g} with step {h:.3g}; "
+                                       "reduce integrator.step")
             out[i] = y
             if progress is not None:
                 progress(t_out[i])

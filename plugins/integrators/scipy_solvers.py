@@ -69,10 +69,8 @@ class ScipySolver(Tolerances, Integrator):
                 filled = reached
         if solver.t == t_out[-1]:
             out[-1] = solver.y  # the solver lands on t_bound exactly: no interpolation error at the end
-        stats = IntegratorStats(
-            nfev=solver.nfev, n_steps=n_steps, n_rejected=n_rejected if stages else None,
-            wall_time=time.perf_counter() - start, njev=solver.njev, nlu=solver.nlu,
-        )
+        stats = IntegratorStats(nfev=solver.nfev, n_steps=n_steps, n_rejected=n_rejected if stages else None,
+                                wall_time=time.perf_counter() - start, njev=solver.njev, nlu=solver.nlu)
         return Solution(t=t_out, y=out, stats=stats)
 
 

@@ -20,11 +20,9 @@ def check_step(name: str, fun: Callable[[float, np.ndarray], np.ndarray], t: flo
     """IntegrationError if ``step`` is too long for the rate of change of ``y`` at ``t``."""
     rate = jacobian_norm(fun, t, y)
     if rate * step > MAX_ANGLE_PER_STEP:
-        raise IntegrationError(
-            f"{name}: integrator.step={step:.3g} is too long at t={t:.6g}, where the state turns at "
-            f"{rate:.3g} rad per time unit ({rate * step:.2g} rad per step, limit {MAX_ANGLE_PER_STEP}); "
-            f"use integrator.step ≤ {MAX_ANGLE_PER_STEP / rate:.2g}"
-        )
+        raise IntegrationError(f"{name}: integrator.step={step:.3g} is too long at t={t:.6g}, where the state turns "
+                               f"at {rate:.3g} rad per time unit ({rate * step:.2g} rad per step, limit "
+                               f"{MAX_ANGLE_PER_STEP}); use integrator.step ≤ {MAX_ANGLE_PER_STEP / rate:.2g}")
 
 
 def jacobian_norm(fun: Callable[[float, np.ndarray], np.ndarray], t: float, y: np.ndarray) -> float:
@@ -45,8 +43,7 @@ def jacobian_norm(fun: Callable[[float, np.ndarray], np.ndarray], t: float, y: n
 
 def compiled_rhs(compiled) -> Callable[[float, np.ndarray], np.ndarray]:
     """The compiled model's right-hand side as a Python callable (for occasional checks only)."""
-    # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-    from gyrolab.kernels import models
+    from gyrolab.kernels import models  # start-up: the kernel imports numba
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
         out = np.empty_like(y)

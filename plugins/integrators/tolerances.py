@@ -44,8 +44,7 @@ class Tolerances:
     def attributes(self) -> dict[str, Any]:
         attrs: dict[str, Any] = {"integrator_rtol": self.used_rtol, "integrator_atol": self.used_atol}
         if (self.used_rtol, self.used_atol) != (self.rtol, self.atol):
-            attrs["integrator_rtol_requested"] = self.rtol
-            attrs["integrator_atol_requested"] = self.atol
+            attrs.update(integrator_rtol_requested=self.rtol, integrator_atol_requested=self.atol)
         if np.isfinite(self.max_step):
             attrs["integrator_max_step"] = self.max_step
         return attrs

@@ -17,17 +17,13 @@ from gyrolab.physics.attitude import frame_from_angles
 from gyrolab.contracts.regime import Regime
 from gyrolab.contracts.system import System
 from gyrolab.errors import ConfigError
+from gyrolab.plugins.regimes.ismail2021 import BodyRatios
 
 SUPPORTED_FORCES = ("uniform_gravity", "newtonian", "magnetic")
 
 
 @dataclass(frozen=True)
-class NondimensionalScene:
-    a: float
-    b: float
-    x0: float
-    y0: float
-    z0: float
+class NondimensionalScene(BodyRatios):
     k: float  # N/c²
     c: float  # √(Mgℓ/C) in model rate units (1 for a nondimensional body)
     r0: float  # initial spin in units of c
@@ -128,8 +124,7 @@ class FixedPointRegime(Regime):
         for key, value in (("periods", periods), ("samples_per_period", samples_per_period)):
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ConfigError(f"regime.{key}={value!r} must be a positive integer")
-        self.periods = periods
-        self.samples_per_period = samples_per_period
+        self.periods, self.samples_per_period = periods, samples_per_period
 
     def scene(self, system: System) -> NondimensionalScene:
         return nondimensional_scene(system, self.name)
@@ -163,12 +158,10 @@ class FixedPointRegime(Regime):
         """Warnings naming the scene's initial values the orbit replaces (p0, q0, φ0)."""
         y = self.initial_state(system)
         given = np.concatenate([system.initial.omega, system.initial.gamma])
-        out = []
-        if np.max(np.abs(given[:2] - y[:2])) > 1e-12 or abs(given[4]) > 1e-12:
-            out.append(f"the analytic orbit starts from its own p0={y[0]:.6g}, q0={y[1]:.6g}, φ0=π/2 "
-                       f"(the scene gave p0={given[0]:.6g}, q0={given[1]:.6g}, γ'0={given[4]:.3g}); "
-                       "r0 and θ0 are the scene's")
-        return out
+        if not (np.max(np.abs(given[:2] - y[:2])) > 1e-12 or abs(given[4]) > 1e-12):
+            return []
+        return [f"the analytic orbit starts from its own p0={y[0]:.6g}, q0={y[1]:.6g}, φ0=π/2 (the scene gave "
+                f"p0={given[0]:.6g}, q0={given[1]:.6g}, γ'0={given[4]:.3g}); r0 and θ0 are the scene's"]
 
     def attributes(self) -> dict[str, Any]:
         return {**super().attributes(), "regime_parameter_long_name": self.parameter_long_name}

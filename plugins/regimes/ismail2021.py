@@ -26,8 +26,16 @@ from dataclasses import dataclass
 import numpy as np
 
 
+@dataclass(frozen=True)
 class BodyRatios:
-    """A1 = (1−b)/a, B1 = (a−1)/b, C1 = b−a of a body with a = A/C, b = B/C (both papers' notation)."""
+    """A body in both papers' notation: a = A/C, b = B/C, the unit centre-of-mass direction (x0', y0', z0'), and
+    A1 = (1−b)/a, B1 = (a−1)/b, C1 = b−a."""
+
+    a: float
+    b: float
+    x0: float
+    y0: float
+    z0: float
 
     @property
     def A1(self) -> float:
@@ -46,11 +54,6 @@ class BodyRatios:
 class Params(BodyRatios):
     """Body and orbit in the paper's nondimensional form (time unit 1/c)."""
 
-    a: float
-    b: float
-    x0: float
-    y0: float
-    z0: float
     k: float  # N/c²
     mu: float  # r0/c
     g0: float  # γ0'' = cos θ0

@@ -39,11 +39,6 @@ def omega3_b(a: float) -> float:
 class Constants(BodyRatios):
     """Constants of the ω = 3 series (eqs. 7, 21, 26, 28); ``printed`` says which a2, L310, α."""
 
-    a: float
-    b: float
-    x0: float
-    y0: float
-    z0: float
     k_gt: float
     theta0: float
     printed: bool = False

@@ -136,9 +136,8 @@ class SmallParameter(FixedPointRegime):
         return out
 
     def attributes(self) -> dict[str, Any]:
-        out = super().attributes()
-        out["regime_order"] = "paper (closed forms)" if self.series_order is None else int(self.series_order)
-        return out
+        order = "paper (closed forms)" if self.series_order is None else int(self.series_order)
+        return {**super().attributes(), "regime_order": order}
 
     def diagnostics(self, system) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
         """Series coefficients, radius of convergence, small divisors and the measured order-N error slope."""
@@ -162,7 +161,7 @@ class SmallParameter(FixedPointRegime):
             warnings.append(f"c/r0 = {eps:.3g} > 0.2: near the edge of the fast-spin domain, expect errors of "
                             f"order (c/r0)² ≈ {eps**2:.2g}")
         if self.series_order is not None:
-            return warnings + self._series_warnings(system, s, eps) + self.reseat_warnings(system)
+            return warnings + self._series_warnings(system, eps) + self.reseat_warnings(system)
         gamma = s.gamma0pp / eps
         if abs(gamma) > 3:
             warnings.append(f"Γ = cos θ0 · r0/c = {gamma:.3g}: the closed forms assume cos θ0 = O(c/r0) "
@@ -172,10 +171,9 @@ class SmallParameter(FixedPointRegime):
             warnings.append(f"a + b − 1 = {s.a + s.b - 1:.3g}: the z0'/(a + b − 1) terms of (35) are large")
         return warnings + self.reseat_warnings(system)
 
-    def _series_warnings(self, system, s, eps: float) -> list[str]:
+    def _series_warnings(self, system, eps: float) -> list[str]:
         """The order-N series' domain: ConfigError beyond its radius of convergence, a warning beyond half of it."""
-        self.check_series_domain(s)
-        R = self.series(system).radius_of_convergence()
+        R = self.series(system).radius_of_convergence()  # (``series`` checks the tilt first)
         if not eps < R:
             raise ConfigError(f"regime small_parameter with order={self.series_order} needs c/r0 below the "
                               f"series' radius of convergence {R:.3g} (estimated from its coefficients), but "

@@ -43,10 +43,8 @@ class FixedPoint(System):
         return 9 if self.carries_alpha else 6
 
     def initial_state(self) -> np.ndarray:
-        parts = [self.initial.omega, self.initial.gamma]
-        if self.carries_alpha:
-            parts.append(self.initial.alpha)
-        return np.concatenate(parts)
+        alpha = [self.initial.alpha] if self.carries_alpha else []
+        return np.concatenate([self.initial.omega, self.initial.gamma, *alpha])
 
     def initial_states(self, initial: Mapping[str, Any],
                        columns: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -95,15 +93,10 @@ class FixedPoint(System):
 
     @property
     def invariants(self) -> tuple[str, ...]:
-        names = []
-        if all(f.conservative for f in self.forces):
-            names.append("energy")
-        if all(f.preserves_area_integral for f in self.forces):
-            names.append("area_integral")
-        names.append("gamma_norm")
-        if self.carries_alpha:
-            names.append("frame_error")
-        return tuple(names)
+        kept = {"energy": all(f.conservative for f in self.forces),
+                "area_integral": all(f.preserves_area_integral for f in self.forces), "gamma_norm": True,
+                "frame_error": self.carries_alpha}
+        return tuple(name for name, monitored in kept.items() if monitored)
 
     def energy(self, y: np.ndarray) -> np.ndarray:
         omega, gamma = y[..., 0:3], y[..., 3:6]

@@ -47,9 +47,7 @@ class OrbitingGyrostat(System):
         if foreign:
             raise ConfigError(f"force {foreign[0]} acts on a body about a fixed point, not on a satellite on a "
                               "circular orbit; valid choices here: newtonian (gravity gradient), magnetic")
-        self.inertia = body.inertia
-        self.k = body.gyrostatic_momentum
-        self.Omega = body.orbit_rate
+        self.inertia, self.k, self.Omega = body.inertia, body.gyrostatic_momentum, body.orbit_rate
         self.needs_beta = any(1 in f.required_axes for f in self.forces)
         self.angles, self.omega0, self.alpha0, self.gamma0 = _initial(dict(initial), self.Omega)
 
