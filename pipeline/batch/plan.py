@@ -89,11 +89,6 @@ class Plan:
         return json.dumps(self.base, sort_keys=True, default=str) if self.base is not None else ""
 
     @property
-    def integrator_name(self) -> str:
-        """The integrator plugin's name (``rk4_numba``, ``auto``, ...)."""
-        return self.integrator_class.name
-
-    @property
     def integrator_class(self) -> type:
         """The integrator plugin's class (what the batch asks for capabilities)."""
         node = OmegaConf.create(self.plain).integrator
