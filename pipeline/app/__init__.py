@@ -141,7 +141,10 @@ def _checked_overrides(source: ConfigSource, args: argparse.Namespace) -> tuple[
                           f"{shorten(sweeps[0].input_line)} ...), or give one value")
     check_launcher_installed(overrides)
     if args.multirun:
-        _refuse_swept_hydra_settings(overrides)
+        for o in sweeps:
+            if o.key_or_group.startswith(("hydra.", "hydra/")):
+                raise ConfigError(f"{shorten(o.input_line)!r} sweeps a Hydra setting; Hydra's settings are one per "
+                                  "sweep, so give a single value")
         check_sweep_size(overrides)  # before anything expands a range(0,1e12,1)
         Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
     return args, overrides
@@ -283,13 +286,6 @@ def _is_group(o: Override, cfg: DictConfig) -> bool:
 def _compose_job(source: ConfigSource, overrides: list[str], sweeping: bool) -> DictConfig:
     return compose_config(overrides, return_hydra_config=True, from_shell=True, config_name=source.config_name,
                           run_mode=RunMode.MULTIRUN if sweeping else RunMode.RUN, refuse_unread=False)
-
-
-def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
-    for o in overrides:
-        if o.is_sweep_override() and (o.key_or_group.startswith(("hydra.", "hydra/"))):
-            raise ConfigError(f"{shorten(o.input_line)!r} sweeps a Hydra setting; Hydra's settings are one per "
-                              "sweep, so give a single value")
 
 
 def validate_scene(scene_cfg: DictConfig, plain: dict) -> Scene | None:
