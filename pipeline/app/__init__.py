@@ -111,7 +111,12 @@ def preflight(args: argparse.Namespace) -> argparse.Namespace:
     cfg = configs[0]
     scene_cfgs = [_without_hydra(composed) for composed in configs]
     plains = [check_scene_config(scene_cfg) for scene_cfg in scene_cfgs]
-    notes = accuracy_notes(configs, [o.input_line for o in overrides])
+    given = [o.input_line for o in overrides]
+    # each job's note on an accuracy its integrator does not read; refused when the command line gives it and no
+    # job reads it (a sweep over integrators gives the target to the jobs that read it, the others warn and record it)
+    notes = [ignored_accuracy(composed, given) for composed in configs]
+    if ACCURACY in given_overrides(given) and all(notes):
+        raise unread_refusal(configs[0], unread_accuracy(configs[0]))
     run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
@@ -119,7 +124,7 @@ def preflight(args: argparse.Namespace) -> argparse.Namespace:
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     scene = validate_scene(scene_cfgs[0], plains[0])
-    refuse_unread(f"task {task_of(cfg)}", [o.input_line for o in overrides], sweep=sweeping)  # batch.* on a plain run
+    refuse_unread(f"task {task_of(cfg)}", given, sweep=sweeping)  # batch.* on a plain run
     check_task(task_of(cfg), scene_cfgs[0], run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
     if not sweeping:  # the run takes the preflight's scene and its accuracy note (_run_one)
@@ -189,16 +194,6 @@ def take_prepared(cfg: DictConfig) -> Prepared | None:
     if prepared is None or "${" in repr(prepared.config):
         return None
     return prepared if OmegaConf.to_container(cfg, resolve=False) == prepared.config else None
-
-
-def accuracy_notes(configs: Sequence[DictConfig], overrides: Sequence[str]) -> list[str | None]:
-    """Each config's note on an ``accuracy`` its integrator does not read (``gyrolab.engine.unread``), or None; a
-    ConfigError when the command line gives ``accuracy`` and no job's integrator reads it (a sweep over integrators
-    gives the target to the jobs that read it; the others warn and record it, as for a value from a config file)."""
-    notes = [ignored_accuracy(composed, overrides) for composed in configs]
-    if ACCURACY in given_overrides(overrides) and all(notes):
-        raise unread_refusal(configs[0], unread_accuracy(configs[0]))
-    return notes
 
 
 def _output_dir_text(cfg: DictConfig, mode: str) -> str:

@@ -70,9 +70,7 @@ class Plan:
     @property
     def shape(self) -> tuple[int, ...]:
         """The stored grid's shape: one dimension per swept key, or (points,) for a list of points."""
-        if self.points is not None:
-            return (len(self.dims[0].values),)
-        return tuple(len(d.values) for d in self.dims)
+        return (len(self.dims[0].values),) if self.points is not None else tuple(len(d.values) for d in self.dims)
 
     @property
     def grid_dims(self) -> tuple[str, ...]:
