@@ -111,7 +111,12 @@ def preflight(args: argparse.Namespace) -> argparse.Namespace:
     cfg = configs[0]
     scene_cfgs = [_without_hydra(composed) for composed in configs]
     plains = [check_scene_config(scene_cfg) for scene_cfg in scene_cfgs]
-    notes = accuracy_notes(configs, [o.input_line for o in overrides])
+    given = [o.input_line for o in overrides]
+    # each job's note on an accuracy its integrator does not read; refused when the command line gives it and no
+    # job reads it (a sweep over integrators gives the target to the jobs that read it, the others warn and record it)
+    notes = [ignored_accuracy(composed, given) for composed in configs]
+    if ACCURACY in given_overrides(given) and all(notes):
+        raise unread_refusal(configs[0], unread_accuracy(configs[0]))
     run_text = _output_dir_text(cfg, "sweep" if sweeping else "run")
     check_output_dir(run_text, "hydra.sweep.dir" if sweeping else "hydra.run.dir")
     run_dir = Path(run_text)
@@ -119,10 +124,10 @@ def preflight(args: argparse.Namespace) -> argparse.Namespace:
     for composed in configs:
         check_config(composed, run_dir, command_line=args.overrides, job_subdir=sweeping)
     scene = validate_scene(scene_cfgs[0], plains[0])
-    refuse_unread(f"task {task_of(cfg)}", [o.input_line for o in overrides], sweep=sweeping)  # batch.* on a plain run
+    refuse_unread(f"task {task_of(cfg)}", given, sweep=sweeping)  # batch.* on a plain run
     check_task(task_of(cfg), scene_cfgs[0], run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
-    if not sweeping:  # the run takes the preflight's scene and its accuracy note (_run_locked)
+    if not sweeping:  # the run takes the preflight's scene and its accuracy note (_run_one)
         _prepared[:] = [Prepared(OmegaConf.to_container(scene_cfgs[0], resolve=False), scene, notes[0])]
     return args
 
@@ -141,7 +146,10 @@ def _checked_overrides(source: ConfigSource, args: argparse.Namespace) -> tuple[
                           f"{shorten(sweeps[0].input_line)} ...), or give one value")
     check_launcher_installed(overrides)
     if args.multirun:
-        _refuse_swept_hydra_settings(overrides)
+        for o in sweeps:
+            if o.key_or_group.startswith(("hydra.", "hydra/")):
+                raise ConfigError(f"{shorten(o.input_line)!r} sweeps a Hydra setting; Hydra's settings are one per "
+                                  "sweep, so give a single value")
         check_sweep_size(overrides)  # before anything expands a range(0,1e12,1)
         Grid.from_overrides(args.overrides)  # discrete sweeps, each value once
     return args, overrides
@@ -186,16 +194,6 @@ def take_prepared(cfg: DictConfig) -> Prepared | None:
     if prepared is None or "${" in repr(prepared.config):
         return None
     return prepared if OmegaConf.to_container(cfg, resolve=False) == prepared.config else None
-
-
-def accuracy_notes(configs: Sequence[DictConfig], overrides: Sequence[str]) -> list[str | None]:
-    """Each config's note on an ``accuracy`` its integrator does not read (``gyrolab.engine.unread``), or None; a
-    ConfigError when the command line gives ``accuracy`` and no job's integrator reads it (a sweep over integrators
-    gives the target to the jobs that read it; the others warn and record it, as for a value from a config file)."""
-    notes = [ignored_accuracy(composed, overrides) for composed in configs]
-    if ACCURACY in given_overrides(overrides) and all(notes):
-        raise unread_refusal(configs[0], unread_accuracy(configs[0]))
-    return notes
 
 
 def _output_dir_text(cfg: DictConfig, mode: str) -> str:
@@ -283,13 +281,6 @@ def _is_group(o: Override, cfg: DictConfig) -> bool:
 def _compose_job(source: ConfigSource, overrides: list[str], sweeping: bool) -> DictConfig:
     return compose_config(overrides, return_hydra_config=True, from_shell=True, config_name=source.config_name,
                           run_mode=RunMode.MULTIRUN if sweeping else RunMode.RUN, refuse_unread=False)
-
-
-def _refuse_swept_hydra_settings(overrides: Sequence[Override]) -> None:
-    for o in overrides:
-        if o.is_sweep_override() and (o.key_or_group.startswith(("hydra.", "hydra/"))):
-            raise ConfigError(f"{shorten(o.input_line)!r} sweeps a Hydra setting; Hydra's settings are one per "
-                              "sweep, so give a single value")
 
 
 def validate_scene(scene_cfg: DictConfig, plain: dict) -> Scene | None:
@@ -418,41 +409,37 @@ def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None, figures:
     """Run the scene, write ``run.nc`` (and, unless ``figures=False``, figures) in ``out_dir``, locked meanwhile and
     cleared of what killed writes left (``writing_in``); GyrolabError on bad input or a failed run."""
     with writing_in(out_dir):
-        return _run_locked(cfg, out_dir, job_id, figures)
+        task = task_of(cfg)
+        prepared = take_prepared(cfg) if job_id is None else None  # a plain run: the preflight's scene and note
+        # an accuracy the integrator does not read (the preflight refused one the command line gave to every job):
+        # said, and recorded in run.nc; for the tasks that run the scene's integrator
+        ignored = None if task not in ("scene", "regime") else prepared.accuracy_ignored if prepared else \
+            ignored_accuracy(cfg, HydraConfig.get().overrides.task)
+        if ignored:
+            log.warning("%s", ignored)
+        if task != "scene":
+            written = run_task(task, cfg, out_dir)
+            for path in written:
+                announce_written(path)
+            return written[0]
+        if prepared and prepared.scene:
+            scene = prepared.scene
+            scene.log_notes()  # into the run's log, as a scene built here says them
+        else:
+            scene = Scene.from_config(cfg)
+        scene.accuracy_ignored = ignored  # in the dataset's attributes, as compose_scene records it
+        ds = scene.run()
+        ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
+        ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
+        path = write_dataset(ds, out_dir / "run.nc")
+        announce_written(path)
+        if not figures:
+            return path
+        from gyrolab.figures.redraw import draw_figures  # matplotlib only when figures are drawn
 
-
-def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: bool) -> Path:
-    task = task_of(cfg)
-    prepared = take_prepared(cfg) if job_id is None else None  # a plain run: the preflight's scene and note
-    # an accuracy the integrator does not read (the preflight refused one the command line gave to every job): said,
-    # and recorded in run.nc; for the tasks that run the scene's integrator
-    ignored = None if task not in ("scene", "regime") else prepared.accuracy_ignored if prepared else \
-        ignored_accuracy(cfg, HydraConfig.get().overrides.task)
-    if ignored:
-        log.warning("%s", ignored)
-    if task != "scene":
-        written = run_task(task, cfg, out_dir)
-        for path in written:
-            announce_written(path)
-        return written[0]
-    if prepared and prepared.scene:
-        scene = prepared.scene
-        scene.log_notes()  # into the run's log, as a scene built here says them
-    else:
-        scene = Scene.from_config(cfg)
-    scene.accuracy_ignored = ignored  # in the dataset's attributes, as compose_scene records it
-    ds = scene.run()
-    ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
-    ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
-    path = write_dataset(ds, out_dir / "run.nc")
-    announce_written(path)
-    if not figures:
+        for figure in draw_figures("run.nc", ds, out_dir, cfg.output):
+            announce_written(figure)
         return path
-    from gyrolab.figures.redraw import draw_figures  # matplotlib only when figures are drawn
-
-    for figure in draw_figures("run.nc", ds, out_dir, cfg.output):
-        announce_written(figure)
-    return path
 
 
 def _quiet_console() -> None:

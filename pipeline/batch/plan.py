@@ -26,7 +26,7 @@ from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, GyrolabError, require_finite
 from gyrolab.sweep.grid import Dim, Grid, _refuse_repeats, dim_names
 from gyrolab.output.cf import unit_attributes
-from gyrolab.sweep.identity import canonical_config, job_code
+from gyrolab.sweep.identity import canonical_config, job_code, plain_config
 
 log = logging.getLogger("gyrolab.batch")
 
@@ -70,9 +70,7 @@ class Plan:
     @property
     def shape(self) -> tuple[int, ...]:
         """The stored grid's shape: one dimension per swept key, or (points,) for a list of points."""
-        if self.points is not None:
-            return (len(self.dims[0].values),)
-        return tuple(len(d.values) for d in self.dims)
+        return (len(self.dims[0].values),) if self.points is not None else tuple(len(d.values) for d in self.dims)
 
     @property
     def grid_dims(self) -> tuple[str, ...]:
@@ -87,11 +85,6 @@ class Plan:
     def base_key(self) -> str:
         """The base config as canonical JSON (a worker's cache key for the scene it rebuilds)."""
         return json.dumps(self.base, sort_keys=True, default=str) if self.base is not None else ""
-
-    @property
-    def integrator_name(self) -> str:
-        """The integrator plugin's name (``rk4_numba``, ``auto``, ...)."""
-        return self.integrator_class.name
 
     @property
     def integrator_class(self) -> type:
@@ -149,8 +142,7 @@ def make_plan(fixed: Sequence[str], dims: Sequence[Dim], *, plain: dict[str, Any
         first = [f"{d.key}={d.labels[0]}" for d in dims]
         composed = compose_config(list(fixed) + first)  # refuses an accuracy given and not read
         ignored = ignored_accuracy(composed, fixed)  # a config file's: said once, and recorded in sweep.nc
-        plain = OmegaConf.to_container(composed, resolve=True)
-        plain.pop("hydra", None)
+        plain = plain_config(composed)
     dims, points = _points(dims, plain)
     if points is None:
         shape = tuple(len(d.values) for d in dims)

@@ -52,7 +52,7 @@ def reproduce_batch(path: Path, stored: xr.Dataset, points: str | None = None) -
     needed = {i for i, block in enumerate(blocks)
               if np.any((selected >= block.start) & (selected < block.stop))}
     same_batch = stored.attrs.get("batch_identity") == plan.identity(size)
-    head = [f"reproducing {path} ({stored.attrs.get('title', '?')}; {plan.integrator_name}): "
+    head = [f"reproducing {path} ({stored.attrs.get('title', '?')}; {plan.integrator_class.name}): "
             f"{'all ' if chosen is None else ''}{selected.size} of {plan.size} points, in {len(needed)} of "
             f"{len(blocks)} chunks of ≤ {size}",
             f"  batch identity {'the same' if same_batch else 'differs'} (stored "

@@ -197,7 +197,7 @@ def batch_integrator(plan: Plan, settings: Settings) -> tuple[Any, dict[str, Any
                                                           plan.combo_params[plan.combo[valid]])
     settings_text = ", ".join(f"{k.removeprefix('integrator_')}={v:.3g}" if isinstance(v, float)
                               else f"{k.removeprefix('integrator_')}={v}" for k, v in method.attributes().items())
-    log.info("batch: %s chose %s (%s) for every chunk, in %.1f s", plan.integrator_name, method.name, settings_text,
+    log.info("batch: %s chose %s (%s) for every chunk, in %.1f s", scene.integrator.name, method.name, settings_text,
              time.perf_counter() - start)
     return method, {**{k: v for k, v in choice.items() if v is not None}, **path_attributes(type(method), settings)}
 

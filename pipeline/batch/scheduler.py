@@ -141,9 +141,7 @@ def _greeting(connection: socket.socket, deadline: float) -> dict | None:
         message = msgpack.unpackb(body[start:start + lengths[0]], raw=False, strict_map_key=False)
     except Exception:  # noqa: BLE001 - any decoding failure means: not Dask's handshake
         return None
-    if not isinstance(message, dict) or not {"compression", "python"} <= set(message):
-        return None
-    return message
+    return message if isinstance(message, dict) and {"compression", "python"} <= set(message) else None
 
 
 def _receive(connection: socket.socket, n: int, deadline: float) -> bytes:

@@ -71,7 +71,7 @@ class Store:
         done = _read_journal(self.journal, self.identity)
         try:
             if not done:   # killed before its first chunk was journaled: the journal starts again
-                _start_journal(self.journal, self.identity)
+                _write_journal(self.journal, "w", f"identity {self.identity}\n")
             else:          # a write that failed mid-line leaves a torn last line: cut it before appending
                 _cut_torn_line(self.journal)
             check_output_target(self.part)  # netCDF follows links: a planted one is refused first
@@ -232,7 +232,7 @@ class Store:
         nc.setncatts({**self._attributes(system), **{f"n_{name}": np.int64(0) for name in STATUS_FLAGS}})
         nc.sync()
         _fsync(self.part)
-        _start_journal(self.journal, self.identity)
+        _write_journal(self.journal, "w", f"identity {self.identity}\n")
 
     def _create_variables(self, result: Any, system: Any) -> None:
         nc, plan = self.nc, self.plan
@@ -323,10 +323,6 @@ def _open(path: Path, mode: str) -> netCDF4.Dataset:
 def _identity_of(path: Path) -> str:
     with _open(path, "r") as nc:
         return str(getattr(nc, "batch_identity", "none (not a gyrolab batch)"))
-
-
-def _start_journal(path: Path, identity: str) -> None:
-    _write_journal(path, "w", f"identity {identity}\n")
 
 
 def _write_journal(path: Path, mode: str, text: str) -> None:

@@ -65,6 +65,6 @@ def check_integrator(plan: Plan, settings: Settings) -> None:
     any integrator runs the other outputs (one without a batch kernel: one ``integrate`` call per point)."""
 
     if settings.output == "indicator" and not plan.integrator_class.supports(VARIATIONAL):
-        raise ConfigError(f"integrator {plan.integrator_name!r} has no variational equations (capability "
+        raise ConfigError(f"integrator {plan.integrator_class.name!r} has no variational equations (capability "
                           f"{VARIATIONAL}), which the chaos indicators of batch.output=indicator need; valid choices: "
                           f"{or_list(integrators_with(VARIATIONAL))}")

@@ -100,10 +100,9 @@ MAX_POINTS = 100_000_000
 
 def check_points(n: float, why: str, *, allow_large: bool = False) -> None:
     """ConfigError when ``n`` points (a grid, a batch) exceed :data:`MAX_POINTS`; ``why`` names the settings."""
-    if allow_large or n <= MAX_POINTS:
-        return
-    raise ConfigError(f"{why} makes {n:.3g} points, beyond the budget of {MAX_POINTS:.0e} points "
-                      f"({_duration(n * 1e-3)} even at 1 ms a point); use fewer points or {ESCAPE}")
+    if not (allow_large or n <= MAX_POINTS):
+        raise ConfigError(f"{why} makes {n:.3g} points, beyond the budget of {MAX_POINTS:.0e} points "
+                          f"({_duration(n * 1e-3)} even at 1 ms a point); use fewer points or {ESCAPE}")
 
 
 def sweep_points(overrides: Any) -> tuple[float, str]:

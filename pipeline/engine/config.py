@@ -187,8 +187,7 @@ def plugin_default_body(group: str, cls: type) -> dict[str, Any] | None:
 
 def group_options(group: str) -> list[str]:
     """Names selectable in a config group (needs an initialised Hydra)."""
-    loader = GlobalHydra.instance().config_loader()
-    return sorted(loader.get_group_options(group))
+    return sorted(GlobalHydra.instance().config_loader().get_group_options(group))
 
 
 def compose_config(overrides: Sequence[str], *, return_hydra_config: bool = False,

@@ -61,7 +61,8 @@ def check_config(cfg: DictConfig, run_dir: Path | None = None, *, command_line: 
     sweep job writes in ``run_dir/<hydra.sweep.subdir>``; ``command_line`` holds the
     overrides the user typed (shell lines of a launcher are accepted from there).
     """
-    scene = _plain(cfg, skip="hydra")
+    scene_keys = [k for k in cfg.keys() if k != "hydra"]
+    scene = resolve_plain(OmegaConf.masked_copy(cfg, scene_keys)) if scene_keys else {}
     hydra = cfg.get("hydra") if "hydra" in cfg else None
     plain_hydra = _resolved_hydra(cfg, run_dir, job_subdir) if hydra is not None and run_dir is not None else {}
     _check_plugin_targets(scene)
@@ -203,11 +204,6 @@ def _protected_dirs() -> tuple[Path, ...]:
 
 # ---- helpers ----------------------------------------------------------------------------------------------
 
-def _plain(cfg: DictConfig, skip: str) -> dict[str, Any]:
-    keys = [k for k in cfg.keys() if k != skip]
-    return resolve_plain(OmegaConf.masked_copy(cfg, keys)) if keys else {}
-
-
 def _resolved_hydra(cfg: DictConfig, run_dir: Path, job_subdir: bool) -> dict[str, Any]:
     """The ``hydra`` node resolved as a job would see it (output_dir set, job 0 of a sweep)."""
     copy = cfg.copy()
@@ -263,18 +259,14 @@ def _check_logging(conf: Any, where: str, out_dir: Path) -> None:
         elif key == ".":
             raise ConfigError(f"{path} sets attributes of a logging object, which a config may not do")
         elif key == "filename":
-            _check_log_file(path, value, out_dir)
+            target = Path(os.path.abspath(os.path.join(out_dir, str(value))))
+            inside = target.parent == out_dir or out_dir in target.parents
+            if not inside or target.suffix != ".log" or os.path.islink(target):
+                raise ConfigError(f"{path}={shorten(str(value))} is not allowed; a log file must be a .log file inside "
+                                  f"the run directory ({shorten(str(out_dir))})")
         if isinstance(value, str) and value.startswith("ext://") and value not in LOGGING_EXTERNALS:
             raise ConfigError(f"{path}={shorten(repr(value))} is not allowed; a logging config may refer only to "
                               "ext://sys.stdout and ext://sys.stderr")
-
-
-def _check_log_file(path: str, value: Any, out_dir: Path) -> None:
-    target = Path(os.path.abspath(os.path.join(out_dir, str(value))))
-    inside = target.parent == out_dir or out_dir in target.parents
-    if not inside or target.suffix != ".log" or os.path.islink(target):
-        raise ConfigError(f"{path}={shorten(str(value))} is not allowed; a log file must be a .log file inside the "
-                          f"run directory ({shorten(str(out_dir))})")
 
 
 def _check_paths(hydra: dict[str, Any], run_dir: Path) -> None:

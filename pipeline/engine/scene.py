@@ -235,7 +235,7 @@ def compose_scene(overrides: Sequence[str] = ()) -> Scene:
     """
     cfg = compose_config(overrides)
     scene = Scene.from_config(cfg)
-    # the gyrolab command says this once per job itself, knowing a sweep's overrides (app._run_locked)
+    # the gyrolab command says this once per job itself, knowing a sweep's overrides (app._run_one)
     scene.accuracy_ignored = ignored_accuracy(cfg, overrides)
     if scene.accuracy_ignored:
         log.warning("%s", scene.accuracy_ignored)

@@ -359,10 +359,8 @@ def validate(cfg: DictConfig) -> dict[str, Any]:
     return plain
 
 
-@cache
-def _structured(schema: type) -> DictConfig:
-    """A schema's config, made once (OmegaConf.merge copies it)."""
-    return OmegaConf.structured(schema)
+#: a schema's config, made once (OmegaConf.merge copies it)
+_structured = cache(OmegaConf.structured)
 
 
 def _group_schemas(cfg: DictConfig) -> list[tuple[str, type]]:
@@ -568,11 +566,10 @@ def resolve_plain(cfg: DictConfig) -> dict[str, Any]:
     except OmegaConfBaseException as error:
         key = getattr(error, "full_key", None) or "?"
         raw = raw_value(cfg, key)
-        raw = "?" if raw is None else raw
         reason = first_line(error).split(" full_key:")[0]
-        return_hint = "refer to an existing key, e.g. ${time.end}, or give a plain value"
-        raise ConfigError(f"{shorten(key)}={shorten(str(raw))} cannot be resolved ({shorten(reason, 160)}); "
-                          f"{return_hint}") from None
+        raise ConfigError(f"{shorten(key)}={shorten(str('?' if raw is None else raw))} cannot be resolved "
+                          f"({shorten(reason, 160)}); refer to an existing key, e.g. ${{time.end}}, or give a plain "
+                          "value") from None
 
 
 def raw_value(cfg: DictConfig, key: str) -> Any:

@@ -138,8 +138,7 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     if not isinstance(families, dict) or not families:
         raise ConfigError("orbit_family.families must name at least one family (body, theta0, section, r0_start, r0_end)")
     traces = [trace(name, _family_spec(name, f)) for name, f in families.items()]
-    ds = dataset(traces, cfg)
-    return write_and_draw("orbit_family.nc", ds, out_dir, cfg.get("output"))
+    return write_and_draw("orbit_family.nc", dataset(traces, cfg), out_dir, cfg.get("output"))
 
 
 def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:

@@ -29,10 +29,6 @@ class Dim:
     labels: tuple[str, ...]
     values: tuple[Any, ...]
 
-    @property
-    def short_name(self) -> str:
-        return self.key.rsplit(".", 1)[-1].lstrip("+~")
-
     def coordinate(self) -> np.ndarray:
         """Numbers stay numbers (float64, or int64 if all are integers); anything else is its label."""
         numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in self.values)
@@ -94,7 +90,7 @@ class Grid:
 def dim_names(dims: Sequence[Dim], reserved: set[str] | frozenset[str] = frozenset()) -> tuple[str, ...]:
     """Each dimension named by its key's last part (``initial.theta0`` -> ``theta0``), the whole key with dots as
     underscores where two would share a name or it is ``reserved``, prefixed ``sweep_`` while it is still taken."""
-    shorts = [d.short_name for d in dims]
+    shorts = [d.key.rsplit(".", 1)[-1].lstrip("+~") for d in dims]
     names: list[str] = []
     for dim, short in zip(dims, shorts):
         name = short if shorts.count(short) == 1 and short not in reserved else dim.key.lstrip("+~").replace(".", "_")
