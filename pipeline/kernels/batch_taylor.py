@@ -316,38 +316,16 @@ def task_size(count: int) -> int:
 
 # ---- calls of the generated functions
 
-def _data(context, builder, ty, value):
-    return builder.bitcast(context.make_array(ty)(context, builder, value).data, ir.DoubleType().as_pointer())
-
-
 @intrinsic
 def _call_series(typingctx, address, order, T, W, Q, t):
     """The generated series at ``address``: ``void f(int64 order, double* T, double* W, double* Q, double* t)``."""
-    sig = types.void(types.int64, types.int64, T, W, Q, t)
-
-    def codegen(context, builder, signature, args):
-        double_ptr, i64 = ir.DoubleType().as_pointer(), ir.IntType(64)
-        fnty = ir.FunctionType(ir.VoidType(), [i64] + [double_ptr] * 4)
-        arrays = [_data(context, builder, ty, v) for ty, v in zip(signature.args[2:], args[2:])]
-        builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [args[1], *arrays])
-        return context.get_dummy_value()
-
-    return sig, codegen
+    return types.void(types.int64, types.int64, T, W, Q, t), simd.call_address
 
 
 @intrinsic
 def _call_constants(typingctx, address, p, Q, lane):
     """The generated ``void constants(double* p, double* q, int64 lane)``: a lane's numbers from its parameters."""
-    sig = types.void(types.int64, p, Q, types.int64)
-
-    def codegen(context, builder, signature, args):
-        double_ptr, i64 = ir.DoubleType().as_pointer(), ir.IntType(64)
-        fnty = ir.FunctionType(ir.VoidType(), [double_ptr, double_ptr, i64])
-        arrays = [_data(context, builder, ty, v) for ty, v in zip(signature.args[1:3], args[1:3])]
-        builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [*arrays, args[3]])
-        return context.get_dummy_value()
-
-    return sig, codegen
+    return types.void(types.int64, p, Q, types.int64), simd.call_address
 
 
 # ---- the step's other parts, for any state size n

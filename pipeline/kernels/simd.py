@@ -1,4 +1,5 @@
-"""LLVM IR helpers for the batch Taylor kernel's vector intrinsics (``batch_taylor``).
+"""LLVM IR helpers of the kernels' intrinsics: calls of generated functions by address (``call_address``) and the
+batch Taylor kernel's vector arithmetic (``batch_taylor``).
 
 Arrays of doubles are seen as rows of vectors: a row holds one component of LANES trajectories (8 on AVX-512,
 4 on AVX2). ``Lanes.log2`` and ``Lanes.exp2`` are vector powers for the lanes' step rule.
@@ -16,6 +17,21 @@ from numba.core import cgutils
 
 LANES = 4  # one AVX2 vector of doubles: the narrowest lanes (``batch_taylor`` passes its own width)
 FUSE = ("contract",)  # the series' multiply and add may fuse (a rounding's worth, as fastmath's contract)
+
+
+def array_data(context, builder, ty, value):
+    """The data pointer (double*) of the array ``value`` of numba type ``ty``."""
+    return builder.bitcast(context.make_array(ty)(context, builder, value).data, ir.DoubleType().as_pointer())
+
+
+def call_address(context, builder, signature, args, extra=()):
+    """An intrinsic's codegen: call ``void f(...)`` at the address args[0] with the other arguments (each array as
+    its data pointer, ``array_data``), then ``extra``."""
+    values = [array_data(context, builder, ty, v) if isinstance(ty, types.Array) else v
+              for ty, v in zip(signature.args[1:], args[1:])] + list(extra)
+    fnty = ir.FunctionType(ir.VoidType(), [v.type for v in values])
+    builder.call(builder.inttoptr(args[0], fnty.as_pointer()), values)
+    return context.get_dummy_value()
 
 
 def vector_arrays(arrays) -> bool:

@@ -30,6 +30,8 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from gyrolab.kernels import simd
+from gyrolab.kernels.simd import array_data as _data
 from gyrolab.kernels.compiler import inline_kernel, kernel
 from gyrolab.kernels.models import taylor_coefficients
 
@@ -38,11 +40,8 @@ MIN_ORDER, MAX_ORDER = 4, 60
 
 
 #: a double step's work besides its series (step size, Kahan update, dense output, the loop), in units of the
-#: series' work per order²: the same series costs ~p² (its Cauchy products) and the rest ~STEP_OVERHEAD. Measured
-#: 2026-11-29 on the Intel Xeon (gyrostat of benchmarks/gyrostat_heyoka.py and the reference scene, orders from
-#: Jorba & Zou's to +5 at half-decade tolerances, the cheapest run reaching each error 1e-6 … 1e-12): 64 made them
-#: 0.84–0.97× (mean 0.93×) and 0.88–0.97× (0.92×) as costly as Jorba & Zou's orders; 32 and 121 gained less
-#: (docs/performance.md, "The order rule"). Double-double steps are series-bound: 0 there.
+#: series' work per order²: the series costs ~p², the rest ~STEP_OVERHEAD (measured: docs/performance.md, "The order
+#: rule"). Double-double steps are series-bound: 0 there.
 STEP_OVERHEAD = 64.0
 
 
@@ -194,11 +193,6 @@ def _splat(b, x):
                             ir.Constant(ir.VectorType(ir.IntType(32), _LANES), [0] * _LANES))
 
 
-def _data(context, b, array_type, array):
-    """The data pointer (double*) of a C-contiguous array."""
-    return b.bitcast(context.make_array(array_type)(context, b, array).data, ir.DoubleType().as_pointer())
-
-
 def _masked_load(b, pointer, mask):
     """The 8 doubles from ``pointer`` where ``mask`` is set, 0 elsewhere (nothing read there)."""
     vec = ir.VectorType(ir.DoubleType(), _LANES)
@@ -223,17 +217,12 @@ def _lanes_in(b, c, n):
     return b.icmp_unsigned("<", b.add(_splat(b, c), _LANE_INDEX), _splat(b, n))
 
 
-def _arrays(*arrays) -> bool:
-    return all(isinstance(a, types.Array) and a.dtype == types.float64 for a in arrays)
-
-
 @intrinsic
 def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
     """Y[i + j] = y + (v_j·dt_j − carry), v_j = Σ_{k≥1} T[k] dt_j^(k−1) (``_emit_horner``), for each dt_j of the tuple
     ``dts`` (one or two): the state dt_j after the step's start from its series, with the compensation the state
     carries."""
-    if not (_arrays(T, y, carry, Y) and all(a.layout == "C" for a in (T, y, carry, Y))
-            and isinstance(dts, types.UniTuple)):
+    if not (simd.vector_arrays([T, y, carry, Y]) and isinstance(dts, types.UniTuple)):
         return None
     sig = types.void(T, order, dts, y, carry, Y, i)
 
@@ -261,7 +250,7 @@ def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
 def _advance(typingctx, T, order, h, y, carry):
     """y ← y + v·h as a compensated (Kahan) sum, v = Σ_{k≥1} T[k] h^(k−1) (``_emit_horner``): the bits lost in the
     additions carried in ``carry``. Returns whether every new component is finite."""
-    if not (_arrays(T, y, carry) and all(a.layout == "C" for a in (T, y, carry))):
+    if not simd.vector_arrays([T, y, carry]):
         return None
     sig = types.boolean(T, order, types.float64, y, carry)
 

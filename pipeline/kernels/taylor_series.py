@@ -724,12 +724,11 @@ def _call(typingctx, address, t, order, size, Y, p):
 
     def codegen(context, builder, signature, args):
         b = builder
-        address_, t_, order_, size_, Y_, p_ = args
+        address_, t_, order_, size_ = args[:4]
         double, i64 = ir.DoubleType(), ir.IntType(64)
         double_ptr, byte_ptr = double.as_pointer(), ir.IntType(8).as_pointer()
         fnty = ir.FunctionType(ir.VoidType(), [double, i64, double_ptr, double_ptr, double_ptr])
-        y, pp = [b.bitcast(cgutils.create_struct_proxy(ty)(context, b, value=v).data, double_ptr)
-                 for ty, v in ((signature.args[4], Y_), (signature.args[5], p_))]
+        y, pp = (simd.array_data(context, b, signature.args[a], args[a]) for a in (4, 5))
         # stacksave/stackrestore: the stack's allocation is freed at once, not when the calling kernel returns
         save = cgutils.get_or_insert_function(b.module, ir.FunctionType(byte_ptr, []), "llvm.stacksave")
         restore = cgutils.get_or_insert_function(b.module, ir.FunctionType(ir.VoidType(), [byte_ptr]),
