@@ -32,10 +32,11 @@ import numpy as np
 
 log = logging.getLogger(__name__)
 
-_UNARY = {"neg": "-{0}", "sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
-          "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})", "arctan": "math.atan({0})",
-          "tanh": "math.tanh({0})", "abs": "abs({0})"}
-_BINARY = {"add": "{0} + {1}", "sub": "{0} - {1}", "mul": "{0} * {1}", "div": "{0} / {1}", "arctan2": "math.atan2({0}, {1})"}
+#: the generated sources' spelling of each operation of one and of two arguments (the generators' shared table)
+UNARY = {"neg": "-{0}", "sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
+         "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})", "arctan": "math.atan({0})",
+         "tanh": "math.tanh({0})", "abs": "abs({0})"}
+BINARY = {"add": "{0} + {1}", "sub": "{0} - {1}", "mul": "{0} * {1}", "div": "{0} / {1}", "arctan2": "math.atan2({0}, {1})"}
 
 
 class NotCompilable(Exception):

@@ -53,7 +53,7 @@ from numba.extending import intrinsic
 
 from gyrolab.kernels import simd
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before the decorators)
-from gyrolab.kernels.expression import Expr, binary_power, generated_module
+from gyrolab.kernels.expression import BINARY, UNARY, Expr, binary_power, generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import Model, traced_model
 from gyrolab.kernels.recurrences import AUXILIARY, Functions
@@ -156,12 +156,8 @@ class _Series:
         self.columns: list[int] = []  # its own columns of W (functions: the series and auxiliaries)
 
 
-# the same of numbers (folded into ``_Numbers``)
-_NUMBER_FUNCTIONS = {"sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
-                     "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})",
-                     "tanh": "math.tanh({0})", "arctan": "math.atan({0})", "abs": "abs({0})",
-                     "arctan2": "math.atan2({0}, {1})", "pow": "{0} ** {1}", "ipow": "{0} ** {1}"}
-
+# the functions of numbers (folded into ``_Numbers``)
+_NUMBER_FUNCTIONS = {**UNARY, **BINARY, "pow": "{0} ** {1}", "ipow": "{0} ** {1}"}
 
 
 class _Program:
