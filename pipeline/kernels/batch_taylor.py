@@ -46,7 +46,7 @@ from gyrolab.kernels.compiler import kernel
 from gyrolab.kernels.expression import generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import CompiledModel, traced_model
-from gyrolab.kernels.recurrences import AUXILIARY, Functions, splat_int
+from gyrolab.kernels.recurrences import AUXILIARY, Functions
 from gyrolab.kernels.taylor_series import plan
 from gyrolab.kernels.vector_width import batch_lanes
 
@@ -226,7 +226,7 @@ def _emit_series(b: ir.IRBuilder, program: dict, lanes: int, order, T, W, Q, t) 
             for i, (op, args, extra, _) in here:
                 if op != "mul":
                     values.update(emit(op, i, args, extra, rows))
-        inv = b.fdiv(splat(1.0), splat_int(b, vec, lanes, b.add(k, const(1))))
+        inv = b.fdiv(splat(1.0), simd.splat(b, b.sitofp(b.add(k, const(1)), ir.DoubleType()), lanes))
         rates = [b.fmul(combination(rate, values), inv, flags=simd.FUSE) for rate in program["rates"]]
         k1 = b.add(k, const(1))
         for m, value in enumerate(rates):

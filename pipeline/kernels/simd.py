@@ -34,6 +34,19 @@ def call_address(context, builder, signature, args, extra=()):
     return context.get_dummy_value()
 
 
+def splat(b, x, lanes):
+    """The scalar value ``x`` in every one of ``lanes`` lanes."""
+    undef = ir.Constant(ir.VectorType(x.type, lanes), ir.Undefined)
+    return b.shuffle_vector(b.insert_element(undef, x, ir.Constant(ir.IntType(32), 0)), undef,
+                            ir.Constant(ir.VectorType(ir.IntType(32), lanes), [0] * lanes))
+
+
+def vector_call(b, vec, name, *args):
+    """The LLVM vector intrinsic ``llvm.NAME`` (fabs, rint, sqrt, ...) on ``args`` of the vector type ``vec``."""
+    fn = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * len(args)), f"llvm.{name}.v{vec.count}f64")
+    return b.call(fn, list(args))
+
+
 def vector_arrays(arrays) -> bool:
     """The intrinsics' arrays: C-contiguous float64, a row of LANES doubles innermost."""
     return all(isinstance(a, types.Array) and a.layout == "C" and a.dtype == types.float64 for a in arrays)
@@ -65,12 +78,6 @@ class Lanes:
         """The vector row of T[index, column] in an array of ``stride`` vectors per index: index · stride + column."""
         return builder.add(builder.mul(index, ir.Constant(index.type, stride)), ir.Constant(index.type, column))
 
-    def splat(self, scalar):
-        b = self.builder
-        one = b.insert_element(ir.Constant(self.vec, ir.Undefined), scalar, ir.Constant(ir.IntType(32), 0))
-        return b.shuffle_vector(one, ir.Constant(self.vec, ir.Undefined), ir.Constant(ir.VectorType(ir.IntType(32), self.width),
-                                                                                      [0] * self.width))
-
     # Vector log2 and exp2 (the Taylor step rule's powers, ``batch_taylor._step_sizes``): relative error a few
     # ulps for normal positive x and for 2^y in [2^−1022, 2^1023]; the callers route other values elsewhere.
     _LN2 = 0.6931471805599453
@@ -86,10 +93,7 @@ class Lanes:
         return ir.Constant(self.vec, [float(value)] * self.width)
 
     def call(self, name, *args):
-        """The LLVM vector intrinsic ``llvm.NAME.vWf64`` (fabs, rint, ...) on ``args``."""
-        function = cgutils.get_or_insert_function(self.builder.module, ir.FunctionType(self.vec, [self.vec] * len(args)),
-                                                  f"llvm.{name}.v{self.width}f64")
-        return self.builder.call(function, list(args))
+        return vector_call(self.builder, self.vec, name, *args)
 
     def log2(self, x):
         """log2(x) for positive normal x: x = 2^e m, m in [√½, √2), ln m = 2 atanh(s), s = (m − 1)/(m + 1),

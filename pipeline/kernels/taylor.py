@@ -158,7 +158,7 @@ def _emit_horner(context, b, T, T_type, order, hs, each):
     rows = b.bitcast(array.data, double.as_pointer())
     n = b.extract_value(array.shape, 1)
     fma = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * 3), f"llvm.fma.v{_LANES}f64")
-    hvs = [_splat(b, h) for h in hs]
+    hvs = [simd.splat(b, h, _LANES) for h in hs]
     chunks = b.udiv(b.add(n, ir.Constant(i64, 2 * _LANES - 1)), ir.Constant(i64, 2 * _LANES))
     with cgutils.for_range(b, chunks) as chunk:
         columns = [b.add(b.mul(chunk.index, ir.Constant(i64, 2 * _LANES)), ir.Constant(i64, half * _LANES))
@@ -185,14 +185,6 @@ def _emit_horner(context, b, T, T_type, order, hs, each):
 _LANE_INDEX = ir.Constant(ir.VectorType(ir.IntType(64), _LANES), list(range(_LANES)))
 
 
-def _splat(b, x):
-    """``x`` (a scalar value) in every lane of a vector."""
-    vec = ir.VectorType(x.type, _LANES)
-    undef = ir.Constant(vec, ir.Undefined)
-    return b.shuffle_vector(b.insert_element(undef, x, ir.Constant(ir.IntType(32), 0)), undef,
-                            ir.Constant(ir.VectorType(ir.IntType(32), _LANES), [0] * _LANES))
-
-
 def _masked_load(b, pointer, mask):
     """The 8 doubles from ``pointer`` where ``mask`` is set, 0 elsewhere (nothing read there)."""
     vec = ir.VectorType(ir.DoubleType(), _LANES)
@@ -214,7 +206,7 @@ def _masked_store(b, value, pointer, mask):
 
 def _lanes_in(b, c, n):
     """The mask of the lanes c … c + 7 that are components (below n)."""
-    return b.icmp_unsigned("<", b.add(_splat(b, c), _LANE_INDEX), _splat(b, n))
+    return b.icmp_unsigned("<", b.add(simd.splat(b, c, _LANES), _LANE_INDEX), simd.splat(b, n, _LANES))
 
 
 @intrinsic
@@ -236,7 +228,7 @@ def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
             mask = _lanes_in(b, c, n)
             y_v, c_v = (_masked_load(b, b.gep(_data(context, b, types_[a], args[a]), [c]), mask) for a in (3, 4))
             row = b.gep(_data(context, b, types_[5], Y_), [b.add(b.mul(b.add(i_, ir.Constant(i_.type, j)), width), c)])
-            _masked_store(b, b.fadd(y_v, b.fsub(b.fmul(v, _splat(b, hs[j])), c_v)), row, mask)
+            _masked_store(b, b.fadd(y_v, b.fsub(b.fmul(v, simd.splat(b, hs[j], _LANES)), c_v)), row, mask)
 
         n = b.extract_value(context.make_array(types_[3])(context, b, y_).shape, 0)
         width = b.extract_value(context.make_array(types_[5])(context, b, Y_).shape, 1)  # Y's row length (≥ n)
@@ -268,7 +260,7 @@ def _advance(typingctx, T, order, h, y, carry):
             mask = _lanes_in(b, c, n)
             y_at, c_at = (b.gep(_data(context, b, types_[a], args[a]), [c]) for a in (3, 4))
             y_v = _masked_load(b, y_at, mask)
-            inc = b.fsub(b.fmul(v, _splat(b, h_)), _masked_load(b, c_at, mask))
+            inc = b.fsub(b.fmul(v, simd.splat(b, h_, _LANES)), _masked_load(b, c_at, mask))
             total = b.fadd(y_v, inc)
             _masked_store(b, b.fsub(b.fsub(total, y_v), inc), c_at, mask)
             _masked_store(b, total, y_at, mask)
