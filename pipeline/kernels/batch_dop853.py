@@ -93,10 +93,10 @@ def run_blocks(block, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejecte
               task * task_size, min(task * task_size + task_size, count))
 
 
-def task_size(count: int) -> int:
-    """Trajectories per parallel task: TASK, or fewer so that a small batch still gives every thread
-    a few tasks (never fewer than LANES: a task fills its lanes)."""
-    return int(max(LANES, min(TASK, -(-count // (4 * numba.get_num_threads())))))
+def task_size(count: int, lanes: int = LANES) -> int:
+    """Trajectories per parallel task (of a batch kernel of ``lanes`` lanes): TASK, or fewer so that a small batch
+    still gives every thread a few tasks (never fewer than ``lanes``: a task fills its lanes)."""
+    return int(max(lanes, min(TASK, -(-count // (4 * numba.get_num_threads())))))
 
 
 @kernel

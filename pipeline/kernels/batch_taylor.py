@@ -41,10 +41,10 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gyrolab.kernels import simd, taylor
+from gyrolab.kernels import batch_dop853, simd, taylor
 from gyrolab.kernels.compiler import kernel
 from gyrolab.kernels.expression import generated_module
-from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
+from gyrolab.kernels.layout import TRACED_ADDRESS
 from gyrolab.kernels.model import CompiledModel, traced_model
 from gyrolab.kernels.recurrences import AUXILIARY, Functions
 from gyrolab.kernels.taylor_series import plan
@@ -57,7 +57,6 @@ from gyrolab.kernels.vector_width import batch_lanes
 LANES = batch_lanes()
 from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP  # noqa: E402
 
-TASK = 256  # trajectories per parallel task, at most
 #: products whose Cauchy sums share one loop over the pairs (j, k − j): their accumulators and the operands'
 #: rows stay in the 32 vector registers
 GROUP = 16
@@ -279,39 +278,28 @@ def _cauchy(b, products, k, rows, load_row, zero, first):
     return out
 
 
-def _columns(program: dict) -> int:
-    """W's columns (``_layout``)."""
-    return max(len(_layout(program["series"])), 1)
-
-
 #: (series address, constants address, numbers, W's columns) of each form's generated lanes, by its rhs kernel's address
-_KERNELS: dict[tuple[int, int], tuple[int, int, int, int] | None] = {}
+_KERNELS: dict[int, tuple[int, int, int, int]] = {}
 
 
 def lanes_kernel(compiled: CompiledModel) -> tuple[int, int, int, int]:
     """The generated lanes of a compiled model: (series address, constants address, numbers, W's columns), compiled
     (or loaded from the disk cache) on first need."""
-    first = TRACED_FIRST_CONSTANT
-    key = (int(compiled.params[TRACED_ADDRESS]), first)  # the right-hand side kernel's address names the form
+    key = int(compiled.params[TRACED_ADDRESS])  # the right-hand side kernel's address names the form
     if key not in _KERNELS:
         model = traced_model(compiled)
-        program = plan(model, first)
+        program = plan(model)
         module = generated_module(source(program), "gyrolab_lanes", f"{model.what} (Taylor lanes)")
         _KERNELS[key] = (int(module.kernel.address), int(module.constants.address), max(len(program["names"]), 1),
-                         _columns(program))
+                         max(len(_layout(program["series"])), 1))
     return _KERNELS[key]
 
 
 def run_lanes(compiled: CompiledModel, Params: np.ndarray, order: int, tol: float, t_out: np.ndarray,
               Y0: np.ndarray, Y: np.ndarray, steps: np.ndarray, status: np.ndarray) -> None:
     """Every trajectory by lanes (``run_blocks``) with the model's generated series (``lanes_kernel``)."""
-    run_blocks(*lanes_kernel(compiled), Params, order, tol, t_out, Y0, Y, steps, status, task_size(len(Y0)))
-
-
-def task_size(count: int) -> int:
-    """Trajectories per parallel task: TASK, or fewer so that a small batch still gives every thread
-    a few tasks (never fewer than LANES: a task fills its lanes)."""
-    return int(max(LANES, min(TASK, -(-count // (4 * numba.get_num_threads())))))
+    run_blocks(*lanes_kernel(compiled), Params, order, tol, t_out, Y0, Y, steps, status,
+               batch_dop853.task_size(len(Y0), LANES))
 
 
 # ---- calls of the generated functions
