@@ -330,6 +330,26 @@ def _components(b, n, emit, block=3):
         emit([b.add(b.mul(blocks, ir.Constant(i64, block)), loop.index)])
 
 
+def _lane_types(T, order, n, *arrays) -> bool:
+    """Whether an intrinsic's arguments are the series T (order + 1, n, LANES), the order, the state size n and
+    arrays of rows of lanes."""
+    return (simd.vector_arrays([T, *arrays]) and T.ndim == 3 and isinstance(order, types.Integer)
+            and isinstance(n, types.Integer))
+
+
+def _lanes_codegen(body):
+    """An intrinsic's codegen that emits ``body(v, b, p, size)``: v its arguments as rows of vectors (``simd.Lanes``),
+    p and size the order and the state size (arguments 1 and 2) as intp."""
+
+    def codegen(context, builder, signature, args):
+        v = simd.Lanes(context, builder, signature, args, LANES)
+        p, size = (context.cast(builder, args[i], signature.args[i], types.intp) for i in (1, 2))
+        body(v, builder, p, size)
+        return context.get_dummy_value()
+
+    return codegen
+
+
 @intrinsic
 def _step_sizes(typingctx, T, order, n, K, S):
     """Every lane's Jorba–Zou step (``taylor.step_size``) from its series T[:, :, lane] (n components), in vector
@@ -340,19 +360,12 @@ def _step_sizes(typingctx, T, order, n, K, S):
     a vanishing n_k drops its term) through 2^(log2(·)/k) (``simd.Lanes.log2``, ``exp2``: a few ulps from the
     scalar power), and in row 1 a flag (1.0) where that path does not apply: a non-finite coefficient, a ratio
     outside the normal doubles, both n_k zero or a step beyond 2^±1000. There the caller takes the scalar rule,
-    so every lane steps as ``taylor.run`` would, to rounding. The scalar rule took 2 powers per lane, a quarter
-    of the lanes' step.
+    so every lane steps as ``taylor.run`` would, to rounding.
     """
-    if not (simd.vector_arrays([T, K, S]) and T.ndim == 3 and isinstance(order, types.Integer)
-            and isinstance(n, types.Integer)):
+    if not _lane_types(T, order, n, K, S):
         return None
-    sig = types.void(T, order, n, K, S)
 
-    def codegen(context, builder, signature, args):
-        v = simd.Lanes(context, builder, signature, args, LANES)
-        b = builder
-        p = context.cast(builder, args[1], signature.args[1], types.intp)
-        size = context.cast(builder, args[2], signature.args[2], types.intp)
+    def body(v, b, p, size):
         tol, safety, inv1, inv2 = [v.load(3, r) for r in range(4)]
         zero, one = v.constant(0.0), v.constant(1.0)
         scale, n1, n2, probe = (cgutils.alloca_once_value(b, x) for x in (one, zero, zero, zero))
@@ -384,9 +397,8 @@ def _step_sizes(typingctx, T, order, n, K, S):
         y = b.select(in_range, y, zero)
         v.store(b.fmul(v.exp2(y), safety), 4, 0)
         v.store(b.select(special, one, zero), 4, 1)
-        return context.get_dummy_value()
 
-    return sig, codegen
+    return types.void(T, order, n, K, S), _lanes_codegen(body)
 
 
 def _horner(v, b, p, size, components, chains):
@@ -414,16 +426,10 @@ def _advance(typingctx, T, order, n, H, carry, D, O, F):
     (``simd.update``'s arithmetic). The output's and the step's Horner chains share their loads of T and
     interleave. Idle lanes have h = 0; a lane without an output ignores O. F[0] receives 0 in every lane whose new
     state is finite (NaN in the others: the sum of its components times 0)."""
-    if not (simd.vector_arrays([T, H, carry, D, O, F]) and T.ndim == 3 and isinstance(order, types.Integer)
-            and isinstance(n, types.Integer)):
+    if not _lane_types(T, order, n, H, carry, D, O, F):
         return None
-    sig = types.void(T, order, n, H, carry, D, O, F)
 
-    def codegen(context, builder, signature, args):
-        v = simd.Lanes(context, builder, signature, args, LANES)
-        b = builder
-        p = context.cast(builder, args[1], signature.args[1], types.intp)
-        size = context.cast(builder, args[2], signature.args[2], types.intp)
+    def body(v, b, p, size):
         h, dt = v.load(3, 0), v.load(5, 0)
         probe = cgutils.alloca_once_value(b, v.constant(0.0))
 
@@ -440,9 +446,8 @@ def _advance(typingctx, T, order, n, H, carry, D, O, F):
 
         _components(b, size, emit)
         v.store(b.load(probe), 7, 0)
-        return context.get_dummy_value()
 
-    return sig, codegen
+    return types.void(T, order, n, H, carry, D, O, F), _lanes_codegen(body)
 
 
 @intrinsic
@@ -450,16 +455,10 @@ def _dense(typingctx, T, order, n, D, carry, O):
     """O[c] = T[0, c] + (Σ_{k≥1} T[k, c] dt^k − carry[c]) in every lane, dt = D[0] (one per lane): each lane's
     series at its own t + dt, Horner in strict arithmetic. Lane for lane the arithmetic of the scalar dense
     output of ``taylor.run``."""
-    if not (simd.vector_arrays([T, D, carry, O]) and T.ndim == 3 and isinstance(order, types.Integer)
-            and isinstance(n, types.Integer)):
+    if not _lane_types(T, order, n, D, carry, O):
         return None
-    sig = types.void(T, order, n, D, carry, O)
 
-    def codegen(context, builder, signature, args):
-        v = simd.Lanes(context, builder, signature, args, LANES)
-        b = builder
-        p = context.cast(builder, args[1], signature.args[1], types.intp)
-        size = context.cast(builder, args[2], signature.args[2], types.intp)
+    def body(v, b, p, size):
         dt = v.load(3, 0)
 
         def emit(components):
@@ -467,9 +466,8 @@ def _dense(typingctx, T, order, n, D, carry, O):
                 v.store(b.fadd(v.load(0, c), b.fsub(b.fmul(output, dt), v.load(4, c))), 5, c)
 
         _components(b, size, emit)
-        return context.get_dummy_value()
 
-    return sig, codegen
+    return types.void(T, order, n, D, carry, O), _lanes_codegen(body)
 
 
 # ---- the driver

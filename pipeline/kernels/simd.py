@@ -15,7 +15,6 @@ from llvmlite import ir
 from numba import types
 from numba.core import cgutils
 
-LANES = 4  # one AVX2 vector of doubles: the narrowest lanes (``batch_taylor`` passes its own width)
 FUSE = ("contract",)  # the series' multiply and add may fuse (a rounding's worth, as fastmath's contract)
 
 
@@ -55,7 +54,7 @@ def vector_arrays(arrays) -> bool:
 class Lanes:
     """LLVM IR helpers of the intrinsics: arrays of doubles seen as rows of ``<LANES x double>`` vectors."""
 
-    def __init__(self, context, builder, signature, args, width=LANES):
+    def __init__(self, context, builder, signature, args, width):
         self.builder = builder
         self.width = width
         self.vec = ir.VectorType(ir.DoubleType(), width)
@@ -72,11 +71,6 @@ class Lanes:
 
     def store(self, value, array, row):
         self.builder.store(value, self.ptr(array, row), align=8)
-
-    @staticmethod
-    def row(builder, index, stride, column):
-        """The vector row of T[index, column] in an array of ``stride`` vectors per index: index · stride + column."""
-        return builder.add(builder.mul(index, ir.Constant(index.type, stride)), ir.Constant(index.type, column))
 
     # Vector log2 and exp2 (the Taylor step rule's powers, ``batch_taylor._step_sizes``): relative error a few
     # ulps for normal positive x and for 2^y in [2^−1022, 2^1023]; the callers route other values elsewhere.
