@@ -46,7 +46,7 @@ from gyrolab.kernels.compiler import kernel
 from gyrolab.kernels.expression import generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS
 from gyrolab.kernels.model import CompiledModel, traced_model
-from gyrolab.kernels.recurrences import AUXILIARY, Functions
+from gyrolab.kernels.recurrences import Functions, work_columns
 from gyrolab.kernels.taylor_series import plan
 from gyrolab.kernels.vector_width import batch_lanes
 
@@ -69,22 +69,6 @@ _P = types.CPointer(types.float64)
 
 
 # ---- the generated series
-
-def _layout(series: list) -> dict[tuple, int]:
-    """W's columns: ("u", operand) for every operand of a product or a function, ("f", series, 0) for a function's
-    result and ("f", series, 1) for a sine's cosine or an auxiliary series."""
-    column: dict[tuple, int] = {}
-    for i, (op, args, _, _) in enumerate(series):
-        if op in ("y", "time", "cos"):  # (the cosine is computed with its sine)
-            continue
-        for u in args:
-            column.setdefault(("u", u), len(column))
-        if op != "mul":
-            column[("f", i, 0)] = len(column)
-            if op == "sin" or op in AUXILIARY:
-                column[("f", i, 1)] = len(column)
-    return column
-
 
 def source(program: dict) -> str:
     """The generated module: ``constants`` (a lane's numbers from its parameter row) and ``kernel`` (the series)."""
@@ -145,7 +129,7 @@ def _emit_series(b: ir.IRBuilder, program: dict, lanes: int, order, T, W, Q, t) 
     T, W, Q, t = (b.bitcast(x, vec.as_pointer()) for x in (T, W, Q, t))
     size, series = program["size"], program["series"]
     operands = program["operands"]
-    column = _layout(series)
+    column = work_columns(series, ("y", "time", "cos"))  # W's: every product's and function's operands
     width = max(len(column), 1)
 
     def const(x: int) -> ir.Constant:
@@ -291,7 +275,7 @@ def lanes_kernel(compiled: CompiledModel) -> tuple[int, int, int, int]:
         program = plan(model)
         module = generated_module(source(program), "gyrolab_lanes", f"{model.what} (Taylor lanes)")
         _KERNELS[key] = (int(module.kernel.address), int(module.constants.address), max(len(program["names"]), 1),
-                         max(len(_layout(program["series"])), 1))
+                         max(len(work_columns(program["series"], ("y", "time", "cos"))), 1))
     return _KERNELS[key]
 
 

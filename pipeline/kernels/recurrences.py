@@ -27,6 +27,22 @@ from gyrolab.kernels import simd
 AUXILIARY = ("tan", "tanh", "arctan", "arctan2")
 
 
+def work_columns(series: list, skip: tuple[str, ...], start: int = 0) -> dict[tuple, int]:
+    """W's columns from ``start`` on: ("u", operand) for every operand of a series whose op is not in ``skip``,
+    ("f", series, 0) for a function's result and ("f", series, 1) for a sine's cosine or an auxiliary series."""
+    column: dict[tuple, int] = {}
+    for i, (op, args, _, _) in enumerate(series):
+        if op in skip:
+            continue
+        for u in args:
+            column.setdefault(("u", u), start + len(column))
+        if op != "mul":
+            column[("f", i, 0)] = start + len(column)
+            if op == "sin" or op in AUXILIARY:
+                column[("f", i, 1)] = start + len(column)
+    return column
+
+
 class Functions:
     """The order-k coefficient of a function of a series, in every lane of a ``<lanes x double>`` vector: at order 0
     its value (libm's, lane by lane, as the scalar kernel's; sqrt and division exact), at order k ≥ 1 its

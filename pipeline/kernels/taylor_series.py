@@ -56,7 +56,7 @@ from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's ca
 from gyrolab.kernels.expression import BINARY, UNARY, Expr, binary_power, generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import Model, traced_model
-from gyrolab.kernels.recurrences import AUXILIARY, Functions
+from gyrolab.kernels.recurrences import Functions, work_columns
 
 ZERO, ONE, MINUS_ONE = "0.0", "1.0", "-1.0"
 #: lanes of the widest vector the series uses (AVX-512's; an AVX2 CPU runs each as two)
@@ -377,19 +377,8 @@ def layout(program: dict) -> tuple[dict[tuple, int], int]:
             column[("L", d, g)] = width
             column[("R", d, g)] = width + _padded(len(products))
             width += 2 * _padded(len(products))
-    for i, (op, args, _, _) in enumerate(program["series"]):
-        if op in ("y", "time", "cos", "mul"):
-            continue
-        for u in args:
-            if ("u", u) not in column:
-                column[("u", u)] = width
-                width += 1
-        column[("f", i, 0)] = width
-        width += 1
-        if op == "sin" or op in AUXILIARY:
-            column[("f", i, 1)] = width
-            width += 1
-    return column, max(width, 1)
+    functions = work_columns(program["series"], ("y", "time", "cos", "mul"), width)
+    return {**column, **functions}, max(width + len(functions), 1)
 
 
 def source(program: dict) -> str:
