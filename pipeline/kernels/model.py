@@ -21,7 +21,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from gyrolab.kernels.expression import (BINARY, UNARY, Expr, Graph, NotCompilable, check_torques, load_generated,
+from gyrolab.kernels.expression import (BINARY, UNARY, Expr, Graph, NotCompilable, check_torques, generated_module,
                                          symbols)
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT, TRACED_TAIL
 
@@ -149,8 +149,8 @@ def block_kernel(model: Model, first_constant: int = TRACED_FIRST_CONSTANT) -> i
     """The address of ``model``'s right-hand side by columns (``Model.block_source``), compiled on first need."""
     key = (id(model), first_constant)
     if key not in _BLOCKS:
-        _BLOCKS[key] = int(load_generated(model.block_source(first_constant), "gyrolab_block",
-                                          f"{model.what} (by columns)").address)
+        _BLOCKS[key] = int(generated_module(model.block_source(first_constant), "gyrolab_block",
+                                            f"{model.what} (by columns)").kernel.address)
     return _BLOCKS[key]
 
 
@@ -183,7 +183,7 @@ def compile(model: Model) -> CompiledModel:
     """The compiled model of ``model``: its right-hand side kernel generated once per form, compiled once per machine
     (cached on disk); the Taylor kernels' entries (the last four) stay 0 until ``taylor_series.ready`` and
     ``series_dd.ready`` compile them."""
-    kernel = load_generated(model.rhs_source(), "gyrolab_rhs", model.what)
+    kernel = generated_module(model.rhs_source(), "gyrolab_rhs", model.what).kernel
     address = int(kernel.address)
     MODELS[address] = model
     params = np.zeros(TRACED_FIRST_CONSTANT + len(model.constants) + TRACED_TAIL)

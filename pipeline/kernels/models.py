@@ -43,8 +43,8 @@ def call_block(typingctx, address, t, Y, P, out, count):
     the arrays' data (``block_rhs``); the stride is Y's row length."""
 
     def codegen(context, builder, signature, args):
-        stride = cgutils.unpack_tuple(builder, context.make_array(signature.args[2])(context, builder, args[2]).shape)[1]
-        return simd.call_address(context, builder, signature, args, [stride])
+        Y_ = context.make_array(signature.args[2])(context, builder, args[2])
+        return simd.call_address(context, builder, signature, args, [cgutils.unpack_tuple(builder, Y_.shape)[1]])
 
     return types.void(types.int64, t, Y, P, out, types.int64), codegen
 

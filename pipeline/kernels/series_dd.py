@@ -27,7 +27,7 @@ from __future__ import annotations
 from typing import Any
 
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before compiling)
-from gyrolab.kernels.expression import BINARY, UNARY, Expr, NotCompilable, binary_power, load_generated
+from gyrolab.kernels.expression import BINARY, UNARY, Expr, NotCompilable, binary_power, generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import Model, traced_model
 
@@ -266,8 +266,8 @@ def ready(compiled: Any) -> bool:
         address = int(p[TRACED_ADDRESS])
         if address not in _KERNELS:  # once per form and process
             program = _Program(model)
-            kernel = load_generated(program.source(), "gyrolab_taylor_dd", f"{model.what} (double-double Taylor)")
-            _KERNELS[address] = (float(kernel.address), float(max(program.columns, 1)))
+            module = generated_module(program.source(), "gyrolab_taylor_dd", f"{model.what} (double-double Taylor)")
+            _KERNELS[address] = (float(module.kernel.address), float(max(program.columns, 1)))
         p[p.size - 2:] = _KERNELS[address]
     return True
 

@@ -42,7 +42,8 @@ def splat(b, x, lanes):
 
 def vector_call(b, vec, name, *args):
     """The LLVM vector intrinsic ``llvm.NAME`` (fabs, rint, sqrt, ...) on ``args`` of the vector type ``vec``."""
-    fn = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * len(args)), f"llvm.{name}.v{vec.count}f64")
+    fn = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * len(args)),
+                                        f"llvm.{name}.v{vec.count}f64")
     return b.call(fn, list(args))
 
 
