@@ -473,9 +473,10 @@ def run_blocks(series, constants, numbers, columns, Params, order, tol, t_out, Y
 
 
 @kernel
-def _load(lane, j, Y0, Params, T, Q, carry, constants):
+def _load(lane, j, Y0, Params, T, Q, carry, constants, Y, t, t0, index, H):
     """Put trajectory j into ``lane`` (or, with j < 0, make the lane idle: a zero state and zero numbers, whose
-    series is zero): its state, a zero carry, and its numbers (``constants``) in Q[:, lane]."""
+    series is zero): its state (and first output), a zero carry, its numbers (``constants``) in Q[:, lane], its
+    time t0, its next output index 1 and no step yet."""
     for c in range(Y0.shape[1]):
         T[0, c, lane] = Y0[j, c] if j >= 0 else 0.0
         carry[c, lane] = 0.0
@@ -483,7 +484,11 @@ def _load(lane, j, Y0, Params, T, Q, carry, constants):
         for r in range(Q.shape[0]):
             Q[r, lane] = 0.0
     else:
+        Y[j, 0] = Y0[j]
         _call_constants(constants, Params[j], Q, lane)
+    t[0, lane] = t0
+    index[lane] = 1
+    H[0, lane] = 0.0
 
 
 @kernel
@@ -524,11 +529,8 @@ def _task(series, constants, numbers, columns, Params, order, tol, t_out, Y0, Y,
     for lane in range(LANES):
         if following < stop:
             traj[lane] = following
-            Y[following, 0] = Y0[following]
             following += 1
-        _load(lane, traj[lane], Y0, Params, T, Q, carry, constants)
-        t[0, lane] = t_out[0]
-        index[lane] = 1
+        _load(lane, traj[lane], Y0, Params, T, Q, carry, constants, Y, t, t_out[0], index, H)
     busy = min(LANES, stop - first)
     while busy > 0:
         _call_series(series, order, T, W, Q, t)
@@ -577,14 +579,10 @@ def _task(series, constants, numbers, columns, Params, order, tol, t_out, Y0, Y,
                         Y[j, i, c] = np.nan
             traj[lane] = following if following < stop else -1  # the lane takes the task's next trajectory
             if following < stop:
-                Y[following, 0] = Y0[following]
                 following += 1
             else:
                 busy -= 1
-            _load(lane, traj[lane], Y0, Params, T, Q, carry, constants)
-            t[0, lane] = t_out[0]
-            index[lane] = 1
-            H[0, lane] = 0.0
+            _load(lane, traj[lane], Y0, Params, T, Q, carry, constants, Y, t, t_out[0], index, H)
 
 
 @kernel
