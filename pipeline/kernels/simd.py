@@ -2,11 +2,8 @@
 batch Taylor kernel's vector arithmetic (``batch_taylor``).
 
 Arrays of doubles are seen as rows of vectors: a row holds one component of LANES trajectories (8 on AVX-512,
-4 on AVX2). ``Lanes.log2`` and ``Lanes.exp2`` are vector powers for the lanes' step rule.
-
-Why intrinsics: numba does not run LLVM's SLP vectoriser, and the Cauchy sums written as numba loops keep their
-accumulators in memory (``batch_taylor``'s docstring); the intrinsics emit the arithmetic over vector values
-directly, the accumulators in registers.
+4 on AVX2). ``Lanes.log2`` and ``Lanes.exp2`` are vector powers for the lanes' step rule. Why intrinsics and not
+numba loops: ``batch_taylor``'s docstring ("Why LLVM IR").
 """
 
 from __future__ import annotations
