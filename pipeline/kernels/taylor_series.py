@@ -92,9 +92,6 @@ class _Numbers:
             self.lines.append(f"{self.names[expr]} = {expr}")
         return self.names[expr]
 
-    def param(self, index: int) -> str:
-        return self._local(f"p[{int(index)}]")
-
     def neg(self, a: str) -> str:
         return {ZERO: ZERO, ONE: MINUS_ONE, MINUS_ONE: ONE}.get(a) or self._local(f"-{a}")
 
@@ -255,7 +252,7 @@ class _Program:
         if op == "time":
             return self._make("time", (), None, depth=0)
         if op == "const":
-            return _Lin(n.param(self.first_constant + a[0]))
+            return _Lin(n._local(f"p[{int(self.first_constant + a[0])}]"))
         if op == "add":
             return self._sum(a)
         if op == "sub":
