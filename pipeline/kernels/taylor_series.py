@@ -178,9 +178,6 @@ class _Program:
 
     # ---- values as linear combinations of series
 
-    def _state(self, index: int) -> _Lin:
-        return self._make("y", (), index, depth=0)
-
     def _make(self, op: str, operands: tuple[_Lin, ...], extra: Any, depth: int | None = None,
               pair: str | None = None) -> _Lin:
         """The series ``op`` of ``operands`` (one per distinct op, operands and extra), as a value."""
@@ -188,7 +185,7 @@ class _Program:
         key = (op, ids, extra)
         if key not in self.found:
             if depth is None:
-                depth = 1 + max((self._depth(v) for v in operands), default=0)
+                depth = 1 + max((self.series[i].depth for v in operands for i, _ in v.terms), default=0)
             self.found[key] = len(self.series)
             self.series.append(_Series(op, ids, extra, depth))
             if pair is not None:  # sin and cos: computed together, the cosine the next series
@@ -201,9 +198,6 @@ class _Program:
             self.operand_ids[value.key] = len(self.operands)
             self.operands.append(value)
         return self.operand_ids[value.key]
-
-    def _depth(self, value: _Lin) -> int:
-        return max((self.series[i].depth for i, _ in value.terms), default=0)
 
     def _sum(self, values: list[_Lin], signs: list[int] | None = None) -> _Lin:
         n = self.numbers
@@ -248,7 +242,7 @@ class _Program:
     def _node(self, op: str, a: list[Any]) -> _Lin:
         n = self.numbers
         if op == "y":
-            return self._state(a[0])
+            return self._make("y", (), a[0], depth=0)
         if op == "time":
             return self._make("time", (), None, depth=0)
         if op == "const":
