@@ -23,7 +23,7 @@ import numpy as np
 
 from gyrolab.kernels import dop853, models
 from gyrolab.kernels.compiler import kernel
-from gyrolab.kernels.dop853 import (A, B, C, N_EXTENDED, N_STAGES, NOT_FINITE, OK, TOO_SMALL_STEP, emit, step_error,
+from gyrolab.kernels.dop853 import (A, C, N_EXTENDED, N_STAGES, NOT_FINITE, OK, TOO_SMALL_STEP, emit, step_error,
                                     step_factor)
 from gyrolab.kernels.models import call_block
 
@@ -93,10 +93,10 @@ def run_blocks(block, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejecte
               task * task_size, min(task * task_size + task_size, count))
 
 
-def task_size(count: int) -> int:
-    """Trajectories per parallel task: TASK, or fewer so that a small batch still gives every thread
-    a few tasks (never fewer than LANES: a task fills its lanes)."""
-    return int(max(LANES, min(TASK, -(-count // (4 * numba.get_num_threads())))))
+def task_size(count: int, lanes: int = LANES) -> int:
+    """Trajectories per parallel task (of a batch kernel of ``lanes`` lanes): TASK, or fewer so that a small batch
+    still gives every thread a few tasks (never fewer than ``lanes``: a task fills its lanes)."""
+    return int(max(lanes, min(TASK, -(-count // (4 * numba.get_num_threads())))))
 
 
 @kernel
@@ -138,13 +138,11 @@ def _task(block, Params, t_out, Y0, Y, rtol, atol, max_step, steps, rejected_ste
     while busy > 0:
         _trial_steps(active, retry, t, h_abs, h, t_next, t_bound, max_step, traj, status)
         K[0] = f
-        for s in range(1, N_STAGES):
-            _stage(K, s, A[s], y, h, ytmp, sums)
+        for s in range(1, N_STAGES + 1):  # stage N_STAGES is y_new (A[N_STAGES] = B)
+            out = y_new if s == N_STAGES else ytmp
+            _stage(K, s, A[s], y, h, out, sums)
             _stage_times(t, C[s], h, ts)
-            call_block(block, ts, ytmp, P, K[s], LANES)
-        _stage(K, N_STAGES, B, y, h, y_new, sums)
-        _stage_times(t, C[N_STAGES], h, ts)
-        call_block(block, ts, y_new, P, K[N_STAGES], LANES)
+            call_block(block, ts, out, P, K[s], LANES)
         if _judge(K, y, y_new, h_abs, rtol, atol, active, retry, dense, traj, index, t_out, t_next, steps,
                   rejected_steps, nfev, status):
             for s in range(N_STAGES + 1, N_EXTENDED):  # the dense output's three extra stages

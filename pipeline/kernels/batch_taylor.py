@@ -41,12 +41,12 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from gyrolab.kernels import simd, taylor
+from gyrolab.kernels import batch_dop853, simd, taylor
 from gyrolab.kernels.compiler import kernel
 from gyrolab.kernels.expression import generated_module
-from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
+from gyrolab.kernels.layout import TRACED_ADDRESS
 from gyrolab.kernels.model import CompiledModel, traced_model
-from gyrolab.kernels.recurrences import AUXILIARY, Functions, splat_int
+from gyrolab.kernels.recurrences import Functions, work_columns
 from gyrolab.kernels.taylor_series import plan
 from gyrolab.kernels.vector_width import batch_lanes
 
@@ -57,7 +57,6 @@ from gyrolab.kernels.vector_width import batch_lanes
 LANES = batch_lanes()
 from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP  # noqa: E402
 
-TASK = 256  # trajectories per parallel task, at most
 #: products whose Cauchy sums share one loop over the pairs (j, k − j): their accumulators and the operands'
 #: rows stay in the 32 vector registers
 GROUP = 16
@@ -70,22 +69,6 @@ _P = types.CPointer(types.float64)
 
 
 # ---- the generated series
-
-def _layout(series: list) -> dict[tuple, int]:
-    """W's columns: ("u", operand) for every operand of a product or a function, ("f", series, 0) for a function's
-    result and ("f", series, 1) for a sine's cosine or an auxiliary series."""
-    column: dict[tuple, int] = {}
-    for i, (op, args, _, _) in enumerate(series):
-        if op in ("y", "time", "cos"):  # (the cosine is computed with its sine)
-            continue
-        for u in args:
-            column.setdefault(("u", u), len(column))
-        if op != "mul":
-            column[("f", i, 0)] = len(column)
-            if op == "sin" or op in AUXILIARY:
-                column[("f", i, 1)] = len(column)
-    return column
-
 
 def source(program: dict) -> str:
     """The generated module: ``constants`` (a lane's numbers from its parameter row) and ``kernel`` (the series)."""
@@ -146,7 +129,7 @@ def _emit_series(b: ir.IRBuilder, program: dict, lanes: int, order, T, W, Q, t) 
     T, W, Q, t = (b.bitcast(x, vec.as_pointer()) for x in (T, W, Q, t))
     size, series = program["size"], program["series"]
     operands = program["operands"]
-    column = _layout(series)
+    column = work_columns(series, ("y", "time", "cos"))  # W's: every product's and function's operands
     width = max(len(column), 1)
 
     def const(x: int) -> ir.Constant:
@@ -226,7 +209,7 @@ def _emit_series(b: ir.IRBuilder, program: dict, lanes: int, order, T, W, Q, t) 
             for i, (op, args, extra, _) in here:
                 if op != "mul":
                     values.update(emit(op, i, args, extra, rows))
-        inv = b.fdiv(splat(1.0), splat_int(b, vec, lanes, b.add(k, const(1))))
+        inv = b.fdiv(splat(1.0), simd.splat(b, b.sitofp(b.add(k, const(1)), ir.DoubleType()), lanes))
         rates = [b.fmul(combination(rate, values), inv, flags=simd.FUSE) for rate in program["rates"]]
         k1 = b.add(k, const(1))
         for m, value in enumerate(rates):
@@ -279,75 +262,42 @@ def _cauchy(b, products, k, rows, load_row, zero, first):
     return out
 
 
-def _columns(program: dict) -> int:
-    """W's columns (``_layout``)."""
-    return max(len(_layout(program["series"])), 1)
-
-
 #: (series address, constants address, numbers, W's columns) of each form's generated lanes, by its rhs kernel's address
-_KERNELS: dict[tuple[int, int], tuple[int, int, int, int] | None] = {}
+_KERNELS: dict[int, tuple[int, int, int, int]] = {}
 
 
 def lanes_kernel(compiled: CompiledModel) -> tuple[int, int, int, int]:
     """The generated lanes of a compiled model: (series address, constants address, numbers, W's columns), compiled
     (or loaded from the disk cache) on first need."""
-    first = TRACED_FIRST_CONSTANT
-    key = (int(compiled.params[TRACED_ADDRESS]), first)  # the right-hand side kernel's address names the form
+    key = int(compiled.params[TRACED_ADDRESS])  # the right-hand side kernel's address names the form
     if key not in _KERNELS:
         model = traced_model(compiled)
-        program = plan(model, first)
+        program = plan(model)
         module = generated_module(source(program), "gyrolab_lanes", f"{model.what} (Taylor lanes)")
         _KERNELS[key] = (int(module.kernel.address), int(module.constants.address), max(len(program["names"]), 1),
-                         _columns(program))
+                         max(len(work_columns(program["series"], ("y", "time", "cos"))), 1))
     return _KERNELS[key]
 
 
 def run_lanes(compiled: CompiledModel, Params: np.ndarray, order: int, tol: float, t_out: np.ndarray,
               Y0: np.ndarray, Y: np.ndarray, steps: np.ndarray, status: np.ndarray) -> None:
     """Every trajectory by lanes (``run_blocks``) with the model's generated series (``lanes_kernel``)."""
-    run_blocks(*lanes_kernel(compiled), Params, order, tol, t_out, Y0, Y, steps, status, task_size(len(Y0)))
-
-
-def task_size(count: int) -> int:
-    """Trajectories per parallel task: TASK, or fewer so that a small batch still gives every thread
-    a few tasks (never fewer than LANES: a task fills its lanes)."""
-    return int(max(LANES, min(TASK, -(-count // (4 * numba.get_num_threads())))))
+    run_blocks(*lanes_kernel(compiled), Params, order, tol, t_out, Y0, Y, steps, status,
+               batch_dop853.task_size(len(Y0), LANES))
 
 
 # ---- calls of the generated functions
 
-def _data(context, builder, ty, value):
-    return builder.bitcast(context.make_array(ty)(context, builder, value).data, ir.DoubleType().as_pointer())
-
-
 @intrinsic
 def _call_series(typingctx, address, order, T, W, Q, t):
     """The generated series at ``address``: ``void f(int64 order, double* T, double* W, double* Q, double* t)``."""
-    sig = types.void(types.int64, types.int64, T, W, Q, t)
-
-    def codegen(context, builder, signature, args):
-        double_ptr, i64 = ir.DoubleType().as_pointer(), ir.IntType(64)
-        fnty = ir.FunctionType(ir.VoidType(), [i64] + [double_ptr] * 4)
-        arrays = [_data(context, builder, ty, v) for ty, v in zip(signature.args[2:], args[2:])]
-        builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [args[1], *arrays])
-        return context.get_dummy_value()
-
-    return sig, codegen
+    return types.void(types.int64, types.int64, T, W, Q, t), simd.call_address
 
 
 @intrinsic
 def _call_constants(typingctx, address, p, Q, lane):
     """The generated ``void constants(double* p, double* q, int64 lane)``: a lane's numbers from its parameters."""
-    sig = types.void(types.int64, p, Q, types.int64)
-
-    def codegen(context, builder, signature, args):
-        double_ptr, i64 = ir.DoubleType().as_pointer(), ir.IntType(64)
-        fnty = ir.FunctionType(ir.VoidType(), [double_ptr, double_ptr, i64])
-        arrays = [_data(context, builder, ty, v) for ty, v in zip(signature.args[1:3], args[1:3])]
-        builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [*arrays, args[3]])
-        return context.get_dummy_value()
-
-    return sig, codegen
+    return types.void(types.int64, p, Q, types.int64), simd.call_address
 
 
 # ---- the step's other parts, for any state size n
@@ -364,6 +314,26 @@ def _components(b, n, emit, block=3):
         emit([b.add(b.mul(blocks, ir.Constant(i64, block)), loop.index)])
 
 
+def _lane_types(T, order, n, *arrays) -> bool:
+    """Whether an intrinsic's arguments are the series T (order + 1, n, LANES), the order, the state size n and
+    arrays of rows of lanes."""
+    return (simd.vector_arrays([T, *arrays]) and T.ndim == 3 and isinstance(order, types.Integer)
+            and isinstance(n, types.Integer))
+
+
+def _lanes_codegen(body):
+    """An intrinsic's codegen that emits ``body(v, b, p, size)``: v its arguments as rows of vectors (``simd.Lanes``),
+    p and size the order and the state size (arguments 1 and 2) as intp."""
+
+    def codegen(context, builder, signature, args):
+        v = simd.Lanes(context, builder, signature, args, LANES)
+        p, size = (context.cast(builder, args[i], signature.args[i], types.intp) for i in (1, 2))
+        body(v, builder, p, size)
+        return context.get_dummy_value()
+
+    return codegen
+
+
 @intrinsic
 def _step_sizes(typingctx, T, order, n, K, S):
     """Every lane's Jorba–Zou step (``taylor.step_size``) from its series T[:, :, lane] (n components), in vector
@@ -374,19 +344,12 @@ def _step_sizes(typingctx, T, order, n, K, S):
     a vanishing n_k drops its term) through 2^(log2(·)/k) (``simd.Lanes.log2``, ``exp2``: a few ulps from the
     scalar power), and in row 1 a flag (1.0) where that path does not apply: a non-finite coefficient, a ratio
     outside the normal doubles, both n_k zero or a step beyond 2^±1000. There the caller takes the scalar rule,
-    so every lane steps as ``taylor.run`` would, to rounding. The scalar rule took 2 powers per lane, a quarter
-    of the lanes' step.
+    so every lane steps as ``taylor.run`` would, to rounding.
     """
-    if not (simd.vector_arrays([T, K, S]) and T.ndim == 3 and isinstance(order, types.Integer)
-            and isinstance(n, types.Integer)):
+    if not _lane_types(T, order, n, K, S):
         return None
-    sig = types.void(T, order, n, K, S)
 
-    def codegen(context, builder, signature, args):
-        v = simd.Lanes(context, builder, signature, args, LANES)
-        b = builder
-        p = context.cast(builder, args[1], signature.args[1], types.intp)
-        size = context.cast(builder, args[2], signature.args[2], types.intp)
+    def body(v, b, p, size):
         tol, safety, inv1, inv2 = [v.load(3, r) for r in range(4)]
         zero, one = v.constant(0.0), v.constant(1.0)
         scale, n1, n2, probe = (cgutils.alloca_once_value(b, x) for x in (one, zero, zero, zero))
@@ -418,9 +381,8 @@ def _step_sizes(typingctx, T, order, n, K, S):
         y = b.select(in_range, y, zero)
         v.store(b.fmul(v.exp2(y), safety), 4, 0)
         v.store(b.select(special, one, zero), 4, 1)
-        return context.get_dummy_value()
 
-    return sig, codegen
+    return types.void(T, order, n, K, S), _lanes_codegen(body)
 
 
 def _horner(v, b, p, size, components, chains):
@@ -448,16 +410,10 @@ def _advance(typingctx, T, order, n, H, carry, D, O, F):
     (``simd.update``'s arithmetic). The output's and the step's Horner chains share their loads of T and
     interleave. Idle lanes have h = 0; a lane without an output ignores O. F[0] receives 0 in every lane whose new
     state is finite (NaN in the others: the sum of its components times 0)."""
-    if not (simd.vector_arrays([T, H, carry, D, O, F]) and T.ndim == 3 and isinstance(order, types.Integer)
-            and isinstance(n, types.Integer)):
+    if not _lane_types(T, order, n, H, carry, D, O, F):
         return None
-    sig = types.void(T, order, n, H, carry, D, O, F)
 
-    def codegen(context, builder, signature, args):
-        v = simd.Lanes(context, builder, signature, args, LANES)
-        b = builder
-        p = context.cast(builder, args[1], signature.args[1], types.intp)
-        size = context.cast(builder, args[2], signature.args[2], types.intp)
+    def body(v, b, p, size):
         h, dt = v.load(3, 0), v.load(5, 0)
         probe = cgutils.alloca_once_value(b, v.constant(0.0))
 
@@ -474,9 +430,8 @@ def _advance(typingctx, T, order, n, H, carry, D, O, F):
 
         _components(b, size, emit)
         v.store(b.load(probe), 7, 0)
-        return context.get_dummy_value()
 
-    return sig, codegen
+    return types.void(T, order, n, H, carry, D, O, F), _lanes_codegen(body)
 
 
 @intrinsic
@@ -484,16 +439,10 @@ def _dense(typingctx, T, order, n, D, carry, O):
     """O[c] = T[0, c] + (Σ_{k≥1} T[k, c] dt^k − carry[c]) in every lane, dt = D[0] (one per lane): each lane's
     series at its own t + dt, Horner in strict arithmetic. Lane for lane the arithmetic of the scalar dense
     output of ``taylor.run``."""
-    if not (simd.vector_arrays([T, D, carry, O]) and T.ndim == 3 and isinstance(order, types.Integer)
-            and isinstance(n, types.Integer)):
+    if not _lane_types(T, order, n, D, carry, O):
         return None
-    sig = types.void(T, order, n, D, carry, O)
 
-    def codegen(context, builder, signature, args):
-        v = simd.Lanes(context, builder, signature, args, LANES)
-        b = builder
-        p = context.cast(builder, args[1], signature.args[1], types.intp)
-        size = context.cast(builder, args[2], signature.args[2], types.intp)
+    def body(v, b, p, size):
         dt = v.load(3, 0)
 
         def emit(components):
@@ -501,9 +450,8 @@ def _dense(typingctx, T, order, n, D, carry, O):
                 v.store(b.fadd(v.load(0, c), b.fsub(b.fmul(output, dt), v.load(4, c))), 5, c)
 
         _components(b, size, emit)
-        return context.get_dummy_value()
 
-    return sig, codegen
+    return types.void(T, order, n, D, carry, O), _lanes_codegen(body)
 
 
 # ---- the driver
@@ -525,9 +473,10 @@ def run_blocks(series, constants, numbers, columns, Params, order, tol, t_out, Y
 
 
 @kernel
-def _load(lane, j, Y0, Params, T, Q, carry, constants):
+def _load(lane, j, Y0, Params, T, Q, carry, constants, Y, t, t0, index, H):
     """Put trajectory j into ``lane`` (or, with j < 0, make the lane idle: a zero state and zero numbers, whose
-    series is zero): its state, a zero carry, and its numbers (``constants``) in Q[:, lane]."""
+    series is zero): its state (and first output), a zero carry, its numbers (``constants``) in Q[:, lane], its
+    time t0, its next output index 1 and no step yet."""
     for c in range(Y0.shape[1]):
         T[0, c, lane] = Y0[j, c] if j >= 0 else 0.0
         carry[c, lane] = 0.0
@@ -535,7 +484,11 @@ def _load(lane, j, Y0, Params, T, Q, carry, constants):
         for r in range(Q.shape[0]):
             Q[r, lane] = 0.0
     else:
+        Y[j, 0] = Y0[j]
         _call_constants(constants, Params[j], Q, lane)
+    t[0, lane] = t0
+    index[lane] = 1
+    H[0, lane] = 0.0
 
 
 @kernel
@@ -576,11 +529,8 @@ def _task(series, constants, numbers, columns, Params, order, tol, t_out, Y0, Y,
     for lane in range(LANES):
         if following < stop:
             traj[lane] = following
-            Y[following, 0] = Y0[following]
             following += 1
-        _load(lane, traj[lane], Y0, Params, T, Q, carry, constants)
-        t[0, lane] = t_out[0]
-        index[lane] = 1
+        _load(lane, traj[lane], Y0, Params, T, Q, carry, constants, Y, t, t_out[0], index, H)
     busy = min(LANES, stop - first)
     while busy > 0:
         _call_series(series, order, T, W, Q, t)
@@ -629,14 +579,10 @@ def _task(series, constants, numbers, columns, Params, order, tol, t_out, Y0, Y,
                         Y[j, i, c] = np.nan
             traj[lane] = following if following < stop else -1  # the lane takes the task's next trajectory
             if following < stop:
-                Y[following, 0] = Y0[following]
                 following += 1
             else:
                 busy -= 1
-            _load(lane, traj[lane], Y0, Params, T, Q, carry, constants)
-            t[0, lane] = t_out[0]
-            index[lane] = 1
-            H[0, lane] = 0.0
+            _load(lane, traj[lane], Y0, Params, T, Q, carry, constants, Y, t, t_out[0], index, H)
 
 
 @kernel

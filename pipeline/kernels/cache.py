@@ -3,7 +3,7 @@
 numba only checks the timestamp of the file that defines a kernel, not of the kernels it calls, so the cache
 lives in a directory named after a hash of this package's sources and numba's version: editing any kernel starts
 a fresh cache instead of reusing stale machine code. The folder is owner-only: numba unpickles its index, and the
-generated kernels (``expression.load_generated``) are imported from it. (numba-free, so that the trust boundary
+generated kernels (``expression.generated_module``) are imported from it. (numba-free, so that the trust boundary
 can check the folder on every run without the half second numba's import costs.)
 """
 
@@ -36,7 +36,7 @@ def cache_dir() -> str:
 
 def _private(folder: Path) -> None:
     """Make ``folder`` (and missing parents) owner-only: numba unpickles its cache index, and the generated kernels
-    (``expression.load_generated``) are imported from it, so no one else may write there."""
+    (``expression.generated_module``) are imported from it, so no one else may write there."""
     folder.parent.mkdir(parents=True, exist_ok=True)
     folder.mkdir(mode=0o700, exist_ok=True)
 

@@ -49,9 +49,7 @@ def initial_step(p, t0, y0, f0, t_bound, max_step, rtol, atol, stats):
     (the bulk of the first compile); the same operations in the same order.
     """
     n = y0.size
-    zero = np.empty(n)
-    for m in range(n):
-        zero[m] = 0.0
+    zero = np.zeros(n)
     interval = abs(t_bound - t0)
     d0 = _rms(y0, zero, y0, atol, rtol)
     d1 = _rms(f0, zero, y0, atol, rtol)

@@ -32,10 +32,12 @@ import numpy as np
 
 log = logging.getLogger(__name__)
 
-_UNARY = {"neg": "-{0}", "sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
-          "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})", "arctan": "math.atan({0})",
-          "tanh": "math.tanh({0})", "abs": "abs({0})"}
-_BINARY = {"add": "{0} + {1}", "sub": "{0} - {1}", "mul": "{0} * {1}", "div": "{0} / {1}", "arctan2": "math.atan2({0}, {1})"}
+#: the generated sources' spelling of each operation of one and of two arguments (the generators' shared table)
+UNARY = {"neg": "-{0}", "sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
+         "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})", "arctan": "math.atan({0})",
+         "tanh": "math.tanh({0})", "abs": "abs({0})"}
+BINARY = {"add": "{0} + {1}", "sub": "{0} - {1}", "mul": "{0} * {1}", "div": "{0} / {1}",
+          "arctan2": "math.atan2({0}, {1})"}
 
 
 class NotCompilable(Exception):
@@ -64,10 +66,6 @@ class Graph:
             raise NotCompilable(f"it uses the non-finite number {float(value)!r}")
         self.constants.append(float(value))
         return self.add("const", len(self.constants) - 1)
-
-
-def _construct(name: str) -> NotCompilable:
-    return NotCompilable(name)
 
 
 class Expr:
@@ -133,11 +131,11 @@ class Expr:
         return self.graph.add("arctan2", self, self.graph.lift(other))
 
     def __bool__(self) -> bool:
-        raise _construct("it branches on the state (an `if`, `and`/`or` or `max`/`min` on it), and compiled code "
+        raise NotCompilable("it branches on the state (an `if`, `and`/`or` or `max`/`min` on it), and compiled code "
                          "cannot branch")
 
     def _compare(self, other: Any) -> bool:
-        raise _construct("it compares the state (`<`, `>`, `==`, an `if` or `max`/`min` on it), and compiled code "
+        raise NotCompilable("it compares the state (`<`, `>`, `==`, an `if` or `max`/`min` on it), and compiled code "
                          "cannot branch")
 
     __lt__ = __le__ = __gt__ = __ge__ = _compare
@@ -148,7 +146,7 @@ class Expr:
     __hash__ = object.__hash__
 
     def __float__(self) -> float:
-        raise _construct("it converts the state to a Python float (`float()` or a `math` function) instead of "
+        raise NotCompilable("it converts the state to a Python float (`float()` or a `math` function) instead of "
                          "using numpy's functions (np.sqrt, np.exp, ...)")
 
     __int__ = __index__ = __complex__ = __float__  # type: ignore[assignment]
@@ -205,11 +203,6 @@ def binary_power(x: Any, n: int, multiply: Any) -> Any:
 
 
 _LOADED: dict[str, Any] = {}
-
-
-def load_generated(source: str, prefix: str, what: str) -> Any:
-    """The ``kernel`` of a generated module (``generated_module``)."""
-    return generated_module(source, prefix, what).kernel
 
 
 def generated_module(source: str, prefix: str, what: str) -> Any:

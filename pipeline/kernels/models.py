@@ -16,32 +16,19 @@ and the series calls are inlined into each of them.
 
 from __future__ import annotations
 
-from llvmlite import ir
 from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
 from gyrolab.kernels.layout import TRACED_ADDRESS
-from gyrolab.kernels import model as _model, taylor_series
+from gyrolab.kernels import model as _model, simd, taylor_series
 from gyrolab.kernels.compiler import inline_kernel, kernel
 
 
 @intrinsic
 def _call_rhs(typingctx, address, t, y, p, out):
     """Call ``void f(double t, double* y, double* p, double* out)`` at ``address`` with the arrays' data."""
-    sig = types.void(types.int64, types.float64, y, p, out)
-
-    def codegen(context, builder, signature, args):
-        address_, t_, y_, p_, out_ = args
-        double_ptr = ir.DoubleType().as_pointer()
-        fnty = ir.FunctionType(ir.VoidType(), [ir.DoubleType(), double_ptr, double_ptr, double_ptr])
-        data = [cgutils.create_struct_proxy(ty)(context, builder, value=v).data
-                for ty, v in zip(signature.args[2:], (y_, p_, out_))]
-        fn = builder.inttoptr(address_, fnty.as_pointer())
-        builder.call(fn, [t_] + [builder.bitcast(d, double_ptr) for d in data])
-        return context.get_dummy_value()
-
-    return sig, codegen
+    return types.void(types.int64, types.float64, y, p, out), simd.call_address
 
 
 def block_rhs(compiled) -> int:
@@ -54,18 +41,12 @@ def block_rhs(compiled) -> int:
 def call_block(typingctx, address, t, Y, P, out, count):
     """Call ``void f(double* t, double* Y, double* P, double* out, int64 count, int64 stride)`` at ``address`` with
     the arrays' data (``block_rhs``); the stride is Y's row length."""
-    sig = types.void(types.int64, t, Y, P, out, types.int64)
 
     def codegen(context, builder, signature, args):
-        double_ptr, i64 = ir.DoubleType().as_pointer(), ir.IntType(64)
-        fnty = ir.FunctionType(ir.VoidType(), [double_ptr] * 4 + [i64, i64])
-        arrays = [context.make_array(ty)(context, builder, v) for ty, v in zip(signature.args[1:5], args[1:5])]
-        stride = cgutils.unpack_tuple(builder, arrays[1].shape)[1]
-        data = [builder.bitcast(a.data, double_ptr) for a in arrays]
-        builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [*data, args[5], stride])
-        return context.get_dummy_value()
+        Y_ = context.make_array(signature.args[2])(context, builder, args[2])
+        return simd.call_address(context, builder, signature, args, [cgutils.unpack_tuple(builder, Y_.shape)[1]])
 
-    return sig, codegen
+    return types.void(types.int64, t, Y, P, out, types.int64), codegen
 
 
 @inline_kernel

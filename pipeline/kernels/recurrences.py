@@ -27,6 +27,22 @@ from gyrolab.kernels import simd
 AUXILIARY = ("tan", "tanh", "arctan", "arctan2")
 
 
+def work_columns(series: list, skip: tuple[str, ...], start: int = 0) -> dict[tuple, int]:
+    """W's columns from ``start`` on: ("u", operand) for every operand of a series whose op is not in ``skip``,
+    ("f", series, 0) for a function's result and ("f", series, 1) for a sine's cosine or an auxiliary series."""
+    column: dict[tuple, int] = {}
+    for i, (op, args, _, _) in enumerate(series):
+        if op in skip:
+            continue
+        for u in args:
+            column.setdefault(("u", u), start + len(column))
+        if op != "mul":
+            column[("f", i, 0)] = start + len(column)
+            if op == "sin" or op in AUXILIARY:
+                column[("f", i, 1)] = start + len(column)
+    return column
+
+
 class Functions:
     """The order-k coefficient of a function of a series, in every lane of a ``<lanes x double>`` vector: at order 0
     its value (libm's, lane by lane, as the scalar kernel's; sqrt and division exact), at order k ≥ 1 its
@@ -37,7 +53,7 @@ class Functions:
         self.b, self.lanes, self.k, self.first = b, lanes, k, first
         self.load, self.store, self.number = load, store, number
         self.vec = ir.VectorType(ir.DoubleType(), lanes)
-        self.kf = splat_int(b, self.vec, lanes, k)
+        self.kf = simd.splat(b, b.sitofp(k, ir.DoubleType()), lanes)
 
     def splat(self, x):
         return ir.Constant(self.vec, [float(x)] * self.lanes)
@@ -69,7 +85,7 @@ class Functions:
         y = (lambda row: self.load(row, ("u", args[1]))) if len(args) > 1 else None
         f = (lambda row: self.load(row, ("f", i, 0)))
         g = (lambda row: self.load(row, ("f", i, 1)))  # the cosine or the auxiliary series
-        jf = (lambda j: splat_int(b, self.vec, self.lanes, j))
+        jf = (lambda j: simd.splat(b, b.sitofp(j, ir.DoubleType()), self.lanes))
         mul = (lambda p, q: b.fmul(p, q, flags=simd.FUSE))
         xk, x0 = rows[args[0]], x(zero)
         slots = [cgutils.alloca_once(b, self.vec) for _ in range(2)]
@@ -140,7 +156,7 @@ class Functions:
         if op == "div":
             return [b.fdiv(x, rows[args[1]])]
         if op == "sqrt":
-            return [simd_call(b, self.vec, "sqrt", x)]
+            return [simd.vector_call(b, self.vec, "sqrt", x)]
         if op == "sin":
             return [self.libm("sin", x), self.libm("cos", x)]
         if op in ("tan", "tanh"):
@@ -153,20 +169,5 @@ class Functions:
         if op == "pow":
             return [self.libm("pow", x, self.number(extra))]
         if op == "abs":
-            return [simd_call(b, self.vec, "fabs", x)]
+            return [simd.vector_call(b, self.vec, "fabs", x)]
         return [self.libm(op, x)]  # exp, log
-
-
-def simd_call(b, vec, name, *args):
-    """The LLVM vector intrinsic ``llvm.NAME`` on ``args``."""
-    fn = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * len(args)),
-                                        f"llvm.{name}.v{vec.count}f64")
-    return b.call(fn, list(args))
-
-
-def splat_int(b, vec, lanes, n):
-    """<lanes x double> of the LLVM integer n."""
-    x = b.sitofp(n, ir.DoubleType())
-    one = b.insert_element(ir.Constant(vec, ir.Undefined), x, ir.Constant(ir.IntType(32), 0))
-    return b.shuffle_vector(one, ir.Constant(vec, ir.Undefined),
-                            ir.Constant(ir.VectorType(ir.IntType(32), lanes), [0] * lanes))

@@ -27,14 +27,11 @@ from __future__ import annotations
 from typing import Any
 
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before compiling)
-from gyrolab.kernels.expression import Expr, NotCompilable, binary_power, load_generated
+from gyrolab.kernels.expression import BINARY, UNARY, Expr, NotCompilable, binary_power, generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import Model, traced_model
 
-_NUMBER_FUNCTIONS = {"sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
-                     "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})",
-                     "tanh": "math.tanh({0})", "arctan": "math.atan({0})", "abs": "abs({0})",
-                     "arctan2": "math.atan2({0}, {1})", "powx": "{0} ** {1}"}
+_NUMBER_FUNCTIONS = {**UNARY, **BINARY, "powx": "{0} ** {1}"}
 
 #: operations on double-double numbers (x, y: their hi, lo names)
 _NUMBER_OPS = {"add": "dd_add({0}, {1}, {2}, {3})", "sub": "dd_add({0}, {1}, -{2}, -{3})", "neg": "-{0}, -{1}",
@@ -269,8 +266,8 @@ def ready(compiled: Any) -> bool:
         address = int(p[TRACED_ADDRESS])
         if address not in _KERNELS:  # once per form and process
             program = _Program(model)
-            kernel = load_generated(program.source(), "gyrolab_taylor_dd", f"{model.what} (double-double Taylor)")
-            _KERNELS[address] = (float(kernel.address), float(max(program.columns, 1)))
+            module = generated_module(program.source(), "gyrolab_taylor_dd", f"{model.what} (double-double Taylor)")
+            _KERNELS[address] = (float(module.kernel.address), float(max(program.columns, 1)))
         p[p.size - 2:] = _KERNELS[address]
     return True
 

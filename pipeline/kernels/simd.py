@@ -1,11 +1,9 @@
-"""LLVM IR helpers for the batch Taylor kernel's vector intrinsics (``batch_taylor``).
+"""LLVM IR helpers of the kernels' intrinsics: calls of generated functions by address (``call_address``) and the
+batch Taylor kernel's vector arithmetic (``batch_taylor``).
 
 Arrays of doubles are seen as rows of vectors: a row holds one component of LANES trajectories (8 on AVX-512,
-4 on AVX2). ``Lanes.log2`` and ``Lanes.exp2`` are vector powers for the lanes' step rule.
-
-Why intrinsics: numba does not run LLVM's SLP vectoriser, and the Cauchy sums written as numba loops keep their
-accumulators in memory (``batch_taylor``'s docstring); the intrinsics emit the arithmetic over vector values
-directly, the accumulators in registers.
+4 on AVX2). ``Lanes.log2`` and ``Lanes.exp2`` are vector powers for the lanes' step rule. Why intrinsics and not
+numba loops: ``batch_taylor``'s docstring ("Why LLVM IR").
 """
 
 from __future__ import annotations
@@ -14,8 +12,36 @@ from llvmlite import ir
 from numba import types
 from numba.core import cgutils
 
-LANES = 4  # one AVX2 vector of doubles: the narrowest lanes (``batch_taylor`` passes its own width)
 FUSE = ("contract",)  # the series' multiply and add may fuse (a rounding's worth, as fastmath's contract)
+
+
+def array_data(context, builder, ty, value):
+    """The data pointer (double*) of the array ``value`` of numba type ``ty``."""
+    return builder.bitcast(context.make_array(ty)(context, builder, value).data, ir.DoubleType().as_pointer())
+
+
+def call_address(context, builder, signature, args, extra=()):
+    """An intrinsic's codegen: call ``void f(...)`` at the address args[0] with the other arguments (each array as
+    its data pointer, ``array_data``), then ``extra``."""
+    values = [array_data(context, builder, ty, v) if isinstance(ty, types.Array) else v
+              for ty, v in zip(signature.args[1:], args[1:])] + list(extra)
+    fnty = ir.FunctionType(ir.VoidType(), [v.type for v in values])
+    builder.call(builder.inttoptr(args[0], fnty.as_pointer()), values)
+    return context.get_dummy_value()
+
+
+def splat(b, x, lanes):
+    """The scalar value ``x`` in every one of ``lanes`` lanes."""
+    undef = ir.Constant(ir.VectorType(x.type, lanes), ir.Undefined)
+    return b.shuffle_vector(b.insert_element(undef, x, ir.Constant(ir.IntType(32), 0)), undef,
+                            ir.Constant(ir.VectorType(ir.IntType(32), lanes), [0] * lanes))
+
+
+def vector_call(b, vec, name, *args):
+    """The LLVM vector intrinsic ``llvm.NAME`` (fabs, rint, sqrt, ...) on ``args`` of the vector type ``vec``."""
+    fn = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * len(args)),
+                                        f"llvm.{name}.v{vec.count}f64")
+    return b.call(fn, list(args))
 
 
 def vector_arrays(arrays) -> bool:
@@ -26,7 +52,7 @@ def vector_arrays(arrays) -> bool:
 class Lanes:
     """LLVM IR helpers of the intrinsics: arrays of doubles seen as rows of ``<LANES x double>`` vectors."""
 
-    def __init__(self, context, builder, signature, args, width=LANES):
+    def __init__(self, context, builder, signature, args, width):
         self.builder = builder
         self.width = width
         self.vec = ir.VectorType(ir.DoubleType(), width)
@@ -44,17 +70,6 @@ class Lanes:
     def store(self, value, array, row):
         self.builder.store(value, self.ptr(array, row), align=8)
 
-    @staticmethod
-    def row(builder, index, stride, column):
-        """The vector row of T[index, column] in an array of ``stride`` vectors per index: index · stride + column."""
-        return builder.add(builder.mul(index, ir.Constant(index.type, stride)), ir.Constant(index.type, column))
-
-    def splat(self, scalar):
-        b = self.builder
-        one = b.insert_element(ir.Constant(self.vec, ir.Undefined), scalar, ir.Constant(ir.IntType(32), 0))
-        return b.shuffle_vector(one, ir.Constant(self.vec, ir.Undefined), ir.Constant(ir.VectorType(ir.IntType(32), self.width),
-                                                                                      [0] * self.width))
-
     # Vector log2 and exp2 (the Taylor step rule's powers, ``batch_taylor._step_sizes``): relative error a few
     # ulps for normal positive x and for 2^y in [2^−1022, 2^1023]; the callers route other values elsewhere.
     _LN2 = 0.6931471805599453
@@ -70,10 +85,7 @@ class Lanes:
         return ir.Constant(self.vec, [float(value)] * self.width)
 
     def call(self, name, *args):
-        """The LLVM vector intrinsic ``llvm.NAME.vWf64`` (fabs, rint, ...) on ``args``."""
-        function = cgutils.get_or_insert_function(self.builder.module, ir.FunctionType(self.vec, [self.vec] * len(args)),
-                                                  f"llvm.{name}.v{self.width}f64")
-        return self.builder.call(function, list(args))
+        return vector_call(self.builder, self.vec, name, *args)
 
     def log2(self, x):
         """log2(x) for positive normal x: x = 2^e m, m in [√½, √2), ln m = 2 atanh(s), s = (m − 1)/(m + 1),

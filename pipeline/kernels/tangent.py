@@ -58,6 +58,33 @@ def _sub(a: Any, b: Any) -> Any:
     return a if _is_zero(b) else _neg(b) if _is_zero(a) else a - b
 
 
+#: an operation's (value of its arguments' values a, slope from a, their slopes d and the value v): textbook rules
+_RULES = {
+    "add": (lambda a: a[0] + a[1], lambda a, d, v: _add(d[0], d[1])),
+    "sub": (lambda a: a[0] - a[1], lambda a, d, v: _sub(d[0], d[1])),
+    "neg": (lambda a: -a[0], lambda a, d, v: _neg(d[0])),
+    "mul": (lambda a: a[0] * a[1], lambda a, d, v: _add(_mul(d[0], a[1]), _mul(a[0], d[1]))),
+    "ipow": (lambda a: a[0] ** int(a[1]),
+             lambda a, d, v: _mul(_mul(int(a[1]), a[0] ** (int(a[1]) - 1)) if int(a[1]) != 1 else 1, d[0])),
+    "sqrt": (lambda a: np.sqrt(a[0]), lambda a, d, v: 0 if _is_zero(d[0]) else d[0] / (2 * v)),
+    "exp": (lambda a: np.exp(a[0]), lambda a, d, v: _mul(v, d[0])),
+    "log": (lambda a: np.log(a[0]), lambda a, d, v: 0 if _is_zero(d[0]) else d[0] / a[0]),
+    "sin": (lambda a: np.sin(a[0]), lambda a, d, v: _mul(np.cos(a[0]), d[0])),
+    "cos": (lambda a: np.cos(a[0]), lambda a, d, v: _mul(-np.sin(a[0]), d[0])),
+    "tan": (lambda a: np.tan(a[0]), lambda a, d, v: _mul(1 + v * v, d[0])),
+    "tanh": (lambda a: np.tanh(a[0]), lambda a, d, v: _mul(1 - v * v, d[0])),
+    "arctan": (lambda a: np.arctan(a[0]), lambda a, d, v: 0 if _is_zero(d[0]) else d[0] / (1 + a[0] * a[0])),
+    # sign(x) dx (undefined at x = 0, as |x|' is)
+    "abs": (lambda a: abs(a[0]), lambda a, d, v: 0 if _is_zero(d[0]) else _mul(a[0] / v, d[0])),
+    "arctan2": (lambda a: np.arctan2(a[0], a[1]),
+                lambda a, d, v: (0 if _is_zero(d[0]) and _is_zero(d[1]) else
+                                 _sub(_mul(a[1], d[0]), _mul(a[0], d[1])) / (a[0] * a[0] + a[1] * a[1]))),
+    # x^y = exp(y log x)
+    "powx": (lambda a: a[0] ** a[1],
+             lambda a, d, v: _mul(v, _add(_mul(d[1], np.log(a[0])), 0 if _is_zero(d[0]) else _mul(a[1], d[0] / a[0])))),
+}
+
+
 def leading(model: Model, size: int) -> Model:
     """The first ``size`` rates of ``model`` as a model of the first ``size`` components; ValueError when they read
     a later component (the block is not closed)."""
@@ -87,56 +114,16 @@ def replay(model: Model, graph: Graph, x: np.ndarray, u: np.ndarray, t: Any,
             v, s = t, 0
         elif op == "const":
             v, s = constants[args[0]], 0
-        elif op == "add":
-            v, s = a[0] + a[1], _add(d[0], d[1])
-        elif op == "sub":
-            v, s = a[0] - a[1], _sub(d[0], d[1])
-        elif op == "neg":
-            v, s = -a[0], _neg(d[0])
-        elif op == "mul":
-            v, s = a[0] * a[1], _add(_mul(d[0], a[1]), _mul(a[0], d[1]))
         elif op == "div":
             if args[1].index not in reciprocal:
                 reciprocal[args[1].index] = 1.0 / a[1]
             r = reciprocal[args[1].index]
             v = a[0] * r
             s = _mul(_sub(d[0], _mul(v, d[1])), r)
-        elif op == "ipow":
-            n = int(args[1])
-            v = a[0] ** n
-            s = _mul(_mul(n, a[0] ** (n - 1)) if n != 1 else 1, d[0])
-        elif op == "sqrt":
-            v = np.sqrt(a[0])
-            s = 0 if _is_zero(d[0]) else d[0] / (2 * v)
-        elif op == "exp":
-            v = np.exp(a[0])
-            s = _mul(v, d[0])
-        elif op == "log":
-            v = np.log(a[0])
-            s = 0 if _is_zero(d[0]) else d[0] / a[0]
-        elif op == "sin":
-            v, s = np.sin(a[0]), _mul(np.cos(a[0]), d[0])
-        elif op == "cos":
-            v, s = np.cos(a[0]), _mul(-np.sin(a[0]), d[0])
-        elif op == "tan":
-            v = np.tan(a[0])
-            s = _mul(1 + v * v, d[0])
-        elif op == "tanh":
-            v = np.tanh(a[0])
-            s = _mul(1 - v * v, d[0])
-        elif op == "arctan":
-            v = np.arctan(a[0])
-            s = 0 if _is_zero(d[0]) else d[0] / (1 + a[0] * a[0])
-        elif op == "abs":
-            v = abs(a[0])
-            s = 0 if _is_zero(d[0]) else _mul(a[0] / v, d[0])  # sign(x) dx (undefined at x = 0, as |x|' is)
-        elif op == "arctan2":
-            v = np.arctan2(a[0], a[1])
-            s = (0 if _is_zero(d[0]) and _is_zero(d[1]) else
-                 _sub(_mul(a[1], d[0]), _mul(a[0], d[1])) / (a[0] * a[0] + a[1] * a[1]))
-        elif op == "powx":  # x^y = exp(y log x)
-            v = a[0] ** a[1]
-            s = _mul(v, _add(_mul(d[1], np.log(a[0])), 0 if _is_zero(d[0]) else _mul(a[1], d[0] / a[0])))
+        elif op in _RULES:
+            value_of, slope_of = _RULES[op]
+            v = value_of(a)
+            s = slope_of(a, d, v)
         else:
             raise NotCompilable(f"its operation {op!r} has no derivative rule")
         value[i], slope[i] = v, s

@@ -30,6 +30,8 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from gyrolab.kernels import simd
+from gyrolab.kernels.simd import array_data as _data
 from gyrolab.kernels.compiler import inline_kernel, kernel
 from gyrolab.kernels.models import taylor_coefficients
 
@@ -38,11 +40,8 @@ MIN_ORDER, MAX_ORDER = 4, 60
 
 
 #: a double step's work besides its series (step size, Kahan update, dense output, the loop), in units of the
-#: series' work per order²: the same series costs ~p² (its Cauchy products) and the rest ~STEP_OVERHEAD. Measured
-#: 2026-11-29 on the Intel Xeon (gyrostat of benchmarks/gyrostat_heyoka.py and the reference scene, orders from
-#: Jorba & Zou's to +5 at half-decade tolerances, the cheapest run reaching each error 1e-6 … 1e-12): 64 made them
-#: 0.84–0.97× (mean 0.93×) and 0.88–0.97× (0.92×) as costly as Jorba & Zou's orders; 32 and 121 gained less
-#: (docs/performance.md, "The order rule"). Double-double steps are series-bound: 0 there.
+#: series' work per order²: the series costs ~p², the rest ~STEP_OVERHEAD (measured: docs/performance.md, "The order
+#: rule"). Double-double steps are series-bound: 0 there.
 STEP_OVERHEAD = 64.0
 
 
@@ -159,7 +158,7 @@ def _emit_horner(context, b, T, T_type, order, hs, each):
     rows = b.bitcast(array.data, double.as_pointer())
     n = b.extract_value(array.shape, 1)
     fma = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * 3), f"llvm.fma.v{_LANES}f64")
-    hvs = [_splat(b, h) for h in hs]
+    hvs = [simd.splat(b, h, _LANES) for h in hs]
     chunks = b.udiv(b.add(n, ir.Constant(i64, 2 * _LANES - 1)), ir.Constant(i64, 2 * _LANES))
     with cgutils.for_range(b, chunks) as chunk:
         columns = [b.add(b.mul(chunk.index, ir.Constant(i64, 2 * _LANES)), ir.Constant(i64, half * _LANES))
@@ -186,19 +185,6 @@ def _emit_horner(context, b, T, T_type, order, hs, each):
 _LANE_INDEX = ir.Constant(ir.VectorType(ir.IntType(64), _LANES), list(range(_LANES)))
 
 
-def _splat(b, x):
-    """``x`` (a scalar value) in every lane of a vector."""
-    vec = ir.VectorType(x.type, _LANES)
-    undef = ir.Constant(vec, ir.Undefined)
-    return b.shuffle_vector(b.insert_element(undef, x, ir.Constant(ir.IntType(32), 0)), undef,
-                            ir.Constant(ir.VectorType(ir.IntType(32), _LANES), [0] * _LANES))
-
-
-def _data(context, b, array_type, array):
-    """The data pointer (double*) of a C-contiguous array."""
-    return b.bitcast(context.make_array(array_type)(context, b, array).data, ir.DoubleType().as_pointer())
-
-
 def _masked_load(b, pointer, mask):
     """The 8 doubles from ``pointer`` where ``mask`` is set, 0 elsewhere (nothing read there)."""
     vec = ir.VectorType(ir.DoubleType(), _LANES)
@@ -220,11 +206,7 @@ def _masked_store(b, value, pointer, mask):
 
 def _lanes_in(b, c, n):
     """The mask of the lanes c … c + 7 that are components (below n)."""
-    return b.icmp_unsigned("<", b.add(_splat(b, c), _LANE_INDEX), _splat(b, n))
-
-
-def _arrays(*arrays) -> bool:
-    return all(isinstance(a, types.Array) and a.dtype == types.float64 for a in arrays)
+    return b.icmp_unsigned("<", b.add(simd.splat(b, c, _LANES), _LANE_INDEX), simd.splat(b, n, _LANES))
 
 
 @intrinsic
@@ -232,8 +214,7 @@ def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
     """Y[i + j] = y + (v_j·dt_j − carry), v_j = Σ_{k≥1} T[k] dt_j^(k−1) (``_emit_horner``), for each dt_j of the tuple
     ``dts`` (one or two): the state dt_j after the step's start from its series, with the compensation the state
     carries."""
-    if not (_arrays(T, y, carry, Y) and all(a.layout == "C" for a in (T, y, carry, Y))
-            and isinstance(dts, types.UniTuple)):
+    if not (simd.vector_arrays([T, y, carry, Y]) and isinstance(dts, types.UniTuple)):
         return None
     sig = types.void(T, order, dts, y, carry, Y, i)
 
@@ -247,7 +228,7 @@ def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
             mask = _lanes_in(b, c, n)
             y_v, c_v = (_masked_load(b, b.gep(_data(context, b, types_[a], args[a]), [c]), mask) for a in (3, 4))
             row = b.gep(_data(context, b, types_[5], Y_), [b.add(b.mul(b.add(i_, ir.Constant(i_.type, j)), width), c)])
-            _masked_store(b, b.fadd(y_v, b.fsub(b.fmul(v, _splat(b, hs[j])), c_v)), row, mask)
+            _masked_store(b, b.fadd(y_v, b.fsub(b.fmul(v, simd.splat(b, hs[j], _LANES)), c_v)), row, mask)
 
         n = b.extract_value(context.make_array(types_[3])(context, b, y_).shape, 0)
         width = b.extract_value(context.make_array(types_[5])(context, b, Y_).shape, 1)  # Y's row length (≥ n)
@@ -261,7 +242,7 @@ def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
 def _advance(typingctx, T, order, h, y, carry):
     """y ← y + v·h as a compensated (Kahan) sum, v = Σ_{k≥1} T[k] h^(k−1) (``_emit_horner``): the bits lost in the
     additions carried in ``carry``. Returns whether every new component is finite."""
-    if not (_arrays(T, y, carry) and all(a.layout == "C" for a in (T, y, carry))):
+    if not simd.vector_arrays([T, y, carry]):
         return None
     sig = types.boolean(T, order, types.float64, y, carry)
 
@@ -279,7 +260,7 @@ def _advance(typingctx, T, order, h, y, carry):
             mask = _lanes_in(b, c, n)
             y_at, c_at = (b.gep(_data(context, b, types_[a], args[a]), [c]) for a in (3, 4))
             y_v = _masked_load(b, y_at, mask)
-            inc = b.fsub(b.fmul(v, _splat(b, h_)), _masked_load(b, c_at, mask))
+            inc = b.fsub(b.fmul(v, simd.splat(b, h_, _LANES)), _masked_load(b, c_at, mask))
             total = b.fadd(y_v, inc)
             _masked_store(b, b.fsub(b.fsub(total, y_v), inc), c_at, mask)
             _masked_store(b, total, y_at, mask)

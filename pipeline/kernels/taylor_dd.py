@@ -21,11 +21,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from llvmlite import ir
 from numba import types
-from numba.core import cgutils
 from numba.extending import intrinsic
 
+from gyrolab.kernels import simd
 from gyrolab.kernels.compiler import inline_kernel, kernel
 from gyrolab.kernels.double_double import dd_add, dd_mul, two_sum
 from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, _norm_row, order_for, step_size
@@ -51,17 +50,7 @@ def _horner(Th, Tl, order, hh, hl, vh, vl):
 def _call_generated(typingctx, address, t, order, Th, Tl, S, p):
     """Call ``void f(double t, int64 order, double* Th, double* Tl, double* S, double* p)`` at ``address``: a traced
     model's generated double-double series (``series_dd``)."""
-    sig = types.void(types.int64, types.float64, types.int64, Th, Tl, S, p)
-
-    def codegen(context, builder, signature, args):
-        double_ptr = ir.DoubleType().as_pointer()
-        fnty = ir.FunctionType(ir.VoidType(), [ir.DoubleType(), ir.IntType(64)] + [double_ptr] * 4)
-        data = [builder.bitcast(cgutils.create_struct_proxy(ty)(context, builder, value=v).data, double_ptr)
-                for ty, v in zip(signature.args[3:], args[3:])]
-        builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [args[1], args[2], *data])
-        return context.get_dummy_value()
-
-    return sig, codegen
+    return types.void(types.int64, types.float64, types.int64, Th, Tl, S, p), simd.call_address
 
 
 @kernel

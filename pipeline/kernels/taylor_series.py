@@ -53,10 +53,10 @@ from numba.extending import intrinsic
 
 from gyrolab.kernels import simd
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before the decorators)
-from gyrolab.kernels.expression import Expr, binary_power, generated_module
+from gyrolab.kernels.expression import BINARY, UNARY, Expr, binary_power, generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import Model, traced_model
-from gyrolab.kernels.recurrences import AUXILIARY, Functions
+from gyrolab.kernels.recurrences import Functions, work_columns
 
 ZERO, ONE, MINUS_ONE = "0.0", "1.0", "-1.0"
 #: lanes of the widest vector the series uses (AVX-512's; an AVX2 CPU runs each as two)
@@ -91,9 +91,6 @@ class _Numbers:
             self.names[expr] = f"c{len(self.names)}"
             self.lines.append(f"{self.names[expr]} = {expr}")
         return self.names[expr]
-
-    def param(self, index: int) -> str:
-        return self._local(f"p[{int(index)}]")
 
     def neg(self, a: str) -> str:
         return {ZERO: ZERO, ONE: MINUS_ONE, MINUS_ONE: ONE}.get(a) or self._local(f"-{a}")
@@ -156,12 +153,8 @@ class _Series:
         self.columns: list[int] = []  # its own columns of W (functions: the series and auxiliaries)
 
 
-# the same of numbers (folded into ``_Numbers``)
-_NUMBER_FUNCTIONS = {"sqrt": "math.sqrt({0})", "exp": "math.exp({0})", "log": "math.log({0})",
-                     "sin": "math.sin({0})", "cos": "math.cos({0})", "tan": "math.tan({0})",
-                     "tanh": "math.tanh({0})", "arctan": "math.atan({0})", "abs": "abs({0})",
-                     "arctan2": "math.atan2({0}, {1})", "pow": "{0} ** {1}", "ipow": "{0} ** {1}"}
-
+# the functions of numbers (folded into ``_Numbers``)
+_NUMBER_FUNCTIONS = {**UNARY, **BINARY, "pow": "{0} ** {1}", "ipow": "{0} ** {1}"}
 
 
 class _Program:
@@ -185,9 +178,6 @@ class _Program:
 
     # ---- values as linear combinations of series
 
-    def _state(self, index: int) -> _Lin:
-        return self._make("y", (), index, depth=0)
-
     def _make(self, op: str, operands: tuple[_Lin, ...], extra: Any, depth: int | None = None,
               pair: str | None = None) -> _Lin:
         """The series ``op`` of ``operands`` (one per distinct op, operands and extra), as a value."""
@@ -195,7 +185,7 @@ class _Program:
         key = (op, ids, extra)
         if key not in self.found:
             if depth is None:
-                depth = 1 + max((self._depth(v) for v in operands), default=0)
+                depth = 1 + max((self.series[i].depth for v in operands for i, _ in v.terms), default=0)
             self.found[key] = len(self.series)
             self.series.append(_Series(op, ids, extra, depth))
             if pair is not None:  # sin and cos: computed together, the cosine the next series
@@ -208,9 +198,6 @@ class _Program:
             self.operand_ids[value.key] = len(self.operands)
             self.operands.append(value)
         return self.operand_ids[value.key]
-
-    def _depth(self, value: _Lin) -> int:
-        return max((self.series[i].depth for i, _ in value.terms), default=0)
 
     def _sum(self, values: list[_Lin], signs: list[int] | None = None) -> _Lin:
         n = self.numbers
@@ -255,11 +242,11 @@ class _Program:
     def _node(self, op: str, a: list[Any]) -> _Lin:
         n = self.numbers
         if op == "y":
-            return self._state(a[0])
+            return self._make("y", (), a[0], depth=0)
         if op == "time":
             return self._make("time", (), None, depth=0)
         if op == "const":
-            return _Lin(n.param(self.first_constant + a[0]))
+            return _Lin(n._local(f"p[{int(self.first_constant + a[0])}]"))
         if op == "add":
             return self._sum(a)
         if op == "sub":
@@ -381,19 +368,8 @@ def layout(program: dict) -> tuple[dict[tuple, int], int]:
             column[("L", d, g)] = width
             column[("R", d, g)] = width + _padded(len(products))
             width += 2 * _padded(len(products))
-    for i, (op, args, _, _) in enumerate(program["series"]):
-        if op in ("y", "time", "cos", "mul"):
-            continue
-        for u in args:
-            if ("u", u) not in column:
-                column[("u", u)] = width
-                width += 1
-        column[("f", i, 0)] = width
-        width += 1
-        if op == "sin" or op in AUXILIARY:
-            column[("f", i, 1)] = width
-            width += 1
-    return column, max(width, 1)
+    functions = work_columns(program["series"], ("y", "time", "cos", "mul"), width)
+    return {**column, **functions}, max(width + len(functions), 1)
 
 
 def source(program: dict) -> str:
@@ -724,12 +700,11 @@ def _call(typingctx, address, t, order, size, Y, p):
 
     def codegen(context, builder, signature, args):
         b = builder
-        address_, t_, order_, size_, Y_, p_ = args
+        address_, t_, order_, size_ = args[:4]
         double, i64 = ir.DoubleType(), ir.IntType(64)
         double_ptr, byte_ptr = double.as_pointer(), ir.IntType(8).as_pointer()
         fnty = ir.FunctionType(ir.VoidType(), [double, i64, double_ptr, double_ptr, double_ptr])
-        y, pp = [b.bitcast(cgutils.create_struct_proxy(ty)(context, b, value=v).data, double_ptr)
-                 for ty, v in ((signature.args[4], Y_), (signature.args[5], p_))]
+        y, pp = (simd.array_data(context, b, signature.args[a], args[a]) for a in (4, 5))
         # stacksave/stackrestore: the stack's allocation is freed at once, not when the calling kernel returns
         save = cgutils.get_or_insert_function(b.module, ir.FunctionType(byte_ptr, []), "llvm.stacksave")
         restore = cgutils.get_or_insert_function(b.module, ir.FunctionType(ir.VoidType(), [byte_ptr]),

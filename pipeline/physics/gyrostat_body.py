@@ -22,10 +22,9 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.physics.body import ModelUnits, _check_inertia, _netcdf_safe, _satisfies_triangle
+from gyrolab.physics.body import UNITS, ModelUnits, _check_inertia, _netcdf_safe, _satisfies_triangle
 from gyrolab.errors import ConfigError, as_number, as_vector3, choices
 
-UNITS = ("si", "nondimensional")
 KEYS = ("units", "inertia", "gyrostatic_momentum", "orbit_rate", "allow_nonphysical")
 
 

@@ -111,10 +111,6 @@ class LindstedtSeries:
         upper = ks >= max(2, len(n) // 2)
         good = upper & (n > 0)
         root = float(np.exp(-np.polyfit(ks[good], np.log(n[good]), 1)[0])) if good.sum() >= 2 else np.nan
-        # ratios two orders apart: with a fixed tilt p, q carry the odd powers and r, γ the even ones and Ω is even
-        # ((ε, p1, q1) → (−ε, −p1, −q1) symmetry), so consecutive ratios alternate
-        domb = _domb_sykes(self.omega)
-        domb_norm = _domb_sykes(n)
         pade = np.nan
         w = self.omega
         even = bool(np.all(np.abs(w[1::2]) <= 1e-14 * np.max(np.abs(w))))
@@ -132,7 +128,9 @@ class LindstedtSeries:
                 pade = float(np.min(np.abs(poles)) ** (1 / power)) if poles.size else np.nan
             except (np.linalg.LinAlgError, ValueError):
                 pade = np.nan
-        return {"root": root, "domb_sykes": domb, "domb_sykes_norm": domb_norm, "pade": pade}
+        # Domb–Sykes by ratios two orders apart: with a fixed tilt p, q carry the odd powers and r, γ the even ones
+        # and Ω is even ((ε, p1, q1) → (−ε, −p1, −q1) symmetry), so consecutive ratios alternate
+        return {"root": root, "domb_sykes": _domb_sykes(self.omega), "domb_sykes_norm": _domb_sykes(n), "pade": pade}
 
     def radius_of_convergence(self) -> float:
         """The median of the root-test, Domb–Sykes (Ω) and Padé estimates: robust to one of them failing.

@@ -53,7 +53,7 @@ def test_a_lane_does_not_depend_on_its_neighbours(integrator):
     lanes = LANE_KERNELS[integrator]
     count = 8 * lanes.LANES * numba.get_num_threads()  # tasks of more trajectories than lanes: refills
     refilled = lanes.LANES + 1
-    assert lanes.task_size(count) > refilled
+    assert batch_dop853.task_size(count, lanes.LANES) > refilled
     probe = _starts(scene, 1, seed=1)
     easy = _starts(scene, count - 1, seed=2, scale=0.01)
     hard = _starts(scene, count - 1, seed=3)
