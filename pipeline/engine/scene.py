@@ -28,6 +28,7 @@ from gyrolab.engine.force_guard import GuardedRhs, plugin_forces
 from gyrolab.engine.progress import Progress
 from gyrolab.engine.unread import ACCURACY_IGNORED_ATTRIBUTE, ignored_accuracy
 from gyrolab.errors import ConfigError, GyrolabError, as_number, require_finite, shorten
+from gyrolab.kernels.model import python_rhs
 from gyrolab.output.dataset import build_dataset, scene_attributes
 
 log = logging.getLogger(__name__)
@@ -140,10 +141,11 @@ class Scene:
 
     @cached_property
     def rhs(self) -> Callable[[float, np.ndarray], np.ndarray]:
-        """The Python right-hand side the integrator calls: the system's own, guarded when a third-party force
-        takes part (``gyrolab.engine.force_guard``: its torque's faults become one sentence naming it)."""
+        """The Python right-hand side the integrator calls: the system's own generated as Python on floats
+        (``kernels.model.python_rhs``: the same numbers, ~5× faster), or, when a third-party force takes part, the
+        system's own guarded (``gyrolab.engine.force_guard``: its torque's faults become one sentence naming it)."""
         plugins = plugin_forces(self.system.forces)
-        return GuardedRhs(self.system, plugins) if plugins else self.system.rhs
+        return GuardedRhs(self.system, plugins) if plugins else python_rhs(self.system)
 
     @cached_property
     def fastest_rate(self) -> float | None:
