@@ -145,7 +145,10 @@ class Scene:
         (``kernels.model.python_rhs``: the same numbers, ~5× faster), or, when a third-party force takes part, the
         system's own guarded (``gyrolab.engine.force_guard``: its torque's faults become one sentence naming it)."""
         plugins = plugin_forces(self.system.forces)
-        return GuardedRhs(self.system, plugins) if plugins else python_rhs(self.system)
+        if plugins:
+            return GuardedRhs(self.system, plugins)
+        # an integrator of the compiled model calls its kernels, not this: no trace (~0.2 ms) for it
+        return self.system.rhs if self.compiled is not None else python_rhs(self.system)
 
     @cached_property
     def fastest_rate(self) -> float | None:
