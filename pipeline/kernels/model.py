@@ -208,7 +208,8 @@ def python_rhs(system: Any) -> Callable[[Any, np.ndarray], np.ndarray]:
     source = model.python_source()
     if source not in _PYTHON:
         namespace = {"math": math, "_array": np.array}
-        exec(builtins.compile(source, f"<gyrolab rhs of {model.what}>", "exec"), namespace)  # (this module has a compile)
+        # the source holds generated names and operators only, no text of a config; builtins': this module has a compile
+        exec(builtins.compile(source, f"<gyrolab rhs of {model.what}>", "exec"), namespace)
         _PYTHON[source] = namespace["make"]
     return _PYTHON[source](tuple(model.constants), system.rhs)
 
