@@ -100,15 +100,17 @@ class Model:
 
     def python_source(self) -> str:
         """``python_rhs``'s source: a factory binding the numbers (c) and the numpy fallback, depending on the form
-        only. Python raises where numpy gives inf or nan (1/0, math.sqrt(−1), an overflowing power): the system's
-        numpy right-hand side then answers, so the two agree there too."""
+        only. Python raises where numpy gives inf or nan (1/0, math.sqrt(−1), an overflowing power; (−8.0) ** (1/3) is
+        complex, which a float array refuses): the system's numpy right-hand side then answers, so the two agree there
+        too."""
         body = self._statements("y{}", "c{}".format, "t", "r{}")
         numbers = f"    {_names('c', len(self.constants))}= c\n" if self.constants else ""
         return (f"def make(c, fallback):\n{numbers}\n    def rhs(t, y):\n        try:\n"
                 f"            {_names('y', self.size)}= y.tolist()\n"
                 + "".join(f"            {line}\n" for line in body)
-                + "        except (ArithmeticError, ValueError):\n            return fallback(t, y)\n"
-                f"        return _array(({_names('r', len(self.rates))}))\n    return rhs\n")
+                + f"            return _array(({_names('r', len(self.rates))}), dtype=float)\n"
+                "        except (ArithmeticError, TypeError, ValueError):\n            return fallback(t, y)\n"
+                "    return rhs\n")
 
     def block_source(self, first_constant: int = TRACED_FIRST_CONSTANT) -> str:
         """The right-hand side of ``count`` trajectories stored by columns (``stride`` lanes a row: Y[i, j], the

@@ -41,19 +41,23 @@ def test_the_python_right_hand_side_is_the_systems_own_bit_for_bit(overrides):
 
 
 class _Toy:
-    name, state_size = "toy", 2
+    name, state_size = "toy", 3
 
     def rhs(self, t, y):
-        return np.array([1.0 / y[0], np.sqrt(y[1]) * t])
+        return np.array([1.0 / y[0], np.sqrt(y[1]) * t, y[0] ** y[1]])
 
 
 def test_the_python_right_hand_side_answers_as_numpy_where_python_raises():
-    """1/0 and √−1 raise in Python and give inf and nan in numpy: the numpy right-hand side answers there."""
+    """1/0 and √−1 raise in Python and (−8) ** (1/3) is complex, where numpy gives inf and nan: the numpy right-hand
+    side answers there."""
     toy = _Toy()
     fast = python_rhs(toy)
-    np.testing.assert_array_equal(fast(2.0, np.array([4.0, 9.0])), [0.25, 6.0])
+    np.testing.assert_array_equal(fast(2.0, np.array([4.0, 9.0, 0.5])), [0.25, 6.0, 4.0 ** 9.0])
     with np.errstate(all="ignore"):
-        np.testing.assert_array_equal(fast(2.0, np.array([0.0, -1.0])), toy.rhs(2.0, np.array([0.0, -1.0])))
+        for y in ([0.0, -1.0, 2.0], [-8.0, 1 / 3, 0.0]):
+            ours, numpy = fast(2.0, np.array(y)), toy.rhs(2.0, np.array(y))
+            assert ours.dtype == float and not np.isfinite(ours).all()
+            np.testing.assert_array_equal(ours, numpy)
     toy.rhs = lambda t, y: np.array([y[0] if y[1] > 0 else -y[0], 0.0])  # a branch on the state: not traceable
     assert python_rhs(toy) == toy.rhs
 
