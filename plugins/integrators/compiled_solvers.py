@@ -24,43 +24,43 @@ from gyrolab.plugins.integrators.tolerances import Tolerances
 from gyrolab.plugins.integrators.step_guard import check_step, compiled_rhs
 
 CHUNKS = 50  # progress reports per run at least (when the run has that many output intervals)
-PACE = 1.0  # seconds of compiled work between two returns to Python (progress reports), about
+PACE = 1.0  # seconds of an adaptive kernel's work between two returns to Python (progress reports), about
+#: a fixed-step method's steps per call into its kernel (~0.1–1 s of work). Counted, not timed: where a run is cut
+#: between calls must not depend on the machine's speed, since lie_poisson rebuilds its momentum Iω from ω at each
+#: call, a change in the last bit (timed chunks made two runs of one config differ at 1e-14)
+STEPS_PER_CALL = 2 ** 20
 
 
 class _Chunks:
-    """Output-index ranges ``(first, stop)`` for the compiled kernels, each taking about ``PACE`` seconds.
+    """Output-index ranges ``(first, stop)`` for the compiled kernels.
 
-    The first range is 1/CHUNKS of the outputs (one output for fixed-step methods, ``steps`` given,
-    whose single output interval may already be long); later ones follow the measured speed, so a
-    long run reports progress about every ``PACE`` seconds and a short one costs only a few calls
-    into the kernel (each call has a fixed cost of some microseconds, which matters for millisecond
-    runs). Fixed-step methods never take more than 1/CHUNKS of the outputs at once and learn
-    when one output interval alone is too long (``step_budget``): that interval is then advanced
+    Adaptive kernels (no ``steps``) resume exactly where a call ended: their first range is 1/CHUNKS of the outputs,
+    later ones follow the measured speed, so a long run reports progress about every ``PACE`` seconds and a short
+    one costs only a few calls into the kernel (each call has a fixed cost of some microseconds, which matters for
+    millisecond runs). Fixed-step methods (``steps`` per output interval given) take at most 1/CHUNKS of the outputs
+    and ``step_budget`` steps at once, at least one interval; an interval alone longer than the budget is advanced
     in pieces (``_interval_in_pieces``).
     """
 
+    step_budget = STEPS_PER_CALL
+
     def __init__(self, n_out: int, steps: np.ndarray | None = None) -> None:
         self.n_out, self.steps = n_out, steps
-        share = max(1, math.ceil((n_out - 1) / CHUNKS))
-        self.cap = share if steps is not None else n_out
-        self.size = 1 if steps is not None else share
-        self.step_rate = 1e5  # steps per second, until measured
+        self.size = max(1, math.ceil((n_out - 1) / CHUNKS))
 
     def __iter__(self):
         first = 1
         while first < self.n_out:
-            stop = min(first + self.size, self.n_out)
+            size = self.size
+            if self.steps is not None:
+                work = np.cumsum(self.steps[first - 1:first - 1 + size])
+                size = max(1, int(np.searchsorted(work, self.step_budget, side="right")))
+            stop = min(first + size, self.n_out)
             tic = time.perf_counter()
             yield first, stop
-            took = max(time.perf_counter() - tic, 1e-6)
-            if self.steps is not None:
-                self.step_rate = max(1e3, float(self.steps[first - 1:stop - 1].sum()) / took)
-            self.size = int(min(self.cap, max(1, (stop - first) * PACE / took)))
+            if self.steps is None:
+                self.size = int(max(1, (stop - first) * PACE / max(time.perf_counter() - tic, 1e-6)))
             first = stop
-
-    @property
-    def step_budget(self) -> int:
-        return max(1000, int(self.step_rate * PACE))
 
 
 def _interval_in_pieces(advance: Any, t0: float, t1: float, m: int, budget: int,

@@ -180,6 +180,30 @@ def test_taylor_steps_do_not_depend_on_how_the_run_is_cut_into_kernel_calls():
         np.testing.assert_array_equal(pieces, whole)
 
 
+@pytest.mark.parametrize("name", ["lie_poisson", "rk4_numba"])
+def test_a_fixed_step_run_does_not_depend_on_the_machines_speed(name, monkeypatch):
+    """Where a fixed-step run is cut between calls into its kernel is counted in steps, not timed: lie_poisson
+    rebuilds its momentum Iω from ω at each call, so a slower machine (here a clock at 10 s a reading) cutting it
+    elsewhere gave other last bits (two runs of one config differed at 1e-14)."""
+    from gyrolab.engine.progress import Progress
+    from gyrolab.plugins.integrators import compiled_solvers
+
+    scene = compose_scene([f"integrator={name}", "time.end=20", "time.n_output=401"])
+    args = (scene.rhs, scene.times, scene.system.initial_state(), Progress(name, 0.0, 20.0), scene.compiled)
+    usual = scene.integrator.integrate(*args).y
+
+    class SlowClock:
+        now = 0.0
+
+        @classmethod
+        def perf_counter(cls):
+            cls.now += 10.0
+            return cls.now
+
+    monkeypatch.setattr(compiled_solvers, "time", SlowClock)
+    np.testing.assert_array_equal(scene.integrator.integrate(*args).y, usual)
+
+
 @pytest.mark.parametrize("direction, size", [("[0.0,0.0,1.0]", 6), ("[0.6,0.0,0.8]", 9)])  # (α: fixed X needed)
 def test_a_scene_with_a_plugin_traces_every_force_and_its_compiled_rhs_is_the_python_rhs(monkeypatch, direction,
                                                                                           size):
