@@ -1,12 +1,10 @@
-"""scipy's DOP853 stepper in numpy, for the default integrator, without importing ``scipy.integrate``.
+"""scipy's DOP853 stepper in numpy, for ``dop853``: the default run need not import ``scipy.integrate``.
 
-``scipy.integrate`` imports all of ``scipy.optimize`` and ``scipy.special`` on first use: 0.36–0.43 CPU s, more than
-the default run's whole integration (docs/performance.md, "The default run"). ``dop853`` steps with this copy of
-scipy's ``DOP853`` (scipy 1.17, ``scipy/integrate/_ivp/rk.py`` and ``common.select_initial_step``, BSD-3-Clause,
-Copyright (c) 2001-2002 Enthought, Inc. 2003, SciPy Developers): the same operations in the same order, so that both
-take the same steps and give the same numbers bit for bit (tests/plugins/test_dop853_stepper.py runs them side by
-side). It keeps only the part of scipy's ``OdeSolver`` interface that ``ScipySolver.integrate`` uses. The tableau is
-the compiled DOP853's (``gyrolab.kernels.dop853_tableau``), itself scipy's numbers.
+That import pulls in ``scipy.optimize`` and ``scipy.special`` (0.36–0.43 CPU s, more than the default run's whole
+integration). This is scipy 1.17's ``DOP853`` and ``select_initial_step`` (``scipy/integrate/_ivp``, BSD-3-Clause,
+Copyright (c) 2001-2002 Enthought, Inc. 2003, SciPy Developers), the same operations in the same order: the same steps
+and numbers bit for bit (tests/plugins/test_dop853_stepper.py runs both side by side), with the part of scipy's
+``OdeSolver`` interface that ``ScipySolver.integrate`` uses. The tableau is the compiled DOP853's, scipy's numbers.
 """
 
 from __future__ import annotations
