@@ -274,8 +274,26 @@ SAME_WORK = "heyoka, auto's work"
 TARGET_TIGHT_BELOW, TARGET, TARGET_TIGHT, NO_ESTIMATE_TARGET = 3e-12, 1.5, 3.0, 1.0
 
 
+#: issue 32, item 3: auto's whole Scene.run() at ε = SCIPY_EPS at least SCIPY_TARGET× faster than what a researcher
+#: writes (scipy's DOP853 through solve_ivp, ``plain_numpy_rhs``) at its cheapest tolerance of SCIPY_TOLS reaching ε
+SCIPY_EPS, SCIPY_TARGET, SCIPY_TOLS = 1e-8, 250.0, (1e-9, 10 ** -9.5, 1e-10, 10 ** -10.5, 1e-11, 1e-12)
+
+
 def target(eps):
     return TARGET_TIGHT if eps < TARGET_TIGHT_BELOW else TARGET
+
+
+def scipy_baseline(reference, rounds=3):
+    """(CPU s, tolerance, final error) of scipy's DOP853 on ``plain_numpy_rhs`` at its cheapest tolerance of
+    SCIPY_TOLS reaching SCIPY_EPS (each timed ``rounds`` times, minimum: ~1–3 s a run), None when none does."""
+    for tol in SCIPY_TOLS:  # loosest first: the first that reaches ε is the cheapest
+        def call(tol=tol):
+            return solve_ivp(plain_numpy_rhs, (0, T_END), Y0, method="DOP853", rtol=tol, atol=tol, t_eval=GRID).y[:, -1]
+        best = interleaved({tol: call}, rounds)[tol]
+        error = float(np.max(np.abs(best[1] - reference)))
+        if error <= SCIPY_EPS:
+            return best[0], tol, error
+    return None
 
 
 def passes(ratios, goal=target):
@@ -337,6 +355,13 @@ def scene_run_only(reference, rounds):
             bare_ratios[eps] = MEDIANS[bare_key] / MEDIANS[peer] if errors[bare_key] <= eps else float("inf")
     print_verdict(ratios)
     print_verdict(bare_ratios, "auto Scene.run(), output.error_estimate=false", lambda eps: NO_ESTIMATE_TARGET)
+    scipy = scipy_baseline(reference)
+    speedup = scipy[0] / MEDIANS[("auto Scene.run()", SCIPY_EPS)] if scipy is not None else float("nan")
+    scipy_verdict = "PASS" if speedup >= SCIPY_TARGET else "FAIL"
+    if scipy is not None:
+        print(f"\nscipy DOP853 (solve_ivp, plain numpy right-hand side) reaching ε = {SCIPY_EPS:g}: {scipy[0]:.2f} s "
+              f"at tol {scipy[1]:.2g} (final error {scipy[2]:.1e}); auto's Scene.run() is {speedup:.0f}× faster "
+              f"(target ≥ {SCIPY_TARGET:g}×): {scipy_verdict}")
     if rows:
         write_results("perf_reference_scene_run", {"rounds": rounds, "ratios": {f"{e:.0e}": r for e, r in ratios.items()}},
                       {"scene_run_verdict": {
@@ -363,7 +388,10 @@ def scene_run_only(reference, rounds):
                                ["`auto`'s whole `Scene.run()` / heyoka doing the same work (its run, the companion "
                                 "run of the error estimate, the variational run of the chaos measure), worst over ε",
                                 f"{max(same_ratios.values()):.2f}×", "(no target: the like-for-like comparison)",
-                                "ahead" if max(same_ratios.values()) <= 1.0 else "behind"]])
+                                "ahead" if max(same_ratios.values()) <= 1.0 else "behind"],
+                               [f"scipy's DOP853 (`solve_ivp`, plain numpy right-hand side) / `auto`'s whole "
+                                f"`Scene.run()`, ε = {SCIPY_EPS:g}", f"{speedup:.0f}×", f"≥ {SCIPY_TARGET:g}×",
+                                scipy_verdict]])
 
 
 def run_breakdown(rounds, quick):
