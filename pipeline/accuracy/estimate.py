@@ -159,8 +159,8 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
         # a double companion may share the run's round-off: a second one at another order (independent round-off)
         # with 1/I, the one rounded parameter every double run shares, moved by its rounding, measures that by their
         # disagreement; ROUNDOFF_MARGIN times below the first's measurement, it stands (~1 ms, not double-double's 17)
-        first = pick.double_first[0].integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
-        second = pick.double_first[1].integrate(scene.system.rhs, scene.times, y0, None,
+        first = pick.double_first[0].integrate(scene.rhs, scene.times, y0, None, companion_model).y
+        second = pick.double_first[1].integrate(scene.rhs, scene.times, y0, None,
                                                 rounding_moved(companion_model)).y  # (kernels.model's)
         difference = np.abs(y - first)
         roundoff = float(np.max(np.abs(first - second)))
@@ -176,7 +176,7 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
         how = f"{how}: two double companions disagree by {roundoff:.2g}, round-off not small against {measured:.2g}"
         if refusal:  # a plugin torque has no double-double kernel
             return _unavailable(f"{how}, and the double-double companion {refusal}")
-    other = pick.integrator.integrate(scene.system.rhs, scene.times, y0, None, companion_model).y
+    other = pick.integrator.integrate(scene.rhs, scene.times, y0, None, companion_model).y
     spent = time.perf_counter() - start
     attrs = {"error_estimate_method": how, "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
     return Comparison(pick.scale * np.abs(y - other), attrs, y)
