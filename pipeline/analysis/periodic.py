@@ -96,9 +96,7 @@ def _flow(inertia, U, N, y0, phi0, t_end, order, tol):
             if nk > 0:
                 h = min(h, (tol * scale / nk) ** (1.0 / kk))
         h = 0.9 * h
-        if not h < np.inf:
-            h = t_end - t
-        if t + h >= t_end:
+        if not h < np.inf or t + h >= t_end:  # the last two coefficients vanish, or the step passes t_end
             h = t_end - t
         w, g, dw, dg = W[order], G[order], dW[order], dG[order]
         for kk in range(order - 1, -1, -1):  # Horner, every component at once
