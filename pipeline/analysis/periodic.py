@@ -96,26 +96,13 @@ def _flow(inertia, U, N, y0, phi0, t_end, order, tol):
             if nk > 0:
                 h = min(h, (tol * scale / nk) ** (1.0 / kk))
         h = 0.9 * h
-        if not h < np.inf:
+        if not h < np.inf or t + h >= t_end:  # the last two coefficients vanish, or the step passes t_end
             h = t_end - t
-        if t + h >= t_end:
-            h = t_end - t
-        for i in range(3):
-            vw = W[order, i]
-            vg = G[order, i]
-            for kk in range(order - 1, -1, -1):
-                vw = vw * h + W[kk, i]
-                vg = vg * h + G[kk, i]
-            y[i] = vw
-            y[3 + i] = vg
-            for m in range(n_tangent):
-                vw = dW[order, m, i]
-                vg = dG[order, m, i]
-                for kk in range(order - 1, -1, -1):
-                    vw = vw * h + dW[kk, m, i]
-                    vg = vg * h + dG[kk, m, i]
-                phi[i, m] = vw
-                phi[3 + i, m] = vg
+        w, g, dw, dg = W[order], G[order], dW[order], dG[order]
+        for kk in range(order - 1, -1, -1):  # Horner, every component at once
+            w, g, dw, dg = w * h + W[kk], g * h + G[kk], dw * h + dW[kk], dg * h + dG[kk]
+        y[0:3], y[3:6] = w, g
+        phi[0:3], phi[3:6] = dw.T, dg.T
         if not np.all(np.isfinite(y)):
             return y, phi, -1
         t += h

@@ -16,11 +16,10 @@ The series is generated from the model's equations, as the single-trajectory ker
 them to Cauchy products of linear combinations of series and functions of series; ``_emit_series`` writes that
 program's recurrences as LLVM IR over ``<LANES x double>``, ``_Functions`` those of the functions and divisions):
 one generated ``cfunc`` per form (cached on disk), with the numbers of the equations per lane in Q (``constants``,
-run when a lane takes a trajectory). Every
-product's Cauchy sum runs over pairs (j, k − j): the operands' rows at j and k − j, loaded once, serve two fused
-multiply-adds of every product that reads them, the pair with the newest coefficient last (the next order's older
-terms overlap its computation). The work arrays start on 64-byte boundaries (``_rows``): numba aligns to 32, and a
-512-bit load across two cache lines costs two.
+run when a lane takes a trajectory). Every product's Cauchy sum runs over pairs (j, k − j): the operands' rows at j
+and k − j, loaded once, serve two fused multiply-adds of every product that reads them, the pair with the newest
+coefficient last (the next order's older terms overlap its computation). The work arrays start on 64-byte
+boundaries (``_rows``): numba aligns to 32, and a 512-bit load across two cache lines costs two.
 
 Why LLVM IR: written as numba loops over lanes, the Cauchy sums are reductions whose accumulators LLVM keeps in
 memory (numba does not run LLVM's SLP vectoriser); such a kernel was 1.2–2× slower than one trajectory per

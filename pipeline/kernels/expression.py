@@ -30,6 +30,8 @@ from typing import Any
 
 import numpy as np
 
+from gyrolab.physics.vectors import cross
+
 log = logging.getLogger(__name__)
 
 #: the generated sources' spelling of each operation of one and of two arguments (the generators' shared table)
@@ -158,10 +160,6 @@ def symbols(graph: Graph, op: str, count: int, first: int = 0) -> np.ndarray:
     for k in range(count):
         out[k] = graph.add(op, first + k) if op == "y" else graph.add(op)
     return out
-
-
-def cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    return np.array([u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]], dtype=object)
 
 
 def check_torques(forces: list[Any]) -> None:

@@ -1,17 +1,11 @@
 """The compiled models integrator kernels can call.
 
-numba caches a kernel only if the functions it calls are module globals
-(a function passed as an argument or closed over is recompiled in every
-process), hence calls through addresses instead of callbacks.
-
-Every model (the fixed point with its built-in or plugin torques, the orbiting gyrostat, a plugin system) is
-compiled from its traced equations (``model``): one form, whose right-hand side is one call of
-the generated kernel through its address (stored in ``p``) and whose Taylor coefficients are one call of the
-generated series kernel (``taylor_series``): the integrator kernels, cached once, serve every model.
-Measured (benchmarks/plugin_speed.py): the indirect call itself costs little.
-
-With one form there is nothing to dispatch: the kernels take the parameter array only, and the right-hand side
-and the series calls are inlined into each of them.
+Every model (the fixed point with its built-in or plugin torques, the orbiting gyrostat, a plugin system) is compiled
+from its traced equations (``model``): its right-hand side is one call of the generated kernel through its address
+(stored in ``p``), its Taylor coefficients one call of the generated series kernel (``taylor_series``). numba caches
+a kernel only if the functions it calls are module globals (a function passed as an argument or closed over is
+recompiled in every process), hence calls through addresses, not callbacks: the integrator kernels, cached once,
+take the parameter array only and serve every model (the indirect call costs little: benchmarks/plugin_speed.py).
 """
 
 from __future__ import annotations

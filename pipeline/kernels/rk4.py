@@ -76,33 +76,23 @@ def run_batch_blocks(block, P, t_out, steps_per_interval, Y0, Y):
             y[:, j] = Y0[j0 + j]
             p[:, j] = P[j0 + j]
             Y[j0 + j, 0] = Y0[j0 + j]
-        k1, k2, k3 = np.empty((n, BLOCK)), np.empty((n, BLOCK)), np.empty((n, BLOCK))
-        k4, tmp = np.empty((n, BLOCK)), np.empty((n, BLOCK))
+        K, tmp = np.empty((4, n, BLOCK)), np.empty((n, BLOCK))
         ts = np.empty(BLOCK)  # the stage's time (``run``'s), in every lane
         for i in range(1, t_out.size):
             steps = steps_per_interval[i - 1]
             h = (t_out[i] - t_out[i - 1]) / steps
             for step in range(steps):
                 t = t_out[i - 1] + step * h
-                ts[:] = t + NODES[0] * h
-                call_block(block, ts, y, p, k1, m)
+                for s in range(4):  # ``_advance``'s stages, across the block's lanes
+                    if s > 0:
+                        a = h if s == 3 else 0.5 * h
+                        for c in range(n):
+                            for j in range(m):
+                                tmp[c, j] = y[c, j] + a * K[s - 1, c, j]
+                    ts[:] = t + NODES[s] * h
+                    call_block(block, ts, y if s == 0 else tmp, p, K[s], m)
                 for c in range(n):
                     for j in range(m):
-                        tmp[c, j] = y[c, j] + 0.5 * h * k1[c, j]
-                ts[:] = t + NODES[1] * h
-                call_block(block, ts, tmp, p, k2, m)
-                for c in range(n):
-                    for j in range(m):
-                        tmp[c, j] = y[c, j] + 0.5 * h * k2[c, j]
-                ts[:] = t + NODES[2] * h
-                call_block(block, ts, tmp, p, k3, m)
-                for c in range(n):
-                    for j in range(m):
-                        tmp[c, j] = y[c, j] + h * k3[c, j]
-                ts[:] = t + NODES[3] * h
-                call_block(block, ts, tmp, p, k4, m)
-                for c in range(n):
-                    for j in range(m):
-                        y[c, j] += (h / 6.0) * (k1[c, j] + 2.0 * k2[c, j] + 2.0 * k3[c, j] + k4[c, j])
+                        y[c, j] += (h / 6.0) * (K[0, c, j] + 2.0 * K[1, c, j] + 2.0 * K[2, c, j] + K[3, c, j])
             for j in range(m):
                 Y[j0 + j, i] = y[:, j]

@@ -1,23 +1,16 @@
 """Taylor series method of high order with automatic step size (Jorba & Zou, Exp. Math. 14, 2005).
 
-The right-hand sides are quadratic, so the Taylor coefficients come from
-Cauchy products (``models.taylor_coefficients``). The order follows from the
-tolerance (``order_for``: Jorba and Zou's p = ⌈−ln(tol)/2 + 1⌉ minimises the series'
-work per unit time when the coefficients decay geometrically; counting a step's other
-work too, the cheapest order is a few higher) and the step from the last
-two coefficients, h = min_k (tol·max(1, ‖y‖)/‖y_k‖)^(1/k) for k = p−1, p,
-times Jorba and Zou's safety factor exp(−0.7/(p−1)). The series is the dense
-output: every output time inside a step is one Horner evaluation, no extra step.
+The coefficients come from the model's generated series (``taylor_series``, one kernel per form of the equations),
+so every model takes the same step code. The order follows from the tolerance (``order_for``: Jorba and Zou's
+p = ⌈−ln(tol)/2 + 1⌉ minimises the series' work per unit time; counting a step's other work too, the cheapest order
+is a few higher) and the step from the last two coefficients, h = min_k (tol·max(1, ‖y‖)/‖y_k‖)^(1/k) for
+k = p−1, p, times Jorba and Zou's safety factor exp(−0.7/(p−1)). The series is the dense output: every output time
+inside a step is one Horner evaluation, no extra step.
 
-The state update y ← y + Σ_{k≥1} y_k h^k is a compensated (Kahan) sum: the low
-bits lost when a small increment is added to an O(1) state are carried to the
-next step, so round-off no longer grows as one ulp of the state per step (the
-floor of the uncompensated update was ~2e-12 over the 3,000 steps of the
-reference scene). Time needs no compensation: the step actually taken is
+The state update y ← y + Σ_{k≥1} y_k h^k is a compensated (Kahan) sum: the low bits lost when a small increment is
+added to an O(1) state are carried to the next step, so round-off does not grow as one ulp of the state per step
+(docs/performance.md, "The Taylor integrator"). Time needs no compensation: the step actually taken is
 h = fl(t + h) − t, exact in floating point, and the state advances by exactly it.
-
-The coefficients come from the model's generated series (``taylor_series``: one kernel per form of the
-equations, the fixed point's included), so every model takes the same step code.
 """
 
 from __future__ import annotations
