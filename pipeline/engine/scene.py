@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
 
@@ -62,6 +62,8 @@ class Scene:
     #: why the config's ``accuracy`` is not read by this scene's integrator, when a config file set it
     #: (``gyrolab.engine.unread``; a given one is refused): recorded in every run dataset as ``accuracy_ignored``
     accuracy_ignored: str | None = None
+    #: the layout of its runs' datasets (``output.dataset``: built once, copied with each run's data)
+    dataset_layout: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     @classmethod
     def from_config(cls, cfg: DictConfig, check: Callable[[System], None] | None = None) -> Scene:

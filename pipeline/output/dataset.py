@@ -46,7 +46,6 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
     variables and attributes to put in while it is assembled (``Scene.run``'s error estimate; cheaper than merging
     into a built dataset). ``integrator``: the one that ran, when not the scene's own (``auto`` run again)."""
     system, integrator = scene.system, integrator or scene.integrator
-    body = system.body
     # each state component contiguous (column-major): the derived variables' arithmetic runs faster, same values
     variables = system.variables(solution.t, np.asfortranarray(solution.y))
     series = {name: variables[name].values for name in system.invariants}
@@ -56,16 +55,33 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
     if add is not None:
         added, added_attrs = add(variables)
         variables.update(added)
-    labels = ["axis"] + [name for name in ("frame_axis",) if any(name in v.dims for v in variables.values())]
-    time = PandasIndex(pd.Index(solution.t), "time")  # given with its index: xarray builds no index for the labels
-    coords = xr.Coordinates({**time.create_variables({"time": xr.Variable("time", solution.t, time_attributes(body))}),
-                             **{name: LABELS.variables[name] for name in labels}},
-                            indexes={"time": time, **{name: LABELS.xindexes[name] for name in labels}})
-    ds = xr.Dataset(variables, coords=coords)
+    ds = _assembled(scene, variables, solution.t)
     before, after = scene.dataset_attributes  # the scene's own, once per scene
     ds.attrs.update({**before, **integrator.attributes(), **solution.stats.attributes(), **after, **added_attrs})
     flag_violated_invariants(ds, system.invariants, integrator.adaptive, series)
     return conform(ds, source=f"run of system {system.name} with integrator {integrator.name}")
+
+
+def _assembled(scene: Scene, variables: dict[str, xr.Variable], t: np.ndarray) -> xr.Dataset:
+    """The dataset of ``variables`` at output times ``t``. xarray's constructor aligns and merges (~0.25 ms on the
+    reference scene): the scene keeps its first result's layout (its data read-only zeros), and a run with the same
+    variables on the same times array copies it with its own data, attributes and encodings (~0.08 ms)."""
+    layout = [(name, v.dims, v.shape, v.dtype) for name, v in variables.items()]
+    kept = scene.dataset_layout
+    if kept is not None and kept[1] is t and kept[0] == layout:
+        ds = kept[2].copy(data={name: v.data for name, v in variables.items()})
+        for name, v in variables.items():
+            ds.variables[name].attrs, ds.variables[name].encoding = v.attrs, v.encoding
+        return ds
+    labels = ["axis"] + [name for name in ("frame_axis",) if any(name in v.dims for v in variables.values())]
+    time = PandasIndex(pd.Index(t), "time")  # given with its index: xarray builds no index for the labels
+    coords = xr.Coordinates({**time.create_variables({"time": xr.Variable("time", t, time_attributes(
+        scene.system.body))}), **{name: LABELS.variables[name] for name in labels}},
+                            indexes={"time": time, **{name: LABELS.xindexes[name] for name in labels}})
+    ds = xr.Dataset(variables, coords=coords)
+    scene.dataset_layout = (layout, t, ds.copy(data={name: np.broadcast_to(np.zeros((), v.dtype), v.shape)
+                                                     for name, v in variables.items()}))
+    return ds
 
 
 def flag_violated_invariants(ds: xr.Dataset, invariants: tuple[str, ...], adaptive: bool,
