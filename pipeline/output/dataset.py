@@ -18,7 +18,7 @@ from gyrolab.compat import install_dask_free_writes
 from gyrolab.contracts.integrator import Integrator, Solution
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.cf import conform, unit_attributes
-from gyrolab.output.invariant_check import max_drift, violated_invariants, violation_sentence
+from gyrolab.output.invariant_check import extremes, max_drift, violated_invariants, violation_sentence
 from gyrolab.output.provenance import provenance
 
 if TYPE_CHECKING:
@@ -48,9 +48,10 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
     system, integrator = scene.system, integrator or scene.integrator
     # each state component contiguous (column-major): the derived variables' arithmetic runs faster, same values
     variables = system.variables(solution.t, np.asfortranarray(solution.y))
-    series = {name: variables[name].values for name in system.invariants}
-    for name, values in series.items():
-        variables[name].attrs["max_abs_drift"] = max_drift(values)
+    invariants = system.invariants
+    found = {name: extremes(variables[name].values) for name in invariants}
+    for name, values in found.items():
+        variables[name].attrs["max_abs_drift"] = max_drift(*values)
     added_attrs: dict[str, Any] = {}
     if add is not None:
         added, added_attrs = add(variables)
@@ -58,7 +59,7 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
     ds = _assembled(scene, variables, solution.t)
     before, after = scene.dataset_attributes  # the scene's own, once per scene
     ds.attrs.update({**before, **integrator.attributes(), **solution.stats.attributes(), **after, **added_attrs})
-    flag_violated_invariants(ds, system.invariants, integrator.adaptive, series)
+    flag_violated_invariants(ds, invariants, integrator.adaptive, found, float(solution.t[-1] - solution.t[0]))
     return conform(ds, source=f"run of system {system.name} with integrator {integrator.name}")
 
 
@@ -85,13 +86,12 @@ def _assembled(scene: Scene, variables: dict[str, xr.Variable], t: np.ndarray) -
 
 
 def flag_violated_invariants(ds: xr.Dataset, invariants: tuple[str, ...], adaptive: bool,
-                             series: dict[str, np.ndarray]) -> None:
+                             seen: dict[str, tuple[float, float, float]], span: float) -> None:
     """Flag each monitored invariant whose drift the integration error does not explain (``invariant_check``;
-    ``series``: the invariants' values): a warning, ``invariant_check = "violated"`` and a ``comment`` on its
-    variable, its name in the attribute ``violated_invariants`` (the figures do not draw it as conserved)."""
-    times = ds.variables["time"].values if "time" in ds.variables else np.empty(0)
-    span = float(times[-1] - times[0]) if times.size else 0.0
-    found = violated_invariants(series, invariants, ds.attrs, adaptive, span)
+    ``seen``: the invariants' ``extremes``, ``span``: the run's): a warning, ``invariant_check = "violated"`` and
+    a ``comment`` on its variable, its name in the attribute ``violated_invariants`` (the figures do not draw it
+    as conserved)."""
+    found = violated_invariants(seen, invariants, ds.attrs, adaptive, span)
     for name, (drift, allowed) in found.items():
         sentence = violation_sentence(name, drift, allowed)
         log.warning("%s", sentence)
