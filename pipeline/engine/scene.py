@@ -13,6 +13,7 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab import accuracy
+from gyrolab.accuracy import estimate
 from gyrolab.contracts import CompiledModel, Integrator, System, registry
 from gyrolab.contracts.capabilities import integrators_with, or_list
 from gyrolab.contracts.claims import check_claims, claim_states
@@ -62,8 +63,8 @@ class Scene:
     #: why the config's ``accuracy`` is not read by this scene's integrator, when a config file set it
     #: (``gyrolab.engine.unread``; a given one is refused): recorded in every run dataset as ``accuracy_ignored``
     accuracy_ignored: str | None = None
-    #: the layout of its runs' datasets (``output.dataset``: built once, copied with each run's data)
-    dataset_layout: tuple | None = field(default=None, init=False, repr=False, compare=False)
+    #: the layouts of its runs' datasets (``output.dataset``: built once, copied with each run's data)
+    dataset_layouts: list = field(default_factory=list, init=False, repr=False, compare=False)
 
     @classmethod
     def from_config(cls, cfg: DictConfig, check: Callable[[System], None] | None = None) -> Scene:
@@ -116,6 +117,11 @@ class Scene:
     def config_yaml(self) -> str:
         """The resolved config as YAML (stored in every dataset; computed once per scene)."""
         return OmegaConf.to_yaml(self.config, resolve=True)
+
+    @cached_property
+    def estimated(self) -> bool:
+        """Whether its runs' errors are measured (``accuracy.estimate.wanted``; the config read once per scene)."""
+        return estimate.wanted(self)
 
     @cached_property
     def dataset_attributes(self) -> tuple[dict[str, Any], dict[str, Any]]:

@@ -125,7 +125,7 @@ def test_a_scenes_later_datasets_copy_its_first_ones_layout_and_equal_a_fresh_bu
     first.omega.attrs["units"], first.energy.values[:] = "changed", 0.0
     other = replace(solution, y=solution.y * np.linspace(1.0, 1.01, len(solution.t))[:, None])  # other states
     again, fresh = dataset.build_dataset(scene, other), dataset.build_dataset(compose_scene(overrides), other)
-    assert scene.dataset_layout is not None and again.energy.attrs["max_abs_drift"] != first.energy.attrs[
+    assert scene.dataset_layouts and again.energy.attrs["max_abs_drift"] != first.energy.attrs[
         "max_abs_drift"]
     for ds in (again, fresh):
         del ds.attrs["date_created"], ds.attrs["history"]
