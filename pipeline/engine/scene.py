@@ -13,7 +13,6 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf
 
 from gyrolab import accuracy
-from gyrolab.accuracy import estimate
 from gyrolab.contracts import CompiledModel, Integrator, System, registry
 from gyrolab.contracts.capabilities import integrators_with, or_list
 from gyrolab.contracts.claims import check_claims, claim_states
@@ -121,7 +120,7 @@ class Scene:
     @cached_property
     def estimated(self) -> bool:
         """Whether its runs' errors are measured (``accuracy.estimate.wanted``; the config read once per scene)."""
-        return estimate.wanted(self)
+        return accuracy.estimate.wanted(self)
 
     @cached_property
     def dataset_attributes(self) -> tuple[dict[str, Any], dict[str, Any]]:

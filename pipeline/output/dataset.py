@@ -18,7 +18,7 @@ from gyrolab.compat import install_dask_free_writes
 from gyrolab.contracts.integrator import Integrator, Solution
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.cf import conform, unit_attributes
-from gyrolab.output.invariant_check import extremes, max_drift, violated_invariants, violation_sentence
+from gyrolab.output.invariant_check import max_drift, violated_invariants, violation_sentence
 from gyrolab.output.provenance import provenance
 
 if TYPE_CHECKING:
@@ -48,14 +48,13 @@ def build_dataset(scene: Scene, solution: Solution, add: Callable[[dict[str, xr.
     system, integrator = scene.system, integrator or scene.integrator
     # each state component contiguous (column-major): the derived variables' arithmetic runs faster, same values
     variables = system.variables(solution.t, np.asfortranarray(solution.y))
-    invariants = system.invariants
-    found = {name: extremes(variables[name].values) for name in invariants}
+    invariants = system.invariants  # each one's (first, largest, smallest) value: its drift and the check read them
+    found = {k: (float(v[0]), float(v.max()), float(v.min())) for k in invariants
+             for v in [np.asarray(variables[k].values, dtype=float)]}
     for name, values in found.items():
         variables[name].attrs["max_abs_drift"] = max_drift(*values)
-    added_attrs: dict[str, Any] = {}
-    if add is not None:
-        added, added_attrs = add(variables)
-        variables.update(added)
+    added, added_attrs = add(variables) if add is not None else ({}, {})
+    variables.update(added)
     ds = _assembled(scene, variables, solution.t)
     before, after = scene.dataset_attributes  # the scene's own, once per scene
     ds.attrs.update({**before, **integrator.attributes(), **solution.stats.attributes(), **after, **added_attrs})
@@ -81,18 +80,16 @@ def _assembled(scene: Scene, variables: dict[str, xr.Variable], t: np.ndarray) -
         scene.system.body))}), **{name: LABELS.variables[name] for name in labels}},
                             indexes={"time": time, **{name: LABELS.xindexes[name] for name in labels}})
     ds = xr.Dataset(variables, coords=coords)
-    scene.dataset_layouts[3:] = []  # (a few: with and without an error estimate, say)
-    scene.dataset_layouts.insert(0, (layout, ds.copy(data={k: np.broadcast_to(np.zeros((), v.dtype), v.shape)
-                                                         for k, v in variables.items()})))
+    scene.dataset_layouts[:] = [(layout, ds.copy(data={k: np.broadcast_to(np.zeros((), v.dtype), v.shape) for k, v in
+                                                       variables.items()})), *scene.dataset_layouts[:3]]  # a few
     return ds
 
 
 def flag_violated_invariants(ds: xr.Dataset, invariants: tuple[str, ...], adaptive: bool,
                              seen: dict[str, tuple[float, float, float]], span: float) -> None:
-    """Flag each monitored invariant whose drift the integration error does not explain (``invariant_check``;
-    ``seen``: the invariants' ``extremes``, ``span``: the run's): a warning, ``invariant_check = "violated"`` and
-    a ``comment`` on its variable, its name in the attribute ``violated_invariants`` (the figures do not draw it
-    as conserved)."""
+    """Flag each monitored invariant whose drift the integration error does not explain (``invariant_check``; ``seen``:
+    their extremes): a warning, ``invariant_check = "violated"`` and a ``comment`` on its variable, its name in the
+    attribute ``violated_invariants`` (the figures do not draw it as conserved)."""
     found = violated_invariants(seen, invariants, ds.attrs, adaptive, span)
     for name, (drift, allowed) in found.items():
         sentence = violation_sentence(name, drift, allowed)

@@ -17,8 +17,6 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from typing import Any
 
-import numpy as np
-
 #: invariants every torque conserves (the kinematics of the frame): the measure of the integration error
 KINEMATIC = ("gamma_norm", "frame_error")
 FLOOR = 1e-6
@@ -48,7 +46,7 @@ def explained_error(attrs: Mapping[str, Any], adaptive: bool, kinematic_drift: f
 def violated_invariants(extremes: Mapping[str, tuple[float, float, float]], invariants: Iterable[str],
                         attrs: Mapping[str, Any], adaptive: bool, span: float) -> dict[str, tuple[float, float]]:
     """{name: (max drift, allowed drift)} of the monitored invariants whose drift the integration does not
-    explain (module docstring); ``extremes`` holds each invariant's (first, largest, smallest) value (``extremes``)."""
+    explain (module docstring); ``extremes`` holds each invariant's (first, largest, smallest) value."""
     invariants = list(invariants)
     kinematic = [max_drift(*extremes[k]) for k in KINEMATIC if k in invariants and k in extremes]
     error = explained_error(attrs, adaptive, max(kinematic) if kinematic else None, span)
@@ -65,15 +63,9 @@ def violated_invariants(extremes: Mapping[str, tuple[float, float, float]], inva
     return out
 
 
-def extremes(values: np.ndarray) -> tuple[float, float, float]:
-    """(first, largest, smallest) of an invariant's values: what its drift and size are read from."""
-    values = np.asarray(values, dtype=float)
-    return float(values[0]), float(values.max()), float(values.min())
-
-
 def max_drift(first: float, high: float, low: float) -> float:
-    """max |v − v0| from the extremes (``extremes``): subtracting v0 is monotone in floating point, so this is the
-    value of np.max(np.abs(values - values[0])) without its two temporaries."""
+    """max |v − v0| from the first, largest and smallest value: subtracting v0 is monotone in floating point, so this
+    is the value of np.max(np.abs(values - values[0])) without its two temporaries."""
     return max(high - first, first - low)
 
 

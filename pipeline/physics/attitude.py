@@ -110,8 +110,6 @@ def unwrap(angles: np.ndarray) -> np.ndarray:
     """``np.unwrap(angles)``, bit for bit, at a third of its cost: only the steps of at least π wrapped (numpy wraps
     all, keeps those), their corrections' running sum (numpy's, which adds zeros between them) spread after each."""
     out = np.array(angles, dtype=float)
-    if out.size < 2:
-        return out
     step = out[1:] - out[:-1]
     jumps = np.flatnonzero(~(np.abs(step) < np.pi))  # (a NaN step among them, as numpy's)
     jump = step[jumps]
