@@ -102,22 +102,8 @@ def euler_angles(alpha: np.ndarray, gamma: np.ndarray) -> tuple[np.ndarray, np.n
     psi_minus_phi = np.arctan2(beta[:, 0] + alpha[:, 1], alpha[:, 0] - beta[:, 1])
     psi = np.where(upper, psi_plus_phi - phi, psi_minus_phi + phi)
     psi = np.angle(np.exp(1j * psi))  # wrap to (−π, π] before unwrapping
-    phi = unwrap(phi)
+    phi = np.unwrap(phi)
     return unwrap_with_pole_combination(psi, phi, upper), theta, phi
-
-
-def unwrap(angles: np.ndarray) -> np.ndarray:
-    """``np.unwrap(angles)``, bit for bit, at a third of its cost: only the steps of at least π wrapped (numpy wraps
-    all, keeps those), their corrections' running sum (numpy's, which adds zeros between them) spread after each."""
-    out = np.array(angles, dtype=float)
-    step = out[1:] - out[:-1]
-    jumps = np.flatnonzero(~(np.abs(step) < np.pi))  # (a NaN step among them, as numpy's)
-    jump = step[jumps]
-    wrapped = np.mod(jump + np.pi, 2.0 * np.pi) - np.pi
-    wrapped[(wrapped == -np.pi) & (jump > 0)] = np.pi
-    total = np.concatenate(([0.0], np.cumsum(wrapped - jump)))
-    out[1:] += np.repeat(total, np.diff(np.concatenate(([0], jumps, [step.size]))))
-    return out
 
 
 def unwrap_with_pole_combination(psi: np.ndarray, phi: np.ndarray, upper: np.ndarray) -> np.ndarray:
@@ -147,4 +133,4 @@ def angles_from_states(t: np.ndarray, y: np.ndarray, psi0: float) -> dict[str, n
     theta, phi = nutation_and_spin(y[:, 3:6])
     rate = (y[:, 0] * y[:, 3] + y[:, 1] * y[:, 4]) / (1.0 - y[:, 5] ** 2)
     psi = psi0 + CubicSpline(t, rate).antiderivative()(t)
-    return {"psi": psi, "theta": theta, "phi": unwrap(phi)}
+    return {"psi": psi, "theta": theta, "phi": np.unwrap(phi)}
