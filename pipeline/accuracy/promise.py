@@ -45,10 +45,9 @@ class Ran:
 
 
 def measured_run(scene: Any, y0: np.ndarray, progress: Any, compiled: Any) -> tuple[Solution, Ran, Any]:
-    """``scene``'s run, its error measured where wanted (``estimate.wanted``) and its promise kept: (the solution,
+    """``scene``'s run, its error measured where wanted (``Scene.estimated``) and its promise kept: (the solution,
     what ran for the dataset, the estimate's ``variables`` for ``build_dataset`` or None)."""
-    integrator = scene.integrator
-    wanted = estimate.wanted(scene)
+    integrator, wanted = scene.integrator, scene.estimated
     # an integrator choosing its method (C7) may try a cheaper one first when its run will be measured
     estimated = {"estimated": True} if wanted and integrator.supports(CHOOSES_METHOD) else {}
     solution = integrator.integrate(scene.rhs, scene.times, y0, progress, compiled, **estimated)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
 
@@ -63,6 +63,8 @@ class Scene:
     #: why the config's ``accuracy`` is not read by this scene's integrator, when a config file set it
     #: (``gyrolab.engine.unread``; a given one is refused): recorded in every run dataset as ``accuracy_ignored``
     accuracy_ignored: str | None = None
+    #: the layouts of its runs' datasets (``output.dataset``: built once, copied with each run's data)
+    dataset_layouts: list = field(default_factory=list, init=False, repr=False, compare=False)
 
     @classmethod
     def from_config(cls, cfg: DictConfig, check: Callable[[System], None] | None = None) -> Scene:
@@ -115,6 +117,11 @@ class Scene:
     def config_yaml(self) -> str:
         """The resolved config as YAML (stored in every dataset; computed once per scene)."""
         return OmegaConf.to_yaml(self.config, resolve=True)
+
+    @cached_property
+    def estimated(self) -> bool:
+        """Whether its runs' errors are measured (``accuracy.estimate.wanted``; the config read once per scene)."""
+        return accuracy.estimate.wanted(self)
 
     @cached_property
     def dataset_attributes(self) -> tuple[dict[str, Any], dict[str, Any]]:

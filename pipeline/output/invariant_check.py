@@ -17,8 +17,6 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from typing import Any
 
-import numpy as np
-
 #: invariants every torque conserves (the kinematics of the frame): the measure of the integration error
 KINEMATIC = ("gamma_norm", "frame_error")
 FLOOR = 1e-6
@@ -45,32 +43,30 @@ def explained_error(attrs: Mapping[str, Any], adaptive: bool, kinematic_drift: f
     return max(FLOOR, *bounds) if bounds else None
 
 
-def violated_invariants(series: Mapping[str, np.ndarray], invariants: Iterable[str], attrs: Mapping[str, Any],
-                        adaptive: bool, span: float) -> dict[str, tuple[float, float]]:
+def violated_invariants(extremes: Mapping[str, tuple[float, float, float]], invariants: Iterable[str],
+                        attrs: Mapping[str, Any], adaptive: bool, span: float) -> dict[str, tuple[float, float]]:
     """{name: (max drift, allowed drift)} of the monitored invariants whose drift the integration does not
-    explain (module docstring); ``series`` holds each invariant's values along the run."""
+    explain (module docstring); ``extremes`` holds each invariant's (first, largest, smallest) value."""
     invariants = list(invariants)
-    kinematic = [max_drift(series[k]) for k in KINEMATIC if k in invariants and k in series]
+    kinematic = [max_drift(*extremes[k]) for k in KINEMATIC if k in invariants and k in extremes]
     error = explained_error(attrs, adaptive, max(kinematic) if kinematic else None, span)
     if error is None:
         return {}
     out = {}
     for name in invariants:
-        if name in KINEMATIC or name not in series:
+        if name in KINEMATIC or name not in extremes:
             continue
-        values = np.asarray(series[name], dtype=float)
-        allowed = error * max(1.0, float(values.max()), -float(values.min()))  # max |v| without a temporary
-        drift = max_drift(values)
+        allowed = error * max(1.0, extremes[name][1], -extremes[name][2])  # max |v|
+        drift = max_drift(*extremes[name])
         if drift > allowed:
             out[name] = (drift, allowed)
     return out
 
 
-def max_drift(values: np.ndarray) -> float:
-    """max |v − v0| from the extremes: subtracting v0 is monotone in floating point, so this is the value of
-    np.max(np.abs(values - values[0])) without its two temporaries."""
-    values = np.asarray(values, dtype=float)
-    return float(max(values.max() - values[0], values[0] - values.min()))
+def max_drift(first: float, high: float, low: float) -> float:
+    """max |v − v0| from the first, largest and smallest value: subtracting v0 is monotone in floating point, so this
+    is the value of np.max(np.abs(values - values[0])) without its two temporaries."""
+    return max(high - first, first - low)
 
 
 def violation_sentence(name: str, drift: float, allowed: float) -> str:

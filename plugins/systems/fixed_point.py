@@ -98,27 +98,21 @@ class FixedPoint(System):
                 "frame_error": self.carries_alpha}
         return tuple(name for name, monitored in kept.items() if monitored)
 
-    def energy(self, y: np.ndarray) -> np.ndarray:
-        omega, gamma = y[..., 0:3], y[..., 3:6]
-        alpha = y[..., 6:9] if self.carries_alpha else None
-        axes = (alpha, cross(gamma, alpha) if self.needs_beta else None, gamma)
-        energy = 0.5 * dot(omega, self.inertia * omega)
-        for force in self.forces:
-            energy = energy + force.potential(axes)
-        return energy
-
     def invariant_values(self, y: np.ndarray) -> dict[str, np.ndarray]:
         """Each monitored invariant (``invariants``) along states ``y`` of shape (..., state size)."""
         omega, gamma = y[..., 0:3], y[..., 3:6]
-        invariants = self.invariants
+        alpha = y[..., 6:9] if self.carries_alpha else None
+        invariants, momentum = self.invariants, self.inertia * omega
         values = {}
         if "energy" in invariants:
-            values["energy"] = self.energy(y)
+            axes = (alpha, cross(gamma, alpha) if self.needs_beta else None, gamma)
+            values["energy"] = 0.5 * dot(omega, momentum)
+            for force in self.forces:
+                values["energy"] = values["energy"] + force.potential(axes)
         if "area_integral" in invariants:
-            values["area_integral"] = dot(self.inertia * omega, gamma)
+            values["area_integral"] = dot(momentum, gamma)
         values["gamma_norm"] = norm(gamma)
         if self.carries_alpha:
-            alpha = y[..., 6:9]
             values["frame_error"] = np.maximum(np.abs(norm(alpha) - 1.0), np.abs(dot(alpha, gamma)))
         return values
 

@@ -370,7 +370,7 @@ def test_the_criterion_judges_drift_against_the_integration_error():
 
     t = np.linspace(0, 1, 11)
     kinematic = 1 + 1e-9 * t  # |γ| drifts by 1e-9: the integration error actually made
-    series = {"energy": 2 + 1e-4 * t, "gamma_norm": kinematic}
+    series = {name: (v[0], v.max(), v.min()) for name, v in {"energy": 2 + 1e-4 * t, "gamma_norm": kinematic}.items()}
     attrs = {"integrator_rtol": 1e-10, "integrator_atol": 1e-10, "integrator_n_steps": 100}
     assert explained_error(attrs, True, 1e-9, 1.0) == pytest.approx(1e-5)  # max(1e3·1e-10·100, 1e3·1e-9, FLOOR)
     assert set(violated_invariants(series, ["energy", "gamma_norm"], attrs, True, 1.0)) == {"energy"}

@@ -113,3 +113,23 @@ def test_the_scene_attributes_are_computed_once_and_shared_read_only():
     np.testing.assert_array_equal(stored, scene.system.initial.omega)
     with pytest.raises(ValueError, match="read-only"):
         stored[0] = 1.0  # shared by every run's dataset: not to be changed through one of them
+
+
+def test_a_scenes_later_datasets_copy_its_first_ones_layout_and_equal_a_fresh_build():
+    """The second dataset of a scene copies the first one's layout with its own data, attributes and encodings: what
+    a fresh scene builds from the same states, and nothing of the first dataset (changed after it was returned)."""
+    from dataclasses import replace
+
+    overrides = [*FIXED_POINT, "force=[uniform_gravity,magnetic]", "force.magnetic.direction=[1.0,0.0,0.0]"]
+    scene, solution, first = _built(overrides)
+    first.omega.attrs["units"], first.energy.values[:] = "changed", 0.0
+    other = replace(solution, y=solution.y * np.linspace(1.0, 1.01, len(solution.t))[:, None])  # other states
+    again, fresh = dataset.build_dataset(scene, other), dataset.build_dataset(compose_scene(overrides), other)
+    assert scene.dataset_layouts and again.energy.attrs["max_abs_drift"] != first.energy.attrs[
+        "max_abs_drift"]
+    for ds in (again, fresh):
+        del ds.attrs["date_created"], ds.attrs["history"]
+    assert again.identical(fresh) and list(again.variables) == list(fresh.variables)
+    assert all(again.variables[k].encoding == v.encoding for k, v in fresh.variables.items())
+    added = dataset.build_dataset(scene, other, lambda stored: ({"copied": stored["energy"].copy()}, {}))
+    assert added.variables["copied"].identical(added.variables["energy"]) and list(added.data_vars)[-1] == "copied"  # another layout

@@ -501,7 +501,7 @@ def test_a_plugin_torque_runs_in_double_double_from_the_scene(tmp_path):
         double = compose_scene(common).run()
     np.testing.assert_allclose(dd.omega, double.omega, rtol=0, atol=1e-12)
     scene = compose_scene(["force=[uniform_gravity]"])  # the same body: kinetic + gravity potential
-    energy = scene.system.energy(np.concatenate([dd.omega, dd.gamma, dd.alpha], axis=1))
+    energy = scene.system.invariant_values(np.concatenate([dd.omega, dd.gamma, dd.alpha], axis=1))["energy"]
     c = float(dd.attrs["force_viscous_drag_coefficient"])
     power = -c * np.sum(dd.omega.values ** 2, axis=1)
     dissipated = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(dd.time.values))])
