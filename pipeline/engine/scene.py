@@ -146,6 +146,10 @@ class Scene:
         wants = integrator.supports(COMPILED_MODEL) or integrator.supports(PREFERS_COMPILED_MODEL)
         return self.compiled_model if wants else None
 
+    def __getstate__(self) -> dict[str, Any]:
+        # the generated right-hand side is a function made in this process: generated again after unpickling
+        return {key: value for key, value in self.__dict__.items() if key != "rhs"}
+
     @cached_property
     def rhs(self) -> Callable[[float, np.ndarray], np.ndarray]:
         """The Python right-hand side the integrator calls: the system's own generated as Python on floats
