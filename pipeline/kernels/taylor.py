@@ -85,17 +85,58 @@ def run(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
     at the start); stats = [coefficient evaluations, steps]. Returns (status, index of the next output
     time to fill).
     """
+    return _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, np.empty(0), np.empty(0),
+                  np.empty((0, y.size)), np.empty(0), np.empty(0))
+
+
+#: the one-pass error estimate (``run_measured``): the series' orders beyond the step's, whose terms are the step's
+#: truncation error with its sign, and the order of the tangent series that carries the error so far along the step
+#: (benchmarks/one_pass_estimate.py: with gyrolab's steps, 6 orders broke the estimate's 2× on the reference scene,
+#: 10 held it within 0.82–1.42×)
+EXTRA_ORDERS, TANGENT_ORDER = 4, 10
+#: the finite difference's step along the error's direction, relative to the state's scale: ~√eps, so that its
+#: truncation and its round-off both leave the tangent series ~1e-8 relative error (the estimate needs one digit)
+DIFFERENCE_STEP = 2.0 ** -26
+
+
+@kernel
+def run_measured(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u, E, growth, G):
+    """``run``, its global error estimated and its perturbations' growth measured in the same pass (docs/integrators.md,
+    "A one-pass error estimate"). e, the error of y (exact − computed; zeros at the start), is carried along each step
+    by the linearised equation e' = J(y(t)) e, whose Taylor series to ``TANGENT_ORDER`` is the directional difference
+    of the model's series at y + δ e/|e| and at y (``_tangent_series``), and each step adds its truncation error, the
+    series' next ``EXTRA_ORDERS`` terms: E[i] = the estimated error at output time i. u, a unit tangent vector, is
+    carried the same way and renormalised at each step: growth = [ln|δ| of the tangent vector it stands for (the fast
+    Lyapunov indicator's quantity), its running maximum, a time t_mark, that maximum at t_mark (the last step ending
+    there or before)], G[i] = the maximum at output time i. (The error's own
+    growth is no such measure: each step's truncation error turns it, and on a regular motion the sum of its growths
+    over the steps climbs where a tangent vector's oscillates.)"""
+    return _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u, E, growth, G)
+
+
+@inline_kernel
+def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u, E, growth, G):
+    """``run`` and ``run_measured``: measured when E has rows."""
     n = y.size
-    T = _coefficient_rows(order + 1, n)
+    measured = E.shape[0] > 0
+    extra = EXTRA_ORDERS if measured else 0
+    T = _coefficient_rows(order + 1 + extra, n)
+    m = min(TANGENT_ORDER, order)
+    # the error's series: rows 0 … m the carried error's (the tangent series), rows order + 1 … the step's truncation
+    # error (T's), zeros between: one Horner sum gives both (``_series_at``)
+    R = _coefficient_rows(order + 1 + extra if measured else 0, n)
+    R[:, :] = 0.0
+    U = _coefficient_rows(m + 1 if measured else 0, n)  # the tangent vector's series
+    end = np.empty((2, n))  # the whole error and the tangent vector at a step's end
     t = state[0]
     n_out = t_out.size
     t_end = t_out[n_out - 1]
     i = i_next
     safety = math.exp(-0.7 / (order - 1))
     while i < i_stop:
-        for m in range(n):
-            T[0, m] = y[m]
-        taylor_coefficients(p, T, order, t)
+        for k in range(n):
+            T[0, k] = y[k]
+        taylor_coefficients(p, T, order + extra, t)
         stats[0] += 1
         scale = max(1.0, _norm_row(T, 0))
         h = step_size(tol, scale, _norm_row(T, order - 1), _norm_row(T, order), order, safety)
@@ -106,12 +147,41 @@ def run(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
         if h <= 0.0:  # the step is below the spacing of floating-point numbers at t: no progress is possible
             state[0] = t
             return TOO_SMALL_STEP, i
+        first = i
         while i + 1 < n_out and t_out[i + 1] <= t_new:  # outputs by pairs: two Horner chains in the time of one
             _dense_output(T, order, (t_out[i] - t, t_out[i + 1] - t), y, carry, Y, i)
             i += 2
         if i < n_out and t_out[i] <= t_new:
             _dense_output(T, order, (t_out[i] - t,), y, carry, Y, i)
             i += 1
+        if measured:
+            _tangent_series(p, T, R, m, e, scale, t)
+            _tangent_series(p, T, U, m, u, scale, t)
+            for k in range(n):
+                for j in range(order + 1, order + 1 + extra):
+                    R[j, k] = T[j, k]
+            j = first
+            while j + 1 < i:
+                _series_at(R, order + extra, (t_out[j] - t, t_out[j + 1] - t), E, j)
+                G[j] = G[j + 1] = growth[1]
+                j += 2
+            if j < i:
+                _series_at(R, order + extra, (t_out[j] - t,), E, j)
+                G[j] = growth[1]
+            _series_at(R, order + extra, (h,), end, 0)
+            _series_at(U, m, (h,), end, 1)
+            size = 0.0
+            for k in range(n):
+                e[k] = end[0, k]
+                size += end[1, k] * end[1, k]
+            size = math.sqrt(size)
+            if size > 0.0 and size < np.inf:  # (a tangent vector that vanished or overflowed: its last direction)
+                for k in range(n):
+                    u[k] = end[1, k] / size
+                growth[0] += math.log(size)
+                growth[1] = max(growth[1], growth[0])
+            if t_new <= growth[2]:
+                growth[3] = growth[1]
         if not _advance(T, order, h, y, carry):
             state[0] = t
             return NOT_FINITE, i
@@ -119,6 +189,30 @@ def run(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
         stats[1] += 1
     state[0] = t
     return OK, i
+
+
+@inline_kernel
+def _tangent_series(p, T, D, m, v, scale, t):
+    """D[0..m] = the Taylor series of the vector v carried along the step by the linearised equations (T: the state's
+    series): (series at y + δ v/|v| − series at y)·|v|/δ, δ = DIFFERENCE_STEP·scale; zero for v = 0."""
+    n = v.size
+    size = 0.0
+    for k in range(n):
+        size = max(size, abs(v[k]))
+    if size == 0.0:
+        for j in range(m + 1):
+            for k in range(n):
+                D[j, k] = 0.0
+        return
+    delta = DIFFERENCE_STEP * scale
+    for k in range(n):
+        D[0, k] = T[0, k] + v[k] * (delta / size)
+    taylor_coefficients(p, D, m, t)
+    for j in range(1, m + 1):
+        for k in range(n):
+            D[j, k] = (D[j, k] - T[j, k]) * (size / delta)
+    for k in range(n):
+        D[0, k] = v[k]
 
 
 #: lanes of the Horner sums' vectors (AVX-512's; an AVX2 CPU runs each as two, a CPU without vectors as scalars)
@@ -226,6 +320,37 @@ def _dense_output(typingctx, T, order, dts, y, carry, Y, i):
         n = b.extract_value(context.make_array(types_[3])(context, b, y_).shape, 0)
         width = b.extract_value(context.make_array(types_[5])(context, b, Y_).shape, 1)  # Y's row length (≥ n)
         _emit_horner(context, b, T_, types_[0], context.cast(b, order_, types_[1], types.int64), hs, each)
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@intrinsic
+def _series_at(typingctx, R, rows, dts, out, i):
+    """out[i + j] = R[0] + v_j·dt_j, v_j = Σ_{k=1..rows} R[k] dt_j^(k−1) (``_emit_horner``), for each dt_j of the tuple
+    ``dts`` (one or two): a series at dt_j, all components in one vector chain (one component's chain after another's
+    took ~80 ns an output time, bound by the multiply-adds' latency)."""
+    if not (simd.vector_arrays([R, out]) and isinstance(dts, types.UniTuple)):
+        return None
+    sig = types.void(R, rows, dts, out, i)
+
+    def codegen(context, b, signature, args):
+        R_, rows_, dts_, out_, i_ = args
+        types_ = signature.args
+        i_ = context.cast(b, i_, types_[4], types.intp)
+        hs = [b.extract_value(dts_, j) for j in range(types_[2].count)]
+        R_data = _data(context, b, types_[0], R_)
+
+        def each(j, c, v):
+            mask = _lanes_in(b, c, n)
+            row = b.gep(_data(context, b, types_[3], out_), [b.add(b.mul(b.add(i_, ir.Constant(i_.type, j)), n), c)])
+            start = _masked_load(b, b.gep(R_data, [c]), mask)
+            _masked_store(b, b.call(fma, [v, simd.splat(b, hs[j], _LANES), start]), row, mask)
+
+        n = b.extract_value(context.make_array(types_[0])(context, b, R_).shape, 1)
+        vec = ir.VectorType(ir.DoubleType(), _LANES)
+        fma = cgutils.get_or_insert_function(b.module, ir.FunctionType(vec, [vec] * 3), f"llvm.fma.v{_LANES}f64")
+        _emit_horner(context, b, R_, types_[0], context.cast(b, rows_, types_[1], types.int64), hs, each)
         return context.get_dummy_value()
 
     return sig, codegen
