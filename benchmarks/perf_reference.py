@@ -396,12 +396,12 @@ def scene_run_only(reference, rounds):
 
 def run_breakdown(rounds, quick):
     """Where ``Scene.run()`` with ``integrator=auto`` spends its time: the regimes' series check, the pilot and
-    final Taylor runs (auto without the series check; the chaos measure's tangent run included, and beside it
-    alone), the error estimate (its companion runs, ``estimate.compare``), the dataset, interleaved like the peer
-    table."""
+    final Taylor run (auto without the series check, its error measured: the final run's one pass measures the
+    growth of perturbations and the error), the chosen run alone without its one pass, the error estimate's
+    decision (``estimate.compare``: the one pass taken, or companion runs near the floor), the dataset, interleaved
+    like the peer table."""
     from gyrolab.output.dataset import build_dataset
     from gyrolab.accuracy import estimate
-    from gyrolab.accuracy.amplification import amplification
     from gyrolab.accuracy.auto import Auto
 
     contestants = {}
@@ -415,15 +415,15 @@ def run_breakdown(rounds, quick):
             return auto._series(None, GRID, y0, compiled, 0.0)
 
         def integration(eps=eps, compiled=compiled, y0=y0):  # no system: auto skips the series check
-            return Auto(accuracy=eps).integrate(None, GRID, y0, None, compiled)
+            return Auto(accuracy=eps).integrate(None, GRID, y0, None, compiled, estimated=True)
 
         solution = integration()
         contestants[("series check", eps)] = series
         contestants[("pilot + Taylor", eps)] = integration
-        contestants[("(of which tangent run)", eps)] = lambda compiled=compiled, y0=y0: amplification(
-            compiled, None, y0, 0.0, 0.1 * T_END, T_END, None)
+        contestants[("(the run without its one pass)", eps)] = lambda method=solution.choice.method, compiled=compiled, \
+            y0=y0: method.integrate(None, GRID, y0, None, compiled)
         contestants[("error estimate", eps)] = lambda scene=scene, solution=solution: estimate.compare(
-            scene, solution.choice.method, solution.y, solution.stats.wall_time)
+            scene, solution.choice.method, solution.y, solution.stats.wall_time, None, solution.estimate)
         contestants[("dataset", eps)] = lambda scene=scene, solution=solution: build_dataset(scene, solution)
         contestants[("Scene.run()", eps)] = scene.run
     interleaved(contestants, 1)
@@ -559,8 +559,8 @@ def main() -> None:
     parser.add_argument("--scene-run", action="store_true",
                         help="only heyoka against auto's Scene.run() per ε, with the PASS/FAIL verdict (issue 24)")
     parser.add_argument("--breakdown", action="store_true",
-                        help="only where auto's Scene.run() spends its time (series check, pilot and run, tangent "
-                             "run, error estimate, dataset)")
+                        help="only where auto's Scene.run() spends its time (series check, pilot and run with its "
+                             "one pass, the run without it, error estimate, dataset)")
     args = parser.parse_args()
     global WALL
     WALL = args.wall

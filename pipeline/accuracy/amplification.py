@@ -23,9 +23,14 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.accuracy.calibration import SHADOW_CHUNKS, SHADOW_OFFSET, TANGENT_SAMPLES, TANGENT_TOLERANCE
+from gyrolab.accuracy.calibration import (MAX_GROWTH, SHADOW_CHUNKS, SHADOW_OFFSET, TANGENT_SAMPLES,
+                                          TANGENT_TOLERANCE)
 from gyrolab.kernels.model import CompiledModel
 from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba
+
+#: the part of the span after which growth beyond a power law is chaos: ``auto``'s default pilot, and the tenth at
+#: which a one-pass run measures its growth (``OwnEstimate.log_growth_tenth``)
+PILOT_FRACTION = 0.1
 
 
 @dataclass(frozen=True)
@@ -41,6 +46,11 @@ class Amplification:
     def factor(self) -> float:
         """How much more than at the pilot's end a perturbation can be at the end (≥ 1)."""
         return math.exp(min(max(self.log_span - self.log_pilot, 0.0), 700.0))
+
+    def chaotic(self, fraction: float) -> bool:
+        """Whether perturbations grow after the pilot (the first ``fraction`` of the span) faster than any power law
+        a pilot fits (t^MAX_GROWTH)."""
+        return self.factor > (1.0 / fraction) ** MAX_GROWTH
 
     @property
     def lyapunov(self) -> float:

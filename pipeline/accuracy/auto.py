@@ -26,14 +26,15 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.accuracy.amplification import amplification
+from gyrolab.accuracy.amplification import PILOT_FRACTION, Amplification, amplification
 from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_FLOOR,
                                           ESTIMATE_SLACK, FIRST_RATIO, FLOOR, MAX_GROWTH, MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE,
                                           MISS_MARGIN, PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
                                           SHADOW_TOLERANCE, TIGHT_RATIO, UNMEASURED_PER_TOL)
-from gyrolab.contracts.integrator import (BATCH_KERNEL, CHOOSES_METHOD, PRECISIONS, PREFERS_COMPILED_MODEL,
-                                          TIME_DEPENDENT, VECTOR_LANES, BatchSolution, Choice, CompiledModel,
-                                          Integrator, IntegratorStats, ProgressCallback, RightHandSide, Solution)
+from gyrolab.contracts.integrator import (BATCH_KERNEL, CHOOSES_METHOD, ESTIMATES_ERROR, PRECISIONS,
+                                          PREFERS_COMPILED_MODEL, TIME_DEPENDENT, VECTOR_LANES, BatchSolution, Choice,
+                                          CompiledModel, Integrator, IntegratorStats, OwnEstimate, ProgressCallback,
+                                          RightHandSide, Solution)
 from gyrolab.errors import ConfigError, GyrolabError, as_number
 from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor, taylor_samples
 from gyrolab.plugins.integrators.step_guard import compiled_rhs
@@ -56,7 +57,7 @@ class Auto(Integrator):
     capabilities = frozenset({PREFERS_COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, CHOOSES_METHOD})
     evaluation_label = "pilot and chosen method's evaluations"
 
-    def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = 0.1, safety: float = 1.0,
+    def __init__(self, *, accuracy: float | None = None, pilot_fraction: float = PILOT_FRACTION, safety: float = 1.0,
                  extended_precision: bool | None = None) -> None:
         if accuracy is None:
             raise ConfigError("integrator=auto needs a target: set accuracy=... (max-norm error of the stored states)")
@@ -94,11 +95,14 @@ class Auto(Integrator):
         return {"accuracy": self.accuracy}
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None = None,
-                  compiled: CompiledModel | None = None, series: bool = True, estimated: bool = False) -> Solution:
+                  compiled: CompiledModel | None = None, series: bool = True, estimated: bool = False,
+                  amp: Amplification | None = None) -> Solution:
         """The cheapest method predicted to meet the accuracy (``series``: a regime's analytic series among the
         candidates), run; what it chose and promises is the solution's ``choice`` (nothing is kept on ``self``).
         ``estimated``: the caller measures the run's error (``gyrolab.accuracy.promise``), so a climb predicted from a
-        chaotic scene's growth is tried in double first (``Choice.measure_first``)."""
+        chaotic scene's growth is tried in double first (``Choice.measure_first``). ``amp``: the growth of
+        perturbations, already measured (by default measured here: by the final run itself where that is the double
+        Taylor method, C8, else by a tangent run first)."""
         # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.taylor import order_for
         from gyrolab.kernels.taylor_series import ready
@@ -123,8 +127,13 @@ class Auto(Integrator):
         order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10), overhead=0.0)
         taylor = compiled is not None and ready(compiled)  # whether the compiled model has Taylor coefficients
         make = functools.partial(_method, compiled, order if taylor else None)
-        # how much the motion amplifies an error present at the pilot's end by the end of the span (chaos: e^{λt})
-        amp = amplification(compiled, fun, y0, t_out[0], t_pilot, t_out[-1], make(SHADOW_TOLERANCE))
+        # how much the motion amplifies an error present at the pilot's end by the end of the span (chaos: e^{λt}):
+        # measured by the double Taylor run itself (its one pass, C8), which is kept where that growth confirms the
+        # choice made without it; else by a tangent run first (~1.5 ms on the reference scene, the run's 3×)
+        provisional = amp is None and taylor and self.pilot_fraction == PILOT_FRACTION
+        if amp is None:
+            amp = Amplification(0.0, 0.0, span, "none yet") if provisional else \
+                amplification(compiled, fun, y0, t_out[0], t_pilot, t_out[-1], make(SHADOW_TOLERANCE))
         loose = None  # the previous round's loose run (tolerance, solution): the next round's tight run
         for _ in range(3):
             pilot_tau = tau
@@ -152,9 +161,8 @@ class Auto(Integrator):
         # update by up to an ulp per step: a target below it is not met in double precision, whatever the tolerance
         steps = tight.stats.n_steps / self.pilot_fraction * max(1.0, (tight_tol / chosen) ** (1.0 / order))
         roundoff = EPS * scale * (math.sqrt(steps) if taylor else steps)
-        chaotic = amp.factor > (1.0 / self.pilot_fraction) ** MAX_GROWTH  # faster than any power law the pilot fits
-        chaos = {"auto_lyapunov_exponent": amp.lyapunov, "auto_amplification": amp.factor,
-                 "auto_amplification_method": amp.how, "auto_chaotic": int(chaotic)}
+        chaotic = amp.chaotic(self.pilot_fraction)  # faster than any power law the pilot fits
+        chaos = _chaos_attributes(amp, chaotic)
         if chaotic:  # round-off committed early grows with the perturbations: up to e^{max ln|δ|}
             roundoff *= CHAOS_MARGIN * math.exp(min(max(amp.log_span, 0.0), 700.0))
             chaos["auto_precision_horizon"] = amp.horizon(self.accuracy, roundoff / math.exp(amp.log_span))
@@ -162,7 +170,10 @@ class Auto(Integrator):
         why = (f"double precision's round-off on this scene (about {roundoff:.1g} over ~{steps:.0f} steps) is below "
                f"accuracy={self.accuracy:g}")
         final = functools.partial(self._final, fun, t_out, y0, progress, compiled, start, per_tol, growth,
-                                  pilot_nfev, chaos)
+                                  pilot_nfev, chaos, estimated=estimated)
+        if climbed and provisional:  # a climb, or a refusal, is chosen with the growth measured first
+            return self.integrate(fun, t_out, y0, progress, compiled, False, estimated, amplification(
+                compiled, fun, y0, t_out[0], t_pilot, t_out[-1], make(SHADOW_TOLERANCE)))
         if climbed:
             up = self._climb(compiled, make, per_tol, roundoff, steps, amp, chaotic, t_out)  # raises if dd can't
             predicted = functools.partial(final, *up) if isinstance(up, tuple) else functools.partial(_raise, up)
@@ -187,15 +198,27 @@ class Auto(Integrator):
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         # the pilot's tight run is as accurate when its tolerance is: the run continues from its end
         resumed = (tight, pilot_times, inside, t_pilot) if tight_tol <= chosen else None
-        return final(make(chosen), chosen, roundoff, why, resumed)
+        return final(make(chosen), chosen, roundoff, why, resumed, provisional=provisional)
 
     def _final(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None,
                compiled: CompiledModel | None, start: float, per_tol: float, growth: float, pilot_nfev: int,
                chaos: dict, method: Integrator, chosen: float, roundoff: float, why: str,
-               resumed: tuple | None = None) -> Solution:
+               resumed: tuple | None = None, estimated: bool = False, provisional: bool = False) -> Solution:
         """``method``'s run at tolerance ``chosen`` over the output times, with what it promises (its truncation error
-        and ``roundoff``) and the attributes saying what was chosen and why (``why``)."""
-        y, final_stats, n_steps = _final_run(method, fun, t_out, y0, progress, compiled, resumed)
+        and ``roundoff``) and the attributes saying what was chosen and why (``why``); ``estimated``: its error
+        estimated in the same pass where the method can (C8). ``provisional``: chosen without the growth of
+        perturbations, which the run measures (C8): kept where that growth is no chaos and leaves the target met,
+        else the choice is made again with it (``integrate(amp=...)``)."""
+        y, final_stats, n_steps, own = _final_run(method, fun, t_out, y0, progress, compiled, resumed,
+                                                  estimated or provisional)
+        if provisional:
+            amp = growth_of(own, t_out[-1] - t_out[0])
+            measured = _amplified(per_tol, growth, amp.factor, self.pilot_fraction, CHAOS_MARGIN)
+            if amp.chaotic(self.pilot_fraction) or self.safety * CALIBRATION * measured * chosen + roundoff > \
+                    self.accuracy:
+                return self.integrate(fun, t_out, y0, progress, compiled, False, estimated, amp)
+            per_tol, chaos = measured, _chaos_attributes(amp, False)
+            own = own if estimated else None
         promised = CALIBRATION * per_tol * chosen + roundoff
         choice = {
             "auto_method": method.name,
@@ -214,7 +237,7 @@ class Auto(Integrator):
         return Solution(t_out, y, IntegratorStats(
             nfev=final_stats.nfev + pilot_nfev, n_steps=n_steps, n_rejected=final_stats.n_rejected,
             wall_time=time.perf_counter() - start, njev=final_stats.njev, nlu=final_stats.nlu),
-            Choice(method, choice, self.accuracy, promised, self.extended_precision))
+            Choice(method, choice, self.accuracy, promised, self.extended_precision), own)
 
     def _climb(self, compiled: CompiledModel | None, make: Any, per_tol: float, roundoff: float, steps: float,
                amp: Any, chaotic: bool, t_out: np.ndarray) -> tuple[Integrator, float, float, str] | ConfigError:
@@ -435,6 +458,18 @@ def at_least(value: float) -> str:
     return f"{digit}e{exponent}" if digit < 10 else f"1e{exponent + 1}"
 
 
+def growth_of(own: OwnEstimate, span: float) -> Amplification:
+    """The growth of perturbations a run measured in its one pass (C8), as ``amplification`` measures it."""
+    return Amplification(own.log_growth_tenth, float(own.log_growth[-1]), span,
+                         "a tangent vector carried by the chosen run itself (its one pass)")
+
+
+def _chaos_attributes(amp: Amplification, chaotic: bool) -> dict[str, Any]:
+    """The dataset attributes saying how the scene amplifies perturbations (``amp``) and whether that is chaos."""
+    return {"auto_lyapunov_exponent": amp.lyapunov, "auto_amplification": amp.factor,
+            "auto_amplification_method": amp.how, "auto_chaotic": int(chaotic)}
+
+
 def _amplified(per_tol: float, growth: float, factor: float, fraction: float, margin: float) -> float:
     """The pilot's predicted final error per unit tolerance, raised where the motion amplifies errors faster than
     the pilot's power law: an error E at the pilot's end grows by up to ``factor`` (``amplification``) and each of
@@ -524,16 +559,21 @@ def _raise(error: Exception) -> Any:
 
 def _final_run(method: Integrator, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                progress: ProgressCallback | None, compiled: CompiledModel | None,
-               resumed: tuple | None) -> tuple[np.ndarray, IntegratorStats, int]:
-    """(outputs, the run's stats, steps) of ``auto``'s chosen ``method`` over ``t_out``: from y0, or, with ``resumed``
-    = (the pilot's tight run, its times, the output times inside the pilot, the pilot's end), from the end of the
-    pilot's tight run, whose outputs inside the pilot are kept."""
+               resumed: tuple | None, estimated: bool) -> tuple[np.ndarray, IntegratorStats, int, OwnEstimate | None]:
+    """(outputs, the run's stats, steps, its own error estimate or None) of ``auto``'s chosen ``method`` over
+    ``t_out``: from y0, or, with ``resumed`` = (the pilot's tight run, its times, the output times inside the pilot,
+    the pilot's end), from the end of the pilot's tight run, whose outputs inside the pilot are kept. ``estimated``:
+    the run estimates its own error where the method can (C8), from y0 (the error of a resumed start is unknown)."""
+    if estimated and method.supports(ESTIMATES_ERROR):
+        solution = method.integrate(fun, t_out, y0, progress, compiled, estimate=True)
+        return solution.y, solution.stats, solution.stats.n_steps, solution.estimate
     if resumed is None:
         solution = method.integrate(fun, t_out, y0, progress, compiled)
-        return solution.y, solution.stats, solution.stats.n_steps
+        return solution.y, solution.stats, solution.stats.n_steps, None
     tight, pilot_times, inside, t_pilot = resumed
     head = np.searchsorted(pilot_times, inside)  # the outputs inside the pilot
     rest = t_out[t_out >= t_pilot]
     tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest, tight.y[-1],
                             progress, compiled)
-    return np.concatenate([tight.y[head], tail.y[-len(rest):]]), tail.stats, tail.stats.n_steps + tight.stats.n_steps
+    return (np.concatenate([tight.y[head], tail.y[-len(rest):]]), tail.stats, tail.stats.n_steps + tight.stats.n_steps,
+            None)

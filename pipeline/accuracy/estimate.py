@@ -26,12 +26,15 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.accuracy.calibration import DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
+from gyrolab.accuracy.amplification import PILOT_FRACTION, Amplification
+from gyrolab.accuracy.calibration import CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
 from gyrolab.kernels.model import rounding_moved
-from gyrolab.contracts.integrator import CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL
+from gyrolab.contracts.integrator import (CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL,
+                                          OwnEstimate)
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
 log = logging.getLogger(__name__)
+EPS = float(np.finfo(float).eps)
 
 @dataclass(frozen=True)
 class Companion:
@@ -128,10 +131,15 @@ class Comparison:
         return variables, attrs
 
 
-def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any = None) -> Comparison:
+def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any = None,
+            own: OwnEstimate | None = None) -> Comparison:
     """Run the companion of ``method``'s run of ``scene`` (stored states ``y``, integration time ``wall_time``; with
     ``check``, a run that is no integration, measured against ``check``) and compare: the measured error estimate,
-    or why none is available."""
+    or why none is available. ``own``: the run's error estimated in the same pass (C8), taken instead of a companion
+    where the run's round-off is ``ROUNDOFF_MARGIN`` times below it (``one_pass``)."""
+    one = None if own is None else one_pass(own, y, scene.times)
+    if isinstance(one, Comparison):
+        return one
     compiled_model = scene.compiled_model
     pick = companion(method, compiled_model is not None) if check is None else Companion(check, 1.0, (
         f"{check.name} ({', '.join(f'{k} {v}' for k, v in check.attributes().items())}) against the analytic series"))
@@ -178,6 +186,7 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
             return _unavailable(f"{how}, and the double-double companion {refusal}")
     other = pick.integrator.integrate(scene.rhs, scene.times, y0, None, companion_model).y
     spent = time.perf_counter() - start
+    how = how if one is None else f"{how} ({one})"
     attrs = {"error_estimate_method": how, "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
     return Comparison(pick.scale * np.abs(y - other), attrs, y)
 
@@ -212,3 +221,29 @@ def _double_taylor(method: Any) -> Any:
     """``method`` when it is the double-precision Taylor method (a method with a rung above it, ``climbed``), whose
     error near its floor is mostly round-off; else None."""
     return method if method.precision == PRECISIONS[0] and method.climbed(1.0) is not None else None
+
+
+def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray) -> Comparison | str:
+    """The run's own estimate (C8) as the measured error, or why not (a companion measures instead). The linearised
+    error equation has no sign for round-off: each output time's estimate adds double precision's round-off there (in
+    quadrature), a
+    random walk of one ulp of the state per step amplified by the growth of perturbations the same pass measured
+    (times ``CHAOS_MARGIN`` on a chaotic scene, as ``auto`` predicts it), and the estimate stands only where that is
+    ``ROUNDOFF_MARGIN`` times below the largest error it measures. (Amplified on regular scenes too: a slow top
+    near its inverted rest, ``tests/helpers/accuracy.ROUND_OFF``, grows perturbations e^9 without chaos and its
+    round-off ended 2.7e-12 away where a walk unamplified said 3e-15.)"""
+    span = float(times[-1] - times[0]) or 1.0
+    margin = CHAOS_MARGIN if Amplification(own.log_growth_tenth, float(own.log_growth[-1]), span, "").chaotic(
+        PILOT_FRACTION) else 1.0
+    scale = max(1.0, float(np.max(np.abs(y))))
+    walk = np.sqrt(1.0 + own.steps * ((times - times[0]) / span))
+    roundoff = (EPS * scale * margin) * walk * np.exp(np.minimum(own.log_growth, 700.0))
+    error = np.abs(own.error)
+    measured = float(np.max(error))
+    if not ROUNDOFF_MARGIN * float(roundoff[-1]) <= measured:
+        return (f"the one-pass estimate, {measured:.2g}, is not {ROUNDOFF_MARGIN:g}× above the run's round-off, about "
+                f"{float(roundoff[-1]):.2g}, which it does not see")
+    # (no error_estimate_cost_ratio: the estimate's work is inside the run's steps, not a run of its own)
+    attrs = {"error_estimate_method": f"{own.how}, plus double precision's round-off (≤ {float(roundoff[-1]):.2g})"}
+    # (in quadrature: the round-off is a random walk's typical size, independent of the truncation error)
+    return Comparison(np.hypot(error, roundoff[:, None]), attrs, y)

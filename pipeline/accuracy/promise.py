@@ -21,7 +21,7 @@ import numpy as np
 from gyrolab.accuracy import estimate
 from gyrolab.accuracy.auto import at_least
 from gyrolab.accuracy.calibration import ESTIMATE_SLACK, MAX_RECHECKS, RECHECK_MARGIN
-from gyrolab.contracts.integrator import CHOOSES_METHOD, Choice, Integrator, Solution
+from gyrolab.contracts.integrator import CHOOSES_METHOD, ESTIMATES_ERROR, Choice, Integrator, Solution
 from gyrolab.errors import ConfigError
 
 log = logging.getLogger(__name__)
@@ -48,9 +48,10 @@ def measured_run(scene: Any, y0: np.ndarray, progress: Any, compiled: Any) -> tu
     """``scene``'s run, its error measured where wanted (``Scene.estimated``) and its promise kept: (the solution,
     what ran for the dataset, the estimate's ``variables`` for ``build_dataset`` or None)."""
     integrator, wanted = scene.integrator, scene.estimated
-    # an integrator choosing its method (C7) may try a cheaper one first when its run will be measured
-    estimated = {"estimated": True} if wanted and integrator.supports(CHOOSES_METHOD) else {}
-    solution = integrator.integrate(scene.rhs, scene.times, y0, progress, compiled, **estimated)
+    # an integrator choosing its method (C7) may try a cheaper one first when its run will be measured; one that
+    # estimates its own error (C8) does it in the same pass
+    solution = integrator.integrate(scene.rhs, scene.times, y0, progress, compiled,
+                                    **_measuring(integrator, wanted, {"estimated": True}))
     _log_stats(integrator.name, solution)
     ran = Ran(integrator, solution.choice)
     if not wanted:
@@ -93,10 +94,21 @@ def _unkept(measured: float, choice: Choice) -> bool:
     return measured > choice.promised or ESTIMATE_SLACK * measured > choice.target
 
 
+def _measuring(integrator: Integrator, wanted: bool, choosing: dict | None = None) -> dict:
+    """The keywords of ``integrator.integrate`` for a run whose error is measured (``wanted``): ``estimate`` for one
+    that estimates its own error (C8), ``choosing`` for one that chooses its method (C7)."""
+    if not wanted:
+        return {}
+    if integrator.supports(CHOOSES_METHOD):
+        return choosing or {}
+    return {"estimate": True} if integrator.supports(ESTIMATES_ERROR) else {}
+
+
 def _compare(scene: Any, solution: Solution) -> estimate.Comparison:
     choice = solution.choice
     method = scene.integrator if choice is None else choice.method
-    return estimate.compare(scene, method, solution.y, solution.stats.wall_time, None if choice is None else choice.check)
+    return estimate.compare(scene, method, solution.y, solution.stats.wall_time, None if choice is None else choice.check,
+                            solution.estimate)
 
 
 def _again(scene: Any, y0: np.ndarray, progress: Any, compiled: Any, choice: Choice, measured: float,
@@ -119,7 +131,7 @@ def _again(scene: Any, y0: np.ndarray, progress: Any, compiled: Any, choice: Cho
                                "error estimate left to check it)", measured)
     method = finer[0]
     try:
-        solution = method.integrate(scene.rhs, scene.times, y0, progress, compiled)
+        solution = method.integrate(scene.rhs, scene.times, y0, progress, compiled, **_measuring(method, True))
     except ConfigError as refused:  # (a model the higher rung cannot run)
         raise ConfigError(f"{scene.integrator.name}'s run measured an error of {measured:.2g} (output.error_estimate), "
                           f"above what it promised, and the more accurate run is refused: {refused}") from None

@@ -57,6 +57,22 @@ class Choice:
     measure_first: bool = False
 
 
+@dataclass(frozen=True)
+class OwnEstimate:
+    """C8: the run's global error, estimated by the integrator in the same pass (``integrate(..., estimate=True)``)."""
+
+    #: the estimated error of every state component at every output time (exact − computed)
+    error: np.ndarray
+    #: ln of how much the motion amplified perturbations by each output time (the running maximum)
+    log_growth: np.ndarray
+    #: the same by the first tenth of the span (an ``auto`` pilot's end: growth after it beyond a power law is chaos)
+    log_growth_tenth: float
+    #: accepted steps (the round-off of the run grows with them)
+    steps: int
+    #: how it was estimated, for the dataset
+    how: str
+
+
 @dataclass
 class Solution:
     """Samples of the state at the requested output times."""
@@ -66,6 +82,8 @@ class Solution:
     stats: IntegratorStats
     #: C7: what was chosen and ran (None for an integrator that does not choose)
     choice: Choice | None = None
+    #: C8: the run's error estimated in the same pass, when asked (``integrate(..., estimate=True)``)
+    estimate: OwnEstimate | None = None
 
 
 # Capabilities (rule 8 of ``Integrator``): declared by the integrator, asked for by the engine, never its name;
@@ -85,9 +103,11 @@ VECTOR_LANES = "vector_lanes"
 VARIATIONAL = "variational"
 #: C7: picks a method and tolerance itself, per scene (``integrate``) and per batch (``choose_batch_method``)
 CHOOSES_METHOD = "chooses_method"
+#: C8: ``integrate(..., estimate=True)`` also estimates the run's global error in the same pass (``Solution.estimate``)
+ESTIMATES_ERROR = "estimates_error"
 #: every capability, in the order the documentation lists them
 CAPABILITIES = (COMPILED_MODEL, PREFERS_COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, VARIATIONAL,
-                CHOOSES_METHOD)
+                CHOOSES_METHOD, ESTIMATES_ERROR)
 #: the precision ladder, lowest rung first: an integrator's ``precision`` names its rung, ``climbed`` goes up one
 PRECISIONS = ("double", "double-double")
 #: the run dataset's attribute holding the integrator's ``evaluation_label`` (what ``integrator_nfev`` counts)
@@ -159,7 +179,7 @@ class Integrator(ABC):
        system's ``compiled_model()``) instead of calling ``fun``.
     7. ``attributes()`` gives its settings for the dataset.
     8. It declares what it can do in ``capabilities`` (a frozenset of this module's capability constants,
-       C1–C7, each with its hook; docs/plugins.md, "Integrator capabilities", says what the engine does with
+       C1–C8, each with its hook; docs/plugins.md, "Integrator capabilities", says what the engine does with
        each) and the engine asks ``supports(capability)``, never for an integrator's name.
        ``evaluation_label``, when set, says what ``nfev`` counts where that is not right-hand-side calls.
     9. ``more_accurate(factor)``, optional: a more accurate run of the same method, which
@@ -171,6 +191,9 @@ class Integrator(ABC):
         A CHOOSES_METHOD integrator returns what it chose with its solution (``Solution.choice``, a ``Choice``);
         ``gyrolab.accuracy`` calls ``integrate(..., estimated=True)`` when it will measure the run, and the
         integrator may then try a cheaper choice first (``Choice.measure_first``).
+    12. An ESTIMATES_ERROR integrator's ``integrate(..., estimate=True)`` returns, with the solution, the run's
+        global error estimated in the same pass (``Solution.estimate``, an ``OwnEstimate``), which
+        ``gyrolab.accuracy`` stores instead of running a companion where the run's round-off is small beside it.
 
     Every subclass's own ``integrate`` is wrapped when the class is defined (``gyrolab.contracts.integrator_rules``),
     so that each call is checked against rules 2–4; a violation is one ``IntegrationError`` sentence naming the

@@ -13,9 +13,10 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.contracts.integrator import (BATCH_KERNEL, COMPILED_MODEL, TIME_DEPENDENT, VARIATIONAL, VECTOR_LANES,
-                                          BatchSolution, CompiledModel, Integrator, IntegratorStats, ProgressCallback,
-                                          RightHandSide, Solution, VariationalSettings)
+from gyrolab.contracts.integrator import (BATCH_KERNEL, COMPILED_MODEL, ESTIMATES_ERROR, TIME_DEPENDENT, VARIATIONAL,
+                                          VECTOR_LANES, BatchSolution, CompiledModel, Integrator, IntegratorStats,
+                                          OwnEstimate, ProgressCallback, RightHandSide, Solution,
+                                          VariationalSettings)
 from gyrolab.errors import ConfigError, IntegrationError, as_number
 from gyrolab.plugins.integrators import batch_kernels
 from gyrolab.plugins.integrators.refinement import half_step, interval_steps
@@ -206,7 +207,7 @@ class Taylor(Integrator):
 
     name = "taylor"
     adaptive = True
-    capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES})
+    capabilities = frozenset({COMPILED_MODEL, TIME_DEPENDENT, BATCH_KERNEL, VECTOR_LANES, ESTIMATES_ERROR})
     # one Taylor step costs about as much as `order` right-hand-side evaluations; nfev counts the series
     evaluation_label = "Taylor series evaluations"
 
@@ -251,7 +252,9 @@ class Taylor(Integrator):
         self.order = order
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
-                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
+                  progress: ProgressCallback | None = None, compiled: CompiledModel | None = None,
+                  estimate: bool = False) -> Solution:
+        """The run; ``estimate`` (C8): its global error estimated in the same pass (``taylor.run_measured``)."""
         from gyrolab.kernels import taylor, taylor_series  # start-up: the kernel imports numba
 
         start = time.perf_counter()
@@ -261,9 +264,26 @@ class Taylor(Integrator):
         carry = np.zeros(len(y))  # (np.zeros_like costs 2 µs more, per pilot run)
         stats = np.zeros(2, dtype=np.int64)
         # one Taylor step costs about as much as `order` right-hand-side evaluations; the series count is reported
-        return _adaptive(lambda reached, stop: taylor.run(compiled.params, self.order, self.tol, t_out, out, reached,
-                                                          stop, state, y, carry, stats),
-                         t_out, out, state, stats, progress, _taylor_failure, start)
+        if not estimate:
+            return _adaptive(lambda reached, stop: taylor.run(compiled.params, self.order, self.tol, t_out, out,
+                                                              reached, stop, state, y, carry, stats),
+                             t_out, out, state, stats, progress, _taylor_failure, start)
+        from gyrolab.kernels import layout, tangent  # (loaded with the kernels)
+
+        error, log_growth = np.zeros_like(out), np.zeros(len(t_out))
+        growth = np.array([0.0, 0.0, t_out[0] + 0.1 * (t_out[-1] - t_out[0]), 0.0])
+        e = np.zeros(len(y))
+        # the tangent vector starts as the chaos measure's does (``tangent.direction``: on the fixed point tangent to
+        # |γ| = 1)
+        u = tangent.direction(y, slice(layout.GAMMA, layout.GAMMA + 3) if compiled.built_in is not None else None)[0]
+        solution = _adaptive(lambda reached, stop: taylor.run_measured(
+            compiled.params, self.order, self.tol, t_out, out, reached, stop, state, y, carry, stats, e, u, error,
+            growth, log_growth), t_out, out, state, stats, progress, _taylor_failure, start)
+        m = min(taylor.TANGENT_ORDER, self.order)
+        solution.estimate = OwnEstimate(error, log_growth, float(growth[3]), int(stats[1]), (
+            f"one pass: each step's truncation error (the series' next {taylor.EXTRA_ORDERS} terms) carried along "
+            f"the run by the linearised equations (their Taylor series to order {m} on the run's own steps)"))
+        return solution
 
     #: below this tol the double-precision kernel gains nothing (round-off)
     TOLERANCE_FLOOR = 1e-16

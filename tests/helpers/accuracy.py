@@ -31,11 +31,12 @@ def long_double_final(overrides) -> np.ndarray:
 
 
 def no_growth(monkeypatch):
-    """auto's amplification measured as none: its prediction then misses the chaos (as a tangent run whose growth
-    scatters low would make it miss)."""
+    """auto's amplification measured as none, by a tangent run first or by its Taylor run's one pass: its prediction
+    then misses the chaos (as a measured growth that scatters low would make it miss)."""
     import gyrolab.accuracy.auto as auto_module
     from gyrolab.accuracy.amplification import Amplification
 
     monkeypatch.setattr(auto_module, "amplification",
                         lambda compiled, fun, y0, t0, t_pilot, t_end, method: Amplification(0.0, 0.0, t_end - t0,
                                                                                            "none (test)"))
+    monkeypatch.setattr(auto_module, "growth_of", lambda own, span: Amplification(0.0, 0.0, span, "none (test)"))
