@@ -55,13 +55,15 @@ def wanted(scene: Any) -> bool:
     return bool(choice)
 
 
-def companion(method: Any, has_compiled: bool) -> Companion | None:
+def companion(method: Any, has_compiled: bool, round_off: bool = False) -> Companion | None:
     """The more accurate run that measures the run of ``method`` (its ``more_accurate``, rule 9 of the contract;
     else the compiled Taylor method at its floor when the scene has a compiled model; else, for a run that is itself
-    the double-precision Taylor method near that floor, the method one rung up the precision ladder), or None."""
+    the double-precision Taylor method near that floor, the method one rung up the precision ladder), or None.
+    ``round_off``: the run's own estimate found its round-off not small (``one_pass``), which a double companion
+    shares: a double Taylor run is then measured as near its floor (two double companions, else double-double)."""
     taylor = _double_taylor(method) if has_compiled else None
     finer = method.more_accurate(TIGHTER)
-    if finer is not None and (taylor is None or taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW):
+    if finer is not None and (taylor is None or (taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW and not round_off)):
         return Companion(*finer)
     if method.precision != PRECISIONS[0]:
         # above double precision a double stand-in would measure its own error, not the run's (docs/integrators.md:
@@ -141,7 +143,7 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
     if isinstance(one, Comparison):
         return one
     compiled_model = scene.compiled_model
-    pick = companion(method, compiled_model is not None) if check is None else Companion(check, 1.0, (
+    pick = companion(method, compiled_model is not None, isinstance(one, str)) if check is None else Companion(check, 1.0, (
         f"{check.name} ({', '.join(f'{k} {v}' for k, v in check.attributes().items())}) against the analytic series"))
     name = getattr(method, "name", type(method).__name__)
     if pick is None:

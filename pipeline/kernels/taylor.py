@@ -205,14 +205,15 @@ def _tangent_series(p, T, D, m, v, scale, t):
                 D[j, k] = 0.0
         return
     delta = DIFFERENCE_STEP * scale
+    forward, back = delta / size, size / delta
     for k in range(n):
-        D[0, k] = T[0, k] + v[k] * (delta / size)
+        D[0, k] = T[0, k] + v[k] * forward
     taylor_coefficients(p, D, m, t)
-    for j in range(1, m + 1):
-        for k in range(n):
-            D[j, k] = (D[j, k] - T[j, k]) * (size / delta)
     for k in range(n):
         D[0, k] = v[k]
+    for j in range(1, m + 1):
+        for k in range(n):
+            D[j, k] = (D[j, k] - T[j, k]) * back
 
 
 #: lanes of the Horner sums' vectors (AVX-512's; an AVX2 CPU runs each as two, a CPU without vectors as scalars)
