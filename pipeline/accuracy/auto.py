@@ -210,7 +210,7 @@ class Auto(Integrator):
         perturbations, which the run measures (C8): kept where that growth is no chaos and leaves the target met,
         else the choice is made again with it (``integrate(amp=...)``)."""
         y, final_stats, n_steps, own = _final_run(method, fun, t_out, y0, progress, compiled, resumed,
-                                                  estimated or provisional)
+                                                  estimated or provisional, estimated)
         if provisional:
             amp = growth_of(own, t_out[-1] - t_out[0])
             measured = _amplified(per_tol, growth, amp.factor, self.pilot_fraction, CHAOS_MARGIN)
@@ -559,13 +559,15 @@ def _raise(error: Exception) -> Any:
 
 def _final_run(method: Integrator, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                progress: ProgressCallback | None, compiled: CompiledModel | None,
-               resumed: tuple | None, estimated: bool) -> tuple[np.ndarray, IntegratorStats, int, OwnEstimate | None]:
-    """(outputs, the run's stats, steps, its own error estimate or None) of ``auto``'s chosen ``method`` over
-    ``t_out``: from y0, or, with ``resumed`` = (the pilot's tight run, its times, the output times inside the pilot,
-    the pilot's end), from the end of the pilot's tight run, whose outputs inside the pilot are kept. ``estimated``:
-    the run estimates its own error where the method can (C8), from y0 (the error of a resumed start is unknown)."""
-    if estimated and method.supports(ESTIMATES_ERROR):
-        solution = method.integrate(fun, t_out, y0, progress, compiled, estimate=True)
+               resumed: tuple | None, measured: bool, estimated: bool
+               ) -> tuple[np.ndarray, IntegratorStats, int, OwnEstimate | None]:
+    """(outputs, the run's stats, steps, its own measurement or None) of ``auto``'s chosen ``method`` over ``t_out``:
+    from y0, or, with ``resumed`` = (the pilot's tight run, its times, the output times inside the pilot, the
+    pilot's end), from the end of the pilot's tight run, whose outputs inside the pilot are kept. ``measured``: the
+    run measures the growth of perturbations where the method can (C8), and its own error too where ``estimated``,
+    from y0 (the error of a resumed start is unknown)."""
+    if measured and method.supports(ESTIMATES_ERROR):  # (without ``estimated``, the growth alone)
+        solution = method.integrate(fun, t_out, y0, progress, compiled, estimate=estimated, growth_only=not estimated)
         return solution.y, solution.stats, solution.stats.n_steps, solution.estimate
     if resumed is None:
         solution = method.integrate(fun, t_out, y0, progress, compiled)

@@ -18,6 +18,7 @@ Stored as ``error_estimate_omega`` (ω's max-norm error at each output time, in 
 from __future__ import annotations
 
 import functools
+import math
 import logging
 import time
 from dataclasses import dataclass
@@ -139,7 +140,7 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
     ``check``, a run that is no integration, measured against ``check``) and compare: the measured error estimate,
     or why none is available. ``own``: the run's error estimated in the same pass (C8), taken instead of a companion
     where the run's round-off is ``ROUNDOFF_MARGIN`` times below it (``one_pass``)."""
-    one = None if own is None else one_pass(own, y, scene.times)
+    one = None if own is None or own.error is None else one_pass(own, y, scene.times)
     if isinstance(one, Comparison):
         return one
     compiled_model = scene.compiled_model
@@ -240,12 +241,13 @@ def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray) -> Comparison |
     scale = max(1.0, float(np.max(np.abs(y))))
     walk = np.sqrt(1.0 + own.steps * ((times - times[0]) / span))
     roundoff = (EPS * scale * margin) * walk * np.exp(np.minimum(own.log_growth, 700.0))
-    error = np.abs(own.error)
-    measured = float(np.max(error))
+    error = np.square(own.error)  # (in place below: np.hypot took ~0.13 ms for 3,001 × 9)
+    measured = math.sqrt(float(np.max(error)))
     if not ROUNDOFF_MARGIN * float(roundoff[-1]) <= measured:
         return (f"the one-pass estimate, {measured:.2g}, is not {ROUNDOFF_MARGIN:g}× above the run's round-off, about "
                 f"{float(roundoff[-1]):.2g}, which it does not see")
     # (no error_estimate_cost_ratio: the estimate's work is inside the run's steps, not a run of its own)
     attrs = {"error_estimate_method": f"{own.how}, plus double precision's round-off (≤ {float(roundoff[-1]):.2g})"}
     # (in quadrature: the round-off is a random walk's typical size, independent of the truncation error)
-    return Comparison(np.hypot(error, roundoff[:, None]), attrs, y)
+    error += np.square(roundoff)[:, None]
+    return Comparison(np.sqrt(error, out=error), attrs, y)

@@ -61,8 +61,9 @@ class Choice:
 class OwnEstimate:
     """C8: the run's global error, estimated by the integrator in the same pass (``integrate(..., estimate=True)``)."""
 
-    #: the estimated error of every state component at every output time (exact − computed)
-    error: np.ndarray
+    #: the estimated error of every state component at every output time (exact − computed); None: the growth
+    #: alone was measured
+    error: np.ndarray | None
     #: ln of how much the motion amplified perturbations by each output time (the running maximum)
     log_growth: np.ndarray
     #: the same by the first tenth of the span (an ``auto`` pilot's end: growth after it beyond a power law is chaos)

@@ -253,9 +253,10 @@ class Taylor(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None,
-                  estimate: bool = False) -> Solution:
-        """The run; ``estimate`` (C8): its global error estimated in the same pass (``taylor.run_measured``)."""
-        from gyrolab.kernels import taylor, taylor_series  # start-up: the kernel imports numba
+                  estimate: bool = False, growth_only: bool = False) -> Solution:
+        """The run; ``estimate`` (C8): its global error estimated in the same pass (``taylor.run_measured``), and the
+        growth of perturbations measured; ``growth_only``: the growth alone (``OwnEstimate.error`` None)."""
+        from gyrolab.kernels import layout, taylor, taylor_series, tangent  # start-up: the kernel imports numba
 
         start = time.perf_counter()
         taylor_series.ready(compiled)  # a traced model's series kernel, compiled on first need (once: then a test)
@@ -264,15 +265,13 @@ class Taylor(Integrator):
         carry = np.zeros(len(y))  # (np.zeros_like costs 2 µs more, per pilot run)
         stats = np.zeros(2, dtype=np.int64)
         # one Taylor step costs about as much as `order` right-hand-side evaluations; the series count is reported
-        if not estimate:
+        if not (estimate or growth_only):
             return _adaptive(lambda reached, stop: taylor.run(compiled.params, self.order, self.tol, t_out, out,
                                                               reached, stop, state, y, carry, stats),
                              t_out, out, state, stats, progress, _taylor_failure, start)
-        from gyrolab.kernels import layout, tangent  # (loaded with the kernels)
-
-        error, log_growth = np.zeros_like(out), np.zeros(len(t_out))
+        error = np.zeros((len(t_out) if estimate else 0, len(y)))
+        e, log_growth = np.zeros(len(y) if estimate else 0), np.zeros(len(t_out))
         growth = np.array([0.0, 0.0, t_out[0] + 0.1 * (t_out[-1] - t_out[0]), 0.0])
-        e = np.zeros(len(y))
         # the tangent vector starts as the chaos measure's does (``tangent.direction``: on the fixed point tangent to
         # |γ| = 1)
         u = tangent.direction(y, slice(layout.GAMMA, layout.GAMMA + 3) if compiled.built_in is not None else None)[0]
@@ -280,7 +279,7 @@ class Taylor(Integrator):
             compiled.params, self.order, self.tol, t_out, out, reached, stop, state, y, carry, stats, e, u, error,
             growth, log_growth), t_out, out, state, stats, progress, _taylor_failure, start)
         m = min(taylor.TANGENT_ORDER, self.order)
-        solution.estimate = OwnEstimate(error, log_growth, float(growth[3]), int(stats[1]), (
+        solution.estimate = OwnEstimate(error if estimate else None, log_growth, float(growth[3]), int(stats[1]), (
             f"one pass: each step's truncation error (the series' next {taylor.EXTRA_ORDERS} terms) carried along "
             f"the run by the linearised equations (their Taylor series to order {m} on the run's own steps)"))
         return solution

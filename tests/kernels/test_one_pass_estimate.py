@@ -54,3 +54,14 @@ def test_the_growth_is_the_generated_tangent_flows(overrides):
     assert abs(own.log_growth_tenth - tangent.log_pilot) < 1.5
     assert abs(own.log_growth[-1] - tangent.log_span) < 1.5
     assert np.all(np.diff(own.log_growth) >= 0)  # a running maximum
+
+
+def test_the_growth_alone_is_the_same_growth_without_the_error():
+    # auto without an error estimate measures the growth alone: the same tangent vector, the same steps
+    scene = compose_scene(REFERENCE)
+    both = _run(scene, 1e-9)
+    alone = Taylor(tol=1e-9).integrate(None, scene.times, scene.system.initial_state(), None, scene.compiled_model,
+                                       growth_only=True)
+    np.testing.assert_array_equal(alone.y, both.y)
+    np.testing.assert_array_equal(alone.estimate.log_growth, both.estimate.log_growth)
+    assert alone.estimate.error is None and alone.estimate.log_growth_tenth == both.estimate.log_growth_tenth
