@@ -90,10 +90,10 @@ def run(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
 
 
 #: the one-pass error estimate (``run_measured``): the series' orders beyond the step's, whose terms are the step's
-#: truncation error with its sign, and the order of the tangent series that carries the error so far along the step
-#: (benchmarks/one_pass_estimate.py: with gyrolab's steps, 6 orders broke the estimate's 2× on the reference scene,
-#: 10 held it within 0.82–1.42×)
-EXTRA_ORDERS, TANGENT_ORDER = 4, 10
+#: truncation error with its sign; the order of the tangent series that carries the error so far along the step; the
+#: relative error a step the tangent vector's shorter series may have. gyrolab.accuracy.calibration's table holds the
+#: same values with the measurements behind them (benchmarks/one_pass_estimate.py checks them)
+EXTRA_ORDERS, TANGENT_ORDER, GROWTH_PER_STEP = 4, 10, 1e-5
 #: the finite difference's step along the error's direction, relative to the state's scale: ~√eps, so that its
 #: truncation and its round-off both leave the tangent series ~1e-8 relative error (the estimate needs one digit)
 DIFFERENCE_STEP = 2.0 ** -26
@@ -129,11 +129,12 @@ def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u
     # error (T's), zeros between: one Horner sum gives both (``_series_at``)
     R = _coefficient_rows(order + 1 + extra if estimating else 0, n)
     R[:, :] = 0.0
-    # the tangent vector's series, shorter: its growth needs ~1e-5 a step (a bias of ~0.02 in ln|δ| over 2,000 steps),
-    # and a step spans ~tol^(1/order)·safety of the series' radius of convergence, which each order gains
+    # the tangent vector's series, shorter: its growth needs GROWTH_PER_STEP a step (a bias of ~0.02 in ln|δ| over
+    # 2,000 steps), and a step spans ~tol^(1/order)·safety of the series' radius of convergence, which each order gains
     u_order = m
     if tol < 1.0:
-        u_order = min(m, max(MIN_ORDER, int(math.ceil(math.log(1e-5) / math.log(tol ** (1.0 / order) * safety)))))
+        u_order = min(m, max(MIN_ORDER, int(math.ceil(math.log(GROWTH_PER_STEP) / math.log(tol ** (1.0 / order)
+                                                                                           * safety)))))
     U = _coefficient_rows(u_order + 1 if measured else 0, n)
     end = np.empty((2, n))  # the whole error and the tangent vector at a step's end
     t = state[0]

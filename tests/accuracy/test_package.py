@@ -14,7 +14,7 @@ from gyrolab.accuracy import calibration as table
 from tests.helpers import REPO
 
 BENCHMARKS = {table.PROMISE: "PROMISE", table.PERF: "PERF", table.CALIBRATE: "CALIBRATE", table.CHAOS: "CHAOS",
-              table.ROUNDOFF: "ROUNDOFF"}
+              table.ROUNDOFF: "ROUNDOFF", table.ONE_PASS: "ONE_PASS"}
 
 
 def test_every_constant_names_a_benchmark_that_reports_on_it():
@@ -24,6 +24,14 @@ def test_every_constant_names_a_benchmark_that_reports_on_it():
         source = (REPO / constant.benchmark.split()[0]).read_text()
         assert f"table.report(table.{BENCHMARKS[constant.benchmark]}," in source, constant.benchmark
         assert constant.basis and getattr(table, constant.name) == constant.value
+
+
+def test_the_one_pass_kernel_runs_with_the_tables_constants():
+    # the kernel, a layer below gyrolab.accuracy, holds its own copy: it must be the table's
+    from gyrolab.kernels import taylor
+
+    for name in ("EXTRA_ORDERS", "TANGENT_ORDER", "GROWTH_PER_STEP"):
+        assert getattr(taylor, name) == table.TABLE[name].value, name
 
 
 def test_no_accuracy_module_keeps_a_constant_of_the_table_for_itself():
