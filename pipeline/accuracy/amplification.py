@@ -67,6 +67,13 @@ class Amplification:
         return math.log(accuracy / floor) / rate
 
 
+def growth_of(own: Any, span: float) -> Amplification:
+    """The growth of perturbations a run measured in its one pass (C8: ``OwnEstimate``'s ln|δ| at the first tenth of
+    the span and at its end), as ``amplification`` measures it."""
+    return Amplification(own.log_growth_tenth, float(own.log_growth[-1]), span,
+                         "a tangent vector carried by the chosen run itself (its one pass)")
+
+
 def amplification(compiled: Any, fun: Any, y0: np.ndarray, t0: float, t_pilot: float, t_end: float,
                   method: Any) -> Amplification:
     """The growth of a unit perturbation over [t0, t_pilot] and [t0, t_end] (``Amplification``).

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.accuracy.amplification import PILOT_FRACTION, Amplification, amplification
+from gyrolab.accuracy.amplification import PILOT_FRACTION, Amplification, amplification, growth_of
 from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_FLOOR,
                                           ESTIMATE_SLACK, FIRST_RATIO, FLOOR, MAX_GROWTH, MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE,
                                           MISS_MARGIN, PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
@@ -128,8 +128,9 @@ class Auto(Integrator):
         taylor = compiled is not None and ready(compiled)  # whether the compiled model has Taylor coefficients
         make = functools.partial(_method, compiled, order if taylor else None)
         # how much the motion amplifies an error present at the pilot's end by the end of the span (chaos: e^{λt}):
-        # measured by the double Taylor run itself (its one pass, C8), which is kept where that growth confirms the
-        # choice made without it; else by a tangent run first (~1.5 ms on the reference scene, the run's 3×)
+        # measured by the double Taylor run itself (its one pass, C8, which measures it at the first tenth: the
+        # default pilot's end), kept where that growth confirms the choice made without it; else by a tangent run
+        # first (~1.5 ms on the reference scene, the run's 3×)
         provisional = amp is None and taylor and self.pilot_fraction == PILOT_FRACTION
         if amp is None:
             amp = Amplification(0.0, 0.0, span, "none yet") if provisional else \
@@ -456,12 +457,6 @@ def at_least(value: float) -> str:
     exponent = math.floor(math.log10(value))
     digit = math.ceil(value / 10.0 ** exponent * (1 - 1e-12))
     return f"{digit}e{exponent}" if digit < 10 else f"1e{exponent + 1}"
-
-
-def growth_of(own: OwnEstimate, span: float) -> Amplification:
-    """The growth of perturbations a run measured in its one pass (C8), as ``amplification`` measures it."""
-    return Amplification(own.log_growth_tenth, float(own.log_growth[-1]), span,
-                         "a tangent vector carried by the chosen run itself (its one pass)")
 
 
 def _chaos_attributes(amp: Amplification, chaotic: bool) -> dict[str, Any]:

@@ -18,8 +18,8 @@ Stored as ``error_estimate_omega`` (ω's max-norm error at each output time, in 
 from __future__ import annotations
 
 import functools
-import math
 import logging
+import math
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.accuracy.amplification import PILOT_FRACTION, Amplification
+from gyrolab.accuracy.amplification import PILOT_FRACTION, growth_of
 from gyrolab.accuracy.calibration import CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
 from gyrolab.kernels.model import rounding_moved
 from gyrolab.contracts.integrator import (CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL,
@@ -228,16 +228,14 @@ def _double_taylor(method: Any) -> Any:
 
 def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray) -> Comparison | str:
     """The run's own estimate (C8) as the measured error, or why not (a companion measures instead). The linearised
-    error equation has no sign for round-off: each output time's estimate adds double precision's round-off there (in
-    quadrature), a
-    random walk of one ulp of the state per step amplified by the growth of perturbations the same pass measured
-    (times ``CHAOS_MARGIN`` on a chaotic scene, as ``auto`` predicts it), and the estimate stands only where that is
-    ``ROUNDOFF_MARGIN`` times below the largest error it measures. (Amplified on regular scenes too: a slow top
-    near its inverted rest, ``tests/helpers/accuracy.ROUND_OFF``, grows perturbations e^9 without chaos and its
-    round-off ended 2.7e-12 away where a walk unamplified said 3e-15.)"""
+    error equation has no sign for round-off: each output time's estimate adds, in quadrature, double precision's
+    round-off there, a random walk of one ulp of the state per step amplified by the growth of perturbations the same
+    pass measured (times ``CHAOS_MARGIN`` on a chaotic scene, as ``auto`` predicts it), and the estimate stands only
+    where that is ``ROUNDOFF_MARGIN`` times below the largest error it measures. (Amplified on regular scenes too: a
+    slow top near its inverted rest, ``tests/helpers/accuracy.ROUND_OFF``, grows perturbations e^9 without chaos and
+    its round-off ended 2.7e-12 away where a walk unamplified said 3e-15.)"""
     span = float(times[-1] - times[0]) or 1.0
-    margin = CHAOS_MARGIN if Amplification(own.log_growth_tenth, float(own.log_growth[-1]), span, "").chaotic(
-        PILOT_FRACTION) else 1.0
+    margin = CHAOS_MARGIN if growth_of(own, span).chaotic(PILOT_FRACTION) else 1.0
     scale = max(1.0, float(np.max(np.abs(y))))
     walk = np.sqrt(1.0 + own.steps * ((times - times[0]) / span))
     roundoff = (EPS * scale * margin) * walk * np.exp(np.minimum(own.log_growth, 700.0))
