@@ -185,7 +185,7 @@ class Auto(Integrator):
             # error estimate measures the target met; else climb as predicted (``Choice.measure_first``).
             chosen = max(min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE),
                          Taylor.TOLERANCE_FLOOR)  # (the tolerance recorded is the one run)
-            resumed = (tight, pilot_times, inside, t_pilot) if tight_tol <= chosen else None
+            resumed = (tight, make(tight_tol), pilot_times, inside, t_pilot) if tight_tol <= chosen else None
             solution = final(make(chosen), chosen, 0.0, (
                 f"double precision's round-off on this chaotic scene is predicted at about {roundoff:.1g} over "
                 f"~{steps:.0f} steps, above accuracy={self.accuracy:g}, from a growth that scatters: run in double "
@@ -198,7 +198,7 @@ class Auto(Integrator):
         if CALIBRATION * per_tol * chosen + roundoff > self.accuracy:  # leave room for the round-off
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         # the pilot's tight run is as accurate when its tolerance is: the run continues from its end
-        resumed = (tight, pilot_times, inside, t_pilot) if tight_tol <= chosen else None
+        resumed = (tight, make(tight_tol), pilot_times, inside, t_pilot) if tight_tol <= chosen else None
         return final(make(chosen), chosen, roundoff, why, resumed, provisional=provisional)
 
     def _final(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None,
@@ -557,20 +557,28 @@ def _final_run(method: Integrator, fun: RightHandSide, t_out: np.ndarray, y0: np
                resumed: tuple | None, measured: bool, estimated: bool
                ) -> tuple[np.ndarray, IntegratorStats, int, OwnEstimate | None]:
     """(outputs, the run's stats, steps, its own measurement or None) of ``auto``'s chosen ``method`` over ``t_out``:
-    from y0, or, with ``resumed`` = (the pilot's tight run, its times, the output times inside the pilot, the
-    pilot's end), from the end of the pilot's tight run, whose outputs inside the pilot are kept. ``measured``: the
-    run measures the growth of perturbations where the method can (C8), and its own error too where ``estimated``,
-    from y0 (the error of a resumed start is unknown)."""
-    if measured and method.supports(ESTIMATES_ERROR):  # (without ``estimated``, the growth alone)
-        solution = method.integrate(fun, t_out, y0, progress, compiled, estimate=estimated, growth_only=not estimated)
-        return solution.y, solution.stats, solution.stats.n_steps, solution.estimate
+    from y0, or, with ``resumed`` = (the pilot's tight run, its method, its times, the output times inside the pilot,
+    the pilot's end), from the end of the pilot's tight run, whose outputs inside the pilot are kept. ``measured``:
+    the run measures the growth of perturbations where the method can (C8), and its own error too where
+    ``estimated``; resumed, the tight run is run again measured (the same states) and the run carries that on."""
+    kind = {"estimate": estimated, "growth_only": not estimated} if measured and method.supports(ESTIMATES_ERROR) \
+        else {}
     if resumed is None:
-        solution = method.integrate(fun, t_out, y0, progress, compiled)
-        return solution.y, solution.stats, solution.stats.n_steps, None
-    tight, pilot_times, inside, t_pilot = resumed
+        solution = method.integrate(fun, t_out, y0, progress, compiled, **kind)
+        return solution.y, solution.stats, solution.stats.n_steps, solution.estimate
+    tight, tight_method, pilot_times, inside, t_pilot = resumed
+    if kind:
+        tight = tight_method.integrate(fun, pilot_times, y0, None, compiled, **kind)
+        kind["resume"] = tight.estimate
     head = np.searchsorted(pilot_times, inside)  # the outputs inside the pilot
     rest = t_out[t_out >= t_pilot]
     tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest, tight.y[-1],
-                            progress, compiled)
-    return (np.concatenate([tight.y[head], tail.y[-len(rest):]]), tail.stats, tail.stats.n_steps + tight.stats.n_steps,
-            None)
+                            progress, compiled, **kind)
+    steps = tail.stats.n_steps + tight.stats.n_steps
+    own = tail.estimate
+    if own is not None:  # the pilot's part and the rest, as one run's
+        head_own = tight.estimate
+        own = replace(own, error=None if own.error is None else np.concatenate([head_own.error[head],
+                                                                                own.error[-len(rest):]]),
+                      log_growth=np.concatenate([head_own.log_growth[head], own.log_growth[-len(rest):]]), steps=steps)
+    return np.concatenate([tight.y[head], tail.y[-len(rest):]]), tail.stats, steps, own

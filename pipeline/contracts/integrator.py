@@ -66,12 +66,16 @@ class OwnEstimate:
     error: np.ndarray | None
     #: ln of how much the motion amplified perturbations by each output time (the running maximum)
     log_growth: np.ndarray
-    #: the same by the first tenth of the span (an ``auto`` pilot's end: growth after it beyond a power law is chaos)
+    #: the same by the first tenth of the span (an ``auto`` pilot's end: growth after it beyond a power law is chaos), or
+    #: for a resumed run where it resumed (``auto`` resumes at its pilot's end)
     log_growth_tenth: float
     #: accepted steps (the round-off of the run grows with them)
     steps: int
     #: how it was estimated, for the dataset
     how: str
+    #: the pass's state at the run's end (the error or an empty array, the unit tangent vector, [ln|δ|, its running
+    #: maximum]): a run resumed from this one's end carries it on (``Taylor.integrate(..., resume=...)``)
+    end: tuple | None = None
 
 
 @dataclass

@@ -253,9 +253,10 @@ class Taylor(Integrator):
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None,
-                  estimate: bool = False, growth_only: bool = False) -> Solution:
+                  estimate: bool = False, growth_only: bool = False, resume: OwnEstimate | None = None) -> Solution:
         """The run; ``estimate`` (C8): its global error estimated in the same pass (``taylor.run_measured``), and the
-        growth of perturbations measured; ``growth_only``: the growth alone (``OwnEstimate.error`` None)."""
+        growth of perturbations measured; ``growth_only``: the growth alone (``OwnEstimate.error`` None). ``resume``:
+        the measurement of a run that ended at y0, whose error, tangent vector and growth this run carries on."""
         from gyrolab.kernels import layout, taylor, taylor_series, tangent  # start-up: the kernel imports numba
 
         start = time.perf_counter()
@@ -270,18 +271,27 @@ class Taylor(Integrator):
                                                               reached, stop, state, y, carry, stats),
                              t_out, out, state, stats, progress, _taylor_failure, start)
         error = np.zeros((len(t_out) if estimate else 0, len(y)))
-        e, log_growth = np.zeros(len(y) if estimate else 0), np.zeros(len(t_out))
-        growth = np.array([0.0, 0.0, t_out[0] + 0.1 * (t_out[-1] - t_out[0]), 0.0])
-        # the tangent vector starts as the chaos measure's does (``tangent.direction``: on the fixed point tangent to
-        # |γ| = 1)
-        u = tangent.direction(y, slice(layout.GAMMA, layout.GAMMA + 3) if compiled.built_in is not None else None)[0]
+        if resume is None:
+            e, log_growth = np.zeros(len(y) if estimate else 0), np.zeros(len(t_out))
+            growth = np.array([0.0, 0.0, t_out[0] + 0.1 * (t_out[-1] - t_out[0]), 0.0])
+            # the tangent vector starts as the chaos measure's does (``tangent.direction``: on the fixed point tangent
+            # to |γ| = 1)
+            u = tangent.direction(y, slice(layout.GAMMA, layout.GAMMA + 3) if compiled.built_in is not None
+                                  else None)[0]
+        else:  # (the growth's mark where it resumes)
+            e, u, (log, top) = np.array(resume.end[0]), np.array(resume.end[1]), resume.end[2]
+            e = e if estimate and e.size else np.zeros(len(y) if estimate else 0)
+            growth, log_growth = np.array([log, top, t_out[0], top]), np.full(len(t_out), top)
+            if estimate:
+                error[0] = e  # (at t_out[0]: the start's own error)
         solution = _adaptive(lambda reached, stop: taylor.run_measured(
             compiled.params, self.order, self.tol, t_out, out, reached, stop, state, y, carry, stats, e, u, error,
             growth, log_growth), t_out, out, state, stats, progress, _taylor_failure, start)
         m = min(taylor.TANGENT_ORDER, self.order)
         solution.estimate = OwnEstimate(error if estimate else None, log_growth, float(growth[3]), int(stats[1]), (
             f"one pass: each step's truncation error (the series' next {taylor.EXTRA_ORDERS} terms) carried along "
-            f"the run by the linearised equations (their Taylor series to order {m} on the run's own steps)"))
+            f"the run by the linearised equations (their Taylor series to order {m} on the run's own steps)"),
+            (e, u, growth[:2].copy()))
         return solution
 
     #: below this tol the double-precision kernel gains nothing (round-off)

@@ -65,3 +65,24 @@ def test_the_growth_alone_is_the_same_growth_without_the_error():
     np.testing.assert_array_equal(alone.y, both.y)
     np.testing.assert_array_equal(alone.estimate.log_growth, both.estimate.log_growth)
     assert alone.estimate.error is None and alone.estimate.log_growth_tenth == both.estimate.log_growth_tenth
+
+
+def test_a_run_resumed_from_another_carries_its_error_and_growth_on():
+    # auto resumes its final run from its pilot's tight run: the second part starts with the first's error and
+    # tangent vector, so the two parts measure what one run would
+    scene = compose_scene(REFERENCE)
+    t, y0, model = scene.times, scene.system.initial_state(), scene.compiled_model
+    half = len(t) // 2
+    first = Taylor(tol=1e-9).integrate(None, t[:half + 1], y0, None, model, estimate=True)
+    second = Taylor(tol=1e-9).integrate(None, t[half:], first.y[-1], None, model, estimate=True,
+                                        resume=first.estimate)
+    whole = _run(scene, 1e-9)
+    actual = np.abs(second.y[:, :6] - long_double_states(scene, t)[half:]).max(axis=1)
+    estimated = np.abs(second.estimate.error[:, :6]).max(axis=1)
+    assert estimated[0] == np.abs(first.estimate.error[-1, :6]).max()  # the first part's error, carried on
+    judged = actual > 1e-12
+    assert judged.sum() > len(judged) // 2
+    ratio = estimated[judged] / actual[judged]
+    assert 0.5 <= ratio.min() and ratio.max() <= 2.0, (ratio.min(), ratio.max())
+    assert abs(second.estimate.log_growth[-1] - whole.estimate.log_growth[-1]) < 0.2
+    assert second.estimate.log_growth_tenth == first.estimate.end[2][1]  # the mark where it resumed
