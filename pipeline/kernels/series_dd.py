@@ -27,12 +27,10 @@ from __future__ import annotations
 from typing import Any
 
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before compiling)
-from gyrolab.kernels.expression import BINARY, UNARY, NotCompilable, generated_module
+from gyrolab.kernels.expression import NotCompilable, generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import Model, traced_model
-from gyrolab.kernels.taylor_series import Lowering
-
-_NUMBER_FUNCTIONS = {**UNARY, **BINARY, "powx": "{0} ** {1}"}
+from gyrolab.kernels.taylor_series import NUMBER_FUNCTIONS, Lowering
 
 #: operations on double-double numbers (x, y: their hi, lo names)
 _NUMBER_OPS = {"add": "dd_add({0}, {1}, {2}, {3})", "sub": "dd_add({0}, {1}, -{2}, -{3})", "neg": "-{0}, -{1}",
@@ -194,7 +192,7 @@ class _Program(Lowering):
         if op in _NUMBER_OPS:
             return _NUMBER_OPS[op].format(*a[0][1], *(a[1][1] if len(a) > 1 else ()))
         args = [v[1][0] if isinstance(v, tuple) else v for v in a]
-        return f"{_NUMBER_FUNCTIONS[op].format(*args)}, 0.0"
+        return f"{NUMBER_FUNCTIONS[op].format(*args)}, 0.0"
 
     def _plus(self, *values: tuple[str, Any]) -> tuple[str, Any]:
         terms: dict[Any, tuple[str, str]] = {}

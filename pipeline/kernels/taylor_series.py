@@ -25,9 +25,7 @@ state's and the products' lanes by shuffles (``gather``), their Cauchy sums Σ_j
 in fused multiply-adds, and the rates' linear combinations as sums of shuffled lanes times coefficient vectors, the
 1/(k + 1) folded into the coefficients (off the chain of dependent operations from one order to the next).
 Functions of series (sin, sqrt, division, ...) run their recurrences in a lane of their own
-(``recurrences.Functions``). The same recurrences as the hand-written fixed-point kernel this replaced, whose
-vectorised form (ω, γ and their cyclic permutations in ``<4 x double>``) it generalises; measured against it in
-docs/performance.md.
+(``recurrences.Functions``). Its speed against the hand-written fixed-point kernel it replaced: docs/performance.md.
 
 Like the right-hand side's kernel it reads the equations' numbers from the parameter array, so the generated source
 depends on the equations' form only: it is compiled once per form (cached on disk under a hash of the source, which
@@ -153,8 +151,8 @@ class _Series:
         self.columns: list[int] = []  # its own columns of W (functions: the series and auxiliaries)
 
 
-# the functions of numbers (folded into ``_Numbers``)
-_NUMBER_FUNCTIONS = {**UNARY, **BINARY, "pow": "{0} ** {1}", "ipow": "{0} ** {1}"}
+# the functions of numbers (folded into ``_Numbers``; ``series_dd``'s, in double)
+NUMBER_FUNCTIONS = {**UNARY, **BINARY, "pow": "{0} ** {1}", "ipow": "{0} ** {1}", "powx": "{0} ** {1}"}
 
 
 class Lowering:
@@ -247,7 +245,7 @@ class _Program(Lowering):
     def _function(self, op: str, x: _Lin, y: _Lin | None = None, e: str | None = None) -> _Lin:
         args = (x,) if y is None else (x, y)
         if all(not v.terms for v in args):  # a number
-            return _Lin(self.numbers.call(_NUMBER_FUNCTIONS[op], *[v.const for v in args], *([e] if e else [])))
+            return _Lin(self.numbers.call(NUMBER_FUNCTIONS[op], *[v.const for v in args], *([e] if e else [])))
         if op in ("sin", "cos"):
             sine = self._make("sin", args, None, pair="cos")
             if op == "sin":
@@ -278,7 +276,7 @@ class _Program(Lowering):
         if op == "ipow":
             if a[0].terms or a[1] == 0:
                 return self._power(a[0], a[1], _Lin(ONE))
-            return _Lin(n.call(_NUMBER_FUNCTIONS["ipow"], a[0].const, int(a[1])))
+            return _Lin(n.call(NUMBER_FUNCTIONS["ipow"], a[0].const, int(a[1])))
         if op == "powx":
             base, exponent = a
             if not exponent.terms:
