@@ -27,11 +27,10 @@ from __future__ import annotations
 from typing import Any
 
 from gyrolab.kernels.compiler import kernel_cache_dir  # noqa: F401  (numba's cache set up before compiling)
-from gyrolab.kernels.expression import BINARY, UNARY, Expr, NotCompilable, binary_power, generated_module
+from gyrolab.kernels.expression import NotCompilable, generated_module
 from gyrolab.kernels.layout import TRACED_ADDRESS, TRACED_FIRST_CONSTANT
 from gyrolab.kernels.model import Model, traced_model
-
-_NUMBER_FUNCTIONS = {**UNARY, **BINARY, "powx": "{0} ** {1}"}
+from gyrolab.kernels.taylor_series import NUMBER_FUNCTIONS, Lowering
 
 #: operations on double-double numbers (x, y: their hi, lo names)
 _NUMBER_OPS = {"add": "dd_add({0}, {1}, {2}, {3})", "sub": "dd_add({0}, {1}, -{2}, -{3})", "neg": "-{0}, -{1}",
@@ -71,7 +70,7 @@ def _terms(value: tuple[str, Any]) -> dict[Any, tuple[str, str]]:
     return value[1] if value[0] == "sum" else {("1",): value[1]}
 
 
-class _Program:
+class _Program(Lowering):
     """The generated statements: numbers once per call, then every series' coefficient k inside ``for k``.
 
     A value is a number ``("num", (hi, lo))`` or a pending sum ``("sum", {term: coefficient})`` of terms
@@ -90,12 +89,7 @@ class _Program:
         self.ready: dict[Any, int] = {}  # a scratch column → the index in ``body`` from which it is written
         self.columns = 0
         self.written: dict[Any, Any] = {}  # a sum's terms → its column; a product → its k-th coefficient's names
-        self.values: dict[int, tuple[str, Any]] = {}
-        for i in sorted(model.live()):
-            op, args = model.graph.nodes[i]
-            self.values[i] = self._node(op, [self.values[a.index] if isinstance(a, Expr) else a for a in args])
-        for m, rate in enumerate(model.rates):
-            value = self.values[rate.index] if isinstance(rate, Expr) else ("num", ("0.0", "0.0"))
+        for m, value in enumerate(self._lower(model, ("num", ("0.0", "0.0")))):
             self.body += [f"rh, rl = {self._combination(_terms(value))}",
                           f"Th[(k + 1) * N + {m}], Tl[(k + 1) * N + {m}] = dd_mul(rh, rl, ih, il)"]
 
@@ -189,7 +183,7 @@ class _Program:
                 return self._mul(a[0], ("num", self._number(f"dd_div(1.0, 0.0, {a[1][1][0]}, {a[1][1][1]})")))
             return self._divide(a[0], a[1])
         if op == "ipow":
-            return self._power(a[0], a[1])
+            return self._power(a[0], a[1], ("num", ONE))
         raise NotCompilable(f"its function {op!r} of the state has no double-double Taylor series here (+ − × / and "
                             "integer powers have); integrator.precision=double runs it")
 
@@ -198,7 +192,7 @@ class _Program:
         if op in _NUMBER_OPS:
             return _NUMBER_OPS[op].format(*a[0][1], *(a[1][1] if len(a) > 1 else ()))
         args = [v[1][0] if isinstance(v, tuple) else v for v in a]
-        return f"{_NUMBER_FUNCTIONS[op].format(*args)}, 0.0"
+        return f"{NUMBER_FUNCTIONS[op].format(*args)}, 0.0"
 
     def _plus(self, *values: tuple[str, Any]) -> tuple[str, Any]:
         terms: dict[Any, tuple[str, str]] = {}
@@ -233,13 +227,6 @@ class _Program:
         return self._written(where, f"sh, sl = {self._combination(_terms(x))}", "for j in range(k):",
                              f"    sh, sl = dot_add(sh, sl, -{fh}, -{fl}, {yh}, {yl})", "sh, sl = dd_norm(sh, sl)",
                              f"{h}, {lo} = dd_div(sh, sl, {y0h}, {y0l})")
-
-    def _power(self, x: tuple[str, Any], n: int) -> tuple[str, Any]:
-        """x^n by binary powering (Cauchy products), 1/x^|n| for n < 0."""
-        if n == 0:
-            return ("num", ONE)
-        result = binary_power(x, abs(n), self._mul)
-        return self._divide(("num", ONE), result) if n < 0 else result
 
     def _loop(self, products: list[Any]) -> list[str]:
         """The statements of a product loop: the k-th coefficients of its Cauchy products, one compensated dot

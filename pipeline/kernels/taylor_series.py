@@ -25,9 +25,7 @@ state's and the products' lanes by shuffles (``gather``), their Cauchy sums Σ_j
 in fused multiply-adds, and the rates' linear combinations as sums of shuffled lanes times coefficient vectors, the
 1/(k + 1) folded into the coefficients (off the chain of dependent operations from one order to the next).
 Functions of series (sin, sqrt, division, ...) run their recurrences in a lane of their own
-(``recurrences.Functions``). The same recurrences as the hand-written fixed-point kernel this replaced, whose
-vectorised form (ω, γ and their cyclic permutations in ``<4 x double>``) it generalises; measured against it in
-docs/performance.md.
+(``recurrences.Functions``). Its speed against the hand-written fixed-point kernel it replaced: docs/performance.md.
 
 Like the right-hand side's kernel it reads the equations' numbers from the parameter array, so the generated source
 depends on the equations' form only: it is compiled once per form (cached on disk under a hash of the source, which
@@ -153,11 +151,31 @@ class _Series:
         self.columns: list[int] = []  # its own columns of W (functions: the series and auxiliaries)
 
 
-# the functions of numbers (folded into ``_Numbers``)
-_NUMBER_FUNCTIONS = {**UNARY, **BINARY, "pow": "{0} ** {1}", "ipow": "{0} ** {1}"}
+# the functions of numbers (folded into ``_Numbers``; ``series_dd``'s, in double)
+NUMBER_FUNCTIONS = {**UNARY, **BINARY, "pow": "{0} ** {1}", "ipow": "{0} ** {1}", "powx": "{0} ** {1}"}
 
 
-class _Program:
+class Lowering:
+    """What this module's lowering (``_Program``, in double) and ``series_dd``'s (in double-double) share: the walk
+    over a traced model's nodes, each value made from its arguments' (``_node``), and a series' integer power."""
+
+    def _lower(self, model: Model, zero: Any) -> list:
+        """The values of the model's rates (``zero`` for a rate of no node)."""
+        values: dict[int, Any] = {}
+        for i in sorted(model.live()):  # the program's nodes in order (each after its arguments), dead ones left out
+            op, args = model.graph.nodes[i]
+            values[i] = self._node(op, [values[a.index] if isinstance(a, Expr) else a for a in args])
+        return [values[v.index] if isinstance(v, Expr) else zero for v in model.rates]
+
+    def _power(self, x: Any, n: int, one: Any) -> Any:
+        """x^n by binary powering (Cauchy products: no division by x_0), 1/x^|n| for n < 0; ``one`` the number 1."""
+        if n == 0:
+            return one
+        result = binary_power(x, abs(n), self._mul)
+        return self._divide(one, result) if n < 0 else result
+
+
+class _Program(Lowering):
     """A traced model's equations, lowered to series and their generated code."""
 
     def __init__(self, model: Model, first_constant: int = TRACED_FIRST_CONSTANT) -> None:
@@ -167,14 +185,10 @@ class _Program:
         self.found: dict[tuple, int] = {}  # a series' key (op and operands) → its id
         self.operands: list[_Lin] = []  # the values series are computed from, one local u<id> each
         self.operand_ids: dict[tuple, int] = {}
-        values: dict[int, _Lin] = {}
-        for i in sorted(model.live()):  # the program's nodes in order (each after its arguments), dead ones left out
-            op, args = model.graph.nodes[i]
-            values[i] = self._node(op, [values[a.index] if isinstance(a, Expr) else a for a in args])
+        self.rates = self._lower(model, _Lin())
         if len(model.rates) != model.size:
             raise ValueError(f"{model.what} has {len(model.rates)} rates for {model.size} state components")
         self.size = model.size
-        self.rates = [values[v.index] if isinstance(v, Expr) else _Lin() for v in model.rates]
 
     # ---- values as linear combinations of series
 
@@ -231,7 +245,7 @@ class _Program:
     def _function(self, op: str, x: _Lin, y: _Lin | None = None, e: str | None = None) -> _Lin:
         args = (x,) if y is None else (x, y)
         if all(not v.terms for v in args):  # a number
-            return _Lin(self.numbers.call(_NUMBER_FUNCTIONS[op], *[v.const for v in args], *([e] if e else [])))
+            return _Lin(self.numbers.call(NUMBER_FUNCTIONS[op], *[v.const for v in args], *([e] if e else [])))
         if op in ("sin", "cos"):
             sine = self._make("sin", args, None, pair="cos")
             if op == "sin":
@@ -258,9 +272,11 @@ class _Program:
         if op == "div":
             if not a[1].terms:
                 return self._scale(a[0], n.div(ONE, a[1].const))
-            return self._function("div", a[0], a[1])
+            return self._divide(a[0], a[1])
         if op == "ipow":
-            return self._ipow(a[0], a[1])
+            if a[0].terms or a[1] == 0:
+                return self._power(a[0], a[1], _Lin(ONE))
+            return _Lin(n.call(NUMBER_FUNCTIONS["ipow"], a[0].const, int(a[1])))
         if op == "powx":
             base, exponent = a
             if not exponent.terms:
@@ -270,14 +286,8 @@ class _Program:
             return self._function("arctan2", a[0], a[1])
         return self._function(op, a[0])
 
-    def _ipow(self, x: _Lin, power: int) -> _Lin:
-        """x^n by binary powering (Cauchy products: no division by x_0), 1/x^|n| for n < 0."""
-        if power == 0:
-            return _Lin(ONE)
-        if not x.terms:
-            return _Lin(self.numbers.call(_NUMBER_FUNCTIONS["ipow"], x.const, int(power)))
-        result = binary_power(x, abs(power), self._mul)
-        return self._function("div", _Lin(ONE), result) if power < 0 else result
+    def _divide(self, x: _Lin, y: _Lin) -> _Lin:
+        return self._function("div", x, y)
 
 
 def plan(model: Any, first_constant: int = TRACED_FIRST_CONSTANT) -> dict:
