@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import contextlib
 import copy
 import dataclasses
 import difflib
@@ -557,11 +558,9 @@ def quiet_logging_failures() -> None:
         error = sys.exc_info()[1]
         why = reason(error) if isinstance(error, OSError) else type(error).__name__
         where = getattr(self, "baseFilename", None) or "stream"
-        try:
+        with contextlib.suppress(Exception):  # stderr itself may be the full device
             print(f"gyrolab: warning: cannot write the log {where} ({why}); its further lines are dropped",
                   file=sys.stderr)
-        except Exception:  # noqa: BLE001 - stderr itself may be the full device
-            pass
 
     handle_error.gyrolab_quiet = True  # type: ignore[attr-defined]
     logging.Handler.handleError = handle_error  # type: ignore[method-assign]
