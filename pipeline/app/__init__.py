@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import contextlib
 import copy
 import dataclasses
 import difflib
@@ -127,7 +128,7 @@ def preflight(args: argparse.Namespace) -> argparse.Namespace:
     refuse_unread(f"task {task_of(cfg)}", given, sweep=sweeping)  # batch.* on a plain run
     check_task(task_of(cfg), scene_cfgs[0], run_dir)  # an experiment's own refusals, before its directory
     check_writable(run_dir)
-    if not sweeping:  # the run takes the preflight's scene and its accuracy note (_run_locked)
+    if not sweeping:  # the run takes the preflight's scene and its accuracy note (_run_one)
         _prepared[:] = [Prepared(OmegaConf.to_container(scene_cfgs[0], resolve=False), scene, notes[0])]
     return args
 
@@ -409,41 +410,37 @@ def _run_one(cfg: DictConfig, out_dir: Path, job_id: str | None = None, figures:
     """Run the scene, write ``run.nc`` (and, unless ``figures=False``, figures) in ``out_dir``, locked meanwhile and
     cleared of what killed writes left (``writing_in``); GyrolabError on bad input or a failed run."""
     with writing_in(out_dir):
-        return _run_locked(cfg, out_dir, job_id, figures)
+        task = task_of(cfg)
+        prepared = take_prepared(cfg) if job_id is None else None  # a plain run: the preflight's scene and note
+        # an accuracy the integrator does not read (the preflight refused one the command line gave to every job):
+        # said, and recorded in run.nc; for the tasks that run the scene's integrator
+        ignored = None if task not in ("scene", "regime") else prepared.accuracy_ignored if prepared else \
+            ignored_accuracy(cfg, HydraConfig.get().overrides.task)
+        if ignored:
+            log.warning("%s", ignored)
+        if task != "scene":
+            written = run_task(task, cfg, out_dir)
+            for path in written:
+                announce_written(path)
+            return written[0]
+        if prepared and prepared.scene:
+            scene = prepared.scene
+            scene.log_notes()  # into the run's log, as a scene built here says them
+        else:
+            scene = Scene.from_config(cfg)
+        scene.accuracy_ignored = ignored  # in the dataset's attributes, as compose_scene records it
+        ds = scene.run()
+        ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
+        ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
+        path = write_dataset(ds, out_dir / "run.nc")
+        announce_written(path)
+        if not figures:
+            return path
+        from gyrolab.figures.redraw import draw_figures  # matplotlib only when figures are drawn
 
-
-def _run_locked(cfg: DictConfig, out_dir: Path, job_id: str | None, figures: bool) -> Path:
-    task = task_of(cfg)
-    prepared = take_prepared(cfg) if job_id is None else None  # a plain run: the preflight's scene and note
-    # an accuracy the integrator does not read (the preflight refused one the command line gave to every job):
-    # said, and recorded in run.nc; for the tasks that run the scene's integrator
-    ignored = None if task not in ("scene", "regime") else prepared.accuracy_ignored if prepared else \
-        ignored_accuracy(cfg, HydraConfig.get().overrides.task)
-    if ignored:
-        log.warning("%s", ignored)
-    if task != "scene":
-        written = run_task(task, cfg, out_dir)
-        for path in written:
-            announce_written(path)
-        return written[0]
-    if prepared and prepared.scene:
-        scene = prepared.scene
-        scene.log_notes()  # into the run's log, as a scene built here says them
-    else:
-        scene = Scene.from_config(cfg)
-    scene.accuracy_ignored = ignored  # in the dataset's attributes, as compose_scene records it
-    ds = scene.run()
-    ds.attrs["hydra_overrides"] = " ".join(HydraConfig.get().overrides.task)
-    ds.attrs["job_id"] = job_identity(cfg) if job_id is None else job_id
-    path = write_dataset(ds, out_dir / "run.nc")
-    announce_written(path)
-    if not figures:
+        for figure in draw_figures("run.nc", ds, out_dir, cfg.output):
+            announce_written(figure)
         return path
-    from gyrolab.figures.redraw import draw_figures  # matplotlib only when figures are drawn
-
-    for figure in draw_figures("run.nc", ds, out_dir, cfg.output):
-        announce_written(figure)
-    return path
 
 
 def _quiet_console() -> None:
@@ -561,11 +558,9 @@ def quiet_logging_failures() -> None:
         error = sys.exc_info()[1]
         why = reason(error) if isinstance(error, OSError) else type(error).__name__
         where = getattr(self, "baseFilename", None) or "stream"
-        try:
+        with contextlib.suppress(Exception):  # stderr itself may be the full device
             print(f"gyrolab: warning: cannot write the log {where} ({why}); its further lines are dropped",
                   file=sys.stderr)
-        except Exception:  # noqa: BLE001 - stderr itself may be the full device
-            pass
 
     handle_error.gyrolab_quiet = True  # type: ignore[attr-defined]
     logging.Handler.handleError = handle_error  # type: ignore[method-assign]

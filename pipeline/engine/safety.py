@@ -111,9 +111,7 @@ def _check_hydra_targets(plain_hydra: dict) -> None:
 def check_stored_config(text: str, where: str) -> DictConfig:
     """A config stored in a dataset, checked as a user's YAML file is (``gyrolab.output.user_yaml.stored_yaml``:
     tags, anchors, depth, size); ConfigError for interpolations."""
-    plain = stored_yaml(text, where)
-    if not isinstance(plain, dict):
-        raise ConfigError(f"{where} is not a YAML mapping of config sections; give a run.nc that gyrolab wrote")
+    plain = stored_yaml(text, where)  # a mapping: stored_yaml refuses anything else
     for path, value in leaves(plain):
         if isinstance(value, str) and "${" in value:
             raise ConfigError(f"{where}: {path}={shorten(repr(value))} is an interpolation, but a stored config is "

@@ -409,9 +409,9 @@ def _check_metadata(node: Any, schema: type, prefix: str) -> None:
         value = node.get(f.name)
         key = f"{prefix}{f.name}"
         expected = f.metadata.get("type")
-        if expected is not None and value != f.metadata.get("alt", object()):
-            if isinstance(value, bool) or not isinstance(value, expected):
-                raise ConfigError(_type_sentence(key, value, expected, f.metadata.get("alt")))
+        if expected is not None and value != f.metadata.get("alt", object()) and (
+                isinstance(value, bool) or not isinstance(value, expected)):
+            raise ConfigError(_type_sentence(key, value, expected, f.metadata.get("alt")))
         if isinstance(value, dict) and dataclasses.is_dataclass(_strip_optional(hints[f.name])):
             _check_metadata(value, _strip_optional(hints[f.name]), key + ".")
 

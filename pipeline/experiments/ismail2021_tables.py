@@ -13,12 +13,11 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 from gyrolab.output.atomic import atomic_path
-from gyrolab.output.cf import conform
+from gyrolab.output.cf import experiment_dataset
 from gyrolab.figures.redraw import write_and_draw
-from gyrolab.output.provenance import provenance
 from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
@@ -132,7 +131,6 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
                                 "for γ2); their difference is RK4 truncation error",
         "what_the_tables_do_not_show": "no O(1/μ) content: no p1, q1, r1, γ'', period or full-model integration; "
                                        "they test nothing of the asymptotic solution",
-        "inferred_parameters": f"A = {A:g} (published), W = {W_P2} (fitted by the research), τ = 2πt/100",
-        "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    conform(ds, source="ismail2021_tables experiment")
+        "inferred_parameters": f"A = {A:g} (published), W = {W_P2} (fitted by the research), τ = 2πt/100"})
+    experiment_dataset(ds, cfg, "ismail2021_tables experiment")
     return written + write_and_draw("ismail2021_tables.nc", ds, out_dir, cfg.get("output"))

@@ -26,8 +26,7 @@ from gyrolab.engine import schemas
 from gyrolab.engine.schemas import Task
 from gyrolab.errors import ConfigError, IntegrationError, as_number
 from gyrolab.figures.redraw import write_and_draw
-from gyrolab.output.cf import conform
-from gyrolab.output.provenance import provenance
+from gyrolab.output.cf import experiment_dataset
 from gyrolab.physics import pendulum
 from gyrolab.plugins.regimes import large_parameter as slow
 from gyrolab.plugins.regimes.base import NondimensionalScene
@@ -152,9 +151,8 @@ def dataset(traces: list[dict], cfg: DictConfig) -> xr.Dataset:
                                                                          "long_name": "located bifurcation index"})}
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update({"title": "exact periodic-orbit families of the heavy body, fast to slow spin",
-                     "summary": _summary(traces),
-                     "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    return conform(ds, source="orbit_family experiment")
+                     "summary": _summary(traces)})
+    return experiment_dataset(ds, cfg, "orbit_family experiment")
 
 
 def _bifurcation_labels(traces: list[dict]) -> list[str]:

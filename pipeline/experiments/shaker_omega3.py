@@ -10,13 +10,12 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
-from gyrolab.output.cf import conform, unit_attributes
+from gyrolab.output.cf import experiment_dataset, unit_attributes
 from gyrolab.output.dataset import time_attributes
 from gyrolab.experiments.regime_run import compute, prepare
 from gyrolab.figures.redraw import write_and_draw
-from gyrolab.output.provenance import provenance
 from gyrolab.engine.schemas import Task
 
 log = logging.getLogger(__name__)
@@ -41,7 +40,6 @@ def run(cfg: DictConfig, out_dir: Path) -> list[Path]:
     ds.attrs.update({"title": f"ω = 3 Euler angles: {scene.system.title()}", **unit_attributes(body),
                      "regime_warnings": " | ".join(warnings) or "none",
                      "period_series": result["period_analytic"], "period_exact": result["orbit"].period,
-                     **{f"max_error_{k}": v for k, v in errors.items()},
-                     "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    conform(ds, source="shaker_omega3 experiment (ω = 3 Euler angles against the exact orbit)")
+                     **{f"max_error_{k}": v for k, v in errors.items()}})
+    experiment_dataset(ds, cfg, "shaker_omega3 experiment (ω = 3 Euler angles against the exact orbit)")
     return write_and_draw("shaker_omega3.nc", ds, out_dir, cfg.get("output"))

@@ -24,8 +24,7 @@ from gyrolab.engine.schemas import Task
 from gyrolab.errors import ConfigError
 from gyrolab.figures.redraw import write_and_draw
 from gyrolab.kernels import layout
-from gyrolab.output.cf import conform
-from gyrolab.output.provenance import provenance
+from gyrolab.output.cf import experiment_dataset
 from gyrolab.physics.reference import fixed_point_reference
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
@@ -136,6 +135,5 @@ def _dataset(rows: list[dict[str, Any]], cfg: DictConfig, reference_name: str, r
     ds = xr.Dataset(data, coords={"run": ("run", np.arange(len(rows), dtype=np.int32),
                                           {"units": "1", "long_name": "run index"})})
     ds.attrs.update({"title": "work against precision", "reference": reference_name, "timing": TIMING.format(repeats),
-                     "repeats": repeats,
-                     "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    return conform(ds, source="work_precision experiment")
+                     "repeats": repeats})
+    return experiment_dataset(ds, cfg, "work_precision experiment")

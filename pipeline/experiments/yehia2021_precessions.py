@@ -17,7 +17,7 @@ import xarray as xr
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from gyrolab.output.atomic import atomic_open
-from gyrolab.output.cf import conform
+from gyrolab.output.cf import conform, experiment_dataset
 from gyrolab.output.dataset import FRAME_AXES
 from gyrolab.errors import ConfigError, as_number
 from gyrolab.analysis.precession.cases import CASES, Case
@@ -26,7 +26,6 @@ from gyrolab.analysis.precession.closed_forms import check_closed_forms
 from gyrolab.analysis.precession.motion import body_config, euler_residual, magnetic_config, vector_residual, window
 from gyrolab.analysis.precession.stability import Floquet, floquet
 from gyrolab.figures.redraw import write_and_draw
-from gyrolab.output.provenance import provenance
 from gyrolab.engine.scene import Scene
 from gyrolab.engine import schemas
 from gyrolab.engine.schemas import Task
@@ -198,6 +197,5 @@ def _dataset(rows: list[dict[str, Any]], closed: list[dict], cfg: DictConfig) ->
               "closed_form": ("closed_form", np.array([c["solution"] for c in closed]),
                               {"long_name": "printed solution"})}
     ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update({"title": "regular precessions of a satellite-gyrostat (Yehia & El-kenani 2021)",
-                     "config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
-    return conform(ds, source="yehia2021_precessions experiment")
+    ds.attrs["title"] = "regular precessions of a satellite-gyrostat (Yehia & El-kenani 2021)"
+    return experiment_dataset(ds, cfg, "yehia2021_precessions experiment")

@@ -22,8 +22,7 @@ PARAMETERS = {"mu": "μ", "c/r0": "c/r₀", "c/r0 (as printed)": "μ = c/r₀ (p
 
 def _spec(ds: xr.Dataset) -> dict[str, Any]:
     try:
-        return stored_yaml(ds.attrs.get("config", ""), "the dataset's config attribute").get("regime_validity",
-                                                                                               {}) or {}
+        return stored_yaml(ds.attrs.get("config", ""), "the dataset's config attribute").get("regime_validity") or {}
     except Exception:  # noqa: BLE001 -- a dataset without its config still draws, with generic labels
         return {}
 

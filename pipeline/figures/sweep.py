@@ -34,11 +34,6 @@ Panel = tuple[str, str, xr.DataArray, bool]
 LABEL_WIDTH = 22
 
 
-def choose_x(ds: xr.Dataset, dims: list[str]) -> str:
-    """The swept dimension with the most values, numeric ones first."""
-    return max(dims, key=lambda d: (ds[d].dtype.kind in "iuf", ds.sizes[d]))
-
-
 def final_values(da: xr.DataArray) -> xr.DataArray:
     """The value at the last output time of each job (the last finite sample when jobs differ in length)."""
     if "time" in da.dims:
@@ -87,8 +82,8 @@ def _ylabel(name: str, unit_text: str) -> str:
 
 
 def _draw(ds: xr.Dataset, panels: list[Panel], title: str) -> Figure:
-    dims = ds.attrs["sweep_dims"].split()
-    xdim = choose_x(ds, dims)
+    # x: the swept dimension with the most values, numeric ones first
+    xdim = max(ds.attrs["sweep_dims"].split(), key=lambda d: (ds[d].dtype.kind in "iuf", ds.sizes[d]))
     ncols = min(3, len(panels))
     nrows = -(-len(panels) // ncols)
     fig, axes = subplots(nrows, ncols, width=SINGLE if ncols == 1 else DOUBLE, height=0.9 + 1.9 * nrows)

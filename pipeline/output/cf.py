@@ -18,8 +18,9 @@ from typing import Any
 
 import numpy as np
 import xarray as xr
+from omegaconf import DictConfig, OmegaConf
 
-from gyrolab.output.provenance import gyrolab_version
+from gyrolab.output.provenance import gyrolab_version, provenance
 
 log = logging.getLogger(__name__)
 
@@ -46,6 +47,12 @@ def conform(ds: xr.Dataset, title: str | None = None, source: str = "") -> xr.Da
     ds.attrs["date_created"] = created
     ds.attrs["history"] = f"{created} written by gyrolab {gyrolab_version()}" + (f": {source}" if source else "")
     return ds
+
+
+def experiment_dataset(ds: xr.Dataset, cfg: DictConfig, source: str) -> xr.Dataset:
+    """An experiment's ``ds`` with its resolved config and the provenance as its last attributes, made CF."""
+    ds.attrs.update({"config": OmegaConf.to_yaml(cfg, resolve=True), **provenance()})
+    return conform(ds, source=source)
 
 
 def _conform_variable(ds: xr.Dataset, name: Any) -> None:

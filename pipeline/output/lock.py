@@ -107,22 +107,16 @@ def lock(directory: str | os.PathLike[str], what: str = "run directory") -> None
 
 
 @contextmanager
-def directory_lock(directory: str | os.PathLike[str], what: str = "run directory") -> Iterator[Path]:
-    """Hold ``directory``'s lock for the block (see ``lock``)."""
+def writing_in(directory: str | os.PathLike[str], what: str = "run directory") -> Iterator[Path]:
+    """Hold ``directory``'s lock for the block (see ``lock``), first removing the temporary files killed writes left
+    in it and its ``figures``."""
     directory = Path(directory)
     lock(directory, what)
     try:
+        clear_temporaries(directory)
         yield directory
     finally:
         unlock(directory)
-
-
-@contextmanager
-def writing_in(directory: str | os.PathLike[str], what: str = "run directory") -> Iterator[Path]:
-    """Hold ``directory``'s lock and remove the temporary files killed writes left in it and its ``figures``."""
-    with directory_lock(directory, what) as held:
-        clear_temporaries(held)
-        yield held
 
 
 def clear_temporaries(directory: str | os.PathLike[str]) -> None:

@@ -147,12 +147,8 @@ def launch_runs(remaining: Sequence[int], jobs: Sequence[Sequence[str]], max_bat
         else:
             runs.append([num])
     size = max_batch_size if max_batch_size and max_batch_size > 0 else None
-    out = []
-    for run in runs:
-        step = size or len(run)
-        for i in range(0, len(run), step):
-            out.append((run[i], [list(jobs[n]) for n in run[i:i + step]]))
-    return out
+    return [(run[i], [list(jobs[n]) for n in run[i:i + step]])
+            for run in runs for step in [size or len(run)] for i in range(0, len(run), step)]
 
 
 class OverridesDoNotApply(Exception):

@@ -27,7 +27,7 @@ from gyrolab.errors import OutputError
 from gyrolab.output import atomic
 from gyrolab.output.atomic import atomic_open, atomic_path
 from gyrolab.output.dataset import write_dataset
-from gyrolab.output.lock import LOCK_NAME, Busy, directory_lock, writing_in
+from gyrolab.output.lock import LOCK_NAME, Busy, writing_in
 from gyrolab.sweep.aggregate import wait_for_jobs
 from gyrolab.sweep.job import run_sweep_job
 from gyrolab.sweep.record import ELSEWHERE, FAILED, FINISHED, read_record
@@ -138,7 +138,7 @@ def test_a_really_full_disk_is_one_sentence(tiny_tmpfs):
     from omegaconf import OmegaConf
 
     hydra_utils._save_config(OmegaConf.create({"a": "x" * 10_000}), "config.yaml", tiny_tmpfs)   # a warning, no file
-    with directory_lock(tiny_tmpfs / "job"):          # a lock needs no data block: a full disk does not stop it
+    with writing_in(tiny_tmpfs / "job"):          # a lock needs no data block: a full disk does not stop it
         pass
     assert leftovers(tiny_tmpfs) == ["filler", "job", "run.nc"]
 
@@ -227,10 +227,10 @@ def test_a_second_run_into_a_directory_in_use_is_refused_before_hydra_writes(tmp
 def test_a_held_directory_is_refused_in_process_and_free_after_release(tmp_path):
     fd = hold_like_another_process(tmp_path)
     with pytest.raises(Busy, match="in use by another gyrolab run .pid 4242 on elsewhere."):
-        with directory_lock(tmp_path):
+        with writing_in(tmp_path):
             pass
     os.close(fd)   # the holder dies: the kernel drops its lock, the stale file does not matter
-    with directory_lock(tmp_path), directory_lock(tmp_path):   # and one process may nest its own lock
+    with writing_in(tmp_path), writing_in(tmp_path):   # and one process may nest its own lock
         assert (tmp_path / LOCK_NAME).read_text().startswith(f"pid {os.getpid()} ")
 
 

@@ -26,7 +26,7 @@ from gyrolab.errors import ConfigError
 from gyrolab.output import trust
 from gyrolab.output.atomic import atomic_open
 from gyrolab.output.foreign import load_dataset, load_run
-from gyrolab.output.lock import LOCK_NAME, directory_lock, try_lock, unlock
+from gyrolab.output.lock import LOCK_NAME, try_lock, unlock, writing_in
 from tests.helpers import one_error_line
 
 SECRET = "the user's own file\n"
@@ -73,7 +73,7 @@ def test_a_lock_never_truncates_a_file_it_did_not_create(tmp_path, victim):
     run = tmp_path / "run"
     run.mkdir()
     os.link(victim, run / LOCK_NAME)  # a hard link: a regular file, but not gyrolab's
-    with directory_lock(run):
+    with writing_in(run):
         assert victim.read_text() == SECRET
     assert victim.read_text() == SECRET
     assert try_lock(tmp_path / "fresh")  # a lock it creates holds its owner's line
