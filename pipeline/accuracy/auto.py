@@ -130,11 +130,12 @@ class Auto(Integrator):
         # how much the motion amplifies an error present at the pilot's end by the end of the span (chaos: e^{λt}):
         # measured by the double Taylor run itself (its one pass, C8, which measures it at the first tenth: the
         # default pilot's end), kept where that growth confirms the choice made without it; else by a tangent run
-        # first (~1.5 ms on the reference scene, the run's 3×)
+        # first (~1.5 ms on the reference scene, the run's 3×), which the chaos margins were calibrated with
+        tangent_run = functools.partial(amplification, compiled, fun, y0, t_out[0], t_pilot, t_out[-1],
+                                        make(SHADOW_TOLERANCE))
         provisional = amp is None and taylor and self.pilot_fraction == PILOT_FRACTION
         if amp is None:
-            amp = Amplification(0.0, 0.0, span, "none yet") if provisional else \
-                amplification(compiled, fun, y0, t_out[0], t_pilot, t_out[-1], make(SHADOW_TOLERANCE))
+            amp = Amplification(0.0, 0.0, span, "none yet") if provisional else tangent_run()
         loose = None  # the previous round's loose run (tolerance, solution): the next round's tight run
         for _ in range(3):
             pilot_tau = tau
@@ -173,8 +174,7 @@ class Auto(Integrator):
         final = functools.partial(self._final, fun, t_out, y0, progress, compiled, start, per_tol, growth,
                                   pilot_nfev, chaos, estimated=estimated)
         if climbed and provisional:  # a climb, or a refusal, is chosen with the growth measured first
-            return self.integrate(fun, t_out, y0, progress, compiled, False, estimated, amplification(
-                compiled, fun, y0, t_out[0], t_pilot, t_out[-1], make(SHADOW_TOLERANCE)))
+            return self.integrate(fun, t_out, y0, progress, compiled, False, estimated, tangent_run())
         if climbed:
             up = self._climb(compiled, make, per_tol, roundoff, steps, amp, chaotic, t_out)  # raises if dd can't
             predicted = functools.partial(final, *up) if isinstance(up, tuple) else functools.partial(_raise, up)
@@ -199,25 +199,27 @@ class Auto(Integrator):
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         # the pilot's tight run is as accurate when its tolerance is: the run continues from its end
         resumed = (tight, make(tight_tol), pilot_times, inside, t_pilot) if tight_tol <= chosen else None
-        return final(make(chosen), chosen, roundoff, why, resumed, provisional=provisional)
+        return final(make(chosen), chosen, roundoff, why, resumed, provisional=tangent_run if provisional else None)
 
     def _final(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None,
                compiled: CompiledModel | None, start: float, per_tol: float, growth: float, pilot_nfev: int,
                chaos: dict, method: Integrator, chosen: float, roundoff: float, why: str,
-               resumed: tuple | None = None, estimated: bool = False, provisional: bool = False) -> Solution:
+               resumed: tuple | None = None, estimated: bool = False, provisional: Any = None) -> Solution:
         """``method``'s run at tolerance ``chosen`` over the output times, with what it promises (its truncation error
         and ``roundoff``) and the attributes saying what was chosen and why (``why``); ``estimated``: its error
-        estimated in the same pass where the method can (C8). ``provisional``: chosen without the growth of
-        perturbations, which the run measures (C8): kept where that growth is no chaos and leaves the target met,
-        else the choice is made again with it (``integrate(amp=...)``)."""
+        estimated in the same pass where the method can (C8). ``provisional`` (the tangent run, a callable): chosen
+        without the growth of perturbations, which the run measures (C8): kept where that growth is no chaos and
+        leaves the target met, else the choice is made again with the tangent run's growth (the measure the chaos
+        margins were calibrated with: with the run's own, which follows α too, audit seed 2026 refused three targets
+        double-double reaches), ``integrate(amp=...)``."""
         y, final_stats, n_steps, own = _final_run(method, fun, t_out, y0, progress, compiled, resumed,
-                                                  estimated or provisional, estimated)
-        if provisional:
+                                                  estimated or provisional is not None, estimated)
+        if provisional is not None:
             amp = growth_of(own, t_out[-1] - t_out[0])
             measured = _amplified(per_tol, growth, amp.factor, self.pilot_fraction, CHAOS_MARGIN)
             if amp.chaotic(self.pilot_fraction) or self.safety * CALIBRATION * measured * chosen + roundoff > \
                     self.accuracy:
-                return self.integrate(fun, t_out, y0, progress, compiled, False, estimated, amp)
+                return self.integrate(fun, t_out, y0, progress, compiled, False, estimated, provisional())
             per_tol, chaos = measured, _chaos_attributes(amp, False)
             own = own if estimated else None
         promised = CALIBRATION * per_tol * chosen + roundoff
