@@ -28,6 +28,8 @@ from gyrolab.accuracy.calibration import (MAX_GROWTH, SHADOW_CHUNKS, SHADOW_OFFS
 from gyrolab.kernels.model import CompiledModel
 from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba
 
+#: double precision's unit round-off: the random walk of round-off ``auto`` predicts and the one pass bounds
+EPS = float(np.finfo(float).eps)
 #: the part of the span after which growth beyond a power law is chaos: ``auto``'s default pilot, and the tenth at
 #: which a one-pass run measures its growth (``OwnEstimate.log_growth_tenth``)
 PILOT_FRACTION = 0.1

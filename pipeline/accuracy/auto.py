@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from gyrolab.accuracy.amplification import PILOT_FRACTION, Amplification, amplification, growth_of
+from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, Amplification, amplification, growth_of
 from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_FLOOR,
                                           ESTIMATE_SLACK, FIRST_RATIO, FLOOR, MAX_GROWTH, MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE,
                                           MISS_MARGIN, PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
@@ -44,7 +44,6 @@ PREDICTION_MEANING = ("an upper estimate of the max-norm error of the stored sta
                       "the pilot's error extrapolated over the span, raised by the measured growth of perturbations, "
                       "times a calibration factor, plus the round-off of the precision that ran; checked at every "
                       "output time by output.error_estimate (gyrolab.accuracy.promise), a prediction only without it")
-EPS = float(np.finfo(float).eps)
 #: the unit round-off of double-double arithmetic (a 106-bit significand), for auto's extended-precision choice
 DOUBLE_DOUBLE_EPS = 2.0 ** -104
 _PILOT_GRID = np.linspace(0.0, 1.0, PILOT_POINTS)

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from gyrolab.accuracy.amplification import PILOT_FRACTION, growth_of
+from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, growth_of
 from gyrolab.accuracy.calibration import CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
 from gyrolab.kernels.model import rounding_moved
 from gyrolab.contracts.integrator import (CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL,
@@ -35,7 +35,7 @@ from gyrolab.contracts.integrator import (CHOOSES_METHOD, COMPILED_MODEL, PRECIS
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
 
 log = logging.getLogger(__name__)
-EPS = float(np.finfo(float).eps)
+
 
 @dataclass(frozen=True)
 class Companion:
