@@ -90,13 +90,28 @@ def run(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
 
 
 #: the one-pass error estimate (``run_measured``): the series' orders beyond the step's, whose terms are the step's
-#: truncation error with its sign; the order of the tangent series that carries the error so far along the step; the
-#: relative error a step the tangent vector's shorter series may have. gyrolab.accuracy.calibration's table holds the
-#: same values with the measurements behind them (benchmarks/one_pass_estimate.py checks them)
+#: truncation error with its sign; the highest order of the tangent series that carry the error so far and the tangent
+#: vector along the step; the relative error a step those series may have (which sets their order). gyrolab.accuracy.
+#: calibration's table holds the same values with the measurements behind them (benchmarks/one_pass_estimate.py checks
+#: them)
 EXTRA_ORDERS, TANGENT_ORDER, GROWTH_PER_STEP = 4, 10, 1e-5
 #: the finite difference's step along the error's direction, relative to the state's scale: ~√eps, so that its
 #: truncation and its round-off both leave the tangent series ~1e-8 relative error (the estimate needs one digit)
 DIFFERENCE_STEP = 2.0 ** -26
+
+
+@inline_kernel
+def tangent_order(order, tol):
+    """The order of the one pass's tangent series (the error's and the tangent vector's), shorter than the step's: a
+    relative error of GROWTH_PER_STEP a step (a bias of ~0.02 in ln|δ| and ~2 % in the error over 2,000 steps) at a
+    step spanning ~tol^(1/order)·safety of the series' radius of convergence, which each order gains, at most
+    TANGENT_ORDER. (The error's series at this order instead of TANGENT_ORDER: on the reference scene at tol 5e-13
+    order 6, the pass ~10 % cheaper, the estimate unchanged: benchmarks/one_pass_estimate.py.)"""
+    m = min(TANGENT_ORDER, order)
+    if tol < 1.0:
+        step = tol ** (1.0 / order) * math.exp(-0.7 / (order - 1))
+        m = min(m, max(MIN_ORDER, int(math.ceil(math.log(GROWTH_PER_STEP) / math.log(step)))))
+    return m
 
 
 @kernel
@@ -104,7 +119,8 @@ def run_measured(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats
     """``run``, its global error estimated and its perturbations' growth measured in the same pass (docs/integrators.md,
     "A one-pass error estimate"). e, the error of y (exact − computed; zeros at the start), is carried along each step
     by the linearised equation e' = J(y(t)) e, whose Taylor series to ``TANGENT_ORDER`` is the directional difference
-    of the model's series at y + δ e/|e| and at y (``_tangent_series``), and each step adds its truncation error, the
+    of the model's series at y + δ e/|e| and at y (``_tangent_series``, to the tangent order ``_steps`` sets), and each
+    step adds its truncation error, the
     series' next ``EXTRA_ORDERS`` terms: E[i] = the estimated error at output time i. u, a unit tangent vector, is
     carried the same way and renormalised at each step: growth = [ln|δ| of the tangent vector it stands for (the fast
     Lyapunov indicator's quantity), its running maximum, a time t_mark, that maximum at t_mark (the last step ending
@@ -124,18 +140,12 @@ def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u
     extra = EXTRA_ORDERS if estimating else 0
     T = _coefficient_rows(order + 1 + extra, n)
     safety = math.exp(-0.7 / (order - 1))
-    m = min(TANGENT_ORDER, order)
+    m = tangent_order(order, tol)
     # the error's series: rows 0 … m the carried error's (the tangent series), rows order + 1 … the step's truncation
     # error (T's), zeros between: one Horner sum gives both (``_series_at``)
     R = _coefficient_rows(order + 1 + extra if estimating else 0, n)
     R[:, :] = 0.0
-    # the tangent vector's series, shorter: its growth needs GROWTH_PER_STEP a step (a bias of ~0.02 in ln|δ| over
-    # 2,000 steps), and a step spans ~tol^(1/order)·safety of the series' radius of convergence, which each order gains
-    u_order = m
-    if tol < 1.0:
-        u_order = min(m, max(MIN_ORDER, int(math.ceil(math.log(GROWTH_PER_STEP) / math.log(tol ** (1.0 / order)
-                                                                                           * safety)))))
-    U = _coefficient_rows(u_order + 1 if measured else 0, n)
+    U = _coefficient_rows(m + 1 if measured else 0, n)
     end = np.empty((2, n))  # the whole error and the tangent vector at a step's end
     t = state[0]
     n_out = t_out.size
@@ -177,10 +187,10 @@ def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u
             for k in range(n):
                 e[k] = end[0, k]
         if measured:
-            _tangent_series(p, T, U, u_order, u, scale, t)
+            _tangent_series(p, T, U, m, u, scale, t)
             for j in range(first, i):
                 G[j] = growth[1]
-            _series_at(U, u_order, (h,), end, 1)
+            _series_at(U, m, (h,), end, 1)
             size = 0.0
             for k in range(n):
                 size += end[1, k] * end[1, k]
