@@ -19,7 +19,7 @@ from gyrolab.contracts.integrator import CompiledModel
 from gyrolab.contracts.system import System
 from gyrolab.kernels import model
 from gyrolab.kernels.expression import check_torques
-from gyrolab.physics.attitude import euler_angles, frame_from_angles, nutation_and_spin
+from gyrolab.physics.attitude import euler_angles, frame_from_angles, nutation_and_spin, unwrap
 from gyrolab.physics.body import Body
 from gyrolab.physics.initial import InitialAttitude
 from gyrolab.physics.vectors import cross, dot, norm
@@ -143,7 +143,7 @@ class FixedPoint(System):
             out["psi"] = variable("time", psi, "rad", "precession angle ψ (unwrapped)")
         else:
             theta, phi = nutation_and_spin(gamma)
-            phi = np.unwrap(phi)
+            phi = unwrap(phi)
         out["theta"] = variable("time", theta, "rad", "nutation angle θ")
         out["phi"] = variable("time", phi, "rad", "proper-rotation angle φ (unwrapped)")
         return out

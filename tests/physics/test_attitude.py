@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from gyrolab.physics.attitude import euler_angles, frame_from_angles, gamma_from_angles
+from gyrolab.physics.attitude import euler_angles, frame_from_angles, gamma_from_angles, unwrap
 
 
 def _angles_of(psi, theta, phi):
@@ -79,3 +79,16 @@ def test_the_combination_defined_at_a_pole_stays_continuous_through_it(pole, ini
     assert abs(offset / (2 * np.pi) - round(offset / (2 * np.pi))) < 1e-9
     np.testing.assert_allclose(combination - offset, direct, atol=1e-9)
     assert np.abs(np.diff(combination)).max() < 0.1
+
+
+def test_unwrap_is_numpys_bit_for_bit():
+    # numpy's np.unwrap is the definition: wrapped rotations at every speed (a step of exactly ±π, where numpy picks
+    # the sign by the step's, and steps of many turns among them), no jump at all, one sample
+    rng = np.random.default_rng(3)
+    for rate in (0.01, 0.5, 3.0, 40.0):
+        angle = np.angle(np.exp(1j * np.cumsum(rng.uniform(-rate, rate, 2001))))
+        np.testing.assert_array_equal(unwrap(angle), np.unwrap(angle))
+    edges = np.array([0.0, np.pi, 0.0, -np.pi, 0.0, 3 * np.pi, -2.5, 2.5, 7.0, -7.0])
+    np.testing.assert_array_equal(unwrap(edges), np.unwrap(edges))
+    for flat in (np.linspace(0.0, 1.0, 50), np.array([2.0])):
+        np.testing.assert_array_equal(unwrap(flat), np.unwrap(flat))
