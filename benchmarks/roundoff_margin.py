@@ -8,7 +8,12 @@ truth: on random scenes (``promise_audit.random_scene``) and tolerances from 3e-
 error (max-norm over every output time and component, against heyoka ``real128``), and for each margin M the
 smallest E / actual among the runs it would trust (R · M ≤ E). The estimate's promise is E / actual ≥ 1/2.
 It also measures the single double companion (E alone) at each tolerance: the runs whose companion tol is at least
-``DOUBLE_DOUBLE_BELOW`` are measured by it alone, without the second companion.
+``DOUBLE_DOUBLE_BELOW`` are measured by it alone, without the second companion. And the rule that comes first for the
+Taylor method's own estimate (``estimate.one_pass``, C8): where its round-off bound is not trusted, the pass's estimate
+P stands when a twin run (the same tolerance and order, the model's rounded numbers moved by an ulp) differs from the
+run by a T that is ``ROUNDOFF_MARGIN`` times below P (tried only where the unamplified walk W is as far below P and
+the bound, W amplified by the growth of perturbations, is at most P);
+measured per output time, P and W in quadrature against the actual error.
 
     pip install -e ".[bench]"
     python benchmarks/roundoff_margin.py --n 120 --seed 5     # ~5 min
@@ -17,13 +22,15 @@ It also measures the single double companion (E alone) at each tolerance: the ru
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 
 import numpy as np
 
 from gyrolab import compose_scene
-from gyrolab.accuracy.calibration import DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
+from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, growth_of
+from gyrolab.accuracy.calibration import CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
 from gyrolab.kernels.model import rounding_moved
 from gyrolab.kernels.taylor import MAX_ORDER
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
@@ -38,18 +45,26 @@ MARGINS = (2.0, 4.0, 6.0, 10.0, 20.0, 50.0)
 RESOLVED = 1e-15
 
 
-def measure(scene, tol: float) -> tuple[float, float, np.ndarray]:
-    """(E, R, the run's states) of the Taylor method at ``tol`` on ``scene``, as ``error_estimate.compare`` measures
-    them near the floor."""
-    y0 = scene.system.initial_state()
+def measure(scene, tol: float) -> tuple[float, float, np.ndarray, dict]:
+    """(E, R, the run's states, the one pass's measures) of the Taylor method at ``tol`` on ``scene``, as
+    ``error_estimate.compare`` measures them near the floor; the one pass's: P and W at every output time, T and the
+    amplified walk B (the pass's round-off bound)."""
+    y0, times = scene.system.initial_state(), scene.times
     run = Taylor(tol=tol)
     double_tol = max(tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
     other = run.order + 2 if run.order + 2 <= MAX_ORDER else run.order - 2
-    y, first = (m.integrate(None, scene.times, y0, None, scene.compiled).y
-                for m in (run, Taylor(order=run.order, tol=double_tol)))
-    second = Taylor(order=other, tol=double_tol).integrate(None, scene.times, y0, None,
-                                                           rounding_moved(scene.compiled)).y
-    return float(np.max(np.abs(y - first))), float(np.max(np.abs(first - second))), y
+    measured = run.integrate(None, times, y0, None, scene.compiled, estimate=True)
+    y = measured.y
+    first = Taylor(order=run.order, tol=double_tol).integrate(None, times, y0, None, scene.compiled).y
+    second = Taylor(order=other, tol=double_tol).integrate(None, times, y0, None, rounding_moved(scene.compiled)).y
+    twin = run.integrate(None, times, y0, None, rounding_moved(scene.compiled)).y
+    scale = max(1.0, float(np.max(np.abs(y))))
+    walk = EPS * scale * np.sqrt(1.0 + measured.estimate.steps * (times - times[0]) / (times[-1] - times[0]))
+    growth = math.exp(min(float(measured.estimate.log_growth[-1]), 700.0))  # (estimate.one_pass's bound, unless chaotic)
+    chaotic = growth_of(measured.estimate, float(times[-1] - times[0])).chaotic(PILOT_FRACTION)
+    own = {"P": np.abs(measured.estimate.error).max(axis=1), "W": walk, "T": float(np.max(np.abs(twin - y))),
+           "B": float(walk[-1]) * growth * (CHAOS_MARGIN if chaotic else 1.0)}
+    return float(np.max(np.abs(y - first))), float(np.max(np.abs(first - second))), y, own
 
 
 def main() -> int:
@@ -60,6 +75,7 @@ def main() -> int:
     rng = np.random.default_rng(args.seed)
     reference = Real128Reference()
     rows = []  # (scene, tol, E, R, actual)
+    passes = []  # (trusted by the twin rule, smallest and largest estimate / actual over the output times judged)
     for index in range(args.n):
         spec = random_scene(rng, index)
         scene = compose_scene(["integrator=taylor", "time.n_output=101", "output.euler_angles=false", *spec.overrides])
@@ -68,10 +84,16 @@ def main() -> int:
         truth = reference.states(scene)
         scale = max(1.0, float(np.max(np.abs(scene.system.initial_state()))))
         for tol in TOLERANCES:
-            estimate, roundoff, y = measure(scene, tol)
+            estimate, roundoff, y, own = measure(scene, tol)
             actual = float(np.max(np.abs(y - truth)))
             if RESOLVED * scale < actual < SATURATED:
                 rows.append((index, tol, estimate, roundoff, actual))
+                largest = float(own["P"].max())
+                trusted = ROUNDOFF_MARGIN * max(float(own["W"][-1]), own["T"]) <= largest and own["B"] <= largest
+                at = np.abs(y - truth).max(axis=1)
+                judged = at > RESOLVED * scale
+                ratio_pass = np.hypot(own["P"], own["W"])[judged] / at[judged]
+                passes.append((trusted, float(ratio_pass.min()), float(ratio_pass.max())))
                 if estimate >= ROUNDOFF_MARGIN * roundoff and estimate < actual / 2:  # trusted, and more than 2× low
                     dd = Taylor(tol=max(tol / TIGHTER, 1e-30), precision="double-double")
                     exact = float(np.max(np.abs(y - dd.integrate(None, scene.times, scene.system.initial_state(),
@@ -97,6 +119,13 @@ def main() -> int:
         if at.size:
             print(f"| {tol:g} | {at.size} | {at.min():.3g} | {at.max():.3g} | {int((at < 0.5).sum())} | "
                   f"{int((at > 2).sum())} |")
+    passes = np.array(passes)
+    twin_trusted = passes[passes[:, 0] == 1.0]
+    twin_low = int((twin_trusted[:, 1] < 0.5).sum())
+    print(f"\nthe one pass where the twin rule trusts it (M = {ROUNDOFF_MARGIN:g}): {len(twin_trusted)} of {len(passes)} "
+          f"runs; its estimate / actual over their output times {twin_trusted[:, 1].min():.3g} … "
+          f"{twin_trusted[:, 2].max():.3g}, {twin_low} runs below 1/2 at some output time, "
+          f"{int((twin_trusted[:, 2] > 2).sum())} above 2")
     from gyrolab.accuracy import calibration as table
 
     trusted = trust >= ROUNDOFF_MARGIN
@@ -104,8 +133,9 @@ def main() -> int:
     alone = ratio[rows[:, 1] / TIGHTER >= DOUBLE_DOUBLE_BELOW]
     off = int(((alone < 0.5) | (alone > 2)).sum())
     supported = table.report(table.ROUNDOFF, {
-        "ROUNDOFF_MARGIN": (low <= max(1, len(rows) // 1000),
-                            f"{low} of {int(trusted.sum())} trusted estimates below 1/2 of the error"),
+        "ROUNDOFF_MARGIN": (low <= max(1, len(rows) // 1000) and twin_low <= max(1, len(passes) // 1000),
+                            f"{low} of {int(trusted.sum())} trusted estimates below 1/2 of the error; by the one pass's "
+                            f"twin rule {twin_low} of {len(twin_trusted)} below 1/2 at some output time"),
         "DOUBLE_DOUBLE_BELOW": (off == 0, f"{off} of {alone.size} runs whose companion tol is ≥ {DOUBLE_DOUBLE_BELOW:g} "
                                           f"measured outside 1/2 … 2× by it alone (E / actual {alone.min():.3g} … "
                                           f"{alone.max():.3g})" if alone.size else "no run that tolerance")})

@@ -145,11 +145,13 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
         taylor = _double_taylor(method)
         # near double precision's floor round-off rivals the truncation error, erratically (audit seed 2026, scene 82
         # at 1e-10: r0 = 12, tol 1.6e-14, 6.1e-11 from real128 where the pass measured 3.8e-11 and its round-off
-        # bound said 5.8e-12; at tol 1e-13 the pass measured 3.61e-10 of 3.62e-10): there the companions measure, as
-        # for a single double companion (``DOUBLE_DOUBLE_BELOW``)
-        one = (f"the run's tolerance, {taylor.tol:.3g}, is near double precision's floor, where round-off rivals "
-               f"truncation") if taylor is not None and taylor.tol / TIGHTER < DOUBLE_DOUBLE_BELOW else \
-            one_pass(own, y, scene.times)
+        # bound said 5.8e-12; at tol 1e-13 the pass measured 3.61e-10 of 3.62e-10): there the bound is not trusted, a
+        # twin run measures the round-off (``one_pass``)
+        near_floor = taylor is not None and taylor.tol / TIGHTER < DOUBLE_DOUBLE_BELOW
+        twin = None if taylor is None or scene.compiled_model is None else functools.partial(
+            taylor.integrate, scene.rhs, scene.times, scene.system.initial_state(), None,
+            rounding_moved(scene.compiled_model))
+        one = one_pass(own, y, scene.times, twin, near_floor, wall_time)
         if isinstance(one, Comparison):
             return one
     compiled_model = scene.compiled_model
@@ -235,13 +237,26 @@ def _double_taylor(method: Any) -> Any:
     return method if method.precision == PRECISIONS[0] and method.climbed(1.0) is not None else None
 
 
-def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray) -> Comparison | str:
+def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray, twin: Any = None, near_floor: bool = False,
+             wall_time: float = 0.0) -> Comparison | str:
     """The run's own estimate (C8) as the measured error, or why not (a companion measures instead). The linearised
-    error equation has no sign for round-off. The estimate stands only where a bound on it is ``ROUNDOFF_MARGIN``
-    times below the largest error it measures: a random walk of one ulp of the state per step, amplified by the
-    growth of perturbations the same pass measured (times ``CHAOS_MARGIN`` on a chaotic scene, as ``auto`` predicts
-    it). (Amplified on regular scenes too: a slow top near its inverted rest, ``tests/helpers/accuracy.ROUND_OFF``,
-    grows perturbations e^9 without chaos and its round-off ended 2.7e-12 away where a walk unamplified said 3e-15.)
+    error equation has no sign for round-off, so the estimate stands only where the run's round-off is
+    ``ROUNDOFF_MARGIN`` times below the largest error it measures, as a bound or a twin run says:
+
+    * the bound, free: a random walk of one ulp of the state per step, amplified by the growth of perturbations the
+      same pass measured (times ``CHAOS_MARGIN`` on a chaotic scene, as ``auto`` predicts it). (Amplified on regular
+      scenes too: a slow top near its inverted rest, ``tests/helpers/accuracy.ROUND_OFF``, grows perturbations e^9
+      without chaos and its round-off ended 2.7e-12 away where a walk unamplified said 3e-15.) Not trusted near the
+      floor (``near_floor``: a companion tol below ``DOUBLE_DOUBLE_BELOW``), where it missed the round-off 4×;
+    * else the twin (``twin()``: the same method on the model with its rounded numbers moved by an ulp,
+      ``rounding_moved``, so the same truncation error and round-off of its own), whose distance from the run
+      measures the round-off, run where the walk unamplified is ``ROUNDOFF_MARGIN`` times below the error (else it
+      could not be trusted either) and the bound at most the error: one run where the companions near the floor are
+      two, or double-double's ~20. The twin moves only the rounded numbers it can tell, alternately up and down, so it
+      may see less of the model's rounding than there is: with the bound up to 2.4× above the error it passed one run
+      that ended 2.1× its estimate away (benchmarks/roundoff_margin.py, seeds 5 and 11: 245 of 1,201 runs trusted, at
+      every output time 0.57–2.8× the actual error against real128; the bound alone trusted 113).
+
     Each output time's estimate then adds, in quadrature, the walk's typical size, unamplified: on the reference scene
     the bound is ~100× the round-off two double companions measure, and added it made early times' estimates 3×
     the actual error."""
@@ -252,11 +267,23 @@ def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray) -> Comparison |
     bound = float(walk[-1] * margin * math.exp(min(float(own.log_growth[-1]), 700.0)))
     error = np.square(own.error)  # (in place below: np.hypot took ~0.13 ms for 3,001 × 9)
     measured = math.sqrt(float(np.max(error)))
-    if not ROUNDOFF_MARGIN * bound <= measured:
-        return (f"the one-pass estimate, {measured:.2g}, is not {ROUNDOFF_MARGIN:g}× above a bound on the run's "
-                f"round-off, {bound:.2g}, which it does not see")
-    # (no error_estimate_cost_ratio: the estimate's work is inside the run's steps, not a run of its own)
+    # (no error_estimate_cost_ratio for the bound: the estimate's work is inside the run's steps, not a run of its own)
     attrs = {"error_estimate_method": f"{own.how}, plus double precision's round-off in quadrature (a random walk "
                                       f"of one ulp a step: {float(walk[-1]):.2g} at the end; bounded by {bound:.2g})"}
+    if near_floor or not ROUNDOFF_MARGIN * bound <= measured:
+        why = (f"the one-pass estimate, {measured:.2g}, is not {ROUNDOFF_MARGIN:g}× above a bound on the run's "
+               f"round-off, {bound:.2g}, which it does not see") if not near_floor else \
+            "the run's tolerance is near double precision's floor, where round-off rivals truncation"
+        if twin is None or not (ROUNDOFF_MARGIN * float(walk[-1]) <= measured and bound <= measured):
+            return why
+        start = time.perf_counter()
+        roundoff = float(np.max(np.abs(twin().y - y)))
+        if not ROUNDOFF_MARGIN * roundoff <= measured:
+            return f"{why}; a twin run with the rounded numbers moved differs by {roundoff:.2g}, not small against it"
+        attrs = {"error_estimate_method": f"{own.how}, plus double precision's round-off in quadrature (a random walk "
+                                          f"of one ulp a step: {float(walk[-1]):.2g} at the end; a twin run with the "
+                                          f"model's rounded numbers moved by an ulp differs by {roundoff:.2g}, "
+                                          f"≥ {ROUNDOFF_MARGIN:g}× below the error measured)",
+                 "error_estimate_cost_ratio": float((time.perf_counter() - start) / max(wall_time, 1e-9))}
     error += np.square(walk)[:, None]
     return Comparison(np.sqrt(error, out=error), attrs, y)
