@@ -212,8 +212,8 @@ class Auto(Integrator):
         estimated in the same pass where the method can (C8). ``provisional`` (the tangent run, a callable): chosen
         without the growth of perturbations, which the run measures (C8): kept where that growth is no chaos and
         leaves the target met, else the choice is made again with the tangent run's growth (the measure the chaos
-        margins were calibrated with: with the run's own, which follows α too, audit seed 2026 refused three targets
-        double-double reaches), ``integrate(amp=...)``."""
+        margins were calibrated with: deciding climbs and refusals with the run's own, audit seed 2026 refused three
+        targets double-double reaches), ``integrate(amp=...)``."""
         y, final_stats, n_steps, own = _final_run(method, fun, t_out, y0, progress, compiled, resumed,
                                                   estimated or provisional is not None, estimated)
         if provisional is not None:

@@ -271,13 +271,15 @@ class Taylor(Integrator):
                                                               reached, stop, state, y, carry, stats),
                              t_out, out, state, stats, progress, _taylor_failure, start)
         error = np.zeros((len(t_out) if estimate else 0, len(y)))
+        flow = tangent.flow_size(compiled)
         if resume is None:
             e, log_growth = np.zeros(len(y) if estimate else 0), np.zeros(len(t_out))
             growth = np.array([0.0, 0.0, t_out[0] + 0.1 * (t_out[-1] - t_out[0]), 0.0])
-            # the tangent vector starts as the chaos measure's does (``tangent.direction``: on the fixed point tangent
-            # to |γ| = 1)
-            u = tangent.direction(y, slice(layout.GAMMA, layout.GAMMA + 3) if compiled.built_in is not None
-                                  else None)[0]
+            # the tangent vector starts as the chaos measure's does (``tangent.direction`` over the components its
+            # flow follows, ``tangent.flow_size``: on the fixed point tangent to |γ| = 1; zeros beyond)
+            u = np.zeros(len(y))
+            u[:flow] = tangent.direction(y[:flow], slice(layout.GAMMA, layout.GAMMA + 3) if compiled.built_in
+                                         is not None else None)[0]
         else:  # (the growth's mark where it resumes)
             e, u, (log, top) = np.array(resume.end[0]), np.array(resume.end[1]), resume.end[2]
             e = e if estimate and e.size else np.zeros(len(y) if estimate else 0)
@@ -286,7 +288,7 @@ class Taylor(Integrator):
                 error[0] = e  # (at t_out[0]: the start's own error)
         solution = _adaptive(lambda reached, stop: taylor.run_measured(
             compiled.params, self.order, self.tol, t_out, out, reached, stop, state, y, carry, stats, e, u, error,
-            growth, log_growth), t_out, out, state, stats, progress, _taylor_failure, start)
+            growth, log_growth, flow), t_out, out, state, stats, progress, _taylor_failure, start)
         m = taylor.tangent_order(self.order, self.tol)
         solution.estimate = OwnEstimate(error if estimate else None, log_growth, float(growth[3]), int(stats[1]), (
             f"one pass: each step's truncation error (the series' next {taylor.EXTRA_ORDERS} terms) carried along "
