@@ -53,7 +53,8 @@ class Choice:
     check: Integrator | None = None
     instead: Callable[[], Solution] | None = None
     #: the run is kept only where its measured error meets ``promised``, else ``instead`` runs (``auto``'s double run
-    #: on a chaotic scene whose predicted round-off asked for double-double: ``integrate(..., estimated=True)``)
+    #: on a chaotic scene whose predicted round-off asked for double-double, or whose own growth raised its prediction
+    #: above the target: ``integrate(..., estimated=True)``)
     measure_first: bool = False
 
 
