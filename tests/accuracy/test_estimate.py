@@ -92,6 +92,55 @@ def test_near_the_floor_where_truncation_dominates_double_runs_measure_it(accura
     _assert_measures(ds, _actual(ds, overrides), resolved_above=resolved_above)
 
 
+def _near_the_floor(tol=1e-13):
+    """The reference scene's Taylor run measured at ``tol`` (near double precision's floor), its stored states and
+    its output times, for ``estimate.one_pass`` with a twin of one's choosing."""
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    scene = compose_scene(SCENE)
+    run_ = Taylor(tol=tol).integrate(None, scene.times, scene.system.initial_state(), None, scene.compiled_model,
+                                     estimate=True)
+    return run_, scene.times
+
+
+class _Twin:
+    """A twin run standing at ``offset`` from the run's states, counting its calls."""
+
+    def __init__(self, y, offset):
+        self.y, self.offset, self.calls = y, offset, 0
+
+    def __call__(self):
+        from types import SimpleNamespace
+
+        self.calls += 1
+        return SimpleNamespace(y=self.y + self.offset)
+
+
+def test_near_the_floor_the_pass_stands_only_where_its_twin_is_6x_below_it():
+    from gyrolab.accuracy import estimate
+
+    run_, times = _near_the_floor()
+    measured = float(np.max(np.abs(run_.estimate.error)))
+    close, far = _Twin(run_.y, measured / 10), _Twin(run_.y, measured / 3)
+    kept = estimate.one_pass(run_.estimate, run_.y, times, close, near_floor=True, wall_time=1e-3)
+    assert isinstance(kept, estimate.Comparison) and close.calls == 1
+    assert "twin run" in kept.attrs["error_estimate_method"] and "error_estimate_cost_ratio" in kept.attrs
+    refused = estimate.one_pass(run_.estimate, run_.y, times, far, near_floor=True)
+    assert isinstance(refused, str) and "twin run" in refused and far.calls == 1
+    # without a twin (no compiled model), near the floor the companions measure
+    assert isinstance(estimate.one_pass(run_.estimate, run_.y, times, None, near_floor=True), str)
+
+
+def test_the_twin_runs_only_where_it_could_be_trusted():
+    # where the walk of one ulp a step is not 6x below the pass's estimate, no twin can confirm it: not run
+    from gyrolab.accuracy import estimate
+
+    run_, times = _near_the_floor()
+    twin = _Twin(run_.y, 0.0)
+    loud = estimate.one_pass(run_.estimate, run_.y * 1e6, times, twin, near_floor=True)  # (a walk 1e6 x larger)
+    assert isinstance(loud, str) and twin.calls == 0
+
+
 #: benchmarks/promise_audit.py's scene where round-off dominates (tests/accuracy/test_promise_audit.py checks it against
 #: heyoka in real128): asked 1e-12, auto chose Taylor at tol 1.5e-16 and ended 2.1e-12 away while the old stand-in
 #: companion (Taylor at tol 1e-16, in double) measured 1.7e-14
