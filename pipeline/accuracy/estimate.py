@@ -253,9 +253,9 @@ def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray, twin: Any = Non
       measures the round-off, run where the walk unamplified is ``ROUNDOFF_MARGIN`` times below the error (else it
       could not be trusted either) and the bound at most the error: one run where the companions near the floor are
       two, or double-double's ~20. The twin moves only the rounded numbers it can tell, alternately up and down, so it
-      may see less of the model's rounding than there is: with the bound up to 2.4× above the error it passed one run
-      that ended 2.1× its estimate away (benchmarks/roundoff_margin.py, seeds 5 and 11: 245 of 1,201 runs trusted, at
-      every output time 0.57–2.8× the actual error against real128; the bound alone trusted 113).
+      may see less of the model's rounding than there is: with the bound up to 3.3× above the error it passed one run
+      that ended 2.1× its estimate away (benchmarks/roundoff_margin.py, seeds 5 and 11: 240 of 1,227 runs trusted, at
+      every output time 0.57–2.8× the actual error against real128; the bound alone trusts ~113).
 
     Each output time's estimate then adds, in quadrature, the walk's typical size, unamplified: on the reference scene
     the bound is ~100× the round-off two double companions measure, and added it made early times' estimates 3×
