@@ -59,8 +59,8 @@ def test_the_growth_is_the_generated_tangent_flows(overrides):
 def test_the_growth_follows_the_flow_not_the_fixed_axis_alpha():
     # α (carried for the Euler angles, read by no torque) grows like the integral of δω; the tangent run follows
     # (ω, γ) only, and so does the one pass: carrying α must not change the growth it measures. (Following α too,
-    # the default scene's growth after the pilot was e^2.35 instead of e^2.12, and auto then ran a tangent run: 9.8 ms
-    # instead of 2.5.)
+    # the default scene's growth after the pilot was e^2.35 instead of e^2.12, and auto then ran a tangent run: ~4 ms
+    # instead of ~2.)
     base = ["initial.theta0=0.4", "time.end=60", "time.n_output=241"]
     with_alpha, without = (compose_scene([*base, f"output.euler_angles={flag}"]) for flag in ("true", "false"))
     assert len(with_alpha.system.initial_state()) == 9 and len(without.system.initial_state()) == 6
