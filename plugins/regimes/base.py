@@ -17,7 +17,7 @@ from gyrolab.physics.attitude import frame_from_angles
 from gyrolab.contracts.regime import Regime
 from gyrolab.contracts.system import System
 from gyrolab.errors import ConfigError
-from gyrolab.plugins.regimes.ismail2021 import BodyRatios
+from gyrolab.plugins.regimes.notation import BodyRatios
 
 SUPPORTED_FORCES = ("uniform_gravity", "newtonian", "magnetic")
 

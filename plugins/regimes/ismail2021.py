@@ -25,29 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
-@dataclass(frozen=True)
-class BodyRatios:
-    """A body in both papers' notation: a = A/C, b = B/C, the unit centre-of-mass direction (x0', y0', z0'), and
-    A1 = (1−b)/a, B1 = (a−1)/b, C1 = b−a."""
-
-    a: float
-    b: float
-    x0: float
-    y0: float
-    z0: float
-
-    @property
-    def A1(self) -> float:
-        return (1 - self.b) / self.a
-
-    @property
-    def B1(self) -> float:
-        return (self.a - 1) / self.b
-
-    @property
-    def C1(self) -> float:
-        return self.b - self.a
+from gyrolab.plugins.regimes.notation import BodyRatios
 
 
 @dataclass(frozen=True)

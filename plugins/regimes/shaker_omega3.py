@@ -27,7 +27,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gyrolab.plugins.regimes.ismail2021 import BodyRatios, euler_poisson_scaled
+from gyrolab.plugins.regimes.ismail2021 import euler_poisson_scaled
+from gyrolab.plugins.regimes.notation import BodyRatios
 
 
 def omega3_b(a: float) -> float:
