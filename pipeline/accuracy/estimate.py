@@ -148,9 +148,8 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
         # bound said 5.8e-12; at tol 1e-13 the pass measured 3.61e-10 of 3.62e-10): there the bound is not trusted, a
         # twin run measures the round-off (``one_pass``)
         near_floor = taylor is not None and taylor.tol / TIGHTER < DOUBLE_DOUBLE_BELOW
-        twin = None if taylor is None or scene.compiled_model is None else functools.partial(
-            taylor.integrate, scene.rhs, scene.times, scene.system.initial_state(), None,
-            rounding_moved(scene.compiled_model))
+        twin = None if taylor is None or scene.compiled_model is None else lambda: taylor.integrate(
+            scene.rhs, scene.times, scene.system.initial_state(), None, rounding_moved(scene.compiled_model))
         one = one_pass(own, y, scene.times, twin, near_floor, wall_time)
         if isinstance(one, Comparison):
             return one
