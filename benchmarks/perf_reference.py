@@ -441,7 +441,7 @@ def calibration(reference):
     1e-13: the measurement behind ``gyrolab.accuracy.calibration.CALIBRATION``, reported against the table. Extremes scenes are judged
     against Taylor at tol 1e-17 (ratios marked * are within 100× of its disagreement with compiled DOP853 at 1e-13,
     i.e. not measured); the reference scene against the extended-precision reference."""
-    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "tests"))
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "tests", "accuracy"))
     from test_extremes import SCENES
 
     from gyrolab.accuracy.auto import Auto

@@ -27,10 +27,11 @@ from typing import Any
 import numpy as np
 
 from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, Amplification, amplification, growth_of
-from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_FLOOR,
-                                          ESTIMATE_SLACK, FIRST_RATIO, FLOOR, MAX_GROWTH, MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE,
-                                          MISS_MARGIN, PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
-                                          SHADOW_TOLERANCE, TIGHT_RATIO, UNMEASURED_PER_TOL)
+from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW,
+                                          DOUBLE_DOUBLE_FLOOR, ESTIMATE_SLACK, FIRST_RATIO, FLOOR, MAX_GROWTH,
+                                          MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE, MISS_MARGIN,
+                                          PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
+                                          SHADOW_TOLERANCE, TIGHT_RATIO, TIGHTER, UNMEASURED_PER_TOL)
 from gyrolab.contracts.integrator import (BATCH_KERNEL, CHOOSES_METHOD, ESTIMATES_ERROR, PRECISIONS,
                                           PREFERS_COMPILED_MODEL, TIME_DEPENDENT, VECTOR_LANES, BatchSolution, Choice,
                                           CompiledModel, Integrator, IntegratorStats, OwnEstimate, ProgressCallback,
@@ -103,7 +104,6 @@ class Auto(Integrator):
         perturbations, already measured (by default measured here: by the final run itself where that is the double
         Taylor method, C8, else by a tangent run first)."""
         # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
-        from gyrolab.kernels.taylor import order_for
         from gyrolab.kernels.taylor_series import ready
 
         start = time.perf_counter()
@@ -121,9 +121,8 @@ class Auto(Integrator):
         inside = t_out[t_out < t_pilot]
         pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * _PILOT_GRID, inside)
         tau, pilot_nfev = min(max(self.accuracy * FIRST_RATIO, MIN_TOLERANCE), MAX_TOLERANCE / 10), 0
-        # one order for the pilot and the final run (error ∝ tolerance): Jorba & Zou's for the expected tolerance,
-        # which the calibration was measured with (docs/performance.md, "The order rule")
-        order = order_for(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10), overhead=0.0)
+        # one order for the pilot and the final run (error ∝ tolerance), for the expected tolerance (``measured_order``)
+        order = measured_order(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
         taylor = compiled is not None and ready(compiled)  # whether the compiled model has Taylor coefficients
         make = functools.partial(_method, compiled, order if taylor else None)
         # how much the motion amplifies an error present at the pilot's end by the end of the span (chaos: e^{λt}):
@@ -459,6 +458,22 @@ class Auto(Integrator):
         solution.wall_time = time.perf_counter() - start
         solution.settings = settings
         return solution
+
+
+def measured_order(tol: float) -> int:
+    """The order of ``auto``'s pilot and final run at the expected tolerance ``tol``: the ``taylor`` integrator's
+    (``order_for``: least work per unit time with a step's work besides its series; the measured run's one pass
+    makes that work larger still), but no higher than Jorba & Zou's at the run tolerance below which the error
+    estimate turns to a twin run or companions (DOUBLE_DOUBLE_BELOW × TIGHTER: order 16), and never below Jorba &
+    Zou's at ``tol``. On the reference scene the whole call took 0.69–0.89× its time with Jorba & Zou's order at
+    ε = 1e-6 … 1e-9 with its error estimate, 0.84–0.97× without. Higher orders measured faster still but weakened the pilot's prediction at loose tolerances
+    (the chaos audit's fast top at ε = 1e-4 ended 1.7e-4 from its first run at order 16) and, uncapped, sent tight
+    targets to companions or broke ε = 1e-12 without an estimate (docs/performance.md, "The order of a measured
+    run")."""
+    from gyrolab.kernels.taylor import order_for  # start-up: the kernel imports numba
+
+    cap = order_for(DOUBLE_DOUBLE_BELOW * TIGHTER, overhead=0.0)
+    return max(order_for(tol, overhead=0.0), min(order_for(tol), cap))
 
 
 def _method(compiled: CompiledModel | None, order: int | None, tol: float) -> Integrator:

@@ -1,11 +1,14 @@
 """auto's pilot and screen statistics (``_error_growth``, ``_comes_back``): the compiled form and the Python form
-(used without a compiled model) agree with each other and with numpy written out independently; and when the
-pilot measures again (``RECENTRE``), its recorded prediction still bounds the error."""
+(used without a compiled model) agree with each other and with numpy written out independently; when the
+pilot measures again (``RECENTRE``), its recorded prediction still bounds the error; and its order
+(``measured_order``) stays between Jorba & Zou's and the cap near the floor."""
+
+import math
 
 import numpy as np
 import pytest
 
-from gyrolab.accuracy.auto import _comes_back, _error_growth, _fast
+from gyrolab.accuracy.auto import _comes_back, _error_growth, _fast, measured_order
 
 TIMES = np.linspace(0.0, 30.0, 361)
 
@@ -89,3 +92,20 @@ def test_a_prediction_far_looser_than_the_pilot_is_measured_again(monkeypatch, o
     truth = Taylor(tol=1e-17).integrate(scene.system.rhs, scene.times[[0, -1]], y0, None, scene.compiled).y[-1]
     error = float(np.max(np.abs(solution.y[-1] - truth)))
     assert error <= solution.choice.promised <= accuracy
+
+
+def jorba_zou(tol):
+    """Jorba & Zou's order ⌈−ln(tol)/2 + 1⌉ (Exp. Math. 14, 2005, §3.2), within the kernel's range 4 … 60."""
+    return min(60, max(4, math.ceil(-math.log(tol) / 2 + 1)))
+
+
+def test_measured_order_is_higher_than_jorba_zou_at_loose_tolerances_and_theirs_near_the_floor():
+    """A measured step costs 2–3× a bare one, so ``auto`` takes a higher order than Jorba & Zou's where the run stays
+    clear of double precision's floor, and theirs at most from the run tolerance 3e-13 down (where the estimate turns
+    to a twin run or companions, and higher orders sent the reference scene's ε = 1e-10 to two companions)."""
+    cap = jorba_zou(3e-13)
+    for tol in np.logspace(-4, -18, 57):
+        order = measured_order(float(tol))
+        assert jorba_zou(tol) <= order <= max(cap, jorba_zou(tol)), tol
+    assert measured_order(1e-9) > jorba_zou(1e-9)
+    assert measured_order(1e-15) == jorba_zou(1e-15)
