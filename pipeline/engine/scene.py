@@ -63,7 +63,7 @@ class Scene:
     #: why the config's ``accuracy`` is not read by this scene's integrator, when a config file set it
     #: (``gyrolab.engine.unread``; a given one is refused): recorded in every run dataset as ``accuracy_ignored``
     accuracy_ignored: str | None = None
-    #: the layouts of its runs' datasets (``output.dataset``: built once, copied with each run's data)
+    #: the layouts of its runs' datasets (``output.dataset``: their coordinates built once, shared by later runs)
     dataset_layouts: list = field(default_factory=list, init=False, repr=False, compare=False)
 
     @classmethod

@@ -123,6 +123,7 @@ def test_a_scenes_later_datasets_copy_its_first_ones_layout_and_equal_a_fresh_bu
     overrides = [*FIXED_POINT, "force=[uniform_gravity,magnetic]", "force.magnetic.direction=[1.0,0.0,0.0]"]
     scene, solution, first = _built(overrides)
     first.omega.attrs["units"], first.energy.values[:] = "changed", 0.0
+    first.time.attrs["units"], first.time.encoding["dtype"] = "changed", "float32"  # a coordinate's too
     other = replace(solution, y=solution.y * np.linspace(1.0, 1.01, len(solution.t))[:, None])  # other states
     again, fresh = dataset.build_dataset(scene, other), dataset.build_dataset(compose_scene(overrides), other)
     assert scene.dataset_layouts and again.energy.attrs["max_abs_drift"] != first.energy.attrs[
