@@ -400,7 +400,7 @@ def taylor_samples(compiled: CompiledModel, tol: float, t_out: np.ndarray, y0: n
     taylor_series.ready(compiled)  # a traced model's series kernel (a scene carrying α is one)
     t_out, y, out = _outputs(t_out, y0)
     state = np.array([t_out[0]])
-    # auto's screen: Jorba & Zou's order, as every run auto makes (its calibration was measured with them)
+    # auto's screen: Jorba & Zou's order (a short bare run near one period; its order moves no calibration)
     status, _ = taylor.run(compiled.params, taylor.order_for(tol, overhead=0.0), tol, t_out, out, 1,
                            len(t_out), state, y, np.zeros(len(y)), np.zeros(2, dtype=np.int64))
     if status != taylor.OK:
