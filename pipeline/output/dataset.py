@@ -14,7 +14,7 @@ import pandas as pd
 import xarray as xr
 from xarray.indexes import PandasIndex
 
-from gyrolab.compat import install_dask_free_writes
+from gyrolab.compat import direct_dataset, install_dask_free_writes
 from gyrolab.contracts.integrator import Integrator, Solution
 from gyrolab.output.atomic import atomic_path
 from gyrolab.output.cf import conform, unit_attributes
@@ -66,17 +66,14 @@ def _assembled(scene: Scene, variables: dict[str, xr.Variable], t: np.ndarray) -
     """The dataset of ``variables`` at output times ``t``. xarray's constructor aligns and merges (~0.25 ms on the
     reference scene, ~2x that after other work has taken the caches): the scene keeps its last results' coordinates
     (their variables and indexes), and a run with the same variables at the same times (bit for bit) is assembled from
-    them and its own variables by ``Dataset._construct_direct``, the constructor xarray's own methods use once they
-    know a dataset is consistent (~0.01 ms; a template's ``copy(data=...)`` took ~0.1). ``tests/engine/test_scene.py``
-    checks the result against a fresh build, so a change of that private constructor fails there, not in a user's
-    run."""
+    them and its own variables (``gyrolab.compat.direct_dataset``: ~0.01 ms; a template's ``copy(data=...)`` took
+    ~0.1)."""
     t = np.asarray(t)
     layout = [(t.dtype, t.shape, t.tobytes())] + [(k, v.dims, v.shape, v.dtype) for k, v in variables.items()]
     for kept, (order, coords, indexes, sizes) in scene.dataset_layouts:
         if kept == layout:  # (each coordinate's variable copied: its attributes and encoding are the dataset's own)
-            return xr.Dataset._construct_direct({name: coords[name].copy(deep=False) if name in coords else
-                                                 variables[name] for name in order}, set(coords), dict(sizes), None,
-                                                dict(indexes))
+            return direct_dataset({name: coords[name].copy(deep=False) if name in coords else variables[name]
+                                   for name in order}, set(coords), sizes, indexes)
     labels = ["axis"] + [name for name in ("frame_axis",) if any(name in v.dims for v in variables.values())]
     time = PandasIndex(pd.Index(t), "time")  # given with its index: xarray builds no index for the labels
     coords = xr.Coordinates({**time.create_variables({"time": xr.Variable("time", t, time_attributes(
