@@ -121,7 +121,7 @@ class Auto(Integrator):
         inside = t_out[t_out < t_pilot]
         pilot_times = np.union1d(t_out[0] + span * self.pilot_fraction * _PILOT_GRID, inside)
         tau, pilot_nfev = min(max(self.accuracy * FIRST_RATIO, MIN_TOLERANCE), MAX_TOLERANCE / 10), 0
-        # one order for the pilot and the final run (error ∝ tolerance), for the expected tolerance (``measured_order``)
+        # one order for the pilot and the final run (error ∝ tolerance), for the expected tolerance
         order = measured_order(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
         taylor = compiled is not None and ready(compiled)  # whether the compiled model has Taylor coefficients
         make = functools.partial(_method, compiled, order if taylor else None)
@@ -465,11 +465,12 @@ def measured_order(tol: float) -> int:
     (``order_for``: least work per unit time with a step's work besides its series; the measured run's one pass
     makes that work larger still), but no higher than Jorba & Zou's at the run tolerance below which the error
     estimate turns to a twin run or companions (DOUBLE_DOUBLE_BELOW × TIGHTER: order 16), and never below Jorba &
-    Zou's at ``tol``. On the reference scene the whole call took 0.69–0.89× its time with Jorba & Zou's order at
-    ε = 1e-6 … 1e-9 with its error estimate, 0.84–0.97× without. Higher orders measured faster still but weakened the pilot's prediction at loose tolerances
-    (the chaos audit's fast top at ε = 1e-4 ended 1.7e-4 from its first run at order 16) and, uncapped, sent tight
-    targets to companions or broke ε = 1e-12 without an estimate (docs/performance.md, "The order of a measured
-    run")."""
+    Zou's at ``tol``. On the reference scene the measured run took 0.69× its time with Jorba & Zou's order at tol
+    1e-7 (16 against 10), 0.87× at 1e-10 (15 against 13); the whole call 0.93–1.00× at ε = 1e-6 … 1e-9 in the
+    interleaved benchmark, where its Python parts weigh more.
+    Higher orders measured faster still but weakened the pilot's prediction at loose tolerances (the chaos audit's
+    fast top at ε = 1e-4 ended 1.7e-4 from its first run at order 16) and, uncapped, sent tight targets to
+    companions or broke ε = 1e-12 without an estimate (docs/performance.md, "The order of a measured run")."""
     from gyrolab.kernels.taylor import order_for  # start-up: the kernel imports numba
 
     cap = order_for(DOUBLE_DOUBLE_BELOW * TIGHTER, overhead=0.0)
