@@ -60,8 +60,9 @@ def measured_run(scene: Any, y0: np.ndarray, progress: Any, compiled: Any) -> tu
     if ran.choice is not None and ran.choice.measure_first and (comparison.max_error is None
                                                                 or _unkept(comparison.max_error, ran.choice)):
         log.info("%s: the error estimate measured %s in %s precision, not %g below accuracy=%g: chosen again as "
-                 "predicted (one rung up, or with a tangent run's growth; or refused)", integrator.name, "nothing" if comparison.max_error is None
-                 else f"{comparison.max_error:.2g}", ran.choice.method.precision, ESTIMATE_SLACK, ran.choice.target)
+                 "predicted (one rung up, or with a tangent run's growth; or refused)", integrator.name,
+                 "nothing" if comparison.max_error is None else f"{comparison.max_error:.2g}",
+                 ran.choice.method.precision, ESTIMATE_SLACK, ran.choice.target)
         measured_in = {f"auto_measured_in_{ran.choice.method.precision}": comparison.max_error} \
             if comparison.max_error is not None else {}
         solution = ran.choice.instead()

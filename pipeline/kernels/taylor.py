@@ -123,14 +123,14 @@ def run_measured(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats
     error, the series' next ``EXTRA_ORDERS`` terms: E[i] = the estimated error at output time i. u, a unit tangent
     vector, is carried the same way and renormalised at each step: growth = [ln|δ| of the tangent vector it stands
     for (the fast Lyapunov indicator's quantity), its running maximum, a time t_mark, that maximum at t_mark (the
-    last step ending there or before)], G[i] = the maximum at output time i. (The error's own growth is no such measure: each step's
-    truncation error turns it, and on a regular motion the sum of its growths over the steps climbs where a tangent
-    vector's oscillates.) The tangent vector follows the first ``flow`` components (``tangent.flow_size``: the fixed
-    point's (ω, γ), not the fixed axis α that no torque reads), zeros beyond, as the chaos measure's tangent run does:
-    α, carried, grows like the integral of δω and raised the default scene's growth after the pilot from e^2.12 to
-    e^2.35, past what ``auto`` keeps without a tangent run (with ``integrator=auto``: ~4 ms instead of ~2). With
-    E of no rows (and e empty) the growth alone is measured (``auto`` without an error estimate): the error's series
-    and the extra orders are ~half the pass."""
+    last step ending there or before)], G[i] = the maximum at output time i. (The error's own growth is no such
+    measure: each step's truncation error turns it, and on a regular motion the sum of its growths over the steps
+    climbs where a tangent vector's oscillates.) The tangent vector follows the first ``flow`` components
+    (``tangent.flow_size``: the fixed point's (ω, γ), not the fixed axis α that no torque reads), zeros beyond, as
+    the chaos measure's tangent run does: α, carried, grows like the integral of δω and raised the default scene's
+    growth after the pilot from e^2.12 to e^2.35, past what ``auto`` keeps without a tangent run (with
+    ``integrator=auto``: ~4 ms instead of ~2). With E of no rows (and e empty) the growth alone is measured (``auto``
+    without an error estimate): the error's series and the extra orders are ~half the pass."""
     return _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u, E, growth, G, flow)
 
 
