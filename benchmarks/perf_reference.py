@@ -394,17 +394,19 @@ def scene_run_only(reference, rounds):
                                 scipy_verdict]])
 
 
-def run_breakdown(rounds, quick):
+def run_breakdown(reference, rounds, quick):
     """Where ``Scene.run()`` with ``integrator=auto`` spends its time: the regimes' series check, the pilot and
     final Taylor run (auto without the series check, its error measured: the final run's one pass measures the
     growth of perturbations and the error), the chosen run alone without its one pass, the error estimate's
     decision (``estimate.compare``: the one pass taken, or companion runs near the floor), the dataset, interleaved
-    like the peer table."""
+    with heyoka's calls as the verdict's benchmark runs them (run alone, the Python parts take about half as long).
+    The floor: the series check, the run without its one pass and the dataset, what the call costs with nothing
+    measured, against heyoka's cheapest tolerance reaching ε."""
     from gyrolab.output.dataset import build_dataset
     from gyrolab.accuracy import estimate
     from gyrolab.accuracy.auto import Auto
 
-    contestants = {}
+    contestants = {("heyoka", tol): call for tol, (call, _) in heyoka_contestants().items()}
     for eps in EPSILONS[::3] if quick else EPSILONS:
         scene = compose_scene(["experiment=perf_reference", f"accuracy={eps}"])
         compiled, y0 = scene.compiled, scene.system.initial_state()
@@ -428,11 +430,20 @@ def run_breakdown(rounds, quick):
         contestants[("Scene.run()", eps)] = scene.run
     interleaved(contestants, 1)
     best = interleaved(contestants, rounds)
+    peers = {key: best.pop(key) for key in [key for key in best if key[0] == "heyoka"]}
+    errors = {key: float(np.max(np.abs(np.asarray(result)[:6] - reference))) for key, (_, result) in peers.items()}
     parts = list(dict.fromkeys(key[0] for key in best))
+    floor_parts = ("series check", "(the run without its one pass)", "dataset")
     print(f"\nWhere `auto`'s Scene.run() spends its time, {'wall' if WALL else 'CPU'} ms (minimum over {rounds} "
-          f"interleaved rounds):\n\n| ε | {' | '.join(parts)} |\n| --- |{' --- |' * len(parts)}")
+          f"rounds interleaved with heyoka's calls; the floor: {' + '.join(floor_parts)}):\n\n"
+          f"| ε | {' | '.join(parts)} | heyoka | floor / heyoka |\n| --- |{' --- |' * (len(parts) + 2)}")
     for eps in dict.fromkeys(key[1] for key in best):
-        print(f"| {eps:.0e} | {' | '.join(f'{best[(part, eps)][0] * 1e3:.2f}' for part in parts)} |")
+        peer = min((key for key in peers if errors[key] <= eps), key=lambda key: peers[key][0], default=None)
+        floor = sum(best[(part, eps)][0] for part in floor_parts)
+        versus = ("not reached", "") if peer is None else (f"{peers[peer][0] * 1e3:.2f}",
+                                                           f"{floor / peers[peer][0]:.2f}×")
+        print(f"| {eps:.0e} | {' | '.join(f'{best[(part, eps)][0] * 1e3:.2f}' for part in parts)} | "
+              f"{' | '.join(versus)} |")
 
 
 def calibration(reference):
@@ -578,10 +589,10 @@ def main() -> None:
         scene_run_only(reference, rounds)
         return
     if args.breakdown:
-        run_breakdown(rounds, args.quick)
+        run_breakdown(reference, rounds, args.quick)
         return
     peer_table(reference, rounds, args.quick)
-    run_breakdown(rounds, args.quick)
+    run_breakdown(reference, rounds, args.quick)
     print(f"\nauto's series check, first call in a process (regime modules imported then): "
           f"{first_series_check() * 1e3:.0f} ms CPU (median of 3 processes)")
 
