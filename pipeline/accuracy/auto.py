@@ -221,13 +221,17 @@ class Auto(Integrator):
         y, final_stats, n_steps, own = _final_run(method, fun, t_out, y0, progress, compiled, resumed,
                                                   estimated or provisional is not None, estimated)
         raised = None
+
+        def again() -> Solution:  # the choice made again with the tangent run's growth
+            return self.integrate(fun, t_out, y0, progress, compiled, False, estimated, provisional())
+
         if provisional is not None:
             amp = growth_of(own, t_out[-1] - t_out[0])
             measured = _amplified(per_tol, growth, amp.factor, self.pilot_fraction, CHAOS_MARGIN)
             if self.safety * CALIBRATION * measured * chosen + roundoff > self.accuracy:
                 raised = CALIBRATION * measured * chosen + roundoff
             if amp.chaotic(self.pilot_fraction) or (raised is not None and not estimated):
-                return self.integrate(fun, t_out, y0, progress, compiled, False, estimated, provisional())
+                return again()
             per_tol, chaos = measured, _chaos_attributes(amp, False)
             own = own if estimated else None
         promised = CALIBRATION * per_tol * chosen + roundoff
@@ -246,13 +250,11 @@ class Auto(Integrator):
             "auto_precision_reason": why,
         }
         measure_first, instead = False, None
-        if raised is not None:  # kept only where its error estimate measures the target met
-            promised, measure_first = self.accuracy / ESTIMATE_SLACK, True
+        if raised is not None:  # kept only where its error estimate measures the target met, else ``again``
+            promised, measure_first, instead = self.accuracy / ESTIMATE_SLACK, True, again
             choice.update({"auto_predicted_error": promised, "auto_predicted_error_by_growth": raised,
                            "auto_precision_reason": f"{why}; the growth of perturbations the run measured raises the "
                            f"prediction to {raised:.2g}: kept only where its error estimate measures the target met"})
-            def instead() -> Solution:  # the choice made again with the tangent run's growth
-                return self.integrate(fun, t_out, y0, progress, compiled, False, estimated, provisional())
         return Solution(t_out, y, IntegratorStats(
             nfev=final_stats.nfev + pilot_nfev, n_steps=n_steps, n_rejected=final_stats.n_rejected,
             wall_time=time.perf_counter() - start, njev=final_stats.njev, nlu=final_stats.nlu),

@@ -294,9 +294,8 @@ def _emit_horner(context, b, T, T_type, order, hs, each):
                 h_old = b.load(high)
                 b.store(b.select(in_high, b.call(fma, [h_old, hv, x_high]), h_old), high)
                 b.store(b.fmul(b.load(power), hv), power)
-        with b.if_then(b.icmp_signed("<", column, n), likely=True):
-            for j, (low, high, power) in enumerate(chains):
-                each(j, column, b.call(fma, [b.load(high), b.load(power), b.load(low)]))
+        for j, (low, high, power) in enumerate(chains):  # (column < n: chunks of eight components, rounded up)
+            each(j, column, b.call(fma, [b.load(high), b.load(power), b.load(low)]))
 
 
 _LANE_INDEX = ir.Constant(ir.VectorType(ir.IntType(64), _LANES), list(range(_LANES)))
