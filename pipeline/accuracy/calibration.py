@@ -16,6 +16,7 @@ CALIBRATE = "benchmarks/perf_reference.py --calibration"
 CHAOS = "benchmarks/chaos_promise.py"
 ROUNDOFF = "benchmarks/roundoff_margin.py"
 ONE_PASS = "benchmarks/one_pass_estimate.py"
+HEAD = "benchmarks/companion_head.py"
 
 
 @dataclass(frozen=True)
@@ -43,6 +44,10 @@ TIGHTER = _c("TIGHTER", 100.0, PERF, "companion this many times more accurate: r
 DOUBLE_DOUBLE_BELOW = _c("DOUBLE_DOUBLE_BELOW", 3e-15, ROUNDOFF, "a double Taylor run whose companion tol is below "
                          "this is measured by two double companions: one alone measured every run at tol 3e-13 within "
                          "0.68–1.92× of the actual error (227 runs, seeds 5 and 11), at 1e-13 0.20–4.2×")
+COMPANION_HEAD = _c("COMPANION_HEAD", 4, HEAD, "orders of the floor companion's series in double-double (the state "
+                    "too, the rest in double): on the reference scene at tol 1e-18 (order 25), heads 2, 3 ended "
+                    "7.9e-15, 3.6e-15 from a double-double run, 4 to 6 within an ulp of the state (8.9e-16), as "
+                    "double-double itself; 3.05 ms against its 17.6 (AMD EPYC, 2026-11-30)")
 ROUNDOFF_MARGIN = _c("ROUNDOFF_MARGIN", 6.0, ROUNDOFF, "a double companion near the floor is trusted when two disagree "
                      "this many times below what it measures: seeds 5 and 11, one of 448 trusted below 1/2 of the "
                      "error, as at 10 (354 trusted); at 4, two of 550. The one pass, where a twin run (rounded numbers "

@@ -28,7 +28,8 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, growth_of
-from gyrolab.accuracy.calibration import CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN, TIGHTER
+from gyrolab.accuracy.calibration import (CHAOS_MARGIN, COMPANION_HEAD, DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN,
+                                         TIGHTER)
 from gyrolab.kernels.model import rounding_moved
 from gyrolab.contracts.integrator import (CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL,
                                           OwnEstimate)
@@ -80,11 +81,14 @@ def companion(method: Any, has_compiled: bool, round_off: bool = False) -> Compa
     from gyrolab.kernels.taylor import MAX_ORDER
 
     up, _, _ = taylor.climbed(TIGHTER)
+    # the rung above with only the state and the series' first COMPANION_HEAD orders in double-double: its round-off
+    # that of the terms beyond, thousands of times below a double run's, for ~1/6 of the whole series' double-double
+    # (reference scene, tol 1e-18: within an ulp of the state, 3.1 ms against 17.6; docs/integrators.md)
+    up = Taylor(tol=up.tol, precision=up.precision, head=COMPANION_HEAD)
     double_tol = max(taylor.tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
     other_order = taylor.order + 2 if taylor.order + 2 <= MAX_ORDER else taylor.order - 2
-    # (double-double at the order for its own tolerance: reference scene, t = 300, tol 1e-18: order 16 25 ms, 22 20 ms)
-    how = (f"compiled Taylor in double-double at tol {up.tol:.3g} ({method.name} runs the Taylor method near double "
-           f"precision's floor)")
+    how = (f"compiled Taylor at tol {up.tol:.3g}, its state and first {COMPANION_HEAD} orders in double-double "
+           f"({method.name} runs the Taylor method near double precision's floor)")
     if double_tol >= taylor.tol:  # a double companion no tighter than the run measures nothing of it: double-double
         return Companion(up, 1.0, how)  # (benchmarks/roundoff_margin.py: at tol 1.5e-16, 0 of 86 pairs trusted)
     return Companion(up, 1.0, how, (Taylor(order=taylor.order, tol=double_tol), Taylor(order=other_order, tol=double_tol)))

@@ -339,20 +339,42 @@ class TaylorDoubleDouble(Taylor):
 
     integrate_batch = Integrator.integrate_batch  # no batch kernel
 
+    def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = DOUBLE_DOUBLE,
+                 head: int | None = None) -> None:
+        """``head``: only the state and the series' first ``head`` orders in double-double, the rest in double
+        (``taylor_dd.run_head``: the error estimate's companion near double precision's floor, ~6× cheaper than the
+        whole series in double-double); its order then follows the double method's rule."""
+        from gyrolab.kernels.taylor import order_for  # start-up: the kernel imports numba
+
+        if head is not None and (isinstance(head, bool) or not isinstance(head, int) or head < 0):
+            raise ConfigError(f"integrator.head={head!r} must be a non-negative integer (or null: the whole series "
+                              "in double-double)")
+        if head is not None and order is None:
+            order = order_for(as_number(tol, "integrator.tol", positive=True))
+        super().__init__(order=order, tol=tol, precision=precision)
+        if head is not None and head >= self.order:
+            raise ConfigError(f"integrator.head={head!r} must be below integrator.order={self.order}")
+        self.head = head
+
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         """``Taylor.integrate`` in double-double (``gyrolab.kernels.taylor_dd``): the state carried in
         double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded
         to double. The initial state is a double, hence exact."""
-        from gyrolab.kernels import taylor_dd  # start-up: the kernel imports numba
+        from gyrolab.kernels import taylor_dd, taylor_series  # start-up: the kernel imports numba
 
         _ready_for_double_double(compiled)
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         low = np.zeros(len(y))  # the state's low parts
-        no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
         state = np.array([t_out[0]])
         stats = np.zeros(2, dtype=np.int64)
+        if self.head is not None:
+            taylor_series.ready(compiled)  # (its orders beyond the head: the double series)
+            return _adaptive(lambda reached, stop: taylor_dd.run_head(compiled.params, self.order, self.head, self.tol,
+                                                                      t_out, out, reached, stop, state, y, low, stats),
+                             t_out, out, state, stats, progress, _taylor_failure, start)
+        no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
         return _adaptive(lambda reached, stop: taylor_dd.run(compiled.params, self.order, self.tol, t_out, out, no_low,
                                                              reached, stop, state, y, low, stats),
                          t_out, out, state, stats, progress, _taylor_failure, start)
@@ -363,8 +385,13 @@ class TaylorDoubleDouble(Taylor):
         tol = self.tol / factor
         if tol < MIN_TOL:
             return None
-        return (Taylor(order=self.order, tol=tol, precision=DOUBLE_DOUBLE), 1.0,
-                f"taylor double-double at tol {tol:.3g} ({factor:g}× tighter), same order")
+        head = "" if self.head is None else f", its first {self.head} orders"
+        return (Taylor(order=self.order, tol=tol, precision=DOUBLE_DOUBLE, head=self.head), 1.0,
+                f"taylor double-double{head} at tol {tol:.3g} ({factor:g}× tighter), same order")
+
+    def attributes(self) -> dict[str, Any]:
+        head = {} if self.head is None else {"integrator_double_double_head": self.head}
+        return {**super().attributes(), **head}
 
 
 def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -> str | None:

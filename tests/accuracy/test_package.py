@@ -14,7 +14,7 @@ from gyrolab.accuracy import calibration as table
 from tests.helpers import REPO
 
 BENCHMARKS = {table.PROMISE: "PROMISE", table.PERF: "PERF", table.CALIBRATE: "CALIBRATE", table.CHAOS: "CHAOS",
-              table.ROUNDOFF: "ROUNDOFF", table.ONE_PASS: "ONE_PASS"}
+              table.ROUNDOFF: "ROUNDOFF", table.ONE_PASS: "ONE_PASS", table.HEAD: "HEAD"}
 
 
 def test_every_constant_names_a_benchmark_that_reports_on_it():

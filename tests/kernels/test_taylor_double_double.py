@@ -532,3 +532,33 @@ def test_a_model_whose_double_double_series_was_never_compiled_stops_instead_of_
     params[-2:] = 0.0  # (layout: the double-double series' address and scratch columns, 0 until ready)
     with pytest.raises(RuntimeError, match="stopped near t=0 "):
         taylor_dd.propagate(params, 1e-26, np.linspace(0.0, 1.0, 3), system.initial_state())
+
+
+def test_a_double_double_head_reaches_the_50_digit_reference_where_double_precision_cannot(chaotic, reference):
+    """``taylor_dd.run_head`` (the error estimate's companion near double precision's floor): the state and the first
+    ``head`` orders in double-double, the rest in double. Its round-off is that of the terms beyond the head, so on
+    the chaotic scene it ends within a few ulp of the state of the 50-digit reference where double Taylor, and the
+    same kernel with no head, end ~two orders of magnitude farther."""
+    from gyrolab.accuracy.calibration import COMPANION_HEAD
+
+    compiled, y0 = chaotic
+    t_out, exact = reference
+    ulp = float(np.spacing(np.max(np.abs(y0))))
+
+    def headed(head):
+        run = Taylor(precision="double-double", tol=1e-18, head=head)
+        assert run.attributes()["integrator_double_double_head"] == head
+        y = run.integrate(None, t_out, y0, None, compiled).y
+        return _errors(y, np.zeros_like(y), exact)
+
+    head = headed(COMPANION_HEAD)
+    assert head[-1] < ulp, head  # measured 2.5e-17 at t = 60: the output's own rounding
+    no_head = headed(0)
+    double = Taylor(tol=1e-16).integrate(None, t_out, y0, None, compiled).y
+    double_errors = _errors(double, np.zeros_like(double), exact)
+    assert min(no_head[-1], double_errors[-1]) > 20 * head[-1], (no_head, double_errors, head)  # 1.7e-15, 3.2e-15
+    # the head is validated: one sentence naming the value and what is valid
+    with pytest.raises(ConfigError, match=r"integrator.head=-1 must be a non-negative integer"):
+        Taylor(precision="double-double", tol=1e-18, head=-1)
+    with pytest.raises(ConfigError, match=r"integrator.head=40 must be below integrator.order"):
+        Taylor(precision="double-double", tol=1e-18, head=40)
