@@ -1,5 +1,5 @@
 """The error estimate's companion near double precision's floor: the Taylor method with its state and only the series'
-first ``head`` orders in double-double (``taylor_dd.run_head``), against the whole series in double-double.
+first ``head`` orders in double-double (``Taylor(head=...)``), against the whole series in double-double.
 
     python benchmarks/companion_head.py          # three scenes × heads 0 … 6 (~20 s)
 
@@ -52,7 +52,8 @@ def main() -> None:
         ulp = float(np.spacing(max(1.0, float(np.max(np.abs(y0))))))
         cells, costs = [], {}
         for head in [*HEADS, None]:
-            y, cost = _timed(Taylor(tol=TOL, precision="double-double", head=head), scene, y0)
+            method = Taylor(tol=TOL, precision="double-double") if head is None else Taylor(tol=TOL, head=head)
+            y, cost = _timed(method, scene, y0)
             ulps = float(np.max(np.abs(y - truth))) / ulp
             costs[head] = (ulps, cost)
             cells.append(f"{ulps:.3g} ulp, {cost * 1e3:.2f} ms")

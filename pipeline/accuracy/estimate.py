@@ -46,6 +46,9 @@ class Companion:
     #: near the Taylor floor: two double companions (the second at another order, 1/I moved by its rounding) tried
     #: before ``integrator`` (double-double, ~30× their time): their disagreement measures what they share (``compare``)
     double_first: tuple[Any, Any] | None = None
+    #: the integrator class whose model it borrows too (a double-double head: the rung above's series), whose refusal
+    #: applies to it
+    borrows: Any = None
 
 
 def wanted(scene: Any) -> bool:
@@ -80,18 +83,20 @@ def companion(method: Any, has_compiled: bool, round_off: bool = False) -> Compa
     # none (docs/integrators.md, "A broken promise nobody was told of")
     from gyrolab.kernels.taylor import MAX_ORDER
 
-    up, _, _ = taylor.climbed(TIGHTER)
-    # the rung above with only the state and the series' first COMPANION_HEAD orders in double-double: its round-off
-    # that of the terms beyond, thousands of times below a double run's, for ~1/6 of the whole series' double-double
+    # the rung above's tolerance, with only the state and the series' first COMPANION_HEAD orders in double-double: its
+    # round-off that of the terms beyond, thousands of times below a double run's, in ~1/6 of double-double's time
     # (reference scene, tol 1e-18: within an ulp of the state, 3.1 ms against 17.6; docs/integrators.md)
-    up = Taylor(tol=up.tol, precision=up.precision, head=COMPANION_HEAD)
+    rung = taylor.climbed(TIGHTER)[0]
+    up = Taylor(tol=rung.tol, head=COMPANION_HEAD)
     double_tol = max(taylor.tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
     other_order = taylor.order + 2 if taylor.order + 2 <= MAX_ORDER else taylor.order - 2
     how = (f"compiled Taylor at tol {up.tol:.3g}, its state and first {COMPANION_HEAD} orders in double-double "
            f"({method.name} runs the Taylor method near double precision's floor)")
     if double_tol >= taylor.tol:  # a double companion no tighter than the run measures nothing of it: double-double
-        return Companion(up, 1.0, how)  # (benchmarks/roundoff_margin.py: at tol 1.5e-16, 0 of 86 pairs trusted)
-    return Companion(up, 1.0, how, (Taylor(order=taylor.order, tol=double_tol), Taylor(order=other_order, tol=double_tol)))
+        return Companion(up, 1.0, how, borrows=type(rung))  # (benchmarks/roundoff_margin.py: at tol 1.5e-16, 0 of 86
+        # pairs trusted)
+    return Companion(up, 1.0, how, (Taylor(order=taylor.order, tol=double_tol), Taylor(order=other_order, tol=double_tol)),
+                     type(rung))
 
 
 @dataclass(frozen=True)
@@ -173,7 +178,8 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
         # the companion's refusal hook prepares the model (a plugin torque's Taylor kernel compiled), or says when
         # it cannot run it
         companion_model = compiled_model
-        refusal = pick.integrator.refusal(compiled_model, scene.system) if compiled_model is not None else None
+        refusal = None if compiled_model is None else pick.integrator.refusal(compiled_model, scene.system) or (
+            pick.borrows.refusal(compiled_model, scene.system) if pick.borrows is not None else None)
         if refusal and pick.double_first is None:  # (near the floor the double companions may still suffice)
             return _unavailable(f"the companion ({pick.how}) {refusal}")
     start = time.perf_counter()

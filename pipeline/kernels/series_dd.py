@@ -7,7 +7,8 @@ The same recurrences as ``taylor_series`` (Moore 1966; Jorba & Zou 2005), writte
     void f(double t, int64 order, double* Th, double* Tl, double* S, double* p)
 
 fills rows 1..order of the state's coefficients (Th, Tl: high and low parts, rows of the state's size) from row 0,
-with S as scratch (``order`` + 1 rows of ``columns`` double-double series). It follows ``taylor_dd``'s rules:
+with S as scratch (zeros: the derived numbers cached at its start on the first call, then ``order`` + 1 rows of
+``columns`` double-double series). It follows ``taylor_dd``'s rules:
 
 * the equations' numbers are doubles from the parameter array, exact as double-doubles; every number derived from
   them (a difference, a product, 1/I) is computed once per call in double-double, so no double rounding caps the
@@ -47,6 +48,7 @@ from gyrolab.kernels.double_double import dd_add, dd_div, dd_div_d, dd_mul, dd_n
 
 M = {columns}
 N = {size}
+B = {cache}
 _P = types.CPointer(types.float64)
 SIGNATURE = types.void(types.float64, types.int64, _P, _P, _P, _P)
 
@@ -100,7 +102,7 @@ class _Program(Lowering):
         if where[0] == "y":
             return f"Th[({j}) * N + {where[1]}]", f"Tl[({j}) * N + {where[1]}]"
         column = where[1]
-        return f"S[(({j}) * M + {column}) * 2]", f"S[(({j}) * M + {column}) * 2 + 1]"
+        return f"S[B + (({j}) * M + {column}) * 2]", f"S[B + (({j}) * M + {column}) * 2 + 1]"
 
     def _number(self, value: str) -> tuple[str, str]:
         names = (f"c{len(self.numbers)}h", f"c{len(self.numbers)}l")
@@ -235,11 +237,32 @@ class _Program(Lowering):
                 *[f"    {h}, {lo} = dot_add({h}, {lo}, {', '.join(self._at(a, 'j'))}, {', '.join(self._at(b, 'k - j'))})"
                   for (h, lo), a, b in products], *[f"{h}, {lo} = dd_norm({h}, {lo})" for (h, lo), _, _ in products]]
 
+    def derived(self) -> list[int]:
+        """The numbers computed from others (a difference, a product, 1/I), not read from ``p``: kept in the
+        scratch's cache (``source``)."""
+        return [i for i, line in enumerate(self.numbers) if not line.split(" = ", 1)[1].startswith("p[")]
+
+    def cache(self) -> int:
+        """The doubles at the scratch's start: a flag and each derived number's (hi, lo)."""
+        return 1 + 2 * len(self.derived())
+
     def source(self) -> str:
         body = [line for item in self.body for line in (self._loop(item) if isinstance(item, list) else [item])]
-        lines = [*self.numbers, "for k in range(order):", "    ih, il = dd_div_d(1.0, 0.0, k + 1.0)",  # 1/(k + 1)
+        # The derived numbers cost ~100 ns a call (3 double-double divisions for 1/I among ~40 operations): a third of
+        # a call to order 4 (the error estimate's companion with a double-double head, a call a step). They are
+        # computed on the first call with a scratch S (zeros: S[0] = 0) and read from S[1 …] after.
+        derived = self.derived()
+        names = [self.numbers[i].split(" = ", 1)[0] for i in derived]
+        read = [line for i, line in enumerate(self.numbers) if i not in derived]
+        lines = [*read, "if S[0] == 0.0:",
+                 *[f"    {self.numbers[i]}" for i in derived],
+                 *[f"    S[{1 + 2 * n}], S[{2 + 2 * n}] = {name}" for n, name in enumerate(names)],
+                 "    S[0] = 1.0",
+                 "else:" if names else "else:  # (no derived numbers)",
+                 *([f"    {name} = S[{1 + 2 * n}], S[{2 + 2 * n}]" for n, name in enumerate(names)] or ["    pass"]),
+                 "for k in range(order):", "    ih, il = dd_div_d(1.0, 0.0, k + 1.0)",  # 1/(k + 1)
                  *[f"    {line}" for line in body]]
-        text = _HEADER.format(columns=max(self.columns, 1), size=self.model.size)
+        text = _HEADER.format(columns=max(self.columns, 1), size=self.model.size, cache=self.cache())
         return text + "".join(f"    {line}\n" for line in lines)
 
 
@@ -254,7 +277,9 @@ def ready(compiled: Any) -> bool:
         if address not in _KERNELS:  # once per form and process
             program = _Program(model)
             module = generated_module(program.source(), "gyrolab_taylor_dd", f"{model.what} (double-double Taylor)")
-            _KERNELS[address] = (float(module.kernel.address), float(max(program.columns, 1)))
+            # scratch "columns" as callers size it, (order + 1)·2·columns doubles: the series' and, once more per
+            # order row, room for the derived numbers' cache at the start (B doubles; a few kB at most)
+            _KERNELS[address] = (float(module.kernel.address), float(max(program.columns, 1) + -(-program.cache() // 2)))
         p[p.size - 2:] = _KERNELS[address]
     return True
 

@@ -26,6 +26,7 @@ from numba.extending import intrinsic
 from gyrolab.kernels import simd
 from gyrolab.kernels.simd import array_data as _data
 from gyrolab.kernels.compiler import inline_kernel, kernel
+from gyrolab.kernels.double_double import dd_add, dd_mul_d
 from gyrolab.kernels.models import taylor_coefficients
 
 OK, TOO_SMALL_STEP, NOT_FINITE = 0, 1, 2  # dop853's codes
@@ -76,17 +77,17 @@ def _norm_row(T, k):
 
 
 @kernel
-def run(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats):
+def run(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, head=0):
     """Advance until t_out[i_stop − 1] is filled.
 
     Steps are clipped at the run's last output time only, never at i_stop: where a call stops must not
     change the steps (the caller sizes calls by wall time, for progress), so every output the last
     step passes is filled, also beyond i_stop. state = [t]; carry = the Kahan compensation of y (zeros
-    at the start); stats = [coefficient evaluations, steps]. Returns (status, index of the next output
-    time to fill).
+    at the start); stats = [coefficient evaluations, steps]. ``head`` > 0: the series' first ``head`` orders and
+    the update in double-double (``_steps``). Returns (status, index of the next output time to fill).
     """
     return _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, np.empty(0), np.empty(0),
-                  np.empty((0, y.size)), np.empty(0), np.empty(0), 0)
+                  np.empty((0, y.size)), np.empty(0), np.empty(0), 0, head)
 
 
 #: the one-pass error estimate (``run_measured``): the series' orders beyond the step's, whose terms are the step's
@@ -115,7 +116,7 @@ def tangent_order(order, tol):
 
 
 @kernel
-def run_measured(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u, E, growth, G, flow):
+def run_measured(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u, E, growth, G, flow, head=0):
     """``run``, its global error estimated and its perturbations' growth measured in the same pass (docs/integrators.md,
     "A one-pass error estimate"). e, the error of y (exact − computed; zeros at the start), is carried along each step
     by the linearised equation e' = J(y(t)) e, whose Taylor series (to ``tangent_order``) is the directional
@@ -131,14 +132,24 @@ def run_measured(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats
     growth after the pilot from e^2.12 to e^2.35, past what ``auto`` keeps without a tangent run (with
     ``integrator=auto``: ~4 ms instead of ~2). With E of no rows (and e empty) the growth alone is measured (``auto``
     without an error estimate): the error's series and the extra orders are ~half the pass."""
-    return _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u, E, growth, G, flow)
+    return _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u, E, growth, G, flow, head)
 
 
 @inline_kernel
-def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u, E, growth, G, flow):
+def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u, E, growth, G, flow, head):
     """``run`` and ``run_measured``: the growth measured when u has components, the error estimated when E has rows
-    too."""
+    too. ``head`` > 0, a double-double head: the series' first ``head`` orders from the model's generated
+    double-double series (``series_dd``, its address in ``p``) at the state y − carry taken as a double-double, and
+    the update y − carry ← y − carry + Σ_{k≥1} T_k h^k in double-double, the terms beyond the head in double. A
+    step's round-off is then that of those terms, ~u·|T_(head+1)·h^(head+1)|, instead of ~u·|T_1·h|: a step's terms
+    fall by ~tol^(1/order) each order (at tol 1e-18 and head 4, ~2,000× less round-off), and the model's numbers
+    derived in double (1/I) reach only those terms (docs/integrators.md, "A companion with a double-double head")."""
     n = y.size
+    Th, Tl, tail = np.zeros((head + 1, n)), np.zeros((head + 1, n)), np.empty(n if head > 0 else 0)
+    S = np.zeros((head + 1) * 2 * int(p[p.size - 1]) if head > 0 else 0)
+    address = int(p[p.size - 2]) if head > 0 else 0
+    if head > 0 and address == 0:  # the series was not compiled (``series_dd.ready`` not called): no step, not a crash
+        return NOT_FINITE, i_next
     measured, estimating = u.size > 0, E.shape[0] > 0
     extra = EXTRA_ORDERS if estimating else 0
     T = _coefficient_rows(order + 1 + extra, n)
@@ -158,6 +169,13 @@ def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u
         for k in range(n):
             T[0, k] = y[k]
         taylor_coefficients(p, T, order + extra, t)
+        if head > 0:
+            for k in range(n):
+                Th[0, k], Tl[0, k] = y[k], -carry[k]
+            _call_dd_series(address, t, head, Th, Tl, S, p)
+            for j in range(1, head + 1):
+                for k in range(n):
+                    T[j, k] = Th[j, k]
         stats[0] += 1
         scale = max(1.0, _norm_row(T, 0))
         h = step_size(tol, scale, _norm_row(T, order - 1), _norm_row(T, order), order, safety)
@@ -205,13 +223,43 @@ def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u
                 growth[1] = max(growth[1], growth[0])
             if t_new <= growth[2]:
                 growth[3] = growth[1]
-        if not _advance(T, order, h, y, carry):
+        if not (_advance(T, order, h, y, carry) if head == 0 else _advance_head(T, Th, Tl, order, head, h, y, carry, tail)):
             state[0] = t
             return NOT_FINITE, i
         t = t_new
         stats[1] += 1
     state[0] = t
     return OK, i
+
+
+@inline_kernel
+def _advance_head(T, Th, Tl, order, head, h, y, carry, tail):
+    """``_advance`` with a double-double head (``_steps``): Σ_{k>head} T_k h^k in double (in ``tail``: rows outside,
+    components inside, the components' Horner chains side by side), then the head's orders and the state y − carry
+    in double-double; y the new state's high part, carry minus its low part. Returns whether every new component is
+    finite."""
+    n = y.size
+    for m in range(n):
+        tail[m] = T[order, m]
+    for k in range(order - 1, head, -1):
+        for m in range(n):
+            tail[m] = tail[m] * h + T[k, m]
+    finite = True
+    for m in range(n):
+        vh, vl = tail[m], 0.0
+        for k in range(head, -1, -1):
+            vh, vl = dd_mul_d(vh, vl, h)
+            vh, vl = dd_add(vh, vl, Th[k, m], Tl[k, m])
+        y[m], carry[m] = vh, -vl
+        finite = finite and math.isfinite(vh) and math.isfinite(vl)
+    return finite
+
+
+@intrinsic
+def _call_dd_series(typingctx, address, t, order, Th, Tl, S, p):
+    """Call ``void f(double t, int64 order, double* Th, double* Tl, double* S, double* p)`` at ``address``: a traced
+    model's generated double-double series (``series_dd``)."""
+    return types.void(types.int64, types.float64, types.int64, Th, Tl, S, p), simd.call_address
 
 
 @inline_kernel

@@ -21,15 +21,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import types
-from numba.extending import intrinsic
 
-from gyrolab.kernels import simd
 from gyrolab.kernels.compiler import inline_kernel, kernel
-from gyrolab.kernels.double_double import dd_add, dd_mul, dd_mul_d, two_sum
-from gyrolab.kernels.models import taylor_coefficients
-from gyrolab.kernels.taylor import (NOT_FINITE, OK, TOO_SMALL_STEP, _coefficient_rows, _dense_output, _norm_row,
-                                    order_for, step_size)
+from gyrolab.kernels.double_double import dd_add, dd_mul, two_sum
+from gyrolab.kernels.taylor import NOT_FINITE, OK, TOO_SMALL_STEP, _call_dd_series, _norm_row, order_for, step_size
 
 #: the smallest tolerance the double-double kernel takes (its unit round-off is 2^-106 ≈ 1.2e-32)
 MIN_TOL = 1e-32
@@ -46,13 +41,6 @@ def _horner(Th, Tl, order, hh, hl, vh, vl):
         for m in range(n):
             ph, pl = dd_mul(vh[m], vl[m], hh, hl)
             vh[m], vl[m] = dd_add(ph, pl, Th[k, m], Tl[k, m])
-
-
-@intrinsic
-def _call_generated(typingctx, address, t, order, Th, Tl, S, p):
-    """Call ``void f(double t, int64 order, double* Th, double* Tl, double* S, double* p)`` at ``address``: a traced
-    model's generated double-double series (``series_dd``)."""
-    return types.void(types.int64, types.float64, types.int64, Th, Tl, S, p), simd.call_address
 
 
 @kernel
@@ -80,7 +68,7 @@ def run(p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stats):
     while i < i_stop:
         for m in range(n):
             Th[0, m], Tl[0, m] = yh[m], yl[m]
-        _call_generated(address, t, order, Th, Tl, S, p)
+        _call_dd_series(address, t, order, Th, Tl, S, p)
         stats[0] += 1
         scale = max(1.0, _norm_row(Th, 0))  # row 0: the state's high parts
         h = step_size(tol, scale, _norm_row(Th, order - 1), _norm_row(Th, order), order, safety)
@@ -110,71 +98,6 @@ def run(p, order, tol, t_out, Y, Ylo, i_next, i_stop, state, yh, yl, stats):
         stats[1] += 1
     state[0] = t
     return code, i
-
-
-@kernel
-def run_head(p, order, head, tol, t_out, Y, i_next, i_stop, state, yh, yl, stats):
-    """``run``'s contract with only the state and the series' first ``head`` orders in double-double, the rest in
-    double (the model's generated double series, ``taylor_series``): a step's round-off is then that of its terms
-    beyond ``head``, ~u·|T_(head+1)·h^(head+1)|, instead of ~u·|T_1·h| (a step's terms fall by ~tol^(1/order) each
-    order: at tol 1e-18 and head 5, ~2,000× less), for a few times a double step's work instead of ~20×. The
-    error-estimate's companion near double precision's floor (``accuracy.estimate``): on the reference scene at tol
-    1e-18 it ends within an ulp of the state (8.9e-16) of a double-double run, double Taylor 1.2e-14 (docs/
-    integrators.md, "A companion with a double-double head"). Outputs are doubles: y + (Σ_{k≥1} T_k dt^k + y_low)
-    from the hi parts (error ~1.5 ulp of the state, not carried)."""
-    n = yh.size
-    T = _coefficient_rows(order + 1, n)
-    Th = np.zeros((head + 1, n))
-    Tl = np.zeros((head + 1, n))
-    S = np.zeros((head + 1) * 2 * int(p[p.size - 1]))
-    address = int(p[p.size - 2])
-    if address == 0:  # the series was not compiled (``series_dd.ready`` not called): no step, not a crash
-        return NOT_FINITE, i_next
-    carry = np.empty(n)  # the dense output's compensation: −y_low (the state is y − carry)
-    t = state[0]
-    n_out = t_out.size
-    t_end = t_out[n_out - 1]
-    i = i_next
-    safety = math.exp(-0.7 / (order - 1))
-    while i < i_stop:
-        for m in range(n):
-            T[0, m], Th[0, m], Tl[0, m], carry[m] = yh[m], yh[m], yl[m], -yl[m]
-        taylor_coefficients(p, T, order, t)
-        _call_generated(address, t, head, Th, Tl, S, p)
-        stats[0] += 1
-        for k in range(1, head + 1):
-            for m in range(n):
-                T[k, m] = Th[k, m]
-        scale = max(1.0, _norm_row(T, 0))
-        h = step_size(tol, scale, _norm_row(T, order - 1), _norm_row(T, order), order, safety)
-        if not h < np.inf:
-            h = t_end - t
-        t_new = min(t + h, t_end)
-        h = t_new - t  # (exact)
-        if h <= 0.0:  # the step is below the spacing of floating-point numbers at t: no progress is possible
-            state[0] = t
-            return TOO_SMALL_STEP, i
-        while i < n_out and t_out[i] <= t_new:
-            _dense_output(T, order, (t_out[i] - t,), yh, carry, Y, i)
-            i += 1
-        finite = True
-        for m in range(n):  # Σ_{k>head} T_k h^k in double, then the head's orders and the state in double-double
-            v = T[order, m]
-            for k in range(order - 1, head, -1):
-                v = v * h + T[k, m]
-            vh, vl = v, 0.0
-            for k in range(head, -1, -1):
-                vh, vl = dd_mul_d(vh, vl, h)
-                vh, vl = dd_add(vh, vl, Th[k, m], Tl[k, m])
-            yh[m], yl[m] = vh, vl
-            finite = finite and math.isfinite(vh) and math.isfinite(vl)
-        if not finite:
-            state[0] = t
-            return NOT_FINITE, i
-        t = t_new
-        stats[1] += 1
-    state[0] = t
-    return OK, i
 
 
 def propagate(p: np.ndarray, tol: float, t_out, y0, order: int | None = None, y0_low=None):

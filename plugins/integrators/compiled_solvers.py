@@ -230,7 +230,11 @@ class Taylor(Integrator):
             cls = TaylorDoubleDouble
         return super().__new__(cls)
 
-    def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = "double") -> None:
+    def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = "double",
+                 head: int = 0) -> None:
+        """``head`` > 0 (double precision): the series' first ``head`` orders and the state's update in double-double,
+        the rest in double (``taylor._steps``): round-off thousands of times below a double run's for ~3× its work
+        (the error estimate's companion near double precision's floor, ``accuracy.estimate``)."""
         from gyrolab.kernels.taylor import MAX_ORDER, MIN_ORDER, order_for  # start-up: the kernel imports numba
 
         if not isinstance(precision, str) or precision not in PRECISIONS:
@@ -250,6 +254,13 @@ class Taylor(Integrator):
             raise ConfigError(f"integrator.order={order!r} must be an integer from {MIN_ORDER} to {MAX_ORDER} "
                               "(or null: chosen from integrator.tol)")
         self.order = order
+        if isinstance(head, bool) or not isinstance(head, int) or not 0 <= head < order:
+            raise ConfigError(f"integrator.head={head!r} must be an integer from 0 to integrator.order − 1 = "
+                              f"{order - 1} (the series' orders computed in double-double; 0: none)")
+        if head and self.precision != DOUBLE:
+            raise ConfigError(f"integrator.head={head!r} is for integrator.precision=double (in {self.precision} "
+                              "the whole series is)")
+        self.head = head
 
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None,
@@ -261,6 +272,8 @@ class Taylor(Integrator):
 
         start = time.perf_counter()
         taylor_series.ready(compiled)  # a traced model's series kernel, compiled on first need (once: then a test)
+        if self.head:
+            _ready_for_double_double(compiled)  # (the head's series)
         t_out, y, out = _outputs(t_out, y0)
         state = np.array([t_out[0]])
         carry = np.zeros(len(y))  # (np.zeros_like costs 2 µs more, per pilot run)
@@ -268,7 +281,7 @@ class Taylor(Integrator):
         # one Taylor step costs about as much as `order` right-hand-side evaluations; the series count is reported
         if not (estimate or growth_only):
             return _adaptive(lambda reached, stop: taylor.run(compiled.params, self.order, self.tol, t_out, out,
-                                                              reached, stop, state, y, carry, stats),
+                                                              reached, stop, state, y, carry, stats, self.head),
                              t_out, out, state, stats, progress, _taylor_failure, start)
         error = np.zeros((len(t_out) if estimate else 0, len(y)))
         flow = tangent.flow_size(compiled)
@@ -288,7 +301,7 @@ class Taylor(Integrator):
                 error[0] = e  # (at t_out[0]: the start's own error)
         solution = _adaptive(lambda reached, stop: taylor.run_measured(
             compiled.params, self.order, self.tol, t_out, out, reached, stop, state, y, carry, stats, e, u, error,
-            growth, log_growth, flow), t_out, out, state, stats, progress, _taylor_failure, start)
+            growth, log_growth, flow, self.head), t_out, out, state, stats, progress, _taylor_failure, start)
         m = taylor.tangent_order(self.order, self.tol)
         solution.estimate = OwnEstimate(error if estimate else None, log_growth, float(growth[3]), int(stats[1]), (
             f"one pass: each step's truncation error (the series' next {taylor.EXTRA_ORDERS} terms) carried along "
@@ -303,7 +316,9 @@ class Taylor(Integrator):
         tol = self.tol / factor
         if tol < self.TOLERANCE_FLOOR:
             return None
-        return Taylor(order=self.order, tol=tol), 1.0, f"taylor at tol {tol:.3g} ({factor:g}× tighter), same order"
+        head = f", its first {self.head} orders in double-double" if self.head else ""
+        return (Taylor(order=self.order, tol=tol, head=self.head), 1.0,
+                f"taylor at tol {tol:.3g} ({factor:g}× tighter), same order{head}")
 
     def climbed(self, factor: float):
         """Rule 11: the double-double rung, ``factor`` times more accurate (None: already on it)."""
@@ -314,7 +329,9 @@ class Taylor(Integrator):
             f"taylor double-double at tol {tol:.3g}: double precision's floor reached"))
 
     def attributes(self) -> dict[str, Any]:
-        return {"integrator_order": self.order, "integrator_tol": self.tol, "integrator_precision": self.precision}
+        head = {"integrator_double_double_head": self.head} if self.head else {}
+        return {"integrator_order": self.order, "integrator_tol": self.tol, "integrator_precision": self.precision,
+                **head}
 
 
 #: ``Taylor``'s arithmetic: ``integrator.precision``
@@ -339,42 +356,20 @@ class TaylorDoubleDouble(Taylor):
 
     integrate_batch = Integrator.integrate_batch  # no batch kernel
 
-    def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = DOUBLE_DOUBLE,
-                 head: int | None = None) -> None:
-        """``head``: only the state and the series' first ``head`` orders in double-double, the rest in double
-        (``taylor_dd.run_head``: the error estimate's companion near double precision's floor, ~6× cheaper than the
-        whole series in double-double); its order then follows the double method's rule."""
-        from gyrolab.kernels.taylor import order_for  # start-up: the kernel imports numba
-
-        if head is not None and (isinstance(head, bool) or not isinstance(head, int) or head < 0):
-            raise ConfigError(f"integrator.head={head!r} must be a non-negative integer (or null: the whole series "
-                              "in double-double)")
-        if head is not None and order is None:
-            order = order_for(as_number(tol, "integrator.tol", positive=True))
-        super().__init__(order=order, tol=tol, precision=precision)
-        if head is not None and head >= self.order:
-            raise ConfigError(f"integrator.head={head!r} must be below integrator.order={self.order}")
-        self.head = head
-
     def integrate(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray,
                   progress: ProgressCallback | None = None, compiled: CompiledModel | None = None) -> Solution:
         """``Taylor.integrate`` in double-double (``gyrolab.kernels.taylor_dd``): the state carried in
         double-double between steps and between the chunks (``_Chunks``, as the double path), the outputs rounded
         to double. The initial state is a double, hence exact."""
-        from gyrolab.kernels import taylor_dd, taylor_series  # start-up: the kernel imports numba
+        from gyrolab.kernels import taylor_dd  # start-up: the kernel imports numba
 
         _ready_for_double_double(compiled)
         start = time.perf_counter()
         t_out, y, out = _outputs(t_out, y0)
         low = np.zeros(len(y))  # the state's low parts
+        no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
         state = np.array([t_out[0]])
         stats = np.zeros(2, dtype=np.int64)
-        if self.head is not None:
-            taylor_series.ready(compiled)  # (its orders beyond the head: the double series)
-            return _adaptive(lambda reached, stop: taylor_dd.run_head(compiled.params, self.order, self.head, self.tol,
-                                                                      t_out, out, reached, stop, state, y, low, stats),
-                             t_out, out, state, stats, progress, _taylor_failure, start)
-        no_low = np.empty((0, len(y)))  # outputs are stored as doubles: the kernel's low-part array is not wanted
         return _adaptive(lambda reached, stop: taylor_dd.run(compiled.params, self.order, self.tol, t_out, out, no_low,
                                                              reached, stop, state, y, low, stats),
                          t_out, out, state, stats, progress, _taylor_failure, start)
@@ -385,13 +380,8 @@ class TaylorDoubleDouble(Taylor):
         tol = self.tol / factor
         if tol < MIN_TOL:
             return None
-        head = "" if self.head is None else f", its first {self.head} orders"
-        return (Taylor(order=self.order, tol=tol, precision=DOUBLE_DOUBLE, head=self.head), 1.0,
-                f"taylor double-double{head} at tol {tol:.3g} ({factor:g}× tighter), same order")
-
-    def attributes(self) -> dict[str, Any]:
-        head = {} if self.head is None else {"integrator_double_double_head": self.head}
-        return {**super().attributes(), **head}
+        return (Taylor(order=self.order, tol=tol, precision=DOUBLE_DOUBLE), 1.0,
+                f"taylor double-double at tol {tol:.3g} ({factor:g}× tighter), same order")
 
 
 def _double_double_refusal_clause(compiled: CompiledModel, system: Any = None) -> str | None:

@@ -21,7 +21,7 @@ import pytest
 from gyrolab.contracts import CompiledModel
 from gyrolab.engine.scene import compose_scene
 from gyrolab.errors import ConfigError
-from gyrolab.kernels import double_double as dd, taylor_dd
+from gyrolab.kernels import double_double as dd, taylor, taylor_dd
 from gyrolab.kernels.layout import (
     CARRIES_ALPHA, GAMMA, GRADIENT, INERTIA, INV_INERTIA, LINEAR, N_PARAMS, N_X, N_Y, N_Z, OMEGA, U_X, U_Y, U_Z,
 )
@@ -383,7 +383,7 @@ def test_a_scene_in_double_double_runs_with_alpha_and_every_builtin_force_and_re
 
 @numba.njit
 def _generated_series(address, t, order, Th, Tl, S, p):
-    taylor_dd._call_generated(address, t, order, Th, Tl, S, p)
+    taylor._call_dd_series(address, t, order, Th, Tl, S, p)
 
 
 def test_the_generated_series_of_products_quotients_powers_and_time_are_exact_to_double_double():
@@ -535,30 +535,28 @@ def test_a_model_whose_double_double_series_was_never_compiled_stops_instead_of_
 
 
 def test_a_double_double_head_reaches_the_50_digit_reference_where_double_precision_cannot(chaotic, reference):
-    """``taylor_dd.run_head`` (the error estimate's companion near double precision's floor): the state and the first
-    ``head`` orders in double-double, the rest in double. Its round-off is that of the terms beyond the head, so on
-    the chaotic scene it ends within a few ulp of the state of the 50-digit reference where double Taylor, and the
-    same kernel with no head, end ~two orders of magnitude farther."""
+    """``Taylor(head=...)`` (the error estimate's companion near double precision's floor): the series' first ``head``
+    orders and the state's update in double-double, the rest in double. Its round-off is that of the terms beyond the
+    head, so on the chaotic scene it ends within an ulp of the state of the 50-digit reference where double Taylor
+    ends ~two orders of magnitude farther; the one pass measures it as it measures a double run."""
     from gyrolab.accuracy.calibration import COMPANION_HEAD
 
     compiled, y0 = chaotic
     t_out, exact = reference
     ulp = float(np.spacing(np.max(np.abs(y0))))
-
-    def headed(head):
-        run = Taylor(precision="double-double", tol=1e-18, head=head)
-        assert run.attributes()["integrator_double_double_head"] == head
-        y = run.integrate(None, t_out, y0, None, compiled).y
-        return _errors(y, np.zeros_like(y), exact)
-
-    head = headed(COMPANION_HEAD)
+    run = Taylor(tol=1e-18, head=COMPANION_HEAD)
+    assert run.attributes()["integrator_double_double_head"] == COMPANION_HEAD and run.precision == "double"
+    y = run.integrate(None, t_out, y0, None, compiled).y
+    head = _errors(y, np.zeros_like(y), exact)
     assert head[-1] < ulp, head  # measured 2.5e-17 at t = 60: the output's own rounding
-    no_head = headed(0)
     double = Taylor(tol=1e-16).integrate(None, t_out, y0, None, compiled).y
     double_errors = _errors(double, np.zeros_like(double), exact)
-    assert min(no_head[-1], double_errors[-1]) > 20 * head[-1], (no_head, double_errors, head)  # 1.7e-15, 3.2e-15
+    assert double_errors[-1] > 20 * head[-1], (double_errors, head)  # 3.2e-15
+    # measured in the same pass, the steps are the same and the states within an ulp of the bare run's
+    measured = run.integrate(None, t_out, y0, None, compiled, estimate=True)
+    assert np.max(np.abs(measured.y - y)) <= ulp and measured.estimate.error is not None
     # the head is validated: one sentence naming the value and what is valid
-    with pytest.raises(ConfigError, match=r"integrator.head=-1 must be a non-negative integer"):
-        Taylor(precision="double-double", tol=1e-18, head=-1)
-    with pytest.raises(ConfigError, match=r"integrator.head=40 must be below integrator.order"):
-        Taylor(precision="double-double", tol=1e-18, head=40)
+    with pytest.raises(ConfigError, match=r"integrator.head=-1 must be an integer from 0 to integrator.order"):
+        Taylor(tol=1e-18, head=-1)
+    with pytest.raises(ConfigError, match=r"integrator.head=4 is for integrator.precision=double"):
+        Taylor(tol=1e-24, precision="double-double", head=4)
