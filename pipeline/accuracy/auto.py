@@ -28,7 +28,8 @@ import numpy as np
 
 from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, Amplification, amplification, growth_of
 from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW,
-                                          DOUBLE_DOUBLE_FLOOR, ESTIMATE_SLACK, FIRST_RATIO, FLOOR, MAX_GROWTH,
+                                          DOUBLE_DOUBLE_FLOOR, ESTIMATE_SLACK, FIRST_RATIO, FLOOR, HEAD_MARGIN,
+                                          MAX_GROWTH,
                                           MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE, MISS_MARGIN,
                                           PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
                                           SHADOW_TOLERANCE, TIGHT_RATIO, TIGHTER, UNMEASURED_PER_TOL)
@@ -37,7 +38,7 @@ from gyrolab.contracts.integrator import (BATCH_KERNEL, CHOOSES_METHOD, ESTIMATE
                                           CompiledModel, Integrator, IntegratorStats, OwnEstimate, ProgressCallback,
                                           RightHandSide, Solution)
 from gyrolab.errors import ConfigError, GyrolabError, as_number
-from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor, taylor_samples
+from gyrolab.plugins.integrators.compiled_solvers import DOP853Numba, Taylor, TaylorDoubleDouble, taylor_samples
 from gyrolab.plugins.integrators.step_guard import compiled_rhs
 
 #: what ``auto_predicted_error`` is, stored beside it in every run
@@ -125,6 +126,10 @@ class Auto(Integrator):
         order = measured_order(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
         taylor = compiled is not None and ready(compiled)  # whether the compiled model has Taylor coefficients
         make = functools.partial(_method, compiled, order if taylor else None)
+        # the final run near the floor with a double-double head where its error is estimated: it is what lets the
+        # estimate stand there without a companion (without one a double run keeps the promise, ~1.5× faster; the
+        # pilot stays in double, as a batch's choice does)
+        make_final = functools.partial(make, headed=estimated)
         # how much the motion amplifies an error present at the pilot's end by the end of the span (chaos: e^{λt}):
         # measured by the double Taylor run itself (its one pass, C8, which measures it at the first tenth: the
         # default pilot's end), kept where that growth confirms the choice made without it; else by a tangent run
@@ -187,7 +192,7 @@ class Auto(Integrator):
             chosen = max(min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE),
                          Taylor.TOLERANCE_FLOOR)  # (the tolerance recorded is the one run)
             resumed = (tight, make(tight_tol), pilot_times, inside, t_pilot) if tight_tol <= chosen else None
-            solution = final(make(chosen), chosen, 0.0, (
+            solution = final(make_final(chosen), chosen, 0.0, (
                 f"double precision's round-off on this chaotic scene is predicted at about {roundoff:.1g} over "
                 f"~{steps:.0f} steps, above accuracy={self.accuracy:g}, from a growth that scatters: run in double "
                 f"first, kept only where its error estimate measures the target met"), resumed)
@@ -200,7 +205,7 @@ class Auto(Integrator):
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         # the pilot's tight run is as accurate when its tolerance is: the run continues from its end
         resumed = (tight, make(tight_tol), pilot_times, inside, t_pilot) if tight_tol <= chosen else None
-        return final(make(chosen), chosen, roundoff, why, resumed, provisional=tangent_run if provisional else None)
+        return final(make_final(chosen), chosen, roundoff, why, resumed, provisional=tangent_run if provisional else None)
 
     def _final(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None,
                compiled: CompiledModel | None, start: float, per_tol: float, growth: float, pilot_nfev: int,
@@ -479,11 +484,30 @@ def measured_order(tol: float) -> int:
     return max(order_for(tol, overhead=0.0), min(order_for(tol), cap))
 
 
-def _method(compiled: CompiledModel | None, order: int | None, tol: float) -> Integrator:
+def head_for(tol: float, order: int) -> int:
+    """The orders of a double-double head (``Taylor(head=...)``) for ``auto``'s Taylor run at ``tol`` and ``order``:
+    none above the run tolerance where the error estimate would turn to a twin run or companions (DOUBLE_DOUBLE_BELOW
+    × TIGHTER), else the fewest (at least one) whose round-off a step, ~u·r^(head+1) of the state with r = tol^(1/order)
+    the fall of a step's terms per order, is HEAD_MARGIN times below the step's truncation error, ~tol: the one pass's
+    estimate then holds near the floor without a companion (docs/integrators.md, "A double-double head in auto's
+    run")."""
+    if tol >= DOUBLE_DOUBLE_BELOW * TIGHTER:
+        return 0
+    fall, head = tol ** (1.0 / order), 1
+    while EPS * fall ** (head + 1) > tol / HEAD_MARGIN and head < order - 1:
+        head += 1
+    return head
+
+
+def _method(compiled: CompiledModel | None, order: int | None, tol: float, headed: bool = False) -> Integrator:
     """The method auto runs at ``tol``: the compiled Taylor method at ``order`` (None: a compiled model without
-    Taylor coefficients, compiled DOP853 instead); scipy's DOP853 without a compiled model."""
+    Taylor coefficients, compiled DOP853 instead), ``headed`` near double precision's floor with a double-double head
+    where the model has a double-double series (``head_for``); scipy's DOP853 without a compiled model."""
     if compiled is not None:
-        return Taylor(order=order, tol=tol) if order is not None else DOP853Numba(rtol=tol, atol=tol)
+        if order is None:
+            return DOP853Numba(rtol=tol, atol=tol)
+        head = head_for(tol, order) if headed else 0
+        return Taylor(order=order, tol=tol, head=head if head and TaylorDoubleDouble.refusal(compiled) is None else 0)
     # start-up: scipy.integrate (~0.35 s) only for a scene without a compiled model
     from gyrolab.plugins.integrators.scipy_solvers import DOP853
 
@@ -609,6 +633,8 @@ def _final_run(method: Integrator, fun: RightHandSide, t_out: np.ndarray, y0: np
     ``estimated``; resumed, it carries on the tight run's measurement (the pilot measured it the same way, else it runs
     again measured: the same states)."""
     kind = _measuring(method, measured, estimated)
+    if resumed is not None and getattr(method, "head", 0) != getattr(resumed[1], "head", 0):
+        resumed = None  # (a run with a double-double head measures its round-off from the start: not from a pilot's)
     if resumed is None:
         solution = method.integrate(fun, t_out, y0, progress, compiled, **kind)
         return solution.y, solution.stats, solution.stats.n_steps, solution.estimate
@@ -619,7 +645,9 @@ def _final_run(method: Integrator, fun: RightHandSide, t_out: np.ndarray, y0: np
         kind["resume"] = tight.estimate
     head = np.searchsorted(pilot_times, inside)  # the outputs inside the pilot
     rest = t_out[t_out >= t_pilot]
-    tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest, tight.y[-1],
+    # (from the state the tight run ended in, with its compensation: the low part of a double-double head's state)
+    start = tight.estimate.end[3] if kind and tight.estimate is not None else tight.y[-1]
+    tail = method.integrate(fun, np.concatenate([[t_pilot], rest]) if rest[0] > t_pilot else rest, start,
                             progress, compiled, **kind)
     steps = tail.stats.n_steps + tight.stats.n_steps
     own = tail.estimate

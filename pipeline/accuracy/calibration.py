@@ -48,6 +48,18 @@ COMPANION_HEAD = _c("COMPANION_HEAD", 4, HEAD, "orders of the floor companion's 
                     "too, the rest in double): on the reference scene at tol 1e-18 (order 25), heads 2, 3 ended "
                     "7.9e-15, 3.6e-15 from a double-double run, 4 to 6 within an ulp of the state (8.9e-16), as "
                     "double-double itself; 3.05 ms against its 17.6 (AMD EPYC, 2026-11-30)")
+HEAD_COMPANION_GROWTH = _c("HEAD_COMPANION_GROWTH", 1e3, HEAD, "the head companion measures runs whose perturbations "
+                           "grew at most this much (its round-off, ~u·2.5e-4 of the state a step at tol 1e-18, "
+                           "grows with them; the chaotic top over t = 200, ~1e10 with the chaos margin, measured "
+                           "2.9x the actual error with it), double-double beyond")
+HEAD_MARGIN = _c("HEAD_MARGIN", 1000.0, HEAD, "auto's run near the floor takes the fewest orders of double-double head "
+                 "whose round-off a step, ~u·tol^((head + 1)/order), is this many times below tol: on the reference "
+                 "scene head 1 at tol 1e-14 (its walk 28× below the error), head 4 at 1e-16 and 7.4e-17 (head 3's "
+                 "walk 1.7× below the error at 1e-16)")
+HEAD_WALK = _c("HEAD_WALK", 2.0, HEAD, "a head run's round-off is at most this many times its measured walk amplified "
+               "by the growth of perturbations (the ulps of each step's terms computed in double): the largest "
+               "ratio of what the one pass missed to that, on three scenes at tol 1e-13 … 1e-16, heads 1 … 4, 1.6 "
+               "(the orbiting gyrostat, head 1, tol 1e-16), besides the outputs' own rounding")
 ROUNDOFF_MARGIN = _c("ROUNDOFF_MARGIN", 6.0, ROUNDOFF, "a double companion near the floor is trusted when two disagree "
                      "this many times below what it measures: seeds 5 and 11, one of 448 trusted below 1/2 of the "
                      "error, as at 10 (354 trusted); at 4, two of 550. The one pass, where a twin run (rounded numbers "

@@ -28,8 +28,8 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, growth_of
-from gyrolab.accuracy.calibration import (CHAOS_MARGIN, COMPANION_HEAD, DOUBLE_DOUBLE_BELOW, ROUNDOFF_MARGIN,
-                                         TIGHTER)
+from gyrolab.accuracy.calibration import (CHAOS_MARGIN, COMPANION_HEAD, DOUBLE_DOUBLE_BELOW, HEAD_COMPANION_GROWTH,
+                                         HEAD_WALK, ROUNDOFF_MARGIN, TIGHTER)
 from gyrolab.kernels.model import rounding_moved
 from gyrolab.contracts.integrator import (CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL,
                                           OwnEstimate)
@@ -60,12 +60,17 @@ def wanted(scene: Any) -> bool:
     return bool(choice)
 
 
-def companion(method: Any, has_compiled: bool, round_off: bool = False) -> Companion | None:
+def companion(method: Any, has_compiled: bool, round_off: bool = False, growth: float = math.inf) -> Companion | None:
     """The more accurate run that measures the run of ``method`` (its ``more_accurate``, rule 9 of the contract;
     else the compiled Taylor method at its floor when the scene has a compiled model; else, for a run that is itself
     the double-precision Taylor method near that floor, the method one rung up the precision ladder), or None.
     ``round_off``: the run's own estimate found its round-off not small (``one_pass``), which a double companion
-    shares: a double Taylor run is then measured as near its floor (two double companions, else double-double)."""
+    shares: a double Taylor run is then measured as near its floor (two double companions, else double-double).
+    ``growth``: how much the motion amplified perturbations over the run, as its own pass measured it (with the
+    chaos margin): one rung up is the Taylor method with a double-double head (``COMPANION_HEAD``) up to
+    ``HEAD_COMPANION_GROWTH``, the whole series in double-double beyond (the head's round-off, ~10⁻⁴ of a double
+    run's, grows with the motion's amplification too: the chaotic top over t = 200, amplified ~10¹⁰, measured 2.9×
+    its run's actual error with it)."""
     taylor = _double_taylor(method) if has_compiled else None
     finer = method.more_accurate(TIGHTER)
     if finer is not None and (taylor is None or (taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW and not round_off)):
@@ -87,14 +92,16 @@ def companion(method: Any, has_compiled: bool, round_off: bool = False) -> Compa
     # round-off that of the terms beyond, thousands of times below a double run's, in ~1/6 of double-double's time
     # (reference scene, tol 1e-18: within an ulp of the state, 3.1 ms against 17.6; docs/integrators.md)
     rung = taylor.climbed(TIGHTER)[0]
-    up = Taylor(tol=rung.tol, head=COMPANION_HEAD)
+    up = Taylor(tol=rung.tol, head=COMPANION_HEAD) if growth <= HEAD_COMPANION_GROWTH else rung
     double_tol = max(taylor.tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
     other_order = taylor.order + 2 if taylor.order + 2 <= MAX_ORDER else taylor.order - 2
-    how = (f"compiled Taylor at tol {up.tol:.3g}, its state and first {COMPANION_HEAD} orders in double-double "
-           f"({method.name} runs the Taylor method near double precision's floor)")
-    if double_tol >= taylor.tol:  # a double companion no tighter than the run measures nothing of it: double-double
+    how = (f"compiled Taylor at tol {up.tol:.3g}, " + (f"its state and first {COMPANION_HEAD} orders in double-double"
+                                                        if up is not rung else "in double-double") +
+           f" ({method.name} runs the Taylor method near double precision's floor)")
+    if double_tol >= taylor.tol or taylor.head:  # a double companion no tighter than the run, or with more round-off
+        # than a run with a double-double head, measures nothing of it: the head companion
         return Companion(up, 1.0, how, borrows=type(rung))  # (benchmarks/roundoff_margin.py: at tol 1.5e-16, 0 of 86
-        # pairs trusted)
+        # double pairs trusted)
     return Companion(up, 1.0, how, (Taylor(order=taylor.order, tol=double_tol), Taylor(order=other_order, tol=double_tol)),
                      type(rung))
 
@@ -163,7 +170,9 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
         if isinstance(one, Comparison):
             return one
     compiled_model = scene.compiled_model
-    pick = companion(method, compiled_model is not None, isinstance(one, str)) if check is None else Companion(check, 1.0, (
+    growth = math.inf if own is None else math.exp(min(float(own.log_growth[-1]), 700.0)) * (
+        CHAOS_MARGIN if growth_of(own, float(scene.times[-1] - scene.times[0]) or 1.0).chaotic(PILOT_FRACTION) else 1.0)
+    pick = companion(method, compiled_model is not None, isinstance(one, str), growth) if check is None else Companion(check, 1.0, (
         f"{check.name} ({', '.join(f'{k} {v}' for k, v in check.attributes().items())}) against the analytic series"))
     name = getattr(method, "name", type(method).__name__)
     if pick is None:
@@ -268,10 +277,12 @@ def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray, twin: Any = Non
 
     Each output time's estimate then adds, in quadrature, the walk's typical size, unamplified: on the reference scene
     the bound is ~100× the round-off two double companions measure, and added it made early times' estimates 3×
-    the actual error."""
+    the actual error. A run with a double-double head measured its round-off itself (``_headed``)."""
     span = float(times[-1] - times[0]) or 1.0
     margin = CHAOS_MARGIN if growth_of(own, span).chaotic(PILOT_FRACTION) else 1.0
     scale = max(1.0, float(np.max(np.abs(y))))
+    if own.roundoff is not None:
+        return _headed(own, y, times, span, margin, scale)
     walk = (EPS * scale) * np.sqrt(1.0 + own.steps * ((times - times[0]) / span))
     bound = float(walk[-1] * margin * math.exp(min(float(own.log_growth[-1]), 700.0)))
     error = np.square(own.error)  # (in place below: np.hypot took ~0.13 ms for 3,001 × 9)
@@ -296,3 +307,26 @@ def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray, twin: Any = Non
                  "error_estimate_cost_ratio": float((time.perf_counter() - start) / max(wall_time, 1e-9))}
     error += np.square(walk)[:, None]
     return Comparison(np.sqrt(error, out=error), attrs, y)
+
+
+def _headed(own: OwnEstimate, y: np.ndarray, times: np.ndarray, span: float, margin: float,
+            scale: float) -> Comparison | str:
+    """``one_pass`` for a run with a double-double head (``Taylor(head=...)``), which measured its round-off: the walk
+    of the ulps of each step's terms computed in double (``OwnEstimate.roundoff``), at most ``HEAD_WALK`` times that,
+    amplified by the growth of perturbations (and ``CHAOS_MARGIN`` on a chaotic scene), plus the outputs' own rounding
+    (half an ulp of the state at each output, not carried, so not amplified). No twin: the model's numbers derived in
+    double reach only those terms. The estimate stands where both are ``ROUNDOFF_MARGIN`` times below it; each output
+    time adds, in quadrature, the walk up to it and the output's rounding."""
+    fraction = (times - times[0]) / span
+    walk = HEAD_WALK * own.roundoff * np.sqrt(fraction)
+    stored = 0.5 * EPS * scale
+    bound = max(HEAD_WALK * own.roundoff * margin * math.exp(min(float(own.log_growth[-1]), 700.0)), stored)
+    error = np.square(own.error)
+    measured = math.sqrt(float(np.max(error)))
+    if not ROUNDOFF_MARGIN * bound <= measured:
+        return (f"the one-pass estimate, {measured:.2g}, is not {ROUNDOFF_MARGIN:g}× above a bound on the run's "
+                f"round-off, {bound:.2g} (its double-double head's measured walk amplified, or its outputs' rounding)")
+    error += (np.square(walk) + stored * stored)[:, None]
+    return Comparison(np.sqrt(error, out=error), {"error_estimate_method": (
+        f"{own.how}, plus the round-off in quadrature (a double-double head: the measured walk of each step's terms "
+        f"computed in double, {float(walk[-1]):.2g} at the end; bounded by {bound:.2g})")}, y)

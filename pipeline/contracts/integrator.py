@@ -74,9 +74,13 @@ class OwnEstimate:
     steps: int
     #: how it was estimated, for the dataset
     how: str
-    #: the pass's state at the run's end (the error or an empty array, the unit tangent vector, [ln|δ|, its running
-    #: maximum]): a run resumed from this one's end carries it on (``Taylor.integrate(..., resume=...)``)
+    #: the pass's state at the run's end (the error or an empty array, the unit tangent vector, (ln|δ|, its running
+    #: maximum, the round-off's walk so far), the state and its compensation): a run resumed from this one's end
+    #: carries it on (``Taylor.integrate(..., resume=...)``)
     end: tuple | None = None
+    #: a run whose round-off it measured (the Taylor method with a double-double head): the random walk of the ulps
+    #: of each step's terms computed in double, √Σ (u·|terms|)², unamplified; None: not measured
+    roundoff: float | None = None
 
 
 @dataclass

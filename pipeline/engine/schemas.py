@@ -228,6 +228,7 @@ class Taylor:
     order: Optional[int] = None
     tol: float = field(default=1e-16, metadata=TOLERANCE)
     precision: str = "double"
+    head: int = 0
 
 
 @dataclass

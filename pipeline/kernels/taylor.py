@@ -124,7 +124,9 @@ def run_measured(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats
     error, the series' next ``EXTRA_ORDERS`` terms: E[i] = the estimated error at output time i. u, a unit tangent
     vector, is carried the same way and renormalised at each step: growth = [ln|δ| of the tangent vector it stands
     for (the fast Lyapunov indicator's quantity), its running maximum, a time t_mark, that maximum at t_mark (the
-    last step ending there or before)], G[i] = the maximum at output time i. (The error's own growth is no such
+    last step ending there or before), with a double-double ``head`` Σ over the steps of the squared max norm of
+    their terms computed in double (their round-off's random walk, in units of u)], G[i] = the maximum at output
+    time i. (The error's own growth is no such
     measure: each step's truncation error turns it, and on a regular motion the sum of its growths over the steps
     climbs where a tangent vector's oscillates.) The tangent vector follows the first ``flow`` components
     (``tangent.flow_size``: the fixed point's (ω, γ), not the fixed axis α that no torque reads), zeros beyond, as
@@ -223,7 +225,13 @@ def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u
                 growth[1] = max(growth[1], growth[0])
             if t_new <= growth[2]:
                 growth[3] = growth[1]
-        if not (_advance(T, order, h, y, carry) if head == 0 else _advance_head(T, Th, Tl, order, head, h, y, carry, tail)):
+        if head == 0:
+            finite = _advance(T, order, h, y, carry)
+        else:
+            finite, doubled = _advance_head(T, Th, Tl, order, head, h, y, carry, tail)
+            if measured:  # the round-off's walk: Σ |the step's terms computed in double|² (``growth``)
+                growth[4] += doubled * doubled
+        if not finite:
             state[0] = t
             return NOT_FINITE, i
         t = t_new
@@ -236,23 +244,24 @@ def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u
 def _advance_head(T, Th, Tl, order, head, h, y, carry, tail):
     """``_advance`` with a double-double head (``_steps``): Σ_{k>head} T_k h^k in double (in ``tail``: rows outside,
     components inside, the components' Horner chains side by side), then the head's orders and the state y − carry
-    in double-double; y the new state's high part, carry minus its low part. Returns whether every new component is
-    finite."""
+    in double-double; y the new state's high part, carry minus its low part. Returns (whether every new component is
+    finite, the max norm of the terms computed in double: the step's round-off is a few ulps of it)."""
     n = y.size
     for m in range(n):
         tail[m] = T[order, m]
     for k in range(order - 1, head, -1):
         for m in range(n):
             tail[m] = tail[m] * h + T[k, m]
-    finite = True
+    finite, doubled, power = True, 0.0, abs(h) ** (head + 1)
     for m in range(n):
+        doubled = max(doubled, abs(tail[m]) * power)
         vh, vl = tail[m], 0.0
         for k in range(head, -1, -1):
             vh, vl = dd_mul_d(vh, vl, h)
             vh, vl = dd_add(vh, vl, Th[k, m], Tl[k, m])
         y[m], carry[m] = vh, -vl
         finite = finite and math.isfinite(vh) and math.isfinite(vl)
-    return finite
+    return finite, doubled
 
 
 @intrinsic

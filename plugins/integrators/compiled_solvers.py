@@ -267,7 +267,9 @@ class Taylor(Integrator):
                   estimate: bool = False, growth_only: bool = False, resume: OwnEstimate | None = None) -> Solution:
         """The run; ``estimate`` (C8): its global error estimated in the same pass (``taylor.run_measured``), and the
         growth of perturbations measured; ``growth_only``: the growth alone (``OwnEstimate.error`` None). ``resume``:
-        the measurement of a run that ended at y0, whose error, tangent vector and growth this run carries on."""
+        the measurement of a run that ended at y0, whose error, tangent vector and growth this run carries on (and
+        the compensation of its state when y0 is that state, ``OwnEstimate.end``: the low part a double-double head
+        carries)."""
         from gyrolab.kernels import layout, taylor, taylor_series, tangent  # start-up: the kernel imports numba
 
         start = time.perf_counter()
@@ -287,16 +289,18 @@ class Taylor(Integrator):
         flow = tangent.flow_size(compiled)
         if resume is None:
             e, log_growth = np.zeros(len(y) if estimate else 0), np.zeros(len(t_out))
-            growth = np.array([0.0, 0.0, t_out[0] + 0.1 * (t_out[-1] - t_out[0]), 0.0])
+            growth = np.array([0.0, 0.0, t_out[0] + 0.1 * (t_out[-1] - t_out[0]), 0.0, 0.0])
             # the tangent vector starts as the chaos measure's does (``tangent.direction`` over the components its
             # flow follows, ``tangent.flow_size``: on the fixed point tangent to |γ| = 1; zeros beyond)
             u = np.zeros(len(y))
             u[:flow] = tangent.direction(y[:flow], slice(layout.GAMMA, layout.GAMMA + 3) if compiled.built_in
                                          is not None else None)[0]
-        else:  # (the growth's mark where it resumes)
-            e, u, (log, top) = np.array(resume.end[0]), np.array(resume.end[1]), resume.end[2]
+        else:  # (the growth's mark where it resumes; from the state the run ended in, its compensation too)
+            e, u, (log, top, walk) = np.array(resume.end[0]), np.array(resume.end[1]), resume.end[2]
+            if np.array_equal(y, resume.end[3]):
+                carry = np.array(resume.end[4])
             e = e if estimate and e.size else np.zeros(len(y) if estimate else 0)
-            growth, log_growth = np.array([log, top, t_out[0], top]), np.full(len(t_out), top)
+            growth, log_growth = np.array([log, top, t_out[0], top, walk]), np.full(len(t_out), top)
             if estimate:
                 error[0] = e  # (at t_out[0]: the start's own error)
         solution = _adaptive(lambda reached, stop: taylor.run_measured(
@@ -306,7 +310,7 @@ class Taylor(Integrator):
         solution.estimate = OwnEstimate(error if estimate else None, log_growth, float(growth[3]), int(stats[1]), (
             f"one pass: each step's truncation error (the series' next {taylor.EXTRA_ORDERS} terms) carried along "
             f"the run by the linearised equations (their Taylor series to order {m} on the run's own steps)"),
-            (e, u, growth[:2].copy()))
+            (e, u, (growth[0], growth[1], growth[4]), y, carry), _EPS * math.sqrt(growth[4]) if self.head else None)
         return solution
 
     #: below this tol the double-precision kernel gains nothing (round-off)
@@ -336,6 +340,8 @@ class Taylor(Integrator):
 
 #: ``Taylor``'s arithmetic: ``integrator.precision``
 DOUBLE, DOUBLE_DOUBLE = "double", "double-double"
+#: double precision's unit: a head run's measured round-off walk is in its units (``OwnEstimate.roundoff``)
+_EPS = float(np.finfo(float).eps)
 PRECISIONS = (DOUBLE, DOUBLE_DOUBLE)
 
 

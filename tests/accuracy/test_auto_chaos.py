@@ -75,11 +75,37 @@ def test_a_climb_predicted_on_a_chaotic_scene_is_tried_in_double_first_and_kept_
 
 
 def test_a_climb_measured_in_double_first_records_what_double_measured():
-    # the chaotic top to t = 200 at 1e-8 (docs/integrators.md): double precision ends ~1e-6 away, so the double
-    # run's estimate breaks ε / 2 and auto climbs, the dataset keeping that measurement
-    ds = compose_scene([*CHAOTIC_TOP, "time.end=200", "integrator=auto", "accuracy=1e-8", "time.n_output=2"]).run()
+    # the chaotic top to t = 200 at 1e-9 (docs/integrators.md): double precision, even with a double-double head at
+    # its floor tolerance, ends ~1.3e-9 away, so the double run's estimate breaks ε / 2 and auto climbs, the dataset
+    # keeping that measurement
+    ds = compose_scene([*CHAOTIC_TOP, "time.end=200", "integrator=auto", "accuracy=1e-9", "time.n_output=2"]).run()
     assert ds.attrs["auto_precision"] == "double-double"
-    assert ds.attrs["auto_measured_in_double"] > 0.5e-8
+    assert ds.attrs["auto_measured_in_double"] > 0.5e-9
+
+
+def test_a_double_double_head_answers_a_chaotic_target_plain_double_cannot():
+    """The same top at 1e-8: plain double precision ends ~1e-6 away (its round-off amplified ~1e9), so auto used to
+    climb to double-double; its run near the floor now carries a double-double head (``auto.head_for``), whose
+    round-off is thousands of times smaller, and answers in double, measured by a double-double companion (the
+    motion amplifies too much for the head companion). Checked against double-double at tol 1e-28."""
+    from gyrolab.kernels import series_dd, taylor_dd
+    from gyrolab.plugins.integrators.compiled_solvers import Taylor
+
+    scene = compose_scene([*CHAOTIC_TOP, "time.end=200", "integrator=auto", "accuracy=1e-8", "time.n_output=2",
+                           "output.euler_angles=false"])
+    ds = scene.run()
+    assert ds.attrs["auto_precision"] == "double" and ds.attrs["auto_double_double_head"] >= 1
+    assert "in double-double" in ds.attrs["error_estimate_method"]
+    series_dd.ready(scene.compiled)
+    y0 = scene.system.initial_state()
+    truth, _ = taylor_dd.propagate(scene.compiled.params, 1e-28, scene.times, y0)
+    actual = np.abs(np.concatenate([ds.omega.values, ds.gamma.values], axis=1) - truth).max()
+    assert actual <= 1e-8 / 2  # measured 1.3e-9
+    estimate = max(ds.attrs["error_estimate_max_omega"], ds.attrs["error_estimate_max_attitude"])
+    assert 0.5 <= estimate / actual <= 2.0
+    plain = Taylor(tol=ds.attrs["auto_tol"], order=ds.attrs["auto_order"]).integrate(None, scene.times, y0, None,
+                                                                                    scene.compiled).y
+    assert np.abs(plain - truth).max() > 20 * actual  # what plain double precision reaches there
 
 
 @pytest.mark.parametrize("scene", [["experiment=perf_reference"], CHAOTIC_TOP, ["body=lagrange_top", "initial=upright"]])
