@@ -28,7 +28,7 @@ import numpy as np
 
 from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, Amplification, amplification, growth_of
 from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW,
-                                          DOUBLE_DOUBLE_FLOOR, ESTIMATE_SLACK, FIRST_RATIO, FLOOR, HEAD_MARGIN,
+                                          DOUBLE_DOUBLE_FLOOR, ESTIMATE_SLACK, FIRST_RATIO, FLOOR, HEAD_ORDERS,
                                           MAX_GROWTH,
                                           MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE, MISS_MARGIN,
                                           PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
@@ -126,10 +126,6 @@ class Auto(Integrator):
         order = measured_order(min(self.accuracy * FIRST_RATIO, MAX_TOLERANCE / 10))
         taylor = compiled is not None and ready(compiled)  # whether the compiled model has Taylor coefficients
         make = functools.partial(_method, compiled, order if taylor else None)
-        # the final run near the floor with a double-double head where its error is estimated: it is what lets the
-        # estimate stand there without a companion (without one a double run keeps the promise, ~1.5× faster; the
-        # pilot stays in double, as a batch's choice does)
-        make_final = functools.partial(make, headed=estimated)
         # how much the motion amplifies an error present at the pilot's end by the end of the span (chaos: e^{λt}):
         # measured by the double Taylor run itself (its one pass, C8, which measures it at the first tenth: the
         # default pilot's end), kept where that growth confirms the choice made without it; else by a tangent run
@@ -191,11 +187,14 @@ class Auto(Integrator):
             # error estimate measures the target met; else climb as predicted (``Choice.measure_first``).
             chosen = max(min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE),
                          Taylor.TOLERANCE_FLOOR)  # (the tolerance recorded is the one run)
-            resumed = (tight, make(tight_tol), pilot_times, inside, t_pilot) if tight_tol <= chosen else None
-            solution = final(make_final(chosen), chosen, 0.0, (
+            # That run carries a double-double head (HEAD_ORDERS): its round-off thousands of times smaller for ~2× a
+            # double run's work, it keeps targets plain double cannot (the chaotic top over t = 200 at 1e-8: 1.3e-9
+            # away where double ends ~1e-6 away), without the whole series in double-double (~15× a double run).
+            solution = final(make(chosen, head=HEAD_ORDERS), chosen, 0.0, (
                 f"double precision's round-off on this chaotic scene is predicted at about {roundoff:.1g} over "
-                f"~{steps:.0f} steps, above accuracy={self.accuracy:g}, from a growth that scatters: run in double "
-                f"first, kept only where its error estimate measures the target met"), resumed)
+                f"~{steps:.0f} steps, above accuracy={self.accuracy:g}, from a growth that scatters: run in double first "
+                f"(with a double-double head), kept only where its error estimate measures the target met"),
+                resumed=None)  # (the head measures its round-off from the start: not from a double pilot's)
             promised = self.accuracy / ESTIMATE_SLACK
             solution.choice = replace(solution.choice, promised=promised, measure_first=True,
                                       attributes={**solution.choice.attributes, "auto_predicted_error": promised},
@@ -205,7 +204,7 @@ class Auto(Integrator):
             chosen = (self.accuracy - roundoff) / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9)
         # the pilot's tight run is as accurate when its tolerance is: the run continues from its end
         resumed = (tight, make(tight_tol), pilot_times, inside, t_pilot) if tight_tol <= chosen else None
-        return final(make_final(chosen), chosen, roundoff, why, resumed, provisional=tangent_run if provisional else None)
+        return final(make(chosen), chosen, roundoff, why, resumed, provisional=tangent_run if provisional else None)
 
     def _final(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None,
                compiled: CompiledModel | None, start: float, per_tol: float, growth: float, pilot_nfev: int,
@@ -484,29 +483,13 @@ def measured_order(tol: float) -> int:
     return max(order_for(tol, overhead=0.0), min(order_for(tol), cap))
 
 
-def head_for(tol: float, order: int) -> int:
-    """The orders of a double-double head (``Taylor(head=...)``) for ``auto``'s Taylor run at ``tol`` and ``order``:
-    none above the run tolerance where the error estimate would turn to a twin run or companions (DOUBLE_DOUBLE_BELOW
-    × TIGHTER), else the fewest (at least one) whose round-off a step, ~u·r^(head+1) of the state with r = tol^(1/order)
-    the fall of a step's terms per order, is HEAD_MARGIN times below the step's truncation error, ~tol: the one pass's
-    estimate then holds near the floor without a companion (docs/integrators.md, "A double-double head in auto's
-    run")."""
-    if tol >= DOUBLE_DOUBLE_BELOW * TIGHTER:
-        return 0
-    fall, head = tol ** (1.0 / order), 1
-    while EPS * fall ** (head + 1) > tol / HEAD_MARGIN and head < order - 1:
-        head += 1
-    return head
-
-
-def _method(compiled: CompiledModel | None, order: int | None, tol: float, headed: bool = False) -> Integrator:
+def _method(compiled: CompiledModel | None, order: int | None, tol: float, head: int = 0) -> Integrator:
     """The method auto runs at ``tol``: the compiled Taylor method at ``order`` (None: a compiled model without
-    Taylor coefficients, compiled DOP853 instead), ``headed`` near double precision's floor with a double-double head
-    where the model has a double-double series (``head_for``); scipy's DOP853 without a compiled model."""
+    Taylor coefficients, compiled DOP853 instead), with a double-double ``head`` where the model has a double-double
+    series; scipy's DOP853 without a compiled model."""
     if compiled is not None:
         if order is None:
             return DOP853Numba(rtol=tol, atol=tol)
-        head = head_for(tol, order) if headed else 0
         return Taylor(order=order, tol=tol, head=head if head and TaylorDoubleDouble.refusal(compiled) is None else 0)
     # start-up: scipy.integrate (~0.35 s) only for a scene without a compiled model
     from gyrolab.plugins.integrators.scipy_solvers import DOP853

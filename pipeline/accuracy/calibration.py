@@ -44,22 +44,20 @@ TIGHTER = _c("TIGHTER", 100.0, PERF, "companion this many times more accurate: r
 DOUBLE_DOUBLE_BELOW = _c("DOUBLE_DOUBLE_BELOW", 3e-15, ROUNDOFF, "a double Taylor run whose companion tol is below "
                          "this is measured by two double companions: one alone measured every run at tol 3e-13 within "
                          "0.68–1.92× of the actual error (227 runs, seeds 5 and 11), at 1e-13 0.20–4.2×")
-COMPANION_HEAD = _c("COMPANION_HEAD", 4, HEAD, "orders of the floor companion's series in double-double (the state "
-                    "too, the rest in double): on the reference scene at tol 1e-18 (order 25), heads 2, 3 ended "
-                    "7.9e-15, 3.6e-15 from a double-double run, 4 to 6 within an ulp of the state (8.9e-16), as "
-                    "double-double itself; 3.05 ms against its 17.6 (AMD EPYC, 2026-11-30)")
+HEAD_ORDERS = _c("HEAD_ORDERS", 4, HEAD, "orders of a double-double head (the state's update too, the rest in double) "
+                 "where one runs: the floor companion, and auto's first run on a chaotic scene whose round-off would "
+                 "climb. At tol 1e-18 (order 25) on four scenes: within an ulp of a double-double run (reference "
+                 "scene: heads 2, 3 ended 8.9 and 4.1 ulps off), or 40x closer than double (a fast top, 112 against "
+                 "4,490 ulps), in 15-20 % of double-double's time (AMD EPYC, 2026-11-30)")
 HEAD_COMPANION_GROWTH = _c("HEAD_COMPANION_GROWTH", 1e3, HEAD, "the head companion measures runs whose perturbations "
                            "grew at most this much (its round-off, ~u·2.5e-4 of the state a step at tol 1e-18, "
-                           "grows with them; the chaotic top over t = 200, ~1e10 with the chaos margin, measured "
-                           "2.9x the actual error with it), double-double beyond")
-HEAD_MARGIN = _c("HEAD_MARGIN", 1000.0, HEAD, "auto's run near the floor takes the fewest orders of double-double head "
-                 "whose round-off a step, ~u·tol^((head + 1)/order), is this many times below tol: on the reference "
-                 "scene head 1 at tol 1e-14 (its walk 28× below the error), head 4 at 1e-16 and 7.4e-17 (head 3's "
-                 "walk 1.7× below the error at 1e-16)")
-HEAD_WALK = _c("HEAD_WALK", 2.0, HEAD, "a head run's round-off is at most this many times its measured walk amplified "
-               "by the growth of perturbations (the ulps of each step's terms computed in double): the largest "
-               "ratio of what the one pass missed to that, on three scenes at tol 1e-13 … 1e-16, heads 1 … 4, 1.6 "
-               "(the orbiting gyrostat, head 1, tol 1e-16), besides the outputs' own rounding")
+                           "grows with them: the scenes above grow <= 97x; on the chaotic top over t = 200, ~3e10, it "
+                           "ended ~1e7 ulps off), double-double beyond")
+HEAD_WALK = _c("HEAD_WALK", 4.0, HEAD, "a head run's round-off is at most this many times the ulps of its steps' terms "
+               "computed in double, added up and amplified by the growth of perturbations (the terms beyond the head "
+               "are also evaluated at the state's high part: an error k times theirs for order k): a head run's "
+               "distance from the same steps with an 8-order head, four scenes at tol 1e-13 … 2e-16, heads 1 … 4: "
+               "at most 3.4 (the fast top at 2e-16, head 3)")
 ROUNDOFF_MARGIN = _c("ROUNDOFF_MARGIN", 6.0, ROUNDOFF, "a double companion near the floor is trusted when two disagree "
                      "this many times below what it measures: seeds 5 and 11, one of 448 trusted below 1/2 of the "
                      "error, as at 10 (354 trusted); at 4, two of 550. The one pass, where a twin run (rounded numbers "

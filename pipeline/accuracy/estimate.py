@@ -28,7 +28,7 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, growth_of
-from gyrolab.accuracy.calibration import (CHAOS_MARGIN, COMPANION_HEAD, DOUBLE_DOUBLE_BELOW, HEAD_COMPANION_GROWTH,
+from gyrolab.accuracy.calibration import (CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW, HEAD_COMPANION_GROWTH, HEAD_ORDERS,
                                          HEAD_WALK, ROUNDOFF_MARGIN, TIGHTER)
 from gyrolab.kernels.model import rounding_moved
 from gyrolab.contracts.integrator import (CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL,
@@ -67,7 +67,7 @@ def companion(method: Any, has_compiled: bool, round_off: bool = False, growth: 
     ``round_off``: the run's own estimate found its round-off not small (``one_pass``), which a double companion
     shares: a double Taylor run is then measured as near its floor (two double companions, else double-double).
     ``growth``: how much the motion amplified perturbations over the run, as its own pass measured it (with the
-    chaos margin): one rung up is the Taylor method with a double-double head (``COMPANION_HEAD``) up to
+    chaos margin): one rung up is the Taylor method with a double-double head (``HEAD_ORDERS``) up to
     ``HEAD_COMPANION_GROWTH``, the whole series in double-double beyond (the head's round-off, ~10⁻⁴ of a double
     run's, grows with the motion's amplification too: the chaotic top over t = 200, amplified ~10¹⁰, measured 2.9×
     its run's actual error with it)."""
@@ -88,14 +88,14 @@ def companion(method: Any, has_compiled: bool, round_off: bool = False, growth: 
     # none (docs/integrators.md, "A broken promise nobody was told of")
     from gyrolab.kernels.taylor import MAX_ORDER
 
-    # the rung above's tolerance, with only the state and the series' first COMPANION_HEAD orders in double-double: its
+    # the rung above's tolerance, with only the state and the series' first HEAD_ORDERS orders in double-double: its
     # round-off that of the terms beyond, thousands of times below a double run's, in ~1/6 of double-double's time
     # (reference scene, tol 1e-18: within an ulp of the state, 3.1 ms against 17.6; docs/integrators.md)
     rung = taylor.climbed(TIGHTER)[0]
-    up = Taylor(tol=rung.tol, head=COMPANION_HEAD) if growth <= HEAD_COMPANION_GROWTH else rung
+    up = Taylor(tol=rung.tol, head=HEAD_ORDERS) if growth <= HEAD_COMPANION_GROWTH else rung
     double_tol = max(taylor.tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
     other_order = taylor.order + 2 if taylor.order + 2 <= MAX_ORDER else taylor.order - 2
-    how = (f"compiled Taylor at tol {up.tol:.3g}, " + (f"its state and first {COMPANION_HEAD} orders in double-double"
+    how = (f"compiled Taylor at tol {up.tol:.3g}, " + (f"its state and first {HEAD_ORDERS} orders in double-double"
                                                         if up is not rung else "in double-double") +
            f" ({method.name} runs the Taylor method near double precision's floor)")
     if double_tol >= taylor.tol or taylor.head:  # a double companion no tighter than the run, or with more round-off
@@ -311,14 +311,14 @@ def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray, twin: Any = Non
 
 def _headed(own: OwnEstimate, y: np.ndarray, times: np.ndarray, span: float, margin: float,
             scale: float) -> Comparison | str:
-    """``one_pass`` for a run with a double-double head (``Taylor(head=...)``), which measured its round-off: the walk
-    of the ulps of each step's terms computed in double (``OwnEstimate.roundoff``), at most ``HEAD_WALK`` times that,
+    """``one_pass`` for a run with a double-double head (``Taylor(head=...)``), which measured its round-off: the ulps
+    of each step's terms computed in double, added up (``OwnEstimate.roundoff``), at most ``HEAD_WALK`` times that,
     amplified by the growth of perturbations (and ``CHAOS_MARGIN`` on a chaotic scene), plus the outputs' own rounding
     (half an ulp of the state at each output, not carried, so not amplified). No twin: the model's numbers derived in
     double reach only those terms. The estimate stands where both are ``ROUNDOFF_MARGIN`` times below it; each output
-    time adds, in quadrature, the walk up to it and the output's rounding."""
+    time adds, in quadrature, the round-off's share up to it (unamplified) and the output's rounding."""
     fraction = (times - times[0]) / span
-    walk = HEAD_WALK * own.roundoff * np.sqrt(fraction)
+    walk = HEAD_WALK * own.roundoff * fraction
     stored = 0.5 * EPS * scale
     bound = max(HEAD_WALK * own.roundoff * margin * math.exp(min(float(own.log_growth[-1]), 700.0)), stored)
     error = np.square(own.error)
@@ -328,5 +328,5 @@ def _headed(own: OwnEstimate, y: np.ndarray, times: np.ndarray, span: float, mar
                 f"round-off, {bound:.2g} (its double-double head's measured walk amplified, or its outputs' rounding)")
     error += (np.square(walk) + stored * stored)[:, None]
     return Comparison(np.sqrt(error, out=error), {"error_estimate_method": (
-        f"{own.how}, plus the round-off in quadrature (a double-double head: the measured walk of each step's terms "
-        f"computed in double, {float(walk[-1]):.2g} at the end; bounded by {bound:.2g})")}, y)
+        f"{own.how}, plus the round-off in quadrature (a double-double head: the ulps of each step's terms computed "
+        f"in double, added up, {float(walk[-1]):.2g} at the end; bounded by {bound:.2g})")}, y)

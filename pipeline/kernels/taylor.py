@@ -124,9 +124,9 @@ def run_measured(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats
     error, the series' next ``EXTRA_ORDERS`` terms: E[i] = the estimated error at output time i. u, a unit tangent
     vector, is carried the same way and renormalised at each step: growth = [ln|δ| of the tangent vector it stands
     for (the fast Lyapunov indicator's quantity), its running maximum, a time t_mark, that maximum at t_mark (the
-    last step ending there or before), with a double-double ``head`` Σ over the steps of the squared max norm of
-    their terms computed in double (their round-off's random walk, in units of u)], G[i] = the maximum at output
-    time i. (The error's own growth is no such
+    last step ending there or before), with a double-double ``head`` Σ over the steps of the max norm of their terms
+    computed in double (their round-off's bound in units of u: it adds up coherently, the model's numbers derived in
+    double, 1/I, erring the same way at every step)], G[i] = the maximum at output time i. (The error's own growth is no such
     measure: each step's truncation error turns it, and on a regular motion the sum of its growths over the steps
     climbs where a tangent vector's oscillates.) The tangent vector follows the first ``flow`` components
     (``tangent.flow_size``: the fixed point's (ω, γ), not the fixed axis α that no torque reads), zeros beyond, as
@@ -229,8 +229,8 @@ def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u
             finite = _advance(T, order, h, y, carry)
         else:
             finite, doubled = _advance_head(T, Th, Tl, order, head, h, y, carry, tail)
-            if measured:  # the round-off's walk: Σ |the step's terms computed in double|² (``growth``)
-                growth[4] += doubled * doubled
+            if measured:  # the round-off's bound: Σ |the step's terms computed in double| (``growth``)
+                growth[4] += doubled
         if not finite:
             state[0] = t
             return NOT_FINITE, i

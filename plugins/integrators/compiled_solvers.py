@@ -310,7 +310,7 @@ class Taylor(Integrator):
         solution.estimate = OwnEstimate(error if estimate else None, log_growth, float(growth[3]), int(stats[1]), (
             f"one pass: each step's truncation error (the series' next {taylor.EXTRA_ORDERS} terms) carried along "
             f"the run by the linearised equations (their Taylor series to order {m} on the run's own steps)"),
-            (e, u, (growth[0], growth[1], growth[4]), y, carry), _EPS * math.sqrt(growth[4]) if self.head else None)
+            (e, u, (growth[0], growth[1], growth[4]), y, carry), _EPS * growth[4] if self.head else None)
         return solution
 
     #: below this tol the double-precision kernel gains nothing (round-off)

@@ -76,7 +76,7 @@ def test_a_climb_predicted_on_a_chaotic_scene_is_tried_in_double_first_and_kept_
 
 def test_a_climb_measured_in_double_first_records_what_double_measured():
     # the chaotic top to t = 200 at 1e-9 (docs/integrators.md): double precision, even with a double-double head at
-    # its floor tolerance, ends ~1.3e-9 away, so the double run's estimate breaks ε / 2 and auto climbs, the dataset
+    # its floor tolerance, ends ~1e-9 away, so the double run's estimate breaks ε / 2 and auto climbs, the dataset
     # keeping that measurement
     ds = compose_scene([*CHAOTIC_TOP, "time.end=200", "integrator=auto", "accuracy=1e-9", "time.n_output=2"]).run()
     assert ds.attrs["auto_precision"] == "double-double"
@@ -85,7 +85,7 @@ def test_a_climb_measured_in_double_first_records_what_double_measured():
 
 def test_a_double_double_head_answers_a_chaotic_target_plain_double_cannot():
     """The same top at 1e-8: plain double precision ends ~1e-6 away (its round-off amplified ~1e9), so auto used to
-    climb to double-double; its run near the floor now carries a double-double head (``auto.head_for``), whose
+    climb to double-double; its first run on a chaotic scene now carries a double-double head (``HEAD_ORDERS``), whose
     round-off is thousands of times smaller, and answers in double, measured by a double-double companion (the
     motion amplifies too much for the head companion). Checked against double-double at tol 1e-28."""
     from gyrolab.kernels import series_dd, taylor_dd

@@ -539,13 +539,13 @@ def test_a_double_double_head_reaches_the_50_digit_reference_where_double_precis
     orders and the state's update in double-double, the rest in double. Its round-off is that of the terms beyond the
     head, so on the chaotic scene it ends within an ulp of the state of the 50-digit reference where double Taylor
     ends ~two orders of magnitude farther; the one pass measures it as it measures a double run."""
-    from gyrolab.accuracy.calibration import COMPANION_HEAD
+    from gyrolab.accuracy.calibration import HEAD_ORDERS
 
     compiled, y0 = chaotic
     t_out, exact = reference
     ulp = float(np.spacing(np.max(np.abs(y0))))
-    run = Taylor(tol=1e-18, head=COMPANION_HEAD)
-    assert run.attributes()["integrator_double_double_head"] == COMPANION_HEAD and run.precision == "double"
+    run = Taylor(tol=1e-18, head=HEAD_ORDERS)
+    assert run.attributes()["integrator_double_double_head"] == HEAD_ORDERS and run.precision == "double"
     y = run.integrate(None, t_out, y0, None, compiled).y
     head = _errors(y, np.zeros_like(y), exact)
     assert head[-1] < ulp, head  # measured 2.5e-17 at t = 60: the output's own rounding
