@@ -124,7 +124,9 @@ def _again(scene: Any, y0: np.ndarray, progress: Any, compiled: Any, choice: Cho
         solution.choice.attributes["auto_recheck"] = f"{what}: integrated instead"
         return solution
     factor = RECHECK_MARGIN * measured / choice.target
-    finer, how = _measurable(choice.method.more_accurate, factor, compiled), "more accurate"
+    # (near double precision's floor a tighter tolerance gains nothing against the round-off that dominates: the run
+    # again with a double-double head, ``estimate.headed``)
+    finer, how = _measurable(estimate.headed(choice.method, compiled).more_accurate, factor, compiled), "more accurate"
     if finer is None and choice.may_climb:
         finer, how = _measurable(choice.method.climbed, factor, compiled), "one rung up the precision ladder"
     if finer is None:

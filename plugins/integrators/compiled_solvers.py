@@ -313,12 +313,13 @@ class Taylor(Integrator):
             (e, u, (growth[0], growth[1], growth[4]), y, carry), _EPS * growth[4] if self.head else None)
         return solution
 
-    #: below this tol the double-precision kernel gains nothing (round-off)
-    TOLERANCE_FLOOR = 1e-16
+    #: below this tol the double-precision kernel gains nothing (round-off); with a double-double head, below the
+    #: second (its round-off ~10⁻⁴ of a double run's a step: benchmarks/companion_head.py)
+    TOLERANCE_FLOOR, HEAD_TOLERANCE_FLOOR = 1e-16, 1e-20
 
     def more_accurate(self, factor: float):
         tol = self.tol / factor
-        if tol < self.TOLERANCE_FLOOR:
+        if tol < (self.HEAD_TOLERANCE_FLOOR if self.head else self.TOLERANCE_FLOOR):
             return None
         head = f", its first {self.head} orders in double-double" if self.head else ""
         return (Taylor(order=self.order, tol=tol, head=self.head), 1.0,
