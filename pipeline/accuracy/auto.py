@@ -29,9 +29,8 @@ import numpy as np
 from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, Amplification, amplification, growth_of
 from gyrolab.accuracy.calibration import (AUTO_SAMPLE, CALIBRATION, CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW,
                                           DOUBLE_DOUBLE_FLOOR, ESTIMATE_SLACK, FIRST_RATIO, FLOOR, HEAD_ORDERS,
-                                          MAX_GROWTH,
-                                          MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE, MISS_MARGIN,
-                                          PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
+                                          MAX_GROWTH, MAX_TOLERANCE, MIN_GROWTH, MIN_PILOT_STEPS, MIN_TOLERANCE,
+                                          MISS_MARGIN, PILOT_POINTS, RECENTRE, SCREEN_POINTS, SCREEN_TOLERANCE,
                                           SHADOW_TOLERANCE, TIGHT_RATIO, TIGHTER, UNMEASURED_PER_TOL)
 from gyrolab.contracts.integrator import (BATCH_KERNEL, CHOOSES_METHOD, ESTIMATES_ERROR, PRECISIONS,
                                           PREFERS_COMPILED_MODEL, TIME_DEPENDENT, VECTOR_LANES, BatchSolution, Choice,
@@ -188,7 +187,7 @@ class Auto(Integrator):
             chosen = max(min(self.accuracy / (self.safety * CALIBRATION * per_tol) * (1 - 1e-9), MAX_TOLERANCE),
                          Taylor.TOLERANCE_FLOOR)  # (the tolerance recorded is the one run)
             # That run carries a double-double head (HEAD_ORDERS): its round-off thousands of times smaller for ~2× a
-            # double run's work, it keeps targets plain double cannot (the chaotic top over t = 200 at 1e-8: 1.3e-9
+            # double run's work, it keeps targets plain double cannot (the chaotic top over t = 200 at 1e-8: 7.6e-10
             # away where double ends ~1e-6 away), without the whole series in double-double (~15× a double run).
             solution = final(make(chosen, head=HEAD_ORDERS), chosen, 0.0, (
                 f"double precision's round-off on this chaotic scene is predicted at about {roundoff:.1g} over "

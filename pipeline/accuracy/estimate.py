@@ -69,8 +69,8 @@ def companion(method: Any, has_compiled: bool, round_off: bool = False, growth: 
     ``growth``: how much the motion amplified perturbations over the run, as its own pass measured it (with the
     chaos margin): one rung up is the Taylor method with a double-double head (``HEAD_ORDERS``) up to
     ``HEAD_COMPANION_GROWTH``, the whole series in double-double beyond (the head's round-off, ~10⁻⁴ of a double
-    run's, grows with the motion's amplification too: the chaotic top over t = 200, amplified ~10¹⁰, measured 2.9×
-    its run's actual error with it)."""
+    run's, grows with the motion's amplification too: on the chaotic top over t = 200, amplified ~3·10¹⁰, the head
+    companion ended ~10⁷ ulps off, benchmarks/companion_head.py)."""
     taylor = _double_taylor(method) if has_compiled else None
     finer = method.more_accurate(TIGHTER)
     if finer is not None and (taylor is None or (taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW and not round_off)):
@@ -326,7 +326,8 @@ def _headed(own: OwnEstimate, y: np.ndarray, times: np.ndarray, span: float, mar
     measured = math.sqrt(float(np.max(error)))
     if not ROUNDOFF_MARGIN * bound <= measured:
         return (f"the one-pass estimate, {measured:.2g}, is not {ROUNDOFF_MARGIN:g}× above a bound on the run's "
-                f"round-off, {bound:.2g} (its double-double head's measured walk amplified, or its outputs' rounding)")
+                f"round-off, {bound:.2g} (its double-double head's measured round-off amplified, or its outputs' "
+                f"rounding)")
     error += (np.square(walk) + stored * stored)[:, None]
     return Comparison(np.sqrt(error, out=error), {"error_estimate_method": (
         f"{own.how}, plus the round-off in quadrature (a double-double head: the ulps of each step's terms computed "
@@ -337,7 +338,8 @@ def headed(method: Any, compiled: Any) -> Any:
     """``method`` with a double-double head (``HEAD_ORDERS``) where it is the double-precision Taylor method near its
     floor (a companion tol below ``DOUBLE_DOUBLE_BELOW``) and the model has a double-double series: there a tighter
     tolerance gains nothing against the round-off that dominates (audit seed 2026, scene 82 at 1e-11: double runs at
-    tol 7e-15 … 1e-16 measured 7.2e-11, 1.9e-11, 1.2e-11; with the head, 3e-13). Else ``method``."""
+    tol 7e-15 … 1e-16 measured 7.2e-11, 1.9e-11, 1.2e-11 and the target was refused; with the head, one rerun
+    measured 5.8e-13, 5.77e-13 from double-double). Else ``method``."""
     taylor = _double_taylor(method)
     if taylor is None or taylor.head or taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW or compiled is None or \
             type(taylor.climbed(1.0)[0]).refusal(compiled) is not None:

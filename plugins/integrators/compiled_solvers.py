@@ -233,8 +233,9 @@ class Taylor(Integrator):
     def __init__(self, *, order: int | None = None, tol: float = 1e-16, precision: str = "double",
                  head: int = 0) -> None:
         """``head`` > 0 (double precision): the series' first ``head`` orders and the state's update in double-double,
-        the rest in double (``taylor._steps``): round-off thousands of times below a double run's for ~3× its work
-        (the error estimate's companion near double precision's floor, ``accuracy.estimate``)."""
+        the rest in double (``taylor._steps``): round-off thousands of times below a double run's for ~2–3× its work
+        (the error estimate's companion near double precision's floor, and ``auto``'s runs where round-off decides:
+        ``gyrolab.accuracy``)."""
         from gyrolab.kernels.taylor import MAX_ORDER, MIN_ORDER, order_for  # start-up: the kernel imports numba
 
         if not isinstance(precision, str) or precision not in PRECISIONS:
@@ -341,7 +342,7 @@ class Taylor(Integrator):
 
 #: ``Taylor``'s arithmetic: ``integrator.precision``
 DOUBLE, DOUBLE_DOUBLE = "double", "double-double"
-#: double precision's unit: a head run's measured round-off walk is in its units (``OwnEstimate.roundoff``)
+#: double precision's unit: a head run's measured round-off is in its units (``OwnEstimate.roundoff``)
 _EPS = float(np.finfo(float).eps)
 PRECISIONS = (DOUBLE, DOUBLE_DOUBLE)
 
