@@ -3,7 +3,8 @@
 A double-precision Taylor run at tol < 1e-12 may err partly by round-off, which a double companion shares in size.
 ``gyrolab.accuracy.estimate`` runs two double companions there (``TIGHTER`` times tighter; the run's order, and
 another order with 1/I moved by its rounding) and keeps the first one's measurement E when their disagreement R is
-``ROUNDOFF_MARGIN`` times below it; else a double-double companion measures. This measures that rule against the
+``ROUNDOFF_MARGIN`` times below it; else the rung above measures (a double-double head, or double-double: printed
+here as the double-double companion). This measures that rule against the
 truth: on random scenes (``promise_audit.random_scene``) and tolerances from 3e-13 to 1.5e-16, E, R and the actual
 error (max-norm over every output time and component, against heyoka ``real128``), and for each margin M the
 smallest E / actual among the runs it would trust (R · M ≤ E). The estimate's promise is E / actual ≥ 1/2.

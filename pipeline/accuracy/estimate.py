@@ -6,9 +6,12 @@ The companion is the method that ran made more accurate by a known factor, as th
 an analytic series (``auto``) is measured against the compiled Taylor method at tol 1e-15. At a method's floor the
 compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model. A double Taylor run near that floor
 errs mostly by round-off, which another double run shares: two double companions measure what they share by their
-disagreement, and where it is not ``ROUNDOFF_MARGIN`` times below the error, the method one rung up (``climbed``:
-double-double) measures it. On by default for the integrators that choose their method (``output.error_estimate:
-null``); ``true``/``false`` choose it for any integrator. The audits behind these rules: docs/integrators.md.
+disagreement, and where it is not ``ROUNDOFF_MARGIN`` times below the error, the rung above's tolerance measures it
+(``climbed``): the Taylor method with a double-double head (``HEAD_ORDERS``), or in double-double on a motion that
+amplifies perturbations more than ``HEAD_COMPANION_GROWTH``. A run with a double-double head of its own measured its
+round-off and may stand on its own estimate (``_headed``). On by default for the integrators that choose their method
+(``output.error_estimate: null``); ``true``/``false`` choose it for any integrator. The audits behind these rules:
+docs/integrators.md.
 
 Stored as ``error_estimate_omega`` (ω's max-norm error at each output time, in ω's units) and
 ``error_estimate_attitude`` (the direction cosines') for systems whose state starts with ω; as ``error_estimate``
