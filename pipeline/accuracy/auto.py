@@ -208,7 +208,7 @@ class Auto(Integrator):
         # 5e-14, then a double-double run): it carries a double-double head (round-off ~100× smaller; the
         # round-off predicted is kept, a margin)
         head = HEAD_ORDERS if estimated and taylor and 2 * ESTIMATE_SLACK * roundoff > self.accuracy else 0
-        return final(make(chosen, head=head), chosen, roundoff, why, None if head else resumed,
+        return final(make(chosen, head=head), chosen, roundoff, why, resumed,
                      provisional=tangent_run if provisional else None)
 
     def _final(self, fun: RightHandSide, t_out: np.ndarray, y0: np.ndarray, progress: ProgressCallback | None,
@@ -621,8 +621,6 @@ def _final_run(method: Integrator, fun: RightHandSide, t_out: np.ndarray, y0: np
     ``estimated``; resumed, it carries on the tight run's measurement (the pilot measured it the same way, else it runs
     again measured: the same states)."""
     kind = _measuring(method, measured, estimated)
-    if resumed is not None and getattr(method, "head", 0) != getattr(resumed[1], "head", 0):
-        resumed = None  # (a run with a double-double head measures its round-off from the start: not from a pilot's)
     if resumed is None:
         solution = method.integrate(fun, t_out, y0, progress, compiled, **kind)
         return solution.y, solution.stats, solution.stats.n_steps, solution.estimate
@@ -641,7 +639,11 @@ def _final_run(method: Integrator, fun: RightHandSide, t_out: np.ndarray, y0: np
     own = tail.estimate
     if own is not None:  # the pilot's part and the rest, as one run's
         head_own = tight.estimate
+        # (a double-double head resumed from a pilot without one measured the round-off of its own steps only: not
+        # measured for the whole run, so a companion measures it, ``estimate.one_pass``)
+        roundoff = own.roundoff if getattr(tight_method, "head", 0) == getattr(method, "head", 0) else None
         own = replace(own, error=None if own.error is None else np.concatenate([head_own.error[head],
                                                                                 own.error[-len(rest):]]),
-                      log_growth=np.concatenate([head_own.log_growth[head], own.log_growth[-len(rest):]]), steps=steps)
+                      log_growth=np.concatenate([head_own.log_growth[head], own.log_growth[-len(rest):]]), steps=steps,
+                      roundoff=roundoff)
     return np.concatenate([tight.y[head], tail.y[-len(rest):]]), tail.stats, steps, own
