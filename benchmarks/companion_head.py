@@ -29,6 +29,7 @@ import math
 
 from gyrolab import compose_scene
 from gyrolab.accuracy import calibration as table
+from gyrolab.accuracy.amplification import EPS
 from gyrolab.accuracy.auto import measured_order
 from gyrolab.kernels import series_dd, taylor_dd
 from gyrolab.plugins.integrators.compiled_solvers import Taylor
@@ -117,7 +118,7 @@ def head_walks() -> tuple[float, float]:
                 measured = run(head)
                 growth = math.exp(measured.estimate.log_growth[-1])
                 ratios.append(float(np.max(np.abs(measured.y - reference))) / (
-                    measured.estimate.roundoff * growth + ulp))
+                    EPS * measured.estimate.roundoff * growth + ulp))
             growths.append(growth)
             worst = max(worst, *ratios)
             print(f"| {name} | {tol:.0e} | {growth:.3g} | {' · '.join(f'{r:.2f}' for r in ratios)} |")

@@ -191,8 +191,8 @@ class Auto(Integrator):
             # away where double ends ~1e-6 away), without the whole series in double-double (~15× a double run).
             solution = final(make(chosen, head=HEAD_ORDERS), chosen, 0.0, (
                 f"double precision's round-off on this chaotic scene is predicted at about {roundoff:.1g} over "
-                f"~{steps:.0f} steps, above accuracy={self.accuracy:g}, from a growth that scatters: run in double first "
-                f"(with a double-double head), kept only where its error estimate measures the target met"),
+                f"~{steps:.0f} steps, above accuracy={self.accuracy:g}, from a growth that scatters: run in double "
+                f"first (with a double-double head), kept only where its error estimate measures the target met"),
                 resumed=None)  # (the head measures its round-off from the start: not from a double pilot's)
             promised = self.accuracy / ESTIMATE_SLACK
             solution.choice = replace(solution.choice, promised=promised, measure_first=True,

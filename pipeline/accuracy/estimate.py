@@ -105,8 +105,8 @@ def companion(method: Any, has_compiled: bool, round_off: bool = False, growth: 
         # than a run with a double-double head, measures nothing of it: the head companion
         return Companion(up, 1.0, how, borrows=type(rung))  # (benchmarks/roundoff_margin.py: at tol 1.5e-16, 0 of 86
         # double pairs trusted)
-    return Companion(up, 1.0, how, (Taylor(order=taylor.order, tol=double_tol), Taylor(order=other_order, tol=double_tol)),
-                     type(rung))
+    doubles = (Taylor(order=taylor.order, tol=double_tol), Taylor(order=other_order, tol=double_tol))
+    return Companion(up, 1.0, how, doubles, type(rung))
 
 
 @dataclass(frozen=True)
@@ -175,8 +175,11 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
     compiled_model = scene.compiled_model
     growth = math.inf if own is None else math.exp(min(float(own.log_growth[-1]), 700.0)) * (
         CHAOS_MARGIN if growth_of(own, float(scene.times[-1] - scene.times[0]) or 1.0).chaotic(PILOT_FRACTION) else 1.0)
-    pick = companion(method, compiled_model is not None, isinstance(one, str), growth) if check is None else Companion(check, 1.0, (
-        f"{check.name} ({', '.join(f'{k} {v}' for k, v in check.attributes().items())}) against the analytic series"))
+    if check is None:
+        pick = companion(method, compiled_model is not None, isinstance(one, str), growth)
+    else:
+        pick = Companion(check, 1.0, f"{check.name} ({', '.join(f'{k} {v}' for k, v in check.attributes().items())}) "
+                                     "against the analytic series")
     name = getattr(method, "name", type(method).__name__)
     if pick is None:
         return _unavailable(f"integrator {name!r} already runs at the compiled Taylor method's floor in double "
@@ -321,10 +324,10 @@ def _headed(own: OwnEstimate, y: np.ndarray, times: np.ndarray, span: float, mar
     double reach only those terms. The estimate stands where both are ``ROUNDOFF_MARGIN`` times below it; each output
     time adds, in quadrature, the round-off's share up to it (unamplified, without the margin: audit seed 2026, scene
     82, with the margin the estimate was 4.4× the actual error) and the output's rounding."""
-    fraction = (times - times[0]) / span
-    walk = own.roundoff * fraction
+    roundoff = EPS * own.roundoff
+    walk = roundoff * ((times - times[0]) / span)
     stored = 0.5 * EPS * scale
-    bound = max(HEAD_WALK * own.roundoff * margin * math.exp(min(float(own.log_growth[-1]), 700.0)), stored)
+    bound = max(HEAD_WALK * roundoff * margin * math.exp(min(float(own.log_growth[-1]), 700.0)), stored)
     error = np.square(own.error)
     measured = math.sqrt(float(np.max(error)))
     if not ROUNDOFF_MARGIN * bound <= measured:

@@ -78,9 +78,9 @@ class OwnEstimate:
     #: maximum, the round-off's walk so far), the state and its compensation): a run resumed from this one's end
     #: carries it on (``Taylor.integrate(..., resume=...)``)
     end: tuple | None = None
-    #: a run whose round-off it measured (the Taylor method with a double-double head): the ulps of each step's terms
-    #: computed in double, added up, Σ u·|terms| (coherently: the model's numbers derived in double err the same way
-    #: at every step), unamplified; None: not measured
+    #: a run whose round-off it measured (the Taylor method with a double-double head): Σ |terms computed in double|
+    #: over its steps, a round-off of that many units u of double precision added up coherently (the model's numbers
+    #: derived in double err the same way at every step), unamplified; None: not measured
     roundoff: float | None = None
 
 

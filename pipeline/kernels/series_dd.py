@@ -11,8 +11,8 @@ with S as scratch (zeros: the derived numbers cached at its start on the first c
 ``columns`` double-double series). It follows ``taylor_dd``'s rules:
 
 * the equations' numbers are doubles from the parameter array, exact as double-doubles; every number derived from
-  them (a difference, a product, 1/I) is computed once per call in double-double, so no double rounding caps the
-  run at 16 digits;
+  them (a difference, a product, 1/I) is computed in double-double once per scratch (a run's first call), so no
+  double rounding caps the run at 16 digits;
 * a Cauchy product is a compensated dot product (``dot_add`` then ``dd_norm``), and so is a sum of series and
   products times numbers (``_Program``); a division is a double-double one; time enters as (t, 0) and (1, 0);
 * no fast-math: reassociation would optimise the error terms away.
@@ -253,13 +253,11 @@ class _Program(Lowering):
         # computed on the first call with a scratch S (zeros: S[0] = 0) and read from S[1 …] after.
         derived = self.derived()
         names = [self.numbers[i].split(" = ", 1)[0] for i in derived]
-        read = [line for i, line in enumerate(self.numbers) if i not in derived]
-        lines = [*read, "if S[0] == 0.0:",
-                 *[f"    {self.numbers[i]}" for i in derived],
-                 *[f"    S[{1 + 2 * n}], S[{2 + 2 * n}] = {name}" for n, name in enumerate(names)],
-                 "    S[0] = 1.0",
-                 "else:" if names else "else:  # (no derived numbers)",
-                 *([f"    {name} = S[{1 + 2 * n}], S[{2 + 2 * n}]" for n, name in enumerate(names)] or ["    pass"]),
+        cached = [] if not names else [
+            "if S[0] == 0.0:", *[f"    {self.numbers[i]}" for i in derived],
+            *[f"    S[{1 + 2 * n}], S[{2 + 2 * n}] = {name}" for n, name in enumerate(names)], "    S[0] = 1.0",
+            "else:", *[f"    {name} = S[{1 + 2 * n}], S[{2 + 2 * n}]" for n, name in enumerate(names)]]
+        lines = [*[line for i, line in enumerate(self.numbers) if i not in derived], *cached,
                  "for k in range(order):", "    ih, il = dd_div_d(1.0, 0.0, k + 1.0)",  # 1/(k + 1)
                  *[f"    {line}" for line in body]]
         text = _HEADER.format(columns=max(self.columns, 1), size=self.model.size, cache=self.cache())
@@ -279,7 +277,8 @@ def ready(compiled: Any) -> bool:
             module = generated_module(program.source(), "gyrolab_taylor_dd", f"{model.what} (double-double Taylor)")
             # scratch "columns" as callers size it, (order + 1)·2·columns doubles: the series' and, once more per
             # order row, room for the derived numbers' cache at the start (B doubles; a few kB at most)
-            _KERNELS[address] = (float(module.kernel.address), float(max(program.columns, 1) + -(-program.cache() // 2)))
+            columns = max(program.columns, 1) + -(-program.cache() // 2)
+            _KERNELS[address] = (float(module.kernel.address), float(columns))
         p[p.size - 2:] = _KERNELS[address]
     return True
 

@@ -126,9 +126,9 @@ def run_measured(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats
     for (the fast Lyapunov indicator's quantity), its running maximum, a time t_mark, that maximum at t_mark (the
     last step ending there or before), with a double-double ``head`` Σ over the steps of the max norm of their terms
     computed in double (their round-off's bound in units of u: it adds up coherently, the model's numbers derived in
-    double, 1/I, erring the same way at every step)], G[i] = the maximum at output time i. (The error's own growth is no such
-    measure: each step's truncation error turns it, and on a regular motion the sum of its growths over the steps
-    climbs where a tangent vector's oscillates.) The tangent vector follows the first ``flow`` components
+    double, 1/I, erring the same way at every step)], G[i] = the maximum at output time i. (The error's own growth is
+    no such measure: each step's truncation error turns it, and on a regular motion the sum of its growths over the
+    steps climbs where a tangent vector's oscillates.) The tangent vector follows the first ``flow`` components
     (``tangent.flow_size``: the fixed point's (ω, γ), not the fixed axis α that no torque reads), zeros beyond, as
     the chaos measure's tangent run does: α, carried, grows like the integral of δω and raised the default scene's
     growth after the pilot from e^2.12 to e^2.35, past what ``auto`` keeps without a tangent run (with

@@ -311,7 +311,7 @@ class Taylor(Integrator):
         solution.estimate = OwnEstimate(error if estimate else None, log_growth, float(growth[3]), int(stats[1]), (
             f"one pass: each step's truncation error (the series' next {taylor.EXTRA_ORDERS} terms) carried along "
             f"the run by the linearised equations (their Taylor series to order {m} on the run's own steps)"),
-            (e, u, (growth[0], growth[1], growth[4]), y, carry), _EPS * growth[4] if self.head else None)
+            (e, u, (growth[0], growth[1], growth[4]), y, carry), float(growth[4]) if self.head else None)
         return solution
 
     #: below this tol the double-precision kernel gains nothing (round-off); with a double-double head, below the
@@ -342,8 +342,6 @@ class Taylor(Integrator):
 
 #: ``Taylor``'s arithmetic: ``integrator.precision``
 DOUBLE, DOUBLE_DOUBLE = "double", "double-double"
-#: double precision's unit: a head run's measured round-off is in its units (``OwnEstimate.roundoff``)
-_EPS = float(np.finfo(float).eps)
 PRECISIONS = (DOUBLE, DOUBLE_DOUBLE)
 
 
