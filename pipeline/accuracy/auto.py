@@ -275,8 +275,8 @@ class Auto(Integrator):
         """(the method one rung up the precision ladder, its tolerance, its round-off, why) where double precision's
         round-off on this scene (``roundoff``) is above the accuracy; else one ConfigError sentence (``_refusal``):
         raised when double-double cannot reach the target either, returned when the ladder stops at double
-        precision. The truncation error per unit tolerance is the pilot's (the double-double run's higher order errs
-        no more per unit tolerance); the round-off is double precision's scaled by the ratio of the unit round-offs."""
+        precision. The truncation error per unit tolerance is the pilot's (the double-double run keeps the pilot's
+        order, ``climbed``); the round-off is double precision's scaled by the ratio of the unit round-offs."""
         # start-up: a compiled kernel's module imports numba, loaded only when such a kernel runs
         from gyrolab.kernels.taylor_dd import MIN_TOL
 

@@ -327,12 +327,16 @@ class Taylor(Integrator):
                 f"taylor at tol {tol:.3g} ({factor:g}× tighter), same order{head}")
 
     def climbed(self, factor: float):
-        """Rule 11: the double-double rung, ``factor`` times more accurate (None: already on it)."""
+        """Rule 11: the double-double rung, ``factor`` times more accurate (None: already on it): at the same order,
+        where the error is proportional to the tolerance. (At Jorba & Zou's order for the tighter tolerance, higher,
+        the error per unit tolerance is larger: a chaotic top at tol 6.5e-15 in double-double, order 18 instead of
+        13, ended 1.7e-10 from real128 instead of 1.7e-11, as far as the double run it measured at tol 6.5e-13,
+        whose error it then measured 26× too small: docs/integrators.md, "A companion at the run's order".)"""
         from gyrolab.kernels.taylor_dd import MIN_TOL  # start-up: the kernel imports numba
 
         tol = max(self.tol / factor, MIN_TOL)
-        return None if self.precision != DOUBLE else (Taylor(tol=tol, precision=DOUBLE_DOUBLE), 1.0, (
-            f"taylor double-double at tol {tol:.3g}: double precision's floor reached"))
+        return None if self.precision != DOUBLE else (Taylor(order=self.order, tol=tol, precision=DOUBLE_DOUBLE), 1.0, (
+            f"taylor double-double at tol {tol:.3g}, same order: double precision's floor reached"))
 
     def attributes(self) -> dict[str, Any]:
         head = {"integrator_double_double_head": self.head} if self.head else {}
