@@ -2,8 +2,9 @@
 
 A tolerance is not an error, and a recorded prediction is only a prediction; what a user can check is a measurement.
 The companion is the method that ran made more accurate by a known factor, as the method itself says
-(``Integrator.more_accurate``, rule 9): ``TIGHTER`` times smaller tolerances, or half the step and Richardson's factor;
-an analytic series (``auto``) is measured against the compiled Taylor method at tol 1e-15. At a method's floor the
+(``Integrator.more_accurate``, rule 9): ``TIGHTER`` times smaller tolerances, or half the step and Richardson's factor
+(a fixed-step run is measured against the compiled Taylor method at its floor first, where that run bounds its own
+error ``FLOOR_COMPANION_MARGIN`` times below the difference: ``_floor_companion``); an analytic series (``auto``) is measured against the compiled Taylor method at tol 1e-15. At a method's floor the
 compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model. A double Taylor run near that floor
 errs mostly by round-off, which another double run shares: two double companions measure what they share by their
 disagreement, and where it is not ``ROUNDOFF_MARGIN`` times below the error, the rung above's tolerance measures it
@@ -31,12 +32,12 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, growth_of
-from gyrolab.accuracy.calibration import (CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW, HEAD_COMPANION_GROWTH, HEAD_ORDERS,
-                                         HEAD_WALK, ROUNDOFF_MARGIN, TIGHTER)
+from gyrolab.accuracy.calibration import (CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW, FLOOR_COMPANION_MARGIN,
+                                         HEAD_COMPANION_GROWTH, HEAD_ORDERS, HEAD_WALK, ROUNDOFF_MARGIN, TIGHTER)
 from gyrolab.kernels.model import rounding_moved
 from gyrolab.contracts.integrator import (CHOOSES_METHOD, COMPILED_MODEL, PRECISIONS, PREFERS_COMPILED_MODEL,
                                           OwnEstimate)
-from gyrolab.plugins.integrators.compiled_solvers import Taylor
+from gyrolab.plugins.integrators.compiled_solvers import Taylor, TaylorDoubleDouble
 
 log = logging.getLogger(__name__)
 
@@ -197,6 +198,10 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
             pick.borrows.refusal(compiled_model, scene.system) if pick.borrows is not None else None)
         if refusal and pick.double_first is None:  # (near the floor the double companions may still suffice)
             return _unavailable(f"the companion ({pick.how}) {refusal}")
+    if check is None and not getattr(method, "adaptive", True) and compiled_model is not None:
+        floor = _floor_companion(scene, method, y, wall_time)
+        if floor is not None:
+            return floor
     start = time.perf_counter()
     y0 = scene.system.initial_state()
     y = np.asarray(y, dtype=float)
@@ -227,6 +232,41 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
     how = how if one is None else f"{how} ({one})"
     attrs = {"error_estimate_method": how, "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
     return Comparison(pick.scale * np.abs(y - other), attrs, y)
+
+
+def _floor_companion(scene: Any, method: Any, y: np.ndarray, wall_time: float) -> Comparison | None:
+    """A fixed-step run measured against the compiled Taylor method at its floor, its own error bounded in the same
+    pass (the truncation it measures, and its round-off amplified by the growth it measures: with a double-double head
+    where the model has that series, whose round-off it measures and which is thousands of times smaller, else a
+    random walk of an ulp a step), where that bound is ``FLOOR_COMPANION_MARGIN`` times below their difference; else
+    None (Richardson's half step measures). Richardson assumes the error ∝ h^p at every output time: a fast top at
+    rk4's step 0.01 (ω·h = 0.2) was measured 0.3× its error at one time, and a lie_poisson run at step 0.002 whose
+    round-off rivals its truncation 0.39× (audit seeds 7 and 11); the Taylor floor, far more accurate there, measures
+    both, and costs less than the run again at half the step. None also where the model has no Taylor coefficients."""
+    model = scene.compiled_model
+    if Taylor.refusal(model, scene.system) is not None:
+        return None
+    start = time.perf_counter()
+    headed = TaylorDoubleDouble.refusal(model) is None
+    # (with a head, tol 1e-18: its round-off no longer the floor, the tolerance is; benchmarks/companion_head.py's)
+    floor = Taylor(tol=1e-18, head=HEAD_ORDERS) if headed else Taylor(tol=Taylor.TOLERANCE_FLOOR)
+    run = floor.integrate(scene.rhs, scene.times, scene.system.initial_state(), None, model, estimate=True)
+    own = run.estimate
+    span = float(scene.times[-1] - scene.times[0]) or 1.0
+    amplified = math.exp(min(float(own.log_growth[-1]), 700.0)) * (
+        CHAOS_MARGIN if growth_of(own, span).chaotic(PILOT_FRACTION) else 1.0)
+    scale = max(1.0, float(np.max(np.abs(run.y))))
+    roundoff = HEAD_WALK * EPS * own.roundoff if headed else EPS * scale * math.sqrt(1.0 + own.steps)
+    bound = max(float(np.max(np.abs(own.error))), roundoff * amplified, 0.5 * EPS * scale)
+    difference = np.abs(np.asarray(y, dtype=float) - run.y)
+    if not FLOOR_COMPANION_MARGIN * bound <= float(np.max(difference)):
+        return None
+    head = f", its first {HEAD_ORDERS} orders in double-double" if headed else ""
+    return Comparison(difference, {
+        "error_estimate_method": f"compiled Taylor at tol {floor.tol:g}{head}, whose own error is bounded by "
+                                 f"{bound:.2g}, ≥ {FLOOR_COMPANION_MARGIN:g}× below the difference (a fixed-step run: "
+                                 "not Richardson's half step, which assumes the error ∝ h^p at every output time)",
+        "error_estimate_cost_ratio": float((time.perf_counter() - start) / max(wall_time, 1e-9))}, y)
 
 
 def _unavailable(why: str) -> Comparison:
