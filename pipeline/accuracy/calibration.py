@@ -112,14 +112,12 @@ MAX_RECHECKS = _c("MAX_RECHECKS", 2, PROMISE, "runs made more accurate before th
 ESTIMATE_SLACK = _c("ESTIMATE_SLACK", 2.0, PROMISE, "a run is kept when its measured error is this many times below "
                     "the target, the estimate's own accuracy: audit seed 2026, scene 61 measured 0.98e-11 of 1e-11, "
                     "ended 1.0e-11 away")
-
-
 FLOOR_COMPANION_MARGIN = _c("FLOOR_COMPANION_MARGIN", 20.0, PROMISE, "a fixed-step run is measured against the "
                             "compiled Taylor method at its floor where that run's own error bound is this many times "
-                            "below the difference (at an output time a tenth of the largest error, its error is then at "
-                            "most half of that time's): else Richardson's half step. Audit seeds 7 and 11: Richardson "
-                            "0.3x at one time on a fast top (rk4, step 0.01, pre-asymptotic), 0.39x where lie_poisson's "
-                            "round-off rivals its error (step 0.002)")
+                            "below the difference (at an output time a tenth of the largest error, its error is then "
+                            "at most half of that time's), else by Richardson's half step: audit seeds 7 and 11, "
+                            "Richardson 0.3× at one time on a fast top (rk4, step 0.01, pre-asymptotic), 0.39× where "
+                            "lie_poisson's round-off rivals its error (step 0.002)")
 
 
 def report(benchmark: str, measured: dict[str, tuple[bool, str]]) -> bool:

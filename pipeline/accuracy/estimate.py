@@ -4,8 +4,8 @@ A tolerance is not an error, and a recorded prediction is only a prediction; wha
 The companion is the method that ran made more accurate by a known factor, as the method itself says
 (``Integrator.more_accurate``, rule 9): ``TIGHTER`` times smaller tolerances, or half the step and Richardson's factor
 (a fixed-step run is measured against the compiled Taylor method at its floor first, where that run bounds its own
-error ``FLOOR_COMPANION_MARGIN`` times below the difference: ``_floor_companion``); an analytic series (``auto``) is measured against the compiled Taylor method at tol 1e-15. At a method's floor the
-compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model. A double Taylor run near that floor
+error ``FLOOR_COMPANION_MARGIN`` times below the difference: ``_floor_companion``); an analytic series (``auto``) is
+measured against the compiled Taylor method at tol 1e-15. At a method's floor the compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model. A double Taylor run near that floor
 errs mostly by round-off, which another double run shares: two double companions measure what they share by their
 disagreement, and where it is not ``ROUNDOFF_MARGIN`` times below the error, the rung above's tolerance measures it
 (``climbed``): the Taylor method with a double-double head (``HEAD_ORDERS``), or in double-double on a motion that
@@ -199,7 +199,7 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
         if refusal and pick.double_first is None:  # (near the floor the double companions may still suffice)
             return _unavailable(f"the companion ({pick.how}) {refusal}")
     if check is None and not getattr(method, "adaptive", True) and compiled_model is not None:
-        floor = _floor_companion(scene, method, y, wall_time)
+        floor = _floor_companion(scene, y, wall_time)
         if floor is not None:
             return floor
     start = time.perf_counter()
@@ -234,7 +234,7 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
     return Comparison(pick.scale * np.abs(y - other), attrs, y)
 
 
-def _floor_companion(scene: Any, method: Any, y: np.ndarray, wall_time: float) -> Comparison | None:
+def _floor_companion(scene: Any, y: np.ndarray, wall_time: float) -> Comparison | None:
     """A fixed-step run measured against the compiled Taylor method at its floor, its own error bounded in the same
     pass (the truncation it measures, and its round-off amplified by the growth it measures: with a double-double head
     where the model has that series, whose round-off it measures and which is thousands of times smaller, else a

@@ -27,7 +27,6 @@ three, not six); the state's rate so differs from the model's own by at most an 
 from __future__ import annotations
 
 import math
-
 from typing import Any
 
 import numpy as np

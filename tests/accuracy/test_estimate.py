@@ -167,9 +167,10 @@ def test_near_the_taylor_floor_the_estimate_measures_amplified_round_off():
 
 
 #: benchmarks/promise_audit.py --seed 7, scene 18: a chaotic top (perturbations grow ×1.7e6) whose auto run at
-#: accuracy=1e-4, double Taylor at tol 6.5e-13 and order 13, is measured near double precision's floor by the double-double
-#: companion at tol/100. At Jorba & Zou's order for that tolerance (18) the companion ended 1.7e-10 from heyoka's real128,
-#: as far as the run, and measured 0.03–0.07× the run's error of ω; at the run's order it is ~10× closer than the run
+#: accuracy=1e-4, double Taylor at tol 6.5e-13 and order 13, is measured near double precision's floor by the
+#: double-double companion at tol/100. At Jorba & Zou's order for that tolerance (18) the companion ended 1.7e-10 from
+#: heyoka's real128, as far as the run, and measured 0.03–0.07× the run's error of ω; at the run's order it is ~10×
+#: closer than the run
 CHAOTIC_FLOOR_SCENE = ["body.a=1.8795", "body.b=1.0807", "force=[uniform_gravity]",
                        "body.com_direction=[0.058043656369928545,-0.2974610482864379,-0.9529679211324708]",
                        "initial.theta0=2.84663", "initial.phi0=0.929837", "initial.psi0=4.47787", "initial.r0=0.911416",
@@ -208,7 +209,8 @@ ROUND_OFF_LIE_POISSON = [
     "time.n_output=101", "output.euler_angles=false", "integrator=lie_poisson", "integrator.step=0.002"]
 
 
-@pytest.mark.parametrize("overrides", [FAST_TOP_RK4, ROUND_OFF_LIE_POISSON], ids=["rk4-fast-top", "lie-poisson-round-off"])
+@pytest.mark.parametrize("overrides", [FAST_TOP_RK4, ROUND_OFF_LIE_POISSON],
+                         ids=["rk4-fast-top", "lie-poisson-round-off"])
 def test_a_fixed_step_run_is_measured_against_the_taylor_floor_at_every_output_time(overrides):
     overrides = [*overrides, "output.error_estimate=true"]
     ds = run(overrides)
