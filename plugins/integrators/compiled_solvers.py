@@ -307,7 +307,7 @@ class Taylor(Integrator):
         solution = _adaptive(lambda reached, stop: taylor.run_measured(
             compiled.params, self.order, self.tol, t_out, out, reached, stop, state, y, carry, stats, e, u, error,
             growth, log_growth, flow, self.head), t_out, out, state, stats, progress, _taylor_failure, start)
-        m = taylor.tangent_order(self.order, self.tol)
+        m = min(taylor.TANGENT_ORDER, self.order)  # (the error's series; the tangent vector's may be shorter)
         solution.estimate = OwnEstimate(error if estimate else None, log_growth, float(growth[3]), int(stats[1]), (
             f"one pass: each step's truncation error (the series' next {taylor.EXTRA_ORDERS} terms) carried along "
             f"the run by the linearised equations (their Taylor series to order {m} on the run's own steps)"),
