@@ -26,7 +26,6 @@ three, not six); the state's rate so differs from the model's own by at most an 
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -205,50 +204,12 @@ def direction(y0s: np.ndarray, sphere: slice | None = None) -> np.ndarray:
     """Unit initial tangent directions, one row per state: a fixed arbitrary direction (no symmetry of a problem
     singles it out); the part in the components ``sphere`` of a state on a unit sphere (the fixed point's γ,
     |γ| = 1) made tangent to it, so the tangent vector stays on the constraint manifold (the flow keeps γ·δγ)."""
-    if np.ndim(y0s) == 1:  # one state (every measured Taylor run's first): in Python floats, ~10× faster, same bits
-        return _direction_of(np.asarray(y0s, dtype=float), sphere)[None]
     y0s = np.atleast_2d(np.asarray(y0s, dtype=float))
     u = np.tile(np.cos(1.7 * np.arange(1, y0s.shape[1] + 1) + 0.3), (len(y0s), 1))
     if sphere is not None:
         g = y0s[:, sphere] / np.linalg.norm(y0s[:, sphere], axis=1, keepdims=True)
         u[:, sphere] -= np.sum(u[:, sphere] * g, axis=1, keepdims=True) * g
     return u / np.linalg.norm(u, axis=1, keepdims=True)
-
-
-def _direction_of(y: np.ndarray, sphere: slice | None) -> np.ndarray:
-    """``direction`` of one state: the same operations in the same order (``_summed``)."""
-    u = np.cos(1.7 * np.arange(1, y.size + 1) + 0.3).tolist()
-    if sphere is not None:
-        part = y[sphere].tolist()
-        size = math.sqrt(_summed([x * x for x in part]))
-        g = [x / size for x in part]
-        lo = sphere.start
-        along = _summed([u[lo + k] * g[k] for k in range(len(g))])
-        for k in range(len(g)):
-            u[lo + k] -= along * g[k]
-    size = math.sqrt(_summed([x * x for x in u]))
-    return np.array([x / size for x in u])
-
-
-def _summed(values: list[float]) -> float:
-    """Σ values as numpy adds up fewer than 128 doubles (its pairwise sum: in sequence below 8, else eight running
-    sums joined pairwise, then the rest in sequence): the same bits as ``np.sum``."""
-    n = len(values)
-    if n < 8:
-        total = 0.0
-        for x in values:
-            total += x
-        return total
-    r = values[:8]
-    i = 8
-    while i < n - n % 8:
-        for j in range(8):
-            r[j] += values[i + j]
-        i += 8
-    total = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
-    for x in values[i:]:
-        total += x
-    return total
 
 
 def initial_augmented(y0s: np.ndarray, u0: np.ndarray | None = None, quadratures: bool = True) -> np.ndarray:

@@ -81,17 +81,3 @@ def test_megno_separates_the_docs_chaotic_top_from_a_fast_regular_one():
 def test_gyrostat_megno_runs_from_its_generated_tangent_flow():
     run = _megno(GYROSTAT, 60.0)
     assert not run["failed"][0] and np.isfinite(run["megno"][0, -1]) and np.isfinite(run["max_nutation_deviation"][0])
-
-
-@pytest.mark.parametrize("size, sphere", [(6, slice(3, 6)), (9, slice(3, 6)), (9, None), (17, None)])
-def test_one_state_direction_is_the_batch_rows(size, sphere):
-    """A measured Taylor run starts its tangent vector from ``direction`` of one state (Python floats, for speed):
-    bit for bit the row numpy's batch form gives that state, unit and tangent to the sphere |γ| = 1."""
-    states = np.random.default_rng(size).normal(size=(20, size)) * np.logspace(-2, 2, 20)[:, None]
-    batch = tangent.direction(np.vstack([states, states]), sphere)  # (two rows or more: numpy's path)
-    for state, row in zip(states, batch):
-        one = tangent.direction(state, sphere)
-        assert np.array_equal(one, row[None])
-        assert abs(np.linalg.norm(one) - 1.0) < 1e-15
-        if sphere is not None:
-            assert abs(one[0, sphere] @ state[sphere]) < 1e-14 * np.linalg.norm(state[sphere])
