@@ -192,6 +192,29 @@ def test_the_double_double_companion_keeps_the_run_order_so_that_it_is_the_more_
     assert np.all(ds.error_estimate_attitude.values[resolved] >= 0.5 * gamma[resolved])
 
 
+#: promise_audit.py --seed 17, scene 55: perturbations grow ×900; auto at 1e-10 runs double Taylor near its floor,
+#: and two double companions at tol 5.4e-16 agreed within 2.1e-12 on an error of 2.6e-11 they share (round-off
+#: amplified): 18× the run's actual error of 1.5e-12
+AMPLIFYING_FLOOR_SCENE = ["body.a=0.6208", "body.b=1.0", "force=[uniform_gravity,newtonian]",
+                          "force.newtonian.k=0.5057",
+                          "body.com_direction=[-0.4858386470327208,0.5379655225415519,0.6888787306964922]",
+                          "initial.theta0=2.57395", "initial.phi0=1.49276", "initial.psi0=2.40954",
+                          "initial.r0=0.831916", "initial.p0=0.2808", "initial.q0=0.05904", "time.end=36.991",
+                          "time.n_output=101", "output.euler_angles=true"]
+
+
+def test_on_a_motion_amplifying_round_off_double_companions_are_not_trusted_near_the_floor():
+    overrides = ["integrator=auto", "accuracy=1e-10", *AMPLIFYING_FLOOR_SCENE]
+    ds = run(overrides)
+    assert "double companions" not in ds.attrs["error_estimate_method"]
+    scene = compose_scene(overrides)
+    truth = long_double_states(scene, scene.times)
+    omega = np.abs(ds.omega.values - truth[:, :3]).max(axis=1)
+    assert omega.max() > 1e-13  # (far above the long-double reference's own error)
+    ratio = float(ds.attrs["error_estimate_max_omega"]) / omega.max()
+    assert 0.5 <= ratio <= 2.0, ratio
+
+
 #: fixed-step runs Richardson's half step measured less than half their error at some output time (promise_audit.py):
 #: a fast top at rk4's step 0.01 (seed 7, scene 72: ω·h = 0.2, 0.3× at t = 5.3) and a slow top whose lie_poisson
 #: round-off at step 0.002 rivals its truncation (seed 11, scene 48: 0.39×; its error at step 0.001 is larger)
