@@ -5,11 +5,12 @@ The companion is the method that ran made more accurate by a known factor, as th
 (``Integrator.more_accurate``, rule 9): ``TIGHTER`` times smaller tolerances, or half the step and Richardson's factor
 (a fixed-step run is measured against the compiled Taylor method at its floor first, where that run bounds its own
 error ``FLOOR_COMPANION_MARGIN`` times below the difference: ``_floor_companion``); an analytic series (``auto``) is
-measured against the compiled Taylor method at tol 1e-15. At a method's floor the compiled Taylor method at tol 1e-16 stands in when the scene has a compiled model. A double Taylor run near that floor
-errs mostly by round-off, which another double run shares: two double companions measure what they share by their
-disagreement, and where it is not ``ROUNDOFF_MARGIN`` times below the error, the rung above's tolerance measures it
-(``climbed``): the Taylor method with a double-double head (``HEAD_ORDERS``), or in double-double on a motion that
-amplifies perturbations more than ``HEAD_COMPANION_GROWTH``. A run with a double-double head of its own measured its
+measured against the compiled Taylor method at tol 1e-15. At a method's floor the compiled Taylor method at tol 1e-16
+stands in when the scene has a compiled model. A double Taylor run near that floor errs mostly by round-off, which
+another double run shares: two double companions measure what they share by their disagreement (below
+``DOUBLE_COMPANION_GROWTH`` of growth), and where it is not ``ROUNDOFF_MARGIN`` times below the error, the rung
+above's tolerance measures it (``climbed``, at the run's order): the Taylor method with a double-double head
+(``HEAD_ORDERS``), or in double-double on a motion that amplifies perturbations more than ``HEAD_COMPANION_GROWTH``. A run with a double-double head of its own measured its
 round-off and may stand on its own estimate (``_headed``). On by default for the integrators that choose their method
 (``output.error_estimate: null``); ``true``/``false`` choose it for any integrator. The audits behind these rules:
 docs/integrators.md.
@@ -177,8 +178,7 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
         if isinstance(one, Comparison):
             return one
     compiled_model = scene.compiled_model
-    growth = math.inf if own is None else math.exp(min(float(own.log_growth[-1]), 700.0)) * (
-        CHAOS_MARGIN if growth_of(own, float(scene.times[-1] - scene.times[0]) or 1.0).chaotic(PILOT_FRACTION) else 1.0)
+    growth = math.inf if own is None else _growth(own, float(scene.times[-1] - scene.times[0]) or 1.0)
     if check is None:
         pick = companion(method, compiled_model is not None, isinstance(one, str), growth)
     else:
@@ -255,12 +255,10 @@ def _floor_companion(scene: Any, y: np.ndarray, wall_time: float) -> Comparison 
     floor = Taylor(tol=1e-18, head=HEAD_ORDERS) if headed else Taylor(tol=Taylor.TOLERANCE_FLOOR)
     run = floor.integrate(scene.rhs, scene.times, scene.system.initial_state(), None, model, estimate=True)
     own = run.estimate
-    span = float(scene.times[-1] - scene.times[0]) or 1.0
-    amplified = math.exp(min(float(own.log_growth[-1]), 700.0)) * (
-        CHAOS_MARGIN if growth_of(own, span).chaotic(PILOT_FRACTION) else 1.0)
     scale = max(1.0, float(np.max(np.abs(run.y))))
     roundoff = HEAD_WALK * EPS * own.roundoff if headed else EPS * scale * math.sqrt(1.0 + own.steps)
-    bound = max(float(np.max(np.abs(own.error))), roundoff * amplified, 0.5 * EPS * scale)
+    growth = _growth(own, float(scene.times[-1] - scene.times[0]) or 1.0)
+    bound = max(float(np.max(np.abs(own.error))), roundoff * growth, 0.5 * EPS * scale)
     difference = np.abs(np.asarray(y, dtype=float) - run.y)
     if not FLOOR_COMPANION_MARGIN * bound <= float(np.max(difference)):
         return None
@@ -270,6 +268,13 @@ def _floor_companion(scene: Any, y: np.ndarray, wall_time: float) -> Comparison 
                                  f"{bound:.2g}, ≥ {FLOOR_COMPANION_MARGIN:g}× below the difference (a fixed-step run: "
                                  "not Richardson's half step, which assumes the error ∝ h^p at every output time)",
         "error_estimate_cost_ratio": float((time.perf_counter() - start) / max(wall_time, 1e-9))}, y)
+
+
+def _growth(own: OwnEstimate, span: float) -> float:
+    """How much the motion amplified perturbations over a run, as the run's own pass measured it (e^{max ln|δ|}),
+    times ``CHAOS_MARGIN`` where that growth is chaos (one numerical trajectory's growth scatters)."""
+    chaos = CHAOS_MARGIN if growth_of(own, span).chaotic(PILOT_FRACTION) else 1.0
+    return math.exp(min(float(own.log_growth[-1]), 700.0)) * chaos
 
 
 def _unavailable(why: str) -> Comparison:
@@ -328,12 +333,12 @@ def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray, twin: Any = Non
     the bound is ~100× the round-off two double companions measure, and added it made early times' estimates 3×
     the actual error. A run with a double-double head measured its round-off itself (``_headed``)."""
     span = float(times[-1] - times[0]) or 1.0
-    margin = CHAOS_MARGIN if growth_of(own, span).chaotic(PILOT_FRACTION) else 1.0
+    growth = _growth(own, span)
     scale = max(1.0, float(np.max(np.abs(y))))
     if own.roundoff is not None:
-        return _headed(own, y, times, span, margin, scale)
+        return _headed(own, y, times, span, growth, scale)
     walk = (EPS * scale) * np.sqrt(1.0 + own.steps * ((times - times[0]) / span))
-    bound = float(walk[-1] * margin * math.exp(min(float(own.log_growth[-1]), 700.0)))
+    bound = float(walk[-1] * growth)
     error = np.square(own.error)  # (in place below: np.hypot took ~0.13 ms for 3,001 × 9)
     measured = math.sqrt(float(np.max(error)))
     # (no error_estimate_cost_ratio for the bound: the estimate's work is inside the run's steps, not a run of its own)
@@ -358,7 +363,7 @@ def one_pass(own: OwnEstimate, y: np.ndarray, times: np.ndarray, twin: Any = Non
     return Comparison(np.sqrt(error, out=error), attrs, y)
 
 
-def _headed(own: OwnEstimate, y: np.ndarray, times: np.ndarray, span: float, margin: float,
+def _headed(own: OwnEstimate, y: np.ndarray, times: np.ndarray, span: float, growth: float,
             scale: float) -> Comparison | str:
     """``one_pass`` for a run with a double-double head (``Taylor(head=...)``), which measured its round-off: the ulps
     of each step's terms computed in double, added up (``OwnEstimate.roundoff``), at most ``HEAD_WALK`` times that,
@@ -370,7 +375,7 @@ def _headed(own: OwnEstimate, y: np.ndarray, times: np.ndarray, span: float, mar
     roundoff = EPS * own.roundoff
     walk = roundoff * ((times - times[0]) / span)
     stored = 0.5 * EPS * scale
-    bound = max(HEAD_WALK * roundoff * margin * math.exp(min(float(own.log_growth[-1]), 700.0)), stored)
+    bound = max(HEAD_WALK * roundoff * growth, stored)
     error = np.square(own.error)
     measured = math.sqrt(float(np.max(error)))
     if not ROUNDOFF_MARGIN * bound <= measured:
@@ -391,6 +396,6 @@ def headed(method: Any, compiled: Any) -> Any:
     measured 5.8e-13, 5.77e-13 from double-double). Else ``method``."""
     taylor = _double_taylor(method)
     if taylor is None or taylor.head or taylor.tol / TIGHTER >= DOUBLE_DOUBLE_BELOW or compiled is None or \
-            type(taylor.climbed(1.0)[0]).refusal(compiled) is not None:
+            TaylorDoubleDouble.refusal(compiled) is not None:
         return method
     return Taylor(order=taylor.order, tol=taylor.tol, head=HEAD_ORDERS)

@@ -163,8 +163,8 @@ def _steps(p, order, tol, t_out, Y, i_next, i_stop, state, y, carry, stats, e, u
     safety = math.exp(-0.7 / (order - 1))
     m = tangent_order(order, tol)
     m_error = min(TANGENT_ORDER, order)  # (shorter, a fast top's error drifted: ``tangent_order``)
-    # the error's series: rows 0 … m_error the carried error's (the tangent series), rows order + 1 … the step's truncation
-    # error (T's), zeros between: one Horner sum gives both (``_series_at``)
+    # the error's series: rows 0 … m_error the carried error's (the tangent series), rows order + 1 … the step's
+    # truncation error (T's), zeros between: one Horner sum gives both (``_series_at``)
     R = _coefficient_rows(order + 1 + extra if estimating else 0, n)
     R[:, :] = 0.0
     U = _coefficient_rows(m + 1 if measured else 0, n)
