@@ -114,10 +114,6 @@ MAX_RECHECKS = _c("MAX_RECHECKS", 2, PROMISE, "runs made more accurate before th
 ESTIMATE_SLACK = _c("ESTIMATE_SLACK", 2.0, PROMISE, "a run is kept when its measured error is this many times below "
                     "the target, the estimate's own accuracy: audit seed 2026, scene 61 measured 0.98e-11 of 1e-11, "
                     "ended 1.0e-11 away")
-DOUBLE_COMPANION_GROWTH = _c("DOUBLE_COMPANION_GROWTH", 100.0, PROMISE, "near double precision's floor, a run whose "
-                             "own pass measured perturbations growing more than this is measured by the head companion "
-                             "without trying two double companions first: audit seed 17, scene 55 (×900) at 1e-10, "
-                             "two double companions agreed within 2.1e-12 and measured 18× the actual error")
 FLOOR_COMPANION_MARGIN = _c("FLOOR_COMPANION_MARGIN", 20.0, PROMISE, "a fixed-step run is measured against the "
                             "compiled Taylor method at its floor where that run's own error bound is this many times "
                             "below the difference (at an output time a tenth of the largest error, its error is then "

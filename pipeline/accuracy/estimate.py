@@ -7,12 +7,12 @@ The companion is the method that ran made more accurate by a known factor, as th
 error ``FLOOR_COMPANION_MARGIN`` times below the difference: ``_floor_companion``); an analytic series (``auto``) is
 measured against the compiled Taylor method at tol 1e-15. At a method's floor the compiled Taylor method at tol 1e-16
 stands in when the scene has a compiled model. A double Taylor run near that floor errs mostly by round-off, which
-another double run shares: two double companions measure what they share by their disagreement (below
-``DOUBLE_COMPANION_GROWTH`` of growth), and where it is not ``ROUNDOFF_MARGIN`` times below the error, the rung
-above's tolerance measures it (``climbed``, at the run's order): the Taylor method with a double-double head
-(``HEAD_ORDERS``), or in double-double on a motion that amplifies perturbations more than ``HEAD_COMPANION_GROWTH``. A run with a double-double head of its own measured its
-round-off and may stand on its own estimate (``_headed``). On by default for the integrators that choose their method
-(``output.error_estimate: null``); ``true``/``false`` choose it for any integrator. The audits behind these rules:
+another double run shares: the rung above's tolerance at the run's order measures it (``climbed``), the Taylor
+method with a double-double head (``HEAD_ORDERS``), or in double-double on a motion that amplifies perturbations more
+than ``HEAD_COMPANION_GROWTH``; two double companions only for a model the rung above cannot run (``_double_pair``).
+A run with a double-double head of its own measured its round-off and may stand on its own estimate (``_headed``). On
+by default for the integrators that choose their method (``output.error_estimate: null``); ``true``/``false`` choose
+it for any integrator. The audits behind these rules:
 docs/integrators.md.
 
 Stored as ``error_estimate_omega`` (ω's max-norm error at each output time, in ω's units) and
@@ -33,7 +33,7 @@ import numpy as np
 import xarray as xr
 
 from gyrolab.accuracy.amplification import EPS, PILOT_FRACTION, growth_of
-from gyrolab.accuracy.calibration import (CHAOS_MARGIN, DOUBLE_COMPANION_GROWTH, DOUBLE_DOUBLE_BELOW,
+from gyrolab.accuracy.calibration import (CHAOS_MARGIN, DOUBLE_DOUBLE_BELOW,
                                          FLOOR_COMPANION_MARGIN, HEAD_COMPANION_GROWTH, HEAD_ORDERS, HEAD_WALK,
                                          ROUNDOFF_MARGIN, TIGHTER)
 from gyrolab.kernels.model import rounding_moved
@@ -49,9 +49,6 @@ class Companion:
     integrator: Any
     scale: float  # error of the stored run ≈ scale · |y − y_companion|
     how: str
-    #: near the Taylor floor: two double companions (the second at another order, 1/I moved by its rounding) tried
-    #: before ``integrator`` (double-double, ~30× their time): their disagreement measures what they share (``compare``)
-    double_first: tuple[Any, Any] | None = None
     #: the integrator class whose model it borrows too (a double-double head: the rung above's series), whose refusal
     #: applies to it
     borrows: Any = None
@@ -71,7 +68,7 @@ def companion(method: Any, has_compiled: bool, round_off: bool = False, growth: 
     else the compiled Taylor method at its floor when the scene has a compiled model; else, for a run that is itself
     the double-precision Taylor method near that floor, the method one rung up the precision ladder), or None.
     ``round_off``: the run's own estimate found its round-off not small (``one_pass``), which a double companion
-    shares: a double Taylor run is then measured as near its floor (two double companions, else double-double).
+    shares: a double Taylor run is then measured as near its floor (one rung up).
     ``growth``: how much the motion amplified perturbations over the run, as its own pass measured it (with the
     chaos margin): one rung up is the Taylor method with a double-double head (``HEAD_ORDERS``) up to
     ``HEAD_COMPANION_GROWTH``, the whole series in double-double beyond (the head's round-off, ~10⁻⁴ of a double
@@ -90,28 +87,20 @@ def companion(method: Any, has_compiled: bool, round_off: bool = False, growth: 
     if taylor is None:
         return Companion(Taylor(tol=Taylor.TOLERANCE_FLOOR), 1.0, f"compiled Taylor at tol {Taylor.TOLERANCE_FLOOR:g} "
                          f"({method.name} cannot be made {TIGHTER:g}× more accurate)")
-    # a double Taylor run near the floor errs mostly by round-off, which another double run shares: double-double has
-    # none (docs/integrators.md, "A broken promise nobody was told of")
-    from gyrolab.kernels.taylor import MAX_ORDER
-
-    # the rung above's tolerance, with only the state and the series' first HEAD_ORDERS orders in double-double: its
-    # round-off that of the terms beyond, thousands of times below a double run's, in ~1/6 of double-double's time
-    # (reference scene, tol 1e-18: within an ulp of the state, 3.1 ms against 17.6; docs/integrators.md)
+    # a double Taylor run near the floor errs mostly by round-off, which another double run shares, also one at
+    # another order with its rounded numbers moved (two such agreed within 6.8e-14 where both were 3e-13 from real128:
+    # audit seed 13, scene 55; docs/integrators.md, "Double companions retired"): the rung above's tolerance, with only
+    # the state and the series' first HEAD_ORDERS orders in double-double: its round-off that of the terms beyond,
+    # thousands of times below a double run's, in ~1/6 of double-double's time (reference scene, tol 1e-18: within an
+    # ulp of the state, 3.1 ms against 17.6); at the run's order, where the error is proportional to the tolerance (at
+    # its own, higher, it measured seed 17's worst output time 0.54x and seed 13's 0.65x, at the run's 0.80x and
+    # 0.92x, for ~25 % more time at ε = 1e-11 … 1e-13 on the reference scene)
     rung = taylor.climbed(TIGHTER)[0]
-    up = Taylor(tol=rung.tol, head=HEAD_ORDERS) if growth <= HEAD_COMPANION_GROWTH else rung
-    double_tol = max(taylor.tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
-    other_order = taylor.order + 2 if taylor.order + 2 <= MAX_ORDER else taylor.order - 2
-    how = (f"compiled Taylor at tol {up.tol:.3g}, " + (f"its state and first {HEAD_ORDERS} orders in double-double"
-                                                        if up is not rung else "in double-double") +
+    up = Taylor(order=rung.order, tol=rung.tol, head=HEAD_ORDERS) if growth <= HEAD_COMPANION_GROWTH else rung
+    how = (f"compiled Taylor at tol {up.tol:.3g}, same order, " +
+           (f"its state and first {HEAD_ORDERS} orders in double-double" if up is not rung else "in double-double") +
            f" ({method.name} runs the Taylor method near double precision's floor)")
-    # a double companion no tighter than the run, or with more round-off than a run with a double-double head, measures
-    # nothing of it; on a motion amplifying perturbations beyond DOUBLE_COMPANION_GROWTH two may share an error their
-    # disagreement does not show (audit seed 17, scene 55): the head companion
-    if double_tol >= taylor.tol or taylor.head or DOUBLE_COMPANION_GROWTH < growth < math.inf:
-        return Companion(up, 1.0, how, borrows=type(rung))  # (benchmarks/roundoff_margin.py: at tol 1.5e-16, 0 of 86
-        # double pairs trusted)
-    doubles = (Taylor(order=taylor.order, tol=double_tol), Taylor(order=other_order, tol=double_tol))
-    return Companion(up, 1.0, how, doubles, type(rung))
+    return Companion(up, 1.0, how, borrows=type(rung))
 
 
 @dataclass(frozen=True)
@@ -199,8 +188,10 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
         companion_model = compiled_model
         refusal = None if compiled_model is None else pick.integrator.refusal(compiled_model, scene.system) or (
             pick.borrows.refusal(compiled_model, scene.system) if pick.borrows is not None else None)
-        if refusal and pick.double_first is None:  # (near the floor the double companions may still suffice)
-            return _unavailable(f"the companion ({pick.how}) {refusal}")
+        if refusal:
+            taylor = _double_taylor(method)
+            return _unavailable(f"the companion ({pick.how}) {refusal}") if taylor is None or check is not None \
+                else _double_pair(scene, taylor, y, wall_time, f"the companion one rung up {refusal}")
     if check is None and not getattr(method, "adaptive", True) and compiled_model is not None:
         floor = _floor_companion(scene, y, wall_time)
         if floor is not None:
@@ -209,32 +200,41 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
     y0 = scene.system.initial_state()
     y = np.asarray(y, dtype=float)
     how = pick.how
-    if pick.double_first is not None:
-        # a double companion may share the run's round-off: a second one at another order (independent round-off)
-        # with 1/I, the one rounded parameter every double run shares, moved by its rounding, measures that by their
-        # disagreement; ROUNDOFF_MARGIN times below the first's measurement, it stands (~1 ms, not double-double's 17)
-        first = pick.double_first[0].integrate(scene.rhs, scene.times, y0, None, companion_model).y
-        second = pick.double_first[1].integrate(scene.rhs, scene.times, y0, None,
-                                                rounding_moved(companion_model)).y  # (kernels.model's)
-        difference = np.abs(y - first)
-        roundoff = float(np.max(np.abs(first - second)))
-        measured = float(np.max(difference))
-        if ROUNDOFF_MARGIN * roundoff <= measured:
-            spent = time.perf_counter() - start
-            attrs = {"error_estimate_method": f"compiled Taylor at tol {pick.double_first[0].tol:.3g}, same order "
-                                              f"(near double precision's floor: a second double companion at order "
-                                              f"{pick.double_first[1].order} disagrees with it by {roundoff:.2g}, "
-                                              f"≥ {ROUNDOFF_MARGIN:g}× below the error measured)",
-                     "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
-            return Comparison(difference, attrs, y)
-        how = f"{how}: two double companions disagree by {roundoff:.2g}, round-off not small against {measured:.2g}"
-        if refusal:  # a plugin torque has no double-double kernel
-            return _unavailable(f"{how}, and the double-double companion {refusal}")
     other = pick.integrator.integrate(scene.rhs, scene.times, y0, None, companion_model).y
     spent = time.perf_counter() - start
     how = how if one is None else f"{how} ({one})"
     attrs = {"error_estimate_method": how, "error_estimate_cost_ratio": float(spent / max(wall_time, 1e-9))}
     return Comparison(pick.scale * np.abs(y - other), attrs, y)
+
+
+def _double_pair(scene: Any, taylor: Taylor, y: np.ndarray, wall_time: float, refusal: str) -> Comparison:
+    """A double Taylor run near the floor of a model without a double-double series (a plugin torque it cannot
+    evaluate; ``refusal`` says why): two double companions at tol/``TIGHTER``, the second at another order with the
+    model's rounded numbers moved (``rounding_moved``), measure it where their disagreement is ``ROUNDOFF_MARGIN``
+    times below the error measured, else nothing does. The weaker measure, kept where the rung above cannot run: two
+    such companions may share an error their disagreement does not show (audit seed 13, scene 55, with a built-in
+    torque: they agreed within 6.8e-14 where both were 3e-13 from real128, and measured 0.48× the run's error at one
+    output time)."""
+    from gyrolab.kernels.taylor import MAX_ORDER
+
+    tol = max(taylor.tol / TIGHTER, Taylor.TOLERANCE_FLOOR)
+    if tol >= taylor.tol:  # a double companion no tighter than the run measures nothing of it
+        return _unavailable(f"{refusal}, and a double companion cannot be tighter than the run (tol {taylor.tol:.3g})")
+    start = time.perf_counter()
+    other_order = taylor.order + 2 if taylor.order + 2 <= MAX_ORDER else taylor.order - 2
+    y0, model = scene.system.initial_state(), scene.compiled_model
+    first = Taylor(order=taylor.order, tol=tol).integrate(scene.rhs, scene.times, y0, None, model).y
+    second = Taylor(order=other_order, tol=tol).integrate(scene.rhs, scene.times, y0, None, rounding_moved(model)).y
+    difference = np.abs(np.asarray(y, dtype=float) - first)
+    roundoff, measured = float(np.max(np.abs(first - second))), float(np.max(difference))
+    if not ROUNDOFF_MARGIN * roundoff <= measured:
+        return _unavailable(f"{refusal}, and two double companions at tol {tol:.3g} disagree by {roundoff:.2g}, "
+                            f"round-off not small against {measured:.2g}")
+    return Comparison(difference, {
+        "error_estimate_method": f"compiled Taylor at tol {tol:.3g}, same order (near double precision's floor, "
+                                 f"{refusal}: a second double companion at order {other_order} disagrees with it by "
+                                 f"{roundoff:.2g}, ≥ {ROUNDOFF_MARGIN:g}× below the error measured)",
+        "error_estimate_cost_ratio": float((time.perf_counter() - start) / max(wall_time, 1e-9))}, y)
 
 
 def _floor_companion(scene: Any, y: np.ndarray, wall_time: float) -> Comparison | None:

@@ -75,16 +75,14 @@ def test_says_why_when_unavailable(monkeypatch):
 
 
 @pytest.mark.parametrize("accuracy, resolved_above, how", [("2e-11", 1e-13, "a twin run"),
-                                                           ("1e-12", 5e-15, "second double companion")])
-def test_near_the_floor_where_truncation_dominates_double_runs_measure_it(accuracy, resolved_above, how):
+                                                           ("1e-12", 5e-15, "same order, its state and first 4 orders")])
+def test_near_the_floor_where_truncation_dominates_it_is_measured(accuracy, resolved_above, how):
     # auto at 2e-11 runs Taylor at tol ~1e-13, below the double-double threshold; on this regular scene its error is
     # truncation, which the run's own one-pass estimate measures where the round-off it does not see is ≥ 6× below
     # it: near the floor a twin run (the model's rounded numbers moved by an ulp) says so by its distance, 2.6e-13
-    # against 1e-11. At 1e-12 (tol 6.7e-15) the twin is too close to the pass's estimate, and two double companions
-    # (other orders: independent round-off), which agree on the error to far better, measure it: they disagree ≥ 6×
-    # below the error measured, trusted at ROUNDOFF_MARGIN = 6 (no ~20 ms double-double companion). (With the exact
-    # inertias moved by an ulp too, the generated kernel's companions disagreed 1.6e-14 against an error of 6.8e-14,
-    # and the double-double companion ran: model.rounding_moved.)
+    # against 1e-11. At 1e-12 (tol 6.7e-15) the twin is too close to the pass's estimate, and the companion one rung
+    # up at the run's order, with a double-double head, measures it (two double companions, which may share their
+    # round-off, measure only a model without a double-double series: estimate._double_pair).
     overrides = [*SCENE, "integrator=auto", f"accuracy={accuracy}"]
     ds = run(overrides)
     assert ds.attrs["auto_tolerance"] < 1e-12
@@ -150,7 +148,7 @@ ROUND_OFF_SCENE = [*ROUND_OFF, "time.n_output=51", "output.euler_angles=false"]
 def test_near_the_taylor_floor_the_estimate_measures_amplified_round_off():
     overrides = ["integrator=taylor", "integrator.tol=1e-16", "output.error_estimate=true", *ROUND_OFF_SCENE]
     ds = run(overrides)
-    assert "double-double" in ds.attrs["error_estimate_method"]  # two double companions saw round-off: escalated
+    assert "double-double" in ds.attrs["error_estimate_method"]  # near the floor: the rung above measures
     actual = _actual(ds, overrides).max()
     assert actual > 1e-13  # far above the long-double reference's own error
     estimate = max(ds.attrs["error_estimate_max_omega"], ds.attrs["error_estimate_max_attitude"])
@@ -213,6 +211,31 @@ def test_on_a_motion_amplifying_round_off_double_companions_are_not_trusted_near
     assert omega.max() > 1e-13  # (far above the long-double reference's own error)
     ratio = float(ds.attrs["error_estimate_max_omega"]) / omega.max()
     assert 0.5 <= ratio <= 2.0, ratio
+
+
+#: promise_audit.py --seed 13, scene 55 (growth ~9): auto at 1e-10 runs double Taylor at tol 3.4e-12 near its floor;
+#: two double companions at tol 3.4e-14 (orders 16 and 18, rounded numbers moved) agreed within 6.8e-14 where both
+#: were 3e-13 from real128, and measured 0.48x the run's error at t = 173.8 (2.9e-13 of a largest 1.2e-12)
+SHARED_ROUND_OFF_SCENE = ["body.a=0.6846", "body.b=0.788", "force=[uniform_gravity,newtonian]",
+                          "body.com_direction=[0.5589919745131356,-0.3418667530102476,0.7554171666146701]",
+                          "force.newtonian.k=0.8188", "initial.theta0=0.181353", "initial.phi0=0.522171",
+                          "initial.psi0=5.89916", "initial.r0=0.567159", "initial.p0=0.005467", "initial.q0=-0.2888",
+                          "time.end=211.93", "time.n_output=101", "output.euler_angles=true"]
+
+
+def test_near_the_floor_the_estimate_holds_at_every_output_time_where_double_companions_share_round_off():
+    overrides = ["integrator=auto", "accuracy=1e-10", *SHARED_ROUND_OFF_SCENE]
+    ds = run(overrides)
+    assert "same order, its state and first 4 orders in double-double" in ds.attrs["error_estimate_method"]
+    scene = compose_scene(overrides)
+    truth = long_double_states(scene, scene.times, alpha=True)
+    actual = np.abs(np.concatenate([ds.omega.values, ds.gamma.values, ds.alpha.values], axis=1) - truth)
+    for part, columns in (("omega", slice(0, 3)), ("attitude", slice(3, 9))):
+        real = actual[:, columns].max(axis=1)
+        assert real.max() > 5e-13  # far above the long-double reference's own error
+        significant = real >= 0.1 * real.max()  # (a pointwise error dips through zero between)
+        ratio = ds[f"error_estimate_{part}"].values[significant] / real[significant]
+        assert 0.5 <= ratio.min() and ratio.max() <= 2.0, (part, ratio.min(), ratio.max())
 
 
 #: fixed-step runs Richardson's half step measured less than half their error at some output time (promise_audit.py):

@@ -17,11 +17,12 @@ ROUND_OFF = ["body.a=0.7046", "body.b=1.4132",
              "initial.r0=0.171348", "initial.p0=-0.2898", "initial.q0=0.08809", "time.end=54.48"]
 
 
-def long_double_states(scene, times) -> np.ndarray:
-    """The long-double reference's (ω, γ) of ``scene`` at ``times``, from the scene's own body, field and start."""
+def long_double_states(scene, times, alpha: bool = False) -> np.ndarray:
+    """The long-double reference's (ω, γ) of ``scene`` at ``times``, from the scene's own body, field and start
+    (``alpha``: (ω, γ, α), of a scene whose state carries α)."""
     p = scene.system.compiled_model().built_in
     return fixed_point_reference(p[layout.INERTIA:layout.INERTIA + 3], p[layout.U_Z:layout.U_Z + 3], p[layout.N_Z],
-                                 scene.system.initial_state()[:6], times).astype(float)
+                                 scene.system.initial_state()[:9 if alpha else 6], times).astype(float)
 
 
 def long_double_final(overrides) -> np.ndarray:
