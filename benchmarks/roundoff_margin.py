@@ -1,10 +1,12 @@
 """Near the Taylor method's floor, when may the error estimate trust a double companion? (``error_estimate``)
 
 A double-precision Taylor run at tol < 1e-12 may err partly by round-off, which a double companion shares in size.
-``gyrolab.accuracy.estimate`` runs two double companions there (``TIGHTER`` times tighter; the run's order, and
-another order with 1/I moved by its rounding) and keeps the first one's measurement E when their disagreement R is
-``ROUNDOFF_MARGIN`` times below it; else the rung above measures (a double-double head, or double-double: printed
-here as the double-double companion). This measures that rule against the
+``gyrolab.accuracy.estimate`` measures it one rung up (a double-double head, or double-double: printed here as the
+double-double companion); only for a model without a double-double series (``estimate._double_pair``) does it run two
+double companions (``TIGHTER`` times tighter; the run's order, and another order with the rounded numbers moved) and
+keep the first one's measurement E when their disagreement R is ``ROUNDOFF_MARGIN`` times below it (until
+2026-11-30 for every model: two such agreed within 6.8e-14 where both were 3e-13 from real128, docs/integrators.md,
+"Double companions retired"). This measures that rule against the
 truth: on random scenes (``promise_audit.random_scene``) and tolerances from 3e-13 to 1.5e-16, E, R and the actual
 error (max-norm over every output time and component, against heyoka ``real128``), and for each margin M the
 smallest E / actual among the runs it would trust (R · M ≤ E). The estimate's promise is E / actual ≥ 1/2.
