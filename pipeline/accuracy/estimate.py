@@ -191,7 +191,8 @@ def compare(scene: Any, method: Any, y: np.ndarray, wall_time: float, check: Any
         if refusal:
             taylor = _double_taylor(method)
             return _unavailable(f"the companion ({pick.how}) {refusal}") if taylor is None or check is not None \
-                else _double_pair(scene, taylor, y, wall_time, f"the companion one rung up {refusal}")
+                else _double_pair(scene, taylor, y, wall_time, f"the companion one rung up {refusal}"
+                                  + ("" if one is None else f"; {one}"))
     if check is None and not getattr(method, "adaptive", True) and compiled_model is not None:
         floor = _floor_companion(scene, y, wall_time)
         if floor is not None:
